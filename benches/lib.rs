@@ -1,0 +1,1 @@
+//! Criterion benchmarks of lieflow live in `benches/`; this library is empty.

@@ -1,0 +1,30 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+
+pub mod group_laws;
+
+use lieflow::Mat;
+
+/// Frobenius distance between two matrices of the same shape.
+pub fn dist(a: &Mat, b: &Mat) -> f64 {
+    (a - b).norm_l2()
+}
+
+/// Matrix exponential by scaling and squaring of a Taylor series: an independent route to exp
+/// for the tests (not used by the library).
+pub fn expm_reference(a: &Mat) -> Mat {
+    let n = a.nrows();
+    let norm = a.norm_l2();
+    let s = if norm > 0.5 { (norm / 0.5).log2().ceil() as i32 } else { 0 };
+    let scaled = a * faer::Scale(0.5f64.powi(s));
+    let mut term = Mat::identity(n, n);
+    let mut sum = Mat::identity(n, n);
+    for k in 1..30 {
+        term = &term * &scaled * faer::Scale(1.0 / k as f64);
+        sum += &term;
+    }
+    for _ in 0..s {
+        sum = &sum * &sum;
+    }
+    sum
+}

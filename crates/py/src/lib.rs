@@ -1,0 +1,32 @@
+//! Python bindings of lieflow: thin PyO3 wrappers that convert arrays and errors and call
+//! `lieflow`. No mathematics lives here.
+
+mod convert;
+mod errors;
+mod integrate;
+mod lie;
+mod pseudo_rigid;
+
+use pyo3::prelude::*;
+
+/// Adds a submodule `name` filled by `fill` to `parent`.
+fn add_submodule<'py>(
+    parent: &Bound<'py, PyModule>,
+    name: &str,
+    fill: fn(&Bound<'py, PyModule>) -> PyResult<()>,
+) -> PyResult<()> {
+    let m = PyModule::new(parent.py(), name)?;
+    fill(&m)?;
+    parent.add_submodule(&m)
+}
+
+/// The native extension of lieflow; import `lieflow` instead.
+#[pymodule]
+fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    errors::register(m)?;
+    add_submodule(m, "lie", lie::register)?;
+    add_submodule(m, "pseudo_rigid", pseudo_rigid::register)?;
+    integrate::register(m)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

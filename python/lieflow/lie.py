@@ -1,0 +1,10 @@
+"""Matrix Lie groups and algebras (bindings of ``lieflow::lie``).
+
+All functions take numpy float64 arrays (or array-likes) and return new arrays; see each
+function's docstring for the equation it implements.
+"""
+
+from . import _lieflow
+from ._reexport import reexport
+
+__all__ = reexport(_lieflow.lie, globals())

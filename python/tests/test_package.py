@@ -1,0 +1,24 @@
+import pytest
+
+import lieflow as lf
+
+
+def test_error_hierarchy():
+    for name in ["NotInGroupError", "ShapeError", "NonFiniteError", "DegenerateStratumError",
+                 "NoUniqueLogError", "InvalidArgumentError", "UnsupportedMethodError",
+                 "ConvergenceError", "LeftDomainError"]:
+        cls = getattr(lf, name)
+        assert issubclass(cls, lf.LieflowError)
+    assert issubclass(lf.LieflowError, ValueError)
+
+
+def test_demo_runs(capsys):
+    from lieflow.cli import main
+
+    assert main(["demo"]) == 0
+    assert "lieflow" in capsys.readouterr().out
+
+
+def test_shape_error_from_binding():
+    with pytest.raises(lf.ShapeError, match=r"expected \(3,\)"):
+        lf.lie.hat([1.0, 2.0])

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Runs every test of lieflow: format and lint checks, the Rust tests (with proptest properties and
+# a smoke run of each criterion bench), then builds the Python extension once and runs pytest.
+# Makes its own virtual environment (.venv, or $LIEFLOW_VENV).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export CARGO_TERM_COLOR=never
+venv=${LIEFLOW_VENV:-.venv}
+t0=$SECONDS
+step() { printf '\n== %s (%ds)\n' "$*" "$((SECONDS - t0))"; }
+
+step "python environment"
+[ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+"$venv/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.9.4,<2" numpy scipy pytest hypothesis
+
+step "cargo fmt --check"
+cargo fmt --all -- --check
+
+step "cargo clippy -D warnings"
+cargo clippy --workspace --all-targets --release -- -D warnings
+
+step "cargo test (release; benches run once in test mode)"
+cargo test --workspace --exclude lieflow-py --release --all-targets
+cargo test --workspace --exclude lieflow-py --release --doc
+
+step "build the extension (maturin develop --release)"
+VIRTUAL_ENV="$PWD/$venv" PATH="$PWD/$venv/bin:$PATH" "$venv/bin/maturin" develop --release -q
+
+step "pytest"
+"$venv/bin/python" -m pytest -q python/tests
+
+step "done"
