@@ -58,7 +58,11 @@ pub fn square_of(what: &str, m: &Mat, n: usize) -> Result<()> {
 /// Checks that a slice has length `len` and is finite.
 pub fn len_of(what: &str, v: &[f64], len: usize) -> Result<()> {
     if v.len() != len {
-        return Err(Error::shape(what, format!("({len},)"), format!("({},)", v.len())));
+        return Err(Error::shape(
+            what,
+            format!("({len},)"),
+            format!("({},)", v.len()),
+        ));
     }
     finite_slice(what, v)
 }
@@ -68,7 +72,10 @@ pub fn positive(what: &str, x: f64) -> Result<()> {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
-        Err(Error::invalid(what, format!("expected a finite number > 0, got {x}")))
+        Err(Error::invalid(
+            what,
+            format!("expected a finite number > 0, got {x}"),
+        ))
     }
 }
 

@@ -47,9 +47,12 @@ pub fn mats(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<Mat>, bool)> {
         2 => Ok((vec![view_to_mat(&v)], false)),
         3 => {
             let (b, r, c) = (v.shape()[0], v.shape()[1], v.shape()[2]);
-            Ok(((0..b)
-                .map(|k| Mat::from_fn(r, c, |i, j| v[[k, i, j]]))
-                .collect(), true))
+            Ok((
+                (0..b)
+                    .map(|k| Mat::from_fn(r, c, |i, j| v[[k, i, j]]))
+                    .collect(),
+                true,
+            ))
         }
         _ => Err(shape_err(what, "(n, n) or a batch (b, n, n)", &v)),
     }
@@ -70,7 +73,9 @@ pub fn vectors(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<Vec<f64>>, bool)> {
     match v.ndim() {
         1 => Ok((vec![v.iter().copied().collect()], false)),
         2 => Ok((
-            v.outer_iter().map(|r| r.iter().copied().collect()).collect(),
+            v.outer_iter()
+                .map(|r| r.iter().copied().collect())
+                .collect(),
             true,
         )),
         _ => Err(shape_err(what, "(d,) or a batch (b, d)", &v)),

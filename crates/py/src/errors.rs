@@ -4,16 +4,66 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-create_exception!(lieflow, LieflowError, PyValueError, "Base class of every lieflow error.");
-create_exception!(lieflow, NotInGroupError, LieflowError, "An argument is not in the required group (e.g. not a rotation, det ≤ 0).");
-create_exception!(lieflow, ShapeError, LieflowError, "An array has the wrong shape.");
-create_exception!(lieflow, NonFiniteError, LieflowError, "An input contains NaN or inf.");
-create_exception!(lieflow, DegenerateStratumError, LieflowError, "Coincident singular values where the principal stratum is required.");
-create_exception!(lieflow, NoUniqueLogError, LieflowError, "The principal logarithm is not unique (rotation by π).");
-create_exception!(lieflow, InvalidArgumentError, LieflowError, "A scalar argument is out of its domain (dt ≤ 0, steps < 1, …).");
-create_exception!(lieflow, UnsupportedMethodError, LieflowError, "The integration method is not supported by the system.");
-create_exception!(lieflow, ConvergenceError, LieflowError, "An iterative solver did not converge.");
-create_exception!(lieflow, LeftDomainError, LieflowError, "A trajectory left its configuration space (e.g. det X ≤ 0).");
+create_exception!(
+    lieflow,
+    LieflowError,
+    PyValueError,
+    "Base class of every lieflow error."
+);
+create_exception!(
+    lieflow,
+    NotInGroupError,
+    LieflowError,
+    "An argument is not in the required group (e.g. not a rotation, det ≤ 0)."
+);
+create_exception!(
+    lieflow,
+    ShapeError,
+    LieflowError,
+    "An array has the wrong shape."
+);
+create_exception!(
+    lieflow,
+    NonFiniteError,
+    LieflowError,
+    "An input contains NaN or inf."
+);
+create_exception!(
+    lieflow,
+    DegenerateStratumError,
+    LieflowError,
+    "Coincident singular values where the principal stratum is required."
+);
+create_exception!(
+    lieflow,
+    NoUniqueLogError,
+    LieflowError,
+    "The principal logarithm is not unique (rotation by π)."
+);
+create_exception!(
+    lieflow,
+    InvalidArgumentError,
+    LieflowError,
+    "A scalar argument is out of its domain (dt ≤ 0, steps < 1, …)."
+);
+create_exception!(
+    lieflow,
+    UnsupportedMethodError,
+    LieflowError,
+    "The integration method is not supported by the system."
+);
+create_exception!(
+    lieflow,
+    ConvergenceError,
+    LieflowError,
+    "An iterative solver did not converge."
+);
+create_exception!(
+    lieflow,
+    LeftDomainError,
+    LieflowError,
+    "A trajectory left its configuration space (e.g. det X ≤ 0)."
+);
 
 /// Converts a core error into the matching Python exception.
 pub fn to_py(e: lieflow::Error) -> PyErr {
@@ -34,6 +84,7 @@ pub fn to_py(e: lieflow::Error) -> PyErr {
 }
 
 /// `lieflow::Result<T>` → `PyResult<T>`.
+#[allow(dead_code)] // used by every binding file once they land
 pub trait IntoPy<T> {
     /// Maps the error with [`to_py`].
     fn py(self) -> PyResult<T>;
@@ -51,10 +102,19 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("NotInGroupError", py.get_type::<NotInGroupError>())?;
     m.add("ShapeError", py.get_type::<ShapeError>())?;
     m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;
-    m.add("DegenerateStratumError", py.get_type::<DegenerateStratumError>())?;
+    m.add(
+        "DegenerateStratumError",
+        py.get_type::<DegenerateStratumError>(),
+    )?;
     m.add("NoUniqueLogError", py.get_type::<NoUniqueLogError>())?;
-    m.add("InvalidArgumentError", py.get_type::<InvalidArgumentError>())?;
-    m.add("UnsupportedMethodError", py.get_type::<UnsupportedMethodError>())?;
+    m.add(
+        "InvalidArgumentError",
+        py.get_type::<InvalidArgumentError>(),
+    )?;
+    m.add(
+        "UnsupportedMethodError",
+        py.get_type::<UnsupportedMethodError>(),
+    )?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("LeftDomainError", py.get_type::<LeftDomainError>())?;
     Ok(())

@@ -52,5 +52,5 @@ pub trait MatrixLieGroup: Clone + std::fmt::Debug {
     /// Coordinates of an algebra element.
     fn coords(xi: &Self::Algebra) -> Vec<f64>;
     /// The algebra element with coordinates `c` (of length `self.dim()`).
-    fn from_coords(&self, c: &[f64]) -> Self::Algebra;
+    fn algebra_from_coords(&self, c: &[f64]) -> Self::Algebra;
 }

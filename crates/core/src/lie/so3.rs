@@ -26,7 +26,10 @@ pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
 pub fn exp(w: &Vector3<f64>) -> Matrix3<f64> {
     let t2 = w.norm_squared();
     let (a, b) = if t2 < 1e-8 {
-        (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0), 0.5 - t2 / 24.0 * (1.0 - t2 / 30.0))
+        (
+            1.0 - t2 / 6.0 * (1.0 - t2 / 20.0),
+            0.5 - t2 / 24.0 * (1.0 - t2 / 30.0),
+        )
     } else {
         let t = t2.sqrt();
         let (s, c) = t.sin_cos();

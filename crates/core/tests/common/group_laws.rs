@@ -17,7 +17,7 @@ fn alg_norm<G: MatrixLieGroup>(a: &G::Algebra) -> f64 {
 fn lin<G: MatrixLieGroup>(g: &G, a: f64, x: &G::Algebra, b: f64, y: &G::Algebra) -> G::Algebra {
     let (x, y) = (G::coords(x), G::coords(y));
     let c: Vec<f64> = x.iter().zip(&y).map(|(p, q)| a * p + b * q).collect();
-    g.from_coords(&c)
+    g.algebra_from_coords(&c)
 }
 
 fn assert_small(what: &str, err: f64, tol: f64) {
@@ -60,7 +60,7 @@ pub fn exp_log<G: MatrixLieGroup>(g: &G, xi: &G::Algebra) {
         assert_small("exp(log g) = g", dist(&again.matrix(), &g.matrix()), 1e-10);
     }
     let c = G::coords(xi);
-    assert_small("coords round trip", alg_dist::<G>(&g.from_coords(&c), xi), 0.0);
+    assert_small("coords round trip", alg_dist::<G>(&g.algebra_from_coords(&c), xi), 0.0);
 }
 
 /// Ad, ad and ad*: matrix formulas, homomorphism, bracket, Jacobi, duality, exp equivariance.
