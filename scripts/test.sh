@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export CARGO_TERM_COLOR=never
-venv=${LIEFLOW_VENV:-.venv}
+venv=$(realpath -m "${LIEFLOW_VENV:-.venv}")
 t0=$SECONDS
 step() { printf '\n== %s (%ds)\n' "$*" "$((SECONDS - t0))"; }
 
@@ -24,7 +24,7 @@ cargo test --workspace --exclude lieflow-py --release --all-targets
 cargo test --workspace --exclude lieflow-py --release --doc
 
 step "build the extension (maturin develop --release)"
-VIRTUAL_ENV="$PWD/$venv" PATH="$PWD/$venv/bin:$PATH" "$venv/bin/maturin" develop --release -q
+VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --release -q
 
 step "pytest"
 "$venv/bin/python" -m pytest -q python/tests
