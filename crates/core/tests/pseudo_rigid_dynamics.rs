@@ -942,3 +942,40 @@ fn dedekind_adjoint_motion_is_a_motion_and_swaps_l_and_gamma() {
         Err(Error::NonFinite { .. })
     ));
 }
+
+// ---------------------------------------------------------------------------------------------
+// Timing (not a test: run with `--ignored --nocapture`; numbers go to docs/bench-pot.md).
+
+#[test]
+#[ignore]
+fn bench_verlet_steps_per_second() {
+    let mut rng = Rng(99);
+    let cases: Vec<(&str, usize, Arc<dyn Potential>, usize)> = vec![
+        ("SVK", 3, Arc::new(svk()), 4_000_000),
+        ("SVK + polytropic gas", 3, elastic_gas(), 2_000_000),
+        ("SVK", 10, Arc::new(svk()), 400_000),
+        ("SVK + polytropic gas", 10, elastic_gas(), 200_000),
+    ];
+    for (name, n, pot, steps) in cases {
+        for check_det in [true, false] {
+            if pot.needs_positive_det() && !check_det {
+                continue;
+            }
+            let x0 = &Mat::identity(n, n) + rng.mat(n, 0.1);
+            let p0 = rng.mat(n, 0.1);
+            let (mut x, mut p) = (x0.clone(), p0.clone());
+            let mut scratch = VerletScratch::new(n);
+            let method = verlet(2).with_check_det(check_det);
+            let start = std::time::Instant::now();
+            method
+                .run(&*pot, &mut x, &mut p, 0.0, 1e-3, steps, &mut scratch)
+                .unwrap();
+            let secs = start.elapsed().as_secs_f64();
+            eprintln!(
+                "{name:>22}, n = {n:>2}, check_det = {check_det:>5}: {:>6.1} ns/step, {:.3e} steps/s",
+                secs / steps as f64 * 1e9,
+                steps as f64 / secs
+            );
+        }
+    }
+}
