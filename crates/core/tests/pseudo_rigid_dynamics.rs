@@ -944,6 +944,52 @@ fn dedekind_adjoint_motion_is_a_motion_and_swaps_l_and_gamma() {
 }
 
 // ---------------------------------------------------------------------------------------------
+// No allocation per step: a global allocator that counts this thread's allocations.
+
+struct CountingAlloc;
+
+thread_local! {
+    static ALLOCS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+unsafe impl std::alloc::GlobalAlloc for CountingAlloc {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAlloc = CountingAlloc;
+
+#[test]
+fn verlet_steps_do_not_allocate() {
+    let mut rng = Rng(15);
+    for n in [2, 3, 4, 7] {
+        let pot = elastic_gas();
+        let x0 = &Mat::identity(n, n) + rng.mat(n, 0.1);
+        let p0 = rng.mat(n, 0.1);
+        let mut scratch = VerletScratch::new(n);
+        let count = |steps: usize, scratch: &mut VerletScratch| {
+            let (mut x, mut p) = (x0.clone(), p0.clone());
+            let before = ALLOCS.with(|c| c.get());
+            verlet(6)
+                .run(&*pot, &mut x, &mut p, 0.0, 1e-3, steps, scratch)
+                .unwrap();
+            ALLOCS.with(|c| c.get()) - before
+        };
+        let (few, many) = (count(1, &mut scratch), count(1000, &mut scratch));
+        assert_eq!(
+            few, many,
+            "n = {n}: allocations grow with the number of steps"
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Timing (not a test: run with `--ignored --nocapture`; numbers go to docs/bench-pot.md).
 
 #[test]
