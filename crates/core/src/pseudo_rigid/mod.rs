@@ -1,1 +1,3 @@
 //! TODO
+pub mod dynamics;
+pub mod potential;
