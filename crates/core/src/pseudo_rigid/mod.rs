@@ -1,1 +1,25 @@
-//! TODO
+//! Generalized pseudo-rigid bodies on GL⁺(n) (001): configuration X ∈ GL⁺(n) with the left,
+//! right and two-sided SO(n) actions X ↦ gX, X ↦ Xh⁻¹, X ↦ gXh⁻¹ (001 (2.2), (6.1)).
+//!
+//! - [`inertia`]: the left/right inertia tensors A^L_X, A^R_X, Ad_X, Adᵀ_X and the bi-inertia
+//!   tensor B_X (operator, matrix, closed-form inverse, eigen-decomposition), all through
+//!   [`BiInertia`];
+//! - [`connection`]: the connections ω^L, ω^R, the bi-connection ω^B, horizontal/vertical
+//!   splits and the locked inertia tensors from the metric;
+//! - [`momentum`]: angular momentum L, circulation Γ, the body coordinates
+//!   (R, A, S, Ω, Ȧ, Λ) and the kinetic energy in its several forms;
+//! - [`strata`]: strata and isotropy of the two-sided action;
+//! - [`riemann`]: the Riemann-ellipsoid variables (Q, N) and their Poisson brackets.
+//!
+//! Conventions (DESIGN.md): so(n) pairing ⟨ξ, η⟩ = ½ tr(ξᵀη) (001 (2.8)), e_ij basis, ξ block
+//! before η block, metric ⟨Y, Z⟩ = tr(YᵀZ) on T_X GL⁺(n) (001 (2.9)).
+
+pub mod connection;
+pub mod inertia;
+pub mod momentum;
+pub mod riemann;
+pub mod strata;
+
+pub use connection::Action;
+pub use inertia::BiInertia;
+pub use momentum::Body;
