@@ -78,14 +78,14 @@ fn operator_matrix(n: usize, blocks: usize, f: impl Fn(&[Mat]) -> Vec<Mat>) -> M
 
 /// The inertia tensors of a pseudo-rigid body at a configuration X ∈ GL⁺(n).
 ///
-/// Built by [`BiInertia::new`] (which checks X ∈ GL⁺(n)); caches XXᵀ, XᵀX and, on first use,
-/// the SVD coordinates X = R A Sᵀ. Operators act on skew-symmetric n×n matrices; matrices are
+/// Built by [`BiInertia::new`] (which checks X ∈ GL⁺(n)); computes and caches XXᵀ, XᵀX and the
+/// SVD coordinates X = R A Sᵀ on first use. Operators act on skew-symmetric n×n matrices; matrices are
 /// in the e_ij basis of DESIGN.md with the ξ block first.
 #[derive(Debug, Clone)]
 pub struct BiInertia {
     x: Mat,
-    xxt: Mat,
-    xtx: Mat,
+    xxt: OnceLock<Mat>,
+    xtx: OnceLock<Mat>,
     svd: OnceLock<SvdCoordinates>,
 }
 
@@ -94,11 +94,21 @@ impl BiInertia {
     pub fn new(x: &Mat) -> Result<Self> {
         gl::check_gl_plus("X", x)?;
         Ok(BiInertia {
-            xxt: x * x.transpose(),
-            xtx: x.transpose() * x,
             x: x.clone(),
+            xxt: OnceLock::new(),
+            xtx: OnceLock::new(),
             svd: OnceLock::new(),
         })
+    }
+
+    /// XXᵀ, computed once.
+    fn xxt(&self) -> &Mat {
+        self.xxt.get_or_init(|| &self.x * self.x.transpose())
+    }
+
+    /// XᵀX, computed once.
+    fn xtx(&self) -> &Mat {
+        self.xtx.get_or_init(|| self.x.transpose() * &self.x)
     }
 
     /// n.
@@ -128,13 +138,13 @@ impl BiInertia {
     /// Left inertia tensor A^L_X ξ = XXᵀξ + ξXXᵀ (001 (2.11)).
     pub fn left(&self, xi: &Mat) -> Result<Mat> {
         self.arg("xi", xi)?;
-        Ok(anticommutator(&self.xxt, xi))
+        Ok(anticommutator(self.xxt(), xi))
     }
 
     /// Right inertia tensor A^R_X η = XᵀXη + ηXᵀX (001 (2.11)).
     pub fn right(&self, eta: &Mat) -> Result<Mat> {
         self.arg("eta", eta)?;
-        Ok(anticommutator(&self.xtx, eta))
+        Ok(anticommutator(self.xtx(), eta))
     }
 
     /// Ad_X η = X η Xᵀ (001 (6.10)).
@@ -159,8 +169,8 @@ impl BiInertia {
     }
 
     fn apply_unchecked(&self, xi: &Mat, eta: &Mat) -> (Mat, Mat) {
-        let top = anticommutator(&self.xxt, xi) - conj(&self.x, eta) * faer::Scale(2.0);
-        let bottom = anticommutator(&self.xtx, eta) - conj_t(&self.x, xi) * faer::Scale(2.0);
+        let top = anticommutator(self.xxt(), xi) - conj(&self.x, eta) * faer::Scale(2.0);
+        let bottom = anticommutator(self.xtx(), eta) - conj_t(&self.x, xi) * faer::Scale(2.0);
         (top, bottom)
     }
 
@@ -175,12 +185,12 @@ impl BiInertia {
 
     /// A^L_X as a matrix in the e_ij basis (001 (2.11)).
     pub fn left_matrix(&self) -> Mat {
-        operator_matrix(self.n(), 1, |v| vec![anticommutator(&self.xxt, &v[0])])
+        operator_matrix(self.n(), 1, |v| vec![anticommutator(self.xxt(), &v[0])])
     }
 
     /// A^R_X as a matrix in the e_ij basis (001 (2.11)).
     pub fn right_matrix(&self) -> Mat {
-        operator_matrix(self.n(), 1, |v| vec![anticommutator(&self.xtx, &v[0])])
+        operator_matrix(self.n(), 1, |v| vec![anticommutator(self.xtx(), &v[0])])
     }
 
     /// Ad_X as a matrix in the e_ij basis (001 (6.10)).
