@@ -30,17 +30,27 @@ pub fn det(x: &Mat) -> f64 {
 
 /// Checks that `x` is a finite square matrix (n ≥ 1) with det X > 0; returns n.
 ///
+/// The sign is decided on X/s with s = ‖X‖_F/√n, whose determinant lies in [−1, 1] (AM–GM on
+/// the singular values), so the test neither overflows nor underflows for well-conditioned X of
+/// any size or scale (det(0.1·I₄₀₀) = 10⁻⁴⁰⁰ underflows, det(0.1·I₄₀₀/s) = 1 does not).
+///
 /// Errors: [`Error::Shape`] if not square, [`Error::NonFinite`] for NaN/inf, and
-/// [`Error::NotInGroup`] with the determinant in the message if det X ≤ 0.
+/// [`Error::NotInGroup`] with the determinant in the message if det X ≤ 0 (numerically: if the
+/// scaled determinant is ≤ 0, i.e. also for X singular to working precision).
 pub fn check_gl_plus(what: &str, x: &Mat) -> Result<usize> {
     let n = check::square(what, x, 1)?;
-    let d = det(x);
-    if d.is_nan() || d <= 0.0 {
+    let scale = x.norm_l2() / (n as f64).sqrt();
+    let scaled = if scale > 0.0 {
+        det(&(x * faer::Scale(1.0 / scale)))
+    } else {
+        0.0
+    };
+    if scaled.is_nan() || scaled <= 0.0 {
         return Err(Error::NotInGroup {
             what: what.into(),
             group: format!("GL+({n})"),
             defect_name: "det X (must be > 0)".into(),
-            defect: d,
+            defect: scaled * scale.powi(n as i32),
             tol: 0.0,
         });
     }
@@ -253,12 +263,15 @@ mod tests {
         let mut neg = Mat::identity(3, 3);
         neg[(0, 0)] = -1.0;
         match svd_coordinates(&neg) {
-            Err(Error::NotInGroup { defect, .. }) => assert_eq!(defect, -1.0),
+            Err(Error::NotInGroup { defect, .. }) => assert!((defect + 1.0).abs() < 1e-14),
             other => panic!("expected NotInGroup, got {other:?}"),
         }
         assert!(matches!(
             svd_coordinates(&Mat::zeros(2, 3)),
             Err(Error::Shape { .. })
         ));
+        // Large n and small scale: det 10⁻⁴⁰⁰ underflows, the check does not.
+        let small = Mat::identity(400, 400) * faer::Scale(0.1);
+        assert_eq!(check_gl_plus("X", &small), Ok(400));
     }
 }

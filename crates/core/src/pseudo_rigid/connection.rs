@@ -61,6 +61,8 @@ pub fn right_connection(b: &BiInertia, y: &Mat) -> Result<Mat> {
 /// Bi-connection ω^B_X(Y) = B_X⁻¹((YXᵀ − XYᵀ) ⊕ (YᵀX − XᵀY)) (001 (6.18)), by the closed-form
 /// inverse of B_X. Needs the principal stratum ([`Error::DegenerateStratum`] otherwise).
 /// ω^B(ξX + Xηᵀ) = ξ ⊕ η (6.19), ω^B_{gXh⁻¹} = Ad_(g,h) ∘ ω^B_X (6.20), ker ω^B = H_X (6.23).
+/// Seed slip: the proof (6.21) as extracted reads B_X⁻¹ B_X⁻¹ (ξ ⊕ η); the step is
+/// B_X⁻¹ B_X (ξ ⊕ η), since J(X, ξX + Xηᵀ) = B_X(ξ ⊕ η) (checked numerically).
 pub fn bi_connection(b: &BiInertia, y: &Mat) -> Result<(Mat, Mat)> {
     tangent(b, y)?;
     let (l, g) = momentum_map_unchecked(b.x(), y);
@@ -106,7 +108,9 @@ pub fn horizontal_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
 /// The locked inertia tensor computed from the metric, an independent route to the inertia
 /// tensors (001 (2.27), (6.24)): the matrix with entries tr(V(e_a)ᵀ V(e_b)) over the e_ij basis,
 /// where V(ξ) = ξX (left, d×d), Xξᵀ (right) or V(ξ ⊕ η) = ξX + Xηᵀ (two-sided, 2d×2d, ξ block
-/// first). Equals the matrix of A^L_X, A^R_X, B_X respectively (2.28), (6.25).
+/// first). Equals the matrix of A^L_X, A^R_X, B_X respectively (2.28), (6.25). The display
+/// (6.25) is missing from the extraction; derived: ‖ξX + Xηᵀ‖² = −tr(ξ²XXᵀ) − tr(η²XᵀX)
+/// + 2 tr(ξXηXᵀ) = ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ with the pairing (6.8), polarised.
 pub fn locked_inertia(b: &BiInertia, action: Action) -> Mat {
     let (n, d) = (b.n(), so::dim(b.n()));
     let zero = Mat::zeros(n, n);

@@ -184,7 +184,7 @@ pub fn kinetic_energy(x: &Mat, v: &Mat) -> Result<f64> {
 }
 
 /// Kinetic part of the Hamiltonian in reduced coordinates (001 (6.30)):
-/// ½⟨p_A, p_A⟩ + ½⟨p_Ω ⊕ p_Λ, B_A⁻¹(p_Ω ⊕ p_Λ)⟩, needing distinct a_i (principal stratum).
+/// ½⟨p_A, p_A⟩ + ½⟨p_Ω ⊕ p_Λ, B_A⁻¹(p_Ω ⊕ p_Λ)⟩, needing distinct a_i > 0 (principal stratum).
 pub fn kinetic_energy_hamiltonian(
     a: &[f64],
     p_a: &[f64],
@@ -192,7 +192,9 @@ pub fn kinetic_energy_hamiltonian(
     p_lambda: &Mat,
 ) -> Result<f64> {
     check::len_of("p_a", p_a, a.len())?;
-    check::finite_slice("a", a)?;
+    for &ai in a {
+        check::positive("a", ai)?;
+    }
     let b = BiInertia::new(&diag(a))?;
     let (o, l) = b.solve(p_omega, p_lambda)?;
     Ok(0.5 * dot(p_a, p_a) + 0.5 * (so::pairing(p_omega, &o) + so::pairing(p_lambda, &l)))
