@@ -13,6 +13,21 @@
 //!
 //! Conventions (DESIGN.md): so(n) pairing ⟨ξ, η⟩ = ½ tr(ξᵀη) (001 (2.8)), e_ij basis, ξ block
 //! before η block, metric ⟨Y, Z⟩ = tr(YᵀZ) on T_X GL⁺(n) (001 (2.9)).
+//!
+//! ```
+//! use lieflow::lie::so::hat_n;
+//! use lieflow::pseudo_rigid::{connection, BiInertia};
+//! use lieflow::Mat;
+//! // A configuration with distinct singular values, and ξ ⊕ η ∈ so(3) ⊕ so(3).
+//! let x = Mat::from_fn(3, 3, |i, j| if i == j { 3.0 - i as f64 } else { 0.1 * (i + 2 * j) as f64 });
+//! let (xi, eta) = (hat_n(&[0.1, 0.2, 0.3])?, hat_n(&[0.0, -0.1, 0.4])?);
+//! let b = BiInertia::new(&x)?;
+//! // The bi-connection recovers ξ ⊕ η from the vertical vector ξX + Xηᵀ (001 (6.19)).
+//! let y = connection::vertical_vector(&b, &xi, &eta)?;
+//! let (xi2, eta2) = connection::bi_connection(&b, &y)?;
+//! assert!((&xi2 - &xi).norm_l2() < 1e-12 && (&eta2 - &eta).norm_l2() < 1e-12);
+//! # Ok::<(), lieflow::Error>(())
+//! ```
 
 pub mod connection;
 pub mod inertia;
