@@ -299,6 +299,12 @@ proptest! {
         for k in 0..c.n {
             prop_assert!(((cp.a[k] - cm.a[k]) / (2.0 * t) - body.adot[k]).abs() < 1e-5 * fd_scale);
         }
+        // (6.26): ω^B(Ẋ) = Ad_(R,S)(Ω ⊕ Λ) — the body velocities are the bi-connection.
+        let b = BiInertia::new(x).unwrap();
+        let (wx, wy) = cn::bi_connection(&b, v).unwrap();
+        let sw = 1e3 * (1.0 + wx.norm_l2() + wy.norm_l2());
+        prop_assert!(close(&wx, &conj(&body.r, &body.omega), sw));
+        prop_assert!(close(&wy, &conj(&body.s, &body.lambda), sw));
         // (2.32), (6.27)
         let (po, pl) = body.momenta().unwrap();
         let (l, g) = mo::momentum_map(x, v).unwrap();
@@ -313,7 +319,6 @@ proptest! {
         prop_assert!((body.kinetic_energy_bi_inertia().unwrap() - k).abs() < tol, "(6.28)");
         let kh = mo::kinetic_energy_hamiltonian(&body.a, &body.adot, &po, &pl).unwrap();
         prop_assert!((kh - k).abs() < 1e-7 * (1.0 + k), "(6.30)");
-        let b = BiInertia::new(x).unwrap();
         let hp = cn::horizontal_part(&b, v, Action::TwoSided).unwrap();
         let (xi, eta) = cn::bi_connection(&b, v).unwrap();
         let k718 = 0.5 * hp.norm_l2().powi(2) + 0.5 * b.quadratic_form(&xi, &eta).unwrap();
@@ -393,6 +398,18 @@ proptest! {
         prop_assert!(close(&l, &mo::angular_momentum(x, p).unwrap(), 1.0));
         prop_assert!(close(&((qdot - l) * faer::Scale(0.5)), &nm, 1.0));
     }
+}
+
+/// (6.7): at a diagonal A with distinct entries the horizontal space is the diagonal matrices, so
+/// the two-sided horizontal part of Y is diag(Y); the body coordinates give Ȧ = diag(Y) too.
+#[test]
+fn horizontal_space_at_a_is_diagonal() {
+    let a = diag(&[3.0, 2.0, 1.5, 0.5]);
+    let y = Mat::from_fn(4, 4, |i, j| ((3 * i + j) as f64).sin());
+    let b = BiInertia::new(&a).unwrap();
+    let hp = cn::horizontal_part(&b, &y, Action::TwoSided).unwrap();
+    let dy = Mat::from_fn(4, 4, |i, j| if i == j { y[(i, i)] } else { 0.0 });
+    assert!(dist(&hp, &dy) < 1e-13, "{hp:?}");
 }
 
 /// (9.2), (9.3) for n = 3 on each stratum.
