@@ -77,7 +77,8 @@ pub fn vertical_vector(b: &BiInertia, xi: &Mat, eta: &Mat) -> Result<Mat> {
     Ok(vertical_unchecked(b.x(), xi, eta))
 }
 
-fn vertical_unchecked(x: &Mat, xi: &Mat, eta: &Mat) -> Mat {
+/// ξX + Xηᵀ without checks.
+pub(crate) fn vertical_unchecked(x: &Mat, xi: &Mat, eta: &Mat) -> Mat {
     xi * x + x * eta.transpose()
 }
 
@@ -110,7 +111,8 @@ pub fn horizontal_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
 /// where V(ξ) = ξX (left, d×d), Xξᵀ (right) or V(ξ ⊕ η) = ξX + Xηᵀ (two-sided, 2d×2d, ξ block
 /// first). Equals the matrix of A^L_X, A^R_X, B_X respectively (2.28), (6.25). The display
 /// (6.25) is missing from the extraction; derived: ‖ξX + Xηᵀ‖² = −tr(ξ²XXᵀ) − tr(η²XᵀX)
-/// + 2 tr(ξXηXᵀ) = ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ with the pairing (6.8), polarised.
+/// + 2 tr(ξXηXᵀ) = ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ with the pairing (6.8), polarised. O(n⁶) (a Gram
+/// matrix of n(n−1) vectors in R^{n²}): a check, not a hot path.
 pub fn locked_inertia(b: &BiInertia, action: Action) -> Mat {
     let (n, d) = (b.n(), so::dim(b.n()));
     let zero = Mat::zeros(n, n);
