@@ -110,9 +110,10 @@ pub fn horizontal_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
 /// tensors (001 (2.27), (6.24)): the matrix with entries tr(V(e_a)ᵀ V(e_b)) over the e_ij basis,
 /// where V(ξ) = ξX (left, d×d), Xξᵀ (right) or V(ξ ⊕ η) = ξX + Xηᵀ (two-sided, 2d×2d, ξ block
 /// first). Equals the matrix of A^L_X, A^R_X, B_X respectively (2.28), (6.25). The display
-/// (6.25) is missing from the extraction; derived: ‖ξX + Xηᵀ‖² = −tr(ξ²XXᵀ) − tr(η²XᵀX)
-/// + 2 tr(ξXηXᵀ) = ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ with the pairing (6.8), polarised. O(n⁶) (a Gram
-/// matrix of n(n−1) vectors in R^{n²}): a check, not a hot path.
+/// (6.25) is missing from the extraction; derived: with ξᵀ = −ξ, ηᵀ = −η,
+/// ‖ξX + Xηᵀ‖² = 2 tr(ξXηXᵀ) − tr(ξ²XXᵀ) − tr(η²XᵀX) = ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ with the pairing
+/// (6.8), polarised. O(n⁶) (a Gram matrix of n(n−1) vectors in R^{n²}): a check, not a hot
+/// path.
 pub fn locked_inertia(b: &BiInertia, action: Action) -> Mat {
     let (n, d) = (b.n(), so::dim(b.n()));
     let zero = Mat::zeros(n, n);
