@@ -1,5 +1,432 @@
-use pyo3::prelude::*;
+//! `lieflow.pseudo_rigid`: bindings of `lieflow::pseudo_rigid` (001: generalized pseudo-rigid
+//! bodies on GL+(n)). Conversions only; every formula lives in the core crate.
+//!
+//! Conventions: so(n) elements are skew (n, n) arrays; matrices on so(n) + so(n) are in the e_ij
+//! basis (i < j, row by row) with the xi block first; pairing <xi, eta> = tr(xi.T @ eta) / 2.
+#![allow(non_snake_case)]
 
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+use lieflow::lie::gl::STRATUM_TOL;
+use lieflow::pseudo_rigid::{
+    connection as cn, momentum as mo, riemann, strata, Action, BiInertia, Body,
+};
+use lieflow::Mat;
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
+use crate::errors::IntoPy;
+
+type Arr2<'py> = Bound<'py, PyArray2<f64>>;
+type Arr1<'py> = Bound<'py, PyArray1<f64>>;
+
+fn at(X: &ArrayIn<'_>) -> PyResult<BiInertia> {
+    BiInertia::new(&mat("X", X)?).py()
+}
+
+fn pair<'py>(py: Python<'py>, (a, b): (Mat, Mat)) -> (Arr2<'py>, Arr2<'py>) {
+    (py_mat(py, &a), py_mat(py, &b))
+}
+
+/// Left inertia tensor A^L_X(xi) = X X^T xi + xi X X^T (001 (2.11)).
+///
+/// Args:
+///     X: (n, n) with det X > 0; xi: (n, n) skew.
+/// Returns:
+///     (n, n) skew array.
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0 or xi not skew).
+#[pyfunction]
+pub fn left_inertia<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+) -> PyResult<Arr2<'py>> {
+    Ok(py_mat(py, &at(&X)?.left(&mat("xi", &xi)?).py()?))
+}
+
+/// Right inertia tensor A^R_X(xi) = X^T X xi + xi X^T X (001 (2.11)).
+///
+/// Args and errors as `left_inertia`.
+#[pyfunction]
+pub fn right_inertia<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+) -> PyResult<Arr2<'py>> {
+    Ok(py_mat(py, &at(&X)?.right(&mat("xi", &xi)?).py()?))
+}
+
+/// The bi-inertia tensor B_X (001 (6.9)) as an (n(n-1), n(n-1)) matrix in the e_ij basis, xi
+/// block first: [[A^L_X, -2 Ad_X], [-2 Ad_X^T, A^R_X]]. Symmetric on all of GL+(n), positive
+/// definite when the singular values of X are distinct (6.14).
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+#[pyfunction]
+pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Arr2<'py>> {
+    Ok(py_mat(py, &at(&X)?.matrix()))
+}
+
+/// B_X(xi + eta) = (A^L_X xi - 2 X eta X^T, -2 X^T xi X + A^R_X eta) (001 (6.9), (6.10)).
+///
+/// Returns:
+///     (top, bottom): two (n, n) skew arrays.
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn bi_inertia_apply<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
+    let r = at(&X)?.apply(&mat("xi", &xi)?, &mat("eta", &eta)?).py()?;
+    Ok(pair(py, r))
+}
+
+/// Solves B_X(xi + eta) = lam + gam by the closed form in the SVD frame (001 (7.6)-(7.9)), in
+/// O(n^3) work: lam' = R^T lam R, gam' = S^T gam S,
+/// xi'_ij = ((a_i^2 + a_j^2) lam'_ij + 2 a_i a_j gam'_ij) / (a_i^2 - a_j^2)^2 (and symmetrically
+/// for eta'), rotated back.
+///
+/// Returns:
+///     (xi, eta): two (n, n) skew arrays.
+/// Raises:
+///     DegenerateStratumError if two singular values of X coincide (gap <= 1e-8 * a_1; the
+///     message gives the smallest gap), ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn bi_inertia_solve<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    lam: ArrayIn<'py>,
+    gam: ArrayIn<'py>,
+) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
+    let r = at(&X)?.solve(&mat("lam", &lam)?, &mat("gam", &gam)?).py()?;
+    Ok(pair(py, r))
+}
+
+/// Eigen-decomposition of B_X (001 (8.14)-(8.15)): eigenvalues (a_i - a_j)^2 and (a_i + a_j)^2
+/// (i < j) with orthonormal eigenvectors (R e_ij R^T + (+/-) S e_ij S^T) / sqrt(2). Valid on all
+/// of GL+(n).
+///
+/// Returns:
+///     (values, vectors): (n(n-1),) non-decreasing and (n(n-1), n(n-1)) with the eigenvectors
+///     as columns in e_ij coordinates (xi block first): B = V diag(values) V^T.
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr1<'py>, Arr2<'py>)> {
+    let (vals, vecs) = at(&X)?.eigen().py()?;
+    Ok((py_vec(py, &vals), py_mat(py, &vecs)))
+}
+
+/// The quadratic form <xi + eta, B_X(xi + eta)> in SVD coordinates (001 (6.14)); equals
+/// |xi X + X eta^T|_F^2.
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn bi_inertia_quadratic_form(
+    X: ArrayIn<'_>,
+    xi: ArrayIn<'_>,
+    eta: ArrayIn<'_>,
+) -> PyResult<f64> {
+    at(&X)?
+        .quadratic_form(&mat("xi", &xi)?, &mat("eta", &eta)?)
+        .py()
+}
+
+/// Left connection omega^L_X(Y) = (A^L_X)^{-1}(Y X^T - X Y^T) (001 (2.14)); defined on all of
+/// GL+(n) (omega^L(xi X) = xi, (2.16)).
+///
+/// Args:
+///     X: (n, n) with det X > 0; Y: (n, n) tangent vector.
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn left_connection<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    Y: ArrayIn<'py>,
+) -> PyResult<Arr2<'py>> {
+    Ok(py_mat(
+        py,
+        &cn::left_connection(&at(&X)?, &mat("Y", &Y)?).py()?,
+    ))
+}
+
+/// Right connection omega^R_X(Y) = (A^R_X)^{-1}(Y^T X - X^T Y) (001 (2.15)); defined on all of
+/// GL+(n) (omega^R(X eta^T) = eta, (2.17)).
+///
+/// Args and errors as `left_connection`.
+#[pyfunction]
+pub fn right_connection<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    Y: ArrayIn<'py>,
+) -> PyResult<Arr2<'py>> {
+    Ok(py_mat(
+        py,
+        &cn::right_connection(&at(&X)?, &mat("Y", &Y)?).py()?,
+    ))
+}
+
+/// Bi-connection omega^B_X(Y) = B_X^{-1}((Y X^T - X Y^T) + (Y^T X - X^T Y)) (001 (6.18)), via
+/// the closed-form inverse. omega^B(xi X + X eta^T) = (xi, eta) (6.19).
+///
+/// Returns:
+///     (xi, eta): two (n, n) skew arrays.
+/// Raises:
+///     DegenerateStratumError (coincident singular values), ShapeError, NonFiniteError,
+///     NotInGroupError.
+#[pyfunction]
+pub fn bi_connection<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    Y: ArrayIn<'py>,
+) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
+    let r = cn::bi_connection(&at(&X)?, &mat("Y", &Y)?).py()?;
+    Ok(pair(py, r))
+}
+
+/// The vertical vector (xi + eta)_P(X) = xi X + X eta^T (001 (6.17)).
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0, xi or eta not skew).
+#[pyfunction]
+pub fn vertical_vector<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+) -> PyResult<Arr2<'py>> {
+    let v = cn::vertical_vector(&at(&X)?, &mat("xi", &xi)?, &mat("eta", &eta)?).py()?;
+    Ok(py_mat(py, &v))
+}
+
+/// Horizontal part of Y at X for an action (001 (2.18)-(2.22), (6.4)-(6.7), (6.23)): Y minus
+/// its orthogonal projection (metric tr(Y^T Z)) onto the orbit's tangent space. "left": the
+/// result H has H X^T = X H^T; "right": H^T X = X^T H; "two-sided": both. Defined on every
+/// stratum (the two-sided projection uses the least-squares inverse of B_X).
+///
+/// Args:
+///     X: (n, n) with det X > 0; Y: (n, n); action: "two-sided" (default), "left" or "right".
+/// Raises:
+///     InvalidArgumentError (unknown action), ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+#[pyo3(signature = (X, Y, action = "two-sided"))]
+pub fn horizontal_part<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    Y: ArrayIn<'py>,
+    action: &str,
+) -> PyResult<Arr2<'py>> {
+    let action: Action = action.parse().py()?;
+    Ok(py_mat(
+        py,
+        &cn::horizontal_part(&at(&X)?, &mat("Y", &Y)?, action).py()?,
+    ))
+}
+
+/// Locked inertia tensor from the metric tr(Y^T Z) (001 (2.27), (6.24)): the matrix of
+/// tr(V(e_a)^T V(e_b)) with V(xi) = xi X ("left"), X xi^T ("right") or xi X + X eta^T
+/// ("two-sided", xi block first). Equals A^L_X, A^R_X, B_X.
+///
+/// Raises:
+///     InvalidArgumentError (unknown action), ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+#[pyo3(signature = (X, action = "two-sided"))]
+pub fn locked_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, action: &str) -> PyResult<Arr2<'py>> {
+    let action: Action = action.parse().py()?;
+    Ok(py_mat(py, &cn::locked_inertia(&at(&X)?, action)))
+}
+
+/// Angular momentum L = V X^T - X V^T (001 (2.29), (7.3)) of a velocity or momentum V at X.
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+#[pyfunction]
+pub fn angular_momentum<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    V: ArrayIn<'py>,
+) -> PyResult<Arr2<'py>> {
+    Ok(py_mat(
+        py,
+        &mo::angular_momentum(&mat("X", &X)?, &mat("V", &V)?).py()?,
+    ))
+}
+
+/// Circulation Gamma = V^T X - X^T V (001 (2.29), (7.3)) of a velocity or momentum V at X.
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+#[pyfunction]
+pub fn circulation<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResult<Arr2<'py>> {
+    Ok(py_mat(
+        py,
+        &mo::circulation(&mat("X", &X)?, &mat("V", &V)?).py()?,
+    ))
+}
+
+type BodyTuple<'py> = (
+    Arr2<'py>,
+    Arr1<'py>,
+    Arr2<'py>,
+    Arr2<'py>,
+    Arr1<'py>,
+    Arr2<'py>,
+);
+
+/// Body coordinates (R, a, S, Omega, adot, Lambda) of (X, V) (001 §4.1): X = R diag(a) S^T,
+/// Omega = R^T dR/dt, Lambda = S^T dS/dt, from R^T V S = Omega A + Adot - A Lambda.
+///
+/// Returns:
+///     (R, a, S, Omega, adot, Lambda).
+/// Raises:
+///     DegenerateStratumError (coincident singular values: Omega, Lambda undetermined),
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn to_body<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResult<BodyTuple<'py>> {
+    let b = mo::to_body(&mat("X", &X)?, &mat("V", &V)?).py()?;
+    Ok((
+        py_mat(py, &b.r),
+        py_vec(py, &b.a),
+        py_mat(py, &b.s),
+        py_mat(py, &b.omega),
+        py_vec(py, &b.adot),
+        py_mat(py, &b.lambda),
+    ))
+}
+
+/// (X, V) from body coordinates: X = R A S^T, V = R (Omega A + Adot - A Lambda) S^T (001 §4.1).
+///
+/// Args:
+///     R, S: (n, n) rotations; a: (n,) positive; Omega, Lambda: (n, n) skew; adot: (n,).
+/// Returns:
+///     (X, V).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (R, S not rotations, Omega, Lambda not skew),
+///     InvalidArgumentError (some a_i <= 0).
+#[pyfunction]
+pub fn from_body<'py>(
+    py: Python<'py>,
+    R: ArrayIn<'py>,
+    a: ArrayIn<'py>,
+    S: ArrayIn<'py>,
+    Omega: ArrayIn<'py>,
+    adot: ArrayIn<'py>,
+    Lambda: ArrayIn<'py>,
+) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
+    let body = Body {
+        r: mat("R", &R)?,
+        a: vector("a", &a)?,
+        s: mat("S", &S)?,
+        omega: mat("Omega", &Omega)?,
+        adot: vector("adot", &adot)?,
+        lambda: mat("Lambda", &Lambda)?,
+    };
+    Ok(pair(py, body.to_state().py()?))
+}
+
+/// Kinetic energy K = tr(V^T V) / 2 (001 (3.2); equal to (4.5), (4.12), (6.28)).
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn kinetic_energy(X: ArrayIn<'_>, V: ArrayIn<'_>) -> PyResult<f64> {
+    mo::kinetic_energy(&mat("X", &X)?, &mat("V", &V)?).py()
+}
+
+/// Stratum and isotropy of X under the two-sided SO(n) x SO(n) action (001 (6.2), (9.2), (9.3)).
+///
+/// Args:
+///     X: (n, n) with det X > 0; tol: relative tolerance for coinciding singular values
+///     (default 1e-8).
+/// Returns:
+///     dict with "singular_values", "multiplicities", "min_gap", "principal", "dim_vertical"
+///     (rank of (xi, eta) -> xi X + X eta^T), "dim_horizontal", "isotropy" (e.g. "(Z2)^2",
+///     "S(O(2)×O(1))", "SO(3)") and "isotropy_dim".
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (tol < 0).
+#[pyfunction]
+#[pyo3(signature = (X, tol = STRATUM_TOL))]
+pub fn stratum<'py>(py: Python<'py>, X: ArrayIn<'py>, tol: f64) -> PyResult<Bound<'py, PyDict>> {
+    let info = strata::classify(&mat("X", &X)?, tol).py()?;
+    let d = PyDict::new(py);
+    d.set_item("singular_values", py_vec(py, &info.stratum.a))?;
+    d.set_item("multiplicities", info.stratum.multiplicities.clone())?;
+    d.set_item("min_gap", info.stratum.min_gap)?;
+    d.set_item("principal", info.stratum.is_principal())?;
+    d.set_item("dim_vertical", info.dim_vertical)?;
+    d.set_item("dim_horizontal", info.dim_horizontal)?;
+    d.set_item("isotropy", info.isotropy)?;
+    d.set_item("isotropy_dim", info.isotropy_dim)?;
+    Ok(d)
+}
+
+/// Riemann-ellipsoid variables (001 (3.4)): Q = X X^T (quadrupole), N = X V^T (shear);
+/// N = (-L + dQ/dt) / 2 (3.10).
+///
+/// Returns:
+///     (Q, N).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn riemann_variables<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    V: ArrayIn<'py>,
+) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
+    Ok(pair(
+        py,
+        riemann::riemann_variables(&mat("X", &X)?, &mat("V", &V)?).py()?,
+    ))
+}
+
+/// Poisson bracket {f, g} of functions of (Q, N) from the structure functions (001 (9.1)):
+/// {Q_ij, Q_kl} = 0, {Q_ij, N_kl} = d_il Q_jk + d_jl Q_ik, {N_ij, N_kl} = d_il N_kj - d_jk N_il.
+///
+/// Args:
+///     Q, N: (n, n); dfdQ, dfdN, dgdQ, dgdN: (n, n) gradients (entries taken as coordinates).
+/// Raises:
+///     ShapeError, NonFiniteError.
+#[pyfunction]
+pub fn riemann_bracket(
+    Q: ArrayIn<'_>,
+    N: ArrayIn<'_>,
+    dfdQ: ArrayIn<'_>,
+    dfdN: ArrayIn<'_>,
+    dgdQ: ArrayIn<'_>,
+    dgdN: ArrayIn<'_>,
+) -> PyResult<f64> {
+    let (fq, fnn) = (mat("dfdQ", &dfdQ)?, mat("dfdN", &dfdN)?);
+    let (gq, gn) = (mat("dgdQ", &dgdQ)?, mat("dgdN", &dgdN)?);
+    riemann::poisson_bracket(&mat("Q", &Q)?, &mat("N", &N)?, (&fq, &fnn), (&gq, &gn)).py()
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(left_inertia, m)?)?;
+    m.add_function(wrap_pyfunction!(right_inertia, m)?)?;
+    m.add_function(wrap_pyfunction!(bi_inertia, m)?)?;
+    m.add_function(wrap_pyfunction!(bi_inertia_apply, m)?)?;
+    m.add_function(wrap_pyfunction!(bi_inertia_solve, m)?)?;
+    m.add_function(wrap_pyfunction!(bi_inertia_eigen, m)?)?;
+    m.add_function(wrap_pyfunction!(bi_inertia_quadratic_form, m)?)?;
+    m.add_function(wrap_pyfunction!(left_connection, m)?)?;
+    m.add_function(wrap_pyfunction!(right_connection, m)?)?;
+    m.add_function(wrap_pyfunction!(bi_connection, m)?)?;
+    m.add_function(wrap_pyfunction!(vertical_vector, m)?)?;
+    m.add_function(wrap_pyfunction!(horizontal_part, m)?)?;
+    m.add_function(wrap_pyfunction!(locked_inertia, m)?)?;
+    m.add_function(wrap_pyfunction!(angular_momentum, m)?)?;
+    m.add_function(wrap_pyfunction!(circulation, m)?)?;
+    m.add_function(wrap_pyfunction!(to_body, m)?)?;
+    m.add_function(wrap_pyfunction!(from_body, m)?)?;
+    m.add_function(wrap_pyfunction!(kinetic_energy, m)?)?;
+    m.add_function(wrap_pyfunction!(stratum, m)?)?;
+    m.add_function(wrap_pyfunction!(riemann_variables, m)?)?;
+    m.add_function(wrap_pyfunction!(riemann_bracket, m)?)?;
     Ok(())
 }

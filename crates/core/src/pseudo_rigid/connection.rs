@@ -1,0 +1,143 @@
+//! Connections on GL⁺(n) (001 §2.2, §6.2–6.3): the left and right connections ω^L, ω^R
+//! (001 (2.14)–(2.15)), the bi-connection ω^B (001 (6.18)), the vertical vectors of the actions
+//! (001 (6.17)), horizontal/vertical splits (001 (2.18)–(2.22), (6.4)–(6.7), (6.23)) and the
+//! locked inertia tensors computed from the metric tr(YᵀZ) (001 (2.27), (6.24)).
+//!
+//! Every function takes the [`BiInertia`] at X (which holds X and caches its SVD).
+
+use std::str::FromStr;
+
+use super::inertia::{check_skew, BiInertia};
+use super::momentum::momentum_map_unchecked;
+use crate::error::{Error, Result};
+use crate::lie::so;
+use crate::{check, Mat};
+
+/// Which SO(n) action: left X ↦ gX, right X ↦ Xh⁻¹, or two-sided X ↦ gXh⁻¹ (001 (2.2), (6.1)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// X ↦ gX.
+    Left,
+    /// X ↦ Xh⁻¹.
+    Right,
+    /// X ↦ gXh⁻¹ of SO(n)×SO(n).
+    TwoSided,
+}
+
+impl FromStr for Action {
+    type Err = Error;
+    /// "left", "right" or "two-sided".
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "left" => Ok(Action::Left),
+            "right" => Ok(Action::Right),
+            "two-sided" => Ok(Action::TwoSided),
+            _ => Err(Error::invalid(
+                "action",
+                format!("expected \"left\", \"right\" or \"two-sided\", got {s:?}"),
+            )),
+        }
+    }
+}
+
+fn tangent(b: &BiInertia, y: &Mat) -> Result<()> {
+    check::square_of("Y", y, b.n())
+}
+
+/// Left connection ω^L_X(Y) = (A^L_X)⁻¹(YXᵀ − XYᵀ) (001 (2.14)); defined on all of GL⁺(n).
+/// ω^L(ξX) = ξ and ω^L_{gX} = Ad_g ∘ ω^L_X (2.16).
+pub fn left_connection(b: &BiInertia, y: &Mat) -> Result<Mat> {
+    tangent(b, y)?;
+    b.left_solve(&momentum_map_unchecked(b.x(), y).0)
+}
+
+/// Right connection ω^R_X(Y) = (A^R_X)⁻¹(YᵀX − XᵀY) (001 (2.15)); defined on all of GL⁺(n).
+/// ω^R(Xηᵀ) = η and ω^R_{Xh⁻¹} = Ad_h ∘ ω^R_X (2.17).
+pub fn right_connection(b: &BiInertia, y: &Mat) -> Result<Mat> {
+    tangent(b, y)?;
+    b.right_solve(&momentum_map_unchecked(b.x(), y).1)
+}
+
+/// Bi-connection ω^B_X(Y) = B_X⁻¹((YXᵀ − XYᵀ) ⊕ (YᵀX − XᵀY)) (001 (6.18)), by the closed-form
+/// inverse of B_X. Needs the principal stratum ([`Error::DegenerateStratum`] otherwise).
+/// ω^B(ξX + Xηᵀ) = ξ ⊕ η (6.19), ω^B_{gXh⁻¹} = Ad_(g,h) ∘ ω^B_X (6.20), ker ω^B = H_X (6.23).
+/// Seed slip: the proof (6.21) as extracted reads B_X⁻¹ B_X⁻¹ (ξ ⊕ η); the step is
+/// B_X⁻¹ B_X (ξ ⊕ η), since J(X, ξX + Xηᵀ) = B_X(ξ ⊕ η) (checked numerically).
+pub fn bi_connection(b: &BiInertia, y: &Mat) -> Result<(Mat, Mat)> {
+    tangent(b, y)?;
+    let (l, g) = momentum_map_unchecked(b.x(), y);
+    b.solve(&l, &g)
+}
+
+/// The vertical vector (ξ ⊕ η)_P(X) = ξX + Xηᵀ induced by ξ ⊕ η ∈ so(n) ⊕ so(n) (001 (6.17));
+/// η = 0 gives the left-action vector ξX, ξ = 0 the right-action vector Xηᵀ.
+pub fn vertical_vector(b: &BiInertia, xi: &Mat, eta: &Mat) -> Result<Mat> {
+    check_skew("xi", xi, b.n())?;
+    check_skew("eta", eta, b.n())?;
+    Ok(vertical_unchecked(b.x(), xi, eta))
+}
+
+/// ξX + Xηᵀ without checks.
+pub(crate) fn vertical_unchecked(x: &Mat, xi: &Mat, eta: &Mat) -> Mat {
+    xi * x + x * eta.transpose()
+}
+
+/// Vertical part of Y ∈ T_X GL⁺(n) for an action: the orthogonal projection (metric tr(YᵀZ))
+/// onto the tangent space of the orbit, ω^L(Y)X (left), Xω^R(Y)ᵀ (right), or (ξ ⊕ η)_P(X) with
+/// ξ ⊕ η = B_X⁺ J(X, Y) (two-sided, 001 (6.4)–(6.5)). B_X⁺ is the least-squares inverse
+/// ([`BiInertia::solve_least_squares`]), so the split is defined on every stratum (it equals
+/// ω^B on the principal one) — the one-sided splits (2.22) likewise.
+pub fn vertical_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
+    tangent(b, y)?;
+    let x = b.x();
+    let zero = Mat::zeros(b.n(), b.n());
+    let (l, g) = momentum_map_unchecked(x, y);
+    let (xi, eta) = match action {
+        Action::Left => (b.left_solve(&l)?, zero),
+        Action::Right => (zero, b.right_solve(&g)?),
+        Action::TwoSided => b.solve_least_squares(&l, &g)?,
+    };
+    Ok(vertical_unchecked(x, &xi, &eta))
+}
+
+/// Horizontal part Y − vertical part (001 (2.20)–(2.22), (6.6), (6.23)): the left one satisfies
+/// YXᵀ = XYᵀ, the right one YᵀX = XᵀY, the two-sided one both.
+pub fn horizontal_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
+    Ok(y - vertical_part(b, y, action)?)
+}
+
+/// The locked inertia tensor computed from the metric, an independent route to the inertia
+/// tensors (001 (2.27), (6.24)): the matrix with entries tr(V(e_a)ᵀ V(e_b)) over the e_ij basis,
+/// where V(ξ) = ξX (left, d×d), Xξᵀ (right) or V(ξ ⊕ η) = ξX + Xηᵀ (two-sided, 2d×2d, ξ block
+/// first). Equals the matrix of A^L_X, A^R_X, B_X respectively (2.28), (6.25). The display
+/// (6.25) is missing from the extraction; derived: with ξᵀ = −ξ, ηᵀ = −η,
+/// ‖ξX + Xηᵀ‖² = 2 tr(ξXηXᵀ) − tr(ξ²XXᵀ) − tr(η²XᵀX) = ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ with the pairing
+/// (6.8), polarised. O(n⁶) (a Gram matrix of n(n−1) vectors in R^{n²}): a check, not a hot
+/// path.
+pub fn locked_inertia(b: &BiInertia, action: Action) -> Mat {
+    let (n, d) = (b.n(), so::dim(b.n()));
+    let zero = Mat::zeros(n, n);
+    let blocks = if action == Action::TwoSided { 2 } else { 1 };
+    let vectors: Vec<Mat> = (0..blocks * d)
+        .map(|k| {
+            let mut c = vec![0.0; blocks * d];
+            c[k] = 1.0;
+            let e = so::hat_n_unchecked(n, &c[..d]);
+            match action {
+                Action::Left => vertical_unchecked(b.x(), &e, &zero),
+                Action::Right => vertical_unchecked(b.x(), &zero, &e),
+                Action::TwoSided => vertical_unchecked(b.x(), &e, &so::hat_n_unchecked(n, &c[d..])),
+            }
+        })
+        .collect();
+    Mat::from_fn(blocks * d, blocks * d, |p, q| {
+        let (u, v) = (&vectors[p], &vectors[q]);
+        let mut s = 0.0;
+        for j in 0..n {
+            for i in 0..n {
+                s += u[(i, j)] * v[(i, j)];
+            }
+        }
+        s
+    })
+}

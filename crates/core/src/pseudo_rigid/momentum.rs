@@ -1,0 +1,259 @@
+//! Momenta, body coordinates and kinetic energy of a pseudo-rigid body (001 §2.4, §4, §5, §6.4).
+//!
+//! With the metric tr(YᵀZ) (001 (2.9)) a velocity Ẋ and a momentum P are the same matrix, so
+//! every function taking a velocity `v` also takes a momentum P: L = PXᵀ − XPᵀ and
+//! Γ = PᵀX − XᵀP (001 (7.3), DESIGN.md) are (2.29) with P = Ẋ.
+
+use nalgebra::Vector3;
+
+use super::inertia::{check_skew, BiInertia};
+use crate::error::Result;
+use crate::lie::gl::{self, SvdCoordinates};
+use crate::lie::so;
+use crate::{check, Mat};
+
+/// Checks a configuration X ∈ GL⁺(n) and a velocity/momentum V of the same size; returns n.
+fn check_state(x: &Mat, v: &Mat) -> Result<usize> {
+    let n = gl::check_gl_plus("X", x)?;
+    check::square_of("V", v, n)?;
+    Ok(n)
+}
+
+/// J = L ⊕ Γ without checks (shared with the connections).
+pub(crate) fn momentum_map_unchecked(x: &Mat, p: &Mat) -> (Mat, Mat) {
+    let pxt = p * x.transpose();
+    let ptx = p.transpose() * x;
+    (&pxt - pxt.transpose(), &ptx - ptx.transpose())
+}
+
+/// Angular momentum L = VXᵀ − XVᵀ (001 (2.29), (7.3)) for a velocity or momentum V at X.
+pub fn angular_momentum(x: &Mat, v: &Mat) -> Result<Mat> {
+    check_state(x, v)?;
+    Ok(momentum_map_unchecked(x, v).0)
+}
+
+/// Circulation Γ = VᵀX − XᵀV (001 (2.29), (7.3)) for a velocity or momentum V at X.
+pub fn circulation(x: &Mat, v: &Mat) -> Result<Mat> {
+    check_state(x, v)?;
+    Ok(momentum_map_unchecked(x, v).1)
+}
+
+/// Momentum map J(X, P) = L ⊕ Γ of the two-sided SO(n)×SO(n) action (001 (7.2)).
+pub fn momentum_map(x: &Mat, p: &Mat) -> Result<(Mat, Mat)> {
+    check_state(x, p)?;
+    Ok(momentum_map_unchecked(x, p))
+}
+
+/// Local coordinates (R, A, S, Ω, Ȧ, Λ) of T GL⁺(n) (001 §4.1, (2.33)): X = R A Sᵀ,
+/// Ω = RᵀṘ, Λ = SᵀṠ.
+#[derive(Debug, Clone)]
+pub struct Body {
+    /// R ∈ SO(n).
+    pub r: Mat,
+    /// Singular values a (the diagonal of A).
+    pub a: Vec<f64>,
+    /// S ∈ SO(n).
+    pub s: Mat,
+    /// Ω = RᵀṘ ∈ so(n).
+    pub omega: Mat,
+    /// Ȧ (the diagonal).
+    pub adot: Vec<f64>,
+    /// Λ = SᵀṠ ∈ so(n).
+    pub lambda: Mat,
+}
+
+/// Body coordinates of (X, Ẋ) on the principal stratum (001 §4.1). With X = R A Sᵀ
+/// ([`gl::svd_coordinates`]) differentiation gives RᵀẊS = ΩA + Ȧ − AΛ =: M; the diagonal is Ȧ
+/// and for i ≠ j the pair (M_ij, M_ji) = (a_j Ω_ij − a_i Λ_ij, −a_i Ω_ij + a_j Λ_ij) solves to
+/// Ω_ij = (a_j M_ij + a_i M_ji)/(a_j² − a_i²), Λ_ij = (a_i M_ij + a_j M_ji)/(a_j² − a_i²).
+///
+/// Errors: X ∉ GL⁺(n), V of the wrong shape or non-finite, [`Error::DegenerateStratum`] off the
+/// principal stratum (Ω and Λ are not determined there).
+pub fn to_body(x: &Mat, v: &Mat) -> Result<Body> {
+    let n = check_state(x, v)?;
+    let c = gl::svd_coordinates(x)?;
+    c.require_principal("body coordinates (Ω, Λ)")?;
+    let SvdCoordinates { r, a, s } = c;
+    let m = r.transpose() * v * &s;
+    let mut omega = Mat::zeros(n, n);
+    let mut lambda = Mat::zeros(n, n);
+    for i in 0..n {
+        for j in i + 1..n {
+            let den = a[j] * a[j] - a[i] * a[i];
+            let (mij, mji) = (m[(i, j)], m[(j, i)]);
+            let o = (a[j] * mij + a[i] * mji) / den;
+            let l = (a[i] * mij + a[j] * mji) / den;
+            omega[(i, j)] = o;
+            omega[(j, i)] = -o;
+            lambda[(i, j)] = l;
+            lambda[(j, i)] = -l;
+        }
+    }
+    let adot = (0..n).map(|i| m[(i, i)]).collect();
+    Ok(Body {
+        r,
+        a,
+        s,
+        omega,
+        adot,
+        lambda,
+    })
+}
+
+impl Body {
+    /// Checks shapes, finiteness, R, S ∈ SO(n), a_i > 0, Ω, Λ ∈ so(n).
+    pub fn validate(&self) -> Result<usize> {
+        let n = self.a.len();
+        gl::from_svd(&self.r, &self.a, &self.s)?;
+        check::len_of("adot", &self.adot, n)?;
+        check_skew("Omega", &self.omega, n)?;
+        check_skew("Lambda", &self.lambda, n)?;
+        Ok(n)
+    }
+
+    /// A = diag(a).
+    pub fn a_matrix(&self) -> Mat {
+        diag(&self.a)
+    }
+
+    /// (X, Ẋ) from body coordinates: X = R A Sᵀ, Ẋ = R(ΩA + Ȧ − AΛ)Sᵀ (001 §4.1, from
+    /// Ṙ = RΩ, Ṡ = SΛ). Defined on every stratum.
+    pub fn to_state(&self) -> Result<(Mat, Mat)> {
+        self.validate()?;
+        let a = self.a_matrix();
+        let x = &self.r * &a * self.s.transpose();
+        let m = &self.omega * &a + diag(&self.adot) - &a * &self.lambda;
+        Ok((x, &self.r * m * self.s.transpose()))
+    }
+
+    /// Body momenta p_Ω ⊕ p_Λ = B_A(Ω ⊕ Λ) = (A²Ω + ΩA² − 2AΛA) ⊕ (A²Λ + ΛA² − 2AΩA)
+    /// (001 (4.15), (6.27), (6.29)); equal to RᵀLR ⊕ SᵀΓS (001 (2.32)).
+    pub fn momenta(&self) -> Result<(Mat, Mat)> {
+        self.validate()?;
+        BiInertia::new(&self.a_matrix())?.apply(&self.omega, &self.lambda)
+    }
+
+    /// The E term of 001 (4.8): E = 𝔇(−(Ω² + Λ²)A + ΩAΛ + ΛAΩ) = ∂K/∂A at fixed Ω, Λ, Ȧ
+    /// (the diagonal, as a vector). Checked against finite differences of (4.5).
+    pub fn e_term(&self) -> Result<Vec<f64>> {
+        let n = self.validate()?;
+        let a = self.a_matrix();
+        let (o, l) = (&self.omega, &self.lambda);
+        let e = -(o * o + l * l) * &a + o * &a * l + l * &a * o;
+        Ok((0..n).map(|i| e[(i, i)]).collect())
+    }
+
+    /// Kinetic energy in body coordinates (001 (4.5)):
+    /// K = ½ tr(Ȧ² − A²(Ω² + Λ²) + 2ΩAΛA).
+    pub fn kinetic_energy(&self) -> Result<f64> {
+        self.validate()?;
+        let a = self.a_matrix();
+        let (o, l) = (&self.omega, &self.lambda);
+        let m = -(&a * &a) * (o * o + l * l) + o * &a * l * &a * faer::Scale(2.0);
+        let tr: f64 = (0..self.a.len()).map(|i| m[(i, i)]).sum();
+        Ok(0.5 * (dot(&self.adot, &self.adot) + tr))
+    }
+
+    /// Kinetic energy through the momenta (001 (4.12)):
+    /// K = ½⟨Ȧ, Ȧ⟩ + ½(⟨Ω, RᵀLR⟩ + ⟨Λ, SᵀΓS⟩), with RᵀLR, SᵀΓS computed from (X, Ẋ).
+    pub fn kinetic_energy_momenta(&self) -> Result<f64> {
+        let (x, v) = self.to_state()?;
+        let (l, g) = momentum_map_unchecked(&x, &v);
+        let (lb, gb) = (
+            self.r.transpose() * l * &self.r,
+            self.s.transpose() * g * &self.s,
+        );
+        Ok(0.5 * dot(&self.adot, &self.adot)
+            + 0.5 * (so::pairing(&self.omega, &lb) + so::pairing(&self.lambda, &gb)))
+    }
+
+    /// Kinetic energy through the bi-inertia tensor (001 (6.28)):
+    /// K = ½⟨Ȧ, Ȧ⟩ + ½⟨Ω ⊕ Λ, B_A(Ω ⊕ Λ)⟩.
+    pub fn kinetic_energy_bi_inertia(&self) -> Result<f64> {
+        let (po, pl) = self.momenta()?;
+        Ok(0.5 * dot(&self.adot, &self.adot)
+            + 0.5 * (so::pairing(&self.omega, &po) + so::pairing(&self.lambda, &pl)))
+    }
+}
+
+/// Kinetic energy K = ½ tr(VᵀV) of a velocity V at X (001 (2.10), (3.2)); with V = P it is
+/// the kinetic part of the Hamiltonian (3.22).
+pub fn kinetic_energy(x: &Mat, v: &Mat) -> Result<f64> {
+    check_state(x, v)?;
+    Ok(0.5 * v.norm_l2().powi(2))
+}
+
+/// Kinetic part of the Hamiltonian in reduced coordinates (001 (6.30)):
+/// ½⟨p_A, p_A⟩ + ½⟨p_Ω ⊕ p_Λ, B_A⁻¹(p_Ω ⊕ p_Λ)⟩, needing distinct a_i > 0 (principal stratum).
+pub fn kinetic_energy_hamiltonian(
+    a: &[f64],
+    p_a: &[f64],
+    p_omega: &Mat,
+    p_lambda: &Mat,
+) -> Result<f64> {
+    check::len_of("p_a", p_a, a.len())?;
+    for &ai in a {
+        check::positive("a", ai)?;
+    }
+    let b = BiInertia::new(&diag(a))?;
+    let (o, l) = b.solve(p_omega, p_lambda)?;
+    Ok(0.5 * dot(p_a, p_a) + 0.5 * (so::pairing(p_omega, &o) + so::pairing(p_lambda, &l)))
+}
+
+fn diag(a: &[f64]) -> Mat {
+    Mat::from_fn(a.len(), a.len(), |i, j| if i == j { a[i] } else { 0.0 })
+}
+
+fn dot(u: &[f64], v: &[f64]) -> f64 {
+    u.iter().zip(v).map(|(p, q)| p * q).sum()
+}
+
+/// n = 3 body angular momentum m and circulation c (001 (5.3)), with Ω = hat(ω), Λ = hat(λ)
+/// (physics hat map, DESIGN.md):
+/// m_k = (a_i² + a_j²) ω_k − 2 a_i a_j λ_k, c_k = (a_i² + a_j²) λ_k − 2 a_i a_j ω_k for (i, j, k)
+/// cyclic. hat(m) = RᵀLR and hat(c) = SᵀΓS (5.2); checked against the matrix forms (4.15).
+pub fn body_momenta_3(
+    a: &Vector3<f64>,
+    omega: &Vector3<f64>,
+    lambda: &Vector3<f64>,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let (s, p) = pair_coefficients_3(a);
+    (
+        s.component_mul(omega) - 2.0 * p.component_mul(lambda),
+        s.component_mul(lambda) - 2.0 * p.component_mul(omega),
+    )
+}
+
+/// (a_i² + a_j², a_i a_j) for the pair (i, j) complementary to each k.
+fn pair_coefficients_3(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let sq = a.component_mul(a);
+    (
+        Vector3::new(sq[1] + sq[2], sq[2] + sq[0], sq[0] + sq[1]),
+        Vector3::new(a[1] * a[2], a[2] * a[0], a[0] * a[1]),
+    )
+}
+
+/// n = 3 vector form of E (001 (5.4)):
+/// E_1 = a_1(ω_2² + ω_3² + λ_2² + λ_3²) − 2a_2 ω_3 λ_3 − 2a_3 ω_2 λ_2 and cyclically.
+/// Checked against the matrix form (4.8): correct as printed.
+pub fn e_term_3(a: &Vector3<f64>, omega: &Vector3<f64>, lambda: &Vector3<f64>) -> Vector3<f64> {
+    let w2 = omega.component_mul(omega) + lambda.component_mul(lambda);
+    let wl = omega.component_mul(lambda);
+    Vector3::from_fn(|i, _| {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        a[i] * (w2[j] + w2[k]) - 2.0 * a[j] * wl[k] - 2.0 * a[k] * wl[j]
+    })
+}
+
+/// n = 3 kinetic energy (001 (5.6)):
+/// K = ½ Σ ȧ_i² + ½ Σ_cyclic ((a_i² + a_j²)(ω_k² + λ_k²) − 4 a_i a_j ω_k λ_k).
+pub fn kinetic_energy_3(
+    a: &Vector3<f64>,
+    adot: &Vector3<f64>,
+    omega: &Vector3<f64>,
+    lambda: &Vector3<f64>,
+) -> f64 {
+    let (s, p) = pair_coefficients_3(a);
+    let w2 = omega.component_mul(omega) + lambda.component_mul(lambda);
+    0.5 * adot.norm_squared() + 0.5 * (s.dot(&w2) - 4.0 * p.dot(&omega.component_mul(lambda)))
+}

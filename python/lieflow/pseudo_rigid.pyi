@@ -1,0 +1,87 @@
+# Type stubs for lieflow.pseudo_rigid (bindings of lieflow::pseudo_rigid, 001).
+# so(n) elements are skew (n, n) arrays; matrices on so(n) + so(n) use the e_ij basis with the
+# xi block first.
+from typing import Literal, TypedDict
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+F64 = NDArray[np.float64]
+Action = Literal["two-sided", "left", "right"]
+
+class StratumInfo(TypedDict):
+    singular_values: F64
+    multiplicities: list[int]
+    min_gap: float
+    principal: bool
+    dim_vertical: int
+    dim_horizontal: int
+    isotropy: str
+    isotropy_dim: int
+
+def left_inertia(X: ArrayLike, xi: ArrayLike) -> F64:
+    """A^L_X xi = X X^T xi + xi X X^T (001 (2.11))."""
+
+def right_inertia(X: ArrayLike, xi: ArrayLike) -> F64:
+    """A^R_X xi = X^T X xi + xi X^T X (001 (2.11))."""
+
+def bi_inertia(X: ArrayLike) -> F64:
+    """B_X as an (n(n-1), n(n-1)) matrix (001 (6.9))."""
+
+def bi_inertia_apply(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> tuple[F64, F64]:
+    """B_X(xi + eta) (001 (6.9))."""
+
+def bi_inertia_solve(X: ArrayLike, lam: ArrayLike, gam: ArrayLike) -> tuple[F64, F64]:
+    """B_X^{-1}(lam + gam) by the closed form (001 (7.6)-(7.9)); principal stratum only."""
+
+def bi_inertia_eigen(X: ArrayLike) -> tuple[F64, F64]:
+    """Eigenvalues (non-decreasing) and eigenvectors (columns) of B_X (001 (8.14)-(8.15))."""
+
+def bi_inertia_quadratic_form(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> float:
+    """<xi + eta, B_X(xi + eta)> in SVD coordinates (001 (6.14))."""
+
+def left_connection(X: ArrayLike, Y: ArrayLike) -> F64:
+    """omega^L_X(Y) (001 (2.14))."""
+
+def right_connection(X: ArrayLike, Y: ArrayLike) -> F64:
+    """omega^R_X(Y) (001 (2.15))."""
+
+def bi_connection(X: ArrayLike, Y: ArrayLike) -> tuple[F64, F64]:
+    """omega^B_X(Y) (001 (6.18)); principal stratum only."""
+
+def vertical_vector(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> F64:
+    """xi X + X eta^T (001 (6.17))."""
+
+def horizontal_part(X: ArrayLike, Y: ArrayLike, action: Action = "two-sided") -> F64:
+    """Horizontal part of Y for the action (001 (2.20)-(2.22), (6.6), (6.23))."""
+
+def locked_inertia(X: ArrayLike, action: Action = "two-sided") -> F64:
+    """Locked inertia tensor from the metric tr(Y^T Z) (001 (2.27), (6.24))."""
+
+def angular_momentum(X: ArrayLike, V: ArrayLike) -> F64:
+    """L = V X^T - X V^T (001 (2.29), (7.3))."""
+
+def circulation(X: ArrayLike, V: ArrayLike) -> F64:
+    """Gamma = V^T X - X^T V (001 (2.29), (7.3))."""
+
+def to_body(X: ArrayLike, V: ArrayLike) -> tuple[F64, F64, F64, F64, F64, F64]:
+    """(R, a, S, Omega, adot, Lambda) (001 §4.1); principal stratum only."""
+
+def from_body(
+    R: ArrayLike, a: ArrayLike, S: ArrayLike, Omega: ArrayLike, adot: ArrayLike, Lambda: ArrayLike
+) -> tuple[F64, F64]:
+    """(X, V) from body coordinates (001 §4.1)."""
+
+def kinetic_energy(X: ArrayLike, V: ArrayLike) -> float:
+    """tr(V^T V) / 2 (001 (3.2), (4.5), (6.28))."""
+
+def stratum(X: ArrayLike, tol: float = 1e-8) -> StratumInfo:
+    """Stratum, dim V_X, dim H_X and isotropy (001 (6.2), (9.2), (9.3))."""
+
+def riemann_variables(X: ArrayLike, V: ArrayLike) -> tuple[F64, F64]:
+    """(Q, N) = (X X^T, X V^T) (001 (3.4))."""
+
+def riemann_bracket(
+    Q: ArrayLike, N: ArrayLike, dfdQ: ArrayLike, dfdN: ArrayLike, dgdQ: ArrayLike, dgdN: ArrayLike
+) -> float:
+    """Poisson bracket of functions of (Q, N) (001 (9.1))."""
