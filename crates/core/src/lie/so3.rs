@@ -471,12 +471,15 @@ mod tests {
 
     #[test]
     fn series_and_closed_form_agree_at_the_switch() {
-        let t = SERIES_T2.sqrt();
-        let below = Coeffs::new(&Vector3::new(t * (1.0 - 1e-9), 0.0, 0.0));
-        let above = Coeffs::new(&Vector3::new(t * (1.0 + 1e-9), 0.0, 0.0));
-        assert!((below.a - above.a).abs() < 1e-14);
-        assert!((below.b - above.b).abs() < 1e-14);
-        assert!((below.c - above.c).abs() < 1e-11);
-        assert!((below.gamma() - above.gamma()).abs() < 1e-11);
+        // Just below the switch the series is used; compare with the closed forms there.
+        let t = SERIES_T2.sqrt() * (1.0 - 1e-9);
+        let k = Coeffs::new(&Vector3::new(0.0, t, 0.0));
+        let (s, c) = t.sin_cos();
+        let h = 0.5 * t;
+        assert!((k.a - s / t).abs() < 1e-15);
+        assert!((k.b - 2.0 * h.sin().powi(2) / (t * t)).abs() < 1e-15);
+        assert!((k.c - (t - s) / t.powi(3)).abs() < 1e-10);
+        let gamma = 1.0 / (t * t) - (1.0 + c) / (2.0 * t * s);
+        assert!((k.gamma() - gamma).abs() < 1e-10);
     }
 }
