@@ -146,17 +146,27 @@ pub fn exp(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::identity() + hat(w) * k.a + hat_sq(w, k.t2) * k.b
 }
 
-/// Rotation angle of R in [0, π] and the vector s = vee((R − Rᵀ)/2) = sin θ · axis.
+/// Rotation angle θ ∈ [0, π] of R, cos θ = (tr R − 1)/2, and s = vee((R − Rᵀ)/2) = sin θ · axis.
+/// θ comes from whichever of cos θ, sin θ = |s| is well conditioned: acos where |cos θ| ≤ ½,
+/// asin elsewhere (as accurate as atan2, and about twice as fast).
 #[inline]
-fn angle_axis_sin(r: &Matrix3<f64>) -> (f64, Vector3<f64>) {
+fn angle_cos_sin(r: &Matrix3<f64>) -> (f64, f64, Vector3<f64>) {
     let s = vee(r);
     let c = 0.5 * (r.trace() - 1.0);
-    (s.norm().atan2(c), s)
+    let n = s.norm().min(1.0);
+    let theta = if c.abs() <= 0.5 {
+        c.acos()
+    } else if c > 0.0 {
+        n.asin()
+    } else {
+        std::f64::consts::PI - n.asin()
+    };
+    (theta, c, s)
 }
 
 /// Principal logarithm of a rotation: the w with |w| = θ ∈ [0, π] and exp(ŵ) = R.
 ///
-/// θ = atan2(|s|, (tr R − 1)/2) with s = vee((R − Rᵀ)/2) = sin θ · a. For cos θ > 0 the
+/// θ from cos θ = (tr R − 1)/2 and sin θ = |s| with s = vee((R − Rᵀ)/2) = sin θ · a. For cos θ > 0 the
 /// result is (θ / sin θ) s (series near 0). For cos θ ≤ 0 (so near π, where s carries no
 /// precision) the axis comes from the symmetric part (R + Rᵀ)/2 − cos θ I = (1 − cos θ) a aᵀ:
 /// its column with the largest diagonal entry, normalized, with the sign of s.
@@ -165,8 +175,7 @@ fn angle_axis_sin(r: &Matrix3<f64>) -> (f64, Vector3<f64>) {
 /// component at the largest diagonal entry of R is positive. [`SO3::log`] refuses angles within
 /// [`LOG_PI_TOL`] of π instead. No checks: `r` is assumed to be a rotation (use [`SO3::new`]).
 pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
-    let (theta, s) = angle_axis_sin(r);
-    let c = 0.5 * (r.trace() - 1.0);
+    let (theta, c, s) = angle_cos_sin(r);
     if c > 0.0 {
         let t2 = theta * theta;
         let f = if t2 < SERIES_T2 {
@@ -367,7 +376,7 @@ impl SO3 {
 
     /// The rotation angle θ ∈ [0, π].
     pub fn angle(&self) -> f64 {
-        angle_axis_sin(&self.0).0
+        angle_cos_sin(&self.0).0
     }
 }
 
