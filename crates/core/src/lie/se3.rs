@@ -58,7 +58,7 @@ pub fn exp(xi: &Vector6<f64>) -> SE3 {
     }
 }
 
-/// Logarithm: ω = [`so3::log`](R) (θ ∈ [0, π]; at θ = π one of the two, as documented there) and
+/// Logarithm: ω = [`so3::log`] of R (θ ∈ [0, π]; at θ = π one of the two, as documented there) and
 /// v = V(ω)⁻¹ t = J_l⁻¹(ω) t, which is regular for θ ≤ π. No checks (see [`SE3::log`]).
 pub fn log(g: &SE3) -> Vector6<f64> {
     let w = so3::log(&g.rot);

@@ -186,11 +186,21 @@ pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
         };
         return s * f;
     }
-    let sym = (r + r.transpose()) * 0.5 - Matrix3::from_diagonal_element(c);
-    let i = (0..3)
-        .max_by(|&i, &j| sym[(i, i)].total_cmp(&sym[(j, j)]))
-        .unwrap_or(0);
-    let mut axis: Vector3<f64> = sym.column(i).into();
+    // Column i of (R + Rᵀ)/2 − cos θ I, i the largest diagonal entry (≥ (1 − cos θ)/3).
+    let i = if r[(0, 0)] >= r[(1, 1)] && r[(0, 0)] >= r[(2, 2)] {
+        0
+    } else if r[(1, 1)] >= r[(2, 2)] {
+        1
+    } else {
+        2
+    };
+    let mut axis = Vector3::from_fn(|j, _| {
+        if j == i {
+            r[(i, i)] - c
+        } else {
+            0.5 * (r[(j, i)] + r[(i, j)])
+        }
+    });
     axis /= axis.norm();
     if axis.dot(&s) < 0.0 {
         axis = -axis;

@@ -198,14 +198,14 @@ fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
     Ok(write(py, &out, b))
 }
 
-/// `so3_log(R, strict=False)`: the principal logarithm w (|w| = θ ∈ [0, π], exp(ŵ) = R),
+/// `so3_log(r, strict=False)`: the principal logarithm w (|w| = θ ∈ [0, π], exp(ŵ) = R),
 /// accurate near θ = 0 and near θ = π (axis from the symmetric part of R there).
 ///
 /// At θ = π exactly both ±π·axis are logarithms: with `strict=False` one of them is returned
 /// (the one whose component at the largest diagonal entry of R is positive); with `strict=True`
 /// NoUniqueLogError is raised when π − θ ≤ 1e-12.
 ///
-/// Args: R — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Args: r — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or |det R − 1| > 1e-10),
 /// NoUniqueLogError (strict only).
 #[pyfunction]
@@ -234,9 +234,9 @@ fn so3_cayley<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
     Ok(write(py, &out, b))
 }
 
-/// `so3_cayley_inv(R)`: the inverse Cayley map, w = 2·vee(R − Rᵀ)/(1 + tr R).
+/// `so3_cayley_inv(r)`: the inverse Cayley map, w = 2·vee(R − Rᵀ)/(1 + tr R).
 ///
-/// Args: R — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Args: r — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (rotation by π:
 /// 1 + tr R ≤ 1e-12, where R + I is singular).
 #[pyfunction]
