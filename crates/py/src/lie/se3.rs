@@ -4,10 +4,10 @@
 use lieflow::lie::se3::{self, SE3};
 use lieflow::lie::MatrixLieGroup;
 use lieflow::Error;
-use nalgebra::Matrix4;
+use nalgebra::{Matrix4, Vector6};
 use pyo3::prelude::*;
 
-use super::so3::{par_map, read_mats, read_vecs, relabel, write, Out};
+use super::so3::{map_batch, par_fill, read_items, relabel, Out};
 use crate::convert::ArrayIn;
 use crate::errors::to_py;
 
@@ -18,9 +18,7 @@ use crate::errors::to_py;
 /// Args: xi — (6,) or (b, 6). Returns (4, 4) or (b, 4, 4). Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (xs, b) = read_vecs::<6>("xi", &xi)?;
-    let out = par_map(py, &xs, b, |x| Ok(se3::exp(x).matrix4()))?;
-    Ok(write(py, &out, b))
+    map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::exp(x).matrix4()))
 }
 
 /// `se3_log(g, strict=False)`: the logarithm ξ = (ω, v) of g = [[R, t], [0, 1]]: ω = so3_log(R)
@@ -33,16 +31,14 @@ fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 #[pyfunction]
 #[pyo3(signature = (g, strict = false))]
 fn se3_log<'py>(py: Python<'py>, g: ArrayIn<'py>, strict: bool) -> PyResult<Out<'py>> {
-    let (ms, b) = read_mats::<4>("g", &g)?;
-    let out = par_map(py, &ms, b, |m| {
+    map_batch(py, "g", &g, |m: &Matrix4<f64>| {
         let g = SE3::from_matrix4(m)?;
         if strict {
             g.log()
         } else {
             Ok(se3::log(&g))
         }
-    })?;
-    Ok(write(py, &out, b))
+    })
 }
 
 /// `se3_Ad(g)`: the 6×6 matrix of the adjoint action on (ω, v) coordinates,
@@ -54,9 +50,9 @@ fn se3_log<'py>(py: Python<'py>, g: ArrayIn<'py>, strict: bool) -> PyResult<Out<
 #[pyfunction]
 #[pyo3(name = "se3_Ad")]
 fn se3_ad<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (ms, b) = read_mats::<4>("g", &g)?;
-    let out = par_map(py, &ms, b, |m| Ok(SE3::from_matrix4(m)?.adjoint_matrix()))?;
-    Ok(write(py, &out, b))
+    map_batch(py, "g", &g, |m: &Matrix4<f64>| {
+        Ok(SE3::from_matrix4(m)?.adjoint_matrix())
+    })
 }
 
 /// `se3_inverse(g)`: (R, t)⁻¹ = (Rᵀ, −Rᵀ t) as a 4×4 matrix.
@@ -65,11 +61,9 @@ fn se3_ad<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 fn se3_inverse<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (ms, b) = read_mats::<4>("g", &g)?;
-    let out = par_map(py, &ms, b, |m| {
+    map_batch(py, "g", &g, |m: &Matrix4<f64>| {
         Ok(SE3::from_matrix4(m)?.inverse().matrix4())
-    })?;
-    Ok(write(py, &out, b))
+    })
 }
 
 /// `se3_compose(g, h)`: the product g·h = (R_g R_h, R_g t_h + t_g) as a 4×4 matrix.
@@ -79,8 +73,8 @@ fn se3_inverse<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// Raises ShapeError (incl. batch lengths that differ), NonFiniteError, NotInGroupError.
 #[pyfunction]
 fn se3_compose<'py>(py: Python<'py>, g: ArrayIn<'py>, h: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (gs, bg) = read_mats::<4>("g", &g)?;
-    let (hs, bh) = read_mats::<4>("h", &h)?;
+    let (gs, bg) = read_items::<Matrix4<f64>>("g", &g)?;
+    let (hs, bh) = read_items::<Matrix4<f64>>("h", &h)?;
     let n = gs.len().max(hs.len());
     if bg && bh && gs.len() != hs.len() {
         return Err(to_py(Error::shape(
@@ -89,16 +83,12 @@ fn se3_compose<'py>(py: Python<'py>, g: ArrayIn<'py>, h: ArrayIn<'py>) -> PyResu
             format!("({}, 4, 4)", hs.len()),
         )));
     }
-    let pairs: Vec<(Matrix4<f64>, Matrix4<f64>)> = (0..n)
-        .map(|k| (gs[k.min(gs.len() - 1)], hs[k.min(hs.len() - 1)]))
-        .collect();
-    let b = bg || bh;
-    let out = par_map(py, &pairs, b, |(g, h)| {
-        Ok(SE3::from_matrix4(g)?
-            .compose(&SE3::from_matrix4(h).map_err(|e| relabel(e, |w| format!("h ({w})")))?)
-            .matrix4())
-    })?;
-    Ok(write(py, &out, b))
+    par_fill(py, n, bg || bh, |k| {
+        let g = SE3::from_matrix4(&gs[k.min(gs.len() - 1)])?;
+        let h = SE3::from_matrix4(&hs[k.min(hs.len() - 1)])
+            .map_err(|e| relabel(e, |w| format!("h ({w})")))?;
+        Ok(g.compose(&h).matrix4())
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -4,7 +4,7 @@
 use lieflow::lie::so3::{self, SO3};
 use lieflow::lie::MatrixLieGroup;
 use lieflow::{check, Error};
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArrayDyn};
 use pyo3::prelude::*;
@@ -15,6 +15,38 @@ use crate::errors::to_py;
 
 /// A numpy array of floats whose shape depends on whether the input was batched.
 pub(super) type Out<'py> = Bound<'py, PyArrayDyn<f64>>;
+
+/// A fixed-size item of a batch (a k-vector or an r×c matrix), read from and written to
+/// numpy's row-major order.
+pub(super) trait Item: Sized {
+    /// Number of floats.
+    const LEN: usize;
+    /// The numpy shape of one item.
+    fn shape() -> Vec<usize>;
+    /// From `LEN` row-major floats.
+    fn load(s: &[f64]) -> Self;
+    /// Into `LEN` row-major floats.
+    fn store(&self, out: &mut [f64]);
+}
+
+impl<const R: usize, const C: usize> Item for SMatrix<f64, R, C> {
+    const LEN: usize = R * C;
+    fn shape() -> Vec<usize> {
+        if C == 1 {
+            vec![R]
+        } else {
+            vec![R, C]
+        }
+    }
+    fn load(s: &[f64]) -> Self {
+        SMatrix::from_row_slice(s)
+    }
+    fn store(&self, out: &mut [f64]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self[(k / C, k % C)];
+        }
+    }
+}
 
 fn shape_str(s: &[usize]) -> String {
     match s {
@@ -29,79 +61,37 @@ fn shape_str(s: &[usize]) -> String {
     }
 }
 
-/// Reads an array of shape `item` or (b, *item) into row-major items of length ∏ item, checking
-/// finiteness (the location of a non-finite entry is its flat index). Returns the flat data and
-/// whether the input was batched.
-fn read(what: &str, a: &ArrayIn<'_>, item: &[usize]) -> PyResult<(Vec<f64>, bool)> {
+/// Reads an array of shape `item` or (b, *item) into flat row-major data, checking finiteness
+/// (the location of a non-finite entry is its flat index). Returns the data and whether the
+/// input was batched.
+fn read<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, bool)> {
+    let item = A::shape();
     let v = a.as_array();
     let s = v.shape();
     let batched = if s == item {
         false
-    } else if s.len() == item.len() + 1 && &s[1..] == item {
+    } else if s.len() == item.len() + 1 && s[1..] == item[..] {
         true
     } else {
         let inner: Vec<String> = item.iter().map(|d| d.to_string()).collect();
         return Err(to_py(Error::shape(
             what,
-            format!("{} or a batch (b, {})", shape_str(item), inner.join(", ")),
+            format!("{} or a batch (b, {})", shape_str(&item), inner.join(", ")),
             shape_str(s),
         )));
     };
-    let data: Vec<f64> = v.iter().copied().collect();
+    let data: Vec<f64> = match v.as_slice() {
+        Some(c) => c.to_vec(),
+        None => v.iter().copied().collect(),
+    };
     check::finite_slice(what, &data).map_err(to_py)?;
     Ok((data, batched))
 }
 
-/// (k,) or (b, k) → k-vectors.
-pub(super) fn read_vecs<const K: usize>(
-    what: &str,
-    a: &ArrayIn<'_>,
-) -> PyResult<(Vec<SVector<f64, K>>, bool)> {
-    let (data, batched) = read(what, a, &[K])?;
-    Ok((
-        data.chunks_exact(K)
-            .map(SVector::from_column_slice)
-            .collect(),
-        batched,
-    ))
-}
-
-/// (k, k) or (b, k, k) → k×k matrices (numpy's row-major order read into nalgebra matrices).
-pub(super) fn read_mats<const K: usize>(
-    what: &str,
-    a: &ArrayIn<'_>,
-) -> PyResult<(Vec<SMatrix<f64, K, K>>, bool)> {
-    let (data, batched) = read(what, a, &[K, K])?;
-    Ok((
-        data.chunks_exact(K * K)
-            .map(SMatrix::from_row_slice)
-            .collect(),
-        batched,
-    ))
-}
-
-/// Items → numpy array of shape `item` (one) or (b, *item) (batch); matrices are written in
-/// numpy's row-major order.
-pub(super) fn write<'py, const R: usize, const C: usize>(
-    py: Python<'py>,
-    items: &[SMatrix<f64, R, C>],
-    batched: bool,
-) -> Out<'py> {
-    let mut shape = Vec::with_capacity(3);
-    if batched {
-        shape.push(items.len());
-    }
-    shape.push(R);
-    if C > 1 {
-        shape.push(C);
-    }
-    let data: Vec<f64> = items
-        .iter()
-        .flat_map(|m| m.transpose().as_slice().to_vec())
-        .collect();
-    ArrayD::from_shape_vec(IxDyn(&shape), data)
-        .expect("shape and data length agree by construction")
-        .into_pyarray(py)
+/// (…item) or (b, …item) → the items.
+pub(super) fn read_items<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<A>, bool)> {
+    let (data, batched) = read::<A>(what, a)?;
+    Ok((data.chunks_exact(A::LEN).map(A::load).collect(), batched))
 }
 
 /// Renames the argument of an error (`what` ↦ `f(what)`), e.g. to add a batch index.
@@ -137,20 +127,26 @@ pub(super) fn relabel(e: Error, f: impl Fn(&str) -> String) -> Error {
     }
 }
 
-/// Maps `f` over `xs` in parallel with the GIL released; the first error (with its batch index
-/// when `batched`) becomes the Python exception.
-pub(super) fn par_map<T, U, F>(py: Python<'_>, xs: &[T], batched: bool, f: F) -> PyResult<Vec<U>>
+/// Fills a new array of `n` items `f(0), …, f(n − 1)` (shape `B::shape()` when not `batched`)
+/// in parallel with the GIL released, writing straight into the buffer that becomes the numpy
+/// array. The first error (with its batch index when `batched`) becomes the Python exception.
+pub(super) fn par_fill<'py, B, F>(
+    py: Python<'py>,
+    n: usize,
+    batched: bool,
+    f: F,
+) -> PyResult<Out<'py>>
 where
-    T: Sync,
-    U: Send,
-    F: Fn(&T) -> lieflow::Result<U> + Sync + Send,
+    B: Item,
+    F: Fn(usize) -> lieflow::Result<B> + Sync + Send,
 {
+    let mut data = vec![0.0; n * B::LEN];
     py.detach(|| {
-        xs.par_iter()
+        data.par_chunks_mut(B::LEN)
             .with_min_len(256)
             .enumerate()
-            .map(|(k, x)| {
-                f(x).map_err(|e| {
+            .try_for_each(|(k, out)| {
+                f(k).map(|b| b.store(out)).map_err(|e| {
                     if batched {
                         relabel(e, |w| format!("{w}[{k}]"))
                     } else {
@@ -158,9 +154,34 @@ where
                     }
                 })
             })
-            .collect::<lieflow::Result<Vec<U>>>()
     })
-    .map_err(to_py)
+    .map_err(to_py)?;
+    let mut shape = B::shape();
+    if batched {
+        shape.insert(0, n);
+    }
+    Ok(ArrayD::from_shape_vec(IxDyn(&shape), data)
+        .expect("n · B::LEN floats fill the shape (b, …B::shape())")
+        .into_pyarray(py))
+}
+
+/// Applies `f` to every item of a (…A) or (b, …A) array: the batched bindings in one call.
+pub(super) fn map_batch<'py, A, B, F>(
+    py: Python<'py>,
+    what: &str,
+    x: &ArrayIn<'py>,
+    f: F,
+) -> PyResult<Out<'py>>
+where
+    A: Item,
+    B: Item,
+    F: Fn(&A) -> lieflow::Result<B> + Sync + Send,
+{
+    let (data, batched) = read::<A>(what, x)?;
+    let n = data.len() / A::LEN;
+    par_fill(py, n, batched, |k| {
+        f(&A::load(&data[k * A::LEN..(k + 1) * A::LEN]))
+    })
 }
 
 /// `hat(w)`: the skew matrix ŵ with ŵ x = w × x (physics convention, 000 §3.3 corrected):
@@ -170,9 +191,7 @@ where
 /// Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (ws, b) = read_vecs::<3>("w", &w)?;
-    let out = par_map(py, &ws, b, |w| Ok(so3::hat(w)))?;
-    Ok(write(py, &out, b))
+    map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::hat(w)))
 }
 
 /// `vee(xi)`: the inverse of `hat`, w with ŵ = xi.
@@ -182,9 +201,7 @@ fn hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// ‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F) > 1e-10).
 #[pyfunction]
 fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (ms, b) = read_mats::<3>("xi", &xi)?;
-    let out = par_map(py, &ms, b, so3::try_vee)?;
-    Ok(write(py, &out, b))
+    map_batch(py, "xi", &xi, so3::try_vee)
 }
 
 /// `so3_exp(w)`: the rotation exp(ŵ) by Rodrigues' formula
@@ -193,9 +210,7 @@ fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (ws, b) = read_vecs::<3>("w", &w)?;
-    let out = par_map(py, &ws, b, |w| Ok(so3::exp(w)))?;
-    Ok(write(py, &out, b))
+    map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::exp(w)))
 }
 
 /// `so3_log(r, strict=False)`: the principal logarithm w (|w| = θ ∈ [0, π], exp(ŵ) = R),
@@ -211,16 +226,14 @@ fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 #[pyfunction]
 #[pyo3(signature = (r, strict = false))]
 fn so3_log<'py>(py: Python<'py>, r: ArrayIn<'py>, strict: bool) -> PyResult<Out<'py>> {
-    let (ms, b) = read_mats::<3>("R", &r)?;
-    let out = par_map(py, &ms, b, |m| {
+    map_batch(py, "R", &r, |m: &Matrix3<f64>| {
         let g = SO3::new(*m)?;
         if strict {
             g.log()
         } else {
             Ok(so3::log(m))
         }
-    })?;
-    Ok(write(py, &out, b))
+    })
 }
 
 /// `so3_cayley(w)`: the Cayley map cay(w) = (I − ŵ/2)⁻¹ (I + ŵ/2) = I + 4/(4 + |w|²)(ŵ + ŵ²/2),
@@ -229,9 +242,7 @@ fn so3_log<'py>(py: Python<'py>, r: ArrayIn<'py>, strict: bool) -> PyResult<Out<
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn so3_cayley<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (ws, b) = read_vecs::<3>("w", &w)?;
-    let out = par_map(py, &ws, b, |w| Ok(so3::cayley(w)))?;
-    Ok(write(py, &out, b))
+    map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::cayley(w)))
 }
 
 /// `so3_cayley_inv(r)`: the inverse Cayley map, w = 2·vee(R − Rᵀ)/(1 + tr R).
@@ -241,9 +252,9 @@ fn so3_cayley<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// 1 + tr R ≤ 1e-12, where R + I is singular).
 #[pyfunction]
 fn so3_cayley_inv<'py>(py: Python<'py>, r: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (ms, b) = read_mats::<3>("R", &r)?;
-    let out = par_map(py, &ms, b, |m| so3::cayley_inv(SO3::new(*m)?.matrix3()))?;
-    Ok(write(py, &out, b))
+    map_batch(py, "R", &r, |m: &Matrix3<f64>| {
+        so3::cayley_inv(SO3::new(*m)?.matrix3())
+    })
 }
 
 /// Shared body of the two Jacobian bindings: J(w), or J⁻¹(w) when `inverse`.
@@ -254,13 +265,11 @@ fn jacobian<'py>(
     forward: fn(&Vector3<f64>) -> Matrix3<f64>,
     backward: fn(&Vector3<f64>) -> lieflow::Result<Matrix3<f64>>,
 ) -> PyResult<Out<'py>> {
-    let (ws, b) = read_vecs::<3>("w", w)?;
-    let out = if inverse {
-        par_map(py, &ws, b, backward)?
+    if inverse {
+        map_batch(py, "w", w, backward)
     } else {
-        par_map(py, &ws, b, |w| Ok(forward(w)))?
-    };
-    Ok(write(py, &out, b))
+        map_batch(py, "w", w, |w: &Vector3<f64>| Ok(forward(w)))
+    }
 }
 
 /// `so3_jacobian_right(w, inverse=False)`: the right Jacobian
