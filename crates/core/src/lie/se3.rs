@@ -52,10 +52,8 @@ pub fn hat(xi: &Vector6<f64>) -> Matrix4<f64> {
 /// ((θ − sin θ)/θ³) ω̂² = J_l(ω) ([`so3::jacobian_left`]), stable near θ = 0 by series.
 pub fn exp(xi: &Vector6<f64>) -> SE3 {
     let (w, v) = split(xi);
-    SE3 {
-        rot: so3::exp(&w),
-        trans: so3::jacobian_left(&w) * v,
-    }
+    let (rot, jl) = so3::exp_and_jacobian_left(&w);
+    SE3 { rot, trans: jl * v }
 }
 
 /// Logarithm: ω = [`so3::log`] of R (θ ∈ [0, π]; at θ = π one of the two, as documented there) and

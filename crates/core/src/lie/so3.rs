@@ -146,6 +146,17 @@ pub fn exp(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::identity() + hat(w) * k.a + hat_sq(w, k.t2) * k.b
 }
 
+/// exp(ŵ) and J_l(w) together from one `sin_cos` (the SE(3) exponential needs both).
+#[inline]
+pub(crate) fn exp_and_jacobian_left(w: &Vector3<f64>) -> (Matrix3<f64>, Matrix3<f64>) {
+    let k = Coeffs::new(w);
+    let (h, h2) = (hat(w), hat_sq(w, k.t2));
+    (
+        Matrix3::identity() + h * k.a + h2 * k.b,
+        Matrix3::identity() + h * k.b + h2 * k.c,
+    )
+}
+
 /// Rotation angle θ ∈ [0, π] of R, cos θ = (tr R − 1)/2, and s = vee((R − Rᵀ)/2) = sin θ · axis.
 /// θ comes from whichever of cos θ, sin θ = |s| is well conditioned: acos where |cos θ| ≤ ½,
 /// asin elsewhere (as accurate as atan2, and about twice as fast).
