@@ -262,3 +262,13 @@ def test_batch_error_names_the_element():
 def test_large_batch_runs_in_parallel_and_matches_scipy():
     ws = rng.normal(size=(20_000, 3))
     assert np.allclose(lie.so3_exp(ws), Rotation.from_rotvec(ws).as_matrix(), atol=1e-14)
+
+
+def test_non_contiguous_and_empty_batches():
+    ws = rng.normal(size=(6, 6))[:, ::2]  # strided view, shape (6, 3)
+    assert np.array_equal(lie.so3_exp(ws), lie.so3_exp(np.ascontiguousarray(ws)))
+    rs = lie.so3_exp(ws)
+    assert np.array_equal(lie.so3_log(np.asfortranarray(rs)), lie.so3_log(rs))
+    assert np.array_equal(lie.hat(np.asfortranarray(ws)), lie.hat(ws))
+    assert lie.so3_exp(np.zeros((0, 3))).shape == (0, 3, 3)
+    assert lie.se3_log(np.zeros((0, 4, 4))).shape == (0, 6)
