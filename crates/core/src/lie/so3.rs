@@ -1,10 +1,25 @@
 //! Fixed-size SO(3) and so(3) ≅ R³ on nalgebra types: the fast path of rigid-body loops.
 //!
 //! Physics hat map (000 §3.3, corrected): hat(w) x = w × x and [hat u, hat v] = hat(u × v).
+//! (The seed prints the first row of ŵ as (0, −ω₁, ω₂); the isomorphism property it proves needs
+//! (0, −ω₃, ω₂), which is what [`hat`] uses and what the tests check.)
+//!
+//! The free functions ([`exp`], [`log`], [`cayley`], the Jacobians, …) work on `Vector3`/`Matrix3`
+//! without checks or allocation, for inner loops. [`SO3`] is the validated rotation type that
+//! implements [`MatrixLieGroup`] (algebra R³, pairing the dot product, ad_u v = u × v).
+//!
+//! Relation to the general so(n) coordinates of [`crate::lie::so`] (basis e_ij, i < j, in the
+//! order (1,2), (1,3), (2,3)): hat(w) has e_ij coordinates c = (−w₃, w₂, −w₁) ([`to_eij`],
+//! [`from_eij`]); the map is an isometry (both pairings are the dot product of the coordinates).
 
 use nalgebra::{Matrix3, Vector3};
 
-/// hat(w) = [[0, −w3, w2], [w3, 0, −w1], [−w2, w1, 0]], so hat(w) x = w × x.
+use crate::check;
+use crate::error::{Error, Result};
+use crate::lie::{so, MatrixLieGroup};
+use crate::Mat;
+
+/// hat(w) = [[0, −w3, w2], [w3, 0, −w1], [−w2, w1, 0]], so hat(w) x = w × x (000 §3.3, corrected).
 #[inline]
 pub fn hat(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
@@ -20,23 +35,451 @@ pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
     )
 }
 
-/// Rodrigues' formula exp(hat w) = I + sinθ/θ hat w + (1 − cosθ)/θ² hat² w, θ = |w|, with Taylor
-/// coefficients for small θ.
+/// [`vee`] with checks: `m` finite and skew to [`so::SKEW_TOL`] (relative defect
+/// ‖m + mᵀ‖_F / max(1, ‖m‖_F)), else [`Error::NonFinite`] / [`Error::NotInGroup`].
+pub fn try_vee(m: &Matrix3<f64>) -> Result<Vector3<f64>> {
+    check::finite_slice("xi", m.as_slice())?;
+    let defect = (m + m.transpose()).norm() / m.norm().max(1.0);
+    if defect > so::SKEW_TOL {
+        return Err(Error::NotInGroup {
+            what: "xi".into(),
+            group: "so(3)".into(),
+            defect_name: "‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F)".into(),
+            defect,
+            tol: so::SKEW_TOL,
+        });
+    }
+    Ok(vee(m))
+}
+
+/// The e_ij coordinates (DESIGN.md, order (1,2), (1,3), (2,3)) of hat(w): c = (−w₃, w₂, −w₁),
+/// so that `so::hat_n(&to_eij(w)) == hat(w)`.
+#[inline]
+pub fn to_eij(w: &Vector3<f64>) -> [f64; 3] {
+    [-w.z, w.y, -w.x]
+}
+
+/// Inverse of [`to_eij`]: w = (−c₃, c₂, −c₁).
+#[inline]
+pub fn from_eij(c: &[f64; 3]) -> Vector3<f64> {
+    Vector3::new(-c[2], c[1], -c[0])
+}
+
+/// Below this θ² the trigonometric coefficients are evaluated by their Taylor series (truncation
+/// error O(θ⁸) < 1e-21 relative; the closed forms would lose up to ~1e-16/θ² there).
+const SERIES_T2: f64 = 1e-4;
+
+/// The coefficients of Rodrigues' formula and of the Jacobians at θ = |w|, from one `sin_cos` of
+/// θ/2 (so 1 − cos θ = 2 sin²(θ/2) has no cancellation).
+#[derive(Clone, Copy, Debug)]
+struct Coeffs {
+    /// θ² = |w|².
+    t2: f64,
+    /// sin θ / θ.
+    a: f64,
+    /// (1 − cos θ) / θ².
+    b: f64,
+    /// (θ − sin θ) / θ³.
+    c: f64,
+    /// sin(θ/2), cos(θ/2) (zero and one in the series branch).
+    half: (f64, f64),
+}
+
+impl Coeffs {
+    #[inline]
+    fn new(w: &Vector3<f64>) -> Self {
+        let t2 = w.norm_squared();
+        if t2 < SERIES_T2 {
+            Coeffs {
+                t2,
+                a: 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0)),
+                b: 0.5 - t2 / 24.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0)),
+                c: 1.0 / 6.0 - t2 / 120.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0)),
+                half: (0.0, 1.0),
+            }
+        } else {
+            let t = t2.sqrt();
+            let (sh, ch) = (0.5 * t).sin_cos();
+            let s = 2.0 * sh * ch;
+            Coeffs {
+                t2,
+                a: s / t,
+                b: 2.0 * sh * sh / t2,
+                c: (t - s) / (t2 * t),
+                half: (sh, ch),
+            }
+        }
+    }
+
+    /// Whether J_l, J_r are singular: θ = 2πk, k ≥ 1, to [`JACOBIAN_INV_TOL`] in sin(θ/2).
+    #[inline]
+    fn singular(&self) -> bool {
+        self.t2 >= SERIES_T2 && self.half.0.abs() < JACOBIAN_INV_TOL
+    }
+
+    /// The coefficient γ(θ) = 1/θ² − (1 + cos θ)/(2θ sin θ) = 1/θ² − cot(θ/2)/(2θ) of ŵ² in
+    /// J⁻¹ (unbounded where [`Coeffs::singular`]).
+    #[inline]
+    fn gamma(&self) -> f64 {
+        let t2 = self.t2;
+        if t2 < SERIES_T2 {
+            // cot x = 1/x − x/3 − x³/45 − 2x⁵/945 − …, x = θ/2.
+            return 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0;
+        }
+        let (sh, ch) = self.half;
+        1.0 / t2 - ch / (2.0 * t2.sqrt() * sh)
+    }
+}
+
+/// ŵ² = w wᵀ − |w|² I, without a matrix product.
+#[inline]
+fn hat_sq(w: &Vector3<f64>, t2: f64) -> Matrix3<f64> {
+    w * w.transpose() - Matrix3::from_diagonal_element(t2)
+}
+
+/// Rodrigues' formula exp(ŵ) = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = |w| (from
+/// ŵ³ = −θ² ŵ; checked against an independent matrix exponential in the tests), with Taylor
+/// coefficients for θ < 1e-2. One `sin_cos`, no allocation; orthogonal to ~1e-15 for θ up to
+/// 1e3 and beyond.
 #[inline]
 pub fn exp(w: &Vector3<f64>) -> Matrix3<f64> {
-    let t2 = w.norm_squared();
-    let (a, b) = if t2 < 1e-8 {
-        (
-            1.0 - t2 / 6.0 * (1.0 - t2 / 20.0),
-            0.5 - t2 / 24.0 * (1.0 - t2 / 30.0),
-        )
+    let k = Coeffs::new(w);
+    Matrix3::identity() + hat(w) * k.a + hat_sq(w, k.t2) * k.b
+}
+
+/// exp(ŵ) and J_l(w) together from one `sin_cos` (the SE(3) exponential needs both).
+#[inline]
+pub(crate) fn exp_and_jacobian_left(w: &Vector3<f64>) -> (Matrix3<f64>, Matrix3<f64>) {
+    let k = Coeffs::new(w);
+    let (h, h2) = (hat(w), hat_sq(w, k.t2));
+    (
+        Matrix3::identity() + h * k.a + h2 * k.b,
+        Matrix3::identity() + h * k.b + h2 * k.c,
+    )
+}
+
+/// Rotation angle θ ∈ [0, π] of R, cos θ = (tr R − 1)/2, and s = vee((R − Rᵀ)/2) = sin θ · axis.
+/// θ comes from whichever of cos θ, sin θ = |s| is well conditioned: acos where |cos θ| ≤ ½,
+/// asin elsewhere (as accurate as atan2, and about twice as fast).
+#[inline]
+fn angle_cos_sin(r: &Matrix3<f64>) -> (f64, f64, Vector3<f64>) {
+    let s = vee(r);
+    let c = 0.5 * (r.trace() - 1.0);
+    let n = s.norm().min(1.0);
+    let theta = if c.abs() <= 0.5 {
+        c.acos()
+    } else if c > 0.0 {
+        n.asin()
     } else {
-        let t = t2.sqrt();
-        let (s, c) = t.sin_cos();
-        (s / t, (1.0 - c) / t2)
+        std::f64::consts::PI - n.asin()
     };
-    let k = hat(w);
-    Matrix3::identity() + k * a + k * k * b
+    (theta, c, s)
+}
+
+/// Principal logarithm of a rotation: the w with |w| = θ ∈ [0, π] and exp(ŵ) = R.
+///
+/// θ from cos θ = (tr R − 1)/2 and sin θ = |s| with s = vee((R − Rᵀ)/2) = sin θ · a. For cos θ > 0 the
+/// result is (θ / sin θ) s (series near 0). For cos θ ≤ 0 (so near π, where s carries no
+/// precision) the axis comes from the symmetric part (R + Rᵀ)/2 − cos θ I = (1 − cos θ) a aᵀ:
+/// its column with the largest diagonal entry, normalized, with the sign of s.
+///
+/// Exactly at θ = π (s = 0) both ±π a are logarithms; this function returns the one whose
+/// component at the largest diagonal entry of R is positive. [`SO3::log`] refuses angles within
+/// [`LOG_PI_TOL`] of π instead. No checks: `r` is assumed to be a rotation (use [`SO3::new`]).
+pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
+    let (theta, c, s) = angle_cos_sin(r);
+    if c > 0.0 {
+        let t2 = theta * theta;
+        let f = if t2 < SERIES_T2 {
+            // θ / sin θ = 1 + θ²/6 + 7θ⁴/360 + 31θ⁶/15120 + …
+            1.0 + t2 / 6.0 + 7.0 * t2 * t2 / 360.0 + 31.0 * t2 * t2 * t2 / 15120.0
+        } else {
+            theta / s.norm()
+        };
+        return s * f;
+    }
+    // Column i of (R + Rᵀ)/2 − cos θ I, i the largest diagonal entry (≥ (1 − cos θ)/3).
+    let i = if r[(0, 0)] >= r[(1, 1)] && r[(0, 0)] >= r[(2, 2)] {
+        0
+    } else if r[(1, 1)] >= r[(2, 2)] {
+        1
+    } else {
+        2
+    };
+    let mut axis = Vector3::from_fn(|j, _| {
+        if j == i {
+            r[(i, i)] - c
+        } else {
+            0.5 * (r[(j, i)] + r[(i, j)])
+        }
+    });
+    axis /= axis.norm();
+    if axis.dot(&s) < 0.0 {
+        axis = -axis;
+    }
+    axis * theta
+}
+
+/// [`SO3::log`] refuses rotations whose angle θ has π − θ ≤ `LOG_PI_TOL`: there the two
+/// candidate logarithms ±θ a are 2θ apart while a rounding-level change of R (~1e-16 per entry,
+/// which moves θ by about as much) decides between them. The free [`log`] always returns one.
+pub const LOG_PI_TOL: f64 = 1e-12;
+
+/// Tolerance on ‖RᵀR − I‖_F and |det R − 1| for accepting a matrix as a rotation.
+pub const ROTATION_TOL: f64 = 1e-10;
+
+/// The defects (‖RᵀR − I‖_F, det R) of a candidate rotation.
+#[inline]
+pub fn rotation_defect(r: &Matrix3<f64>) -> (f64, f64) {
+    (
+        (r.transpose() * r - Matrix3::identity()).norm(),
+        r.determinant(),
+    )
+}
+
+/// Whether `r` is finite, with ‖RᵀR − I‖_F ≤ `tol` and |det R − 1| ≤ `tol`.
+pub fn is_rotation(r: &Matrix3<f64>, tol: f64) -> bool {
+    let (o, d) = rotation_defect(r);
+    o <= tol && (d - 1.0).abs() <= tol
+}
+
+/// The rotation nearest to `m` in the Frobenius norm (polar factor, by nalgebra's SVD):
+/// m = U Σ Vᵀ ↦ U diag(1, 1, det(U Vᵀ)) Vᵀ. Unique when rank m ≥ 2 and, if det m < 0, σ₂ > σ₃.
+/// Errors on non-finite input.
+pub fn project(m: &Matrix3<f64>) -> Result<Matrix3<f64>> {
+    check::finite_slice("M", m.as_slice())?;
+    let svd = m.svd(true, true);
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return Err(Error::NotConverged {
+            what: "SVD of M".into(),
+            iterations: 0,
+            residual: f64::NAN,
+            tol: 0.0,
+        });
+    };
+    let mut d = Matrix3::identity();
+    d[(2, 2)] = (u * vt).determinant().signum();
+    Ok(u * d * vt)
+}
+
+/// Cayley map cay(w) = (I − ŵ/2)⁻¹ (I + ŵ/2) = I + 4/(4 + |w|²) (ŵ + ŵ²/2).
+///
+/// Scaling: the ½ makes cay agree with exp to second order (cay(w) = exp(ŵ) + O(|w|³)); cay(w)
+/// is the rotation about w/|w| by the angle 2 atan(|w|/2) (eigenvalue (2 + iθ)/(2 − iθ)).
+#[inline]
+pub fn cayley(w: &Vector3<f64>) -> Matrix3<f64> {
+    let t2 = w.norm_squared();
+    let f = 4.0 / (4.0 + t2);
+    Matrix3::identity() + (hat(w) + hat_sq(w, t2) * 0.5) * f
+}
+
+/// [`cayley_inv`] errors when 1 + tr R ≤ `CAYLEY_INV_TOL` (a rotation by π, where R + I is
+/// singular and cay⁻¹ is undefined).
+pub const CAYLEY_INV_TOL: f64 = 1e-12;
+
+/// Inverse Cayley map: ŵ = 2 (R + I)⁻¹ (R − I), in closed form w = 2 vee(R − Rᵀ) / (1 + tr R)
+/// (from tr cay(w) = 3 − 4|w|²/(4 + |w|²), i.e. 1 + tr R = 16/(4 + |w|²), and
+/// R − Rᵀ = 8/(4 + |w|²) ŵ). Error [`Error::InvalidArgument`] when 1 + tr R ≤ [`CAYLEY_INV_TOL`].
+#[inline]
+pub fn cayley_inv(r: &Matrix3<f64>) -> Result<Vector3<f64>> {
+    let d = 1.0 + r.trace();
+    if d.is_nan() || d <= CAYLEY_INV_TOL {
+        return Err(Error::invalid(
+            "R",
+            format!(
+                "the inverse Cayley map needs R + I invertible (rotation angle < π): \
+                 1 + tr R = {d:.3e} ≤ {CAYLEY_INV_TOL:.0e}"
+            ),
+        ));
+    }
+    Ok(vee(r) * (4.0 / d))
+}
+
+/// Right Jacobian of exp (the right-trivialized differential):
+/// J_r(w) = I − ((1 − cos θ)/θ²) ŵ + ((θ − sin θ)/θ³) ŵ², so that
+/// exp(w + δ) = exp(w) exp(J_r(w) δ) + O(|δ|²). Standard closed form (not in the seeds; e.g.
+/// Solà, Deray, Atchuthan, "A micro Lie theory for state estimation in robotics", 2018, SO(3)
+/// appendix); checked against central differences of [`exp`] in the tests.
+#[inline]
+pub fn jacobian_right(w: &Vector3<f64>) -> Matrix3<f64> {
+    let k = Coeffs::new(w);
+    Matrix3::identity() - hat(w) * k.b + hat_sq(w, k.t2) * k.c
+}
+
+/// Left Jacobian of exp (the left-trivialized differential, dexp_w):
+/// J_l(w) = I + ((1 − cos θ)/θ²) ŵ + ((θ − sin θ)/θ³) ŵ² = J_r(−w) = J_r(w)ᵀ = exp(ŵ) J_r(w),
+/// so that exp(w + δ) = exp(J_l(w) δ) exp(w) + O(|δ|²). It is also the V matrix of the SE(3)
+/// exponential ([`crate::lie::se3::exp`]).
+#[inline]
+pub fn jacobian_left(w: &Vector3<f64>) -> Matrix3<f64> {
+    let k = Coeffs::new(w);
+    Matrix3::identity() + hat(w) * k.b + hat_sq(w, k.t2) * k.c
+}
+
+/// J_r⁻¹ and J_l⁻¹ are singular where sin(θ/2) = 0, θ = 2πk (k ≥ 1); they error when
+/// |sin(θ/2)| < `JACOBIAN_INV_TOL` there.
+pub const JACOBIAN_INV_TOL: f64 = 1e-12;
+
+/// I + (σ/2) ŵ + γ(θ) ŵ²: J_r⁻¹ for σ = 1, J_l⁻¹ for σ = −1.
+#[inline]
+fn jacobian_inv(w: &Vector3<f64>, k: &Coeffs, sigma: f64) -> Matrix3<f64> {
+    Matrix3::identity() + hat(w) * (0.5 * sigma) + hat_sq(w, k.t2) * k.gamma()
+}
+
+fn checked_jacobian_inv(w: &Vector3<f64>, sigma: f64) -> Result<Matrix3<f64>> {
+    let k = Coeffs::new(w);
+    if k.singular() {
+        return Err(Error::invalid(
+            "w",
+            format!(
+                "the so(3) Jacobian is singular at |w| = 2πk (k ≥ 1); |w| = {:.15}",
+                w.norm()
+            ),
+        ));
+    }
+    Ok(jacobian_inv(w, &k, sigma))
+}
+
+/// J_r⁻¹(w) = I + ½ ŵ + γ(θ) ŵ², γ = 1/θ² − (1 + cos θ)/(2θ sin θ) (series 1/12 + θ²/720 +
+/// θ⁴/30240 near 0). Error [`Error::InvalidArgument`] at θ = 2πk, k ≥ 1 (see
+/// [`JACOBIAN_INV_TOL`]).
+#[inline]
+pub fn jacobian_right_inv(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+    checked_jacobian_inv(w, 1.0)
+}
+
+/// J_l⁻¹(w) = I − ½ ŵ + γ(θ) ŵ² = J_r⁻¹(w)ᵀ (γ and errors as in [`jacobian_right_inv`]).
+#[inline]
+pub fn jacobian_left_inv(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+    checked_jacobian_inv(w, -1.0)
+}
+
+/// J_l⁻¹(w) without the singularity check, for |w| ≤ π (outputs of [`log`]), where
+/// sin(θ/2) ≥ sin(θ/2)|_{θ=10⁻²} and γ is regular.
+#[inline]
+pub(crate) fn jacobian_left_inv_principal(w: &Vector3<f64>) -> Matrix3<f64> {
+    jacobian_inv(w, &Coeffs::new(w), -1.0)
+}
+
+/// A rotation: a 3×3 matrix R with RᵀR = I and det R = 1 (to [`ROTATION_TOL`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SO3(Matrix3<f64>);
+
+impl SO3 {
+    /// Validates `r`: finite ([`Error::NonFinite`]), ‖RᵀR − I‖_F ≤ [`ROTATION_TOL`] and
+    /// |det R − 1| ≤ [`ROTATION_TOL`] ([`Error::NotInGroup`] with the measured defect).
+    pub fn new(r: Matrix3<f64>) -> Result<Self> {
+        check::finite_slice("R", r.as_slice())?;
+        let (o, d) = rotation_defect(&r);
+        let not_in = |defect_name: &str, defect: f64| Error::NotInGroup {
+            what: "R".into(),
+            group: "SO(3)".into(),
+            defect_name: defect_name.into(),
+            defect,
+            tol: ROTATION_TOL,
+        };
+        if o > ROTATION_TOL {
+            return Err(not_in("‖RᵀR − I‖_F", o));
+        }
+        if (d - 1.0).abs() > ROTATION_TOL {
+            return Err(not_in("|det R − 1|", (d - 1.0).abs()));
+        }
+        Ok(SO3(r))
+    }
+
+    /// Wraps `r` without checks (for matrices known to be rotations, e.g. outputs of [`exp`]).
+    #[inline]
+    pub fn new_unchecked(r: Matrix3<f64>) -> Self {
+        SO3(r)
+    }
+
+    /// The rotation matrix.
+    #[inline]
+    pub fn matrix3(&self) -> &Matrix3<f64> {
+        &self.0
+    }
+
+    /// The rotation angle θ ∈ [0, π].
+    pub fn angle(&self) -> f64 {
+        angle_cos_sin(&self.0).0
+    }
+}
+
+impl MatrixLieGroup for SO3 {
+    type Algebra = Vector3<f64>;
+
+    fn dim(&self) -> usize {
+        3
+    }
+
+    fn identity_like(&self) -> Self {
+        SO3(Matrix3::identity())
+    }
+
+    fn compose(&self, other: &Self) -> Self {
+        SO3(self.0 * other.0)
+    }
+
+    /// R⁻¹ = Rᵀ.
+    fn inverse(&self) -> Self {
+        SO3(self.0.transpose())
+    }
+
+    /// Rodrigues' formula, [`exp`].
+    fn exp(xi: &Vector3<f64>) -> Self {
+        SO3(exp(xi))
+    }
+
+    /// [`log`], with [`Error::NoUniqueLog`] when π − θ ≤ [`LOG_PI_TOL`].
+    fn log(&self) -> Result<Vector3<f64>> {
+        let theta = self.angle();
+        let distance = std::f64::consts::PI - theta;
+        if distance <= LOG_PI_TOL {
+            return Err(Error::NoUniqueLog {
+                what: "R".into(),
+                angle: theta,
+                distance,
+            });
+        }
+        Ok(log(&self.0))
+    }
+
+    /// Ad_R w = R w (R ŵ Rᵀ = (R w)^).
+    fn adjoint(&self, xi: &Vector3<f64>) -> Vector3<f64> {
+        self.0 * xi
+    }
+
+    /// ad_u v = u × v ([û, v̂] = (u × v)^).
+    fn ad(xi: &Vector3<f64>, eta: &Vector3<f64>) -> Vector3<f64> {
+        xi.cross(eta)
+    }
+
+    /// ad*_ξ μ = μ × ξ: ⟨μ, ξ × η⟩ = ⟨μ × ξ, η⟩ (000 §3.3: ad*_Ω Π = [Π, Ω̂] ≅ Π × Ω).
+    fn ad_star(xi: &Vector3<f64>, mu: &Vector3<f64>) -> Vector3<f64> {
+        mu.cross(xi)
+    }
+
+    /// The dot product (= ½ tr(μ̂ᵀ ξ̂), the so(n) pairing of 001 (2.8)).
+    fn pairing(mu: &Vector3<f64>, xi: &Vector3<f64>) -> f64 {
+        mu.dot(xi)
+    }
+
+    fn matrix(&self) -> Mat {
+        Mat::from_fn(3, 3, |i, j| self.0[(i, j)])
+    }
+
+    fn algebra_matrix(xi: &Vector3<f64>) -> Mat {
+        let h = hat(xi);
+        Mat::from_fn(3, 3, |i, j| h[(i, j)])
+    }
+
+    fn coords(xi: &Vector3<f64>) -> Vec<f64> {
+        vec![xi.x, xi.y, xi.z]
+    }
+
+    fn algebra_from_coords(&self, c: &[f64]) -> Vector3<f64> {
+        Vector3::new(c[0], c[1], c[2])
+    }
 }
 
 #[cfg(test)]
@@ -58,5 +501,19 @@ mod tests {
         let w = Vector3::new(1e-6, -2e-6, 3e-7);
         let r = exp(&w);
         assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-15);
+    }
+
+    #[test]
+    fn series_and_closed_form_agree_at_the_switch() {
+        // Just below the switch the series is used; compare with the closed forms there.
+        let t = SERIES_T2.sqrt() * (1.0 - 1e-9);
+        let k = Coeffs::new(&Vector3::new(0.0, t, 0.0));
+        let (s, c) = t.sin_cos();
+        let h = 0.5 * t;
+        assert!((k.a - s / t).abs() < 1e-15);
+        assert!((k.b - 2.0 * h.sin().powi(2) / (t * t)).abs() < 1e-15);
+        assert!((k.c - (t - s) / t.powi(3)).abs() < 1e-10);
+        let gamma = 1.0 / (t * t) - (1.0 + c) / (2.0 * t * s);
+        assert!((k.gamma() - gamma).abs() < 1e-10);
     }
 }

@@ -1,15 +1,317 @@
-use numpy::PyArray2;
+//! Bindings of `lieflow::lie::so3`: the fixed-size SO(3)/so(3) fast path, batched over a leading
+//! axis (run in parallel with rayon, the GIL released). Also the batch helpers used by `se3.rs`.
+
+use lieflow::lie::so3::{self, SO3};
+use lieflow::lie::MatrixLieGroup;
+use lieflow::{check, Error};
+use nalgebra::{Matrix3, SMatrix, Vector3};
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArrayDyn};
 use pyo3::prelude::*;
+use rayon::prelude::*;
 
-use crate::convert::{py_mat3, vec3, ArrayIn};
+use crate::convert::ArrayIn;
+use crate::errors::to_py;
 
-/// hat(w): the skew matrix with hat(w) x = w × x (physics convention).
+/// A numpy array of floats whose shape depends on whether the input was batched.
+pub(super) type Out<'py> = Bound<'py, PyArrayDyn<f64>>;
+
+/// A fixed-size item of a batch (a k-vector or an r×c matrix), read from and written to
+/// numpy's row-major order.
+pub(super) trait Item: Sized {
+    /// Number of floats.
+    const LEN: usize;
+    /// The numpy shape of one item.
+    fn shape() -> Vec<usize>;
+    /// From `LEN` row-major floats.
+    fn load(s: &[f64]) -> Self;
+    /// Into `LEN` row-major floats.
+    fn store(&self, out: &mut [f64]);
+}
+
+impl<const R: usize, const C: usize> Item for SMatrix<f64, R, C> {
+    const LEN: usize = R * C;
+    fn shape() -> Vec<usize> {
+        if C == 1 {
+            vec![R]
+        } else {
+            vec![R, C]
+        }
+    }
+    fn load(s: &[f64]) -> Self {
+        SMatrix::from_row_slice(s)
+    }
+    fn store(&self, out: &mut [f64]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self[(k / C, k % C)];
+        }
+    }
+}
+
+fn shape_str(s: &[usize]) -> String {
+    match s {
+        [d] => format!("({d},)"),
+        _ => format!(
+            "({})",
+            s.iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// Reads an array of shape `item` or (b, *item) into flat row-major data, checking finiteness
+/// (the location of a non-finite entry is its flat index). Returns the data and whether the
+/// input was batched.
+fn read<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, bool)> {
+    let item = A::shape();
+    let v = a.as_array();
+    let s = v.shape();
+    let batched = if s == item {
+        false
+    } else if s.len() == item.len() + 1 && s[1..] == item[..] {
+        true
+    } else {
+        let inner: Vec<String> = item.iter().map(|d| d.to_string()).collect();
+        return Err(to_py(Error::shape(
+            what,
+            format!("{} or a batch (b, {})", shape_str(&item), inner.join(", ")),
+            shape_str(s),
+        )));
+    };
+    let data: Vec<f64> = match v.as_slice() {
+        Some(c) => c.to_vec(),
+        None => v.iter().copied().collect(),
+    };
+    check::finite_slice(what, &data).map_err(to_py)?;
+    Ok((data, batched))
+}
+
+/// (…item) or (b, …item) → the items.
+pub(super) fn read_items<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<A>, bool)> {
+    let (data, batched) = read::<A>(what, a)?;
+    Ok((data.chunks_exact(A::LEN).map(A::load).collect(), batched))
+}
+
+/// Renames the argument of an error (`what` ↦ `f(what)`), e.g. to add a batch index.
+pub(super) fn relabel(e: Error, f: impl Fn(&str) -> String) -> Error {
+    match e {
+        Error::NotInGroup {
+            what,
+            group,
+            defect_name,
+            defect,
+            tol,
+        } => Error::NotInGroup {
+            what: f(&what),
+            group,
+            defect_name,
+            defect,
+            tol,
+        },
+        Error::NoUniqueLog {
+            what,
+            angle,
+            distance,
+        } => Error::NoUniqueLog {
+            what: f(&what),
+            angle,
+            distance,
+        },
+        Error::InvalidArgument { what, message } => Error::InvalidArgument {
+            what: f(&what),
+            message,
+        },
+        other => other,
+    }
+}
+
+/// Fills a new array of `n` items `f(0), …, f(n − 1)` (shape `B::shape()` when not `batched`)
+/// in parallel with the GIL released, writing straight into the buffer that becomes the numpy
+/// array. The first error (with its batch index when `batched`) becomes the Python exception.
+pub(super) fn par_fill<'py, B, F>(
+    py: Python<'py>,
+    n: usize,
+    batched: bool,
+    f: F,
+) -> PyResult<Out<'py>>
+where
+    B: Item,
+    F: Fn(usize) -> lieflow::Result<B> + Sync + Send,
+{
+    let mut data = vec![0.0; n * B::LEN];
+    py.detach(|| {
+        data.par_chunks_mut(B::LEN)
+            .with_min_len(256)
+            .enumerate()
+            .try_for_each(|(k, out)| {
+                f(k).map(|b| b.store(out)).map_err(|e| {
+                    if batched {
+                        relabel(e, |w| format!("{w}[{k}]"))
+                    } else {
+                        e
+                    }
+                })
+            })
+    })
+    .map_err(to_py)?;
+    let mut shape = B::shape();
+    if batched {
+        shape.insert(0, n);
+    }
+    Ok(ArrayD::from_shape_vec(IxDyn(&shape), data)
+        .expect("n · B::LEN floats fill the shape (b, …B::shape())")
+        .into_pyarray(py))
+}
+
+/// Applies `f` to every item of a (…A) or (b, …A) array: the batched bindings in one call.
+pub(super) fn map_batch<'py, A, B, F>(
+    py: Python<'py>,
+    what: &str,
+    x: &ArrayIn<'py>,
+    f: F,
+) -> PyResult<Out<'py>>
+where
+    A: Item,
+    B: Item,
+    F: Fn(&A) -> lieflow::Result<B> + Sync + Send,
+{
+    let (data, batched) = read::<A>(what, x)?;
+    let n = data.len() / A::LEN;
+    par_fill(py, n, batched, |k| {
+        f(&A::load(&data[k * A::LEN..(k + 1) * A::LEN]))
+    })
+}
+
+/// `hat(w)`: the skew matrix ŵ with ŵ x = w × x (physics convention, 000 §3.3 corrected):
+/// ŵ = [[0, −w3, w2], [w3, 0, −w1], [−w2, w1, 0]].
+///
+/// Args: w — shape (3,) or a batch (b, 3). Returns (3, 3) or (b, 3, 3).
+/// Raises ShapeError, NonFiniteError.
 #[pyfunction]
-fn hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    Ok(py_mat3(py, &lieflow::lie::so3::hat(&vec3("w", &w)?)))
+fn hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::hat(w)))
+}
+
+/// `vee(xi)`: the inverse of `hat`, w with ŵ = xi.
+///
+/// Args: xi — a skew-symmetric (3, 3) matrix or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Raises ShapeError, NonFiniteError, NotInGroupError (xi not skew: relative defect
+/// ‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F) > 1e-10).
+#[pyfunction]
+fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "xi", &xi, so3::try_vee)
+}
+
+/// `so3_exp(w)`: the rotation exp(ŵ) by Rodrigues' formula
+/// R = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = |w| (rotation by θ about w/θ).
+///
+/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
+#[pyfunction]
+fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::exp(w)))
+}
+
+/// `so3_log(r, strict=False)`: the principal logarithm w (|w| = θ ∈ [0, π], exp(ŵ) = R),
+/// accurate near θ = 0 and near θ = π (axis from the symmetric part of R there).
+///
+/// At θ = π exactly both ±π·axis are logarithms: with `strict=False` one of them is returned
+/// (the one whose component at the largest diagonal entry of R is positive); with `strict=True`
+/// NoUniqueLogError is raised when π − θ ≤ 1e-12.
+///
+/// Args: r — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or |det R − 1| > 1e-10),
+/// NoUniqueLogError (strict only).
+#[pyfunction]
+#[pyo3(signature = (r, strict = false))]
+fn so3_log<'py>(py: Python<'py>, r: ArrayIn<'py>, strict: bool) -> PyResult<Out<'py>> {
+    map_batch(py, "R", &r, |m: &Matrix3<f64>| {
+        let g = SO3::new(*m)?;
+        if strict {
+            g.log()
+        } else {
+            Ok(so3::log(m))
+        }
+    })
+}
+
+/// `so3_cayley(w)`: the Cayley map cay(w) = (I − ŵ/2)⁻¹ (I + ŵ/2) = I + 4/(4 + |w|²)(ŵ + ŵ²/2),
+/// a rotation about w by the angle 2·atan(|w|/2) (agrees with exp to second order).
+///
+/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
+#[pyfunction]
+fn so3_cayley<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::cayley(w)))
+}
+
+/// `so3_cayley_inv(r)`: the inverse Cayley map, w = 2·vee(R − Rᵀ)/(1 + tr R).
+///
+/// Args: r — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Raises ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (rotation by π:
+/// 1 + tr R ≤ 1e-12, where R + I is singular).
+#[pyfunction]
+fn so3_cayley_inv<'py>(py: Python<'py>, r: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "R", &r, |m: &Matrix3<f64>| {
+        so3::cayley_inv(SO3::new(*m)?.matrix3())
+    })
+}
+
+/// Shared body of the two Jacobian bindings: J(w), or J⁻¹(w) when `inverse`.
+fn jacobian<'py>(
+    py: Python<'py>,
+    w: &ArrayIn<'py>,
+    inverse: bool,
+    forward: fn(&Vector3<f64>) -> Matrix3<f64>,
+    backward: fn(&Vector3<f64>) -> lieflow::Result<Matrix3<f64>>,
+) -> PyResult<Out<'py>> {
+    if inverse {
+        map_batch(py, "w", w, backward)
+    } else {
+        map_batch(py, "w", w, |w: &Vector3<f64>| Ok(forward(w)))
+    }
+}
+
+/// `so3_jacobian_right(w, inverse=False)`: the right Jacobian
+/// J_r(w) = I − ((1 − cos θ)/θ²) ŵ + ((θ − sin θ)/θ³) ŵ², so that
+/// exp(w + δ) ≈ exp(w) exp(J_r(w) δ); with `inverse=True` its inverse
+/// J_r⁻¹ = I + ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
+///
+/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1).
+#[pyfunction]
+#[pyo3(signature = (w, inverse = false))]
+fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
+    jacobian(
+        py,
+        &w,
+        inverse,
+        so3::jacobian_right,
+        so3::jacobian_right_inv,
+    )
+}
+
+/// `so3_jacobian_left(w, inverse=False)`: the left Jacobian (dexp_w)
+/// J_l(w) = I + ((1 − cos θ)/θ²) ŵ + ((θ − sin θ)/θ³) ŵ² = J_r(w)ᵀ, so that
+/// exp(w + δ) ≈ exp(J_l(w) δ) exp(w); with `inverse=True` its inverse
+/// J_l⁻¹ = I − ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
+///
+/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1).
+#[pyfunction]
+#[pyo3(signature = (w, inverse = false))]
+fn so3_jacobian_left<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
+    jacobian(py, &w, inverse, so3::jacobian_left, so3::jacobian_left_inv)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hat, m)?)?;
+    m.add_function(wrap_pyfunction!(vee, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_exp, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_log, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_cayley, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_cayley_inv, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_jacobian_right, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_jacobian_left, m)?)?;
     Ok(())
 }
