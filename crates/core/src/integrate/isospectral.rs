@@ -88,17 +88,19 @@ impl IsospectralMidpoint {
             self.products();
             // M̃ ← M_n − a [W, M̃] + a² W M̃ W, with [W, M̃] = P − Pᵀ; kept exactly skew.
             let mut diff = 0.0f64;
+            let mut finite = true;
             for i in 0..n {
                 for j in i + 1..n {
                     let comm = self.p[i * n + j] - self.p[j * n + i];
                     let v = self.m0[i * n + j] - a * comm + a2 * self.q[i * n + j];
                     diff = diff.max((v - self.mt[i * n + j]).abs());
+                    finite &= v.is_finite();
                     self.mt[i * n + j] = v;
                     self.mt[j * n + i] = -v;
                 }
             }
             iter += 1;
-            if !diff.is_finite() {
+            if !finite || !diff.is_finite() {
                 return Err(Error::NotConverged {
                     what: "isospectral midpoint fixed-point iteration".into(),
                     iterations: iter,

@@ -173,7 +173,7 @@ pub trait System: Sync {
     fn to_internal(&self, _state: &mut State) {}
 
     /// Inverse of [`System::to_internal`].
-    fn from_internal(&self, _state: &mut State) {}
+    fn to_user(&self, _state: &mut State) {}
 
     /// Builds a stepper for `method` and step `dt` (both already validated by the driver).
     fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>>;
@@ -357,7 +357,7 @@ fn run_checked<S: System + ?Sized>(
         done += k;
         out.z.copy_from_slice(&state.z);
         out.attitude = state.attitude;
-        system.from_internal(&mut out);
+        system.to_user(&mut out);
         if let Err(e) = check::finite_slice("state", &out.z) {
             return Err(Error::LeftDomain {
                 what: "state".into(),

@@ -132,8 +132,8 @@ impl Lgvi {
         }
     }
 
-    /// One step. Π and Γ are advanced by increments, Π_{k+1} = Π_k + [(h/2)τ_k + (Fᵀ − I)P]
-    /// + (h/2)τ_{k+1}, Γ_{k+1} = Γ_k + (Fᵀ − I)Γ_k, added with compensated summation: along a
+    /// One step. Π and Γ are advanced by increments, Π_{k+1} = Π_k + [(h/2)τ_k + (Fᵀ − I)P] +
+    /// (h/2)τ_{k+1}, Γ_{k+1} = Γ_k + (Fᵀ − I)Γ_k, added with compensated summation: along a
     /// free-body run F is nearly the same rotation at every step, and forming Fᵀ P directly has a
     /// rounding bias that makes |Π|² drift linearly (~1e-11 after 10⁶ steps).
     pub fn step(&self, s: &mut LgviState) -> Result<()> {

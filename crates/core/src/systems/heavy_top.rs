@@ -165,7 +165,7 @@ impl System for HeavyTop {
     fn to_internal(&self, state: &mut State) {
         top::state_to_frame(&self.frame, state);
     }
-    fn from_internal(&self, state: &mut State) {
+    fn to_user(&self, state: &mut State) {
         top::state_from_frame(&self.frame, state);
     }
     fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {

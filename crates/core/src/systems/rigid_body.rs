@@ -207,7 +207,7 @@ impl System for RigidBody {
     fn to_internal(&self, state: &mut State) {
         top::state_to_frame(&self.frame, state);
     }
-    fn from_internal(&self, state: &mut State) {
+    fn to_user(&self, state: &mut State) {
         top::state_from_frame(&self.frame, state);
     }
     fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
@@ -465,7 +465,7 @@ impl System for GeneralizedRigidBody {
     fn to_internal(&self, state: &mut State) {
         self.conjugate(state, true);
     }
-    fn from_internal(&self, state: &mut State) {
+    fn to_user(&self, state: &mut State) {
         self.conjugate(state, false);
     }
     fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
