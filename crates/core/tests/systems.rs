@@ -416,8 +416,10 @@ fn chunks_continue_the_run() {
     for (x, y) in whole.final_state.z.iter().zip(&c.final_state.z) {
         assert!((x - y).abs() < 1e-14);
     }
-    // steps not a multiple of save_every: samples at 0, 3, 6, 9; final state at 10.
-    let t = integrate(&b, Method::Rk4, &s0, 0.1, 10, 3).unwrap();
+    // steps not a multiple of save_every: samples at 0, 3, 6, 9; final state at 10. Systems also
+    // work as trait objects (what a binding holds).
+    let sys: &dyn System = &b;
+    let t = integrate(sys, Method::Rk4, &s0, 0.1, 10, 3).unwrap();
     assert_eq!(t.t.len(), 4);
     assert!((t.t[3] - 0.9).abs() < 1e-15);
     assert_eq!(t.attitude.as_ref().unwrap().len(), 36);
