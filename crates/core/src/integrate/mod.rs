@@ -331,13 +331,28 @@ fn run_checked<S: System + ?Sized>(
 ) -> Result<Trajectory> {
     let dim = system.dim();
     let n_saved = steps / save_every + 1;
+    let too_many = || {
+        Error::invalid(
+            "save_every",
+            format!("{n_saved} samples of {dim} values do not fit in memory; save less often"),
+        )
+    };
     let mut traj = Trajectory {
-        t: Vec::with_capacity(n_saved),
-        states: Vec::with_capacity(n_saved * dim),
-        attitude: state0.attitude.map(|_| Vec::with_capacity(9 * n_saved)),
+        t: Vec::new(),
+        states: Vec::new(),
+        attitude: state0.attitude.map(|_| Vec::new()),
         dim,
         final_state: state0.clone(),
     };
+    traj.t.try_reserve_exact(n_saved).map_err(|_| too_many())?;
+    let values = n_saved.checked_mul(dim).ok_or_else(too_many)?;
+    traj.states
+        .try_reserve_exact(values)
+        .map_err(|_| too_many())?;
+    if let Some(a) = traj.attitude.as_mut() {
+        let values = n_saved.checked_mul(9).ok_or_else(too_many)?;
+        a.try_reserve_exact(values).map_err(|_| too_many())?;
+    }
     let mut stepper = system.stepper(method, dt)?;
     let mut state = state0.clone();
     system.to_internal(&mut state);
