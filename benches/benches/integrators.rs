@@ -1,6 +1,142 @@
-use criterion::{criterion_group, criterion_main, Criterion};
+//! Integrator benchmarks: ns per step for every method and system, batch throughput on 1 and 2
+//! threads, and (with `--bench`) a work–precision table for the free rigid body to T = 100.
+//!
+//! `cargo bench -p lieflow-benches --bench integrators` (results in docs/bench-integ.md).
 
-fn placeholder(_c: &mut Criterion) {}
+use criterion::{BatchSize, Criterion};
+use lieflow::integrate::{integrate, integrate_batch, Method, State, System};
+use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
+use std::hint::black_box;
+use std::time::Instant;
 
-criterion_group!(benches, placeholder);
-criterion_main!(benches);
+const M0: [f64; 3] = [1.0, 0.5, -0.3];
+const I3: [f64; 9] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+/// Steps per timed run of the per-step benchmarks (the figure reported is time / STEPS).
+const STEPS: usize = 1000;
+
+fn per_step<S: System>(c: &mut Criterion, group: &str, sys: &S, state: &State, methods: &[Method]) {
+    let mut g = c.benchmark_group(group);
+    g.throughput(criterion::Throughput::Elements(STEPS as u64));
+    for &m in methods {
+        g.bench_function(m.name(), |b| {
+            b.iter_batched(
+                || state.clone(),
+                |s| integrate(sys, m, black_box(&s), 0.01, STEPS, STEPS).unwrap(),
+                BatchSize::SmallInput,
+            )
+        });
+    }
+    g.finish();
+}
+
+fn steps(c: &mut Criterion) {
+    let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
+    per_step(c, "rigid_body", &body, &body.state(M0), &Method::ALL);
+    per_step(
+        c,
+        "rigid_body_attitude",
+        &body,
+        &body.state_with_attitude(M0, I3),
+        &Method::ALL,
+    );
+    let top = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
+    per_step(
+        c,
+        "heavy_top",
+        &top,
+        &top.state(M0, [0.0, 0.0, 1.0]),
+        top.methods(),
+    );
+    let pend = SphericalPendulum::new(1.0, 1.0, 9.81).unwrap();
+    let s = pend.state_from_spherical(1.0, 0.0, 0.3, 1.2).unwrap();
+    per_step(c, "spherical_pendulum", &pend, &s, pend.methods());
+    for n in [4, 5] {
+        let j: Vec<f64> = (0..n).map(|i| 0.5 + 0.37 * i as f64).collect();
+        let z: Vec<f64> = (0..n * (n - 1) / 2)
+            .map(|k| ((k as f64 + 1.0) * 1.7).sin())
+            .collect();
+        let b = GeneralizedRigidBody::new(&j).unwrap();
+        per_step(c, &format!("so{n}_body"), &b, &State::new(z), b.methods());
+    }
+}
+
+fn batch(c: &mut Criterion) {
+    let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
+    let states: Vec<State> = (0..10_000)
+        .map(|k| {
+            let a = k as f64 * 1e-4;
+            body.state([1.0 - a, 0.5 + a, -0.3 + 0.5 * a])
+        })
+        .collect();
+    let mut g = c.benchmark_group("batch_rigid_body_1e4x1e3");
+    g.sample_size(10);
+    g.throughput(criterion::Throughput::Elements(10_000 * 1000));
+    for threads in [1, 2] {
+        g.bench_function(format!("splitting_{threads}_threads"), |b| {
+            b.iter(|| {
+                integrate_batch(
+                    &body,
+                    Method::Splitting,
+                    &states,
+                    0.01,
+                    1000,
+                    1000,
+                    Some(threads),
+                )
+                .unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+/// Error at T = 100 against the exact solution and the best of 7 wall times, for each method
+/// over a range of steps; printed as a markdown table.
+fn work_precision() {
+    let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
+    let exact = body.exact_momentum(&M0, 100.0).unwrap();
+    let s0 = body.state(M0);
+    println!("| method | dt | steps | error at T=100 | time (µs) |");
+    println!("|---|---|---|---|---|");
+    let grid: [(Method, &[usize]); 6] = [
+        (Method::Splitting, &[10_000, 20_000, 50_000, 100_000]),
+        (Method::Splitting4, &[1000, 1250, 2000, 4000]),
+        (Method::Splitting6, &[300, 400, 500, 1000]),
+        (Method::Lgvi, &[10_000, 100_000]),
+        (Method::Isospectral, &[10_000, 100_000]),
+        (Method::Rk4, &[2000, 4000, 5000, 10_000]),
+    ];
+    for (m, ns) in grid {
+        for &n in ns {
+            let dt = 100.0 / n as f64;
+            let mut best = f64::INFINITY;
+            let mut err = 0.0;
+            for _ in 0..7 {
+                let t0 = Instant::now();
+                let traj = integrate(&body, m, black_box(&s0), dt, n, n).unwrap();
+                best = best.min(t0.elapsed().as_secs_f64());
+                let z = &traj.final_state.z;
+                err = (0..3)
+                    .map(|i| (z[i] - exact[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+            }
+            println!(
+                "| {} | {dt} | {n} | {err:.2e} | {:.1} |",
+                m.name(),
+                best * 1e6
+            );
+        }
+    }
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--bench") && std::env::var_os("SKIP_WORK_PRECISION").is_none()
+    {
+        work_precision();
+    }
+    let mut c = Criterion::default().configure_from_args();
+    steps(&mut c);
+    batch(&mut c);
+    c.final_summary();
+}

@@ -18,6 +18,7 @@
 //! ```
 
 pub mod check;
+pub mod elliptic;
 pub mod error;
 pub mod integrate;
 pub mod lie;

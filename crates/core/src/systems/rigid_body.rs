@@ -1,0 +1,539 @@
+//! The free rigid body (Euler top) on so(3)* (000 §3–§4) and the generalized rigid body on so(n)*
+//! (Euler–Arnold / Manakov equations, the form of 001 (7.25)).
+//!
+//! **so(3)\*.** Body angular momentum M ∈ R³, Ω = I⁻¹M, Euler's equation Ṁ = M × Ω (000 §4, the
+//! Euler–Poincaré equation d/dt ∂ℓ/∂Ω = ∂ℓ/∂Ω × Ω with ℓ = ½ Ω·IΩ); energy H = ½ M·I⁻¹M; Casimir
+//! |M|²; attitude Ṙ = R hat(Ω); spatial angular momentum R M is conserved (000 Theorem 4.2).
+//! The inertia is given by its principal moments or as a symmetric positive-definite matrix,
+//! diagonalised once (I = Q diag Qᵀ, Q ∈ SO(3)); the steppers work in the principal frame
+//! (M' = QᵀM, R' = RQ) and the driver maps back.
+//!
+//! **so(n)\*.** M = JΩ + ΩJ with J = diag(J_i) (the mass matrix; a symmetric J is diagonalised
+//! once), so Ω_ij = M_ij / (J_i + J_j); Ṁ = [M, Ω]; H = ½⟨M, Ω⟩ = ½ Σ_{i<j} M_ij Ω_ij; Casimirs
+//! C_k = ½ tr((MᵀM)^k), k = 1…⌊n/2⌋ (they fix the spectrum of M). Coordinates are the e_ij
+//! coordinates of `lie::so::vee_n`. Sign check against so(3): the matrix of the physics hat map
+//! satisfies [hat M, hat Ω] = hat(M × Ω), so Ṁ = [M, Ω] is Euler's equation; in e_ij coordinates
+//! c = (−w₃, w₂, −w₁), and with J_i + J_j = I_k ({i, j, k} = {1, 2, 3}) the energies agree (tested).
+
+use super::top::{self, TopField, TopSplitting};
+use crate::check;
+use crate::elliptic;
+use crate::error::{Error, Result};
+use crate::integrate::isospectral::IsospectralMidpoint;
+use crate::integrate::rk::{Rk4, VectorField};
+use crate::integrate::variational::{Lgvi, LgviState};
+use crate::integrate::{Method, State, Stepper, System};
+use crate::Mat;
+use nalgebra::{Matrix3, Vector3};
+
+/// A free rigid body with inertia tensor I (000 §3.1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigidBody {
+    moments: [f64; 3],
+    frame: Option<Matrix3<f64>>,
+}
+
+impl RigidBody {
+    /// A body with principal moments I₁, I₂, I₃ > 0 (body axes = principal axes).
+    pub fn new(moments: [f64; 3]) -> Result<Self> {
+        top::check_moments(&moments)?;
+        Ok(RigidBody {
+            moments,
+            frame: None,
+        })
+    }
+
+    /// A body with a symmetric positive-definite inertia matrix (row-major), diagonalised once.
+    pub fn from_matrix(inertia: &[f64; 9]) -> Result<Self> {
+        let (moments, q) = top::principal_frame(inertia)?;
+        Ok(RigidBody {
+            moments,
+            frame: Some(q),
+        })
+    }
+
+    /// The principal moments (in the order of the principal frame).
+    pub fn moments(&self) -> [f64; 3] {
+        self.moments
+    }
+
+    /// The principal frame Q (columns = principal axes in body coordinates), if the inertia was
+    /// given as a matrix.
+    pub fn frame(&self) -> Option<Matrix3<f64>> {
+        self.frame
+    }
+
+    /// A state with body momentum M and no attitude.
+    pub fn state(&self, m: [f64; 3]) -> State {
+        State::new(m.to_vec())
+    }
+
+    /// A state with body momentum M and attitude R (row-major).
+    pub fn state_with_attitude(&self, m: [f64; 3], r: [f64; 9]) -> State {
+        State::with_attitude(m.to_vec(), r)
+    }
+
+    /// Body angular velocity Ω = I⁻¹M (user frame).
+    pub fn angular_velocity(&self, m: &[f64]) -> Result<[f64; 3]> {
+        check::len_of("M", m, 3)?;
+        let mi = top::to_frame(&self.frame, m);
+        let w = Vector3::from_fn(|i, _| mi[i] / self.moments[i]);
+        Ok(top::from_frame(&self.frame, &w).into())
+    }
+
+    /// Spatial angular momentum R M (000 Theorem 4.2), conserved.
+    pub fn spatial_momentum(state: &State) -> Result<[f64; 3]> {
+        check::len_of("M", &state.z, 3)?;
+        let r = state
+            .attitude
+            .ok_or_else(|| Error::invalid("state", "the spatial momentum needs the attitude R"))?;
+        let r = Matrix3::from_row_slice(&r);
+        Ok((r * Vector3::from_column_slice(&state.z)).into())
+    }
+
+    /// The exact body momentum M(t) from M(0) = `m0` by Jacobi elliptic functions (user frame).
+    ///
+    /// With principal moments relabelled so that I₂ is the middle one and D = |M|²/(2H) between
+    /// I₂ and I₃ (a proper rotation of the axes, one sign flip if the relabelling is odd):
+    /// M₁ = a₁ cn u, M₂ = a₂ sn u, M₃ = ε a₃ dn u, u = u₀ + λt, with
+    /// a₁² = (2H − |M|²/I₃)/(1/I₁ − 1/I₃), a₃² = |M|² − a₁², a₂² = a₁²(1/I₁ − 1/I₃)/(1/I₂ − 1/I₃),
+    /// m = k² = a₂²(1/I₁ − 1/I₂)/(a₃²(1/I₁ − 1/I₃)), λ = ε a₁a₃(1/I₁ − 1/I₃)/a₂, ε = sign M₃,
+    /// u₀ = F(atan2(M₂/a₂, M₁/a₁) | m). (Derived by substituting into Ṁ = M × Ω; cf. Landau &
+    /// Lifshitz, *Mechanics* §37.) A symmetric body rotates M uniformly about its symmetry axis.
+    /// Errors: a state on the separatrix |M|² = 2H I₂ (k = 1), non-finite input.
+    pub fn exact_momentum(&self, m0: &[f64], t: f64) -> Result<[f64; 3]> {
+        check::len_of("M0", m0, 3)?;
+        check::finite_slice("t", &[t])?;
+        let mi = top::to_frame(&self.frame, m0);
+        let m = exact_principal(&self.moments, &mi, t)?;
+        Ok(top::from_frame(&self.frame, &m).into())
+    }
+
+    fn field(&self, attitude: bool) -> TopField {
+        TopField::new(self.moments, None, attitude)
+    }
+}
+
+/// Exact M(t) in the principal frame.
+fn exact_principal(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Result<Vector3<f64>> {
+    let mu2 = m0.norm_squared();
+    if mu2 == 0.0 {
+        return Ok(*m0);
+    }
+    let two_h: f64 = (0..3).map(|i| m0[i] * m0[i] / inertia[i]).sum();
+    let mut idx = [0usize, 1, 2];
+    idx.sort_by(|&a, &b| inertia[a].total_cmp(&inertia[b]));
+    let (lo, mid, hi) = (idx[0], idx[1], idx[2]);
+    let (ilo, imid, ihi) = (inertia[lo], inertia[mid], inertia[hi]);
+    let eq = |a: f64, b: f64| (a - b).abs() <= 1e-14 * a.max(b);
+    if eq(ilo, ihi) {
+        return Ok(*m0);
+    }
+    if eq(ilo, imid) || eq(imid, ihi) {
+        // Symmetric top: H = ½|M|²/I_o + ½ M_s²(1/I_s − 1/I_o), a uniform rotation about e_s.
+        let (s, io) = if eq(ilo, imid) { (hi, ilo) } else { (lo, ihi) };
+        let w = m0[s] * (1.0 / inertia[s] - 1.0 / io);
+        let mut m = *m0;
+        top::rotate_axis(&mut m, s, t * w);
+        return Ok(m);
+    }
+    let d = mu2 / two_h;
+    if eq(d, imid) {
+        return Err(Error::invalid(
+            "M0",
+            "the state lies on the separatrix |M|² = 2H·I_mid (elliptic modulus k = 1)",
+        ));
+    }
+    // Axes (p, mid, s): s carries dn, D lies between I_mid and I_s.
+    let (p, s) = if d > imid { (lo, hi) } else { (hi, lo) };
+    let perm = [p, mid, s];
+    // Sign of the permutation: cyclic ⇔ even. Flip the middle component if odd (proper rotation).
+    let even = (perm[1] + 3 - perm[0]) % 3 == 1;
+    let sg = if even { 1.0 } else { -1.0 };
+    let y0 = Vector3::new(m0[p], sg * m0[mid], m0[s]);
+    let (i1, i2, i3) = (inertia[p], inertia[mid], inertia[s]);
+    let (d13, d12, d23) = (
+        1.0 / i1 - 1.0 / i3,
+        1.0 / i1 - 1.0 / i2,
+        1.0 / i2 - 1.0 / i3,
+    );
+    let a1s = ((two_h - mu2 / i3) / d13).max(0.0);
+    if a1s <= 1e-30 * mu2 {
+        return Ok(*m0); // steady rotation about the s axis
+    }
+    let a3s = mu2 - a1s;
+    let a2s = a1s * d13 / d23;
+    let mm = a2s * d12 / (a3s * d13);
+    let (a1, a2, a3) = (a1s.sqrt(), a2s.sqrt(), a3s.sqrt());
+    let eps = if y0.z >= 0.0 { 1.0 } else { -1.0 };
+    let lambda = eps * a1 * a3 * d13 / a2;
+    let phi0 = (y0.y / a2).atan2(y0.x / a1);
+    let u0 = elliptic::ellipf(phi0, mm)?;
+    let (sn, cn, dn) = elliptic::ellipj(u0 + lambda * t, mm)?;
+    let y = Vector3::new(a1 * cn, a2 * sn, eps * a3 * dn);
+    let mut m = Vector3::zeros();
+    m[p] = y.x;
+    m[mid] = sg * y.y;
+    m[s] = y.z;
+    Ok(m)
+}
+
+const RIGID_METHODS: [Method; 6] = Method::ALL;
+
+impl System for RigidBody {
+    fn name(&self) -> &'static str {
+        "RigidBody"
+    }
+    fn dim(&self) -> usize {
+        3
+    }
+    fn has_attitude(&self) -> bool {
+        true
+    }
+    fn methods(&self) -> &'static [Method] {
+        &RIGID_METHODS
+    }
+    /// H = ½ M·I⁻¹M.
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        check::len_of("state", z, 3)?;
+        let m = top::to_frame(&self.frame, z);
+        Ok(0.5 * (0..3).map(|i| m[i] * m[i] / self.moments[i]).sum::<f64>())
+    }
+    /// [|M|²].
+    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {
+        check::len_of("state", z, 3)?;
+        Ok(vec![z.iter().map(|x| x * x).sum()])
+    }
+    fn to_internal(&self, state: &mut State) {
+        top::state_to_frame(&self.frame, state);
+    }
+    fn to_user(&self, state: &mut State) {
+        top::state_from_frame(&self.frame, state);
+    }
+    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
+        self.check_method(method)?;
+        Ok(match method {
+            Method::Splitting | Method::Splitting4 | Method::Splitting6 => {
+                Box::new(TopSplitting::new(self.moments, None, method, dt))
+            }
+            Method::Lgvi => Box::new(LgviStepper(Lgvi::new(self.moments, dt, None))),
+            Method::Isospectral => Box::new(So3Isospectral::new(&self.moments, dt)),
+            Method::Rk4 => Box::new(top::TopRk4::new(self.field(false), self.field(true), dt)),
+        })
+    }
+}
+
+/// The LGVI on a rigid-body or heavy-top state (z = M or (M, Γ)).
+pub(crate) struct LgviStepper(pub(crate) Lgvi);
+
+impl Stepper for LgviStepper {
+    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
+        let mut s = LgviState::new(
+            Vector3::from_column_slice(&state.z[..3]),
+            (state.z.len() == 6).then(|| Vector3::from_column_slice(&state.z[3..6])),
+            state.attitude.map(|r| Matrix3::from_row_slice(&r)),
+        );
+        for k in top::chunks(steps) {
+            for _ in 0..k {
+                self.0.step(&mut s)?;
+            }
+            if let Some(r) = s.r.as_mut() {
+                top::reorthonormalize(r);
+            }
+        }
+        state.z[..3].copy_from_slice(s.m.as_slice());
+        if let Some(g) = s.gamma {
+            state.z[3..6].copy_from_slice(g.as_slice());
+        }
+        if let Some(r) = s.r {
+            state.attitude = Some(top::row_major(&r));
+        }
+        Ok(())
+    }
+}
+
+/// The isospectral midpoint on so(3) through the matrix hat(M): d_12 = I₃, d_13 = I₂, d_23 = I₁.
+struct So3Isospectral {
+    kernel: IsospectralMidpoint,
+    h: f64,
+    mat: [f64; 9],
+}
+
+impl So3Isospectral {
+    fn new(moments: &[f64; 3], h: f64) -> Self {
+        let [i1, i2, i3] = *moments;
+        let d = [0.0, i3, i2, i3, 0.0, i1, i2, i1, 0.0];
+        So3Isospectral {
+            kernel: IsospectralMidpoint::new(3, &d, h),
+            h,
+            mat: [0.0; 9],
+        }
+    }
+}
+
+impl Stepper for So3Isospectral {
+    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
+        let m = Vector3::from_column_slice(&state.z);
+        self.mat = top::row_major(&crate::lie::so3::hat(&m));
+        let mut r = state.attitude.map(|r| Matrix3::from_row_slice(&r));
+        for k in top::chunks(steps) {
+            for _ in 0..k {
+                self.kernel.step(&mut self.mat)?;
+                if let Some(r) = r.as_mut() {
+                    let w = self.kernel.omega();
+                    let v = Vector3::new(w[7], w[2], w[3]) * (0.5 * self.h);
+                    *r *= crate::integrate::variational::cayley(&v);
+                }
+            }
+            if let Some(r) = r.as_mut() {
+                top::reorthonormalize(r);
+            }
+        }
+        let mm = &self.mat;
+        state.z.copy_from_slice(&[mm[7], mm[2], mm[3]]);
+        if let Some(r) = r {
+            state.attitude = Some(top::row_major(&r));
+        }
+        Ok(())
+    }
+}
+
+/// The generalized rigid body on so(n)*: M = JΩ + ΩJ, Ṁ = [M, Ω] (Euler–Arnold; Manakov).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeneralizedRigidBody {
+    n: usize,
+    j: Vec<f64>,
+    frame: Option<Mat>,
+    /// d_ij = J_i + J_j, row-major n×n (diagonal unused).
+    d: Vec<f64>,
+    /// (coordinate index, sign) of entry (i, j) of hat_n, row-major; sign 0 on the diagonal.
+    index: Vec<(usize, f64)>,
+}
+
+impl GeneralizedRigidBody {
+    /// A body with principal mass-matrix entries J_i ≥ 0, n ≥ 2, J_i + J_j > 0 for i ≠ j.
+    pub fn new(j: &[f64]) -> Result<Self> {
+        let n = j.len();
+        if n < 2 {
+            return Err(Error::shape("J", "(n,) with n ≥ 2", format!("({n},)")));
+        }
+        check::finite_slice("J", j)?;
+        for (i, &ji) in j.iter().enumerate() {
+            if ji < 0.0 {
+                return Err(Error::invalid("J", format!("J[{i}] = {ji} < 0")));
+            }
+        }
+        let mut d = vec![0.0; n * n];
+        let mut index = vec![(0usize, 0.0); n * n];
+        let mut c = 0;
+        for i in 0..n {
+            for k in i + 1..n {
+                let s = j[i] + j[k];
+                if s <= 0.0 {
+                    return Err(Error::invalid(
+                        "J",
+                        format!("J[{i}] + J[{k}] = {s} must be > 0 (non-positive inertia)"),
+                    ));
+                }
+                d[i * n + k] = s;
+                d[k * n + i] = s;
+                index[i * n + k] = (c, 1.0);
+                index[k * n + i] = (c, -1.0);
+                c += 1;
+            }
+        }
+        Ok(GeneralizedRigidBody {
+            n,
+            j: j.to_vec(),
+            frame: None,
+            d,
+            index,
+        })
+    }
+
+    /// A body with a symmetric positive-semidefinite mass matrix J (n×n), diagonalised once.
+    pub fn from_matrix(j: &Mat) -> Result<Self> {
+        let n = check::square("J", j, 2)?;
+        let asym = (0..n)
+            .flat_map(|a| (0..n).map(move |b| (a, b)))
+            .fold(0.0f64, |s, (a, b)| s.max((j[(a, b)] - j[(b, a)]).abs()));
+        if asym > 1e-12 * j.norm_l2().max(1.0) {
+            return Err(Error::invalid(
+                "J",
+                format!("not symmetric (max |J − Jᵀ| = {asym:.3e})"),
+            ));
+        }
+        let eig = j
+            .self_adjoint_eigen(faer::Side::Lower)
+            .map_err(|e| Error::invalid("J", format!("eigendecomposition failed: {e:?}")))?;
+        let vals: Vec<f64> = (0..n).map(|i| eig.S()[i]).collect();
+        let mut q = Mat::from_fn(n, n, |a, b| eig.U()[(a, b)]);
+        if q.determinant() < 0.0 {
+            for a in 0..n {
+                q[(a, n - 1)] = -q[(a, n - 1)];
+            }
+        }
+        let mut body = Self::new(&vals)?;
+        body.frame = Some(q);
+        Ok(body)
+    }
+
+    /// n.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The principal entries J_i.
+    pub fn principal(&self) -> &[f64] {
+        &self.j
+    }
+
+    fn entry(&self, z: &[f64], i: usize, k: usize) -> f64 {
+        let (c, s) = self.index[i * self.n + k];
+        s * z[c]
+    }
+
+    fn dense(&self, z: &[f64], out: &mut [f64]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            let (c, s) = self.index[k];
+            *o = s * z[c];
+        }
+    }
+
+    fn coords(&self, m: &[f64], z: &mut [f64]) {
+        let n = self.n;
+        let mut c = 0;
+        for i in 0..n {
+            for k in i + 1..n {
+                z[c] = m[i * n + k];
+                c += 1;
+            }
+        }
+    }
+
+    fn conjugate(&self, state: &mut State, transpose_first: bool) {
+        if let Some(q) = &self.frame {
+            let m = crate::lie::so::hat_n_unchecked(self.n, &state.z);
+            let m = if transpose_first {
+                q.transpose() * &m * q
+            } else {
+                q * &m * q.transpose()
+            };
+            state.z = crate::lie::so::vee_n_unchecked(&m);
+        }
+    }
+}
+
+impl System for GeneralizedRigidBody {
+    fn name(&self) -> &'static str {
+        "GeneralizedRigidBody"
+    }
+    fn dim(&self) -> usize {
+        self.n * (self.n - 1) / 2
+    }
+    fn methods(&self) -> &'static [Method] {
+        &[Method::Isospectral, Method::Rk4]
+    }
+    /// H = ½ Σ_{i<j} M_ij² / (J_i + J_j) (principal frame).
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        check::len_of("state", z, self.dim())?;
+        let mut s = State::new(z.to_vec());
+        self.to_internal(&mut s);
+        let n = self.n;
+        let mut e = 0.0;
+        for i in 0..n {
+            for k in i + 1..n {
+                let m = self.entry(&s.z, i, k);
+                e += m * m / self.d[i * n + k];
+            }
+        }
+        Ok(0.5 * e)
+    }
+    /// C_k = ½ tr((MᵀM)^k), k = 1…⌊n/2⌋ (C₁ = |M|² on so(3)).
+    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {
+        check::len_of("state", z, self.dim())?;
+        let m = crate::lie::so::hat_n_unchecked(self.n, z);
+        let a = m.transpose() * &m;
+        let mut p = a.clone();
+        let mut out = Vec::with_capacity(self.n / 2);
+        for _ in 0..self.n / 2 {
+            out.push(0.5 * (0..self.n).map(|i| p[(i, i)]).sum::<f64>());
+            p = &p * &a;
+        }
+        Ok(out)
+    }
+    fn to_internal(&self, state: &mut State) {
+        self.conjugate(state, true);
+    }
+    fn to_user(&self, state: &mut State) {
+        self.conjugate(state, false);
+    }
+    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
+        self.check_method(method)?;
+        let n = self.n;
+        Ok(match method {
+            Method::Isospectral => Box::new(SonIsospectral {
+                body: self,
+                kernel: IsospectralMidpoint::new(n, &self.d, dt),
+                mat: vec![0.0; n * n],
+            }),
+            _ => Box::new(SonRk4 {
+                body: self,
+                rk: Rk4::new(dt, self.dim()),
+            }),
+        })
+    }
+}
+
+struct SonIsospectral<'a> {
+    body: &'a GeneralizedRigidBody,
+    kernel: IsospectralMidpoint,
+    mat: Vec<f64>,
+}
+
+impl Stepper for SonIsospectral<'_> {
+    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
+        self.body.dense(&state.z, &mut self.mat);
+        for _ in 0..steps {
+            self.kernel.step(&mut self.mat)?;
+        }
+        self.body.coords(&self.mat, &mut state.z);
+        Ok(())
+    }
+}
+
+impl VectorField for GeneralizedRigidBody {
+    /// Ṁ = [M, Ω] in e_ij coordinates (principal frame).
+    fn eval(&self, z: &[f64], dz: &mut [f64]) {
+        let n = self.n;
+        let om = |i: usize, k: usize| {
+            if i == k {
+                0.0
+            } else {
+                self.entry(z, i, k) / self.d[i * n + k]
+            }
+        };
+        let mut c = 0;
+        for i in 0..n {
+            for j in i + 1..n {
+                let mut s = 0.0;
+                for k in 0..n {
+                    s += self.entry(z, i, k) * om(k, j) - om(i, k) * self.entry(z, k, j);
+                }
+                dz[c] = s;
+                c += 1;
+            }
+        }
+    }
+}
+
+struct SonRk4<'a> {
+    body: &'a GeneralizedRigidBody,
+    rk: Rk4,
+}
+
+impl Stepper for SonRk4<'_> {
+    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
+        self.rk.run(self.body, &mut state.z, steps)
+    }
+}
