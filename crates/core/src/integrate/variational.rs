@@ -20,19 +20,13 @@
 //! rotation Fᵀ and by kicks orthogonal to Γ.
 
 use crate::error::{Error, Result};
+use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
 
 /// Newton tolerance on |Δg| relative to 1 + |g|.
 pub const TOL: f64 = 2.0 * f64::EPSILON;
 /// Maximal Newton iterations per step.
 pub const MAX_ITER: usize = 30;
-
-/// Cayley map g ↦ (I − ĝ)⁻¹(I + ĝ) = I + 2(ĝ + ĝ²)/(1 + |g|²) (rotation by 2 atan|g| about g).
-// TODO(merge): use lie::so3::cayley (note its scaling convention: here F = cay_so3(2g)).
-pub(crate) fn cayley(g: &Vector3<f64>) -> Matrix3<f64> {
-    let gh = crate::lie::so3::hat(g);
-    Matrix3::identity() + (gh + gh * gh) * (2.0 / (1.0 + g.norm_squared()))
-}
 
 /// (cay(g) − I) v = 2(g × v + g × (g × v))/(1 + |g|²), computed without forming cay(g) − I by
 /// subtraction, so its rounding error is O(ε|g||v|) rather than O(ε|v|).
@@ -153,7 +147,7 @@ impl Lgvi {
         let kick = self.torque(&s.gamma) * (0.5 * h);
         compensated_add(&mut s.m, &mut s.carry_m, kick);
         if let Some(r) = s.r.as_mut() {
-            *r *= cayley(&g);
+            *r *= so3::cayley(&(g * 2.0)); // (I − ĝ)⁻¹(I + ĝ) = cay(2g)
         }
         Ok(())
     }

@@ -281,8 +281,8 @@ impl Stepper for So3Isospectral {
                 self.kernel.step(&mut self.mat)?;
                 if let Some(r) = r.as_mut() {
                     let w = self.kernel.omega();
-                    let v = Vector3::new(w[7], w[2], w[3]) * (0.5 * self.h);
-                    *r *= crate::integrate::variational::cayley(&v);
+                    let v = Vector3::new(w[7], w[2], w[3]) * self.h;
+                    *r *= crate::lie::so3::cayley(&v);
                 }
             }
             if let Some(r) = r.as_mut() {
