@@ -7,7 +7,11 @@ use lieflow::Mat;
 
 fn alg_dist<G: MatrixLieGroup>(a: &G::Algebra, b: &G::Algebra) -> f64 {
     let (a, b) = (G::coords(a), G::coords(b));
-    a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+    a.iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 fn alg_norm<G: MatrixLieGroup>(a: &G::Algebra) -> f64 {
@@ -30,9 +34,21 @@ pub fn group_axioms<G: MatrixLieGroup>(g: &G, h: &G, k: &G) {
     let rhs = g.compose(&h.compose(k));
     assert_small("associativity", dist(&lhs.matrix(), &rhs.matrix()), 1e-12);
     let e = g.identity_like();
-    assert_small("right identity", dist(&g.compose(&e).matrix(), &g.matrix()), 1e-14);
-    assert_small("left identity", dist(&e.compose(g).matrix(), &g.matrix()), 1e-14);
-    assert_small("inverse", dist(&g.compose(&g.inverse()).matrix(), &e.matrix()), 1e-12);
+    assert_small(
+        "right identity",
+        dist(&g.compose(&e).matrix(), &g.matrix()),
+        1e-14,
+    );
+    assert_small(
+        "left identity",
+        dist(&e.compose(g).matrix(), &g.matrix()),
+        1e-14,
+    );
+    assert_small(
+        "inverse",
+        dist(&g.compose(&g.inverse()).matrix(), &e.matrix()),
+        1e-12,
+    );
     assert_small(
         "homomorphism",
         dist(&g.compose(h).matrix(), &(g.matrix() * h.matrix())),
@@ -52,7 +68,11 @@ pub fn exp_log<G: MatrixLieGroup>(g: &G, xi: &G::Algebra) {
     );
     let half = lin::<G>(g, 0.5, xi, 0.0, xi);
     let hh = G::exp(&half).compose(&G::exp(&half));
-    assert_small("exp(ξ/2)² = exp ξ", dist(&hh.matrix(), &x.matrix()), 1e-12 * scale);
+    assert_small(
+        "exp(ξ/2)² = exp ξ",
+        dist(&hh.matrix(), &x.matrix()),
+        1e-12 * scale,
+    );
     let back = x.log().expect("log of exp inside the injectivity radius");
     assert_small("log(exp ξ) = ξ", alg_dist::<G>(&back, xi), 1e-10 * scale);
     if let Ok(l) = g.log() {
@@ -60,17 +80,32 @@ pub fn exp_log<G: MatrixLieGroup>(g: &G, xi: &G::Algebra) {
         assert_small("exp(log g) = g", dist(&again.matrix(), &g.matrix()), 1e-10);
     }
     let c = G::coords(xi);
-    assert_small("coords round trip", alg_dist::<G>(&g.algebra_from_coords(&c), xi), 0.0);
+    assert_small(
+        "coords round trip",
+        alg_dist::<G>(&g.algebra_from_coords(&c), xi),
+        0.0,
+    );
 }
 
 /// Ad, ad and ad*: matrix formulas, homomorphism, bracket, Jacobi, duality, exp equivariance.
-pub fn adjoint_laws<G: MatrixLieGroup>(g: &G, h: &G, xi: &G::Algebra, eta: &G::Algebra, zeta: &G::Algebra) {
-    let scale = (1.0 + alg_norm::<G>(xi)) * (1.0 + alg_norm::<G>(eta)) * (1.0 + alg_norm::<G>(zeta));
+pub fn adjoint_laws<G: MatrixLieGroup>(
+    g: &G,
+    h: &G,
+    xi: &G::Algebra,
+    eta: &G::Algebra,
+    zeta: &G::Algebra,
+) {
+    let scale =
+        (1.0 + alg_norm::<G>(xi)) * (1.0 + alg_norm::<G>(eta)) * (1.0 + alg_norm::<G>(zeta));
     let gm = g.matrix();
     let gi = g.inverse().matrix();
     // Ad_g ξ = g ξ g⁻¹ in the matrix representation.
     let ad_g = G::algebra_matrix(&g.adjoint(xi));
-    assert_small("Ad_g ξ = g ξ g⁻¹", dist(&ad_g, &(&gm * G::algebra_matrix(xi) * &gi)), 1e-11 * scale);
+    assert_small(
+        "Ad_g ξ = g ξ g⁻¹",
+        dist(&ad_g, &(&gm * G::algebra_matrix(xi) * &gi)),
+        1e-11 * scale,
+    );
     // Ad_{gh} = Ad_g Ad_h.
     let lhs = g.compose(h).adjoint(xi);
     let rhs = g.adjoint(&h.adjoint(xi));
@@ -78,11 +113,19 @@ pub fn adjoint_laws<G: MatrixLieGroup>(g: &G, h: &G, xi: &G::Algebra, eta: &G::A
     // [ξ, η] is the matrix commutator.
     let (xm, ym): (Mat, Mat) = (G::algebra_matrix(xi), G::algebra_matrix(eta));
     let br = G::algebra_matrix(&G::ad(xi, eta));
-    assert_small("ad = commutator", dist(&br, &(&xm * &ym - &ym * &xm)), 1e-12 * scale);
+    assert_small(
+        "ad = commutator",
+        dist(&br, &(&xm * &ym - &ym * &xm)),
+        1e-12 * scale,
+    );
     // Ad preserves the bracket.
     let lhs = g.adjoint(&G::ad(xi, eta));
     let rhs = G::ad(&g.adjoint(xi), &g.adjoint(eta));
-    assert_small("Ad_g[ξ,η] = [Ad_g ξ, Ad_g η]", alg_dist::<G>(&lhs, &rhs), 1e-10 * scale);
+    assert_small(
+        "Ad_g[ξ,η] = [Ad_g ξ, Ad_g η]",
+        alg_dist::<G>(&lhs, &rhs),
+        1e-10 * scale,
+    );
     // Antisymmetry and Jacobi.
     let anti = lin::<G>(g, 1.0, &G::ad(xi, eta), 1.0, &G::ad(eta, xi));
     assert_small("antisymmetry", alg_norm::<G>(&anti), 1e-12 * scale);

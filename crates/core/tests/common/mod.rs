@@ -15,7 +15,11 @@ pub fn dist(a: &Mat, b: &Mat) -> f64 {
 pub fn expm_reference(a: &Mat) -> Mat {
     let n = a.nrows();
     let norm = a.norm_l2();
-    let s = if norm > 0.5 { (norm / 0.5).log2().ceil() as i32 } else { 0 };
+    let s = if norm > 0.5 {
+        (norm / 0.5).log2().ceil() as i32
+    } else {
+        0
+    };
     let scaled = a * faer::Scale(0.5f64.powi(s));
     let mut term = Mat::identity(n, n);
     let mut sum = Mat::identity(n, n);
