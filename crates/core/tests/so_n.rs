@@ -114,7 +114,7 @@ proptest! {
 
     /// exp ξ ∈ SO(n) to 1e-13 for |ξ| up to 10³ and agrees with an independent expm.
     #[test]
-    fn exp_is_rotation_for_large_arguments((n, a) in algebra(1.0), scale in 1.0..1e3f64) {
+    fn exp_is_rotation_for_large_arguments((_n, a) in algebra(1.0), scale in 1.0..1e3f64) {
         let xi = hat(&a) * faer::Scale(scale / (1e-300 + so::norm(&hat(&a))));
         let r = so::exp(&xi).unwrap();
         prop_assert!(so::orthogonality_defect(&r) < 1e-13, "defect {}", so::orthogonality_defect(&r));
@@ -154,7 +154,7 @@ proptest! {
     }
 
     #[test]
-    fn cayley_maps_into_so_and_inverts((n, a) in algebra(5.0)) {
+    fn cayley_maps_into_so_and_inverts((_n, a) in algebra(5.0)) {
         let xi = hat(&a);
         let r = so::cayley(&xi).unwrap();
         prop_assert!(so::is_rotation(&r, 1e-12).unwrap());
@@ -164,7 +164,6 @@ proptest! {
         let small = &xi * faer::Scale(1e-3);
         let e = dist(&so::cayley(&small).unwrap(), &so::exp(&small).unwrap());
         prop_assert!(e < 1e-9 * (1.0 + so::norm(&xi)).powi(3), "cay − exp = {e:.3e}");
-        let _ = n;
     }
 
     /// d/dt exp(ξ + tη)|₀ = dexp_ξ(η) exp ξ = exp ξ dexp_{−ξ}(η), by central differences.

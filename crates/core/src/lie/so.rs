@@ -488,19 +488,7 @@ fn bernoulli_coefficients() -> &'static [f64] {
         let small = [pi2 / 6.0, pi2 * pi2 / 90.0, pi2 * pi2 * pi2 / 945.0];
         for m in 1..=DEXP_INV_MAX_TERMS / 2 {
             let p = 2 * m as i32;
-            let mut zeta = 1.0;
-            if m <= 3 {
-                zeta = small[m - 1];
-            }
-            let mut j = 2.0f64;
-            while m > 3 {
-                let t = j.powi(-p);
-                zeta += t;
-                if t < 1e-18 * zeta {
-                    break;
-                }
-                j += 1.0;
-            }
+            let zeta = if m <= 3 { small[m - 1] } else { zeta_direct(p) };
             let sign = if m % 2 == 1 { 1.0 } else { -1.0 };
             b[2 * m] = sign * 2.0 * zeta / two_pi.powi(p);
         }
@@ -509,6 +497,20 @@ fn bernoulli_coefficients() -> &'static [f64] {
 }
 
 const DEXP_INV_MAX_TERMS: usize = 400;
+
+/// ζ(p) = Σ_{j≥1} j⁻ᵖ by direct summation (for p ≥ 8 at most ~180 terms to 10⁻¹⁸).
+fn zeta_direct(p: i32) -> f64 {
+    let mut zeta = 1.0;
+    let mut j = 2.0f64;
+    loop {
+        let t = j.powi(-p);
+        zeta += t;
+        if t < 1e-18 * zeta {
+            return zeta;
+        }
+        j += 1.0;
+    }
+}
 
 /// Inverse of [`dexp`] (same right-trivialized convention): dexp⁻¹_ξ η = Σ_k B_k/k! ad_ξᵏ η with
 /// the Bernoulli numbers B_0 = 1, B_1 = −½, B_2 = 1/6, … (000 §3).
@@ -723,6 +725,28 @@ mod tests {
         let a = hat_n(&[1.0, 2.0, 3.0]).unwrap();
         let b = hat_n(&[4.0, 5.0, 6.0]).unwrap();
         assert!((pairing(&a, &b) - 32.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn bernoulli_coefficients_match_known_values() {
+        // z/(eᶻ − 1) = 1 − z/2 + z²/12 − z⁴/720 + z⁶/30240 − z⁸/1209600 + …
+        let b = bernoulli_coefficients();
+        let known = [
+            1.0,
+            -0.5,
+            1.0 / 12.0,
+            0.0,
+            -1.0 / 720.0,
+            0.0,
+            1.0 / 30240.0,
+            0.0,
+        ];
+        for (k, v) in known.iter().enumerate() {
+            assert!((b[k] - v).abs() <= 1e-15 * v.abs(), "b_{k}");
+        }
+        assert!((b[8] + 1.0 / 1_209_600.0).abs() < 1e-15 / 1_209_600.0);
+        // B_10 = 5/66.
+        assert!((b[10] - 5.0 / 66.0 / 3_628_800.0).abs() < 1e-15 * b[10]);
     }
 
     #[test]
