@@ -498,18 +498,11 @@ fn bernoulli_coefficients() -> &'static [f64] {
 
 const DEXP_INV_MAX_TERMS: usize = 400;
 
-/// ζ(p) = Σ_{j≥1} j⁻ᵖ by direct summation (for p ≥ 8 at most ~180 terms to 10⁻¹⁸).
+/// ζ(p) = Σ_{j≥1} j⁻ᵖ by direct summation for p ≥ 8, smallest terms first, up to the J with
+/// J⁻ᵖ < 10⁻²⁰ (at most ~320 terms; the dropped tail is below 10⁻²⁰ · J/(p − 1)).
 fn zeta_direct(p: i32) -> f64 {
-    let mut zeta = 1.0;
-    let mut j = 2.0f64;
-    loop {
-        let t = j.powi(-p);
-        zeta += t;
-        if t < 1e-18 * zeta {
-            return zeta;
-        }
-        j += 1.0;
-    }
+    let last = (1e20f64.powf(1.0 / p as f64)).ceil() as i32;
+    (2..=last).rev().map(|j| f64::from(j).powi(-p)).sum::<f64>() + 1.0
 }
 
 /// Inverse of [`dexp`] (same right-trivialized convention): dexp⁻¹_ξ η = Σ_k B_k/k! ad_ξᵏ η with
