@@ -429,3 +429,21 @@ fn log_accuracy_near_pi_follows_the_condition_number() {
         }
     }
 }
+
+/// Every Padé degree (3, 5, 7, 9, 13 and 13 with squarings) against the independent expm.
+#[test]
+fn exp_every_pade_degree_against_reference() {
+    for n in [4, 6, 8] {
+        let c: Vec<f64> = (0..so::dim(n))
+            .map(|k| ((k * 31 % 17) as f64 - 8.0) / 8.0)
+            .collect();
+        let unit = hat(&c) * faer::Scale(1.0 / so::norm(&hat(&c)));
+        for scale in [1e-4, 5e-3, 0.05, 0.3, 0.8, 2.0, 5.0, 40.0, 900.0] {
+            let xi = &unit * faer::Scale(scale);
+            let r = so::exp(&xi).unwrap();
+            let e = dist(&r, &expm_reference(&xi));
+            assert!(e < 2e-15 * (1.0 + scale), "n={n} |ξ|={scale}: {e:.2e}");
+            assert!(so::orthogonality_defect(&r) < 1e-14, "n={n} |ξ|={scale}");
+        }
+    }
+}

@@ -221,9 +221,10 @@ pub fn norm(xi: &Mat) -> f64 {
 /// Exponential map so(n) → SO(n) (000 §3).
 ///
 /// n = 2: exp [[0, a], [−a, 0]] = [[cos a, sin a], [−sin a, cos a]]. n = 3: Rodrigues through
-/// [`so3::exp`] (w = [`e_ij_to_so3`] of the coordinates). n > 3: scaling and squaring with the
-/// diagonal Padé(13) approximant (Higham 2005): ‖ξ/2ˢ‖₁ ≤ θ₁₃ = 5.37, r = (V − U)⁻¹ (V + U) with
-/// U, V the odd and even parts of the Padé numerator, then s squarings. For skew ξ, V is
+/// [`so3::exp`] (w = [`e_ij_to_so3`] of the coordinates). n > 3: scaling and squaring with
+/// diagonal Padé approximants of degree m = 3, 5, 7, 9 or 13 chosen by ‖ξ‖₁ (Higham 2005, as
+/// scipy's expm): r = (V − U)⁻¹ (V + U) with U, V the odd and even parts of the Padé numerator,
+/// on ξ/2ˢ with ‖ξ/2ˢ‖₁ ≤ θ₁₃ = 5.37 when m = 13, then s squarings. For skew ξ, V is
 /// symmetric and U skew, so r is orthogonal up to rounding (diagonal Padé approximants map
 /// so(n) into SO(n)); after squarings, one Newton–Schulz step R ← R (3I − RᵀR)/2 squares the
 /// accumulated O(2ˢ ε) orthogonality defect away, so ‖RᵀR − I‖ stays at round-off for |ξ| up to
@@ -265,26 +266,56 @@ fn spectral_fn(u: faer::MatRef<'_, f64>, f: &[f64]) -> Mat {
     uf * u.transpose()
 }
 
-/// Padé(13) coefficients b_0, …, b_13 of exp (Higham 2005, Table 2.3 / scipy's expm).
-const PADE13: [f64; 14] = [
-    64764752532480000.0,
-    32382376266240000.0,
-    7771770303897600.0,
-    1187353796428800.0,
-    129060195264000.0,
-    10559470521600.0,
-    670442572800.0,
-    33522128640.0,
-    1323241920.0,
-    40840800.0,
-    960960.0,
-    16380.0,
-    182.0,
-    1.0,
+/// Coefficients b_0, …, b_m of the diagonal Padé approximants of exp of degree m = 3, 5, 7, 9, 13
+/// with their thresholds θ_m on ‖A‖₁ below which the approximation error is under the unit
+/// round-off (Higham 2005, Tables 2.3 and 10.2; the same as scipy's expm).
+const PADE: [(f64, &[f64]); 5] = [
+    (1.495585217958292e-2, &[120.0, 60.0, 12.0, 1.0]),
+    (
+        2.53939833006323e-1,
+        &[30240.0, 15120.0, 3360.0, 420.0, 30.0, 1.0],
+    ),
+    (
+        9.504178996162932e-1,
+        &[
+            17297280.0, 8648640.0, 1995840.0, 277200.0, 25200.0, 1512.0, 56.0, 1.0,
+        ],
+    ),
+    (
+        2.097847961257068,
+        &[
+            17643225600.0,
+            8821612800.0,
+            2075673600.0,
+            302702400.0,
+            30270240.0,
+            2162160.0,
+            110880.0,
+            3960.0,
+            90.0,
+            1.0,
+        ],
+    ),
+    (
+        5.371920351148152,
+        &[
+            64764752532480000.0,
+            32382376266240000.0,
+            7771770303897600.0,
+            1187353796428800.0,
+            129060195264000.0,
+            10559470521600.0,
+            670442572800.0,
+            33522128640.0,
+            1323241920.0,
+            40840800.0,
+            960960.0,
+            16380.0,
+            182.0,
+            1.0,
+        ],
+    ),
 ];
-
-/// ‖A/2ˢ‖₁ ≤ θ_13 = 5.37 keeps the Padé(13) error below the unit round-off (Higham 2005).
-const PADE13_THETA: f64 = 5.371920351148152;
 
 fn norm_1(a: &Mat) -> f64 {
     (0..a.ncols())
@@ -292,30 +323,54 @@ fn norm_1(a: &Mat) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Scaling and squaring with the diagonal Padé(13) approximant r = (V − U)⁻¹ (V + U), U the odd
-/// and V the even part of its numerator. For skew ξ, V is symmetric and U skew, so r is exactly
-/// orthogonal in exact arithmetic (a diagonal Padé approximant of exp maps so(n) into SO(n)).
+/// Σ_k c_k P_k + c0 I over matrices P_k of one size, in one pass.
+fn lin_comb(n: usize, terms: &[(f64, &Mat)], c0: f64) -> Mat {
+    Mat::from_fn(n, n, |i, j| {
+        let d = if i == j { c0 } else { 0.0 };
+        terms.iter().map(|(c, p)| c * p[(i, j)]).sum::<f64>() + d
+    })
+}
+
+/// Scaling and squaring with diagonal Padé approximants r_m = (V − U)⁻¹ (V + U), U the odd and V
+/// the even part of the numerator, m the lowest degree whose θ_m bounds ‖ξ‖₁, else m = 13 on
+/// ξ/2ˢ (Higham 2005). For skew ξ, V is symmetric and U skew, so r_m is orthogonal up to
+/// rounding (diagonal Padé approximants map so(n) into SO(n)).
 fn exp_pade(xi: &Mat) -> Mat {
     let n = xi.nrows();
     let nrm = norm_1(xi);
-    let s = if nrm > PADE13_THETA {
-        (nrm / PADE13_THETA).log2().ceil() as i32
-    } else {
-        0
+    let (theta13, b13) = PADE[4];
+    let (s, b) = match PADE.iter().find(|(theta, _)| nrm <= *theta) {
+        Some((_, b)) => (0, *b),
+        None => ((nrm / theta13).log2().ceil() as i32, b13),
     };
     let a = xi * faer::Scale(0.5f64.powi(s));
     let a2 = &a * &a;
-    let a4 = &a2 * &a2;
-    let a6 = &a4 * &a2;
-    let b = &PADE13;
-    let comb = |c6: f64, c4: f64, c2: f64, c0: f64| {
-        Mat::from_fn(n, n, |i, j| {
-            let d = if i == j { c0 } else { 0.0 };
-            c6 * a6[(i, j)] + c4 * a4[(i, j)] + c2 * a2[(i, j)] + d
-        })
+    let (u, v) = if b.len() == 14 {
+        let a4 = &a2 * &a2;
+        let a6 = &a4 * &a2;
+        let t = |c: [usize; 3]| [(b[c[0]], &a6), (b[c[1]], &a4), (b[c[2]], &a2)];
+        let u = &a * (&a6 * lin_comb(n, &t([13, 11, 9]), 0.0) + lin_comb(n, &t([7, 5, 3]), b[1]));
+        let v = &a6 * lin_comb(n, &t([12, 10, 8]), 0.0) + lin_comb(n, &t([6, 4, 2]), b[0]);
+        (u, v)
+    } else {
+        // Even powers A², A⁴, … up to A^(m−1).
+        let mut pows = vec![a2];
+        while 2 * pows.len() + 2 < b.len() - 1 {
+            let next = &pows[pows.len() - 1] * &pows[0];
+            pows.push(next);
+        }
+        let odd: Vec<(f64, &Mat)> = pows
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (b[2 * k + 3], p))
+            .collect();
+        let even: Vec<(f64, &Mat)> = pows
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (b[2 * k + 2], p))
+            .collect();
+        (&a * lin_comb(n, &odd, b[1]), lin_comb(n, &even, b[0]))
     };
-    let u = &a * (&a6 * comb(b[13], b[11], b[9], 0.0) + comb(b[7], b[5], b[3], b[1]));
-    let v = &a6 * comb(b[12], b[10], b[8], 0.0) + comb(b[6], b[4], b[2], b[0]);
     let mut r = (&v - &u).partial_piv_lu().solve(&v + &u);
     for _ in 0..s {
         r = &r * &r;
