@@ -222,8 +222,8 @@ pub fn norm(xi: &Mat) -> f64 {
 ///
 /// n = 2: exp [[0, a], [−a, 0]] = [[cos a, sin a], [−sin a, cos a]]. n = 3: Rodrigues through
 /// [`so3::exp`] (w = [`e_ij_to_so3`] of the coordinates). n > 3: scaling and squaring with
-/// diagonal Padé approximants of degree m = 3, 5, 7, 9 or 13 chosen by ‖ξ‖₁ (Higham 2005, as
-/// scipy's expm): r = (V − U)⁻¹ (V + U) with U, V the odd and even parts of the Padé numerator,
+/// diagonal Padé approximants of degree m = 3, 5, 7, 9 or 13 chosen from ‖ξᵖ‖₁^{1/p} (Higham
+/// 2005, Al-Mohy & Higham 2009, as scipy's expm): r = (V − U)⁻¹ (V + U) with U, V the odd and even parts of the Padé numerator,
 /// on ξ/2ˢ with ‖ξ/2ˢ‖₁ ≤ θ₁₃ = 5.37 when m = 13, then s squarings. For skew ξ, V is
 /// symmetric and U skew, so r is orthogonal up to rounding (diagonal Padé approximants map
 /// so(n) into SO(n)); after squarings, one Newton–Schulz step R ← R (3I − RᵀR)/2 squares the
@@ -332,53 +332,78 @@ fn lin_comb(n: usize, terms: &[(f64, &Mat)], c0: f64) -> Mat {
 }
 
 /// Scaling and squaring with diagonal Padé approximants r_m = (V − U)⁻¹ (V + U), U the odd and V
-/// the even part of the numerator, m the lowest degree whose θ_m bounds ‖ξ‖₁, else m = 13 on
-/// ξ/2ˢ (Higham 2005). For skew ξ, V is symmetric and U skew, so r_m is orthogonal up to
-/// rounding (diagonal Padé approximants map so(n) into SO(n)).
+/// the even part of the numerator (Higham 2005). The degree m and the scaling s follow
+/// Al-Mohy & Higham 2009 (as scipy's expm): with d_p = ‖ξᵖ‖₁^{1/p} from the exact powers
+/// ξ², ξ⁴, ξ⁶ (and the bounds d₈ ≤ min(d₄, (‖ξ²‖‖ξ⁶‖)^{1/8}), d₁₀ ≤ (‖ξ⁴‖‖ξ⁶‖)^{1/10}), the lowest
+/// m ∈ {3, 5, 7, 9} with max(d's) ≤ θ_m, else m = 13 on ξ/2ˢ. For skew ξ, V is symmetric and
+/// U skew, so r_m is orthogonal up to rounding (diagonal Padé approximants map so(n) into
+/// SO(n)); after s ≥ 1 squarings one Newton–Schulz step removes the accumulated defect.
 fn exp_pade(xi: &Mat) -> Mat {
-    let n = xi.nrows();
-    let nrm = norm_1(xi);
-    let (theta13, b13) = PADE[4];
-    let (s, b) = match PADE.iter().find(|(theta, _)| nrm <= *theta) {
-        Some((_, b)) => (0, *b),
-        None => ((nrm / theta13).log2().ceil() as i32, b13),
-    };
-    let a = xi * faer::Scale(0.5f64.powi(s));
-    let a2 = &a * &a;
-    let (u, v) = if b.len() == 14 {
-        let a4 = &a2 * &a2;
-        let a6 = &a4 * &a2;
-        let t = |c: [usize; 3]| [(b[c[0]], &a6), (b[c[1]], &a4), (b[c[2]], &a2)];
-        let u = &a * (&a6 * lin_comb(n, &t([13, 11, 9]), 0.0) + lin_comb(n, &t([7, 5, 3]), b[1]));
-        let v = &a6 * lin_comb(n, &t([12, 10, 8]), 0.0) + lin_comb(n, &t([6, 4, 2]), b[0]);
-        (u, v)
+    let a2 = xi * xi;
+    let a4 = &a2 * &a2;
+    let a6 = &a4 * &a2;
+    let (n2, n4, n6) = (norm_1(&a2), norm_1(&a4), norm_1(&a6));
+    let (d4, d6) = (n4.powf(0.25), n6.powf(1.0 / 6.0));
+    let d8 = d4.min((n2 * n6).powf(0.125));
+    let d10 = (n4 * n6).powf(0.1);
+    let eta1 = d4.max(d6);
+    let eta3 = d6.max(d8);
+    let theta = |m: usize| PADE[m].0;
+    let (u, v) = if eta1 <= theta(0) {
+        pade_low(xi, &[&a2], PADE[0].1)
+    } else if eta1 <= theta(1) {
+        pade_low(xi, &[&a2, &a4], PADE[1].1)
+    } else if eta3 <= theta(2) {
+        pade_low(xi, &[&a2, &a4, &a6], PADE[2].1)
+    } else if eta3 <= theta(3) {
+        pade_low(xi, &[&a2, &a4, &a6, &(&a4 * &a4)], PADE[3].1)
     } else {
-        // Even powers A², A⁴, … up to A^(m−1).
-        let mut pows = vec![a2];
-        while 2 * pows.len() + 2 < b.len() - 1 {
-            let next = &pows[pows.len() - 1] * &pows[0];
-            pows.push(next);
+        let eta5 = eta3.min(d8.max(d10));
+        let s = (eta5 / theta(4)).log2().ceil().max(0.0) as i32;
+        let (u, v) = pade13(
+            &(xi * faer::Scale(0.5f64.powi(s))),
+            &(a2 * faer::Scale(0.25f64.powi(s))),
+            &(a4 * faer::Scale(0.0625f64.powi(s))),
+            &(a6 * faer::Scale(0.015625f64.powi(s))),
+        );
+        let mut r = solve_pade(&u, &v);
+        for _ in 0..s {
+            r = &r * &r;
         }
-        let odd: Vec<(f64, &Mat)> = pows
-            .iter()
-            .enumerate()
-            .map(|(k, p)| (b[2 * k + 3], p))
-            .collect();
-        let even: Vec<(f64, &Mat)> = pows
-            .iter()
-            .enumerate()
-            .map(|(k, p)| (b[2 * k + 2], p))
-            .collect();
-        (&a * lin_comb(n, &odd, b[1]), lin_comb(n, &even, b[0]))
+        return if s == 0 { r } else { newton_schulz_step(&r) };
     };
-    let mut r = (&v - &u).partial_piv_lu().solve(&v + &u);
-    for _ in 0..s {
-        r = &r * &r;
-    }
-    if s == 0 {
-        return r;
-    }
-    newton_schulz_step(&r)
+    solve_pade(&u, &v)
+}
+
+/// r = (V − U)⁻¹ (V + U).
+fn solve_pade(u: &Mat, v: &Mat) -> Mat {
+    (v - u).partial_piv_lu().solve(v + u)
+}
+
+/// U and V of the Padé approximant of degree m ≤ 9 from the even powers A², A⁴, … , A^(m−1).
+fn pade_low(a: &Mat, pows: &[&Mat], b: &[f64]) -> (Mat, Mat) {
+    let n = a.nrows();
+    let odd: Vec<(f64, &Mat)> = pows
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (b[2 * k + 3], *p))
+        .collect();
+    let even: Vec<(f64, &Mat)> = pows
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (b[2 * k + 2], *p))
+        .collect();
+    (a * lin_comb(n, &odd, b[1]), lin_comb(n, &even, b[0]))
+}
+
+/// U and V of the Padé approximant of degree 13 (Higham 2005, (10.35)).
+fn pade13(a: &Mat, a2: &Mat, a4: &Mat, a6: &Mat) -> (Mat, Mat) {
+    let n = a.nrows();
+    let b = PADE[4].1;
+    let t = |c: [usize; 3]| [(b[c[0]], a6), (b[c[1]], a4), (b[c[2]], a2)];
+    let u = a * (a6 * lin_comb(n, &t([13, 11, 9]), 0.0) + lin_comb(n, &t([7, 5, 3]), b[1]));
+    let v = a6 * lin_comb(n, &t([12, 10, 8]), 0.0) + lin_comb(n, &t([6, 4, 2]), b[0]);
+    (u, v)
 }
 
 /// One Newton–Schulz step toward the orthogonal polar factor: R (3I − RᵀR)/2. Squares the
