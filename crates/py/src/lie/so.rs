@@ -3,33 +3,58 @@
 
 use lieflow::lie::{product, so};
 use lieflow::{Mat, Result};
-use numpy::{PyArray2, PyArray3};
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
 use crate::convert::{mat, mats, py_mat, py_mats, py_vec, py_vecs, vectors, ArrayIn};
 use crate::errors::IntoPy;
 
-/// Applies `f` to one matrix or to a batch (b, n, n); a batch runs in parallel (rayon) with the
-/// GIL released. Returns an (n, n) or (b, n, n) array.
+/// Applies `f` to one matrix or to a batch (b, n, n). A batch is copied once into a contiguous
+/// buffer, then converted, mapped and written to the output in parallel (rayon) with the GIL
+/// released. Returns an (n, n) or (b, n, n) array.
 fn map_mats<'py>(
     py: Python<'py>,
     what: &str,
     a: &ArrayIn<'py>,
     f: fn(&Mat) -> Result<Mat>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (ms, batched) = mats(what, a)?;
-    if !batched {
-        return Ok(py_mat(py, &f(&ms[0]).py()?).into_any());
+    let v = a.as_array();
+    if v.ndim() != 3 {
+        return Ok(py_mat(py, &f(&mat(what, a)?).py()?).into_any());
     }
+    let (b, r, c) = (v.shape()[0], v.shape()[1], v.shape()[2]);
+    if r * c == 0 {
+        // Let the core report the shape error of an empty matrix.
+        f(&Mat::zeros(r, c)).py()?;
+    }
+    let data: Vec<f64> = match v.as_slice() {
+        Some(s) => s.to_vec(),
+        None => v.iter().copied().collect(),
+    };
     let out = py
-        .detach(|| ms.par_iter().map(f).collect::<Result<Vec<Mat>>>())
+        .detach(|| -> Result<Vec<f64>> {
+            let mut out = vec![0.0; data.len()];
+            if b > 0 {
+                out.par_chunks_mut(r * c)
+                    .zip(data.par_chunks(r * c))
+                    .try_for_each(|(o, x)| {
+                        let y = f(&Mat::from_fn(r, c, |i, j| x[i * c + j]))?;
+                        for i in 0..r {
+                            for j in 0..c {
+                                o[i * c + j] = y[(i, j)];
+                            }
+                        }
+                        Ok(())
+                    })?;
+            }
+            Ok(out)
+        })
         .py()?;
-    if out.is_empty() {
-        let n = a.as_array().shape()[1];
-        return Ok(PyArray3::<f64>::zeros(py, [0, n, n], false).into_any());
-    }
-    Ok(py_mats(py, &out).into_any())
+    let arr = Array3::from_shape_vec((b, r, c), out)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    Ok(arr.into_pyarray(py).into_any())
 }
 
 /// Skew-symmetric matrix with coordinates `c` in the e_ij basis (i < j, +1 at (i, j), −1 at
