@@ -105,7 +105,7 @@ proptest! {
         prop_assert!(dist(&br.0, &(&u.0 * &v.0 - &v.0 * &u.0)) < 1e-14);
         prop_assert!(dist(&br.1, &(&u.1 * &v.1 - &v.1 * &u.1)) < 1e-14);
         let s = so::pairing(&u.0, &v.0) + so::pairing(&u.1, &v.1);
-        prop_assert!((product::pairing(&u, &v) - s).abs() < 1e-14);
+        prop_assert!((product::pairing(&u, &v).unwrap() - s).abs() < 1e-14);
         // Coordinates: ξ block first, then η block.
         let c = SOnProduct::coords(&u);
         prop_assert_eq!(&c[..d], &so::vee_n(&u.0).unwrap()[..]);
@@ -398,6 +398,10 @@ fn error_paths() {
     assert!(product::bracket(&(x3.clone(), x3.clone()), &(x4.clone(), x4.clone())).is_err());
     assert!(product::bracket(&(x3.clone(), nan.clone()), &(x3.clone(), x3.clone())).is_err());
     assert!(SOnProduct::identity(0).is_err());
+    assert!(product::pairing(&(x3.clone(), x3.clone()), &(x4.clone(), x4.clone())).is_err());
+    // The unchecked kernels never panic on mismatched sizes: they return NaN.
+    assert!(so::pairing(&x3, &x4).is_nan());
+    assert!(so::bracket(&x3, &x4)[(0, 0)].is_nan());
     // The trait's exp never panics on bad input: it returns NaN.
     let e = SOn::exp(&nan).into_mat();
     assert!(e[(0, 0)].is_nan() || e[(0, 1)].is_nan());

@@ -93,7 +93,14 @@ fn bracket_unchecked(a: &PairAlgebra, b: &PairAlgebra) -> PairAlgebra {
 }
 
 /// The pairing on so(n) ⊕ so(n): ⟨(μ, ν), (ξ, η)⟩ = ⟨μ, ξ⟩ + ⟨ν, η⟩ (001 (6.8)).
-pub fn pairing(a: &PairAlgebra, b: &PairAlgebra) -> f64 {
+pub fn pairing(a: &PairAlgebra, b: &PairAlgebra) -> Result<f64> {
+    let n = check_pair("a", a)?;
+    so::check_algebra_of("b.0", &b.0, n)?;
+    so::check_algebra_of("b.1", &b.1, n)?;
+    Ok(pairing_unchecked(a, b))
+}
+
+fn pairing_unchecked(a: &PairAlgebra, b: &PairAlgebra) -> f64 {
     so::pairing(&a.0, &b.0) + so::pairing(&a.1, &b.1)
 }
 
@@ -149,7 +156,7 @@ impl MatrixLieGroup for SOnProduct {
         (SOn::ad_star(&x.0, &mu.0), SOn::ad_star(&x.1, &mu.1))
     }
     fn pairing(mu: &PairAlgebra, x: &PairAlgebra) -> f64 {
-        pairing(mu, x)
+        pairing_unchecked(mu, x)
     }
     fn matrix(&self) -> Mat {
         block_diag(self.g.as_mat(), self.h.as_mat())

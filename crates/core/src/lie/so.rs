@@ -90,13 +90,22 @@ pub fn skew_defect(xi: &Mat) -> f64 {
     sym.sqrt() / all.sqrt().max(1.0)
 }
 
-/// Lie bracket [ξ, η] = ξη − ηξ.
+/// Lie bracket [ξ, η] = ξη − ηξ. Unchecked (see [`ad`]); never panics: operands of different
+/// or non-square shapes give a matrix of NaN.
 pub fn bracket(xi: &Mat, eta: &Mat) -> Mat {
+    let n = xi.nrows();
+    if xi.ncols() != n || eta.nrows() != n || eta.ncols() != n {
+        return nan_mat(n, xi.ncols());
+    }
     xi * eta - eta * xi
 }
 
-/// Pairing ⟨ξ, η⟩ = ½ tr(ξᵀη) on so(n) (001 (2.8)).
+/// Pairing ⟨ξ, η⟩ = ½ tr(ξᵀη) on so(n) (001 (2.8)). Unchecked; NaN for operands of different
+/// shapes.
 pub fn pairing(xi: &Mat, eta: &Mat) -> f64 {
+    if xi.nrows() != eta.nrows() || xi.ncols() != eta.ncols() {
+        return f64::NAN;
+    }
     let mut s = 0.0;
     for j in 0..xi.ncols() {
         for i in 0..xi.nrows() {
