@@ -332,12 +332,16 @@ fn norm_1(a: &Mat) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Σ_k c_k P_k + c0 I over matrices P_k of one size, in one pass.
+/// Σ_k c_k P_k + c0 I over n×n matrices P_k (fused, vectorized passes).
 fn lin_comb(n: usize, terms: &[(f64, &Mat)], c0: f64) -> Mat {
-    Mat::from_fn(n, n, |i, j| {
-        let d = if i == j { c0 } else { 0.0 };
-        terms.iter().map(|(c, p)| c * p[(i, j)]).sum::<f64>() + d
-    })
+    let mut out = Mat::zeros(n, n);
+    for &(c, p) in terms {
+        faer::zip!(&mut out, p).for_each(|faer::unzip!(o, x)| *o += c * *x);
+    }
+    for i in 0..n {
+        out[(i, i)] += c0;
+    }
+    out
 }
 
 /// Scaling and squaring with diagonal Padé approximants r_m = (V − U)⁻¹ (V + U), U the odd and V
