@@ -287,7 +287,7 @@ fn log_near_pi_and_at_pi() {
         let angles = vec![PI - 1e-3; n / 2];
         let (xi, r) = planes(n, &angles, &q);
         let l = so::log(&r).unwrap();
-        assert!(dist(&l, &xi) < 1e-9, "n = {n}: {:.3e}", dist(&l, &xi));
+        assert!(dist(&l, &xi) < 1e-12, "n = {n}: {:.3e}", dist(&l, &xi));
         let (_, r) = planes(n, &[PI], &q);
         match so::log(&r) {
             Err(e @ Error::NoUniqueLog { .. }) => {
@@ -409,27 +409,29 @@ fn error_paths() {
     assert!(e[(0, 0)].is_nan());
 }
 
-/// Near π the logarithm loses accuracy like ε_mach / (π − θ) (its condition number); lieflow
-/// stays within a small factor of that (measured: ~2·10⁻¹⁰ at π − θ = 2·10⁻⁶, n = 8).
+/// Near π, log takes the rotation planes from the symmetric part of R (accurate there) instead
+/// of the skew part (accurate only to ε/sin θ): log and exp∘log stay at round-off up to the
+/// rejection threshold (before this, the error grew like 10⁻¹⁵/(π − θ)).
 #[test]
-fn log_accuracy_near_pi_follows_the_condition_number() {
+fn log_near_pi_stays_at_round_off() {
     for n in [3, 4, 5, 8] {
         let q = rot(n, &vec![0.4; so::dim(n)]);
         for eps in [1e-2, 1e-3, 1e-4, 1e-5, 2e-6] {
             let mut angles = vec![0.7; n / 2];
             angles[0] = PI - eps;
+            if n >= 8 {
+                angles[2] = PI - eps; // a 4-dimensional cluster of equal obtuse angles
+                angles[3] = 2.0;
+            }
             let (xi, r) = planes(n, &angles, &q);
             let l = so::log(&r).unwrap();
-            assert!(
-                dist(&l, &xi) < 2e-15 / eps + 1e-13,
-                "n={n} ε={eps:e}: {:.2e}",
-                dist(&l, &xi)
-            );
+            let e = dist(&l, &xi);
+            // In a cluster of several planes with one angle only A determines J: there ξ is as
+            // ill-conditioned as θ / sin θ (R itself is still reproduced to round-off).
+            let tol = if n >= 8 { 1e-13 + 1e-15 / eps } else { 1e-13 };
+            assert!(e < tol, "n={n} ε={eps:e}: log {e:.2e}");
             let back = dist(&so::exp(&l).unwrap(), &r);
-            assert!(
-                back < 1e-15 / eps + 1e-13,
-                "n={n} ε={eps:e}: exp∘log {back:.2e}"
-            );
+            assert!(back < 1e-13, "n={n} ε={eps:e}: exp∘log {back:.2e}");
         }
     }
 }

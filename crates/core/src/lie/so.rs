@@ -452,11 +452,14 @@ fn check_angle(what: &str, angle: f64) -> Result<()> {
 
 /// Principal logarithm SO(n) → so(n): the ξ with exp ξ = R and all rotation angles in [0, π).
 ///
-/// With C = (R + Rᵀ)/2 = cos(√S) and A = (R − Rᵀ)/2 = ξ sinc(√S) (see [`exp`]),
-/// ξ = g(C) A with g = θ / sin θ, a function of the symmetric C evaluated through its
-/// eigendecomposition C = U diag(cos θ_j) Uᵀ, with sin θ_j = ‖A u_j‖ and θ_j = atan2(sin θ_j,
-/// cos θ_j) (stable near θ = 0 and as accurate as the data allows near π). n = 2 and n = 3 have a single rotation plane: θ = atan2(|A|, cos θ) with
-/// cos θ = (tr R − n + 2)/2 and ξ = (θ / |A|) A, |A| = sin θ the pairing norm.
+/// With C = (R + Rᵀ)/2 = cos(√S) and A = (R − Rᵀ)/2 = ξ sinc(√S) (S = ξᵀξ, see [`exp`]) and
+/// the eigendecomposition C = Σ cos θ_j u_j u_jᵀ, sin θ_j = ‖A u_j‖ and θ_j = atan2(sin θ_j,
+/// cos θ_j). On the acute eigenspaces (cos θ ≥ 0), ξ = g(C) A with g = θ / sin θ (stable near
+/// θ = 0). On each cluster of obtuse eigenvalues the rotation planes are taken from C (whose
+/// eigenvectors are accurate there, while A/sin θ loses accuracy like ε/sin θ near π), and the
+/// complex structure J from the orthogonal polar factor of A restricted to the cluster, so
+/// exp(log R) = R holds to round-off up to the rejection threshold [`LOG_PI_TOL`].
+/// n = 2: θ = atan2(R₁₂, R₁₁). n = 3 with θ ≤ π/2: ξ = (θ / |A|) A, θ = atan2(|A|, (tr R − 1)/2).
 ///
 /// Errors: `R` not a finite n×n rotation (‖RᵀR − I‖_F > [`ROTATION_TOL`] or det R ≤ 0) →
 /// [`Error::NotInGroup`]; a rotation angle within [`LOG_PI_TOL`] of π → [`Error::NoUniqueLog`]
@@ -481,42 +484,84 @@ fn log_rotation(r: &Mat) -> Result<Mat> {
             }))
         }
         3 => {
+            let cos = 0.5 * (r[(0, 0)] + r[(1, 1)] + r[(2, 2)] - 1.0);
+            if cos < 0.0 {
+                return log_spectral(r, &a);
+            }
             let s = norm(&a);
-            let c = 0.5 * (r[(0, 0)] + r[(1, 1)] + r[(2, 2)] - 1.0);
-            let angle = s.atan2(c);
-            check_angle("R", angle)?;
+            let angle = s.atan2(cos);
             let f = if s > 0.0 { angle / s } else { 1.0 };
             Ok(a * faer::Scale(f))
         }
-        _ => {
-            let c = (r + r.transpose()) * faer::Scale(0.5);
-            let eig = c
-                .self_adjoint_eigen(faer::Side::Lower)
-                .map_err(|_| Error::NotConverged {
-                    what: "symmetric eigendecomposition in so::log".into(),
-                    iterations: 0,
-                    residual: f64::NAN,
-                    tol: 0.0,
-                })?;
-            let lam = eig.S().column_vector();
-            // sin θ_j = ‖A u_j‖ for a unit eigenvector u_j of C (A u_j = sin θ_j J u_j): more
-            // accurate near π than √(1 − c_j²), so that θ_j = atan2(sin θ_j, cos θ_j) and
-            // g_j = θ_j / sin θ_j keep the conditioning of the problem there.
-            let au = &a * eig.U();
-            let mut g = vec![0.0; n];
-            let mut max_angle = 0.0f64;
-            for j in 0..n {
-                let s = au.col(j).norm_l2();
-                let angle = s.atan2(lam[j].clamp(-1.0, 1.0));
-                max_angle = max_angle.max(angle);
-                g[j] = if s > 0.0 { angle / s } else { 1.0 };
-            }
-            check_angle("R", max_angle)?;
-            let gm = spectral_fn(eig.U(), &g);
-            let xi = (&gm * &a + &a * &gm) * faer::Scale(0.5);
-            Ok((&xi - xi.transpose()) * faer::Scale(0.5))
+        _ => log_spectral(r, &a),
+    }
+}
+
+/// Eigenvalues of C closer than this are treated as one cluster (one rotation angle) in the
+/// obtuse part of [`log`].
+const LOG_CLUSTER_TOL: f64 = 1e-8;
+
+/// The spectral logarithm (n ≥ 3; n = 3 only for angles > π/2), see [`log`].
+fn log_spectral(r: &Mat, a: &Mat) -> Result<Mat> {
+    let n = r.nrows();
+    let c = (r + r.transpose()) * faer::Scale(0.5);
+    let eig = c
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|_| Error::NotConverged {
+            what: "symmetric eigendecomposition in so::log".into(),
+            iterations: 0,
+            residual: f64::NAN,
+            tol: 0.0,
+        })?;
+    let (u, lam) = (eig.U(), eig.S().column_vector());
+    // sin θ_j = ‖A u_j‖ for a unit eigenvector u_j of C (A u_j = sin θ_j J u_j) is accurate near
+    // π, unlike √(1 − c_j²).
+    let au = a * u;
+    let mut angle = vec![0.0; n];
+    let mut g = vec![0.0; n];
+    for j in 0..n {
+        let s = au.col(j).norm_l2();
+        angle[j] = s.atan2(lam[j].clamp(-1.0, 1.0));
+        g[j] = if s > 0.0 { angle[j] / s } else { 1.0 };
+    }
+    check_angle("R", angle.iter().copied().fold(0.0, f64::max))?;
+    // Eigenvalues ascend: the obtuse angles (cos θ < 0) come first, in clusters.
+    let obtuse = (0..n).take_while(|&j| lam[j] < 0.0).count();
+    let mut clusters = Vec::new();
+    let mut start = 0;
+    for j in 1..=obtuse {
+        if j == obtuse || lam[j] - lam[j - 1] > LOG_CLUSTER_TOL {
+            clusters.push((start, j));
+            start = j;
         }
     }
+    // Acute part (and odd clusters, which only rounding can produce): ξ = g(C) A.
+    let mut g_acute = g.clone();
+    for &(p, q) in &clusters {
+        if (q - p) % 2 == 0 {
+            g_acute[p..q].iter_mut().for_each(|x| *x = 0.0);
+        }
+    }
+    let gm = spectral_fn(u, &g_acute);
+    let mut xi = (&gm * a + a * &gm) * faer::Scale(0.5);
+    // Obtuse clusters: the plane(s) from the eigenvectors of C (accurate to ε, while A/sin θ
+    // is only accurate to ε/sin θ near π), the complex structure J as the orthogonal polar
+    // factor of B = V_cᵀ A V_c = sin θ J, and ξ_c = V_c ½(ΘJ + JΘ) V_cᵀ.
+    for &(p, q) in clusters.iter().filter(|(p, q)| (q - p) % 2 == 0) {
+        let vc = u.subcols(p, q - p);
+        let b = vc.transpose() * au.subcols(p, q - p);
+        let svd = b.svd().map_err(|_| Error::NotConverged {
+            what: "SVD in so::log".into(),
+            iterations: 0,
+            residual: f64::NAN,
+            tol: 0.0,
+        })?;
+        let j = svd.U() * svd.V().transpose();
+        let m = q - p;
+        let sym = Mat::from_fn(m, m, |k, l| 0.5 * (angle[p + k] + angle[p + l]) * j[(k, l)]);
+        xi += vc * sym * vc.transpose();
+    }
+    Ok((&xi - xi.transpose()) * faer::Scale(0.5))
 }
 
 // ---------------------------------------------------------------------------------------------
