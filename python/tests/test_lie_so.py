@@ -223,3 +223,12 @@ def test_exp_is_rotation_and_log_inverts(c):
             np.testing.assert_allclose(lie.so_exp(lie.so_log(R)), R, atol=1e-9)
         except lf.NoUniqueLogError:
             pass
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 7, 10])
+def test_log_of_haar_random_rotations(n):
+    rng = np.random.default_rng(n)
+    Rs = np.stack([rand_rot(n, rng) for _ in range(200)])
+    logs = lie.so_log(Rs)
+    np.testing.assert_array_equal(logs, -np.swapaxes(logs, 1, 2))
+    np.testing.assert_allclose(lie.so_exp(logs), Rs, atol=1e-13)
