@@ -453,3 +453,27 @@ fn exp_every_pade_degree_against_reference() {
         }
     }
 }
+
+/// The closed forms of dexp and dexp⁻¹ at n = 3 agree with the series route, run at n = 4 on
+/// the same matrices embedded in the upper-left 3×3 block (an invariant subalgebra).
+#[test]
+fn dexp_closed_form_n3_matches_series() {
+    let embed = |m: &Mat| Mat::from_fn(4, 4, |i, j| if i < 3 && j < 3 { m[(i, j)] } else { 0.0 });
+    let eta = hat(&[0.3, -0.8, 0.5]);
+    for scale in [0.0, 1e-5, 1e-3, 0.02, 0.5, 1.0, 2.0, 3.1, 7.0, 20.0] {
+        let xi = hat(&[0.6, 0.48, -0.64]) * faer::Scale(scale);
+        let closed = so::dexp(&xi, &eta).unwrap();
+        let series = so::dexp(&embed(&xi), &embed(&eta)).unwrap();
+        assert!(
+            dist(&embed(&closed), &series) < 1e-14 * (1.0 + scale),
+            "dexp, |ξ| = {scale}"
+        );
+        if scale < PI {
+            let closed = so::dexp_inv(&xi, &eta).unwrap();
+            let series = so::dexp_inv(&embed(&xi), &embed(&eta)).unwrap();
+            let e = dist(&embed(&closed), &series);
+            assert!(e < 1e-13, "dexp⁻¹, |ξ| = {scale}: {e:.2e}");
+        }
+    }
+    assert!(so::dexp_inv(&hat(&[0.0, 0.0, 3.2]), &eta).is_err());
+}

@@ -624,10 +624,14 @@ pub fn cayley_inv(r: &Mat) -> Result<Mat> {
 /// (the second is the left-trivialized form). Defined for every ξ: the series is summed at
 /// ξ/2ˢ with |ξ|/2ˢ ≤ ½ (terms fall at least like 0.71ᵏ/(k+1)!, truncated when below 10⁻¹⁷ of
 /// the sum) and doubled back s times with dexp_{2y} = ½ (dexp_y + Ad_{exp y} dexp_y), which
-/// avoids the cancellation of the raw series for large |ξ|.
+/// avoids the cancellation of the raw series for large |ξ|. n = 3: closed form
+/// (see [`dexp3`]).
 pub fn dexp(xi: &Mat, eta: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
     check_algebra_of("eta", eta, n)?;
+    if n == 3 {
+        return Ok(dexp3(xi, eta, false));
+    }
     let nx = norm(xi);
     let mut s = 0;
     while nx * 0.5f64.powi(s) > 0.5 {
@@ -649,6 +653,38 @@ pub fn dexp(xi: &Mat, eta: &Mat) -> Result<Mat> {
         sum = (&sum + &conj) * faer::Scale(0.5);
     }
     Ok(sum)
+}
+
+/// Closed forms at n = 3 through w = vee(ξ), v = vee(η) (physics convention, where ad_ξ is
+/// w × ·): with X = ad_ξ and θ = |w|,
+///
+///   dexp_ξ = (eˣ − 1)/X = I + (1 − cos θ)/θ² X + (θ − sin θ)/θ³ X²,
+///   dexp⁻¹_ξ = X/(eˣ − 1) = I − X/2 + (1 − (θ/2) cot(θ/2))/θ² X²
+///
+/// (from X³ = −θ² X), with Taylor coefficients for θ < 10⁻³.
+fn dexp3(xi: &Mat, eta: &Mat, inverse: bool) -> Mat {
+    let w = so3::vee(&to_matrix3(xi));
+    let v = so3::vee(&to_matrix3(eta));
+    let t2 = w.norm_squared();
+    let (a, b) = if inverse {
+        let c = if t2 < 1e-6 {
+            1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
+        } else {
+            let t = t2.sqrt();
+            (1.0 - 0.5 * t / (0.5 * t).tan()) / t2
+        };
+        (-0.5, c)
+    } else if t2 < 1e-6 {
+        (
+            0.5 - t2 / 24.0 + t2 * t2 / 720.0,
+            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
+        )
+    } else {
+        let t = t2.sqrt();
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    let wv = w.cross(&v);
+    from_matrix3(&so3::hat(&(v + wv * a + w.cross(&wv) * b)))
 }
 
 /// Coefficients b_k = B_k / k! of z / (eᶻ − 1) = Σ b_k zᵏ (B_1 = −½), from
@@ -688,12 +724,16 @@ fn zeta_direct(p: i32) -> f64 {
 /// Domain |ξ| < π (|ξ| the pairing norm, [`norm`]): the eigenvalues of ad_ξ are ±i(θ_j ± θ_k)
 /// and ±iθ_j, of modulus ≤ √2|ξ| < 2π, inside the radius of convergence 2π; the terms then fall
 /// at least like (√2|ξ|/2π)ᵏ ≤ 0.71ᵏ and the sum is truncated when a bound of the tail is below
-/// 10⁻¹⁷ of the sum. Outside the domain → [`Error::InvalidArgument`].
+/// 10⁻¹⁷ of the sum. n = 3: closed form (see [`dexp3`]). Outside the domain →
+/// [`Error::InvalidArgument`].
 pub fn dexp_inv(xi: &Mat, eta: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
     check_algebra_of("eta", eta, n)?;
     let nx = norm(xi);
     let pi = std::f64::consts::PI;
+    if n == 3 && nx < pi {
+        return Ok(dexp3(xi, eta, true));
+    }
     if nx >= pi {
         return Err(Error::invalid(
             "xi",
