@@ -402,6 +402,19 @@ fn error_paths() {
     // The unchecked kernels never panic on mismatched sizes: they return NaN.
     assert!(so::pairing(&x3, &x4).is_nan());
     assert!(so::bracket(&x3, &x4)[(0, 0)].is_nan());
+    // Huge arguments: a clear error, never a hang or an overflow.
+    let huge = hat(&[1e200, -3e199, 2e200]);
+    let huge5 = hat(&[1e200; 10]);
+    for h in [&huge, &huge5] {
+        assert!(matches!(so::exp(h), Err(Error::InvalidArgument { .. })));
+        let e = so::dexp(
+            h,
+            &so::hat_n_unchecked(h.nrows(), &vec![0.1; so::dim(h.nrows())]),
+        );
+        assert!(matches!(e, Err(Error::InvalidArgument { .. })));
+    }
+    assert!(so::dexp_inv(&huge, &x3).is_err());
+    assert!(so::exp_unchecked(&huge5)[(0, 0)].is_nan());
     // The trait's exp never panics on bad input: it returns NaN.
     let e = SOn::exp(&nan).into_mat();
     assert!(e[(0, 0)].is_nan() || e[(0, 1)].is_nan());

@@ -243,7 +243,23 @@ pub fn norm(xi: &Mat) -> f64 {
 /// Errors if `xi` is not a finite skew n×n matrix with n ≥ 2.
 pub fn exp(xi: &Mat) -> Result<Mat> {
     check_algebra("xi", xi)?;
+    check_exp_norm(xi)?;
     Ok(exp_unchecked(xi))
+}
+
+/// Largest |ξ| accepted by [`exp`] and [`dexp`]: beyond it ε_mach |ξ| exceeds 0.2 rad, so no
+/// rotation angle is determined any more (and the squarings would overflow for |ξ| ~ 10¹⁵⁴).
+pub const EXP_MAX_NORM: f64 = 1e15;
+
+fn check_exp_norm(xi: &Mat) -> Result<()> {
+    let nx = norm(xi);
+    if nx > EXP_MAX_NORM || !nx.is_finite() {
+        return Err(Error::invalid(
+            "xi",
+            format!("|ξ| = {nx:.3e} exceeds {EXP_MAX_NORM:.0e}: the rotation angles are lost to rounding"),
+        ));
+    }
+    Ok(())
 }
 
 /// [`exp`] without validation, for inner loops on known-good input. Never panics: a non-square
@@ -372,6 +388,9 @@ fn exp_pade(xi: &Mat) -> Mat {
         pade_low(xi, &[&a2, &a4, &a6, &(&a4 * &a4)], PADE[3].1)
     } else {
         let eta5 = eta3.min(d8.max(d10));
+        if !eta5.is_finite() {
+            return nan_mat(xi.nrows(), xi.ncols());
+        }
         let s = (eta5 / theta(4)).log2().ceil().max(0.0) as i32;
         let (u, v) = pade13(
             &(xi * faer::Scale(0.5f64.powi(s))),
@@ -629,6 +648,7 @@ pub fn cayley_inv(r: &Mat) -> Result<Mat> {
 pub fn dexp(xi: &Mat, eta: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
     check_algebra_of("eta", eta, n)?;
+    check_exp_norm(xi)?;
     if n == 3 {
         return Ok(dexp3(xi, eta, false));
     }
