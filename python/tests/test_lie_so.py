@@ -195,6 +195,13 @@ def test_error_paths():
         lie.dexp_inv(lie.hat_n([0.0, 0.0, 3.2]), xi)
     with pytest.raises(lf.InvalidArgumentError):
         lie.is_rotation(R, tol=-1.0)
+    huge = lie.hat_n([1e200, -3e199, 2e200, 1e200, 1e200, 1e200])
+    with pytest.raises(lf.InvalidArgumentError, match="1e15"):
+        lie.so_exp(huge)
+    with pytest.raises(lf.InvalidArgumentError):
+        lie.so_exp(np.stack([xi, 1e200 * xi]))
+    with pytest.raises(lf.InvalidArgumentError):
+        lie.dexp(huge, np.zeros((4, 4)))
     with pytest.raises(lf.NotInGroupError):
         lie.product_Ad(R, refl, xi, xi)
     with pytest.raises(lf.ShapeError):

@@ -115,7 +115,8 @@ fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
 /// Returns:
 ///     R: shape (n, n) or (b, n, n), in SO(n).
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (xi not skew).
+///     ShapeError, NonFiniteError, NotInGroupError (xi not skew),
+///     InvalidArgumentError (|ξ| > 1e15, where rounding leaves no angle information).
 #[pyfunction]
 fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
     map_mats(py, "xi", &xi, so::exp)
@@ -175,7 +176,7 @@ fn cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAr
 /// Returns:
 ///     skew matrix (n, n).
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (not skew).
+///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (|ξ| > 1e15).
 #[pyfunction]
 fn dexp<'py>(
     py: Python<'py>,
