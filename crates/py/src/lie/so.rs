@@ -1,5 +1,358 @@
-use pyo3::prelude::*;
+//! `lieflow.lie`: SO(n) and so(n) for any n ≥ 2, and SO(n) × SO(n) (bindings of
+//! `lieflow::lie::so` and `lieflow::lie::product`).
 
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+use lieflow::lie::{product, so};
+use lieflow::{Mat, Result};
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+
+use crate::convert::{mat, mats, py_mat, py_mats, py_vec, py_vecs, vectors, ArrayIn};
+use crate::errors::IntoPy;
+
+/// Applies `f` to one matrix or to a batch (b, n, n). A batch is copied once into a contiguous
+/// buffer, then converted, mapped and written to the output in parallel (rayon) with the GIL
+/// released. Returns an (n, n) or (b, n, n) array.
+fn map_mats<'py>(
+    py: Python<'py>,
+    what: &str,
+    a: &ArrayIn<'py>,
+    f: fn(&Mat) -> Result<Mat>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let v = a.as_array();
+    if v.ndim() != 3 {
+        return Ok(py_mat(py, &f(&mat(what, a)?).py()?).into_any());
+    }
+    let (b, r, c) = (v.shape()[0], v.shape()[1], v.shape()[2]);
+    if r * c == 0 {
+        // Let the core report the shape error of an empty matrix.
+        f(&Mat::zeros(r, c)).py()?;
+    }
+    let data: Vec<f64> = match v.as_slice() {
+        Some(s) => s.to_vec(),
+        None => v.iter().copied().collect(),
+    };
+    let out = py
+        .detach(|| -> Result<Vec<f64>> {
+            let mut out = vec![0.0; data.len()];
+            if b > 0 {
+                out.par_chunks_mut(r * c)
+                    .zip(data.par_chunks(r * c))
+                    .try_for_each(|(o, x)| {
+                        let y = f(&Mat::from_fn(r, c, |i, j| x[i * c + j]))?;
+                        for i in 0..r {
+                            for j in 0..c {
+                                o[i * c + j] = y[(i, j)];
+                            }
+                        }
+                        Ok(())
+                    })?;
+            }
+            Ok(out)
+        })
+        .py()?;
+    let arr = Array3::from_shape_vec((b, r, c), out)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    Ok(arr.into_pyarray(py).into_any())
+}
+
+/// Skew-symmetric matrix with coordinates `c` in the e_ij basis (i < j, +1 at (i, j), −1 at
+/// (j, i)), ordered (1,2), (1,3), …, (1,n), (2,3), …, (n−1,n).
+///
+/// Args:
+///     c: shape (d,) with d = n(n−1)/2 for some n ≥ 2, or a batch (b, d).
+/// Returns:
+///     xi: shape (n, n), or (b, n, n) for a batch.
+/// Raises:
+///     ShapeError: d is not of the form n(n−1)/2. NonFiniteError: NaN or inf in c.
+#[pyfunction]
+fn hat_n<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let (cs, batched) = vectors("c", &c)?;
+    let out = cs
+        .iter()
+        .map(|v| so::hat_n(v))
+        .collect::<Result<Vec<Mat>>>()
+        .py()?;
+    if batched {
+        Ok(py_mats(py, &out).into_any())
+    } else {
+        Ok(py_mat(py, &out[0]).into_any())
+    }
+}
+
+/// Coordinates of a skew-symmetric matrix in the e_ij basis (the inverse of `hat_n`).
+///
+/// Args:
+///     xi: shape (n, n), skew-symmetric (relative defect ‖ξ + ξᵀ‖ ≤ 1e-10), or a batch (b, n, n).
+/// Returns:
+///     c: shape (n(n−1)/2,), or (b, n(n−1)/2).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (not skew).
+#[pyfunction]
+fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let (ms, batched) = mats("xi", &xi)?;
+    let out = ms
+        .iter()
+        .map(so::vee_n)
+        .collect::<Result<Vec<Vec<f64>>>>()
+        .py()?;
+    if batched {
+        Ok(py_vecs(py, &out).into_any())
+    } else {
+        Ok(py_vec(py, &out[0]).into_any())
+    }
+}
+
+/// Exponential map so(n) → SO(n).
+///
+/// Closed form for n = 2, Rodrigues for n = 3, and for n > 3
+/// exp ξ = cos(√S) + ξ sinc(√S) with S = ξᵀξ (symmetric eigendecomposition), orthogonal to
+/// round-off even for |ξ| ~ 1e3.
+///
+/// Args:
+///     xi: skew matrix (n, n), or a batch (b, n, n) computed in parallel without the GIL.
+/// Returns:
+///     R: shape (n, n) or (b, n, n), in SO(n).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (xi not skew),
+///     InvalidArgumentError (|ξ| > 1e15, where rounding leaves no angle information).
+#[pyfunction]
+fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+    map_mats(py, "xi", &xi, so::exp)
+}
+
+/// Principal logarithm SO(n) → so(n) (all rotation angles in [0, π)).
+///
+/// Args:
+///     R: rotation (n, n) (‖RᵀR − I‖_F ≤ 1e-10, det R > 0), or a batch (b, n, n) computed in
+///         parallel without the GIL.
+/// Returns:
+///     xi: skew matrix (n, n) or (b, n, n) with so_exp(xi) = R.
+/// Raises:
+///     NotInGroupError: R not a rotation (the message gives ‖RᵀR − I‖_F and det R).
+///     NoUniqueLogError: a rotation angle within 1e-6 of π (the message gives the angle).
+///     ShapeError, NonFiniteError.
+#[pyfunction]
+#[allow(non_snake_case)]
+fn so_log<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+    map_mats(py, "R", &R, so::log)
+}
+
+/// Cayley map cay(ξ) = (I − ξ/2)⁻¹ (I + ξ/2), so(n) → SO(n).
+///
+/// Args:
+///     xi: skew matrix (n, n).
+/// Returns:
+///     R: rotation (n, n).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (not skew).
+#[pyfunction]
+fn cayley<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    Ok(py_mat(py, &so::cayley(&mat("xi", &xi)?).py()?))
+}
+
+/// Inverse Cayley map ξ = 2 (I + R)⁻¹ (R − I), the exact inverse of `cayley`.
+///
+/// Args:
+///     R: rotation (n, n).
+/// Returns:
+///     xi: skew matrix (n, n).
+/// Raises:
+///     InvalidArgumentError: I + R singular (R has an eigenvalue −1).
+///     NotInGroupError, ShapeError, NonFiniteError.
+#[pyfunction]
+#[allow(non_snake_case)]
+fn cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    Ok(py_mat(py, &so::cayley_inv(&mat("R", &R)?).py()?))
+}
+
+/// Right-trivialized derivative of exp: dexp_ξ η = Σ_k ad_ξᵏ η / (k+1)!, so that
+/// d/dt so_exp(ξ + tη) at t = 0 equals dexp(ξ, η) @ so_exp(ξ)
+/// (and so_exp(ξ) @ dexp(−ξ, η), the left-trivialized form). Any ξ.
+///
+/// Args:
+///     xi, eta: skew matrices (n, n).
+/// Returns:
+///     skew matrix (n, n).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (|ξ| > 1e15).
+#[pyfunction]
+fn dexp<'py>(
+    py: Python<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = so::dexp(&mat("xi", &xi)?, &mat("eta", &eta)?).py()?;
+    Ok(py_mat(py, &r))
+}
+
+/// Inverse of `dexp` (Bernoulli series Σ_k B_k/k! ad_ξᵏ η), for |ξ| < π where |ξ|² = ½ tr(ξᵀξ).
+///
+/// Args:
+///     xi, eta: skew matrices (n, n).
+/// Returns:
+///     skew matrix (n, n) with dexp(xi, result) = eta.
+/// Raises:
+///     InvalidArgumentError: |ξ| ≥ π. ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+fn dexp_inv<'py>(
+    py: Python<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = so::dexp_inv(&mat("xi", &xi)?, &mat("eta", &eta)?).py()?;
+    Ok(py_mat(py, &r))
+}
+
+/// Adjoint action Ad_g ξ = g ξ gᵀ of SO(n) on so(n).
+///
+/// Args:
+///     g: rotation (n, n). xi: skew matrix (n, n).
+/// Returns:
+///     skew matrix (n, n).
+/// Raises:
+///     NotInGroupError (g not a rotation or xi not skew), ShapeError, NonFiniteError.
+#[pyfunction]
+#[pyo3(name = "Ad")]
+fn adjoint<'py>(
+    py: Python<'py>,
+    g: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = so::adjoint(&mat("g", &g)?, &mat("xi", &xi)?).py()?;
+    Ok(py_mat(py, &r))
+}
+
+/// ad_ξ η = [ξ, η] = ξη − ηξ on so(n).
+///
+/// Args:
+///     xi, eta: skew matrices (n, n).
+/// Returns:
+///     skew matrix (n, n).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (not skew).
+#[pyfunction]
+fn ad<'py>(
+    py: Python<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = so::ad(&mat("xi", &xi)?, &mat("eta", &eta)?).py()?;
+    Ok(py_mat(py, &r))
+}
+
+/// Coadjoint action ad*_ξ μ = [μ, ξ], with so(n)* identified with so(n) by the pairing
+/// ⟨ξ, η⟩ = ½ tr(ξᵀη), so that ⟨ad*_ξ μ, η⟩ = ⟨μ, [ξ, η]⟩ (000 §3.3).
+///
+/// Args:
+///     xi, mu: skew matrices (n, n).
+/// Returns:
+///     skew matrix (n, n).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (not skew).
+#[pyfunction]
+fn ad_star<'py>(
+    py: Python<'py>,
+    xi: ArrayIn<'py>,
+    mu: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = so::ad_star(&mat("xi", &xi)?, &mat("mu", &mu)?).py()?;
+    Ok(py_mat(py, &r))
+}
+
+/// Whether R is in SO(n): ‖RᵀR − I‖_F ≤ tol and det R > 0.
+///
+/// Args:
+///     R: square matrix (n, n). tol: positive tolerance (default 1e-10).
+/// Returns:
+///     bool.
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError (tol not a positive number).
+#[pyfunction]
+#[pyo3(signature = (R, tol = so::ROTATION_TOL))]
+#[allow(non_snake_case)]
+fn is_rotation(R: ArrayIn<'_>, tol: f64) -> PyResult<bool> {
+    so::is_rotation(&mat("R", &R)?, tol).py()
+}
+
+/// Nearest rotation to M in the Frobenius norm: U D Vᵀ from the SVD M = U Σ Vᵀ with
+/// D = diag(1, …, 1, sign det(UVᵀ)) (the polar factor when det M > 0).
+///
+/// Args:
+///     M: square matrix (n, n).
+/// Returns:
+///     R: rotation (n, n).
+/// Raises:
+///     ShapeError, NonFiniteError.
+#[pyfunction]
+#[allow(non_snake_case)]
+fn project_to_so<'py>(py: Python<'py>, M: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    Ok(py_mat(py, &so::project_to_so(&mat("M", &M)?).py()?))
+}
+
+type Pair<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
+/// Adjoint action of SO(n) × SO(n) on so(n) ⊕ so(n): Ad_(g,h)(ξ, η) = (g ξ gᵀ, h η hᵀ)
+/// (componentwise, 001 (7.23)).
+///
+/// Args:
+///     g, h: rotations (n, n). xi, eta: skew matrices (n, n).
+/// Returns:
+///     (xi', eta'): two skew matrices (n, n).
+/// Raises:
+///     NotInGroupError, ShapeError, NonFiniteError.
+#[pyfunction]
+#[pyo3(name = "product_Ad")]
+fn product_adjoint<'py>(
+    py: Python<'py>,
+    g: ArrayIn<'py>,
+    h: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+) -> PyResult<Pair<'py>> {
+    let x = (mat("xi", &xi)?, mat("eta", &eta)?);
+    let (a, b) = product::adjoint(&mat("g", &g)?, &mat("h", &h)?, &x).py()?;
+    Ok((py_mat(py, &a), py_mat(py, &b)))
+}
+
+/// Bracket on so(n) ⊕ so(n), 001 (7.26): [(ξ', η'), (ξ, η)] = ([ξ', ξ], [η', η]).
+///
+/// Args:
+///     xi1, eta1, xi2, eta2: skew matrices (n, n).
+/// Returns:
+///     ([xi1, xi2], [eta1, eta2]): two skew matrices (n, n).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (not skew).
+#[pyfunction]
+fn product_bracket<'py>(
+    py: Python<'py>,
+    xi1: ArrayIn<'py>,
+    eta1: ArrayIn<'py>,
+    xi2: ArrayIn<'py>,
+    eta2: ArrayIn<'py>,
+) -> PyResult<Pair<'py>> {
+    let a = (mat("xi1", &xi1)?, mat("eta1", &eta1)?);
+    let b = (mat("xi2", &xi2)?, mat("eta2", &eta2)?);
+    let (x, y) = product::bracket(&a, &b).py()?;
+    Ok((py_mat(py, &x), py_mat(py, &y)))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(hat_n, m)?)?;
+    m.add_function(wrap_pyfunction!(vee_n, m)?)?;
+    m.add_function(wrap_pyfunction!(so_exp, m)?)?;
+    m.add_function(wrap_pyfunction!(so_log, m)?)?;
+    m.add_function(wrap_pyfunction!(cayley, m)?)?;
+    m.add_function(wrap_pyfunction!(cayley_inv, m)?)?;
+    m.add_function(wrap_pyfunction!(dexp, m)?)?;
+    m.add_function(wrap_pyfunction!(dexp_inv, m)?)?;
+    m.add_function(wrap_pyfunction!(adjoint, m)?)?;
+    m.add_function(wrap_pyfunction!(ad, m)?)?;
+    m.add_function(wrap_pyfunction!(ad_star, m)?)?;
+    m.add_function(wrap_pyfunction!(is_rotation, m)?)?;
+    m.add_function(wrap_pyfunction!(project_to_so, m)?)?;
+    m.add_function(wrap_pyfunction!(product_adjoint, m)?)?;
+    m.add_function(wrap_pyfunction!(product_bracket, m)?)?;
     Ok(())
 }

@@ -1,0 +1,77 @@
+"""so_exp from Python against scipy.linalg.expm on the same inputs.
+
+Run: python benches/python/bench_so_exp.py [--quick]
+
+For n = 3 and n = 50: one call, and a batch (10⁴ for n = 3; 10³ for n = 50, where 10⁴ inputs
+would be 200 MB of input and output and minutes of scipy time). scipy is timed as a Python loop
+over expm and as one call of expm on the stacked (b, n, n) array (supported since scipy 1.9).
+Prints a Markdown table of the best-of-k wall times.
+"""
+
+import argparse
+import os
+import time
+
+import numpy as np
+import scipy
+import scipy.linalg
+
+import lieflow as lf
+
+
+def best_time(f, repeat):
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        f()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def skew_batch(b, n, rng):
+    a = rng.normal(size=(b, n, n))
+    xi = a - np.swapaxes(a, 1, 2)
+    norms = np.sqrt(0.5 * np.einsum("bij,bij->b", xi, xi))
+    return xi * (1.5 / norms)[:, None, None]
+
+
+def fmt(t):
+    return f"{t * 1e6:.1f} µs" if t < 1e-3 else f"{t * 1e3:.2f} ms"
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--quick", action="store_true", help="fewer repeats and smaller batches")
+    args = p.parse_args()
+    rng = np.random.default_rng(0)
+    cases = [(3, 1), (3, 10_000), (50, 1), (50, 1_000)]
+    if args.quick:
+        cases = [(3, 1), (3, 1_000), (50, 1), (50, 100)]
+    print(f"lieflow {lf.__version__}, numpy {np.__version__}, scipy {scipy.__version__}, "
+          f"{os.cpu_count()} CPUs")
+    print()
+    print("| n | batch | lieflow so_exp | scipy expm loop | scipy expm stacked | "
+          "speed-up vs loop | speed-up vs stacked |")
+    print("|---|---|---|---|---|---|---|")
+    for n, b in cases:
+        xs = skew_batch(b, n, rng)
+        repeat = 3 if b > 1 else 200
+        if args.quick:
+            repeat = max(1, repeat // 10)
+        if b == 1:
+            x = xs[0]
+            t_lf = best_time(lambda: lf.lie.so_exp(x), repeat)
+            t_loop = best_time(lambda: scipy.linalg.expm(x), repeat)
+            t_stack = t_loop
+            np.testing.assert_allclose(lf.lie.so_exp(x), scipy.linalg.expm(x), atol=1e-12)
+        else:
+            t_lf = best_time(lambda: lf.lie.so_exp(xs), repeat)
+            t_loop = best_time(lambda: [scipy.linalg.expm(x) for x in xs], repeat)
+            t_stack = best_time(lambda: scipy.linalg.expm(xs), repeat)
+            np.testing.assert_allclose(lf.lie.so_exp(xs), scipy.linalg.expm(xs), atol=1e-12)
+        print(f"| {n} | {b} | {fmt(t_lf)} | {fmt(t_loop)} | {fmt(t_stack)} | "
+              f"{t_loop / t_lf:.1f}× | {t_stack / t_lf:.1f}× |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,241 @@
+"""Tests of the so(n)/SO(n) and SO(n)×SO(n) bindings: values against scipy, shapes, batches and
+every error path."""
+
+import numpy as np
+import pytest
+import scipy.linalg
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+import lieflow as lf
+from lieflow import lie
+
+RNG = np.random.default_rng(7)
+
+
+def rand_skew(n, scale=1.0, rng=RNG):
+    a = rng.normal(size=(n, n)) * scale
+    return a - a.T
+
+
+def rand_rot(n, rng=RNG):
+    q, r = np.linalg.qr(rng.normal(size=(n, n)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+def pairing(a, b):
+    return 0.5 * np.trace(a.T @ b)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5, 8, 12])
+def test_exp_log_against_scipy(n):
+    xi = rand_skew(n, 0.3)
+    R = lie.so_exp(xi)
+    assert R.shape == (n, n)
+    np.testing.assert_allclose(R, scipy.linalg.expm(xi), atol=1e-13)
+    np.testing.assert_allclose(lie.so_log(R), xi, atol=1e-12)
+    np.testing.assert_allclose(lie.so_log(R), np.real(scipy.linalg.logm(R)), atol=1e-10)
+
+
+def test_hat_vee_basis_order():
+    c = np.arange(1.0, 7.0)
+    m = lie.hat_n(c)
+    assert m.shape == (4, 4)
+    assert m[0, 1] == 1.0 and m[0, 3] == 3.0 and m[1, 2] == 4.0 and m[3, 2] == -6.0
+    np.testing.assert_array_equal(lie.vee_n(m), c)
+    batch = lie.hat_n(np.stack([c, 2 * c]))
+    assert batch.shape == (2, 4, 4)
+    np.testing.assert_array_equal(lie.vee_n(batch), np.stack([c, 2 * c]))
+
+
+def test_so3_coordinate_relation():
+    w = np.array([0.3, -1.1, 0.7])
+    c = np.array([-w[2], w[1], -w[0]])
+    np.testing.assert_array_equal(lie.hat_n(c), np.array(
+        [[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]))
+
+
+@pytest.mark.parametrize("n", [3, 6])
+def test_batch_matches_single_calls(n):
+    xs = np.stack([rand_skew(n) for _ in range(50)])
+    Rs = lie.so_exp(xs)
+    assert Rs.shape == (50, n, n)
+    for x, R in zip(xs, Rs):
+        np.testing.assert_array_equal(R, lie.so_exp(x))
+    np.testing.assert_allclose(scipy.linalg.expm(xs), Rs, atol=1e-12)
+    logs = lie.so_log(Rs)
+    assert logs.shape == (50, n, n)
+    np.testing.assert_allclose(lie.so_exp(logs), Rs, atol=1e-12)
+    assert lie.so_exp(np.zeros((0, n, n))).shape == (0, n, n)
+
+
+def test_large_argument_stays_orthogonal():
+    xi = rand_skew(10)
+    xi *= 1e3 / np.sqrt(pairing(xi, xi))
+    R = lie.so_exp(xi)
+    assert np.linalg.norm(R.T @ R - np.eye(10)) < 1e-13
+    assert abs(np.linalg.det(R) - 1) < 1e-13
+
+
+def test_cayley_and_inverse():
+    xi = rand_skew(5)
+    R = lie.cayley(xi)
+    np.testing.assert_allclose(R, np.linalg.solve(np.eye(5) - xi / 2, np.eye(5) + xi / 2),
+                               atol=1e-14)
+    assert lie.is_rotation(R)
+    np.testing.assert_allclose(lie.cayley_inv(R), xi, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [3, 5])
+def test_dexp_finite_differences_and_inverse(n):
+    xi, eta = rand_skew(n, 0.4), rand_skew(n)
+    h = 1e-6
+    fd = (scipy.linalg.expm(xi + h * eta) - scipy.linalg.expm(xi - h * eta)) / (2 * h)
+    R = scipy.linalg.expm(xi)
+    np.testing.assert_allclose(lie.dexp(xi, eta) @ R, fd, atol=1e-8)
+    np.testing.assert_allclose(R @ lie.dexp(-xi, eta), fd, atol=1e-8)
+    np.testing.assert_allclose(lie.dexp_inv(xi, lie.dexp(xi, eta)), eta, atol=1e-12)
+
+
+def test_Ad_ad_ad_star():
+    n = 4
+    g, xi, eta, mu = rand_rot(n), rand_skew(n), rand_skew(n), rand_skew(n)
+    np.testing.assert_allclose(lie.Ad(g, xi), g @ xi @ g.T, atol=1e-14)
+    np.testing.assert_allclose(lie.ad(xi, eta), xi @ eta - eta @ xi, atol=1e-14)
+    # ⟨ad*_ξ μ, η⟩ = ⟨μ, ad_ξ η⟩ under ½ tr(ξᵀη).
+    assert abs(pairing(lie.ad_star(xi, mu), eta) - pairing(mu, lie.ad(xi, eta))) < 1e-13
+
+
+def test_is_rotation_and_projection():
+    R = rand_rot(6)
+    assert lie.is_rotation(R) and lie.is_rotation(R, tol=1e-12)
+    assert not lie.is_rotation(1.01 * R)
+    refl = R.copy()
+    refl[:, 0] *= -1
+    assert not lie.is_rotation(refl)
+    np.testing.assert_allclose(lie.project_to_so(R), R, atol=1e-14)
+    M = R + 0.1 * RNG.normal(size=(6, 6))
+    P = lie.project_to_so(M)
+    assert lie.is_rotation(P)
+    if np.linalg.det(M) > 0:
+        np.testing.assert_allclose(P, scipy.linalg.polar(M)[0], atol=1e-12)
+    np.testing.assert_allclose(lie.project_to_so(P), P, atol=1e-14)
+    assert lie.is_rotation(lie.project_to_so(refl))
+
+
+def test_product_group():
+    g, h, xi, eta = rand_rot(3), rand_rot(3), rand_skew(3), rand_skew(3)
+    a, b = lie.product_Ad(g, h, xi, eta)
+    np.testing.assert_allclose(a, g @ xi @ g.T, atol=1e-14)
+    np.testing.assert_allclose(b, h @ eta @ h.T, atol=1e-14)
+    x2, e2 = rand_skew(3), rand_skew(3)
+    a, b = lie.product_bracket(xi, eta, x2, e2)
+    np.testing.assert_allclose(a, xi @ x2 - x2 @ xi, atol=1e-14)
+    np.testing.assert_allclose(b, eta @ e2 - e2 @ eta, atol=1e-14)
+
+
+def test_error_paths():
+    xi = rand_skew(3)
+    R = rand_rot(3)
+    nan = xi.copy()
+    nan[0, 1] = np.nan
+    inf = R.copy()
+    inf[2, 2] = np.inf
+    not_skew = xi + np.eye(3)
+    shapes = [np.zeros((2, 3)), np.zeros(3), np.zeros((1, 1)), np.zeros((2, 2, 2, 2))]
+    one_arg = [lie.so_exp, lie.so_log, lie.cayley, lie.cayley_inv, lie.project_to_so,
+               lie.is_rotation, lie.vee_n]
+    for f in one_arg:
+        for bad in shapes:
+            with pytest.raises(lf.ShapeError):
+                f(bad)
+    for f in [lie.so_exp, lie.cayley, lie.vee_n, lie.project_to_so, lie.is_rotation]:
+        with pytest.raises(lf.NonFiniteError):
+            f(nan)
+    for f in [lie.so_log, lie.cayley_inv, lie.project_to_so, lie.is_rotation]:
+        with pytest.raises(lf.NonFiniteError):
+            f(inf)
+    for f in [lie.so_exp, lie.cayley, lie.vee_n]:
+        with pytest.raises(lf.NotInGroupError):
+            f(not_skew)
+    with pytest.raises(lf.ShapeError):
+        lie.hat_n([1.0, 2.0])
+    with pytest.raises(lf.NonFiniteError):
+        lie.hat_n([1.0, np.nan, 0.0])
+    for two in [lie.dexp, lie.dexp_inv, lie.ad, lie.ad_star]:
+        with pytest.raises(lf.ShapeError):
+            two(xi, rand_skew(4))
+        with pytest.raises(lf.NonFiniteError):
+            two(xi, nan)
+        with pytest.raises(lf.NotInGroupError):
+            two(not_skew, xi)
+    with pytest.raises(lf.NotInGroupError):
+        lie.Ad(1.1 * R, xi)
+    with pytest.raises(lf.ShapeError):
+        lie.Ad(rand_rot(4), xi)
+    # Not a rotation: the message gives the orthogonality defect and the determinant.
+    refl = np.diag([1.0, 1.0, -1.0])
+    with pytest.raises(lf.NotInGroupError, match=r"‖RᵀR − I‖_F \(det R = -1"):
+        lie.so_log(refl)
+    with pytest.raises(lf.NotInGroupError):
+        lie.so_log(np.stack([R, 1.1 * R]))
+    # Rotation by π: the log is not unique; the message gives the angle.
+    half_turn = np.diag([-1.0, -1.0, 1.0, 1.0])
+    with pytest.raises(lf.NoUniqueLogError, match=r"angle 3\.14159265358979"):
+        lie.so_log(half_turn)
+    with pytest.raises(lf.NoUniqueLogError):
+        lie.so_log(np.diag([-1.0, -1.0, 1.0]))
+    with pytest.raises(lf.InvalidArgumentError, match="singular"):
+        lie.cayley_inv(half_turn)
+    with pytest.raises(lf.InvalidArgumentError, match="π"):
+        lie.dexp_inv(lie.hat_n([0.0, 0.0, 3.2]), xi)
+    with pytest.raises(lf.InvalidArgumentError):
+        lie.is_rotation(R, tol=-1.0)
+    huge = lie.hat_n([1e200, -3e199, 2e200, 1e200, 1e200, 1e200])
+    with pytest.raises(lf.InvalidArgumentError, match="1e15"):
+        lie.so_exp(huge)
+    with pytest.raises(lf.InvalidArgumentError):
+        lie.so_exp(np.stack([xi, 1e200 * xi]))
+    with pytest.raises(lf.InvalidArgumentError):
+        lie.dexp(huge, np.zeros((4, 4)))
+    with pytest.raises(lf.NotInGroupError):
+        lie.product_Ad(R, refl, xi, xi)
+    with pytest.raises(lf.ShapeError):
+        lie.product_bracket(xi, xi, rand_skew(4), rand_skew(4))
+
+
+skew_coords = st.integers(2, 8).flatmap(
+    lambda n: arrays(np.float64, n * (n - 1) // 2,
+                     elements=st.floats(-3.0, 3.0, allow_nan=False, allow_infinity=False)))
+
+
+@settings(max_examples=200, deadline=None)
+@given(skew_coords)
+def test_exp_is_rotation_and_log_inverts(c):
+    xi = lie.hat_n(c)
+    R = lie.so_exp(xi)
+    n = xi.shape[0]
+    assert np.linalg.norm(R.T @ R - np.eye(n)) < 1e-13
+    assert abs(np.linalg.det(R) - 1.0) < 1e-12
+    assert lie.is_rotation(R)
+    norm = np.linalg.norm(c)
+    if norm < np.pi - 1e-3:
+        np.testing.assert_allclose(lie.so_log(R), xi, atol=1e-10)
+    else:
+        try:
+            np.testing.assert_allclose(lie.so_exp(lie.so_log(R)), R, atol=1e-9)
+        except lf.NoUniqueLogError:
+            pass
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 7, 10])
+def test_log_of_haar_random_rotations(n):
+    rng = np.random.default_rng(n)
+    Rs = np.stack([rand_rot(n, rng) for _ in range(200)])
+    logs = lie.so_log(Rs)
+    np.testing.assert_array_equal(logs, -np.swapaxes(logs, 1, 2))
+    np.testing.assert_allclose(lie.so_exp(logs), Rs, atol=1e-13)
