@@ -1,6 +1,6 @@
 """Type stubs of ``lieflow.lie``."""
 
-from typing import Tuple
+from typing import Tuple, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -43,3 +43,70 @@ def product_Ad(g: _In, h: _In, xi: _In, eta: _In) -> Tuple[_F, _F]:
     """(g ξ gᵀ, h η hᵀ)."""
 def product_bracket(xi1: _In, eta1: _In, xi2: _In, eta2: _In) -> Tuple[_F, _F]:
     """([ξ1, ξ2], [η1, η2])."""
+
+
+# --- SO(3)/so(3) fast path and SE(3) ---
+# Every function accepts one element or a batch along a leading axis b and returns the same
+# batching. so(3) vectors use the physics hat map (hat(w) @ x == cross(w, x)); se(3) vectors are
+# (omega, v) with the rotation FIRST; SE(3) elements are 4x4 homogeneous matrices.
+
+def hat(w: _In) -> _F:
+    """(3,) -> (3, 3) or (b, 3) -> (b, 3, 3): skew matrix with hat(w) @ x = w x x."""
+
+def vee(xi: _In) -> _F:
+    """(3, 3) -> (3,) or (b, 3, 3) -> (b, 3); NotInGroupError if xi is not skew."""
+
+def so3_exp(w: _In) -> _F:
+    """Rodrigues: (3,) -> (3, 3) or (b, 3) -> (b, 3, 3)."""
+
+def so3_log(r: _In, strict: bool = False) -> _F:
+    """Principal log |w| <= pi: (3, 3) -> (3,) or (b, 3, 3) -> (b, 3); strict raises at pi."""
+
+def so3_cayley(w: _In) -> _F:
+    """cay(w) = (I - hat(w)/2)^-1 (I + hat(w)/2): (3,) -> (3, 3), batched."""
+
+def so3_cayley_inv(r: _In) -> _F:
+    """Inverse Cayley map: (3, 3) -> (3,), batched; InvalidArgumentError at a half turn."""
+
+def so3_jacobian_right(w: _In, inverse: bool = False) -> _F:
+    """J_r(w) (or J_r(w)^-1): exp(w + d) ~ exp(w) exp(J_r d); (3,) -> (3, 3), batched."""
+
+def so3_jacobian_left(w: _In, inverse: bool = False) -> _F:
+    """J_l(w) (or J_l(w)^-1): exp(w + d) ~ exp(J_l d) exp(w); (3,) -> (3, 3), batched."""
+
+def se3_exp(xi: _In) -> _F:
+    """(6,) -> (4, 4) or (b, 6) -> (b, 4, 4); xi = (omega, v)."""
+
+def se3_log(g: _In, strict: bool = False) -> _F:
+    """(4, 4) -> (6,) or (b, 4, 4) -> (b, 6); strict raises NoUniqueLogError at angle pi."""
+
+def se3_Ad(g: _In) -> _F:
+    """Adjoint matrix [[R, 0], [hat(t) R, R]]: (4, 4) -> (6, 6), batched."""
+
+def se3_inverse(g: _In) -> _F:
+    """(4, 4) -> (4, 4), batched."""
+
+def se3_compose(g: _In, h: _In) -> _F:
+    """g @ h for (4, 4) or (b, 4, 4) (a single matrix broadcasts against a batch)."""
+
+
+# --- GL+(n) ---
+
+class GLStratum(TypedDict):
+    singular_values: _F
+    multiplicities: list[int]
+    min_gap: float
+    tol: float
+    principal: bool
+
+def svd_coordinates(X: _In) -> tuple[_F, _F, _F]:
+    """SVD coordinates (R, a, S) with X = R @ diag(a) @ S.T, R, S in SO(n) (001 (2.4))."""
+
+def from_svd(R: _In, a: _In, S: _In) -> _F:
+    """X = R @ diag(a) @ S.T (001 (2.6))."""
+
+def polar(X: _In) -> tuple[_F, _F]:
+    """Polar decomposition X = R @ P, R in SO(n), P symmetric positive definite."""
+
+def stratum(X: _In, tol: float = 1e-8) -> GLStratum:
+    """Coincidences of the singular values of X (001 §6.1, (9.2))."""
