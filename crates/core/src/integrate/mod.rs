@@ -33,6 +33,7 @@ pub mod verlet;
 
 use crate::check;
 use crate::error::{Error, Result};
+use crate::lie::so3;
 use rayon::prelude::*;
 
 /// An integration method, named as in the Python API.
@@ -208,42 +209,9 @@ pub trait System: Sync {
     }
 }
 
-/// Tolerance on ‖RᵀR − I‖_F for an attitude passed in.
-pub const ROTATION_TOL: f64 = 1e-10;
-
-/// Checks that a row-major 3×3 matrix is finite and in SO(3).
+/// Checks that a row-major 3×3 attitude is finite and in SO(3) (to [`so3::ROTATION_TOL`]).
 pub fn check_rotation(r: &[f64; 9]) -> Result<()> {
-    check::finite_slice("attitude", r)?;
-    let defect = orthogonality_defect(r);
-    let det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6])
-        + r[2] * (r[3] * r[7] - r[4] * r[6]);
-    if defect > ROTATION_TOL || det <= 0.0 {
-        return Err(Error::NotInGroup {
-            what: "attitude".into(),
-            group: "SO(3)".into(),
-            defect_name: if det <= 0.0 {
-                "det R ≤ 0; ‖RᵀR − I‖_F".into()
-            } else {
-                "‖RᵀR − I‖_F".into()
-            },
-            defect,
-            tol: ROTATION_TOL,
-        });
-    }
-    Ok(())
-}
-
-/// ‖RᵀR − I‖_F of a row-major 3×3 matrix.
-pub fn orthogonality_defect(r: &[f64; 9]) -> f64 {
-    let mut s = 0.0;
-    for i in 0..3 {
-        for j in 0..3 {
-            let d: f64 = (0..3).map(|k| r[3 * k + i] * r[3 * k + j]).sum::<f64>()
-                - if i == j { 1.0 } else { 0.0 };
-            s += d * d;
-        }
-    }
-    s.sqrt()
+    so3::check_rotation("attitude", &nalgebra::Matrix3::from_row_slice(r))
 }
 
 /// A computed trajectory: the saved samples and the final state.

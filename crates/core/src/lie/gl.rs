@@ -9,6 +9,7 @@
 
 use crate::check;
 use crate::error::{Error, Result};
+use crate::lie::so;
 use crate::Mat;
 
 /// Default relative tolerance for deciding that two singular values coincide:
@@ -19,9 +20,6 @@ use crate::Mat;
 /// functions are ill-conditioned: the inverse of the bi-inertia tensor has condition number
 /// ((a_i + a_j)/(a_i − a_j))², about 4·10¹⁶ at a relative gap of 10⁻⁸.
 pub const STRATUM_TOL: f64 = 1e-8;
-
-/// Tolerance on ‖RᵀR − I‖_F for accepting R, S as rotations in [`from_svd`].
-pub const ROTATION_TOL: f64 = 1e-10;
 
 /// Determinant of a square matrix (faer LU).
 pub fn det(x: &Mat) -> f64 {
@@ -55,27 +53,6 @@ pub fn check_gl_plus(what: &str, x: &Mat) -> Result<usize> {
         });
     }
     Ok(n)
-}
-
-/// Checks that `r` is an n×n rotation: finite, ‖RᵀR − I‖_F ≤ [`ROTATION_TOL`], det R > 0.
-pub fn check_rotation(what: &str, r: &Mat, n: usize) -> Result<()> {
-    check::square_of(what, r, n)?;
-    let defect = (r.transpose() * r - Mat::identity(n, n)).norm_l2();
-    let d = det(r);
-    if defect > ROTATION_TOL || d <= 0.0 {
-        return Err(Error::NotInGroup {
-            what: what.into(),
-            group: format!("SO({n})"),
-            defect_name: if d <= 0.0 {
-                "det R (must be +1)".into()
-            } else {
-                "‖RᵀR − I‖_F".into()
-            },
-            defect: if d <= 0.0 { d } else { defect },
-            tol: ROTATION_TOL,
-        });
-    }
-    Ok(())
 }
 
 /// SVD coordinates (R, a, S) of X ∈ GL⁺(n): X = R diag(a) Sᵀ (001 (2.4), S⁻¹ = Sᵀ).
@@ -159,8 +136,9 @@ pub fn from_svd(r: &Mat, a: &[f64], s: &Mat) -> Result<Mat> {
         return Err(Error::shape("a", "(n,) with n ≥ 1", "(0,)"));
     }
     check::finite_slice("a", a)?;
-    check_rotation("R", r, n)?;
-    check_rotation("S", s, n)?;
+    for (what, m) in [("R", r), ("S", s)] {
+        so::check_rotation_of(what, m, n)?;
+    }
     if let Some(i) = a.iter().position(|&ai| ai <= 0.0) {
         return Err(Error::invalid(
             "a",

@@ -177,6 +177,18 @@ pub fn is_rotation(r: &Mat, tol: f64) -> Result<bool> {
 /// returns n. The error message carries both the orthogonality defect and the determinant.
 pub fn check_rotation(what: &str, r: &Mat) -> Result<usize> {
     let n = check::square(what, r, 2)?;
+    rotation_error(what, r, n)?;
+    Ok(n)
+}
+
+/// [`check_rotation`] for a given size n ≥ 1 (SO(1) = {1} is allowed: the SVD coordinates of
+/// GL⁺(1) use it).
+pub fn check_rotation_of(what: &str, r: &Mat, n: usize) -> Result<()> {
+    check::square_of(what, r, n)?;
+    rotation_error(what, r, n)
+}
+
+fn rotation_error(what: &str, r: &Mat, n: usize) -> Result<()> {
     let defect = orthogonality_defect(r);
     let det = r.determinant();
     if defect > ROTATION_TOL || det <= 0.0 {
@@ -188,7 +200,7 @@ pub fn check_rotation(what: &str, r: &Mat) -> Result<usize> {
             tol: ROTATION_TOL,
         });
     }
-    Ok(n)
+    Ok(())
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -361,6 +361,27 @@ pub(crate) fn jacobian_left_inv_principal(w: &Vector3<f64>) -> Matrix3<f64> {
     jacobian_inv(w, &Coeffs::new(w), -1.0)
 }
 
+/// Checks that `r` is finite and in SO(3): ‖RᵀR − I‖_F and |det R − 1| at most [`ROTATION_TOL`]
+/// (Error::NotInGroup naming the failed measure, or Error::NonFinite).
+pub fn check_rotation(what: &str, r: &Matrix3<f64>) -> Result<()> {
+    check::finite_slice(what, r.as_slice())?;
+    let (o, d) = rotation_defect(r);
+    let not_in = |defect_name: &str, defect: f64| Error::NotInGroup {
+        what: what.into(),
+        group: "SO(3)".into(),
+        defect_name: defect_name.into(),
+        defect,
+        tol: ROTATION_TOL,
+    };
+    if o > ROTATION_TOL {
+        return Err(not_in("‖RᵀR − I‖_F", o));
+    }
+    if (d - 1.0).abs() > ROTATION_TOL {
+        return Err(not_in("|det R − 1|", (d - 1.0).abs()));
+    }
+    Ok(())
+}
+
 /// A rotation: a 3×3 matrix R with RᵀR = I and det R = 1 (to [`ROTATION_TOL`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SO3(Matrix3<f64>);
@@ -369,21 +390,7 @@ impl SO3 {
     /// Validates `r`: finite ([`Error::NonFinite`]), ‖RᵀR − I‖_F ≤ [`ROTATION_TOL`] and
     /// |det R − 1| ≤ [`ROTATION_TOL`] ([`Error::NotInGroup`] with the measured defect).
     pub fn new(r: Matrix3<f64>) -> Result<Self> {
-        check::finite_slice("R", r.as_slice())?;
-        let (o, d) = rotation_defect(&r);
-        let not_in = |defect_name: &str, defect: f64| Error::NotInGroup {
-            what: "R".into(),
-            group: "SO(3)".into(),
-            defect_name: defect_name.into(),
-            defect,
-            tol: ROTATION_TOL,
-        };
-        if o > ROTATION_TOL {
-            return Err(not_in("‖RᵀR − I‖_F", o));
-        }
-        if (d - 1.0).abs() > ROTATION_TOL {
-            return Err(not_in("|det R − 1|", (d - 1.0).abs()));
-        }
+        check_rotation("R", &r)?;
         Ok(SO3(r))
     }
 

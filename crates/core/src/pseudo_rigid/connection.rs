@@ -7,7 +7,7 @@
 
 use std::str::FromStr;
 
-use super::inertia::{check_skew, BiInertia};
+use super::inertia::BiInertia;
 use super::momentum::momentum_map_unchecked;
 use crate::error::{Error, Result};
 use crate::lie::so;
@@ -72,8 +72,8 @@ pub fn bi_connection(b: &BiInertia, y: &Mat) -> Result<(Mat, Mat)> {
 /// The vertical vector (ξ ⊕ η)_P(X) = ξX + Xηᵀ induced by ξ ⊕ η ∈ so(n) ⊕ so(n) (001 (6.17));
 /// η = 0 gives the left-action vector ξX, ξ = 0 the right-action vector Xηᵀ.
 pub fn vertical_vector(b: &BiInertia, xi: &Mat, eta: &Mat) -> Result<Mat> {
-    check_skew("xi", xi, b.n())?;
-    check_skew("eta", eta, b.n())?;
+    so::check_algebra_of("xi", xi, b.n())?;
+    so::check_algebra_of("eta", eta, b.n())?;
     Ok(vertical_unchecked(b.x(), xi, eta))
 }
 

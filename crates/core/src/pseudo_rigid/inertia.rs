@@ -8,26 +8,10 @@
 
 use std::sync::OnceLock;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::lie::gl::{self, SvdCoordinates};
 use crate::lie::so;
-use crate::{check, Mat};
-
-/// Checks that `m` is an n×n finite skew-symmetric matrix (to [`so::SKEW_TOL`], relative).
-pub fn check_skew(what: &str, m: &Mat, n: usize) -> Result<()> {
-    check::square_of(what, m, n)?;
-    let defect = so::skew_defect(m);
-    if defect > so::SKEW_TOL {
-        return Err(Error::NotInGroup {
-            what: what.into(),
-            group: format!("so({n})"),
-            defect_name: "‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F)".into(),
-            defect,
-            tol: so::SKEW_TOL,
-        });
-    }
-    Ok(())
-}
+use crate::Mat;
 
 /// g ξ gᵀ (Ad_g for g ∈ SO(n)).
 pub(crate) fn conj(g: &Mat, xi: &Mat) -> Mat {
@@ -132,7 +116,7 @@ impl BiInertia {
 
     /// Checks an so(n) argument of the right size.
     fn arg(&self, what: &str, xi: &Mat) -> Result<()> {
-        check_skew(what, xi, self.n())
+        so::check_algebra_of(what, xi, self.n())
     }
 
     /// Left inertia tensor A^L_X ξ = XXᵀξ + ξXXᵀ (001 (2.11)).

@@ -6,7 +6,7 @@
 
 use nalgebra::Vector3;
 
-use super::inertia::{check_skew, BiInertia};
+use super::inertia::BiInertia;
 use crate::error::Result;
 use crate::lie::gl::{self, SvdCoordinates};
 use crate::lie::so;
@@ -106,8 +106,8 @@ impl Body {
         let n = self.a.len();
         gl::from_svd(&self.r, &self.a, &self.s)?;
         check::len_of("adot", &self.adot, n)?;
-        check_skew("Omega", &self.omega, n)?;
-        check_skew("Lambda", &self.lambda, n)?;
+        so::check_algebra_of("Omega", &self.omega, n)?;
+        so::check_algebra_of("Lambda", &self.lambda, n)?;
         Ok(n)
     }
 
