@@ -13,8 +13,9 @@ use crate::errors::to_py;
 /// Any array-like input, cast to float64.
 pub type ArrayIn<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
-fn shape_str(v: &ArrayViewD<'_, f64>) -> String {
-    let s: Vec<String> = v.shape().iter().map(|d| d.to_string()).collect();
+/// A shape as numpy prints it: "(3,)", "(2, 3)".
+pub fn shape_str(shape: &[usize]) -> String {
+    let s: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
     if s.len() == 1 {
         format!("({},)", s[0])
     } else {
@@ -23,7 +24,7 @@ fn shape_str(v: &ArrayViewD<'_, f64>) -> String {
 }
 
 fn shape_err(what: &str, expected: &str, v: &ArrayViewD<'_, f64>) -> PyErr {
-    to_py(Error::shape(what, expected, shape_str(v)))
+    to_py(Error::shape(what, expected, shape_str(v.shape())))
 }
 
 fn view_to_mat(v: &ArrayViewD<'_, f64>) -> Mat {

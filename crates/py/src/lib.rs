@@ -1,6 +1,7 @@
 //! Python bindings of lieflow: thin PyO3 wrappers that convert arrays and errors and call
 //! `lieflow`. No mathematics lives here.
 
+mod batch;
 #[allow(dead_code)] // some converters are only used once every binding lands
 mod convert;
 mod errors;

@@ -7,7 +7,7 @@ use lieflow::Error;
 use nalgebra::{Matrix4, Vector6};
 use pyo3::prelude::*;
 
-use super::so3::{map_batch, par_fill, read_items, relabel, Out};
+use crate::batch::{map_batch, par_fill, read_items, relabel, Out};
 use crate::convert::ArrayIn;
 use crate::errors::to_py;
 
