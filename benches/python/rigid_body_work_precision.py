@@ -103,6 +103,7 @@ def main():
         for name in dict.fromkeys(n for n, *_ in rows):
             pts = [(s, e) for n, _, s, e in rows if n == name]
             ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=name)
+        ax.axhline(1e-8, color="gray", lw=0.8, ls="--")
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("max error of M(T), T = 100")
         ax.set_title("Free rigid body, I = diag(1,2,3): work-precision")

@@ -118,6 +118,7 @@ class Recording:
 
 def test_default_chunking_splits_long_runs(body, monkeypatch):
     monkeypatch.setattr(sys.modules["lieflow.integrate"], "CHUNK_WORK", 1000)
+    monkeypatch.setattr(sys.modules["lieflow.integrate"], "MIN_CHUNK_STEPS", 100)
     rec = Recording(body)
     tr = lf.integrate(rec, np.tile(M0, (4, 1)), dt=0.01, steps=1000, save_every=100)
     assert rec.calls == [200] * 5 and tr.states.shape == (4, 11, 3)
@@ -126,6 +127,9 @@ def test_default_chunking_splits_long_runs(body, monkeypatch):
     rec = Recording(body)
     lf.integrate(rec, M0, dt=0.01, steps=2500, save_every=700)   # cap 1000 < save_every
     assert rec.calls == [700, 700, 700, 400]
+    rec = Recording(body)
+    lf.integrate(rec, np.tile(M0, (50, 1)), dt=0.01, steps=250, save_every=1)
+    assert rec.calls == [100, 100, 50]                          # MIN_CHUNK_STEPS for big batches
 
 
 def test_progress_bar_tqdm_and_fallback(body, capsys, monkeypatch):
@@ -238,6 +242,16 @@ def test_constraint_errors():
         lf.integrate(top, top.state(M0, [1.0, 0, 0]), dt=0.01, steps=10, attitude=np.eye(3))
 
 
+def test_solver_failures_are_typed_errors():
+    """Absurd steps: the implicit solvers report non-convergence, RK4 the blow-up."""
+    body = lf.RigidBody(I)
+    for method in ["isospectral", "lgvi"]:
+        with pytest.raises(lf.ConvergenceError, match="did not converge"):
+            lf.integrate(body, [100.0, 50.0, -30.0], dt=10.0, steps=100, method=method)
+    with pytest.raises(lf.LeftDomainError, match="non-finite"):
+        lf.integrate(body, [100.0, 50.0, -30.0], dt=10.0, steps=100, method="rk4")
+
+
 def test_trajectory_forwarding(body):
     tr = lf.integrate(body, M0, dt=0.01, steps=100, save_every=10)
     np.testing.assert_allclose(tr.angular_velocity(), tr.states / I)
@@ -333,6 +347,20 @@ def test_heavy_top_against_dop853():
     assert np.ptp(tr.energy()) < 1e-3
 
 
+def test_heavy_top_matrix_inertia():
+    q = rotation([2, 1, -1], 0.8)
+    chi = np.array([0.2, 0.1, 1.0])
+    a = lf.HeavyTop(q @ np.diag(I) @ q.T, 0.6, chi=q @ chi)
+    b = lf.HeavyTop(I, 0.6, chi=chi)
+    np.testing.assert_allclose(np.sort(a.moments), I, rtol=1e-12)
+    g0 = rotation([1, 0, 0], 0.4)[2]
+    ta = lf.integrate(a, (q @ M0, q @ g0), dt=0.01, steps=300, method="splitting4", save_every=30)
+    tb = lf.integrate(b, (M0, g0), dt=0.01, steps=300, method="splitting4", save_every=30)
+    np.testing.assert_allclose(ta.M, tb.M @ q.T, atol=1e-12)
+    np.testing.assert_allclose(ta.Gamma, tb.Gamma @ q.T, atol=1e-12)
+    np.testing.assert_allclose(ta.energy(), tb.energy(), atol=1e-13)
+
+
 def test_lagrange_top_and_attitude():
     top = lf.HeavyTop([2.0, 2.0, 1.0], 1.5)
     r0 = rotation([1, 1, 0], 0.5)
@@ -412,6 +440,17 @@ def test_random_valid_inputs_never_give_nan(inertia, m, dt, case, seed, method_i
     tr = lf.integrate(system, z0, dt=dt, steps=200, method=method, save_every=10, attitude=r0)
     assert np.all(np.isfinite(tr.states)) and np.all(np.isfinite(tr.attitude))
     assert np.all(np.isfinite(tr.energy())) and np.all(np.isfinite(tr.casimirs()))
+
+
+@settings(max_examples=15, deadline=None)
+@given(n=st.integers(3, 5), seed=st.integers(0, 2**31), dt=st.floats(1e-4, 0.05),
+       method=st.sampled_from(lf.GeneralizedRigidBody.methods()))
+def test_random_so_n_body_never_gives_nan(n, seed, dt, method):
+    rng = np.random.default_rng(seed)
+    body = lf.GeneralizedRigidBody(rng.uniform(0.3, 3.0, n))
+    z0 = rng.uniform(-2, 2, n * (n - 1) // 2)
+    tr = lf.integrate(body, z0, dt=dt, steps=100, method=method, save_every=10)
+    assert np.all(np.isfinite(tr.states)) and np.all(np.isfinite(tr.casimirs()))
 
 
 @settings(max_examples=15, deadline=None)
