@@ -144,6 +144,8 @@ def test_exact_solution_against_scipy_ellipj_and_dop853():
     np.testing.assert_allclose(exact, ref.y.T, atol=1e-9)
 
 
+# DOP853's error estimate divides 0/0 on steady rotations (M0 on a principal axis): harmless.
+@pytest.mark.filterwarnings("ignore:invalid value encountered in scalar divide:RuntimeWarning")
 @settings(max_examples=25, deadline=None)
 @given(st.lists(st.floats(0.5, 4.0), min_size=3, max_size=3),
        st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3))

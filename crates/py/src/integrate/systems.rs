@@ -372,7 +372,10 @@ pub struct PyHeavyTop {
 #[pymethods]
 impl PyHeavyTop {
     #[new]
-    #[pyo3(signature = (inertia, mgl, chi = [0.0, 0.0, 1.0]))]
+    #[pyo3(
+        signature = (inertia, mgl, chi = [0.0, 0.0, 1.0]),
+        text_signature = "(inertia, mgl, chi=(0.0, 0.0, 1.0))"
+    )]
     fn new(inertia: ArrayIn<'_>, mgl: f64, chi: [f64; 3]) -> PyResult<PyClassInitializer<Self>> {
         let top = match self::inertia(&inertia)? {
             Inertia::Moments(m) => core::HeavyTop::new(m, mgl, chi),
