@@ -314,6 +314,10 @@ def test_heavy_top_errors():
         top._normalize_state(M0)
     with pytest.raises(lf.NonFiniteError):
         top._normalize_state((M0, [0, np.nan, 1]))
+    with pytest.raises(lf.ShapeError, match="Gamma"):
+        top._normalize_state((M0, [0.0, 1.0]))
+    z, batched = top._normalize_state((np.ones(6), np.zeros(6)))     # two flat states: a batch
+    assert batched and z.shape == (2, 6)
 
 
 # ---------------------------------------------------------------- SphericalPendulum

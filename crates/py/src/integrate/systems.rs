@@ -484,8 +484,9 @@ impl PyHeavyTop {
             if pair.len() == 2 {
                 let m: ArrayIn<'py> = pair.get_item(0)?.extract()?;
                 let g: ArrayIn<'py> = pair.get_item(1)?.extract()?;
+                // A pair of 3-vectors (or batches of them); two 6-vectors are a batch of states.
                 let last3 = |a: &ArrayIn<'py>| a.as_array().shape().last() == Some(&3);
-                if last3(&m) && last3(&g) {
+                if last3(&m) || last3(&g) {
                     let z: ArrayIn<'py> = self.state(py, m, Some(g), None)?.extract()?;
                     return normalize_flat(py, 6, &z.as_array());
                 }
