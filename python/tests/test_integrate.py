@@ -233,6 +233,10 @@ def test_bad_attitudes(body):
 
 def test_constraint_errors():
     p = lf.SphericalPendulum()
+    z = p.state_from_spherical([0.5, 1.0, 1.5], 0.0)
+    z[2, 0] += 0.1
+    with pytest.raises(lf.InvalidArgumentError, match=r"batch member 2: .*\|q\| = 1"):
+        lf.integrate(p, z, dt=0.01, steps=10)
     with pytest.raises(lf.InvalidArgumentError, match=r"\|q\| = 1"):
         lf.integrate(p, [0, 0, -2.0, 0, 0, 0], dt=0.01, steps=10)
     with pytest.raises(lf.InvalidArgumentError, match=r"q·L = 0"):

@@ -124,6 +124,25 @@ pub(crate) fn normalize_flat<'py>(
     Ok((z.into_pyarray(py), batched))
 }
 
+/// The Python exception for an error of a run over `states0`; an invalid member of a batch is
+/// named ("batch member i: …").
+fn in_batch(py: Python<'_>, sys: &dyn System, states0: &[State], e: Error) -> PyErr {
+    let member = match states0 {
+        [_, _, ..] => states0
+            .iter()
+            .position(|s| sys.check_state(s).as_ref().err() == Some(&e)),
+        _ => None,
+    };
+    let err = to_py(e);
+    match member {
+        Some(i) => PyErr::from_type(
+            err.get_type(py),
+            format!("batch member {i}: {}", err.value(py)),
+        ),
+        None => err,
+    }
+}
+
 /// Row-major (b, …) data from the trajectories' pieces.
 fn stack<'a>(pieces: impl Iterator<Item = &'a [f64]>, capacity: usize) -> Vec<f64> {
     let mut out = Vec::with_capacity(capacity);
@@ -198,7 +217,7 @@ impl LiePoissonSystem {
                     integrate_batch(sys, method, &states0, dt, steps, save_every, None)
                 }
             })
-            .py()?;
+            .map_err(|e| in_batch(py, sys, &states0, e))?;
         let (b, d, k) = (states0.len(), sys.dim(), steps / save_every + 1);
         let states = stack(trajs.iter().map(|t| t.states.as_slice()), b * k * d);
         let z_final = stack(trajs.iter().map(|t| t.final_state.z.as_slice()), b * d);
