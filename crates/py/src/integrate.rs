@@ -3,9 +3,10 @@
 //! the chunking, progress display and Ctrl-C handling in Python).
 //!
 //! Every system class derives from [`LiePoissonSystem`], which holds the core system as a
-//! `dyn System` and implements the protocol once: `state_dim`, `methods()`, `_normalize_state`,
-//! `_run` (the batch in parallel with the GIL released), and the vectorised `energy` and
-//! `casimirs`. The subclasses (in [`systems`]) add constructors and their own observables.
+//! `dyn System` and implements the protocol once: `state_dim`, `_normalize_state`, `_run` (the
+//! batch in parallel with the GIL released), and the vectorised `energy` and `casimirs`. The
+//! subclasses (in [`systems`]) add constructors, the static `methods()` and their own
+//! observables; the elliptic functions behind the exact rigid-body solution are in [`elliptic`].
 
 mod elliptic;
 mod items;
