@@ -352,6 +352,34 @@ fn son_orders_and_matrix_mass() {
     assert!((b.energy(&a).unwrap() - bm.energy(&bz).unwrap()).abs() < 1e-12);
 }
 
+#[test]
+fn son_mass_matrix_with_a_zero_eigenvalue_is_accepted() {
+    // J = Q diag(0, 1, 2) Qᵀ is PSD with J_i + J_j > 0; round-off in its eigen-decomposition can
+    // make the zero eigenvalue slightly negative, which must not be rejected.
+    let (c, s) = (0.7f64.cos(), 0.7f64.sin());
+    let q = Mat::from_fn(3, 3, |a, b| match (a, b) {
+        (0, 0) | (2, 2) => c,
+        (0, 2) => -s,
+        (2, 0) => s,
+        (1, 1) => 1.0,
+        _ => 0.0,
+    });
+    let d = Mat::from_fn(3, 3, |a, b| if a == b { [0.0, 1.0, 2.0][a] } else { 0.0 });
+    let j = &q * &d * q.transpose();
+    let body = GeneralizedRigidBody::from_matrix(&j).unwrap();
+    let mut p = body.principal().to_vec();
+    p.sort_by(f64::total_cmp);
+    for (got, want) in p.iter().zip([0.0, 1.0, 2.0]) {
+        assert!((got - want).abs() < 1e-14, "{p:?}");
+    }
+    // A truly negative eigenvalue is still an error.
+    let bad = Mat::from_fn(3, 3, |a, b| if a == b { [-0.1, 1.0, 2.0][a] } else { 0.0 });
+    assert!(matches!(
+        GeneralizedRigidBody::from_matrix(&bad),
+        Err(Error::InvalidArgument { .. })
+    ));
+}
+
 // ---------------------------------------------------------------- inertia matrix
 
 #[test]

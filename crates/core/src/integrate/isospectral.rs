@@ -102,9 +102,11 @@ impl IsospectralMidpoint {
             iter += 1;
             if !finite || !diff.is_finite() {
                 return Err(Error::NotConverged {
-                    what: "isospectral midpoint fixed-point iteration".into(),
+                    what: "isospectral midpoint fixed-point iteration (diverged to a non-finite \
+                           iterate; reduce dt)"
+                        .into(),
                     iterations: iter,
-                    residual: diff,
+                    residual: f64::INFINITY,
                     tol: TOL,
                 });
             }

@@ -366,7 +366,13 @@ impl GeneralizedRigidBody {
         let eig = j
             .self_adjoint_eigen(faer::Side::Lower)
             .map_err(|e| Error::invalid("J", format!("eigendecomposition failed: {e:?}")))?;
-        let vals: Vec<f64> = (0..n).map(|i| eig.S()[i]).collect();
+        // Round-off can leave a zero eigenvalue of a PSD J slightly negative: clamp those within
+        // 1e-12·‖J‖ to 0 and let `new` reject what is truly negative.
+        let floor = 1e-12 * j.norm_l2();
+        let vals: Vec<f64> = (0..n)
+            .map(|i| eig.S()[i])
+            .map(|v| if v < 0.0 && v >= -floor { 0.0 } else { v })
+            .collect();
         let mut q = Mat::from_fn(n, n, |a, b| eig.U()[(a, b)]);
         if q.determinant() < 0.0 {
             for a in 0..n {
