@@ -135,8 +135,7 @@ impl System for HeavyTop {
     /// H = ½ M·I⁻¹M + mgl Γ·χ.
     fn energy(&self, z: &[f64]) -> Result<f64> {
         check::len_of("state", z, 6)?;
-        let m = top::to_frame(&self.frame, &z[..3]);
-        let t: f64 = 0.5 * (0..3).map(|i| m[i] * m[i] / self.moments[i]).sum::<f64>();
+        let t = top::kinetic_energy(&self.frame, &self.moments, &z[..3]);
         Ok(t + self.mgl * Vector3::from_column_slice(&z[3..]).dot(&self.chi))
     }
     /// [|Γ|², M·Γ].

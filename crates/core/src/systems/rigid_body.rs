@@ -196,8 +196,7 @@ impl System for RigidBody {
     /// H = ½ M·I⁻¹M.
     fn energy(&self, z: &[f64]) -> Result<f64> {
         check::len_of("state", z, 3)?;
-        let m = top::to_frame(&self.frame, z);
-        Ok(0.5 * (0..3).map(|i| m[i] * m[i] / self.moments[i]).sum::<f64>())
+        Ok(top::kinetic_energy(&self.frame, &self.moments, z))
     }
     /// [|M|²].
     fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {

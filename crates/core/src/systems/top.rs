@@ -87,6 +87,12 @@ pub(crate) fn from_frame(frame: &Option<Matrix3<f64>>, v: &Vector3<f64>) -> Vect
     }
 }
 
+/// Kinetic energy ½ M·I⁻¹M of a body momentum given in the user frame (000 §3–§4).
+pub(crate) fn kinetic_energy(frame: &Option<Matrix3<f64>>, moments: &[f64; 3], m: &[f64]) -> f64 {
+    let m = to_frame(frame, m);
+    0.5 * (0..3).map(|i| m[i] * m[i] / moments[i]).sum::<f64>()
+}
+
 /// Row-major copy of a 3×3 matrix.
 pub(crate) fn row_major(r: &Matrix3<f64>) -> [f64; 9] {
     let mut out = [0.0; 9];
