@@ -13,6 +13,7 @@
 //! `check_det` (the default) a step that ends with det X ≤ 0 stops the run with
 //! [`Error::LeftDomain`]. Potentials defined only on GL⁺(n) (a volumetric term) are always checked.
 
+use super::splitting::Composition;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::pseudo_rigid::potential::{self, Potential, Workspace};
@@ -51,39 +52,15 @@ impl VerletOrder {
             VerletOrder::Six => 6,
         }
     }
-}
 
-/// Triple-jump weights of order 4: (w₁, w₀, w₁), w₁ = 1/(2 − 2^{1/3}), w₀ = 1 − 2w₁
-/// (Yoshida 1990, Phys. Lett. A 150, 262).
-const ORDER4: [f64; 3] = [
-    1.351_207_191_959_657_8,
-    -1.702_414_383_919_315_3,
-    1.351_207_191_959_657_8,
-];
-
-/// Yoshida's order-6 "solution A" weights (w₃, w₂, w₁, w₀, w₁, w₂, w₃) (Yoshida 1990, Table 1).
-const ORDER6: [f64; 7] = [
-    0.784_513_610_477_557_3,
-    0.235_573_213_359_358_1,
-    -1.177_679_984_178_871,
-    1.315_186_320_683_911_2,
-    -1.177_679_984_178_871,
-    0.235_573_213_359_358_1,
-    0.784_513_610_477_557_3,
-];
-
-/// Runs one composed step of size `dt` as substeps `step(w_i dt)`.
-// TODO(merge): use the generic composition of integrate::splitting
-fn compose(order: VerletOrder, dt: f64, mut step: impl FnMut(f64) -> Result<()>) -> Result<()> {
-    let weights: &[f64] = match order {
-        VerletOrder::Two => &[1.0],
-        VerletOrder::Four => &ORDER4,
-        VerletOrder::Six => &ORDER6,
-    };
-    for w in weights {
-        step(w * dt)?;
+    /// The symmetric composition of Verlet steps giving this order ([`Composition`]).
+    pub fn composition(self) -> Composition {
+        match self {
+            VerletOrder::Two => Composition::strang(),
+            VerletOrder::Four => Composition::triple_jump4(),
+            VerletOrder::Six => Composition::yoshida6(),
+        }
     }
-    Ok(())
 }
 
 /// Caller-owned scratch for [`Verlet::run`] on n×n matrices (no allocation per step).
@@ -184,9 +161,11 @@ impl Verlet {
         }
         grad.fill(0.0);
         potential.add_gradient(x.as_ref(), grad.as_mut(), ws);
+        let composition = self.order.composition();
         for k in 0..steps {
             let mut t = t0 + k as f64 * dt;
-            compose(self.order, dt, |h| {
+            for &g in composition.gammas() {
+                let h = g * dt;
                 potential::axpy(p.as_mut(), -0.5 * h, grad.as_ref());
                 potential::axpy(x.as_mut(), h, p.as_ref());
                 t += h;
@@ -209,8 +188,7 @@ impl Verlet {
                 grad.fill(0.0);
                 potential.add_gradient(x.as_ref(), grad.as_mut(), ws);
                 potential::axpy(p.as_mut(), -0.5 * h, grad.as_ref());
-                Ok(())
-            })?;
+            }
         }
         check::finite_mat("X after integration", x)?;
         check::finite_mat("P after integration", p)?;
