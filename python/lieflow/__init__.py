@@ -22,6 +22,7 @@ from ._lieflow import (
     __version__,
 )
 from . import lie, pseudo_rigid
+from ._lieflow import PseudoRigidBody; from . import potentials  # noqa: E702
 
 __all__ = [
     "ConvergenceError",
