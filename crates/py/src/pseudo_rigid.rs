@@ -488,6 +488,8 @@ pub fn reconstruct<'py>(
     ))
 }
 
+type ArrD<'py> = Bound<'py, numpy::PyArrayDyn<f64>>;
+
 /// Dedekind's adjoint motion X -> X^T, P -> P^T of stacked frames (..., n, n) (000 §5.3): maps
 /// motions to motions and swaps angular momentum and circulation.
 ///
@@ -500,10 +502,7 @@ pub fn adjoint_motion<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
     P: ArrayIn<'py>,
-) -> PyResult<(
-    Bound<'py, numpy::PyArrayDyn<f64>>,
-    Bound<'py, numpy::PyArrayDyn<f64>>,
-)> {
+) -> PyResult<(ArrD<'py>, ArrD<'py>)> {
     use numpy::IntoPyArray;
     let (xv, pv) = (X.as_array(), P.as_array());
     let shape = xv.shape().to_vec();
