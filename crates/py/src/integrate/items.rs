@@ -1,0 +1,146 @@
+//! Vectorised observables: apply a per-item function over the leading axes of numpy arrays, with
+//! numpy broadcasting of the leading axes between several inputs.
+//!
+//! An *item* is the trailing block of an array (a state vector (d,), an attitude (3, 3), a
+//! scalar ()), and the leading axes are any batch/time axes: `energy` maps (..., d) to (...),
+//! `spatial_momentum` maps (..., 3) and (..., 3, 3) to (..., 3).
+
+use lieflow::Error;
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArrayDyn};
+use pyo3::prelude::*;
+use pyo3::types::PyFloat;
+
+use crate::convert::ArrayIn;
+use crate::errors::to_py;
+
+/// A float64 numpy array of any shape.
+pub type Out<'py> = Bound<'py, PyArrayDyn<f64>>;
+
+/// One input of [`map_items`]: its name (for errors), the array and the shape of one item.
+pub struct Input<'a, 'py> {
+    pub what: &'a str,
+    pub array: &'a ArrayIn<'py>,
+    pub item: &'a [usize],
+}
+
+/// A shape as numpy prints it.
+pub fn shape_str(s: &[usize]) -> String {
+    match s {
+        [d] => format!("({d},)"),
+        _ => format!(
+            "({})",
+            s.iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+fn expected_str(item: &[usize]) -> String {
+    if item.is_empty() {
+        "a scalar or an array".into()
+    } else {
+        let inner: Vec<String> = item.iter().map(|d| d.to_string()).collect();
+        format!("(..., {})", inner.join(", "))
+    }
+}
+
+/// numpy's broadcasting of several shapes; `None` if they do not broadcast.
+fn broadcast(shapes: &[&[usize]]) -> Option<Vec<usize>> {
+    let n = shapes.iter().map(|s| s.len()).max().unwrap_or(0);
+    let mut out = vec![1; n];
+    for s in shapes {
+        for (k, &d) in s.iter().enumerate() {
+            let o = &mut out[n - s.len() + k];
+            if *o == 1 {
+                *o = d;
+            } else if d != 1 && d != *o {
+                return None;
+            }
+        }
+    }
+    Some(out)
+}
+
+/// Applies `f(items, out)` to every combination of items along the (broadcast) leading axes of
+/// the inputs; `out` has `out_item` shape. Returns an array of shape (...lead, ...out_item), or a
+/// Python float when that shape is () (one scalar-valued item, like numpy's scalar results).
+/// Shape mismatches become `ShapeError`; errors of `f` are returned unchanged.
+pub fn map_items<'py, F>(
+    py: Python<'py>,
+    inputs: &[Input<'_, 'py>],
+    out_item: &[usize],
+    f: F,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
+{
+    let views: Vec<_> = inputs.iter().map(|i| i.array.as_array()).collect();
+    let mut leads = Vec::with_capacity(inputs.len());
+    for (inp, v) in inputs.iter().zip(&views) {
+        let s = v.shape();
+        let k = inp.item.len();
+        if s.len() < k || s[s.len() - k..] != *inp.item {
+            return Err(to_py(Error::shape(
+                inp.what,
+                expected_str(inp.item),
+                shape_str(s),
+            )));
+        }
+        leads.push(&s[..s.len() - k]);
+    }
+    let lead = broadcast(&leads).ok_or_else(|| {
+        let got: Vec<String> = inputs
+            .iter()
+            .zip(&views)
+            .map(|(i, v)| format!("{} {}", i.what, shape_str(v.shape())))
+            .collect();
+        to_py(Error::shape(
+            "inputs",
+            "leading axes that broadcast together",
+            got.join(", "),
+        ))
+    })?;
+    let count: usize = lead.iter().product();
+    let data: Vec<Vec<f64>> = inputs
+        .iter()
+        .zip(&views)
+        .map(|(inp, v)| {
+            let full: Vec<usize> = lead.iter().chain(inp.item).copied().collect();
+            // Broadcasting to a shape computed from this very input cannot fail.
+            v.broadcast(IxDyn(&full))
+                .map(|b| b.iter().copied().collect())
+                .ok_or_else(|| to_py(Error::shape(inp.what, shape_str(&full), "")))
+        })
+        .collect::<PyResult<_>>()?;
+    let lens: Vec<usize> = inputs.iter().map(|i| i.item.iter().product()).collect();
+    let out_len: usize = out_item.iter().product();
+    let mut out = vec![0.0; count * out_len];
+    let mut items: Vec<&[f64]> = Vec::with_capacity(inputs.len());
+    for (k, o) in out.chunks_mut(out_len.max(1)).enumerate().take(count) {
+        items.clear();
+        items.extend(data.iter().zip(&lens).map(|(d, &l)| &d[k * l..(k + 1) * l]));
+        f(&items, &mut o[..out_len]).map_err(to_py)?;
+    }
+    let shape: Vec<usize> = lead.iter().chain(out_item).copied().collect();
+    if shape.is_empty() {
+        return Ok(PyFloat::new(py, out[0]).into_any());
+    }
+    Ok(array(py, &shape, out)?.into_any())
+}
+
+/// A numpy array of the given shape from row-major data.
+pub fn array<'py>(py: Python<'py>, shape: &[usize], data: Vec<f64>) -> PyResult<Out<'py>> {
+    let got = data.len();
+    ArrayD::from_shape_vec(IxDyn(shape), data)
+        .map(|a| a.into_pyarray(py))
+        .map_err(|_| {
+            to_py(Error::shape(
+                "output",
+                shape_str(shape),
+                format!("{got} values"),
+            ))
+        })
+}
