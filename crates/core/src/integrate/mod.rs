@@ -54,7 +54,7 @@ pub enum Method {
     Rk4,
     /// Störmer–Verlet on T*GL⁺(n) (pseudo-rigid bodies), order 2.
     Verlet,
-    /// Störmer–Verlet, Yoshida's triple-jump composition, order 4.
+    /// Störmer–Verlet, Suzuki's 5-stage composition, order 4.
     Verlet4,
     /// Störmer–Verlet, Yoshida's 7-stage composition, order 6.
     Verlet6,
