@@ -189,3 +189,11 @@ def test_demo_runs(tmp_path, capsys):
     assert main(["demo", "--figure", str(tmp_path / "demo.png")]) == 0
     out = capsys.readouterr().out
     assert "energy" in out and "circulation" in out
+
+
+def test_run_t0_offsets_the_exit_time():
+    x = np.diag([1.0, 1.5, 2.0])
+    body = lf.PseudoRigidBody(3, potential=pot.Harmonic(1.0))
+    z0, _ = body._normalize_state((x, -x))
+    with pytest.raises(lf.LeftDomainError, match=r"t = 10\.78"):
+        body._run(z0, None, 1e-3, 2000, 1, "verlet", t0=10.0)

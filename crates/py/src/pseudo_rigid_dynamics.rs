@@ -348,6 +348,12 @@ impl PyPseudoRigidBody {
         self.d()
     }
 
+    /// False: the pseudo-rigid body carries no attitude.
+    #[getter]
+    fn has_attitude(&self) -> bool {
+        false
+    }
+
     /// Whether det X > 0 is enforced during integrations.
     #[getter]
     fn check_det(&self) -> bool {
@@ -430,8 +436,10 @@ impl PyPseudoRigidBody {
         Ok((arr.into_pyarray(py), batched))
     }
 
-    /// Integrates a batch z0 (b, d) (protocol in docs/integrate-protocol): returns
+    /// Integrates a batch z0 (b, d) (the integration protocol): returns
     /// (states (b, k, d), None, z_final (b, d), None) with k = steps // save_every + 1.
+    /// `t0` (keyword, default 0) is the time of z0, added to the time a LeftDomainError names
+    /// (for drivers that integrate in chunks).
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError, InvalidArgumentError (dt, steps, save_every, method, an
@@ -439,6 +447,7 @@ impl PyPseudoRigidBody {
     ///     DegenerateStratumError ("reduced" off the principal stratum), LeftDomainError (det X
     ///     reached 0 at the time named in the message).
     #[allow(clippy::type_complexity, clippy::too_many_arguments)]
+    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method, *, t0=0.0))]
     fn _run<'py>(
         &self,
         py: Python<'py>,
@@ -448,6 +457,7 @@ impl PyPseudoRigidBody {
         steps: i64,
         save_every: i64,
         method: &str,
+        t0: f64,
     ) -> PyResult<(
         Dyn<'py>,
         Option<Py<PyAny>>,
@@ -496,7 +506,16 @@ impl PyPseudoRigidBody {
         let res =
             py.detach(|| integrate_batch(body, method, &states0, dt, steps, save_every, threads));
         self.potential.take_callback_error()?;
-        let trajs = res.py()?;
+        let trajs = res
+            .map_err(|e| match e {
+                Error::LeftDomain { what, t, message } => Error::LeftDomain {
+                    what,
+                    t: t + t0,
+                    message,
+                },
+                e => e,
+            })
+            .py()?;
         let b = trajs.len();
         let k = steps / save_every + 1;
         let mut all = Vec::with_capacity(b * k * d);
