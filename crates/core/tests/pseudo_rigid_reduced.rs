@@ -352,3 +352,24 @@ fn leaving_gl_plus_names_the_time_for_both_methods() {
         }
     }
 }
+
+#[test]
+fn reduced_method_stops_at_an_unresolved_near_collision_of_semi_axes() {
+    // This motion has an avoided crossing a₁ ≈ a₂ (gap ≈ 5e-5) near t = 2.3 (found with Verlet);
+    // the reduced step cannot resolve it and must stop there instead of returning bad data.
+    let b = body(3);
+    let x0 = Mat::from_fn(3, 3, |i, j| {
+        [[1.2, 0.05, 0.0], [0.0, 1.0, 0.03], [0.02, 0.0, 0.85]][i][j]
+    });
+    let p0 = Mat::from_fn(3, 3, |i, j| {
+        [[0.0, 0.4, -0.1], [-0.2, 0.05, 0.3], [0.15, -0.25, 0.0]][i][j]
+    });
+    let s0 = b.state(&x0, &p0).unwrap();
+    for dt in [1e-3, 2.5e-4] {
+        match integrate(&b, Method::Reduced, &s0, dt, (6.0 / dt) as usize, 100) {
+            Err(Error::LeftDomain { t, .. }) => assert!((t - 2.3).abs() < 0.05, "t = {t}"),
+            other => panic!("dt = {dt}: expected LeftDomain, got {other:?}"),
+        }
+    }
+    assert!(integrate(&b, Method::Verlet4, &s0, 1e-3, 6000, 100).is_ok());
+}
