@@ -1,17 +1,19 @@
 //! The reduced pseudo-rigid body (001 §7) and the `PseudoRigidBody` system of the driver.
 
 use lieflow::integrate::splitting::Composition;
+use lieflow::integrate::verlet::{Verlet, VerletOrder, VerletScratch};
 use lieflow::integrate::{integrate, integrate_batch, Method, State, System};
 use lieflow::pseudo_rigid::dynamics::FullBody;
 use lieflow::pseudo_rigid::momentum;
 use lieflow::pseudo_rigid::potential::{
-    Harmonic, Potential, SaintVenantKirchhoff, Sum, Volumetric, Zero,
+    self, Harmonic, Potential, SaintVenantKirchhoff, Sum, Volumetric, Workspace, Zero,
 };
 use lieflow::pseudo_rigid::reduced::{
     momenta_of_velocities, reconstruct, reduce, spectral_invariants, ReducedSplitting, ReducedState,
 };
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::{Error, Mat};
+use nalgebra::Matrix3;
 use std::sync::Arc;
 
 fn elastic_gas() -> Arc<dyn Potential> {
@@ -371,4 +373,106 @@ fn reduced_method_stops_at_an_unresolved_near_collision_of_semi_axes() {
         }
     }
     assert!(integrate(&b, Method::Verlet4, &s0, 1e-3, 6000, 100).is_ok());
+}
+
+/// Delegates to a potential but hides its n = 3 fast path, so Verlet takes the general loop.
+#[derive(Debug)]
+struct General(Arc<dyn Potential>);
+
+impl Potential for General {
+    fn value(&self, x: faer::MatRef<'_, f64>, ws: &mut Workspace) -> f64 {
+        self.0.value(x, ws)
+    }
+    fn add_gradient(
+        &self,
+        x: faer::MatRef<'_, f64>,
+        out: faer::MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        self.0.add_gradient(x, out, ws)
+    }
+    fn needs_positive_det(&self) -> bool {
+        self.0.needs_positive_det()
+    }
+}
+
+fn potentials3() -> Vec<Arc<dyn Potential>> {
+    vec![
+        Arc::new(Zero),
+        Arc::new(Harmonic::new(1.7).unwrap()),
+        Arc::new(SaintVenantKirchhoff::new(0.7, 1.3).unwrap()),
+        Arc::new(Volumetric::polytropic(0.4, 1.4).unwrap()),
+        Arc::new(Volumetric::polytropic(0.4, 1.0).unwrap()),
+        elastic_gas(),
+    ]
+}
+
+#[test]
+fn fixed_size_gradients_match_the_general_kernels() {
+    let (x, _) = initial(3);
+    let x3 = Matrix3::from_fn(|i, j| x[(i, j)]);
+    for pot in potentials3() {
+        let g = potential::gradient(&*pot, &x).unwrap();
+        let g3 = pot
+            .gradient3(&x3)
+            .expect("built-ins have the n = 3 fast path");
+        let err = (0..9)
+            .map(|k| (g[(k / 3, k % 3)] - g3[(k / 3, k % 3)]).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-13 * g.norm_l2().max(1.0), "{pot:?}: {err}");
+    }
+    assert!(General(elastic_gas()).gradient3(&x3).is_none());
+}
+
+#[test]
+fn verlet_fast_path_matches_the_general_loop() {
+    let (x0, p0) = initial(3);
+    for pot in potentials3() {
+        for order in [VerletOrder::Two, VerletOrder::Six] {
+            let v = Verlet::new(order).with_check_det(false);
+            let run = |pot: &dyn Potential| {
+                let (mut x, mut p) = (x0.clone(), p0.clone());
+                v.run(
+                    pot,
+                    &mut x,
+                    &mut p,
+                    0.0,
+                    1e-2,
+                    200,
+                    &mut VerletScratch::new(3),
+                )
+                .unwrap();
+                (x, p)
+            };
+            let (xf, pf) = run(&*pot);
+            let (xg, pg) = run(&General(pot.clone()));
+            assert!(
+                rel(&xf, &xg) < 1e-12 && rel(&pf, &pg) < 1e-12,
+                "{pot:?} {order:?}"
+            );
+        }
+    }
+    // The exit error and the state left at the exit agree too.
+    let h: Arc<dyn Potential> = Arc::new(Harmonic::new(1.0).unwrap());
+    let x = Mat::from_fn(3, 3, |i, j| if i == j { 1.0 + 0.5 * i as f64 } else { 0.0 });
+    let exit = |pot: &dyn Potential| {
+        let (mut xe, mut pe) = (x.clone(), -&x);
+        let e = Verlet::new(VerletOrder::Two).run(
+            pot,
+            &mut xe,
+            &mut pe,
+            1.0,
+            1e-3,
+            2000,
+            &mut VerletScratch::new(3),
+        );
+        match e {
+            Err(Error::LeftDomain { t, .. }) => (t, xe),
+            other => panic!("expected LeftDomain, got {other:?}"),
+        }
+    };
+    let ((tf, xf), (tg, xg)) = (exit(&*h), exit(&General(h.clone())));
+    assert_eq!(tf, tg);
+    assert!((tf - 1.0 - std::f64::consts::FRAC_PI_4).abs() < 2e-3);
+    assert!(rel(&xf, &xg) < 1e-12);
 }

@@ -18,6 +18,7 @@ use crate::check;
 use crate::error::{Error, Result};
 use crate::pseudo_rigid::potential::{self, Potential, Workspace};
 use crate::Mat;
+use nalgebra::Matrix3;
 
 /// Order of the Verlet method: 2 (plain), 4 or 6 (symmetric composition).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -159,9 +160,33 @@ impl Verlet {
                 });
             }
         }
+        let composition = self.order.composition();
+        if n == 3 {
+            let x3 = Matrix3::from_fn(|i, j| x[(i, j)]);
+            if let Some(g3) = potential.gradient3(&x3) {
+                let mut s3 = (x3, Matrix3::from_fn(|i, j| p[(i, j)]));
+                let run = run3(
+                    potential,
+                    &composition,
+                    &mut s3,
+                    g3,
+                    (t0, dt, steps),
+                    check_det,
+                );
+                for i in 0..3 {
+                    for j in 0..3 {
+                        x[(i, j)] = s3.0[(i, j)];
+                        p[(i, j)] = s3.1[(i, j)];
+                    }
+                }
+                run?;
+                check::finite_mat("X after integration", x)?;
+                check::finite_mat("P after integration", p)?;
+                return Ok(());
+            }
+        }
         grad.fill(0.0);
         potential.add_gradient(x.as_ref(), grad.as_mut(), ws);
-        let composition = self.order.composition();
         for k in 0..steps {
             let mut t = t0 + k as f64 * dt;
             for &g in composition.gammas() {
@@ -172,17 +197,7 @@ impl Verlet {
                 if check_det {
                     let d = potential::det(x.as_ref(), ws);
                     if d.is_nan() || d <= 0.0 {
-                        return Err(Error::LeftDomain {
-                            what: format!("X (pseudo-rigid body in GL+({n}))"),
-                            t,
-                            message: format!(
-                                "det X = {d:.3e} ≤ 0 after step {} (dt = {dt}): the motion left \
-                                 GL+({n}); the equations extend to all n×n matrices, so pass \
-                                 check_det = false to continue (not possible with a volumetric \
-                                 potential, which is defined only for det X > 0)",
-                                k + 1
-                            ),
-                        });
+                        return Err(left_domain(n, t, d, k + 1, dt));
                     }
                 }
                 grad.fill(0.0);
@@ -194,4 +209,52 @@ impl Verlet {
         check::finite_mat("P after integration", p)?;
         Ok(())
     }
+}
+
+/// The error for det X ≤ 0 found at time `t` after step `step`.
+fn left_domain(n: usize, t: f64, d: f64, step: usize, dt: f64) -> Error {
+    Error::LeftDomain {
+        what: format!("X (pseudo-rigid body in GL+({n}))"),
+        t,
+        message: format!(
+            "det X = {d:.3e} ≤ 0 after step {step} (dt = {dt}): the motion left GL+({n}); the \
+             equations extend to all n×n matrices, so pass check_det = false to continue (not \
+             possible with a volumetric potential, which is defined only for det X > 0)"
+        ),
+    }
+}
+
+/// The n = 3 loop of [`Verlet::run`] on stack matrices, for potentials with
+/// [`Potential::gradient3`]; the same arithmetic as the general loop. `s` = (X, P) is left at
+/// the last state computed (also on error); `g` = ∂U/∂X at the initial X.
+fn run3(
+    potential: &dyn Potential,
+    composition: &Composition,
+    s: &mut (Matrix3<f64>, Matrix3<f64>),
+    mut g: Matrix3<f64>,
+    (t0, dt, steps): (f64, f64, usize),
+    check_det: bool,
+) -> Result<()> {
+    let (x, p) = s;
+    for k in 0..steps {
+        let mut t = t0 + k as f64 * dt;
+        for &w in composition.gammas() {
+            let h = w * dt;
+            *p -= g * (0.5 * h);
+            *x += *p * h;
+            t += h;
+            if check_det {
+                let d = x.determinant();
+                if d.is_nan() || d <= 0.0 {
+                    return Err(left_domain(3, t, d, k + 1, dt));
+                }
+            }
+            // A potential's fast path does not come and go; NaN would surface as NonFinite.
+            g = potential
+                .gradient3(x)
+                .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
+            *p -= g * (0.5 * h);
+        }
+    }
+    Ok(())
 }
