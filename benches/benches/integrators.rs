@@ -31,13 +31,13 @@ fn per_step<S: System>(c: &mut Criterion, group: &str, sys: &S, state: &State, m
 
 fn steps(c: &mut Criterion) {
     let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
-    per_step(c, "rigid_body", &body, &body.state(M0), &Method::ALL);
+    per_step(c, "rigid_body", &body, &body.state(M0), body.methods());
     per_step(
         c,
         "rigid_body_attitude",
         &body,
         &body.state_with_attitude(M0, I3),
-        &Method::ALL,
+        body.methods(),
     );
     let top = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
     per_step(

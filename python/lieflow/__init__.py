@@ -36,6 +36,7 @@ from ._lieflow import (
 )
 from . import elliptic, lie, pseudo_rigid
 from .integrate import Trajectory, integrate
+from ._lieflow import PseudoRigidBody; from . import potentials  # noqa: E702
 
 __all__ = [
     "ConvergenceError",

@@ -85,3 +85,22 @@ def riemann_bracket(
     Q: ArrayLike, N: ArrayLike, dfdQ: ArrayLike, dfdN: ArrayLike, dgdQ: ArrayLike, dgdN: ArrayLike
 ) -> float:
     """Poisson bracket of functions of (Q, N) (001 (9.1))."""
+
+class Reduced(TypedDict):
+    a: F64
+    p_a: F64
+    p_Omega: F64
+    p_Lambda: F64
+    R: F64
+    S: F64
+
+def reduce(X: ArrayLike, P: ArrayLike) -> Reduced:
+    """(X, P) -> (a, p_a, p_Omega, p_Lambda) and the frames R, S (001 §7)."""
+
+def reconstruct(
+    R: ArrayLike, S: ArrayLike, a: ArrayLike, p_a: ArrayLike, p_Omega: ArrayLike, p_Lambda: ArrayLike
+) -> tuple[F64, F64]:
+    """(X, P) from reduced coordinates and frames (001 (7.9)); inverse of `reduce`."""
+
+def adjoint_motion(X: ArrayLike, P: ArrayLike) -> tuple[F64, F64]:
+    """Dedekind's adjoint motion (X^T, P^T) of stacked frames (..., n, n)."""

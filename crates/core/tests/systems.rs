@@ -526,7 +526,7 @@ fn bad_input_gets_typed_errors() {
         other => panic!("expected UnsupportedMethod, got {other:?}"),
     }
     assert!(matches!(
-        Method::from_name("verlet"),
+        Method::from_name("verlet8"),
         Err(Error::InvalidArgument { .. })
     ));
     assert_eq!(Method::from_name("splitting6"), Ok(Method::Splitting6));

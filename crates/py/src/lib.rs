@@ -8,6 +8,7 @@ mod errors;
 mod integrate;
 mod lie;
 mod pseudo_rigid;
+mod pseudo_rigid_dynamics;
 
 use pyo3::prelude::*;
 
@@ -29,6 +30,7 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     add_submodule(m, "lie", lie::register)?;
     add_submodule(m, "pseudo_rigid", pseudo_rigid::register)?;
     integrate::register(m)?;
+    pseudo_rigid_dynamics::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -428,5 +428,100 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stratum, m)?)?;
     m.add_function(wrap_pyfunction!(riemann_variables, m)?)?;
     m.add_function(wrap_pyfunction!(riemann_bracket, m)?)?;
+    m.add_function(wrap_pyfunction!(reduce, m)?)?;
+    m.add_function(wrap_pyfunction!(reconstruct, m)?)?;
+    m.add_function(wrap_pyfunction!(adjoint_motion, m)?)?;
     Ok(())
+}
+
+/// Reduction (X, P) -> (a, p_a, p_Omega, p_Lambda) on the principal stratum (001 §7):
+/// X = R diag(a) S^T (a decreasing), p_a = diag(R^T P S), p_Omega = R^T L R, p_Lambda = S^T Γ S.
+///
+/// Returns:
+///     dict with "a", "p_a" ((n,) arrays), "p_Omega", "p_Lambda", "R", "S" ((n, n) arrays).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0), DegenerateStratumError.
+#[pyfunction]
+pub fn reduce<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    P: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (st, r, s) = lieflow::pseudo_rigid::reduced::reduce(&mat("X", &X)?, &mat("P", &P)?).py()?;
+    let d = PyDict::new(py);
+    d.set_item("a", py_vec(py, &st.a))?;
+    d.set_item("p_a", py_vec(py, &st.p_a))?;
+    d.set_item("p_Omega", py_mat(py, &st.p_omega))?;
+    d.set_item("p_Lambda", py_mat(py, &st.p_lambda))?;
+    d.set_item("R", py_mat(py, &r))?;
+    d.set_item("S", py_mat(py, &s))?;
+    Ok(d)
+}
+
+/// Reconstruction (R, S, a, p_a, p_Omega, p_Lambda) -> (X, P), the inverse of `reduce`:
+/// X = R A S^T, P = R(Omega A + diag(p_a) - A Lambda) S^T with Omega + Lambda =
+/// B_A^{-1}(p_Omega + p_Lambda) (001 (7.9)).
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (R, S not rotations, p's not skew),
+///     InvalidArgumentError (a_i <= 0), DegenerateStratumError (equal a_i).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn reconstruct<'py>(
+    py: Python<'py>,
+    R: ArrayIn<'py>,
+    S: ArrayIn<'py>,
+    a: ArrayIn<'py>,
+    p_a: ArrayIn<'py>,
+    p_Omega: ArrayIn<'py>,
+    p_Lambda: ArrayIn<'py>,
+) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
+    let st = lieflow::pseudo_rigid::reduced::ReducedState {
+        a: vector("a", &a)?,
+        p_a: vector("p_a", &p_a)?,
+        p_omega: mat("p_Omega", &p_Omega)?,
+        p_lambda: mat("p_Lambda", &p_Lambda)?,
+    };
+    Ok(pair(
+        py,
+        lieflow::pseudo_rigid::reduced::reconstruct(&mat("R", &R)?, &mat("S", &S)?, &st).py()?,
+    ))
+}
+
+type ArrD<'py> = Bound<'py, numpy::PyArrayDyn<f64>>;
+
+/// Dedekind's adjoint motion X -> X^T, P -> P^T of stacked frames (..., n, n) (000 §5.3): maps
+/// motions to motions and swaps angular momentum and circulation.
+///
+/// Returns:
+///     (X^T, P^T) with the shapes of the inputs.
+/// Raises:
+///     ShapeError, NonFiniteError.
+#[pyfunction]
+pub fn adjoint_motion<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    P: ArrayIn<'py>,
+) -> PyResult<(ArrD<'py>, ArrD<'py>)> {
+    use numpy::IntoPyArray;
+    let (xv, pv) = (X.as_array(), P.as_array());
+    let shape = xv.shape().to_vec();
+    let k = shape.len();
+    if k < 2 || shape[k - 1] != shape[k - 2] || pv.shape() != shape.as_slice() {
+        return Err(crate::errors::to_py(lieflow::Error::shape(
+            "X, P",
+            "two arrays of the same shape (..., n, n)",
+            format!("{:?} and {:?}", shape, pv.shape()),
+        )));
+    }
+    let n = shape[k - 1];
+    let xs: Vec<f64> = xv.iter().copied().collect();
+    let ps: Vec<f64> = pv.iter().copied().collect();
+    let (xt, pt) = lieflow::pseudo_rigid::dynamics::adjoint_motion(n, &xs, &ps).py()?;
+    let arr = |v: Vec<f64>| {
+        numpy::ndarray::ArrayD::from_shape_vec(numpy::ndarray::IxDyn(&shape), v)
+            .map(|a| a.into_pyarray(py))
+            .map_err(|e| crate::errors::to_py(lieflow::Error::invalid("X", e.to_string())))
+    };
+    Ok((arr(xt)?, arr(pt)?))
 }

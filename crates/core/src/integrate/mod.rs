@@ -13,6 +13,8 @@
 //! | `isospectral` | isospectral symplectic midpoint (Modin & Viviani 2020) | 2 | [`isospectral`] |
 //! | `lgvi`        | Lie group variational integrator (Lee, Leok & McClamroch) | 2 | [`variational`] |
 //! | `rk4`         | classical Runge–Kutta (non-geometric baseline)         | 4 | [`rk`] |
+//! | `verlet`, `verlet4`, `verlet6` | Störmer–Verlet on T*GL⁺(n) and its compositions | 2, 4, 6 | [`verlet`] |
+//! | `reduced`     | pseudo-rigid body, reduced-space splitting (001 §7)    | 2 | [`crate::pseudo_rigid::reduced`] |
 //!
 //! ```
 //! use lieflow::integrate::{integrate, Method, System};
@@ -51,17 +53,30 @@ pub enum Method {
     Lgvi,
     /// Classical fourth-order Runge–Kutta, the non-geometric baseline.
     Rk4,
+    /// Störmer–Verlet on T*GL⁺(n) (pseudo-rigid bodies), order 2.
+    Verlet,
+    /// Störmer–Verlet, Suzuki's 5-stage composition, order 4.
+    Verlet4,
+    /// Störmer–Verlet, Yoshida's 7-stage composition, order 6.
+    Verlet6,
+    /// Reduced-space splitting of the pseudo-rigid body on the principal stratum
+    /// ([`crate::pseudo_rigid::reduced`]), order 2, exact coadjoint orbits.
+    Reduced,
 }
 
 impl Method {
     /// Every method, in the order of the table above.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 10] = [
         Method::Splitting,
         Method::Splitting4,
         Method::Splitting6,
         Method::Isospectral,
         Method::Lgvi,
         Method::Rk4,
+        Method::Verlet,
+        Method::Verlet4,
+        Method::Verlet6,
+        Method::Reduced,
     ];
 
     /// The method's name in the Python API ("splitting", "splitting4", …).
@@ -73,6 +88,10 @@ impl Method {
             Method::Isospectral => "isospectral",
             Method::Lgvi => "lgvi",
             Method::Rk4 => "rk4",
+            Method::Verlet => "verlet",
+            Method::Verlet4 => "verlet4",
+            Method::Verlet6 => "verlet6",
+            Method::Reduced => "reduced",
         }
     }
 
@@ -95,9 +114,13 @@ impl Method {
     /// The nominal order of accuracy.
     pub fn order(self) -> u32 {
         match self {
-            Method::Splitting | Method::Isospectral | Method::Lgvi => 2,
-            Method::Splitting4 | Method::Rk4 => 4,
-            Method::Splitting6 => 6,
+            Method::Splitting
+            | Method::Isospectral
+            | Method::Lgvi
+            | Method::Verlet
+            | Method::Reduced => 2,
+            Method::Splitting4 | Method::Rk4 | Method::Verlet4 => 4,
+            Method::Splitting6 | Method::Verlet6 => 6,
         }
     }
 }

@@ -1,5 +1,5 @@
 //! Störmer–Verlet for separable Hamiltonians H = ½ tr(PᵀP) + U(X) on T*GL⁺(n) (001 (3.22)),
-//! and its symmetric compositions of order 4 and 6 (Yoshida 1990).
+//! and its symmetric compositions of order 4 (Suzuki 1990) and 6 (Yoshida 1990).
 //!
 //! One step of size h is kick–drift–kick: P ← P − (h/2)∂U/∂X(X); X ← X + hP;
 //! P ← P − (h/2)∂U/∂X(X). It is symplectic, symmetric (order 2), and equivariant under the linear
@@ -13,17 +13,19 @@
 //! `check_det` (the default) a step that ends with det X ≤ 0 stops the run with
 //! [`Error::LeftDomain`]. Potentials defined only on GL⁺(n) (a volumetric term) are always checked.
 
+use super::splitting::Composition;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::pseudo_rigid::potential::{self, Potential, Workspace};
 use crate::Mat;
+use nalgebra::Matrix3;
 
 /// Order of the Verlet method: 2 (plain), 4 or 6 (symmetric composition).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VerletOrder {
     /// Störmer–Verlet, order 2.
     Two,
-    /// Yoshida's triple jump of Verlet, order 4 (3 stages).
+    /// Suzuki's 5-stage composition of Verlet, order 4 (smaller error than the triple jump).
     Four,
     /// Yoshida's composition "solution A" of Verlet, order 6 (7 stages).
     Six,
@@ -51,39 +53,15 @@ impl VerletOrder {
             VerletOrder::Six => 6,
         }
     }
-}
 
-/// Triple-jump weights of order 4: (w₁, w₀, w₁), w₁ = 1/(2 − 2^{1/3}), w₀ = 1 − 2w₁
-/// (Yoshida 1990, Phys. Lett. A 150, 262).
-const ORDER4: [f64; 3] = [
-    1.351_207_191_959_657_8,
-    -1.702_414_383_919_315_3,
-    1.351_207_191_959_657_8,
-];
-
-/// Yoshida's order-6 "solution A" weights (w₃, w₂, w₁, w₀, w₁, w₂, w₃) (Yoshida 1990, Table 1).
-const ORDER6: [f64; 7] = [
-    0.784_513_610_477_557_3,
-    0.235_573_213_359_358_1,
-    -1.177_679_984_178_871,
-    1.315_186_320_683_911_2,
-    -1.177_679_984_178_871,
-    0.235_573_213_359_358_1,
-    0.784_513_610_477_557_3,
-];
-
-/// Runs one composed step of size `dt` as substeps `step(w_i dt)`.
-// TODO(merge): use the generic composition of integrate::splitting
-fn compose(order: VerletOrder, dt: f64, mut step: impl FnMut(f64) -> Result<()>) -> Result<()> {
-    let weights: &[f64] = match order {
-        VerletOrder::Two => &[1.0],
-        VerletOrder::Four => &ORDER4,
-        VerletOrder::Six => &ORDER6,
-    };
-    for w in weights {
-        step(w * dt)?;
+    /// The symmetric composition of Verlet steps giving this order ([`Composition`]).
+    pub fn composition(self) -> Composition {
+        match self {
+            VerletOrder::Two => Composition::strang(),
+            VerletOrder::Four => Composition::suzuki4(),
+            VerletOrder::Six => Composition::yoshida6(),
+        }
     }
-    Ok(())
 }
 
 /// Caller-owned scratch for [`Verlet::run`] on n×n matrices (no allocation per step).
@@ -182,38 +160,101 @@ impl Verlet {
                 });
             }
         }
+        let composition = self.order.composition();
+        if n == 3 {
+            let x3 = Matrix3::from_fn(|i, j| x[(i, j)]);
+            if let Some(g3) = potential.gradient3(&x3) {
+                let mut s3 = (x3, Matrix3::from_fn(|i, j| p[(i, j)]));
+                let run = run3(
+                    potential,
+                    &composition,
+                    &mut s3,
+                    g3,
+                    (t0, dt, steps),
+                    check_det,
+                );
+                for i in 0..3 {
+                    for j in 0..3 {
+                        x[(i, j)] = s3.0[(i, j)];
+                        p[(i, j)] = s3.1[(i, j)];
+                    }
+                }
+                run?;
+                check::finite_mat("X after integration", x)?;
+                check::finite_mat("P after integration", p)?;
+                return Ok(());
+            }
+        }
         grad.fill(0.0);
         potential.add_gradient(x.as_ref(), grad.as_mut(), ws);
         for k in 0..steps {
             let mut t = t0 + k as f64 * dt;
-            compose(self.order, dt, |h| {
+            for &g in composition.gammas() {
+                let h = g * dt;
                 potential::axpy(p.as_mut(), -0.5 * h, grad.as_ref());
                 potential::axpy(x.as_mut(), h, p.as_ref());
                 t += h;
                 if check_det {
                     let d = potential::det(x.as_ref(), ws);
                     if d.is_nan() || d <= 0.0 {
-                        return Err(Error::LeftDomain {
-                            what: format!("X (pseudo-rigid body in GL+({n}))"),
-                            t,
-                            message: format!(
-                                "det X = {d:.3e} ≤ 0 after step {} (dt = {dt}): the motion left \
-                                 GL+({n}); the equations extend to all n×n matrices, so pass \
-                                 check_det = false to continue (not possible with a volumetric \
-                                 potential, which is defined only for det X > 0)",
-                                k + 1
-                            ),
-                        });
+                        return Err(left_domain(n, t, d, k + 1, dt));
                     }
                 }
                 grad.fill(0.0);
                 potential.add_gradient(x.as_ref(), grad.as_mut(), ws);
                 potential::axpy(p.as_mut(), -0.5 * h, grad.as_ref());
-                Ok(())
-            })?;
+            }
         }
         check::finite_mat("X after integration", x)?;
         check::finite_mat("P after integration", p)?;
         Ok(())
     }
+}
+
+/// The error for det X ≤ 0 found at time `t` after step `step`.
+fn left_domain(n: usize, t: f64, d: f64, step: usize, dt: f64) -> Error {
+    Error::LeftDomain {
+        what: format!("X (pseudo-rigid body in GL+({n}))"),
+        t,
+        message: format!(
+            "det X = {d:.3e} ≤ 0 after step {step} (dt = {dt}): the motion left GL+({n}); the \
+             equations extend to all n×n matrices, so pass check_det = false to continue (not \
+             possible with a volumetric potential, which is defined only for det X > 0)"
+        ),
+    }
+}
+
+/// The n = 3 loop of [`Verlet::run`] on stack matrices, for potentials with
+/// [`Potential::gradient3`]; the same arithmetic as the general loop. `s` = (X, P) is left at
+/// the last state computed (also on error); `g` = ∂U/∂X at the initial X.
+fn run3(
+    potential: &dyn Potential,
+    composition: &Composition,
+    s: &mut (Matrix3<f64>, Matrix3<f64>),
+    mut g: Matrix3<f64>,
+    (t0, dt, steps): (f64, f64, usize),
+    check_det: bool,
+) -> Result<()> {
+    let (x, p) = s;
+    for k in 0..steps {
+        let mut t = t0 + k as f64 * dt;
+        for &w in composition.gammas() {
+            let h = w * dt;
+            *p -= g * (0.5 * h);
+            *x += *p * h;
+            t += h;
+            if check_det {
+                let d = x.determinant();
+                if d.is_nan() || d <= 0.0 {
+                    return Err(left_domain(3, t, d, k + 1, dt));
+                }
+            }
+            // A potential's fast path does not come and go; NaN would surface as NonFinite.
+            g = potential
+                .gradient3(x)
+                .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
+            *p -= g * (0.5 * h);
+        }
+    }
+    Ok(())
 }

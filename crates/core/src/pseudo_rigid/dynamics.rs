@@ -15,6 +15,7 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::so;
+use crate::pseudo_rigid::momentum;
 use crate::pseudo_rigid::potential::{self, Potential, Workspace};
 use crate::Mat;
 use faer::Side;
@@ -205,18 +206,13 @@ impl FullBody {
                 });
             }
         }
+        let (p_omega, p_lambda) = momentum::body_momenta(a, omega, lambda)?;
+        let e = momentum::e_term(a, omega, lambda);
         let am = Mat::from_fn(n, n, |i, j| if i == j { a[i] } else { 0.0 });
-        let a2 = &am * &am;
-        let p_omega = &a2 * omega + omega * &a2 - (&am * lambda * &am) * faer::Scale(2.0);
-        let p_lambda = &a2 * lambda + lambda * &a2 - (&am * omega * &am) * faer::Scale(2.0);
-        let e_full = -((omega * omega + lambda * lambda) * &am)
-            + omega * &am * lambda
-            + lambda * &am * omega;
         let mut ws = self.workspace();
         let mut g = Mat::zeros(n, n);
         self.potential
             .add_gradient(am.as_ref(), g.as_mut(), &mut ws);
-        let e: Vec<f64> = (0..n).map(|i| e_full[(i, i)]).collect();
         let a_ddot = (0..n).map(|i| e[i] - g[(i, i)]).collect();
         let p_omega_dot = so::bracket(&p_omega, omega);
         let p_lambda_dot = so::bracket(&p_lambda, lambda);
@@ -258,17 +254,8 @@ impl FullBody {
             ));
         }
         let (w, l) = (omega, lambda);
-        let mut m = Vector3::zeros();
-        let mut c = Vector3::zeros();
-        let mut e = Vector3::zeros();
-        for i in 0..3 {
-            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-            m[i] = (a[j] * a[j] + a[k] * a[k]) * w[i] - 2.0 * a[j] * a[k] * l[i];
-            c[i] = (a[j] * a[j] + a[k] * a[k]) * l[i] - 2.0 * a[j] * a[k] * w[i];
-            e[i] = a[i] * (w[j] * w[j] + w[k] * w[k] + l[j] * l[j] + l[k] * l[k])
-                - 2.0 * a[j] * w[k] * l[k]
-                - 2.0 * a[k] * w[j] * l[j];
-        }
+        let (m, c) = momentum::body_momenta_3(a, w, l);
+        let e = momentum::e_term_3(a, w, l);
         let am = Mat::from_fn(3, 3, |i, j| if i == j { a[i] } else { 0.0 });
         let mut ws = self.workspace();
         let mut g = Mat::zeros(3, 3);

@@ -13,7 +13,10 @@
 //!   polytropic volumetric, sums);
 //! - [`dynamics`]: the full Hamiltonian system on T*GL⁺(n) (001 (3.22)), the Riemann-ellipsoid
 //!   form (3.20), the Lagrangian form (Prop. 4.2) and Dedekind's adjoint motion;
-//! - [`riemann`]: the Riemann-ellipsoid variables (Q, N) and their Poisson brackets.
+//! - [`riemann`]: the Riemann-ellipsoid variables (Q, N) and their Poisson brackets;
+//! - [`reduced`]: the reduced system on the principal stratum (001 §7): reduction,
+//!   reconstruction, the reduced vector field and an orbit-preserving splitting integrator;
+//! - [`system`]: [`PseudoRigidBody`], the body as a system of the integration driver.
 //!
 //! Conventions (DESIGN.md): so(n) pairing ⟨ξ, η⟩ = ½ tr(ξᵀη) (001 (2.8)), e_ij basis, ξ block
 //! before η block, metric ⟨Y, Z⟩ = tr(YᵀZ) on T_X GL⁺(n) (001 (2.9)).
@@ -38,9 +41,12 @@ pub mod dynamics;
 pub mod inertia;
 pub mod momentum;
 pub mod potential;
+pub mod reduced;
 pub mod riemann;
 pub mod strata;
+pub mod system;
 
 pub use connection::Action;
 pub use inertia::BiInertia;
 pub use momentum::Body;
+pub use system::PseudoRigidBody;

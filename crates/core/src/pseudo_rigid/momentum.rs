@@ -130,17 +130,14 @@ impl Body {
     /// (001 (4.15), (6.27), (6.29)); equal to RᵀLR ⊕ SᵀΓS (001 (2.32)).
     pub fn momenta(&self) -> Result<(Mat, Mat)> {
         self.validate()?;
-        BiInertia::new(&self.a_matrix())?.apply(&self.omega, &self.lambda)
+        body_momenta(&self.a, &self.omega, &self.lambda)
     }
 
     /// The E term of 001 (4.8): E = 𝔇(−(Ω² + Λ²)A + ΩAΛ + ΛAΩ) = ∂K/∂A at fixed Ω, Λ, Ȧ
     /// (the diagonal, as a vector). Checked against finite differences of (4.5).
     pub fn e_term(&self) -> Result<Vec<f64>> {
-        let n = self.validate()?;
-        let a = self.a_matrix();
-        let (o, l) = (&self.omega, &self.lambda);
-        let e = -(o * o + l * l) * &a + o * &a * l + l * &a * o;
-        Ok((0..n).map(|i| e[(i, i)]).collect())
+        self.validate()?;
+        Ok(e_term(&self.a, &self.omega, &self.lambda))
     }
 
     /// Kinetic energy in body coordinates (001 (4.5)):
@@ -174,6 +171,21 @@ impl Body {
         Ok(0.5 * dot(&self.adot, &self.adot)
             + 0.5 * (so::pairing(&self.omega, &po) + so::pairing(&self.lambda, &pl)))
     }
+}
+
+/// The E term of 001 (4.8) at (A, Ω, Λ), unchecked (callers validate): the diagonal of
+/// −(Ω² + Λ²)A + ΩAΛ + ΛAΩ, as a vector. [`Body::e_term`] is the checked form.
+pub(crate) fn e_term(a: &[f64], omega: &Mat, lambda: &Mat) -> Vec<f64> {
+    let a = diag(a);
+    let (o, l) = (omega, lambda);
+    let e = -(o * o + l * l) * &a + o * &a * l + l * &a * o;
+    (0..a.nrows()).map(|i| e[(i, i)]).collect()
+}
+
+/// Body momenta p_Ω ⊕ p_Λ = B_A(Ω ⊕ Λ) at A = diag(a) (001 (4.15), (6.27)); [`Body::momenta`]
+/// is the same at a full body state. `a` > 0 in any order, Ω, Λ skew n×n (checked).
+pub fn body_momenta(a: &[f64], omega: &Mat, lambda: &Mat) -> Result<(Mat, Mat)> {
+    BiInertia::new(&diag(a))?.apply(omega, lambda)
 }
 
 /// Kinetic energy K = ½ tr(VᵀV) of a velocity V at X (001 (2.10), (3.2)); with V = P it is

@@ -21,6 +21,7 @@ use crate::Mat;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, inverse};
 use faer::{Accum, MatMut, MatRef, Par};
+use nalgebra::Matrix3;
 use std::fmt::Debug;
 use std::sync::Arc;
 
@@ -83,6 +84,13 @@ pub trait Potential: Send + Sync + Debug {
     fn needs_positive_det(&self) -> bool {
         false
     }
+
+    /// Fixed-size fast path for n = 3: ∂U/∂X at a 3×3 X, or `None` if the potential has none
+    /// (callers then use [`Potential::add_gradient`]). Must equal `add_gradient` (tested); lets
+    /// the n = 3 Verlet loop run on stack matrices.
+    fn gradient3(&self, _x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        None
+    }
 }
 
 /// Checks det X > 0 when the potential needs it (shape and finiteness are checked by callers).
@@ -129,6 +137,9 @@ impl Potential for Zero {
         0.0
     }
     fn add_gradient(&self, _x: MatRef<'_, f64>, _out: MatMut<'_, f64>, _ws: &mut Workspace) {}
+    fn gradient3(&self, _x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        Some(Matrix3::zeros())
+    }
 }
 
 /// Harmonic (isotropic linear-spring) potential U = (k/2) tr(XᵀX), ∂U/∂X = kX; 000 §5.3.
@@ -157,6 +168,9 @@ impl Potential for Harmonic {
     }
     fn add_gradient(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>, _ws: &mut Workspace) {
         axpy(out, self.k, x);
+    }
+    fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        Some(x * self.k)
     }
 }
 
@@ -228,6 +242,16 @@ impl Potential for SaintVenantKirchhoff {
         }
         mul(out, Accum::Add, x, ws.tmp.as_ref(), 1.0);
     }
+    fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        // The same S = μC + (λ tr E − μ)I over C = XᵀX as add_gradient.
+        let c = x.transpose() * x;
+        let tr = 0.5 * (c.trace() - 3.0);
+        let mut st = c * self.mu;
+        for i in 0..3 {
+            st[(i, i)] += self.lambda * tr - self.mu;
+        }
+        Some(x * st)
+    }
 }
 
 /// Volumetric energy of a polytropic gas filling the body, U = f(det X) (001 §4.1: a function of
@@ -289,6 +313,19 @@ impl Potential for Volumetric {
         axpy(out, scale, cof.as_ref());
         ws.tmp = cof;
     }
+    fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        // cof X = (adj X)ᵀ, by cross products of the columns; det X = ⟨x₀, x₁ × x₂⟩.
+        let (c0, c1, c2) = (x.column(0), x.column(1), x.column(2));
+        let cof = Matrix3::from_columns(&[c1.cross(&c2), c2.cross(&c0), c0.cross(&c1)]);
+        let d = c0.dot(&cof.column(0));
+        let pressure = if self.gamma == 1.0 {
+            self.kappa / d
+        } else {
+            self.kappa * d.powf(-self.gamma)
+        };
+        let scale = if d > 0.0 { -pressure } else { f64::NAN };
+        Some(cof * scale)
+    }
     fn needs_positive_det(&self) -> bool {
         true
     }
@@ -319,6 +356,13 @@ impl Potential for Sum {
         for t in &self.terms {
             t.add_gradient(x, out.as_mut(), ws);
         }
+    }
+    fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        let mut g = Matrix3::zeros();
+        for t in &self.terms {
+            g += t.gradient3(x)?;
+        }
+        Some(g)
     }
     fn needs_positive_det(&self) -> bool {
         self.terms.iter().any(|t| t.needs_positive_det())

@@ -178,7 +178,14 @@ fn exact_principal(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Result<Vect
     Ok(m)
 }
 
-const RIGID_METHODS: [Method; 6] = Method::ALL;
+const RIGID_METHODS: [Method; 6] = [
+    Method::Splitting,
+    Method::Splitting4,
+    Method::Splitting6,
+    Method::Isospectral,
+    Method::Lgvi,
+    Method::Rk4,
+];
 
 impl System for RigidBody {
     fn name(&self) -> &'static str {
@@ -212,12 +219,10 @@ impl System for RigidBody {
     fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
         self.check_method(method)?;
         Ok(match method {
-            Method::Splitting | Method::Splitting4 | Method::Splitting6 => {
-                Box::new(TopSplitting::new(self.moments, None, method, dt))
-            }
             Method::Lgvi => Box::new(LgviStepper(Lgvi::new(self.moments, dt, None))),
             Method::Isospectral => Box::new(So3Isospectral::new(&self.moments, dt)),
             Method::Rk4 => Box::new(top::TopRk4::new(self.field(false), self.field(true), dt)),
+            _ => Box::new(TopSplitting::new(self.moments, None, method, dt)),
         })
     }
 }
