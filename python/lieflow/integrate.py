@@ -7,7 +7,7 @@ released), an optional progress bar, and the assembly of the ``Trajectory``.
 
 Protocol a system implements (see ``docs`` of ``LiePoissonSystem``): ``methods()``, ``state_dim``,
 ``_normalize_state(state0) -> (z0 (b, d), batched)``, ``_run(z0, attitude0, dt, steps,
-save_every, method) -> (states (b, k, d), attitude (b, k, 3, 3) | None, z_final (b, d),
+save_every, method, *, t0) -> (states (b, k, d), attitude (b, k, 3, 3) | None, z_final (b, d),
 attitude_final (b, 3, 3) | None)``, vectorised ``energy`` and ``casimirs``; optionally
 ``_fields(states) -> dict`` of named views and further observables ``NAME(states)``.
 """
@@ -145,13 +145,13 @@ def integrate(system, state0, dt, steps, method="splitting", save_every=1, attit
             if done % save_every == 0 and save_every <= cap:
                 # Whole save intervals: keep the samples the native run saved.
                 n = min(cap // save_every * save_every, steps - done)
-                s, a, z, att = system._run(z, att, dt, n, save_every, method)
+                s, a, z, att = system._run(z, att, dt, n, save_every, method, t0=done * dt)
                 states.append(s[:, 1:])
                 atts.append(None if a is None else a[:, 1:])
             else:
                 # Part of a long save interval: keep only the end point, if it is a sample.
                 n = min(cap, save_every - done % save_every, steps - done)
-                _, _, z, att = system._run(z, att, dt, n, n, method)
+                _, _, z, att = system._run(z, att, dt, n, n, method, t0=done * dt)
                 if (done + n) % save_every == 0:
                     states.append(z[:, None, :])
                     atts.append(None if att is None else att[:, None])

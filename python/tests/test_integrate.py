@@ -111,9 +111,9 @@ class Recording:
     def __getattr__(self, name):
         return getattr(self.inner, name)
 
-    def _run(self, z0, attitude0, dt, steps, save_every, method):
-        self.calls.append(steps)
-        return self.inner._run(z0, attitude0, dt, steps, save_every, method)
+    def _run(self, z0, attitude0, dt, steps, save_every, method, *, t0=0.0):
+        self.calls.append((steps, t0))
+        return self.inner._run(z0, attitude0, dt, steps, save_every, method, t0=t0)
 
 
 def test_default_chunking_splits_long_runs(body, monkeypatch):
@@ -121,15 +121,15 @@ def test_default_chunking_splits_long_runs(body, monkeypatch):
     monkeypatch.setattr(sys.modules["lieflow.integrate"], "MIN_CHUNK_STEPS", 100)
     rec = Recording(body)
     tr = lf.integrate(rec, np.tile(M0, (4, 1)), dt=0.01, steps=1000, save_every=100)
-    assert rec.calls == [200] * 5 and tr.states.shape == (4, 11, 3)
+    assert rec.calls == [(200, k * 2.0) for k in range(5)] and tr.states.shape == (4, 11, 3)
     one = lf.integrate(body, np.tile(M0, (4, 1)), dt=0.01, steps=1000, save_every=100)
     np.testing.assert_allclose(tr.states, one.states, atol=1e-14)
     rec = Recording(body)
     lf.integrate(rec, M0, dt=0.01, steps=2500, save_every=700)   # cap 1000 < save_every
-    assert rec.calls == [700, 700, 700, 400]
+    assert [n for n, _ in rec.calls] == [700, 700, 700, 400]
     rec = Recording(body)
     lf.integrate(rec, np.tile(M0, (50, 1)), dt=0.01, steps=250, save_every=1)
-    assert rec.calls == [100, 100, 50]                          # MIN_CHUNK_STEPS for big batches
+    assert [n for n, _ in rec.calls] == [100, 100, 50]  # MIN_CHUNK_STEPS for big batches
 
 
 def test_progress_bar_tqdm_and_fallback(body, capsys, monkeypatch):

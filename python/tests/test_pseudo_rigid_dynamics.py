@@ -197,3 +197,12 @@ def test_run_t0_offsets_the_exit_time():
     z0, _ = body._normalize_state((x, -x))
     with pytest.raises(lf.LeftDomainError, match=r"t = 10\.78"):
         body._run(z0, None, 1e-3, 2000, 1, "verlet", t0=10.0)
+
+
+def test_chunked_integrate_names_the_absolute_exit_time():
+    # X(t) = X0 (cos t − sin t) leaves GL+(3) at t = π/4; with 100-step chunks the crossing
+    # falls in the 8th chunk, and the error must name the time from the start of the run.
+    x = np.diag([1.0, 1.5, 2.0])
+    body = lf.PseudoRigidBody(3, potential=pot.Harmonic(1.0))
+    with pytest.raises(lf.LeftDomainError, match=r"t = 0\.78"):
+        lf.integrate(body, (x, -x), dt=1e-3, steps=2000, method="verlet", chunk_steps=100)

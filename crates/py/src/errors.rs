@@ -83,6 +83,19 @@ pub fn to_py(e: lieflow::Error) -> PyErr {
     }
 }
 
+/// Adds `t0` to the time a [`lieflow::Error::LeftDomain`] names, for runs that start at t0 (the
+/// chunks of `lf.integrate`); other errors pass unchanged.
+pub fn shift_time(e: lieflow::Error, t0: f64) -> lieflow::Error {
+    match e {
+        lieflow::Error::LeftDomain { what, t, message } => lieflow::Error::LeftDomain {
+            what,
+            t: t + t0,
+            message,
+        },
+        e => e,
+    }
+}
+
 /// `lieflow::Result<T>` → `PyResult<T>`.
 #[allow(dead_code)] // used by every binding file once they land
 pub trait IntoPy<T> {

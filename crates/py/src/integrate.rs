@@ -21,7 +21,7 @@ use numpy::{IntoPyArray, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
 use crate::convert::ArrayIn;
-use crate::errors::{to_py, IntoPy};
+use crate::errors::{shift_time, to_py, IntoPy};
 use items::{array, map_items, shape_str, Input, Out};
 
 /// A core system usable from any thread.
@@ -187,7 +187,8 @@ impl LiePoissonSystem {
     ///
     /// Args:
     ///     z0: (b, d) initial states; attitude0: (b, 3, 3) rotations or None; dt > 0;
-    ///     steps >= 1; save_every >= 1; method: a name from `methods()`.
+    ///     steps >= 1; save_every >= 1; method: a name from `methods()`; t0 (keyword): the
+    ///     time of z0, added to the time a LeftDomainError names.
     /// Returns:
     ///     (states (b, k, d), attitude (b, k, 3, 3) or None, z_final (b, d),
     ///     attitude_final (b, 3, 3) or None), k = steps // save_every + 1.
@@ -195,7 +196,7 @@ impl LiePoissonSystem {
     ///     InvalidArgumentError (dt, steps, save_every, unknown method, constraints),
     ///     UnsupportedMethodError, ShapeError, NonFiniteError, NotInGroupError (attitude),
     ///     ConvergenceError (implicit methods), LeftDomainError (the state became non-finite).
-    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method))]
+    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method, *, t0 = 0.0))]
     #[allow(clippy::too_many_arguments)]
     fn _run<'py>(
         &self,
@@ -206,6 +207,7 @@ impl LiePoissonSystem {
         steps: usize,
         save_every: usize,
         method: &str,
+        t0: f64,
     ) -> PyResult<RunOut<'py>> {
         let method = Method::from_name(method).py()?;
         let states0 = self.initial_states(&z0, attitude0.as_ref())?;
@@ -218,7 +220,7 @@ impl LiePoissonSystem {
                     integrate_batch(sys, method, &states0, dt, steps, save_every, None)
                 }
             })
-            .map_err(|e| in_batch(py, sys, &states0, e))?;
+            .map_err(|e| in_batch(py, sys, &states0, shift_time(e, t0)))?;
         let (b, d, k) = (states0.len(), sys.dim(), steps / save_every + 1);
         let states = stack(trajs.iter().map(|t| t.states.as_slice()), b * k * d);
         let z_final = stack(trajs.iter().map(|t| t.final_state.z.as_slice()), b * d);

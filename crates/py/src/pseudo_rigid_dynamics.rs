@@ -22,7 +22,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
 use crate::convert::{mat, py_mat, ArrayIn};
-use crate::errors::{to_py, IntoPy};
+use crate::errors::{shift_time, to_py, IntoPy};
 
 /// An SO(n)×SO(n)-invariant potential U(X) of a pseudo-rigid body (001 §4.1). Build one with
 /// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Zero()` or
@@ -506,16 +506,7 @@ impl PyPseudoRigidBody {
         let res =
             py.detach(|| integrate_batch(body, method, &states0, dt, steps, save_every, threads));
         self.potential.take_callback_error()?;
-        let trajs = res
-            .map_err(|e| match e {
-                Error::LeftDomain { what, t, message } => Error::LeftDomain {
-                    what,
-                    t: t + t0,
-                    message,
-                },
-                e => e,
-            })
-            .py()?;
+        let trajs = res.map_err(|e| shift_time(e, t0)).py()?;
         let b = trajs.len();
         let k = steps / save_every + 1;
         let mut all = Vec::with_capacity(b * k * d);

@@ -62,7 +62,6 @@ use crate::error::{Error, Result};
 use crate::integrate::splitting::{run_sequence, Composition};
 use crate::lie::{gl, so};
 use crate::pseudo_rigid::dynamics::FullBody;
-use crate::pseudo_rigid::inertia::check_skew;
 use crate::pseudo_rigid::momentum::{self, momentum_map_unchecked};
 use crate::pseudo_rigid::potential::{Potential, Workspace};
 use crate::Mat;
@@ -126,8 +125,8 @@ impl ReducedState {
         check::finite_slice("a", &self.a)?;
         check::len_of("p_a", &self.p_a, n)?;
         check::finite_slice("p_a", &self.p_a)?;
-        check_skew("p_omega", &self.p_omega, n)?;
-        check_skew("p_lambda", &self.p_lambda, n)?;
+        so::check_algebra_of("p_omega", &self.p_omega, n)?;
+        so::check_algebra_of("p_lambda", &self.p_lambda, n)?;
         if let Some(i) = self.a.iter().position(|&ai| ai <= 0.0) {
             return Err(Error::invalid(
                 "a",
