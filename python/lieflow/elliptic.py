@@ -3,6 +3,6 @@
 ``ellipf``. They give the exact solution of the free rigid body, ``RigidBody.exact_solution``."""
 
 from . import _lieflow
-from ._reexport import reexport
+from ._reexport import reexport as _reexport
 
-__all__ = reexport(_lieflow.elliptic, globals())
+__all__ = _reexport(_lieflow.elliptic, globals())

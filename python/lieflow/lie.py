@@ -5,6 +5,6 @@ function's docstring for the equation it implements.
 """
 
 from . import _lieflow
-from ._reexport import reexport
+from ._reexport import reexport as _reexport
 
-__all__ = reexport(_lieflow.lie, globals())
+__all__ = _reexport(_lieflow.lie, globals())

@@ -6,6 +6,6 @@ add them with ``+``.
 """
 
 from . import _lieflow
-from ._reexport import reexport
+from ._reexport import reexport as _reexport
 
-__all__ = reexport(_lieflow.potentials, globals())
+__all__ = _reexport(_lieflow.potentials, globals())

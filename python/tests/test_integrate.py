@@ -465,3 +465,34 @@ def test_random_pendulum_never_gives_nan(theta, thd, phd, dt, method):
     tr = lf.integrate(p, p.state_from_spherical(theta, 0.0, thd, phd), dt=dt, steps=200,
                       method=method, save_every=20)
     assert np.all(np.isfinite(tr.states))
+
+
+def test_integration_releases_the_gil():
+    # A Python thread counts while one long native call runs. With the GIL released it counts at
+    # its free rate; were the GIL held, it could only run for the few ms of a switch interval.
+    import threading
+
+    counter, stop = [0], threading.Event()
+
+    def count():
+        while not stop.is_set():
+            counter[0] += 1
+
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        time.sleep(0.02)
+        c0, t0 = counter[0], time.perf_counter()
+        time.sleep(0.1)
+        rate = (counter[0] - c0) / (time.perf_counter() - t0)
+        c0, t0 = counter[0], time.perf_counter()
+        steps = 5_000_000
+        lf.integrate(body, M0, dt=1e-5, steps=steps, method="rk4", save_every=steps,
+                     chunk_steps=steps)
+        seconds = time.perf_counter() - t0
+        during = counter[0] - c0
+    finally:
+        stop.set()
+        t.join()
+    assert seconds > 0.05 and during > 0.15 * rate * seconds, (seconds, during, rate)

@@ -272,3 +272,11 @@ def test_non_contiguous_and_empty_batches():
     assert np.array_equal(lie.hat(np.asfortranarray(ws)), lie.hat(ws))
     assert lie.so3_exp(np.zeros((0, 3))).shape == (0, 3, 3)
     assert lie.se3_log(np.zeros((0, 4, 4))).shape == (0, 6)
+
+
+def test_se3_compose_broadcasts_and_accepts_empty_batches():
+    g = lie.se3_exp([0.1, 0.2, 0.3, 1.0, 2.0, 3.0])
+    hs = lie.se3_exp(np.random.default_rng(0).standard_normal((4, 6)))
+    np.testing.assert_allclose(lie.se3_compose(g, hs), g @ hs, atol=1e-14)
+    for args in [(g, np.zeros((0, 4, 4))), (np.zeros((0, 4, 4)), g)]:
+        assert lie.se3_compose(*args).shape == (0, 4, 4)

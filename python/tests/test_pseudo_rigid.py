@@ -200,3 +200,14 @@ def test_errors():
         pr.from_body(np.eye(3), [1.0, 1.0, 1.0], np.eye(3), xi, [0, 0], xi)
     with pytest.raises(lf.ShapeError):
         pr.riemann_bracket(np.eye(3), np.eye(2), np.eye(3), np.eye(3), np.eye(3), np.eye(3))
+
+
+def test_dense_outputs_refuse_sizes_that_cannot_be_allocated():
+    # B_X at n = 200 would hold (200·199)² ≈ 1.6e9 entries (12.7 GB): a typed error, not an abort.
+    x = np.eye(200)
+    for f in [pr.bi_inertia, pr.bi_inertia_eigen]:
+        with pytest.raises(lf.InvalidArgumentError, match="entries"):
+            f(x)
+    with pytest.raises(lf.InvalidArgumentError, match="entries"):
+        pr.locked_inertia(x, "two-sided")
+    assert pr.bi_inertia(np.eye(4)).shape == (12, 12)

@@ -128,8 +128,9 @@ def test_reduce_reconstruct_and_adjoint_motion():
 def test_error_paths():
     body = lf.PseudoRigidBody(3, potential=elastic())
     z0, _ = body._normalize_state((X0, P0))
-    with pytest.raises(lf.InvalidArgumentError):
-        lf.PseudoRigidBody(1)
+    for n in [1, -1, 2**32]:  # too small, negative, 2n² overflowing the address space
+        with pytest.raises(lf.InvalidArgumentError, match="n"):
+            lf.PseudoRigidBody(n)
     with pytest.raises(lf.InvalidArgumentError):
         pot.Harmonic(-1.0)
     with pytest.raises(lf.InvalidArgumentError):
@@ -164,8 +165,18 @@ def test_error_paths():
         body._run(body._normalize_state((-X0, P0))[0], None, 0.1, 10, 1, "verlet")
     with pytest.raises(lf.DegenerateStratumError):
         body._run(body._normalize_state((np.eye(3), P0))[0], None, 0.1, 10, 1, "reduced")
-    with pytest.raises(lf.ShapeError):
-        body.energy(np.zeros((4, 5)))
+    for observable in [body.energy, body.casimirs, body.angular_momentum, body.circulation,
+                       body.singular_values]:
+        with pytest.raises(lf.ShapeError):
+            observable(np.zeros((4, 5)))
+        with pytest.raises(lf.NonFiniteError):
+            observable(np.full(18, np.nan))
+    for p in [pot.Harmonic(1.0), elastic(), pot.Volumetric(1.0)]:
+        for f in [p.value, p.gradient]:
+            with pytest.raises(lf.ShapeError):
+                f(np.zeros((3, 2)))
+            with pytest.raises(lf.NonFiniteError):
+                f(np.full((3, 3), np.nan))
     with pytest.raises(lf.NotInGroupError):
         body.energy(body._normalize_state((-X0, P0))[0])
     with pytest.raises(lf.NotInGroupError):

@@ -201,6 +201,11 @@ def test_observable_errors():
         body.spatial_momentum(np.zeros((2, 3)), np.tile(np.eye(3), (3, 1, 1)))
     with pytest.raises(lf.ShapeError):
         body.spatial_momentum(M0, np.eye(2))
+    so4 = lf.GeneralizedRigidBody([1.0, 2.0, 3.0, 4.0])
+    with pytest.raises(lf.ShapeError, match=r"\(\.\.\., 6\)"):
+        so4.matrix(np.zeros(5))
+    with pytest.raises(lf.NonFiniteError):
+        so4.matrix(np.full(6, np.nan))
 
 
 # ---------------------------------------------------------------- GeneralizedRigidBody
@@ -303,6 +308,10 @@ def test_heavy_top_errors():
         lf.HeavyTop(I, -1.0)
     with pytest.raises(lf.InvalidArgumentError, match="chi"):
         lf.HeavyTop(I, 1.0, chi=[0.0, 0.0, 0.0])
+    with pytest.raises(lf.ShapeError, match="chi"):
+        lf.HeavyTop(I, 1.0, chi=[1.0, 2.0])
+    with pytest.raises(lf.NonFiniteError):
+        lf.HeavyTop(I, 1.0, chi=[1.0, np.nan, 0.0])
     with pytest.raises(lf.InvalidArgumentError):
         lf.HeavyTop([0.0, 1.0, 1.0], 1.0)
     top = lf.HeavyTop(I, 1.0)

@@ -79,6 +79,25 @@ pub fn positive(what: &str, x: f64) -> Result<()> {
     }
 }
 
+/// Largest dense array lieflow allocates on request: 2²⁸ entries (2 GiB of f64). Larger requests
+/// (e.g. the n(n−1)×n(n−1) bi-inertia matrix at n ≳ 130) are refused with a clear error instead
+/// of aborting the process when the allocation fails.
+pub const MAX_DENSE_ENTRIES: usize = 1 << 28;
+
+/// Checks that a dense `rows × cols` array fits [`MAX_DENSE_ENTRIES`] (without overflow).
+pub fn dense_size(what: &str, rows: usize, cols: usize) -> Result<()> {
+    match rows.checked_mul(cols) {
+        Some(k) if k <= MAX_DENSE_ENTRIES => Ok(()),
+        _ => Err(Error::invalid(
+            what,
+            format!(
+                "a dense {rows}×{cols} array exceeds the limit of {MAX_DENSE_ENTRIES} entries \
+                 (2 GiB); use the operator form or a smaller n"
+            ),
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -95,5 +114,8 @@ mod tests {
         assert!(positive("dt", f64::INFINITY).is_err());
         assert!(len_of("v", &[1.0, 2.0], 3).is_err());
         assert!(len_of("v", &[1.0, f64::NAN], 2).is_err());
+        assert!(dense_size("B", 1 << 14, 1 << 14).is_ok());
+        assert!(dense_size("B", (1 << 14) + 1, 1 << 14).is_err());
+        assert!(dense_size("B", usize::MAX, 2).is_err());
     }
 }

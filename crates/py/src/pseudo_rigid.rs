@@ -24,6 +24,15 @@ fn at(X: &ArrayIn<'_>) -> PyResult<BiInertia> {
     BiInertia::new(&mat("X", X)?).py()
 }
 
+/// [`at`] for the functions that return a dense n(n−1)×n(n−1) matrix: refuses sizes that cannot
+/// be allocated (an abort would take the Python process down) with InvalidArgumentError.
+fn at_dense(X: &ArrayIn<'_>) -> PyResult<BiInertia> {
+    let b = at(X)?;
+    let d = b.n() * (b.n() - 1);
+    lieflow::check::dense_size("X", d, d).py()?;
+    Ok(b)
+}
+
 fn pair<'py>(py: Python<'py>, (a, b): (Mat, Mat)) -> (Arr2<'py>, Arr2<'py>) {
     (py_mat(py, &a), py_mat(py, &b))
 }
@@ -65,7 +74,7 @@ pub fn right_inertia<'py>(
 ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
 #[pyfunction]
 pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(py, &at(&X)?.matrix()))
+    Ok(py_mat(py, &at_dense(&X)?.matrix()))
 }
 
 /// B_X(xi + eta) = (A^L_X xi - 2 X eta X^T, -2 X^T xi X + A^R_X eta) (001 (6.9), (6.10)).
@@ -117,7 +126,7 @@ pub fn bi_inertia_solve<'py>(
 ///     ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr1<'py>, Arr2<'py>)> {
-    let (vals, vecs) = at(&X)?.eigen().py()?;
+    let (vals, vecs) = at_dense(&X)?.eigen().py()?;
     Ok((py_vec(py, &vals), py_mat(py, &vecs)))
 }
 
@@ -239,7 +248,7 @@ pub fn horizontal_part<'py>(
 #[pyo3(signature = (X, action = "two-sided"))]
 pub fn locked_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, action: &str) -> PyResult<Arr2<'py>> {
     let action: Action = action.parse().py()?;
-    Ok(py_mat(py, &cn::locked_inertia(&at(&X)?, action)))
+    Ok(py_mat(py, &cn::locked_inertia(&at_dense(&X)?, action)))
 }
 
 /// Angular momentum L = V X^T - X V^T (001 (2.29), (7.3)) of a velocity or momentum V at X.

@@ -328,7 +328,9 @@ impl PyPseudoRigidBody {
 impl PyPseudoRigidBody {
     #[new]
     #[pyo3(signature = (n, potential=None, check_det=true))]
-    fn new(n: usize, potential: Option<Bound<'_, PyPotential>>, check_det: bool) -> PyResult<Self> {
+    fn new(n: i64, potential: Option<Bound<'_, PyPotential>>, check_det: bool) -> PyResult<Self> {
+        let n = usize::try_from(n)
+            .map_err(|_| to_py(Error::invalid("n", format!("expected n ≥ 2, got {n}"))))?;
         let potential = potential.map_or_else(Zero, |p| p.get().clone());
         Ok(PyPseudoRigidBody {
             body: CoreBody::new(n, potential.inner.clone(), check_det).py()?,

@@ -72,6 +72,8 @@ impl FullBody {
         if n < 2 {
             return Err(Error::invalid("n", format!("expected n ≥ 2, got {n}")));
         }
+        // The state (X, P) holds 2n² floats.
+        check::dense_size("n", 2 * n.min(usize::MAX / 2), n)?;
         Ok(FullBody { n, potential })
     }
 

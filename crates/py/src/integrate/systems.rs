@@ -16,7 +16,7 @@ use pyo3::PyClassInitializer;
 
 use super::items::{map_items, shape_str, Input};
 use super::{method_names, normalize_flat, LiePoissonSystem};
-use crate::convert::{py_mat3, py_vec, ArrayIn};
+use crate::convert::{self, py_mat3, py_vec, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -333,7 +333,7 @@ impl PyGeneralizedRigidBody {
             item: &[so::dim(n)],
         }];
         map_items(py, &inputs, &[n, n], |z, out| {
-            let m = so::hat_n_unchecked(n, z[0]);
+            let m = so::hat_n(z[0])?;
             for (k, o) in out.iter_mut().enumerate() {
                 *o = m[(k / n, k % n)];
             }
@@ -373,10 +373,18 @@ pub struct PyHeavyTop {
 impl PyHeavyTop {
     #[new]
     #[pyo3(
-        signature = (inertia, mgl, chi = [0.0, 0.0, 1.0]),
+        signature = (inertia, mgl, chi = None),
         text_signature = "(inertia, mgl, chi=(0.0, 0.0, 1.0))"
     )]
-    fn new(inertia: ArrayIn<'_>, mgl: f64, chi: [f64; 3]) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        inertia: ArrayIn<'_>,
+        mgl: f64,
+        chi: Option<ArrayIn<'_>>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let chi = match chi {
+            Some(c) => convert::vec3("chi", &c)?.into(),
+            None => [0.0, 0.0, 1.0],
+        };
         let top = match self::inertia(&inertia)? {
             Inertia::Moments(m) => core::HeavyTop::new(m, mgl, chi),
             Inertia::Matrix(m) => core::HeavyTop::from_matrix(&m, mgl, chi),

@@ -75,7 +75,12 @@ fn se3_inverse<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
 fn se3_compose<'py>(py: Python<'py>, g: ArrayIn<'py>, h: ArrayIn<'py>) -> PyResult<Out<'py>> {
     let (gs, bg) = read_items::<Matrix4<f64>>("g", &g)?;
     let (hs, bh) = read_items::<Matrix4<f64>>("h", &h)?;
-    let n = gs.len().max(hs.len());
+    // A single element broadcasts over the other batch; an empty batch gives an empty result.
+    let n = if gs.is_empty() || hs.is_empty() {
+        0
+    } else {
+        gs.len().max(hs.len())
+    };
     if bg && bh && gs.len() != hs.len() {
         return Err(to_py(Error::shape(
             "h",
