@@ -288,7 +288,8 @@ type BodyTuple<'py> = (
     Arr2<'py>,
 );
 
-/// Body coordinates (R, a, S, Omega, adot, Lambda) of (X, V) (001 §4.1): X = R diag(a) S^T,
+/// Body coordinates (R, a, S, Omega, adot, Lambda) of (X, V) (001 (2.4), (2.33), §4.1):
+/// X = R diag(a) S^T,
 /// Omega = R^T dR/dt, Lambda = S^T dS/dt, from R^T V S = Omega A + Adot - A Lambda.
 ///
 /// Returns:
@@ -309,7 +310,8 @@ pub fn to_body<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResu
     ))
 }
 
-/// (X, V) from body coordinates: X = R A S^T, V = R (Omega A + Adot - A Lambda) S^T (001 §4.1).
+/// (X, V) from body coordinates: X = R A S^T, V = R (Omega A + Adot - A Lambda) S^T
+/// (001 (2.4), (2.33), §4.1).
 ///
 /// Args:
 ///     R, S: (n, n) rotations; a: (n,) positive; Omega, Lambda: (n, n) skew; adot: (n,).
@@ -444,7 +446,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// Reduction (X, P) -> (a, p_a, p_Omega, p_Lambda) on the principal stratum (001 §7):
-/// X = R diag(a) S^T (a decreasing), p_a = diag(R^T P S), p_Omega = R^T L R, p_Lambda = S^T Γ S.
+/// X = R diag(a) S^T (a decreasing), p_a = diag(R^T P S), p_Omega = R^T L R, p_Lambda = S^T Γ S
+/// (001 (2.32), (6.27)).
 ///
 /// Returns:
 ///     dict with "a", "p_a" ((n,) arrays), "p_Omega", "p_Lambda", "R", "S" ((n, n) arrays).
