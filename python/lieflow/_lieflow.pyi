@@ -5,6 +5,12 @@ observables are vectorised over leading axes (..., d) and return a float for a s
 """
 
 from types import ModuleType
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+F64 = NDArray[np.float64]
 
 class LieflowError(ValueError): ...
 class NotInGroupError(LieflowError): ...
@@ -20,13 +26,9 @@ class LeftDomainError(LieflowError): ...
 __version__: str
 lie: ModuleType
 pseudo_rigid: ModuleType
+potentials: ModuleType
+elliptic: ModuleType
 
-from typing import Any
-
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
-
-F64 = NDArray[np.float64]
 
 class LiePoissonSystem:
     """Base class: the protocol `lieflow.integrate` drives."""
@@ -120,4 +122,34 @@ class SphericalPendulum(LiePoissonSystem):
         """theta from the downward vertical; broadcasts; -> (..., 6)."""
     def vertical_momentum(self, states: ArrayLike) -> F64 | float:
         """L3: (..., 6) -> (...)."""
+    def _fields(self, states: ArrayLike) -> dict[str, F64]: ...
+
+
+# --- the pseudo-rigid body on T*GL+(n): z = (X row-major, P row-major), d = 2 n^2 ---
+
+
+class PseudoRigidBody:
+    """Generalized pseudo-rigid body on T*GL+(n), H = tr(P^T P)/2 + U(X) (001 (3.22))."""
+
+    def __init__(self, n: int, potential: Potential | None = None, check_det: bool = True) -> None: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def state_dim(self) -> int: ...
+    @property
+    def has_attitude(self) -> bool: ...
+    @property
+    def check_det(self) -> bool: ...
+    @property
+    def potential(self) -> Potential: ...
+    def methods(self) -> list[str]: ...
+    def _normalize_state(self, state0: Any) -> tuple[F64, bool]: ...
+    def _run(
+        self, z0: ArrayLike, attitude0: None, dt: float, steps: int, save_every: int, method: str
+    ) -> tuple[F64, None, F64, None]: ...
+    def energy(self, states: ArrayLike) -> F64: ...
+    def casimirs(self, states: ArrayLike) -> F64: ...
+    def angular_momentum(self, states: ArrayLike) -> F64: ...
+    def circulation(self, states: ArrayLike) -> F64: ...
+    def singular_values(self, states: ArrayLike) -> F64: ...
     def _fields(self, states: ArrayLike) -> dict[str, F64]: ...

@@ -2,25 +2,10 @@
 
 mod common;
 
-use common::dist;
+use common::{dist, gl_plus, rotation};
 use lieflow::lie::gl;
 use lieflow::{Error, Mat};
 use proptest::prelude::*;
-
-/// A matrix with det > 0 from entries (flips the first row if needed).
-fn gl_plus(n: usize, v: &[f64]) -> Mat {
-    let mut m = Mat::from_fn(n, n, |i, j| v[i * n + j]);
-    if gl::det(&m) < 0.0 {
-        for j in 0..n {
-            m[(0, j)] = -m[(0, j)];
-        }
-    }
-    m
-}
-
-fn rotation(n: usize, v: &[f64]) -> Mat {
-    gl::polar(&gl_plus(n, v)).unwrap().0
-}
 
 fn is_rotation(r: &Mat) -> bool {
     let n = r.nrows();

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::dist;
+use common::{dist, gl_plus, rotation};
 use faer::linalg::solvers::Solve;
 use lieflow::lie::{gl, so, so3};
 use lieflow::pseudo_rigid::{
@@ -12,20 +12,6 @@ use lieflow::pseudo_rigid::{
 use lieflow::{Error, Mat};
 use nalgebra::Vector3;
 use proptest::prelude::*;
-
-fn gl_plus(n: usize, v: &[f64]) -> Mat {
-    let mut m = Mat::from_fn(n, n, |i, j| v[i * n + j]);
-    if gl::det(&m) < 0.0 {
-        for j in 0..n {
-            m[(0, j)] = -m[(0, j)];
-        }
-    }
-    m
-}
-
-fn rotation(n: usize, v: &[f64]) -> Mat {
-    gl::polar(&gl_plus(n, v)).unwrap().0
-}
 
 fn skew(n: usize, v: &[f64]) -> Mat {
     so::hat_n_unchecked(n, &v[..so::dim(n)])

@@ -3,6 +3,7 @@
 
 pub mod group_laws;
 
+use lieflow::lie::gl;
 use lieflow::Mat;
 
 /// Frobenius distance between two matrices of the same shape.
@@ -31,4 +32,21 @@ pub fn expm_reference(a: &Mat) -> Mat {
         sum = &sum * &sum;
     }
     sum
+}
+
+/// An n×n matrix with det > 0 from the first n² entries of `v` (the first row is flipped if
+/// needed).
+pub fn gl_plus(n: usize, v: &[f64]) -> Mat {
+    let mut m = Mat::from_fn(n, n, |i, j| v[i * n + j]);
+    if gl::det(&m) < 0.0 {
+        for j in 0..n {
+            m[(0, j)] = -m[(0, j)];
+        }
+    }
+    m
+}
+
+/// A rotation in SO(n): the polar factor of [`gl_plus`].
+pub fn rotation(n: usize, v: &[f64]) -> Mat {
+    gl::polar(&gl_plus(n, v)).unwrap().0
 }
