@@ -22,7 +22,6 @@ def run(body, state0, dt, steps, save_every=1, method="verlet"):
     return states if batched else states[0]
 
 
-needs_integrate = pytest.mark.skipif(not hasattr(lf, "integrate"), reason="lf.integrate not merged")
 
 
 def test_potentials_values_gradients_and_sums():
@@ -183,7 +182,6 @@ def test_error_paths():
         pot.Volumetric(1.0).value(-X0)
 
 
-@needs_integrate
 def test_lf_integrate_trajectory():
     body = lf.PseudoRigidBody(3, potential=elastic())
     traj = lf.integrate(body, (X0, P0), dt=1e-3, steps=1000, method="verlet4", save_every=100)
