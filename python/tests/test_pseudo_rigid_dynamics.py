@@ -22,8 +22,6 @@ def run(body, state0, dt, steps, save_every=1, method="verlet"):
     return states if batched else states[0]
 
 
-
-
 def test_potentials_values_gradients_and_sums():
     X = X0
     h = pot.Harmonic(2.0)
