@@ -10,22 +10,13 @@ Prints a Markdown table of the best-of-k wall times.
 
 import argparse
 import os
-import time
 
 import numpy as np
 import scipy
 import scipy.linalg
 
 import lieflow as lf
-
-
-def best_time(f, repeat):
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f()
-        best = min(best, time.perf_counter() - t0)
-    return best
+from timing import best_time
 
 
 def skew_batch(b, n, rng):
@@ -60,14 +51,14 @@ def main():
             repeat = max(1, repeat // 10)
         if b == 1:
             x = xs[0]
-            t_lf = best_time(lambda: lf.lie.so_exp(x), repeat)
-            t_loop = best_time(lambda: scipy.linalg.expm(x), repeat)
+            t_lf = best_time(lambda: lf.lie.so_exp(x), repeat)[0]
+            t_loop = best_time(lambda: scipy.linalg.expm(x), repeat)[0]
             t_stack = t_loop
             np.testing.assert_allclose(lf.lie.so_exp(x), scipy.linalg.expm(x), atol=1e-12)
         else:
-            t_lf = best_time(lambda: lf.lie.so_exp(xs), repeat)
-            t_loop = best_time(lambda: [scipy.linalg.expm(x) for x in xs], repeat)
-            t_stack = best_time(lambda: scipy.linalg.expm(xs), repeat)
+            t_lf = best_time(lambda: lf.lie.so_exp(xs), repeat)[0]
+            t_loop = best_time(lambda: [scipy.linalg.expm(x) for x in xs], repeat)[0]
+            t_stack = best_time(lambda: scipy.linalg.expm(xs), repeat)[0]
             np.testing.assert_allclose(lf.lie.so_exp(xs), scipy.linalg.expm(xs), atol=1e-12)
         print(f"| {n} | {b} | {fmt(t_lf)} | {fmt(t_loop)} | {fmt(t_stack)} | "
               f"{t_loop / t_lf:.1f}× | {t_stack / t_lf:.1f}× |")

@@ -13,38 +13,29 @@ I = diag(1, 2, 3), method "splitting"):
 import os
 import subprocess
 import sys
-import time
 
 import numpy as np
 
 import lieflow as lf
+from timing import best_time
 
 M0 = np.array([1.0, 0.5, -0.3])
-
-
-def best(fn, repeats):
-    out = float("inf")
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        out = min(out, time.perf_counter() - t0)
-    return out
 
 
 def batch_child():
     body = lf.RigidBody([1.0, 2.0, 3.0])
     m0 = np.random.default_rng(0).standard_normal((10_000, 3))
-    sec = best(lambda: lf.integrate(body, m0, dt=0.01, steps=1000, save_every=1000), 3)
+    sec = best_time(lambda: lf.integrate(body, m0, dt=0.01, steps=1000, save_every=1000), 3)[0]
     print(sec)
 
 
 def main():
     body = lf.RigidBody([1.0, 2.0, 3.0])
-    sec = best(lambda: lf.integrate(body, M0, dt=0.01, steps=1), 2000)
+    sec = best_time(lambda: lf.integrate(body, M0, dt=0.01, steps=1), 2000)[0]
     print(f"lf.integrate per-call overhead (steps=1):        {sec * 1e6:8.2f} us")
     n = 2_000_000
-    one = best(lambda: lf.integrate(body, M0, dt=1e-3, steps=n, save_every=n, chunk_steps=n), 3)
-    chunked = best(lambda: lf.integrate(body, M0, dt=1e-3, steps=n, save_every=n), 3)
+    one = best_time(lambda: lf.integrate(body, M0, dt=1e-3, steps=n, save_every=n, chunk_steps=n), 3)[0]
+    chunked = best_time(lambda: lf.integrate(body, M0, dt=1e-3, steps=n, save_every=n), 3)[0]
     print(f"2e6 steps, one native call:                      {one / n * 1e9:8.2f} ns/step")
     print(f"2e6 steps, default chunks of {sys.modules['lieflow.integrate'].CHUNK_WORK} steps:    "
           f"{chunked / n * 1e9:8.2f} ns/step")

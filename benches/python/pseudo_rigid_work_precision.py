@@ -13,12 +13,12 @@ numpy (one call per stage), the usual way such a model is written in Python.
 
 import os
 import platform
-import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 import lieflow as lf
+from timing import best_time
 
 LAM, MU = 0.7, 1.3
 T = 20.0
@@ -34,16 +34,6 @@ def rhs(t, y):
     E = 0.5 * (X.T @ X - I3)
     S = LAM * np.trace(E) * I3 + 2 * MU * E
     return np.concatenate([P, -(X @ S).ravel()])
-
-
-def best_time(fn, repeats=3, budget=0.3, max_repeats=200):
-    best, out, spent, n = float("inf"), None, 0.0, 0
-    while n < repeats or (spent < budget and n < max_repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        dt = time.perf_counter() - t0
-        best, spent, n = min(best, dt), spent + dt, n + 1
-    return best, out
 
 
 def lieflow_final(method, dt):
@@ -70,7 +60,7 @@ def main():
         ("verlet6", [1e-1, 5e-2, 2.5e-2, 1.25e-2]),
     ]:
         for dt in dts:
-            t, z = best_time(lambda: lieflow_final(method, dt))
+            t, z = best_time(lambda: lieflow_final(method, dt), budget=0.3, max_repeats=200)
             rows.append((method, f"dt={dt:g}", np.max(np.abs(z - ref)), t))
     for tol in [1e-4, 1e-6, 1e-8, 1e-10, 1e-12]:
         t, z = best_time(lambda: dop853_final(tol), repeats=1, budget=1.0)

@@ -12,12 +12,12 @@ lieflow's times include the per-call overhead of `lf.integrate` (a few microseco
 import argparse
 import os
 import platform
-import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 import lieflow as lf
+from timing import best_time
 
 I = np.array([1.0, 2.0, 3.0])
 M0 = np.array([1.0, 0.5, -0.3])
@@ -27,19 +27,6 @@ T = 100.0
 def euler(t, m):
     om = m / I
     return np.cross(m, om)
-
-
-def best_time(fn, repeats=3, budget=0.3, max_repeats=500):
-    """Best wall time of `fn` over at least `repeats` calls, more while within `budget` seconds."""
-    best = float("inf")
-    out = None
-    spent, n = 0.0, 0
-    while n < repeats or (spent < budget and n < max_repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        dt = time.perf_counter() - t0
-        best, spent, n = min(best, dt), spent + dt, n + 1
-    return best, out
 
 
 def main():
@@ -61,13 +48,15 @@ def main():
             sec, sol = best_time(
                 lambda: solve_ivp(euler, (0, T), M0, method=method, rtol=tol, atol=tol * 1e-2),
                 repeats=3,
+                budget=0.3,
             )
             rows.append((f"scipy {method}", f"rtol={tol:.0e}", sec, np.max(np.abs(sol.y[:, -1] - exact))))
     for method in lf.RigidBody.methods():
         for steps in [250, 500, 1000, 2000, 4000, 8000, 16000, 32000]:
             dt = T / steps
             sec, tr = best_time(
-                lambda: lf.integrate(body, M0, dt=dt, steps=steps, method=method, save_every=steps)
+                lambda: lf.integrate(body, M0, dt=dt, steps=steps, method=method, save_every=steps),
+                budget=0.3,
             )
             err = np.max(np.abs(np.asarray(tr.states)[-1] - exact))
             rows.append((f"lieflow {method}", f"steps={steps}", sec, err))
