@@ -38,6 +38,27 @@ fn energy_tenths<S: System>(s: &S, traj: &lieflow::integrate::Trajectory) -> (f6
 
 // ---------------------------------------------------------------- heavy top
 
+/// Errors at t = 2 against `reference` for the step sizes `dts` and the observed order
+/// log₂(e₀/e₁) (`dts[1] = dts[0]/2`).
+fn observed_order<S: System>(
+    sys: &S,
+    method: Method,
+    s0: &State,
+    reference: &[f64],
+    dts: [f64; 2],
+) -> ([f64; 2], f64) {
+    let e = dts.map(|dt| {
+        let n = (2.0 / dt) as usize;
+        let z = integrate(sys, method, s0, dt, n, n).unwrap().final_state.z;
+        z.iter()
+            .zip(reference)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    });
+    (e, (e[0] / e[1]).log2())
+}
+
 fn top() -> HeavyTop {
     HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap()
 }
@@ -122,19 +143,7 @@ fn heavy_top_orders_and_zero_gravity_limit() {
         (Method::Lgvi, [0.02, 0.01]),
         (Method::Rk4, [0.1, 0.05]),
     ] {
-        let e: Vec<f64> = dts
-            .iter()
-            .map(|&dt| {
-                let n = (2.0 / dt) as usize;
-                let z = integrate(&t, method, &s0, dt, n, n).unwrap().final_state.z;
-                z.iter()
-                    .zip(&reference)
-                    .map(|(a, b)| (a - b).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .collect();
-        let p = (e[0] / e[1]).log2();
+        let (e, p) = observed_order(&t, method, &s0, &reference, dts);
         eprintln!("heavy top {method:?}: errors {e:?}, order {p:.3}");
         assert!(
             (p - method.order() as f64).abs() < 0.2,
@@ -299,19 +308,7 @@ fn son_orders_and_matrix_mass() {
         (Method::Isospectral, [0.02, 0.01]),
         (Method::Rk4, [0.1, 0.05]),
     ] {
-        let e: Vec<f64> = dts
-            .iter()
-            .map(|&dt| {
-                let n = (2.0 / dt) as usize;
-                let zz = integrate(&b, method, &s0, dt, n, n).unwrap().final_state.z;
-                zz.iter()
-                    .zip(&reference)
-                    .map(|(a, b)| (a - b).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .collect();
-        let p = (e[0] / e[1]).log2();
+        let (_, p) = observed_order(&b, method, &s0, &reference, dts);
         assert!(
             (p - method.order() as f64).abs() < 0.2,
             "so(4) {method:?}: order {p}"
