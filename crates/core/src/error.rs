@@ -125,6 +125,22 @@ impl Error {
         }
     }
 
+    /// The same error about member `i` of a batch ("batch member i: " before what it names).
+    pub fn in_member(mut self, i: usize) -> Self {
+        match &mut self {
+            Error::NotInGroup { what, .. }
+            | Error::Shape { what, .. }
+            | Error::NonFinite { what, .. }
+            | Error::DegenerateStratum { what, .. }
+            | Error::NoUniqueLog { what, .. }
+            | Error::InvalidArgument { what, .. }
+            | Error::NotConverged { what, .. }
+            | Error::LeftDomain { what, .. } => *what = format!("batch member {i}: {what}"),
+            Error::UnsupportedMethod { .. } | Error::Interrupted { .. } => {}
+        }
+        self
+    }
+
     /// Shorthand for [`Error::Shape`].
     pub fn shape(
         what: impl Into<String>,

@@ -1,256 +1,59 @@
-//! Structure-preserving integrators and the integration driver.
+//! Structure-preserving integration: state spaces, problem kinds, methods as values, and the one
+//! driver that owns time.
 //!
-//! Methods are values ([`Method`]) passed to one driver, [`integrate`] (one initial state) or
-//! [`integrate_batch`] (many, in parallel with rayon). A mechanical system implements [`System`]:
-//! it says which methods it supports and builds a [`Stepper`] for a method and a time step. The
-//! stepper advances a [`State`] in place; the driver saves every `save_every`-th state.
-//!
-//! | method        | kind                                                  | order | module |
-//! |---------------|-------------------------------------------------------|-------|--------|
-//! | `splitting`   | Lie–Poisson splitting, Strang composition             | 2 | [`splitting`] |
-//! | `splitting4`  | the same, Suzuki's 5-stage composition                | 4 | [`splitting`] |
-//! | `splitting6`  | the same, Yoshida's 7-stage composition               | 6 | [`splitting`] |
-//! | `isospectral` | isospectral symplectic midpoint (Modin & Viviani 2020) | 2 | [`isospectral`] |
-//! | `lgvi`        | Lie group variational integrator (Lee, Leok & McClamroch) | 2 | [`variational`] |
-//! | `rk4`         | classical Runge–Kutta (non-geometric baseline)         | 4 | [`rk`] |
-//! | `verlet`, `verlet4`, `verlet6` | Störmer–Verlet on T*GL⁺(n) and its compositions | 2, 4, 6 | [`verlet`] |
-//! | `reduced`     | pseudo-rigid body, reduced-space splitting (001 §7)    | 2 | [`crate::pseudo_rigid::reduced`] |
+//! - [`space`]: a state is one flat vector cut into named blocks ([`Space`]: ℝᵏ, SO(3), S², n×n
+//!   matrices, so(n)*) with membership checks, retraction and named views;
+//! - [`problem`]: the kinds a system can implement ([`problem::VectorField`], [`problem::Split`],
+//!   [`problem::Separable`], [`problem::Canonical`], [`problem::Constrained`],
+//!   [`problem::Nonholonomic`], [`problem::GroupField`], [`problem::Symmetric`]);
+//! - [`methods`]: one file per method family, each generic over the kind it needs;
+//! - [`method`]: the [`Integrator`] and [`Stepper`] traits, each system's [`Catalog`] of named
+//!   methods, and [`System`], any catalogued problem as a trait object;
+//! - this module: the driver. A [`Run`] validates once, owns the clock and the stepper for the
+//!   whole run (callers that work in chunks resume the same run), retracts curved blocks every
+//!   [`RETRACT_EVERY`] steps for methods that keep the manifold, and saves every
+//!   `save_every`-th state; [`integrate`] and [`integrate_batch`] (rayon) are built on it.
 //!
 //! ```
-//! use lieflow::integrate::{integrate, Method, System};
+//! use lieflow::integrate::{integrate, Problem};
 //! use lieflow::systems::RigidBody;
 //! let body = RigidBody::new([1.0, 2.0, 3.0])?;
-//! let traj = integrate(&body, Method::Splitting4, &body.state([1.0, 0.5, -0.3]), 1e-2, 1000, 100)?;
+//! let traj = integrate(&body, "splitting4", &[1.0, 0.5, -0.3], 1e-2, 1000, 100)?;
 //! assert_eq!(traj.len(), 11);
 //! let (h0, h1) = (body.energy(traj.state(0))?, body.energy(traj.state(10))?);
 //! assert!((h1 - h0).abs() < 1e-9);
 //! # Ok::<(), lieflow::Error>(())
 //! ```
 
-pub mod isospectral;
-pub mod rk;
-pub mod splitting;
-pub mod variational;
-pub mod verlet;
+pub mod method;
+pub mod methods;
+pub mod problem;
+pub mod space;
+
+pub use method::{Catalog, Clock, Entry, Integrator, Properties, Stepper, System};
+pub use problem::Problem;
+pub use space::{Block, Space};
 
 use crate::check;
 use crate::error::{Error, Result};
-use crate::lie::so3;
 use rayon::prelude::*;
 
-/// An integration method, named as in the Python API.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Lie–Poisson splitting with exact sub-flows, Strang composition (order 2).
-    Splitting,
-    /// Lie–Poisson splitting, Suzuki's fourth-order composition of Strang steps.
-    Splitting4,
-    /// Lie–Poisson splitting, Yoshida's sixth-order composition of Strang steps.
-    Splitting6,
-    /// Isospectral symplectic midpoint on so(n)* (Modin & Viviani 2020), order 2.
-    Isospectral,
-    /// Lie group variational integrator in Cayley coordinates (Lee, Leok & McClamroch), order 2.
-    Lgvi,
-    /// Classical fourth-order Runge–Kutta, the non-geometric baseline.
-    Rk4,
-    /// Störmer–Verlet on T*GL⁺(n) (pseudo-rigid bodies), order 2.
-    Verlet,
-    /// Störmer–Verlet, Suzuki's 5-stage composition, order 4.
-    Verlet4,
-    /// Störmer–Verlet, Yoshida's 7-stage composition, order 6.
-    Verlet6,
-    /// Reduced-space splitting of the pseudo-rigid body on the principal stratum
-    /// ([`crate::pseudo_rigid::reduced`]), order 2, exact coadjoint orbits.
-    Reduced,
-}
-
-impl Method {
-    /// Every method, in the order of the table above.
-    pub const ALL: [Method; 10] = [
-        Method::Splitting,
-        Method::Splitting4,
-        Method::Splitting6,
-        Method::Isospectral,
-        Method::Lgvi,
-        Method::Rk4,
-        Method::Verlet,
-        Method::Verlet4,
-        Method::Verlet6,
-        Method::Reduced,
-    ];
-
-    /// The method's name in the Python API ("splitting", "splitting4", …).
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Splitting => "splitting",
-            Method::Splitting4 => "splitting4",
-            Method::Splitting6 => "splitting6",
-            Method::Isospectral => "isospectral",
-            Method::Lgvi => "lgvi",
-            Method::Rk4 => "rk4",
-            Method::Verlet => "verlet",
-            Method::Verlet4 => "verlet4",
-            Method::Verlet6 => "verlet6",
-            Method::Reduced => "reduced",
-        }
-    }
-
-    /// Parses a method name; an unknown name gives [`Error::InvalidArgument`] listing all names.
-    pub fn from_name(name: &str) -> Result<Method> {
-        Method::ALL
-            .into_iter()
-            .find(|m| m.name() == name)
-            .ok_or_else(|| {
-                Error::invalid(
-                    "method",
-                    format!(
-                        "unknown method {name:?}; known methods: {}",
-                        names(&Method::ALL)
-                    ),
-                )
-            })
-    }
-
-    /// The nominal order of accuracy.
-    pub fn order(self) -> u32 {
-        match self {
-            Method::Splitting
-            | Method::Isospectral
-            | Method::Lgvi
-            | Method::Verlet
-            | Method::Reduced => 2,
-            Method::Splitting4 | Method::Rk4 | Method::Verlet4 => 4,
-            Method::Splitting6 | Method::Verlet6 => 6,
-        }
-    }
-}
-
-/// Comma-separated method names.
-fn names(methods: &[Method]) -> String {
-    methods
-        .iter()
-        .map(|m| m.name())
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// A state of a system: the reduced state `z` (flat, layout fixed by the system, see
-/// [`System::dim`]) and, for systems on SO(3) that track it, the attitude R ∈ SO(3) (row-major).
-#[derive(Clone, Debug, PartialEq)]
-pub struct State {
-    /// The reduced (Lie–Poisson) state, length [`System::dim`].
-    pub z: Vec<f64>,
-    /// The attitude R (body-to-space rotation, row-major 3×3), when tracked.
-    pub attitude: Option<[f64; 9]>,
-}
-
-impl State {
-    /// A state without attitude.
-    pub fn new(z: Vec<f64>) -> Self {
-        State { z, attitude: None }
-    }
-
-    /// A state with attitude R (row-major).
-    pub fn with_attitude(z: Vec<f64>, r: [f64; 9]) -> Self {
-        State {
-            z,
-            attitude: Some(r),
-        }
-    }
-}
-
-/// Advances a state by whole time steps, in place, without allocating.
-pub trait Stepper {
-    /// Advances `state` (in the system's internal frame, see [`System::to_internal`]) by `steps`
-    /// steps of the step size the stepper was built with.
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()>;
-}
-
-/// A mechanical system that the driver can integrate.
-pub trait System: Sync {
-    /// A short name for messages ("RigidBody", …).
-    fn name(&self) -> &'static str;
-
-    /// Length of the reduced state `z`.
-    fn dim(&self) -> usize;
-
-    /// Whether the system can carry an attitude R ∈ SO(3) along.
-    fn has_attitude(&self) -> bool {
-        false
-    }
-
-    /// The supported methods.
-    fn methods(&self) -> &'static [Method];
-
-    /// The energy (Hamiltonian) of a reduced state (user frame).
-    fn energy(&self, z: &[f64]) -> Result<f64>;
-
-    /// The Casimir functions (and other exact invariants of the reduced dynamics) of a state.
-    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>>;
-
-    /// Checks a state beyond its length and finiteness (system constraints such as |q| = 1).
-    fn check_constraints(&self, _state: &State) -> Result<()> {
-        Ok(())
-    }
-
-    /// Maps a state from the user's frame to the frame the steppers work in (e.g. the principal
-    /// axes of an inertia given as a full matrix). The identity by default.
-    fn to_internal(&self, _state: &mut State) {}
-
-    /// Inverse of [`System::to_internal`].
-    fn to_user(&self, _state: &mut State) {}
-
-    /// Builds a stepper for `method` and step `dt` (both already validated by the driver).
-    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>>;
-
-    /// Full validation of a state: length, finiteness, attitude in SO(3), system constraints.
-    fn check_state(&self, state: &State) -> Result<()> {
-        check::len_of("state", &state.z, self.dim())?;
-        if let Some(r) = &state.attitude {
-            if !self.has_attitude() {
-                return Err(Error::invalid(
-                    "attitude",
-                    format!("{} carries no attitude", self.name()),
-                ));
-            }
-            check_rotation(r)?;
-        }
-        self.check_constraints(state)
-    }
-
-    /// Checks that `method` is supported, else [`Error::UnsupportedMethod`] listing the supported.
-    fn check_method(&self, method: Method) -> Result<()> {
-        if self.methods().contains(&method) {
-            Ok(())
-        } else {
-            Err(Error::UnsupportedMethod {
-                method: method.name().into(),
-                system: self.name().into(),
-                supported: names(self.methods()),
-            })
-        }
-    }
-}
-
-/// Checks that a row-major 3×3 attitude is finite and in SO(3) (to [`so3::ROTATION_TOL`]).
-pub fn check_rotation(r: &[f64; 9]) -> Result<()> {
-    so3::check_rotation("attitude", &nalgebra::Matrix3::from_row_slice(r))
-}
+/// Steps between two retractions of the curved blocks (SO(3), S²) of a state. A retraction moves
+/// the state by round-off (‖RᵀR − I‖ ~ 1e-15) and keeps the rounding errors of many products of
+/// rotations from accumulating (without it ‖RᵀR − I‖ reaches ~6e-12 after 10⁶ steps).
+pub const RETRACT_EVERY: u64 = 256;
 
 /// A computed trajectory: the saved samples and the final state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trajectory {
-    /// Sample times t₀ + k·save_every·dt, k = 0, 1, …, ⌊steps / save_every⌋ (t₀ = 0).
+    /// Sample times t₀ + k·save_every·dt.
     pub t: Vec<f64>,
-    /// The saved reduced states, row-major (len × dim).
+    /// The saved states (user frame), row-major (len × dim).
     pub states: Vec<f64>,
-    /// The saved attitudes (len × 9, row-major R), when the initial state had one.
-    pub attitude: Option<Vec<f64>>,
-    /// Length of one reduced state.
+    /// Length of one state.
     pub dim: usize,
-    /// The state after all `steps` steps (also when `steps` is not a multiple of `save_every`);
-    /// pass it as the next initial state to integrate in chunks.
-    pub final_state: State,
+    /// The state after all steps (also when `steps` is not a multiple of `save_every`).
+    pub final_state: Vec<f64>,
 }
 
 impl Trajectory {
@@ -264,147 +67,261 @@ impl Trajectory {
         self.t.is_empty()
     }
 
-    /// The k-th saved reduced state.
+    /// The k-th saved state.
     pub fn state(&self, k: usize) -> &[f64] {
         &self.states[k * self.dim..(k + 1) * self.dim]
     }
+}
 
-    /// The k-th saved attitude (row-major), if tracked.
-    pub fn attitude(&self, k: usize) -> Option<&[f64]> {
-        self.attitude.as_ref().map(|a| &a[9 * k..9 * (k + 1)])
+/// An integration in progress: one stepper, one clock, states validated once.
+///
+/// The run does not hold the problem (so that it can live in a Python object next to an
+/// `Arc<dyn System>`); every call takes it again, and it must be the one the run was made for.
+pub struct Run {
+    stepper: Box<dyn Stepper>,
+    retract: Option<space::Space>,
+    save_every: u64,
+    clock: Clock,
+    buf: Vec<f64>,
+}
+
+impl Run {
+    /// Starts a run of `system` with its method called `method`, from `z0` (user frame) at time
+    /// `t0`, step `dt`, saving every `save_every`-th state.
+    ///
+    /// Errors: `dt` ≤ 0 or non-finite, `save_every` < 1, non-finite `t0`
+    /// ([`Error::InvalidArgument`]); an unknown method ([`Error::UnsupportedMethod`]); a state of
+    /// the wrong length, non-finite or off its space or constraints.
+    pub fn new<S: System + ?Sized>(
+        system: &S,
+        method: &str,
+        z0: &[f64],
+        dt: f64,
+        save_every: usize,
+        t0: f64,
+    ) -> Result<Run> {
+        check_run(dt, save_every, t0)?;
+        check_state(system, z0)?;
+        let (stepper, properties) = system.stepper(method, dt)?;
+        Run::start(system, stepper, properties, z0, dt, save_every, t0)
+    }
+
+    /// Starts a run of `problem` with a method value (see [`Run::new`]).
+    pub fn with<P: Problem, M: Integrator<P> + ?Sized>(
+        problem: &P,
+        method: &M,
+        z0: &[f64],
+        dt: f64,
+        save_every: usize,
+        t0: f64,
+    ) -> Result<Run> {
+        check_run(dt, save_every, t0)?;
+        check_state(problem, z0)?;
+        let stepper = method.stepper(problem, dt)?;
+        Run::start(
+            problem,
+            stepper,
+            method.properties(),
+            z0,
+            dt,
+            save_every,
+            t0,
+        )
+    }
+
+    fn start<P: Problem + ?Sized>(
+        problem: &P,
+        mut stepper: Box<dyn Stepper>,
+        properties: Properties,
+        z0: &[f64],
+        dt: f64,
+        save_every: usize,
+        t0: f64,
+    ) -> Result<Run> {
+        let space = problem.space();
+        let mut buf = z0.to_vec();
+        problem.to_internal(&mut buf);
+        stepper.set(&buf)?;
+        Ok(Run {
+            stepper,
+            retract: (properties.manifold && space.is_curved()).then_some(space),
+            save_every: save_every as u64,
+            clock: Clock { t0, dt, done: 0 },
+            buf,
+        })
+    }
+
+    /// Steps done so far.
+    pub fn steps_done(&self) -> u64 {
+        self.clock.done
+    }
+
+    /// The current time t₀ + steps_done·dt.
+    pub fn time(&self) -> f64 {
+        self.clock.time(0)
+    }
+
+    /// The current state (user frame).
+    pub fn state<P: Problem + ?Sized>(&self, problem: &P) -> Vec<f64> {
+        let mut z = self.buf.clone();
+        self.stepper.get(&mut z);
+        problem.to_user(&mut z);
+        z
+    }
+
+    /// Advances by `steps` steps, appending to `out` the state (user frame) at every step number
+    /// (counted from the start of the run) that is a multiple of `save_every`. Returns how many
+    /// states were appended. Stops with [`Error::LeftDomain`] (naming the absolute time) when the
+    /// state becomes non-finite or leaves the problem's domain.
+    pub fn advance<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        steps: u64,
+        out: &mut Vec<f64>,
+    ) -> Result<usize> {
+        let end = self.clock.done + steps;
+        let mut saved = 0;
+        while self.clock.done < end {
+            let done = self.clock.done;
+            let next_save = (done / self.save_every + 1) * self.save_every;
+            let mut stop = end.min(next_save);
+            if self.retract.is_some() {
+                stop = stop.min((done / RETRACT_EVERY + 1) * RETRACT_EVERY);
+            }
+            self.stepper.advance((stop - done) as usize, self.clock)?;
+            self.clock.done = stop;
+            if let Some(space) = &self.retract {
+                if stop % RETRACT_EVERY == 0 {
+                    self.stepper.get(&mut self.buf);
+                    space.retract(&mut self.buf);
+                    self.stepper.set(&self.buf)?;
+                }
+            }
+            if stop % self.save_every == 0 || stop == end {
+                self.stepper.get(&mut self.buf);
+                problem.to_user(&mut self.buf);
+                if let Err(e) = check::finite_slice("state", &self.buf) {
+                    return Err(Error::LeftDomain {
+                        what: format!("{} state", problem.name()),
+                        t: self.clock.time(0),
+                        message: format!(
+                            "the integration produced a non-finite value ({e}); the step dt = {} \
+                             is too large for this motion, or the motion blows up",
+                            self.clock.dt
+                        ),
+                    });
+                }
+                if stop % self.save_every == 0 {
+                    out.try_reserve(self.buf.len()).map_err(|_| too_many())?;
+                    out.extend_from_slice(&self.buf);
+                    saved += 1;
+                }
+                problem.to_internal(&mut self.buf);
+            }
+        }
+        Ok(saved)
     }
 }
 
-fn check_run(dt: f64, steps: usize, save_every: usize) -> Result<()> {
+fn too_many() -> Error {
+    Error::invalid(
+        "save_every",
+        "the saved states do not fit in memory; save less often",
+    )
+}
+
+fn check_run(dt: f64, save_every: usize, t0: f64) -> Result<()> {
     check::positive("dt", dt)?;
-    if steps < 1 {
-        return Err(Error::invalid("steps", "expected steps ≥ 1, got 0"));
-    }
     if save_every < 1 {
         return Err(Error::invalid(
             "save_every",
             "expected save_every ≥ 1, got 0",
         ));
     }
+    if !t0.is_finite() {
+        return Err(Error::invalid(
+            "t0",
+            format!("expected a finite time, got {t0}"),
+        ));
+    }
     Ok(())
 }
 
-/// Integrates `system` from `state0` by `steps` steps of size `dt` with `method`, saving every
-/// `save_every`-th state (and the initial one). States are in the user's frame.
+/// Checks a state (user frame) against the problem's space and constraints.
+pub fn check_state<P: Problem + ?Sized>(problem: &P, z: &[f64]) -> Result<()> {
+    problem.space().check("state", z)?;
+    problem.check_state(z)
+}
+
+fn check_steps(steps: usize) -> Result<()> {
+    if steps < 1 {
+        return Err(Error::invalid("steps", "expected steps ≥ 1, got 0"));
+    }
+    Ok(())
+}
+
+/// Runs `run` for `steps` steps from its start and collects the trajectory.
+fn collect<P: Problem + ?Sized>(
+    problem: &P,
+    mut run: Run,
+    z0: &[f64],
+    steps: usize,
+) -> Result<Trajectory> {
+    let dim = z0.len();
+    let n_saved = steps / run.save_every as usize + 1;
+    let mut states = Vec::new();
+    let values = n_saved.checked_mul(dim).ok_or_else(too_many)?;
+    states.try_reserve_exact(values).map_err(|_| too_many())?;
+    states.extend_from_slice(z0);
+    run.advance(problem, steps as u64, &mut states)?;
+    let every = run.save_every as f64 * run.clock.dt;
+    Ok(Trajectory {
+        t: (0..n_saved)
+            .map(|k| run.clock.t0 + k as f64 * every)
+            .collect(),
+        final_state: run.state(problem),
+        states,
+        dim,
+    })
+}
+
+/// Integrates `system` from `z0` (user frame) by `steps` steps of size `dt` with its method called
+/// `method`, saving every `save_every`-th state and the initial one (t₀ = 0).
 ///
-/// Errors: `dt` ≤ 0 or non-finite, `steps` < 1, `save_every` < 1 ([`Error::InvalidArgument`]);
-/// wrong state length ([`Error::Shape`]); NaN/inf ([`Error::NonFinite`]); attitude not in SO(3)
-/// ([`Error::NotInGroup`]); a method the system does not support ([`Error::UnsupportedMethod`]);
-/// an implicit solve that fails ([`Error::NotConverged`]); a state that becomes non-finite.
-///
-/// To integrate in chunks (e.g. to check for Ctrl-C in between), call again with
-/// `traj.final_state` and drop the first sample of the new chunk.
+/// Errors: those of [`Run::new`] and [`Run::advance`], and `steps` < 1.
 pub fn integrate<S: System + ?Sized>(
     system: &S,
-    method: Method,
-    state0: &State,
+    method: &str,
+    z0: &[f64],
     dt: f64,
     steps: usize,
     save_every: usize,
 ) -> Result<Trajectory> {
-    check_run(dt, steps, save_every)?;
-    system.check_method(method)?;
-    system.check_state(state0)?;
-    run_checked(system, method, state0, dt, steps, save_every)
+    check_steps(steps)?;
+    let run = Run::new(system, method, z0, dt, save_every, 0.0)?;
+    collect(system, run, z0, steps)
 }
 
-fn run_checked<S: System + ?Sized>(
-    system: &S,
-    method: Method,
-    state0: &State,
+/// [`integrate`] with a method value (`&Splitting(Composition::suzuki4())`, `&Gauss(2)`, …)
+/// instead of a catalogued name: any method of the right kind, with any coefficients.
+pub fn integrate_with<P: Problem, M: Integrator<P> + ?Sized>(
+    problem: &P,
+    method: &M,
+    z0: &[f64],
     dt: f64,
     steps: usize,
     save_every: usize,
 ) -> Result<Trajectory> {
-    let dim = system.dim();
-    let n_saved = steps / save_every + 1;
-    let too_many = || {
-        Error::invalid(
-            "save_every",
-            format!("{n_saved} samples of {dim} values do not fit in memory; save less often"),
-        )
-    };
-    let mut traj = Trajectory {
-        t: Vec::new(),
-        states: Vec::new(),
-        attitude: state0.attitude.map(|_| Vec::new()),
-        dim,
-        final_state: state0.clone(),
-    };
-    traj.t.try_reserve_exact(n_saved).map_err(|_| too_many())?;
-    let values = n_saved.checked_mul(dim).ok_or_else(too_many)?;
-    traj.states
-        .try_reserve_exact(values)
-        .map_err(|_| too_many())?;
-    if let Some(a) = traj.attitude.as_mut() {
-        let values = n_saved.checked_mul(9).ok_or_else(too_many)?;
-        a.try_reserve_exact(values).map_err(|_| too_many())?;
-    }
-    let mut stepper = system.stepper(method, dt)?;
-    let mut state = state0.clone();
-    system.to_internal(&mut state);
-    let mut out = state0.clone();
-    let save = |traj: &mut Trajectory, out: &State, k: usize| {
-        traj.t.push(k as f64 * dt);
-        traj.states.extend_from_slice(&out.z);
-        if let (Some(a), Some(r)) = (traj.attitude.as_mut(), out.attitude.as_ref()) {
-            a.extend_from_slice(r);
-        }
-    };
-    save(&mut traj, &out, 0);
-    let mut done = 0;
-    while done < steps {
-        let k = save_every.min(steps - done);
-        stepper.run(&mut state, k)?;
-        done += k;
-        out.z.copy_from_slice(&state.z);
-        out.attitude = state.attitude;
-        system.to_user(&mut out);
-        if let Err(e) = check::finite_slice("state", &out.z) {
-            return Err(Error::LeftDomain {
-                what: "state".into(),
-                t: done as f64 * dt,
-                message: format!("the integration produced a non-finite value ({e})"),
-            });
-        }
-        if k == save_every {
-            save(&mut traj, &out, done);
-        }
-    }
-    traj.final_state = out;
-    Ok(traj)
+    check_steps(steps)?;
+    let run = Run::with(problem, method, z0, dt, save_every, 0.0)?;
+    collect(problem, run, z0, steps)
 }
 
-/// Integrates many initial states in parallel (rayon), each exactly as [`integrate`] would.
-///
-/// `threads`: `None` uses rayon's global pool (all cores); `Some(n)` runs on a pool of n threads.
-/// Every input is validated before any work starts; the first error (in input order) is returned.
-/// The step loops do not allocate: each trajectory allocates its output once.
-pub fn integrate_batch<S: System + ?Sized>(
-    system: &S,
-    method: Method,
-    states0: &[State],
-    dt: f64,
-    steps: usize,
-    save_every: usize,
+/// Runs `work` on rayon's global pool (`threads` = None) or on a pool of `threads` threads.
+pub fn with_threads<T: Send>(
     threads: Option<usize>,
-) -> Result<Vec<Trajectory>> {
-    check_run(dt, steps, save_every)?;
-    system.check_method(method)?;
-    for s in states0 {
-        system.check_state(s)?;
-    }
-    let work = || {
-        states0
-            .par_iter()
-            .map(|s| run_checked(system, method, s, dt, steps, save_every))
-            .collect::<Result<Vec<_>>>()
-    };
+    work: impl FnOnce() -> Result<T> + Send,
+) -> Result<T> {
     match threads {
         None => work(),
         Some(0) => Err(Error::invalid("threads", "expected threads ≥ 1, got 0")),
@@ -414,4 +331,32 @@ pub fn integrate_batch<S: System + ?Sized>(
             .map_err(|e| Error::invalid("threads", format!("cannot build a pool of {n}: {e}")))?
             .install(work),
     }
+}
+
+/// Integrates many initial states in parallel (rayon), each exactly as [`integrate`] would.
+///
+/// `threads`: `None` uses rayon's global pool (all cores); `Some(n)` a pool of n threads. Every
+/// input is validated before any work starts; an error names the batch member.
+pub fn integrate_batch<S: System + ?Sized>(
+    system: &S,
+    method: &str,
+    states0: &[Vec<f64>],
+    dt: f64,
+    steps: usize,
+    save_every: usize,
+    threads: Option<usize>,
+) -> Result<Vec<Trajectory>> {
+    check_steps(steps)?;
+    let runs = states0
+        .iter()
+        .enumerate()
+        .map(|(i, z)| Run::new(system, method, z, dt, save_every, 0.0).map_err(|e| e.in_member(i)))
+        .collect::<Result<Vec<_>>>()?;
+    with_threads(threads, || {
+        runs.into_par_iter()
+            .zip(states0.par_iter())
+            .enumerate()
+            .map(|(i, (run, z0))| collect(system, run, z0, steps).map_err(|e| e.in_member(i)))
+            .collect()
+    })
 }

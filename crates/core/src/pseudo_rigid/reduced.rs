@@ -27,7 +27,7 @@
 //! (Legendre transform: ∂K/∂a|_(μ,ν) = −∂K/∂a|_(Ω,Λ)); the tests check the field against
 //! [`FullBody::lagrange_vector_field`] and against finite differences of the full flow.
 //!
-//! # The integrator ([`ReducedSplitting`], method `"reduced"`)
+//! # The integrator (method `"reduced"`: `Splitting` over the reduced flows, [`ReducedWork`])
 //! H = T + U + Σ_{i<j} K_ij with T = ½|p_a|². Every piece has an exact flow:
 //! - T: a ← a + t p_a;
 //! - U: p_a ← p_a − t ∂U/∂a;
@@ -37,7 +37,7 @@
 //!   p_a ← p_a − t ∂K_ij/∂a (entries i, j only), and the frames follow exactly:
 //!   R ← R Gᵀ, S ← S G'ᵀ (Ṙ = RΩ, Ṡ = SΛ with constant Ω, Λ).
 //!
-//! One step is the palindromic Strang composition of these flows ([`Composition::sequence`]),
+//! One step is the palindromic Strang composition of these flows (`Composition::sequence`),
 //! T(h/2) U(h/2) K₁₂(h/2) … K_last(h) … K₁₂(h/2) U(h/2) T(h/2): symmetric, order 2, a Poisson
 //! map of the reduced space (a composition of exact Hamiltonian flows) and, with the frames, a
 //! symplectic map of T*GL⁺(n). It preserves exactly (to round-off):
@@ -54,12 +54,16 @@
 //! μ_ij + ν_ij is small); a step whose rotation substep turns by more than [`MAX_ANGLE`] stops the
 //! run with [`Error::LeftDomain`] naming the time, rather than return inaccurate data.
 //!
+//! [`super::PseudoRigidBody`] is a `Split` problem with these flows (flow 0 = T, 1 = U, then the
+//! pairs (i, j) in e_ij order); its working state is a [`ReducedWork`], so a run reduces (X, P)
+//! once and reconstructs only when a state is read.
+//!
 //! Each K_ij flow costs O(n) (two Givens conjugations, two column rotations), so a step costs
 //! O(n³) (n(n−1)/2 pairs, plus one gradient of U at diag(a)).
 
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::splitting::{run_sequence, Composition};
+use crate::integrate::problem::Violation;
 use crate::lie::{gl, so};
 use crate::pseudo_rigid::dynamics::FullBody;
 use crate::pseudo_rigid::momentum::{self, momentum_map_unchecked};
@@ -278,11 +282,11 @@ pub fn momenta_of_velocities(state: &ReducedState) -> Result<(Mat, Mat)> {
     momentum::body_momenta(&state.a, &o, &l)
 }
 
-/// The reduced-space splitting integrator (module docs): state (a, p_a, μ, ν) and frames
-/// (R, S), advanced by exact flows; no allocation per step.
+/// The working state of the reduced splitting (module docs): (a, p_a, μ, ν), the frames (R, S),
+/// the scratch of the U flow and the largest rotation angle of the current step; no allocation
+/// per step.
 #[derive(Debug)]
-pub struct ReducedSplitting {
-    seq: Vec<(usize, f64)>,
+pub struct ReducedWork {
     pairs: Vec<(usize, usize)>,
     /// Current reduced state.
     pub state: ReducedState,
@@ -293,27 +297,31 @@ pub struct ReducedSplitting {
     amat: Mat,
     grad: Mat,
     ws: Workspace,
+    angle: f64,
 }
 
-impl ReducedSplitting {
-    /// Starts from (X, P) (reduced with [`reduce`]), with the symmetric `composition` of the
-    /// Strang step (order 2 for [`Composition::strang`]).
-    pub fn new(x: &Mat, p: &Mat, composition: &Composition) -> Result<Self> {
+impl ReducedWork {
+    /// Reduces (X, P) ([`reduce`]).
+    pub fn new(x: &Mat, p: &Mat) -> Result<Self> {
         let (state, r, s) = reduce(x, p)?;
         let n = state.a.len();
-        let pairs: Vec<(usize, usize)> = (0..n)
-            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-            .collect();
-        Ok(ReducedSplitting {
-            seq: composition.sequence(2 + pairs.len()),
-            pairs,
+        Ok(ReducedWork {
+            pairs: (0..n)
+                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+                .collect(),
             state,
             r,
             s,
             amat: Mat::zeros(n, n),
             grad: Mat::zeros(n, n),
             ws: Workspace::new(n),
+            angle: 0.0,
         })
+    }
+
+    /// The number of exact flows: T, U and one per pair i < j.
+    pub fn flows(n: usize) -> usize {
+        2 + n * (n - 1) / 2
     }
 
     /// The current (X, P) (reconstructed).
@@ -324,95 +332,87 @@ impl ReducedSplitting {
         (x, lift_momentum(&self.r, &self.s, &self.state, &o, &l))
     }
 
-    /// Advances by `steps` steps of size `h` from time `t0`, with `potential` U. Stops with
-    /// [`Error::LeftDomain`] (naming the time) when some a_i ≤ 0, two a_i meet or a value becomes
-    /// non-finite.
-    pub fn run(&mut self, potential: &dyn Potential, t0: f64, h: f64, steps: usize) -> Result<()> {
-        let ReducedSplitting {
-            seq,
-            pairs,
-            state,
-            r,
-            s,
-            amat,
-            grad,
-            ws,
-        } = self;
+    /// The exact flow i over time τ with potential U: 0 = T, 1 = U, 2 + k = the k-th pair.
+    pub fn flow(&mut self, i: usize, t: f64, potential: &dyn Potential) {
+        let st = &mut self.state;
+        let n = st.a.len();
+        match i {
+            0 => {
+                for (a, p) in st.a.iter_mut().zip(&st.p_a) {
+                    *a += t * p;
+                }
+            }
+            1 => {
+                for k in 0..n {
+                    self.amat[(k, k)] = st.a[k];
+                }
+                self.grad.fill(0.0);
+                potential.add_gradient(self.amat.as_ref(), self.grad.as_mut(), &mut self.ws);
+                for k in 0..n {
+                    st.p_a[k] -= t * self.grad[(k, k)];
+                }
+            }
+            f => {
+                let (i, j) = self.pairs[f - 2];
+                let q = st.pair(i, j);
+                self.angle = self
+                    .angle
+                    .max((t * q.omega).abs())
+                    .max((t * q.lambda).abs());
+                st.p_a[i] -= t * q.dk_dai;
+                st.p_a[j] -= t * q.dk_daj;
+                let (sw, cw) = (t * q.omega).sin_cos();
+                givens_conj(&mut st.p_omega, i, j, cw, sw);
+                givens_cols(&mut self.r, i, j, cw, sw);
+                let (sl, cl) = (t * q.lambda).sin_cos();
+                givens_conj(&mut st.p_lambda, i, j, cl, sl);
+                givens_cols(&mut self.s, i, j, cl, sl);
+            }
+        }
+    }
+
+    /// Checks the state after a step: some a_i ≤ 0, two a_i reordered (met), a non-finite value,
+    /// or a rotation substep larger than [`MAX_ANGLE`] end the run.
+    pub fn check_step(&mut self) -> std::result::Result<(), Violation> {
+        let state = &self.state;
         let n = state.a.len();
-        for k in 0..steps {
-            let mut angle: f64 = 0.0;
-            run_sequence(seq, h, 1, state, |flow, t, st| match flow {
-                0 => {
-                    for (a, p) in st.a.iter_mut().zip(&st.p_a) {
-                        *a += t * p;
-                    }
-                }
-                1 => {
-                    for i in 0..n {
-                        amat[(i, i)] = st.a[i];
-                    }
-                    grad.fill(0.0);
-                    potential.add_gradient(amat.as_ref(), grad.as_mut(), ws);
-                    for i in 0..n {
-                        st.p_a[i] -= t * grad[(i, i)];
-                    }
-                }
-                f => {
-                    let (i, j) = pairs[f - 2];
-                    let q = st.pair(i, j);
-                    angle = angle.max((t * q.omega).abs()).max((t * q.lambda).abs());
-                    st.p_a[i] -= t * q.dk_dai;
-                    st.p_a[j] -= t * q.dk_daj;
-                    let (sw, cw) = (t * q.omega).sin_cos();
-                    givens_conj(&mut st.p_omega, i, j, cw, sw);
-                    givens_cols(r, i, j, cw, sw);
-                    let (sl, cl) = (t * q.lambda).sin_cos();
-                    givens_conj(&mut st.p_lambda, i, j, cl, sl);
-                    givens_cols(s, i, j, cl, sl);
-                }
+        let angle = std::mem::take(&mut self.angle);
+        let bad = state.a.iter().any(|&a| a.is_nan() || a <= 0.0)
+            || state.p_a.iter().any(|p| !p.is_finite());
+        if bad {
+            return Err(Violation {
+                what: format!("reduced pseudo-rigid body state (a, p_a) in GL+({n})"),
+                message: format!(
+                    "a = {:?}, p_a = {:?}: the motion left the principal stratum of GL+({n}) (a \
+                     singular value reached 0, two met, or the state overflowed); the reduced \
+                     method needs distinct a_i > 0 — use method 'verlet' for such motions",
+                    state.a, state.p_a
+                ),
             });
-            let t = t0 + (k + 1) as f64 * h;
-            let bad = state.a.iter().any(|&a| a.is_nan() || a <= 0.0)
-                || state.p_a.iter().any(|p| !p.is_finite());
-            if bad {
-                return Err(Error::LeftDomain {
-                    what: format!("reduced pseudo-rigid body state (a, p_a) in GL+({n})"),
-                    t,
-                    message: format!(
-                        "a = {:?}, p_a = {:?} (dt = {h}): the motion left the principal stratum \
-                         of GL+({n}) (a singular value reached 0, two met, or the state \
-                         overflowed); the reduced method needs distinct a_i > 0 — use method \
-                         'verlet' for such motions",
-                        state.a, state.p_a
-                    ),
-                });
-            }
-            // The exact flow cannot reorder the a_i (the barrier (μ_ij + ν_ij)²/(4(a_i − a_j)²)
-            // repels them); a step that does has jumped over an unresolved near-collision.
-            let crossed = state.a.windows(2).any(|w| w[0] <= w[1]);
-            if angle > MAX_ANGLE || crossed {
-                return Err(Error::LeftDomain {
-                    what: format!(
-                        "reduced pseudo-rigid body state (a) near the boundary of the principal \
-                         stratum of GL+({n})"
-                    ),
-                    t,
-                    message: format!(
-                        "a = {:?}: two semi-axes came so close that a step reordered them or a \
-                         rotation substep turned by {angle:.2} rad (limit {MAX_ANGLE} rad; the \
-                         rates Ω_ij, Λ_ij grow like 1/(a_i − a_j)²); the step dt = {h} does not \
-                         resolve the motion there — reduce dt or use method 'verlet', which has \
-                         no such singularity",
-                        state.a
-                    ),
-                });
-            }
+        }
+        // The exact flow cannot reorder the a_i (the barrier (μ_ij + ν_ij)²/(4(a_i − a_j)²)
+        // repels them); a step that does has jumped over an unresolved near-collision.
+        let crossed = state.a.windows(2).any(|w| w[0] <= w[1]);
+        if angle > MAX_ANGLE || crossed {
+            return Err(Violation {
+                what: format!(
+                    "reduced pseudo-rigid body state (a) near the boundary of the principal \
+                     stratum of GL+({n})"
+                ),
+                message: format!(
+                    "a = {:?}: two semi-axes came so close that a step reordered them or a \
+                     rotation substep turned by {angle:.2} rad (limit {MAX_ANGLE} rad; the rates \
+                     Ω_ij, Λ_ij grow like 1/(a_i − a_j)²); the step does not resolve the motion \
+                     there — reduce dt or use method 'verlet', which has no such singularity",
+                    state.a
+                ),
+            });
         }
         Ok(())
     }
 }
 
-/// Largest rotation angle |τ| of one K_ij sub-flow that [`ReducedSplitting::run`] accepts: a
+/// Largest rotation angle |τ| of one K_ij sub-flow that [`ReducedWork::check_step`] accepts: a
 /// step that turns the frames by more has stopped resolving the motion near a coincidence of
 /// semi-axes, and the run stops instead of returning inaccurate data.
 pub const MAX_ANGLE: f64 = 0.5;

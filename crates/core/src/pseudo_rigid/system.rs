@@ -1,20 +1,23 @@
-//! The pseudo-rigid body as an integrable [`System`] of the driver ([`crate::integrate`]).
+//! The pseudo-rigid body as a system of the integration driver ([`crate::integrate`]).
 //!
-//! State layout: z = (X row-major, P row-major), length 2n². Methods `verlet`, `verlet4`,
-//! `verlet6` ([`crate::integrate::verlet`], on all of T*GL⁺(n), or all n×n matrices with
-//! `check_det = false`) and `reduced` ([`super::reduced`], on the principal stratum; it maps
-//! (X, P) to the reduced space once, integrates there, and reconstructs (X, P) at save points).
+//! State layout: z = (X row-major, P row-major), length 2n². The body is two problem kinds:
+//! - [`Separable`] (H = ½ tr(PᵀP) + U(X), 001 (3.22)): methods `verlet`, `verlet4`, `verlet6`
+//!   ([`Verlet`] on all of T*GL⁺(n), or on all n×n matrices with `check_det` off); the force has
+//!   a stack-matrix fast path at n = 3 ([`Potential::gradient3`]);
+//! - [`Split`] with the flows of the reduced system on the principal stratum (001 §7,
+//!   [`super::reduced`]): method `reduced`, a [`Splitting`] whose working state is the reduced
+//!   one, so a run reduces (X, P) once and reconstructs only when a state is read.
 //!
 //! ```
 //! use std::sync::Arc;
-//! use lieflow::integrate::{integrate, Method, System};
+//! use lieflow::integrate::{integrate, Problem};
 //! use lieflow::pseudo_rigid::potential::Harmonic;
 //! use lieflow::pseudo_rigid::system::PseudoRigidBody;
 //! use lieflow::Mat;
 //! let body = PseudoRigidBody::new(3, Arc::new(Harmonic::new(1.0)?), true)?;
 //! let x0 = Mat::from_fn(3, 3, |i, j| if i == j { 1.0 + 0.2 * i as f64 } else { 0.0 });
 //! let p0 = Mat::from_fn(3, 3, |i, j| 0.1 * (i as f64 - j as f64));
-//! let traj = integrate(&body, Method::Verlet4, &body.state(&x0, &p0)?, 1e-2, 100, 10)?;
+//! let traj = integrate(&body, "verlet4", &body.state(&x0, &p0)?, 1e-2, 100, 10)?;
 //! let (e0, e1) = (body.energy(traj.state(0))?, body.energy(traj.state(10))?);
 //! assert!((e1 - e0).abs() < 1e-8);
 //! # Ok::<(), lieflow::Error>(())
@@ -24,23 +27,17 @@ use std::sync::Arc;
 
 use super::dynamics::FullBody;
 use super::momentum::momentum_map_unchecked;
-use super::potential::Potential;
-use super::reduced::{spectral_invariants, ReducedSplitting};
+use super::potential::{self, Potential, Workspace};
+use super::reduced::{spectral_invariants, ReducedWork};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::splitting::Composition;
-use crate::integrate::verlet::{Verlet, VerletOrder, VerletScratch};
-use crate::integrate::{Method, State, Stepper, System};
+use crate::integrate::methods::{Composition, Splitting, Verlet};
+use crate::integrate::problem::{Separable, Split, Violation};
+use crate::integrate::space::{Block, Space};
+use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::gl;
 use crate::Mat;
-
-/// The methods of [`PseudoRigidBody`].
-pub const METHODS: [Method; 4] = [
-    Method::Verlet,
-    Method::Verlet4,
-    Method::Verlet6,
-    Method::Reduced,
-];
+use nalgebra::Matrix3;
 
 /// A generalized pseudo-rigid body H = ½ tr(PᵀP) + U(X) (001 (3.22)) for the integration
 /// driver, with state z = (X, P) row-major.
@@ -76,21 +73,15 @@ impl PseudoRigidBody {
     }
 
     /// The flat state z = (X, P) row-major (checked: n×n, finite).
-    pub fn state(&self, x: &Mat, p: &Mat) -> Result<State> {
+    pub fn state(&self, x: &Mat, p: &Mat) -> Result<Vec<f64>> {
         let n = self.n();
         check::square_of("X", x, n)?;
         check::square_of("P", p, n)?;
         check::finite_mat("X", x)?;
         check::finite_mat("P", p)?;
-        let mut z = Vec::with_capacity(2 * n * n);
-        for m in [x, p] {
-            for i in 0..n {
-                for j in 0..n {
-                    z.push(m[(i, j)]);
-                }
-            }
-        }
-        Ok(State::new(z))
+        let mut z = vec![0.0; 2 * n * n];
+        write_back(n, x, p, &mut z);
+        Ok(z)
     }
 
     /// (X, P) from a flat state (checked length).
@@ -139,136 +130,165 @@ fn write_back(n: usize, x: &Mat, p: &Mat, z: &mut [f64]) {
     }
 }
 
-impl System for PseudoRigidBody {
+impl Problem for PseudoRigidBody {
     fn name(&self) -> &'static str {
         "PseudoRigidBody"
     }
 
-    fn dim(&self) -> usize {
-        2 * self.n() * self.n()
-    }
-
-    fn methods(&self) -> &'static [Method] {
-        &METHODS
+    fn space(&self) -> Space {
+        let n = self.n();
+        Space::new([("X", Block::Matrix(n)), ("P", Block::Matrix(n))])
     }
 
     /// H = ½ tr(PᵀP) + U(X) (001 (3.22)).
     fn energy(&self, z: &[f64]) -> Result<f64> {
         let (x, p) = self.split(z)?;
-        check::finite_slice("state", z)?;
         self.body.hamiltonian(&x, &p)
     }
 
     /// The spectral invariants ½tr((LᵀL)^k) then ½tr((ΓᵀΓ)^k), k = 1…⌊n/2⌋: they fix the
     /// coadjoint orbits of p_Ω = RᵀLR and p_Λ = SᵀΓS (the Casimirs of the reduced space, 001 §7).
-    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         let (l, g) = self.momenta(z)?;
         let mut c = spectral_invariants(&l);
         c.extend(spectral_invariants(&g));
         Ok(c)
     }
 
+    fn invariant_count(&self) -> usize {
+        2 * (self.n() / 2)
+    }
+
     /// det X > 0 when checked.
-    fn check_constraints(&self, state: &State) -> Result<()> {
+    fn check_state(&self, z: &[f64]) -> Result<()> {
         if self.check_det() {
-            let (x, _) = split_unchecked(self.n(), &state.z);
+            let (x, _) = split_unchecked(self.n(), z);
             gl::check_gl_plus("X0", &x)?;
         }
         Ok(())
     }
-
-    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
-        self.check_method(method)?;
-        let n = self.n();
-        let order = match method {
-            Method::Verlet => VerletOrder::Two,
-            Method::Verlet4 => VerletOrder::Four,
-            Method::Verlet6 => VerletOrder::Six,
-            _ => {
-                return Ok(Box::new(ReducedStepper {
-                    body: self,
-                    dt,
-                    done: 0,
-                    cache: None,
-                }))
-            }
-        };
-        Ok(Box::new(VerletStepper {
-            body: self,
-            verlet: Verlet::new(order).with_check_det(self.check_det),
-            dt,
-            done: 0,
-            x: Mat::zeros(n, n),
-            p: Mat::zeros(n, n),
-            scratch: VerletScratch::new(n),
-        }))
-    }
 }
 
-/// Verlet of order 2, 4 or 6 on the flat state.
-struct VerletStepper<'a> {
-    body: &'a PseudoRigidBody,
-    verlet: Verlet,
-    dt: f64,
-    done: usize,
+/// Scratch of the force: the potential's workspace and two n×n matrices.
+#[derive(Debug)]
+pub struct ForceScratch {
+    ws: Workspace,
     x: Mat,
-    p: Mat,
-    scratch: VerletScratch,
+    grad: Mat,
 }
 
-impl Stepper for VerletStepper<'_> {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        let n = self.body.n();
-        let nn = n * n;
-        for i in 0..n {
-            for j in 0..n {
-                self.x[(i, j)] = state.z[i * n + j];
-                self.p[(i, j)] = state.z[nn + i * n + j];
+impl Separable for PseudoRigidBody {
+    type Scratch = ForceScratch;
+
+    fn scratch(&self) -> ForceScratch {
+        let n = self.n();
+        ForceScratch {
+            ws: Workspace::new(n),
+            x: Mat::zeros(n, n),
+            grad: Mat::zeros(n, n),
+        }
+    }
+
+    fn dof(&self) -> usize {
+        self.n() * self.n()
+    }
+
+    /// v = P (T = ½ tr(PᵀP)).
+    fn velocity(&self, p: &[f64], v: &mut [f64]) {
+        v.copy_from_slice(p);
+    }
+
+    /// f = −∂U/∂X, on stack matrices at n = 3 when the potential has
+    /// [`Potential::gradient3`].
+    fn force(&self, q: &[f64], f: &mut [f64], s: &mut ForceScratch) {
+        let pot = self.body.potential();
+        if q.len() == 9 {
+            if let Some(g) = pot.gradient3(&Matrix3::from_row_slice(q)) {
+                for i in 0..3 {
+                    for j in 0..3 {
+                        f[3 * i + j] = -g[(i, j)];
+                    }
+                }
+                return;
             }
         }
-        let t0 = self.done as f64 * self.dt;
-        self.verlet.run(
-            self.body.full().potential(),
-            &mut self.x,
-            &mut self.p,
-            t0,
-            self.dt,
-            steps,
-            &mut self.scratch,
-        )?;
-        self.done += steps;
-        write_back(n, &self.x, &self.p, &mut state.z);
-        Ok(())
+        let n = s.x.nrows();
+        for (k, v) in q.iter().enumerate() {
+            s.x[(k / n, k % n)] = *v;
+        }
+        s.grad.fill(0.0);
+        pot.add_gradient(s.x.as_ref(), s.grad.as_mut(), &mut s.ws);
+        for (k, v) in f.iter_mut().enumerate() {
+            *v = -s.grad[(k / n, k % n)];
+        }
+    }
+
+    /// det X > 0 when checked.
+    fn admissible(&self, q: &[f64], s: &mut ForceScratch) -> std::result::Result<(), Violation> {
+        if !self.check_det() {
+            return Ok(());
+        }
+        let n = s.x.nrows();
+        let d = if n == 3 {
+            Matrix3::from_row_slice(q).determinant()
+        } else {
+            for (k, v) in q.iter().enumerate() {
+                s.x[(k / n, k % n)] = *v;
+            }
+            potential::det(s.x.as_ref(), &mut s.ws)
+        };
+        if d > 0.0 {
+            return Ok(());
+        }
+        let advice = if self.body.potential().needs_positive_det() {
+            "a volumetric potential is defined only for det X > 0, so the motion ends here"
+        } else {
+            "the equations extend to all n×n matrices: construct the body with check_det = false \
+             to continue through det X = 0"
+        };
+        Err(Violation {
+            what: format!("X (pseudo-rigid body in GL+({n}))"),
+            message: format!("det X = {d:.3e} ≤ 0: the motion left GL+({n}); {advice}"),
+        })
     }
 }
 
-/// The reduced-space splitting; keeps the reduced state between calls (it reduces again only if
-/// the state it is given is not the one it returned).
-struct ReducedStepper<'a> {
-    body: &'a PseudoRigidBody,
-    dt: f64,
-    done: usize,
-    cache: Option<(Vec<f64>, ReducedSplitting)>,
+/// The flows of the reduced system on the principal stratum (001 §7, [`super::reduced`]).
+impl Split for PseudoRigidBody {
+    type Work = ReducedWork;
+
+    fn load(&self, z: &[f64]) -> Result<ReducedWork> {
+        let (x, p) = split_unchecked(self.n(), z);
+        ReducedWork::new(&x, &p)
+    }
+
+    fn store(&self, w: &ReducedWork, z: &mut [f64]) {
+        let (x, p) = w.full_state();
+        write_back(self.n(), &x, &p, z);
+    }
+
+    fn flows(&self) -> usize {
+        ReducedWork::flows(self.n())
+    }
+
+    fn flow(&self, i: usize, tau: f64, w: &mut ReducedWork) {
+        w.flow(i, tau, self.body.potential());
+    }
+
+    const CHECKED: bool = true;
+
+    fn check_step(&self, w: &mut ReducedWork) -> std::result::Result<(), Violation> {
+        w.check_step()
+    }
 }
 
-impl Stepper for ReducedStepper<'_> {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        let n = self.body.n();
-        let cache = match self.cache.as_mut() {
-            Some(c) if c.0 == state.z => c,
-            _ => {
-                let (x, p) = split_unchecked(n, &state.z);
-                let split = ReducedSplitting::new(&x, &p, &Composition::strang())?;
-                self.cache.insert((state.z.clone(), split))
-            }
-        };
-        let (z, split) = (&mut cache.0, &mut cache.1);
-        let t0 = self.done as f64 * self.dt;
-        split.run(self.body.full().potential(), t0, self.dt, steps)?;
-        self.done += steps;
-        let (x, p) = split.full_state();
-        write_back(n, &x, &p, &mut state.z);
-        z.copy_from_slice(&state.z);
-        Ok(())
+impl Catalog for PseudoRigidBody {
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("verlet", Verlet::strang()),
+            Entry::new("verlet4", Verlet(Composition::suzuki4())),
+            Entry::new("verlet6", Verlet(Composition::yoshida6())),
+            Entry::new("reduced", Splitting::strang()),
+        ]
     }
 }

@@ -13,24 +13,24 @@
 //! Lagrangian with Γ = R⁻¹e₃ and obtains IΩ̇ = IΩ × Ω + gΓ × X_b: the same equations with
 //! mgl χ = g X_b (mass absorbed in X_b).
 
-use super::rigid_body::LgviStepper;
-use super::top::{self, TopField, TopRk4, TopSplitting};
+use super::lgvi::Lgvi;
+use super::top::{self, top_kinds, Top};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::variational::Lgvi;
-use crate::integrate::{Method, State, Stepper, System};
+use crate::integrate::methods::{Composition, Rk4, Splitting};
+use crate::integrate::space::Space;
+use crate::integrate::{Catalog, Entry, Problem};
 use nalgebra::{Matrix3, Vector3};
 
 /// A heavy top with inertia I, weight parameter mgl ≥ 0 and centre-of-mass direction χ.
+/// State z = (M, Γ), or (M, Γ, R) with Γ = Rᵀe₃ for the top that carries its attitude
+/// ([`HeavyTop::with_attitude`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeavyTop {
-    moments: [f64; 3],
-    frame: Option<Matrix3<f64>>,
+    pub(crate) top: Top,
     mgl: f64,
     /// Unit χ in the user's body frame.
     chi: Vector3<f64>,
-    /// c = mgl χ in the principal frame.
-    c: [f64; 3],
 }
 
 impl HeavyTop {
@@ -70,17 +70,27 @@ impl HeavyTop {
         let chi = chi / norm;
         let c = top::to_frame(&frame, chi.as_slice()) * mgl;
         Ok(HeavyTop {
-            moments,
-            frame,
+            top: Top::new(moments, frame, Some(c.into())),
             mgl,
             chi,
-            c: c.into(),
         })
+    }
+
+    /// The same top carrying its attitude R ∈ SO(3) along: state (M, Γ, R row-major).
+    pub fn with_attitude(&self) -> Self {
+        let mut t = self.clone();
+        t.top.set_lifted(true);
+        t
+    }
+
+    /// Whether the state carries the attitude.
+    pub fn has_attitude(&self) -> bool {
+        self.top.lifted
     }
 
     /// The principal moments.
     pub fn moments(&self) -> [f64; 3] {
-        self.moments
+        self.top.moments
     }
 
     /// mgl.
@@ -93,63 +103,43 @@ impl HeavyTop {
         self.chi.into()
     }
 
-    /// A state (M, Γ) without attitude.
-    pub fn state(&self, m: [f64; 3], gamma: [f64; 3]) -> State {
-        State::new([m, gamma].concat())
+    /// A state (M, Γ).
+    pub fn state(&self, m: [f64; 3], gamma: [f64; 3]) -> Vec<f64> {
+        [m, gamma].concat()
     }
 
-    /// A state (M, Rᵀe₃) with attitude R (row-major).
-    pub fn state_with_attitude(&self, m: [f64; 3], r: [f64; 9]) -> State {
-        State::with_attitude([m, [r[6], r[7], r[8]]].concat(), r)
-    }
-
-    fn fields(&self) -> (TopField, TopField) {
-        (
-            TopField::new(self.moments, Some(self.c), false),
-            TopField::new(self.moments, Some(self.c), true),
-        )
+    /// The state (M, Rᵀe₃, R) of the top with attitude (R row-major).
+    pub fn state_with_attitude(&self, m: [f64; 3], r: [f64; 9]) -> Vec<f64> {
+        [&m[..], &r[6..9], &r[..]].concat()
     }
 }
 
-const TOP_METHODS: [Method; 5] = [
-    Method::Splitting,
-    Method::Splitting4,
-    Method::Splitting6,
-    Method::Lgvi,
-    Method::Rk4,
-];
-
-impl System for HeavyTop {
+impl Problem for HeavyTop {
     fn name(&self) -> &'static str {
         "HeavyTop"
     }
-    fn dim(&self) -> usize {
-        6
-    }
-    fn has_attitude(&self) -> bool {
-        true
-    }
-    fn methods(&self) -> &'static [Method] {
-        &TOP_METHODS
+    fn space(&self) -> Space {
+        self.top.space()
     }
     /// H = ½ M·I⁻¹M + mgl Γ·χ.
     fn energy(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, 6)?;
-        let t = top::kinetic_energy(&self.frame, &self.moments, &z[..3]);
-        Ok(t + self.mgl * Vector3::from_column_slice(&z[3..]).dot(&self.chi))
+        let t = self.top.kinetic_energy(&z[..3]);
+        Ok(t + self.mgl * Vector3::from_column_slice(&z[3..6]).dot(&self.chi))
     }
     /// [|Γ|², M·Γ].
-    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {
-        check::len_of("state", z, 6)?;
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         let m = Vector3::from_column_slice(&z[..3]);
-        let g = Vector3::from_column_slice(&z[3..]);
+        let g = Vector3::from_column_slice(&z[3..6]);
         Ok(vec![g.norm_squared(), m.dot(&g)])
     }
-    /// With an attitude, Γ must equal Rᵀe₃ (to 1e-9).
-    fn check_constraints(&self, state: &State) -> Result<()> {
-        if let Some(r) = &state.attitude {
+    fn invariant_count(&self) -> usize {
+        2
+    }
+    /// With the attitude, Γ must equal Rᵀe₃ (to 1e-9).
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        if self.top.lifted {
             let d = (0..3)
-                .map(|i| (r[6 + i] - state.z[3 + i]).powi(2))
+                .map(|i| (z[12 + i] - z[3 + i]).powi(2))
                 .sum::<f64>()
                 .sqrt();
             if d > 1e-9 {
@@ -161,21 +151,28 @@ impl System for HeavyTop {
         }
         Ok(())
     }
-    fn to_internal(&self, state: &mut State) {
-        top::state_to_frame(&self.frame, state);
+    fn to_internal(&self, z: &mut [f64]) {
+        self.top.to_internal(z)
     }
-    fn to_user(&self, state: &mut State) {
-        top::state_from_frame(&self.frame, state);
+    fn to_user(&self, z: &mut [f64]) {
+        self.top.to_user(z)
     }
-    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
-        self.check_method(method)?;
-        Ok(match method {
-            Method::Lgvi => Box::new(LgviStepper(Lgvi::new(self.moments, dt, Some(self.c)))),
-            Method::Rk4 => {
-                let (p, f) = self.fields();
-                Box::new(TopRk4::new(p, f, dt))
-            }
-            _ => Box::new(TopSplitting::new(self.moments, Some(self.c), method, dt)),
-        })
+}
+
+top_kinds!(HeavyTop);
+
+impl Catalog for HeavyTop {
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("splitting", Splitting::strang()),
+            Entry::new("splitting4", Splitting(Composition::suzuki4())),
+            Entry::new("splitting6", Splitting(Composition::yoshida6())),
+            Entry::new("lgvi", Lgvi),
+            Entry::new("rk4", Rk4),
+        ]
+    }
+
+    fn lifted(&self) -> Option<Self> {
+        Some(self.with_attitude())
     }
 }

@@ -1,17 +1,23 @@
 //! Lie–Poisson systems of 000 §3–§5: the free rigid body on so(3)* and so(n)*, the heavy top and
-//! the spherical pendulum. Each implements [`crate::integrate::System`].
+//! the spherical pendulum. Each is a [`crate::integrate::Problem`] with the problem kinds it has
+//! and a [`crate::integrate::Catalog`] of methods; the methods that only these systems have (the
+//! isospectral midpoint, the LGVI) live here, next to them.
 //!
 //! State layouts (flat f64 arrays, see each type):
-//! * [`RigidBody`]: z = M (3), optional attitude R (3×3 row-major);
+//! * [`RigidBody`]: z = M (3), or (M, R) with R ∈ SO(3) row-major when it carries its attitude;
 //! * [`GeneralizedRigidBody`]: z = e_ij coordinates of M ∈ so(n) (n(n−1)/2, `lie::so::vee_n`);
-//! * [`HeavyTop`]: z = (M, Γ) (6), optional attitude R with Γ = Rᵀe₃;
+//! * [`HeavyTop`]: z = (M, Γ) (6), or (M, Γ, R) with Γ = Rᵀe₃;
 //! * [`SphericalPendulum`]: z = (q, L) (6), |q| = 1, q·L = 0.
 
 pub mod heavy_top;
+pub mod isospectral;
+pub mod lgvi;
 pub mod rigid_body;
 pub mod spherical_pendulum;
 mod top;
 
 pub use heavy_top::HeavyTop;
+pub use isospectral::Isospectral;
+pub use lgvi::Lgvi;
 pub use rigid_body::{GeneralizedRigidBody, RigidBody};
 pub use spherical_pendulum::SphericalPendulum;

@@ -5,8 +5,9 @@
 //! Euler–Poincaré equation d/dt ∂ℓ/∂Ω = ∂ℓ/∂Ω × Ω with ℓ = ½ Ω·IΩ); energy H = ½ M·I⁻¹M; Casimir
 //! |M|²; attitude Ṙ = R hat(Ω); spatial angular momentum R M is conserved (000 Theorem 4.2).
 //! The inertia is given by its principal moments or as a symmetric positive-definite matrix,
-//! diagonalised once (I = Q diag Qᵀ, Q ∈ SO(3)); the steppers work in the principal frame
-//! (M' = QᵀM, R' = RQ) and the driver maps back.
+//! diagonalised once (I = Q diag Qᵀ, Q ∈ SO(3)); the kernels work in the principal frame
+//! (M' = QᵀM, R' = RQ) and the driver maps back. State z = M, or (M, R) for the body that carries
+//! its attitude ([`RigidBody::with_attitude`]).
 //!
 //! **so(n)\*.** M = JΩ + ΩJ with J = diag(J_i) (the mass matrix; a symmetric J is diagonalised
 //! once), so Ω_ij = M_ij / (J_i + J_j); Ṁ = [M, Ω]; H = ½⟨M, Ω⟩ = ½ Σ_{i<j} M_ij Ω_ij; Casimirs
@@ -15,22 +16,24 @@
 //! satisfies [hat M, hat Ω] = hat(M × Ω), so Ṁ = [M, Ω] is Euler's equation; in e_ij coordinates
 //! c = (−w₃, w₂, −w₁), and with J_i + J_j = I_k ({i, j, k} = {1, 2, 3}) the energies agree (tested).
 
-use super::top::{self, TopField, TopSplitting};
+use super::isospectral::Isospectral;
+use super::lgvi::Lgvi;
+use super::top::{self, top_kinds, Top};
 use crate::check;
 use crate::elliptic;
 use crate::error::{Error, Result};
-use crate::integrate::isospectral::IsospectralMidpoint;
-use crate::integrate::rk::{Rk4, VectorField};
-use crate::integrate::variational::{Lgvi, LgviState};
-use crate::integrate::{Method, State, Stepper, System};
+use crate::integrate::methods::{Composition, Rk4, Splitting};
+use crate::integrate::problem::VectorField;
+use crate::integrate::space::{Block, Space};
+use crate::integrate::{Catalog, Entry, Problem};
+use crate::lie::so;
 use crate::Mat;
 use nalgebra::{Matrix3, Vector3};
 
 /// A free rigid body with inertia tensor I (000 §3.1).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RigidBody {
-    moments: [f64; 3],
-    frame: Option<Matrix3<f64>>,
+    pub(crate) top: Top,
 }
 
 impl RigidBody {
@@ -38,8 +41,7 @@ impl RigidBody {
     pub fn new(moments: [f64; 3]) -> Result<Self> {
         top::check_moments(&moments)?;
         Ok(RigidBody {
-            moments,
-            frame: None,
+            top: Top::new(moments, None, None),
         })
     }
 
@@ -47,48 +49,52 @@ impl RigidBody {
     pub fn from_matrix(inertia: &[f64; 9]) -> Result<Self> {
         let (moments, q) = top::principal_frame(inertia)?;
         Ok(RigidBody {
-            moments,
-            frame: Some(q),
+            top: Top::new(moments, Some(q), None),
         })
+    }
+
+    /// The same body carrying its attitude R ∈ SO(3) along: state (M, R row-major), Ṙ = R hat(Ω);
+    /// its invariants add the spatial momentum R M (000 Theorem 4.2).
+    pub fn with_attitude(&self) -> Self {
+        let mut top = self.top.clone();
+        top.set_lifted(true);
+        RigidBody { top }
+    }
+
+    /// Whether the state carries the attitude.
+    pub fn has_attitude(&self) -> bool {
+        self.top.lifted
     }
 
     /// The principal moments (in the order of the principal frame).
     pub fn moments(&self) -> [f64; 3] {
-        self.moments
+        self.top.moments
     }
 
     /// The principal frame Q (columns = principal axes in body coordinates), if the inertia was
     /// given as a matrix.
     pub fn frame(&self) -> Option<Matrix3<f64>> {
-        self.frame
+        self.top.frame
     }
 
-    /// A state with body momentum M and no attitude.
-    pub fn state(&self, m: [f64; 3]) -> State {
-        State::new(m.to_vec())
-    }
-
-    /// A state with body momentum M and attitude R (row-major).
-    pub fn state_with_attitude(&self, m: [f64; 3], r: [f64; 9]) -> State {
-        State::with_attitude(m.to_vec(), r)
+    /// The state (M, R) of the body with attitude (R row-major).
+    pub fn state_with_attitude(&self, m: [f64; 3], r: [f64; 9]) -> Vec<f64> {
+        [&m[..], &r[..]].concat()
     }
 
     /// Body angular velocity Ω = I⁻¹M (user frame).
     pub fn angular_velocity(&self, m: &[f64]) -> Result<[f64; 3]> {
         check::len_of("M", m, 3)?;
-        let mi = top::to_frame(&self.frame, m);
-        let w = Vector3::from_fn(|i, _| mi[i] / self.moments[i]);
-        Ok(top::from_frame(&self.frame, &w).into())
+        let mi = top::to_frame(&self.top.frame, m);
+        let w = Vector3::from_fn(|i, _| mi[i] / self.top.moments[i]);
+        Ok(top::from_frame(&self.top.frame, &w).into())
     }
 
-    /// Spatial angular momentum R M (000 Theorem 4.2), conserved.
-    pub fn spatial_momentum(state: &State) -> Result<[f64; 3]> {
-        check::len_of("M", &state.z, 3)?;
-        let r = state
-            .attitude
-            .ok_or_else(|| Error::invalid("state", "the spatial momentum needs the attitude R"))?;
-        let r = Matrix3::from_row_slice(&r);
-        Ok((r * Vector3::from_column_slice(&state.z)).into())
+    /// Spatial angular momentum R M (000 Theorem 4.2), conserved, of a state (M, R).
+    pub fn spatial_momentum(z: &[f64]) -> Result<[f64; 3]> {
+        check::len_of("state (M, R)", z, 12)?;
+        let r = Matrix3::from_row_slice(&z[3..]);
+        Ok((r * Vector3::from_column_slice(&z[..3])).into())
     }
 
     /// The exact body momentum M(t) from M(0) = `m0` by Jacobi elliptic functions (user frame).
@@ -104,13 +110,9 @@ impl RigidBody {
     pub fn exact_momentum(&self, m0: &[f64], t: f64) -> Result<[f64; 3]> {
         check::len_of("M0", m0, 3)?;
         check::finite_slice("t", &[t])?;
-        let mi = top::to_frame(&self.frame, m0);
-        let m = exact_principal(&self.moments, &mi, t)?;
-        Ok(top::from_frame(&self.frame, &m).into())
-    }
-
-    fn field(&self, attitude: bool) -> TopField {
-        TopField::new(self.moments, None, attitude)
+        let mi = top::to_frame(&self.top.frame, m0);
+        let m = exact_principal(&self.top.moments, &mi, t)?;
+        Ok(top::from_frame(&self.top.frame, &m).into())
     }
 }
 
@@ -178,127 +180,56 @@ fn exact_principal(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Result<Vect
     Ok(m)
 }
 
-const RIGID_METHODS: [Method; 6] = [
-    Method::Splitting,
-    Method::Splitting4,
-    Method::Splitting6,
-    Method::Isospectral,
-    Method::Lgvi,
-    Method::Rk4,
-];
-
-impl System for RigidBody {
+impl Problem for RigidBody {
     fn name(&self) -> &'static str {
         "RigidBody"
     }
-    fn dim(&self) -> usize {
-        3
-    }
-    fn has_attitude(&self) -> bool {
-        true
-    }
-    fn methods(&self) -> &'static [Method] {
-        &RIGID_METHODS
+    fn space(&self) -> Space {
+        self.top.space()
     }
     /// H = ½ M·I⁻¹M.
     fn energy(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, 3)?;
-        Ok(top::kinetic_energy(&self.frame, &self.moments, z))
+        Ok(self.top.kinetic_energy(&z[..3]))
     }
-    /// [|M|²].
-    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {
-        check::len_of("state", z, 3)?;
-        Ok(vec![z.iter().map(|x| x * x).sum()])
+    /// [|M|²], and with the attitude also the spatial momentum R M.
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        let mut c = vec![z[..3].iter().map(|x| x * x).sum()];
+        if self.top.lifted {
+            c.extend(Self::spatial_momentum(z)?);
+        }
+        Ok(c)
     }
-    fn to_internal(&self, state: &mut State) {
-        top::state_to_frame(&self.frame, state);
+    fn invariant_count(&self) -> usize {
+        if self.top.lifted {
+            4
+        } else {
+            1
+        }
     }
-    fn to_user(&self, state: &mut State) {
-        top::state_from_frame(&self.frame, state);
+    fn to_internal(&self, z: &mut [f64]) {
+        self.top.to_internal(z)
     }
-    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
-        self.check_method(method)?;
-        Ok(match method {
-            Method::Lgvi => Box::new(LgviStepper(Lgvi::new(self.moments, dt, None))),
-            Method::Isospectral => Box::new(So3Isospectral::new(&self.moments, dt)),
-            Method::Rk4 => Box::new(top::TopRk4::new(self.field(false), self.field(true), dt)),
-            _ => Box::new(TopSplitting::new(self.moments, None, method, dt)),
-        })
+    fn to_user(&self, z: &mut [f64]) {
+        self.top.to_user(z)
     }
 }
 
-/// The LGVI on a rigid-body or heavy-top state (z = M or (M, Γ)).
-pub(crate) struct LgviStepper(pub(crate) Lgvi);
+top_kinds!(RigidBody);
 
-impl Stepper for LgviStepper {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        let mut s = LgviState::new(
-            Vector3::from_column_slice(&state.z[..3]),
-            (state.z.len() == 6).then(|| Vector3::from_column_slice(&state.z[3..6])),
-            state.attitude.map(|r| Matrix3::from_row_slice(&r)),
-        );
-        for k in top::chunks(steps) {
-            for _ in 0..k {
-                self.0.step(&mut s)?;
-            }
-            if let Some(r) = s.r.as_mut() {
-                top::reorthonormalize(r);
-            }
-        }
-        state.z[..3].copy_from_slice(s.m.as_slice());
-        if let Some(g) = s.gamma {
-            state.z[3..6].copy_from_slice(g.as_slice());
-        }
-        if let Some(r) = s.r {
-            state.attitude = Some(top::row_major(&r));
-        }
-        Ok(())
+impl Catalog for RigidBody {
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("splitting", Splitting::strang()),
+            Entry::new("splitting4", Splitting(Composition::suzuki4())),
+            Entry::new("splitting6", Splitting(Composition::yoshida6())),
+            Entry::new("isospectral", Isospectral),
+            Entry::new("lgvi", Lgvi),
+            Entry::new("rk4", Rk4),
+        ]
     }
-}
 
-/// The isospectral midpoint on so(3) through the matrix hat(M): d_12 = I₃, d_13 = I₂, d_23 = I₁.
-struct So3Isospectral {
-    kernel: IsospectralMidpoint,
-    h: f64,
-    mat: [f64; 9],
-}
-
-impl So3Isospectral {
-    fn new(moments: &[f64; 3], h: f64) -> Self {
-        let [i1, i2, i3] = *moments;
-        let d = [0.0, i3, i2, i3, 0.0, i1, i2, i1, 0.0];
-        So3Isospectral {
-            kernel: IsospectralMidpoint::new(3, &d, h),
-            h,
-            mat: [0.0; 9],
-        }
-    }
-}
-
-impl Stepper for So3Isospectral {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        let m = Vector3::from_column_slice(&state.z);
-        self.mat = top::row_major(&crate::lie::so3::hat(&m));
-        let mut r = state.attitude.map(|r| Matrix3::from_row_slice(&r));
-        for k in top::chunks(steps) {
-            for _ in 0..k {
-                self.kernel.step(&mut self.mat)?;
-                if let Some(r) = r.as_mut() {
-                    let w = self.kernel.omega();
-                    let v = Vector3::new(w[7], w[2], w[3]) * self.h;
-                    *r *= crate::lie::so3::cayley(&v);
-                }
-            }
-            if let Some(r) = r.as_mut() {
-                top::reorthonormalize(r);
-            }
-        }
-        let mm = &self.mat;
-        state.z.copy_from_slice(&[mm[7], mm[2], mm[3]]);
-        if let Some(r) = r {
-            state.attitude = Some(top::row_major(&r));
-        }
-        Ok(())
+    fn lifted(&self) -> Option<Self> {
+        Some(self.with_attitude())
     }
 }
 
@@ -403,14 +334,14 @@ impl GeneralizedRigidBody {
         s * z[c]
     }
 
-    fn dense(&self, z: &[f64], out: &mut [f64]) {
+    pub(crate) fn dense(&self, z: &[f64], out: &mut [f64]) {
         for (k, o) in out.iter_mut().enumerate() {
             let (c, s) = self.index[k];
             *o = s * z[c];
         }
     }
 
-    fn coords(&self, m: &[f64], z: &mut [f64]) {
+    pub(crate) fn coords(&self, m: &[f64], z: &mut [f64]) {
         let n = self.n;
         let mut c = 0;
         for i in 0..n {
@@ -421,100 +352,64 @@ impl GeneralizedRigidBody {
         }
     }
 
-    fn conjugate(&self, state: &mut State, transpose_first: bool) {
+    /// The denominators d_ij = J_i + J_j (row-major n×n, diagonal unused).
+    pub(crate) fn denominators(&self) -> &[f64] {
+        &self.d
+    }
+
+    fn conjugate(&self, z: &mut [f64], transpose_first: bool) {
         if let Some(q) = &self.frame {
-            let m = crate::lie::so::hat_n_unchecked(self.n, &state.z);
+            let m = so::hat_n_unchecked(self.n, z);
             let m = if transpose_first {
                 q.transpose() * &m * q
             } else {
                 q * &m * q.transpose()
             };
-            state.z = crate::lie::so::vee_n_unchecked(&m);
+            z.copy_from_slice(&so::vee_n_unchecked(&m));
         }
     }
 }
 
-impl System for GeneralizedRigidBody {
+impl Problem for GeneralizedRigidBody {
     fn name(&self) -> &'static str {
         "GeneralizedRigidBody"
     }
-    fn dim(&self) -> usize {
-        self.n * (self.n - 1) / 2
-    }
-    fn methods(&self) -> &'static [Method] {
-        &[Method::Isospectral, Method::Rk4]
+    fn space(&self) -> Space {
+        Space::new([("M", Block::SoDual(self.n))])
     }
     /// H = ½ Σ_{i<j} M_ij² / (J_i + J_j) (principal frame).
     fn energy(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, self.dim())?;
-        let mut s = State::new(z.to_vec());
-        self.to_internal(&mut s);
+        let mut zi = z.to_vec();
+        self.to_internal(&mut zi);
         let n = self.n;
         let mut e = 0.0;
         for i in 0..n {
             for k in i + 1..n {
-                let m = self.entry(&s.z, i, k);
+                let m = self.entry(&zi, i, k);
                 e += m * m / self.d[i * n + k];
             }
         }
         Ok(0.5 * e)
     }
     /// C_k = ½ tr((MᵀM)^k), k = 1…⌊n/2⌋ (C₁ = |M|² on so(3)).
-    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {
-        check::len_of("state", z, self.dim())?;
-        let m = crate::lie::so::hat_n_unchecked(self.n, z);
-        let a = m.transpose() * &m;
-        let mut p = a.clone();
-        let mut out = Vec::with_capacity(self.n / 2);
-        for _ in 0..self.n / 2 {
-            out.push(0.5 * (0..self.n).map(|i| p[(i, i)]).sum::<f64>());
-            p = &p * &a;
-        }
-        Ok(out)
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        let m = so::hat_n_unchecked(self.n, z);
+        Ok(crate::pseudo_rigid::reduced::spectral_invariants(&m))
     }
-    fn to_internal(&self, state: &mut State) {
-        self.conjugate(state, true);
+    fn invariant_count(&self) -> usize {
+        self.n / 2
     }
-    fn to_user(&self, state: &mut State) {
-        self.conjugate(state, false);
+    fn to_internal(&self, z: &mut [f64]) {
+        self.conjugate(z, true);
     }
-    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
-        self.check_method(method)?;
-        let n = self.n;
-        Ok(match method {
-            Method::Isospectral => Box::new(SonIsospectral {
-                body: self,
-                kernel: IsospectralMidpoint::new(n, &self.d, dt),
-                mat: vec![0.0; n * n],
-            }),
-            _ => Box::new(SonRk4 {
-                body: self,
-                rk: Rk4::new(dt, self.dim()),
-            }),
-        })
-    }
-}
-
-struct SonIsospectral<'a> {
-    body: &'a GeneralizedRigidBody,
-    kernel: IsospectralMidpoint,
-    mat: Vec<f64>,
-}
-
-impl Stepper for SonIsospectral<'_> {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        self.body.dense(&state.z, &mut self.mat);
-        for _ in 0..steps {
-            self.kernel.step(&mut self.mat)?;
-        }
-        self.body.coords(&self.mat, &mut state.z);
-        Ok(())
+    fn to_user(&self, z: &mut [f64]) {
+        self.conjugate(z, false);
     }
 }
 
 impl VectorField for GeneralizedRigidBody {
     /// Ṁ = [M, Ω] in e_ij coordinates (principal frame).
-    fn eval(&self, z: &[f64], dz: &mut [f64]) {
+    fn field(&self, z: &[f64], dz: &mut [f64]) {
         let n = self.n;
         let om = |i: usize, k: usize| {
             if i == k {
@@ -537,13 +432,11 @@ impl VectorField for GeneralizedRigidBody {
     }
 }
 
-struct SonRk4<'a> {
-    body: &'a GeneralizedRigidBody,
-    rk: Rk4,
-}
-
-impl Stepper for SonRk4<'_> {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        self.rk.run(self.body, &mut state.z, steps)
+impl Catalog for GeneralizedRigidBody {
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("isospectral", Isospectral),
+            Entry::new("rk4", Rk4),
+        ]
     }
 }

@@ -21,9 +21,10 @@
 
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::rk::{Rk4, VectorField};
-use crate::integrate::splitting::{run_sequence, Composition};
-use crate::integrate::{Method, State, Stepper, System};
+use crate::integrate::methods::{Composition, Rk4, Splitting};
+use crate::integrate::problem::{Split, VectorField};
+use crate::integrate::space::{Block, Space};
+use crate::integrate::{Catalog, Entry, Problem};
 use nalgebra::Vector3;
 
 /// Tolerance of the constraints |q| = 1 and q·L = 0 on an initial state.
@@ -71,7 +72,7 @@ impl SphericalPendulum {
         phi: f64,
         theta_dot: f64,
         phi_dot: f64,
-    ) -> Result<State> {
+    ) -> Result<Vec<f64>> {
         check::finite_slice("spherical coordinates", &[theta, phi, theta_dot, phi_dot])?;
         let (st, ct) = theta.sin_cos();
         let (sp, cp) = phi.sin_cos();
@@ -79,7 +80,7 @@ impl SphericalPendulum {
         let qd = Vector3::new(ct * cp, ct * sp, st) * theta_dot
             + Vector3::new(-st * sp, st * cp, 0.0) * phi_dot;
         let l = q.cross(&qd) * self.inertia();
-        Ok(State::new([q.as_slice(), l.as_slice()].concat()))
+        Ok([q.as_slice(), l.as_slice()].concat())
     }
 
     /// The vertical angular momentum L₃ (conserved).
@@ -87,99 +88,79 @@ impl SphericalPendulum {
         check::len_of("state", z, 6)?;
         Ok(z[5])
     }
+
+    fn casimirs(z: &[f64]) -> [f64; 2] {
+        [
+            z[..3].iter().map(|x| x * x).sum(),
+            (0..3).map(|i| z[i] * z[3 + i]).sum(),
+        ]
+    }
 }
 
-impl System for SphericalPendulum {
+impl Problem for SphericalPendulum {
     fn name(&self) -> &'static str {
         "SphericalPendulum"
     }
-    fn dim(&self) -> usize {
-        6
-    }
-    fn methods(&self) -> &'static [Method] {
-        &[
-            Method::Splitting,
-            Method::Splitting4,
-            Method::Splitting6,
-            Method::Rk4,
-        ]
+    fn space(&self) -> Space {
+        Space::new([("q", Block::Real(3)), ("L", Block::Real(3))])
     }
     /// H = |L|²/(2ml²) + mgl q₃.
     fn energy(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, 6)?;
         let l2: f64 = z[3..].iter().map(|x| x * x).sum();
         Ok(0.5 * l2 / self.inertia() + self.mgl() * z[2])
     }
-    /// [|q|², q·L].
-    fn casimirs(&self, z: &[f64]) -> Result<Vec<f64>> {
-        check::len_of("state", z, 6)?;
-        Ok(vec![
-            z[..3].iter().map(|x| x * x).sum(),
-            (0..3).map(|i| z[i] * z[3 + i]).sum(),
-        ])
+    /// [|q|², q·L] (the Casimirs; the vertical momentum L₃ is [`Self::vertical_momentum`]).
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        Ok(Self::casimirs(z).to_vec())
+    }
+    fn invariant_count(&self) -> usize {
+        2
     }
     /// |q| = 1 and q·L = 0 to [`CONSTRAINT_TOL`].
-    fn check_constraints(&self, state: &State) -> Result<()> {
-        let c = self.casimirs(&state.z)?;
-        let l = state.z[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
-        if (c[0].sqrt() - 1.0).abs() > CONSTRAINT_TOL || c[1].abs() > CONSTRAINT_TOL * l.max(1.0) {
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        let [q2, ql] = Self::casimirs(z);
+        let l = z[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
+        if (q2.sqrt() - 1.0).abs() > CONSTRAINT_TOL || ql.abs() > CONSTRAINT_TOL * l.max(1.0) {
             return Err(Error::invalid(
                 "state",
                 format!(
-                    "a spherical-pendulum state needs |q| = 1 and q·L = 0; got |q| = {}, q·L = {}",
-                    c[0].sqrt(),
-                    c[1]
+                    "a spherical-pendulum state needs |q| = 1 and q·L = 0; got |q| = {}, q·L = {ql}",
+                    q2.sqrt()
                 ),
             ));
         }
         Ok(())
     }
-    fn stepper<'a>(&'a self, method: Method, dt: f64) -> Result<Box<dyn Stepper + 'a>> {
-        self.check_method(method)?;
-        Ok(match method {
-            Method::Rk4 => Box::new(PendulumRk4(self.clone(), Rk4::new(dt, 6))),
-            _ => Box::new(PendulumSplitting {
-                seq: Composition::for_method(method)
-                    .unwrap_or_else(Composition::strang)
-                    .sequence(2),
-                h: dt,
-                inv_i: 1.0 / self.inertia(),
-                mgl: self.mgl(),
-            }),
-        })
+}
+
+/// Flow 0: the potential kick L ↦ L + t mgl e₃ × q; flow 1: the kinetic rotation of q about L.
+impl Split for SphericalPendulum {
+    type Work = (Vector3<f64>, Vector3<f64>);
+    fn load(&self, z: &[f64]) -> Result<Self::Work> {
+        Ok((
+            Vector3::from_column_slice(&z[..3]),
+            Vector3::from_column_slice(&z[3..]),
+        ))
     }
-}
-
-struct PendulumSplitting {
-    seq: Vec<(usize, f64)>,
-    h: f64,
-    inv_i: f64,
-    mgl: f64,
-}
-
-impl Stepper for PendulumSplitting {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        let mut ql = (
-            Vector3::from_column_slice(&state.z[..3]),
-            Vector3::from_column_slice(&state.z[3..]),
-        );
-        let (inv_i, mgl) = (self.inv_i, self.mgl);
-        run_sequence(&self.seq, self.h, steps, &mut ql, |i, tau, (q, l)| {
-            if i == 0 {
-                *l += Vector3::new(-q.y, q.x, 0.0) * (tau * mgl);
-            } else {
-                *q = crate::lie::so3::exp(&(*l * (tau * inv_i))) * *q;
-            }
-        });
-        state.z[..3].copy_from_slice(ql.0.as_slice());
-        state.z[3..].copy_from_slice(ql.1.as_slice());
-        Ok(())
+    fn store(&self, (q, l): &Self::Work, z: &mut [f64]) {
+        z[..3].copy_from_slice(q.as_slice());
+        z[3..].copy_from_slice(l.as_slice());
+    }
+    fn flows(&self) -> usize {
+        2
+    }
+    fn flow(&self, i: usize, tau: f64, (q, l): &mut Self::Work) {
+        if i == 0 {
+            *l += Vector3::new(-q.y, q.x, 0.0) * (tau * self.mgl());
+        } else {
+            *q = crate::lie::so3::exp(&(*l * (tau / self.inertia()))) * *q;
+        }
     }
 }
 
 impl VectorField for SphericalPendulum {
     /// q̇ = ω × q, L̇ = mgl e₃ × q.
-    fn eval(&self, y: &[f64], dy: &mut [f64]) {
+    fn field(&self, y: &[f64], dy: &mut [f64]) {
         let q = Vector3::from_column_slice(&y[..3]);
         let w = Vector3::from_column_slice(&y[3..]) / self.inertia();
         dy[..3].copy_from_slice(w.cross(&q).as_slice());
@@ -187,10 +168,13 @@ impl VectorField for SphericalPendulum {
     }
 }
 
-struct PendulumRk4(SphericalPendulum, Rk4);
-
-impl Stepper for PendulumRk4 {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        self.1.run(&self.0, &mut state.z, steps)
+impl Catalog for SphericalPendulum {
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("splitting", Splitting::strang()),
+            Entry::new("splitting4", Splitting(Composition::suzuki4())),
+            Entry::new("splitting6", Splitting(Composition::yoshida6())),
+            Entry::new("rk4", Rk4),
+        ]
     }
 }

@@ -1,5 +1,6 @@
-//! Shared machinery of the bodies on SO(3): principal frames, the exact sub-flows of the
-//! Lie–Poisson splitting, and the Euler(–Poisson) vector field for the RK4 baseline.
+//! What the bodies on SO(3) share ([`super::RigidBody`], [`super::HeavyTop`]): principal frames,
+//! the state layout (M, [Γ], [R]), the exact sub-flows of the Lie–Poisson splitting (the
+//! [`Split`] kind), and the Euler(–Poisson) vector field (the [`VectorField`] kind).
 //!
 //! **Splitting** (McLachlan, "Explicit Lie–Poisson integration and the Euler equations", Phys.
 //! Rev. Lett. 71 (1993); Touma & Wisdom, "Lie–Poisson integrators for rigid body dynamics in the
@@ -23,9 +24,7 @@
 
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::rk::{Rk4, VectorField};
-use crate::integrate::splitting::{run_sequence, Composition};
-use crate::integrate::{Method, State, Stepper};
+use crate::integrate::space::{Block, Space};
 use nalgebra::{Matrix3, Vector3};
 
 /// Checks principal moments: finite and > 0.
@@ -87,12 +86,6 @@ pub(crate) fn from_frame(frame: &Option<Matrix3<f64>>, v: &Vector3<f64>) -> Vect
     }
 }
 
-/// Kinetic energy ½ M·I⁻¹M of a body momentum given in the user frame (000 §3–§4).
-pub(crate) fn kinetic_energy(frame: &Option<Matrix3<f64>>, moments: &[f64; 3], m: &[f64]) -> f64 {
-    let m = to_frame(frame, m);
-    0.5 * (0..3).map(|i| m[i] * m[i] / moments[i]).sum::<f64>()
-}
-
 /// Row-major copy of a 3×3 matrix.
 pub(crate) fn row_major(r: &Matrix3<f64>) -> [f64; 9] {
     let mut out = [0.0; 9];
@@ -102,30 +95,6 @@ pub(crate) fn row_major(r: &Matrix3<f64>) -> [f64; 9] {
         }
     }
     out
-}
-
-fn map_state(frame: &Option<Matrix3<f64>>, state: &mut State, inverse: bool) {
-    if let Some(q) = frame {
-        let qm = if inverse { *q } else { q.transpose() };
-        for v in state.z.chunks_exact_mut(3) {
-            let w = qm * Vector3::from_column_slice(v);
-            v.copy_from_slice(w.as_slice());
-        }
-        if let Some(r) = state.attitude.as_mut() {
-            let rm = Matrix3::from_row_slice(r);
-            *r = row_major(&(rm * if inverse { q.transpose() } else { *q }));
-        }
-    }
-}
-
-/// Body vectors v ↦ Qᵀv, R ↦ RQ.
-pub(crate) fn state_to_frame(frame: &Option<Matrix3<f64>>, state: &mut State) {
-    map_state(frame, state, false);
-}
-
-/// Inverse of [`state_to_frame`].
-pub(crate) fn state_from_frame(frame: &Option<Matrix3<f64>>, state: &mut State) {
-    map_state(frame, state, true);
 }
 
 /// Rotates v about e_k by the angle −θ: the flow of v̇ = v × (θ/t) e_k over time t.
@@ -143,25 +112,6 @@ fn rotate_axis_sc(v: &mut Vector3<f64>, k: usize, s: f64, c: f64) {
     v[j] = c * vj - s * vi;
 }
 
-/// Steps between two re-projections of an attitude onto SO(3).
-pub(crate) const REORTHONORMALIZE_EVERY: usize = 256;
-
-/// Chunk sizes ≤ [`REORTHONORMALIZE_EVERY`] summing to `steps`.
-pub(crate) fn chunks(steps: usize) -> impl Iterator<Item = usize> {
-    let n = REORTHONORMALIZE_EVERY;
-    (0..steps.div_ceil(n)).map(move |c| n.min(steps - c * n))
-}
-
-/// One Newton step of the polar decomposition, R ↦ R(3I − RᵀR)/2: for R = Q(I + E), E symmetric,
-/// the result is Q(I + O(E²)). Every attitude-carrying stepper applies it every
-/// [`REORTHONORMALIZE_EVERY`] steps, a change at round-off level (‖RᵀR − I‖ ~ 1e-15) that keeps
-/// the rounding errors of many products of rotations from accumulating (without it ‖RᵀR − I‖
-/// reaches ~6e-12 after 10⁶ steps).
-#[inline]
-pub(crate) fn reorthonormalize(r: &mut Matrix3<f64>) {
-    *r = *r * (Matrix3::identity() * 3.0 - r.transpose() * *r) * 0.5;
-}
-
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Flow {
     /// ½ a M_k² for the a-th non-reference axis.
@@ -172,72 +122,156 @@ enum Flow {
     Kick,
 }
 
-/// The Lie–Poisson splitting of a rigid body or heavy top (see the module docs).
-pub(crate) struct TopSplitting {
-    h: f64,
+/// A body on SO(3): principal moments, the principal frame of an inertia given as a matrix, the
+/// gravity vector c = mgl χ of a heavy top (principal frame), and whether the state carries the
+/// attitude R. State layout (flat): M (3), then Γ (3) for a heavy top, then R (9, row-major)
+/// when lifted.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Top {
+    pub(crate) moments: [f64; 3],
+    pub(crate) frame: Option<Matrix3<f64>>,
+    pub(crate) c: Option<Vector3<f64>>,
+    pub(crate) lifted: bool,
     axes: [usize; 2],
     coef: [f64; 2],
     inv_ir: f64,
-    c: Option<Vector3<f64>>,
-    plain: (Vec<(usize, f64)>, Vec<Flow>),
-    full: (Vec<(usize, f64)>, Vec<Flow>),
+    kinds: [Flow; 4],
+    flows: usize,
 }
 
-struct Body {
-    m: Vector3<f64>,
-    g: Option<Vector3<f64>>,
-    r: Option<Matrix3<f64>>,
+/// The working form of a body's state for the flows: registers for M, Γ and R.
+#[derive(Clone, Copy, Debug)]
+pub struct TopWork {
+    pub(crate) m: Vector3<f64>,
+    pub(crate) g: Option<Vector3<f64>>,
+    pub(crate) r: Option<Matrix3<f64>>,
 }
 
-impl TopSplitting {
-    /// `moments`: principal moments; `c = mgl χ` for the heavy top (principal frame).
-    pub(crate) fn new(moments: [f64; 3], c: Option<[f64; 3]>, method: Method, h: f64) -> Self {
-        let comp = Composition::for_method(method).unwrap_or_else(Composition::strang);
+impl Top {
+    pub(crate) fn new(moments: [f64; 3], frame: Option<Matrix3<f64>>, c: Option<[f64; 3]>) -> Self {
         let mut idx = [0usize, 1, 2];
         idx.sort_by(|&a, &b| moments[a].total_cmp(&moments[b]));
         let r = idx[1];
         let axes = [(r + 1) % 3, (r + 2) % 3];
-        let coef = axes.map(|k| 1.0 / moments[k] - 1.0 / moments[r]);
-        let with = |flows: Vec<Flow>| (comp.sequence(flows.len()), flows);
-        let full = if c.is_some() {
-            vec![Flow::Kick, Flow::Axis(0), Flow::Axis(1), Flow::Casimir]
-        } else {
-            vec![Flow::Axis(0), Flow::Axis(1), Flow::Casimir]
-        };
-        let plain = if c.is_some() {
-            full.clone()
-        } else {
-            vec![Flow::Axis(0), Flow::Axis(1)]
-        };
-        TopSplitting {
-            h,
-            axes,
-            coef,
-            inv_ir: 1.0 / moments[r],
+        let mut top = Top {
+            moments,
+            frame,
             c: c.map(Vector3::from),
-            plain: with(plain),
-            full: with(full),
+            lifted: false,
+            axes,
+            coef: axes.map(|k| 1.0 / moments[k] - 1.0 / moments[r]),
+            inv_ir: 1.0 / moments[r],
+            kinds: [Flow::Axis(0); 4],
+            flows: 0,
+        };
+        top.set_lifted(false);
+        top
+    }
+
+    /// The same body with or without the attitude; the flows follow (the Casimir flow moves only
+    /// R and Γ, so the free body without attitude has two flows).
+    pub(crate) fn set_lifted(&mut self, lifted: bool) {
+        self.lifted = lifted;
+        let (kinds, flows): (&[Flow], usize) = match (self.c.is_some(), lifted) {
+            (true, _) => (
+                &[Flow::Kick, Flow::Axis(0), Flow::Axis(1), Flow::Casimir],
+                4,
+            ),
+            (false, true) => (&[Flow::Axis(0), Flow::Axis(1), Flow::Casimir], 3),
+            (false, false) => (&[Flow::Axis(0), Flow::Axis(1)], 2),
+        };
+        self.kinds[..kinds.len()].copy_from_slice(kinds);
+        self.flows = flows;
+    }
+
+    /// The space: `M: ℝ³` (and `Gamma: ℝ³` for a heavy top), then `R: SO(3)` when lifted.
+    pub(crate) fn space(&self) -> Space {
+        let mut s = Space::new([("M", Block::Real(3))]);
+        if self.c.is_some() {
+            s = s.with("Gamma", Block::Real(3));
+        }
+        if self.lifted {
+            s = s.with("R", Block::SO3);
+        }
+        s
+    }
+
+    /// Offset of R in the state.
+    fn r_at(&self) -> usize {
+        if self.c.is_some() {
+            6
+        } else {
+            3
         }
     }
-}
 
-impl Stepper for TopSplitting {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        let mut b = Body {
-            m: Vector3::from_column_slice(&state.z[..3]),
-            g: (state.z.len() == 6).then(|| Vector3::from_column_slice(&state.z[3..6])),
-            r: state.attitude.map(|r| Matrix3::from_row_slice(&r)),
-        };
-        let (seq, flows) = if b.r.is_some() {
-            (&self.full.0, &self.full.1)
-        } else {
-            (&self.plain.0, &self.plain.1)
-        };
-        let (axes, coef, inv_ir, c) = (self.axes, self.coef, self.inv_ir, self.c);
-        let mut flow = |i: usize, tau: f64, b: &mut Body| match flows[i] {
+    /// Kinetic energy ½ M·I⁻¹M of a body momentum given in the user frame (000 §3–§4).
+    pub(crate) fn kinetic_energy(&self, m: &[f64]) -> f64 {
+        let m = to_frame(&self.frame, m);
+        0.5 * (0..3).map(|i| m[i] * m[i] / self.moments[i]).sum::<f64>()
+    }
+
+    /// The attitude R of a lifted state.
+    pub(crate) fn attitude(&self, z: &[f64]) -> Option<Matrix3<f64>> {
+        let at = self.r_at();
+        self.lifted.then(|| Matrix3::from_row_slice(&z[at..at + 9]))
+    }
+
+    fn map_frame(&self, z: &mut [f64], inverse: bool) {
+        if let Some(q) = &self.frame {
+            let qm = if inverse { *q } else { q.transpose() };
+            let at = self.r_at();
+            for v in z[..at].chunks_exact_mut(3) {
+                let w = qm * Vector3::from_column_slice(v);
+                v.copy_from_slice(w.as_slice());
+            }
+            if let Some(r) = self.attitude(z) {
+                let r = r * if inverse { q.transpose() } else { *q };
+                z[at..at + 9].copy_from_slice(&row_major(&r));
+            }
+        }
+    }
+
+    /// Body vectors v ↦ Qᵀv, R ↦ RQ (user frame → principal frame).
+    pub(crate) fn to_internal(&self, z: &mut [f64]) {
+        self.map_frame(z, false);
+    }
+
+    /// Inverse of [`Top::to_internal`].
+    pub(crate) fn to_user(&self, z: &mut [f64]) {
+        self.map_frame(z, true);
+    }
+
+    pub(crate) fn load(&self, z: &[f64]) -> TopWork {
+        TopWork {
+            m: Vector3::from_column_slice(&z[..3]),
+            g: self.c.map(|_| Vector3::from_column_slice(&z[3..6])),
+            r: self.attitude(z),
+        }
+    }
+
+    pub(crate) fn store(&self, w: &TopWork, z: &mut [f64]) {
+        z[..3].copy_from_slice(w.m.as_slice());
+        if let Some(g) = &w.g {
+            z[3..6].copy_from_slice(g.as_slice());
+        }
+        if let Some(r) = &w.r {
+            let at = self.r_at();
+            z[at..at + 9].copy_from_slice(&row_major(r));
+        }
+    }
+
+    pub(crate) fn flows(&self) -> usize {
+        self.flows
+    }
+
+    /// The exact flow i over time τ (module docs).
+    #[inline]
+    pub(crate) fn flow(&self, i: usize, tau: f64, b: &mut TopWork) {
+        match self.kinds[i] {
             Flow::Axis(a) => {
-                let k = axes[a];
-                let (s, co) = (tau * coef[a] * b.m[k]).sin_cos();
+                let k = self.axes[a];
+                let (s, co) = (tau * self.coef[a] * b.m[k]).sin_cos();
                 rotate_axis_sc(&mut b.m, k, s, co);
                 if let Some(g) = b.g.as_mut() {
                     rotate_axis_sc(g, k, s, co);
@@ -250,122 +284,80 @@ impl Stepper for TopSplitting {
                 }
             }
             Flow::Casimir => {
-                if b.g.is_some() || b.r.is_some() {
-                    let e = crate::lie::so3::exp(&(b.m * (tau * inv_ir)));
-                    if let Some(g) = b.g.as_mut() {
-                        *g = e.transpose() * *g;
-                    }
-                    if let Some(r) = b.r.as_mut() {
-                        *r *= e;
-                    }
+                let e = crate::lie::so3::exp(&(b.m * (tau * self.inv_ir)));
+                if let Some(g) = b.g.as_mut() {
+                    *g = e.transpose() * *g;
+                }
+                if let Some(r) = b.r.as_mut() {
+                    *r *= e;
                 }
             }
             Flow::Kick => {
-                if let (Some(g), Some(c)) = (b.g, c) {
+                if let (Some(g), Some(c)) = (b.g, self.c) {
                     b.m += g.cross(&c) * tau;
                 }
             }
-        };
-        if b.r.is_some() {
-            for k in chunks(steps) {
-                run_sequence(seq, self.h, k, &mut b, &mut flow);
-                if let Some(r) = b.r.as_mut() {
-                    reorthonormalize(r);
-                }
-            }
-        } else {
-            run_sequence(seq, self.h, steps, &mut b, &mut flow);
-        }
-        state.z[..3].copy_from_slice(b.m.as_slice());
-        if let Some(g) = b.g {
-            state.z[3..6].copy_from_slice(g.as_slice());
-        }
-        if let Some(r) = b.r {
-            state.attitude = Some(row_major(&r));
-        }
-        Ok(())
-    }
-}
-
-/// Euler–Poisson vector field on y = (M, [Γ], [R row-major]): Ṁ = M × Ω + Γ × c, Γ̇ = Γ × Ω,
-/// Ṙ = R hat(Ω), Ω = I⁻¹M (principal frame).
-pub(crate) struct TopField {
-    inv_i: Vector3<f64>,
-    c: Option<Vector3<f64>>,
-    attitude: bool,
-}
-
-impl TopField {
-    pub(crate) fn new(moments: [f64; 3], c: Option<[f64; 3]>, attitude: bool) -> Self {
-        TopField {
-            inv_i: Vector3::from(moments.map(|i| 1.0 / i)),
-            c: c.map(Vector3::from),
-            attitude,
         }
     }
 
-    /// Length of y.
-    pub(crate) fn len(&self) -> usize {
-        3 + if self.c.is_some() { 3 } else { 0 } + if self.attitude { 9 } else { 0 }
-    }
-}
-
-impl VectorField for TopField {
-    fn eval(&self, y: &[f64], dy: &mut [f64]) {
+    /// The Euler–Poisson field on (M, [Γ], [R]): Ṁ = M × Ω + Γ × c, Γ̇ = Γ × Ω, Ṙ = R hat(Ω),
+    /// Ω = I⁻¹M (principal frame).
+    pub(crate) fn field(&self, y: &[f64], dy: &mut [f64]) {
         let m = Vector3::from_column_slice(&y[..3]);
-        let w = m.component_mul(&self.inv_i);
+        let w = Vector3::from_fn(|i, _| m[i] / self.moments[i]);
         let mut dm = m.cross(&w);
-        let mut off = 3;
         if let Some(c) = &self.c {
             let g = Vector3::from_column_slice(&y[3..6]);
             dm += g.cross(c);
             dy[3..6].copy_from_slice(g.cross(&w).as_slice());
-            off = 6;
         }
         dy[..3].copy_from_slice(dm.as_slice());
-        if self.attitude {
-            let r = Matrix3::from_row_slice(&y[off..off + 9]);
-            dy[off..off + 9].copy_from_slice(&row_major(&(r * crate::lie::so3::hat(&w))));
+        if let Some(r) = self.attitude(y) {
+            let at = self.r_at();
+            dy[at..at + 9].copy_from_slice(&row_major(&(r * crate::lie::so3::hat(&w))));
         }
     }
 }
 
-/// RK4 on a rigid-body / heavy-top state, with or without attitude.
-pub(crate) struct TopRk4 {
-    plain: (TopField, Rk4),
-    full: (TopField, Rk4),
-    y: Vec<f64>,
-}
+/// The problem kinds of a body on SO(3) with a field `top: Top`: [`Split`] (the Lie–Poisson
+/// splitting), [`VectorField`] (RK4) and the [`super::lgvi::Lgvi`] method.
+macro_rules! top_kinds {
+    ($t:ty) => {
+        impl $crate::integrate::problem::Split for $t {
+            type Work = $crate::systems::top::TopWork;
+            fn load(&self, z: &[f64]) -> $crate::Result<Self::Work> {
+                Ok(self.top.load(z))
+            }
+            fn store(&self, w: &Self::Work, z: &mut [f64]) {
+                self.top.store(w, z)
+            }
+            fn flows(&self) -> usize {
+                self.top.flows()
+            }
+            #[inline]
+            fn flow(&self, i: usize, tau: f64, w: &mut Self::Work) {
+                self.top.flow(i, tau, w)
+            }
+        }
 
-impl TopRk4 {
-    pub(crate) fn new(plain: TopField, full: TopField, h: f64) -> Self {
-        let (np, nf) = (plain.len(), full.len());
-        TopRk4 {
-            plain: (plain, Rk4::new(h, np)),
-            full: (full, Rk4::new(h, nf)),
-            y: vec![0.0; nf],
+        impl $crate::integrate::problem::VectorField for $t {
+            fn field(&self, z: &[f64], dz: &mut [f64]) {
+                self.top.field(z, dz)
+            }
         }
-    }
-}
 
-impl Stepper for TopRk4 {
-    fn run(&mut self, state: &mut State, steps: usize) -> Result<()> {
-        let d = state.z.len();
-        let (field, rk) = if state.attitude.is_some() {
-            (&self.full.0, &mut self.full.1)
-        } else {
-            (&self.plain.0, &mut self.plain.1)
-        };
-        let y = &mut self.y[..field.len()];
-        y[..d].copy_from_slice(&state.z);
-        if let Some(r) = &state.attitude {
-            y[d..].copy_from_slice(r);
+        impl $crate::integrate::Integrator<$t> for $crate::systems::lgvi::Lgvi {
+            fn properties(&self) -> $crate::integrate::Properties {
+                $crate::integrate::Properties::geometric(2)
+            }
+            fn stepper(
+                &self,
+                problem: &$t,
+                dt: f64,
+            ) -> $crate::Result<Box<dyn $crate::integrate::Stepper>> {
+                Ok(self.stepper_for(&problem.top, dt))
+            }
         }
-        rk.run(field, y, steps)?;
-        state.z.copy_from_slice(&y[..d]);
-        if let Some(r) = state.attitude.as_mut() {
-            r.copy_from_slice(&y[d..]);
-        }
-        Ok(())
-    }
+    };
 }
+pub(crate) use top_kinds;

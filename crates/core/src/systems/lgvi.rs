@@ -15,11 +15,16 @@
 //! F J_d − J_d Fᵀ = 2 (Jg + g × Jg)^ / (1 + |g|²), so the implicit equation is the 3-vector
 //! equation 2(Jg + g × Jg) = h P (1 + |g|²), P = Π_k + (h/2)τ_k, solved by Newton's method.
 //!
+//! The method value is [`Lgvi`], in the catalogs of [`super::RigidBody`] and [`super::HeavyTop`]
+//! (as `lgvi`); it works on the same state layout as the splitting ([`super::top::Top`]).
+//!
 //! Order 2, symplectic on T*SO(3) (resp. the heavy-top phase space), R stays in SO(3) and |Π|²,
 //! R Π (free body), |Γ|² and Π·Γ (heavy top) are kept to round-off: Π and Γ move only by the
 //! rotation Fᵀ and by kicks orthogonal to Γ.
 
-use crate::error::{Error, Result};
+use super::top::{Top, TopWork};
+use crate::error::Result;
+use crate::integrate::{Clock, Stepper};
 use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
 
@@ -27,6 +32,24 @@ use nalgebra::{Matrix3, Vector3};
 pub const TOL: f64 = 2.0 * f64::EPSILON;
 /// Maximal Newton iterations per step.
 pub const MAX_ITER: usize = 30;
+
+/// The Lie group variational integrator (a method value), order 2.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Lgvi;
+
+impl Lgvi {
+    /// The stepper for a body on SO(3) with step `h`.
+    pub(crate) fn stepper_for(&self, top: &Top, h: f64) -> Box<dyn Stepper> {
+        Box::new(LgviStepper {
+            top: top.clone(),
+            h,
+            j: Vector3::from(top.moments),
+            w: None,
+            carry_m: Vector3::zeros(),
+            carry_g: Vector3::zeros(),
+        })
+    }
+}
 
 /// (cay(g) − I) v = 2(g × v + g × (g × v))/(1 + |g|²), computed without forming cay(g) − I by
 /// subtraction, so its rounding error is O(ε|g||v|) rather than O(ε|v|).
@@ -44,83 +67,43 @@ fn compensated_add(sum: &mut Vector3<f64>, carry: &mut Vector3<f64>, inc: Vector
     *sum = t;
 }
 
-/// The state the LGVI advances: Π, optionally Γ and R, and the carries of the compensated sums.
-pub struct LgviState {
-    /// Body momentum Π.
-    pub m: Vector3<f64>,
-    /// Γ = Rᵀe₃ (heavy top).
-    pub gamma: Option<Vector3<f64>>,
-    /// Attitude R.
-    pub r: Option<Matrix3<f64>>,
+/// The LGVI on (Π, [Γ], [R]) with the carries of the compensated sums.
+struct LgviStepper {
+    top: Top,
+    h: f64,
+    j: Vector3<f64>,
+    w: Option<TopWork>,
     carry_m: Vector3<f64>,
     carry_g: Vector3<f64>,
 }
 
-impl LgviState {
-    /// Wraps a state (zero carries).
-    pub fn new(m: Vector3<f64>, gamma: Option<Vector3<f64>>, r: Option<Matrix3<f64>>) -> Self {
-        LgviState {
-            m,
-            gamma,
-            r,
-            carry_m: Vector3::zeros(),
-            carry_g: Vector3::zeros(),
-        }
-    }
-}
+/// Why a Newton solve stopped: iterations and last residual.
+struct Failed(usize, f64);
 
-/// The LGVI of a rigid body with principal moments `inertia` (internal principal frame), and
-/// optionally a gravity torque τ = Γ × c with c = mgl χ.
-pub struct Lgvi {
-    h: f64,
-    j: Vector3<f64>,
-    c: Option<Vector3<f64>>,
-}
-
-impl Lgvi {
-    /// A stepper of step `h`; `c = mgl χ` for the heavy top, `None` for the free body.
-    pub fn new(inertia: [f64; 3], h: f64, c: Option<[f64; 3]>) -> Self {
-        Lgvi {
-            h,
-            j: Vector3::from(inertia),
-            c: c.map(Vector3::from),
-        }
-    }
-
+impl LgviStepper {
     /// Solves 2(Jg + g × Jg) = P (1 + |g|²) for the Cayley vector g of F (P = h·momentum).
-    pub fn solve(&self, p: &Vector3<f64>) -> Result<Vector3<f64>> {
+    fn solve(&self, p: &Vector3<f64>) -> std::result::Result<Vector3<f64>, Failed> {
         let j = Matrix3::from_diagonal(&self.j);
         let mut g = p.component_div(&self.j) * 0.5;
         for iter in 1..=MAX_ITER {
             let jg = j * g;
             let phi = (jg + g.cross(&jg)) * 2.0 - p * (1.0 + g.norm_squared());
-            let jac = (j + crate::lie::so3::hat(&g) * j - crate::lie::so3::hat(&jg)) * 2.0
-                - p * g.transpose() * 2.0;
-            let dg = jac.lu().solve(&phi).ok_or_else(|| Error::NotConverged {
-                what: "LGVI Newton iteration (singular Jacobian; reduce dt)".into(),
-                iterations: iter,
-                residual: phi.norm(),
-                tol: TOL,
-            })?;
+            let jac = (j + so3::hat(&g) * j - so3::hat(&jg)) * 2.0 - p * g.transpose() * 2.0;
+            let dg = jac.lu().solve(&phi).ok_or(Failed(iter, phi.norm()))?;
             g -= dg;
             let size = dg.norm();
             if !size.is_finite() {
-                break;
+                return Err(Failed(iter, f64::INFINITY));
             }
             if size <= TOL * (1.0 + g.norm()) {
                 return Ok(g);
             }
         }
-        Err(Error::NotConverged {
-            what: "LGVI Newton iteration (reduce dt)".into(),
-            iterations: MAX_ITER,
-            residual: f64::NAN,
-            tol: TOL,
-        })
+        Err(Failed(MAX_ITER, f64::NAN))
     }
 
     fn torque(&self, gamma: &Option<Vector3<f64>>) -> Vector3<f64> {
-        match (&self.c, gamma) {
+        match (&self.top.c, gamma) {
             (Some(c), Some(g)) => g.cross(c),
             _ => Vector3::zeros(),
         }
@@ -130,25 +113,63 @@ impl Lgvi {
     /// (h/2)τ_{k+1}, Γ_{k+1} = Γ_k + (Fᵀ − I)Γ_k, added with compensated summation: along a
     /// free-body run F is nearly the same rotation at every step, and forming Fᵀ P directly has a
     /// rounding bias that makes |Π|² drift linearly (~1e-11 after 10⁶ steps).
-    pub fn step(&self, s: &mut LgviState) -> Result<()> {
+    fn step(&mut self, mut s: TopWork) -> std::result::Result<TopWork, Failed> {
         let h = self.h;
-        let kick = self.torque(&s.gamma) * (0.5 * h);
+        let kick = self.torque(&s.g) * (0.5 * h);
         let p = s.m + kick;
         let g = self.solve(&(p * h))?;
         compensated_add(
             &mut s.m,
-            &mut s.carry_m,
+            &mut self.carry_m,
             kick + cayley_minus_identity(&-g, &p),
         );
-        if let Some(gam) = s.gamma.as_mut() {
+        if let Some(gam) = s.g.as_mut() {
             let dg = cayley_minus_identity(&-g, gam);
-            compensated_add(gam, &mut s.carry_g, dg);
+            compensated_add(gam, &mut self.carry_g, dg);
         }
-        let kick = self.torque(&s.gamma) * (0.5 * h);
-        compensated_add(&mut s.m, &mut s.carry_m, kick);
+        let kick = self.torque(&s.g) * (0.5 * h);
+        compensated_add(&mut s.m, &mut self.carry_m, kick);
         if let Some(r) = s.r.as_mut() {
             *r *= so3::cayley(&(g * 2.0)); // (I − ĝ)⁻¹(I + ĝ) = cay(2g)
         }
+        Ok(s)
+    }
+}
+
+impl Stepper for LgviStepper {
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        self.w = Some(self.top.load(z));
+        self.carry_m = Vector3::zeros();
+        self.carry_g = Vector3::zeros();
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        if let Some(w) = &self.w {
+            self.top.store(w, z);
+        }
+    }
+
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        let Some(mut w) = self.w.take() else {
+            return Ok(());
+        };
+        for k in 0..steps {
+            match self.step(w) {
+                Ok(next) => w = next,
+                Err(Failed(iterations, residual)) => {
+                    self.w = Some(w);
+                    return Err(clock.not_converged(
+                        k,
+                        "LGVI Newton iteration",
+                        iterations,
+                        residual,
+                        TOL,
+                    ));
+                }
+            }
+        }
+        self.w = Some(w);
         Ok(())
     }
 }

@@ -16,9 +16,17 @@
 //! The implicit equation for M̃ is solved by the fixed-point iteration
 //! M̃ ← M_n − h/2 [Ω̃, M̃] + h²/4 Ω̃ M̃ Ω̃ (a contraction for h‖Ω‖ small), stopped when the update
 //! is below [`TOL`] relative to max|M_n| (or stagnates at round-off below 1e-12); otherwise
-//! [`crate::Error::NotConverged`].
+//! [`crate::Error::NotConverged`] naming the step.
+//!
+//! The method value is [`Isospectral`], in the catalogs of [`super::RigidBody`] (through the
+//! so(3) matrix hat(M), with the attitude) and [`super::GeneralizedRigidBody`].
 
-use crate::error::{Error, Result};
+use super::top;
+use super::{GeneralizedRigidBody, RigidBody};
+use crate::error::Result;
+use crate::integrate::{Clock, Integrator, Properties, Stepper};
+use crate::lie::so3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Relative tolerance of the fixed-point iteration (a few units of round-off).
 pub const TOL: f64 = 4.0 * f64::EPSILON;
@@ -69,8 +77,9 @@ impl IsospectralMidpoint {
         matmul(n, &self.p, &self.w, &mut self.q);
     }
 
-    /// One step on the skew matrix `m` (row-major n×n), in place.
-    pub fn step(&mut self, m: &mut [f64]) -> Result<()> {
+    /// One step on the skew matrix `m` (row-major n×n), in place; on failure the iterations
+    /// taken and the last relative update (∞ for a diverged iteration).
+    pub fn step(&mut self, m: &mut [f64]) -> std::result::Result<(), (usize, f64)> {
         let n = self.n;
         let (a, a2) = (0.5 * self.h, 0.25 * self.h * self.h);
         self.m0.copy_from_slice(m);
@@ -101,25 +110,13 @@ impl IsospectralMidpoint {
             }
             iter += 1;
             if !finite || !diff.is_finite() {
-                return Err(Error::NotConverged {
-                    what: "isospectral midpoint fixed-point iteration (diverged to a non-finite \
-                           iterate; reduce dt)"
-                        .into(),
-                    iterations: iter,
-                    residual: f64::INFINITY,
-                    tol: TOL,
-                });
+                return Err((iter, f64::INFINITY));
             }
             if diff <= TOL * scale || (diff >= prev && diff <= 1e-12 * scale) {
                 break;
             }
             if iter >= MAX_ITER {
-                return Err(Error::NotConverged {
-                    what: "isospectral midpoint fixed-point iteration (reduce dt)".into(),
-                    iterations: iter,
-                    residual: diff / scale,
-                    tol: TOL,
-                });
+                return Err((iter, diff / scale));
             }
             prev = diff;
         }
@@ -151,5 +148,116 @@ fn matmul(n: usize, a: &[f64], b: &[f64], c: &mut [f64]) {
             }
             c[i * n + j] = s;
         }
+    }
+}
+
+/// The isospectral symplectic midpoint (a method value), order 2.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Isospectral;
+
+fn failed(clock: &Clock, k: usize, (iterations, residual): (usize, f64)) -> crate::Error {
+    clock.not_converged(
+        k,
+        "isospectral midpoint fixed-point iteration",
+        iterations,
+        residual,
+        TOL,
+    )
+}
+
+impl Integrator<RigidBody> for Isospectral {
+    fn properties(&self) -> Properties {
+        Properties::geometric(2)
+    }
+
+    /// On so(3) through the matrix hat(M): d_12 = I₃, d_13 = I₂, d_23 = I₁.
+    fn stepper(&self, body: &RigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
+        let [i1, i2, i3] = body.top.moments;
+        let d = [0.0, i3, i2, i3, 0.0, i1, i2, i1, 0.0];
+        Ok(Box::new(So3Stepper {
+            kernel: IsospectralMidpoint::new(3, &d, dt),
+            h: dt,
+            mat: [0.0; 9],
+            r: None,
+            lifted: body.top.lifted,
+        }))
+    }
+}
+
+struct So3Stepper {
+    kernel: IsospectralMidpoint,
+    h: f64,
+    mat: [f64; 9],
+    r: Option<Matrix3<f64>>,
+    lifted: bool,
+}
+
+impl Stepper for So3Stepper {
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        self.mat = top::row_major(&so3::hat(&Vector3::from_column_slice(&z[..3])));
+        self.r = self.lifted.then(|| Matrix3::from_row_slice(&z[3..12]));
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        let m = &self.mat;
+        z[..3].copy_from_slice(&[m[7], m[2], m[3]]);
+        if let Some(r) = &self.r {
+            z[3..12].copy_from_slice(&top::row_major(r));
+        }
+    }
+
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        for k in 0..steps {
+            self.kernel
+                .step(&mut self.mat)
+                .map_err(|e| failed(&clock, k, e))?;
+            if let Some(r) = self.r.as_mut() {
+                let w = self.kernel.omega();
+                *r *= so3::cayley(&(Vector3::new(w[7], w[2], w[3]) * self.h));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Integrator<GeneralizedRigidBody> for Isospectral {
+    fn properties(&self) -> Properties {
+        Properties::geometric(2)
+    }
+
+    fn stepper(&self, body: &GeneralizedRigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
+        let n = body.n();
+        Ok(Box::new(SonStepper {
+            kernel: IsospectralMidpoint::new(n, body.denominators(), dt),
+            body: body.clone(),
+            mat: vec![0.0; n * n],
+        }))
+    }
+}
+
+struct SonStepper {
+    kernel: IsospectralMidpoint,
+    body: GeneralizedRigidBody,
+    mat: Vec<f64>,
+}
+
+impl Stepper for SonStepper {
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        self.body.dense(z, &mut self.mat);
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        self.body.coords(&self.mat, z);
+    }
+
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        for k in 0..steps {
+            self.kernel
+                .step(&mut self.mat)
+                .map_err(|e| failed(&clock, k, e))?;
+        }
+        Ok(())
     }
 }

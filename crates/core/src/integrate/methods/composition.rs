@@ -1,6 +1,7 @@
-//! Splitting methods: symmetric compositions of a symmetric second-order step.
+//! Symmetric compositions of a symmetric second-order step, and the flattened flow sequences of
+//! splitting methods.
 //!
-//! One piece of code serves every splitting of lieflow. A Hamiltonian H = H₁ + … + H_n whose
+//! One piece of code serves every splitting and every composed method of lieflow. A Hamiltonian H = H₁ + … + H_n whose
 //! pieces have exact flows φ_i (rotations about body axes, momentum kicks, …) gets the palindromic
 //! Strang step S_h = φ₁(h/2)…φ_{n−1}(h/2) φ_n(h) φ_{n−1}(h/2)…φ₁(h/2), second order and symmetric
 //! (S_h⁻¹ = S_{−h}); the composition S_{γ_s h}…S_{γ₁ h} with palindromic weights γ lifts it to
@@ -16,7 +17,7 @@
 //! [`Composition::compose`] composes any symmetric base step (not necessarily a flow), e.g. an
 //! implicit or Störmer–Verlet step.
 
-use super::Method;
+use crate::error::{Error, Result};
 
 /// Weights of a symmetric composition of a symmetric second-order method.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,14 +70,32 @@ impl Composition {
         }
     }
 
-    /// The composition behind a splitting method (`splitting`, `splitting4`, `splitting6`).
-    pub fn for_method(method: Method) -> Option<Self> {
-        match method {
-            Method::Splitting => Some(Self::strang()),
-            Method::Splitting4 => Some(Self::suzuki4()),
-            Method::Splitting6 => Some(Self::yoshida6()),
-            _ => None,
+    /// A composition with user weights γ and the order the user claims for it. The weights must
+    /// be finite, sum to 1 (to 1e-12) and be palindromic (γ_i = γ_{s+1−i}, so the composition of
+    /// a symmetric step is symmetric, and its order even); the claim is the user's (the generic
+    /// order tests measure it).
+    pub fn new(gammas: Vec<f64>, order: u32) -> Result<Self> {
+        let bad = |m: String| Err(Error::invalid("composition", m));
+        if gammas.is_empty() || gammas.iter().any(|g| !g.is_finite()) {
+            return bad(format!("expected finite weights, got {gammas:?}"));
         }
+        let sum: f64 = gammas.iter().sum();
+        if (sum - 1.0).abs() > 1e-12 {
+            return bad(format!("the weights must sum to 1, got {sum}"));
+        }
+        if gammas
+            .iter()
+            .zip(gammas.iter().rev())
+            .any(|(a, b)| (a - b).abs() > 1e-14)
+        {
+            return bad(format!("the weights must be palindromic, got {gammas:?}"));
+        }
+        if order < 2 || order % 2 == 1 {
+            return bad(format!(
+                "the order of a symmetric composition is even ≥ 2, got {order}"
+            ));
+        }
+        Ok(Composition { gammas, order })
     }
 
     /// The weights γ (they sum to 1).

@@ -1,0 +1,248 @@
+//! Methods as values, steppers, and each system's catalog of named methods.
+//!
+//! A method is a value (`Splitting(Composition::suzuki4())`, `Verlet::strang()`, `Gauss(2)`,
+//! `Rk4`) that implements [`Integrator<P>`] for every problem `P` of the kind it needs. It builds
+//! a [`Stepper`]: an object that owns a copy of the problem, the method's scratch and the current
+//! state in the method's working form, and advances it without allocating.
+//!
+//! A system publishes a [`Catalog`]: the (name, method) pairs the Python API knows it by
+//! ("splitting4", "verlet", …); the first entry is the system's default. Through the blanket
+//! [`System`] implementation every catalogued problem is usable as a `dyn System` by name, which
+//! is what the driver and the Python bindings hold.
+
+use std::sync::Arc;
+
+use super::problem::{Problem, Violation};
+use crate::error::{Error, Result};
+
+/// What a method claims, for a given problem; the generic test suite checks every claim.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Properties {
+    /// The order of accuracy.
+    pub order: u32,
+    /// A symplectic (Poisson) map: bounded energy error over long times.
+    pub symplectic: bool,
+    /// Symmetric: Φ_{−h} ∘ Φ_h = id (time-reversible for reversible systems).
+    pub symmetric: bool,
+    /// Keeps [`Problem::invariants`] to round-off.
+    pub invariants: bool,
+    /// Keeps the curved blocks of the space (SO(3), S²) to round-off; the driver then retracts
+    /// them now and then so that round-off does not accumulate. A method without this claim
+    /// (RK4) is left to drift off, as it does.
+    pub manifold: bool,
+}
+
+impl Properties {
+    /// A structure-preserving method of the given order (all claims true).
+    pub fn geometric(order: u32) -> Self {
+        Properties {
+            order,
+            symplectic: true,
+            symmetric: true,
+            invariants: true,
+            manifold: true,
+        }
+    }
+
+    /// A method of the given order that keeps no structure (the baseline).
+    pub fn plain(order: u32) -> Self {
+        Properties {
+            order,
+            symplectic: false,
+            symmetric: false,
+            invariants: false,
+            manifold: false,
+        }
+    }
+}
+
+/// The one clock of a run: the time t₀ of step 0, the step size and the steps already done.
+/// Steppers name absolute times in their errors through it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clock {
+    /// Time of step 0 of the whole run.
+    pub t0: f64,
+    /// The step size.
+    pub dt: f64,
+    /// Steps done before the current call of [`Stepper::advance`].
+    pub done: u64,
+}
+
+impl Clock {
+    /// The time after `k` more steps.
+    pub fn time(&self, k: usize) -> f64 {
+        self.t0 + (self.done + k as u64) as f64 * self.dt
+    }
+
+    /// The error for a domain violation found during step `k + 1` of this call (k steps done).
+    pub fn left_domain(&self, k: usize, v: Violation) -> Error {
+        let step = self.done + k as u64 + 1;
+        Error::LeftDomain {
+            what: v.what,
+            t: self.time(k + 1),
+            message: format!("{} (found in step {step}, dt = {})", v.message, self.dt),
+        }
+    }
+
+    /// The error for a non-converged implicit solve in step `k + 1` of this call.
+    pub fn not_converged(
+        &self,
+        k: usize,
+        what: &str,
+        iterations: usize,
+        residual: f64,
+        tol: f64,
+    ) -> Error {
+        Error::NotConverged {
+            what: format!(
+                "{what} in step {} (t = {}; reduce dt)",
+                self.done + k as u64 + 1,
+                self.time(k + 1)
+            ),
+            iterations,
+            residual,
+            tol,
+        }
+    }
+}
+
+/// Advances a state by whole steps; owns the problem, the method's scratch and the state.
+pub trait Stepper: Send {
+    /// Sets the current state from a flat state (internal frame).
+    fn set(&mut self, z: &[f64]) -> Result<()>;
+
+    /// Writes the current state (internal frame) to `z`.
+    fn get(&self, z: &mut [f64]);
+
+    /// Advances by `steps` steps; `clock` says which steps these are.
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()>;
+}
+
+/// A method for problems of kind `P`.
+pub trait Integrator<P: ?Sized>: Send + Sync {
+    /// What the method claims for `P`.
+    fn properties(&self) -> Properties;
+
+    /// A stepper of step size `dt` (> 0, finite; checked by the driver) for `problem`.
+    fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>>;
+}
+
+/// A named method of a system's catalog.
+pub struct Entry<P: ?Sized> {
+    /// The name the Python API knows it by.
+    pub name: &'static str,
+    /// The method.
+    pub method: Box<dyn Integrator<P>>,
+}
+
+impl<P: ?Sized> Entry<P> {
+    /// The entry `name` → `method`.
+    pub fn new(name: &'static str, method: impl Integrator<P> + 'static) -> Self {
+        Entry {
+            name,
+            method: Box::new(method),
+        }
+    }
+}
+
+/// A system's named methods; the first is its default.
+pub trait Catalog: Problem + Clone + 'static {
+    /// The (name, method) pairs.
+    fn catalog(&self) -> Vec<Entry<Self>>;
+
+    /// The same system carrying its attitude R ∈ SO(3) along as a last block `R`, if it can.
+    fn lifted(&self) -> Option<Self> {
+        None
+    }
+}
+
+/// A system the driver integrates by method name: every [`Catalog`] problem, as a trait object.
+pub trait System: Problem {
+    /// The names and properties of the catalogued methods; the first is the default.
+    fn methods(&self) -> Vec<(&'static str, Properties)>;
+
+    /// A stepper for the method called `method`, or [`Error::UnsupportedMethod`] listing this
+    /// system's methods (with a suggestion when the name is close to one of them).
+    fn stepper(&self, method: &str, dt: f64) -> Result<(Box<dyn Stepper>, Properties)>;
+
+    /// The system carrying its attitude along ([`Catalog::lifted`]).
+    fn lift(&self) -> Option<Arc<dyn System>>;
+}
+
+impl<P: Catalog> System for P {
+    fn methods(&self) -> Vec<(&'static str, Properties)> {
+        self.catalog()
+            .iter()
+            .map(|e| (e.name, e.method.properties()))
+            .collect()
+    }
+
+    fn stepper(&self, method: &str, dt: f64) -> Result<(Box<dyn Stepper>, Properties)> {
+        let catalog = self.catalog();
+        match catalog.iter().find(|e| e.name == method) {
+            Some(e) => Ok((e.method.stepper(self, dt)?, e.method.properties())),
+            None => Err(unsupported(
+                self.name(),
+                method,
+                &catalog.iter().map(|e| e.name).collect::<Vec<_>>(),
+            )),
+        }
+    }
+
+    fn lift(&self) -> Option<Arc<dyn System>> {
+        self.lifted().map(|s| Arc::new(s) as Arc<dyn System>)
+    }
+}
+
+/// The error for an unknown method: the system's own methods, and the closest one when the name
+/// looks like a typo of it.
+pub fn unsupported(system: &str, method: &str, names: &[&str]) -> Error {
+    let close = names
+        .iter()
+        .map(|n| (edit_distance(method, n), *n))
+        .min()
+        .filter(|&(d, n)| d <= 2.max(n.len() / 3));
+    let mut supported = names.join(", ");
+    if let Some((_, n)) = close {
+        supported.push_str(&format!(" (did you mean {n:?}?)"));
+    }
+    Error::UnsupportedMethod {
+        method: method.into(),
+        system: system.into(),
+        supported,
+    }
+}
+
+/// Levenshtein distance of two strings (by characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for j in 0..b.len() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != b[j]))
+                .min(row[j] + 1)
+                .min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn suggestions_for_typos_only() {
+        let names = ["splitting", "splitting4", "rk4"];
+        let msg = |m| unsupported("RigidBody", m, &names).to_string();
+        assert!(msg("spliting").contains("did you mean \"splitting\""));
+        assert!(msg("rk5").contains("did you mean \"rk4\""));
+        assert!(!msg("verlet").contains("did you mean"));
+        assert!(msg("verlet").contains("splitting, splitting4, rk4"));
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+    }
+}

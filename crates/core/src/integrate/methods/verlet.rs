@@ -1,0 +1,108 @@
+//! `Verlet(Composition)`: Störmer–Verlet for a [`Separable`] Hamiltonian H = T(p) + U(q), and its
+//! symmetric compositions of order 4 (Suzuki 1990) and 6 (Yoshida 1990).
+//!
+//! One step of size h is kick–drift–kick: p ← p + (h/2) f(q); q ← q + h ∂T/∂p(p);
+//! p ← p + (h/2) f(q), with f = −∂U/∂q (Hairer, Lubich & Wanner, *Geometric Numerical
+//! Integration*, §I.3). It is the Strang splitting of the exact flows of T and U: symplectic,
+//! symmetric, order 2, and equivariant under every linear symmetry of T and U, so it keeps their
+//! quadratic momentum maps exactly (for the pseudo-rigid body L = PXᵀ − XPᵀ and Γ = PᵀX − XᵀP,
+//! 001 (7.3)). The energy error stays bounded over exponentially long times.
+//!
+//! The force at the end of a substep is reused at the start of the next (first same as last), so
+//! a step costs one force evaluation per stage. After every drift the position is checked
+//! ([`Separable::admissible`]); a position outside the domain stops the run with
+//! [`crate::Error::LeftDomain`] naming the step and the time at its end.
+
+use super::composition::Composition;
+use crate::error::Result;
+use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
+use crate::integrate::problem::Separable;
+
+/// Störmer–Verlet composed with the given [`Composition`] (order 2, 4 or 6 for the built-in
+/// compositions).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verlet(pub Composition);
+
+impl Verlet {
+    /// Plain Störmer–Verlet, order 2.
+    pub fn strang() -> Self {
+        Verlet(Composition::strang())
+    }
+}
+
+impl<P: Separable + Clone + 'static> Integrator<P> for Verlet {
+    fn properties(&self) -> Properties {
+        Properties::geometric(self.0.order())
+    }
+
+    fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
+        let d = problem.dof();
+        Ok(Box::new(VerletStepper {
+            scratch: problem.scratch(),
+            problem: problem.clone(),
+            steps: self.0.gammas().iter().map(|g| g * dt).collect(),
+            z: vec![0.0; 2 * d],
+            f: vec![0.0; d],
+            v: vec![0.0; d],
+        }))
+    }
+}
+
+struct VerletStepper<P: Separable> {
+    problem: P,
+    scratch: P::Scratch,
+    /// The substep sizes γ_i h.
+    steps: Vec<f64>,
+    /// (q, p).
+    z: Vec<f64>,
+    /// f(q) at the current q.
+    f: Vec<f64>,
+    v: Vec<f64>,
+}
+
+impl<P: Separable> Stepper for VerletStepper<P> {
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        self.z.copy_from_slice(z);
+        let d = self.f.len();
+        self.problem
+            .force(&self.z[..d], &mut self.f, &mut self.scratch);
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        z.copy_from_slice(&self.z);
+    }
+
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        let VerletStepper {
+            problem,
+            scratch,
+            steps: hs,
+            z,
+            f,
+            v,
+        } = self;
+        let (q, p) = z.split_at_mut(f.len());
+        for k in 0..steps {
+            for &h in hs.iter() {
+                axpy(p, 0.5 * h, f);
+                problem.velocity(p, v);
+                axpy(q, h, v);
+                problem
+                    .admissible(q, scratch)
+                    .map_err(|e| clock.left_domain(k, e))?;
+                problem.force(q, f, scratch);
+                axpy(p, 0.5 * h, f);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// y ← y + a x.
+#[inline]
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
+    }
+}

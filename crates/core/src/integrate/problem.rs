@@ -1,0 +1,189 @@
+//! Problem kinds: what a mechanical system offers to the integrators.
+//!
+//! Every system is a [`Problem`] (a state space, an energy, the invariants its geometric methods
+//! keep, optionally a chart between the user's frame and the one the kernels work in). On top of
+//! it a system implements the kinds it has, in the manner of GeometricIntegrators.jl's problem
+//! types, and every method is generic over the kind it needs:
+//!
+//! | kind | what the system provides | methods over it |
+//! |------|--------------------------|-----------------|
+//! | [`VectorField`] | ż = f(z) | `Rk4` |
+//! | [`Split`] | H = H₁ + … + H_m with exact flows | `Splitting(Composition)` |
+//! | [`Separable`] | H = T(p) + U(q): velocity ∂T/∂p and force −∂U/∂q | `Verlet(Composition)` |
+//! | [`Canonical`] | H(q, p) and its gradient | `Gauss(s)` (implicit midpoint = `Gauss(1)`) |
+//! | [`Constrained`] | a [`Separable`] with holonomic g(q) = 0 | `Rattle` |
+//! | [`Nonholonomic`] | a [`Separable`] with velocity constraints A(q) q̇ = 0 | `NonholonomicRattle` |
+//! | [`GroupField`] | ż = ξ(z)·z for a Lie-algebra valued ξ acting on z | `Rkmk4` |
+//! | [`Symmetric`] | a momentum map J and infinitesimal generators | (equilibria, tests) |
+//!
+//! Kernels work on flat slices of the state in the internal frame; they do not check lengths (the
+//! driver checks a state once, against [`Problem::space`]) and do not allocate (per-thread
+//! scratch comes from the kind's `Scratch` type).
+
+use super::space::Space;
+use crate::error::Result;
+
+/// What every system offers: its state space, energy and invariants.
+pub trait Problem: Send + Sync {
+    /// A short name for messages ("RigidBody", …).
+    fn name(&self) -> &'static str;
+
+    /// The state space (layout of the flat state vector, user frame and internal frame alike).
+    fn space(&self) -> Space;
+
+    /// The energy (Hamiltonian) of a state in the user's frame (`z.len()` = the space's dim).
+    fn energy(&self, z: &[f64]) -> Result<f64>;
+
+    /// The exact invariants the system's geometric methods keep (Casimirs, momentum maps, …) of a
+    /// state in the user's frame (`z.len()` = the space's dim); [`Problem::invariant_count`] values.
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>>;
+
+    /// The number of values [`Problem::invariants`] returns.
+    fn invariant_count(&self) -> usize;
+
+    /// Checks constraints of a state beyond its space (|q| = 1 and q·L = 0, det X > 0, …).
+    fn check_state(&self, _z: &[f64]) -> Result<()> {
+        Ok(())
+    }
+
+    /// Maps a state from the user's frame to the frame the kernels work in (e.g. the principal
+    /// axes of an inertia given as a full matrix). The identity by default.
+    fn to_internal(&self, _z: &mut [f64]) {}
+
+    /// Inverse of [`Problem::to_internal`].
+    fn to_user(&self, _z: &mut [f64]) {}
+}
+
+/// A state found outside the domain of a problem during a step (det X ≤ 0, a coordinate
+/// singularity, …); the method turns it into [`crate::Error::LeftDomain`] with the time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Violation {
+    /// What left the domain.
+    pub what: String,
+    /// Why, and what to do about it (in words that suit every caller).
+    pub message: String,
+}
+
+/// An ordinary differential equation ż = f(z) (internal frame).
+pub trait VectorField: Problem {
+    /// Evaluates f(z) into `dz`.
+    fn field(&self, z: &[f64], dz: &mut [f64]);
+}
+
+/// A Hamiltonian H = H₀ + … + H_{m−1} whose pieces have exact flows φ_i (Lie–Poisson splittings,
+/// kick–drift splittings, reduced flows). Flow 0 is the outermost of the palindromic Strang step,
+/// flow m − 1 the middle one ([`crate::integrate::methods::Composition::sequence`]).
+pub trait Split: Problem {
+    /// The working form of a state the flows act on (registers, or reduced coordinates).
+    type Work: Send;
+
+    /// The working form of a flat state (internal frame); may fail where the working
+    /// coordinates do not exist.
+    fn load(&self, z: &[f64]) -> Result<Self::Work>;
+
+    /// Writes the working form back to a flat state (internal frame).
+    fn store(&self, w: &Self::Work, z: &mut [f64]);
+
+    /// The number m of exact flows.
+    fn flows(&self) -> usize;
+
+    /// Applies the exact flow φ_i over time τ.
+    fn flow(&self, i: usize, tau: f64, w: &mut Self::Work);
+
+    /// Whether [`Split::check_step`] must run after every step (then steps are not fused).
+    const CHECKED: bool = false;
+
+    /// Checks the working state after a step (for coordinates with a boundary).
+    fn check_step(&self, _w: &mut Self::Work) -> std::result::Result<(), Violation> {
+        Ok(())
+    }
+}
+
+/// A separable Hamiltonian H(q, p) = T(p) + U(q) on T*ℝᵈ with state z = (q, p), d = [`Separable::dof`].
+pub trait Separable: Problem {
+    /// Per-thread scratch of [`Separable::force`].
+    type Scratch: Send;
+
+    /// Fresh scratch.
+    fn scratch(&self) -> Self::Scratch;
+
+    /// The number d of degrees of freedom.
+    fn dof(&self) -> usize;
+
+    /// The velocity v = ∂T/∂p (linear in p, v = M⁻¹p, for the constrained kinds).
+    fn velocity(&self, p: &[f64], v: &mut [f64]);
+
+    /// The force f = −∂U/∂q.
+    fn force(&self, q: &[f64], f: &mut [f64], s: &mut Self::Scratch);
+
+    /// Checks a position reached by a drift (det X > 0, …). Always admissible by default.
+    fn admissible(&self, _q: &[f64], _s: &mut Self::Scratch) -> std::result::Result<(), Violation> {
+        Ok(())
+    }
+}
+
+/// A canonical Hamiltonian system H(q, p) on T*ℝᵈ with state z = (q, p).
+pub trait Canonical: Problem {
+    /// The number d of degrees of freedom.
+    fn dof(&self) -> usize;
+
+    /// H(q, p) (internal frame).
+    fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64;
+
+    /// The gradient: `hq` = ∂H/∂q, `hp` = ∂H/∂p.
+    fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]);
+}
+
+/// A [`Separable`] system with T = ½ pᵀM⁻¹p restricted by holonomic constraints g(q) = 0
+/// (g: ℝᵈ → ℝᵐ, full rank Jacobian G(q) = ∂g/∂q).
+pub trait Constrained: Separable {
+    /// The number m of constraints.
+    fn constraints(&self) -> usize;
+
+    /// g(q) into `g` (m values).
+    fn constraint(&self, q: &[f64], g: &mut [f64]);
+
+    /// G(q) = ∂g/∂q into `jac` (m × d, row-major).
+    fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64]);
+}
+
+/// A [`Separable`] system with T = ½ pᵀM⁻¹p restricted by linear velocity constraints
+/// A(q) q̇ = 0 (A: m × d of full rank), with the Lagrange–d'Alembert principle.
+pub trait Nonholonomic: Separable {
+    /// The number m of constraints.
+    fn constraints(&self) -> usize;
+
+    /// A(q) into `a` (m × d, row-major).
+    fn constraint_matrix(&self, q: &[f64], a: &mut [f64]);
+}
+
+/// A vector field of the form ż = ξ(z)·z, where ξ(z) lies in a Lie algebra g (coordinates of
+/// length [`GroupField::algebra_dim`]) acting on the state: the setting of Runge–Kutta–Munthe-Kaas
+/// methods, which stay on the group orbit of the initial state (coadjoint orbits, SO(3)).
+pub trait GroupField: Problem {
+    /// dim g.
+    fn algebra_dim(&self) -> usize;
+
+    /// ξ(z) ∈ g.
+    fn generator(&self, z: &[f64], xi: &mut [f64]);
+
+    /// z ← exp(ξ)·z, exactly on the orbit.
+    fn act(&self, xi: &[f64], z: &mut [f64]);
+
+    /// dexp⁻¹_u(v) ∈ g (the inverse of the derivative of exp at u, applied to v).
+    fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64]);
+}
+
+/// A system with a symmetry: a momentum map J: state → g* and the infinitesimal generators of
+/// the action (the data relative equilibria and their stability need).
+pub trait Symmetric: Problem {
+    /// dim g.
+    fn symmetry_dim(&self) -> usize;
+
+    /// J(z) ∈ g* (user frame), [`Symmetric::symmetry_dim`] values.
+    fn momentum_map(&self, z: &[f64]) -> Result<Vec<f64>>;
+
+    /// The infinitesimal generator ξ_Z(z) (the velocity of the state under the one-parameter
+    /// group exp(tξ)), user frame.
+    fn generator(&self, xi: &[f64], z: &[f64]) -> Result<Vec<f64>>;
+}
