@@ -8,7 +8,9 @@ elliptic      Jacobi elliptic functions sn, cn, dn and the integrals K(m), F(phi
 
 Systems and integration
 -----------------------
+System                                                          base class of every system
 RigidBody, GeneralizedRigidBody, HeavyTop, SphericalPendulum   Lie–Poisson systems of 000 §3–§5
+PseudoRigidBody, potentials                                     pseudo-rigid bodies of 001
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``).
@@ -30,19 +32,24 @@ from ._lieflow import (
 from ._lieflow import (
     GeneralizedRigidBody,
     HeavyTop,
-    LiePoissonSystem,
+    Integration,
+    PseudoRigidBody,
     RigidBody,
     SphericalPendulum,
+    System,
 )
-from . import elliptic, lie, pseudo_rigid
+from . import elliptic, lie, potentials, pseudo_rigid
 from .integrate import Trajectory, integrate
-from ._lieflow import PseudoRigidBody; from . import potentials  # noqa: E702
+
+#: The former name of the base class of the Lie–Poisson systems (kept for existing code).
+LiePoissonSystem = System
 
 __all__ = [
     "ConvergenceError",
     "DegenerateStratumError",
     "GeneralizedRigidBody",
     "HeavyTop",
+    "Integration",
     "InvalidArgumentError",
     "LeftDomainError",
     "LiePoissonSystem",
@@ -50,14 +57,17 @@ __all__ = [
     "NoUniqueLogError",
     "NonFiniteError",
     "NotInGroupError",
+    "PseudoRigidBody",
     "RigidBody",
     "ShapeError",
     "SphericalPendulum",
+    "System",
     "Trajectory",
     "UnsupportedMethodError",
     "__version__",
     "elliptic",
     "integrate",
     "lie",
+    "potentials",
     "pseudo_rigid",
 ]

@@ -1,15 +1,19 @@
 """Integration driver: ``integrate(system, state0, dt=..., steps=..., method=...)`` -> ``Trajectory``.
 
-Pure presentation and control around the native systems (``lieflow.RigidBody`` and friends, or any
-object speaking the protocol below): argument checks, chunking of long runs so that Ctrl-C is
+Pure presentation and control around the native systems (subclasses of ``lieflow.System``, or
+any object speaking the protocol below): argument checks, chunking of long runs so that Ctrl-C is
 honoured promptly (Python handles signals between native calls; the native work runs with the GIL
-released), an optional progress bar, and the assembly of the ``Trajectory``.
+released), an optional progress bar, and the assembly of the ``Trajectory``. The chunks resume
+one native run (``Integration``): validation happens once, the clock and the steppers live for
+the whole run, and the result does not depend on the chunking.
 
-Protocol a system implements (see ``docs`` of ``LiePoissonSystem``): ``methods()``, ``state_dim``,
-``_normalize_state(state0) -> (z0 (b, d), batched)``, ``_run(z0, attitude0, dt, steps,
-save_every, method, *, t0) -> (states (b, k, d), attitude (b, k, 3, 3) | None, z_final (b, d),
-attitude_final (b, 3, 3) | None)``, vectorised ``energy`` and ``casimirs``; optionally
-``_fields(states) -> dict`` of named views and further observables ``NAME(states)``.
+Protocol a system implements (``lieflow.System`` implements it once for every system):
+``methods()`` (the first is the default), ``state_dim``, ``_normalize_state(state0) -> (z0 (b, d),
+batched)``, ``_start(z0, attitude0, dt, method, save_every, *, t0, threads) -> run`` with
+``run.advance(steps) -> (states (b, k, d), attitude (b, k, 3, 3) | None)`` (the states saved in
+those steps) and ``run.state() -> (z (b, d), attitude (b, 3, 3) | None)``, vectorised ``energy``
+and ``invariants``/``casimirs``; optionally ``_fields(states) -> dict`` of named views and further
+observables ``NAME(states)``.
 """
 
 import operator
@@ -91,35 +95,35 @@ class _Progress:
             sys.stderr.flush()
 
 
-def integrate(system, state0, dt, steps, method="splitting", save_every=1, attitude=None,
-              progress=False, chunk_steps=None):
+def integrate(system, state0, dt, steps, method=None, save_every=1, attitude=None,
+              progress=False, chunk_steps=None, threads=None):
     """Integrates ``system`` from ``state0`` by ``steps`` fixed steps of size ``dt``.
 
     Args:
         system: a system object, e.g. ``RigidBody([1, 2, 3])``.
-        state0: an initial state in the system's layout (for ``RigidBody`` the momentum M (3,)),
-            or a batch of them along a leading axis; a batch runs in parallel on all cores.
+        state0: an initial state in the system's layout (for ``RigidBody`` the momentum M (3,);
+            a tuple with one array per field, e.g. ``(M, Gamma)`` or ``(X, P)``, also works), or
+            a batch of them along a leading axis; a batch runs in parallel on all cores.
         dt: the time step (> 0).
         steps: the number of steps (>= 1).
-        method: one of ``system.methods()``: "splitting", "splitting4", "splitting6",
-            "isospectral", "lgvi", "rk4".
+        method: one of ``system.methods()`` (default: the first, the system's own default).
         save_every: keep every ``save_every``-th state (and the initial one): the trajectory has
             ``steps // save_every + 1`` samples at t = j * save_every * dt.
         attitude: for systems on SO(3): the initial attitude R (3, 3) (shared by a batch) or one
             per batch member (b, 3, 3); it is then integrated along.
         progress: show a progress bar (tqdm if installed, else a line on stderr).
         chunk_steps: steps per native call (default: ``CHUNK_WORK // batch size``, at least
-            ``MIN_CHUNK_STEPS``). Ctrl-C is noticed between calls. Results do not depend on it
-            beyond round-off.
+            ``MIN_CHUNK_STEPS``). Ctrl-C is noticed between calls. Results do not depend on it.
+        threads: threads for a batch (default: all cores).
 
     Returns:
         A ``Trajectory``.
 
     Raises:
-        InvalidArgumentError (dt <= 0 or non-finite, steps < 1, save_every < 1, unknown method,
-        state constraints), UnsupportedMethodError (lists the supported methods), ShapeError,
-        NonFiniteError, NotInGroupError (attitude), ConvergenceError, LeftDomainError;
-        KeyboardInterrupt on Ctrl-C.
+        InvalidArgumentError (dt <= 0 or non-finite, steps < 1, save_every < 1, state
+        constraints), UnsupportedMethodError (lists the system's methods), ShapeError,
+        NonFiniteError, NotInGroupError (attitude), ConvergenceError, LeftDomainError (naming the
+        time from the start of the run); KeyboardInterrupt on Ctrl-C.
     """
     steps = _count("steps", steps)
     save_every = _count("save_every", save_every)
@@ -127,7 +131,9 @@ def integrate(system, state0, dt, steps, method="splitting", save_every=1, attit
         dt = float(dt)
     except (TypeError, ValueError):
         raise InvalidArgumentError(f"invalid dt: expected a finite number > 0, got {dt!r}") from None
-    if not isinstance(method, str):
+    if method is None:
+        method = system.methods()[0]
+    elif not isinstance(method, str):
         raise InvalidArgumentError(f"invalid method: expected a name, got {method!r}")
     z, batched = system._normalize_state(state0)
     b = z.shape[0]
@@ -136,30 +142,25 @@ def integrate(system, state0, dt, steps, method="splitting", save_every=1, attit
         cap = max(MIN_CHUNK_STEPS, CHUNK_WORK // max(b, 1))
     else:
         cap = _count("chunk_steps", chunk_steps)
+    if threads is not None:
+        threads = _count("threads", threads)
 
+    run = system._start(z, att, dt, method, save_every, threads=threads)
     states, atts = [z[:, None, :]], [None if att is None else att[:, None]]
     bar = _Progress(steps, progress, f"{type(system).__name__} {method}")
     try:
         done = 0
         while done < steps:
-            if done % save_every == 0 and save_every <= cap:
-                # Whole save intervals: keep the samples the native run saved.
-                n = min(cap // save_every * save_every, steps - done)
-                s, a, z, att = system._run(z, att, dt, n, save_every, method, t0=done * dt)
-                states.append(s[:, 1:])
-                atts.append(None if a is None else a[:, 1:])
-            else:
-                # Part of a long save interval: keep only the end point, if it is a sample.
-                n = min(cap, save_every - done % save_every, steps - done)
-                _, _, z, att = system._run(z, att, dt, n, n, method, t0=done * dt)
-                if (done + n) % save_every == 0:
-                    states.append(z[:, None, :])
-                    atts.append(None if att is None else att[:, None])
+            n = min(cap, steps - done)
+            s, a = run.advance(n)
+            states.append(s)
+            atts.append(a)
             done += n
             bar.update(n)
     finally:
         bar.close()
 
+    z, att = run.state()
     states = np.concatenate(states, axis=1)
     attitudes = None if att is None else np.concatenate(atts, axis=1)
     t = np.arange(states.shape[1]) * (save_every * dt)
@@ -217,9 +218,14 @@ class Trajectory:
         """The energy at every sample: (k,) or (b, k)."""
         return np.asarray(self.system.energy(self.states))
 
+    def invariants(self):
+        """The invariants the system's geometric methods keep, at every sample: (k, c) or
+        (b, k, c)."""
+        return np.asarray(self.system.invariants(self.states))
+
     def casimirs(self):
-        """The Casimirs at every sample: (k, c) or (b, k, c)."""
-        return np.asarray(self.system.casimirs(self.states))
+        """The same as ``invariants()`` (the Casimirs of the Lie–Poisson systems)."""
+        return self.invariants()
 
     def _fields(self):
         if self._field_cache is None:

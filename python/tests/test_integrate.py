@@ -103,7 +103,7 @@ def test_continue_from_final_state(body):
 
 
 class Recording:
-    """A duck-typed system (the protocol only) that records the steps of each native call."""
+    """A duck-typed system (the protocol only) that records (steps, time) of each native call."""
 
     def __init__(self, inner):
         self.inner, self.calls = inner, []
@@ -111,9 +111,18 @@ class Recording:
     def __getattr__(self, name):
         return getattr(self.inner, name)
 
-    def _run(self, z0, attitude0, dt, steps, save_every, method, *, t0=0.0):
-        self.calls.append((steps, t0))
-        return self.inner._run(z0, attitude0, dt, steps, save_every, method, t0=t0)
+    def _start(self, *args, **kwargs):
+        run, calls = self.inner._start(*args, **kwargs), self.calls
+
+        class Run:
+            def advance(self, steps):
+                calls.append((steps, run.time))
+                return run.advance(steps)
+
+            def state(self):
+                return run.state()
+
+        return Run()
 
 
 def test_default_chunking_splits_long_runs(body, monkeypatch):
@@ -121,12 +130,12 @@ def test_default_chunking_splits_long_runs(body, monkeypatch):
     monkeypatch.setattr(sys.modules["lieflow.integrate"], "MIN_CHUNK_STEPS", 100)
     rec = Recording(body)
     tr = lf.integrate(rec, np.tile(M0, (4, 1)), dt=0.01, steps=1000, save_every=100)
-    assert rec.calls == [(200, k * 2.0) for k in range(5)] and tr.states.shape == (4, 11, 3)
+    assert rec.calls == [(250, k * 2.5) for k in range(4)] and tr.states.shape == (4, 11, 3)
     one = lf.integrate(body, np.tile(M0, (4, 1)), dt=0.01, steps=1000, save_every=100)
     np.testing.assert_allclose(tr.states, one.states, atol=1e-14)
     rec = Recording(body)
-    lf.integrate(rec, M0, dt=0.01, steps=2500, save_every=700)   # cap 1000 < save_every
-    assert [n for n, _ in rec.calls] == [700, 700, 700, 400]
+    tr = lf.integrate(rec, M0, dt=0.01, steps=2500, save_every=700)   # cap 1000 < save_every
+    assert [n for n, _ in rec.calls] == [1000, 1000, 500] and len(tr) == 4
     rec = Recording(body)
     lf.integrate(rec, np.tile(M0, (50, 1)), dt=0.01, steps=250, save_every=1)
     assert [n for n, _ in rec.calls] == [100, 100, 50]  # MIN_CHUNK_STEPS for big batches
@@ -182,7 +191,7 @@ def test_ctrl_c_stops_a_long_run():
     (dict(steps=True), lf.InvalidArgumentError, "steps"),
     (dict(save_every=0), lf.InvalidArgumentError, "save_every"),
     (dict(chunk_steps=0), lf.InvalidArgumentError, "chunk_steps"),
-    (dict(method="euler"), lf.InvalidArgumentError, "unknown method"),
+    (dict(method="euler"), lf.UnsupportedMethodError, "supported methods: splitting, "),
     (dict(method=3), lf.InvalidArgumentError, "method"),
 ])
 def test_bad_arguments(body, kw, exc, match):
@@ -209,7 +218,18 @@ def test_unsupported_method_lists_supported():
     with pytest.raises(lf.UnsupportedMethodError, match="splitting, splitting4, splitting6, lgvi, rk4"):
         lf.integrate(top, z, dt=0.01, steps=10, method="isospectral")
     with pytest.raises(lf.UnsupportedMethodError, match="isospectral, rk4"):
-        lf.integrate(lf.GeneralizedRigidBody([1, 2, 3, 4]), np.ones(6), dt=0.01, steps=10)
+        lf.integrate(lf.GeneralizedRigidBody([1, 2, 3, 4]), np.ones(6), dt=0.01, steps=10,
+                     method="splitting")
+    with pytest.raises(lf.UnsupportedMethodError, match=r"lgvi, rk4.*\(did you mean \"rk4\"\?\)"):
+        lf.integrate(lf.RigidBody(I), M0, dt=0.01, steps=10, method="rk5")
+    with pytest.raises(lf.UnsupportedMethodError) as e:
+        lf.integrate(lf.RigidBody(I), M0, dt=0.01, steps=10, method="verlet")
+    assert "did you mean" not in str(e.value) and "reduced" not in str(e.value)
+    # The default method is the system's own first method (it was "splitting" for every system).
+    for system, z0 in [(lf.GeneralizedRigidBody([1, 2, 3, 4]), np.ones(6)),
+                       (lf.PseudoRigidBody(2), (np.eye(2), np.ones((2, 2))))]:
+        tr = lf.integrate(system, z0, dt=0.01, steps=10)
+        assert tr.method == system.methods()[0] and len(tr) == 11
 
 
 def test_bad_attitudes(body):

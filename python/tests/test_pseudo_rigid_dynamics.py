@@ -150,7 +150,7 @@ def test_error_paths():
         body._run(z0, None, 0.1, 0, 1, "verlet")
     with pytest.raises(lf.InvalidArgumentError):
         body._run(z0, None, 0.1, 10, -1, "verlet")
-    with pytest.raises(lf.InvalidArgumentError):
+    with pytest.raises(lf.UnsupportedMethodError, match="verlet, verlet4, verlet6, reduced"):
         body._run(z0, None, 0.1, 10, 1, "nope")
     with pytest.raises(lf.InvalidArgumentError):
         body._run(z0, np.eye(3)[None], 0.1, 10, 1, "verlet")

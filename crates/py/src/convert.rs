@@ -92,14 +92,6 @@ pub fn vec3(what: &str, a: &ArrayIn<'_>) -> PyResult<Vector3<f64>> {
     Ok(Vector3::new(v[[0]], v[[1]], v[[2]]))
 }
 
-/// A 3×3 matrix.
-pub fn mat3(what: &str, a: &ArrayIn<'_>) -> PyResult<Matrix3<f64>> {
-    let v = a.as_array();
-    if v.shape() != [3, 3] {
-        return Err(shape_err(what, "(3, 3)", &v));
-    }
-    Ok(Matrix3::from_fn(|i, j| v[[i, j]]))
-}
 
 /// Matrix → 2-D numpy array.
 pub fn py_mat<'py>(py: Python<'py>, m: &Mat) -> Bound<'py, PyArray2<f64>> {
@@ -128,7 +120,3 @@ pub fn py_mat3<'py>(py: Python<'py>, m: &Matrix3<f64>) -> Bound<'py, PyArray2<f6
     Array2::from_shape_fn((3, 3), |(i, j)| m[(i, j)]).into_pyarray(py)
 }
 
-/// 3-vector → numpy.
-pub fn py_vec3<'py>(py: Python<'py>, v: &Vector3<f64>) -> Bound<'py, PyArray1<f64>> {
-    Array1::from(vec![v.x, v.y, v.z]).into_pyarray(py)
-}

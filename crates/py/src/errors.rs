@@ -65,10 +65,16 @@ create_exception!(
     "A trajectory left its configuration space (e.g. det X ≤ 0)."
 );
 
+/// Rust spellings in core messages and their Python equivalents (advice in the caller's
+/// language).
+const SPELLINGS: [(&str, &str); 2] = [("check_det = false", "check_det=False"), ("f64", "float")];
+
 /// Converts a core error into the matching Python exception.
 pub fn to_py(e: lieflow::Error) -> PyErr {
     use lieflow::Error as E;
-    let msg = e.to_string();
+    let msg = SPELLINGS
+        .iter()
+        .fold(e.to_string(), |m, (rust, python)| m.replace(rust, python));
     match e {
         E::NotInGroup { .. } => NotInGroupError::new_err(msg),
         E::Shape { .. } => ShapeError::new_err(msg),
@@ -83,21 +89,7 @@ pub fn to_py(e: lieflow::Error) -> PyErr {
     }
 }
 
-/// Adds `t0` to the time a [`lieflow::Error::LeftDomain`] names, for runs that start at t0 (the
-/// chunks of `lf.integrate`); other errors pass unchanged.
-pub fn shift_time(e: lieflow::Error, t0: f64) -> lieflow::Error {
-    match e {
-        lieflow::Error::LeftDomain { what, t, message } => lieflow::Error::LeftDomain {
-            what,
-            t: t + t0,
-            message,
-        },
-        e => e,
-    }
-}
-
 /// `lieflow::Result<T>` → `PyResult<T>`.
-#[allow(dead_code)] // used by every binding file once they land
 pub trait IntoPy<T> {
     /// Maps the error with [`to_py`].
     fn py(self) -> PyResult<T>;

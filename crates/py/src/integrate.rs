@@ -1,68 +1,82 @@
-//! The native half of `lieflow.integrate`: the Lie–Poisson systems of `lieflow::systems` as Python
-//! classes and the integration protocol they share (see `python/lieflow/integrate.py`, which does
-//! the chunking, progress display and Ctrl-C handling in Python).
-//!
-//! Every system class derives from [`LiePoissonSystem`], which holds the core system as a
-//! `dyn System` and implements the protocol once: `state_dim`, `_normalize_state`, `_run` (the
-//! batch in parallel with the GIL released), and the vectorised `energy` and `casimirs`. The
-//! subclasses (in [`systems`]) add constructors, the static `methods()` and their own
-//! observables; the elliptic functions behind the exact rigid-body solution are in [`elliptic`].
+//! `lieflow.Integration`: a native run in progress (a batch of `lieflow::integrate::Run`s). The
+//! chunked driver `lieflow.integrate` (Python: progress, Ctrl-C) resumes the same native
+//! steppers chunk after chunk, so a run validates once, keeps its clock, and never converts its
+//! state back and forth.
 
-mod elliptic;
-mod items;
-mod systems;
+use std::sync::{Arc, Mutex};
 
-use std::sync::Arc;
-
-use lieflow::integrate::{integrate, integrate_batch, Method, State, System, Trajectory};
-use lieflow::{check, Error};
-use numpy::ndarray::{Array2, Array3, ArrayViewD};
-use numpy::{IntoPyArray, PyArray2, PyArray3};
+use lieflow::integrate::{Run, System};
+use lieflow::Error;
+use numpy::{PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
+use rayon::prelude::*;
 
-use crate::convert::ArrayIn;
-use crate::errors::{shift_time, to_py, IntoPy};
-use items::{array, map_items, shape_str, Input, Out};
+use crate::convert::{shape_str, ArrayIn};
+use crate::errors::{to_py, IntoPy};
+use crate::items::{array, Out};
+use crate::system::Callbacks;
 
-/// A core system usable from any thread.
-pub(crate) type Dyn = Arc<dyn System + Send + Sync>;
-
-/// The names of `methods`.
-pub(crate) fn method_names(methods: &[Method]) -> Vec<&'static str> {
-    methods.iter().map(|m| m.name()).collect()
-}
-
-/// The result of `_run`: states (b, k, d), attitude (b, k, 3, 3) or None, final z (b, d), final
-/// attitude (b, 3, 3) or None.
-type RunOut<'py> = (
+/// The result of `System._run`: states (b, k, d), attitude (b, k, 3, 3) or None, final states
+/// (b, d), final attitude (b, 3, 3) or None.
+pub(crate) type RunOut<'py> = (
     Out<'py>,
     Option<Out<'py>>,
     Bound<'py, PyArray2<f64>>,
     Option<Bound<'py, PyArray3<f64>>>,
 );
 
-/// Base class of the Lie–Poisson systems (RigidBody, GeneralizedRigidBody, HeavyTop,
-/// SphericalPendulum): the protocol `lieflow.integrate` drives.
-///
-/// A state is a flat float64 vector z of length `state_dim` (layout fixed by each system);
-/// systems on SO(3) can carry an attitude R (3, 3) along.
-#[pyclass(module = "lieflow", subclass, frozen)]
-pub struct LiePoissonSystem {
-    sys: Dyn,
+/// A native integration in progress (made by `System._start`); `advance(steps)` continues it.
+#[pyclass(module = "lieflow", name = "Integration")]
+pub struct Integration {
+    sys: Arc<dyn System>,
+    callbacks: Option<Arc<dyn Callbacks>>,
+    runs: Mutex<Vec<Run>>,
+    pool: Option<rayon::ThreadPool>,
+    /// Length of a state without the attitude.
+    d: usize,
+    attitude: bool,
+    save_every: u64,
+    /// Steps done (the same for every member).
+    done: u64,
 }
 
-impl LiePoissonSystem {
-    pub(crate) fn new(sys: Dyn) -> Self {
-        LiePoissonSystem { sys }
-    }
+/// A count ≥ 1 from a Python integer.
+fn count(what: &str, v: i64) -> PyResult<usize> {
+    usize::try_from(v)
+        .ok()
+        .filter(|&u| u >= 1)
+        .ok_or_else(|| to_py(Error::invalid(what, format!("expected {what} ≥ 1, got {v}"))))
+}
 
-    /// Reads (b, d) initial states and an optional (b, 3, 3) attitude.
-    fn initial_states(
-        &self,
+impl Integration {
+    /// Validates everything once and starts one run per row of `z0`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn start(
+        sys: Arc<dyn System>,
+        callbacks: Option<Arc<dyn Callbacks>>,
         z0: &ArrayIn<'_>,
         attitude0: Option<&ArrayIn<'_>>,
-    ) -> PyResult<Vec<State>> {
-        let d = self.sys.dim();
+        dt: f64,
+        method: &str,
+        save_every: i64,
+        t0: f64,
+        threads: Option<i64>,
+    ) -> PyResult<Self> {
+        let save_every = count("save_every", save_every)?;
+        let pool = match threads {
+            None => None,
+            Some(n) => {
+                let n = count("threads", n)?;
+                Some(
+                    rayon::ThreadPoolBuilder::new()
+                        .num_threads(n)
+                        .build()
+                        .map_err(|e| to_py(Error::invalid("threads", e.to_string())))?,
+                )
+            }
+        };
+        let full = sys.space().dim();
+        let d = if attitude0.is_some() { full - 9 } else { full };
         let z = z0.as_array();
         if z.ndim() != 2 || z.shape()[1] != d {
             return Err(to_py(Error::shape(
@@ -72,10 +86,7 @@ impl LiePoissonSystem {
             )));
         }
         let b = z.shape()[0];
-        let mut states: Vec<State> = z
-            .outer_iter()
-            .map(|row| State::new(row.iter().copied().collect()))
-            .collect();
+        let mut states: Vec<Vec<f64>> = z.outer_iter().map(|r| r.iter().copied().collect()).collect();
         if let Some(a) = attitude0 {
             let a = a.as_array();
             if a.shape() != [b, 3, 3] {
@@ -86,220 +97,145 @@ impl LiePoissonSystem {
                 )));
             }
             for (s, r) in states.iter_mut().zip(a.outer_iter()) {
-                let mut m = [0.0; 9];
-                for (o, v) in m.iter_mut().zip(r.iter()) {
-                    *o = *v;
-                }
-                s.attitude = Some(m);
+                s.extend(r.iter());
             }
         }
-        Ok(states)
-    }
-}
-
-/// Parses flat initial states: (d,) or a batch (b, d), finite. Returns ((b, d), batched).
-pub(crate) fn normalize_flat<'py>(
-    py: Python<'py>,
-    d: usize,
-    v: &ArrayViewD<'_, f64>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, bool)> {
-    let bad = || {
-        to_py(Error::shape(
-            "state0",
-            format!("({d},) or a batch (b, {d})"),
-            shape_str(v.shape()),
-        ))
-    };
-    let batched = match v.ndim() {
-        1 => false,
-        2 => true,
-        _ => return Err(bad()),
-    };
-    if v.shape()[v.ndim() - 1] != d {
-        return Err(bad());
-    }
-    let data: Vec<f64> = v.iter().copied().collect();
-    check::finite_slice("state0", &data).py()?;
-    let b = data.len() / d;
-    let z = Array2::from_shape_vec((b, d), data).map_err(|_| bad())?;
-    Ok((z.into_pyarray(py), batched))
-}
-
-/// The Python exception for an error of a run over `states0`; an invalid member of a batch is
-/// named ("batch member i: …").
-fn in_batch(py: Python<'_>, sys: &dyn System, states0: &[State], e: Error) -> PyErr {
-    let member = match states0 {
-        [_, _, ..] => states0
+        let runs = states
             .iter()
-            .position(|s| sys.check_state(s).as_ref().err() == Some(&e)),
-        _ => None,
-    };
-    let err = to_py(e);
-    match member {
-        Some(i) => PyErr::from_type(
-            err.get_type(py),
-            format!("batch member {i}: {}", err.value(py)),
-        ),
-        None => err,
+            .enumerate()
+            .map(|(i, z)| {
+                Run::new(&*sys, method, z, dt, save_every, t0)
+                    .map_err(|e| if b > 1 { e.in_member(i) } else { e })
+            })
+            .collect::<lieflow::Result<Vec<_>>>()
+            .py()?;
+        Ok(Integration {
+            sys,
+            callbacks,
+            runs: Mutex::new(runs),
+            pool,
+            d,
+            attitude: attitude0.is_some(),
+            save_every: save_every as u64,
+            done: 0,
+        })
     }
-}
 
-/// Row-major (b, …) data from the trajectories' pieces.
-fn stack<'a>(pieces: impl Iterator<Item = &'a [f64]>, capacity: usize) -> Vec<f64> {
-    let mut out = Vec::with_capacity(capacity);
-    for p in pieces {
-        out.extend_from_slice(p);
+    /// Splits (b, k, full) data into states (b, k, d) and attitudes (b, k, 3, 3).
+    fn split<'py>(
+        &self,
+        py: Python<'py>,
+        data: &[f64],
+        b: usize,
+        k: usize,
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+        let full = self.d + if self.attitude { 9 } else { 0 };
+        let mut z = Vec::with_capacity(b * k * self.d);
+        let mut r = Vec::with_capacity(if self.attitude { b * k * 9 } else { 0 });
+        for s in data.chunks_exact(full) {
+            z.extend_from_slice(&s[..self.d]);
+            r.extend_from_slice(&s[self.d..]);
+        }
+        let states = array(py, &[b, k, self.d], z)?;
+        let att = if self.attitude {
+            Some(array(py, &[b, k, 3, 3], r)?)
+        } else {
+            None
+        };
+        Ok((states, att))
     }
-    out
+
+    /// `_run`: the initial states and the states saved in `steps` more steps, and the final
+    /// states.
+    pub(crate) fn run_all<'py>(&mut self, py: Python<'py>, steps: i64) -> PyResult<RunOut<'py>> {
+        let (z0, r0) = self.state(py)?;
+        let (rest, r_rest) = self.advance(py, steps)?;
+        let (zf, rf) = self.state(py)?;
+        let np = py.import("numpy")?;
+        let join = |first: Bound<'py, PyAny>, rest: Out<'py>| -> PyResult<Out<'py>> {
+            let first = np.call_method1("expand_dims", (first, 1))?;
+            Ok(np
+                .call_method1("concatenate", ((first, rest), 1))?
+                .cast_into()?)
+        };
+        let states = join(z0.into_any(), rest)?;
+        let att = match (r0, r_rest) {
+            (Some(r0), Some(r)) => Some(join(r0.into_any(), r)?),
+            _ => None,
+        };
+        Ok((states, att, zf, rf))
+    }
 }
 
 #[pymethods]
-impl LiePoissonSystem {
-    /// Length d of the flat state vector z.
-    #[getter]
-    fn state_dim(&self) -> usize {
-        self.sys.dim()
-    }
-
-    /// Whether the system can carry an attitude R in SO(3) along (`integrate(..., attitude=R0)`).
-    #[getter]
-    fn has_attitude(&self) -> bool {
-        self.sys.has_attitude()
-    }
-
-    /// Parses an initial state: (d,) or a batch (b, d) of flat states.
+impl Integration {
+    /// Advances every member by `steps` steps (in parallel, GIL released).
     ///
     /// Returns:
-    ///     (z0, batched): z0 a (b, d) float64 array (b = 1 when not batched).
+    ///     (states (b, k, d), attitude (b, k, 3, 3) or None): the states saved in these steps
+    ///     (every `save_every`-th step counted from the start of the run).
     /// Raises:
-    ///     ShapeError, NonFiniteError.
-    fn _normalize_state<'py>(
-        &self,
+    ///     InvalidArgumentError (steps < 1), ConvergenceError, LeftDomainError (naming the
+    ///     absolute time); the exception of a Python callable the system called.
+    fn advance<'py>(
+        &mut self,
         py: Python<'py>,
-        state0: ArrayIn<'py>,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, bool)> {
-        normalize_flat(py, self.sys.dim(), &state0.as_array())
-    }
-
-    /// Integrates every row of `z0` by `steps` steps of size `dt` with `method`, saving every
-    /// `save_every`-th state (and the initial one). The rows run in parallel (rayon) with the GIL
-    /// released. Use `lieflow.integrate`, which calls this in chunks.
-    ///
-    /// Args:
-    ///     z0: (b, d) initial states; attitude0: (b, 3, 3) rotations or None; dt > 0;
-    ///     steps >= 1; save_every >= 1; method: a name from `methods()`; t0 (keyword): the
-    ///     time of z0, added to the time a LeftDomainError names.
-    /// Returns:
-    ///     (states (b, k, d), attitude (b, k, 3, 3) or None, z_final (b, d),
-    ///     attitude_final (b, 3, 3) or None), k = steps // save_every + 1.
-    /// Raises:
-    ///     InvalidArgumentError (dt, steps, save_every, unknown method, constraints),
-    ///     UnsupportedMethodError, ShapeError, NonFiniteError, NotInGroupError (attitude),
-    ///     ConvergenceError (implicit methods), LeftDomainError (the state became non-finite).
-    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method, *, t0 = 0.0))]
-    #[allow(clippy::too_many_arguments)]
-    fn _run<'py>(
-        &self,
-        py: Python<'py>,
-        z0: ArrayIn<'py>,
-        attitude0: Option<ArrayIn<'py>>,
-        dt: f64,
-        steps: usize,
-        save_every: usize,
-        method: &str,
-        t0: f64,
-    ) -> PyResult<RunOut<'py>> {
-        let method = Method::from_name(method).py()?;
-        let states0 = self.initial_states(&z0, attitude0.as_ref())?;
+        steps: i64,
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+        let steps = count("steps", steps)? as u64;
         let sys = &*self.sys;
-        let trajs: Vec<Trajectory> = py
-            .detach(|| {
-                if let [s] = states0.as_slice() {
-                    integrate(sys, method, s, dt, steps, save_every).map(|t| vec![t])
-                } else {
-                    integrate_batch(sys, method, &states0, dt, steps, save_every, None)
-                }
-            })
-            .map_err(|e| in_batch(py, sys, &states0, shift_time(e, t0)))?;
-        let (b, d, k) = (states0.len(), sys.dim(), steps / save_every + 1);
-        let states = stack(trajs.iter().map(|t| t.states.as_slice()), b * k * d);
-        let z_final = stack(trajs.iter().map(|t| t.final_state.z.as_slice()), b * d);
-        let states = array(py, &[b, k, d], states)?;
-        let z_final = Array2::from_shape_vec((b, d), z_final)
-            .map_err(|_| to_py(Error::shape("z_final", format!("({b}, {d})"), "")))?
-            .into_pyarray(py);
-        if attitude0.is_none() {
-            return Ok((states, None, z_final, None));
+        let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
+        let b = runs.len();
+        let pool = &self.pool;
+        let result = py.detach(|| {
+            let mut work = move || {
+                runs.par_iter_mut()
+                    .enumerate()
+                    .map(|(i, run)| {
+                        let mut out = Vec::new();
+                        run.advance(sys, steps, &mut out)
+                            .map(|_| out)
+                            .map_err(|e| if b > 1 { e.in_member(i) } else { e })
+                    })
+                    .collect::<lieflow::Result<Vec<Vec<f64>>>>()
+            };
+            match pool {
+                Some(p) => p.install(work),
+                None => work(),
+            }
+        });
+        if let Some(c) = &self.callbacks {
+            c.take_error()?;
         }
-        let att = stack(
-            trajs
-                .iter()
-                .map(|t| t.attitude.as_deref().unwrap_or_default()),
-            b * k * 9,
-        );
-        let att_final = stack(
-            trajs
-                .iter()
-                .map(|t| t.final_state.attitude.as_ref().map_or(&[][..], |r| &r[..])),
-            b * 9,
-        );
-        let att = array(py, &[b, k, 3, 3], att)?;
-        let att_final = Array3::from_shape_vec((b, 3, 3), att_final)
-            .map_err(|_| to_py(Error::shape("attitude_final", format!("({b}, 3, 3)"), "")))?
-            .into_pyarray(py);
-        Ok((states, Some(att), z_final, Some(att_final)))
+        let outs = result.py()?;
+        let k = (self.done + steps) / self.save_every - self.done / self.save_every;
+        self.done += steps;
+        self.split(py, &outs.concat(), b, k as usize)
     }
 
-    /// The energy (Hamiltonian) of states, vectorised: (..., d) -> (...).
-    ///
-    /// Raises:
-    ///     ShapeError, NonFiniteError.
-    fn energy<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let d = [self.sys.dim()];
-        let inputs = [Input {
-            what: "states",
-            array: &states,
-            item: &d,
-        }];
-        map_items(py, &inputs, &[], |z, out| {
-            out[0] = self.sys.energy(z[0])?;
-            Ok(())
-        })
+    /// The current states (b, d) and attitudes (b, 3, 3) or None.
+    fn state<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>)> {
+        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        let b = runs.len();
+        let data: Vec<f64> = runs.iter().flat_map(|r| r.state(&*self.sys)).collect();
+        let (z, r) = self.split(py, &data, b, 1)?;
+        let z = z
+            .reshape([b, self.d])?
+            .cast_into::<PyArray2<f64>>()?;
+        let r = match r {
+            Some(r) => Some(r.reshape([b, 3, 3])?.cast_into::<PyArray3<f64>>()?),
+            None => None,
+        };
+        Ok((z, r))
     }
 
-    /// The Casimir functions (exact invariants of the reduced dynamics) of states, vectorised:
-    /// (..., d) -> (..., c). See each system for the list.
-    ///
-    /// Raises:
-    ///     ShapeError, NonFiniteError.
-    fn casimirs<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let d = self.sys.dim();
-        let c = self.sys.casimirs(&vec![0.0; d]).py()?.len();
-        let inputs = [Input {
-            what: "states",
-            array: &states,
-            item: &[d],
-        }];
-        map_items(py, &inputs, &[c], |z, out| {
-            out.copy_from_slice(&self.sys.casimirs(z[0])?);
-            Ok(())
-        })
+    /// The time of the current states.
+    #[getter]
+    fn time(&self) -> f64 {
+        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        runs.first().map_or(0.0, |r| r.time())
     }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "<lieflow {} (state_dim={})>",
-            self.sys.name(),
-            self.sys.dim()
-        )
-    }
-}
-
-/// Registers the system classes and the `elliptic` submodule in the top-level native module.
-pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<LiePoissonSystem>()?;
-    systems::register(m)?;
-    let e = PyModule::new(m.py(), "elliptic")?;
-    elliptic::register(&e)?;
-    m.add_submodule(&e)
 }

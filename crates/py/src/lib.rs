@@ -1,14 +1,18 @@
 //! Python bindings of lieflow: thin PyO3 wrappers that convert arrays and errors and call
-//! `lieflow`. No mathematics lives here.
+//! `lieflow`. No mathematics lives here. The folders mirror `crates/core/src`: `lie/`,
+//! `pseudo_rigid/`, `systems/`, `integrate.rs` and `elliptic.rs`; `system.rs` is the one base
+//! class of every system class.
 
 mod batch;
-#[allow(dead_code)] // some converters are only used once every binding lands
 mod convert;
+mod elliptic;
 mod errors;
 mod integrate;
+mod items;
 mod lie;
 mod pseudo_rigid;
-mod pseudo_rigid_dynamics;
+mod system;
+mod systems;
 
 use pyo3::prelude::*;
 
@@ -29,8 +33,15 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     add_submodule(m, "lie", lie::register)?;
     add_submodule(m, "pseudo_rigid", pseudo_rigid::register)?;
-    integrate::register(m)?;
-    pseudo_rigid_dynamics::register(m)?;
+    // Named as the Python module that re-exports it, so that potentials pickle by reference.
+    let potentials = PyModule::new(m.py(), "lieflow.potentials")?;
+    pseudo_rigid::potential::register(&potentials)?;
+    m.add("potentials", potentials)?;
+    add_submodule(m, "elliptic", elliptic::register)?;
+    m.add_class::<system::PySystem>()?;
+    m.add_class::<integrate::Integration>()?;
+    systems::register(m)?;
+    m.add_class::<pseudo_rigid::system::PyPseudoRigidBody>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -5,7 +5,7 @@
 use lieflow::elliptic;
 use pyo3::prelude::*;
 
-use super::items::{map_items, Input};
+use crate::items::{map_items, Input};
 use crate::convert::ArrayIn;
 
 type Any<'py> = Bound<'py, PyAny>;

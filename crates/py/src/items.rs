@@ -11,7 +11,7 @@ use numpy::{IntoPyArray, PyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyFloat;
 
-use crate::convert::ArrayIn;
+use crate::convert::{shape_str, ArrayIn};
 use crate::errors::to_py;
 
 /// A float64 numpy array of any shape.
@@ -22,20 +22,6 @@ pub struct Input<'a, 'py> {
     pub what: &'a str,
     pub array: &'a ArrayIn<'py>,
     pub item: &'a [usize],
-}
-
-/// A shape as numpy prints it.
-pub fn shape_str(s: &[usize]) -> String {
-    match s {
-        [d] => format!("({d},)"),
-        _ => format!(
-            "({})",
-            s.iter()
-                .map(|d| d.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    }
 }
 
 fn expected_str(item: &[usize]) -> String {

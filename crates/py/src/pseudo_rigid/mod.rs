@@ -5,6 +5,9 @@
 //! basis (i < j, row by row) with the xi block first; pairing <xi, eta> = tr(xi.T @ eta) / 2.
 #![allow(non_snake_case)]
 
+pub mod potential;
+pub mod system;
+
 use lieflow::lie::gl::STRATUM_TOL;
 use lieflow::pseudo_rigid::{
     connection as cn, momentum as mo, riemann, strata, Action, BiInertia, Body,

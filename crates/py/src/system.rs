@@ -1,0 +1,390 @@
+//! `lieflow.System`: the one base class of every system class. It implements the whole protocol
+//! `lieflow.integrate` drives, once, from the core system's state space and catalog: `methods()`,
+//! named fields, `energy`, `invariants`, `_normalize_state`, `_start`/`_run` (native runs with
+//! the GIL released, a batch in parallel), `__reduce__` (pickling) and `__repr__`. A system
+//! class is a thin subclass: its constructor and its own observables.
+
+use std::sync::Arc;
+
+use lieflow::integrate::{Block, Space, System};
+use lieflow::{check, Error};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple, PyType};
+
+use crate::convert::{shape_str, ArrayIn};
+use crate::errors::{to_py, IntoPy};
+use crate::integrate::{Integration, RunOut};
+use crate::items::{map_items, Input};
+
+/// Errors raised by Python callables that a system calls from native code (a callable
+/// potential): such a system runs single-threaded, and the first error is re-raised afterwards.
+pub(crate) trait Callbacks: Send + Sync {
+    /// The first recorded exception, if any (and forget it).
+    fn take_error(&self) -> PyResult<()>;
+}
+
+/// Base class of every lieflow system (RigidBody, HeavyTop, PseudoRigidBody, …): the
+/// integration protocol over a native system.
+///
+/// A state is a flat float64 vector of length `state_dim` cut into named blocks (`fields`);
+/// systems on SO(3) can carry an attitude R (3, 3) along (`has_attitude`). Systems pickle (by
+/// their constructor arguments), so they can be sent to other processes.
+#[pyclass(module = "lieflow", name = "System", subclass, frozen)]
+pub struct PySystem {
+    pub(crate) sys: Arc<dyn System>,
+    lifted: Option<Arc<dyn System>>,
+    args: Py<PyTuple>,
+    names: &'static [&'static str],
+    pub(crate) callbacks: Option<Arc<dyn Callbacks>>,
+}
+
+impl PySystem {
+    /// The base part of a system object over `sys`, built from the constructor arguments `args`
+    /// (named `names`, used by `__repr__`; `__reduce__` passes them to the class again).
+    pub(crate) fn new<S: lieflow::integrate::Catalog>(
+        sys: S,
+        args: Bound<'_, PyTuple>,
+        names: &'static [&'static str],
+    ) -> Self {
+        PySystem {
+            lifted: System::lift(&sys),
+            sys: Arc::new(sys),
+            args: args.unbind(),
+            names,
+            callbacks: None,
+        }
+    }
+
+    /// The same, for a system that calls Python callables.
+    pub(crate) fn with_callbacks(mut self, callbacks: Option<Arc<dyn Callbacks>>) -> Self {
+        self.callbacks = callbacks;
+        self
+    }
+
+    /// Re-raises the first exception of a Python callable, if any.
+    pub(crate) fn take_callback_error(&self) -> PyResult<()> {
+        self.callbacks.as_ref().map_or(Ok(()), |c| c.take_error())
+    }
+
+    /// The core system of a run: the lifted one when an attitude is given.
+    fn runner(&self, attitude: bool) -> PyResult<&Arc<dyn System>> {
+        if !attitude {
+            return Ok(&self.sys);
+        }
+        self.lifted.as_ref().ok_or_else(|| {
+            to_py(Error::invalid(
+                "attitude",
+                format!("{} carries no attitude", self.sys.name()),
+            ))
+        })
+    }
+
+    /// Applies `f(state) -> values` to every state (..., d), checking finiteness; output
+    /// (..., *out_item).
+    pub(crate) fn map_states<'py>(
+        &self,
+        py: Python<'py>,
+        states: &ArrayIn<'py>,
+        out_item: &[usize],
+        f: impl Fn(&[f64], &mut [f64]) -> lieflow::Result<()>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let d = [self.sys.space().dim()];
+        let inputs = [Input {
+            what: "states",
+            array: states,
+            item: &d,
+        }];
+        let out = map_items(py, &inputs, out_item, |z, out| {
+            check::finite_slice("states", z[0])?;
+            f(z[0], out)
+        });
+        self.take_callback_error()?;
+        out
+    }
+}
+
+/// Reads one block of a tuple-form state: an array whose trailing shape is the block's view
+/// shape; returns the rows of block values and the leading shape.
+fn block_rows(
+    name: &str,
+    block: Block,
+    a: &ArrayIn<'_>,
+) -> PyResult<(Vec<f64>, Vec<usize>)> {
+    let v = a.as_array();
+    let item = block.shape();
+    let s = v.shape();
+    let k = item.len();
+    if s.len() < k || s.len() > k + 1 || s[s.len() - k..] != item[..] {
+        return Err(to_py(Error::shape(
+            name,
+            format!("{} or a batch (b, ...)", shape_str(&item)),
+            shape_str(s),
+        )));
+    }
+    let data: Vec<f64> = v.iter().copied().collect();
+    check::finite_slice(name, &data).py()?;
+    let rows = match block {
+        Block::SoDual(n) => {
+            let mut out = Vec::new();
+            for m in data.chunks_exact(n * n) {
+                let m = lieflow::Mat::from_fn(n, n, |i, j| m[i * n + j]);
+                out.extend(lieflow::lie::so::vee_n(&m).py()?);
+            }
+            out
+        }
+        _ => data,
+    };
+    Ok((rows, s[..s.len() - k].to_vec()))
+}
+
+/// A (b, d) array from rows, or a ShapeError.
+fn rows_array<'py>(
+    py: Python<'py>,
+    rows: Vec<f64>,
+    d: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let b = if d == 0 { 0 } else { rows.len() / d };
+    Array2::from_shape_vec((b, d), rows)
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| to_py(Error::shape("state0", format!("(b, {d})"), e.to_string())))
+}
+
+/// Parses a state in tuple form: one array per block (a batch along a leading axis).
+fn from_blocks<'py>(
+    py: Python<'py>,
+    space: &Space,
+    parts: &Bound<'py, PyAny>,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, bool)> {
+    let mut columns = Vec::new();
+    let mut lead: Option<Vec<usize>> = None;
+    for (k, (name, block, _)) in space.ranges().enumerate() {
+        let a: ArrayIn<'py> = parts.get_item(k)?.extract()?;
+        let (rows, l) = block_rows(name, block, &a)?;
+        match &lead {
+            Some(first) if *first != l => {
+                return Err(to_py(Error::shape(
+                    name,
+                    format!("the leading shape of the other parts {}", shape_str(first)),
+                    shape_str(&l),
+                )))
+            }
+            _ => lead = Some(l),
+        }
+        columns.push((rows, block.len()));
+    }
+    let lead = lead.unwrap_or_default();
+    let b = lead.iter().product::<usize>();
+    let d = space.dim();
+    let mut z = Vec::with_capacity(b * d);
+    for i in 0..b {
+        for (rows, len) in &columns {
+            z.extend_from_slice(&rows[i * len..(i + 1) * len]);
+        }
+    }
+    Ok((rows_array(py, z, d)?, !lead.is_empty()))
+}
+
+#[pymethods]
+impl PySystem {
+    /// The names of the integration methods of this kind of system; the first is the default.
+    #[classmethod]
+    fn methods(cls: &Bound<'_, PyType>) -> PyResult<Vec<&'static str>> {
+        let example = cls.call1(cls.getattr("_example_args")?.cast_into::<PyTuple>()?)?;
+        let sys = &example.cast::<PySystem>()?.get().sys;
+        Ok(sys.methods().into_iter().map(|(name, _)| name).collect())
+    }
+
+    /// Length d of the flat state vector.
+    #[getter]
+    fn state_dim(&self) -> usize {
+        self.sys.space().dim()
+    }
+
+    /// The names of the state's blocks, in order (views of a trajectory carry these names).
+    #[getter]
+    fn fields(&self) -> Vec<&'static str> {
+        self.sys.space().blocks().iter().map(|(n, _)| *n).collect()
+    }
+
+    /// Whether the system can carry an attitude R in SO(3) along (`integrate(..., attitude=R0)`).
+    #[getter]
+    fn has_attitude(&self) -> bool {
+        self.lifted.is_some()
+    }
+
+    /// Parses an initial state: a flat state (d,) or a batch (b, d), or a tuple with one array
+    /// per field (e.g. (M, Gamma), (X, P)), each with an optional leading batch axis.
+    ///
+    /// Returns:
+    ///     (z0, batched): z0 a (b, d) float64 array (b = 1 when not batched).
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn _normalize_state<'py>(
+        &self,
+        py: Python<'py>,
+        state0: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, bool)> {
+        let space = self.sys.space();
+        let d = space.dim();
+        let blocks = space.blocks().len();
+        let sequence = state0.is_instance_of::<PyTuple>() || state0.is_instance_of::<PyList>();
+        if sequence && blocks > 1 && state0.len()? == blocks {
+            // One array per block, unless these are flat states (a batch of length `blocks`).
+            let first: ArrayIn<'py> = state0.get_item(0)?.extract()?;
+            let shape = space.blocks()[0].1.shape();
+            if first.as_array().shape().ends_with(&shape) {
+                return from_blocks(py, &space, state0);
+            }
+        }
+        let a: ArrayIn<'py> = state0.extract()?;
+        let v = a.as_array();
+        let bad = || {
+            to_py(Error::shape(
+                "state0",
+                format!("({d},) or a batch (b, {d})"),
+                shape_str(v.shape()),
+            ))
+        };
+        if !(v.ndim() == 1 || v.ndim() == 2) || v.shape()[v.ndim() - 1] != d {
+            return Err(bad());
+        }
+        let data: Vec<f64> = v.iter().copied().collect();
+        check::finite_slice("state0", &data).py()?;
+        Ok((rows_array(py, data, d)?, v.ndim() == 2))
+    }
+
+    /// Starts a native run of every row of `z0` (the chunked driver of `lieflow.integrate`
+    /// resumes it with `advance`).
+    ///
+    /// Args:
+    ///     z0: (b, d) initial states; attitude0: (b, 3, 3) rotations or None; dt > 0; method: a
+    ///     name from `methods()`; save_every >= 1; t0 (keyword): the time of z0; threads
+    ///     (keyword): None for all cores, or the number of threads.
+    /// Raises:
+    ///     InvalidArgumentError, UnsupportedMethodError, ShapeError, NonFiniteError,
+    ///     NotInGroupError (state constraints and attitude).
+    #[pyo3(signature = (z0, attitude0, dt, method, save_every, *, t0 = 0.0, threads = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn _start(
+        &self,
+        z0: ArrayIn<'_>,
+        attitude0: Option<ArrayIn<'_>>,
+        dt: f64,
+        method: &str,
+        save_every: i64,
+        t0: f64,
+        threads: Option<i64>,
+    ) -> PyResult<Integration> {
+        let sys = self.runner(attitude0.is_some())?.clone();
+        let threads = if self.callbacks.is_some() {
+            Some(1)
+        } else {
+            threads
+        };
+        Integration::start(
+            sys,
+            self.callbacks.clone(),
+            &z0,
+            attitude0.as_ref(),
+            dt,
+            method,
+            save_every,
+            t0,
+            threads,
+        )
+    }
+
+    /// Integrates every row of `z0` by `steps` steps in one native run (see `_start`).
+    ///
+    /// Returns:
+    ///     (states (b, k, d), attitude (b, k, 3, 3) or None, z_final (b, d), attitude_final
+    ///     (b, 3, 3) or None), k = steps // save_every + 1.
+    /// Raises:
+    ///     as `_start`, and ConvergenceError, LeftDomainError (naming the time) during the run.
+    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method, *, t0 = 0.0, threads = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn _run<'py>(
+        &self,
+        py: Python<'py>,
+        z0: ArrayIn<'py>,
+        attitude0: Option<ArrayIn<'py>>,
+        dt: f64,
+        steps: i64,
+        save_every: i64,
+        method: &str,
+        t0: f64,
+        threads: Option<i64>,
+    ) -> PyResult<RunOut<'py>> {
+        let mut run = self._start(z0, attitude0, dt, method, save_every, t0, threads)?;
+        run.run_all(py, steps)
+    }
+
+    /// The energy (Hamiltonian) of states, vectorised: (..., d) -> (...).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn energy<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.map_states(py, &states, &[], |z, out| {
+            out[0] = self.sys.energy(z)?;
+            Ok(())
+        })
+    }
+
+    /// The invariants the system's geometric methods keep exactly (Casimirs, momentum maps) of
+    /// states, vectorised: (..., d) -> (..., c). See each system for the list.
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn invariants<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.map_states(py, &states, &[self.sys.invariant_count()], |z, out| {
+            out.copy_from_slice(&self.sys.invariants(z)?);
+            Ok(())
+        })
+    }
+
+    /// The same as `invariants` (the Casimirs of the Lie–Poisson systems).
+    fn casimirs<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.invariants(py, states)
+    }
+
+    /// Named views of states (..., d): {field: (..., *shape)} (so(n)* blocks as skew matrices).
+    fn _fields<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let dict = PyDict::new(py);
+        let d = [self.sys.space().dim()];
+        for (name, block, range) in self.sys.space().ranges() {
+            let inputs = [Input {
+                what: "states",
+                array: &states,
+                item: &d,
+            }];
+            let v = map_items(py, &inputs, &block.shape(), |z, out| {
+                block.view(&z[0][range.clone()], out);
+                Ok(())
+            })?;
+            dict.set_item(name, v)?;
+        }
+        Ok(dict)
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyType>, Bound<'py, PyTuple>)> {
+        Ok((slf.get_type(), slf.get().args.bind(slf.py()).clone()))
+    }
+
+    fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
+        let this = slf.get();
+        let args = this.args.bind(slf.py());
+        let mut parts = Vec::new();
+        for (name, value) in this.names.iter().zip(args.iter()) {
+            parts.push(format!("{name}={}", value.repr()?));
+        }
+        Ok(format!("{}({})", this.sys.name(), parts.join(", ")))
+    }
+}

@@ -1,0 +1,166 @@
+//! `HeavyTop`: binding of `lieflow::systems::heavy_top` (000 §5.2). A thin subclass of
+//! `lieflow.System`: constructor and observables.
+#![allow(non_snake_case)]
+
+use lieflow::systems as core;
+use lieflow::Error;
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use pyo3::PyClassInitializer;
+
+use super::Inertia;
+use crate::convert::{self, py_vec, ArrayIn};
+use crate::errors::{to_py, IntoPy};
+use crate::items::{map_items, Input};
+use crate::system::PySystem;
+
+type Any<'py> = Bound<'py, PyAny>;
+
+/// The heavy top (000 §5.2): a rigid body with a fixed point in uniform gravity.
+///
+/// State z = (M, Gamma) (6,): body angular momentum M and Gamma = R^T e3, the upward vertical
+/// seen in the body. dM/dt = M x Omega + mgl Gamma x chi, dGamma/dt = Gamma x Omega,
+/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2 + mgl Gamma . chi; Casimirs [|Gamma|^2,
+/// M . Gamma]; for the Lagrange top (I1 = I2, chi = e3) also M3 is conserved. With an attitude
+/// R, Gamma must equal R^T e3 (use `state(M, attitude=R)`).
+/// Methods: splitting, splitting4, splitting6, lgvi, rk4.
+///
+/// Args:
+///     inertia: principal moments (3,) or a (3, 3) symmetric positive-definite matrix;
+///     mgl: weight times distance of the centre of mass from the fixed point (>= 0);
+///     chi: direction of the centre of mass in the body (normalised; default e3).
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError.
+#[pyclass(name = "HeavyTop", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyHeavyTop {
+    top: core::HeavyTop,
+}
+
+#[pymethods]
+impl PyHeavyTop {
+    #[new]
+    #[pyo3(
+        signature = (inertia, mgl, chi = None),
+        text_signature = "(inertia, mgl, chi=(0.0, 0.0, 1.0))"
+    )]
+    fn new(
+        inertia: &Bound<'_, PyAny>,
+        mgl: f64,
+        chi: Option<ArrayIn<'_>>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let chi = match chi {
+            Some(c) => convert::vec3("chi", &c)?.into(),
+            None => [0.0, 0.0, 1.0],
+        };
+        let top = match super::inertia(&inertia.extract()?)? {
+            Inertia::Moments(m) => core::HeavyTop::new(m, mgl, chi),
+            Inertia::Matrix(m) => core::HeavyTop::from_matrix(&m, mgl, chi),
+        }
+        .py()?;
+        let py = inertia.py();
+        let args = PyTuple::new(
+            py,
+            [inertia.clone(), mgl.into_pyobject(py)?.into_any(), py_vec(py, &chi).into_any()],
+        )?;
+        let base = PySystem::new(top.clone(), args, &["inertia", "mgl", "chi"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PyHeavyTop { top }))
+    }
+
+    /// Names of the observables that take (states, attitude); `Trajectory` passes its attitude.
+    #[classattr]
+    fn _attitude_observables() -> (&'static str,) {
+        ("spatial_momentum",)
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> ([f64; 3], f64) {
+        ([1.0, 2.0, 3.0], 1.0)
+    }
+
+    /// The principal moments of inertia (3,).
+    #[getter]
+    fn moments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        py_vec(py, &self.top.moments())
+    }
+
+    /// mgl (weight times the distance of the centre of mass from the fixed point).
+    #[getter]
+    fn mgl(&self) -> f64 {
+        self.top.mgl()
+    }
+
+    /// The unit direction chi of the centre of mass (body frame).
+    #[getter]
+    fn chi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        py_vec(py, &self.top.chi())
+    }
+
+    /// A flat state z = (M, Gamma) from M (..., 3) and either Gamma (..., 3) or the attitude R
+    /// (..., 3, 3) (then Gamma = R^T e3, the third row of R); leading axes broadcast.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (neither or both of Gamma and attitude), ShapeError.
+    #[pyo3(signature = (M, Gamma = None, attitude = None))]
+    fn state<'py>(
+        &self,
+        py: Python<'py>,
+        M: ArrayIn<'py>,
+        Gamma: Option<ArrayIn<'py>>,
+        attitude: Option<ArrayIn<'py>>,
+    ) -> PyResult<Any<'py>> {
+        let m = Input {
+            what: "M",
+            array: &M,
+            item: &[3],
+        };
+        match (&Gamma, &attitude) {
+            (Some(g), None) => {
+                let g = Input {
+                    what: "Gamma",
+                    array: g,
+                    item: &[3],
+                };
+                map_items(py, &[m, g], &[6], |x, out| {
+                    out[..3].copy_from_slice(x[0]);
+                    out[3..].copy_from_slice(x[1]);
+                    Ok(())
+                })
+            }
+            (None, Some(r)) => {
+                let r = Input {
+                    what: "attitude",
+                    array: r,
+                    item: &[3, 3],
+                };
+                map_items(py, &[m, r], &[6], |x, out| {
+                    out[..3].copy_from_slice(x[0]);
+                    out[3..].copy_from_slice(&x[1][6..9]); // Γ = Rᵀe₃, the third row of R
+                    Ok(())
+                })
+            }
+            _ => Err(to_py(Error::invalid(
+                "state",
+                "give exactly one of Gamma and attitude",
+            ))),
+        }
+    }
+
+    /// Spatial angular momentum R M, vectorised with broadcasting: states (..., 6) and
+    /// attitude (..., 3, 3) -> (..., 3). Only its vertical component M . Gamma is conserved.
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn spatial_momentum<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+        attitude: ArrayIn<'py>,
+    ) -> PyResult<Any<'py>> {
+        super::spatial_momentum(py, &states, &attitude, 6)
+    }
+
+
+}
+

@@ -1,0 +1,75 @@
+//! The Lie–Poisson system classes (bindings of `lieflow::systems`, 000 §3–§5): `RigidBody`,
+//! `GeneralizedRigidBody`, `HeavyTop`, `SphericalPendulum`, thin subclasses of `lieflow.System`,
+//! and the helpers the bodies on SO(3) share.
+
+mod heavy_top;
+mod rigid_body;
+mod spherical_pendulum;
+
+use lieflow::systems::RigidBody;
+use lieflow::Error;
+use pyo3::prelude::*;
+
+use crate::convert::{shape_str, ArrayIn};
+use crate::errors::to_py;
+use crate::items::{map_items, Input};
+
+/// Principal moments (3,) or a symmetric positive-definite matrix (3, 3).
+enum Inertia {
+    Moments([f64; 3]),
+    Matrix([f64; 9]),
+}
+
+fn inertia(a: &ArrayIn<'_>) -> PyResult<Inertia> {
+    let v = a.as_array();
+    let data: Vec<f64> = v.iter().copied().collect();
+    match v.shape() {
+        [3] => Ok(Inertia::Moments([data[0], data[1], data[2]])),
+        [3, 3] => {
+            let mut m = [0.0; 9];
+            m.copy_from_slice(&data);
+            Ok(Inertia::Matrix(m))
+        }
+        s => Err(to_py(Error::shape(
+            "inertia",
+            "(3,) principal moments or a (3, 3) symmetric positive-definite matrix",
+            shape_str(s),
+        ))),
+    }
+}
+
+/// Spatial angular momentum R M (000 Theorem 4.2) of states whose first three entries are M,
+/// with attitudes R; leading axes broadcast: (..., d), (..., 3, 3) -> (..., 3).
+fn spatial_momentum<'py>(
+    py: Python<'py>,
+    states: &ArrayIn<'py>,
+    attitude: &ArrayIn<'py>,
+    d: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let inputs = [
+        Input {
+            what: "states",
+            array: states,
+            item: &[d],
+        },
+        Input {
+            what: "attitude",
+            array: attitude,
+            item: &[3, 3],
+        },
+    ];
+    map_items(py, &inputs, &[3], |x, out| {
+        let z = [&x[0][..3], x[1]].concat();
+        lieflow::check::finite_slice("states", &z)?;
+        out.copy_from_slice(&RigidBody::spatial_momentum(&z)?);
+        Ok(())
+    })
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<rigid_body::PyRigidBody>()?;
+    m.add_class::<rigid_body::PyGeneralizedRigidBody>()?;
+    m.add_class::<heavy_top::PyHeavyTop>()?;
+    m.add_class::<spherical_pendulum::PySphericalPendulum>()?;
+    Ok(())
+}

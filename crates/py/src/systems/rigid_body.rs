@@ -1,0 +1,253 @@
+//! `RigidBody` and `GeneralizedRigidBody`: bindings of `lieflow::systems::rigid_body` (000 §3–§4,
+//! the so(n) body). Thin subclasses of `lieflow.System`: constructors and observables.
+#![allow(non_snake_case)]
+
+use lieflow::lie::so;
+use lieflow::systems as core;
+use lieflow::{Error, Mat};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use pyo3::PyClassInitializer;
+
+use super::Inertia;
+use crate::convert::{py_mat3, py_vec, shape_str, ArrayIn};
+use crate::errors::{to_py, IntoPy};
+use crate::items::{map_items, Input};
+use crate::system::PySystem;
+
+type Any<'py> = Bound<'py, PyAny>;
+
+/// A free rigid body (Euler top) on so(3)* (000 §3–§4).
+///
+/// State z = M, the body angular momentum (3,). Euler's equation dM/dt = M x Omega with
+/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2; Casimir [|M|^2]. Carries an attitude R
+/// (dR/dt = R hat(Omega)) when `integrate(..., attitude=R0)` is given; R M is conserved.
+/// Methods: splitting, splitting4, splitting6, isospectral, lgvi, rk4.
+///
+/// Args:
+///     inertia: principal moments (3,) > 0, or a (3, 3) symmetric positive-definite matrix
+///         (diagonalised once; states stay in the given body frame).
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError (non-positive or non-symmetric inertia).
+#[pyclass(name = "RigidBody", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyRigidBody {
+    body: core::RigidBody,
+}
+
+#[pymethods]
+impl PyRigidBody {
+    #[new]
+    #[pyo3(signature = (inertia))]
+    fn new(inertia: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
+        let body = match super::inertia(&inertia.extract()?)? {
+            Inertia::Moments(m) => core::RigidBody::new(m),
+            Inertia::Matrix(m) => core::RigidBody::from_matrix(&m),
+        }
+        .py()?;
+        let base = PySystem::new(body.clone(), PyTuple::new(inertia.py(), [inertia])?, &["inertia"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PyRigidBody { body }))
+    }
+
+    /// Names of the observables that take (states, attitude); `Trajectory` passes its attitude.
+    #[classattr]
+    fn _attitude_observables() -> (&'static str,) {
+        ("spatial_momentum",)
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> ([f64; 3],) {
+        ([1.0, 2.0, 3.0],)
+    }
+
+    /// The principal moments of inertia (3,).
+    #[getter]
+    fn moments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        py_vec(py, &self.body.moments())
+    }
+
+    /// The principal frame Q in SO(3) (columns = principal axes, I = Q diag(moments) Q^T) when
+    /// the inertia was given as a matrix, else None.
+    #[getter]
+    fn frame<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        self.body.frame().map(|q| py_mat3(py, &q))
+    }
+
+    /// Body angular velocity Omega = I^{-1} M, vectorised: (..., 3) -> (..., 3).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn angular_velocity<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let inputs = [Input {
+            what: "states",
+            array: &states,
+            item: &[3],
+        }];
+        map_items(py, &inputs, &[3], |m, out| {
+            out.copy_from_slice(&self.body.angular_velocity(m[0])?);
+            Ok(())
+        })
+    }
+
+    /// Spatial angular momentum R M (000 Theorem 4.2), conserved; vectorised with numpy
+    /// broadcasting: states (..., 3) and attitude (..., 3, 3) -> (..., 3).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn spatial_momentum<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+        attitude: ArrayIn<'py>,
+    ) -> PyResult<Any<'py>> {
+        super::spatial_momentum(py, &states, &attitude, 3)
+    }
+
+    /// The exact body momentum M(t) from M(0) = M0 by Jacobi elliptic functions (000 §4; the
+    /// classical solution M1 = a1 cn u, M2 = a2 sn u, M3 = a3 dn u in suitably ordered principal
+    /// axes, u = u0 + lambda t; see `lieflow::systems::RigidBody::exact_momentum`).
+    ///
+    /// Args:
+    ///     M0: (3,) or (..., 3); t: a time or a 1-D array of times (k,).
+    /// Returns:
+    ///     (..., 3) for a scalar t, (..., k, 3) for an array of times.
+    /// Raises:
+    ///     InvalidArgumentError (M0 on the separatrix |M|^2 = 2 H I_mid, where the elliptic
+    ///     modulus is 1), ShapeError, NonFiniteError.
+    fn exact_solution<'py>(
+        &self,
+        py: Python<'py>,
+        M0: ArrayIn<'py>,
+        t: ArrayIn<'py>,
+    ) -> PyResult<Any<'py>> {
+        let tv = t.as_array();
+        if tv.ndim() > 1 {
+            return Err(to_py(Error::shape(
+                "t",
+                "a scalar or a 1-D array (k,)",
+                shape_str(tv.shape()),
+            )));
+        }
+        let times: Vec<f64> = tv.iter().copied().collect();
+        let out_item: Vec<usize> = tv.shape().iter().copied().chain([3]).collect();
+        let inputs = [Input {
+            what: "M0",
+            array: &M0,
+            item: &[3],
+        }];
+        map_items(py, &inputs, &out_item, |m, out| {
+            for (o, &ti) in out.chunks_exact_mut(3).zip(&times) {
+                o.copy_from_slice(&self.body.exact_momentum(m[0], ti)?);
+            }
+            Ok(())
+        })
+    }
+
+
+}
+
+/// The generalized rigid body on so(n)* (Euler–Arnold / Manakov equations; the form of the
+/// pseudo-rigid body's reduced equation 001 (7.25)).
+///
+/// M = J Omega + Omega J with J the mass matrix; dM/dt = [M, Omega]; energy
+/// H = sum_{i<j} M_ij^2 / (J_i + J_j) / 2 (principal frame); Casimirs C_k = tr((M^T M)^k) / 2,
+/// k = 1 .. n // 2 (they fix the spectrum of M). State z = the e_ij coordinates of the skew
+/// matrix M (i < j, row by row), length n(n-1)/2; `state(M)` and `matrix(z)` convert.
+/// Methods: isospectral, rk4.
+///
+/// Args:
+///     J: principal entries (n,) (n >= 2, J_i >= 0, J_i + J_j > 0), or a symmetric
+///         positive-semidefinite (n, n) matrix (diagonalised once).
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError.
+#[pyclass(name = "GeneralizedRigidBody", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyGeneralizedRigidBody {
+    body: core::GeneralizedRigidBody,
+}
+
+#[pymethods]
+impl PyGeneralizedRigidBody {
+    #[new]
+    #[pyo3(signature = (J))]
+    fn new(J: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
+        let a: ArrayIn<'_> = J.extract()?;
+        let v = a.as_array();
+        let body = match v.ndim() {
+            1 => core::GeneralizedRigidBody::new(&v.iter().copied().collect::<Vec<_>>()),
+            2 => core::GeneralizedRigidBody::from_matrix(&Mat::from_fn(
+                v.shape()[0],
+                v.shape()[1],
+                |i, j| v[[i, j]],
+            )),
+            _ => Err(Error::shape(
+                "J",
+                "(n,) principal entries or an (n, n) symmetric matrix",
+                shape_str(v.shape()),
+            )),
+        }
+        .py()?;
+        let base = PySystem::new(body.clone(), PyTuple::new(J.py(), [J])?, &["J"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PyGeneralizedRigidBody { body }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> ([f64; 2],) {
+        ([1.0, 1.0],)
+    }
+
+    /// The dimension n (M is n x n).
+    #[getter]
+    fn n(&self) -> usize {
+        self.body.n()
+    }
+
+    /// The principal entries J_i (n,).
+    #[getter]
+    fn moments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        py_vec(py, self.body.principal())
+    }
+
+    /// Flat state z (e_ij coordinates, `lieflow.lie.vee_n`) of skew matrices: (..., n, n) ->
+    /// (..., n(n-1)/2).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError, NotInGroupError (M not skew-symmetric).
+    fn state<'py>(&self, py: Python<'py>, M: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let n = self.body.n();
+        let inputs = [Input {
+            what: "M",
+            array: &M,
+            item: &[n, n],
+        }];
+        map_items(py, &inputs, &[so::dim(n)], |m, out| {
+            let m = Mat::from_fn(n, n, |i, j| m[0][i * n + j]);
+            out.copy_from_slice(&so::vee_n(&m)?);
+            Ok(())
+        })
+    }
+
+    /// The skew matrices M of flat states: (..., n(n-1)/2) -> (..., n, n).
+    ///
+    /// Raises:
+    ///     ShapeError.
+    fn matrix<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let n = self.body.n();
+        let inputs = [Input {
+            what: "states",
+            array: &states,
+            item: &[so::dim(n)],
+        }];
+        map_items(py, &inputs, &[n, n], |z, out| {
+            let m = so::hat_n(z[0])?;
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = m[(k / n, k % n)];
+            }
+            Ok(())
+        })
+    }
+
+
+}
+

@@ -1,0 +1,143 @@
+//! `SphericalPendulum`: binding of `lieflow::systems::spherical_pendulum` (000 §5.1). A thin
+//! subclass of `lieflow.System`: constructor and observables.
+
+use lieflow::systems as core;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use pyo3::PyClassInitializer;
+
+use crate::convert::ArrayIn;
+use crate::errors::IntoPy;
+use crate::items::{map_items, Input};
+use crate::system::PySystem;
+
+type Any<'py> = Bound<'py, PyAny>;
+
+/// The spherical pendulum (000 §5.1) as a Lie–Poisson system on se(3)*.
+///
+/// State z = (q, L) (6,): q the unit vector from the pivot to the bob (e3 up) and
+/// L = m l^2 q x dq/dt the angular momentum about the pivot. dq/dt = L x q / (m l^2),
+/// dL/dt = m g l e3 x q; energy H = |L|^2 / (2 m l^2) + m g l q3; Casimirs [|q|^2, q . L]
+/// (a state needs |q| = 1 and q . L = 0); the vertical momentum L3 is conserved.
+/// Methods: splitting, splitting4, splitting6, rk4.
+///
+/// Args:
+///     mass > 0, length > 0, g >= 0.
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "SphericalPendulum", module = "lieflow", extends = PySystem, frozen)]
+pub struct PySphericalPendulum {
+    pendulum: core::SphericalPendulum,
+    mass: f64,
+    length: f64,
+    g: f64,
+}
+
+#[pymethods]
+impl PySphericalPendulum {
+    #[new]
+    #[pyo3(signature = (mass = 1.0, length = 1.0, g = 9.81))]
+    fn new(py: Python<'_>, mass: f64, length: f64, g: f64) -> PyResult<PyClassInitializer<Self>> {
+        let pendulum = core::SphericalPendulum::new(mass, length, g).py()?;
+        let args = PyTuple::new(py, [mass, length, g])?;
+        let base = PySystem::new(pendulum.clone(), args, &["mass", "length", "g"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PySphericalPendulum {
+            pendulum,
+            mass,
+            length,
+            g,
+        }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args<'py>(py: Python<'py>) -> Bound<'py, PyTuple> {
+        PyTuple::empty(py)
+    }
+
+    /// The mass of the bob.
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.mass
+    }
+
+    /// The length of the rod.
+    #[getter]
+    fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// The gravitational acceleration.
+    #[getter]
+    fn g(&self) -> f64 {
+        self.g
+    }
+
+    /// The state (q, L) from the spherical coordinates of 000 §5.1.1 (theta from the downward
+    /// vertical): q = (sin th cos ph, sin th sin ph, -cos th), L = m l^2 q x dq/dt. The four
+    /// arguments broadcast like numpy arrays; the result has shape (..., 6).
+    ///
+    /// Raises:
+    ///     ShapeError (shapes that do not broadcast), NonFiniteError.
+    #[pyo3(signature = (theta, phi, theta_dot = None, phi_dot = None))]
+    fn state_from_spherical<'py>(
+        &self,
+        py: Python<'py>,
+        theta: ArrayIn<'py>,
+        phi: ArrayIn<'py>,
+        theta_dot: Option<ArrayIn<'py>>,
+        phi_dot: Option<ArrayIn<'py>>,
+    ) -> PyResult<Any<'py>> {
+        let zero = || -> PyResult<ArrayIn<'py>> { 0.0f64.into_pyobject(py)?.extract() };
+        let theta_dot = theta_dot.map_or_else(zero, Ok)?;
+        let phi_dot = phi_dot.map_or_else(zero, Ok)?;
+        let inputs = [
+            Input {
+                what: "theta",
+                array: &theta,
+                item: &[],
+            },
+            Input {
+                what: "phi",
+                array: &phi,
+                item: &[],
+            },
+            Input {
+                what: "theta_dot",
+                array: &theta_dot,
+                item: &[],
+            },
+            Input {
+                what: "phi_dot",
+                array: &phi_dot,
+                item: &[],
+            },
+        ];
+        map_items(py, &inputs, &[6], |x, out| {
+            let s = self
+                .pendulum
+                .state_from_spherical(x[0][0], x[1][0], x[2][0], x[3][0])?;
+            out.copy_from_slice(&s);
+            Ok(())
+        })
+    }
+
+    /// The vertical angular momentum L3 (conserved), vectorised: (..., 6) -> (...).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn vertical_momentum<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let inputs = [Input {
+            what: "states",
+            array: &states,
+            item: &[6],
+        }];
+        map_items(py, &inputs, &[], |z, out| {
+            out[0] = self.pendulum.vertical_momentum(z[0])?;
+            Ok(())
+        })
+    }
+
+
+}
+
