@@ -75,7 +75,7 @@ pub trait VectorField: Problem {
 /// flow m − 1 the middle one ([`crate::integrate::methods::Composition::sequence`]).
 pub trait Split: Problem {
     /// The working form of a state the flows act on (registers, or reduced coordinates).
-    type Work: Send;
+    type Work: Send + Clone;
 
     /// The working form of a flat state (internal frame); may fail where the working
     /// coordinates do not exist.
@@ -160,18 +160,28 @@ pub trait Nonholonomic: Separable {
 /// A vector field of the form ż = ξ(z)·z, where ξ(z) lies in a Lie algebra g (coordinates of
 /// length [`GroupField::algebra_dim`]) acting on the state: the setting of Runge–Kutta–Munthe-Kaas
 /// methods, which stay on the group orbit of the initial state (coadjoint orbits, SO(3)).
+///
+/// The action is a left action, so a curve z(t) = exp(u(t))·z₀ solves ż = ξ(z)·z when
+/// u̇ = dexp⁻¹_u(ξ(z)) with the right-trivialized derivative d/dt exp(u) = dexp_u(u̇)·exp(u).
 pub trait GroupField: Problem {
+    /// Per-thread scratch of the kernels below (matrices of a runtime size, …).
+    type Scratch: Send;
+
+    /// Fresh scratch.
+    fn scratch(&self) -> Self::Scratch;
+
     /// dim g.
     fn algebra_dim(&self) -> usize;
 
     /// ξ(z) ∈ g.
-    fn generator(&self, z: &[f64], xi: &mut [f64]);
+    fn generator(&self, z: &[f64], xi: &mut [f64], s: &mut Self::Scratch);
 
     /// z ← exp(ξ)·z, exactly on the orbit.
-    fn act(&self, xi: &[f64], z: &mut [f64]);
+    fn act(&self, xi: &[f64], z: &mut [f64], s: &mut Self::Scratch);
 
-    /// dexp⁻¹_u(v) ∈ g (the inverse of the derivative of exp at u, applied to v).
-    fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64]);
+    /// dexp⁻¹_u(v) ∈ g (the inverse of the right-trivialized derivative of exp at u, applied to
+    /// v); non-finite values where u lies outside the domain the implementation supports.
+    fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut Self::Scratch);
 }
 
 /// A system with a symmetry: a momentum map J: state → g* and the infinitesimal generators of

@@ -300,6 +300,22 @@ pub struct ReducedWork {
     angle: f64,
 }
 
+impl Clone for ReducedWork {
+    fn clone(&self) -> Self {
+        let n = self.state.a.len();
+        ReducedWork {
+            pairs: self.pairs.clone(),
+            state: self.state.clone(),
+            r: self.r.clone(),
+            s: self.s.clone(),
+            amat: Mat::zeros(n, n),
+            grad: Mat::zeros(n, n),
+            ws: Workspace::new(n),
+            angle: self.angle,
+        }
+    }
+}
+
 impl ReducedWork {
     /// Reduces (X, P) ([`reduce`]).
     pub fn new(x: &Mat, p: &Mat) -> Result<Self> {

@@ -5,7 +5,10 @@
 //! keeps every Casimir of the bracket and every momentum map the pieces share, and is symplectic
 //! where the pieces are Hamiltonian on a symplectic space. The first and last flows of consecutive
 //! steps are fused (they are the same flow), unless the problem checks every step
-//! ([`Split::CHECKED`]).
+//! ([`Split::CHECKED`]). The fusion is lazy: the time of the outer flow that ends a step is kept
+//! pending and applied with the next step (or, on a copy, when the state is read), so the
+//! sequence of operations — and the result, bit for bit — does not depend on how a run is cut
+//! into calls of [`Stepper::advance`].
 
 use super::composition::{run_sequence, Composition};
 use crate::error::Result;
@@ -34,6 +37,7 @@ impl<P: Split + Clone + 'static> Integrator<P> for Splitting {
             problem: problem.clone(),
             h: dt,
             work: None,
+            pending: 0.0,
         }))
     }
 }
@@ -43,17 +47,26 @@ struct SplittingStepper<P: Split> {
     seq: Vec<(usize, f64)>,
     h: f64,
     work: Option<P::Work>,
+    /// Time of the outer flow `seq[0]` not yet applied (lazy first-same-as-last fusion).
+    pending: f64,
 }
 
 impl<P: Split> Stepper for SplittingStepper<P> {
     fn set(&mut self, z: &[f64]) -> Result<()> {
         self.work = Some(self.problem.load(z)?);
+        self.pending = 0.0;
         Ok(())
     }
 
     fn get(&self, z: &mut [f64]) {
         if let Some(w) = &self.work {
-            self.problem.store(w, z);
+            if self.pending == 0.0 {
+                self.problem.store(w, z);
+            } else {
+                let mut w = w.clone();
+                self.problem.flow(self.seq[0].0, self.pending, &mut w);
+                self.problem.store(&w, z);
+            }
         }
     }
 
@@ -68,8 +81,22 @@ impl<P: Split> Stepper for SplittingStepper<P> {
                 run_sequence(&self.seq, self.h, 1, w, flow);
                 p.check_step(w).map_err(|v| clock.left_domain(k, v))?;
             }
-        } else {
-            run_sequence(&self.seq, self.h, steps, w, flow);
+            return Ok(());
+        }
+        let (h, seq) = (self.h, &self.seq);
+        let (outer, c0) = seq[0];
+        let inner = &seq[1..seq.len().saturating_sub(1)];
+        let c_last = if seq.len() > 1 { seq[seq.len() - 1].1 } else { 0.0 };
+        for _ in 0..steps {
+            self.pending += c0 * h;
+            if inner.is_empty() && seq.len() == 1 {
+                continue; // a single flow: its times add up until the state is read
+            }
+            flow(outer, self.pending, w);
+            for &(i, c) in inner {
+                flow(i, c * h, w);
+            }
+            self.pending = c_last * h;
         }
         Ok(())
     }
