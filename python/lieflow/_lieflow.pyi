@@ -30,30 +30,53 @@ potentials: ModuleType
 elliptic: ModuleType
 
 
-class LiePoissonSystem:
-    """Base class: the protocol `lieflow.integrate` drives."""
+class Integration:
+    """A native run in progress (from `System._start`); `advance` continues it."""
 
+    @property
+    def time(self) -> float: ...
+    def advance(self, steps: int) -> tuple[F64, F64 | None]:
+        """The states (b, k, d) and attitudes (b, k, 3, 3) | None saved in `steps` more steps."""
+    def state(self) -> tuple[F64, F64 | None]:
+        """The current states (b, d) and attitudes (b, 3, 3) | None."""
+
+class System:
+    """Base class of every system: the protocol `lieflow.integrate` drives, pickling, repr."""
+
+    @classmethod
+    def methods(cls) -> list[str]:
+        """The integration methods; the first is the default."""
     @property
     def state_dim(self) -> int: ...
     @property
+    def fields(self) -> list[str]:
+        """Names of the state's blocks."""
+    @property
     def has_attitude(self) -> bool: ...
     def _normalize_state(self, state0: Any) -> tuple[F64, bool]: ...
+    def _start(
+        self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, method: str,
+        save_every: int, *, t0: float = 0.0, threads: int | None = None,
+    ) -> Integration: ...
     def _run(
         self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, steps: int,
-        save_every: int, method: str,
+        save_every: int, method: str, *, t0: float = 0.0, threads: int | None = None,
     ) -> tuple[F64, F64 | None, F64, F64 | None]: ...
     def energy(self, states: ArrayLike) -> F64 | float:
         """(..., d) -> (...)."""
+    def invariants(self, states: ArrayLike) -> F64:
+        """(..., d) -> (..., c): what the geometric methods keep exactly."""
     def casimirs(self, states: ArrayLike) -> F64:
-        """(..., d) -> (..., c)."""
+        """The same as `invariants`."""
+    def __reduce__(self) -> tuple[type, tuple[Any, ...]]: ...
 
-class RigidBody(LiePoissonSystem):
+LiePoissonSystem = System
+
+class RigidBody(System):
     """Free rigid body on so(3)*: z = M (3,); Casimir [|M|^2]; all six methods."""
 
     def __init__(self, inertia: ArrayLike) -> None:
         """inertia: principal moments (3,) or a (3, 3) SPD matrix."""
-    @staticmethod
-    def methods() -> list[str]: ...
     @property
     def moments(self) -> F64: ...
     @property
@@ -64,15 +87,12 @@ class RigidBody(LiePoissonSystem):
         """R M: (..., 3), (..., 3, 3) -> (..., 3)."""
     def exact_solution(self, M0: ArrayLike, t: ArrayLike) -> F64:
         """Jacobi-elliptic M(t): (..., 3) and (k,) -> (..., k, 3); scalar t -> (..., 3)."""
-    def _fields(self, states: ArrayLike) -> dict[str, F64]: ...
 
-class GeneralizedRigidBody(LiePoissonSystem):
+class GeneralizedRigidBody(System):
     """Euler–Arnold body on so(n)*: z = e_ij coordinates of M; methods isospectral, rk4."""
 
     def __init__(self, J: ArrayLike) -> None:
         """J: principal entries (n,) or a symmetric PSD (n, n) matrix."""
-    @staticmethod
-    def methods() -> list[str]: ...
     @property
     def n(self) -> int: ...
     @property
@@ -81,14 +101,11 @@ class GeneralizedRigidBody(LiePoissonSystem):
         """Skew (..., n, n) -> (..., n(n-1)/2)."""
     def matrix(self, states: ArrayLike) -> F64:
         """(..., n(n-1)/2) -> skew (..., n, n)."""
-    def _fields(self, states: ArrayLike) -> dict[str, F64]: ...
 
-class HeavyTop(LiePoissonSystem):
+class HeavyTop(System):
     """Heavy top: z = (M, Gamma) (6,); Casimirs [|Gamma|^2, M . Gamma]."""
 
     def __init__(self, inertia: ArrayLike, mgl: float, chi: ArrayLike = ...) -> None: ...
-    @staticmethod
-    def methods() -> list[str]: ...
     @property
     def moments(self) -> F64: ...
     @property
@@ -101,14 +118,11 @@ class HeavyTop(LiePoissonSystem):
         """(M, Gamma) or (M, R^T e3) -> (..., 6)."""
     def spatial_momentum(self, states: ArrayLike, attitude: ArrayLike) -> F64:
         """R M: (..., 6), (..., 3, 3) -> (..., 3)."""
-    def _fields(self, states: ArrayLike) -> dict[str, F64]: ...
 
-class SphericalPendulum(LiePoissonSystem):
+class SphericalPendulum(System):
     """Spherical pendulum on se(3)*: z = (q, L) (6,), |q| = 1, q . L = 0."""
 
     def __init__(self, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> None: ...
-    @staticmethod
-    def methods() -> list[str]: ...
     @property
     def mass(self) -> float: ...
     @property
@@ -122,34 +136,21 @@ class SphericalPendulum(LiePoissonSystem):
         """theta from the downward vertical; broadcasts; -> (..., 6)."""
     def vertical_momentum(self, states: ArrayLike) -> F64 | float:
         """L3: (..., 6) -> (...)."""
-    def _fields(self, states: ArrayLike) -> dict[str, F64]: ...
 
 
 # --- the pseudo-rigid body on T*GL+(n): z = (X row-major, P row-major), d = 2 n^2 ---
 
 
-class PseudoRigidBody:
+class PseudoRigidBody(System):
     """Generalized pseudo-rigid body on T*GL+(n), H = tr(P^T P)/2 + U(X) (001 (3.22))."""
 
     def __init__(self, n: int, potential: Potential | None = None, check_det: bool = True) -> None: ...
     @property
     def n(self) -> int: ...
     @property
-    def state_dim(self) -> int: ...
-    @property
-    def has_attitude(self) -> bool: ...
-    @property
     def check_det(self) -> bool: ...
     @property
     def potential(self) -> Potential: ...
-    def methods(self) -> list[str]: ...
-    def _normalize_state(self, state0: Any) -> tuple[F64, bool]: ...
-    def _run(
-        self, z0: ArrayLike, attitude0: None, dt: float, steps: int, save_every: int, method: str
-    ) -> tuple[F64, None, F64, None]: ...
-    def energy(self, states: ArrayLike) -> F64: ...
-    def casimirs(self, states: ArrayLike) -> F64: ...
     def angular_momentum(self, states: ArrayLike) -> F64: ...
     def circulation(self, states: ArrayLike) -> F64: ...
     def singular_values(self, states: ArrayLike) -> F64: ...
-    def _fields(self, states: ArrayLike) -> dict[str, F64]: ...

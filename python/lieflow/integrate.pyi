@@ -8,29 +8,35 @@ F64 = NDArray[np.float64]
 
 CHUNK_WORK: int
 
+class NativeRun(Protocol):
+    def advance(self, steps: int) -> tuple[F64, F64 | None]: ...
+    def state(self) -> tuple[F64, F64 | None]: ...
+
 class IntegrableSystem(Protocol):
-    """The protocol `integrate` drives (implemented by `LiePoissonSystem` and its subclasses)."""
+    """The protocol `integrate` drives (implemented once by `lieflow.System`)."""
 
     @property
     def state_dim(self) -> int: ...
     def methods(self) -> list[str]: ...
     def _normalize_state(self, state0: Any) -> tuple[F64, bool]: ...
-    def _run(
-        self, z0: F64, attitude0: F64 | None, dt: float, steps: int, save_every: int, method: str
-    ) -> tuple[F64, F64 | None, F64, F64 | None]: ...
+    def _start(
+        self, z0: F64, attitude0: F64 | None, dt: float, method: str, save_every: int, *,
+        t0: float = 0.0, threads: int | None = None,
+    ) -> NativeRun: ...
     def energy(self, states: ArrayLike) -> F64 | float: ...
-    def casimirs(self, states: ArrayLike) -> F64: ...
+    def invariants(self, states: ArrayLike) -> F64: ...
 
 def integrate(
     system: IntegrableSystem,
     state0: Any,
     dt: float,
     steps: int,
-    method: str = "splitting",
+    method: str | None = None,
     save_every: int = 1,
     attitude: ArrayLike | None = None,
     progress: bool = False,
     chunk_steps: int | None = None,
+    threads: int | None = None,
 ) -> Trajectory:
     """Integrate `steps` fixed steps of size `dt`; k = steps // save_every + 1 samples."""
 
@@ -52,8 +58,10 @@ class Trajectory:
     def __len__(self) -> int: ...
     def energy(self) -> F64:
         """(k,) or (b, k)."""
-    def casimirs(self) -> F64:
+    def invariants(self) -> F64:
         """(k, c) or (b, k, c)."""
+    def casimirs(self) -> F64:
+        """The same as `invariants()`."""
     def __getattr__(self, name: str) -> Any:
         """Named fields of the system (M, Gamma, q, L, ...) or an observable
         `traj.NAME(...) == system.NAME(traj.states, ...)`."""

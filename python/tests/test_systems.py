@@ -70,7 +70,7 @@ def test_rigid_body_basics():
     assert isinstance(body, lf.LiePoissonSystem)
     assert body.state_dim == 3 and body.has_attitude
     assert lf.RigidBody.methods() == body.methods() == [
-        "splitting", "splitting4", "splitting6", "isospectral", "lgvi", "rk4"]
+        "splitting", "splitting4", "splitting6", "isospectral", "lgvi", "rk4", "rkmk4"]
     np.testing.assert_array_equal(body.moments, I)
     assert body.frame is None
     assert "RigidBody" in repr(body)
@@ -221,7 +221,7 @@ def test_generalized_rigid_body():
     j = np.array([1.0, 2.0, 3.0, 4.5])
     body = lf.GeneralizedRigidBody(j)
     assert body.n == 4 and body.state_dim == 6 and not body.has_attitude
-    assert lf.GeneralizedRigidBody.methods() == ["isospectral", "rk4"]
+    assert lf.GeneralizedRigidBody.methods() == ["isospectral", "rk4", "rkmk4"]
     np.testing.assert_array_equal(body.moments, j)
     m = np.stack([skew(rng, 4) for _ in range(3)])
     z = body.state(m)

@@ -92,7 +92,6 @@ pub fn vec3(what: &str, a: &ArrayIn<'_>) -> PyResult<Vector3<f64>> {
     Ok(Vector3::new(v[[0]], v[[1]], v[[2]]))
 }
 
-
 /// Matrix → 2-D numpy array.
 pub fn py_mat<'py>(py: Python<'py>, m: &Mat) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
@@ -119,4 +118,3 @@ pub fn py_vecs<'py>(py: Python<'py>, vs: &[Vec<f64>]) -> Bound<'py, PyArray2<f64
 pub fn py_mat3<'py>(py: Python<'py>, m: &Matrix3<f64>) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_fn((3, 3), |(i, j)| m[(i, j)]).into_pyarray(py)
 }
-

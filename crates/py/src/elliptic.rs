@@ -5,8 +5,8 @@
 use lieflow::elliptic;
 use pyo3::prelude::*;
 
-use crate::items::{map_items, Input};
 use crate::convert::ArrayIn;
+use crate::items::{map_items, Input};
 
 type Any<'py> = Bound<'py, PyAny>;
 

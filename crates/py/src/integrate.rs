@@ -42,10 +42,12 @@ pub struct Integration {
 
 /// A count ≥ 1 from a Python integer.
 fn count(what: &str, v: i64) -> PyResult<usize> {
-    usize::try_from(v)
-        .ok()
-        .filter(|&u| u >= 1)
-        .ok_or_else(|| to_py(Error::invalid(what, format!("expected {what} ≥ 1, got {v}"))))
+    usize::try_from(v).ok().filter(|&u| u >= 1).ok_or_else(|| {
+        to_py(Error::invalid(
+            what,
+            format!("expected {what} ≥ 1, got {v}"),
+        ))
+    })
 }
 
 impl Integration {
@@ -86,7 +88,10 @@ impl Integration {
             )));
         }
         let b = z.shape()[0];
-        let mut states: Vec<Vec<f64>> = z.outer_iter().map(|r| r.iter().copied().collect()).collect();
+        let mut states: Vec<Vec<f64>> = z
+            .outer_iter()
+            .map(|r| r.iter().copied().collect())
+            .collect();
         if let Some(a) = attitude0 {
             let a = a.as_array();
             if a.shape() != [b, 3, 3] {
@@ -104,8 +109,13 @@ impl Integration {
             .iter()
             .enumerate()
             .map(|(i, z)| {
-                Run::new(&*sys, method, z, dt, save_every, t0)
-                    .map_err(|e| if b > 1 { e.in_member(i) } else { e })
+                Run::new(&*sys, method, z, dt, save_every, t0).map_err(|e| {
+                    if b > 1 {
+                        e.in_member(i)
+                    } else {
+                        e
+                    }
+                })
             })
             .collect::<lieflow::Result<Vec<_>>>()
             .py()?;
@@ -193,9 +203,13 @@ impl Integration {
                     .enumerate()
                     .map(|(i, run)| {
                         let mut out = Vec::new();
-                        run.advance(sys, steps, &mut out)
-                            .map(|_| out)
-                            .map_err(|e| if b > 1 { e.in_member(i) } else { e })
+                        run.advance(sys, steps, &mut out).map(|_| out).map_err(|e| {
+                            if b > 1 {
+                                e.in_member(i)
+                            } else {
+                                e
+                            }
+                        })
                     })
                     .collect::<lieflow::Result<Vec<Vec<f64>>>>()
             };
@@ -222,9 +236,7 @@ impl Integration {
         let b = runs.len();
         let data: Vec<f64> = runs.iter().flat_map(|r| r.state(&*self.sys)).collect();
         let (z, r) = self.split(py, &data, b, 1)?;
-        let z = z
-            .reshape([b, self.d])?
-            .cast_into::<PyArray2<f64>>()?;
+        let z = z.reshape([b, self.d])?.cast_into::<PyArray2<f64>>()?;
         let r = match r {
             Some(r) => Some(r.reshape([b, 3, 3])?.cast_into::<PyArray3<f64>>()?),
             None => None,

@@ -24,6 +24,13 @@ pub struct Input<'a, 'py> {
     pub item: &'a [usize],
 }
 
+impl<'a, 'py> Input<'a, 'py> {
+    /// The input `what` with items of shape `item`.
+    pub fn new(what: &'a str, array: &'a ArrayIn<'py>, item: &'a [usize]) -> Self {
+        Input { what, array, item }
+    }
+}
+
 fn expected_str(item: &[usize]) -> String {
     if item.is_empty() {
         "a scalar or an array".into()

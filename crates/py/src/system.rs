@@ -91,11 +91,7 @@ impl PySystem {
         f: impl Fn(&[f64], &mut [f64]) -> lieflow::Result<()>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let d = [self.sys.space().dim()];
-        let inputs = [Input {
-            what: "states",
-            array: states,
-            item: &d,
-        }];
+        let inputs = [Input::new("states", states, &d)];
         let out = map_items(py, &inputs, out_item, |z, out| {
             check::finite_slice("states", z[0])?;
             f(z[0], out)
@@ -107,11 +103,7 @@ impl PySystem {
 
 /// Reads one block of a tuple-form state: an array whose trailing shape is the block's view
 /// shape; returns the rows of block values and the leading shape.
-fn block_rows(
-    name: &str,
-    block: Block,
-    a: &ArrayIn<'_>,
-) -> PyResult<(Vec<f64>, Vec<usize>)> {
+fn block_rows(name: &str, block: Block, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, Vec<usize>)> {
     let v = a.as_array();
     let item = block.shape();
     let s = v.shape();
@@ -358,11 +350,7 @@ impl PySystem {
         let dict = PyDict::new(py);
         let d = [self.sys.space().dim()];
         for (name, block, range) in self.sys.space().ranges() {
-            let inputs = [Input {
-                what: "states",
-                array: &states,
-                item: &d,
-            }];
+            let inputs = [Input::new("states", &states, &d)];
             let v = map_items(py, &inputs, &block.shape(), |z, out| {
                 block.view(&z[0][range.clone()], out);
                 Ok(())

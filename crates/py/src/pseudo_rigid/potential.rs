@@ -270,7 +270,6 @@ fn Callable(value: Bound<'_, PyAny>, gradient: Bound<'_, PyAny>) -> PyResult<PyP
     })
 }
 
-
 impl Callbacks for CallablePotential {
     fn take_error(&self) -> PyResult<()> {
         CallablePotential::take_error(self)

@@ -8,7 +8,6 @@ use std::sync::Arc;
 use lieflow::pseudo_rigid::PseudoRigidBody as CoreBody;
 use lieflow::{Error, Mat};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
 use pyo3::PyClassInitializer;
 
 use super::potential::{PyPotential, Zero};
@@ -69,20 +68,15 @@ impl PyPseudoRigidBody {
         let pot = potential.get();
         let body = CoreBody::new(size, pot.inner.clone(), check_det).py()?;
         let callbacks = pot.callback.clone().map(|c| c as Arc<dyn Callbacks>);
-        let args = PyTuple::new(
-            py,
-            [
-                n.into_pyobject(py)?.into_any(),
-                potential.clone().into_any(),
-                check_det.into_pyobject(py)?.to_owned().into_any(),
-            ],
-        )?;
+        let args = (n, potential.clone(), check_det).into_pyobject(py)?;
         let base = PySystem::new(body.clone(), args, &["n", "potential", "check_det"])
             .with_callbacks(callbacks);
-        Ok(PyClassInitializer::from(base).add_subclass(PyPseudoRigidBody {
-            body,
-            potential: potential.unbind(),
-        }))
+        Ok(
+            PyClassInitializer::from(base).add_subclass(PyPseudoRigidBody {
+                body,
+                potential: potential.unbind(),
+            }),
+        )
     }
 
     /// Constructor arguments of an example instance (for `methods()` on the class).
@@ -115,10 +109,12 @@ impl PyPseudoRigidBody {
         states: crate::convert::ArrayIn<'py>,
     ) -> PyResult<Any<'py>> {
         let (this, n) = (slf.get(), slf.get().n());
-        slf.as_super().get().map_states(slf.py(), &states, &[n, n], |z, out| {
-            flat(&this.body.momenta(z)?.0, out);
-            Ok(())
-        })
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[n, n], |z, out| {
+                flat(&this.body.momenta(z)?.0, out);
+                Ok(())
+            })
     }
 
     /// Circulation Γ = P^T X - X^T P (001 (7.3)) of states (..., d) -> (..., n, n).
@@ -127,10 +123,12 @@ impl PyPseudoRigidBody {
         states: crate::convert::ArrayIn<'py>,
     ) -> PyResult<Any<'py>> {
         let (this, n) = (slf.get(), slf.get().n());
-        slf.as_super().get().map_states(slf.py(), &states, &[n, n], |z, out| {
-            flat(&this.body.momenta(z)?.1, out);
-            Ok(())
-        })
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[n, n], |z, out| {
+                flat(&this.body.momenta(z)?.1, out);
+                Ok(())
+            })
     }
 
     /// Singular values a_1 >= ... >= a_n of X (the semi-axes), states (..., d) -> (..., n).
@@ -139,9 +137,11 @@ impl PyPseudoRigidBody {
         states: crate::convert::ArrayIn<'py>,
     ) -> PyResult<Any<'py>> {
         let (this, n) = (slf.get(), slf.get().n());
-        slf.as_super().get().map_states(slf.py(), &states, &[n], |z, out| {
-            out.copy_from_slice(&this.body.singular_values(z)?);
-            Ok(())
-        })
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[n], |z, out| {
+                out.copy_from_slice(&this.body.singular_values(z)?);
+                Ok(())
+            })
     }
 }

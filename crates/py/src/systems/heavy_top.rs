@@ -6,7 +6,6 @@ use lieflow::systems as core;
 use lieflow::Error;
 use numpy::PyArray1;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
 use pyo3::PyClassInitializer;
 
 use super::Inertia;
@@ -59,10 +58,7 @@ impl PyHeavyTop {
         }
         .py()?;
         let py = inertia.py();
-        let args = PyTuple::new(
-            py,
-            [inertia.clone(), mgl.into_pyobject(py)?.into_any(), py_vec(py, &chi).into_any()],
-        )?;
+        let args = (inertia, mgl, py_vec(py, &chi)).into_pyobject(py)?;
         let base = PySystem::new(top.clone(), args, &["inertia", "mgl", "chi"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyHeavyTop { top }))
     }
@@ -110,18 +106,10 @@ impl PyHeavyTop {
         Gamma: Option<ArrayIn<'py>>,
         attitude: Option<ArrayIn<'py>>,
     ) -> PyResult<Any<'py>> {
-        let m = Input {
-            what: "M",
-            array: &M,
-            item: &[3],
-        };
+        let m = Input::new("M", &M, &[3]);
         match (&Gamma, &attitude) {
             (Some(g), None) => {
-                let g = Input {
-                    what: "Gamma",
-                    array: g,
-                    item: &[3],
-                };
+                let g = Input::new("Gamma", g, &[3]);
                 map_items(py, &[m, g], &[6], |x, out| {
                     out[..3].copy_from_slice(x[0]);
                     out[3..].copy_from_slice(x[1]);
@@ -129,11 +117,7 @@ impl PyHeavyTop {
                 })
             }
             (None, Some(r)) => {
-                let r = Input {
-                    what: "attitude",
-                    array: r,
-                    item: &[3, 3],
-                };
+                let r = Input::new("attitude", r, &[3, 3]);
                 map_items(py, &[m, r], &[6], |x, out| {
                     out[..3].copy_from_slice(x[0]);
                     out[3..].copy_from_slice(&x[1][6..9]); // Γ = Rᵀe₃, the third row of R
@@ -160,7 +144,4 @@ impl PyHeavyTop {
     ) -> PyResult<Any<'py>> {
         super::spatial_momentum(py, &states, &attitude, 6)
     }
-
-
 }
-

@@ -46,24 +46,20 @@ fn spatial_momentum<'py>(
     attitude: &ArrayIn<'py>,
     d: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let inputs = [
-        Input {
-            what: "states",
-            array: states,
-            item: &[d],
+    map_items(
+        py,
+        &[
+            Input::new("states", states, &[d]),
+            Input::new("attitude", attitude, &[3, 3]),
+        ],
+        &[3],
+        |x, out| {
+            let z = [&x[0][..3], x[1]].concat();
+            lieflow::check::finite_slice("states", &z)?;
+            out.copy_from_slice(&RigidBody::spatial_momentum(&z)?);
+            Ok(())
         },
-        Input {
-            what: "attitude",
-            array: attitude,
-            item: &[3, 3],
-        },
-    ];
-    map_items(py, &inputs, &[3], |x, out| {
-        let z = [&x[0][..3], x[1]].concat();
-        lieflow::check::finite_slice("states", &z)?;
-        out.copy_from_slice(&RigidBody::spatial_momentum(&z)?);
-        Ok(())
-    })
+    )
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

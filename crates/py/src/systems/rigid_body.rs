@@ -7,7 +7,6 @@ use lieflow::systems as core;
 use lieflow::{Error, Mat};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
 use pyo3::PyClassInitializer;
 
 use super::Inertia;
@@ -45,7 +44,11 @@ impl PyRigidBody {
             Inertia::Matrix(m) => core::RigidBody::from_matrix(&m),
         }
         .py()?;
-        let base = PySystem::new(body.clone(), PyTuple::new(inertia.py(), [inertia])?, &["inertia"]);
+        let base = PySystem::new(
+            body.clone(),
+            (inertia,).into_pyobject(inertia.py())?,
+            &["inertia"],
+        );
         Ok(PyClassInitializer::from(base).add_subclass(PyRigidBody { body }))
     }
 
@@ -79,15 +82,15 @@ impl PyRigidBody {
     /// Raises:
     ///     ShapeError, NonFiniteError.
     fn angular_velocity<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let inputs = [Input {
-            what: "states",
-            array: &states,
-            item: &[3],
-        }];
-        map_items(py, &inputs, &[3], |m, out| {
-            out.copy_from_slice(&self.body.angular_velocity(m[0])?);
-            Ok(())
-        })
+        map_items(
+            py,
+            &[Input::new("states", &states, &[3])],
+            &[3],
+            |m, out| {
+                out.copy_from_slice(&self.body.angular_velocity(m[0])?);
+                Ok(())
+            },
+        )
     }
 
     /// Spatial angular momentum R M (000 Theorem 4.2), conserved; vectorised with numpy
@@ -131,20 +134,13 @@ impl PyRigidBody {
         }
         let times: Vec<f64> = tv.iter().copied().collect();
         let out_item: Vec<usize> = tv.shape().iter().copied().chain([3]).collect();
-        let inputs = [Input {
-            what: "M0",
-            array: &M0,
-            item: &[3],
-        }];
-        map_items(py, &inputs, &out_item, |m, out| {
+        map_items(py, &[Input::new("M0", &M0, &[3])], &out_item, |m, out| {
             for (o, &ti) in out.chunks_exact_mut(3).zip(&times) {
                 o.copy_from_slice(&self.body.exact_momentum(m[0], ti)?);
             }
             Ok(())
         })
     }
-
-
 }
 
 /// The generalized rigid body on so(n)* (Euler–Arnold / Manakov equations; the form of the
@@ -187,7 +183,7 @@ impl PyGeneralizedRigidBody {
             )),
         }
         .py()?;
-        let base = PySystem::new(body.clone(), PyTuple::new(J.py(), [J])?, &["J"]);
+        let base = PySystem::new(body.clone(), (J,).into_pyobject(J.py())?, &["J"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyGeneralizedRigidBody { body }))
     }
 
@@ -216,16 +212,16 @@ impl PyGeneralizedRigidBody {
     ///     ShapeError, NonFiniteError, NotInGroupError (M not skew-symmetric).
     fn state<'py>(&self, py: Python<'py>, M: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let n = self.body.n();
-        let inputs = [Input {
-            what: "M",
-            array: &M,
-            item: &[n, n],
-        }];
-        map_items(py, &inputs, &[so::dim(n)], |m, out| {
-            let m = Mat::from_fn(n, n, |i, j| m[0][i * n + j]);
-            out.copy_from_slice(&so::vee_n(&m)?);
-            Ok(())
-        })
+        map_items(
+            py,
+            &[Input::new("M", &M, &[n, n])],
+            &[so::dim(n)],
+            |m, out| {
+                let m = Mat::from_fn(n, n, |i, j| m[0][i * n + j]);
+                out.copy_from_slice(&so::vee_n(&m)?);
+                Ok(())
+            },
+        )
     }
 
     /// The skew matrices M of flat states: (..., n(n-1)/2) -> (..., n, n).
@@ -234,20 +230,17 @@ impl PyGeneralizedRigidBody {
     ///     ShapeError.
     fn matrix<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let n = self.body.n();
-        let inputs = [Input {
-            what: "states",
-            array: &states,
-            item: &[so::dim(n)],
-        }];
-        map_items(py, &inputs, &[n, n], |z, out| {
-            let m = so::hat_n(z[0])?;
-            for (k, o) in out.iter_mut().enumerate() {
-                *o = m[(k / n, k % n)];
-            }
-            Ok(())
-        })
+        map_items(
+            py,
+            &[Input::new("states", &states, &[so::dim(n)])],
+            &[n, n],
+            |z, out| {
+                let m = so::hat_n(z[0])?;
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o = m[(k / n, k % n)];
+                }
+                Ok(())
+            },
+        )
     }
-
-
 }
-

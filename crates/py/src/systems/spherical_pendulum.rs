@@ -39,14 +39,16 @@ impl PySphericalPendulum {
     #[pyo3(signature = (mass = 1.0, length = 1.0, g = 9.81))]
     fn new(py: Python<'_>, mass: f64, length: f64, g: f64) -> PyResult<PyClassInitializer<Self>> {
         let pendulum = core::SphericalPendulum::new(mass, length, g).py()?;
-        let args = PyTuple::new(py, [mass, length, g])?;
+        let args = (mass, length, g).into_pyobject(py)?;
         let base = PySystem::new(pendulum.clone(), args, &["mass", "length", "g"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PySphericalPendulum {
-            pendulum,
-            mass,
-            length,
-            g,
-        }))
+        Ok(
+            PyClassInitializer::from(base).add_subclass(PySphericalPendulum {
+                pendulum,
+                mass,
+                length,
+                g,
+            }),
+        )
     }
 
     /// Constructor arguments of an example instance (for `methods()` on the class).
@@ -91,35 +93,23 @@ impl PySphericalPendulum {
         let zero = || -> PyResult<ArrayIn<'py>> { 0.0f64.into_pyobject(py)?.extract() };
         let theta_dot = theta_dot.map_or_else(zero, Ok)?;
         let phi_dot = phi_dot.map_or_else(zero, Ok)?;
-        let inputs = [
-            Input {
-                what: "theta",
-                array: &theta,
-                item: &[],
+        map_items(
+            py,
+            &[
+                Input::new("theta", &theta, &[]),
+                Input::new("phi", &phi, &[]),
+                Input::new("theta_dot", &theta_dot, &[]),
+                Input::new("phi_dot", &phi_dot, &[]),
+            ],
+            &[6],
+            |x, out| {
+                let s = self
+                    .pendulum
+                    .state_from_spherical(x[0][0], x[1][0], x[2][0], x[3][0])?;
+                out.copy_from_slice(&s);
+                Ok(())
             },
-            Input {
-                what: "phi",
-                array: &phi,
-                item: &[],
-            },
-            Input {
-                what: "theta_dot",
-                array: &theta_dot,
-                item: &[],
-            },
-            Input {
-                what: "phi_dot",
-                array: &phi_dot,
-                item: &[],
-            },
-        ];
-        map_items(py, &inputs, &[6], |x, out| {
-            let s = self
-                .pendulum
-                .state_from_spherical(x[0][0], x[1][0], x[2][0], x[3][0])?;
-            out.copy_from_slice(&s);
-            Ok(())
-        })
+        )
     }
 
     /// The vertical angular momentum L3 (conserved), vectorised: (..., 6) -> (...).
@@ -127,17 +117,9 @@ impl PySphericalPendulum {
     /// Raises:
     ///     ShapeError, NonFiniteError.
     fn vertical_momentum<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let inputs = [Input {
-            what: "states",
-            array: &states,
-            item: &[6],
-        }];
-        map_items(py, &inputs, &[], |z, out| {
+        map_items(py, &[Input::new("states", &states, &[6])], &[], |z, out| {
             out[0] = self.pendulum.vertical_momentum(z[0])?;
             Ok(())
         })
     }
-
-
 }
-
