@@ -32,10 +32,10 @@ use super::reduced::{spectral_invariants, ReducedWork};
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Splitting, Verlet};
-use crate::integrate::problem::{Separable, Split, Violation};
+use crate::integrate::problem::{Separable, Split, Symmetric, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
-use crate::lie::gl;
+use crate::lie::{gl, so};
 use crate::Mat;
 use nalgebra::Matrix3;
 
@@ -279,6 +279,38 @@ impl Split for PseudoRigidBody {
 
     fn check_step(&self, w: &mut ReducedWork) -> std::result::Result<(), Violation> {
         w.check_step()
+    }
+}
+
+/// The two-sided action (X, P) ↦ (gXhᵀ, gPhᵀ) of SO(n)×SO(n), the cotangent lift of X ↦ gXhᵀ
+/// (001 (6.1)); an element of the algebra is ξ ⊕ η in e_ij coordinates, ξ block first.
+impl Symmetric for PseudoRigidBody {
+    fn symmetry_dim(&self) -> usize {
+        2 * so::dim(self.n())
+    }
+
+    /// J = L ⊕ Γ (001 (7.3)) in e_ij coordinates: ⟨J, ξ ⊕ η⟩ = tr(Pᵀ(ξX − Xη)).
+    fn momentum_map(&self, z: &[f64]) -> Result<Vec<f64>> {
+        let (l, g) = self.momenta(z)?;
+        let mut j = so::vee_n_unchecked(&l);
+        j.extend(so::vee_n_unchecked(&g));
+        Ok(j)
+    }
+
+    /// (ξX − Xη, ξP − Pη), the velocity of t ↦ (e^{tξ} X e^{−tη}, e^{tξ} P e^{−tη}).
+    fn generator(&self, xi: &[f64], z: &[f64]) -> Result<Vec<f64>> {
+        let n = self.n();
+        let d = so::dim(n);
+        check::len_of("xi ⊕ eta", xi, 2 * d)?;
+        check::finite_slice("xi ⊕ eta", xi)?;
+        let (x, p) = self.split(z)?;
+        let (a, b) = (
+            so::hat_n_unchecked(n, &xi[..d]),
+            so::hat_n_unchecked(n, &xi[d..]),
+        );
+        let mut out = vec![0.0; 2 * n * n];
+        write_back(n, &(&a * &x - &x * &b), &(&a * &p - &p * &b), &mut out);
+        Ok(out)
     }
 }
 

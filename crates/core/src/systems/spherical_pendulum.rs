@@ -22,7 +22,7 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Splitting};
-use crate::integrate::problem::{Split, VectorField};
+use crate::integrate::problem::{Split, Symmetric, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 use nalgebra::Vector3;
@@ -155,6 +155,26 @@ impl Split for SphericalPendulum {
         } else {
             *q = crate::lie::so3::exp(&(*l * (tau / self.inertia()))) * *q;
         }
+    }
+}
+
+/// Rotations about the vertical e₃ (the symmetry of gravity): (q, L) ↦ (gq, gL).
+impl Symmetric for SphericalPendulum {
+    fn symmetry_dim(&self) -> usize {
+        1
+    }
+
+    /// J = L₃, the vertical angular momentum.
+    fn momentum_map(&self, z: &[f64]) -> Result<Vec<f64>> {
+        Ok(vec![self.vertical_momentum(z)?])
+    }
+
+    /// (ξ e₃ × q, ξ e₃ × L).
+    fn generator(&self, xi: &[f64], z: &[f64]) -> Result<Vec<f64>> {
+        check::len_of("xi", xi, 1)?;
+        check::len_of("state", z, 6)?;
+        let w = xi[0];
+        Ok(vec![-w * z[1], w * z[0], 0.0, -w * z[4], w * z[3], 0.0])
     }
 }
 
