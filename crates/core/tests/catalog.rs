@@ -11,7 +11,6 @@ use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
-use lieflow::Mat;
 use nalgebra::Vector3;
 
 /// A system with an initial state, a time span, a base step and its time-reversal map ρ
