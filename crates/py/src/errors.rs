@@ -67,7 +67,7 @@ create_exception!(
 
 /// Rust spellings in core messages and their Python equivalents (advice in the caller's
 /// language).
-const SPELLINGS: [(&str, &str); 2] = [("check_det = false", "check_det=False"), ("f64", "float")];
+const SPELLINGS: [(&str, &str); 1] = [("check_det = false", "check_det=False")];
 
 /// Converts a core error into the matching Python exception.
 pub fn to_py(e: lieflow::Error) -> PyErr {

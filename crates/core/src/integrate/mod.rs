@@ -100,10 +100,9 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        check_run(dt, save_every, t0)?;
-        check_state(system, z0)?;
-        let (stepper, properties) = system.stepper(method, dt)?;
-        Run::start(system, stepper, properties, z0, dt, save_every, t0)
+        Run::start(system, z0, dt, save_every, t0, || {
+            system.stepper(method, dt)
+        })
     }
 
     /// Starts a run of `problem` with a method value (see [`Run::new`]).
@@ -115,29 +114,23 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        check_run(dt, save_every, t0)?;
-        check_state(problem, z0)?;
-        let stepper = method.stepper(problem, dt)?;
-        Run::start(
-            problem,
-            stepper,
-            method.properties(),
-            z0,
-            dt,
-            save_every,
-            t0,
-        )
+        Run::start(problem, z0, dt, save_every, t0, || {
+            Ok((method.stepper(problem, dt)?, method.properties()))
+        })
     }
 
+    /// Validates the arguments and the state once, then builds the stepper and sets its state.
     fn start<P: Problem + ?Sized>(
         problem: &P,
-        mut stepper: Box<dyn Stepper>,
-        properties: Properties,
         z0: &[f64],
         dt: f64,
         save_every: usize,
         t0: f64,
+        stepper: impl FnOnce() -> Result<(Box<dyn Stepper>, Properties)>,
     ) -> Result<Run> {
+        check_run(dt, save_every, t0)?;
+        check_state(problem, z0)?;
+        let (mut stepper, properties) = stepper()?;
         let space = problem.space();
         let mut buf = z0.to_vec();
         problem.to_internal(&mut buf);

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
 use super::potential::{PyPotential, Zero};
+use crate::convert::ArrayIn;
 use crate::errors::{to_py, IntoPy};
 use crate::system::{Callbacks, PySystem};
 
@@ -42,11 +43,12 @@ impl PyPseudoRigidBody {
 }
 
 /// Row-major values of an n×n matrix.
-fn flat(m: &Mat, out: &mut [f64]) {
+fn flat(m: &Mat, out: &mut [f64]) -> lieflow::Result<()> {
     let n = m.nrows();
     for (k, o) in out.iter_mut().enumerate() {
         *o = m[(k / n, k % n)];
     }
+    Ok(())
 }
 
 #[pymethods]
@@ -104,44 +106,39 @@ impl PyPseudoRigidBody {
     }
 
     /// Angular momentum L = P X^T - X P^T (001 (7.3)) of states (..., d) -> (..., n, n).
-    fn angular_momentum<'py>(
-        slf: &Bound<'py, Self>,
-        states: crate::convert::ArrayIn<'py>,
-    ) -> PyResult<Any<'py>> {
-        let (this, n) = (slf.get(), slf.get().n());
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[n, n], |z, out| {
-                flat(&this.body.momenta(z)?.0, out);
-                Ok(())
-            })
+    fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let n = slf.get().n();
+        observe(slf, states, &[n, n], |b, z, out| {
+            flat(&b.momenta(z)?.0, out)
+        })
     }
 
     /// Circulation Γ = P^T X - X^T P (001 (7.3)) of states (..., d) -> (..., n, n).
-    fn circulation<'py>(
-        slf: &Bound<'py, Self>,
-        states: crate::convert::ArrayIn<'py>,
-    ) -> PyResult<Any<'py>> {
-        let (this, n) = (slf.get(), slf.get().n());
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[n, n], |z, out| {
-                flat(&this.body.momenta(z)?.1, out);
-                Ok(())
-            })
+    fn circulation<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let n = slf.get().n();
+        observe(slf, states, &[n, n], |b, z, out| {
+            flat(&b.momenta(z)?.1, out)
+        })
     }
 
     /// Singular values a_1 >= ... >= a_n of X (the semi-axes), states (..., d) -> (..., n).
-    fn singular_values<'py>(
-        slf: &Bound<'py, Self>,
-        states: crate::convert::ArrayIn<'py>,
-    ) -> PyResult<Any<'py>> {
-        let (this, n) = (slf.get(), slf.get().n());
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[n], |z, out| {
-                out.copy_from_slice(&this.body.singular_values(z)?);
-                Ok(())
-            })
+    fn singular_values<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let n = slf.get().n();
+        observe(slf, states, &[n], |b, z, out| {
+            out.copy_from_slice(&b.singular_values(z)?);
+            Ok(())
+        })
     }
+}
+
+/// An observable `f(body, state, out)` of states (..., d) -> (..., *shape).
+fn observe<'py>(
+    slf: &Bound<'py, PyPseudoRigidBody>,
+    states: ArrayIn<'py>,
+    shape: &[usize],
+    f: impl Fn(&CoreBody, &[f64], &mut [f64]) -> lieflow::Result<()>,
+) -> PyResult<Any<'py>> {
+    let body = &slf.get().body;
+    let base = slf.as_super().get();
+    base.map_states(slf.py(), &states, shape, |z, out| f(body, z, out))
 }
