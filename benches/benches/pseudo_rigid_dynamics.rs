@@ -2,18 +2,18 @@
 //! Saint Venant–Kirchhoff potential, n = 3 and n = 10, and the reduced-space splitting at n = 3.
 //!
 //! Run: `CARGO_TARGET_DIR=… cargo bench -p lieflow-benches --bench pseudo_rigid_dynamics`;
-//! results in docs/bench-pr5.md. Each measured iteration runs `STEPS` steps in place, so the
-//! time per step is the reported time divided by `STEPS`.
+//! results in docs/bench-pr5.md. Each measured iteration advances one driver run
+//! (`lieflow::integrate::Run`, built once) by `STEPS` steps, so the time per step is the
+//! reported time divided by `STEPS`.
 
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use lieflow::integrate::splitting::Composition;
-use lieflow::integrate::verlet::{Verlet, VerletOrder, VerletScratch};
+use lieflow::integrate::Run;
 use lieflow::pseudo_rigid::potential::{Potential, SaintVenantKirchhoff};
-use lieflow::pseudo_rigid::reduced::ReducedSplitting;
+use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::Mat;
 
 const STEPS: usize = 1000;
@@ -31,48 +31,64 @@ fn initial(n: usize) -> (Mat, Mat) {
     (x, p)
 }
 
+/// A run of `method` on the body, started once at (X₀, P₀) and advanced in place by every
+/// measured iteration (one state saved per `STEPS` steps, into a reserved buffer).
+fn bench_run(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    id: BenchmarkId,
+    body: &PseudoRigidBody,
+    method: &str,
+    dt: f64,
+) {
+    let (x0, p0) = initial(body.n());
+    let z0 = body.state(&x0, &p0).unwrap();
+    let mut run = Run::new(body, method, &z0, dt, STEPS, 0.0).unwrap();
+    let mut out = Vec::with_capacity(z0.len());
+    g.bench_function(id, |b| {
+        b.iter(|| {
+            out.clear();
+            run.advance(body, STEPS as u64, &mut out).unwrap();
+            black_box(&out);
+        })
+    });
+}
+
 fn verlet(c: &mut Criterion) {
     let svk: Arc<dyn Potential> = Arc::new(SaintVenantKirchhoff::new(0.7, 1.3).unwrap());
     let mut g = c.benchmark_group("pseudo_rigid_verlet_svk");
     g.measurement_time(Duration::from_secs(3));
     g.throughput(Throughput::Elements(STEPS as u64));
     for n in [3, 10] {
-        let (x0, p0) = initial(n);
-        let (mut x, mut p) = (x0.clone(), p0.clone());
-        let mut scratch = VerletScratch::new(n);
-        let method = Verlet::new(VerletOrder::Two).with_check_det(false);
-        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
-            b.iter(|| {
-                method
-                    .run(&*svk, &mut x, &mut p, 0.0, 1e-4, STEPS, &mut scratch)
-                    .unwrap();
-                black_box(&x);
-            })
-        });
-        let (mut x, mut p) = (x0.clone(), p0.clone());
-        let checked = Verlet::new(VerletOrder::Two);
-        g.bench_with_input(BenchmarkId::new("check_det", n), &n, |b, _| {
-            b.iter(|| {
-                checked
-                    .run(&*svk, &mut x, &mut p, 0.0, 1e-4, STEPS, &mut scratch)
-                    .unwrap();
-                black_box(&x);
-            })
-        });
+        let free = PseudoRigidBody::new(n, svk.clone(), false).unwrap();
+        bench_run(
+            &mut g,
+            BenchmarkId::from_parameter(n),
+            &free,
+            "verlet",
+            1e-4,
+        );
+        let checked = PseudoRigidBody::new(n, svk.clone(), true).unwrap();
+        bench_run(
+            &mut g,
+            BenchmarkId::new("check_det", n),
+            &checked,
+            "verlet",
+            1e-4,
+        );
     }
     g.finish();
     let mut g = c.benchmark_group("pseudo_rigid_reduced_svk");
     g.measurement_time(Duration::from_secs(3));
     g.throughput(Throughput::Elements(STEPS as u64));
     for n in [3, 10] {
-        let (x0, p0) = initial(n);
-        let mut split = ReducedSplitting::new(&x0, &p0, &Composition::strang()).unwrap();
-        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
-            b.iter(|| {
-                split.run(&*svk, 0.0, 1e-5, STEPS).unwrap();
-                black_box(&split.state);
-            })
-        });
+        let body = PseudoRigidBody::new(n, svk.clone(), false).unwrap();
+        bench_run(
+            &mut g,
+            BenchmarkId::from_parameter(n),
+            &body,
+            "reduced",
+            1e-5,
+        );
     }
     g.finish();
 }

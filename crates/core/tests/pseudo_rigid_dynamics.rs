@@ -4,12 +4,14 @@
 mod common;
 
 use common::dist;
-use lieflow::integrate::verlet::{Verlet, VerletOrder, VerletScratch};
+use lieflow::integrate::methods::{Composition, Verlet};
+use lieflow::integrate::{integrate as drive, integrate_with, Run, System};
 use lieflow::lie::so3;
 use lieflow::pseudo_rigid::dynamics::{adjoint_motion, FullBody};
 use lieflow::pseudo_rigid::potential::{
     self, Harmonic, Potential, SaintVenantKirchhoff, Sum, Volumetric, Zero,
 };
+use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::{Error, Mat};
 use nalgebra::Vector3;
 use proptest::prelude::*;
@@ -107,48 +109,54 @@ fn all_potentials() -> Vec<(&'static str, Arc<dyn Potential>)> {
     ]
 }
 
-fn verlet(order: usize) -> Verlet {
-    Verlet::new(VerletOrder::from_order(order).unwrap())
+/// The catalog name of Verlet of order 2, 4 or 6 ([`PseudoRigidBody`]).
+fn verlet(order: usize) -> &'static str {
+    match order {
+        2 => "verlet",
+        4 => "verlet4",
+        6 => "verlet6",
+        _ => panic!("Verlet has orders 2, 4 and 6, got {order}"),
+    }
 }
 
-/// Runs `steps` steps and returns the final (X, P).
+/// The pseudo-rigid body of the driver with potential `pot` in n dimensions; `check_det`: stop
+/// when det X ≤ 0 (always on for a volumetric potential).
+fn body_of(pot: Arc<dyn Potential>, n: usize, check_det: bool) -> PseudoRigidBody {
+    PseudoRigidBody::new(n, pot, check_det).unwrap()
+}
+
+/// Runs `steps` steps of `method` and returns the final (X, P).
 fn integrate(
-    pot: &dyn Potential,
-    method: Verlet,
+    pot: Arc<dyn Potential>,
+    method: &str,
+    check_det: bool,
     x0: &Mat,
     p0: &Mat,
     dt: f64,
     steps: usize,
 ) -> (Mat, Mat) {
-    let (mut x, mut p) = (x0.clone(), p0.clone());
-    let mut scratch = VerletScratch::new(x0.nrows());
-    method
-        .run(pot, &mut x, &mut p, 0.0, dt, steps, &mut scratch)
-        .unwrap();
-    (x, p)
+    let b = body_of(pot, x0.nrows(), check_det);
+    let traj = drive(&b, method, &b.state(x0, p0).unwrap(), dt, steps, steps).unwrap();
+    b.split(&traj.final_state).unwrap()
 }
 
-/// Frames (X_k, P_k), k = 0..=frames, every `every` steps.
+/// Frames (X_k, P_k), k = 0..=frames, every `every` steps (det X checked).
 fn frames(
-    pot: &dyn Potential,
-    method: Verlet,
+    pot: Arc<dyn Potential>,
+    method: &str,
     x0: &Mat,
     p0: &Mat,
     dt: f64,
     every: usize,
     frames: usize,
 ) -> Vec<(Mat, Mat)> {
-    let (mut x, mut p) = (x0.clone(), p0.clone());
-    let mut scratch = VerletScratch::new(x0.nrows());
-    let mut out = vec![(x.clone(), p.clone())];
-    for k in 0..frames {
-        let t0 = (k * every) as f64 * dt;
-        method
-            .run(pot, &mut x, &mut p, t0, dt, every, &mut scratch)
-            .unwrap();
-        out.push((x.clone(), p.clone()));
-    }
-    out
+    let b = body_of(pot, x0.nrows(), true);
+    let z0 = b.state(x0, p0).unwrap();
+    let traj = drive(&b, method, &z0, dt, every * frames, every).unwrap();
+    assert_eq!(traj.len(), frames + 1);
+    (0..traj.len())
+        .map(|k| b.split(traj.state(k)).unwrap())
+        .collect()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -318,7 +326,7 @@ fn free_body_moves_on_straight_lines() {
         let x0 = rng.gl_plus(n);
         let p0 = rng.mat(n, 0.1);
         for order in [2, 4, 6] {
-            let (x, p) = integrate(&Zero, verlet(order), &x0, &p0, 1e-2, 100);
+            let (x, p) = integrate(Arc::new(Zero), verlet(order), true, &x0, &p0, 1e-2, 100);
             let exact = &x0 + &p0 * faer::Scale(1.0);
             // Round-off only: 100 × (1, 3 or 7) additions of ~1e-3 to entries of size ~1.
             let err = rel(&x, &exact);
@@ -342,7 +350,7 @@ fn harmonic_oscillator_orders_2_4_6_through_det_zero() {
     // n = 3 (odd): X(t + π/ω) = −X(t), so det X changes sign before T; check_det is off.
     let mut rng = Rng(3);
     let (n, omega) = (3, 1.3);
-    let pot = Harmonic::new(omega * omega).unwrap();
+    let pot: Arc<dyn Potential> = Arc::new(Harmonic::new(omega * omega).unwrap());
     let x0 = rng.gl_plus(n);
     let p0 = rng.mat(n, 1.0);
     let t_end = std::f64::consts::PI / omega + 0.4;
@@ -353,8 +361,15 @@ fn harmonic_oscillator_orders_2_4_6_through_det_zero() {
     );
     for (order, coarse) in [(2usize, 400usize), (4, 80), (6, 40)] {
         let err = |steps: usize| {
-            let method = verlet(order).with_check_det(false);
-            let (x, p) = integrate(&pot, method, &x0, &p0, t_end / steps as f64, steps);
+            let (x, p) = integrate(
+                pot.clone(),
+                verlet(order),
+                false,
+                &x0,
+                &p0,
+                t_end / steps as f64,
+                steps,
+            );
             dist(&x, &xe) + dist(&p, &pe)
         };
         let (e1, e2) = (err(coarse), err(2 * coarse));
@@ -373,14 +388,21 @@ fn harmonic_oscillator_orders_2_4_6_through_det_zero() {
 fn harmonic_oscillator_for_n_2_to_6() {
     let mut rng = Rng(4);
     let omega = 0.9;
-    let pot = Harmonic::new(omega * omega).unwrap();
+    let pot: Arc<dyn Potential> = Arc::new(Harmonic::new(omega * omega).unwrap());
     for n in 2..=6 {
         let x0 = rng.gl_plus(n);
         let p0 = rng.mat(n, 0.5);
         let steps = 200;
         let t_end = 2.0;
-        let method = verlet(6).with_check_det(false);
-        let (x, p) = integrate(&pot, method, &x0, &p0, t_end / steps as f64, steps);
+        let (x, p) = integrate(
+            pot.clone(),
+            verlet(6),
+            false,
+            &x0,
+            &p0,
+            t_end / steps as f64,
+            steps,
+        );
         let (xe, pe) = harmonic_exact(&x0, &p0, omega, t_end);
         assert!(dist(&x, &xe) + dist(&p, &pe) < 1e-10, "n = {n}");
     }
@@ -390,7 +412,7 @@ fn harmonic_oscillator_for_n_2_to_6() {
 fn leaving_gl_plus_stops_with_the_time_of_exit() {
     let mut rng = Rng(5);
     let (n, omega) = (3, 1.3);
-    let pot = Harmonic::new(omega * omega).unwrap();
+    let pot: Arc<dyn Potential> = Arc::new(Harmonic::new(omega * omega).unwrap());
     let x0 = rng.gl_plus(n);
     let p0 = rng.mat(n, 1.0);
     // First root t* of det X(t) for the exact motion, by scanning and bisection.
@@ -409,17 +431,23 @@ fn leaving_gl_plus_stops_with_the_time_of_exit() {
         }
     }
     let dt = 1e-3;
+    let b = body_of(pot.clone(), n, true);
+    let z0 = b.state(&x0, &p0).unwrap();
     for order in [2, 4, 6] {
-        let (mut x, mut p) = (x0.clone(), p0.clone());
-        let mut scratch = VerletScratch::new(n);
         let steps = (10.0 / dt) as usize;
-        match verlet(order).run(&pot, &mut x, &mut p, 0.0, dt, steps, &mut scratch) {
+        let mut run = Run::new(&b, verlet(order), &z0, dt, steps, 0.0).unwrap();
+        match run.advance(&b, steps as u64, &mut Vec::new()) {
             Err(Error::LeftDomain { t, message, .. }) => {
+                // t is the time at the end of the step in which det X ≤ 0 was found.
                 assert!(
                     t >= t_lo - 1e-6 && t <= t_lo + dt + 1e-6,
                     "t = {t}, t* = {t_lo}"
                 );
-                assert!(message.contains("check_det"));
+                assert!(message.contains("check_det"), "{message}");
+                let k = (t / dt).round();
+                assert!(message.contains(&format!("found in step {k}")), "{message}");
+                // The run is left at the first state found outside GL⁺(n).
+                let (x, _) = b.split(&run.state(&b)).unwrap();
                 assert!(det(&x) <= 0.0);
             }
             other => panic!("expected LeftDomain, got {other:?}"),
@@ -427,14 +455,7 @@ fn leaving_gl_plus_stops_with_the_time_of_exit() {
     }
     // X(t + π/ω) = −X(t) with check_det off.
     let half = std::f64::consts::PI / omega;
-    let (x, _) = integrate(
-        &pot,
-        verlet(6).with_check_det(false),
-        &x0,
-        &p0,
-        half / 200.0,
-        200,
-    );
+    let (x, _) = integrate(pot, verlet(6), false, &x0, &p0, half / 200.0, 200);
     assert!(dist(&x, &(-&x0)) < 1e-9);
 }
 
@@ -444,32 +465,32 @@ fn volumetric_potentials_are_always_checked() {
     let pot = elastic_gas();
     let x0 = Mat::identity(3, 3);
     let p0 = Mat::identity(3, 3) * faer::Scale(-3.0);
-    let (mut x, mut p) = (x0.clone(), p0.clone());
-    let mut scratch = VerletScratch::new(3);
-    let res =
-        verlet(2)
-            .with_check_det(false)
-            .run(&*pot, &mut x, &mut p, 5.0, 1.0, 10, &mut scratch);
+    let b = body_of(pot, 3, false);
+    assert!(b.check_det());
+    let mut run = Run::new(&b, "verlet", &b.state(&x0, &p0).unwrap(), 1.0, 10, 5.0).unwrap();
+    let res = run.advance(&b, 10, &mut Vec::new());
     assert!(
         matches!(res, Err(Error::LeftDomain { t, .. }) if t == 6.0),
         "{res:?}"
     );
 }
 
-fn same_bits(a: &Mat, b: &Mat) -> bool {
-    a.nrows() == b.nrows()
-        && a.ncols() == b.ncols()
-        && (0..a.nrows())
-            .all(|i| (0..a.ncols()).all(|j| a[(i, j)].to_bits() == b[(i, j)].to_bits()))
+/// The flat state (X, P) row-major of any X, P (no checks: for states of the wrong shape).
+fn flat(x: &Mat, p: &Mat) -> Vec<f64> {
+    let row_major = |m: &Mat| {
+        (0..m.nrows())
+            .flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)]))
+            .collect::<Vec<f64>>()
+    };
+    [row_major(x), row_major(p)].concat()
 }
 
 #[test]
 fn run_rejects_bad_input_and_changes_nothing() {
-    let pot = svk();
+    let pot: Arc<dyn Potential> = Arc::new(svk());
+    let b = body_of(pot.clone(), 3, true);
     let x0 = Mat::identity(3, 3);
     let p0 = Mat::zeros(3, 3);
-    let mut scratch = VerletScratch::new(3);
-    let m = verlet(2);
     let mut bad_det = x0.clone();
     bad_det[(2, 2)] = -1.0;
     let mut nan = x0.clone();
@@ -502,23 +523,59 @@ fn run_rejects_bad_input_and_changes_nothing() {
         }),
     ];
     for (x_in, p_in, dt, steps, ok) in cases {
-        let (mut x, mut p) = (x_in.clone(), p_in.clone());
-        let err = m
-            .run(&pot, &mut x, &mut p, 0.0, dt, steps, &mut scratch)
-            .unwrap_err();
+        // The driver takes the state by reference: it validates before any work and cannot
+        // change the caller's data; check that anyway, bit for bit.
+        let z = flat(&x_in, &p_in);
+        let before: Vec<u64> = z.iter().map(|v| v.to_bits()).collect();
+        for method in ["verlet", "verlet4", "verlet6"] {
+            let err = drive(&b, method, &z, dt, steps, 1).unwrap_err();
+            assert!(ok(&err), "{method}: {err:?}");
+            let err = Run::new(&b, method, &z, dt, 1, 0.0)
+                .and_then(|mut run| run.advance(&b, steps as u64, &mut Vec::new()));
+            if steps > 0 {
+                assert!(ok(&err.unwrap_err()), "{method}");
+            }
+        }
+        let err = integrate_with(&b, &Verlet::strang(), &z, dt, steps, 1).unwrap_err();
         assert!(ok(&err), "{err:?}");
-        assert!(
-            same_bits(&x, &x_in) && same_bits(&p, &p_in),
+        assert_eq!(
+            z.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            before,
             "state changed"
         );
     }
+    // (X, P) of the wrong shape are rejected by the state builder too.
+    assert!(matches!(
+        b.state(&Mat::identity(2, 2), &p0),
+        Err(Error::Shape { .. })
+    ));
     // The same det X₀ ≤ 0 is fine with check_det off for an elastic potential.
-    let (mut x, mut p) = (bad_det, p0.clone());
-    m.with_check_det(false)
-        .run(&pot, &mut x, &mut p, 0.0, 0.1, 10, &mut scratch)
-        .unwrap();
-    assert!(VerletOrder::from_order(3).is_err());
-    assert_eq!(VerletOrder::from_order(6).unwrap().order(), 6);
+    let free = body_of(pot, 3, false);
+    drive(
+        &free,
+        "verlet",
+        &free.state(&bad_det, &p0).unwrap(),
+        0.1,
+        10,
+        10,
+    )
+    .unwrap();
+    // Methods are the body's catalog (orders 2, 4, 6) or values with any valid composition.
+    assert!(matches!(
+        drive(&b, "verlet3", &flat(&x0, &p0), 0.1, 10, 1),
+        Err(Error::UnsupportedMethod { .. })
+    ));
+    assert!(Composition::new(vec![1.0], 3).is_err());
+    let orders: Vec<(&str, u32)> = b.methods().into_iter().map(|(m, p)| (m, p.order)).collect();
+    assert_eq!(
+        orders,
+        [
+            ("verlet", 2),
+            ("verlet4", 4),
+            ("verlet6", 6),
+            ("reduced", 2)
+        ]
+    );
 }
 
 #[test]
@@ -529,14 +586,7 @@ fn verlet_preserves_angular_momentum_and_circulation() {
     let p0 = rng.mat(3, 0.8);
     let (l0, g0) = (ang_mom(&x0, &p0), circulation(&x0, &p0));
     // SVK is defined on all n×n matrices (and does not keep det X > 0): check_det off.
-    let (x, p) = integrate(
-        &pot,
-        verlet(2).with_check_det(false),
-        &x0,
-        &p0,
-        1e-2,
-        100_000,
-    );
+    let (x, p) = integrate(Arc::new(pot), verlet(2), false, &x0, &p0, 1e-2, 100_000);
     let (dl, dg) = (rel(&ang_mom(&x, &p), &l0), rel(&circulation(&x, &p), &g0));
     eprintln!("SVK n = 3, 1e5 Verlet steps: L drift {dl:.2e}, Γ drift {dg:.2e}");
     assert!(
@@ -552,7 +602,7 @@ fn verlet_preserves_angular_momentum_and_circulation() {
         let p0 = rng.mat(n, 0.4);
         let (l0, g0) = (ang_mom(&x0, &p0), circulation(&x0, &p0));
         for order in [4, 6] {
-            let (x, p) = integrate(&*elastic_gas(), verlet(order), &x0, &p0, 1e-2, 3_000);
+            let (x, p) = integrate(elastic_gas(), verlet(order), true, &x0, &p0, 1e-2, 3_000);
             let (dl, dg) = (rel(&ang_mom(&x, &p), &l0), rel(&circulation(&x, &p), &g0));
             assert!(
                 dl < 1e-12 && dg < 1e-12,
@@ -571,23 +621,20 @@ fn energy_error_is_bounded_over_a_million_steps() {
     let p0 = rng.mat(3, 0.8);
     let h0 = body.hamiltonian(&x0, &p0).unwrap();
     let (dt, chunk, chunks) = (1e-2, 100, 10_000);
-    let (mut x, mut p) = (x0.clone(), p0.clone());
-    let mut scratch = VerletScratch::new(3);
+    let b = body_of(pot, 3, true);
+    // One run resumed chunk by chunk (the run owns the clock).
+    let mut run = Run::new(&b, "verlet", &b.state(&x0, &p0).unwrap(), dt, chunk, 0.0).unwrap();
+    let mut saved = Vec::with_capacity(9 * 2 * 2);
     let mut errs = Vec::with_capacity(chunks);
     for k in 0..chunks {
-        verlet(2)
-            .run(
-                &*pot,
-                &mut x,
-                &mut p,
-                (k * chunk) as f64 * dt,
-                dt,
-                chunk,
-                &mut scratch,
-            )
-            .unwrap();
+        saved.clear();
+        assert_eq!(run.advance(&b, chunk as u64, &mut saved).unwrap(), 1);
+        assert_eq!(run.steps_done(), ((k + 1) * chunk) as u64);
+        let (x, p) = b.split(&run.state(&b)).unwrap();
+        assert_eq!(b.split(&saved).unwrap(), (x.clone(), p.clone()));
         errs.push((body.hamiltonian(&x, &p).unwrap() - h0).abs() / h0.abs());
     }
+    assert!((run.time() - (chunks * chunk) as f64 * dt).abs() < 1e-9);
     let tenth = chunks / 10;
     let first = errs[..tenth].iter().cloned().fold(0.0, f64::max);
     let last = errs[chunks - tenth..].iter().cloned().fold(0.0, f64::max);
@@ -702,7 +749,7 @@ fn full_trajectories_satisfy_the_riemann_equations() {
         let x0 = rng.gl_plus(n);
         let p0 = rng.mat(n, 0.7);
         let h = 1e-3;
-        let fr = frames(body.potential(), verlet(6), &x0, &p0, h, 1, 600);
+        let fr = frames(body.potential_arc(), verlet(6), &x0, &p0, h, 1, 600);
         for c in [2, 300, 598] {
             let qn: Vec<(Mat, Mat)> = (c - 2..=c + 2)
                 .map(|k| {
@@ -770,7 +817,7 @@ fn full_trajectories_satisfy_the_lagrangian_form() {
         let x0 = rng.gl_plus(n);
         let p0 = rng.mat(n, 0.6);
         let h = 1e-3;
-        let fr = frames(body.potential(), verlet(6), &x0, &p0, h, 1, 300);
+        let fr = frames(body.potential_arc(), verlet(6), &x0, &p0, h, 1, 300);
         for c in [2, 150, 298] {
             let svds = aligned_svds(&fr, c);
             let (u, a, v) = &svds[2];
@@ -905,10 +952,10 @@ fn dedekind_adjoint_motion_is_a_motion_and_swaps_l_and_gamma() {
         let pot = elastic_gas();
         let x0 = rng.gl_plus(n);
         let p0 = rng.mat(n, 0.7);
-        let direct = frames(&*pot, verlet(4), &x0, &p0, 1e-2, 50, 8);
+        let direct = frames(pot.clone(), verlet(4), &x0, &p0, 1e-2, 50, 8);
         let xt = x0.transpose().to_owned();
         let pt = p0.transpose().to_owned();
-        let adjoint = frames(&*pot, verlet(4), &xt, &pt, 1e-2, 50, 8);
+        let adjoint = frames(pot.clone(), verlet(4), &xt, &pt, 1e-2, 50, 8);
         let (xs, ps) = stack(&direct);
         let (axs, aps) = adjoint_motion(n, &xs, &ps).unwrap();
         let (bxs, bps) = stack(&adjoint);
@@ -965,26 +1012,61 @@ unsafe impl std::alloc::GlobalAlloc for CountingAlloc {
 #[global_allocator]
 static GLOBAL: CountingAlloc = CountingAlloc;
 
+/// Allocations made on this thread by `f`.
+fn allocations(f: impl FnOnce()) -> usize {
+    let before = ALLOCS.with(|c| c.get());
+    f();
+    ALLOCS.with(|c| c.get()) - before
+}
+
+/// Allocations of `Run::advance` by `steps` steps of a run built (and its output reserved)
+/// beforehand; save_every = steps, so exactly one state is saved.
+fn advance_allocations<S: System>(
+    sys: &S,
+    method: &str,
+    z0: &[f64],
+    dt: f64,
+    steps: usize,
+) -> usize {
+    let mut run = Run::new(sys, method, z0, dt, steps, 0.0).unwrap();
+    let mut out = Vec::with_capacity(z0.len());
+    let count = allocations(|| {
+        assert_eq!(run.advance(sys, steps as u64, &mut out).unwrap(), 1);
+    });
+    assert_eq!(out.len(), z0.len());
+    count
+}
+
 #[test]
 fn verlet_steps_do_not_allocate() {
+    // The counter sees this thread's allocations (so a count of 0 below means something).
+    assert!(allocations(|| drop(std::hint::black_box(vec![0u8; 16]))) > 0);
     let mut rng = Rng(15);
     for n in [2, 3, 4, 7] {
         let pot = elastic_gas();
         let x0 = &Mat::identity(n, n) + rng.mat(n, 0.1);
         let p0 = rng.mat(n, 0.1);
-        let mut scratch = VerletScratch::new(n);
-        let count = |steps: usize, scratch: &mut VerletScratch| {
-            let (mut x, mut p) = (x0.clone(), p0.clone());
-            let before = ALLOCS.with(|c| c.get());
-            verlet(6)
-                .run(&*pot, &mut x, &mut p, 0.0, 1e-3, steps, scratch)
-                .unwrap();
-            ALLOCS.with(|c| c.get()) - before
-        };
-        let (few, many) = (count(1, &mut scratch), count(1000, &mut scratch));
+        let b = body_of(pot, n, true);
+        let z0 = b.state(&x0, &p0).unwrap();
+        let count = |steps: usize| advance_allocations(&b, "verlet6", &z0, 1e-3, steps);
+        let (few, many) = (count(1), count(1000));
         assert_eq!(
             few, many,
             "n = {n}: allocations grow with the number of steps"
+        );
+        assert_eq!(many, 0, "n = {n}: the step loop allocates");
+    }
+    // The same for the rigid body's splitting, with and without the attitude (the attitude run
+    // crosses the driver's retractions, every 256 steps).
+    let body = lieflow::systems::RigidBody::new([1.0, 2.0, 3.0]).unwrap();
+    let m0 = [1.0, 0.5, -0.3];
+    let lifted = body.with_attitude();
+    let z0 = lifted.state_with_attitude(m0, [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+    for steps in [1, 1000] {
+        assert_eq!(advance_allocations(&body, "splitting", &m0, 1e-2, steps), 0);
+        assert_eq!(
+            advance_allocations(&lifted, "splitting", &z0, 1e-2, steps),
+            0
         );
     }
 }
@@ -1009,13 +1091,12 @@ fn bench_verlet_steps_per_second() {
             }
             let x0 = &Mat::identity(n, n) + rng.mat(n, 0.1);
             let p0 = rng.mat(n, 0.1);
-            let (mut x, mut p) = (x0.clone(), p0.clone());
-            let mut scratch = VerletScratch::new(n);
-            let method = verlet(2).with_check_det(check_det);
+            let b = body_of(pot.clone(), n, check_det);
+            let mut run =
+                Run::new(&b, "verlet", &b.state(&x0, &p0).unwrap(), 1e-3, steps, 0.0).unwrap();
+            let mut out = Vec::with_capacity(2 * n * n);
             let start = std::time::Instant::now();
-            method
-                .run(&*pot, &mut x, &mut p, 0.0, 1e-3, steps, &mut scratch)
-                .unwrap();
+            run.advance(&b, steps as u64, &mut out).unwrap();
             let secs = start.elapsed().as_secs_f64();
             eprintln!(
                 "{name:>22}, n = {n:>2}, check_det = {check_det:>5}: {:>6.1} ns/step, {:.3e} steps/s",

@@ -1,15 +1,15 @@
 //! The reduced pseudo-rigid body (001 §7) and the `PseudoRigidBody` system of the driver.
 
-use lieflow::integrate::splitting::Composition;
-use lieflow::integrate::verlet::{Verlet, VerletOrder, VerletScratch};
-use lieflow::integrate::{integrate, integrate_batch, Method, State, System};
+use lieflow::integrate::methods::composition::{run_sequence, Composition};
+use lieflow::integrate::methods::Verlet;
+use lieflow::integrate::{integrate, integrate_batch, integrate_with, Problem, Run, System};
 use lieflow::pseudo_rigid::dynamics::FullBody;
 use lieflow::pseudo_rigid::momentum;
 use lieflow::pseudo_rigid::potential::{
     self, Harmonic, Potential, SaintVenantKirchhoff, Sum, Volumetric, Workspace, Zero,
 };
 use lieflow::pseudo_rigid::reduced::{
-    momenta_of_velocities, reconstruct, reduce, spectral_invariants, ReducedSplitting, ReducedState,
+    momenta_of_velocities, reconstruct, reduce, spectral_invariants, ReducedState, ReducedWork,
 };
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::{Error, Mat};
@@ -46,7 +46,17 @@ fn body(n: usize) -> PseudoRigidBody {
     PseudoRigidBody::new(n, elastic_gas(), true).unwrap()
 }
 
-fn final_xp(b: &PseudoRigidBody, m: Method, dt: f64, steps: usize) -> (Mat, Mat) {
+/// The nominal order of the method called `name` in the system's catalog.
+fn order<S: System + ?Sized>(sys: &S, name: &str) -> u32 {
+    sys.methods()
+        .into_iter()
+        .find(|(n, _)| *n == name)
+        .unwrap_or_else(|| panic!("{} has no method {name:?}", sys.name()))
+        .1
+        .order
+}
+
+fn final_xp(b: &PseudoRigidBody, m: &str, dt: f64, steps: usize) -> (Mat, Mat) {
     let n = b.n();
     let (x0, p0) = initial(n);
     let traj = integrate(b, m, &b.state(&x0, &p0).unwrap(), dt, steps, steps).unwrap();
@@ -128,11 +138,11 @@ fn reduced_field_is_the_derivative_of_the_reduced_full_flow() {
     let (red0, _, _) = reduce(&x0, &p0).unwrap();
     let f = red0.vector_field(full).unwrap();
     let h = 1e-3;
-    let fwd = final_xp(&b, Method::Verlet6, h / 20.0, 20);
+    let fwd = final_xp(&b, "verlet6", h / 20.0, 20);
     let (xm, pm) = {
         // Backward in time: the motion of (X, −P) reversed.
         let s = b.state(&x0, &(-&p0)).unwrap();
-        let traj = integrate(&b, Method::Verlet6, &s, h / 20.0, 20, 20).unwrap();
+        let traj = integrate(&b, "verlet6", &s, h / 20.0, 20, 20).unwrap();
         let (x, p) = b.split(traj.state(1)).unwrap();
         (x, -p)
     };
@@ -155,9 +165,9 @@ fn full_and_reduced_flows_agree_to_second_order() {
     for n in [2, 3, 4] {
         let b = body(n);
         let t = 0.5;
-        let (xr, pr) = final_xp(&b, Method::Verlet6, t / 400.0, 400);
+        let (xr, pr) = final_xp(&b, "verlet6", t / 400.0, 400);
         let err = |steps: usize| {
-            let (x, p) = final_xp(&b, Method::Reduced, t / steps as f64, steps);
+            let (x, p) = final_xp(&b, "reduced", t / steps as f64, steps);
             rel(&x, &xr).max(rel(&p, &pr))
         };
         let (e1, e2) = (err(200), err(400));
@@ -172,12 +182,18 @@ fn reduced_method_keeps_the_coadjoint_orbits_and_momenta() {
     for n in [3, 5] {
         let (x, p) = initial(n);
         let pot = elastic_gas();
-        let mut split = ReducedSplitting::new(&x, &p, &Composition::strang()).unwrap();
+        // The kernel of method "reduced": the Strang step of the reduced flows, checked after
+        // every step, on the reduced working state.
+        let seq = Composition::strang().sequence(ReducedWork::flows(n));
+        let mut split = ReducedWork::new(&x, &p).unwrap();
         let (so, sl) = (
             spectral_invariants(&split.state.p_omega),
             spectral_invariants(&split.state.p_lambda),
         );
-        split.run(&*pot, 0.0, 1e-3, 10_000).unwrap();
+        for _ in 0..10_000 {
+            run_sequence(&seq, 1e-3, 1, &mut split, |i, tau, w| w.flow(i, tau, &*pot));
+            split.check_step().unwrap();
+        }
         let (so2, sl2) = (
             spectral_invariants(&split.state.p_omega),
             spectral_invariants(&split.state.p_lambda),
@@ -191,6 +207,18 @@ fn reduced_method_keeps_the_coadjoint_orbits_and_momenta() {
         assert!(rel(&l1, &l0) < 1e-12 && rel(&g1, &g0) < 1e-12, "n = {n}");
         // The entries themselves changed (the body rotates): the test is not vacuous.
         assert!((&split.state.p_omega - &reduce(&x, &p).unwrap().0.p_omega).norm_l2() > 1e-3);
+        // The driver's method "reduced" is this kernel: the same final state, bit for bit.
+        let b = body(n);
+        let traj = integrate(
+            &b,
+            "reduced",
+            &b.state(&x, &p).unwrap(),
+            1e-3,
+            10_000,
+            10_000,
+        )
+        .unwrap();
+        assert_eq!(traj.final_state, b.state(&x1, &p1).unwrap(), "n = {n}");
     }
 }
 
@@ -200,7 +228,7 @@ fn reduced_energy_error_is_bounded() {
     let (x0, p0) = initial(3);
     let traj = integrate(
         &b,
-        Method::Reduced,
+        "reduced",
         &b.state(&x0, &p0).unwrap(),
         1e-3,
         20_000,
@@ -219,15 +247,7 @@ fn system_free_body_and_orders() {
     let n = 3;
     let b = PseudoRigidBody::new(n, Arc::new(Zero), true).unwrap();
     let (x0, p0) = initial(n);
-    let traj = integrate(
-        &b,
-        Method::Verlet,
-        &b.state(&x0, &p0).unwrap(),
-        0.01,
-        50,
-        50,
-    )
-    .unwrap();
+    let traj = integrate(&b, "verlet", &b.state(&x0, &p0).unwrap(), 0.01, 50, 50).unwrap();
     let (x, p) = b.split(traj.state(1)).unwrap();
     assert!(rel(&x, &(&x0 + &p0 * faer::Scale(0.5))) < 1e-13 && rel(&p, &p0) < 1e-15);
     // Harmonic: orders 2, 4, 6 through the driver.
@@ -236,15 +256,16 @@ fn system_free_body_and_orders() {
     let w = k.sqrt();
     let t = 1.0;
     let exact = &x0 * faer::Scale((w * t).cos()) + &p0 * faer::Scale((w * t).sin() / w);
-    for (m, order, s1) in [
-        (Method::Verlet, 2.0, 100),
-        (Method::Verlet4, 4.0, 40),
-        (Method::Verlet6, 6.0, 20),
-    ] {
+    for (m, s1) in [("verlet", 100), ("verlet4", 40), ("verlet6", 20)] {
+        let order = order(&hb, m) as f64;
         let err = |steps: usize| rel(&final_xp(&hb, m, t / steps as f64, steps).0, &exact);
         let order_obs = (err(s1) / err(2 * s1)).log2();
-        assert!((order_obs - order).abs() < 0.2, "{m:?}: {order_obs}");
+        assert!((order_obs - order).abs() < 0.2, "{m}: {order_obs}");
     }
+    assert_eq!(
+        ["verlet", "verlet4", "verlet6", "reduced"].map(|m| order(&hb, m)),
+        [2, 4, 6, 2]
+    );
 }
 
 #[test]
@@ -253,17 +274,18 @@ fn system_invariants_and_batches() {
         let b = body(n);
         let (x0, p0) = initial(n);
         let s0 = b.state(&x0, &p0).unwrap();
-        let c0 = b.casimirs(&s0.z).unwrap();
+        let c0 = b.invariants(&s0).unwrap();
         assert_eq!(c0.len(), 2 * (n / 2));
-        for m in [Method::Verlet, Method::Reduced] {
+        assert_eq!(b.invariant_count(), c0.len());
+        for m in ["verlet", "reduced"] {
             let trajs =
                 integrate_batch(&b, m, &[s0.clone(), s0.clone()], 1e-3, 400, 200, None).unwrap();
             assert_eq!(trajs[0], trajs[1]);
-            let c1 = b.casimirs(trajs[0].state(2)).unwrap();
+            let c1 = b.invariants(trajs[0].state(2)).unwrap();
             for (u, v) in c0.iter().zip(&c1) {
-                assert!((u - v).abs() < 1e-11 * u.abs().max(1.0), "n = {n}, {m:?}");
+                assert!((u - v).abs() < 1e-11 * u.abs().max(1.0), "n = {n}, {m}");
             }
-            let (l0, _) = b.momenta(&s0.z).unwrap();
+            let (l0, _) = b.momenta(&s0).unwrap();
             let (l1, _) = b.momenta(trajs[0].state(2)).unwrap();
             assert!(rel(&l1, &l0) < 1e-12);
             let a = b.singular_values(trajs[0].state(2)).unwrap();
@@ -279,11 +301,11 @@ fn system_errors() {
     let (x0, p0) = initial(n);
     let s0 = b.state(&x0, &p0).unwrap();
     assert!(matches!(
-        integrate(&b, Method::Splitting, &s0, 0.1, 1, 1),
+        integrate(&b, "splitting", &s0, 0.1, 1, 1),
         Err(Error::UnsupportedMethod { .. })
     ));
     assert!(matches!(
-        integrate(&b, Method::Verlet, &State::new(vec![1.0; 5]), 0.1, 1, 1),
+        integrate(&b, "verlet", &[1.0; 5], 0.1, 1, 1),
         Err(Error::Shape { .. })
     ));
     assert!(matches!(
@@ -291,13 +313,13 @@ fn system_errors() {
         Err(Error::Shape { .. })
     ));
     let mut bad = s0.clone();
-    bad.z[3] = f64::NAN;
+    bad[3] = f64::NAN;
     assert!(matches!(
-        integrate(&b, Method::Verlet, &bad, 0.1, 1, 1),
+        integrate(&b, "verlet", &bad, 0.1, 1, 1),
         Err(Error::NonFinite { .. })
     ));
     let neg = b.state(&(-&x0), &p0).unwrap();
-    for m in [Method::Verlet, Method::Reduced] {
+    for m in ["verlet", "reduced"] {
         assert!(matches!(
             integrate(&b, m, &neg, 0.1, 1, 1),
             Err(Error::NotInGroup { .. })
@@ -310,10 +332,10 @@ fn system_errors() {
     // Degenerate stratum for the reduced method only.
     let eye = b.state(&Mat::identity(n, n), &p0).unwrap();
     assert!(matches!(
-        integrate(&b, Method::Reduced, &eye, 0.1, 1, 1),
+        integrate(&b, "reduced", &eye, 0.1, 1, 1),
         Err(Error::DegenerateStratum { .. })
     ));
-    assert!(integrate(&b, Method::Verlet, &eye, 0.1, 1, 1).is_ok());
+    assert!(integrate(&b, "verlet", &eye, 0.1, 1, 1).is_ok());
     assert!(matches!(
         ReducedState {
             a: vec![1.0, -1.0],
@@ -335,9 +357,9 @@ fn leaving_gl_plus_names_the_time_for_both_methods() {
     for check in [true, false] {
         let b = PseudoRigidBody::new(n, Arc::new(Harmonic::new(1.0).unwrap()), check).unwrap();
         let s0 = b.state(&x0, &p0).unwrap();
-        for m in [Method::Verlet, Method::Reduced] {
+        for m in ["verlet", "reduced"] {
             let r = integrate(&b, m, &s0, 1e-3, 2000, 100);
-            if !check && m == Method::Verlet {
+            if !check && m == "verlet" {
                 assert!(r.is_ok());
                 continue;
             }
@@ -345,10 +367,10 @@ fn leaving_gl_plus_names_the_time_for_both_methods() {
                 Err(Error::LeftDomain { t, .. }) => {
                     assert!(
                         (t - std::f64::consts::FRAC_PI_4).abs() < 2e-3,
-                        "{m:?}: t = {t}"
+                        "{m}: t = {t}"
                     )
                 }
-                other => panic!("{m:?}: expected LeftDomain, got {other:?}"),
+                other => panic!("{m}: expected LeftDomain, got {other:?}"),
             }
         }
     }
@@ -367,12 +389,12 @@ fn reduced_method_stops_at_an_unresolved_near_collision_of_semi_axes() {
     });
     let s0 = b.state(&x0, &p0).unwrap();
     for dt in [1e-3, 2.5e-4] {
-        match integrate(&b, Method::Reduced, &s0, dt, (6.0 / dt) as usize, 100) {
+        match integrate(&b, "reduced", &s0, dt, (6.0 / dt) as usize, 100) {
             Err(Error::LeftDomain { t, .. }) => assert!((t - 2.3).abs() < 0.05, "t = {t}"),
             other => panic!("dt = {dt}: expected LeftDomain, got {other:?}"),
         }
     }
-    assert!(integrate(&b, Method::Verlet4, &s0, 1e-3, 6000, 100).is_ok());
+    assert!(integrate(&b, "verlet4", &s0, 1e-3, 6000, 100).is_ok());
 }
 
 /// Delegates to a potential but hides its n = 3 fast path, so Verlet takes the general loop.
@@ -428,50 +450,36 @@ fn fixed_size_gradients_match_the_general_kernels() {
 fn verlet_fast_path_matches_the_general_loop() {
     let (x0, p0) = initial(3);
     for pot in potentials3() {
-        for order in [VerletOrder::Two, VerletOrder::Six] {
-            let v = Verlet::new(order).with_check_det(false);
-            let run = |pot: &dyn Potential| {
-                let (mut x, mut p) = (x0.clone(), p0.clone());
-                v.run(
-                    pot,
-                    &mut x,
-                    &mut p,
-                    0.0,
-                    1e-2,
-                    200,
-                    &mut VerletScratch::new(3),
-                )
-                .unwrap();
-                (x, p)
+        for v in [Verlet::strang(), Verlet(Composition::yoshida6())] {
+            let run = |pot: Arc<dyn Potential>| {
+                let b = PseudoRigidBody::new(3, pot, false).unwrap();
+                let traj =
+                    integrate_with(&b, &v, &b.state(&x0, &p0).unwrap(), 1e-2, 200, 200).unwrap();
+                b.split(&traj.final_state).unwrap()
             };
-            let (xf, pf) = run(&*pot);
-            let (xg, pg) = run(&General(pot.clone()));
+            let (xf, pf) = run(pot.clone());
+            let (xg, pg) = run(Arc::new(General(pot.clone())));
             assert!(
                 rel(&xf, &xg) < 1e-12 && rel(&pf, &pg) < 1e-12,
-                "{pot:?} {order:?}"
+                "{pot:?} order {}",
+                v.0.order()
             );
         }
     }
-    // The exit error and the state left at the exit agree too.
+    // The exit error and the state left at the exit agree too (a run started at t0 = 1).
     let h: Arc<dyn Potential> = Arc::new(Harmonic::new(1.0).unwrap());
     let x = Mat::from_fn(3, 3, |i, j| if i == j { 1.0 + 0.5 * i as f64 } else { 0.0 });
-    let exit = |pot: &dyn Potential| {
-        let (mut xe, mut pe) = (x.clone(), -&x);
-        let e = Verlet::new(VerletOrder::Two).run(
-            pot,
-            &mut xe,
-            &mut pe,
-            1.0,
-            1e-3,
-            2000,
-            &mut VerletScratch::new(3),
-        );
+    let exit = |pot: Arc<dyn Potential>| {
+        let b = PseudoRigidBody::new(3, pot, true).unwrap();
+        let z0 = b.state(&x, &(-&x)).unwrap();
+        let mut run = Run::new(&b, "verlet", &z0, 1e-3, 2000, 1.0).unwrap();
+        let e = run.advance(&b, 2000, &mut Vec::new());
         match e {
-            Err(Error::LeftDomain { t, .. }) => (t, xe),
+            Err(Error::LeftDomain { t, .. }) => (t, b.split(&run.state(&b)).unwrap().0),
             other => panic!("expected LeftDomain, got {other:?}"),
         }
     };
-    let ((tf, xf), (tg, xg)) = (exit(&*h), exit(&General(h.clone())));
+    let ((tf, xf), (tg, xg)) = (exit(h.clone()), exit(Arc::new(General(h.clone()))));
     assert_eq!(tf, tg);
     assert!((tf - 1.0 - std::f64::consts::FRAC_PI_4).abs() < 2e-3);
     assert!(rel(&xf, &xg) < 1e-12);

@@ -223,7 +223,7 @@ mod tests {
         assert_eq!(s.range("R"), Some(3..12));
         assert!(s.is_curved());
         assert_eq!(s.describe(), "M: R^3 × R: SO(3)");
-        let mut z = vec![1.0, 2.0, 3.0, 1.0, 1e-9, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let mut z = vec![1.0, 2.0, 3.0, 1.0, 1e-11, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
         assert!(s.check("z", &z).is_ok());
         z[4] = 1e-3;
         assert!(matches!(s.check("z", &z), Err(Error::NotInGroup { .. })));
