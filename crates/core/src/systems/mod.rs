@@ -8,16 +8,27 @@
 //! * [`GeneralizedRigidBody`]: z = e_ij coordinates of M ∈ so(n) (n(n−1)/2, `lie::so::vee_n`);
 //! * [`HeavyTop`]: z = (M, Γ) (6), or (M, Γ, R) with Γ = Rᵀe₃;
 //! * [`SphericalPendulum`]: z = (q, L) (6), |q| = 1, q·L = 0.
+//!
+//! Test problems of the other problem kinds (canonical, holonomic, nonholonomic):
+//! * [`Pendulum`]: z = (q, p) (2), the planar pendulum in canonical coordinates;
+//! * [`SphereParticle`]: z = (q, p) (6), a particle on the sphere |q| = l, q·p = 0;
+//! * [`RollingDisk`]: z = (x, y, θ, φ, p_x, p_y, p_θ, p_φ) (8), the vertical rolling disk.
 
 pub mod heavy_top;
 pub mod isospectral;
 pub mod lgvi;
+pub mod pendulum;
 pub mod rigid_body;
+pub mod rolling_disk;
+pub mod sphere_particle;
 pub mod spherical_pendulum;
 mod top;
 
 pub use heavy_top::HeavyTop;
 pub use isospectral::Isospectral;
 pub use lgvi::Lgvi;
+pub use pendulum::Pendulum;
 pub use rigid_body::{GeneralizedRigidBody, RigidBody};
+pub use rolling_disk::RollingDisk;
+pub use sphere_particle::SphereParticle;
 pub use spherical_pendulum::SphericalPendulum;

