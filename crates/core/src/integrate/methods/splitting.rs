@@ -86,7 +86,11 @@ impl<P: Split> Stepper for SplittingStepper<P> {
         let (h, seq) = (self.h, &self.seq);
         let (outer, c0) = seq[0];
         let inner = &seq[1..seq.len().saturating_sub(1)];
-        let c_last = if seq.len() > 1 { seq[seq.len() - 1].1 } else { 0.0 };
+        let c_last = if seq.len() > 1 {
+            seq[seq.len() - 1].1
+        } else {
+            0.0
+        };
         for _ in 0..steps {
             self.pending += c0 * h;
             if inner.is_empty() && seq.len() == 1 {
