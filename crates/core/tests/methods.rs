@@ -7,7 +7,7 @@
 use lieflow::integrate::methods::{
     Gauss, NonholonomicRattle, Rattle, Rk4, Rkmk4, Verlet, IMPLICIT_MIDPOINT,
 };
-use lieflow::integrate::problem::{Canonical, GroupField, Separable, VectorField};
+use lieflow::integrate::problem::{Canonical, GroupField, Separable, VectorField, Violation};
 use lieflow::integrate::{integrate, integrate_with, Block, Integrator, Problem, Space, System};
 use lieflow::lie::{so, so3};
 use lieflow::systems::{
@@ -203,9 +203,10 @@ impl Separable for HenonHeiles {
     fn velocity(&self, p: &[f64], v: &mut [f64]) {
         v.copy_from_slice(p);
     }
-    fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) {
+    fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) -> std::result::Result<(), Violation> {
         f[0] = -(q[0] + 2.0 * q[0] * q[1]);
         f[1] = -(q[1] + q[0] * q[0] - q[1] * q[1]);
+        Ok(())
     }
 }
 

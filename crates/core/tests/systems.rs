@@ -524,7 +524,8 @@ fn bad_input_gets_typed_errors() {
             "splitting6",
             "isospectral",
             "lgvi",
-            "rk4"
+            "rk4",
+            "rkmk4"
         ]
     );
     assert_eq!(order(&b, "splitting6"), 6);

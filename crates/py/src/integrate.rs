@@ -25,6 +25,9 @@ pub(crate) type RunOut<'py> = (
     Option<Bound<'py, PyArray3<f64>>>,
 );
 
+/// Current states (b, d) and attitudes (b, 3, 3) or None.
+type States<'py> = (Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>);
+
 /// A native integration in progress (made by `System._start`); `advance(steps)` continues it.
 #[pyclass(module = "lieflow", name = "Integration")]
 pub struct Integration {
@@ -228,10 +231,7 @@ impl Integration {
     }
 
     /// The current states (b, d) and attitudes (b, 3, 3) or None.
-    fn state<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>)> {
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
         let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
         let b = runs.len();
         let data: Vec<f64> = runs.iter().flat_map(|r| r.state(&*self.sys)).collect();

@@ -137,7 +137,7 @@ fn rows_array<'py>(
     rows: Vec<f64>,
     d: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let b = if d == 0 { 0 } else { rows.len() / d };
+    let b = rows.len().checked_div(d).unwrap_or(0);
     Array2::from_shape_vec((b, d), rows)
         .map(|a| a.into_pyarray(py))
         .map_err(|e| to_py(Error::shape("state0", format!("(b, {d})"), e.to_string())))

@@ -64,6 +64,13 @@ pub struct Violation {
     pub message: String,
 }
 
+impl Violation {
+    /// The error for a state handed to a stepper (not reached by a step) outside the domain.
+    pub fn at_start(self) -> crate::Error {
+        crate::Error::invalid("state", format!("{}: {}", self.what, self.message))
+    }
+}
+
 /// An ordinary differential equation ż = f(z) (internal frame).
 pub trait VectorField: Problem {
     /// Evaluates f(z) into `dz`.
@@ -113,13 +120,24 @@ pub trait Separable: Problem {
     /// The velocity v = ∂T/∂p (linear in p, v = M⁻¹p, for the constrained kinds).
     fn velocity(&self, p: &[f64], v: &mut [f64]);
 
-    /// The force f = −∂U/∂q.
-    fn force(&self, q: &[f64], f: &mut [f64], s: &mut Self::Scratch);
-
-    /// Checks a position reached by a drift (det X > 0, …). Always admissible by default.
-    fn admissible(&self, _q: &[f64], _s: &mut Self::Scratch) -> std::result::Result<(), Violation> {
-        Ok(())
+    /// The exact flow of T over time h: q ← q + h ∂T/∂p(p) (`v` is scratch of length d).
+    /// Override it where the velocity need not be formed (T = ½|p|²).
+    fn drift(&self, q: &mut [f64], p: &[f64], h: f64, v: &mut [f64]) {
+        self.velocity(p, v);
+        for (qi, vi) in q.iter_mut().zip(v.iter()) {
+            *qi += h * vi;
+        }
     }
+
+    /// The force f = −∂U/∂q, or the [`Violation`] if q lies outside the problem's domain
+    /// (det X ≤ 0, …; f is then unspecified). One call both checks and evaluates, so a kernel
+    /// reads a new position once.
+    fn force(
+        &self,
+        q: &[f64],
+        f: &mut [f64],
+        s: &mut Self::Scratch,
+    ) -> std::result::Result<(), Violation>;
 }
 
 /// A canonical Hamiltonian system H(q, p) on T*ℝᵈ with state z = (q, p).

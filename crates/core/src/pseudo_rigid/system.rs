@@ -37,6 +37,7 @@ use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::{gl, so};
 use crate::Mat;
+use faer::{MatMut, MatRef};
 use nalgebra::Matrix3;
 
 /// A generalized pseudo-rigid body H = ½ tr(PᵀP) + U(X) (001 (3.22)) for the integration
@@ -44,6 +45,7 @@ use nalgebra::Matrix3;
 #[derive(Debug, Clone)]
 pub struct PseudoRigidBody {
     body: FullBody,
+    /// Whether det X > 0 is enforced (asked for, or required by the potential).
     check_det: bool,
 }
 
@@ -52,8 +54,8 @@ impl PseudoRigidBody {
     /// [`Error::LeftDomain`] when det X ≤ 0 (always on for potentials defined only on GL⁺(n)).
     pub fn new(n: usize, potential: Arc<dyn Potential>, check_det: bool) -> Result<Self> {
         Ok(PseudoRigidBody {
+            check_det: check_det || potential.needs_positive_det(),
             body: FullBody::new(n, potential)?,
-            check_det,
         })
     }
 
@@ -69,7 +71,7 @@ impl PseudoRigidBody {
 
     /// Whether det X > 0 is enforced.
     pub fn check_det(&self) -> bool {
-        self.check_det || self.body.potential().needs_positive_det()
+        self.check_det
     }
 
     /// The flat state z = (X, P) row-major (checked: n×n, finite).
@@ -169,12 +171,19 @@ impl Problem for PseudoRigidBody {
     }
 }
 
-/// Scratch of the force: the potential's workspace and two n×n matrices.
+/// The 3×3 matrix of 9 row-major values (the n = 3 fast path), built without bounds checks.
+#[inline]
+fn mat3(q: &[f64]) -> Option<Matrix3<f64>> {
+    let q: &[f64; 9] = q.try_into().ok()?;
+    Some(Matrix3::new(
+        q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8],
+    ))
+}
+
+/// Scratch of the force: the potential's workspace.
 #[derive(Debug)]
 pub struct ForceScratch {
     ws: Workspace,
-    x: Mat,
-    grad: Mat,
 }
 
 impl Separable for PseudoRigidBody {
@@ -184,8 +193,6 @@ impl Separable for PseudoRigidBody {
         let n = self.n();
         ForceScratch {
             ws: Workspace::new(n),
-            x: Mat::zeros(n, n),
-            grad: Mat::zeros(n, n),
         }
     }
 
@@ -198,58 +205,83 @@ impl Separable for PseudoRigidBody {
         v.copy_from_slice(p);
     }
 
-    /// f = −∂U/∂X, on stack matrices at n = 3 when the potential has
-    /// [`Potential::gradient3`].
-    fn force(&self, q: &[f64], f: &mut [f64], s: &mut ForceScratch) {
-        let pot = self.body.potential();
-        if q.len() == 9 {
-            if let Some(g) = pot.gradient3(&Matrix3::from_row_slice(q)) {
-                for i in 0..3 {
-                    for j in 0..3 {
-                        f[3 * i + j] = -g[(i, j)];
-                    }
-                }
-                return;
-            }
-        }
-        let n = s.x.nrows();
-        for (k, v) in q.iter().enumerate() {
-            s.x[(k / n, k % n)] = *v;
-        }
-        s.grad.fill(0.0);
-        pot.add_gradient(s.x.as_ref(), s.grad.as_mut(), &mut s.ws);
-        for (k, v) in f.iter_mut().enumerate() {
-            *v = -s.grad[(k / n, k % n)];
+    /// X ← X + hP.
+    fn drift(&self, q: &mut [f64], p: &[f64], h: f64, _v: &mut [f64]) {
+        for (x, p) in q.iter_mut().zip(p) {
+            *x += h * p;
         }
     }
 
-    /// det X > 0 when checked.
-    fn admissible(&self, q: &[f64], s: &mut ForceScratch) -> std::result::Result<(), Violation> {
-        if !self.check_det() {
-            return Ok(());
-        }
-        let n = s.x.nrows();
-        let d = if n == 3 {
-            Matrix3::from_row_slice(q).determinant()
-        } else {
-            for (k, v) in q.iter().enumerate() {
-                s.x[(k / n, k % n)] = *v;
+    /// f = −∂U/∂X, on stack matrices at n = 3 when the potential has
+    /// [`Potential::gradient3`]; a violation where det X ≤ 0 and det X is checked.
+    #[inline]
+    fn force(
+        &self,
+        q: &[f64],
+        f: &mut [f64],
+        s: &mut ForceScratch,
+    ) -> std::result::Result<(), Violation> {
+        let pot = self.body.potential();
+        let check = self.check_det;
+        if let (Some(x), 9) = (mat3(q), f.len()) {
+            if check {
+                let d = x.determinant();
+                if d.is_nan() || d <= 0.0 {
+                    return Err(self.left_gl_plus(d));
+                }
             }
-            potential::det(s.x.as_ref(), &mut s.ws)
-        };
-        if d > 0.0 {
-            return Ok(());
+            if let Some(g) = pot.gradient3(&x) {
+                // The column-major values of gᵀ are the row-major values of g; one contiguous
+                // copy (vector stores, which the next kick's vector loads read back at once).
+                for (fk, gk) in f.iter_mut().zip(g.transpose().as_slice()) {
+                    *fk = -gk;
+                }
+                return Ok(());
+            }
         }
+        self.force_dense(q, f, s, check)
+    }
+}
+
+impl PseudoRigidBody {
+    /// [`Separable::force`] for any n, on views of the row-major slices (no copies).
+    #[inline(never)]
+    fn force_dense(
+        &self,
+        q: &[f64],
+        f: &mut [f64],
+        s: &mut ForceScratch,
+        check: bool,
+    ) -> std::result::Result<(), Violation> {
+        let pot = self.body.potential();
+        let n = s.ws.n();
+        let x = MatRef::from_row_major_slice(q, n, n);
+        if check {
+            let d = potential::det(x, &mut s.ws);
+            if d.is_nan() || d <= 0.0 {
+                return Err(self.left_gl_plus(d));
+            }
+        }
+        f.fill(0.0);
+        pot.add_gradient(x, MatMut::from_row_major_slice_mut(f, n, n), &mut s.ws);
+        f.iter_mut().for_each(|v| *v = -*v);
+        Ok(())
+    }
+
+    /// The violation det X = d ≤ 0, with the advice that fits the potential.
+    #[cold]
+    fn left_gl_plus(&self, d: f64) -> Violation {
+        let n = self.n();
         let advice = if self.body.potential().needs_positive_det() {
             "a volumetric potential is defined only for det X > 0, so the motion ends here"
         } else {
             "the equations extend to all n×n matrices: construct the body with check_det = false \
              to continue through det X = 0"
         };
-        Err(Violation {
+        Violation {
             what: format!("X (pseudo-rigid body in GL+({n}))"),
             message: format!("det X = {d:.3e} ≤ 0: the motion left GL+({n}); {advice}"),
-        })
+        }
     }
 }
 

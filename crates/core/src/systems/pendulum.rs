@@ -18,7 +18,7 @@ use crate::check;
 use crate::elliptic::{ellipj, ellipk};
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Gauss, Rk4, Verlet, IMPLICIT_MIDPOINT};
-use crate::integrate::problem::{Canonical, Separable, VectorField};
+use crate::integrate::problem::{Canonical, Separable, VectorField, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 
@@ -120,8 +120,9 @@ impl Separable for Pendulum {
         v[0] = p[0] / self.inertia();
     }
     /// f = −mgl sin q.
-    fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) {
+    fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) -> std::result::Result<(), Violation> {
         f[0] = -self.mgl() * q[0].sin();
+        Ok(())
     }
 }
 

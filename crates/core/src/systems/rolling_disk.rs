@@ -24,7 +24,7 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::NonholonomicRattle;
-use crate::integrate::problem::{Nonholonomic, Separable};
+use crate::integrate::problem::{Nonholonomic, Separable, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 
@@ -190,8 +190,9 @@ impl Separable for RollingDisk {
         v[3] = p[3] / self.turn_inertia;
     }
     /// f = (−m g̃, 0, 0, −k sin φ).
-    fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) {
+    fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) -> std::result::Result<(), Violation> {
         f.copy_from_slice(&[-self.mass * self.tilt, 0.0, 0.0, -self.spring * q[3].sin()]);
+        Ok(())
     }
 }
 

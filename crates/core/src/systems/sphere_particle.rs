@@ -15,7 +15,7 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::Rattle;
-use crate::integrate::problem::{Constrained, Separable};
+use crate::integrate::problem::{Constrained, Separable, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 use nalgebra::Vector3;
@@ -123,8 +123,9 @@ impl Separable for SphereParticle {
         }
     }
     /// f = −m g e₃.
-    fn force(&self, _q: &[f64], f: &mut [f64], _s: &mut ()) {
+    fn force(&self, _q: &[f64], f: &mut [f64], _s: &mut ()) -> std::result::Result<(), Violation> {
         f.copy_from_slice(&[0.0, 0.0, -self.mass * self.gravity]);
+        Ok(())
     }
 }
 

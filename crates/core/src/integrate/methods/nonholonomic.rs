@@ -34,7 +34,7 @@
 use super::rattle::{axpy, dot, max_abs, singular, Failure, Rows};
 use crate::error::Result;
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
-use crate::integrate::problem::{Nonholonomic, Separable};
+use crate::integrate::problem::{Nonholonomic, Separable, Violation};
 
 /// The RATTLE-type nonholonomic method (order 2, symmetric and reversible, not symplectic).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -100,10 +100,12 @@ struct NonholonomicStepper<P: Separable> {
 
 impl<P: Nonholonomic> NonholonomicStepper<P> {
     /// f, A and W at the current q.
-    fn load(&mut self) {
-        self.problem.force(&self.q, &mut self.f, &mut self.scratch);
+    fn load(&mut self) -> std::result::Result<(), Violation> {
+        self.problem
+            .force(&self.q, &mut self.f, &mut self.scratch)?;
         self.problem.constraint_matrix(&self.q, &mut self.rows.c);
         self.rows.update_w(&self.problem);
+        Ok(())
     }
 
     /// p_{n+1/2} = p̃ − A(q_n)ᵀw into `ph`, its velocity into `v`, the midpoint into `qbar`.
@@ -157,11 +159,8 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
         }
         // q_{n+1} = q_n + h M⁻¹p_{n+1/2}.
         axpy(&mut self.q, h, &self.v);
-        self.problem
-            .admissible(&self.q, &mut self.scratch)
-            .map_err(Failure::Domain)?;
         self.p.copy_from_slice(&self.ph);
-        self.load();
+        self.load().map_err(Failure::Domain)?;
         // p_{n+1} = p_{n+1/2} + h/2 f(q_{n+1}) − A(q_{n+1})ᵀ(h/2)ν, A M⁻¹p_{n+1} = 0.
         axpy(&mut self.p, 0.5 * h, &self.f);
         if !self.rows.project(&self.problem, &mut self.p, &mut self.v) {
@@ -176,8 +175,7 @@ impl<P: Nonholonomic> Stepper for NonholonomicStepper<P> {
         let d = self.q.len();
         self.q.copy_from_slice(&z[..d]);
         self.p.copy_from_slice(&z[d..]);
-        self.load();
-        Ok(())
+        self.load().map_err(|v| v.at_start())
     }
 
     fn get(&self, z: &mut [f64]) {

@@ -217,10 +217,12 @@ struct RattleStepper<P: Separable> {
 
 impl<P: Constrained> RattleStepper<P> {
     /// f, G and W at the current q.
-    fn load(&mut self) {
-        self.problem.force(&self.q, &mut self.f, &mut self.scratch);
+    fn load(&mut self) -> std::result::Result<(), Violation> {
+        self.problem
+            .force(&self.q, &mut self.f, &mut self.scratch)?;
         self.problem.constraint_jacobian(&self.q, &mut self.rows.c);
         self.rows.update_w(&self.problem);
+        Ok(())
     }
 
     fn step(&mut self) -> std::result::Result<(), Failure> {
@@ -280,8 +282,7 @@ impl<P: Constrained> RattleStepper<P> {
             axpy(p, -nb / h, &rows.c[b * d..(b + 1) * d]);
         }
         q.copy_from_slice(qn);
-        problem.admissible(q, scratch).map_err(Failure::Domain)?;
-        problem.force(q, f, scratch);
+        problem.force(q, f, scratch).map_err(Failure::Domain)?;
         problem.constraint_jacobian(q, &mut rows.c);
         rows.update_w(problem);
         // p_{n+1} = p_{n+1/2} + h/2 f(q_{n+1}) − G(q_{n+1})ᵀκ, G M⁻¹p_{n+1} = 0.
@@ -298,8 +299,7 @@ impl<P: Constrained> Stepper for RattleStepper<P> {
         let d = self.q.len();
         self.q.copy_from_slice(&z[..d]);
         self.p.copy_from_slice(&z[d..]);
-        self.load();
-        Ok(())
+        self.load().map_err(|v| v.at_start())
     }
 
     fn get(&self, z: &mut [f64]) {

@@ -65,8 +65,8 @@ impl<P: Separable> Stepper for VerletStepper<P> {
         self.z.copy_from_slice(z);
         let d = self.f.len();
         self.problem
-            .force(&self.z[..d], &mut self.f, &mut self.scratch);
-        Ok(())
+            .force(&self.z[..d], &mut self.f, &mut self.scratch)
+            .map_err(|v| v.at_start())
     }
 
     fn get(&self, z: &mut [f64]) {
@@ -74,29 +74,75 @@ impl<P: Separable> Stepper for VerletStepper<P> {
     }
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
-        let VerletStepper {
-            problem,
-            scratch,
-            steps: hs,
-            z,
-            f,
-            v,
-        } = self;
-        let (q, p) = z.split_at_mut(f.len());
-        for k in 0..steps {
-            for &h in hs.iter() {
-                axpy(p, 0.5 * h, f);
-                problem.velocity(p, v);
-                axpy(q, h, v);
-                problem
-                    .admissible(q, scratch)
-                    .map_err(|e| clock.left_domain(k, e))?;
-                problem.force(q, f, scratch);
-                axpy(p, 0.5 * h, f);
+        match self.f.len() {
+            // A 3×3 configuration (the pseudo-rigid body in 3-D): the same loop on stack arrays
+            // of constant length, which the compiler unrolls.
+            9 => self.advance_fixed::<9>(steps, clock),
+            _ => {
+                let d = self.f.len();
+                let (q, p) = self.z.split_at_mut(d);
+                let (f, v) = (&mut self.f[..], &mut self.v[..]);
+                kick_drift_kick(
+                    &self.problem,
+                    &mut self.scratch,
+                    &self.steps,
+                    [q, p, f, v],
+                    steps,
+                    clock,
+                )
             }
         }
-        Ok(())
     }
+}
+
+impl<P: Separable> VerletStepper<P> {
+    /// [`kick_drift_kick`] on copies of the state in arrays of length D = d.
+    fn advance_fixed<const D: usize>(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        let mut q = [0.0; D];
+        let mut p = [0.0; D];
+        let mut f = [0.0; D];
+        let mut v = [0.0; D];
+        q.copy_from_slice(&self.z[..D]);
+        p.copy_from_slice(&self.z[D..]);
+        f.copy_from_slice(&self.f);
+        let parts = [&mut q[..], &mut p[..], &mut f[..], &mut v[..]];
+        let result = kick_drift_kick(
+            &self.problem,
+            &mut self.scratch,
+            &self.steps,
+            parts,
+            steps,
+            clock,
+        );
+        self.z[..D].copy_from_slice(&q);
+        self.z[D..].copy_from_slice(&p);
+        self.f.copy_from_slice(&f);
+        result
+    }
+}
+
+/// `steps` Verlet steps (each a composition of kick–drift–kick substeps of sizes `hs`) on
+/// [q, p, f, v]; f = f(q) on entry and on exit; the state is left where a violation was found.
+#[inline(always)]
+fn kick_drift_kick<P: Separable>(
+    problem: &P,
+    scratch: &mut P::Scratch,
+    hs: &[f64],
+    [q, p, f, v]: [&mut [f64]; 4],
+    steps: usize,
+    clock: Clock,
+) -> Result<()> {
+    for k in 0..steps {
+        for &h in hs {
+            axpy(p, 0.5 * h, f);
+            problem.drift(q, p, h, v);
+            problem
+                .force(q, f, scratch)
+                .map_err(|e| clock.left_domain(k, e))?;
+            axpy(p, 0.5 * h, f);
+        }
+    }
+    Ok(())
 }
 
 /// y ← y + a x.
