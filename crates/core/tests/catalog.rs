@@ -10,7 +10,10 @@ use lieflow::integrate::{check_state, integrate, System};
 use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::PseudoRigidBody;
-use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
+use lieflow::systems::{
+    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, SphereParticle,
+    SphericalPendulum,
+};
 use nalgebra::Vector3;
 
 /// A system with an initial state, a time span, a base step and its time-reversal map ρ
@@ -68,6 +71,15 @@ fn cases() -> Vec<Case> {
     let r = rotation_rows();
     let z_top = [m0.clone(), r[6..9].to_vec(), r.clone()].concat();
     let pend = SphericalPendulum::new(2.0, 1.5, 9.81).unwrap();
+    let particle = SphereParticle::new(2.0, 1.5, 9.81).unwrap();
+    let z_particle = particle
+        .from_spherical(&pend.state_from_spherical(0.8, 0.1, 0.3, 1.2).unwrap())
+        .unwrap();
+    let disk = RollingDisk::new(1.0, 0.5, 0.125, 0.0625)
+        .unwrap()
+        .with_potential(0.4, 0.0)
+        .unwrap();
+    let z_disk = disk.state([0.1, -0.2, 0.3, 0.7], 2.0, 0.5).unwrap();
     let elastic = Arc::new(Sum::new(vec![
         Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()),
         Arc::new(Volumetric::polytropic(0.5, 1.4).unwrap()),
@@ -136,6 +148,33 @@ fn cases() -> Vec<Case> {
             t_end: 2.0,
             dt: 0.01,
             reverse: |z| negate(3..6)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "Pendulum",
+            system: Arc::new(Pendulum::new(1.0, 1.0, 9.81).unwrap()),
+            z0: vec![1.2, 0.3],
+            t_end: 2.0,
+            dt: 0.02,
+            reverse: |z| negate(1..2)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "SphereParticle",
+            system: Arc::new(particle),
+            z0: z_particle,
+            t_end: 2.0,
+            dt: 0.01,
+            reverse: |z| negate(3..6)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "RollingDisk with a spring",
+            system: Arc::new(disk),
+            z0: z_disk,
+            t_end: 2.0,
+            dt: 0.01,
+            reverse: |z| negate(4..8)(z),
             long_skip: &[],
         },
         Case {
