@@ -3,6 +3,9 @@
 
 #![allow(clippy::excessive_precision)] // reference values are quoted as printed by mpmath
 
+mod common;
+
+use common::order;
 use lieflow::elliptic::{ellipf, ellipj, ellipk};
 use lieflow::integrate::{integrate, Problem, System, Trajectory};
 use lieflow::systems::RigidBody;
@@ -133,16 +136,6 @@ fn exact_solution_solves_euler_equation() {
             assert!((b.invariants(&m).unwrap()[0] - c0).abs() < 1e-13);
         }
     }
-}
-
-/// The nominal order of the method called `name` in the system's catalog.
-fn order<S: System + ?Sized>(sys: &S, name: &str) -> u32 {
-    sys.methods()
-        .into_iter()
-        .find(|(n, _)| *n == name)
-        .unwrap_or_else(|| panic!("{} has no method {name:?}", sys.name()))
-        .1
-        .order
 }
 
 fn err_at(b: &RigidBody, method: &str, dt: f64, t_end: f64) -> f64 {

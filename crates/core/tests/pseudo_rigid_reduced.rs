@@ -1,8 +1,11 @@
 //! The reduced pseudo-rigid body (001 §7) and the `PseudoRigidBody` system of the driver.
 
+mod common;
+
+use common::order;
 use lieflow::integrate::methods::composition::{run_sequence, Composition};
 use lieflow::integrate::methods::Verlet;
-use lieflow::integrate::{integrate, integrate_batch, integrate_with, Problem, Run, System};
+use lieflow::integrate::{integrate, integrate_batch, integrate_with, Problem, Run};
 use lieflow::pseudo_rigid::dynamics::FullBody;
 use lieflow::pseudo_rigid::momentum;
 use lieflow::pseudo_rigid::potential::{
@@ -44,16 +47,6 @@ fn rel(a: &Mat, b: &Mat) -> f64 {
 
 fn body(n: usize) -> PseudoRigidBody {
     PseudoRigidBody::new(n, elastic_gas(), true).unwrap()
-}
-
-/// The nominal order of the method called `name` in the system's catalog.
-fn order<S: System + ?Sized>(sys: &S, name: &str) -> u32 {
-    sys.methods()
-        .into_iter()
-        .find(|(n, _)| *n == name)
-        .unwrap_or_else(|| panic!("{} has no method {name:?}", sys.name()))
-        .1
-        .order
 }
 
 fn final_xp(b: &PseudoRigidBody, m: &str, dt: f64, steps: usize) -> (Mat, Mat) {

@@ -1,6 +1,9 @@
 //! The other Lie–Poisson systems (heavy top, spherical pendulum, the so(n) body), inertia given as
 //! a matrix, the batch driver, chunked integration and every error path of the driver.
 
+mod common;
+
+use common::order;
 use lieflow::integrate::{check_state, integrate, integrate_batch, Problem, System, Trajectory};
 use lieflow::lie::so3;
 use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
@@ -17,16 +20,6 @@ fn row_major(r: &Matrix3<f64>) -> [f64; 9] {
         }
     }
     o
-}
-
-/// The nominal order of the method called `name` in the system's catalog.
-fn order<S: System + ?Sized>(sys: &S, name: &str) -> u32 {
-    sys.methods()
-        .into_iter()
-        .find(|(n, _)| *n == name)
-        .unwrap_or_else(|| panic!("{} has no method {name:?}", sys.name()))
-        .1
-        .order
 }
 
 fn max_rel_drift<S: Problem>(s: &S, traj: &Trajectory, k: usize) -> f64 {

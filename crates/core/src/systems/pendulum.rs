@@ -22,17 +22,18 @@ use crate::integrate::problem::{Canonical, Separable, VectorField, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 
-/// A planar pendulum with mass m, length l and gravity g; state z = (q, p).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Pendulum {
-    mass: f64,
-    length: f64,
-    gravity: f64,
+/// The parameters every pendulum shares: a bob of mass m > 0 on a massless rod of length l > 0 in
+/// gravity g ≥ 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Bob {
+    pub(crate) mass: f64,
+    pub(crate) length: f64,
+    pub(crate) gravity: f64,
 }
 
-impl Pendulum {
-    /// m > 0, l > 0, g ≥ 0.
-    pub fn new(mass: f64, length: f64, gravity: f64) -> Result<Self> {
+impl Bob {
+    /// Checked parameters.
+    pub(crate) fn new(mass: f64, length: f64, gravity: f64) -> Result<Self> {
         check::positive("mass", mass)?;
         check::positive("length", length)?;
         if !(gravity.is_finite() && gravity >= 0.0) {
@@ -41,19 +42,36 @@ impl Pendulum {
                 format!("expected a finite number ≥ 0, got {gravity}"),
             ));
         }
-        Ok(Pendulum {
+        Ok(Bob {
             mass,
             length,
             gravity,
         })
     }
 
-    fn inertia(&self) -> f64 {
+    /// The moment of inertia m l² about the pivot.
+    pub(crate) fn inertia(&self) -> f64 {
         self.mass * self.length * self.length
     }
 
-    fn mgl(&self) -> f64 {
+    /// m g l.
+    pub(crate) fn mgl(&self) -> f64 {
         self.mass * self.gravity * self.length
+    }
+}
+
+/// A planar pendulum with mass m, length l and gravity g; state z = (q, p).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pendulum {
+    bob: Bob,
+}
+
+impl Pendulum {
+    /// m > 0, l > 0, g ≥ 0.
+    pub fn new(mass: f64, length: f64, gravity: f64) -> Result<Self> {
+        Ok(Pendulum {
+            bob: Bob::new(mass, length, gravity)?,
+        })
     }
 
     /// The exact state (q, p) at time t of the pendulum released at rest from the angle
@@ -68,9 +86,12 @@ impl Pendulum {
         }
         let k = (0.5 * amplitude).sin();
         let m = k * k;
-        let w = (self.gravity / self.length).sqrt();
+        let w = (self.bob.gravity / self.bob.length).sqrt();
         let (sn, cn, _) = ellipj(ellipk(m)? - w * t, m)?;
-        Ok([2.0 * (k * sn).asin(), -2.0 * self.inertia() * k * w * cn])
+        Ok([
+            2.0 * (k * sn).asin(),
+            -2.0 * self.bob.inertia() * k * w * cn,
+        ])
     }
 }
 
@@ -100,12 +121,12 @@ impl Canonical for Pendulum {
         1
     }
     fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
-        0.5 * p[0] * p[0] / self.inertia() - self.mgl() * q[0].cos()
+        0.5 * p[0] * p[0] / self.bob.inertia() - self.bob.mgl() * q[0].cos()
     }
     /// ∂H/∂q = mgl sin q, ∂H/∂p = p/(ml²).
     fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
-        hq[0] = self.mgl() * q[0].sin();
-        hp[0] = p[0] / self.inertia();
+        hq[0] = self.bob.mgl() * q[0].sin();
+        hp[0] = p[0] / self.bob.inertia();
     }
 }
 
@@ -117,11 +138,11 @@ impl Separable for Pendulum {
     }
     /// v = p/(ml²).
     fn velocity(&self, p: &[f64], v: &mut [f64]) {
-        v[0] = p[0] / self.inertia();
+        v[0] = p[0] / self.bob.inertia();
     }
     /// f = −mgl sin q.
     fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) -> std::result::Result<(), Violation> {
-        f[0] = -self.mgl() * q[0].sin();
+        f[0] = -self.bob.mgl() * q[0].sin();
         Ok(())
     }
 }
@@ -129,8 +150,8 @@ impl Separable for Pendulum {
 impl VectorField for Pendulum {
     /// q̇ = p/(ml²), ṗ = −mgl sin q.
     fn field(&self, z: &[f64], dz: &mut [f64]) {
-        dz[0] = z[1] / self.inertia();
-        dz[1] = -self.mgl() * z[0].sin();
+        dz[0] = z[1] / self.bob.inertia();
+        dz[1] = -self.bob.mgl() * z[0].sin();
     }
 }
 

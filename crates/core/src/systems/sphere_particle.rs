@@ -12,6 +12,7 @@
 //! L = q × p ([`SphereParticle::from_spherical`], [`SphereParticle::to_spherical`]): since L ⊥ u,
 //! p = m l u̇ = L × u / l, and |p|²/(2m) = |L|²/(2ml²).
 
+use super::pendulum::Bob;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::Rattle;
@@ -26,26 +27,14 @@ pub const CONSTRAINT_TOL: f64 = 1e-10;
 /// A particle of mass m on the sphere of radius l in gravity g; state z = (q, p).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SphereParticle {
-    mass: f64,
-    length: f64,
-    gravity: f64,
+    bob: Bob,
 }
 
 impl SphereParticle {
     /// m > 0, l > 0, g ≥ 0.
     pub fn new(mass: f64, length: f64, gravity: f64) -> Result<Self> {
-        check::positive("mass", mass)?;
-        check::positive("length", length)?;
-        if !(gravity.is_finite() && gravity >= 0.0) {
-            return Err(Error::invalid(
-                "gravity",
-                format!("expected a finite number ≥ 0, got {gravity}"),
-            ));
-        }
         Ok(SphereParticle {
-            mass,
-            length,
-            gravity,
+            bob: Bob::new(mass, length, gravity)?,
         })
     }
 
@@ -56,8 +45,8 @@ impl SphereParticle {
         check::finite_slice("spherical-pendulum state (u, L)", z)?;
         let u = Vector3::from_column_slice(&z[..3]);
         let l = Vector3::from_column_slice(&z[3..]);
-        let q = u * self.length;
-        let p = l.cross(&u) / self.length;
+        let q = u * self.bob.length;
+        let p = l.cross(&u) / self.bob.length;
         Ok([q.as_slice(), p.as_slice()].concat())
     }
 
@@ -66,7 +55,7 @@ impl SphereParticle {
         check::len_of("state (q, p)", z, 6)?;
         let q = Vector3::from_column_slice(&z[..3]);
         let p = Vector3::from_column_slice(&z[3..]);
-        Ok([(q / self.length).as_slice(), q.cross(&p).as_slice()].concat())
+        Ok([(q / self.bob.length).as_slice(), q.cross(&p).as_slice()].concat())
     }
 }
 
@@ -80,7 +69,7 @@ impl Problem for SphereParticle {
     /// H = |p|²/(2m) + m g q₃.
     fn energy(&self, z: &[f64]) -> Result<f64> {
         let p2: f64 = z[3..].iter().map(|x| x * x).sum();
-        Ok(0.5 * p2 / self.mass + self.mass * self.gravity * z[2])
+        Ok(0.5 * p2 / self.bob.mass + self.bob.mass * self.bob.gravity * z[2])
     }
     /// [(q × p)₃], the vertical angular momentum.
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
@@ -94,15 +83,15 @@ impl Problem for SphereParticle {
         let r = z[..3].iter().map(|x| x * x).sum::<f64>().sqrt();
         let pn = z[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
         let qp: f64 = (0..3).map(|i| z[i] * z[3 + i]).sum();
-        if (r - self.length).abs() > CONSTRAINT_TOL * self.length
-            || qp.abs() > CONSTRAINT_TOL * self.length * pn
+        if (r - self.bob.length).abs() > CONSTRAINT_TOL * self.bob.length
+            || qp.abs() > CONSTRAINT_TOL * self.bob.length * pn
         {
             return Err(Error::invalid(
                 "state",
                 format!(
                     "a sphere-particle state needs |q| = l = {} and q·p = 0; got |q| = {r}, \
                      q·p = {qp}",
-                    self.length
+                    self.bob.length
                 ),
             ));
         }
@@ -119,12 +108,12 @@ impl Separable for SphereParticle {
     /// v = p/m.
     fn velocity(&self, p: &[f64], v: &mut [f64]) {
         for (vi, pi) in v.iter_mut().zip(p) {
-            *vi = pi / self.mass;
+            *vi = pi / self.bob.mass;
         }
     }
     /// f = −m g e₃.
     fn force(&self, _q: &[f64], f: &mut [f64], _s: &mut ()) -> std::result::Result<(), Violation> {
-        f.copy_from_slice(&[0.0, 0.0, -self.mass * self.gravity]);
+        f.copy_from_slice(&[0.0, 0.0, -self.bob.mass * self.bob.gravity]);
         Ok(())
     }
 }
@@ -135,7 +124,7 @@ impl Constrained for SphereParticle {
     }
     /// g(q) = (|q|² − l²)/2.
     fn constraint(&self, q: &[f64], g: &mut [f64]) {
-        g[0] = 0.5 * (q.iter().map(|x| x * x).sum::<f64>() - self.length * self.length);
+        g[0] = 0.5 * (q.iter().map(|x| x * x).sum::<f64>() - self.bob.length * self.bob.length);
     }
     /// G(q) = qᵀ.
     fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64]) {

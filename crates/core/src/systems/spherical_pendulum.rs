@@ -19,6 +19,7 @@
 //! Splitting: the kinetic flow rotates q about the fixed L by the angle t|L|/(ml²); the potential
 //! flow kicks L ↦ L + t mgl e₃ × q. Both are exact, keep |q|², q·L and L₃ exactly.
 
+use super::pendulum::Bob;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Splitting};
@@ -33,35 +34,15 @@ pub const CONSTRAINT_TOL: f64 = 1e-10;
 /// A spherical pendulum with mass m, length l and gravity g.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SphericalPendulum {
-    mass: f64,
-    length: f64,
-    gravity: f64,
+    bob: Bob,
 }
 
 impl SphericalPendulum {
     /// m > 0, l > 0, g ≥ 0.
     pub fn new(mass: f64, length: f64, gravity: f64) -> Result<Self> {
-        check::positive("mass", mass)?;
-        check::positive("length", length)?;
-        if !(gravity.is_finite() && gravity >= 0.0) {
-            return Err(Error::invalid(
-                "gravity",
-                format!("expected a finite number ≥ 0, got {gravity}"),
-            ));
-        }
         Ok(SphericalPendulum {
-            mass,
-            length,
-            gravity,
+            bob: Bob::new(mass, length, gravity)?,
         })
-    }
-
-    fn inertia(&self) -> f64 {
-        self.mass * self.length * self.length
-    }
-
-    fn mgl(&self) -> f64 {
-        self.mass * self.gravity * self.length
     }
 
     /// The state (q, L) from spherical coordinates of 000 §5.1.1 (θ from the downward vertical):
@@ -79,7 +60,7 @@ impl SphericalPendulum {
         let q = Vector3::new(st * cp, st * sp, -ct);
         let qd = Vector3::new(ct * cp, ct * sp, st) * theta_dot
             + Vector3::new(-st * sp, st * cp, 0.0) * phi_dot;
-        let l = q.cross(&qd) * self.inertia();
+        let l = q.cross(&qd) * self.bob.inertia();
         Ok([q.as_slice(), l.as_slice()].concat())
     }
 
@@ -107,7 +88,7 @@ impl Problem for SphericalPendulum {
     /// H = |L|²/(2ml²) + mgl q₃.
     fn energy(&self, z: &[f64]) -> Result<f64> {
         let l2: f64 = z[3..].iter().map(|x| x * x).sum();
-        Ok(0.5 * l2 / self.inertia() + self.mgl() * z[2])
+        Ok(0.5 * l2 / self.bob.inertia() + self.bob.mgl() * z[2])
     }
     /// [|q|², q·L] (the Casimirs; the vertical momentum L₃ is [`Self::vertical_momentum`]).
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
@@ -151,9 +132,9 @@ impl Split for SphericalPendulum {
     }
     fn flow(&self, i: usize, tau: f64, (q, l): &mut Self::Work) {
         if i == 0 {
-            *l += Vector3::new(-q.y, q.x, 0.0) * (tau * self.mgl());
+            *l += Vector3::new(-q.y, q.x, 0.0) * (tau * self.bob.mgl());
         } else {
-            *q = crate::lie::so3::exp(&(*l * (tau / self.inertia()))) * *q;
+            *q = crate::lie::so3::exp(&(*l * (tau / self.bob.inertia()))) * *q;
         }
     }
 }
@@ -182,9 +163,9 @@ impl VectorField for SphericalPendulum {
     /// q̇ = ω × q, L̇ = mgl e₃ × q.
     fn field(&self, y: &[f64], dy: &mut [f64]) {
         let q = Vector3::from_column_slice(&y[..3]);
-        let w = Vector3::from_column_slice(&y[3..]) / self.inertia();
+        let w = Vector3::from_column_slice(&y[3..]) / self.bob.inertia();
         dy[..3].copy_from_slice(w.cross(&q).as_slice());
-        dy[3..].copy_from_slice(&[-self.mgl() * q.y, self.mgl() * q.x, 0.0]);
+        dy[3..].copy_from_slice(&[-self.bob.mgl() * q.y, self.bob.mgl() * q.x, 0.0]);
     }
 }
 

@@ -3,6 +3,7 @@
 
 pub mod group_laws;
 
+use lieflow::integrate::System;
 use lieflow::lie::gl;
 use lieflow::Mat;
 
@@ -49,4 +50,14 @@ pub fn gl_plus(n: usize, v: &[f64]) -> Mat {
 /// A rotation in SO(n): the polar factor of [`gl_plus`].
 pub fn rotation(n: usize, v: &[f64]) -> Mat {
     gl::polar(&gl_plus(n, v)).unwrap().0
+}
+
+/// The nominal order of the method called `name` in the system's catalog.
+pub fn order<S: System + ?Sized>(sys: &S, name: &str) -> u32 {
+    sys.methods()
+        .into_iter()
+        .find(|(n, _)| *n == name)
+        .unwrap_or_else(|| panic!("{} has no method {name:?}", sys.name()))
+        .1
+        .order
 }
