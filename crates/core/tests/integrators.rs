@@ -7,7 +7,7 @@ mod common;
 
 use common::order;
 use lieflow::elliptic::{ellipf, ellipj, ellipk};
-use lieflow::integrate::{integrate, Problem, System, Trajectory};
+use lieflow::integrate::{integrate, Problem, Trajectory};
 use lieflow::systems::RigidBody;
 use nalgebra::{Matrix3, Vector3};
 
