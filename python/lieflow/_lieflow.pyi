@@ -33,6 +33,7 @@ elliptic: ModuleType
 class Integration:
     """A native run in progress (from `System._start`); `advance` continues it."""
 
+    method: str
     @property
     def time(self) -> float: ...
     def advance(self, steps: int) -> tuple[F64, F64 | None]:
@@ -55,7 +56,7 @@ class System:
     def has_attitude(self) -> bool: ...
     def _normalize_state(self, state0: Any) -> tuple[F64, bool]: ...
     def _start(
-        self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, method: str,
+        self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, method: str | None,
         save_every: int, *, t0: float = 0.0, threads: int | None = None,
     ) -> Integration: ...
     def _run(

@@ -9,9 +9,10 @@ the whole run, and the result does not depend on the chunking.
 
 Protocol a system implements (``lieflow.System`` implements it once for every system):
 ``methods()`` (the first is the default), ``state_dim``, ``_normalize_state(state0) -> (z0 (b, d),
-batched)``, ``_start(z0, attitude0, dt, method, save_every, *, t0, threads) -> run`` with
-``run.advance(steps) -> (states (b, k, d), attitude (b, k, 3, 3) | None)`` (the states saved in
-those steps) and ``run.state() -> (z (b, d), attitude (b, 3, 3) | None)``, vectorised ``energy``
+batched)``, ``_start(z0, attitude0, dt, method | None, save_every, *, t0, threads) -> run`` with
+``run.method`` (the name), ``run.advance(steps) -> (states (b, k, d), attitude (b, k, 3, 3) |
+None)`` (the states saved in those steps) and ``run.state() -> (z (b, d), attitude (b, 3, 3) |
+None)``, vectorised ``energy``
 and ``invariants``/``casimirs``; optionally ``_fields(states) -> dict`` of named views and further
 observables ``NAME(states)``.
 """
@@ -131,9 +132,7 @@ def integrate(system, state0, dt, steps, method=None, save_every=1, attitude=Non
         dt = float(dt)
     except (TypeError, ValueError):
         raise InvalidArgumentError(f"invalid dt: expected a finite number > 0, got {dt!r}") from None
-    if method is None:
-        method = system.methods()[0]
-    elif not isinstance(method, str):
+    if method is not None and not isinstance(method, str):
         raise InvalidArgumentError(f"invalid method: expected a name, got {method!r}")
     z, batched = system._normalize_state(state0)
     b = z.shape[0]
@@ -146,6 +145,7 @@ def integrate(system, state0, dt, steps, method=None, save_every=1, attitude=Non
         threads = _count("threads", threads)
 
     run = system._start(z, att, dt, method, save_every, threads=threads)
+    method = run.method
     states, atts = [z[:, None, :]], [None if att is None else att[:, None]]
     bar = _Progress(steps, progress, f"{type(system).__name__} {method}")
     try:

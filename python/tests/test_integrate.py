@@ -115,6 +115,8 @@ class Recording:
         run, calls = self.inner._start(*args, **kwargs), self.calls
 
         class Run:
+            method = run.method
+
             def advance(self, steps):
                 calls.append((steps, run.time))
                 return run.advance(steps)

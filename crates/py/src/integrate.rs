@@ -31,6 +31,9 @@ type States<'py> = (Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>
 /// A native integration in progress (made by `System._start`); `advance(steps)` continues it.
 #[pyclass(module = "lieflow", name = "Integration")]
 pub struct Integration {
+    /// The method's name.
+    #[pyo3(get)]
+    method: String,
     sys: Arc<dyn System>,
     callbacks: Option<Arc<dyn Callbacks>>,
     runs: Mutex<Vec<Run>>,
@@ -62,12 +65,16 @@ impl Integration {
         z0: &ArrayIn<'_>,
         attitude0: Option<&ArrayIn<'_>>,
         dt: f64,
-        method: &str,
+        method: Option<&str>,
         save_every: i64,
         t0: f64,
         threads: Option<i64>,
     ) -> PyResult<Self> {
         let save_every = count("save_every", save_every)?;
+        let method = match method {
+            Some(m) => m,
+            None => sys.methods().first().map_or("", |(name, _)| name),
+        };
         let pool = match threads {
             None => None,
             Some(n) => {
@@ -123,6 +130,7 @@ impl Integration {
             .collect::<lieflow::Result<Vec<_>>>()
             .py()?;
         Ok(Integration {
+            method: method.to_string(),
             sys,
             callbacks,
             runs: Mutex::new(runs),

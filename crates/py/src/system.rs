@@ -252,7 +252,8 @@ impl PySystem {
     ///
     /// Args:
     ///     z0: (b, d) initial states; attitude0: (b, 3, 3) rotations or None; dt > 0; method: a
-    ///     name from `methods()`; save_every >= 1; t0 (keyword): the time of z0; threads
+    ///     name from `methods()`, or None for the first (the system's default); save_every >= 1;
+    ///     t0 (keyword): the time of z0; threads
     ///     (keyword): None for all cores, or the number of threads.
     /// Raises:
     ///     InvalidArgumentError, UnsupportedMethodError, ShapeError, NonFiniteError,
@@ -264,7 +265,7 @@ impl PySystem {
         z0: ArrayIn<'_>,
         attitude0: Option<ArrayIn<'_>>,
         dt: f64,
-        method: &str,
+        method: Option<&str>,
         save_every: i64,
         t0: f64,
         threads: Option<i64>,
@@ -305,7 +306,7 @@ impl PySystem {
         dt: f64,
         steps: i64,
         save_every: i64,
-        method: &str,
+        method: Option<&str>,
         t0: f64,
         threads: Option<i64>,
     ) -> PyResult<RunOut<'py>> {
