@@ -11,6 +11,8 @@ Systems and integration
 System                                                          base class of every system
 RigidBody, GeneralizedRigidBody, HeavyTop, SphericalPendulum   Lie–Poisson systems of 000 §3–§5
 PseudoRigidBody, potentials                                     pseudo-rigid bodies of 001
+Pendulum, SphereParticle, RollingDisk                           canonical, constrained and
+                                                                nonholonomic test problems
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``).
@@ -33,8 +35,11 @@ from ._lieflow import (
     GeneralizedRigidBody,
     HeavyTop,
     Integration,
+    Pendulum,
     PseudoRigidBody,
     RigidBody,
+    RollingDisk,
+    SphereParticle,
     SphericalPendulum,
     System,
 )
@@ -57,8 +62,11 @@ __all__ = [
     "NoUniqueLogError",
     "NonFiniteError",
     "NotInGroupError",
+    "Pendulum",
     "PseudoRigidBody",
     "RigidBody",
+    "RollingDisk",
+    "SphereParticle",
     "ShapeError",
     "SphericalPendulum",
     "System",

@@ -139,6 +139,31 @@ class SphericalPendulum(System):
         """L3: (..., 6) -> (...)."""
 
 
+class Pendulum(System):
+    """Planar pendulum in canonical coordinates (q, p); methods midpoint, gauss4, gauss6, verlet, rk4."""
+
+    def __init__(self, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> None: ...
+    def exact(self, amplitude: ArrayLike, t: ArrayLike) -> F64:
+        """(...) -> (..., 2): the elliptic solution released at rest from `amplitude`."""
+
+class SphereParticle(System):
+    """Particle on the sphere |q| = l in gravity (RATTLE)."""
+
+    def __init__(self, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> None: ...
+    def from_spherical(self, states: ArrayLike) -> F64:
+        """SphericalPendulum states (..., 6) -> (q, p) (..., 6)."""
+
+class RollingDisk(System):
+    """Vertical rolling disk (nonholonomic)."""
+
+    def __init__(
+        self, mass: float, radius: float, roll_inertia: float, turn_inertia: float,
+        spring: float = 0.0, tilt: float = 0.0,
+    ) -> None: ...
+    def state(self, q: ArrayLike, theta_dot: float, phi_dot: float) -> list[float]: ...
+    def constraint_residual(self, states: ArrayLike) -> F64 | float: ...
+
+
 # --- the pseudo-rigid body on T*GL+(n): z = (X row-major, P row-major), d = 2 n^2 ---
 
 

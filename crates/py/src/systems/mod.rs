@@ -1,9 +1,12 @@
-//! The Lie–Poisson system classes (bindings of `lieflow::systems`, 000 §3–§5): `RigidBody`,
-//! `GeneralizedRigidBody`, `HeavyTop`, `SphericalPendulum`, thin subclasses of `lieflow.System`,
-//! and the helpers the bodies on SO(3) share.
+//! The system classes of `lieflow::systems`: the Lie–Poisson systems of 000 §3–§5 (`RigidBody`,
+//! `GeneralizedRigidBody`, `HeavyTop`, `SphericalPendulum`) and the test problems of the
+//! mechanics core (`Pendulum`, `SphereParticle`, `RollingDisk`), thin subclasses of
+//! `lieflow.System`, and the helpers the bodies on SO(3) share.
 
 mod heavy_top;
+mod pendulum;
 mod rigid_body;
+mod rolling_disk;
 mod spherical_pendulum;
 
 use lieflow::systems::RigidBody;
@@ -67,5 +70,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<rigid_body::PyGeneralizedRigidBody>()?;
     m.add_class::<heavy_top::PyHeavyTop>()?;
     m.add_class::<spherical_pendulum::PySphericalPendulum>()?;
+    m.add_class::<pendulum::PyPendulum>()?;
+    m.add_class::<pendulum::PySphereParticle>()?;
+    m.add_class::<rolling_disk::PyRollingDisk>()?;
     Ok(())
 }

@@ -1,0 +1,119 @@
+//! `Pendulum` and `SphereParticle`: bindings of `lieflow::systems::{pendulum, sphere_particle}`,
+//! the canonical and the holonomically constrained test problems of the mechanics core. Thin
+//! subclasses of `lieflow.System`.
+
+use lieflow::systems as core;
+use pyo3::prelude::*;
+use pyo3::PyClassInitializer;
+
+use crate::convert::ArrayIn;
+use crate::errors::IntoPy;
+use crate::items::{map_items, Input};
+use crate::system::PySystem;
+
+/// A planar pendulum in canonical coordinates: q the angle from the downward vertical,
+/// p = m l^2 dq/dt, H = p^2 / (2 m l^2) - m g l cos q. State (q, p); fields q, p.
+/// Methods: midpoint (the implicit midpoint rule, Gauss(1)), gauss4, gauss6 (symplectic
+/// Gauss–Legendre), verlet, rk4.
+///
+/// Args:
+///     mass > 0, length > 0, g >= 0.
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "Pendulum", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyPendulum {
+    pendulum: core::Pendulum,
+}
+
+#[pymethods]
+impl PyPendulum {
+    #[new]
+    #[pyo3(signature = (mass = 1.0, length = 1.0, g = 9.81))]
+    fn new(py: Python<'_>, mass: f64, length: f64, g: f64) -> PyResult<PyClassInitializer<Self>> {
+        let pendulum = core::Pendulum::new(mass, length, g).py()?;
+        let args = (mass, length, g).into_pyobject(py)?;
+        let base = PySystem::new(pendulum.clone(), args, &["mass", "length", "g"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PyPendulum { pendulum }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> (f64,) {
+        (1.0,)
+    }
+
+    /// The exact state (q, p) at times t of the pendulum released at rest from the angle
+    /// `amplitude` (|amplitude| < pi), by Jacobi elliptic functions; broadcast: (...) -> (..., 2).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError, NonFiniteError, ShapeError.
+    fn exact<'py>(
+        &self,
+        py: Python<'py>,
+        amplitude: ArrayIn<'py>,
+        t: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let inputs = [
+            Input::new("amplitude", &amplitude, &[]),
+            Input::new("t", &t, &[]),
+        ];
+        map_items(py, &inputs, &[2], |x, out| {
+            out.copy_from_slice(&self.pendulum.exact(x[0][0], x[1][0])?);
+            Ok(())
+        })
+    }
+}
+
+/// A particle of mass m on the sphere |q| = l in gravity g (the spherical pendulum in Cartesian
+/// coordinates), H = |p|^2 / (2m) + m g q3 with the constraint (|q|^2 - l^2) / 2 = 0. State
+/// (q, p) with |q| = l and q . p = 0; fields q, p. Invariant: the vertical angular momentum
+/// (q x p)_3. Method: rattle (RATTLE: constraints kept to round-off, symplectic).
+///
+/// Args:
+///     mass > 0, length > 0, g >= 0.
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "SphereParticle", module = "lieflow", extends = PySystem, frozen)]
+pub struct PySphereParticle {
+    particle: core::SphereParticle,
+}
+
+#[pymethods]
+impl PySphereParticle {
+    #[new]
+    #[pyo3(signature = (mass = 1.0, length = 1.0, g = 9.81))]
+    fn new(py: Python<'_>, mass: f64, length: f64, g: f64) -> PyResult<PyClassInitializer<Self>> {
+        let particle = core::SphereParticle::new(mass, length, g).py()?;
+        let args = (mass, length, g).into_pyobject(py)?;
+        let base = PySystem::new(particle.clone(), args, &["mass", "length", "g"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PySphereParticle { particle }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> (f64,) {
+        (1.0,)
+    }
+
+    /// States (q, p) of `SphericalPendulum` states (u, L) with the same m, l, g:
+    /// (..., 6) -> (..., 6).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    #[pyo3(name = "from_spherical")]
+    fn spherical_to_cartesian<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        map_items(
+            py,
+            &[Input::new("states", &states, &[6])],
+            &[6],
+            |z, out| {
+                out.copy_from_slice(&self.particle.from_spherical(z[0])?);
+                Ok(())
+            },
+        )
+    }
+}

@@ -1,0 +1,87 @@
+//! `RollingDisk`: binding of `lieflow::systems::rolling_disk`, the nonholonomic test problem of
+//! the mechanics core. A thin subclass of `lieflow.System`.
+
+use lieflow::systems as core;
+use pyo3::prelude::*;
+use pyo3::PyClassInitializer;
+
+use crate::convert::ArrayIn;
+use crate::errors::IntoPy;
+use crate::items::{map_items, Input};
+use crate::system::PySystem;
+
+/// The vertical rolling disk (Bloch, Nonholonomic Mechanics and Control, §1.4): q = (x, y,
+/// theta, phi) (contact point, rolling angle, heading), p = M dq/dt with
+/// M = diag(m, m, I, J), rolling without slipping dx/dt = R cos(phi) dtheta/dt,
+/// dy/dt = R sin(phi) dtheta/dt, in the potential U = spring (1 - cos phi) + m tilt x.
+/// State (q, p); fields q, p. Method: nonholonomic (a reversible discrete Lagrange–d'Alembert
+/// method of RATTLE type; the constraints hold to round-off at every step).
+///
+/// Args:
+///     mass, radius, roll_inertia, turn_inertia > 0; spring, tilt finite (default 0).
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "RollingDisk", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyRollingDisk {
+    disk: core::RollingDisk,
+}
+
+#[pymethods]
+impl PyRollingDisk {
+    #[new]
+    #[pyo3(signature = (mass, radius, roll_inertia, turn_inertia, spring = 0.0, tilt = 0.0))]
+    fn new(
+        py: Python<'_>,
+        mass: f64,
+        radius: f64,
+        roll_inertia: f64,
+        turn_inertia: f64,
+        spring: f64,
+        tilt: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let disk = core::RollingDisk::new(mass, radius, roll_inertia, turn_inertia)
+            .and_then(|d| d.with_potential(spring, tilt))
+            .py()?;
+        let args = (mass, radius, roll_inertia, turn_inertia, spring, tilt).into_pyobject(py)?;
+        let names = &[
+            "mass",
+            "radius",
+            "roll_inertia",
+            "turn_inertia",
+            "spring",
+            "tilt",
+        ];
+        let base = PySystem::new(disk.clone(), args, names);
+        Ok(PyClassInitializer::from(base).add_subclass(PyRollingDisk { disk }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> (f64, f64, f64, f64) {
+        (1.0, 1.0, 1.0, 1.0)
+    }
+
+    /// The state (q, p) rolling with the rates dtheta/dt, dphi/dt from q = (x, y, theta, phi).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn state(&self, q: [f64; 4], theta_dot: f64, phi_dot: f64) -> PyResult<Vec<f64>> {
+        self.disk.state(q, theta_dot, phi_dot).py()
+    }
+
+    /// The relative residual |A(q) M^-1 p| / |M^-1 p| of the rolling constraints, vectorised:
+    /// (..., 8) -> (...).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn constraint_residual<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        map_items(py, &[Input::new("states", &states, &[8])], &[], |z, out| {
+            out[0] = self.disk.constraint_residual(z[0])?;
+            Ok(())
+        })
+    }
+}
