@@ -406,6 +406,15 @@ impl Potential for General {
     ) {
         self.0.add_gradient(x, out, ws)
     }
+    fn add_hessian(
+        &self,
+        x: faer::MatRef<'_, f64>,
+        v: faer::MatRef<'_, f64>,
+        out: faer::MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        self.0.add_hessian(x, v, out, ws)
+    }
     fn needs_positive_det(&self) -> bool {
         self.0.needs_positive_det()
     }

@@ -11,9 +11,13 @@
 //! - [`SaintVenantKirchhoff`]: U = (λ/2)(tr E)² + μ tr(E²), E = ½(XᵀX − I);
 //! - [`Volumetric`]: the polytropic gas U = κ (det(X)^{1−γ} − 1)/(γ − 1) (γ > 1), and its γ → 1
 //!   limit U = −κ ln det X (isothermal);
+//! - [`Stretch`]: the isotropic quadratic stretch energy U = (k/2) Σ_i (σ_i(X) − 1)²;
 //! - [`Sum`] of potentials, and [`Zero`] (the free body).
 //!
-//! The checked entry points for single evaluations are [`value`] and [`gradient`].
+//! Every potential also has an analytic Hessian, as the directional second derivative
+//! D²U(X)\[V\] = d/dε ∂U/∂X(X + εV)|_{ε=0} ([`Potential::add_hessian`]), used for the stability of
+//! relative equilibria (001 §8). The checked entry points for single evaluations are [`value`],
+//! [`gradient`], [`hessian_product`] and [`hessian`] (the n²×n² matrix).
 
 use crate::check;
 use crate::error::{Error, Result};
@@ -31,6 +35,7 @@ use std::sync::Arc;
 pub struct Workspace {
     n: usize,
     tmp: Mat,
+    tmp2: Mat,
     lu: Mat,
     perm_fwd: Vec<usize>,
     perm_bwd: Vec<usize>,
@@ -55,6 +60,7 @@ impl Workspace {
         Workspace {
             n,
             tmp: Mat::zeros(n, n),
+            tmp2: Mat::zeros(n, n),
             lu: Mat::zeros(n, n),
             perm_fwd: vec![0; n],
             perm_bwd: vec![0; n],
@@ -68,7 +74,7 @@ impl Workspace {
     }
 }
 
-/// A potential energy U(X) on n×n matrices (001 §4.1), with its gradient ∂U/∂X.
+/// A potential energy U(X) on n×n matrices (001 §4.1), with its gradient ∂U/∂X and Hessian.
 ///
 /// Implementations are kernels for hot loops: they assume `x` is n×n with n = `ws.n()`, finite,
 /// and (if [`Potential::needs_positive_det`]) det X > 0; they do not check and do not allocate.
@@ -79,6 +85,20 @@ pub trait Potential: Send + Sync + Debug {
 
     /// Adds ∂U/∂X (the gradient for the pairing tr(AᵀB)) to `out`.
     fn add_gradient(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>, ws: &mut Workspace);
+
+    /// Adds the Hessian applied to V, D²U(X)\[V\] = d/dε ∂U/∂X(X + εV)|_{ε=0}, to `out`: the
+    /// matrix H with ⟨W, H⟩ = D²U(X)\[V, W\] for the pairing tr(AᵀB), symmetric in V and W.
+    ///
+    /// Required, so that no potential is without a Hessian silently; implementations give it
+    /// analytically (a Python callable without one falls back to finite differences, documented
+    /// there). `v` is n×n like `x`.
+    fn add_hessian(
+        &self,
+        x: MatRef<'_, f64>,
+        v: MatRef<'_, f64>,
+        out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    );
 
     /// Whether U is defined only on GL⁺(n) (det X > 0). Integrators then always check det X.
     fn needs_positive_det(&self) -> bool {
@@ -128,6 +148,47 @@ pub fn gradient(pot: &dyn Potential, x: &Mat) -> Result<Mat> {
     Ok(g)
 }
 
+/// The Hessian applied to a direction, D²U(X)\[V\] = d/dε ∂U/∂X(X + εV)|_{ε=0}
+/// ([`Potential::add_hessian`]), checked like [`value`]; V must be n×n and finite.
+pub fn hessian_product(pot: &dyn Potential, x: &Mat, v: &Mat) -> Result<Mat> {
+    let n = check::square("X", x, 2)?;
+    check::square_of("V", v, n)?;
+    let mut ws = Workspace::new(n);
+    check_point(pot, x, &mut ws)?;
+    let mut h = Mat::zeros(n, n);
+    pot.add_hessian(x.as_ref(), v.as_ref(), h.as_mut(), &mut ws);
+    Ok(h)
+}
+
+/// The Hessian of U at X as an n²×n² matrix in the row-major vec(X) basis: entry
+/// (p·n + q, i·n + j) is ∂²U/∂X_pq∂X_ij, i.e. column i·n + j is D²U(X)\[E_ij\] (E_ij the unit
+/// matrix with 1 at (i, j)) flattened row-major. Symmetric. Checked like [`value`], and refused
+/// with [`Error::InvalidArgument`] when n⁴ exceeds [`check::MAX_DENSE_ENTRIES`].
+pub fn hessian(pot: &dyn Potential, x: &Mat) -> Result<Mat> {
+    let n = check::square("X", x, 2)?;
+    let m = n.saturating_mul(n);
+    check::dense_size("Hessian", m, m)?;
+    let mut ws = Workspace::new(n);
+    check_point(pot, x, &mut ws)?;
+    let mut h = Mat::zeros(m, m);
+    let mut e = Mat::zeros(n, n);
+    let mut col = Mat::zeros(n, n);
+    for i in 0..n {
+        for j in 0..n {
+            e[(i, j)] = 1.0;
+            col.fill(0.0);
+            pot.add_hessian(x.as_ref(), e.as_ref(), col.as_mut(), &mut ws);
+            e[(i, j)] = 0.0;
+            for p in 0..n {
+                for q in 0..n {
+                    h[(p * n + q, i * n + j)] = col[(p, q)];
+                }
+            }
+        }
+    }
+    Ok(h)
+}
+
 /// U = 0: the free pseudo-rigid body, whose motions are straight lines X(t) = X₀ + tP₀.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Zero;
@@ -137,12 +198,21 @@ impl Potential for Zero {
         0.0
     }
     fn add_gradient(&self, _x: MatRef<'_, f64>, _out: MatMut<'_, f64>, _ws: &mut Workspace) {}
+    fn add_hessian(
+        &self,
+        _x: MatRef<'_, f64>,
+        _v: MatRef<'_, f64>,
+        _out: MatMut<'_, f64>,
+        _ws: &mut Workspace,
+    ) {
+    }
     fn gradient3(&self, _x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         Some(Matrix3::zeros())
     }
 }
 
-/// Harmonic (isotropic linear-spring) potential U = (k/2) tr(XᵀX), ∂U/∂X = kX; 000 §5.3.
+/// Harmonic (isotropic linear-spring) potential U = (k/2) tr(XᵀX), ∂U/∂X = kX, D²U\[V\] = kV;
+/// 000 §5.3.
 ///
 /// Its motions are X(t) = X₀ cos ωt + (P₀/ω) sin ωt with ω = √k.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,6 +239,15 @@ impl Potential for Harmonic {
     fn add_gradient(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>, _ws: &mut Workspace) {
         axpy(out, self.k, x);
     }
+    fn add_hessian(
+        &self,
+        _x: MatRef<'_, f64>,
+        v: MatRef<'_, f64>,
+        out: MatMut<'_, f64>,
+        _ws: &mut Workspace,
+    ) {
+        axpy(out, self.k, v);
+    }
     fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         Some(x * self.k)
     }
@@ -180,6 +259,9 @@ impl Potential for Harmonic {
 /// ∂U/∂X = X S with the second Piola–Kirchhoff stress S = λ (tr E) I + 2μE (derived from
 /// dE = ½(dXᵀX + XᵀdX)). Since tr E and tr E² depend on XᵀX only through its eigenvalues a_i²,
 /// U = U(A) is SO(n)×SO(n)-invariant (001 §4.1).
+///
+/// Hessian: with C = XᵀX, S = μC + (λ tr E − μ)I, dC\[V\] = VᵀX + XᵀV and d tr E\[V\] = tr(XᵀV),
+/// D²U(X)\[V\] = V S + X (μ(VᵀX + XᵀV) + λ tr(XᵀV) I).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SaintVenantKirchhoff {
     lambda: f64,
@@ -223,6 +305,19 @@ impl SaintVenantKirchhoff {
         }
         (tr, tr2)
     }
+
+    /// Writes the second Piola–Kirchhoff stress S = λ tr(E) I + 2μE = μC + (λ tr E − μ)I into
+    /// `ws.tmp`.
+    fn stress(&self, x: MatRef<'_, f64>, ws: &mut Workspace) {
+        let (tr, _) = Self::strain(x, ws);
+        let n = x.nrows();
+        for j in 0..n {
+            for i in 0..n {
+                ws.tmp[(i, j)] *= self.mu;
+            }
+            ws.tmp[(j, j)] += self.lambda * tr - self.mu;
+        }
+    }
 }
 
 impl Potential for SaintVenantKirchhoff {
@@ -231,14 +326,24 @@ impl Potential for SaintVenantKirchhoff {
         0.5 * self.lambda * tr * tr + self.mu * tr2
     }
     fn add_gradient(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>, ws: &mut Workspace) {
-        let (tr, _) = Self::strain(x, ws);
-        // S = λ tr(E) I + 2μE = λ tr(E) I + μ(C − I), written over C.
-        let n = x.nrows();
-        for j in 0..n {
-            for i in 0..n {
-                ws.tmp[(i, j)] *= self.mu;
-            }
-            ws.tmp[(j, j)] += self.lambda * tr - self.mu;
+        self.stress(x, ws);
+        mul(out, Accum::Add, x, ws.tmp.as_ref(), 1.0);
+    }
+    fn add_hessian(
+        &self,
+        x: MatRef<'_, f64>,
+        v: MatRef<'_, f64>,
+        mut out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        // V S, then X dS with dS = μ(VᵀX + XᵀV) + λ tr(XᵀV) I.
+        self.stress(x, ws);
+        mul(out.as_mut(), Accum::Add, v, ws.tmp.as_ref(), 1.0);
+        let dtr = inner(x, v);
+        mul(ws.tmp.as_mut(), Accum::Replace, v.transpose(), x, self.mu);
+        mul(ws.tmp.as_mut(), Accum::Add, x.transpose(), v, self.mu);
+        for i in 0..x.nrows() {
+            ws.tmp[(i, i)] += self.lambda * dtr;
         }
         mul(out, Accum::Add, x, ws.tmp.as_ref(), 1.0);
     }
@@ -262,6 +367,9 @@ impl Potential for SaintVenantKirchhoff {
 /// ∂U/∂X = −κ det(X)^{−γ} cof(X) = −κ det(X)^{1−γ} X⁻ᵀ (from ∂ det/∂X = det(X) X⁻ᵀ = cof X).
 /// U → +∞ as det X → 0⁺, so this term keeps bodies from collapsing. Defined on GL⁺(n) only:
 /// [`Potential::value`] returns +∞ for det X ≤ 0 and integrators always check det X.
+///
+/// Hessian, from d(det^{1−γ})\[V\] = (1−γ) det(X)^{1−γ} tr(X⁻¹V) and dX⁻ᵀ\[V\] = −X⁻ᵀVᵀX⁻ᵀ:
+/// D²U(X)\[V\] = κ det(X)^{1−γ} (X⁻ᵀVᵀX⁻ᵀ − (1−γ) tr(X⁻¹V) X⁻ᵀ) (NaN for det X ≤ 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Volumetric {
     kappa: f64,
@@ -313,6 +421,37 @@ impl Potential for Volumetric {
         axpy(out, scale, cof.as_ref());
         ws.tmp = cof;
     }
+    fn add_hessian(
+        &self,
+        x: MatRef<'_, f64>,
+        v: MatRef<'_, f64>,
+        mut out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        // Over cof X = det(X) X⁻ᵀ: D²U[V] = κ det^{−1−γ} (cof Vᵀ cof − (1−γ)⟨cof, V⟩ cof),
+        // since tr(X⁻¹V) = ⟨X⁻ᵀ, V⟩.
+        let mut cof = std::mem::replace(&mut ws.tmp, Mat::new());
+        let d = det_cofactor(x, cof.as_mut(), ws);
+        let c = if d > 0.0 {
+            self.kappa * d.powf(-1.0 - self.gamma)
+        } else {
+            f64::NAN
+        };
+        mul(
+            ws.tmp2.as_mut(),
+            Accum::Replace,
+            v.transpose(),
+            cof.as_ref(),
+            1.0,
+        );
+        mul(out.as_mut(), Accum::Add, cof.as_ref(), ws.tmp2.as_ref(), c);
+        axpy(
+            out,
+            -c * (1.0 - self.gamma) * inner(cof.as_ref(), v),
+            cof.as_ref(),
+        );
+        ws.tmp = cof;
+    }
     fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         // cof X = (adj X)ᵀ, by cross products of the columns; det X = ⟨x₀, x₁ × x₂⟩.
         let (c0, c1, c2) = (x.column(0), x.column(1), x.column(2));
@@ -328,6 +467,120 @@ impl Potential for Volumetric {
     }
     fn needs_positive_det(&self) -> bool {
         true
+    }
+}
+
+/// Isotropic quadratic stretch energy U = (k/2) Σ_i (σ_i(X) − 1)² over the singular values σ_i
+/// of X: zero exactly on the rotations, a function of the singular values only, hence
+/// SO(n)×SO(n)-invariant (001 §4.1, U = U(A)).
+///
+/// Gradient, from the SVD X = R diag(σ) Sᵀ (R, S ∈ O(n); dσ_i\[V\] = (RᵀVS)_ii):
+/// ∂U/∂X = R diag(k(σ − 1)) Sᵀ = k(X − RSᵀ). On GL⁺(n) the orthogonal factor RSᵀ is the polar
+/// rotation polar(X) = X(XᵀX)^{−1/2}, so ∂U/∂X = k(X − polar X).
+///
+/// Hessian: the derivative of the polar factor is d(RSᵀ)\[V\] = R Ω Sᵀ with Ω skew solving
+/// Ωdiag(σ) + diag(σ)Ω = M − Mᵀ, M = RᵀVS (differentiate X = (RSᵀ)P with P symmetric), i.e.
+/// Ω_ij = (M_ij − M_ji)/(σ_i + σ_j); so D²U(X)\[V\] = k(V − R Ω Sᵀ).
+///
+/// The SVD form is defined for every X (so [`Potential::needs_positive_det`] is false), but U is
+/// smooth only where all σ_i > 0 (det X ≠ 0; Σ σ_i, the nuclear norm, has a kink at singular X)
+/// and the Hessian formula needs σ_i + σ_j > 0 for i ≠ j. Coincident σ_i are fine (the
+/// orthogonal polar factor is unique for invertible X even where the SVD is not). Each
+/// evaluation computes a faer SVD, which allocates (the n = 3 gradient uses nalgebra's
+/// stack-allocated SVD).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stretch {
+    k: f64,
+}
+
+impl Stretch {
+    /// Stiffness k > 0 (finite).
+    pub fn new(k: f64) -> Result<Self> {
+        check::positive("k", k)?;
+        Ok(Stretch { k })
+    }
+    /// The stiffness k.
+    pub fn k(&self) -> f64 {
+        self.k
+    }
+}
+
+/// The SVD X = R diag(σ) Sᵀ (faer; R, S orthogonal, σ nonnegative and non-increasing), or `None`
+/// if it does not converge.
+fn svd_of(x: MatRef<'_, f64>) -> Option<(Mat, Vec<f64>, Mat)> {
+    let svd = x.svd().ok()?;
+    let sigma = svd.S().column_vector().iter().copied().collect();
+    Some((svd.U().to_owned(), sigma, svd.V().to_owned()))
+}
+
+impl Potential for Stretch {
+    fn value(&self, x: MatRef<'_, f64>, _ws: &mut Workspace) -> f64 {
+        match x.singular_values() {
+            Ok(sigma) => 0.5 * self.k * sigma.iter().map(|s| (s - 1.0) * (s - 1.0)).sum::<f64>(),
+            Err(_) => f64::NAN,
+        }
+    }
+    fn add_gradient(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>, ws: &mut Workspace) {
+        let Some((r, sigma, s)) = svd_of(x) else {
+            out.fill(f64::NAN);
+            return;
+        };
+        // out += R diag(k(σ − 1)) Sᵀ.
+        let n = x.nrows();
+        for j in 0..n {
+            for i in 0..n {
+                ws.tmp[(i, j)] = r[(i, j)] * self.k * (sigma[j] - 1.0);
+            }
+        }
+        mul(out, Accum::Add, ws.tmp.as_ref(), s.transpose(), 1.0);
+    }
+    fn add_hessian(
+        &self,
+        x: MatRef<'_, f64>,
+        v: MatRef<'_, f64>,
+        mut out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        let Some((r, sigma, s)) = svd_of(x) else {
+            out.fill(f64::NAN);
+            return;
+        };
+        // M = RᵀVS in ws.tmp; Ω_ij = (M_ij − M_ji)/(σ_i + σ_j) in ws.tmp2.
+        let n = x.nrows();
+        mul(ws.tmp2.as_mut(), Accum::Replace, r.transpose(), v, 1.0);
+        mul(
+            ws.tmp.as_mut(),
+            Accum::Replace,
+            ws.tmp2.as_ref(),
+            s.as_ref(),
+            1.0,
+        );
+        for j in 0..n {
+            ws.tmp2[(j, j)] = 0.0;
+            for i in 0..j {
+                let w = (ws.tmp[(i, j)] - ws.tmp[(j, i)]) / (sigma[i] + sigma[j]);
+                ws.tmp2[(i, j)] = w;
+                ws.tmp2[(j, i)] = -w;
+            }
+        }
+        // out += k(V − R Ω Sᵀ).
+        axpy(out.as_mut(), self.k, v);
+        mul(
+            ws.tmp.as_mut(),
+            Accum::Replace,
+            r.as_ref(),
+            ws.tmp2.as_ref(),
+            1.0,
+        );
+        mul(out, Accum::Add, ws.tmp.as_ref(), s.transpose(), -self.k);
+    }
+    fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        // The same R diag(k(σ − 1)) Sᵀ with nalgebra's 3×3 SVD (None, i.e. the general kernel,
+        // if it does not converge).
+        let svd = x.try_svd(true, true, f64::EPSILON, 1000)?;
+        let (r, st) = (svd.u?, svd.v_t?);
+        let d = svd.singular_values.map(|s| self.k * (s - 1.0));
+        Some(r * Matrix3::from_diagonal(&d) * st)
     }
 }
 
@@ -357,6 +610,17 @@ impl Potential for Sum {
             t.add_gradient(x, out.as_mut(), ws);
         }
     }
+    fn add_hessian(
+        &self,
+        x: MatRef<'_, f64>,
+        v: MatRef<'_, f64>,
+        mut out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        for t in &self.terms {
+            t.add_hessian(x, v, out.as_mut(), ws);
+        }
+    }
     fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         let mut g = Matrix3::zeros();
         for t in &self.terms {
@@ -382,6 +646,17 @@ pub(crate) fn frob2(x: MatRef<'_, f64>) -> f64 {
     for j in 0..x.ncols() {
         for i in 0..x.nrows() {
             s += x[(i, j)] * x[(i, j)];
+        }
+    }
+    s
+}
+
+/// ⟨A, B⟩ = tr(AᵀB).
+pub(crate) fn inner(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {
+    let mut s = 0.0;
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            s += a[(i, j)] * b[(i, j)];
         }
     }
     s

@@ -6,8 +6,8 @@ use std::fmt;
 use std::sync::{Arc, Mutex};
 
 use lieflow::pseudo_rigid::potential::{
-    self as pot, Harmonic as CoreHarmonic, SaintVenantKirchhoff as CoreSvk, Sum,
-    Volumetric as CoreVolumetric, Workspace, Zero as CoreZero,
+    self as pot, Harmonic as CoreHarmonic, SaintVenantKirchhoff as CoreSvk, Stretch as CoreStretch,
+    Sum, Volumetric as CoreVolumetric, Workspace, Zero as CoreZero,
 };
 use lieflow::{Error, Mat};
 use numpy::PyArray2;
@@ -19,8 +19,8 @@ use crate::errors::{to_py, IntoPy};
 use crate::system::Callbacks;
 
 /// An SO(n)×SO(n)-invariant potential U(X) of a pseudo-rigid body (001 §4.1). Build one with
-/// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Zero()` or
-/// `Callable(U, grad_U)`; add potentials with `+`.
+/// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Stretch(k)`,
+/// `Zero()` or `Callable(U, grad_U, hess_U=None)`; add potentials with `+`.
 #[pyclass(module = "lieflow.potentials", frozen, name = "Potential")]
 #[derive(Clone)]
 pub struct PyPotential {
@@ -52,6 +52,23 @@ impl PyPotential {
         let g = pot::gradient(&*self.inner, &mat("X", &X)?).py()?;
         self.take_callback_error()?;
         Ok(py_mat(py, &g))
+    }
+
+    /// The Hessian of U at X applied to a direction V, D²U(X)[V] = d/de dU/dX(X + e V) at e = 0,
+    /// as an (n, n) array H with sum(W * H) = D²U(X)[V, W] (symmetric in V and W).
+    ///
+    /// Raises:
+    ///     ShapeError (X not square, V not of the shape of X), NonFiniteError,
+    ///     NotInGroupError (det X <= 0 for a volumetric term).
+    fn hessian<'py>(
+        &self,
+        py: Python<'py>,
+        X: ArrayIn<'py>,
+        V: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let h = pot::hessian_product(&*self.inner, &mat("X", &X)?, &mat("V", &V)?).py()?;
+        self.take_callback_error()?;
+        Ok(py_mat(py, &h))
     }
 
     /// The sum of two potentials.
@@ -107,6 +124,8 @@ impl PyPotential {
 pub(crate) struct CallablePotential {
     value: Py<PyAny>,
     gradient: Py<PyAny>,
+    /// `hessian(X, V)`, or `None` for central differences of `gradient`.
+    hessian: Option<Py<PyAny>>,
     error: Mutex<Option<PyErr>>,
 }
 
@@ -136,8 +155,37 @@ impl CallablePotential {
         f: &Py<PyAny>,
         x: faer::MatRef<'_, f64>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let m = Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)]);
-        f.bind(py).call1((py_mat(py, &m),))
+        f.bind(py).call1((py_mat(py, &x.to_owned()),))
+    }
+
+    /// Adds the (n, n) array returned by a callable (`what` names it in errors) to `out`, or
+    /// records the error and fills `out` with NaN.
+    fn add_returned(
+        &self,
+        what: &str,
+        returned: PyResult<Bound<'_, PyAny>>,
+        mut out: faer::MatMut<'_, f64>,
+    ) {
+        let n = out.nrows();
+        let m = returned.and_then(|g| {
+            let g: ArrayIn<'_> = g.extract()?;
+            let m = mat(what, &g)?;
+            if m.nrows() != n || m.ncols() != n {
+                return Err(to_py(Error::shape(
+                    what,
+                    format!("({n}, {n})"),
+                    format!("({}, {})", m.nrows(), m.ncols()),
+                )));
+            }
+            Ok(m)
+        });
+        match m {
+            Ok(m) => out += &m,
+            Err(e) => {
+                self.record(e);
+                out.fill(f64::NAN);
+            }
+        }
     }
 }
 
@@ -160,41 +208,45 @@ impl pot::Potential for CallablePotential {
     fn add_gradient(
         &self,
         x: faer::MatRef<'_, f64>,
-        mut out: faer::MatMut<'_, f64>,
+        out: faer::MatMut<'_, f64>,
         _ws: &mut Workspace,
     ) {
-        let n = x.nrows();
         Python::attach(|py| {
-            let g = self.call(py, &self.gradient, x).and_then(|g| {
-                let g: ArrayIn<'_> = g.extract()?;
-                let m = mat("gradient", &g)?;
-                if m.nrows() != n || m.ncols() != n {
-                    return Err(to_py(Error::shape(
-                        "gradient returned by the callable",
-                        format!("({n}, {n})"),
-                        format!("({}, {})", m.nrows(), m.ncols()),
-                    )));
-                }
-                Ok(m)
-            });
-            match g {
-                Ok(m) => {
-                    for i in 0..n {
-                        for j in 0..n {
-                            out[(i, j)] += m[(i, j)];
-                        }
-                    }
-                }
-                Err(e) => {
-                    self.record(e);
-                    for i in 0..n {
-                        for j in 0..n {
-                            out[(i, j)] = f64::NAN;
-                        }
-                    }
-                }
-            }
+            let g = self.call(py, &self.gradient, x);
+            self.add_returned("gradient returned by the callable", g, out);
         });
+    }
+
+    /// The `hessian(X, V)` callable if given; otherwise the central difference
+    /// (∇U(X + hV̂) − ∇U(X − hV̂)) ‖V‖/(2h) of the gradient callable along V̂ = V/‖V‖ with
+    /// h = 1e-6·max(1, ‖X‖) (Frobenius norms; error O(h²) + O(ε/h) relative).
+    fn add_hessian(
+        &self,
+        x: faer::MatRef<'_, f64>,
+        v: faer::MatRef<'_, f64>,
+        mut out: faer::MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        if let Some(hessian) = &self.hessian {
+            Python::attach(|py| {
+                let h = hessian
+                    .bind(py)
+                    .call1((py_mat(py, &x.to_owned()), py_mat(py, &v.to_owned())));
+                self.add_returned("hessian returned by the callable", h, out);
+            });
+            return;
+        }
+        let norm_v = v.norm_l2();
+        if norm_v == 0.0 {
+            return;
+        }
+        let h = 1e-6 * x.norm_l2().max(1.0);
+        let step = v * faer::Scale(h / norm_v);
+        let (n, c) = (x.nrows(), 0.5 * norm_v / h);
+        let (mut gp, mut gm) = (Mat::zeros(n, n), Mat::zeros(n, n));
+        self.add_gradient((x + &step).as_ref(), gp.as_mut(), ws);
+        self.add_gradient((x - &step).as_ref(), gm.as_mut(), ws);
+        out += (gp - gm) * faer::Scale(c);
     }
 }
 
@@ -232,22 +284,46 @@ fn Volumetric(py: Python<'_>, kappa: f64, gamma: f64) -> PyResult<PyPotential> {
     PyPotential::new(py, inner, desc, "Volumetric", [kappa, gamma])
 }
 
+/// Isotropic quadratic stretch energy U = (k/2) sum_i (s_i - 1)^2 over the singular values s_i
+/// of X; k > 0. dU/dX = k (X - polar(X)) (polar(X) = X (X^T X)^(-1/2), the rotation of X on
+/// GL+(n)). Defined for every X through the SVD, but smooth only where det X != 0.
+///
+/// Raises:
+///     InvalidArgumentError: k <= 0 or not finite.
+#[pyfunction]
+fn Stretch(py: Python<'_>, k: f64) -> PyResult<PyPotential> {
+    let inner = Arc::new(CoreStretch::new(k).py()?);
+    PyPotential::new(py, inner, format!("Stretch({k})"), "Stretch", [k])
+}
+
 /// U = 0, the free body (motions X(t) = X0 + t P0).
 #[pyfunction]
 pub(crate) fn Zero(py: Python<'_>) -> PyResult<PyPotential> {
     PyPotential::new(py, Arc::new(CoreZero), "Zero()".into(), "Zero", [0.0; 0])
 }
 
-/// A potential from Python callables: `value(X) -> float` and `gradient(X) -> (n, n) array`,
-/// both called with an (n, n) float64 array. This is the slow path (each call takes the GIL);
-/// U must be SO(n)×SO(n)-invariant (a function of the singular values of X) for L and Γ to be
-/// conserved. Exceptions raised by the callables are re-raised by the integration.
+/// A potential from Python callables: `value(X) -> float`, `gradient(X) -> (n, n) array` and
+/// optionally `hessian(X, V) -> (n, n) array`, the Hessian applied to a direction,
+/// d/de gradient(X + e V) at e = 0; all are called with (n, n) float64 arrays. Without `hessian`,
+/// `Potential.hessian` uses central differences of `gradient`:
+/// (gradient(X + h V/|V|) - gradient(X - h V/|V|)) |V| / (2h) with h = 1e-6 max(1, |X|)
+/// (Frobenius norms), accurate to about 1e-6 relative for a smooth gradient.
+/// This is the slow path (each call takes the GIL); U must be SO(n)×SO(n)-invariant (a function
+/// of the singular values of X) for L and Γ to be conserved. Exceptions raised by the callables
+/// are re-raised by the integration.
 ///
 /// Raises:
-///     TypeError: value or gradient not callable.
+///     TypeError: value, gradient or hessian not callable.
 #[pyfunction]
-fn Callable(value: Bound<'_, PyAny>, gradient: Bound<'_, PyAny>) -> PyResult<PyPotential> {
-    for (what, f) in [("value", &value), ("gradient", &gradient)] {
+#[pyo3(signature = (value, gradient, hessian=None))]
+fn Callable<'py>(
+    value: Bound<'py, PyAny>,
+    gradient: Bound<'py, PyAny>,
+    hessian: Option<Bound<'py, PyAny>>,
+) -> PyResult<PyPotential> {
+    let mut fns = vec![("value", &value), ("gradient", &gradient)];
+    fns.extend(hessian.as_ref().map(|h| ("hessian", h)));
+    for (what, f) in fns {
         if !f.is_callable() {
             return Err(pyo3::exceptions::PyTypeError::new_err(format!(
                 "{what} must be callable"
@@ -257,11 +333,14 @@ fn Callable(value: Bound<'_, PyAny>, gradient: Bound<'_, PyAny>) -> PyResult<PyP
     let cb = Arc::new(CallablePotential {
         value: value.clone().unbind(),
         gradient: gradient.clone().unbind(),
+        hessian: hessian.as_ref().map(|h| h.clone().unbind()),
         error: Mutex::new(None),
     });
     let py = value.py();
     let f = py.import("lieflow.potentials")?.getattr("Callable")?;
-    let args = PyTuple::new(py, [&value, &gradient])?.unbind();
+    let mut args = vec![value.clone(), gradient.clone()];
+    args.extend(hessian);
+    let args = PyTuple::new(py, args)?.unbind();
     Ok(PyPotential {
         inner: cb.clone(),
         desc: "Callable(...)".into(),
@@ -282,6 +361,7 @@ pub fn register(p: &Bound<'_, PyModule>) -> PyResult<()> {
     p.add_function(wrap_pyfunction!(Harmonic, p)?)?;
     p.add_function(wrap_pyfunction!(SaintVenantKirchhoff, p)?)?;
     p.add_function(wrap_pyfunction!(Volumetric, p)?)?;
+    p.add_function(wrap_pyfunction!(Stretch, p)?)?;
     p.add_function(wrap_pyfunction!(Zero, p)?)?;
     p.add_function(wrap_pyfunction!(Callable, p)?)?;
     Ok(())
