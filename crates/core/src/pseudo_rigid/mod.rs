@@ -11,6 +11,7 @@
 //! - [`strata`]: strata and isotropy of the two-sided action;
 //! - [`potential`]: SO(n)×SO(n)-invariant potentials U(X) (harmonic, Saint Venant–Kirchhoff,
 //!   polytropic volumetric, sums);
+//! - [`equilibria`]: relative equilibria, the augmented and amended potentials (001 §8);
 //! - [`dynamics`]: the full Hamiltonian system on T*GL⁺(n) (001 (3.22)), the Riemann-ellipsoid
 //!   form (3.20), the Lagrangian form (Prop. 4.2) and Dedekind's adjoint motion;
 //! - [`riemann`]: the Riemann-ellipsoid variables (Q, N) and their Poisson brackets;
@@ -38,6 +39,7 @@
 
 pub mod connection;
 pub mod dynamics;
+pub mod equilibria;
 pub mod inertia;
 pub mod momentum;
 pub mod potential;

@@ -1,0 +1,508 @@
+//! Relative equilibria, augmented and amended potentials of the pseudo-rigid body (001 §8).
+
+use lieflow::integrate::{integrate, Problem};
+use lieflow::lie::so::{self, hat_n};
+use lieflow::pseudo_rigid::dynamics::FullBody;
+use lieflow::pseudo_rigid::equilibria::{
+    amended_force, amended_gradient, amended_potential, augmented_gradient, augmented_potential,
+    equilibria_for_momenta, equilibria_for_shape, equilibria_for_velocities,
+    equilibrium_directions, equilibrium_residual, force_balance, RelativeEquilibrium,
+};
+use lieflow::pseudo_rigid::momentum::momentum_map;
+use lieflow::pseudo_rigid::potential::{
+    self, Harmonic, Potential, SaintVenantKirchhoff, Sum, Volumetric,
+};
+use lieflow::pseudo_rigid::reduced::ReducedState;
+use lieflow::pseudo_rigid::{BiInertia, PseudoRigidBody};
+use lieflow::{Error, Mat};
+use std::sync::Arc;
+
+fn elastic_gas() -> Arc<dyn Potential> {
+    Arc::new(Sum::new(vec![
+        Arc::new(SaintVenantKirchhoff::new(0.7, 1.3).unwrap()),
+        Arc::new(Volumetric::polytropic(0.4, 1.4).unwrap()),
+    ]))
+}
+
+/// Saint Venant–Kirchhoff with Lamé λ = 0.5, μ = 1 (the closed forms below use these).
+fn svk() -> Arc<dyn Potential> {
+    Arc::new(SaintVenantKirchhoff::new(0.5, 1.0).unwrap())
+}
+
+fn sample_x(n: usize) -> Mat {
+    Mat::from_fn(n, n, |i, j| {
+        if i == j {
+            1.6 - 0.3 * i as f64
+        } else {
+            0.1 * ((2 * i + 3 * j) as f64).sin()
+        }
+    })
+}
+
+fn skew(n: usize, seed: f64) -> Mat {
+    let c: Vec<f64> = (0..n * (n - 1) / 2)
+        .map(|k| (seed + 1.7 * k as f64).sin())
+        .collect();
+    hat_n(&c).unwrap()
+}
+
+fn e(n: usize, i: usize, j: usize) -> Mat {
+    let mut c = vec![0.0; n * (n - 1) / 2];
+    let mut k = 0;
+    for p in 0..n {
+        for q in p + 1..n {
+            if (p, q) == (i, j) {
+                c[k] = 1.0;
+            }
+            k += 1;
+        }
+    }
+    hat_n(&c).unwrap()
+}
+
+fn scaled(m: &Mat, s: f64) -> Mat {
+    m * faer::Scale(s)
+}
+
+/// Central-difference gradient of f at X (tr pairing).
+fn fd_gradient(f: impl Fn(&Mat) -> f64, x: &Mat) -> Mat {
+    let n = x.nrows();
+    let h = 1e-5;
+    Mat::from_fn(n, n, |i, j| {
+        let (mut p, mut m) = (x.clone(), x.clone());
+        p[(i, j)] += h;
+        m[(i, j)] -= h;
+        (f(&p) - f(&m)) / (2.0 * h)
+    })
+}
+
+fn rel(a: &Mat, b: &Mat) -> f64 {
+    (a - b).norm_l2() / b.norm_l2().max(1e-300)
+}
+
+#[test]
+fn quadratic_form_of_bi_inertia_is_the_vertical_kinetic_energy() {
+    for n in [2, 3, 4] {
+        let x = sample_x(n);
+        let (xi, eta) = (skew(n, 0.3), skew(n, 1.1));
+        let (bx, by) = BiInertia::new(&x).unwrap().apply(&xi, &eta).unwrap();
+        let form = so::pairing(&xi, &bx) + so::pairing(&eta, &by);
+        let w = &xi * &x - &x * &eta;
+        let w2 = &xi * &x + &x * eta.transpose();
+        assert!((form - w.norm_l2().powi(2)).abs() < 1e-12 * form.abs());
+        assert!((w - w2).norm_l2() < 1e-14);
+        // A sign slip (ξX + Xη) would not match.
+        let wrong = &xi * &x + &x * &eta;
+        assert!((form - wrong.norm_l2().powi(2)).abs() > 1e-3);
+    }
+}
+
+#[test]
+fn augmented_and_amended_gradients_match_finite_differences() {
+    let pot = elastic_gas();
+    for n in [2, 3, 4] {
+        let x = sample_x(n);
+        let (xi, eta) = (skew(n, 0.3), skew(n, 1.1));
+        let g = augmented_gradient(&*pot, &x, &xi, &eta).unwrap();
+        let fd = fd_gradient(|y| augmented_potential(&*pot, y, &xi, &eta).unwrap(), &x);
+        assert!(rel(&g, &fd) < 1e-8, "augmented n={n}: {}", rel(&g, &fd));
+        let (lam, gam) = (skew(n, 2.0), skew(n, -0.7));
+        let g = amended_gradient(&*pot, &x, &lam, &gam).unwrap();
+        let fd = fd_gradient(|y| amended_potential(&*pot, y, &lam, &gam).unwrap(), &x);
+        assert!(rel(&g, &fd) < 1e-7, "amended n={n}: {}", rel(&g, &fd));
+    }
+}
+
+#[test]
+fn amended_equals_augmented_at_the_legendre_pair() {
+    let pot = elastic_gas();
+    for n in [2, 3, 4] {
+        let x = sample_x(n);
+        let (lam, gam) = (skew(n, 2.0), skew(n, -0.7));
+        let (xi, eta) = BiInertia::new(&x).unwrap().solve(&lam, &gam).unwrap();
+        let u = potential::value(&*pot, &x).unwrap();
+        let v = amended_potential(&*pot, &x, &lam, &gam).unwrap();
+        let w = augmented_potential(&*pot, &x, &xi, &eta).unwrap();
+        // ½⟨J, B⁻¹J⟩ = ½⟨v, Bv⟩: the kinetic terms are equal and of opposite sign.
+        assert!((v + w - 2.0 * u).abs() < 1e-12 * v.abs().max(1.0));
+        assert!(v > u);
+        // Legendre: the X-gradients coincide.
+        let gv = amended_gradient(&*pot, &x, &lam, &gam).unwrap();
+        let gw = augmented_gradient(&*pot, &x, &xi, &eta).unwrap();
+        assert!(rel(&gv, &gw) < 1e-11);
+    }
+}
+
+#[test]
+fn amended_potential_needs_the_principal_stratum() {
+    let x = Mat::from_fn(3, 3, |i, j| if i == j { [1.0, 1.0, 0.5][i] } else { 0.0 });
+    let (lam, gam) = (skew(3, 0.1), skew(3, 0.2));
+    let err = amended_potential(&*svk(), &x, &lam, &gam).unwrap_err();
+    assert!(matches!(err, Error::DegenerateStratum { .. }), "{err}");
+    assert!(amended_gradient(&*svk(), &x, &lam, &gam).is_err());
+}
+
+#[test]
+fn directions_satisfy_8_6_and_generic_combinations_do_not() {
+    for a in [
+        vec![1.5, 1.0],
+        vec![2.0, 1.3, 0.6],
+        vec![2.1, 1.6, 1.0, 0.4],
+    ] {
+        let n = a.len();
+        let dirs = equilibrium_directions(&a).unwrap();
+        let (pairs, quads) = (n * (n - 1), if n == 4 { 3 * 4 } else { 0 });
+        assert_eq!(dirs.len(), pairs + quads, "n = {n}");
+        let b =
+            BiInertia::new(&Mat::from_fn(n, n, |i, j| if i == j { a[i] } else { 0.0 })).unwrap();
+        for d in &dirs {
+            assert!(
+                equilibrium_residual(&a, &d.xi, &d.eta).unwrap() < 1e-13,
+                "{}",
+                d.description
+            );
+            // Each plane's component is an eigenvector with eigenvalue (a_i − s a_j)² (8.15).
+            if d.planes.len() == 1 {
+                let (bx, by) = b.apply(&d.xi, &d.eta).unwrap();
+                let l = d.eigenvalues[0];
+                assert!((&bx - scaled(&d.xi, l)).norm_l2() < 1e-12);
+                assert!((&by - scaled(&d.eta, l)).norm_l2() < 1e-12);
+            }
+        }
+        // (8.18) for n = 4: e_12 ⊕ e_12 + e_34 ⊕ e_34, distinct eigenvalues, still admissible.
+        if n == 4 {
+            let d = dirs
+                .iter()
+                .find(|d| d.planes == vec![(0, 1), (2, 3)] && d.signs == vec![1.0, 1.0])
+                .unwrap();
+            assert!(d.eigenvalues[0] != d.eigenvalues[1]);
+            assert_eq!(d.description, "e_12 ⊕ e_12 + e_34 ⊕ e_34");
+        }
+        // Any ω e_ij ⊕ μ e_ij in one plane is admissible too.
+        let (x1, y1) = (scaled(&e(n, 0, 1), 0.7), scaled(&e(n, 0, 1), -0.2));
+        assert!(equilibrium_residual(&a, &x1, &y1).unwrap() < 1e-13);
+        if n >= 3 {
+            // Two planes sharing an axis: (8.16) with [e_12, e_13] ≠ 0.
+            let xi = &e(n, 0, 1) + &e(n, 0, 2);
+            let eta = &e(n, 0, 1) - &e(n, 0, 2);
+            assert!(equilibrium_residual(&a, &xi, &eta).unwrap() > 1e-2);
+            let (xi, eta) = (skew(n, 0.3), skew(n, 1.1));
+            assert!(equilibrium_residual(&a, &xi, &eta).unwrap() > 1e-2);
+        }
+    }
+}
+
+#[test]
+fn off_diagonal_augmented_gradient_vanishes_exactly_when_8_6_holds() {
+    let pot = elastic_gas();
+    let a = [2.1, 1.6, 1.0, 0.4];
+    let x = Mat::from_fn(4, 4, |i, j| if i == j { a[i] } else { 0.0 });
+    let off = |xi: &Mat, eta: &Mat| {
+        let g = augmented_gradient(&*pot, &x, xi, eta).unwrap();
+        Mat::from_fn(4, 4, |i, j| if i == j { 0.0 } else { g[(i, j)] }).norm_l2()
+    };
+    for d in equilibrium_directions(&a).unwrap() {
+        let (xi, eta) = (scaled(&d.xi, 0.8), scaled(&d.eta, 0.8));
+        assert!(off(&xi, &eta) < 1e-13);
+    }
+    let (xi, eta) = (skew(4, 0.3), skew(4, 1.1));
+    assert!(off(&xi, &eta) > 1e-2 && equilibrium_residual(&a, &xi, &eta).unwrap() > 1e-2);
+}
+
+/// The closed-form Riemann-type ellipsoid of U = SVK(λ = 1/2, μ = 1), n = 3, Ω = ω e_12,
+/// Λ = m e_12: a₁² + a₂² = q, a₁a₂ = 2ωm, a₃² = q − s with s = ω² + m² and
+/// q = (s(1 + λ/2μ) + 3λ/2 + μ)/(μ + λ) (derived in the comments of the test body).
+fn svk_closed_form(w: f64, m: f64) -> [f64; 3] {
+    // g_k = a_k(c + a_k²), c = λ tr E − μ; force balance in the plane gives c − s + q = 0 and
+    // a₁a₂ = 2ωm (μ = 1); g₃ = 0 gives a₃² = −c; tr E = ½(q + a₃² − 3).
+    let (lam, mu) = (0.5, 1.0);
+    let s = w * w + m * m;
+    let q = (s * (1.0 + lam / (2.0 * mu)) + 1.5 * lam + mu) / (mu + lam);
+    let p = 2.0 * w * m / mu;
+    let (plus, minus) = ((q + 2.0 * p).sqrt(), (q - 2.0 * p).sqrt());
+    let c = s - mu * q;
+    [0.5 * (plus + minus), 0.5 * (plus - minus), (-c / mu).sqrt()]
+}
+
+#[test]
+fn velocities_solver_finds_the_closed_form_svk_ellipsoids() {
+    let pot = svk();
+    let (w, m) = (0.6, 0.4);
+    let expect = svk_closed_form(w, m);
+    assert!((expect[0] - 1.2).abs() < 1e-12 && (expect[1] - 0.4).abs() < 1e-12);
+    let (xi, eta) = (scaled(&e(3, 0, 1), w), scaled(&e(3, 0, 1), m));
+    let sols = equilibria_for_velocities(&*pot, &xi, &eta, (0.2, 2.0), 5).unwrap();
+    assert_eq!(
+        sols.len(),
+        2,
+        "{:?}",
+        sols.iter().map(|s| &s.a).collect::<Vec<_>>()
+    );
+    let swapped = [expect[1], expect[0], expect[2]];
+    for target in [expect, swapped] {
+        let s = sols
+            .iter()
+            .find(|s| s.a.iter().zip(&target).all(|(x, y)| (x - y).abs() < 1e-9))
+            .unwrap_or_else(|| panic!("missing {target:?}"));
+        assert!(s.residuals.force < 1e-10 && s.residuals.motion < 1e-10);
+        assert!(s.residuals.commutator < 1e-13);
+        // λ ⊕ γ = L ⊕ Γ of (X₀, P₀).
+        let (l, g) = momentum_map(&s.x0(), &s.p0()).unwrap();
+        assert!((&l - &s.lam).norm_l2() < 1e-13 && (&g - &s.gam).norm_l2() < 1e-13);
+    }
+    // A wrong centrifugal sign would move the solution: check the force balance directly.
+    let f = force_balance(&*pot, &expect, &xi, &eta).unwrap();
+    assert!(f.iter().all(|v| v.abs() < 1e-12));
+    let f_wrong = force_balance(&*pot, &expect, &xi, &scaled(&eta, -1.0)).unwrap();
+    assert!(f_wrong.iter().any(|v| v.abs() > 1e-2));
+}
+
+#[test]
+fn opposite_senses_have_only_coincident_axes() {
+    // ωμ < 0 needs a₁a₂ < 0: no principal solution; the solver reports the axisymmetric ones.
+    let (xi, eta) = (scaled(&e(3, 0, 1), 0.6), scaled(&e(3, 0, 1), -0.4));
+    match equilibria_for_velocities(&*svk(), &xi, &eta, (0.2, 2.0), 4) {
+        Err(Error::DegenerateStratum { what, .. }) => assert!(what.contains("coincident")),
+        Ok(v) => assert!(v.is_empty()),
+        Err(e) => panic!("{e}"),
+    }
+}
+
+#[test]
+fn shape_solver_recovers_the_velocities_exactly() {
+    let pot = svk();
+    let a = svk_closed_form(0.6, 0.4);
+    let sols = equilibria_for_shape(&*pot, &a, (0, 1)).unwrap();
+    assert_eq!(sols.len(), 4);
+    let wm: Vec<(f64, f64)> = sols.iter().map(|s| (s.xi[(0, 1)], s.eta[(0, 1)])).collect();
+    for target in [(0.6, 0.4), (0.4, 0.6), (-0.6, -0.4), (-0.4, -0.6)] {
+        assert!(
+            wm.iter()
+                .any(|(w, m)| (w - target.0).abs() < 1e-12 && (m - target.1).abs() < 1e-12),
+            "{target:?} not in {wm:?}"
+        );
+    }
+    for s in &sols {
+        assert!(s.residuals.motion < 1e-12 && s.residuals.commutator < 1e-13);
+    }
+    // Another plane: the force on a₂ is not balanced there.
+    let err = equilibria_for_shape(&*pot, &a, (0, 2)).unwrap_err();
+    assert!(matches!(err, Error::InvalidArgument { .. }), "{err}");
+    let err = equilibria_for_shape(&*pot, &[1.0, 1.0, 0.9], (0, 1)).unwrap_err();
+    assert!(matches!(err, Error::DegenerateStratum { .. }), "{err}");
+}
+
+#[test]
+fn shape_solver_closed_form_harmonic_plus_gas_in_two_dimensions() {
+    // U = (k/2)|X|² − κ... polytropic: g_k = k a_k − c/a_k with c = κ d^{1−γ}, d = a₁a₂, so
+    // (ω + μ)² = k + c/d and (ω − μ)² = k − c/d.
+    let (k, kappa, gamma) = (1.0, 0.4, 1.4);
+    let pot: Arc<dyn Potential> = Arc::new(Sum::new(vec![
+        Arc::new(Harmonic::new(k).unwrap()),
+        Arc::new(Volumetric::polytropic(kappa, gamma).unwrap()),
+    ]));
+    let a = [1.5, 0.8];
+    let d: f64 = a[0] * a[1];
+    let c = kappa * d.powf(1.0 - gamma);
+    let (u, v) = ((k + c / d).sqrt(), (k - c / d).sqrt());
+    let sols = equilibria_for_shape(&*pot, &a, (0, 1)).unwrap();
+    assert_eq!(sols.len(), 4);
+    for s in &sols {
+        let (w, m) = (s.xi[(0, 1)], s.eta[(0, 1)]);
+        assert!(((w + m).abs() - u).abs() < 1e-12 && ((w - m).abs() - v).abs() < 1e-12);
+        assert!(s.residuals.motion < 1e-12);
+    }
+    // A small body: the gas pressure wins, (ω − μ)² < 0.
+    let err = equilibria_for_shape(&*pot, &[0.5, 0.3], (0, 1)).unwrap_err();
+    assert!(matches!(err, Error::InvalidArgument { .. }), "{err}");
+}
+
+#[test]
+fn harmonic_rigid_rotation_is_a_whole_family() {
+    // U = (k/2)|X|², n = 2, Ω = ω e_12, Λ = 0: force balance (k − ω²)a = 0.
+    let k = 2.0;
+    let pot = Harmonic::new(k).unwrap();
+    let xi = scaled(&e(2, 0, 1), k.sqrt());
+    let err = equilibria_for_velocities(&pot, &xi, &Mat::zeros(2, 2), (0.5, 2.0), 3).unwrap_err();
+    match err {
+        Error::InvalidArgument { message, .. } => assert!(message.contains("continuum")),
+        e => panic!("{e}"),
+    }
+    // The shape solver sees the same: (ω, μ) = (±√k, 0), (0, ±√k) for any shape.
+    let sols = equilibria_for_shape(&pot, &[1.7, 0.6], (0, 1)).unwrap();
+    assert_eq!(sols.len(), 4);
+    // ω² ≠ k: no relative equilibrium at all.
+    let xi = scaled(&e(2, 0, 1), 1.0);
+    let sols = equilibria_for_velocities(&pot, &xi, &Mat::zeros(2, 2), (0.5, 2.0), 3).unwrap();
+    assert!(sols.is_empty());
+}
+
+#[test]
+fn velocities_violating_8_6_are_reported() {
+    let pot = svk();
+    let (xi, eta) = (scaled(&e(3, 0, 1), 0.5), scaled(&e(3, 0, 2), 0.5));
+    let err = equilibria_for_velocities(&*pot, &xi, &eta, (0.3, 2.0), 3).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::InvalidArgument { .. } | Error::DegenerateStratum { .. }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("8.6") || err.to_string().contains("coincident"));
+}
+
+#[test]
+fn four_dimensional_sum_over_two_disjoint_planes() {
+    // SVK(λ = 1/2, μ = 1), Ω = ω₁e_12 + ω₂e_34, Λ = m₁e_12 + m₂e_34 (8.18): per plane
+    // c − s_k + q_k = 0, a_i a_j = 2ω_k m_k, and c = λ tr E − μ with tr E = ½(q₁ + q₂ − 4), so
+    // c(1 + λ) = λ(s₁ + s₂)/2 − 2λ − 1.
+    let pot = svk();
+    let ((w1, m1), (w2, m2)) = ((0.6, 0.4), (0.5, 0.3));
+    let (s1, s2) = (w1 * w1 + m1 * m1, w2 * w2 + m2 * m2);
+    let c = (0.5 * (s1 + s2) / 2.0 - 1.0 - 1.0) / 1.5;
+    let axes = |s: f64, p: f64| {
+        let q = s - c;
+        let (u, v) = ((q + 2.0 * p).sqrt(), (q - 2.0 * p).sqrt());
+        (0.5 * (u + v), 0.5 * (u - v))
+    };
+    let (a1, a2) = axes(s1, 2.0 * w1 * m1);
+    let (a3, a4) = axes(s2, 2.0 * w2 * m2);
+    let xi = &scaled(&e(4, 0, 1), w1) + &scaled(&e(4, 2, 3), w2);
+    let eta = &scaled(&e(4, 0, 1), m1) + &scaled(&e(4, 2, 3), m2);
+    assert!(equilibrium_residual(&[a1, a2, a3, a4], &xi, &eta).unwrap() < 1e-13);
+    let sols = equilibria_for_velocities(&*pot, &xi, &eta, (0.2, 2.0), 4).unwrap();
+    assert_eq!(
+        sols.len(),
+        4,
+        "{:?}",
+        sols.iter().map(|s| &s.a).collect::<Vec<_>>()
+    );
+    for target in [
+        [a1, a2, a3, a4],
+        [a2, a1, a3, a4],
+        [a1, a2, a4, a3],
+        [a2, a1, a4, a3],
+    ] {
+        let s = sols
+            .iter()
+            .find(|s| s.a.iter().zip(&target).all(|(x, y)| (x - y).abs() < 1e-9))
+            .unwrap_or_else(|| panic!("missing {target:?}"));
+        assert!(s.residuals.motion < 1e-10 && s.residuals.commutator < 1e-13);
+    }
+    check_motion(&pot, &sols[0]);
+}
+
+#[test]
+fn momenta_solver_finds_the_amended_critical_points() {
+    let pot = svk();
+    let a = svk_closed_form(0.6, 0.4);
+    let re = RelativeEquilibrium::from_velocities(
+        &*pot,
+        &a,
+        &scaled(&e(3, 0, 1), 0.6),
+        &scaled(&e(3, 0, 1), 0.4),
+    )
+    .unwrap();
+    // The amended force vanishes there and equals −ṗ_a of the reduced vector field.
+    let f = amended_force(&*pot, &a, &re.lam, &re.gam).unwrap();
+    assert!(f.iter().all(|v| v.abs() < 1e-12), "{f:?}");
+    let b = [1.3, 0.7, 1.1];
+    let f = amended_force(&*pot, &b, &re.lam, &re.gam).unwrap();
+    let state = ReducedState {
+        a: b.to_vec(),
+        p_a: vec![0.0; 3],
+        p_omega: re.lam.clone(),
+        p_lambda: re.gam.clone(),
+    };
+    let rates = state
+        .vector_field(&FullBody::new(3, pot.clone()).unwrap())
+        .unwrap();
+    for (fk, pk) in f.iter().zip(&rates.p_a_dot) {
+        assert!((fk + pk).abs() < 1e-12);
+    }
+    // And the gradient of the amended potential over shapes (finite differences in a).
+    let v = |a: &[f64]| {
+        let x = Mat::from_fn(3, 3, |i, j| if i == j { a[i] } else { 0.0 });
+        amended_potential(&*pot, &x, &re.lam, &re.gam).unwrap()
+    };
+    for k in 0..3 {
+        let (mut p, mut m) = (b.to_vec(), b.to_vec());
+        p[k] += 1e-6;
+        m[k] -= 1e-6;
+        assert!(((v(&p) - v(&m)) / 2e-6 - f[k]).abs() < 1e-7);
+    }
+    let sols = equilibria_for_momenta(&*pot, &re.lam, &re.gam, (0.2, 2.0), 5).unwrap();
+    let hit = sols
+        .iter()
+        .find(|s| s.a.iter().zip(&a).all(|(x, y)| (x - y).abs() < 1e-9))
+        .expect("the velocity solution is an amended critical point");
+    assert!((&hit.xi - &re.xi).norm_l2() < 1e-9 && (&hit.eta - &re.eta).norm_l2() < 1e-9);
+    for s in &sols {
+        assert!(s.residuals.motion < 1e-9, "{:?}", s.residuals);
+    }
+}
+
+/// The curve solves Hamilton's equations (finite differences in t), verlet4 follows it, and
+/// L, Γ, E stay at the equilibrium's values.
+fn check_motion(pot: &Arc<dyn Potential>, re: &RelativeEquilibrium) {
+    let n = re.n();
+    let body = FullBody::new(n, pot.clone()).unwrap();
+    let h = 1e-4;
+    for t in [0.0, 0.7, 3.1] {
+        let m = re.motion(&[t - h, t, t + h]).unwrap();
+        let (x, p) = &m[1];
+        let (xd, pd) = body.vector_field(x, p).unwrap();
+        let xfd = (&m[2].0 - &m[0].0) * faer::Scale(0.5 / h);
+        let pfd = (&m[2].1 - &m[0].1) * faer::Scale(0.5 / h);
+        assert!(rel(&xfd, &xd) < 1e-8, "Ẋ at t={t}: {}", rel(&xfd, &xd));
+        assert!(rel(&pfd, &pd) < 1e-8, "Ṗ at t={t}: {}", rel(&pfd, &pd));
+        let (l, g) = momentum_map(x, p).unwrap();
+        assert!((&l - &re.lam).norm_l2() < 1e-12 && (&g - &re.gam).norm_l2() < 1e-12);
+        assert!((body.hamiltonian(x, p).unwrap() - re.energy).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn verlet4_stays_on_the_relative_equilibrium() {
+    let pot = svk();
+    let sols = equilibria_for_shape(&*pot, &svk_closed_form(0.6, 0.4), (0, 1)).unwrap();
+    let re = &sols[0];
+    check_motion(&pot, re);
+    let body = PseudoRigidBody::new(3, pot.clone(), true).unwrap();
+    let z0 = body.state(&re.x0(), &re.p0()).unwrap();
+    let (dt, steps, every) = (0.01, 2000, 100);
+    let traj = integrate(&body, "verlet4", &z0, dt, steps, every).unwrap();
+    let times: Vec<f64> = (0..traj.len()).map(|k| (k * every) as f64 * dt).collect();
+    let exact = re.motion(&times).unwrap();
+    let mut worst: f64 = 0.0;
+    let (mut dl, mut de): (f64, f64) = (0.0, 0.0);
+    for (k, (x, p)) in exact.iter().enumerate() {
+        let (xn, pn) = body.split(traj.state(k)).unwrap();
+        worst = worst.max((&xn - x).norm_l2().max((&pn - p).norm_l2()));
+        let (l, g) = body.momenta(traj.state(k)).unwrap();
+        dl = dl.max((&l - &re.lam).norm_l2().max((&g - &re.gam).norm_l2()));
+        de = de.max((body.energy(traj.state(k)).unwrap() - re.energy).abs());
+    }
+    eprintln!(
+        "verlet4 dt={dt}, t={}: max |Δ(X,P)| = {worst:.2e}, |ΔJ| = {dl:.2e}, |ΔE| = {de:.2e}",
+        steps as f64 * dt
+    );
+    assert!(worst < 1e-7, "{worst}");
+    assert!(dl < 1e-11, "{dl}");
+    assert!(de < 1e-9, "{de}");
+}
+
+#[test]
+fn bad_input_is_rejected() {
+    let pot = svk();
+    let z = Mat::zeros(3, 3);
+    assert!(equilibrium_residual(&[1.0, -1.0, 0.5], &z, &z).is_err());
+    assert!(equilibrium_directions(&[1.0]).is_err());
+    assert!(equilibria_for_velocities(&*pot, &z, &z, (1.0, 0.5), 3).is_err());
+    assert!(equilibria_for_velocities(&*pot, &z, &z, (0.5, 1.0), 0).is_err());
+    assert!(equilibria_for_shape(&*pot, &[1.0, 0.5, 0.7], (1, 1)).is_err());
+    assert!(equilibria_for_shape(&*pot, &[1.0, f64::NAN, 0.7], (0, 1)).is_err());
+    let not_skew = Mat::from_fn(3, 3, |i, j| (i + j) as f64);
+    assert!(augmented_potential(&*pot, &sample_x(3), &not_skew, &z).is_err());
+}
