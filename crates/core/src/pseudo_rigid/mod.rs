@@ -17,6 +17,7 @@
 //! - [`riemann`]: the Riemann-ellipsoid variables (Q, N) and their Poisson brackets;
 //! - [`reduced`]: the reduced system on the principal stratum (001 §7): reduction,
 //!   reconstruction, the reduced vector field and an orbit-preserving splitting integrator;
+//! - [`stability`]: energy–momentum and spectral stability of relative equilibria (001 §8);
 //! - [`system`]: [`PseudoRigidBody`], the body as a system of the integration driver.
 //!
 //! Conventions (DESIGN.md): so(n) pairing ⟨ξ, η⟩ = ½ tr(ξᵀη) (001 (2.8)), e_ij basis, ξ block
@@ -45,6 +46,7 @@ pub mod momentum;
 pub mod potential;
 pub mod reduced;
 pub mod riemann;
+pub mod stability;
 pub mod strata;
 pub mod system;
 
