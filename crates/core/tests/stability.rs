@@ -488,3 +488,28 @@ fn scan() {
         }
     }
 }
+
+#[test]
+fn free_body_at_rest_is_finite_and_marginal() {
+    // U = 0, Ω = Λ = 0: every shape is an equilibrium, the orbits are points (leaf = (a, p_a)),
+    // D²H = diag(0, I) (inconclusive) and L is nilpotent (all eigenvalues 0, spectrally stable).
+    let body = FullBody::new(3, Arc::new(potential::Zero)).unwrap();
+    let z = Mat::zeros(3, 3);
+    let s = stability(&body, &[1.3, 1.0, 0.8], &z, &z).unwrap();
+    assert_eq!(s.leaf_dim, 6);
+    assert_eq!(s.forced_zeros.len(), 6);
+    assert!(!s.energy_momentum.stable && !s.energy_momentum.conclusive);
+    assert!(s.spectral.stable);
+    let all = s
+        .energy_momentum
+        .eigenvalues
+        .iter()
+        .chain(&s.spectral.eigenvalues)
+        .chain(&s.full_spectrum);
+    assert!(all.clone().all(|e| e.0.is_finite() && e.1.is_finite()));
+    assert!(s
+        .spectral
+        .eigenvalues
+        .iter()
+        .all(|e| e.0 == 0.0 && e.1 == 0.0));
+}
