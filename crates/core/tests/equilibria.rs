@@ -391,6 +391,8 @@ fn four_dimensional_sum_over_two_disjoint_planes() {
         assert!(s.residuals.motion < 1e-10 && s.residuals.commutator < 1e-13);
     }
     check_motion(&pot, &sols[0]);
+    let worst = check_verlet(&pot, &sols[0], 0.01, 1000);
+    assert!(worst < 1e-7, "{worst}");
 }
 
 #[test]
@@ -463,15 +465,12 @@ fn check_motion(pot: &Arc<dyn Potential>, re: &RelativeEquilibrium) {
     }
 }
 
-#[test]
-fn verlet4_stays_on_the_relative_equilibrium() {
-    let pot = svk();
-    let sols = equilibria_for_shape(&*pot, &svk_closed_form(0.6, 0.4), (0, 1)).unwrap();
-    let re = &sols[0];
-    check_motion(&pot, re);
-    let body = PseudoRigidBody::new(3, pot.clone(), true).unwrap();
+/// A verlet4 run from (X₀, P₀) follows X(t) = e^{tΩ}A₀e^{−tΛ}; L, Γ and E keep their values.
+/// Returns the largest deviation in (X, P).
+fn check_verlet(pot: &Arc<dyn Potential>, re: &RelativeEquilibrium, dt: f64, steps: usize) -> f64 {
+    let body = PseudoRigidBody::new(re.n(), pot.clone(), true).unwrap();
     let z0 = body.state(&re.x0(), &re.p0()).unwrap();
-    let (dt, steps, every) = (0.01, 2000, 100);
+    let every = 100;
     let traj = integrate(&body, "verlet4", &z0, dt, steps, every).unwrap();
     let times: Vec<f64> = (0..traj.len()).map(|k| (k * every) as f64 * dt).collect();
     let exact = re.motion(&times).unwrap();
@@ -485,12 +484,27 @@ fn verlet4_stays_on_the_relative_equilibrium() {
         de = de.max((body.energy(traj.state(k)).unwrap() - re.energy).abs());
     }
     eprintln!(
-        "verlet4 dt={dt}, t={}: max |Δ(X,P)| = {worst:.2e}, |ΔJ| = {dl:.2e}, |ΔE| = {de:.2e}",
+        "n = {}, verlet4 dt = {dt}, t = {}: max |Δ(X, P)| = {worst:.2e}, |ΔJ| = {dl:.2e}, \
+         |ΔE| = {de:.2e}",
+        re.n(),
         steps as f64 * dt
     );
-    assert!(worst < 1e-7, "{worst}");
     assert!(dl < 1e-11, "{dl}");
     assert!(de < 1e-9, "{de}");
+    worst
+}
+
+#[test]
+fn verlet4_stays_on_the_relative_equilibrium() {
+    let pot = svk();
+    let sols = equilibria_for_shape(&*pot, &svk_closed_form(0.6, 0.4), (0, 1)).unwrap();
+    let re = &sols[0];
+    check_motion(&pot, re);
+    let worst = check_verlet(&pot, re, 0.01, 2000);
+    assert!(worst < 1e-7, "{worst}");
+    // Fourth order: halving dt divides the deviation by ≈ 16.
+    let finer = check_verlet(&pot, re, 0.005, 4000);
+    assert!(worst / finer > 10.0, "{worst} / {finer}");
 }
 
 #[test]
@@ -505,4 +519,24 @@ fn bad_input_is_rejected() {
     assert!(equilibria_for_shape(&*pot, &[1.0, f64::NAN, 0.7], (0, 1)).is_err());
     let not_skew = Mat::from_fn(3, 3, |i, j| (i + j) as f64);
     assert!(augmented_potential(&*pot, &sample_x(3), &not_skew, &z).is_err());
+}
+
+#[test]
+fn harmonic_gas_plane_rotation_is_degenerate_or_a_family() {
+    // U = (k/2)|X|² + polytropic gas, n = 3, Ω = ω e_12, Λ = μ e_12: with c = κ det^{1−γ},
+    // a₁F₁ − a₂F₂ = (k − ω² − μ²)(a₁² − a₂²), so for ω² + μ² ≠ k only a₁ = a₂ balances
+    // (B_A singular, seed-errata §8), and for ω² + μ² = k the balance is c = 2ωμ a₁a₂, k a₃² = c:
+    // a one-parameter family of shapes.
+    let pot: Arc<dyn Potential> = Arc::new(Sum::new(vec![
+        Arc::new(Harmonic::new(1.0).unwrap()),
+        Arc::new(Volumetric::polytropic(0.4, 1.4).unwrap()),
+    ]));
+    let (xi, eta) = (scaled(&e(3, 0, 1), 0.6), scaled(&e(3, 0, 1), 0.4));
+    let err = equilibria_for_velocities(&*pot, &xi, &eta, (0.3, 2.0), 4).unwrap_err();
+    assert!(matches!(err, Error::DegenerateStratum { .. }), "{err}");
+    let (xi, eta) = (scaled(&e(3, 0, 1), 0.8), scaled(&e(3, 0, 1), 0.6));
+    match equilibria_for_velocities(&*pot, &xi, &eta, (0.3, 2.0), 4).unwrap_err() {
+        Error::InvalidArgument { message, .. } => assert!(message.contains("continuum")),
+        e => panic!("{e}"),
+    }
 }
