@@ -1,7 +1,7 @@
 # Type stubs for lieflow.pseudo_rigid (bindings of lieflow::pseudo_rigid, 001).
 # so(n) elements are skew (n, n) arrays; matrices on so(n) + so(n) use the e_ij basis with the
 # xi block first.
-from typing import Literal, TypedDict
+from typing import Any, Literal, TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -104,3 +104,43 @@ def reconstruct(
 
 def adjoint_motion(X: ArrayLike, P: ArrayLike) -> tuple[F64, F64]:
     """Dedekind's adjoint motion (X^T, P^T) of stacked frames (..., n, n)."""
+
+# --- relative equilibria and their stability (001 §8) ---
+
+def amended_potential(X: ArrayLike, lam: ArrayLike, gam: ArrayLike, potential: Any) -> float:
+    """V_{lam+gam}(X) = U(X) + <lam+gam, B_X^{-1}(lam+gam)>/2 (001 (8.11))."""
+def augmented_potential(X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any) -> float:
+    """U_{xi+eta}(X) = U(X) - <xi+eta, B_X(xi+eta)>/2 (001 (8.12))."""
+def augmented_gradient(X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any) -> F64:
+    """dU_{xi+eta}/dX, (n, n)."""
+def equilibrium_directions(a: ArrayLike) -> list[dict[str, Any]]:
+    """Velocity directions satisfying (8.6) for A = diag(a): (8.15), (8.17)-(8.18)."""
+def relative_equilibria(
+    potential: Any, *, shape: ArrayLike | None = None,
+    velocities: tuple[ArrayLike, ArrayLike] | None = None,
+    momenta: tuple[ArrayLike, ArrayLike] | None = None, plane: tuple[int, int] | None = None,
+    bounds: tuple[float, float] = (0.05, 5.0), starts: int = 6,
+) -> list[RelativeEquilibrium]: ...
+
+class Verdict:
+    eigenvalues: NDArray[np.complex128]
+    stable: bool
+    conclusive: bool
+    max_real_part: float
+    tol: float
+
+class Stability:
+    energy_momentum: Verdict
+    spectral: Verdict
+
+class RelativeEquilibrium:
+    shape: F64
+    xi: F64
+    eta: F64
+    L: F64
+    Gamma: F64
+    energy: float
+    residuals: dict[str, float]
+    def motion(self, t: ArrayLike) -> tuple[F64, F64]:
+        """(X(t), P(t)), each (k, n, n)."""
+    def stability(self) -> Stability: ...

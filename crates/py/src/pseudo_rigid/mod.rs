@@ -5,6 +5,7 @@
 //! basis (i < j, row by row) with the xi block first; pairing <xi, eta> = tr(xi.T @ eta) / 2.
 #![allow(non_snake_case)]
 
+pub mod equilibria;
 pub mod potential;
 pub mod system;
 
@@ -445,6 +446,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reduce, m)?)?;
     m.add_function(wrap_pyfunction!(reconstruct, m)?)?;
     m.add_function(wrap_pyfunction!(adjoint_motion, m)?)?;
+    equilibria::register(m)?;
     Ok(())
 }
 

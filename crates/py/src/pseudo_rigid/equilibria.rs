@@ -1,0 +1,379 @@
+//! Relative equilibria of pseudo-rigid bodies and their stability (001 §8): bindings of
+//! `lieflow::pseudo_rigid::{equilibria, stability}` in `lieflow.pseudo_rigid`. Conversions only.
+#![allow(non_snake_case)]
+
+use std::sync::Arc;
+
+use lieflow::pseudo_rigid::dynamics::FullBody;
+use lieflow::pseudo_rigid::equilibria as eq;
+use lieflow::pseudo_rigid::potential::Potential;
+use lieflow::pseudo_rigid::stability as st;
+use lieflow::{Error, Mat};
+use numpy::ndarray::Array3;
+use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyArray3};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use super::potential::PyPotential;
+use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
+use crate::errors::{to_py, IntoPy};
+
+type Arr2<'py> = Bound<'py, PyArray2<f64>>;
+
+/// Runs `f` on the potential and re-raises the first exception of a callable potential.
+fn with_potential<T>(
+    potential: &Bound<'_, PyPotential>,
+    f: impl FnOnce(&dyn Potential) -> lieflow::Result<T>,
+) -> PyResult<T> {
+    let p = potential.get();
+    let out = f(&*p.inner);
+    if let Some(c) = &p.callback {
+        c.take_error()?;
+    }
+    out.py()
+}
+
+/// The amended potential V_{lam+gam}(X) = U(X) + <lam+gam, B_X^{-1}(lam+gam)>/2 (001 (8.11)) for
+/// spatial momenta lam = L, gam = Γ (skew (n, n)) and X on the principal stratum.
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError, DegenerateStratumError.
+#[pyfunction]
+fn amended_potential(
+    X: ArrayIn<'_>,
+    lam: ArrayIn<'_>,
+    gam: ArrayIn<'_>,
+    potential: &Bound<'_, PyPotential>,
+) -> PyResult<f64> {
+    let (x, l, g) = (mat("X", &X)?, mat("lam", &lam)?, mat("gam", &gam)?);
+    with_potential(potential, |p| eq::amended_potential(p, &x, &l, &g))
+}
+
+/// The augmented potential U_{xi+eta}(X) = U(X) - <xi+eta, B_X(xi+eta)>/2 (001 (8.12)), with
+/// <xi+eta, B_X(xi+eta)> = |xi X - X eta|^2, for angular velocities xi, eta (skew (n, n)).
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+fn augmented_potential(
+    X: ArrayIn<'_>,
+    xi: ArrayIn<'_>,
+    eta: ArrayIn<'_>,
+    potential: &Bound<'_, PyPotential>,
+) -> PyResult<f64> {
+    let (x, a, b) = (mat("X", &X)?, mat("xi", &xi)?, mat("eta", &eta)?);
+    with_potential(potential, |p| eq::augmented_potential(p, &x, &a, &b))
+}
+
+/// dU_{xi+eta}/dX (pairing tr(A^T B)) as an (n, n) array (001 (8.12)); it vanishes at a relative
+/// equilibrium X0 with velocities xi, eta.
+///
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+fn augmented_gradient<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+    potential: &Bound<'py, PyPotential>,
+) -> PyResult<Arr2<'py>> {
+    let (x, a, b) = (mat("X", &X)?, mat("xi", &xi)?, mat("eta", &eta)?);
+    let g = with_potential(potential, |p| eq::augmented_gradient(p, &x, &a, &b))?;
+    Ok(py_mat(py, &g))
+}
+
+/// The admissible velocity directions xi + eta for the diagonal shape A = diag(a): those that
+/// satisfy condition (8.6), [xi+eta, B_A(xi+eta)] = 0 — the eigen-directions e_ij + (±e_ij) of
+/// B_A (8.15) and, for n >= 4, sums over pairwise disjoint planes (8.17)–(8.18).
+///
+/// Returns:
+///     a list of dicts with keys xi, eta ((n, n) skew), planes (list of (i, j), 0-based),
+///     signs, eigenvalues (of B_A, (a_i -+ a_j)^2) and description.
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError (a_i <= 0), DegenerateStratumError.
+#[pyfunction]
+fn equilibrium_directions<'py>(
+    py: Python<'py>,
+    a: ArrayIn<'py>,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let dirs = eq::equilibrium_directions(&vector("a", &a)?).py()?;
+    dirs.iter()
+        .map(|d| {
+            let dict = PyDict::new(py);
+            dict.set_item("xi", py_mat(py, &d.xi))?;
+            dict.set_item("eta", py_mat(py, &d.eta))?;
+            dict.set_item("planes", d.planes.clone())?;
+            dict.set_item("signs", d.signs.clone())?;
+            dict.set_item("eigenvalues", d.eigenvalues.clone())?;
+            dict.set_item("description", d.description.clone())?;
+            Ok(dict)
+        })
+        .collect()
+}
+
+/// A skew (n, n) pair from a Python pair.
+fn pair(what: &str, v: &Bound<'_, PyAny>) -> PyResult<(Mat, Mat)> {
+    let (a, b): (ArrayIn<'_>, ArrayIn<'_>) = v.extract().map_err(|_| {
+        to_py(Error::invalid(
+            what,
+            "expected a pair of skew (n, n) arrays",
+        ))
+    })?;
+    Ok((mat(what, &a)?, mat(what, &b)?))
+}
+
+/// Relative equilibria of a pseudo-rigid body with the given potential (001 §8), represented at
+/// the diagonal shape X0 = diag(a) (so body and spatial quantities agree at t = 0). Exactly one
+/// way of asking:
+///
+/// * ``velocities=(xi, eta)``: the shapes a in the box ``bounds`` (Newton from ``starts``^n grid
+///   points) for which the angular velocities xi, eta (skew (n, n)) give a relative equilibrium;
+/// * ``shape=a, plane=(i, j)``: every rotation xi = w e_ij, eta = m e_ij in that plane (0-based)
+///   that makes diag(a) a relative equilibrium, solved exactly;
+/// * ``momenta=(lam, gam)``: the critical points of the amended potential (8.8), (8.11) over
+///   shapes at the given body momenta.
+///
+/// Degenerate situations are answered, not hidden: coincident semi-axes (B_A singular) raise
+/// DegenerateStratumError; a whole family of solutions raises InvalidArgumentError naming it.
+///
+/// Returns:
+///     a list of RelativeEquilibrium (empty: none in the box).
+/// Raises:
+///     InvalidArgumentError, ShapeError, NonFiniteError, DegenerateStratumError.
+#[pyfunction]
+#[pyo3(signature = (potential, *, shape = None, velocities = None, momenta = None, plane = None,
+                    bounds = (0.05, 5.0), starts = 6))]
+#[allow(clippy::too_many_arguments)]
+fn relative_equilibria(
+    potential: &Bound<'_, PyPotential>,
+    shape: Option<ArrayIn<'_>>,
+    velocities: Option<Bound<'_, PyAny>>,
+    momenta: Option<Bound<'_, PyAny>>,
+    plane: Option<(usize, usize)>,
+    bounds: (f64, f64),
+    starts: usize,
+) -> PyResult<Vec<RelativeEquilibrium>> {
+    let found = match (&shape, &velocities, &momenta, plane) {
+        (Some(a), None, None, Some(plane)) => {
+            let a = vector("shape", a)?;
+            with_potential(potential, |p| eq::equilibria_for_shape(p, &a, plane))?
+        }
+        (None, Some(v), None, None) => {
+            let (xi, eta) = pair("velocities", v)?;
+            with_potential(potential, |p| {
+                eq::equilibria_for_velocities(p, &xi, &eta, bounds, starts)
+            })?
+        }
+        (None, None, Some(m), None) => {
+            let (lam, gam) = pair("momenta", m)?;
+            with_potential(potential, |p| {
+                eq::equilibria_for_momenta(p, &lam, &gam, bounds, starts)
+            })?
+        }
+        _ => {
+            return Err(to_py(Error::invalid(
+                "arguments",
+                "give exactly one of: shape= with plane=, velocities=, momenta=",
+            )))
+        }
+    };
+    let pot = potential.get().inner.clone();
+    Ok(found
+        .into_iter()
+        .map(|inner| RelativeEquilibrium {
+            inner,
+            potential: pot.clone(),
+        })
+        .collect())
+}
+
+/// A relative equilibrium X(t) = exp(t xi) A0 exp(-t eta) (001 (8.2)–(8.3)) through the diagonal
+/// shape A0 = diag(shape), with constant body velocities xi, eta and momenta L, Gamma.
+#[pyclass(module = "lieflow.pseudo_rigid", name = "RelativeEquilibrium", frozen)]
+pub struct RelativeEquilibrium {
+    inner: eq::RelativeEquilibrium,
+    potential: Arc<dyn Potential>,
+}
+
+#[pymethods]
+impl RelativeEquilibrium {
+    /// The semi-axes a (n,): A0 = diag(a).
+    #[getter]
+    fn shape<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        py_vec(py, &self.inner.a)
+    }
+
+    /// The angular velocity xi = Omega (skew (n, n)).
+    #[getter]
+    fn xi<'py>(&self, py: Python<'py>) -> Arr2<'py> {
+        py_mat(py, &self.inner.xi)
+    }
+
+    /// The velocity of the right action eta = Lambda (skew (n, n)).
+    #[getter]
+    fn eta<'py>(&self, py: Python<'py>) -> Arr2<'py> {
+        py_mat(py, &self.inner.eta)
+    }
+
+    /// The angular momentum L = P X^T - X P^T at X0 (001 (7.3)).
+    #[getter]
+    fn L<'py>(&self, py: Python<'py>) -> Arr2<'py> {
+        py_mat(py, &self.inner.lam)
+    }
+
+    /// The circulation Gamma = P^T X - X^T P at X0 (001 (7.3)).
+    #[getter]
+    fn Gamma<'py>(&self, py: Python<'py>) -> Arr2<'py> {
+        py_mat(py, &self.inner.gam)
+    }
+
+    /// The energy H = tr(P^T P)/2 + U(X) along the motion.
+    #[getter]
+    fn energy(&self) -> f64 {
+        self.inner.energy
+    }
+
+    /// {"force": |grad_a U_xi+eta|, "commutator": the (8.6) residual, "motion":
+    /// |dU_xi+eta/dX (A0)|}.
+    #[getter]
+    fn residuals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let r = &self.inner.residuals;
+        let d = PyDict::new(py);
+        d.set_item("force", r.force)?;
+        d.set_item("commutator", r.commutator)?;
+        d.set_item("motion", r.motion)?;
+        Ok(d)
+    }
+
+    /// The motion (X(t), P(t)) at k times: two (k, n, n) arrays.
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn motion<'py>(
+        &self,
+        py: Python<'py>,
+        t: ArrayIn<'py>,
+    ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+        let times: Vec<f64> = t.as_array().iter().copied().collect();
+        let frames = self.inner.motion(&times).py()?;
+        let n = self.inner.n();
+        let stack = |pick: fn(&(Mat, Mat)) -> &Mat| {
+            Array3::from_shape_fn((frames.len(), n, n), |(k, i, j)| pick(&frames[k])[(i, j)])
+                .into_pyarray(py)
+        };
+        Ok((stack(|f| &f.0), stack(|f| &f.1)))
+    }
+
+    /// The two stability verdicts (001 §8): `energy_momentum` (the Hessian of the reduced
+    /// Hamiltonian on the symplectic leaf: positive definite => nonlinearly stable; indefinite
+    /// => inconclusive) and `spectral` (eigenvalues of the linearised reduced equations
+    /// (7.24)–(7.28) on the leaf: a positive real part => unstable).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (not a reduced equilibrium to 1e-8), DegenerateStratumError.
+    fn stability(&self) -> PyResult<Stability> {
+        let n = self.inner.n();
+        let body = FullBody::new(n, self.potential.clone()).py()?;
+        let s = st::stability(&body, &self.inner.a, &self.inner.xi, &self.inner.eta).py()?;
+        Ok(Stability {
+            energy_momentum: s.energy_momentum.into(),
+            spectral: s.spectral.into(),
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RelativeEquilibrium(shape={:?}, energy={:.6e}, residual={:.1e})",
+            self.inner.a, self.inner.energy, self.inner.residuals.motion
+        )
+    }
+}
+
+/// The two stability verdicts of a relative equilibrium.
+#[pyclass(module = "lieflow.pseudo_rigid", name = "Stability", frozen, get_all)]
+pub struct Stability {
+    /// The energy–momentum verdict (Hessian of H on the symplectic leaf).
+    energy_momentum: Verdict,
+    /// The spectral verdict (linearisation of the reduced equations on the leaf).
+    spectral: Verdict,
+}
+
+/// One verdict: the eigenvalues it rests on and whether they prove stability.
+#[pyclass(module = "lieflow.pseudo_rigid", name = "Verdict", frozen)]
+#[derive(Clone)]
+pub struct Verdict {
+    eigenvalues: Vec<Complex64>,
+    /// Whether the verdict is "stable".
+    #[pyo3(get)]
+    stable: bool,
+    /// Whether the verdict decides: stable by a definite Hessian, or unstable by a positive
+    /// real part; an indefinite Hessian or a purely imaginary spectrum is not conclusive.
+    #[pyo3(get)]
+    conclusive: bool,
+    /// The largest real part of the eigenvalues.
+    #[pyo3(get)]
+    max_real_part: f64,
+    /// The tolerance the verdict used.
+    #[pyo3(get)]
+    tol: f64,
+}
+
+impl From<st::Verdict> for Verdict {
+    fn from(v: st::Verdict) -> Self {
+        Verdict {
+            eigenvalues: v
+                .eigenvalues
+                .iter()
+                .map(|&(re, im)| Complex64::new(re, im))
+                .collect(),
+            stable: v.stable,
+            conclusive: v.conclusive,
+            max_real_part: v.max_real_part,
+            tol: v.tol,
+        }
+    }
+}
+
+#[pymethods]
+impl Verdict {
+    /// The eigenvalues (complex array; real for the energy–momentum Hessian).
+    #[getter]
+    fn eigenvalues<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<Complex64>> {
+        PyArray1::from_vec(py, self.eigenvalues.clone())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Verdict(stable={}, conclusive={}, max_real_part={:.3e}, {} eigenvalues)",
+            self.stable,
+            self.conclusive,
+            self.max_real_part,
+            self.eigenvalues.len()
+        )
+    }
+}
+
+#[pymethods]
+impl Stability {
+    fn __repr__(&self) -> String {
+        format!(
+            "Stability(energy_momentum={}, spectral={})",
+            self.energy_momentum.__repr__(),
+            self.spectral.__repr__()
+        )
+    }
+}
+
+/// Adds the functions and classes to `lieflow.pseudo_rigid`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(amended_potential, m)?)?;
+    m.add_function(wrap_pyfunction!(augmented_potential, m)?)?;
+    m.add_function(wrap_pyfunction!(augmented_gradient, m)?)?;
+    m.add_function(wrap_pyfunction!(equilibrium_directions, m)?)?;
+    m.add_function(wrap_pyfunction!(relative_equilibria, m)?)?;
+    m.add_class::<RelativeEquilibrium>()?;
+    m.add_class::<Stability>()?;
+    m.add_class::<Verdict>()?;
+    Ok(())
+}

@@ -1,0 +1,123 @@
+"""Relative equilibria of pseudo-rigid bodies and their stability from Python (001 §8):
+augmented/amended potentials against finite differences and each other, the admissible
+directions (8.6), the three solvers, the motion against the integrator, and the two stability
+verdicts against simulations."""
+
+import numpy as np
+import pytest
+
+import lieflow as lf
+
+pr = lf.pseudo_rigid
+pot = lf.potentials
+
+
+def e(i, j, n=3):
+    m = np.zeros((n, n))
+    m[i, j], m[j, i] = 1.0, -1.0
+    return m
+
+
+SVK = pot.SaintVenantKirchhoff(1.0, 1.0)
+
+
+def test_augmented_gradient_is_the_derivative_and_vanishes_at_an_equilibrium():
+    rng = np.random.default_rng(3)
+    x = np.diag([1.3, 1.0, 0.8]) + 0.05 * rng.standard_normal((3, 3))
+    xi, eta = 0.4 * e(0, 1) + 0.1 * e(1, 2), 0.2 * e(0, 2)
+    g = pr.augmented_gradient(x, xi, eta, SVK)
+    v = rng.standard_normal((3, 3))
+    h = 1e-6
+    fd = (pr.augmented_potential(x + h * v, xi, eta, SVK)
+          - pr.augmented_potential(x - h * v, xi, eta, SVK)) / (2 * h)
+    assert abs(fd - np.sum(g * v)) < 1e-7 * max(1.0, abs(fd))
+    # U_aug = U - |xi X - X eta|^2 / 2 (the quadratic form of B_X, 001 (6.25)).
+    w = xi @ x - x @ eta
+    assert abs(pr.augmented_potential(x, xi, eta, SVK) - (SVK.value(x) - 0.5 * np.sum(w * w))) < 1e-13
+    (r,) = [q for q in pr.relative_equilibria(SVK, velocities=(0.5 * e(0, 1), 0.9 * e(0, 1)),
+                                              bounds=(0.05, 3.0), starts=5)
+            if q.shape[0] > q.shape[1]]
+    assert np.abs(pr.augmented_gradient(np.diag(r.shape), r.xi, r.eta, SVK)).max() < 1e-12
+
+
+def test_amended_and_augmented_potentials_are_legendre_partners():
+    x = np.diag([1.4, 1.0, 0.7])
+    xi, eta = 0.3 * e(0, 1), -0.2 * e(0, 1)
+    lam, gam = pr.bi_inertia_apply(x, xi, eta)
+    u = SVK.value(x)
+    # V + U_aug = 2U at lam + gam = B_X(xi + eta).
+    assert abs(pr.amended_potential(x, lam, gam, SVK) + pr.augmented_potential(x, xi, eta, SVK)
+               - 2 * u) < 1e-13
+
+
+def test_directions_satisfy_8_6_and_include_disjoint_plane_sums_for_n_4():
+    for a in ([3.0, 2.0, 1.0], [4.0, 3.0, 2.0, 1.0]):
+        dirs = pr.equilibrium_directions(a)
+        b = np.array(a)
+        for d in dirs:
+            lam, gam = pr.bi_inertia_apply(np.diag(b), d["xi"], d["eta"])
+            assert np.abs(d["xi"] @ lam - lam @ d["xi"]).max() < 1e-12
+            assert np.abs(d["eta"] @ gam - gam @ d["eta"]).max() < 1e-12
+        if len(a) == 4:
+            assert any(len(d["planes"]) == 2 for d in dirs)
+
+
+def test_solvers_agree_and_motion_solves_the_equations():
+    xi, eta = 0.5 * e(0, 1), 0.9 * e(0, 1)
+    found = pr.relative_equilibria(SVK, velocities=(xi, eta), bounds=(0.05, 3.0), starts=5)
+    assert len(found) >= 1
+    r = found[0]
+    assert max(r.residuals.values()) < 1e-10
+    # The shape solver finds the same velocities back (and their sign/Dedekind partners).
+    by_shape = pr.relative_equilibria(SVK, shape=r.shape, plane=(0, 1))
+    assert any(np.allclose(q.xi, xi) and np.allclose(q.eta, eta) for q in by_shape)
+    # The momenta solver finds the same shape back.
+    by_momenta = pr.relative_equilibria(SVK, momenta=(r.L, r.Gamma), bounds=(0.05, 3.0), starts=5)
+    assert any(np.allclose(q.shape, r.shape, atol=1e-8) for q in by_momenta)
+    # The motion is a solution: verlet4 from (X0, P0) follows it.
+    t = np.linspace(0.0, 10.0, 11)
+    X, P = r.motion(t)
+    assert X.shape == (11, 3, 3) and P.shape == (11, 3, 3)
+    body = lf.PseudoRigidBody(3, SVK)
+    tr = lf.integrate(body, (X[0], P[0]), dt=0.01, steps=1000, method="verlet4", save_every=100)
+    assert np.abs(tr.X - X).max() < 1e-8 and np.abs(tr.P - P).max() < 1e-8
+    np.testing.assert_allclose(tr.energy(), r.energy, rtol=1e-12)
+    np.testing.assert_allclose(tr.angular_momentum()[-1], r.L, atol=1e-12)
+
+
+def test_degenerate_cases_are_reported():
+    with pytest.raises(lf.InvalidArgumentError):
+        pr.relative_equilibria(SVK, shape=[1.2, 1.0, 0.8])   # no plane
+    with pytest.raises(lf.DegenerateStratumError):
+        pr.relative_equilibria(SVK, shape=[1.0, 1.0, 0.8], plane=(0, 1))
+    with pytest.raises(lf.InvalidArgumentError):   # a force off the plane cannot be balanced
+        pr.relative_equilibria(SVK, shape=[1.5, 1.2, 0.5], plane=(0, 1))
+
+
+@pytest.mark.parametrize("w, l, stable", [(0.5, 0.9, True), (0.3, 0.5, False)])
+def test_stability_verdicts_agree_with_simulation(w, l, stable):
+    found = pr.relative_equilibria(SVK, velocities=(w * e(0, 1), l * e(0, 1)),
+                                   bounds=(0.05, 3.0), starts=5)
+    r = max(found, key=lambda q: q.shape[0])
+    s = r.stability()
+    assert s.spectral.stable == stable and s.spectral.conclusive != stable
+    assert s.energy_momentum.stable == stable
+    if stable:
+        assert s.energy_momentum.conclusive and np.all(s.energy_momentum.eigenvalues.real > 0)
+    else:
+        assert s.spectral.max_real_part > 0.1
+    X, P = r.motion([0.0])
+    rng = np.random.default_rng(1)
+    X0 = X[0] + 1e-4 * rng.standard_normal((3, 3))
+    body = lf.PseudoRigidBody(3, SVK, check_det=False)
+    tr = lf.integrate(body, (X0, P[0]), dt=0.01, steps=20_000, method="verlet4", save_every=100)
+    dev = np.abs(tr.singular_values() - np.sort(r.shape)[::-1]).max()
+    assert (dev < 1e-3) == stable, dev
+
+
+def test_stretch_potential_family_in_one_plane():
+    st = pot.Stretch(1.0)
+    found = pr.relative_equilibria(st, shape=[1.5, 1.2, 1.0], plane=(0, 1))
+    assert len(found) == 4 and all(q.residuals["motion"] < 1e-12 for q in found)
+    speeds = sorted((round(abs(q.xi[0, 1]), 12), round(abs(q.eta[0, 1]), 12)) for q in found)
+    assert speeds[0] == speeds[1]      # ± signs of the same rotation
