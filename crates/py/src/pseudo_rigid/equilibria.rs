@@ -19,6 +19,7 @@ use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
+type Arr3<'py> = Bound<'py, PyArray3<f64>>;
 
 /// Runs `f` on the potential and re-raises the first exception of a callable potential.
 fn with_potential<T>(
@@ -250,11 +251,7 @@ impl RelativeEquilibrium {
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.
-    fn motion<'py>(
-        &self,
-        py: Python<'py>,
-        t: ArrayIn<'py>,
-    ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+    fn motion<'py>(&self, py: Python<'py>, t: ArrayIn<'py>) -> PyResult<(Arr3<'py>, Arr3<'py>)> {
         let times: Vec<f64> = t.as_array().iter().copied().collect();
         let frames = self.inner.motion(&times).py()?;
         let n = self.inner.n();
