@@ -113,6 +113,14 @@ def augmented_potential(X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: 
     """U_{xi+eta}(X) = U(X) - <xi+eta, B_X(xi+eta)>/2 (001 (8.12))."""
 def augmented_gradient(X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any) -> F64:
     """dU_{xi+eta}/dX, (n, n)."""
+def augmented_hessian(
+    X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any, V: ArrayLike | None = None
+) -> F64:
+    """D^2U_{xi+eta}(X)[V], (n, n); without V the (n^2, n^2) row-major vec(X) matrix (001 (8.12))."""
+def amended_hessian(
+    X: ArrayLike, lam: ArrayLike, gam: ArrayLike, potential: Any, V: ArrayLike | None = None
+) -> F64:
+    """D^2V_{lam+gam}(X)[V], (n, n); without V the (n^2, n^2) row-major vec(X) matrix (001 (8.11))."""
 def equilibrium_directions(a: ArrayLike) -> list[dict[str, Any]]:
     """Velocity directions satisfying (8.6) for A = diag(a): (8.15), (8.17)-(8.18)."""
 def relative_equilibria(

@@ -121,3 +121,85 @@ def test_stretch_potential_family_in_one_plane():
     assert len(found) == 4 and all(q.residuals["motion"] < 1e-12 for q in found)
     speeds = sorted((round(abs(q.xi[0, 1]), 12), round(abs(q.eta[0, 1]), 12)) for q in found)
     assert speeds[0] == speeds[1]      # ± signs of the same rotation
+
+
+# --- Hessians of the augmented and amended potentials (001 (8.11)-(8.12)) ---
+
+HESSIAN_POTENTIALS = [
+    pot.SaintVenantKirchhoff(0.7, 1.3),
+    pot.Harmonic(0.8) + pot.Volumetric(0.4, 1.4),
+    pot.Stretch(1.1),
+]
+
+
+def _skew(rng, n, s=1.0):
+    m = s * rng.standard_normal((n, n))
+    return 0.5 * (m - m.T)
+
+
+def _principal(rng, n):
+    while True:
+        x = np.diag(1.0 + 0.3 * np.arange(n)) + 0.15 * rng.standard_normal((n, n))
+        sv = np.linalg.svd(x, compute_uv=False)
+        if np.linalg.det(x) > 0 and np.min(-np.diff(sv)) > 0.1 and sv[-1] > 0.3:
+            return x
+
+
+def _fd_amended_gradient(x, lam, gam, p, h=1e-4):
+    """Central-difference gradient of amended_potential (tr pairing), O(h^4) five-point rule."""
+    g = np.zeros_like(x)
+    for idx in np.ndindex(*x.shape):
+        e = np.zeros_like(x)
+        e[idx] = h
+        f = [pr.amended_potential(x + k * e, lam, gam, p) for k in (-2, -1, 1, 2)]
+        g[idx] = (f[0] - 8 * f[1] + 8 * f[2] - f[3]) / (12 * h)
+    return g
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+@pytest.mark.parametrize("p", HESSIAN_POTENTIALS, ids=["svk", "harmonic+gas", "stretch"])
+def test_augmented_hessian_is_the_derivative_of_augmented_gradient(n, p):
+    rng = np.random.default_rng(10 + n)
+    x = _principal(rng, n)
+    xi, eta, v = _skew(rng, n, 0.8), _skew(rng, n, 0.8), rng.standard_normal((n, n))
+    hv = pr.augmented_hessian(x, xi, eta, p, V=v)
+    h = 1e-5
+    fd = (pr.augmented_gradient(x + h * v, xi, eta, p)
+          - pr.augmented_gradient(x - h * v, xi, eta, p)) / (2 * h)
+    assert hv.shape == (n, n)
+    assert np.linalg.norm(hv - fd) < 1e-7 * np.linalg.norm(fd)
+    m = pr.augmented_hessian(x, xi, eta, p)
+    assert m.shape == (n * n, n * n)
+    np.testing.assert_allclose(m, m.T, atol=1e-12 * np.abs(m).max())
+    # Row-major vec basis: M @ vec(V) = vec(D^2[V]).
+    np.testing.assert_allclose(m @ v.ravel(), hv.ravel(), atol=1e-12 * np.abs(hv).max())
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+@pytest.mark.parametrize("p", HESSIAN_POTENTIALS, ids=["svk", "harmonic+gas", "stretch"])
+def test_amended_hessian_against_finite_differences_of_the_amended_potential(n, p):
+    rng = np.random.default_rng(20 + n)
+    x = _principal(rng, n)
+    lam, gam, v = _skew(rng, n), _skew(rng, n), rng.standard_normal((n, n))
+    hv = pr.amended_hessian(x, lam, gam, p, V=v)
+    h = 1e-4
+    fd = (_fd_amended_gradient(x + h * v, lam, gam, p)
+          - _fd_amended_gradient(x - h * v, lam, gam, p)) / (2 * h)
+    assert np.linalg.norm(hv - fd) < 1e-5 * np.linalg.norm(fd)
+    m = pr.amended_hessian(x, lam, gam, p)
+    np.testing.assert_allclose(m, m.T, atol=1e-11 * np.abs(m).max())
+    np.testing.assert_allclose(m @ v.ravel(), hv.ravel(), atol=1e-12 * np.abs(hv).max())
+    # The amended Hessian is the augmented one at xi + eta = B_X^{-1}(lam + gam) plus a
+    # positive semidefinite term.
+    xi, eta = pr.bi_inertia_solve(x, lam, gam)
+    d = m - pr.augmented_hessian(x, xi, eta, p)
+    ev = np.linalg.eigvalsh(0.5 * (d + d.T))
+    assert ev.min() > -1e-10 * ev.max()
+
+
+def test_hessians_reject_bad_input():
+    x = np.diag([1.3, 1.0, 0.8])
+    with pytest.raises(lf.ShapeError):
+        pr.augmented_hessian(x, e(0, 1), e(0, 2), SVK, V=np.zeros((2, 2)))
+    with pytest.raises(lf.DegenerateStratumError):
+        pr.amended_hessian(np.eye(3), e(0, 1), e(0, 2), SVK)

@@ -4,13 +4,15 @@ use lieflow::integrate::{integrate, Problem};
 use lieflow::lie::so::{self, hat_n};
 use lieflow::pseudo_rigid::dynamics::FullBody;
 use lieflow::pseudo_rigid::equilibria::{
-    amended_force, amended_gradient, amended_potential, augmented_gradient, augmented_potential,
-    equilibria_for_momenta, equilibria_for_shape, equilibria_for_velocities,
-    equilibrium_directions, equilibrium_residual, force_balance, RelativeEquilibrium,
+    amended_force, amended_gradient, amended_hessian, amended_hessian_matrix, amended_potential,
+    amended_velocity_derivative, augmented_gradient, augmented_hessian, augmented_hessian_matrix,
+    augmented_potential, equilibria_for_momenta, equilibria_for_shape, equilibria_for_velocities,
+    equilibrium_directions, equilibrium_residual, force_balance, search_momenta, search_velocities,
+    RelativeEquilibrium,
 };
 use lieflow::pseudo_rigid::momentum::momentum_map;
 use lieflow::pseudo_rigid::potential::{
-    self, Harmonic, Potential, SaintVenantKirchhoff, Sum, Volumetric,
+    self, Harmonic, Potential, SaintVenantKirchhoff, Stretch, Sum, Volumetric,
 };
 use lieflow::pseudo_rigid::reduced::ReducedState;
 use lieflow::pseudo_rigid::{BiInertia, PseudoRigidBody};
@@ -539,4 +541,257 @@ fn harmonic_gas_plane_rotation_is_degenerate_or_a_family() {
         Error::InvalidArgument { message, .. } => assert!(message.contains("continuum")),
         e => panic!("{e}"),
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hessians of the augmented and amended potentials (001 (8.11)–(8.12))
+
+/// A small deterministic generator (xorshift) for the random points below.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+    fn mat(&mut self, n: usize, s: f64) -> Mat {
+        Mat::from_fn(n, n, |_, _| s * self.next())
+    }
+    fn skew(&mut self, n: usize, s: f64) -> Mat {
+        let m = self.mat(n, s);
+        (&m - m.transpose()) * faer::Scale(0.5)
+    }
+    /// A point of the principal stratum: det > 0, singular values separated by ≥ 0.1.
+    fn principal(&mut self, n: usize) -> Mat {
+        loop {
+            let x = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + 0.3 * i as f64 } else { 0.0 })
+                + self.mat(n, 0.25);
+            let sv = x.singular_values().unwrap();
+            let sep = sv.windows(2).all(|w| (w[0] - w[1]).abs() > 0.1);
+            if sep && x.determinant() > 0.0 && sv[n - 1] > 0.3 {
+                return x;
+            }
+        }
+    }
+}
+
+fn hessian_potentials() -> Vec<(&'static str, Arc<dyn Potential>)> {
+    vec![
+        (
+            "SVK",
+            Arc::new(SaintVenantKirchhoff::new(0.7, 1.3).unwrap()),
+        ),
+        (
+            "Harmonic+Volumetric",
+            Arc::new(Sum::new(vec![
+                Arc::new(Harmonic::new(0.8).unwrap()),
+                Arc::new(Volumetric::polytropic(0.4, 1.4).unwrap()),
+            ])),
+        ),
+        ("Stretch", Arc::new(Stretch::new(1.1).unwrap())),
+    ]
+}
+
+/// Central difference of a matrix-valued map along V.
+fn fd_direction(f: impl Fn(&Mat) -> Mat, x: &Mat, v: &Mat, h: f64) -> Mat {
+    (f(&(x + v * faer::Scale(h))) - f(&(x - v * faer::Scale(h)))) * faer::Scale(0.5 / h)
+}
+
+fn tr(a: &Mat, b: &Mat) -> f64 {
+    (a.transpose() * b).diagonal().column_vector().iter().sum()
+}
+
+#[test]
+fn hessians_match_finite_differences_of_the_gradients() {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let (mut worst_aug, mut worst_am) = (0.0_f64, 0.0_f64);
+    for n in [2, 3, 4] {
+        for (name, pot) in hessian_potentials() {
+            for _ in 0..3 {
+                let x = rng.principal(n);
+                let (xi, eta) = (rng.skew(n, 0.8), rng.skew(n, 0.8));
+                let (lam, gam) = (rng.skew(n, 1.0), rng.skew(n, 1.0));
+                let v = rng.mat(n, 1.0);
+                let h = augmented_hessian(&*pot, &x, &xi, &eta, &v).unwrap();
+                let fd = fd_direction(
+                    |y| augmented_gradient(&*pot, y, &xi, &eta).unwrap(),
+                    &x,
+                    &v,
+                    1e-5,
+                );
+                let e = rel(&h, &fd);
+                worst_aug = worst_aug.max(e);
+                assert!(e < 1e-7, "augmented {name} n={n}: {e:.2e}");
+                let h = amended_hessian(&*pot, &x, &lam, &gam, &v).unwrap();
+                let fd = fd_direction(
+                    |y| amended_gradient(&*pot, y, &lam, &gam).unwrap(),
+                    &x,
+                    &v,
+                    1e-5,
+                );
+                let e = rel(&h, &fd);
+                worst_am = worst_am.max(e);
+                assert!(e < 1e-6, "amended {name} n={n}: {e:.2e}");
+            }
+        }
+    }
+    println!("worst relative FD error: augmented {worst_aug:.2e}, amended {worst_am:.2e}");
+}
+
+#[test]
+fn hessians_are_symmetric_and_the_dense_matrices_agree() {
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    for n in [2, 3, 4] {
+        for (name, pot) in hessian_potentials() {
+            let x = rng.principal(n);
+            let (xi, eta) = (rng.skew(n, 0.8), rng.skew(n, 0.8));
+            let (lam, gam) = (rng.skew(n, 1.0), rng.skew(n, 1.0));
+            let (v, w) = (rng.mat(n, 1.0), rng.mat(n, 1.0));
+            let aug = |d: &Mat| augmented_hessian(&*pot, &x, &xi, &eta, d).unwrap();
+            let am = |d: &Mat| amended_hessian(&*pot, &x, &lam, &gam, d).unwrap();
+            for (what, f) in [
+                ("augmented", &aug as &dyn Fn(&Mat) -> Mat),
+                ("amended", &am),
+            ] {
+                let (a, b) = (tr(&w, &f(&v)), tr(&v, &f(&w)));
+                assert!(
+                    (a - b).abs() < 1e-12 * a.abs().max(1.0),
+                    "{what} {name} n={n}: {a} vs {b}"
+                );
+            }
+            let ha = augmented_hessian_matrix(&*pot, &x, &xi, &eta).unwrap();
+            let hm = amended_hessian_matrix(&*pot, &x, &lam, &gam).unwrap();
+            for (what, m, f) in [
+                ("augmented", &ha, &aug as &dyn Fn(&Mat) -> Mat),
+                ("amended", &hm, &am),
+            ] {
+                assert_eq!((m.nrows(), m.ncols()), (n * n, n * n));
+                assert!(
+                    rel(&m.transpose().to_owned(), m) < 1e-12,
+                    "{what} {name} n={n} not symmetric"
+                );
+                let fv = f(&v);
+                let mv = m * Mat::from_fn(n * n, 1, |k, _| v[(k / n, k % n)]);
+                let col = Mat::from_fn(n, n, |i, j| mv[(i * n + j, 0)]);
+                assert!(
+                    rel(&col, &fv) < 1e-12,
+                    "{what} {name} n={n}: dense ≠ directional"
+                );
+            }
+        }
+    }
+}
+
+/// ⟨Y, D²V[V]⟩ − ⟨Y, D²U_κ[V]⟩ = tr((L_X Dκ[Y])ᵀ L_X Dκ[V]) with κ = B_X⁻¹(λ ⊕ γ); Dκ both
+/// analytic and by finite differences of B_X⁻¹(λ ⊕ γ) (the second route).
+fn check_relation(pot: &dyn Potential, x: &Mat, lam: &Mat, gam: &Mat, y: &Mat, v: &Mat) -> f64 {
+    let b = BiInertia::new(x).unwrap();
+    let (xi, eta) = b.solve(lam, gam).unwrap();
+    let lx = |(p, q): &(Mat, Mat)| p * x - x * q;
+    let dk = |d: &Mat| amended_velocity_derivative(x, lam, gam, d).unwrap();
+    let (dy, dv) = (dk(y), dk(v));
+    // Dκ by finite differences of κ(X) = B_X⁻¹(λ ⊕ γ).
+    let kappa = |z: &Mat| BiInertia::new(z).unwrap().solve(lam, gam).unwrap();
+    for (d, an) in [(y, &dy), (v, &dv)] {
+        let fd0 = fd_direction(|z| kappa(z).0, x, d, 1e-5);
+        let fd1 = fd_direction(|z| kappa(z).1, x, d, 1e-5);
+        assert!(rel(&an.0, &fd0) < 1e-6 && rel(&an.1, &fd1) < 1e-6);
+    }
+    let am = tr(y, &amended_hessian(pot, x, lam, gam, v).unwrap());
+    let aug = tr(y, &augmented_hessian(pot, x, &xi, &eta, v).unwrap());
+    let extra = tr(&lx(&dy), &lx(&dv));
+    // Also ⟨Dκ[Y], B_X Dκ[V]⟩ via BiInertia (the so(n) ⊕ so(n) pairing).
+    let (p, q) = b.apply(&dv.0, &dv.1).unwrap();
+    let extra2 = so::pairing(&dy.0, &p) + so::pairing(&dy.1, &q);
+    assert!((extra - extra2).abs() < 1e-12 * extra.abs().max(1.0));
+    let err = (am - aug - extra).abs() / am.abs().max(aug.abs()).max(1.0);
+    assert!(err < 1e-11, "relation: {am} vs {aug} + {extra}");
+    // The extra term is positive semidefinite: ⟨Dκ[V], B_X Dκ[V]⟩ = ‖L_X Dκ[V]‖² ≥ 0, and the
+    // quadratic forms differ by it.
+    let qa = tr(v, &amended_hessian(pot, x, lam, gam, v).unwrap());
+    let qu = tr(v, &augmented_hessian(pot, x, &xi, &eta, v).unwrap());
+    assert!(qa - qu >= -1e-12 * qa.abs().max(1.0));
+    err
+}
+
+#[test]
+fn amended_hessian_is_augmented_plus_a_positive_term() {
+    let mut rng = Rng(0xdead_beef_cafe_f00d);
+    // Random points of the principal stratum.
+    for n in [2, 3, 4] {
+        for (_, pot) in hessian_potentials() {
+            let x = rng.principal(n);
+            let (lam, gam) = (rng.skew(n, 1.0), rng.skew(n, 1.0));
+            let (y, v) = (rng.mat(n, 1.0), rng.mat(n, 1.0));
+            check_relation(&*pot, &x, &lam, &gam, &y, &v);
+        }
+    }
+    // At relative equilibria from the exact shape solver: both gradients vanish there, and the
+    // Hessians are related as above (λ ⊕ γ = B_A(Ω ⊕ Λ), A = diag(a), body = spatial at t = 0).
+    let pot = svk();
+    let a = svk_closed_form(0.6, 0.4);
+    let sols = equilibria_for_shape(&*pot, &a, (0, 1)).unwrap();
+    assert_eq!(sols.len(), 4);
+    for re in &sols {
+        let x = re.x0();
+        let ga = augmented_gradient(&*pot, &x, &re.xi, &re.eta).unwrap();
+        let gm = amended_gradient(&*pot, &x, &re.lam, &re.gam).unwrap();
+        assert!(ga.norm_l2() < 1e-11 && gm.norm_l2() < 1e-11);
+        let hm = amended_hessian_matrix(&*pot, &x, &re.lam, &re.gam).unwrap();
+        let ha = augmented_hessian_matrix(&*pot, &x, &re.xi, &re.eta).unwrap();
+        // The difference is C*B_X C with C = Dκ: symmetric positive semidefinite, rank ≤ 6.
+        let d = &hm - &ha;
+        let ev = d.self_adjoint_eigenvalues(faer::Side::Lower).unwrap();
+        let top = ev.iter().copied().fold(0.0, f64::max);
+        assert!(ev.iter().all(|&l| l >= -1e-10 * top), "{ev:?}");
+        assert!(ev.iter().filter(|&&l| l > 1e-10 * top).count() <= 6);
+        for _ in 0..5 {
+            let (y, v) = (rng.mat(3, 1.0), rng.mat(3, 1.0));
+            check_relation(&*pot, &x, &re.lam, &re.gam, &y, &v);
+        }
+    }
+}
+
+#[test]
+fn hessians_reject_bad_input() {
+    let pot = svk();
+    let x = sample_x(3);
+    let (xi, eta) = (skew(3, 0.3), skew(3, 1.1));
+    assert!(augmented_hessian(&*pot, &x, &xi, &eta, &Mat::zeros(2, 2)).is_err());
+    assert!(augmented_hessian(&*pot, &x, &x, &eta, &x).is_err());
+    let degenerate = Mat::identity(3, 3);
+    let err = amended_hessian(&*pot, &degenerate, &xi, &eta, &x).unwrap_err();
+    assert!(matches!(err, Error::DegenerateStratum { .. }), "{err}");
+    let err = amended_hessian_matrix(&*pot, &degenerate, &xi, &eta).unwrap_err();
+    assert!(matches!(err, Error::DegenerateStratum { .. }), "{err}");
+}
+
+#[test]
+fn search_reports_the_coincident_solutions_the_solvers_drop() {
+    let pot = svk();
+    let (xi, eta) = (scaled(&e(3, 0, 1), 0.6), scaled(&e(3, 0, 1), 0.4));
+    let found = search_velocities(&*pot, &xi, &eta, (0.2, 2.0), 5).unwrap();
+    let sols = equilibria_for_velocities(&*pot, &xi, &eta, (0.2, 2.0), 5).unwrap();
+    assert_eq!(found.equilibria, sols);
+    println!(
+        "velocities: coincident shapes dropped: {:?}",
+        found.coincident
+    );
+    for a in &found.coincident {
+        let g = (0..a.len())
+            .flat_map(|i| (i + 1..a.len()).map(move |j| (i, j)))
+            .map(|(i, j)| (a[i] - a[j]).abs())
+            .fold(f64::INFINITY, f64::min);
+        assert!(g <= 1e-7 * 2.0, "{a:?}");
+        // They do balance the forces: X(t) = e^{tΩ}Ae^{−tΛ} is a motion there too.
+        let f = force_balance(&*pot, a, &xi, &eta).unwrap();
+        assert!(f.iter().all(|v| v.abs() < 1e-8), "{f:?}");
+    }
+    let re = &sols[0];
+    let found = search_momenta(&*pot, &re.lam, &re.gam, (0.2, 2.0), 5).unwrap();
+    let sols = equilibria_for_momenta(&*pot, &re.lam, &re.gam, (0.2, 2.0), 5).unwrap();
+    assert_eq!(found.equilibria, sols);
+    println!("momenta: coincident shapes dropped: {:?}", found.coincident);
 }

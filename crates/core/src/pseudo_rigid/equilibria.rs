@@ -55,6 +55,7 @@ use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::{gl, so};
 use crate::pseudo_rigid::inertia::BiInertia;
+use crate::pseudo_rigid::momentum::momentum_map_unchecked;
 use crate::pseudo_rigid::potential::{self, Potential};
 use crate::Mat;
 use faer::linalg::solvers::Solve;
@@ -139,6 +140,153 @@ pub fn amended_gradient(pot: &dyn Potential, x: &Mat, lam: &Mat, gam: &Mat) -> R
     let (xi, eta) = b.solve(lam, gam)?;
     let g = potential::gradient(pot, x)?;
     finite_mat("amended gradient", g - kinetic_gradient(x, &xi, &eta))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hessians of the augmented and amended potentials
+//
+// Notation: L_X(ξ ⊕ η) = ξX − Xη (the vertical vector, [`super::connection::vertical_vector`]).
+// Its adjoint for ⟨ξ ⊕ η, ζ ⊕ θ⟩ = ½tr(ξᵀζ) + ½tr(ηᵀθ) against tr(AᵀY): since tr(ξᵀM) =
+// ⟨ξ, M − Mᵀ⟩ for skew ξ, tr((ξX − Xη)ᵀY) = ⟨ξ, YXᵀ − XYᵀ⟩ + ⟨η, YᵀX − XᵀY⟩, so
+//
+//   L_X*(Y) = (YXᵀ − XYᵀ) ⊕ (YᵀX − XᵀY) = J(X, Y)   (the momentum map, 001 (7.3)),
+//
+// in e_ij coordinates (L_X*Y)_ξ,ij = (YXᵀ − XYᵀ)_ij, (L_X*Y)_η,ij = (YᵀX − XᵀY)_ij, and
+// B_X = L_X* L_X (001 (6.9); [`super::connection::bi_connection`] is B_X⁻¹ L_X*).
+// With κ = ξ ⊕ η, W = L_X κ and G(X, κ) = ∂/∂X ½‖L_X κ‖² = ξᵀW − Wηᵀ = −(ξW − Wη) (linear in X):
+//
+// - augmented (001 (8.12)): G is linear in X, so D²U_κ(X)[V] = D²U(X)[V] − G(V, κ)
+//   = D²U(X)[V] + ξW_V − W_Vη, W_V = ξV − Vη.
+// - amended (001 (8.11)): ∇V(X) = ∇U(X) − G(X, κ(X)), κ(X) = B_X⁻¹(λ ⊕ γ). Differentiating
+//   B_X κ = λ ⊕ γ: Dκ[V] = −B_X⁻¹((D_X B_X)[V] κ), (D_X B_X)[V] κ = L_V*(L_X κ) + L_X*(L_V κ)
+//   = J(V, W) + J(X, W_V). With δκ = δξ ⊕ δη = Dκ[V] and W' = L_X δκ,
+//   D_κ G(X, κ)[δκ] = −(ξW' − W'η) − (δξW − Wδη), and
+//   D²V(X)[V] = D²U(X)[V] − G(V, κ) − D_κ G(X, κ)[Dκ[V]] = D²U_κ(X)[V] − D_κ G(X, κ)[Dκ[V]].
+// - the relation: ⟨Y, D_κ G(X, κ)[δκ]⟩ = ⟨δκ, (D_X B_X)[Y] κ⟩ = −⟨δκ, B_X Dκ[Y]⟩, hence for all
+//   X on the principal stratum and all Y, V
+//
+//   ⟨Y, D²V_{λ⊕γ}(X)[V]⟩ = ⟨Y, D²U_κ(X)[V]⟩ + ⟨Dκ[Y], B_X Dκ[V]⟩
+//                         = ⟨Y, D²U_κ(X)[V]⟩ + tr((L_X Dκ[Y])ᵀ L_X Dκ[V]):
+//
+//   the amended Hessian is the augmented one (at κ = B_X⁻¹(λ ⊕ γ)) plus a positive
+//   semidefinite term (checked in `tests/equilibria.rs`).
+
+/// D_κ κ(X)[V] = −B_X⁻¹(J(V, W) + J(X, W_V)) at κ = ξ ⊕ η (module notes above).
+fn velocity_derivative(b: &BiInertia, xi: &Mat, eta: &Mat, v: &Mat) -> Result<(Mat, Mat)> {
+    let x = b.x();
+    let w = vertical(x, xi, eta);
+    let wv = vertical(v, xi, eta);
+    let (l1, g1) = momentum_map_unchecked(v, &w);
+    let (l2, g2) = momentum_map_unchecked(x, &wv);
+    let (dxi, deta) = b.solve(&(l1 + l2), &(g1 + g2))?;
+    Ok((-dxi, -deta))
+}
+
+/// The derivative D_κ κ(X)[V] of the velocities κ(X) = B_X⁻¹(λ ⊕ γ) at fixed momenta, as the
+/// pair (δξ, δη) = −B_X⁻¹(L_V*L_X κ + L_X*L_V κ) (module notes on the Hessians; L_X κ = ξX − Xη,
+/// L_X*Y = J(X, Y) = (YXᵀ − XYᵀ) ⊕ (YᵀX − XᵀY)).
+///
+/// Errors as [`amended_potential`], and V not n×n or not finite.
+pub fn amended_velocity_derivative(x: &Mat, lam: &Mat, gam: &Mat, v: &Mat) -> Result<(Mat, Mat)> {
+    let b = BiInertia::new(x)?;
+    check::square_of("V", v, b.n())?;
+    let (xi, eta) = b.solve(lam, gam)?;
+    velocity_derivative(&b, &xi, &eta, v)
+}
+
+/// D²U_{ξ⊕η}(X)\[V\] = D²U(X)\[V\] − (ξᵀW_V − W_Vηᵀ) = D²U(X)\[V\] + ξW_V − W_Vη with
+/// W_V = ξV − Vη (001 (8.12); the kinetic part −½‖ξX − Xη‖² is quadratic in X). The directional
+/// Hessian for the pairing tr(AᵀB): d/dε ∂U_{ξ⊕η}/∂X(X + εV) at ε = 0; symmetric.
+///
+/// Errors as [`augmented_potential`], and V not n×n or not finite.
+pub fn augmented_hessian(
+    pot: &dyn Potential,
+    x: &Mat,
+    xi: &Mat,
+    eta: &Mat,
+    v: &Mat,
+) -> Result<Mat> {
+    let h = potential::hessian_product(pot, x, v)?;
+    check_pair(("xi", "eta"), xi, eta, x.nrows())?;
+    finite_mat("augmented Hessian", h - kinetic_gradient(v, xi, eta))
+}
+
+/// D²V_{λ⊕γ}(X)\[V\] (001 (8.11)), analytic (module notes on the Hessians): with
+/// κ = ξ ⊕ η = B_X⁻¹(λ ⊕ γ), W = ξX − Xη, W_V = ξV − Vη, δξ ⊕ δη = Dκ[V]
+/// ([`amended_velocity_derivative`]) and W' = δξX − Xδη,
+///
+/// D²V[V] = D²U(X)[V] + (ξW_V − W_Vη) + (ξW' − W'η) + (δξW − Wδη)
+///        = [`augmented_hessian`] at κ + (ξW' − W'η) + (δξW − Wδη).
+///
+/// Symmetric, and ⟨Y, D²V[V]⟩ = ⟨Y, D²U_κ[V]⟩ + ⟨Dκ[Y], B_X Dκ[V]⟩.
+///
+/// Errors as [`amended_potential`], and V not n×n or not finite.
+pub fn amended_hessian(pot: &dyn Potential, x: &Mat, lam: &Mat, gam: &Mat, v: &Mat) -> Result<Mat> {
+    let b = BiInertia::new(x)?;
+    let (xi, eta) = b.solve(lam, gam)?;
+    let h = potential::hessian_product(pot, x, v)?;
+    finite_mat("amended Hessian", h + amended_kinetic(&b, &xi, &eta, v)?)
+}
+
+/// The kinetic part of D²V[V] at κ = ξ ⊕ η: −G(V, κ) − D_κG(X, κ)[Dκ[V]].
+fn amended_kinetic(b: &BiInertia, xi: &Mat, eta: &Mat, v: &Mat) -> Result<Mat> {
+    let x = b.x();
+    let w = vertical(x, xi, eta);
+    let (dxi, deta) = velocity_derivative(b, xi, eta, v)?;
+    let w1 = vertical(x, &dxi, &deta);
+    let dg = xi * &w1 - &w1 * eta + &dxi * &w - &w * &deta;
+    Ok(dg - kinetic_gradient(v, xi, eta))
+}
+
+/// The n²×n² matrix of a linear map on n×n matrices in the row-major vec basis: column i·n + j
+/// is f(E_ij) flattened row-major (as [`potential::hessian`]).
+fn dense_operator(n: usize, what: &str, mut f: impl FnMut(&Mat) -> Result<Mat>) -> Result<Mat> {
+    let m = n.saturating_mul(n);
+    check::dense_size(what, m, m)?;
+    let mut h = Mat::zeros(m, m);
+    let mut e = Mat::zeros(n, n);
+    for i in 0..n {
+        for j in 0..n {
+            e[(i, j)] = 1.0;
+            let col = f(&e)?;
+            e[(i, j)] = 0.0;
+            for p in 0..n {
+                for q in 0..n {
+                    h[(p * n + q, i * n + j)] = col[(p, q)];
+                }
+            }
+        }
+    }
+    Ok(h)
+}
+
+/// The Hessian of U_{ξ⊕η} (001 (8.12)) as an n²×n² matrix in the row-major vec(X) basis: column
+/// i·n + j is [`augmented_hessian`] at V = E_ij flattened row-major. Symmetric.
+///
+/// Errors as [`augmented_hessian`], and [`Error::InvalidArgument`] when n⁴ exceeds
+/// [`check::MAX_DENSE_ENTRIES`].
+pub fn augmented_hessian_matrix(pot: &dyn Potential, x: &Mat, xi: &Mat, eta: &Mat) -> Result<Mat> {
+    let n = check::square("X", x, 2)?;
+    check::dense_size("augmented Hessian", n * n, n * n)?;
+    let u = potential::hessian(pot, x)?;
+    check_pair(("xi", "eta"), xi, eta, n)?;
+    let k = dense_operator(n, "augmented Hessian", |e| Ok(kinetic_gradient(e, xi, eta)))?;
+    finite_mat("augmented Hessian", u - k)
+}
+
+/// The Hessian of V_{λ⊕γ} (001 (8.11)) as an n²×n² matrix in the row-major vec(X) basis: column
+/// i·n + j is [`amended_hessian`] at V = E_ij flattened row-major. Symmetric.
+///
+/// Errors as [`amended_hessian`], and [`Error::InvalidArgument`] when n⁴ exceeds
+/// [`check::MAX_DENSE_ENTRIES`].
+pub fn amended_hessian_matrix(pot: &dyn Potential, x: &Mat, lam: &Mat, gam: &Mat) -> Result<Mat> {
+    let n = check::square("X", x, 2)?;
+    check::dense_size("amended Hessian", n * n, n * n)?;
+    let b = BiInertia::new(x)?;
+    let (xi, eta) = b.solve(lam, gam)?;
+    let u = potential::hessian(pot, x)?;
+    let k = dense_operator(n, "amended Hessian", |e| amended_kinetic(&b, &xi, &eta, e))?;
+    finite_mat("amended Hessian", u + k)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -590,6 +738,17 @@ fn check_bounds(bounds: (f64, f64), starts: usize, n: usize) -> Result<()> {
     Ok(())
 }
 
+/// The full outcome of [`search_velocities`] / [`search_momenta`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Search {
+    /// The relative equilibria on the principal stratum (what `equilibria_for_*` returns).
+    pub equilibria: Vec<RelativeEquilibrium>,
+    /// Semi-axes a of the solutions with coincident entries (gap ≤ 1e-7·bounds.1) found in the
+    /// box, deduplicated. B_A is singular there (seed-errata §8), so they carry no
+    /// [`RelativeEquilibrium`]; `equilibria_for_*` drop them when principal solutions exist.
+    pub coincident: Vec<Vec<f64>>,
+}
+
 /// Outcome of the multistart solve.
 struct Found {
     principal: Vec<Vec<f64>>,
@@ -686,6 +845,10 @@ fn coincident_error(what: &str, found: &Found) -> Error {
 /// [`Error::DegenerateStratum`] if the only solutions have coincident semi-axes (B_A singular,
 /// seed-errata §8); [`Error::InvalidArgument`] naming the family if a solution is not isolated.
 /// An empty vector means no relative equilibrium in the box.
+///
+/// Solutions with coincident semi-axes found **alongside** principal ones are not returned here
+/// (B_A is singular there, so they are not [`RelativeEquilibrium`]s with determined velocities);
+/// [`search_velocities`] returns them too, as [`Search::coincident`].
 pub fn equilibria_for_velocities(
     pot: &dyn Potential,
     xi: &Mat,
@@ -693,6 +856,19 @@ pub fn equilibria_for_velocities(
     bounds: (f64, f64),
     starts: usize,
 ) -> Result<Vec<RelativeEquilibrium>> {
+    Ok(search_velocities(pot, xi, eta, bounds, starts)?.equilibria)
+}
+
+/// [`equilibria_for_velocities`] with the coincident-axis solutions it drops: the same search,
+/// the same errors (an error when only coincident-axis solutions exist), and
+/// [`Search::coincident`] listing the shapes with coincident semi-axes found in the box.
+pub fn search_velocities(
+    pot: &dyn Potential,
+    xi: &Mat,
+    eta: &Mat,
+    bounds: (f64, f64),
+    starts: usize,
+) -> Result<Search> {
     let n = so::check_algebra("xi", xi)?;
     so::check_algebra_of("eta", eta, n)?;
     check_bounds(bounds, starts, n)?;
@@ -740,7 +916,10 @@ pub fn equilibria_for_velocities(
         check_isolated(&f, a, "relative equilibria for these velocities")?;
         out.push(RelativeEquilibrium::from_velocities(pot, a, xi, eta)?);
     }
-    Ok(out)
+    Ok(Search {
+        equilibria: out,
+        coincident: found.coincident,
+    })
 }
 
 /// Central-difference Hessian norm scale of U in the semi-axes (for tolerances only).
@@ -847,6 +1026,9 @@ pub fn equilibria_for_shape(
 /// (8.11), [`amended_force`]) in the box, by Newton from `starts`ⁿ grid points, deduplicated. If
 /// the planes of μ and ν are not pairwise disjoint, the commutators [μ, Ω], [ν, Λ] (001 (8.7))
 /// are solved together with the force. Errors as [`equilibria_for_velocities`].
+///
+/// Coincident-axis solutions found alongside principal ones are dropped as in
+/// [`equilibria_for_velocities`]; [`search_momenta`] returns them.
 pub fn equilibria_for_momenta(
     pot: &dyn Potential,
     lam: &Mat,
@@ -854,6 +1036,18 @@ pub fn equilibria_for_momenta(
     bounds: (f64, f64),
     starts: usize,
 ) -> Result<Vec<RelativeEquilibrium>> {
+    Ok(search_momenta(pot, lam, gam, bounds, starts)?.equilibria)
+}
+
+/// [`equilibria_for_momenta`] with the coincident-axis solutions it drops
+/// ([`Search::coincident`]); otherwise identical.
+pub fn search_momenta(
+    pot: &dyn Potential,
+    lam: &Mat,
+    gam: &Mat,
+    bounds: (f64, f64),
+    starts: usize,
+) -> Result<Search> {
     let n = so::check_algebra("lam", lam)?;
     so::check_algebra_of("gam", gam, n)?;
     check_bounds(bounds, starts, n)?;
@@ -894,5 +1088,8 @@ pub fn equilibria_for_momenta(
         check_isolated(&f, a, "relative equilibria for these momenta")?;
         out.push(RelativeEquilibrium::from_momenta(pot, a, lam, gam)?);
     }
-    Ok(out)
+    Ok(Search {
+        equilibria: out,
+        coincident: found.coincident,
+    })
 }

@@ -84,6 +84,70 @@ fn augmented_gradient<'py>(
     Ok(py_mat(py, &g))
 }
 
+/// The Hessian of the augmented potential U_{xi+eta} (001 (8.12)) at X, pairing tr(A^T B):
+/// D^2U_{xi+eta}(X)[V] = D^2U(X)[V] + xi W_V - W_V eta with W_V = xi V - V eta (the kinetic
+/// part -|xi X - X eta|^2/2 is quadratic in X).
+///
+/// Returns:
+///     with V an (n, n) direction: D^2U_{xi+eta}(X)[V], (n, n); without V: the symmetric
+///     (n^2, n^2) matrix in the row-major vec(X) basis (column i*n + j is the product with the
+///     unit matrix E_ij, flattened row-major).
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (n^4 too large).
+#[pyfunction]
+#[pyo3(signature = (X, xi, eta, potential, V = None))]
+fn augmented_hessian<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+    potential: &Bound<'py, PyPotential>,
+    V: Option<ArrayIn<'py>>,
+) -> PyResult<Arr2<'py>> {
+    let (x, a, b) = (mat("X", &X)?, mat("xi", &xi)?, mat("eta", &eta)?);
+    let h = match V {
+        Some(v) => {
+            let v = mat("V", &v)?;
+            with_potential(potential, |p| eq::augmented_hessian(p, &x, &a, &b, &v))?
+        }
+        None => with_potential(potential, |p| eq::augmented_hessian_matrix(p, &x, &a, &b))?,
+    };
+    Ok(py_mat(py, &h))
+}
+
+/// The Hessian of the amended potential V_{lam+gam}(X) = U(X) + <lam+gam, B_X^{-1}(lam+gam)>/2
+/// (001 (8.11)), analytic: with kappa = xi+eta = B_X^{-1}(lam+gam) and its derivative
+/// dkappa[V] = -B_X^{-1}(J(V, W) + J(X, W_V)) (J the momentum map, W = xi X - X eta,
+/// W_V = xi V - V eta), it is the augmented Hessian at kappa plus a positive semidefinite
+/// term: <Y, D^2V[V]> = <Y, D^2U_kappa[V]> + <dkappa[Y], B_X dkappa[V]>.
+///
+/// Returns:
+///     with V an (n, n) direction: D^2V_{lam+gam}(X)[V], (n, n); without V: the symmetric
+///     (n^2, n^2) matrix in the row-major vec(X) basis.
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError, DegenerateStratumError (X off the principal
+///     stratum), InvalidArgumentError (n^4 too large).
+#[pyfunction]
+#[pyo3(signature = (X, lam, gam, potential, V = None))]
+fn amended_hessian<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    lam: ArrayIn<'py>,
+    gam: ArrayIn<'py>,
+    potential: &Bound<'py, PyPotential>,
+    V: Option<ArrayIn<'py>>,
+) -> PyResult<Arr2<'py>> {
+    let (x, l, g) = (mat("X", &X)?, mat("lam", &lam)?, mat("gam", &gam)?);
+    let h = match V {
+        Some(v) => {
+            let v = mat("V", &v)?;
+            with_potential(potential, |p| eq::amended_hessian(p, &x, &l, &g, &v))?
+        }
+        None => with_potential(potential, |p| eq::amended_hessian_matrix(p, &x, &l, &g))?,
+    };
+    Ok(py_mat(py, &h))
+}
+
 /// The admissible velocity directions xi + eta for the diagonal shape A = diag(a): those that
 /// satisfy condition (8.6), [xi+eta, B_A(xi+eta)] = 0 — the eigen-directions e_ij + (±e_ij) of
 /// B_A (8.15) and, for n >= 4, sums over pairwise disjoint planes (8.17)–(8.18).
@@ -367,6 +431,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(amended_potential, m)?)?;
     m.add_function(wrap_pyfunction!(augmented_potential, m)?)?;
     m.add_function(wrap_pyfunction!(augmented_gradient, m)?)?;
+    m.add_function(wrap_pyfunction!(augmented_hessian, m)?)?;
+    m.add_function(wrap_pyfunction!(amended_hessian, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium_directions, m)?)?;
     m.add_function(wrap_pyfunction!(relative_equilibria, m)?)?;
     m.add_class::<RelativeEquilibrium>()?;
