@@ -203,3 +203,18 @@ def test_hessians_reject_bad_input():
         pr.augmented_hessian(x, e(0, 1), e(0, 2), SVK, V=np.zeros((2, 2)))
     with pytest.raises(lf.DegenerateStratumError):
         pr.amended_hessian(np.eye(3), e(0, 1), e(0, 2), SVK)
+
+
+def test_n4_equilibrium_with_two_disjoint_planes_is_judged_and_simulated():
+    # An (8.18) combination: rotation in the planes (1,2) and (3,4) at once.
+    xi, eta = 0.3 * e(0, 1, 4) + 0.5 * e(2, 3, 4), 0.5 * e(0, 1, 4) + 0.9 * e(2, 3, 4)
+    found = pr.relative_equilibria(SVK, velocities=(xi, eta), bounds=(0.05, 3.0), starts=4)
+    r = found[0]
+    assert max(r.residuals.values()) < 1e-12 and len(set(np.round(r.shape, 6))) == 4
+    s = r.stability()
+    assert not s.spectral.stable and s.spectral.max_real_part > 0.2
+    X, P = r.motion([0.0])
+    body = lf.PseudoRigidBody(4, SVK, check_det=False)
+    X0 = X[0] + 1e-4 * np.random.default_rng(2).standard_normal((4, 4))
+    tr = lf.integrate(body, (X0, P[0]), dt=0.01, steps=10_000, method="verlet4", save_every=100)
+    assert np.abs(tr.singular_values() - np.sort(r.shape)[::-1]).max() > 1e-2   # it leaves
