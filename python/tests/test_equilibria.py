@@ -218,3 +218,10 @@ def test_n4_equilibrium_with_two_disjoint_planes_is_judged_and_simulated():
     X0 = X[0] + 1e-4 * np.random.default_rng(2).standard_normal((4, 4))
     tr = lf.integrate(body, (X0, P[0]), dt=0.01, steps=10_000, method="verlet4", save_every=100)
     assert np.abs(tr.singular_values() - np.sort(r.shape)[::-1]).max() > 1e-2   # it leaves
+
+
+def test_coincident_solutions_found_beside_principal_ones_are_named_in_a_warning():
+    with pytest.warns(UserWarning, match="coincident semi-axes"):
+        found = pr.relative_equilibria(SVK, velocities=(0.6 * e(0, 1), 0.4 * e(0, 1)),
+                                       bounds=(0.05, 3.0), starts=5)
+    assert found and all(len(set(np.round(q.shape, 8))) == 3 for q in found)

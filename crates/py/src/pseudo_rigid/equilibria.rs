@@ -202,6 +202,9 @@ fn pair(what: &str, v: &Bound<'_, PyAny>) -> PyResult<(Mat, Mat)> {
 /// Degenerate situations are answered, not hidden: coincident semi-axes (B_A singular) raise
 /// DegenerateStratumError; a whole family of solutions raises InvalidArgumentError naming it.
 ///
+/// Solutions with coincident semi-axes (where B_A is singular, so no RelativeEquilibrium exists)
+/// found next to principal ones are named in a UserWarning, not returned.
+///
 /// Returns:
 ///     a list of RelativeEquilibrium (empty: none in the box).
 /// Raises:
@@ -219,21 +222,24 @@ fn relative_equilibria(
     bounds: (f64, f64),
     starts: usize,
 ) -> PyResult<Vec<RelativeEquilibrium>> {
-    let found = match (&shape, &velocities, &momenta, plane) {
+    let search = match (&shape, &velocities, &momenta, plane) {
         (Some(a), None, None, Some(plane)) => {
             let a = vector("shape", a)?;
-            with_potential(potential, |p| eq::equilibria_for_shape(p, &a, plane))?
+            eq::Search {
+                equilibria: with_potential(potential, |p| eq::equilibria_for_shape(p, &a, plane))?,
+                coincident: Vec::new(),
+            }
         }
         (None, Some(v), None, None) => {
             let (xi, eta) = pair("velocities", v)?;
             with_potential(potential, |p| {
-                eq::equilibria_for_velocities(p, &xi, &eta, bounds, starts)
+                eq::search_velocities(p, &xi, &eta, bounds, starts)
             })?
         }
         (None, None, Some(m), None) => {
             let (lam, gam) = pair("momenta", m)?;
             with_potential(potential, |p| {
-                eq::equilibria_for_momenta(p, &lam, &gam, bounds, starts)
+                eq::search_momenta(p, &lam, &gam, bounds, starts)
             })?
         }
         _ => {
@@ -243,8 +249,24 @@ fn relative_equilibria(
             )))
         }
     };
+    if !search.coincident.is_empty() {
+        let py = potential.py();
+        let msg = format!(
+            "relative_equilibria: left out {} solution(s) with coincident semi-axes (off the \
+             principal stratum, where B_A is singular): {:?}",
+            search.coincident.len(),
+            search.coincident
+        );
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(msg)?,
+            1,
+        )?;
+    }
     let pot = potential.get().inner.clone();
-    Ok(found
+    Ok(search
+        .equilibria
         .into_iter()
         .map(|inner| RelativeEquilibrium {
             inner,
