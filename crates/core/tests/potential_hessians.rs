@@ -2,6 +2,9 @@
 //! equilibria, 001 §8) and the stretch potential U = (k/2) Σ (σ_i − 1)²: every analytic formula
 //! against finite differences and a second route.
 
+mod common;
+
+use common::Rng;
 use lieflow::error::Error;
 use lieflow::lie::gl;
 use lieflow::pseudo_rigid::potential::{
@@ -11,41 +14,26 @@ use lieflow::Mat;
 use nalgebra::Matrix3;
 use std::sync::Arc;
 
-/// SplitMix64 → uniform numbers in [−1, 1).
-struct Rng(u64);
+/// A point of GL⁺(n) with singular values in [0.3, 3] (random rotations, stretches).
+fn gl_plus(rng: &mut Rng, n: usize) -> Mat {
+    let (r, s) = (rotation(rng, n), rotation(rng, n));
+    let a = Mat::from_fn(n, n, |i, j| {
+        if i == j {
+            0.3 + 1.35 * (1.0 + rng.uniform())
+        } else {
+            0.0
+        }
+    });
+    &r * &a * s.transpose()
+}
 
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-    fn mat(&mut self, n: usize) -> Mat {
-        Mat::from_fn(n, n, |_, _| self.uniform())
-    }
-    /// A point of GL⁺(n) with singular values in [0.3, 3] (random rotations, stretches).
-    fn gl_plus(&mut self, n: usize) -> Mat {
-        let (r, s) = (self.rotation(n), self.rotation(n));
-        let a = Mat::from_fn(n, n, |i, j| {
-            if i == j {
-                0.3 + 1.35 * (1.0 + self.uniform())
-            } else {
-                0.0
-            }
-        });
-        &r * &a * s.transpose()
-    }
-    /// A rotation in SO(n) (the polar factor of a random matrix of GL⁺(n)).
-    fn rotation(&mut self, n: usize) -> Mat {
-        loop {
-            let m = self.mat(n);
-            if gl::det(&m).abs() > 0.05 {
-                let m = if gl::det(&m) > 0.0 { m } else { flip_row0(&m) };
-                return gl::polar(&m).unwrap().0;
-            }
+/// A rotation in SO(n) (the polar factor of a random matrix of GL⁺(n)).
+fn rotation(rng: &mut Rng, n: usize) -> Mat {
+    loop {
+        let m = rng.mat(n, 1.0);
+        if gl::det(&m).abs() > 0.05 {
+            let m = if gl::det(&m) > 0.0 { m } else { flip_row0(&m) };
+            return gl::polar(&m).unwrap().0;
         }
     }
 }
@@ -105,8 +93,8 @@ fn hessians_match_finite_differences_of_the_gradients() {
     for pot in potentials() {
         for n in 2..=5 {
             for _ in 0..4 {
-                let x = rng.gl_plus(n);
-                let v = rng.mat(n);
+                let x = gl_plus(&mut rng, n);
+                let v = rng.mat(n, 1.0);
                 let h = hess(&*pot, &x, &v);
                 // Fourth-order Richardson extrapolation of two central differences.
                 let (f1, f2) = (
@@ -128,8 +116,8 @@ fn hessians_are_symmetric_bilinear_forms() {
     let mut rng = Rng(12);
     for pot in potentials() {
         for n in 2..=5 {
-            let x = rng.gl_plus(n);
-            let (v, w) = (rng.mat(n), rng.mat(n));
+            let x = gl_plus(&mut rng, n);
+            let (v, w) = (rng.mat(n, 1.0), rng.mat(n, 1.0));
             let (hv, hw) = (hess(&*pot, &x, &v), hess(&*pot, &x, &w));
             let (a, b) = (inner(&w, &hv), inner(&v, &hw));
             let scale = w.norm_l2() * hv.norm_l2() + v.norm_l2() * hw.norm_l2();
@@ -153,7 +141,7 @@ fn dense_hessian_is_symmetric_and_agrees_with_the_directional_form() {
     let mut rng = Rng(13);
     for pot in potentials() {
         for n in 2..=4 {
-            let x = rng.gl_plus(n);
+            let x = gl_plus(&mut rng, n);
             let h = potential::hessian(&*pot, &x).unwrap();
             assert_eq!((h.nrows(), h.ncols()), (n * n, n * n));
             let asym = (&h - h.transpose()).norm_l2();
@@ -162,7 +150,7 @@ fn dense_hessian_is_symmetric_and_agrees_with_the_directional_form() {
                 "{pot:?}: {asym:.2e}"
             );
             // H vec(V) = vec(D²U[V]) in the row-major basis.
-            let v = rng.mat(n);
+            let v = rng.mat(n, 1.0);
             let hv = hess(&*pot, &x, &v);
             let vec_v = Mat::from_fn(n * n, 1, |k, _| v[(k / n, k % n)]);
             let prod = &h * &vec_v;
@@ -210,8 +198,8 @@ fn stretch_gradient_matches_finite_differences_of_the_value() {
     let pot = Stretch::new(1.9).unwrap();
     for n in 2..=5 {
         for _ in 0..4 {
-            let x = rng.gl_plus(n);
-            let v = rng.mat(n);
+            let x = gl_plus(&mut rng, n);
+            let v = rng.mat(n, 1.0);
             let g = potential::gradient(&pot, &x).unwrap();
             let u = |t: f64| potential::value(&pot, &(&x + &v * faer::Scale(t))).unwrap();
             let (d1, d2) = ((u(1e-3) - u(-1e-3)) / 2e-3, (u(5e-4) - u(-5e-4)) / 1e-3);
@@ -229,7 +217,7 @@ fn stretch_gradient_is_k_times_x_minus_its_polar_rotation() {
     let k = 0.8;
     let pot = Stretch::new(k).unwrap();
     for n in 2..=6 {
-        let x = rng.gl_plus(n);
+        let x = gl_plus(&mut rng, n);
         let (r, _) = gl::polar(&x).unwrap();
         let closed = (&x - &r) * faer::Scale(k);
         let g = potential::gradient(&pot, &x).unwrap();
@@ -248,8 +236,8 @@ fn stretch_is_bi_invariant_and_vanishes_with_its_gradient_on_rotations() {
     let mut rng = Rng(23);
     let pot = Stretch::new(3.1).unwrap();
     for n in 2..=5 {
-        let x = rng.gl_plus(n);
-        let (g, h) = (rng.rotation(n), rng.rotation(n));
+        let x = gl_plus(&mut rng, n);
+        let (g, h) = (rotation(&mut rng, n), rotation(&mut rng, n));
         let u = potential::value(&pot, &x).unwrap();
         let moved = &g * &x * h.transpose();
         let u_moved = potential::value(&pot, &moved).unwrap();
@@ -263,7 +251,7 @@ fn stretch_is_bi_invariant_and_vanishes_with_its_gradient_on_rotations() {
         assert!(potential::value(&pot, &g).unwrap().abs() < 1e-24);
         assert!(potential::gradient(&pot, &g).unwrap().norm_l2() < 1e-13);
         // At a rotation Q (all σ = 1): ⟨V, D²U[V]⟩ = k‖sym(QᵀV)‖², zero along so(n) rotations.
-        let v = rng.mat(n);
+        let v = rng.mat(n, 1.0);
         let qv = g.transpose() * &v;
         let sym = (&qv + qv.transpose()) * faer::Scale(0.5);
         let quad = inner(&v, &hess(&pot, &g, &v));
@@ -281,14 +269,14 @@ fn stretch_hessian_where_singular_values_coincide_or_det_is_negative() {
     let mut rng = Rng(24);
     let pot = Stretch::new(1.1).unwrap();
     for n in 2..=4 {
-        let q = rng.rotation(n);
+        let q = rotation(&mut rng, n);
         let mut points = vec![
             &q * faer::Scale(1.3),
             Mat::identity(n, n) * faer::Scale(2.0),
         ];
-        points.push(flip_row0(&rng.gl_plus(n)));
+        points.push(flip_row0(&gl_plus(&mut rng, n)));
         for x in points {
-            let v = rng.mat(n);
+            let v = rng.mat(n, 1.0);
             let h = hess(&pot, &x, &v);
             let fd = fd_hessian(&pot, &x, &v, 1e-5);
             let err = (&fd - &h).norm_l2() / h.norm_l2();
@@ -302,7 +290,7 @@ fn stretch_fixed_size_gradient_matches_the_general_kernel() {
     let mut rng = Rng(25);
     let pot = Stretch::new(1.4).unwrap();
     for _ in 0..10 {
-        let x = rng.gl_plus(3);
+        let x = gl_plus(&mut rng, 3);
         let g = potential::gradient(&pot, &x).unwrap();
         let g3 = pot.gradient3(&Matrix3::from_fn(|i, j| x[(i, j)])).unwrap();
         let err = (0..9)

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::dist;
+use common::{dist, Rng};
 use lieflow::integrate::methods::{Composition, Verlet};
 use lieflow::integrate::{integrate as drive, integrate_with, Run, System};
 use lieflow::lie::so3;
@@ -20,30 +20,14 @@ use std::sync::Arc;
 // ---------------------------------------------------------------------------------------------
 // Helpers (L, Γ, Q, N and SVD coordinates are computed inline here, per DESIGN.md).
 
-/// SplitMix64 → uniform numbers in [−1, 1).
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-    fn mat(&mut self, n: usize, scale: f64) -> Mat {
-        Mat::from_fn(n, n, |_, _| scale * self.uniform())
-    }
-    /// A point of GL⁺(n) near the identity with well separated singular values.
-    fn gl_plus(&mut self, n: usize) -> Mat {
-        loop {
-            let x = Mat::from_fn(n, n, |i, j| {
-                (if i == j { 1.0 + 0.25 * i as f64 } else { 0.0 }) + 0.3 * self.uniform()
-            });
-            if x.as_ref().determinant() > 0.2 {
-                return x;
-            }
+/// A point of GL⁺(n) near the identity with well separated singular values.
+fn gl_plus(rng: &mut Rng, n: usize) -> Mat {
+    loop {
+        let x = Mat::from_fn(n, n, |i, j| {
+            (if i == j { 1.0 + 0.25 * i as f64 } else { 0.0 }) + 0.3 * rng.uniform()
+        });
+        if x.as_ref().determinant() > 0.2 {
+            return x;
         }
     }
 }
@@ -167,7 +151,7 @@ fn gradients_match_central_finite_differences() {
     let mut rng = Rng(1);
     for (name, pot) in all_potentials() {
         for n in 2..=6 {
-            let x = rng.gl_plus(n);
+            let x = gl_plus(&mut rng, n);
             let g = potential::gradient(&*pot, &x).unwrap();
             let h = 1e-5;
             let mut fd = Mat::zeros(n, n);
@@ -323,7 +307,7 @@ fn constructors_and_checked_evaluations_reject_bad_input() {
 fn free_body_moves_on_straight_lines() {
     let mut rng = Rng(2);
     for n in 2..=6 {
-        let x0 = rng.gl_plus(n);
+        let x0 = gl_plus(&mut rng, n);
         let p0 = rng.mat(n, 0.1);
         for order in [2, 4, 6] {
             let (x, p) = integrate(Arc::new(Zero), verlet(order), true, &x0, &p0, 1e-2, 100);
@@ -351,7 +335,7 @@ fn harmonic_oscillator_orders_2_4_6_through_det_zero() {
     let mut rng = Rng(3);
     let (n, omega) = (3, 1.3);
     let pot: Arc<dyn Potential> = Arc::new(Harmonic::new(omega * omega).unwrap());
-    let x0 = rng.gl_plus(n);
+    let x0 = gl_plus(&mut rng, n);
     let p0 = rng.mat(n, 1.0);
     let t_end = std::f64::consts::PI / omega + 0.4;
     let (xe, pe) = harmonic_exact(&x0, &p0, omega, t_end);
@@ -390,7 +374,7 @@ fn harmonic_oscillator_for_n_2_to_6() {
     let omega = 0.9;
     let pot: Arc<dyn Potential> = Arc::new(Harmonic::new(omega * omega).unwrap());
     for n in 2..=6 {
-        let x0 = rng.gl_plus(n);
+        let x0 = gl_plus(&mut rng, n);
         let p0 = rng.mat(n, 0.5);
         let steps = 200;
         let t_end = 2.0;
@@ -413,7 +397,7 @@ fn leaving_gl_plus_stops_with_the_time_of_exit() {
     let mut rng = Rng(5);
     let (n, omega) = (3, 1.3);
     let pot: Arc<dyn Potential> = Arc::new(Harmonic::new(omega * omega).unwrap());
-    let x0 = rng.gl_plus(n);
+    let x0 = gl_plus(&mut rng, n);
     let p0 = rng.mat(n, 1.0);
     // First root t* of det X(t) for the exact motion, by scanning and bisection.
     let d = |t: f64| det(&harmonic_exact(&x0, &p0, omega, t).0);
@@ -582,7 +566,7 @@ fn run_rejects_bad_input_and_changes_nothing() {
 fn verlet_preserves_angular_momentum_and_circulation() {
     let mut rng = Rng(6);
     let pot = svk();
-    let x0 = rng.gl_plus(3);
+    let x0 = gl_plus(&mut rng, 3);
     let p0 = rng.mat(3, 0.8);
     let (l0, g0) = (ang_mom(&x0, &p0), circulation(&x0, &p0));
     // SVK is defined on all n×n matrices (and does not keep det X > 0): check_det off.
@@ -617,7 +601,7 @@ fn energy_error_is_bounded_over_a_million_steps() {
     let mut rng = Rng(7);
     let pot = elastic_gas();
     let body = FullBody::new(3, pot.clone()).unwrap();
-    let x0 = rng.gl_plus(3);
+    let x0 = gl_plus(&mut rng, 3);
     let p0 = rng.mat(3, 0.8);
     let h0 = body.hamiltonian(&x0, &p0).unwrap();
     let (dt, chunk, chunks) = (1e-2, 100, 10_000);
@@ -653,7 +637,7 @@ fn energy_error_is_bounded_over_a_million_steps() {
 fn hamiltonian_and_vector_field() {
     let mut rng = Rng(8);
     let body = FullBody::new(4, elastic_gas()).unwrap();
-    let x = rng.gl_plus(4);
+    let x = gl_plus(&mut rng, 4);
     let p = rng.mat(4, 0.5);
     let h = body.hamiltonian(&x, &p).unwrap();
     let u = potential::value(body.potential(), &x).unwrap();
@@ -689,7 +673,7 @@ fn riemann_force_is_two_q_du_dq() {
     let mut rng = Rng(9);
     for (name, pot) in all_potentials() {
         let n = 3;
-        let x = rng.gl_plus(n);
+        let x = gl_plus(&mut rng, n);
         let q = &x * x.transpose();
         let v = |q: &Mat| potential::value(&*pot, &sqrt_spd(q)).unwrap();
         let h = 1e-6;
@@ -718,7 +702,7 @@ fn riemann_equations_follow_from_hamilton_equations() {
     let mut rng = Rng(10);
     for n in 2..=6 {
         let body = FullBody::new(n, elastic_gas()).unwrap();
-        let x = rng.gl_plus(n);
+        let x = gl_plus(&mut rng, n);
         let p = rng.mat(n, 0.7);
         let (_, pd) = body.vector_field(&x, &p).unwrap();
         let q = &x * x.transpose();
@@ -746,7 +730,7 @@ fn full_trajectories_satisfy_the_riemann_equations() {
     let mut rng = Rng(11);
     for n in [2, 3, 5] {
         let body = FullBody::new(n, elastic_gas()).unwrap();
-        let x0 = rng.gl_plus(n);
+        let x0 = gl_plus(&mut rng, n);
         let p0 = rng.mat(n, 0.7);
         let h = 1e-3;
         let fr = frames(body.potential_arc(), verlet(6), &x0, &p0, h, 1, 600);
@@ -814,7 +798,7 @@ fn full_trajectories_satisfy_the_lagrangian_form() {
     let mut rng = Rng(12);
     for n in [2, 3, 4] {
         let body = FullBody::new(n, elastic_gas()).unwrap();
-        let x0 = rng.gl_plus(n);
+        let x0 = gl_plus(&mut rng, n);
         let p0 = rng.mat(n, 0.6);
         let h = 1e-3;
         let fr = frames(body.potential_arc(), verlet(6), &x0, &p0, h, 1, 300);
@@ -950,7 +934,7 @@ fn dedekind_adjoint_motion_is_a_motion_and_swaps_l_and_gamma() {
     let mut rng = Rng(14);
     for n in [2, 3, 4] {
         let pot = elastic_gas();
-        let x0 = rng.gl_plus(n);
+        let x0 = gl_plus(&mut rng, n);
         let p0 = rng.mat(n, 0.7);
         let direct = frames(pot.clone(), verlet(4), &x0, &p0, 1e-2, 50, 8);
         let xt = x0.transpose().to_owned();

@@ -61,3 +61,23 @@ pub fn order<S: System + ?Sized>(sys: &S, name: &str) -> u32 {
         .1
         .order
 }
+
+/// SplitMix64 → uniform numbers in [−1, 1): a small deterministic generator for the tests.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// The next uniform number in [−1, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    /// An n×n matrix of uniform entries in [−scale, scale).
+    pub fn mat(&mut self, n: usize, scale: f64) -> Mat {
+        Mat::from_fn(n, n, |_, _| scale * self.uniform())
+    }
+}
