@@ -13,6 +13,7 @@ RigidBody, GeneralizedRigidBody, HeavyTop, SphericalPendulum   Lie–Poisson sys
 PseudoRigidBody, potentials                                     pseudo-rigid bodies of 001
 Pendulum, SphereParticle, RollingDisk                           canonical, constrained and
                                                                 nonholonomic test problems
+RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``).
@@ -37,11 +38,13 @@ from ._lieflow import (
     Integration,
     Pendulum,
     PseudoRigidBody,
+    RelativisticTangentTop,
     RigidBody,
     RollingDisk,
     SphereParticle,
     SphericalPendulum,
     System,
+    WeakFieldTop,
 )
 from . import elliptic, lie, potentials, pseudo_rigid
 from .integrate import Trajectory, integrate
@@ -64,6 +67,7 @@ __all__ = [
     "NotInGroupError",
     "Pendulum",
     "PseudoRigidBody",
+    "RelativisticTangentTop",
     "RigidBody",
     "RollingDisk",
     "SphereParticle",
@@ -72,6 +76,7 @@ __all__ = [
     "System",
     "Trajectory",
     "UnsupportedMethodError",
+    "WeakFieldTop",
     "__version__",
     "elliptic",
     "integrate",

@@ -5,6 +5,7 @@
 
 mod heavy_top;
 mod pendulum;
+mod relativistic_top;
 mod rigid_body;
 mod rolling_disk;
 mod spherical_pendulum;
@@ -73,5 +74,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<pendulum::PyPendulum>()?;
     m.add_class::<pendulum::PySphereParticle>()?;
     m.add_class::<rolling_disk::PyRollingDisk>()?;
+    m.add_class::<relativistic_top::PyRelativisticTangentTop>()?;
+    m.add_class::<relativistic_top::PyWeakFieldTop>()?;
     Ok(())
 }

@@ -1,0 +1,152 @@
+//! `RelativisticTangentTop` and `WeakFieldTop`: bindings of `lieflow::systems::relativistic_top`
+//! (002 §IV). Thin subclasses of `lieflow.System`.
+
+use lieflow::systems::relativistic_top as core;
+use lieflow::Error;
+use pyo3::prelude::*;
+use pyo3::PyClassInitializer;
+
+use crate::convert::ArrayIn;
+use crate::errors::{to_py, IntoPy};
+use crate::items::{map_items, Input};
+use crate::system::PySystem;
+
+/// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical
+/// sign of the Lagrangian, L = -m/gamma + thetadot^2 (I gamma + gamma^3 xdot^T K(theta) xdot)/2).
+/// State (x, y, theta, p_x, p_y, p_theta); fields x, theta, p, p_theta; speeds |xdot| < 1.
+/// Methods: gauss4 (default), gauss6, midpoint, rk4.
+///
+/// Args:
+///     mass > 0; inertia: the scalar tr I (the symmetric top) or the second-moment tensor as
+///         (I11, I12, I22), positive semidefinite.
+/// Raises:
+///     InvalidArgumentError, ShapeError.
+#[pyclass(name = "RelativisticTangentTop", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyRelativisticTangentTop {
+    top: core::RelativisticTangentTop,
+}
+
+#[pymethods]
+impl PyRelativisticTangentTop {
+    #[new]
+    fn new(mass: f64, inertia: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
+        let top = match inertia.extract::<f64>() {
+            Ok(i) => core::RelativisticTangentTop::symmetric(mass, i),
+            Err(_) => match inertia.extract::<[f64; 3]>() {
+                Ok(m) => core::RelativisticTangentTop::new(mass, m),
+                Err(_) => Err(Error::shape(
+                    "inertia",
+                    "a float or (I11, I12, I22)",
+                    "other",
+                )),
+            },
+        }
+        .py()?;
+        let args = (mass, inertia).into_pyobject(inertia.py())?;
+        let base = PySystem::new(top.clone(), args, &["mass", "inertia"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PyRelativisticTangentTop { top }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> (f64, f64) {
+        (1.0, 0.1)
+    }
+
+    /// The canonical state from the position x (2,), the angle theta and the velocities.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (|xdot| >= 1, a Legendre map not invertible), NonFiniteError.
+    fn state(&self, x: [f64; 2], theta: f64, xdot: [f64; 2], thetadot: f64) -> PyResult<Vec<f64>> {
+        self.top.state(x, theta, xdot, thetadot).py()
+    }
+
+    /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError, InvalidArgumentError.
+    fn velocities<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        map_items(
+            py,
+            &[Input::new("states", &states, &[6])],
+            &[3],
+            |z, out| {
+                out.copy_from_slice(&self.top.velocities(z[0])?);
+                Ok(())
+            },
+        )
+    }
+}
+
+/// The tangent top in the weak-field limit of a static space-time with potential phi (002
+/// (115)–(120), (115) with its dt^2 restored and the sign of the spin–field coupling of (118)
+/// corrected). State (x, y, theta, p_x, p_y, p_theta). Methods: gauss4 (default), gauss6,
+/// midpoint, rk4.
+///
+/// Args:
+///     mass > 0, inertia > 0 (tr I); exactly one of gm (phi = -gm/r) or g (a uniform field,
+///     (2,)).
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "WeakFieldTop", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyWeakFieldTop {
+    top: core::WeakFieldTop,
+}
+
+#[pymethods]
+impl PyWeakFieldTop {
+    #[new]
+    #[pyo3(signature = (mass, inertia, *, gm = None, g = None))]
+    fn new(
+        py: Python<'_>,
+        mass: f64,
+        inertia: f64,
+        gm: Option<f64>,
+        g: Option<[f64; 2]>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let potential = match (gm, g) {
+            (Some(gm), None) => core::Potential::point_mass(gm),
+            (None, Some(g)) => core::Potential::uniform(g),
+            _ => Err(Error::invalid("potential", "give exactly one of gm and g")),
+        }
+        .map_err(to_py)?;
+        let top = core::WeakFieldTop::new(mass, inertia, potential).py()?;
+        let args = (mass, inertia, gm, g).into_pyobject(py)?;
+        let base = PySystem::new(top.clone(), args, &["mass", "inertia", "gm", "g"]);
+        Ok(PyClassInitializer::from(base).add_subclass(PyWeakFieldTop { top }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> (f64, f64, Option<f64>) {
+        (1.0, 0.1, Some(1.0))
+    }
+
+    /// The canonical state from the position x (2,), the angle theta and the velocities.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (outside the weak-field domain), NonFiniteError.
+    fn state(&self, x: [f64; 2], theta: f64, xdot: [f64; 2], thetadot: f64) -> PyResult<Vec<f64>> {
+        self.top.state(x, theta, xdot, thetadot).py()
+    }
+
+    /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
+    /// vectorised: (..., 6) -> (...).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn angular_momentum<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        map_items(py, &[Input::new("states", &states, &[6])], &[], |z, out| {
+            out[0] = self.top.angular_momentum(z[0])?;
+            Ok(())
+        })
+    }
+}
