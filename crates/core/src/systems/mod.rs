@@ -14,12 +14,16 @@
 //! * [`SphereParticle`]: z = (q, p) (6), a particle on the sphere |q| = l, q·p = 0;
 //! * [`RollingDisk`]: z = (x, y, θ, φ, p_x, p_y, p_θ, p_φ) (8), the vertical rolling disk.
 //!
+//! 002 §IV: [`RelativisticTangentTop`] (Minkowski) and [`WeakFieldTop`] (weak static field):
+//! z = (x, y, θ, p_x, p_y, p_θ) (6).
+//!
 //! 002: [`TangentTop`]: z = (x¹, x², θ, p₁, p₂, p_θ) (6), the tangent Euler top on a [`Surface`].
 
 pub mod heavy_top;
 pub mod isospectral;
 pub mod lgvi;
 pub mod pendulum;
+pub mod relativistic_top;
 pub mod rigid_body;
 pub mod rolling_disk;
 pub mod sphere_particle;
@@ -32,6 +36,7 @@ pub use heavy_top::HeavyTop;
 pub use isospectral::Isospectral;
 pub use lgvi::Lgvi;
 pub use pendulum::Pendulum;
+pub use relativistic_top::{Potential, PotentialValue, RelativisticTangentTop, WeakFieldTop};
 pub use rigid_body::{GeneralizedRigidBody, RigidBody};
 pub use rolling_disk::RollingDisk;
 pub use sphere_particle::SphereParticle;
