@@ -13,6 +13,7 @@ RigidBody, GeneralizedRigidBody, HeavyTop, SphericalPendulum   Lie–Poisson sys
 PseudoRigidBody, potentials                                     pseudo-rigid bodies of 001
 Pendulum, SphereParticle, RollingDisk                           canonical, constrained and
                                                                 nonholonomic test problems
+TangentTop, surfaces                                            the tangent Euler top of 002 §II–III
 RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
@@ -44,9 +45,10 @@ from ._lieflow import (
     SphereParticle,
     SphericalPendulum,
     System,
+    TangentTop,
     WeakFieldTop,
 )
-from . import elliptic, lie, potentials, pseudo_rigid
+from . import elliptic, lie, potentials, pseudo_rigid, surfaces
 from .integrate import Trajectory, integrate
 
 #: The former name of the base class of the Lie–Poisson systems (kept for existing code).
@@ -74,6 +76,7 @@ __all__ = [
     "ShapeError",
     "SphericalPendulum",
     "System",
+    "TangentTop",
     "Trajectory",
     "UnsupportedMethodError",
     "WeakFieldTop",
@@ -83,4 +86,5 @@ __all__ = [
     "lie",
     "potentials",
     "pseudo_rigid",
+    "surfaces",
 ]

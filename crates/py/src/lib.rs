@@ -37,6 +37,9 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let potentials = PyModule::new(m.py(), "lieflow.potentials")?;
     pseudo_rigid::potential::register(&potentials)?;
     m.add("potentials", potentials)?;
+    let surfaces = PyModule::new(m.py(), "lieflow.surfaces")?;
+    systems::tangent_top::register_surfaces(&surfaces)?;
+    m.add("surfaces", surfaces)?;
     add_submodule(m, "elliptic", elliptic::register)?;
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;

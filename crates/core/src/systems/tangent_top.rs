@@ -217,7 +217,11 @@ impl Problem for TangentTop {
         "TangentTop"
     }
     fn space(&self) -> Space {
-        Space::new([("q", Block::Real(3)), ("p", Block::Real(3))])
+        Space::new([
+            ("x", Block::Real(2)),
+            ("theta", Block::Real(1)),
+            ("p", Block::Real(3)),
+        ])
     }
     /// H = ½ g^{AB} p_A p_B.
     fn energy(&self, z: &[f64]) -> Result<f64> {

@@ -1,0 +1,7 @@
+"""Surfaces for the tangent Euler top (bindings of ``lieflow::systems::surface``, 002 §II):
+``Plane()``, ``Sphere(radius)``, ``HyperbolicPlane()``. They pickle."""
+
+from . import _lieflow
+from ._reexport import reexport as _reexport
+
+__all__ = _reexport(_lieflow.surfaces, globals())
