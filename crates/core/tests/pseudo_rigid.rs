@@ -363,6 +363,13 @@ proptest! {
         let iso: usize = info.stratum.multiplicities.iter().map(|&m| m * (m - 1) / 2).sum();
         prop_assert_eq!(info.dim_vertical, n * (n - 1) - iso);
         prop_assert_eq!(info.dim_horizontal + info.dim_vertical, n * n);
+        // A second route: the rank of B_X = L*L (its eigenvalues (a_i ∓ a_j)², 001 (8.15)) from
+        // the symmetric eigen-decomposition of the dense matrix.
+        let bmat = BiInertia::new(&x).unwrap().matrix();
+        let eig = bmat.self_adjoint_eigen(faer::Side::Lower).unwrap();
+        let top = (0..bmat.nrows()).map(|k| eig.S()[k]).fold(0.0f64, f64::max);
+        let rank = (0..bmat.nrows()).filter(|&k| eig.S()[k] > 1e-9 * top).count();
+        prop_assert_eq!(rank, info.dim_vertical);
     }
 
     /// (9.1) against the canonical bracket on T*GL⁺(n) for linear functions
