@@ -18,7 +18,10 @@ def test_integrals_are_kept(surface, x0):
     top = lf.TangentTop(surface, 1.0, 0.5)
     z0 = top.state(x0, 0.2, [0.1, 0.3], 1.5)
     tr = lf.integrate(top, z0, dt=0.01, steps=2000, method="gauss6", save_every=100)
-    assert tr.x.shape == (21, 2) and tr.theta.shape == (21, 1) and tr.p.shape == (21, 3)
+    assert tr.x.shape == (21, 2) and tr.theta.shape == (21,) and tr.p.shape == (21, 3)
+    assert tr.xdot.shape == (21, 2) and tr.thetadot.shape == (21,)
+    np.testing.assert_allclose(tr.xdot[0], [0.1, 0.3], atol=1e-14)
+    np.testing.assert_allclose(tr.thetadot[0], 1.5, atol=1e-14)
     assert np.ptp(tr.energy()) < 1e-13 and np.ptp(tr.p_theta()) == 0.0
     assert np.abs(np.ptp(tr.killing_momenta(), axis=0)).max() < 1e-13
     copy = pickle.loads(pickle.dumps(top))

@@ -347,7 +347,11 @@ impl PySystem {
     }
 
     /// Named views of states (..., d): {field: (..., *shape)} (so(n)* blocks as skew matrices).
-    fn _fields<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyDict>> {
+    pub(crate) fn _fields<'py>(
+        &self,
+        py: Python<'py>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let dict = PyDict::new(py);
         let d = [self.sys.space().dim()];
         for (name, block, range) in self.sys.space().ranges() {

@@ -132,6 +132,27 @@ impl PyTangentTop {
         self.top.state(x, theta, xdot, thetadot).py()
     }
 
+    /// Named views for `Trajectory`: x (..., 2), theta (...), p (..., 3), and the velocities
+    /// xdot (..., 2) and thetadot (...).
+    fn _fields<'py>(
+        slf: &Bound<'py, Self>,
+        states: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        let py = slf.py();
+        let fields = slf.as_super().get()._fields(py, states.extract()?)?;
+        let pick = |a: &Bound<'py, PyAny>, k: Bound<'py, PyAny>| {
+            a.call_method1("__getitem__", ((py.Ellipsis(), k),))
+        };
+        if let Some(theta) = fields.get_item("theta")? {
+            fields.set_item("theta", pick(&theta, 0i64.into_pyobject(py)?.into_any())?)?;
+        }
+        let v = slf.get().velocities(py, states.extract()?)?;
+        let first_two = pyo3::types::PySlice::new(py, 0, 2, 1).into_any();
+        fields.set_item("xdot", pick(&v, first_two)?)?;
+        fields.set_item("thetadot", pick(&v, 2i64.into_pyobject(py)?.into_any())?)?;
+        Ok(fields)
+    }
+
     /// The velocities (x1dot, x2dot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
     fn velocities<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         map_items(
