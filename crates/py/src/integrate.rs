@@ -14,7 +14,13 @@ use rayon::prelude::*;
 use crate::convert::{shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{array, Out};
-use crate::system::Callbacks;
+
+/// Errors raised by Python callables that a system calls from native code (a callable
+/// potential): such a system runs single-threaded, and the first error is re-raised afterwards.
+pub(crate) trait Callbacks: Send + Sync {
+    /// The first recorded exception, if any (and forget it).
+    fn take_error(&self) -> PyResult<()>;
+}
 
 /// The result of `System._run`: states (b, k, d), attitude (b, k, 3, 3) or None, final states
 /// (b, d), final attitude (b, 3, 3) or None.

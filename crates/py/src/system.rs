@@ -15,15 +15,8 @@ use pyo3::types::{PyDict, PyList, PyTuple, PyType};
 
 use crate::convert::{shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
-use crate::integrate::{Integration, RunOut};
+use crate::integrate::{Callbacks, Integration, RunOut};
 use crate::items::{map_items, Input};
-
-/// Errors raised by Python callables that a system calls from native code (a callable
-/// potential): such a system runs single-threaded, and the first error is re-raised afterwards.
-pub(crate) trait Callbacks: Send + Sync {
-    /// The first recorded exception, if any (and forget it).
-    fn take_error(&self) -> PyResult<()>;
-}
 
 /// Base class of every lieflow system (RigidBody, HeavyTop, PseudoRigidBody, …): the
 /// integration protocol over a native system.

@@ -16,7 +16,7 @@ use pyo3::types::PyTuple;
 
 use crate::convert::{mat, py_mat, ArrayIn};
 use crate::errors::{to_py, IntoPy};
-use crate::system::Callbacks;
+use crate::integrate::Callbacks;
 
 /// An SO(n)×SO(n)-invariant potential U(X) of a pseudo-rigid body (001 §4.1). Build one with
 /// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Stretch(k)`,

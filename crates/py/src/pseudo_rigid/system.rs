@@ -13,7 +13,8 @@ use pyo3::PyClassInitializer;
 use super::potential::{PyPotential, Zero};
 use crate::convert::ArrayIn;
 use crate::errors::{to_py, IntoPy};
-use crate::system::{Callbacks, PySystem};
+use crate::integrate::Callbacks;
+use crate::system::PySystem;
 
 type Any<'py> = Bound<'py, PyAny>;
 
