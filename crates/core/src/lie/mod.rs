@@ -7,6 +7,10 @@
 //! e_ij (i < j) has +1 at (i, j) and −1 at (j, i). On so(3) ≅ R³ the physics hat map is used
 //! ([`so3::hat`]), with the dot product as pairing.
 
+/// Tolerance on ‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F) for accepting a matrix as skew-symmetric (so(n)
+/// and so(3) alike).
+pub const SKEW_TOL: f64 = 1e-10;
+
 pub mod gl;
 pub mod product;
 pub mod se3;

@@ -49,8 +49,7 @@ pub fn hat_n_unchecked(n: usize, c: &[f64]) -> Mat {
     m
 }
 
-/// Tolerance on ‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F) for accepting a matrix as skew-symmetric.
-pub const SKEW_TOL: f64 = 1e-10;
+pub use super::SKEW_TOL;
 
 /// Coordinates of a skew-symmetric matrix in the e_ij basis (upper triangle, row by row).
 ///

@@ -16,7 +16,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::check;
 use crate::error::{Error, Result};
-use crate::lie::{so, MatrixLieGroup};
+use crate::lie::MatrixLieGroup;
 use crate::Mat;
 
 /// hat(w) = [[0, −w3, w2], [w3, 0, −w1], [−w2, w1, 0]], so hat(w) x = w × x (000 §3.3, corrected).
@@ -35,25 +35,25 @@ pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
     )
 }
 
-/// [`vee`] with checks: `m` finite and skew to [`so::SKEW_TOL`] (relative defect
+/// [`vee`] with checks: `m` finite and skew to [`super::SKEW_TOL`] (relative defect
 /// ‖m + mᵀ‖_F / max(1, ‖m‖_F)), else [`Error::NonFinite`] / [`Error::NotInGroup`].
 pub fn try_vee(m: &Matrix3<f64>) -> Result<Vector3<f64>> {
     check::finite_slice("xi", m.as_slice())?;
     let defect = (m + m.transpose()).norm() / m.norm().max(1.0);
-    if defect > so::SKEW_TOL {
+    if defect > super::SKEW_TOL {
         return Err(Error::NotInGroup {
             what: "xi".into(),
             group: "so(3)".into(),
             defect_name: "‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F)".into(),
             defect,
-            tol: so::SKEW_TOL,
+            tol: super::SKEW_TOL,
         });
     }
     Ok(vee(m))
 }
 
 /// The e_ij coordinates (DESIGN.md, order (1,2), (1,3), (2,3)) of hat(w): c = (−w₃, w₂, −w₁),
-/// so that `so::hat_n(&to_eij(w)) == hat(w)`.
+/// so that `hat_n(&to_eij(w)) == hat(w)` (`hat_n` of the so(n) module).
 #[inline]
 pub fn to_eij(w: &Vector3<f64>) -> [f64; 3] {
     [-w.z, w.y, -w.x]

@@ -175,6 +175,103 @@ fn rot90(a: [f64; 2]) -> [f64; 2] {
 // Minkowski
 // ---------------------------------------------------------------------------------------------
 
+/// What both tops share: a Lagrangian L(q, q̇) in q = (x, y, θ) with its derivatives, and the
+/// inverse of its Legendre map, from which H, Hamilton's equations, the state helpers and the
+/// catalog follow once ([`legendre_kinds`]).
+trait Legendre: Problem {
+    /// L, ∂L/∂q̇, ∂L/∂q and ∂²L/∂q̇² at (q, q̇); None where L is not defined.
+    fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs>;
+
+    /// q̇ with ∂L/∂q̇(q, q̇) = p, and the derivatives there; None where the map is not inverted.
+    fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)>;
+
+    /// The error for a (q, q̇) where L is not defined.
+    fn undefined(&self, q: [f64; 3], v: [f64; 3]) -> Error;
+}
+
+/// L(q, q̇), checked.
+fn lagrangian<T: Legendre>(t: &T, q: [f64; 3], v: [f64; 3]) -> Result<f64> {
+    check::finite_slice("q and qdot", &[q[0], q[1], q[2], v[0], v[1], v[2]])?;
+    t.derivs(&q, &Vector3::from(v))
+        .map(|d| d.l)
+        .ok_or_else(|| t.undefined(q, v))
+}
+
+/// The canonical state (q, ∂L/∂q̇) at (q, q̇); the Legendre map must be invertible there.
+fn state<T: Legendre>(t: &T, q: [f64; 3], v: [f64; 3]) -> Result<Vec<f64>> {
+    check::finite_slice(
+        "x, theta, xdot, thetadot",
+        &[q[0], q[1], q[2], v[0], v[1], v[2]],
+    )?;
+    let d = t
+        .derivs(&q, &Vector3::from(v))
+        .ok_or_else(|| t.undefined(q, v))?;
+    if d.hess.cholesky().is_none() {
+        return Err(not_invertible(t.name()));
+    }
+    Ok(vec![q[0], q[1], q[2], d.lv[0], d.lv[1], d.lv[2]])
+}
+
+/// The velocities of a state (the inverse Legendre map).
+fn velocities<T: Legendre>(t: &T, z: &[f64]) -> Result<[f64; 3]> {
+    check::len_of("state", z, 6)?;
+    t.solve(&z[..3], &z[3..])
+        .map(|(v, _)| [v[0], v[1], v[2]])
+        .ok_or_else(|| not_invertible(t.name()))
+}
+
+/// E = H = p·q̇ − L of a state.
+fn energy<T: Legendre>(t: &T, z: &[f64]) -> Result<f64> {
+    check::len_of("state", z, 6)?;
+    let sol = t.solve(&z[..3], &z[3..]);
+    if sol.is_none() {
+        return Err(not_invertible(t.name()));
+    }
+    Ok(hamiltonian_of(&z[3..], sol))
+}
+
+/// `Canonical` (H and its gradient through the inverse Legendre map), `VectorField` (Hamilton's
+/// equations, for rk4) and the catalog of a [`Legendre`] top.
+macro_rules! legendre_kinds {
+    ($t:ty) => {
+        impl Canonical for $t {
+            fn dof(&self) -> usize {
+                3
+            }
+            fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
+                hamiltonian_of(p, self.solve(q, p))
+            }
+            fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
+                gradient_of(self.solve(q, p), hq, hp);
+            }
+        }
+
+        impl VectorField for $t {
+            /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
+            fn field(&self, z: &[f64], dz: &mut [f64]) {
+                let (hq, hp) = dz.split_at_mut(3);
+                gradient_of(self.solve(&z[..3], &z[3..]), hq, hp);
+                for (qd, pd) in hq.iter_mut().zip(hp.iter_mut()) {
+                    let h_q = *qd;
+                    *qd = *pd;
+                    *pd = -h_q;
+                }
+            }
+        }
+
+        impl Catalog for $t {
+            fn catalog(&self) -> Vec<Entry<Self>> {
+                vec![
+                    Entry::new("gauss4", Gauss(2)),
+                    Entry::new("gauss6", Gauss(3)),
+                    Entry::new("midpoint", IMPLICIT_MIDPOINT),
+                    Entry::new("rk4", Rk4),
+                ]
+            }
+        }
+    };
+}
+
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time, 002 (87)–(96) (module docs):
 /// L = −m/γ + ½θ̇²(𝕀γ + γ³ẋᵀK(θ)ẋ), K(θ) = R(θ) J I Jᵀ R(θ)ᵀ, physical sign (−L of 002 (90)).
 /// State z = (x, y, θ, p_x, p_y, p_θ); speeds |ẋ| < 1 (c = 1).
@@ -239,57 +336,10 @@ impl RelativisticTangentTop {
         ([k11, k12, k22], [-2.0 * k12, k11 - k22, 2.0 * k12])
     }
 
-    /// Derivatives of L at (q, q̇); None where |ẋ| ≥ 1 or the input is not finite.
-    fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
-        let (u, w) = ([v[0], v[1]], v[2]);
-        let s = u[0] * u[0] + u[1] * u[1];
-        if !(s.is_finite() && s < 1.0 && w.is_finite() && q[2].is_finite()) {
-            return None;
-        }
-        let m = self.mass;
-        let tr = self.inertia();
-        let g = 1.0 / (1.0 - s).sqrt();
-        let (g3, g5) = (g * g * g, g * g * g * g * g);
-        let g7 = g5 * g * g;
-        let (k, kp) = self.k(q[2]);
-        let ku = [k[0] * u[0] + k[1] * u[1], k[1] * u[0] + k[2] * u[1]];
-        let qk = u[0] * ku[0] + u[1] * ku[1];
-        let qkp = kp[0] * u[0] * u[0] + 2.0 * kp[1] * u[0] * u[1] + kp[2] * u[1] * u[1];
-        let w2 = w * w;
-        let l = -m / g + 0.5 * w2 * (tr * g + g3 * qk);
-        let a_s = m * g + 0.5 * w2 * tr * g3 + 1.5 * w2 * g5 * qk;
-        let b_s = m * g3 + 1.5 * w2 * tr * g5 + 7.5 * w2 * g7 * qk;
-        let lv = Vector3::new(
-            a_s * u[0] + w2 * g3 * ku[0],
-            a_s * u[1] + w2 * g3 * ku[1],
-            w * (tr * g + g3 * qk),
-        );
-        let lq = Vector3::new(0.0, 0.0, 0.5 * w2 * g3 * qkp);
-        let mut hess = Matrix3::zeros();
-        let kk = [[k[0], k[1]], [k[1], k[2]]];
-        for i in 0..2 {
-            for j in 0..2 {
-                let delta = if i == j { 1.0 } else { 0.0 };
-                hess[(i, j)] = a_s * delta
-                    + b_s * u[i] * u[j]
-                    + 3.0 * w2 * g5 * (u[i] * ku[j] + ku[i] * u[j])
-                    + w2 * g3 * kk[i][j];
-            }
-            let huw = w * ((tr * g3 + 3.0 * g5 * qk) * u[i] + 2.0 * g3 * ku[i]);
-            hess[(i, 2)] = huw;
-            hess[(2, i)] = huw;
-        }
-        hess[(2, 2)] = tr * g + g3 * qk;
-        Some(Derivs { l, lv, lq, hess })
-    }
-
     /// L(q, q̇) of 002 (90) (physical sign, module docs), q = (x, y, θ), q̇ = (ẋ, ẏ, θ̇).
     /// Errors: non-finite input, |ẋ| ≥ 1.
     pub fn lagrangian(&self, q: [f64; 3], qdot: [f64; 3]) -> Result<f64> {
-        check::finite_slice("q and qdot", &[q[0], q[1], q[2], qdot[0], qdot[1], qdot[2]])?;
-        self.derivs(&q, &Vector3::from(qdot))
-            .map(|d| d.l)
-            .ok_or_else(|| superluminal(qdot))
+        lagrangian(self, q, qdot)
     }
 
     /// The canonical state (x, y, θ, p_x, p_y, p_θ) with p = ∂L/∂q̇ at the given position, angle
@@ -302,41 +352,13 @@ impl RelativisticTangentTop {
         xdot: [f64; 2],
         thetadot: f64,
     ) -> Result<Vec<f64>> {
-        let q = [x[0], x[1], theta];
-        let v = [xdot[0], xdot[1], thetadot];
-        check::finite_slice(
-            "x, theta, xdot, thetadot",
-            &[q[0], q[1], q[2], v[0], v[1], v[2]],
-        )?;
-        let d = self
-            .derivs(&q, &Vector3::from(v))
-            .ok_or_else(|| superluminal(v))?;
-        if d.hess.cholesky().is_none() {
-            return Err(not_invertible(self.name()));
-        }
-        Ok(vec![q[0], q[1], q[2], d.lv[0], d.lv[1], d.lv[2]])
-    }
-
-    fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
-        // Start from a free particle of the mass the spin adds to at low speed
-        // (p ≈ (m + ω²(𝕀/2 + K))ẋ, bounded by m + ω²𝕀·3/2; u = p/√(M² + |p|²) is slower than light)
-        // with the spin of a top at rest; failing that, from rest.
-        let tr = self.inertia();
-        let w = p[2] / tr;
-        let mm = self.mass + 1.5 * w * w * tr;
-        let e = (mm * mm + p[0] * p[0] + p[1] * p[1]).sqrt();
-        let guess = Vector3::new(p[0] / e, p[1] / e, w);
-        legendre_inverse(p, guess, |v| self.derivs(q, v))
-            .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, w), |v| self.derivs(q, v)))
+        state(self, [x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
     }
 
     /// The velocities (ẋ, ẏ, θ̇) of a state (the inverse Legendre map). Errors: wrong length,
     /// non-finite, or momenta outside the range of the Legendre map.
     pub fn velocities(&self, z: &[f64]) -> Result<[f64; 3]> {
-        check::len_of("state", z, 6)?;
-        self.solve(&z[..3], &z[3..])
-            .map(|(v, _)| [v[0], v[1], v[2]])
-            .ok_or_else(|| not_invertible(self.name()))
+        velocities(self, z)
     }
 
     fn symmetric_only(&self, what: &str) -> Result<f64> {
@@ -450,12 +472,7 @@ impl Problem for RelativisticTangentTop {
     }
     /// E = H = p·q̇ − L (002 (96) for the symmetric top, with the physical sign).
     fn energy(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, 6)?;
-        let sol = self.solve(&z[..3], &z[3..]);
-        if sol.is_none() {
-            return Err(not_invertible(self.name()));
-        }
-        Ok(hamiltonian_of(&z[3..], sol))
+        energy(self, z)
     }
     /// (p_x, p_y), and p_θ for the symmetric top: momenta of cyclic coordinates, linear, so kept
     /// exactly by the Gauss methods.
@@ -475,41 +492,70 @@ impl Problem for RelativisticTangentTop {
     }
 }
 
-impl Canonical for RelativisticTangentTop {
-    fn dof(&self) -> usize {
-        3
-    }
-    fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
-        hamiltonian_of(p, self.solve(q, p))
-    }
-    fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
-        gradient_of(self.solve(q, p), hq, hp);
-    }
-}
-
-impl VectorField for RelativisticTangentTop {
-    /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let (hq, hp) = dz.split_at_mut(3);
-        gradient_of(self.solve(&z[..3], &z[3..]), hq, hp);
-        for (qd, pd) in hq.iter_mut().zip(hp.iter_mut()) {
-            let h_q = *qd;
-            *qd = *pd;
-            *pd = -h_q;
+impl Legendre for RelativisticTangentTop {
+    /// Derivatives of L at (q, q̇); None where |ẋ| ≥ 1 or the input is not finite.
+    fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
+        let (u, w) = ([v[0], v[1]], v[2]);
+        let s = u[0] * u[0] + u[1] * u[1];
+        if !(s.is_finite() && s < 1.0 && w.is_finite() && q[2].is_finite()) {
+            return None;
         }
+        let m = self.mass;
+        let tr = self.inertia();
+        let g = 1.0 / (1.0 - s).sqrt();
+        let (g3, g5) = (g * g * g, g * g * g * g * g);
+        let g7 = g5 * g * g;
+        let (k, kp) = self.k(q[2]);
+        let ku = [k[0] * u[0] + k[1] * u[1], k[1] * u[0] + k[2] * u[1]];
+        let qk = u[0] * ku[0] + u[1] * ku[1];
+        let qkp = kp[0] * u[0] * u[0] + 2.0 * kp[1] * u[0] * u[1] + kp[2] * u[1] * u[1];
+        let w2 = w * w;
+        let l = -m / g + 0.5 * w2 * (tr * g + g3 * qk);
+        let a_s = m * g + 0.5 * w2 * tr * g3 + 1.5 * w2 * g5 * qk;
+        let b_s = m * g3 + 1.5 * w2 * tr * g5 + 7.5 * w2 * g7 * qk;
+        let lv = Vector3::new(
+            a_s * u[0] + w2 * g3 * ku[0],
+            a_s * u[1] + w2 * g3 * ku[1],
+            w * (tr * g + g3 * qk),
+        );
+        let lq = Vector3::new(0.0, 0.0, 0.5 * w2 * g3 * qkp);
+        let mut hess = Matrix3::zeros();
+        let kk = [[k[0], k[1]], [k[1], k[2]]];
+        for i in 0..2 {
+            for j in 0..2 {
+                let delta = if i == j { 1.0 } else { 0.0 };
+                hess[(i, j)] = a_s * delta
+                    + b_s * u[i] * u[j]
+                    + 3.0 * w2 * g5 * (u[i] * ku[j] + ku[i] * u[j])
+                    + w2 * g3 * kk[i][j];
+            }
+            let huw = w * ((tr * g3 + 3.0 * g5 * qk) * u[i] + 2.0 * g3 * ku[i]);
+            hess[(i, 2)] = huw;
+            hess[(2, i)] = huw;
+        }
+        hess[(2, 2)] = tr * g + g3 * qk;
+        Some(Derivs { l, lv, lq, hess })
+    }
+
+    fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
+        // Start from a free particle of the mass the spin adds to at low speed
+        // (p ≈ (m + ω²(𝕀/2 + K))ẋ, bounded by m + ω²𝕀·3/2; u = p/√(M² + |p|²) is slower than light)
+        // with the spin of a top at rest; failing that, from rest.
+        let tr = self.inertia();
+        let w = p[2] / tr;
+        let mm = self.mass + 1.5 * w * w * tr;
+        let e = (mm * mm + p[0] * p[0] + p[1] * p[1]).sqrt();
+        let guess = Vector3::new(p[0] / e, p[1] / e, w);
+        legendre_inverse(p, guess, |v| self.derivs(q, v))
+            .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, w), |v| self.derivs(q, v)))
+    }
+
+    fn undefined(&self, _q: [f64; 3], v: [f64; 3]) -> Error {
+        superluminal(v)
     }
 }
 
-impl Catalog for RelativisticTangentTop {
-    fn catalog(&self) -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("gauss4", Gauss(2)),
-            Entry::new("gauss6", Gauss(3)),
-            Entry::new("midpoint", IMPLICIT_MIDPOINT),
-            Entry::new("rk4", Rk4),
-        ]
-    }
-}
+legendre_kinds!(RelativisticTangentTop);
 
 // ---------------------------------------------------------------------------------------------
 // Weak field
@@ -633,6 +679,88 @@ impl WeakFieldTop {
         &self.potential
     }
 
+    /// L(q, q̇) of 002 (118) (corrected, physical sign), q = (x, y, θ), q̇ = (ẋ, ẏ, θ̇).
+    /// Errors: non-finite input or potential.
+    pub fn lagrangian(&self, q: [f64; 3], qdot: [f64; 3]) -> Result<f64> {
+        lagrangian(self, q, qdot)
+    }
+
+    /// The canonical state with p = ∂L/∂q̇ (see [`RelativisticTangentTop::state`]).
+    pub fn state(
+        &self,
+        x: [f64; 2],
+        theta: f64,
+        xdot: [f64; 2],
+        thetadot: f64,
+    ) -> Result<Vec<f64>> {
+        state(self, [x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
+    }
+
+    /// The velocities (ẋ, ẏ, θ̇) of a state. Errors: wrong length, non-finite, outside the
+    /// potential's domain or the range of the Legendre map.
+    pub fn velocities(&self, z: &[f64]) -> Result<[f64; 3]> {
+        velocities(self, z)
+    }
+
+    /// The angular momentum x p_y − y p_x about the origin (conserved for a central potential).
+    pub fn angular_momentum(&self, z: &[f64]) -> Result<f64> {
+        check::len_of("state", z, 6)?;
+        Ok(z[0] * z[4] - z[1] * z[3])
+    }
+}
+
+fn outside_potential(q: [f64; 3]) -> Error {
+    Error::invalid(
+        "x",
+        format!(
+            "the potential or its derivatives are not finite at ({}, {})",
+            q[0], q[1]
+        ),
+    )
+}
+
+impl Problem for WeakFieldTop {
+    fn name(&self) -> &'static str {
+        "WeakFieldTop"
+    }
+    fn space(&self) -> Space {
+        space()
+    }
+    /// E = p·q̇ − L = ½mv² + mφ + I₀θ̇²(1 − φ + 3v²) + I₀θ̇(G_yẋ − G_xẏ) (module docs).
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        energy(self, z)
+    }
+    /// p_θ (θ is cyclic); for the point mass also x p_y − y p_x (quadratic); for a uniform field
+    /// also the momentum across the field, p·Ĵĝ (linear). The Gauss methods keep all of them.
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        check::len_of("state", z, 6)?;
+        let mut out = vec![z[5]];
+        match &self.potential.kind {
+            PotentialKind::PointMass { .. } => out.push(z[0] * z[4] - z[1] * z[3]),
+            PotentialKind::Uniform { g } => {
+                let n = g[0].hypot(g[1]);
+                if n > 0.0 {
+                    let t = rot90([g[0] / n, g[1] / n]);
+                    out.push(t[0] * z[3] + t[1] * z[4]);
+                }
+            }
+            PotentialKind::Custom(_) => {}
+        }
+        Ok(out)
+    }
+    fn invariant_count(&self) -> usize {
+        match &self.potential.kind {
+            PotentialKind::PointMass { .. } => 2,
+            PotentialKind::Uniform { g } => 1 + usize::from(g[0].hypot(g[1]) > 0.0),
+            PotentialKind::Custom(_) => 1,
+        }
+    }
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        self.velocities(z).map(|_| ())
+    }
+}
+
+impl Legendre for WeakFieldTop {
     /// Derivatives of L at (q, q̇); None where φ or q̇ is not finite.
     fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
         let pv = self.potential.eval([q[0], q[1]]);
@@ -670,147 +798,14 @@ impl WeakFieldTop {
         Some(Derivs { l, lv, lq, hess })
     }
 
-    /// L(q, q̇) of 002 (118) (corrected, physical sign), q = (x, y, θ), q̇ = (ẋ, ẏ, θ̇).
-    /// Errors: non-finite input or potential.
-    pub fn lagrangian(&self, q: [f64; 3], qdot: [f64; 3]) -> Result<f64> {
-        check::finite_slice("q and qdot", &[q[0], q[1], q[2], qdot[0], qdot[1], qdot[2]])?;
-        self.derivs(&q, &Vector3::from(qdot))
-            .map(|d| d.l)
-            .ok_or_else(|| outside_potential(q))
-    }
-
-    /// The canonical state with p = ∂L/∂q̇ (see [`RelativisticTangentTop::state`]).
-    pub fn state(
-        &self,
-        x: [f64; 2],
-        theta: f64,
-        xdot: [f64; 2],
-        thetadot: f64,
-    ) -> Result<Vec<f64>> {
-        let q = [x[0], x[1], theta];
-        let v = [xdot[0], xdot[1], thetadot];
-        check::finite_slice(
-            "x, theta, xdot, thetadot",
-            &[q[0], q[1], q[2], v[0], v[1], v[2]],
-        )?;
-        let d = self
-            .derivs(&q, &Vector3::from(v))
-            .ok_or_else(|| outside_potential(q))?;
-        if d.hess.cholesky().is_none() {
-            return Err(not_invertible(self.name()));
-        }
-        Ok(vec![q[0], q[1], q[2], d.lv[0], d.lv[1], d.lv[2]])
-    }
-
     fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
         let guess = Vector3::new(p[0] / self.mass, p[1] / self.mass, p[2] / (2.0 * self.i0));
         legendre_inverse(p, guess, |v| self.derivs(q, v))
     }
 
-    /// The velocities (ẋ, ẏ, θ̇) of a state. Errors: wrong length, non-finite, outside the
-    /// potential's domain or the range of the Legendre map.
-    pub fn velocities(&self, z: &[f64]) -> Result<[f64; 3]> {
-        check::len_of("state", z, 6)?;
-        self.solve(&z[..3], &z[3..])
-            .map(|(v, _)| [v[0], v[1], v[2]])
-            .ok_or_else(|| not_invertible(self.name()))
-    }
-
-    /// The angular momentum x p_y − y p_x about the origin (conserved for a central potential).
-    pub fn angular_momentum(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, 6)?;
-        Ok(z[0] * z[4] - z[1] * z[3])
+    fn undefined(&self, q: [f64; 3], _v: [f64; 3]) -> Error {
+        outside_potential(q)
     }
 }
 
-fn outside_potential(q: [f64; 3]) -> Error {
-    Error::invalid(
-        "x",
-        format!(
-            "the potential or its derivatives are not finite at ({}, {})",
-            q[0], q[1]
-        ),
-    )
-}
-
-impl Problem for WeakFieldTop {
-    fn name(&self) -> &'static str {
-        "WeakFieldTop"
-    }
-    fn space(&self) -> Space {
-        space()
-    }
-    /// E = p·q̇ − L = ½mv² + mφ + I₀θ̇²(1 − φ + 3v²) + I₀θ̇(G_yẋ − G_xẏ) (module docs).
-    fn energy(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, 6)?;
-        let sol = self.solve(&z[..3], &z[3..]);
-        if sol.is_none() {
-            return Err(not_invertible(self.name()));
-        }
-        Ok(hamiltonian_of(&z[3..], sol))
-    }
-    /// p_θ (θ is cyclic); for the point mass also x p_y − y p_x (quadratic); for a uniform field
-    /// also the momentum across the field, p·Ĵĝ (linear). The Gauss methods keep all of them.
-    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        check::len_of("state", z, 6)?;
-        let mut out = vec![z[5]];
-        match &self.potential.kind {
-            PotentialKind::PointMass { .. } => out.push(z[0] * z[4] - z[1] * z[3]),
-            PotentialKind::Uniform { g } => {
-                let n = g[0].hypot(g[1]);
-                if n > 0.0 {
-                    let t = rot90([g[0] / n, g[1] / n]);
-                    out.push(t[0] * z[3] + t[1] * z[4]);
-                }
-            }
-            PotentialKind::Custom(_) => {}
-        }
-        Ok(out)
-    }
-    fn invariant_count(&self) -> usize {
-        match &self.potential.kind {
-            PotentialKind::PointMass { .. } => 2,
-            PotentialKind::Uniform { g } => 1 + usize::from(g[0].hypot(g[1]) > 0.0),
-            PotentialKind::Custom(_) => 1,
-        }
-    }
-    fn check_state(&self, z: &[f64]) -> Result<()> {
-        self.velocities(z).map(|_| ())
-    }
-}
-
-impl Canonical for WeakFieldTop {
-    fn dof(&self) -> usize {
-        3
-    }
-    fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
-        hamiltonian_of(p, self.solve(q, p))
-    }
-    fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
-        gradient_of(self.solve(q, p), hq, hp);
-    }
-}
-
-impl VectorField for WeakFieldTop {
-    /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let (hq, hp) = dz.split_at_mut(3);
-        gradient_of(self.solve(&z[..3], &z[3..]), hq, hp);
-        for (qd, pd) in hq.iter_mut().zip(hp.iter_mut()) {
-            let h_q = *qd;
-            *qd = *pd;
-            *pd = -h_q;
-        }
-    }
-}
-
-impl Catalog for WeakFieldTop {
-    fn catalog(&self) -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("gauss4", Gauss(2)),
-            Entry::new("gauss6", Gauss(3)),
-            Entry::new("midpoint", IMPLICIT_MIDPOINT),
-            Entry::new("rk4", Rk4),
-        ]
-    }
-}
+legendre_kinds!(WeakFieldTop);
