@@ -41,5 +41,5 @@ pub use rigid_body::{GeneralizedRigidBody, RigidBody};
 pub use rolling_disk::RollingDisk;
 pub use sphere_particle::SphereParticle;
 pub use spherical_pendulum::SphericalPendulum;
-pub use surface::{HyperbolicPlane, MetricSurface, Plane, Revolution, Sphere, Surface};
-pub use tangent_top::TangentTop;
+pub use surface::{Graph, HyperbolicPlane, MetricSurface, Plane, Revolution, Sphere, Surface};
+pub use tangent_top::{ChargedParticle, TangentTop};

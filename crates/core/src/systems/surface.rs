@@ -21,7 +21,8 @@
 //! dφ_t Ê₁ along t and use [X, dφ_t Ê₁] = 0).
 //!
 //! Built-ins with closed forms (each derived below and checked against finite differences in
-//! `tests/tangent_top.rs`): [`Plane`], [`Sphere`], [`HyperbolicPlane`], [`Revolution`]; and the
+//! `tests/tangent_top.rs`): [`Plane`], [`Sphere`], [`HyperbolicPlane`], [`Revolution`], [`Graph`];
+//! and the
 //! numerical [`MetricSurface`] for a metric and frame given as closures.
 
 use std::fmt;
@@ -51,8 +52,21 @@ pub struct Geometry {
     pub dalpha: Mat2,
 }
 
-/// A surface embedded in ℝ³ (002 §II.D): position, unit normal n = Ê₁ × Ê₂ and the second
-/// fundamental form h_ij = ⟨∂_i ∂_j X, n⟩ (the scalar form H_p of 002 (31) for this n).
+/// The shape operator of an embedded surface in the reference frame, W_aμ = e_a^α h_αμ
+/// = −⟨Ê_a, ∂_μ n⟩, and its first derivatives: the normal turns by dn(v) = −(W v)_a Ê_a, so a body
+/// point ξ^a E_a of the tangent top moves out of the tangent plane at the rate ⟨W v, ξ⟩ in the
+/// reference frame (002 (35)–(37)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shape {
+    /// `w[a][μ]` = W_aμ.
+    pub w: Mat2,
+    /// `dw[k][a][μ]` = ∂_k W_aμ.
+    pub dw: [Mat2; 2],
+}
+
+/// A surface embedded in ℝ³ (002 §II.D): position, unit normal n = Ê₁ × Ê₂, the second
+/// fundamental form h_ij = ⟨∂_i ∂_j X, n⟩ (the scalar form H_p of 002 (31) for this n) and the
+/// shape operator in the frame with its derivatives ([`Shape`]).
 pub trait Embedding {
     /// The point X(x) ∈ ℝ³.
     fn position(&self, x: Vec2) -> [f64; 3];
@@ -62,6 +76,8 @@ pub trait Embedding {
     fn second_fundamental_form(&self, x: Vec2) -> Mat2;
     /// The ambient components of a tangent vector v^i ∂_i: v^i ∂_i X.
     fn tangent(&self, x: Vec2, v: Vec2) -> [f64; 3];
+    /// W = e h and ∂W at x ([`Shape`]).
+    fn shape(&self, x: Vec2) -> Shape;
 }
 
 /// A two-dimensional Riemannian surface in a local chart with an orthonormal frame (module docs).
@@ -240,6 +256,12 @@ impl Embedding for Plane {
     fn tangent(&self, _x: Vec2, v: Vec2) -> [f64; 3] {
         [v[0], v[1], 0.0]
     }
+    fn shape(&self, _x: Vec2) -> Shape {
+        Shape {
+            w: ZERO2,
+            dw: [ZERO2; 2],
+        }
+    }
 }
 
 /// The sphere of radius R in colatitude and longitude x = (ϑ, φ), 0 < ϑ < π:
@@ -350,6 +372,14 @@ impl Embedding for Sphere {
             -r * s * v[0],
         ]
     }
+    /// W = −diag(1, sin ϑ) (∂_μ n = ∂_μ X / R).
+    fn shape(&self, x: Vec2) -> Shape {
+        let (s, c) = x[0].sin_cos();
+        Shape {
+            w: [[-1.0, 0.0], [0.0, -s]],
+            dw: [[[0.0, 0.0], [0.0, -c]], ZERO2],
+        }
+    }
 }
 
 /// The hyperbolic plane in the Poincaré half-plane x = (x, y), y > 0, g = (dx² + dy²)/y²
@@ -417,11 +447,12 @@ impl Surface for HyperbolicPlane {
     }
 }
 
-/// A profile function s ↦ (f(s), f′(s), f″(s)).
-pub type Profile = Arc<dyn Fn(f64) -> [f64; 3] + Send + Sync>;
+/// A profile function s ↦ (f(s), f′(s), f″(s), f‴(s)) (the third derivative enters only the
+/// shape operator's derivative, i.e. the embedded top).
+pub type Profile = Arc<dyn Fn(f64) -> [f64; 4] + Send + Sync>;
 
 /// A surface of revolution X(s, φ) = (r(s) cos φ, r(s) sin φ, z(s)) about the z axis, from the
-/// profile functions r and z with their first two derivatives, on s_min < s < s_max with
+/// profile functions r and z with their first three derivatives, on s_min < s < s_max with
 /// r(s) > 0. Coordinates x = (s, φ); with λ = √(r′² + z′²):
 /// g = diag(λ², r²), Ê₁ = ∂s/λ, Ê₂ = ∂φ/r.
 ///
@@ -431,7 +462,7 @@ pub type Profile = Arc<dyn Fn(f64) -> [f64; 3] + Send + Sync>;
 /// (ψ = 0): X_φ = (0, 1, 0), momentum p_φ (002 §III.A).
 ///
 /// **Embedding.** n = Ê₁ × Ê₂ = (−z′ cos φ, −z′ sin φ, r′)/λ,
-/// h = diag((r′z″ − z′r″)/λ, r z′/λ).
+/// h = diag((r′z″ − z′r″)/λ, r z′/λ), so W = e h = diag((r′z″ − z′r″)/λ², z′/λ).
 #[derive(Clone)]
 pub struct Revolution {
     r: Profile,
@@ -448,11 +479,11 @@ impl fmt::Debug for Revolution {
 }
 
 impl Revolution {
-    /// The surface of the profile r(s), z(s) (each returning the value and its first two
+    /// The surface of the profile r(s), z(s) (each returning the value and its first three
     /// derivatives) on s_min < s < s_max. Errors: a non-finite or empty range.
     pub fn new(
-        r: impl Fn(f64) -> [f64; 3] + Send + Sync + 'static,
-        z: impl Fn(f64) -> [f64; 3] + Send + Sync + 'static,
+        r: impl Fn(f64) -> [f64; 4] + Send + Sync + 'static,
+        z: impl Fn(f64) -> [f64; 4] + Send + Sync + 'static,
         range: (f64, f64),
     ) -> Result<Self> {
         check::finite_slice("range", &[range.0, range.1])?;
@@ -474,8 +505,14 @@ impl Revolution {
         check::positive("radius", radius)?;
         let rr = radius;
         Revolution::new(
-            move |s| [rr * s.sin(), rr * s.cos(), -rr * s.sin()],
-            move |s| [rr * s.cos(), -rr * s.sin(), -rr * s.cos()],
+            move |s| {
+                let (sn, cs) = s.sin_cos();
+                [rr * sn, rr * cs, -rr * sn, -rr * cs]
+            },
+            move |s| {
+                let (sn, cs) = s.sin_cos();
+                [rr * cs, -rr * sn, -rr * cs, rr * sn]
+            },
             (0.0, std::f64::consts::PI),
         )
     }
@@ -492,16 +529,22 @@ impl Revolution {
             ));
         }
         Revolution::new(
-            move |s| [a + b * s.cos(), -b * s.sin(), -b * s.cos()],
-            move |s| [b * s.sin(), b * s.cos(), -b * s.sin()],
+            move |s| {
+                let (sn, cs) = s.sin_cos();
+                [a + b * cs, -b * sn, -b * cs, b * sn]
+            },
+            move |s| {
+                let (sn, cs) = s.sin_cos();
+                [b * sn, b * cs, -b * sn, -b * cs]
+            },
             (-std::f64::consts::PI, std::f64::consts::PI),
         )
     }
 
     /// (r, r′, r″, z′, z″, λ) at s.
     fn profile(&self, s: f64) -> (f64, f64, f64, f64, f64, f64) {
-        let [r, dr, ddr] = (self.r)(s);
-        let [_, dz, ddz] = (self.z)(s);
+        let [r, dr, ddr, _] = (self.r)(s);
+        let [_, dz, ddz, _] = (self.z)(s);
         (r, dr, ddr, dz, ddz, (dr * dr + dz * dz).sqrt())
     }
 }
@@ -605,6 +648,234 @@ impl Embedding for Revolution {
             dz * v[0],
         ]
     }
+    /// W₁₁ = k/λ², W₂₂ = z′/λ with k = r′z″ − z′r″, λ² = r′² + z′²; ∂_s by the quotient rule
+    /// (k′ = r′z‴ − z′r‴, (λ²)′ = 2(r′r″ + z′z″)).
+    fn shape(&self, x: Vec2) -> Shape {
+        let [_, dr, ddr, dddr] = (self.r)(x[0]);
+        let [_, dz, ddz, dddz] = (self.z)(x[0]);
+        let l2 = dr * dr + dz * dz;
+        let l = l2.sqrt();
+        let dl2 = 2.0 * (dr * ddr + dz * ddz);
+        let k = dr * ddz - dz * ddr;
+        let dk = dr * dddz - dz * dddr;
+        Shape {
+            w: [[k / l2, 0.0], [0.0, dz / l]],
+            dw: [
+                [
+                    [dk / l2 - k * dl2 / (l2 * l2), 0.0],
+                    [0.0, ddz / l - 0.5 * dz * dl2 / (l2 * l)],
+                ],
+                ZERO2,
+            ],
+        }
+    }
+}
+
+/// The derivatives of a function f(x, y) at a point, up to third order.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Jet {
+    /// f.
+    pub value: f64,
+    /// (f_x, f_y).
+    pub gradient: Vec2,
+    /// [[f_xx, f_xy], [f_xy, f_yy]].
+    pub hessian: Mat2,
+    /// (f_xxx, f_xxy, f_xyy, f_yyy).
+    pub third: [f64; 4],
+}
+
+impl Jet {
+    fn is_finite(&self) -> bool {
+        self.value.is_finite()
+            && finite2(self.gradient)
+            && self.hessian.iter().flatten().all(|v| v.is_finite())
+            && self.third.iter().all(|v| v.is_finite())
+    }
+
+    /// f_ijk (symmetric; the number of y's among i, j, k picks the entry).
+    fn t(&self, i: usize, j: usize, k: usize) -> f64 {
+        self.third[i + j + k]
+    }
+}
+
+/// A graph z = f(x, y) over the plane, coordinates x = (x, y), from the jet of f (value and
+/// derivatives to third order; [`Jet`]).
+///
+/// With p = f_x, q = f_y, u = 1 + p², D = 1 + p² + q²: g_ij = δ_ij + f_i f_j (det g = D),
+/// ∂_k g_ij = f_ik f_j + f_i f_jk; the frame is Gram–Schmidt of (∂x, ∂y),
+/// Ê₁ = ∂x/√u, Ê₂ = (−pq ∂x + u ∂y)/√(uD); n = (−p, −q, 1)/√D = Ê₁ × Ê₂; h_ij = f_ij/√D.
+///
+/// **Connection.** In ℝ³, Ê₁ = (1, 0, p)/√u and Ê₂ = (−pq, u, q)/√(uD); the tangential part of
+/// ∂_i Ê₁ is ∇_{∂_i}Ê₁, so α_i = ⟨∂_i Ê₁, Ê₂⟩ = f_xi q/(u√D) (the ∂_i(1/√u) part is along Ê₁).
+/// K = (f_xx f_yy − f_xy²)/D².
+/// No Killing fields in general (a quadric of revolution is better served by [`Revolution`]).
+#[derive(Clone)]
+pub struct Graph {
+    jet: Arc<dyn Fn(Vec2) -> Jet + Send + Sync>,
+}
+
+impl fmt::Debug for Graph {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Graph").finish_non_exhaustive()
+    }
+}
+
+/// What the graph's formulas share at one point.
+struct GraphLocal {
+    j: Jet,
+    u: f64,
+    d: f64,
+    /// ∂_k u, ∂_k D.
+    du: Vec2,
+    dd: Vec2,
+}
+
+impl Graph {
+    /// The graph of f given by its jet (module docs of [`Graph`]).
+    pub fn new(jet: impl Fn(Vec2) -> Jet + Send + Sync + 'static) -> Self {
+        Graph { jet: Arc::new(jet) }
+    }
+
+    /// The quadric z = (a x² + b y²)/2: a paraboloid for ab > 0, a saddle for ab < 0, a cylinder
+    /// when one is zero. Errors: a non-finite coefficient.
+    pub fn quadric(a: f64, b: f64) -> Result<Self> {
+        check::finite_slice("a and b", &[a, b])?;
+        Ok(Graph::new(move |x| Jet {
+            value: 0.5 * (a * x[0] * x[0] + b * x[1] * x[1]),
+            gradient: [a * x[0], b * x[1]],
+            hessian: [[a, 0.0], [0.0, b]],
+            third: [0.0; 4],
+        }))
+    }
+
+    fn local(&self, x: Vec2) -> GraphLocal {
+        let j = (self.jet)(x);
+        let ([p, q], h) = (j.gradient, j.hessian);
+        GraphLocal {
+            j,
+            u: 1.0 + p * p,
+            d: 1.0 + p * p + q * q,
+            du: [2.0 * p * h[0][0], 2.0 * p * h[0][1]],
+            dd: std::array::from_fn(|k| 2.0 * (p * h[0][k] + q * h[1][k])),
+        }
+    }
+
+    /// The frame e and its derivatives ∂_k e.
+    fn frame_and_derivatives(l: &GraphLocal) -> (Mat2, [Mat2; 2]) {
+        let ([p, q], h) = (l.j.gradient, l.j.hessian);
+        let (u, d) = (l.u, l.d);
+        let a = 1.0 / u.sqrt();
+        let c = 1.0 / (u * d).sqrt();
+        let e = [[a, 0.0], [-p * q * c, u * c]];
+        let de = std::array::from_fn(|k| {
+            let da = -0.5 * a * l.du[k] / u;
+            let dc = -0.5 * c * (l.du[k] / u + l.dd[k] / d);
+            let dpq = h[0][k] * q + p * h[1][k];
+            [[da, 0.0], [-dpq * c - p * q * dc, l.du[k] * c + u * dc]]
+        });
+        (e, de)
+    }
+}
+
+impl Surface for Graph {
+    fn name(&self) -> &'static str {
+        "Graph"
+    }
+    fn domain(&self) -> &'static str {
+        "the points where f and its derivatives are finite"
+    }
+    fn contains(&self, x: Vec2) -> bool {
+        finite2(x) && (self.jet)(x).is_finite()
+    }
+    fn metric(&self, x: Vec2) -> Mat2 {
+        let [p, q] = (self.jet)(x).gradient;
+        [[1.0 + p * p, p * q], [p * q, 1.0 + q * q]]
+    }
+    fn metric_derivatives(&self, x: Vec2) -> [Mat2; 2] {
+        let j = (self.jet)(x);
+        let (f, h) = (j.gradient, j.hessian);
+        std::array::from_fn(|k| {
+            std::array::from_fn(|a| std::array::from_fn(|b| h[a][k] * f[b] + f[a] * h[b][k]))
+        })
+    }
+    fn frame(&self, x: Vec2) -> Mat2 {
+        Graph::frame_and_derivatives(&self.local(x)).0
+    }
+    fn connection(&self, x: Vec2) -> Vec2 {
+        let l = self.local(x);
+        let q = l.j.gradient[1];
+        let den = l.u * l.d.sqrt();
+        [l.j.hessian[0][0] * q / den, l.j.hessian[0][1] * q / den]
+    }
+    /// ∂_k α_i = (f_xik q + f_xi f_yk)/(u√D) − α_i (∂_k u/u + ½ ∂_k D/D).
+    fn connection_derivatives(&self, x: Vec2) -> Mat2 {
+        let l = self.local(x);
+        let (q, h) = (l.j.gradient[1], l.j.hessian);
+        let den = l.u * l.d.sqrt();
+        std::array::from_fn(|k| {
+            let dlog = l.du[k] / l.u + 0.5 * l.dd[k] / l.d;
+            std::array::from_fn(|i| {
+                let alpha = h[0][i] * q / den;
+                (l.j.t(0, i, k) * q + h[0][i] * h[1][k]) / den - alpha * dlog
+            })
+        })
+    }
+    fn curvature(&self, x: Vec2) -> f64 {
+        let l = self.local(x);
+        det(&l.j.hessian) / (l.d * l.d)
+    }
+    fn embedding(&self) -> Option<&dyn Embedding> {
+        Some(self)
+    }
+}
+
+impl Embedding for Graph {
+    fn position(&self, x: Vec2) -> [f64; 3] {
+        [x[0], x[1], (self.jet)(x).value]
+    }
+    fn normal(&self, x: Vec2) -> [f64; 3] {
+        let [p, q] = (self.jet)(x).gradient;
+        let r = (1.0 + p * p + q * q).sqrt();
+        [-p / r, -q / r, 1.0 / r]
+    }
+    fn second_fundamental_form(&self, x: Vec2) -> Mat2 {
+        let j = (self.jet)(x);
+        let [p, q] = j.gradient;
+        let r = (1.0 + p * p + q * q).sqrt();
+        j.hessian.map(|row| row.map(|v| v / r))
+    }
+    fn tangent(&self, x: Vec2, v: Vec2) -> [f64; 3] {
+        let [p, q] = (self.jet)(x).gradient;
+        [v[0], v[1], p * v[0] + q * v[1]]
+    }
+    /// W = e h, ∂_k W = (∂_k e) h + e ∂_k h with ∂_k h_ij = f_ijk/√D − ½ f_ij ∂_k D/D^{3/2}.
+    fn shape(&self, x: Vec2) -> Shape {
+        let l = self.local(x);
+        let (e, de) = Graph::frame_and_derivatives(&l);
+        let r = l.d.sqrt();
+        let h: Mat2 = l.j.hessian.map(|row| row.map(|v| v / r));
+        let dh: [Mat2; 2] = std::array::from_fn(|k| {
+            std::array::from_fn(|i| {
+                std::array::from_fn(|jj| {
+                    l.j.t(i, jj, k) / r - 0.5 * l.j.hessian[i][jj] * l.dd[k] / (l.d * r)
+                })
+            })
+        });
+        Shape {
+            w: mul(&e, &h),
+            dw: std::array::from_fn(|k| add(&mul(&de[k], &h), &mul(&e, &dh[k]))),
+        }
+    }
+}
+
+/// The product of 2×2 matrices.
+pub fn mul(a: &Mat2, b: &Mat2) -> Mat2 {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j]))
+}
+
+/// The sum of 2×2 matrices.
+pub fn add(a: &Mat2, b: &Mat2) -> Mat2 {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[i][j] + b[i][j]))
 }
 
 /// A closure of the chart returning a 2×2 matrix.

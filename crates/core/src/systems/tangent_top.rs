@@ -37,12 +37,23 @@
 //! the surface, lifted to (x, θ) as in [`crate::systems::surface`], the momentum J = p_A X^A
 //! (Noether; it generates the isometry that moves the frame along, 002 §III.A, §III.C).
 //!
-//! Only the intrinsic top is implemented; the second-fundamental-form term of an embedded surface
-//! (002 (37), (39)) is not.
+//! **Embedded surfaces** (002 §II.D, (29)–(39), derived again). On a surface in ℝ³ a body point
+//! c + ξ^a E_a moves with ∇̃_ċ E_a = ∇_ċ E_a + B(ċ, E_a), and the normal parts add
+//! ½ I_ab h(ċ, E_a) h(ċ, E_b) to L (002 (37); the cross terms vanish since B ⊥ TM). In the
+//! reference frame h(ċ, Ê_a) = (W ẋ)_a with the shape operator W = e h ([`Shape`]), and
+//! E_a = S_ba Ê_b with S = R(θ), so the term is ½ ẋᵀ Wᵀ Q(θ) W ẋ with Q(θ) = S I Sᵀ. The
+//! translational metric becomes G(x, θ) = m g + Wᵀ Q W, and everything above holds with m g → G;
+//! in addition ∂H/∂θ = −½ (W v)ᵀ Q′(θ) (W v), Q′ = S (J I − I J) Sᵀ (J the rotation by π/2).
+//! For a symmetric body, I = (𝕀/2) Id, Q is constant and WᵀW = h g⁻¹ h (002 (38)), giving
+//! 002 (39); then p_θ is still conserved. For an anisotropic body the Lagrangian depends on θ and
+//! p_θ is not conserved; the Killing momenta of isometries that are rigid motions of ℝ³ (all
+//! those of the built-ins) are. On the sphere of radius R this is exactly the Euler top about
+//! the centre with the body tensor [[mR² + I₂₂, −I₁₂, 0], [−I₁₂, mR² + I₁₁, 0], [0, 0, 𝕀]] in the
+//! frame (E₁, E₂, n) (tested against [`crate::systems::RigidBody`]).
 
 use std::sync::Arc;
 
-use super::surface::{inverse, Surface, Vec2};
+use super::surface::{add, inner, inverse, mul, Mat2, Shape, Surface, Vec2};
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Gauss, Rk4, IMPLICIT_MIDPOINT};
@@ -50,42 +61,141 @@ use crate::integrate::problem::{Canonical, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 
-/// The tangent Euler top of mass m and scalar inertia 𝕀 = tr I (002 (42)) on a surface; state
-/// z = (x¹, x², θ, p₁, p₂, p_θ) (module docs).
+/// The tangent Euler top of mass m and Euler tensor I (002 (42)) on a surface, intrinsic or
+/// embedded (module docs); state z = (x¹, x², θ, p₁, p₂, p_θ).
 #[derive(Clone, Debug)]
 pub struct TangentTop {
     surface: Arc<dyn Surface>,
     mass: f64,
-    inertia: f64,
+    /// The Euler tensor I = ∫ξξᵀ dm.
+    tensor: Mat2,
+    embedded: bool,
+}
+
+/// The pieces of H at one configuration: G = m g + WᵀQW with ∂_k G and ∂_θ G, α and ∂α.
+struct Local {
+    g: Mat2,
+    dg: [Mat2; 2],
+    dtheta: Mat2,
+    alpha: Vec2,
+    dalpha: Mat2,
+}
+
+fn transpose(a: &Mat2) -> Mat2 {
+    [[a[0][0], a[1][0]], [a[0][1], a[1][1]]]
+}
+
+/// aᵀ b c.
+fn sandwich(a: &Mat2, b: &Mat2, c: &Mat2) -> Mat2 {
+    mul(&transpose(a), &mul(b, c))
+}
+
+fn quad(m: &Mat2, v: Vec2) -> f64 {
+    inner(m, v, v)
 }
 
 impl TangentTop {
-    /// A top of mass m > 0 and inertia 𝕀 > 0 on `surface`.
+    /// A symmetric top, I = (𝕀/2) Id, of mass m > 0 and inertia 𝕀 = tr I > 0 on `surface`
+    /// (intrinsic; [`TangentTop::embedded`] adds the embedding term).
     pub fn new(surface: Arc<dyn Surface>, mass: f64, inertia: f64) -> Result<Self> {
-        check::positive("mass", mass)?;
         check::positive("inertia", inertia)?;
+        TangentTop::with_tensor(surface, mass, [0.5 * inertia, 0.0, 0.0, 0.5 * inertia])
+    }
+
+    /// A top whose body has the 2×2 Euler tensor `tensor` = ∫ξξᵀ dm (row-major, symmetric,
+    /// positive semi-definite with positive trace). The intrinsic dynamics depends on 𝕀 = tr I
+    /// only; the embedded one on all of I. Errors: mass ≤ 0, a tensor that is not symmetric
+    /// positive semi-definite or has zero trace.
+    pub fn with_tensor(surface: Arc<dyn Surface>, mass: f64, tensor: [f64; 4]) -> Result<Self> {
+        check::positive("mass", mass)?;
+        check::finite_slice("inertia tensor", &tensor)?;
+        let tr = tensor[0] + tensor[3];
+        let sym = (tensor[1] - tensor[2]).abs() <= 1e-12 * tr.abs();
+        let psd = tensor[0] >= 0.0
+            && tensor[3] >= 0.0
+            && tensor[0] * tensor[3] - tensor[1] * tensor[2] >= -1e-14 * tr * tr;
+        if !(sym && psd && tr > 0.0) {
+            return Err(Error::invalid(
+                "inertia tensor",
+                format!(
+                    "expected a symmetric positive semi-definite Euler tensor ∫ξξᵀ dm with \
+                     positive trace, got {tensor:?}"
+                ),
+            ));
+        }
+        let off = 0.5 * (tensor[1] + tensor[2]);
         Ok(TangentTop {
             surface,
             mass,
-            inertia,
+            tensor: [[tensor[0], off], [off, tensor[3]]],
+            embedded: false,
         })
     }
 
-    /// A top whose body has the 2×2 Euler tensor `tensor` (row-major, symmetric, positive
-    /// semi-definite with positive trace): only 𝕀 = tr I enters the dynamics (module docs).
-    pub fn with_tensor(surface: Arc<dyn Surface>, mass: f64, tensor: [f64; 4]) -> Result<Self> {
-        check::finite_slice("inertia tensor", &tensor)?;
-        let sym = (tensor[1] - tensor[2]).abs() <= 1e-12 * (tensor[0] + tensor[3]).abs();
-        let psd = tensor[0] >= 0.0
-            && tensor[3] >= 0.0
-            && tensor[0] * tensor[3] - tensor[1] * tensor[2] >= 0.0;
-        if !(sym && psd) {
+    /// The same top moving on the surface as embedded in ℝ³: the second-fundamental-form term of
+    /// 002 (37) (module docs). Errors: a surface without an embedding.
+    pub fn embedded(mut self) -> Result<Self> {
+        if self.surface.embedding().is_none() {
             return Err(Error::invalid(
-                "inertia tensor",
-                "expected a symmetric positive semi-definite Euler tensor ∫ξξᵀ dm",
+                "embedded",
+                format!(
+                    "the {} chart has no embedding in ℝ³; use Plane, Sphere, Revolution or Graph",
+                    self.surface.name()
+                ),
             ));
         }
-        TangentTop::new(surface, mass, tensor[0] + tensor[3])
+        self.embedded = true;
+        Ok(self)
+    }
+
+    /// Whether the embedding term of 002 (37) is included.
+    pub fn is_embedded(&self) -> bool {
+        self.embedded
+    }
+
+    /// Whether the Euler tensor is a multiple of the identity (p_θ is then conserved).
+    pub fn is_symmetric(&self) -> bool {
+        let t = &self.tensor;
+        let tol = 1e-14 * (t[0][0] + t[1][1]);
+        (t[0][0] - t[1][1]).abs() <= tol && t[0][1].abs() <= tol
+    }
+
+    /// Whether the dynamics depends on θ (embedded and not symmetric).
+    fn depends_on_theta(&self) -> bool {
+        self.embedded && !self.is_symmetric()
+    }
+
+    /// G, ∂G, ∂_θG, α, ∂α at (x, θ); x must be in the domain.
+    fn local(&self, x: Vec2, theta: f64) -> Local {
+        let geo = self.surface.geometry(x);
+        let m = self.mass;
+        let mut g = geo.g.map(|r| r.map(|v| m * v));
+        let mut dg = geo.dg.map(|d| d.map(|r| r.map(|v| m * v)));
+        let mut dtheta = [[0.0; 2]; 2];
+        if self.embedded {
+            let emb = self.surface.embedding().expect("checked by embedded()");
+            let Shape { w, dw } = emb.shape(x);
+            let (sn, cs) = theta.sin_cos();
+            let s = [[cs, -sn], [sn, cs]];
+            let j = [[0.0, -1.0], [1.0, 0.0]];
+            let i = &self.tensor;
+            let q = sandwich(&transpose(&s), i, &transpose(&s));
+            let comm = add(&mul(&j, i), &mul(i, &j).map(|r| r.map(|v| -v)));
+            let dq = sandwich(&transpose(&s), &comm, &transpose(&s));
+            g = add(&g, &sandwich(&w, &q, &w));
+            for (d, dwk) in dg.iter_mut().zip(&dw) {
+                let a = sandwich(dwk, &q, &w);
+                *d = add(d, &add(&a, &transpose(&a)));
+            }
+            dtheta = sandwich(&w, &dq, &w);
+        }
+        Local {
+            g,
+            dg,
+            dtheta,
+            alpha: geo.alpha,
+            dalpha: geo.dalpha,
+        }
     }
 
     /// The surface.
@@ -100,42 +210,48 @@ impl TangentTop {
 
     /// 𝕀 = tr I.
     pub fn inertia(&self) -> f64 {
-        self.inertia
+        self.tensor[0][0] + self.tensor[1][1]
     }
 
-    /// The metric g_AB of 002 (47) (corrected signs, module docs) at x. Errors: x outside the
-    /// surface's domain.
-    pub fn metric(&self, x: Vec2) -> Result<[[f64; 3]; 3]> {
+    /// The Euler tensor I (row-major).
+    pub fn tensor(&self) -> [f64; 4] {
+        let t = &self.tensor;
+        [t[0][0], t[0][1], t[1][0], t[1][1]]
+    }
+
+    /// The metric g_AB of 002 (47) (corrected signs, module docs) at η = (x¹, x², θ), with
+    /// m g → G(x, θ) for the embedded top. Errors: x outside the surface's domain, non-finite η.
+    pub fn metric(&self, eta: [f64; 3]) -> Result<[[f64; 3]; 3]> {
+        check::finite_slice("eta", &eta)?;
+        let x = [eta[0], eta[1]];
         self.surface.check(x).map_err(|v| v.at_start())?;
-        let g = self.surface.metric(x);
-        let a = self.surface.connection(x);
-        let (m, i) = (self.mass, self.inertia);
+        let l = self.local(x, eta[2]);
+        let (g, a, i) = (l.g, l.alpha, self.inertia());
         Ok([
             [
-                m * g[0][0] + i * a[0] * a[0],
-                m * g[0][1] + i * a[0] * a[1],
+                g[0][0] + i * a[0] * a[0],
+                g[0][1] + i * a[0] * a[1],
                 i * a[0],
             ],
             [
-                m * g[1][0] + i * a[1] * a[0],
-                m * g[1][1] + i * a[1] * a[1],
+                g[1][0] + i * a[1] * a[0],
+                g[1][1] + i * a[1] * a[1],
                 i * a[1],
             ],
             [i * a[0], i * a[1], i],
         ])
     }
 
-    /// The Lagrangian L = ½ m g_ij ẋ^i ẋ^j + ½ 𝕀 (θ̇ + α_i ẋ^i)² at (η, η̇). Errors: x outside the
-    /// domain, non-finite input.
+    /// The Lagrangian L = ½ ẋᵀ G ẋ + ½ 𝕀 (θ̇ + α_i ẋ^i)² at (η, η̇), G = m g (+ WᵀQW embedded).
+    /// Errors: x outside the domain, non-finite input.
     pub fn lagrangian(&self, eta: [f64; 3], etadot: [f64; 3]) -> Result<f64> {
         check::finite_slice("eta and etadot", &[eta, etadot].concat())?;
         let x = [eta[0], eta[1]];
         self.surface.check(x).map_err(|v| v.at_start())?;
-        let g = self.surface.metric(x);
-        let a = self.surface.connection(x);
+        let l = self.local(x, eta[2]);
         let v = [etadot[0], etadot[1]];
-        let s = etadot[2] + a[0] * v[0] + a[1] * v[1];
-        Ok(0.5 * self.mass * super::surface::inner(&g, v, v) + 0.5 * self.inertia * s * s)
+        let s = etadot[2] + l.alpha[0] * v[0] + l.alpha[1] * v[1];
+        Ok(0.5 * quad(&l.g, v) + 0.5 * self.inertia() * s * s)
     }
 
     /// The canonical state z = (x, θ, p) with p_A = g_AB η̇^B (Legendre transform) of the top at x
@@ -143,7 +259,7 @@ impl TangentTop {
     pub fn state(&self, x: Vec2, theta: f64, xdot: Vec2, thetadot: f64) -> Result<Vec<f64>> {
         check::finite_slice("x, theta, xdot, thetadot", &[x[0], x[1], theta])?;
         check::finite_slice("xdot, thetadot", &[xdot[0], xdot[1], thetadot])?;
-        let g = self.metric(x)?;
+        let g = self.metric([x[0], x[1], theta])?;
         let eta_dot = [xdot[0], xdot[1], thetadot];
         let mut z = vec![x[0], x[1], theta, 0.0, 0.0, 0.0];
         for a in 0..3 {
@@ -228,19 +344,25 @@ impl Problem for TangentTop {
         self.check_z(z)?;
         Ok(self.hamiltonian(&z[..3], &z[3..]))
     }
-    /// [p_θ, the Killing momenta of the affine generators] — the ones quadratic in z, which the
-    /// Gauss methods keep to round-off (all of them on the plane, J_z on the sphere, J_E and J_H
-    /// on H², p_φ on a surface of revolution). [`TangentTop::killing_momenta`] gives all.
+    /// [p_θ (unless the top is embedded and anisotropic, module docs), the Killing momenta of
+    /// the affine generators] — the ones quadratic in z, which the Gauss methods keep to
+    /// round-off (all of them on the plane, J_z on the sphere, J_E and J_H on H², p_φ on a
+    /// surface of revolution). [`TangentTop::killing_momenta`] gives all.
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         self.check_z(z)?;
-        let mut v = vec![z[5]];
+        let mut v = if self.depends_on_theta() {
+            vec![]
+        } else {
+            vec![z[5]]
+        };
         v.extend(self.killing_values(z, true));
         Ok(v)
     }
     fn invariant_count(&self) -> usize {
-        1 + (0..self.surface.killing_count())
-            .filter(|&k| self.surface.killing_is_affine(k))
-            .count()
+        usize::from(!self.depends_on_theta())
+            + (0..self.surface.killing_count())
+                .filter(|&k| self.surface.killing_is_affine(k))
+                .count()
     }
     /// x in the surface's domain.
     fn check_state(&self, z: &[f64]) -> Result<()> {
@@ -259,8 +381,9 @@ impl Canonical for TangentTop {
         // H = ½ p_A g^{AB} p_B = ½ p·η̇.
         0.5 * (p[0] * hp[0] + p[1] * hp[1] + p[2] * hp[2])
     }
-    /// ∂H/∂p = (v, p_θ/𝕀 − α·v), ∂H/∂x^k = −½ m vᵀ(∂_k g)v − p_θ (∂_k α_i) v^i, ∂H/∂θ = 0
-    /// (module docs); NaN outside the domain (the method then reports the step).
+    /// ∂H/∂p = (v, p_θ/𝕀 − α·v), ∂H/∂x^k = −½ vᵀ(∂_k G)v − p_θ (∂_k α_i) v^i,
+    /// ∂H/∂θ = −½ vᵀ(∂_θ G)v (zero unless embedded and anisotropic; module docs); NaN outside
+    /// the domain (the method then reports the step).
     fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
         let x = [q[0], q[1]];
         if !self.surface.contains(x) {
@@ -268,26 +391,32 @@ impl Canonical for TangentTop {
             hp[..3].fill(f64::NAN);
             return;
         }
-        let geo = self.surface.geometry(x);
-        let gi = inverse(&geo.g);
+        let l = self.local(x, q[2]);
         let pt = p[2];
-        let a = geo.alpha;
-        let pi = [p[0] - pt * a[0], p[1] - pt * a[1]];
-        let m = self.mass;
-        let v = [
-            (gi[0][0] * pi[0] + gi[0][1] * pi[1]) / m,
-            (gi[1][0] * pi[0] + gi[1][1] * pi[1]) / m,
-        ];
+        let (v, force) = charged_particle(&l, [p[0], p[1]], pt);
         hp[0] = v[0];
         hp[1] = v[1];
-        hp[2] = pt / self.inertia - (a[0] * v[0] + a[1] * v[1]);
-        for (h, (d, da)) in hq.iter_mut().zip(geo.dg.iter().zip(&geo.dalpha)) {
-            let vgv =
-                d[0][0] * v[0] * v[0] + (d[0][1] + d[1][0]) * v[0] * v[1] + d[1][1] * v[1] * v[1];
-            *h = -0.5 * m * vgv - pt * (da[0] * v[0] + da[1] * v[1]);
-        }
-        hq[2] = 0.0;
+        hp[2] = pt / self.inertia() - (l.alpha[0] * v[0] + l.alpha[1] * v[1]);
+        hq[0] = -force[0];
+        hq[1] = -force[1];
+        hq[2] = -0.5 * quad(&l.dtheta, v);
     }
+}
+
+/// The charged particle of 002 §III.B at one point: for H = ½ πᵀ G⁻¹ π, π = p − e α, the
+/// velocity v = G⁻¹π and the force −∂H/∂x^k = ½ vᵀ(∂_k G)v + e (∂_k α_i) v^i.
+fn charged_particle(l: &Local, p: Vec2, e: f64) -> (Vec2, Vec2) {
+    let gi = inverse(&l.g);
+    let pi = [p[0] - e * l.alpha[0], p[1] - e * l.alpha[1]];
+    let v = [
+        gi[0][0] * pi[0] + gi[0][1] * pi[1],
+        gi[1][0] * pi[0] + gi[1][1] * pi[1],
+    ];
+    let force = std::array::from_fn(|k| {
+        let da = l.dalpha[k];
+        0.5 * quad(&l.dg[k], v) + e * (da[0] * v[0] + da[1] * v[1])
+    });
+    (v, force)
 }
 
 impl VectorField for TangentTop {
@@ -304,11 +433,206 @@ impl VectorField for TangentTop {
 
 impl Catalog for TangentTop {
     fn catalog(&self) -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("midpoint", IMPLICIT_MIDPOINT),
-            Entry::new("gauss4", Gauss(2)),
-            Entry::new("gauss6", Gauss(3)),
-            Entry::new("rk4", Rk4),
-        ]
+        methods()
+    }
+}
+
+/// The methods of both systems: the symplectic Gauss–Legendre family and RK4 as the baseline.
+fn methods<P: Canonical + VectorField + Clone + Send + Sync + 'static>() -> Vec<Entry<P>> {
+    vec![
+        Entry::new("midpoint", IMPLICIT_MIDPOINT),
+        Entry::new("gauss4", Gauss(2)),
+        Entry::new("gauss6", Gauss(3)),
+        Entry::new("rk4", Rk4),
+    ]
+}
+
+/// The charged particle equivalent to a tangent top (002 §III.B): with p_θ fixed, the centre of
+/// the top moves as a particle of mass m on the surface in the magnetic potential A = α (the
+/// connection 1-form) with charge e = p_θ. State z = (x¹, x², p₁, p₂).
+///
+/// **Derivation (Routh).** For L = ½ ẋᵀGẋ + ½𝕀(θ̇ + α·ẋ)², G = m g, θ is cyclic; the Routhian
+/// R = L − p_θθ̇ = ½ ẋᵀGẋ + p_θ α·ẋ − p_θ²/(2𝕀) is the Lagrangian 002 (57) with metric
+/// ĝ = G/m = g, potential A = α and charge q = p_θ (the last term is constant), whose
+/// Euler–Lagrange equations are those of (x¹, x²) in the top's. **Slip:** 002 (58) puts 𝕀ααᵀ/m
+/// into ĝ, A = −α and the charge ½𝕀θ̇, reasoning that θ̇ is conserved; it is p_θ = 𝕀(θ̇ + α·ẋ)
+/// that is conserved, not θ̇, and that regrouping does not give the top's x-equations (the
+/// test `magnetic_analogue_reproduces_the_centre` checks the Routh form). For a symmetric
+/// embedded top, G includes the (39) term: ĝ = g + (I₀/m) h g⁻¹ h. An anisotropic embedded top
+/// has no such analogue (its Lagrangian depends on θ).
+///
+/// H = ½ πᵀG⁻¹π, π = p − e α, so that the top's energy is H + p_θ²/(2𝕀). The Killing momenta
+/// are the top's with p_θ = e: J = p_i X^i + e ψ̇ (the magnetic translations).
+#[derive(Clone, Debug)]
+pub struct ChargedParticle {
+    top: TangentTop,
+    charge: f64,
+}
+
+impl TangentTop {
+    /// The charged particle of 002 §III.B for the tops with p_θ = `p_theta` ([`ChargedParticle`]).
+    /// Errors: non-finite p_θ; an anisotropic embedded top (its Lagrangian depends on θ).
+    pub fn magnetic_analogue(&self, p_theta: f64) -> Result<ChargedParticle> {
+        check::finite_slice("p_theta", &[p_theta])?;
+        if self.depends_on_theta() {
+            return Err(Error::invalid(
+                "magnetic_analogue",
+                "an anisotropic embedded top depends on θ and has no charged-particle analogue",
+            ));
+        }
+        Ok(ChargedParticle {
+            top: self.clone(),
+            charge: p_theta,
+        })
+    }
+}
+
+impl ChargedParticle {
+    /// The top it stands for.
+    pub fn top(&self) -> &TangentTop {
+        &self.top
+    }
+
+    /// The charge e = p_θ.
+    pub fn charge(&self) -> f64 {
+        self.charge
+    }
+
+    fn check_x(&self, x: Vec2) -> Result<()> {
+        check::finite_slice("x", &x)?;
+        self.top.surface.check(x).map_err(|v| v.at_start())
+    }
+
+    /// ĝ(x) = G/m (= g intrinsically; module docs). Errors: x outside the chart.
+    pub fn metric(&self, x: Vec2) -> Result<Mat2> {
+        self.check_x(x)?;
+        let m = self.top.mass;
+        Ok(self.top.local(x, 0.0).g.map(|r| r.map(|v| v / m)))
+    }
+
+    /// The magnetic potential A = α (the frame's connection 1-form). Errors: x outside the chart.
+    pub fn potential(&self, x: Vec2) -> Result<Vec2> {
+        self.check_x(x)?;
+        Ok(self.top.surface.connection(x))
+    }
+
+    /// The canonical state (x, p = Gẋ + eα) at x with velocity ẋ. Errors: x outside the chart,
+    /// non-finite input.
+    pub fn state(&self, x: Vec2, xdot: Vec2) -> Result<Vec<f64>> {
+        check::finite_slice("xdot", &xdot)?;
+        self.check_x(x)?;
+        let l = self.top.local(x, 0.0);
+        let e = self.charge;
+        Ok(vec![
+            x[0],
+            x[1],
+            l.g[0][0] * xdot[0] + l.g[0][1] * xdot[1] + e * l.alpha[0],
+            l.g[1][0] * xdot[0] + l.g[1][1] * xdot[1] + e * l.alpha[1],
+        ])
+    }
+
+    fn check_z(&self, z: &[f64]) -> Result<()> {
+        check::len_of("state", z, 4)?;
+        check::finite_slice("state", z)?;
+        self.top
+            .surface
+            .check([z[0], z[1]])
+            .map_err(|v| v.at_start())
+    }
+
+    /// The velocity ẋ = G⁻¹(p − eα).
+    pub fn velocities(&self, z: &[f64]) -> Result<Vec2> {
+        self.check_z(z)?;
+        Ok(charged_particle(
+            &self.top.local([z[0], z[1]], 0.0),
+            [z[2], z[3]],
+            self.charge,
+        )
+        .0)
+    }
+
+    /// The momenta of the surface's Killing fields, J = p_i X^i + e ψ̇, in the order of
+    /// [`Surface::killing`] (those of the top at p_θ = e).
+    pub fn killing_momenta(&self, z: &[f64]) -> Result<Vec<f64>> {
+        self.check_z(z)?;
+        Ok(self.killing_values(z, false))
+    }
+
+    fn killing_values(&self, z: &[f64], affine_only: bool) -> Vec<f64> {
+        let top_z = [z[0], z[1], 0.0, z[2], z[3], self.charge];
+        self.top.killing_values(&top_z, affine_only)
+    }
+}
+
+impl Problem for ChargedParticle {
+    fn name(&self) -> &'static str {
+        "ChargedParticle"
+    }
+    fn space(&self) -> Space {
+        Space::new([("x", Block::Real(2)), ("p", Block::Real(2))])
+    }
+    /// H = ½ πᵀG⁻¹π.
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        self.check_z(z)?;
+        Ok(self.hamiltonian(&z[..2], &z[2..]))
+    }
+    /// The Killing momenta of the affine generators (as for the top).
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        self.check_z(z)?;
+        Ok(self.killing_values(z, true))
+    }
+    fn invariant_count(&self) -> usize {
+        self.top.invariant_count() - 1
+    }
+    /// x in the surface's domain.
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        self.top
+            .surface
+            .check([z[0], z[1]])
+            .map_err(|v| v.at_start())
+    }
+}
+
+impl Canonical for ChargedParticle {
+    fn dof(&self) -> usize {
+        2
+    }
+    /// H = ½ p·ẋ − ½ e α·ẋ = ½ π·v.
+    fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
+        let (mut hq, mut hp) = ([0.0; 2], [0.0; 2]);
+        self.gradient(q, p, &mut hq, &mut hp);
+        let a = self.top.surface.connection([q[0], q[1]]);
+        let e = self.charge;
+        0.5 * ((p[0] - e * a[0]) * hp[0] + (p[1] - e * a[1]) * hp[1])
+    }
+    /// ∂H/∂p = v, ∂H/∂x = −(½ vᵀ(∂G)v + e (∂α) v); NaN outside the domain.
+    fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
+        let x = [q[0], q[1]];
+        if !self.top.surface.contains(x) {
+            hq[..2].fill(f64::NAN);
+            hp[..2].fill(f64::NAN);
+            return;
+        }
+        let (v, force) = charged_particle(&self.top.local(x, 0.0), [p[0], p[1]], self.charge);
+        hp[..2].copy_from_slice(&v);
+        hq[0] = -force[0];
+        hq[1] = -force[1];
+    }
+}
+
+impl VectorField for ChargedParticle {
+    /// ż = (∂H/∂p, −∂H/∂q).
+    fn field(&self, z: &[f64], dz: &mut [f64]) {
+        let (mut hq, mut hp) = ([0.0; 2], [0.0; 2]);
+        self.gradient(&z[..2], &z[2..4], &mut hq, &mut hp);
+        dz[..2].copy_from_slice(&hp);
+        dz[2] = -hq[0];
+        dz[3] = -hq[1];
+    }
+}
+
+impl Catalog for ChargedParticle {
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        methods()
     }
 }
