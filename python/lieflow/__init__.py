@@ -13,7 +13,7 @@ RigidBody, GeneralizedRigidBody, HeavyTop, SphericalPendulum   Lie–Poisson sys
 PseudoRigidBody, potentials                                     pseudo-rigid bodies of 001
 Pendulum, SphereParticle, RollingDisk                           canonical, constrained and
                                                                 nonholonomic test problems
-TangentTop, surfaces                                            the tangent Euler top of 002 §II–III
+TangentTop, ChargedParticle, surfaces                           the tangent Euler top of 002 §II–III
 RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
@@ -34,6 +34,7 @@ from ._lieflow import (
     __version__,
 )
 from ._lieflow import (
+    ChargedParticle,
     GeneralizedRigidBody,
     HeavyTop,
     Integration,
@@ -55,6 +56,7 @@ from .integrate import Trajectory, integrate
 LiePoissonSystem = System
 
 __all__ = [
+    "ChargedParticle",
     "ConvergenceError",
     "DegenerateStratumError",
     "GeneralizedRigidBody",

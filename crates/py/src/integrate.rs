@@ -16,10 +16,31 @@ use crate::errors::{to_py, IntoPy};
 use crate::items::{array, Out};
 
 /// Errors raised by Python callables that a system calls from native code (a callable
-/// potential): such a system runs single-threaded, and the first error is re-raised afterwards.
+/// potential or surface): such a system runs single-threaded, and the first error is re-raised
+/// afterwards.
 pub(crate) trait Callbacks: Send + Sync {
     /// The first recorded exception, if any (and forget it).
     fn take_error(&self) -> PyResult<()>;
+}
+
+/// Where native code that called Python keeps the first exception until it can be raised (the
+/// native side goes on with NaN, which stops the computation at the next check).
+#[derive(Default)]
+pub(crate) struct ErrorSlot(Mutex<Option<PyErr>>);
+
+impl ErrorSlot {
+    /// Keeps `e` unless an earlier error is waiting.
+    pub(crate) fn record(&self, e: PyErr) {
+        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        slot.get_or_insert(e);
+    }
+}
+
+impl Callbacks for ErrorSlot {
+    fn take_error(&self) -> PyResult<()> {
+        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        slot.take().map_or(Ok(()), Err)
+    }
 }
 
 /// The result of `System._run`: states (b, k, d), attitude (b, k, 3, 3) or None, final states

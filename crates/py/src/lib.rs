@@ -38,7 +38,7 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     pseudo_rigid::potential::register(&potentials)?;
     m.add("potentials", potentials)?;
     let surfaces = PyModule::new(m.py(), "lieflow.surfaces")?;
-    systems::tangent_top::register_surfaces(&surfaces)?;
+    systems::surfaces::register(&surfaces)?;
     m.add("surfaces", surfaces)?;
     add_submodule(m, "elliptic", elliptic::register)?;
     m.add_class::<system::PySystem>()?;

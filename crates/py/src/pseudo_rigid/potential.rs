@@ -3,7 +3,7 @@
 #![allow(non_snake_case)]
 
 use std::fmt;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use lieflow::pseudo_rigid::potential::{
     self as pot, Harmonic as CoreHarmonic, SaintVenantKirchhoff as CoreSvk, Stretch as CoreStretch,
@@ -16,7 +16,7 @@ use pyo3::types::PyTuple;
 
 use crate::convert::{mat, py_mat, ArrayIn};
 use crate::errors::{to_py, IntoPy};
-use crate::integrate::Callbacks;
+use crate::integrate::{Callbacks, ErrorSlot};
 
 /// An SO(n)×SO(n)-invariant potential U(X) of a pseudo-rigid body (001 §4.1). Build one with
 /// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Stretch(k)`,
@@ -126,7 +126,7 @@ pub(crate) struct CallablePotential {
     gradient: Py<PyAny>,
     /// `hessian(X, V)`, or `None` for central differences of `gradient`.
     hessian: Option<Py<PyAny>>,
-    error: Mutex<Option<PyErr>>,
+    error: ErrorSlot,
 }
 
 impl fmt::Debug for CallablePotential {
@@ -137,16 +137,11 @@ impl fmt::Debug for CallablePotential {
 
 impl CallablePotential {
     fn record(&self, e: PyErr) {
-        let mut slot = self.error.lock().unwrap_or_else(|p| p.into_inner());
-        slot.get_or_insert(e);
+        self.error.record(e);
     }
 
     pub(crate) fn take_error(&self) -> PyResult<()> {
-        let mut slot = self.error.lock().unwrap_or_else(|p| p.into_inner());
-        match slot.take() {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
+        self.error.take_error()
     }
 
     fn call<'py>(
@@ -334,7 +329,7 @@ fn Callable<'py>(
         value: value.clone().unbind(),
         gradient: gradient.clone().unbind(),
         hessian: hessian.as_ref().map(|h| h.clone().unbind()),
-        error: Mutex::new(None),
+        error: ErrorSlot::default(),
     });
     let py = value.py();
     let f = py.import("lieflow.potentials")?.getattr("Callable")?;

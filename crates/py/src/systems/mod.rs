@@ -9,6 +9,7 @@ mod relativistic_top;
 mod rigid_body;
 mod rolling_disk;
 mod spherical_pendulum;
+pub mod surfaces;
 pub mod tangent_top;
 
 use lieflow::systems::RigidBody;
@@ -78,5 +79,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<relativistic_top::PyRelativisticTangentTop>()?;
     m.add_class::<relativistic_top::PyWeakFieldTop>()?;
     m.add_class::<tangent_top::PyTangentTop>()?;
+    m.add_class::<tangent_top::PyChargedParticle>()?;
     Ok(())
 }

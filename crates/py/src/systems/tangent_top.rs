@@ -1,104 +1,62 @@
-//! `lieflow.surfaces` and `TangentTop`: bindings of `lieflow::systems::{surface, tangent_top}`
-//! (002 §II–III). Surfaces pickle by the function and arguments that made them; `TangentTop` is a
-//! thin subclass of `lieflow.System`.
+//! `TangentTop` and `ChargedParticle`: bindings of `lieflow::systems::tangent_top` (002 §II–III),
+//! thin subclasses of `lieflow.System`.
 #![allow(non_snake_case)]
 
-use std::sync::Arc;
-
-use lieflow::systems::{surface, TangentTop};
+use lieflow::systems::{ChargedParticle, TangentTop};
+use lieflow::Error;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyDict, PySlice};
 use pyo3::PyClassInitializer;
 
-use crate::convert::ArrayIn;
-use crate::errors::IntoPy;
-use crate::items::{map_items, Input};
+use crate::convert::{mat, ArrayIn};
+use crate::errors::{to_py, IntoPy};
 use crate::system::PySystem;
+use crate::systems::surfaces::Plane;
+pub(crate) use crate::systems::surfaces::PySurface;
 
 type Any<'py> = Bound<'py, PyAny>;
 
-/// A surface in local coordinates x = (x1, x2) with an orthonormal frame (E1, E2) (002 §II):
-/// `Plane()`, `Sphere(radius)`, `HyperbolicPlane()`.
-#[pyclass(module = "lieflow.surfaces", name = "Surface", frozen)]
-pub struct PySurface {
-    inner: Arc<dyn surface::Surface>,
-    /// How to rebuild it: (name, args) of the function in `lieflow.surfaces`.
-    recipe: (&'static str, Vec<f64>),
+/// `states[..., k]` for an index or slice `k`.
+fn pick<'py>(a: &Any<'py>, k: Any<'py>) -> PyResult<Any<'py>> {
+    let py = a.py();
+    a.call_method1("__getitem__", ((py.Ellipsis(), k),))
 }
 
-#[pymethods]
-impl PySurface {
-    /// The Gaussian curvature K at x.
-    ///
-    /// Raises:
-    ///     InvalidArgumentError (x outside the chart).
-    fn curvature(&self, x: [f64; 2]) -> PyResult<f64> {
-        self.inner.check(x).map_err(|v| v.at_start()).py()?;
-        Ok(self.inner.curvature(x))
+/// The Euler tensor from a scalar I = tr I (a symmetric body) or a (2, 2) array.
+fn tensor(inertia: &Any<'_>) -> PyResult<[f64; 4]> {
+    if let Ok(i) = inertia.extract::<f64>() {
+        return Ok([0.5 * i, 0.0, 0.0, 0.5 * i]);
     }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Any<'py>, Bound<'py, PyTuple>)> {
-        let f = py.import("lieflow.surfaces")?.getattr(self.recipe.0)?;
-        Ok((f, PyTuple::new(py, self.recipe.1.clone())?))
+    let a: ArrayIn<'_> = inertia.extract()?;
+    let m = mat("inertia", &a)?;
+    if m.nrows() != 2 || m.ncols() != 2 {
+        return Err(to_py(Error::shape(
+            "inertia",
+            "a number (tr I) or (2, 2)",
+            format!("({}, {})", m.nrows(), m.ncols()),
+        )));
     }
-
-    fn __repr__(&self) -> String {
-        let args: Vec<String> = self.recipe.1.iter().map(|a| a.to_string()).collect();
-        format!("{}({})", self.recipe.0, args.join(", "))
-    }
+    Ok([m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)]])
 }
 
-/// The Euclidean plane, Cartesian x = (x, y), E = (d/dx, d/dy).
-#[pyfunction]
-fn Plane() -> PySurface {
-    PySurface {
-        inner: Arc::new(surface::Plane),
-        recipe: ("Plane", vec![]),
-    }
-}
-
-/// The sphere of radius R, x = (colatitude, longitude), E1 = d/dtheta / R,
-/// E2 = d/dphi / (R sin theta).
-///
-/// Raises:
-///     InvalidArgumentError (R <= 0).
-#[pyfunction]
-fn Sphere(radius: f64) -> PyResult<PySurface> {
-    Ok(PySurface {
-        inner: Arc::new(surface::Sphere::new(radius).py()?),
-        recipe: ("Sphere", vec![radius]),
-    })
-}
-
-/// The hyperbolic plane in the Poincaré half-plane y > 0 (002 (67)), E1 = y d/dx, E2 = y d/dy.
-#[pyfunction]
-fn HyperbolicPlane() -> PySurface {
-    PySurface {
-        inner: Arc::new(surface::HyperbolicPlane),
-        recipe: ("HyperbolicPlane", vec![]),
-    }
-}
-
-/// Fills the `surfaces` submodule.
-pub fn register_surfaces(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<PySurface>()?;
-    m.add_function(wrap_pyfunction!(Plane, m)?)?;
-    m.add_function(wrap_pyfunction!(Sphere, m)?)?;
-    m.add_function(wrap_pyfunction!(HyperbolicPlane, m)?)?;
-    Ok(())
-}
-
-/// The tangent Euler top on a surface (002 §II–III): a rigid body carried as an orthonormal frame
-/// tangent to the surface; configuration (x1, x2, theta), theta the angle from E1 to the body's
-/// E1; L = m g(xdot, xdot)/2 + I (thetadot + w(xdot))^2 / 2 with w the connection 1-form (002
-/// (43); the cross term of (45)/(47) with the corrected sign). State (x1, x2, theta, p1, p2,
-/// p_theta); fields x (2), theta (1), p (3: the momenta conjugate to x1, x2, theta). Invariants: p_theta and the Killing momenta of the affine
+/// The tangent Euler top on a surface (002 §II–III): a rigid planar body carried as an
+/// orthonormal frame tangent to the surface; configuration (x1, x2, theta), theta the angle from
+/// the surface's E1 to the body's E1. L = m g(xdot, xdot)/2 + I (thetadot + w(xdot))^2 / 2 with
+/// w the connection 1-form (002 (43); the cross term of (45)/(47) with the corrected sign); with
+/// `embedded=True` the body moves as embedded in R^3 and L gains the second-fundamental-form
+/// term of 002 (37) (for a symmetric body, (39)), which for an anisotropic body depends on theta.
+/// State (x1, x2, theta, p1, p2, p_theta); fields x (2), theta, p (3), xdot (2), thetadot.
+/// Invariants: p_theta (unless embedded and anisotropic) and the Killing momenta of the affine
 /// isometries. Methods: midpoint, gauss4, gauss6 (symplectic Gauss–Legendre), rk4.
 ///
 /// Args:
-///     surface: a `lieflow.surfaces` surface; mass > 0; inertia: I = tr of the inertia tensor > 0.
+///     surface: a `lieflow.surfaces` surface.
+///     mass: m > 0.
+///     inertia: the scalar I = tr of the Euler tensor (a symmetric body, tensor I/2 Id), or the
+///         (2, 2) Euler tensor integral xi xi^T dm (symmetric positive semi-definite).
+///     embedded: include the embedding term (surfaces with an embedding in R^3 only).
 /// Raises:
-///     InvalidArgumentError.
+///     InvalidArgumentError, ShapeError.
 #[pyclass(name = "TangentTop", module = "lieflow", extends = PySystem, frozen)]
 pub struct PyTangentTop {
     top: TangentTop,
@@ -107,90 +65,243 @@ pub struct PyTangentTop {
 #[pymethods]
 impl PyTangentTop {
     #[new]
+    #[pyo3(signature = (surface, mass, inertia, embedded=false))]
     fn new(
         surface: Bound<'_, PySurface>,
         mass: f64,
-        inertia: f64,
+        inertia: Any<'_>,
+        embedded: bool,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let top = TangentTop::new(surface.get().inner.clone(), mass, inertia).py()?;
-        let args = (surface.clone(), mass, inertia).into_pyobject(surface.py())?;
-        let base = PySystem::new(top.clone(), args, &["surface", "mass", "inertia"]);
+        let s = surface.get();
+        let mut top = TangentTop::with_tensor(s.inner.clone(), mass, tensor(&inertia)?).py()?;
+        if embedded {
+            top = top.embedded().py()?;
+        }
+        let args = (surface.clone(), mass, inertia, embedded).into_pyobject(surface.py())?;
+        let base = PySystem::new(
+            top.clone(),
+            args,
+            &["surface", "mass", "inertia", "embedded"],
+        )
+        .with_callbacks(s.callbacks());
         Ok(PyClassInitializer::from(base).add_subclass(PyTangentTop { top }))
     }
 
     /// Constructor arguments of an example instance (for `methods()` on the class).
     #[classattr]
-    fn _example_args() -> (PySurface, f64, f64) {
-        (Plane(), 1.0, 1.0)
+    fn _example_args(py: Python<'_>) -> PyResult<(PySurface, f64, f64)> {
+        Ok((Plane(py)?, 1.0, 1.0))
+    }
+
+    /// The Euler tensor (2, 2).
+    #[getter]
+    fn tensor(&self) -> [[f64; 2]; 2] {
+        let t = self.top.tensor();
+        [[t[0], t[1]], [t[2], t[3]]]
     }
 
     /// The canonical state from x (2,), theta and the velocities (Legendre transform of (47)).
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart), NonFiniteError.
-    fn state(&self, x: [f64; 2], theta: f64, xdot: [f64; 2], thetadot: f64) -> PyResult<Vec<f64>> {
-        self.top.state(x, theta, xdot, thetadot).py()
+    fn state(
+        slf: &Bound<'_, Self>,
+        x: [f64; 2],
+        theta: f64,
+        xdot: [f64; 2],
+        thetadot: f64,
+    ) -> PyResult<Vec<f64>> {
+        let z = slf.get().top.state(x, theta, xdot, thetadot);
+        slf.as_super().get().take_callback_error()?;
+        z.py()
     }
 
     /// Named views for `Trajectory`: x (..., 2), theta (...), p (..., 3), and the velocities
     /// xdot (..., 2) and thetadot (...).
-    fn _fields<'py>(
-        slf: &Bound<'py, Self>,
-        states: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    fn _fields<'py>(slf: &Bound<'py, Self>, states: &Any<'py>) -> PyResult<Bound<'py, PyDict>> {
         let py = slf.py();
         let fields = slf.as_super().get()._fields(py, states.extract()?)?;
-        let pick = |a: &Bound<'py, PyAny>, k: Bound<'py, PyAny>| {
-            a.call_method1("__getitem__", ((py.Ellipsis(), k),))
-        };
         if let Some(theta) = fields.get_item("theta")? {
             fields.set_item("theta", pick(&theta, 0i64.into_pyobject(py)?.into_any())?)?;
         }
-        let v = slf.get().velocities(py, states.extract()?)?;
-        let first_two = pyo3::types::PySlice::new(py, 0, 2, 1).into_any();
-        fields.set_item("xdot", pick(&v, first_two)?)?;
+        let v = Self::velocities(slf, states.extract()?)?;
+        fields.set_item("xdot", pick(&v, PySlice::new(py, 0, 2, 1).into_any())?)?;
         fields.set_item("thetadot", pick(&v, 2i64.into_pyobject(py)?.into_any())?)?;
         Ok(fields)
     }
 
     /// The velocities (x1dot, x2dot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
-    fn velocities<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        map_items(
-            py,
-            &[Input::new("states", &states, &[6])],
-            &[3],
-            |z, out| {
-                out.copy_from_slice(&self.top.velocities(z[0])?);
+    fn velocities<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let top = &slf.get().top;
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[3], |z, out| {
+                out.copy_from_slice(&top.velocities(z)?);
                 Ok(())
-            },
-        )
+            })
     }
 
-    /// The body's angular momentum p_theta (kept exactly by the Gauss methods), (..., 6) -> (...).
-    fn p_theta<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        map_items(py, &[Input::new("states", &states, &[6])], &[], |z, out| {
-            out[0] = self.top.p_theta(z[0])?;
-            Ok(())
-        })
+    /// The body's angular momentum p_theta (kept exactly by the Gauss methods when conserved),
+    /// (..., 6) -> (...).
+    fn p_theta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let top = &slf.get().top;
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[], |z, out| {
+                out[0] = top.p_theta(z)?;
+                Ok(())
+            })
     }
 
     /// All Killing momenta J = p_A X^A of the surface's isometry group (Plane: translations x, y
     /// and the rotation; Sphere: the ambient angular momentum x, y, z; HyperbolicPlane: the
-    /// Möbius generators E, H, F), (..., 6) -> (..., k).
-    fn killing_momenta<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let probe = self
-            .top
-            .killing_momenta(&[0.3, 0.7, 0.0, 0.0, 0.0, 0.0])
-            .py()?
-            .len();
-        map_items(
-            py,
-            &[Input::new("states", &states, &[6])],
-            &[probe],
-            |z, out| {
-                out.copy_from_slice(&self.top.killing_momenta(z[0])?);
+    /// Möbius generators E, H, F; Revolution and Torus: p_phi), (..., 6) -> (..., k).
+    fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let top = &slf.get().top;
+        let k = top.surface().killing_count();
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[k], |z, out| {
+                out.copy_from_slice(&top.killing_momenta(z)?);
                 Ok(())
-            },
-        )
+            })
+    }
+
+    /// The body in R^3 for a surface with an embedding: rows (position c, E1, E2),
+    /// (..., 6) -> (..., 3, 3).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (the surface has no embedding).
+    fn ambient_frame<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let top = &slf.get().top;
+        if top.surface().embedding().is_none() {
+            return Err(to_py(Error::invalid(
+                "ambient_frame",
+                format!("the {} chart has no embedding in R^3", top.surface().name()),
+            )));
+        }
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[3, 3], |z, out| {
+                let f = top.ambient_frame(z)?.expect("checked above");
+                out.copy_from_slice(f.as_flattened());
+                Ok(())
+            })
+    }
+
+    /// The charged particle equivalent to tops with this p_theta (002 §III.B, Routh form): its
+    /// path x(t) is the centre's. See `ChargedParticle`.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (an anisotropic embedded top depends on theta and has none).
+    fn magnetic_analogue<'py>(slf: &Bound<'py, Self>, p_theta: f64) -> PyResult<Any<'py>> {
+        let py = slf.py();
+        let cls = py.import("lieflow")?.getattr("ChargedParticle")?;
+        cls.call1((slf.clone(), p_theta))
+    }
+}
+
+/// The charged particle of 002 §III.B that stands for a tangent top with angular momentum
+/// p_theta: mass m on the surface with metric g (plus the (39) term for a symmetric embedded
+/// top), magnetic potential A = alpha (the frame's connection 1-form) and charge p_theta. The
+/// Routhian of the top gives it; 002 (58) prints a different metric, potential and charge (a
+/// slip: it is p_theta, not thetadot, that is conserved). State (x1, x2, p1, p2); fields x, p,
+/// xdot. H = |p - p_theta A|^2_G / 2 (the top's energy minus p_theta^2 / (2 I)).
+///
+/// Args:
+///     top: a `TangentTop` (not an anisotropic embedded one).
+///     charge: p_theta.
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "ChargedParticle", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyChargedParticle {
+    particle: ChargedParticle,
+}
+
+#[pymethods]
+impl PyChargedParticle {
+    #[new]
+    fn new(top: Bound<'_, PyTangentTop>, charge: f64) -> PyResult<PyClassInitializer<Self>> {
+        let particle = top.get().top.magnetic_analogue(charge).py()?;
+        let callbacks = top.as_super().get().callbacks.clone();
+        let args = (top.clone(), charge).into_pyobject(top.py())?;
+        let base =
+            PySystem::new(particle.clone(), args, &["top", "charge"]).with_callbacks(callbacks);
+        Ok(PyClassInitializer::from(base).add_subclass(PyChargedParticle { particle }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args(py: Python<'_>) -> PyResult<(Py<PyTangentTop>, f64)> {
+        let plane = Bound::new(py, Plane(py)?)?;
+        let one = 1.0f64.into_pyobject(py)?.into_any();
+        Ok((
+            Py::new(py, PyTangentTop::new(plane, 1.0, one, false)?)?,
+            1.0,
+        ))
+    }
+
+    /// The charge p_theta.
+    #[getter]
+    fn charge(&self) -> f64 {
+        self.particle.charge()
+    }
+
+    /// The metric of the particle at x (2, 2): g, plus (I/2m) h g^-1 h for a symmetric embedded
+    /// top.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart).
+    fn metric(&self, x: [f64; 2]) -> PyResult<[[f64; 2]; 2]> {
+        self.particle.metric(x).py()
+    }
+
+    /// The magnetic potential A = alpha at x.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart).
+    fn potential(&self, x: [f64; 2]) -> PyResult<[f64; 2]> {
+        self.particle.potential(x).py()
+    }
+
+    /// The canonical state (x, p = m G xdot + charge A) from x and xdot.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart), NonFiniteError.
+    fn state(slf: &Bound<'_, Self>, x: [f64; 2], xdot: [f64; 2]) -> PyResult<Vec<f64>> {
+        let z = slf.get().particle.state(x, xdot);
+        slf.as_super().get().take_callback_error()?;
+        z.py()
+    }
+
+    /// Named views for `Trajectory`: x (..., 2), p (..., 2), xdot (..., 2).
+    fn _fields<'py>(slf: &Bound<'py, Self>, states: &Any<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let py = slf.py();
+        let fields = slf.as_super().get()._fields(py, states.extract()?)?;
+        fields.set_item("xdot", Self::velocities(slf, states.extract()?)?)?;
+        Ok(fields)
+    }
+
+    /// The velocities xdot of states, (..., 4) -> (..., 2).
+    fn velocities<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let p = &slf.get().particle;
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[2], |z, out| {
+                out.copy_from_slice(&p.velocities(z)?);
+                Ok(())
+            })
+    }
+
+    /// The Killing momenta, those of the top at p_theta = charge, (..., 4) -> (..., k).
+    fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let p = &slf.get().particle;
+        let k = p.top().surface().killing_count();
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[k], |z, out| {
+                out.copy_from_slice(&p.killing_momenta(z)?);
+                Ok(())
+            })
     }
 }

@@ -1,0 +1,353 @@
+//! `lieflow.surfaces`: the surfaces of `lieflow::systems::surface` (002 §II–III), built in or
+//! from Python callables. A surface pickles by the function of this module and the arguments that
+//! made it (callables pickle by reference, so pass module-level functions).
+#![allow(non_snake_case)]
+
+use std::sync::Arc;
+
+use lieflow::systems::surface::{self, Jet, Mat2, Surface, Vec2};
+use lieflow::Error;
+use numpy::ndarray::arr2;
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use crate::convert::{shape_str, ArrayIn};
+use crate::errors::{to_py, IntoPy};
+use crate::integrate::{Callbacks, ErrorSlot};
+
+type Any<'py> = Bound<'py, PyAny>;
+
+/// A surface in local coordinates x = (x1, x2) with an orthonormal frame (E1, E2) and the
+/// connection 1-form w = alpha_i dx^i of that frame, w(v) = <nabla_v E1, E2> (002 (43)).
+/// Made by `Plane`, `Sphere`, `HyperbolicPlane`, `Revolution`, `Torus`, `Graph`, `Quadric` and
+/// `MetricSurface` of this module.
+#[pyclass(module = "lieflow.surfaces", name = "Surface", frozen)]
+pub struct PySurface {
+    pub(crate) inner: Arc<dyn Surface>,
+    /// (function of `lieflow.surfaces`, its arguments), for pickling.
+    recipe: (&'static str, Py<PyTuple>),
+    desc: String,
+    /// The first exception of the Python callables, for the surfaces made from them.
+    errors: Option<Arc<ErrorSlot>>,
+}
+
+impl PySurface {
+    fn new(
+        inner: Arc<dyn Surface>,
+        name: &'static str,
+        args: Bound<'_, PyTuple>,
+        errors: Option<Arc<ErrorSlot>>,
+    ) -> PyResult<Self> {
+        let desc = format!("{name}{}", args.repr()?);
+        Ok(PySurface {
+            inner,
+            recipe: (name, args.unbind()),
+            desc: desc.replace(",)", ")"),
+            errors,
+        })
+    }
+
+    /// Where a system on this surface finds the exceptions of its callables.
+    pub(crate) fn callbacks(&self) -> Option<Arc<dyn Callbacks>> {
+        self.errors.clone().map(|e| e as Arc<dyn Callbacks>)
+    }
+
+    /// Re-raises a callable's exception, if any.
+    fn take_error(&self) -> PyResult<()> {
+        self.errors.as_ref().map_or(Ok(()), |e| e.take_error())
+    }
+
+    /// x, checked to lie in the chart (a callable's exception comes first).
+    fn point(&self, x: Vec2) -> PyResult<Vec2> {
+        let inside = self.inner.check(x);
+        self.take_error()?;
+        inside.map_err(|v| v.at_start()).py()?;
+        Ok(x)
+    }
+
+    /// `f(x)` for a checked x, re-raising a callable's exception.
+    fn at<T>(&self, x: Vec2, f: impl FnOnce(Vec2) -> T) -> PyResult<T> {
+        let x = self.point(x)?;
+        let v = f(x);
+        self.take_error()?;
+        Ok(v)
+    }
+}
+
+fn mat2(py: Python<'_>, m: Mat2) -> Bound<'_, PyArray2<f64>> {
+    arr2(&m).into_pyarray(py)
+}
+
+#[pymethods]
+impl PySurface {
+    /// The Gaussian curvature K at x.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart).
+    fn curvature(&self, x: Vec2) -> PyResult<f64> {
+        self.at(x, |x| self.inner.curvature(x))
+    }
+
+    /// The metric g_ij at x, (2, 2).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart).
+    fn metric<'py>(&self, py: Python<'py>, x: Vec2) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(mat2(py, self.at(x, |x| self.inner.metric(x))?))
+    }
+
+    /// The orthonormal frame at x, (2, 2): row a holds the components e_a^i of E_a = e_a^i d_i.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart).
+    fn frame<'py>(&self, py: Python<'py>, x: Vec2) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(mat2(py, self.at(x, |x| self.inner.frame(x))?))
+    }
+
+    /// The connection 1-form (alpha_1, alpha_2) of the frame at x (002 (43)).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart).
+    fn connection(&self, x: Vec2) -> PyResult<Vec2> {
+        self.at(x, |x| self.inner.connection(x))
+    }
+
+    /// The names of the Killing generators, in the order of `TangentTop.killing_momenta`.
+    #[getter]
+    fn killing_names(&self) -> Vec<&'static str> {
+        self.inner.killing_names().to_vec()
+    }
+
+    /// Whether the surface comes with an embedding in R^3 (needed by `TangentTop(...,
+    /// embedded=True)` and `TangentTop.ambient_frame`).
+    #[getter]
+    fn has_embedding(&self) -> bool {
+        self.inner.embedding().is_some()
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Any<'py>, Bound<'py, PyTuple>)> {
+        let f = py.import("lieflow.surfaces")?.getattr(self.recipe.0)?;
+        Ok((f, self.recipe.1.bind(py).clone()))
+    }
+
+    fn __repr__(&self) -> String {
+        self.desc.clone()
+    }
+}
+
+/// Calls `f(*args)` and reads the array it returns, which must have `shape` (row-major); on an
+/// exception or a wrong return records the error and gives NaN (native code then stops at its
+/// next check and the error is raised).
+fn call_floats<const N: usize>(
+    errors: &ErrorSlot,
+    f: &Py<PyAny>,
+    args: &[f64],
+    what: &str,
+    shape: &[usize],
+) -> [f64; N] {
+    Python::attach(|py| {
+        let out = PyTuple::new(py, args)
+            .and_then(|a| f.bind(py).call1(a))
+            .and_then(|v| {
+                let a: ArrayIn<'_> = v.extract()?;
+                let v = a.as_array();
+                if v.shape() != shape {
+                    return Err(to_py(Error::shape(
+                        what,
+                        shape_str(shape),
+                        shape_str(v.shape()),
+                    )));
+                }
+                let mut out = [0.0; N];
+                for (o, x) in out.iter_mut().zip(v.iter()) {
+                    *o = *x;
+                }
+                Ok(out)
+            });
+        out.unwrap_or_else(|e| {
+            errors.record(e);
+            [f64::NAN; N]
+        })
+    })
+}
+
+fn callable(what: &str, f: &Any<'_>) -> PyResult<Py<PyAny>> {
+    if f.is_callable() {
+        Ok(f.clone().unbind())
+    } else {
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "{what} must be callable"
+        )))
+    }
+}
+
+/// A surface made of native code.
+fn native(
+    py: Python<'_>,
+    inner: impl Surface + 'static,
+    name: &'static str,
+    args: &[f64],
+) -> PyResult<PySurface> {
+    PySurface::new(Arc::new(inner), name, PyTuple::new(py, args)?, None)
+}
+
+/// The Euclidean plane, Cartesian x = (x, y), E = (d/dx, d/dy). Killing generators: translations
+/// along x and y, the rotation about the origin.
+#[pyfunction]
+pub(crate) fn Plane(py: Python<'_>) -> PyResult<PySurface> {
+    native(py, surface::Plane, "Plane", &[])
+}
+
+/// The sphere of radius R, x = (colatitude, longitude), E1 = d/dtheta / R,
+/// E2 = d/dphi / (R sin theta). Killing generators: rotations about the ambient x, y, z axes.
+///
+/// Raises:
+///     InvalidArgumentError (R <= 0).
+#[pyfunction]
+fn Sphere(py: Python<'_>, radius: f64) -> PyResult<PySurface> {
+    native(py, surface::Sphere::new(radius).py()?, "Sphere", &[radius])
+}
+
+/// The hyperbolic plane in the Poincaré half-plane y > 0 (002 (67)), E1 = y d/dx, E2 = y d/dy.
+/// Killing generators: the Möbius one-parameter groups of E, H, F in sl(2, R). Not embedded.
+#[pyfunction]
+fn HyperbolicPlane(py: Python<'_>) -> PyResult<PySurface> {
+    native(py, surface::HyperbolicPlane, "HyperbolicPlane", &[])
+}
+
+/// The surface of revolution X(s, phi) = (r(s) cos phi, r(s) sin phi, z(s)) about the z axis on
+/// s_min < s < s_max (where r > 0), coordinates x = (s, phi), E1 = d/ds / |X_s|,
+/// E2 = d/dphi / r. `r` and `z` are callables s -> (f, f', f'', f''') (the third derivative
+/// enters only the embedded top). Killing generator: the rotation about z (momentum p_phi).
+/// Slow path: every evaluation calls Python; exceptions raised by the callables are re-raised.
+///
+/// Raises:
+///     TypeError (not callable), InvalidArgumentError (an empty or non-finite range).
+#[pyfunction]
+fn Revolution<'py>(r: Any<'py>, z: Any<'py>, s_range: (f64, f64)) -> PyResult<PySurface> {
+    let py = r.py();
+    let errors = Arc::new(ErrorSlot::default());
+    let profile = |what: &'static str, f: Py<PyAny>| {
+        let errors = errors.clone();
+        move |s: f64| call_floats::<4>(&errors, &f, &[s], what, &[4])
+    };
+    let inner = surface::Revolution::new(
+        profile("r(s)", callable("r", &r)?),
+        profile("z(s)", callable("z", &z)?),
+        s_range,
+    )
+    .py()?;
+    let args = (r, z, s_range).into_pyobject(py)?;
+    PySurface::new(Arc::new(inner), "Revolution", args, Some(errors))
+}
+
+/// The torus of radii a > b > 0 as a surface of revolution: r = a + b cos s, z = b sin s,
+/// -pi < s < pi.
+///
+/// Raises:
+///     InvalidArgumentError (not a > b > 0).
+#[pyfunction]
+fn Torus(py: Python<'_>, a: f64, b: f64) -> PyResult<PySurface> {
+    native(py, surface::Revolution::torus(a, b).py()?, "Torus", &[a, b])
+}
+
+/// The graph z = f(x, y), coordinates x = (x, y), frame by Gram–Schmidt of (d/dx, d/dy). `f` is a
+/// callable (x, y) -> the 10 numbers (f, f_x, f_y, f_xx, f_xy, f_yy, f_xxx, f_xxy, f_xyy, f_yyy).
+/// Slow path: every evaluation calls Python; exceptions raised by `f` are re-raised.
+///
+/// Raises:
+///     TypeError (not callable).
+#[pyfunction]
+fn Graph(f: Any<'_>) -> PyResult<PySurface> {
+    let py = f.py();
+    let errors = Arc::new(ErrorSlot::default());
+    let (slot, call) = (errors.clone(), callable("f", &f)?);
+    let inner = surface::Graph::new(move |x: Vec2| {
+        let v = call_floats::<10>(&slot, &call, &x, "f(x, y)", &[10]);
+        Jet {
+            value: v[0],
+            gradient: [v[1], v[2]],
+            hessian: [[v[3], v[4]], [v[4], v[5]]],
+            third: [v[6], v[7], v[8], v[9]],
+        }
+    });
+    let args = (f,).into_pyobject(py)?;
+    PySurface::new(Arc::new(inner), "Graph", args, Some(errors))
+}
+
+/// The quadric z = (a x^2 + b y^2)/2 as a graph (paraboloid for ab > 0, saddle for ab < 0).
+///
+/// Raises:
+///     NonFiniteError.
+#[pyfunction]
+fn Quadric(py: Python<'_>, a: f64, b: f64) -> PyResult<PySurface> {
+    native(py, surface::Graph::quadric(a, b).py()?, "Quadric", &[a, b])
+}
+
+/// A surface given by its metric and an orthonormal frame, as callables x1, x2 -> (2, 2) arrays:
+/// `metric` g_ij, `frame` with row a the components of E_a (orthonormal for g, positively
+/// oriented); `domain(x1, x2) -> bool` optionally restricts the chart. The connection 1-form and
+/// the derivatives are computed numerically (errors about 1e-12 in alpha, 1e-9 in its
+/// derivatives). No Killing generators, no embedding. The slowest path: the differences call
+/// the two callables about 180 times per evaluation of a top's vector field, so a gauss4 step
+/// costs some thousands of Python calls; prefer a built-in, `Revolution` or `Graph` where one
+/// fits.
+///
+/// Raises:
+///     TypeError (not callable).
+#[pyfunction]
+#[pyo3(signature = (metric, frame, domain=None))]
+fn MetricSurface<'py>(
+    metric: Any<'py>,
+    frame: Any<'py>,
+    domain: Option<Any<'py>>,
+) -> PyResult<PySurface> {
+    let py = metric.py();
+    let errors = Arc::new(ErrorSlot::default());
+    let field = |what: &'static str, f: Py<PyAny>| {
+        let errors = errors.clone();
+        move |x: Vec2| {
+            let v = call_floats::<4>(&errors, &f, &x, what, &[2, 2]);
+            [[v[0], v[1]], [v[2], v[3]]]
+        }
+    };
+    let dom: Option<surface::DomainFn> = match &domain {
+        Some(d) => {
+            let (slot, d) = (errors.clone(), callable("domain", d)?);
+            Some(Arc::new(move |x: Vec2| {
+                Python::attach(|py| {
+                    d.bind(py)
+                        .call1((x[0], x[1]))
+                        .and_then(|v| v.is_truthy())
+                        .unwrap_or_else(|e| {
+                            slot.record(e);
+                            false
+                        })
+                })
+            }))
+        }
+        None => None,
+    };
+    let inner = surface::MetricSurface::new(
+        field("metric(x1, x2)", callable("metric", &metric)?),
+        field("frame(x1, x2)", callable("frame", &frame)?),
+        dom,
+    );
+    let args = (metric, frame, domain).into_pyobject(py)?;
+    PySurface::new(Arc::new(inner), "MetricSurface", args, Some(errors))
+}
+
+/// Fills the `surfaces` submodule.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PySurface>()?;
+    m.add_function(wrap_pyfunction!(Plane, m)?)?;
+    m.add_function(wrap_pyfunction!(Sphere, m)?)?;
+    m.add_function(wrap_pyfunction!(HyperbolicPlane, m)?)?;
+    m.add_function(wrap_pyfunction!(Revolution, m)?)?;
+    m.add_function(wrap_pyfunction!(Torus, m)?)?;
+    m.add_function(wrap_pyfunction!(Graph, m)?)?;
+    m.add_function(wrap_pyfunction!(Quadric, m)?)?;
+    m.add_function(wrap_pyfunction!(MetricSurface, m)?)?;
+    Ok(())
+}
