@@ -182,12 +182,19 @@ class PseudoRigidBody(System):
     def singular_values(self, states: ArrayLike) -> F64: ...
 
 class RelativisticTangentTop(System):
-    """The relativistic tangent top in Minkowski space (002 (87)-(96)); gauss4, gauss6, midpoint, rk4."""
+    """The relativistic tangent top in Minkowski space (002 (87)-(96)), or with `surface` the
+    symmetric top on -dt^2 + g over that surface (002 (97)-(103)); gauss4, gauss6, midpoint, rk4."""
 
-    def __init__(self, mass: float, inertia: float | tuple[float, float, float]) -> None: ...
+    def __init__(
+        self, mass: float, inertia: float | tuple[float, float, float], surface: Any | None = None,
+    ) -> None: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
     def velocities(self, states: ArrayLike) -> F64:
         """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
+    def speed_and_spin(self, states: ArrayLike) -> F64:
+        """(..., 6) -> (..., 2): v = sqrt(g(xdot, xdot)), s = thetadot + w(xdot)."""
+    def killing_momenta(self, states: ArrayLike) -> F64:
+        """(..., 6) -> (..., k): the Killing momenta of the surface (the plane's by default)."""
 
 class WeakFieldTop(System):
     """The tangent top in a weak static gravitational field (002 (115)-(120), corrected)."""

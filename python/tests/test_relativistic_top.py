@@ -1,6 +1,8 @@
 """The relativistic tangent top (002 §IV) from Python: the symmetric top in Minkowski space keeps
 its speed and spin and satisfies the re-derived relations (94)–(96); the weak-field top keeps its
-energy and angular momentum and follows the Newtonian orbit when the spin vanishes."""
+energy and angular momentum and follows the Newtonian orbit when the spin vanishes; the top on a
+curved static space-time over a surface (002 (97)-(103)) keeps its energy, p_theta and Killing
+momenta, pickles, and rejects bad surfaces."""
 
 import pickle
 
@@ -40,3 +42,75 @@ def test_weak_field_top_conserves_energy_and_angular_momentum():
     assert np.abs(r - 1.0).max() < 1e-2
     with pytest.raises(lf.InvalidArgumentError):
         lf.WeakFieldTop(1.0, 1e-3)
+
+
+def test_symmetric_top_on_a_sphere_conserves_energy_p_theta_and_j_z():
+    # 002 (97)-(103): the top on -dt^2 + g over the unit sphere; gauss6 keeps p_theta and the
+    # affine Killing momentum J_z to round-off, the energy to ~1e-14; v and s stay constant.
+    top = lf.RelativisticTangentTop(1.0, 0.2, surface=lf.surfaces.Sphere(1.0))
+    z0 = top.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)
+    tr = lf.integrate(top, z0, dt=0.02, steps=2000, method="gauss6", save_every=100)
+    assert np.ptp(tr.energy()) < 1e-12
+    assert np.ptp(tr.states[:, 5]) < 1e-14
+    inv = top.invariants(tr.states)
+    assert inv.shape == (len(tr.states), 2)             # p_theta, J_z
+    assert np.ptp(inv, axis=0).max() < 1e-12
+    j = top.killing_momenta(tr.states)
+    assert j.shape == (len(tr.states), 3)
+    assert np.ptp(j, axis=0).max() < 1e-10
+    vs = top.speed_and_spin(tr.states)
+    assert np.ptp(vs, axis=0).max() < 1e-12 and 0.4 < vs[0, 0] < 0.6
+    # The centre moves: the run is not trivial.
+    assert np.ptp(tr.states[:, 1]) > 0.5
+
+
+def test_surface_top_pickles_and_reproduces_the_run():
+    top = lf.RelativisticTangentTop(1.0, 0.2, lf.surfaces.HyperbolicPlane())
+    copy = pickle.loads(pickle.dumps(top))
+    assert "HyperbolicPlane" in repr(copy)
+    z0 = top.state([0.1, 1.0], 0.0, [0.4, 0.2], 1.3)
+    a = lf.integrate(top, z0, dt=0.05, steps=40).states
+    b = lf.integrate(copy, z0, dt=0.05, steps=40).states
+    np.testing.assert_array_equal(a, b)
+    # On the Plane it is the Minkowski top.
+    plane = lf.RelativisticTangentTop(1.0, 0.2, surface=lf.surfaces.Plane())
+    flat = lf.RelativisticTangentTop(1.0, 0.2)
+    z0 = flat.state([0.0, 0.0], 0.3, [0.5, 0.2], 2.0)
+    np.testing.assert_allclose(lf.integrate(plane, z0, dt=0.05, steps=40).states,
+                               lf.integrate(flat, z0, dt=0.05, steps=40).states, atol=1e-13)
+    np.testing.assert_allclose(flat.killing_momenta(z0), plane.killing_momenta(z0), atol=1e-15)
+
+
+def test_bad_surface_arguments_are_rejected():
+    with pytest.raises(TypeError):
+        lf.RelativisticTangentTop(1.0, 0.2, surface="sphere")
+    with pytest.raises(TypeError):
+        lf.RelativisticTangentTop(1.0, 0.2, surface=lf.TangentTop(lf.surfaces.Plane(), 1.0, 1.0))
+    with pytest.raises(lf.InvalidArgumentError):   # anisotropic body: Minkowski plane only
+        lf.RelativisticTangentTop(1.0, (0.1, 0.0, 0.2), surface=lf.surfaces.Sphere(1.0))
+    top = lf.RelativisticTangentTop(1.0, 0.2, surface=lf.surfaces.Sphere(2.0))
+    with pytest.raises(lf.InvalidArgumentError):   # v = R |dtheta/dt| = 1.2
+        top.state([1.0, 0.0], 0.0, [0.6, 0.0], 1.0)
+    with pytest.raises(lf.InvalidArgumentError):   # outside the chart 0 < theta < pi
+        top.state([-0.1, 0.0], 0.0, [0.1, 0.0], 1.0)
+
+
+def test_surface_from_callables_matches_the_sphere_and_raises_their_errors():
+    S = lf.surfaces
+
+    def metric(t, p):
+        return [[1.0, 0.0], [0.0, np.sin(t) ** 2]]
+
+    def frame(t, p):
+        if t > 1.5:
+            raise RuntimeError("frame failed")
+        return [[1.0, 0.0], [0.0, 1.0 / np.sin(t)]]
+
+    python = lf.RelativisticTangentTop(1.0, 0.2, S.MetricSurface(metric, frame, None))
+    native = lf.RelativisticTangentTop(1.0, 0.2, S.Sphere(1.0))
+    z0 = native.state([1.0, 0.3], 0.5, [0.2, 0.3], 1.5)
+    a = lf.integrate(python, z0, dt=0.02, steps=20).states
+    b = lf.integrate(native, z0, dt=0.02, steps=20).states
+    np.testing.assert_allclose(a, b, atol=1e-7)
+    with pytest.raises(RuntimeError, match="frame failed"):
+        python.state([1.6, 0.0], 0.0, [0.1, 0.0], 1.0)

@@ -1,6 +1,7 @@
-//! 002 §IV: the relativistic tangent Euler top in the plane, in Minkowski space-time
-//! ([`RelativisticTangentTop`], 002 (87)–(96)) and in the weak-field limit of a static
-//! gravitational potential φ(x, y) ([`WeakFieldTop`], 002 (115)–(120)).
+//! 002 §IV: the relativistic tangent Euler top in Minkowski space-time and on a curved static
+//! space-time −dt² + γ_ij dxⁱdxʲ over a surface ([`RelativisticTangentTop`], 002 (87)–(111)), and
+//! in the weak-field limit of a static gravitational potential φ(x, y) ([`WeakFieldTop`],
+//! 002 (115)–(120)).
 //!
 //! # Set-up (002 (81)–(82))
 //! A planar body with mass distribution dm(ξ), centre of mass at ξ = 0, second-moment tensor
@@ -53,6 +54,60 @@
 //! What makes v constant is the invertibility of the Legendre map along the motion, which
 //! [`RelativisticTangentTop`] checks.
 //!
+//! # Curved static space-time (002 (97)–(111))
+//! The metric ds² = −dt² + γ_ij dxⁱdxʲ with γ = g the metric of a [`Surface`] (orthonormal frame
+//! Ê_a, connection 1-form w(v) = ⟨∇_vÊ₁, Ê₂⟩ = α·v, see [`crate::systems::surface`]). The lapse is
+//! 1, so ∂_t is parallel and no Christoffel symbol carries a t (002 (86)): with ċ = ∂_t + ẋ and
+//! E₁ = cos θ Ê₁ + sin θ Ê₂, E₂ = −sin θ Ê₁ + cos θ Ê₂,
+//!
+//! ∇_ċE₁ = s E₂,  ∇_ċE₂ = −s E₁,   s = θ̇ + α·ẋ   (the covariant spin rate),
+//!
+//! i.e. in the reference frame ∇_ċE_i = (Ṡ + ΩS)_ji Ê_j with Ω = w(ẋ) J, Ṡ + ΩS = s J S. With the
+//! frame components u_a = g(ẋ, Ê_a) of ẋ (|u|² = g(ẋ, ẋ) = v²), the integrand of (82) is
+//! √(1 − |u + s J S ξ|²), the Minkowski one with ẋ → u and θ̇ → s. So, to second order in ξ,
+//!
+//! L = −m/γ + ½ s² (𝕀γ + γ³ uᵀK(θ)u),   γ = (1 − g(ẋ, ẋ))^{−1/2},      (002 (102), physical sign)
+//!
+//! and for the symmetric top (K = (𝕀/2) Id, uᵀKu = 𝕀v²/2)
+//!
+//! L = −m/γ + ½ 𝕀 s² (γ + ½ γ³ v²)    (002 (103), physical sign; the L of [`TangentTop`] − m as v → 0).
+//!
+//! Only the symmetric top is implemented on a surface ([`RelativisticTangentTop::on_surface`]):
+//! for an anisotropic body L depends on u = e♭ẋ itself, whose x-derivatives need the derivatives
+//! of the frame, which [`Surface`] does not provide (it gives g, ∂g, α, ∂α); the anisotropic top
+//! stays in the Minkowski plane ([`RelativisticTangentTop::new`]).
+//!
+//! **Derivatives** (the kernel of the symmetric top on a surface). With Q = g(ẋ, ẋ),
+//! f(Q) = γ + ½Qγ³, f′ = γ³ + ¾Qγ⁵, f″ = (9/4)γ⁵ + (15/8)Qγ⁷, L = −m√(1 − Q) + ½𝕀s²f(Q),
+//! λ = ∂L/∂Q = ½mγ + ½𝕀s²f′, σ = ∂L/∂s = 𝕀sf, n = gẋ:
+//! p_x = 2λ n + σ α,  p_θ = σ,  ∂L/∂x^k = λ ẋᵀ(∂_k g)ẋ + σ (∂_kα)·ẋ,  ∂L/∂θ = 0,
+//! and the Hessian in (ẋ, θ̇) from L_QQ = ¼mγ³ + ½𝕀s²f″, L_Qs = 𝕀sf′, L_ss = 𝕀f.
+//!
+//! **Conserved.** E = p·q̇ − L = mγ + ½𝕀s²(γ + (5/2)v²γ³ + (3/2)v⁴γ⁵) (002 (96) with θ̇ → s);
+//! p_θ = 𝕀 s f(v²) (θ is cyclic); and for every Killing field X of the surface, lifted to
+//! (x, θ) as in [`crate::systems::surface`], J = p_A X^A (v², s and so L are invariant under the
+//! lifted isometries; [`RelativisticTangentTop::killing_momenta`], computed by
+//! [`crate::systems::TangentTop::killing_momenta`]). Since E and p_θ are functions of (v, s) only,
+//! v and s are constant along a motion (where (v, s) ↦ (E, p_θ) is locally invertible, as for
+//! slow tops; the sphere test checks it), and the x-equation is
+//! 2λ g∇_tẋ = σ dw(ẋ, ·): a charge σ = p_θ of mass 2λ = mγ + 𝕀s²f′ in the "magnetic field" −K dA,
+//! moving on a curve of geodesic curvature κ = |p_θ K|/(2λ v) (on the sphere: a circle). 002 (94)
+//! holds with |p| read as |p_x − p_θ α|_{g⁻¹} = 2λv, and (95), (96) with θ̇ → s.
+//!
+//! **The seed's (97)–(103)** (checked by the test `curved_lagrangian_is_the_expansion_of_82`
+//! against the exact (82) over a ring of mass points on the sphere and on the hyperbolic plane,
+//! with ∇_ċE_i computed from the Christoffel symbols of g and the frame, not from α): the
+//! structure of (102)–(103) is right (in the seed's sign, L_seed = −L) once the following are read
+//! as intended. (97) writes γ_ij dxⁱdxⁱ for γ_ij dxⁱdxʲ; (99)/(101) write ξʲS_jiω_jᵏ for
+//! ξⁱS_jiω_jᵏ; the first term of (102) and (103) is m(1 − γ_ij ẋⁱẋʲ), without the square root
+//! ((108) restores it: m√(1 − v²)); the matrix ω of (102)–(103) must be read as Ω_kj = ω_jᵏ(ċ)
+//! (column j the components of ∇_ċÊ_j, so Ω = w(ẋ) J): with the other index order the cross term
+//! 2tr(ṠSᵀωᵀ) flips sign and (103) would give (θ̇ − α·ẋ)², which the ring test rejects; and (103)
+//! writes ⟨ċ, E_j⟩ (body frame) where (102) has ⟨ċ, Ê_j⟩ (the same here, the bracket being s² Id
+//! for the symmetric top, but not for an anisotropic one). In (103) "I" is the seed's I₀ = 𝕀/2,
+//! as in (93). (104)–(114), the frame independence: s = θ̇ + α·ẋ is invariant under Ê → R(χ)Ê
+//! (θ → θ − χ, α → α + dχ), and so are v² and L.
+//!
 //! # Weak field (002 (115)–(120))
 //! The static metric is ds² = −e^{2φ(x)} dt² + δ_ij dxⁱdxʲ (**slip corrected:** 002 (115) lacks
 //! the dt² of the time-time term and writes ẋ for dx). With E₀ = e^{−φ}∂_t, Γ^t_{ti} = ∂_iφ, so
@@ -90,14 +145,17 @@
 //! the plane has Δφ = −GM/r³ ≠ 0, so it acts in the point-mass field.
 //!
 //! # State
-//! Both systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ)); build one from
-//! velocities with `state`, read the velocities back with `velocities`.
+//! Both systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)
+//! are its chart's coordinates and p₁, p₂ their momenta); build one from velocities with `state`,
+//! read the velocities back with `velocities`.
 
 use std::fmt;
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::surface::{inverse, Geometry, Plane, Surface};
+use super::tangent_top::TangentTop;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Gauss, Rk4, IMPLICIT_MIDPOINT};
@@ -187,6 +245,11 @@ trait Legendre: Problem {
 
     /// The error for a (q, q̇) where L is not defined.
     fn undefined(&self, q: [f64; 3], v: [f64; 3]) -> Error;
+
+    /// Checks that q lies in the configuration space's chart (before a Legendre inversion).
+    fn check_point(&self, _q: &[f64]) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// L(q, q̇), checked.
@@ -215,6 +278,8 @@ fn state<T: Legendre>(t: &T, q: [f64; 3], v: [f64; 3]) -> Result<Vec<f64>> {
 /// The velocities of a state (the inverse Legendre map).
 fn velocities<T: Legendre>(t: &T, z: &[f64]) -> Result<[f64; 3]> {
     check::len_of("state", z, 6)?;
+    check::finite_slice("state", z)?;
+    t.check_point(&z[..3])?;
     t.solve(&z[..3], &z[3..])
         .map(|(v, _)| [v[0], v[1], v[2]])
         .ok_or_else(|| not_invertible(t.name()))
@@ -223,6 +288,8 @@ fn velocities<T: Legendre>(t: &T, z: &[f64]) -> Result<[f64; 3]> {
 /// E = H = p·q̇ − L of a state.
 fn energy<T: Legendre>(t: &T, z: &[f64]) -> Result<f64> {
     check::len_of("state", z, 6)?;
+    check::finite_slice("state", z)?;
+    t.check_point(&z[..3])?;
     let sol = t.solve(&z[..3], &z[3..]);
     if sol.is_none() {
         return Err(not_invertible(t.name()));
@@ -273,13 +340,32 @@ macro_rules! legendre_kinds {
 }
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time, 002 (87)–(96) (module docs):
-/// L = −m/γ + ½θ̇²(𝕀γ + γ³ẋᵀK(θ)ẋ), K(θ) = R(θ) J I Jᵀ R(θ)ᵀ, physical sign (−L of 002 (90)).
-/// State z = (x, y, θ, p_x, p_y, p_θ); speeds |ẋ| < 1 (c = 1).
-#[derive(Clone, Debug, PartialEq)]
+/// L = −m/γ + ½θ̇²(𝕀γ + γ³ẋᵀK(θ)ẋ), K(θ) = R(θ) J I Jᵀ R(θ)ᵀ, physical sign (−L of 002 (90));
+/// or, built by [`RelativisticTangentTop::on_surface`], the symmetric top on the static
+/// space-time −dt² + g over a [`Surface`], 002 (97)–(103): L = −m/γ + ½𝕀s²(γ + ½γ³v²),
+/// v² = g(ẋ, ẋ), s = θ̇ + α·ẋ. State z = (x¹, x², θ, p₁, p₂, p_θ); speeds v < 1 (c = 1).
+#[derive(Clone, Debug)]
 pub struct RelativisticTangentTop {
     mass: f64,
     /// The second-moment tensor I = ∫ξξᵀdm as (I₁₁, I₁₂, I₂₂).
     moments: [f64; 3],
+    /// The spatial slice: None for the Minkowski plane in Cartesian coordinates (the closed-form
+    /// kernel of 002 (90), any I); a surface for [`RelativisticTangentTop::on_surface`] (the
+    /// kernel of the symmetric top, 002 (103)).
+    surface: Option<Arc<dyn Surface>>,
+}
+
+/// Equal masses and moments on the same space-time: both Minkowski, or the same surface object.
+impl PartialEq for RelativisticTangentTop {
+    fn eq(&self, other: &Self) -> bool {
+        self.mass == other.mass
+            && self.moments == other.moments
+            && match (&self.surface, &other.surface) {
+                (None, None) => true,
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                _ => false,
+            }
+    }
 }
 
 impl RelativisticTangentTop {
@@ -298,13 +384,72 @@ impl RelativisticTangentTop {
                 ),
             ));
         }
-        Ok(RelativisticTangentTop { mass, moments })
+        Ok(RelativisticTangentTop {
+            mass,
+            moments,
+            surface: None,
+        })
     }
 
     /// The symmetric top, I = (𝕀/2)·Id (the seed's "2I = 𝕀" of 002 (93)); `inertia` = 𝕀 > 0.
     pub fn symmetric(mass: f64, inertia: f64) -> Result<Self> {
         check::positive("inertia", inertia)?;
         Self::new(mass, [0.5 * inertia, 0.0, 0.5 * inertia])
+    }
+
+    /// The symmetric top (I = (𝕀/2)·Id, `inertia` = 𝕀 > 0) of mass m > 0 on the static space-time
+    /// ds² = −dt² + g over `surface` (002 (97)–(103), module docs); z = (x¹, x², θ, p₁, p₂, p_θ)
+    /// in the surface's chart. (An anisotropic body is supported in the Minkowski plane only,
+    /// [`RelativisticTangentTop::new`].) On [`Plane`] it is the same top as
+    /// [`RelativisticTangentTop::symmetric`], with the Killing momenta of SE(2) as invariants.
+    pub fn on_surface(surface: Arc<dyn Surface>, mass: f64, inertia: f64) -> Result<Self> {
+        let top = Self::symmetric(mass, inertia)?;
+        Ok(RelativisticTangentTop {
+            surface: Some(surface),
+            ..top
+        })
+    }
+
+    /// The spatial slice: the surface of [`RelativisticTangentTop::on_surface`], else [`Plane`].
+    pub fn surface(&self) -> Arc<dyn Surface> {
+        self.surface.clone().unwrap_or_else(|| Arc::new(Plane))
+    }
+
+    /// Whether the top lives on a surface ([`RelativisticTangentTop::on_surface`]) rather than
+    /// in the Minkowski plane of [`RelativisticTangentTop::new`].
+    pub fn is_on_surface(&self) -> bool {
+        self.surface.is_some()
+    }
+
+    /// The non-relativistic limit: the classical (intrinsic) [`TangentTop`] of the same mass and
+    /// Euler tensor on the same surface (the Plane for a Minkowski top). As all velocities scale
+    /// by ε → 0, L + m → the classical L up to O(ε⁴) (module docs).
+    pub fn classical_limit(&self) -> Result<TangentTop> {
+        let [a, b, c] = self.moments;
+        TangentTop::with_tensor(self.surface(), self.mass, [a, b, b, c])
+    }
+
+    /// The momenta J = p_A X^A of the Killing fields of the surface lifted to (x, θ), in the order
+    /// of [`Surface::killing`] (on the Minkowski plane: p_x, p_y and x p_y − y p_x + p_θ, the
+    /// last conserved for any I). Errors: wrong length, non-finite, x outside the chart.
+    pub fn killing_momenta(&self, z: &[f64]) -> Result<Vec<f64>> {
+        // p_A X^A does not involve m or I: the classical top's implementation is the same.
+        self.classical_limit()?.killing_momenta(z)
+    }
+
+    /// The speed v = √g(ẋ, ẋ) and the covariant spin rate s = θ̇ + α·ẋ of a state (both constant
+    /// along a motion of the symmetric top, module docs). Errors: as
+    /// [`RelativisticTangentTop::velocities`].
+    pub fn speed_and_spin(&self, z: &[f64]) -> Result<(f64, f64)> {
+        let v = self.velocities(z)?;
+        let surface = self.surface();
+        let x = [z[0], z[1]];
+        let (g, a) = (surface.metric(x), surface.connection(x));
+        let xd = [v[0], v[1]];
+        Ok((
+            super::surface::inner(&g, xd, xd).sqrt(),
+            v[2] + a[0] * xd[0] + a[1] * xd[1],
+        ))
     }
 
     /// The mass m.
@@ -373,7 +518,8 @@ impl RelativisticTangentTop {
     }
 
     /// |p| as a function of the speed v and J = p_θ for the symmetric top, 002 (94) (module docs;
-    /// the seed's J is half of this one). Errors: not symmetric, v ∉ [0, 1), non-finite J.
+    /// the seed's J is half of this one; on a surface |p| = |p_x − p_θ α|_{g⁻¹}). Errors: not
+    /// symmetric, v ∉ [0, 1), non-finite J.
     pub fn momentum_94(&self, v: f64, j: f64) -> Result<f64> {
         let i0 = self.symmetric_only("momentum_94")?;
         check_speed(v)?;
@@ -383,7 +529,8 @@ impl RelativisticTangentTop {
         Ok(m * g * v * (1.0 + j * j * (1.0 - s) * (4.0 - s) / (2.0 * i0 * m * (2.0 - s).powi(2))))
     }
 
-    /// θ̇ of the symmetric top from v and J = p_θ, 002 (95): θ̇ = J/(2I₀γ(1 + ½v²γ²)).
+    /// θ̇ of the symmetric top from v and J = p_θ, 002 (95): θ̇ = J/(2I₀γ(1 + ½v²γ²)) (on a
+    /// surface: the covariant spin rate s = θ̇ + α·ẋ).
     pub fn spin_rate_95(&self, v: f64, j: f64) -> Result<f64> {
         let i0 = self.symmetric_only("spin_rate_95")?;
         check_speed(v)?;
@@ -393,7 +540,7 @@ impl RelativisticTangentTop {
     }
 
     /// The energy of the symmetric top from v and θ̇, 002 (96) (physical sign):
-    /// E = mγ + I₀θ̇²(γ + (5/2)v²γ³ + (3/2)v⁴γ⁵).
+    /// E = mγ + I₀θ̇²(γ + (5/2)v²γ³ + (3/2)v⁴γ⁵) (on a surface with θ̇ → s = θ̇ + α·ẋ).
     pub fn energy_96(&self, v: f64, thetadot: f64) -> Result<f64> {
         let i0 = self.symmetric_only("energy_96")?;
         check_speed(v)?;
@@ -416,14 +563,12 @@ fn check_speed(v: f64) -> Result<()> {
     }
 }
 
-fn superluminal(v: [f64; 3]) -> Error {
+fn superluminal(v: [f64; 3], speed: f64) -> Error {
     Error::invalid(
         "velocity",
         format!(
-            "expected a speed |ẋ| < 1 (c = 1), got |({}, {})| = {}",
-            v[0],
-            v[1],
-            v[0].hypot(v[1])
+            "expected a speed |ẋ| < 1 (c = 1), got |({}, {})| = {speed}",
+            v[0], v[1],
         ),
     )
 }
@@ -474,18 +619,36 @@ impl Problem for RelativisticTangentTop {
     fn energy(&self, z: &[f64]) -> Result<f64> {
         energy(self, z)
     }
-    /// (p_x, p_y), and p_θ for the symmetric top: momenta of cyclic coordinates, linear, so kept
-    /// exactly by the Gauss methods.
+    /// Minkowski: (p_x, p_y), and p_θ for the symmetric top: momenta of cyclic coordinates,
+    /// linear, so kept exactly by the Gauss methods. On a surface: p_θ and the Killing momenta of
+    /// the affine generators ([`Surface::killing_is_affine`]; quadratic in z, so also kept by the
+    /// Gauss methods); [`RelativisticTangentTop::killing_momenta`] gives all.
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         check::len_of("state", z, 6)?;
-        let mut out = vec![z[3], z[4]];
-        if self.is_symmetric() {
-            out.push(z[5]);
-        }
-        Ok(out)
+        let Some(surface) = &self.surface else {
+            let mut out = vec![z[3], z[4]];
+            if self.is_symmetric() {
+                out.push(z[5]);
+            }
+            return Ok(out);
+        };
+        let j = self.killing_momenta(z)?;
+        let affine = j
+            .into_iter()
+            .enumerate()
+            .filter(|&(k, _)| surface.killing_is_affine(k))
+            .map(|(_, jk)| jk);
+        Ok(std::iter::once(z[5]).chain(affine).collect())
     }
     fn invariant_count(&self) -> usize {
-        2 + usize::from(self.is_symmetric())
+        match &self.surface {
+            None => 2 + usize::from(self.is_symmetric()),
+            Some(surface) => {
+                1 + (0..surface.killing_count())
+                    .filter(|&k| surface.killing_is_affine(k))
+                    .count()
+            }
+        }
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.velocities(z).map(|_| ())
@@ -493,8 +656,144 @@ impl Problem for RelativisticTangentTop {
 }
 
 impl Legendre for RelativisticTangentTop {
-    /// Derivatives of L at (q, q̇); None where |ẋ| ≥ 1 or the input is not finite.
+    /// Derivatives of L at (q, q̇); None where v ≥ 1, x is outside the chart or the input is not
+    /// finite.
     fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
+        match &self.surface {
+            None => self.minkowski_derivs(q, v),
+            Some(surface) => {
+                let x = [q[0], q[1]];
+                if !(surface.contains(x) && q[2].is_finite()) {
+                    return None;
+                }
+                self.curved_derivs(&surface.geometry(x), v)
+            }
+        }
+    }
+
+    fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
+        match &self.surface {
+            None => self.minkowski_solve(q, p),
+            Some(surface) => {
+                let x = [q[0], q[1]];
+                if !(surface.contains(x) && q[2].is_finite()) {
+                    return None;
+                }
+                self.curved_solve(&surface.geometry(x), p)
+            }
+        }
+    }
+
+    fn undefined(&self, q: [f64; 3], v: [f64; 3]) -> Error {
+        match &self.surface {
+            None => superluminal(v, v[0].hypot(v[1])),
+            Some(surface) => {
+                let x = [q[0], q[1]];
+                if let Err(e) = surface.check(x) {
+                    return e.at_start();
+                }
+                let speed = super::surface::inner(&surface.metric(x), [v[0], v[1]], [v[0], v[1]]);
+                superluminal(v, speed.sqrt())
+            }
+        }
+    }
+
+    fn check_point(&self, q: &[f64]) -> Result<()> {
+        match &self.surface {
+            None => Ok(()),
+            Some(surface) => surface.check([q[0], q[1]]).map_err(|e| e.at_start()),
+        }
+    }
+}
+
+legendre_kinds!(RelativisticTangentTop);
+
+impl RelativisticTangentTop {
+    /// The symmetric top on a surface (module docs, "Derivatives"): L, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇² at
+    /// the geometry of x and q̇ = (ẋ, θ̇); None where g(ẋ, ẋ) ≥ 1 or q̇ is not finite.
+    fn curved_derivs(&self, geo: &Geometry, v: &Vector3<f64>) -> Option<Derivs> {
+        let (m, tr) = (self.mass, self.inertia());
+        let (xd, w) = ([v[0], v[1]], v[2]);
+        let g = &geo.g;
+        let n = [
+            g[0][0] * xd[0] + g[0][1] * xd[1],
+            g[1][0] * xd[0] + g[1][1] * xd[1],
+        ];
+        let qq = n[0] * xd[0] + n[1] * xd[1];
+        if !(qq.is_finite() && qq < 1.0 && w.is_finite()) {
+            return None;
+        }
+        let a = geo.alpha;
+        let s = w + a[0] * xd[0] + a[1] * xd[1];
+        let g1 = 1.0 / (1.0 - qq).sqrt();
+        let g3 = g1 * g1 * g1;
+        let g5 = g3 * g1 * g1;
+        let g7 = g5 * g1 * g1;
+        let f = g1 + 0.5 * qq * g3;
+        let f1 = g3 + 0.75 * qq * g5;
+        let f2 = 2.25 * g5 + 1.875 * qq * g7;
+        let s2 = s * s;
+        let l = -m / g1 + 0.5 * tr * s2 * f;
+        let lam = 0.5 * m * g1 + 0.5 * tr * s2 * f1; // ∂L/∂Q
+        let sig = tr * s * f; // ∂L/∂s = p_θ
+        let l_qq = 0.25 * m * g3 + 0.5 * tr * s2 * f2;
+        let l_qs = tr * s * f1;
+        let l_ss = tr * f;
+        let lv = Vector3::new(
+            2.0 * lam * n[0] + sig * a[0],
+            2.0 * lam * n[1] + sig * a[1],
+            sig,
+        );
+        let mut lq = Vector3::zeros();
+        for k in 0..2 {
+            let d = &geo.dg[k];
+            let vgv = d[0][0] * xd[0] * xd[0]
+                + (d[0][1] + d[1][0]) * xd[0] * xd[1]
+                + d[1][1] * xd[1] * xd[1];
+            let da = geo.dalpha[k];
+            lq[k] = lam * vgv + sig * (da[0] * xd[0] + da[1] * xd[1]);
+        }
+        let mut hess = Matrix3::zeros();
+        for i in 0..2 {
+            for j in 0..2 {
+                hess[(i, j)] = 2.0 * lam * g[i][j]
+                    + 4.0 * l_qq * n[i] * n[j]
+                    + 2.0 * l_qs * (n[i] * a[j] + a[i] * n[j])
+                    + l_ss * a[i] * a[j];
+            }
+            let h = 2.0 * l_qs * n[i] + l_ss * a[i];
+            hess[(i, 2)] = h;
+            hess[(2, i)] = h;
+        }
+        hess[(2, 2)] = l_ss;
+        Some(Derivs { l, lv, lq, hess })
+    }
+
+    /// The inverse Legendre map of the top on a surface: from a free particle of mass
+    /// m + 𝕀 s² (exact at low speed) carrying π = p_x − p_θ α at spin s = p_θ/𝕀, slower than
+    /// light; failing that, from rest.
+    fn curved_solve(&self, geo: &Geometry, p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
+        let tr = self.inertia();
+        let s = p[2] / tr;
+        let a = geo.alpha;
+        let pi = [p[0] - p[2] * a[0], p[1] - p[2] * a[1]];
+        let gi = inverse(&geo.g);
+        let up = [
+            gi[0][0] * pi[0] + gi[0][1] * pi[1],
+            gi[1][0] * pi[0] + gi[1][1] * pi[1],
+        ];
+        let mm = self.mass + tr * s * s;
+        let e = (mm * mm + up[0] * pi[0] + up[1] * pi[1]).sqrt();
+        let xd = [up[0] / e, up[1] / e];
+        let guess = Vector3::new(xd[0], xd[1], s - a[0] * xd[0] - a[1] * xd[1]);
+        legendre_inverse(p, guess, |v| self.curved_derivs(geo, v)).or_else(|| {
+            legendre_inverse(p, Vector3::new(0.0, 0.0, s), |v| self.curved_derivs(geo, v))
+        })
+    }
+
+    /// Derivatives of the Minkowski L (002 (90)) at (q, q̇); None where |ẋ| ≥ 1 or the input is
+    /// not finite.
+    fn minkowski_derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
         let (u, w) = ([v[0], v[1]], v[2]);
         let s = u[0] * u[0] + u[1] * u[1];
         if !(s.is_finite() && s < 1.0 && w.is_finite() && q[2].is_finite()) {
@@ -537,7 +836,7 @@ impl Legendre for RelativisticTangentTop {
         Some(Derivs { l, lv, lq, hess })
     }
 
-    fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
+    fn minkowski_solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
         // Start from a free particle of the mass the spin adds to at low speed
         // (p ≈ (m + ω²(𝕀/2 + K))ẋ, bounded by m + ω²𝕀·3/2; u = p/√(M² + |p|²) is slower than light)
         // with the spin of a top at rest; failing that, from rest.
@@ -546,16 +845,13 @@ impl Legendre for RelativisticTangentTop {
         let mm = self.mass + 1.5 * w * w * tr;
         let e = (mm * mm + p[0] * p[0] + p[1] * p[1]).sqrt();
         let guess = Vector3::new(p[0] / e, p[1] / e, w);
-        legendre_inverse(p, guess, |v| self.derivs(q, v))
-            .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, w), |v| self.derivs(q, v)))
-    }
-
-    fn undefined(&self, _q: [f64; 3], v: [f64; 3]) -> Error {
-        superluminal(v)
+        legendre_inverse(p, guess, |v| self.minkowski_derivs(q, v)).or_else(|| {
+            legendre_inverse(p, Vector3::new(0.0, 0.0, w), |v| {
+                self.minkowski_derivs(q, v)
+            })
+        })
     }
 }
-
-legendre_kinds!(RelativisticTangentTop);
 
 // ---------------------------------------------------------------------------------------------
 // Weak field

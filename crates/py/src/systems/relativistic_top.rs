@@ -10,17 +10,23 @@ use crate::convert::ArrayIn;
 use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, Input};
 use crate::system::PySystem;
+use crate::systems::surfaces::PySurface;
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical
-/// sign of the Lagrangian, L = -m/gamma + thetadot^2 (I gamma + gamma^3 xdot^T K(theta) xdot)/2).
-/// State (x, y, theta, p_x, p_y, p_theta); fields x, theta, p, p_theta; speeds |xdot| < 1.
-/// Methods: gauss4 (default), gauss6, midpoint, rk4.
+/// sign of the Lagrangian, L = -m/gamma + thetadot^2 (I gamma + gamma^3 xdot^T K(theta) xdot)/2),
+/// or, with `surface`, the symmetric top on the static space-time -dt^2 + g over that surface
+/// (002 (97)–(103)): L = -m/gamma + I s^2 (gamma + gamma^3 v^2 / 2) / 2, v^2 = g(xdot, xdot),
+/// s = thetadot + w(xdot) with w the surface's connection 1-form. State (x1, x2, theta, p1, p2,
+/// p_theta) in the chart; fields x, theta, p, p_theta; speeds v < 1. Invariants: (p_x, p_y)
+/// and, for the symmetric top, p_theta (Minkowski); p_theta and the Killing momenta of the
+/// affine isometries (surface). Methods: gauss4 (default), gauss6, midpoint, rk4.
 ///
 /// Args:
 ///     mass > 0; inertia: the scalar tr I (the symmetric top) or the second-moment tensor as
-///         (I11, I12, I22), positive semidefinite.
+///         (I11, I12, I22), positive semidefinite (Minkowski only); surface: a
+///         `lieflow.surfaces` surface, or None for the Minkowski plane.
 /// Raises:
-///     InvalidArgumentError, ShapeError.
+///     InvalidArgumentError, ShapeError, TypeError (surface not a lieflow surface).
 #[pyclass(name = "RelativisticTangentTop", module = "lieflow", extends = PySystem, frozen)]
 pub struct PyRelativisticTangentTop {
     top: core::RelativisticTangentTop,
@@ -29,10 +35,18 @@ pub struct PyRelativisticTangentTop {
 #[pymethods]
 impl PyRelativisticTangentTop {
     #[new]
-    fn new(mass: f64, inertia: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
-        let top = match inertia.extract::<f64>() {
-            Ok(i) => core::RelativisticTangentTop::symmetric(mass, i),
-            Err(_) => match inertia.extract::<[f64; 3]>() {
+    #[pyo3(signature = (mass, inertia, surface = None))]
+    fn new(
+        mass: f64,
+        inertia: &Bound<'_, PyAny>,
+        surface: Option<Bound<'_, PySurface>>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let top = match (inertia.extract::<f64>(), &surface) {
+            (Ok(i), None) => core::RelativisticTangentTop::symmetric(mass, i),
+            (Ok(i), Some(s)) => {
+                core::RelativisticTangentTop::on_surface(s.get().inner.clone(), mass, i)
+            }
+            (Err(_), None) => match inertia.extract::<[f64; 3]>() {
                 Ok(m) => core::RelativisticTangentTop::new(mass, m),
                 Err(_) => Err(Error::shape(
                     "inertia",
@@ -40,10 +54,16 @@ impl PyRelativisticTangentTop {
                     "other",
                 )),
             },
+            (Err(_), Some(_)) => Err(Error::invalid(
+                "inertia",
+                "on a surface only the symmetric top is implemented: give the scalar tr I",
+            )),
         }
         .py()?;
-        let args = (mass, inertia).into_pyobject(inertia.py())?;
-        let base = PySystem::new(top.clone(), args, &["mass", "inertia"]);
+        let callbacks = surface.as_ref().and_then(|s| s.get().callbacks());
+        let args = (mass, inertia, surface).into_pyobject(inertia.py())?;
+        let base = PySystem::new(top.clone(), args, &["mass", "inertia", "surface"])
+            .with_callbacks(callbacks);
         Ok(PyClassInitializer::from(base).add_subclass(PyRelativisticTangentTop { top }))
     }
 
@@ -56,9 +76,18 @@ impl PyRelativisticTangentTop {
     /// The canonical state from the position x (2,), the angle theta and the velocities.
     ///
     /// Raises:
-    ///     InvalidArgumentError (|xdot| >= 1, a Legendre map not invertible), NonFiniteError.
-    fn state(&self, x: [f64; 2], theta: f64, xdot: [f64; 2], thetadot: f64) -> PyResult<Vec<f64>> {
-        self.top.state(x, theta, xdot, thetadot).py()
+    ///     InvalidArgumentError (v >= 1, x outside the surface's chart, a Legendre map not
+    ///     invertible), NonFiniteError.
+    fn state(
+        slf: &Bound<'_, Self>,
+        x: [f64; 2],
+        theta: f64,
+        xdot: [f64; 2],
+        thetadot: f64,
+    ) -> PyResult<Vec<f64>> {
+        let z = slf.get().top.state(x, theta, xdot, thetadot);
+        slf.as_super().get().take_callback_error()?;
+        z.py()
     }
 
     /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
@@ -66,19 +95,56 @@ impl PyRelativisticTangentTop {
     /// Raises:
     ///     ShapeError, NonFiniteError, InvalidArgumentError.
     fn velocities<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        map_items(
-            py,
-            &[Input::new("states", &states, &[6])],
-            &[3],
-            |z, out| {
-                out.copy_from_slice(&self.top.velocities(z[0])?);
+        let top = &slf.get().top;
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[3], |z, out| {
+                out.copy_from_slice(&top.velocities(z)?);
                 Ok(())
-            },
-        )
+            })
+    }
+
+    /// The speed v = sqrt(g(xdot, xdot)) and the covariant spin rate s = thetadot + w(xdot) of
+    /// states (both constant along a motion of the symmetric top), vectorised:
+    /// (..., 6) -> (..., 2).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError, InvalidArgumentError.
+    fn speed_and_spin<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = &slf.get().top;
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[2], |z, out| {
+                let (v, s) = top.speed_and_spin(z)?;
+                out.copy_from_slice(&[v, s]);
+                Ok(())
+            })
+    }
+
+    /// All Killing momenta J = p_A X^A of the surface's isometry group (the Minkowski plane and
+    /// Plane: translations x, y and the rotation; Sphere: the ambient angular momentum x, y, z;
+    /// HyperbolicPlane: the Möbius generators E, H, F; Revolution: p_phi), (..., 6) -> (..., k).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError, InvalidArgumentError (x outside the chart).
+    fn killing_momenta<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = &slf.get().top;
+        let k = top.surface().killing_count();
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[k], |z, out| {
+                out.copy_from_slice(&top.killing_momenta(z)?);
+                Ok(())
+            })
     }
 }
 
