@@ -17,7 +17,10 @@
 //! 002 §IV: [`RelativisticTangentTop`] (Minkowski) and [`WeakFieldTop`] (weak static field):
 //! z = (x, y, θ, p_x, p_y, p_θ) (6).
 //!
-//! 002: [`TangentTop`]: z = (x¹, x², θ, p₁, p₂, p_θ) (6), the tangent Euler top on a [`Surface`].
+//! 002: [`TangentTop`]: z = (x¹, x², θ, p₁, p₂, p_θ) (6), the tangent Euler top on a [`Surface`];
+//! [`ChargedParticle`]: z = (x¹, x², p₁, p₂) (4), its magnetic analogue.
+//!
+//! 003 §1: [`RollingDisks`]: z = (θ₁, θ₂, p₁, p₂) (4), two disks rolling against each other.
 
 pub mod heavy_top;
 pub mod isospectral;
@@ -26,6 +29,7 @@ pub mod pendulum;
 pub mod relativistic_top;
 pub mod rigid_body;
 pub mod rolling_disk;
+pub mod rolling_disks;
 pub mod sphere_particle;
 pub mod spherical_pendulum;
 pub mod surface;
@@ -39,6 +43,7 @@ pub use pendulum::Pendulum;
 pub use relativistic_top::{Potential, PotentialValue, RelativisticTangentTop, WeakFieldTop};
 pub use rigid_body::{GeneralizedRigidBody, RigidBody};
 pub use rolling_disk::RollingDisk;
+pub use rolling_disks::RollingDisks;
 pub use sphere_particle::SphereParticle;
 pub use spherical_pendulum::SphericalPendulum;
 pub use surface::{Graph, HyperbolicPlane, MetricSurface, Plane, Revolution, Sphere, Surface};

@@ -158,7 +158,7 @@ use super::surface::{inverse, Geometry, Plane, Surface};
 use super::tangent_top::TangentTop;
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Gauss, Rk4, IMPLICIT_MIDPOINT};
+use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::{Canonical, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
@@ -328,12 +328,7 @@ macro_rules! legendre_kinds {
 
         impl Catalog for $t {
             fn catalog(&self) -> Vec<Entry<Self>> {
-                vec![
-                    Entry::new("gauss4", Gauss(2)),
-                    Entry::new("gauss6", Gauss(3)),
-                    Entry::new("midpoint", IMPLICIT_MIDPOINT),
-                    Entry::new("rk4", Rk4),
-                ]
+                canonical_catalog()
             }
         }
     };

@@ -56,7 +56,7 @@ use std::sync::Arc;
 use super::surface::{add, inner, inverse, mul, Mat2, Shape, Surface, Vec2};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Gauss, Rk4, IMPLICIT_MIDPOINT};
+use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::{Canonical, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
@@ -433,18 +433,8 @@ impl VectorField for TangentTop {
 
 impl Catalog for TangentTop {
     fn catalog(&self) -> Vec<Entry<Self>> {
-        methods()
+        canonical_catalog()
     }
-}
-
-/// The methods of both systems: the symplectic Gauss–Legendre family and RK4 as the baseline.
-fn methods<P: Canonical + VectorField + Clone + Send + Sync + 'static>() -> Vec<Entry<P>> {
-    vec![
-        Entry::new("midpoint", IMPLICIT_MIDPOINT),
-        Entry::new("gauss4", Gauss(2)),
-        Entry::new("gauss6", Gauss(3)),
-        Entry::new("rk4", Rk4),
-    ]
 }
 
 /// The charged particle equivalent to a tangent top (002 §III.B): with p_θ fixed, the centre of
@@ -633,6 +623,6 @@ impl VectorField for ChargedParticle {
 
 impl Catalog for ChargedParticle {
     fn catalog(&self) -> Vec<Entry<Self>> {
-        methods()
+        canonical_catalog()
     }
 }

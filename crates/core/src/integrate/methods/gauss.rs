@@ -15,8 +15,8 @@
 //! ‖y‖_∞)), the s·d̂ × s·d̂ matrix I − h A⊗J (d̂ = 2·dof) is LU-factored once per step (faer,
 //! partial pivoting, storage allocated with the stepper), and
 //! (I − h A⊗J) ΔZ = −Z + h (A⊗I) F(Z),  Z ← Z + ΔZ
-//! is iterated from Z_i = h c_i f(y) until ΔZ vanishes or ‖ΔZ‖_∞ stops decreasing (round-off
-//! reached) below [`STAGNATION_TOL`]·‖y‖_∞; otherwise [`crate::Error::NotConverged`] names the
+//! is iterated from Z_i = h c_i f(y) until ‖ΔZ‖_∞ falls below ε²‖y‖_∞ or stops decreasing
+//! (round-off reached) below [`STAGNATION_TOL`]·‖y‖_∞; otherwise [`crate::Error::NotConverged`] names the
 //! step after [`MAX_ITER`] iterations. The update uses the stage derivatives F of the last
 //! iteration (they differ from those at the final Z by round-off) and compensated (Kahan)
 //! summation. Both the stopping rule and the summation follow Hairer, McLachlan & Razakarivony,
@@ -49,6 +49,9 @@ pub const IMPLICIT_MIDPOINT: Gauss = Gauss(1);
 pub const STAGNATION_TOL: f64 = 1e-12;
 /// Maximal number of simplified Newton iterations per step.
 pub const MAX_ITER: usize = 50;
+
+/// ‖ΔZ‖_∞ ≤ ε²·‖y‖_∞ ends the iteration whether or not it still decreases.
+const NEGLIGIBLE: f64 = f64::EPSILON * f64::EPSILON;
 
 /// Butcher tableau (A row-major s×s, b, c) of the s-stage Gauss method, HLW §II.1.3.
 fn tableau(s: usize) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
@@ -254,7 +257,10 @@ impl<P: Canonical> GaussStepper<P> {
             for (zk, dk) in z.iter_mut().zip(dz.iter()) {
                 *zk += dk;
             }
-            if norm == 0.0 || (norm >= prev && norm <= STAGNATION_TOL * scale) {
+            // Done when ΔZ vanishes, stagnates at round-off, or has fallen far below it (a
+            // sequence that keeps shrinking in components far smaller than ‖y‖, as at a
+            // relative equilibrium where ṗ is round-off, would otherwise run out of iterations).
+            if norm <= NEGLIGIBLE * scale || (norm >= prev && norm <= STAGNATION_TOL * scale) {
                 break;
             }
             if iter >= MAX_ITER {

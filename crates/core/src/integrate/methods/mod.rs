@@ -18,3 +18,18 @@ pub use rk4::Rk4;
 pub use rkmk::Rkmk4;
 pub use splitting::Splitting;
 pub use verlet::Verlet;
+
+use crate::integrate::method::Entry;
+use crate::integrate::problem::{Canonical, VectorField};
+
+/// The catalog of a general (non-separable) canonical system: the symplectic Gauss–Legendre
+/// methods "gauss4" (the default), "gauss6", "midpoint", and "rk4" as the non-geometric
+/// baseline.
+pub fn canonical_catalog<P: Canonical + VectorField + Clone + 'static>() -> Vec<Entry<P>> {
+    vec![
+        Entry::new("gauss4", Gauss(2)),
+        Entry::new("gauss6", Gauss(3)),
+        Entry::new("midpoint", IMPLICIT_MIDPOINT),
+        Entry::new("rk4", Rk4),
+    ]
+}
