@@ -15,6 +15,7 @@ Pendulum, SphereParticle, RollingDisk                           canonical, const
                                                                 nonholonomic test problems
 TangentTop, ChargedParticle, surfaces                           the tangent Euler top of 002 §II–III
 RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
+RollingDisks                                                    two rolling disks of 003 §1
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``).
@@ -43,6 +44,8 @@ from ._lieflow import (
     RelativisticTangentTop,
     RigidBody,
     RollingDisk,
+    RollingDisks,
+    RollingDisksEquilibrium,
     SphereParticle,
     SphericalPendulum,
     System,
@@ -74,6 +77,8 @@ __all__ = [
     "RelativisticTangentTop",
     "RigidBody",
     "RollingDisk",
+    "RollingDisks",
+    "RollingDisksEquilibrium",
     "SphereParticle",
     "ShapeError",
     "SphericalPendulum",

@@ -8,6 +8,7 @@ mod pendulum;
 mod relativistic_top;
 mod rigid_body;
 mod rolling_disk;
+mod rolling_disks;
 mod spherical_pendulum;
 pub mod surfaces;
 pub mod tangent_top;
@@ -76,6 +77,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<pendulum::PyPendulum>()?;
     m.add_class::<pendulum::PySphereParticle>()?;
     m.add_class::<rolling_disk::PyRollingDisk>()?;
+    m.add_class::<rolling_disks::PyRollingDisks>()?;
+    m.add_class::<rolling_disks::PyDisksEquilibrium>()?;
     m.add_class::<relativistic_top::PyRelativisticTangentTop>()?;
     m.add_class::<relativistic_top::PyWeakFieldTop>()?;
     m.add_class::<tangent_top::PyTangentTop>()?;

@@ -1,0 +1,283 @@
+//! `RollingDisks`: binding of `lieflow::systems::rolling_disks` (003 §1), a thin subclass of
+//! `lieflow.System`, and its relative equilibria.
+
+use lieflow::systems::rolling_disks::DisksEquilibrium;
+use lieflow::systems::RollingDisks;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use pyo3::PyClassInitializer;
+
+use crate::convert::ArrayIn;
+use crate::errors::IntoPy;
+use crate::system::PySystem;
+
+type Any<'py> = Bound<'py, PyAny>;
+
+/// A point of the plane from a complex number or a 2-vector.
+fn point(what: &str, v: &Any<'_>) -> PyResult<[f64; 2]> {
+    if let Ok(p) = v.extract::<[f64; 2]>() {
+        return Ok(p);
+    }
+    match (v.getattr("real"), v.getattr("imag")) {
+        (Ok(re), Ok(im)) => Ok([re.extract()?, im.extract()?]),
+        _ => Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "{what} must be a complex number or a sequence of two numbers"
+        ))),
+    }
+}
+
+/// Two disks rolling against each other in the plane without slipping (003 §1). Disk k has
+/// radius r_k, centre of mass gamma_k in its reference disk (a complex number or a 2-vector),
+/// mass m_k and moment of inertia I_k about its centre (003 (6): the integral of |p|^2). The
+/// rolling constraint integrates to R phi - r1 theta1 - r2 theta2 = c (R = r1 + r2, c the
+/// rolling constant), leaving the two disk angles theta = (theta1, theta2); the centre of mass
+/// of the pair is at the origin. State (theta1, theta2, p1, p2); fields theta (2), p (2),
+/// thetadot (2), phi (the direction of the contact point from disk 1's centre).
+/// H = p^T M(theta)^-1 p / 2; invariant: the angular momentum J = p1 + p2. Methods: gauss4
+/// (default), gauss6, midpoint (symplectic Gauss–Legendre), rk4.
+///
+/// Raises:
+///     InvalidArgumentError (r, m <= 0, |gamma| >= r, I <= m |gamma|^2), TypeError.
+#[pyclass(name = "RollingDisks", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyRollingDisks {
+    disks: RollingDisks,
+}
+
+#[pymethods]
+impl PyRollingDisks {
+    #[new]
+    #[pyo3(signature = (r1, r2, gamma1, gamma2, m1, m2, inertia1, inertia2, rolling_constant = 0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        r1: f64,
+        r2: f64,
+        gamma1: Any<'_>,
+        gamma2: Any<'_>,
+        m1: f64,
+        m2: f64,
+        inertia1: f64,
+        inertia2: f64,
+        rolling_constant: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let (g1, g2) = (point("gamma1", &gamma1)?, point("gamma2", &gamma2)?);
+        let disks = RollingDisks::new([r1, r2], [g1, g2], [m1, m2], [inertia1, inertia2])
+            .and_then(|d| d.with_rolling_constant(rolling_constant))
+            .py()?;
+        let args =
+            (r1, r2, g1, g2, m1, m2, inertia1, inertia2, rolling_constant).into_pyobject(py)?;
+        let names = &[
+            "r1",
+            "r2",
+            "gamma1",
+            "gamma2",
+            "m1",
+            "m2",
+            "inertia1",
+            "inertia2",
+            "rolling_constant",
+        ];
+        let base = PySystem::new(disks.clone(), args, names);
+        Ok(PyClassInitializer::from(base).add_subclass(PyRollingDisks { disks }))
+    }
+
+    /// Constructor arguments of an example instance (for `methods()` on the class).
+    #[classattr]
+    fn _example_args() -> (f64, f64, [f64; 2], [f64; 2], f64, f64, f64, f64) {
+        (1.0, 0.7, [0.3, 0.1], [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6)
+    }
+
+    /// The rolling constant c.
+    #[getter]
+    fn rolling_constant(&self) -> f64 {
+        self.disks.rolling_constant()
+    }
+
+    /// The state (theta, M(theta) thetadot) from the angles and their rates.
+    ///
+    /// Raises:
+    ///     NonFiniteError.
+    fn state(&self, theta: [f64; 2], thetadot: [f64; 2]) -> PyResult<Vec<f64>> {
+        self.disks.state(theta, thetadot).py()
+    }
+
+    /// The mass matrix M(theta) of T = thetadot^T M thetadot / 2 (2, 2).
+    fn mass_matrix(&self, theta: [f64; 2]) -> PyResult<[[f64; 2]; 2]> {
+        self.disks.mass_matrix(theta).py()
+    }
+
+    /// The locked inertia (1, 1) M(theta) (1, 1)^T: the moment of inertia of the pair rotating
+    /// rigidly about its centre of mass.
+    fn locked_inertia(&self, theta: [f64; 2]) -> PyResult<f64> {
+        self.disks.locked_inertia(theta).py()
+    }
+
+    /// Named views for `Trajectory`: theta (..., 2), p (..., 2), thetadot (..., 2), phi (...).
+    fn _fields<'py>(slf: &Bound<'py, Self>, states: &Any<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let py = slf.py();
+        let base = slf.as_super().get();
+        let fields = base._fields(py, states.extract()?)?;
+        let disks = &slf.get().disks;
+        let states: ArrayIn<'py> = states.extract()?;
+        let v = base.map_states(py, &states, &[2], |z, out| {
+            out.copy_from_slice(&disks.velocities(z)?);
+            Ok(())
+        })?;
+        let phi = base.map_states(py, &states, &[], |z, out| {
+            out[0] = disks.phi([z[0], z[1]]);
+            Ok(())
+        })?;
+        fields.set_item("thetadot", v)?;
+        fields.set_item("phi", phi)?;
+        Ok(fields)
+    }
+
+    /// The total angular momentum about the centre of mass, J = p1 + p2, (..., 4) -> (...).
+    fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let disks = &slf.get().disks;
+        slf.as_super()
+            .get()
+            .map_states(slf.py(), &states, &[], |z, out| {
+                out[0] = disks.angular_momentum(z)?;
+                Ok(())
+            })
+    }
+
+    /// Where the pieces are, in the centre-of-mass frame (003 (4)): a dict of arrays
+    /// "centres" (..., 2, 2) (the disks' centres), "masses" (..., 2, 2) (their centres of
+    /// mass) and "contact" (..., 2) (the contact point), from states (..., 4).
+    fn positions<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (py, disks) = (slf.py(), &slf.get().disks);
+        let base = slf.as_super().get();
+        let out = PyDict::new(py);
+        let centres = base.map_states(py, &states, &[2, 2], |z, o| {
+            o.copy_from_slice(disks.positions(z)?.centres.as_flattened());
+            Ok(())
+        })?;
+        let masses = base.map_states(py, &states, &[2, 2], |z, o| {
+            o.copy_from_slice(disks.positions(z)?.masses.as_flattened());
+            Ok(())
+        })?;
+        let contact = base.map_states(py, &states, &[2], |z, o| {
+            o.copy_from_slice(&disks.positions(z)?.contact);
+            Ok(())
+        })?;
+        out.set_item("centres", centres)?;
+        out.set_item("masses", masses)?;
+        out.set_item("contact", contact)?;
+        Ok(out)
+    }
+
+    /// Every rotational relative equilibrium (the pair rotating rigidly about its centre of
+    /// mass) with theta1 in `theta1_range` (default: one turn of disk 1), in the gauge where
+    /// the contact point lies in the direction phi = 0 from disk 1's centre, for the rolling
+    /// constant `rolling_constant` (default: the system's). They are the configurations in
+    /// which both centres of mass and the contact point are collinear; stable where the locked
+    /// inertia is maximal along the rolling direction (003 §1, corrected; see the module docs
+    /// of `lieflow::systems::rolling_disks`).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (an empty range), NonFiniteError.
+    #[pyo3(signature = (rolling_constant = None, theta1_range = (0.0, std::f64::consts::TAU)))]
+    fn relative_equilibria(
+        &self,
+        rolling_constant: Option<f64>,
+        theta1_range: (f64, f64),
+    ) -> PyResult<Vec<PyDisksEquilibrium>> {
+        let disks = match rolling_constant {
+            Some(c) => self.disks.clone().with_rolling_constant(c).py()?,
+            None => self.disks.clone(),
+        };
+        let eqs = disks.relative_equilibria(theta1_range).py()?;
+        Ok(eqs
+            .into_iter()
+            .map(|eq| PyDisksEquilibrium {
+                eq,
+                disks: disks.clone(),
+            })
+            .collect())
+    }
+}
+
+/// A rotational relative equilibrium of `RollingDisks`: the pair rotating rigidly about its
+/// centre of mass with any angular velocity omega != 0 (the equilibria and their stability do
+/// not depend on it).
+#[pyclass(name = "RollingDisksEquilibrium", module = "lieflow", frozen)]
+pub struct PyDisksEquilibrium {
+    eq: DisksEquilibrium,
+    disks: RollingDisks,
+}
+
+#[pymethods]
+impl PyDisksEquilibrium {
+    /// theta1.
+    #[getter]
+    fn theta1(&self) -> f64 {
+        self.eq.theta[0]
+    }
+
+    /// theta2.
+    #[getter]
+    fn theta2(&self) -> f64 {
+        self.eq.theta[1]
+    }
+
+    /// Stable (a strict minimum of the amended potential): perturbations of the shape stay
+    /// small for all time.
+    #[getter]
+    fn stable(&self) -> bool {
+        self.eq.stable
+    }
+
+    /// The critical point is degenerate (the stability verdict is inconclusive).
+    #[getter]
+    fn degenerate(&self) -> bool {
+        self.eq.degenerate
+    }
+
+    /// The contact point P (centre-of-mass frame, gauge phi = 0).
+    #[getter]
+    fn contact_point(&self) -> [f64; 2] {
+        self.eq.contact
+    }
+
+    /// The range of |omega| for which it is a relative equilibrium: (0, inf), every rotation.
+    #[getter]
+    fn angular_velocity_range(&self) -> (f64, f64) {
+        (0.0, f64::INFINITY)
+    }
+
+    /// The locked inertia there.
+    #[getter]
+    fn locked_inertia(&self) -> f64 {
+        self.eq.locked_inertia
+    }
+
+    /// The second derivative of the locked inertia along the rolling direction (r2, -r1):
+    /// negative where stable.
+    #[getter]
+    fn curvature(&self) -> f64 {
+        self.eq.curvature
+    }
+
+    /// The state of the rotation with angular velocity omega.
+    ///
+    /// Raises:
+    ///     NonFiniteError.
+    #[pyo3(signature = (omega = 1.0))]
+    fn state(&self, omega: f64) -> PyResult<Vec<f64>> {
+        self.eq.state(&self.disks, omega).py()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RollingDisksEquilibrium(theta1={:.6}, theta2={:.6}, stable={})",
+            self.eq.theta[0],
+            self.eq.theta[1],
+            if self.eq.stable { "True" } else { "False" }
+        )
+    }
+}
