@@ -154,7 +154,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::surface::{inverse, Geometry, Plane, Surface};
+use super::surface::{self, inverse, Geometry, Plane, Surface};
 use super::tangent_top::TangentTop;
 use crate::check;
 use crate::error::{Error, Result};
@@ -428,8 +428,10 @@ impl RelativisticTangentTop {
     /// of [`Surface::killing`] (on the Minkowski plane: p_x, p_y and x p_y − y p_x + p_θ, the
     /// last conserved for any I). Errors: wrong length, non-finite, x outside the chart.
     pub fn killing_momenta(&self, z: &[f64]) -> Result<Vec<f64>> {
-        // p_A X^A does not involve m or I: the classical top's implementation is the same.
-        self.classical_limit()?.killing_momenta(z)
+        check::len_of("state", z, 6)?;
+        check::finite_slice("state", z)?;
+        self.check_point(&z[..3])?;
+        Ok(surface::killing_momenta(&*self.surface(), z, false))
     }
 
     /// The speed v = √g(ẋ, ẋ) and the covariant spin rate s = θ̇ + α·ẋ of a state (both constant
@@ -627,12 +629,9 @@ impl Problem for RelativisticTangentTop {
             }
             return Ok(out);
         };
-        let j = self.killing_momenta(z)?;
-        let affine = j
-            .into_iter()
-            .enumerate()
-            .filter(|&(k, _)| surface.killing_is_affine(k))
-            .map(|(_, jk)| jk);
+        check::finite_slice("state", z)?;
+        self.check_point(&z[..3])?;
+        let affine = surface::killing_momenta(&**surface, z, true);
         Ok(std::iter::once(z[5]).chain(affine).collect())
     }
     fn invariant_count(&self) -> usize {

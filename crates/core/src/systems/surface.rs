@@ -169,6 +169,22 @@ pub trait Surface: Send + Sync + fmt::Debug {
     }
 }
 
+/// The momenta J_k = p_A X_k^A of a surface's Killing generators lifted to the frame bundle, at
+/// a state z = (x¹, x², θ, p₁, p₂, p_θ) of a body carried by a frame (the tangent tops), in the
+/// order of [`Surface::killing`]; with `affine_only`, those of the affine generators only (the
+/// ones quadratic in z). Noether's theorem makes them conserved for every Lagrangian on the frame
+/// bundle invariant under the lifted isometries.
+pub fn killing_momenta(surface: &dyn Surface, z: &[f64], affine_only: bool) -> Vec<f64> {
+    let x = [z[0], z[1]];
+    (0..surface.killing_count())
+        .filter(|&k| !affine_only || surface.killing_is_affine(k))
+        .map(|k| {
+            let xk = surface.killing(k, x);
+            (0..3).map(|a| z[3 + a] * xk[a]).sum()
+        })
+        .collect()
+}
+
 /// det of a 2×2 matrix.
 pub fn det(m: &Mat2) -> f64 {
     m[0][0] * m[1][1] - m[0][1] * m[1][0]

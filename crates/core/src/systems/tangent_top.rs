@@ -53,7 +53,7 @@
 
 use std::sync::Arc;
 
-use super::surface::{add, inner, inverse, mul, Mat2, Shape, Surface, Vec2};
+use super::surface::{self, add, inner, inverse, mul, Mat2, Shape, Surface, Vec2};
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::canonical_catalog;
@@ -299,14 +299,7 @@ impl TangentTop {
     }
 
     fn killing_values(&self, z: &[f64], affine_only: bool) -> Vec<f64> {
-        let x = [z[0], z[1]];
-        (0..self.surface.killing_count())
-            .filter(|&k| !affine_only || self.surface.killing_is_affine(k))
-            .map(|k| {
-                let xk = self.surface.killing(k, x);
-                (0..3).map(|a| z[3 + a] * xk[a]).sum()
-            })
-            .collect()
+        surface::killing_momenta(&*self.surface, z, affine_only)
     }
 
     /// The body frame in ℝ³ for an embedded surface: (position c, E₁, E₂), None otherwise.
