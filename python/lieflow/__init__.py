@@ -15,6 +15,7 @@ Pendulum, SphereParticle, RollingDisk                           canonical, const
                                                                 nonholonomic test problems
 TangentTop, ChargedParticle, surfaces                           the tangent Euler top of 002 §II–III
 RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
+RollingSpheres                                                  two rolling spheres of 003 §2
 RollingDisks                                                    two rolling disks of 003 §1
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
@@ -46,6 +47,7 @@ from ._lieflow import (
     RollingDisk,
     RollingDisks,
     RollingDisksEquilibrium,
+    RollingSpheres,
     SphereParticle,
     SphericalPendulum,
     System,
@@ -77,6 +79,7 @@ __all__ = [
     "RelativisticTangentTop",
     "RigidBody",
     "RollingDisk",
+    "RollingSpheres",
     "RollingDisks",
     "RollingDisksEquilibrium",
     "SphereParticle",

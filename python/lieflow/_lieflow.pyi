@@ -163,6 +163,40 @@ class RollingDisk(System):
     def state(self, q: ArrayLike, theta_dot: float, phi_dot: float) -> list[float]: ...
     def constraint_residual(self, states: ArrayLike) -> F64 | float: ...
 
+class RollingSpheres(System):
+    """Two spheres rolling against each other without slipping (003 §2); state
+    (z1, z2, u, Omega1, Omega2) (27,); midpoint, midpoint4, rkmk4, rk4."""
+
+    def __init__(
+        self, r1: float, r2: float, gamma1: ArrayLike, gamma2: ArrayLike, m1: float, m2: float,
+        inertia1: ArrayLike, inertia2: ArrayLike,
+    ) -> None: ...
+    @property
+    def scale(self) -> float: ...
+    @property
+    def alphas(self) -> tuple[float, float]: ...
+    def state(
+        self, z1: ArrayLike, z2: ArrayLike, u: ArrayLike, Omega1: ArrayLike, Omega2: ArrayLike,
+    ) -> list[float]: ...
+    def planar_state(self, theta: ArrayLike, phi: float, theta_dot: ArrayLike) -> list[float]: ...
+    def to_planar(self, state: ArrayLike, tol: float = 1e-9) -> tuple[float, float, float, float, float]: ...
+    def angular_momentum(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 3): total angular momentum about the centre of mass (conserved)."""
+    def body_momenta(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 2, 3)."""
+    def spatial_momenta(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 2, 3); P1 + P2 = angular_momentum."""
+    def udot(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 3): du/dt of 003 (10)."""
+    def contact_point(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 3)."""
+    def centres(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 2, 3): geometric centres."""
+    def centres_of_mass(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 2, 3)."""
+    def accelerations(self, states: ArrayLike) -> F64:
+        """(..., 27) -> (..., 2, 3): (dOmega1/dt, dOmega2/dt)."""
+
 
 # --- the pseudo-rigid body on T*GL+(n): z = (X row-major, P row-major), d = 2 n^2 ---
 

@@ -21,6 +21,9 @@
 //! [`ChargedParticle`]: z = (x¹, x², p₁, p₂) (4), its magnetic analogue.
 //!
 //! 003 §1: [`RollingDisks`]: z = (θ₁, θ₂, p₁, p₂) (4), two disks rolling against each other.
+//!
+//! 003 §2: [`RollingSpheres`]: z = (z₁, z₂, u, Ω₁, Ω₂) (27), two spheres rolling against each
+//! other (z_k ∈ SO(3) row-major, u ∈ S²).
 
 pub mod heavy_top;
 pub mod isospectral;
@@ -30,6 +33,7 @@ pub mod relativistic_top;
 pub mod rigid_body;
 pub mod rolling_disk;
 pub mod rolling_disks;
+pub mod rolling_spheres;
 pub mod sphere_particle;
 pub mod spherical_pendulum;
 pub mod surface;
@@ -44,6 +48,7 @@ pub use relativistic_top::{Potential, PotentialValue, RelativisticTangentTop, We
 pub use rigid_body::{GeneralizedRigidBody, RigidBody};
 pub use rolling_disk::RollingDisk;
 pub use rolling_disks::RollingDisks;
+pub use rolling_spheres::RollingSpheres;
 pub use sphere_particle::SphereParticle;
 pub use spherical_pendulum::SphericalPendulum;
 pub use surface::{Graph, HyperbolicPlane, MetricSurface, Plane, Revolution, Sphere, Surface};

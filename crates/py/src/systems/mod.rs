@@ -8,6 +8,7 @@ mod pendulum;
 mod relativistic_top;
 mod rigid_body;
 mod rolling_disk;
+mod rolling_spheres;
 mod rolling_disks;
 mod spherical_pendulum;
 pub mod surfaces;
@@ -77,6 +78,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<pendulum::PyPendulum>()?;
     m.add_class::<pendulum::PySphereParticle>()?;
     m.add_class::<rolling_disk::PyRollingDisk>()?;
+    m.add_class::<rolling_spheres::PyRollingSpheres>()?;
     m.add_class::<rolling_disks::PyRollingDisks>()?;
     m.add_class::<rolling_disks::PyDisksEquilibrium>()?;
     m.add_class::<relativistic_top::PyRelativisticTangentTop>()?;

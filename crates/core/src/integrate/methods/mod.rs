@@ -3,6 +3,7 @@
 
 pub mod composition;
 pub mod gauss;
+pub mod lie_midpoint;
 pub mod nonholonomic;
 pub mod rattle;
 pub mod rk4;
@@ -12,6 +13,7 @@ pub mod verlet;
 
 pub use composition::Composition;
 pub use gauss::{Gauss, IMPLICIT_MIDPOINT};
+pub use lie_midpoint::LieMidpoint;
 pub use nonholonomic::NonholonomicRattle;
 pub use rattle::Rattle;
 pub use rk4::Rk4;
