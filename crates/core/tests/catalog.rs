@@ -11,8 +11,8 @@ use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::systems::{
-    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, SphereParticle,
-    SphericalPendulum,
+    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, RollingDisks, RollingSpheres,
+    Sphere, SphereParticle, SphericalPendulum, TangentTop,
 };
 use nalgebra::Vector3;
 
@@ -61,6 +61,10 @@ fn pseudo_rigid_state(n: usize) -> Vec<f64> {
     x.chain(p.iter().copied()).collect()
 }
 
+fn matrix_rows(m: nalgebra::Matrix3<f64>) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
+}
+
 fn cases() -> Vec<Case> {
     let m0 = vec![1.0, 0.5, -0.3];
     let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
@@ -71,6 +75,35 @@ fn cases() -> Vec<Case> {
     let r = rotation_rows();
     let z_top = [m0.clone(), r[6..9].to_vec(), r.clone()].concat();
     let pend = SphericalPendulum::new(2.0, 1.5, 9.81).unwrap();
+    let tangent = TangentTop::new(Arc::new(Sphere::new(1.0).unwrap()), 1.0, 0.6).unwrap();
+    let embedded = TangentTop::with_tensor(
+        Arc::new(Sphere::new(1.4).unwrap()),
+        0.9,
+        [0.5, 0.1, 0.1, 0.2],
+    )
+    .unwrap()
+    .embedded()
+    .unwrap();
+    let disks = RollingDisks::new(
+        [1.0, 0.7],
+        [[0.3, 0.1], [-0.2, 0.25]],
+        [1.0, 1.5],
+        [0.8, 0.6],
+    )
+    .unwrap()
+    .with_rolling_constant(0.4)
+    .unwrap();
+    let spheres = RollingSpheres::new(
+        0.7,
+        1.3,
+        [0.1, -0.2, 0.15],
+        [-0.3, 0.2, 0.4],
+        2.0,
+        3.5,
+        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
+        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
+    )
+    .unwrap();
     let particle = SphereParticle::new(2.0, 1.5, 9.81).unwrap();
     let z_particle = particle
         .from_spherical(&pend.state_from_spherical(0.8, 0.1, 0.3, 1.2).unwrap())
@@ -175,6 +208,50 @@ fn cases() -> Vec<Case> {
             t_end: 2.0,
             dt: 0.01,
             reverse: |z| negate(4..8)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "TangentTop on the sphere",
+            system: Arc::new(tangent.clone()),
+            z0: tangent.state([1.2, 0.3], 0.4, [0.5, -0.3], 0.8).unwrap(),
+            t_end: 2.0,
+            dt: 0.02,
+            reverse: |z| negate(3..6)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "TangentTop embedded, anisotropic, on the sphere",
+            system: Arc::new(embedded.clone()),
+            z0: embedded.state([1.1, 0.3], 0.4, [0.5, -0.3], 0.8).unwrap(),
+            t_end: 2.0,
+            dt: 0.02,
+            reverse: |z| negate(3..6)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "RollingDisks",
+            system: Arc::new(disks.clone()),
+            z0: disks.state([0.3, -1.1], [0.7, 0.2]).unwrap(),
+            t_end: 2.0,
+            dt: 0.02,
+            reverse: |z| negate(2..4)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "RollingSpheres",
+            system: Arc::new(spheres.clone()),
+            z0: spheres
+                .state(
+                    matrix_rows(so3::exp(&Vector3::new(0.3, -0.2, 0.5))),
+                    matrix_rows(so3::exp(&Vector3::new(-0.4, 0.1, 0.2))),
+                    [0.6, 0.0, 0.8],
+                    [0.5, -0.3, 0.8],
+                    [-0.2, 0.4, 0.1],
+                )
+                .unwrap(),
+            t_end: 1.0,
+            dt: 0.01,
+            reverse: |z| negate(21..27)(z),
             long_skip: &[],
         },
         Case {
@@ -383,4 +460,17 @@ fn momentum_maps_of_symmetric_systems() {
         let body = PseudoRigidBody::new(n, Arc::new(Harmonic::new(1.5).unwrap()), false).unwrap();
         check_symmetry(&body, &pseudo_rigid_state(n), "verlet", true);
     }
+    let disks = RollingDisks::new(
+        [1.0, 0.7],
+        [[0.3, 0.1], [-0.2, 0.25]],
+        [1.0, 1.5],
+        [0.8, 0.6],
+    )
+    .unwrap();
+    check_symmetry(
+        &disks,
+        &disks.state([0.3, -1.1], [0.7, 0.2]).unwrap(),
+        "gauss4",
+        true,
+    );
 }
