@@ -74,7 +74,10 @@ pub fn positive(what: &str, x: f64) -> Result<()> {
     } else {
         Err(Error::invalid(
             what,
-            format!("expected a finite number > 0, got {x}"),
+            format!(
+                "expected a finite number > 0, got {}",
+                crate::error::fmt_num(x)
+            ),
         ))
     }
 }

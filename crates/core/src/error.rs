@@ -96,7 +96,7 @@ pub enum Error {
         tol: f64,
     },
     /// A simulation left the domain of its configuration space (e.g. det X ≤ 0 in GL+(n)).
-    #[error("{what} at t = {t}: {message}")]
+    #[error("{what} at t = {}: {message}", fmt_num(*t))]
     LeftDomain {
         /// What left the domain.
         what: String,
@@ -113,6 +113,18 @@ pub enum Error {
     },
 }
 
+/// A number for a message: the shortest round-trip form (`0.01`, `123.5`) where that is short,
+/// the exponent form (`1e300`, `2.5e-170`) for |x| ≥ 1e7 or |x| < 1e-4, so that huge and tiny
+/// values are not printed with hundreds of digits.
+pub fn fmt_num(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e7).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Result alias used throughout lieflow.
 pub type Result<T> = std::result::Result<T, Error>;
 
@@ -122,6 +134,15 @@ impl Error {
         Error::InvalidArgument {
             what: what.into(),
             message: message.into(),
+        }
+    }
+
+    /// [`Error::InvalidArgument`] for a result that is not representable in f64: `what` names
+    /// the argument, `message` says which quantity overflows (or underflows) and why.
+    pub fn overflow(what: impl Into<String>, message: impl std::fmt::Display) -> Self {
+        Error::InvalidArgument {
+            what: what.into(),
+            message: format!("overflow: {message}"),
         }
     }
 

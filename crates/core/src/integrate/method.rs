@@ -80,7 +80,11 @@ impl Clock {
         Error::LeftDomain {
             what: v.what,
             t: self.time(k + 1),
-            message: format!("{} (found in step {step}, dt = {})", v.message, self.dt),
+            message: format!(
+                "{} (found in step {step}, dt = {})",
+                v.message,
+                crate::error::fmt_num(self.dt)
+            ),
         }
     }
 
@@ -95,9 +99,10 @@ impl Clock {
     ) -> Error {
         Error::NotConverged {
             what: format!(
-                "{what} in step {} (t = {}; reduce dt)",
+                "{what} in step {} (t = {}, dt = {}; reduce dt)",
                 self.done + k as u64 + 1,
-                self.time(k + 1)
+                crate::error::fmt_num(self.time(k + 1)),
+                crate::error::fmt_num(self.dt)
             ),
             iterations,
             residual,

@@ -182,27 +182,25 @@ impl Run {
                 stop = stop.min((done / RETRACT_EVERY + 1) * RETRACT_EVERY);
             }
             self.stepper.advance((stop - done) as usize, self.clock)?;
+            // The one finiteness guard of every method and system: after each chunk (at most
+            // RETRACT_EVERY or save_every steps), before the state is retracted, saved or
+            // handed on, so a NaN/inf is reported with the steps that made it and never
+            // passed on as the next chunk's input.
+            self.stepper.get(&mut self.buf);
+            if let Err(e) = check::finite_slice("state", &self.buf) {
+                return Err(self.non_finite(problem.name(), done, stop, e));
+            }
             self.clock.done = stop;
             if let Some(space) = &self.retract {
                 if stop % RETRACT_EVERY == 0 {
-                    self.stepper.get(&mut self.buf);
                     space.retract(&mut self.buf);
                     self.stepper.set(&self.buf)?;
                 }
             }
             if stop % self.save_every == 0 || stop == end {
-                self.stepper.get(&mut self.buf);
                 problem.to_user(&mut self.buf);
                 if let Err(e) = check::finite_slice("state", &self.buf) {
-                    return Err(Error::LeftDomain {
-                        what: format!("{} state", problem.name()),
-                        t: self.clock.time(0),
-                        message: format!(
-                            "the integration produced a non-finite value ({e}); the step dt = {} \
-                             is too large for this motion, or the motion blows up",
-                            self.clock.dt
-                        ),
-                    });
+                    return Err(self.non_finite(problem.name(), done, stop, e));
                 }
                 if stop % self.save_every == 0 {
                     out.try_reserve(self.buf.len()).map_err(|_| too_many())?;
@@ -213,6 +211,30 @@ impl Run {
             }
         }
         Ok(saved)
+    }
+}
+
+impl Run {
+    /// The error of the finiteness guard: the state after steps `done + 1 ..= stop` (absolute
+    /// step numbers) is not finite. The clock stays at `done`, the last finite state.
+    fn non_finite(&self, name: &str, done: u64, stop: u64, e: Error) -> Error {
+        use crate::error::fmt_num;
+        let steps = if stop == done + 1 {
+            format!("step {stop}")
+        } else {
+            format!("one of the steps {} to {stop}", done + 1)
+        };
+        Error::LeftDomain {
+            what: format!("{name} state"),
+            t: self.clock.t0 + stop as f64 * self.clock.dt,
+            message: format!(
+                "{steps} (dt = {}, from t = {}) produced a non-finite value ({e}); the step is \
+                 too large for this motion (|dt·ω| beyond the range where rotation angles are \
+                 resolved, or an overflow), or the motion blows up",
+                fmt_num(self.clock.dt),
+                fmt_num(self.clock.t0 + done as f64 * self.clock.dt),
+            ),
+        }
     }
 }
 

@@ -26,33 +26,83 @@ pub fn det(x: &Mat) -> f64 {
     x.determinant()
 }
 
-/// Checks that `x` is a finite square matrix (n ≥ 1) with det X > 0; returns n.
-///
-/// The sign is decided on X/s with s = ‖X‖_F/√n, whose determinant lies in [−1, 1] (AM–GM on
-/// the singular values), so the test neither overflows nor underflows for well-conditioned X of
-/// any size or scale (det(0.1·I₄₀₀) = 10⁻⁴⁰⁰ underflows, det(0.1·I₄₀₀/s) = 1 does not).
+/// sign(det X) ∈ {−1, 0, 1} and ln|det X| from an LU factorization with partial pivoting
+/// (faer): det X = sign(P) Π u_ii. The log-determinant is finite for every finite nonsingular X
+/// of any size and scale (det diag(1, …, 2000) = 2000! ≈ 10⁵⁷³⁵ overflows, its logarithm does
+/// not). A zero pivot gives (0, −∞); NaN input gives (NaN, NaN).
+pub fn det_sign_ln(x: &Mat) -> (f64, f64) {
+    let n = x.nrows();
+    if n == 0 {
+        return (1.0, 0.0);
+    }
+    let lu = x.partial_piv_lu();
+    let u = lu.U();
+    // sign of the row permutation: (−1)^(n − number of cycles).
+    let (fwd, _) = lu.P().arrays();
+    let mut seen = vec![false; n];
+    let mut cycles = 0;
+    for i in 0..n {
+        if !seen[i] {
+            cycles += 1;
+            let mut j = i;
+            while !seen[j] {
+                seen[j] = true;
+                j = fwd[j];
+            }
+        }
+    }
+    let mut sign = if (n - cycles) % 2 == 0 { 1.0 } else { -1.0 };
+    let mut ln = 0.0;
+    for i in 0..n {
+        let d = u[(i, i)];
+        if d.is_nan() {
+            return (f64::NAN, f64::NAN);
+        }
+        if d == 0.0 {
+            return (0.0, f64::NEG_INFINITY);
+        }
+        sign *= d.signum();
+        ln += d.abs().ln();
+    }
+    (sign, ln)
+}
+
+/// The one GL⁺(n) membership test: X finite and square (n ≥ 1) with det X > 0, decided on the
+/// sign of the LU factorization ([`det_sign_ln`]), never on the product of the pivots (which
+/// overflows or underflows for large n or extreme scales although det X > 0 is plain).
 ///
 /// Errors: [`Error::Shape`] if not square, [`Error::NonFinite`] for NaN/inf, and
-/// [`Error::NotInGroup`] with the determinant in the message if det X ≤ 0 (numerically: if the
-/// scaled determinant is ≤ 0, i.e. also for X singular to working precision).
+/// [`Error::NotInGroup`] with the determinant in the message if det X ≤ 0 (numerically: if a
+/// pivot is zero or the sign is negative, i.e. also for X singular to working precision).
 pub fn check_gl_plus(what: &str, x: &Mat) -> Result<usize> {
     let n = check::square(what, x, 1)?;
-    let scale = x.norm_l2() / (n as f64).sqrt();
-    let scaled = if scale > 0.0 {
-        det(&(x * faer::Scale(1.0 / scale)))
-    } else {
-        0.0
-    };
-    if scaled.is_nan() || scaled <= 0.0 {
+    check_det_positive(what, &format!("GL+({n})"), x)?;
+    Ok(n)
+}
+
+/// The sign test of [`check_gl_plus`] on a finite square `x`, with the group named `group` in the
+/// error (e.g. "GL+(3) (the domain of this potential)").
+pub fn check_det_positive(what: &str, group: &str, x: &Mat) -> Result<()> {
+    let (sign, ln) = det_sign_ln(x);
+    if sign.is_nan() || sign <= 0.0 {
+        let det = sign * ln.exp();
+        let (defect_name, defect) = if det.is_finite() || sign.is_nan() {
+            ("det X (must be > 0)".to_string(), det)
+        } else {
+            (
+                format!("sign of det X (|det X| = e^{ln:.6e}, beyond the f64 range; must be > 0)"),
+                sign,
+            )
+        };
         return Err(Error::NotInGroup {
             what: what.into(),
-            group: format!("GL+({n})"),
-            defect_name: "det X (must be > 0)".into(),
-            defect: scaled * scale.powi(n as i32),
+            group: group.into(),
+            defect_name,
+            defect,
             tol: 0.0,
         });
     }
-    Ok(n)
+    Ok(())
 }
 
 /// SVD coordinates (R, a, S) of X ∈ GL⁺(n): X = R diag(a) Sᵀ (001 (2.4), S⁻¹ = Sᵀ).

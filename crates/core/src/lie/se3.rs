@@ -50,10 +50,31 @@ pub fn hat(xi: &Vector6<f64>) -> Matrix4<f64> {
 
 /// Exponential exp(ξ̂) = [[exp(ω̂), V(ω) v], [0, 1]] with V(ω) = I + ((1 − cos θ)/θ²) ω̂ +
 /// ((θ − sin θ)/θ³) ω̂² = J_l(ω) ([`so3::jacobian_left`]), stable near θ = 0 by series.
+/// No checks (NaN beyond the rule of [`crate::lie::ANGLE_ROUNDING_TOL`]; see [`try_exp`]).
 pub fn exp(xi: &Vector6<f64>) -> SE3 {
     let (w, v) = split(xi);
     let (rot, jl) = so3::exp_and_jacobian_left(&w);
     SE3 { rot, trans: jl * v }
+}
+
+/// [`exp`] with checks: ξ finite, |ω| within the rule of all exponentials
+/// ([`so3::check_exp_arg`], [`crate::lie::ANGLE_ROUNDING_TOL`]) and the translation V(ω) v
+/// representable (an overflow error naming v otherwise).
+pub fn try_exp(xi: &Vector6<f64>) -> Result<SE3> {
+    check::finite_slice("xi", xi.as_slice())?;
+    let (w, _) = split(xi);
+    so3::check_exp_arg("ω", "the SE(3) exponential", &w)?;
+    let g = exp(xi);
+    if g.trans.iter().any(|x| !x.is_finite()) {
+        return Err(Error::overflow(
+            "xi",
+            format!(
+                "the translation V(ω) v of the SE(3) exponential exceeds the f64 range                  (|v| = {})",
+                crate::error::fmt_num(crate::lie::scaled_norm(xi.iter().skip(3)))
+            ),
+        ));
+    }
+    Ok(g)
 }
 
 /// Logarithm: ω = [`so3::log`] of R (θ ∈ [0, π]; at θ = π one of the two, as documented there) and

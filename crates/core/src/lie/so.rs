@@ -254,23 +254,26 @@ pub fn norm(xi: &Mat) -> f64 {
 /// Errors if `xi` is not a finite skew n×n matrix with n ≥ 2.
 pub fn exp(xi: &Mat) -> Result<Mat> {
     check_algebra("xi", xi)?;
-    check_exp_norm(xi)?;
+    check_exp_norm("exp", xi)?;
     Ok(exp_unchecked(xi))
 }
 
-/// Largest |ξ| accepted by [`exp`] and [`dexp`]: beyond it ε_mach |ξ| exceeds 0.2 rad, so no
-/// rotation angle is determined any more (and the squarings would overflow for |ξ| ~ 10¹⁵⁴).
-pub const EXP_MAX_NORM: f64 = 1e15;
+/// Largest |ξ| accepted by [`exp`] and [`dexp`]: the one rule of all exponentials,
+/// [`super::EXP_MAX_NORM`] ≈ 2.25e14 (see [`super::ANGLE_ROUNDING_TOL`]).
+pub use super::EXP_MAX_NORM;
 
-fn check_exp_norm(xi: &Mat) -> Result<()> {
-    let nx = norm(xi);
-    if nx > EXP_MAX_NORM || !nx.is_finite() {
-        return Err(Error::invalid(
-            "xi",
-            format!("|ξ| = {nx:.3e} exceeds {EXP_MAX_NORM:.0e}: the rotation angles are lost to rounding"),
-        ));
-    }
-    Ok(())
+/// [`norm`] without overflow: finite for every finite ξ (1e300 stays 1e300).
+fn scaled_norm(xi: &Mat) -> f64 {
+    let n = xi.nrows().min(xi.ncols());
+    let upper: Vec<f64> = (0..n)
+        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+        .map(|(i, j)| 0.5 * (xi[(i, j)] - xi[(j, i)]))
+        .collect();
+    super::scaled_norm(upper.iter())
+}
+
+fn check_exp_norm(map: &str, xi: &Mat) -> Result<()> {
+    super::check_exp_norm("xi", map, scaled_norm(xi))
 }
 
 /// [`exp`] without validation, for inner loops on known-good input. Never panics: a non-square
@@ -283,7 +286,7 @@ pub fn exp_unchecked(xi: &Mat) -> Mat {
     match n {
         0 | 1 => Mat::identity(n, n),
         2 => {
-            let (s, c) = (0.5 * (xi[(0, 1)] - xi[(1, 0)])).sin_cos();
+            let (s, c) = super::angle_sin_cos(0.5 * (xi[(0, 1)] - xi[(1, 0)]));
             Mat::from_fn(2, 2, |i, j| match (i, j) {
                 (0, 1) => s,
                 (1, 0) => -s,
@@ -413,7 +416,7 @@ fn exp_pade(xi: &Mat) -> Mat {
         for _ in 0..s {
             r = &r * &r;
         }
-        return if s == 0 { r } else { newton_schulz_step(&r) };
+        return if s == 0 { r } else { orthogonalize(r) };
     };
     solve_pade(&u, &v)
 }
@@ -449,19 +452,31 @@ fn pade13(a: &Mat, a2: &Mat, a4: &Mat, a6: &Mat) -> (Mat, Mat) {
     (u, v)
 }
 
-/// One Newton–Schulz step toward the orthogonal polar factor: R (3I − RᵀR)/2. Squares the
-/// orthogonality defect of a nearly orthogonal R.
-fn newton_schulz_step(r: &Mat) -> Mat {
+/// Newton–Schulz steps toward the orthogonal polar factor, R ← R (3I − RᵀR)/2, each squaring
+/// the orthogonality defect δ = ‖RᵀR − I‖_F, until a step starts from δ ≤ 1e-8 (so it ends at
+/// round-off). One step after the usual few squarings (δ ~ 1e-14); up to four after the ~45
+/// squarings of |ξ| near [`EXP_MAX_NORM`], where the defect doubles with every squaring
+/// (2⁴⁵ ε ≈ 1e-2).
+fn orthogonalize(mut r: Mat) -> Mat {
     let n = r.nrows();
-    let g = r.transpose() * r;
-    let m = Mat::from_fn(n, n, |i, j| {
-        if i == j {
-            1.5 - 0.5 * g[(i, j)]
-        } else {
-            -0.5 * g[(i, j)]
+    for _ in 0..8 {
+        let g = r.transpose() * &r;
+        let mut defect = 0.0f64;
+        let m = Mat::from_fn(n, n, |i, j| {
+            let e = g[(i, j)] - if i == j { 1.0 } else { 0.0 };
+            defect += e * e;
+            if i == j {
+                1.5 - 0.5 * g[(i, j)]
+            } else {
+                -0.5 * g[(i, j)]
+            }
+        });
+        r = &r * m;
+        if defect.sqrt() <= 1e-8 {
+            break;
         }
-    });
-    r * m
+    }
+    r
 }
 
 /// Rotations whose largest angle is within this distance of π are refused by [`log`]: at π the
@@ -599,11 +614,19 @@ fn log_spectral(r: &Mat, a: &Mat) -> Result<Mat> {
 
 /// Cayley map cay(ξ) = (I − ξ/2)⁻¹ (I + ξ/2), so(n) → SO(n), a second-order approximation of
 /// exp (cay ξ = exp ξ + O(|ξ|³)). I − ξ/2 is always invertible (eigenvalues 1 − iθ/2).
+///
+/// Defined for every ξ (its angles 2 atan(θ_j/2) tend to π): both factors are scaled by
+/// c = 1/max(1, max |ξ_ij|), cay ξ = (cI − cξ/2)⁻¹ (cI + cξ/2), so the solve sees entries of
+/// order one and the result is finite and orthogonal for every finite ξ.
 pub fn cayley(xi: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
-    let half = xi * faer::Scale(0.5);
-    let minus = Mat::identity(n, n) - &half;
-    let plus = Mat::identity(n, n) + &half;
+    let m = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .fold(1.0f64, |m, (i, j)| m.max(xi[(i, j)].abs()));
+    let c = 1.0 / m;
+    let half = xi * faer::Scale(0.5 * c);
+    let minus = Mat::identity(n, n) * faer::Scale(c) - &half;
+    let plus = Mat::identity(n, n) * faer::Scale(c) + &half;
     Ok(minus.partial_piv_lu().solve(&plus))
 }
 
@@ -659,7 +682,7 @@ pub fn cayley_inv(r: &Mat) -> Result<Mat> {
 pub fn dexp(xi: &Mat, eta: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
     check_algebra_of("eta", eta, n)?;
-    check_exp_norm(xi)?;
+    check_exp_norm("dexp", xi)?;
     if n == 3 {
         return Ok(dexp3(xi, eta, false));
     }

@@ -86,9 +86,21 @@ struct Coeffs {
 }
 
 impl Coeffs {
+    /// NaN coefficients beyond [`super::EXP_MAX_NORM`] (the rule of
+    /// [`super::ANGLE_ROUNDING_TOL`]; the checked maps refuse there first).
     #[inline]
     fn new(w: &Vector3<f64>) -> Self {
         let t2 = w.norm_squared();
+        if !(t2 <= super::EXP_MAX_NORM * super::EXP_MAX_NORM) {
+            let nan = f64::NAN;
+            return Coeffs {
+                t2: nan,
+                a: nan,
+                b: nan,
+                c: nan,
+                half: (nan, nan),
+            };
+        }
         if t2 < SERIES_T2 {
             Coeffs {
                 t2,
@@ -140,11 +152,25 @@ fn hat_sq(w: &Vector3<f64>, t2: f64) -> Matrix3<f64> {
 /// Rodrigues' formula exp(ŵ) = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = |w| (from
 /// ŵ³ = −θ² ŵ; checked against an independent matrix exponential in the tests), with Taylor
 /// coefficients for θ < 1e-2. One `sin_cos`, no allocation; orthogonal to ~1e-15 for θ up to
-/// 1e3 and beyond.
+/// 1e3 and beyond. No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`try_exp`]).
 #[inline]
 pub fn exp(w: &Vector3<f64>) -> Matrix3<f64> {
     let k = Coeffs::new(w);
     Matrix3::identity() + hat(w) * k.a + hat_sq(w, k.t2) * k.b
+}
+
+/// The checks of the exponential-type maps of so(3): `w` (called `what`) finite
+/// ([`Error::NonFinite`]) and |w| ≤ [`super::EXP_MAX_NORM`] (the rule of
+/// [`super::ANGLE_ROUNDING_TOL`], [`Error::InvalidArgument`] naming `map`).
+pub fn check_exp_arg(what: &str, map: &str, w: &Vector3<f64>) -> Result<()> {
+    check::finite_slice(what, w.as_slice())?;
+    super::check_exp_norm(what, map, super::scaled_norm(w.iter()))
+}
+
+/// [`exp`] with the checks of [`check_exp_arg`].
+pub fn try_exp(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+    check_exp_arg("w", "exp", w)?;
+    Ok(exp(w))
 }
 
 /// exp(ŵ) and J_l(w) together from one `sin_cos` (the SE(3) exponential needs both).
@@ -266,11 +292,21 @@ pub fn project(m: &Matrix3<f64>) -> Result<Matrix3<f64>> {
 ///
 /// Scaling: the ½ makes cay agree with exp to second order (cay(w) = exp(ŵ) + O(|w|³)); cay(w)
 /// is the rotation about w/|w| by the angle 2 atan(|w|/2) (eigenvalue (2 + iθ)/(2 − iθ)).
+///
+/// Defined for every w (the angle tends to π as |w| → ∞); for |w| > 1e100 it is evaluated in
+/// the scale-safe form I + 4θ/(4 + θ²) û + 2θ²/(4 + θ²) û² with û = w/θ and θ from
+/// [`super::scaled_norm`], so it is finite and a rotation for every finite w.
 #[inline]
 pub fn cayley(w: &Vector3<f64>) -> Matrix3<f64> {
     let t2 = w.norm_squared();
-    let f = 4.0 / (4.0 + t2);
-    Matrix3::identity() + (hat(w) + hat_sq(w, t2) * 0.5) * f
+    if t2 <= 1e200 {
+        let f = 4.0 / (4.0 + t2);
+        return Matrix3::identity() + (hat(w) + hat_sq(w, t2) * 0.5) * f;
+    }
+    let t = super::scaled_norm(w.iter());
+    let u = w / t;
+    let (a, b) = (4.0 / (4.0 / t + t), 2.0 / (4.0 / t / t + 1.0));
+    Matrix3::identity() + hat(&u) * a + hat_sq(&u, 1.0) * b
 }
 
 /// [`cayley_inv`] errors when 1 + tr R ≤ `CAYLEY_INV_TOL` (a rotation by π, where R + I is
@@ -300,6 +336,8 @@ pub fn cayley_inv(r: &Matrix3<f64>) -> Result<Vector3<f64>> {
 /// exp(w + δ) = exp(w) exp(J_r(w) δ) + O(|δ|²). Standard closed form (not in the seeds; e.g.
 /// Solà, Deray, Atchuthan, "A micro Lie theory for state estimation in robotics", 2018, SO(3)
 /// appendix); checked against central differences of [`exp`] in the tests.
+///
+/// No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`try_jacobian_right`]).
 #[inline]
 pub fn jacobian_right(w: &Vector3<f64>) -> Matrix3<f64> {
     let k = Coeffs::new(w);
@@ -310,10 +348,24 @@ pub fn jacobian_right(w: &Vector3<f64>) -> Matrix3<f64> {
 /// J_l(w) = I + ((1 − cos θ)/θ²) ŵ + ((θ − sin θ)/θ³) ŵ² = J_r(−w) = J_r(w)ᵀ = exp(ŵ) J_r(w),
 /// so that exp(w + δ) = exp(J_l(w) δ) exp(w) + O(|δ|²). It is also the V matrix of the SE(3)
 /// exponential ([`crate::lie::se3::exp`]).
+///
+/// No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`try_jacobian_left`]).
 #[inline]
 pub fn jacobian_left(w: &Vector3<f64>) -> Matrix3<f64> {
     let k = Coeffs::new(w);
     Matrix3::identity() + hat(w) * k.b + hat_sq(w, k.t2) * k.c
+}
+
+/// [`jacobian_right`] with the checks of [`check_exp_arg`].
+pub fn try_jacobian_right(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+    check_exp_arg("w", "the so(3) Jacobian", w)?;
+    Ok(jacobian_right(w))
+}
+
+/// [`jacobian_left`] with the checks of [`check_exp_arg`].
+pub fn try_jacobian_left(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+    check_exp_arg("w", "the so(3) Jacobian", w)?;
+    Ok(jacobian_left(w))
 }
 
 /// J_r⁻¹ and J_l⁻¹ are singular where sin(θ/2) = 0, θ = 2πk (k ≥ 1); they error when
@@ -327,6 +379,7 @@ fn jacobian_inv(w: &Vector3<f64>, k: &Coeffs, sigma: f64) -> Matrix3<f64> {
 }
 
 fn checked_jacobian_inv(w: &Vector3<f64>, sigma: f64) -> Result<Matrix3<f64>> {
+    check_exp_arg("w", "the inverse so(3) Jacobian", w)?;
     let k = Coeffs::new(w);
     if k.singular() {
         return Err(Error::invalid(
@@ -342,7 +395,7 @@ fn checked_jacobian_inv(w: &Vector3<f64>, sigma: f64) -> Result<Matrix3<f64>> {
 
 /// J_r⁻¹(w) = I + ½ ŵ + γ(θ) ŵ², γ = 1/θ² − (1 + cos θ)/(2θ sin θ) (series 1/12 + θ²/720 +
 /// θ⁴/30240 near 0). Error [`Error::InvalidArgument`] at θ = 2πk, k ≥ 1 (see
-/// [`JACOBIAN_INV_TOL`]).
+/// [`JACOBIAN_INV_TOL`]) and beyond [`super::EXP_MAX_NORM`] ([`check_exp_arg`]).
 #[inline]
 pub fn jacobian_right_inv(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
     checked_jacobian_inv(w, 1.0)

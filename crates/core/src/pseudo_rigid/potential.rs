@@ -116,15 +116,12 @@ pub trait Potential: Send + Sync + Debug {
 /// Checks det X > 0 when the potential needs it (shape and finiteness are checked by callers).
 pub(crate) fn check_point(pot: &dyn Potential, x: &Mat, ws: &mut Workspace) -> Result<()> {
     if pot.needs_positive_det() {
+        // Fast path: a normal positive product of the pivots settles it; otherwise (overflow,
+        // underflow, NaN, det ≤ 0) the one membership test of GL⁺(n) decides on the sign.
         let d = det(x.as_ref(), ws);
-        if d.is_nan() || d <= 0.0 {
-            return Err(Error::NotInGroup {
-                what: "X".into(),
-                group: format!("GL+({}) (the domain of this potential)", x.nrows()),
-                defect_name: "det X".into(),
-                defect: d,
-                tol: 0.0,
-            });
+        if !(d.is_normal() && d > 0.0) {
+            let group = format!("GL+({}) (the domain of this potential)", x.nrows());
+            crate::lie::gl::check_det_positive("X", &group, x)?;
         }
     }
     Ok(())

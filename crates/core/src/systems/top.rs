@@ -97,10 +97,12 @@ pub(crate) fn row_major(r: &Matrix3<f64>) -> [f64; 9] {
     out
 }
 
-/// Rotates v about e_k by the angle −θ: the flow of v̇ = v × (θ/t) e_k over time t.
+/// Rotates v about e_k by the angle −θ: the flow of v̇ = v × (θ/t) e_k over time t. NaN beyond
+/// the angle range of every exponential ([`crate::lie::angle_sin_cos`]), which the driver's
+/// finiteness guard reports with the step.
 #[inline]
 pub(crate) fn rotate_axis(v: &mut Vector3<f64>, k: usize, theta: f64) {
-    let (s, c) = theta.sin_cos();
+    let (s, c) = crate::lie::angle_sin_cos(theta);
     rotate_axis_sc(v, k, s, c);
 }
 
@@ -271,7 +273,8 @@ impl Top {
         match self.kinds[i] {
             Flow::Axis(a) => {
                 let k = self.axes[a];
-                let (s, co) = (tau * self.coef[a] * b.m[k]).sin_cos();
+                // NaN where the angle is lost to rounding (see `rotate_axis`).
+                let (s, co) = crate::lie::angle_sin_cos(tau * self.coef[a] * b.m[k]);
                 rotate_axis_sc(&mut b.m, k, s, co);
                 if let Some(g) = b.g.as_mut() {
                     rotate_axis_sc(g, k, s, co);

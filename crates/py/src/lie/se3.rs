@@ -15,10 +15,13 @@ use crate::errors::to_py;
 /// V(ω) = I + ((1 − cos θ)/θ²) ω̂ + ((θ − sin θ)/θ³) ω̂² (the left Jacobian of SO(3)), θ = |ω|;
 /// equal to scipy.linalg.expm([[ω̂, v], [0, 0]]).
 ///
-/// Args: xi — (6,) or (b, 6). Returns (4, 4) or (b, 4, 4). Raises ShapeError, NonFiniteError.
+/// Args: xi — (6,) or (b, 6). Returns (4, 4) or (b, 4, 4). Raises ShapeError, NonFiniteError,
+/// InvalidArgumentError (|ω| > 2.25e14, the rule of so3_exp; a translation beyond the f64 range).
 #[pyfunction]
 fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::exp(x).matrix4()))
+    map_batch(py, "xi", &xi, |x: &Vector6<f64>| {
+        Ok(se3::try_exp(x)?.matrix4())
+    })
 }
 
 /// `se3_log(g, strict=False)`: the logarithm ξ = (ω, v) of g = [[R, t], [0, 1]]: ω = so3_log(R)

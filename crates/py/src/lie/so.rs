@@ -116,7 +116,8 @@ fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
 ///     R: shape (n, n) or (b, n, n), in SO(n).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (xi not skew),
-///     InvalidArgumentError (|ξ| > 1e15, where rounding leaves no angle information).
+///     InvalidArgumentError (|ξ| > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of
+///     the angles is lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
 fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
     map_mats(py, "xi", &xi, so::exp)
@@ -176,7 +177,7 @@ fn cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAr
 /// Returns:
 ///     skew matrix (n, n).
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (|ξ| > 1e15).
+///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (|ξ| > 2.25e14).
 #[pyfunction]
 fn dexp<'py>(
     py: Python<'py>,

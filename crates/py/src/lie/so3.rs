@@ -32,10 +32,12 @@ fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// `so3_exp(w)`: the rotation exp(ŵ) by Rodrigues' formula
 /// R = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = |w| (rotation by θ about w/θ).
 ///
-/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
+/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError,
+/// InvalidArgumentError (|w| > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of the angle is
+/// lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
 fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::exp(w)))
+    map_batch(py, "w", &w, so3::try_exp)
 }
 
 /// `so3_log(r, strict=False)`: the principal logarithm w (|w| = θ ∈ [0, π], exp(ŵ) = R),
@@ -62,7 +64,8 @@ fn so3_log<'py>(py: Python<'py>, r: ArrayIn<'py>, strict: bool) -> PyResult<Out<
 }
 
 /// `so3_cayley(w)`: the Cayley map cay(w) = (I − ŵ/2)⁻¹ (I + ŵ/2) = I + 4/(4 + |w|²)(ŵ + ŵ²/2),
-/// a rotation about w by the angle 2·atan(|w|/2) (agrees with exp to second order).
+/// a rotation about w by the angle 2·atan(|w|/2) (agrees with exp to second order); defined and
+/// computed scale-safely for every finite w (the angle tends to π as |w| → ∞).
 ///
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
 #[pyfunction]
@@ -87,14 +90,10 @@ fn jacobian<'py>(
     py: Python<'py>,
     w: &ArrayIn<'py>,
     inverse: bool,
-    forward: fn(&Vector3<f64>) -> Matrix3<f64>,
+    forward: fn(&Vector3<f64>) -> lieflow::Result<Matrix3<f64>>,
     backward: fn(&Vector3<f64>) -> lieflow::Result<Matrix3<f64>>,
 ) -> PyResult<Out<'py>> {
-    if inverse {
-        map_batch(py, "w", w, backward)
-    } else {
-        map_batch(py, "w", w, |w: &Vector3<f64>| Ok(forward(w)))
-    }
+    map_batch(py, "w", w, if inverse { backward } else { forward })
 }
 
 /// `so3_jacobian_right(w, inverse=False)`: the right Jacobian
@@ -103,7 +102,8 @@ fn jacobian<'py>(
 /// J_r⁻¹ = I + ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
 ///
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
-/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1;
+/// |w| > 2.25e14, the rule of so3_exp).
 #[pyfunction]
 #[pyo3(signature = (w, inverse = false))]
 fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
@@ -111,7 +111,7 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
         py,
         &w,
         inverse,
-        so3::jacobian_right,
+        so3::try_jacobian_right,
         so3::jacobian_right_inv,
     )
 }
@@ -122,11 +122,18 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
 /// J_l⁻¹ = I − ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
 ///
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
-/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1;
+/// |w| > 2.25e14, the rule of so3_exp).
 #[pyfunction]
 #[pyo3(signature = (w, inverse = false))]
 fn so3_jacobian_left<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
-    jacobian(py, &w, inverse, so3::jacobian_left, so3::jacobian_left_inv)
+    jacobian(
+        py,
+        &w,
+        inverse,
+        so3::try_jacobian_left,
+        so3::jacobian_left_inv,
+    )
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
