@@ -17,6 +17,7 @@ and ``invariants``/``casimirs``; optionally ``_fields(states) -> dict`` of named
 observables ``NAME(states)``.
 """
 
+import numbers
 import operator
 import sys
 
@@ -36,18 +37,43 @@ MIN_CHUNK_STEPS = 250
 
 
 def _count(name, value):
-    """An integer >= 1 (bools and floats rejected)."""
-    if isinstance(value, bool):
-        raise InvalidArgumentError(f"invalid {name}: expected an integer >= 1, got {value!r}")
+    """An integer >= 1: TypeError for another type (bools and floats included),
+    InvalidArgumentError for an integer < 1."""
     try:
+        if isinstance(value, bool):
+            raise TypeError
         n = operator.index(value)
     except TypeError:
-        raise InvalidArgumentError(
-            f"invalid {name}: expected an integer >= 1, got {value!r}"
+        raise TypeError(
+            f"invalid {name}: expected an integer >= 1, got {type(value).__name__} {value!r}"
         ) from None
     if n < 1:
         raise InvalidArgumentError(f"invalid {name}: expected an integer >= 1, got {n}")
     return n
+
+
+def _step(dt):
+    """The time step as a float: TypeError unless a real number (str, bool, complex and arrays
+    of size > 1 refused), InvalidArgumentError unless finite and > 0."""
+    ok = isinstance(dt, numbers.Real) and not isinstance(dt, bool)
+    if not ok and isinstance(dt, np.ndarray) and dt.shape == () and dt.dtype.kind in "iuf":
+        ok = True  # a 0-d numpy array of a real number
+    if not ok:
+        raise TypeError(f"invalid dt: expected a real number > 0, got {type(dt).__name__} {dt!r}")
+    dt = float(dt)
+    if not (np.isfinite(dt) and dt > 0):
+        raise InvalidArgumentError(f"invalid dt: expected a finite number > 0, got {dt!r}")
+    return dt
+
+
+def _check_system(system):
+    """TypeError unless ``system`` speaks the protocol (a ``lieflow.System`` instance or alike)."""
+    if isinstance(system, type):
+        raise TypeError(f"expected a lieflow system, got the class {system.__name__}; make one "
+                        f"first, e.g. {system.__name__}(...)")
+    if not all(callable(getattr(system, a, None)) for a in ("_normalize_state", "_start")):
+        raise TypeError(f"expected a lieflow system (e.g. lf.RigidBody([1, 2, 3])), got "
+                        f"{type(system).__name__} {system!r:.60}")
 
 
 def _attitude(attitude, b, batched):
@@ -121,19 +147,21 @@ def integrate(system, state0, dt, steps, method=None, save_every=1, attitude=Non
         A ``Trajectory``.
 
     Raises:
+        TypeError (``system`` not a system; ``dt`` not a real number; ``steps``, ``save_every``,
+        ``chunk_steps``, ``threads`` not integers; ``method`` not a str),
         InvalidArgumentError (dt <= 0 or non-finite, steps < 1, save_every < 1, state
         constraints), UnsupportedMethodError (lists the system's methods), ShapeError,
         NonFiniteError, NotInGroupError (attitude), ConvergenceError, LeftDomainError (naming the
         time from the start of the run); KeyboardInterrupt on Ctrl-C.
     """
+    # Every argument's type and range in one place, before any native call.
+    _check_system(system)
     steps = _count("steps", steps)
     save_every = _count("save_every", save_every)
-    try:
-        dt = float(dt)
-    except (TypeError, ValueError):
-        raise InvalidArgumentError(f"invalid dt: expected a finite number > 0, got {dt!r}") from None
+    dt = _step(dt)
     if method is not None and not isinstance(method, str):
-        raise InvalidArgumentError(f"invalid method: expected a name, got {method!r}")
+        raise TypeError(f"invalid method: expected a name (str), got {type(method).__name__} "
+                        f"{method!r}")
     z, batched = system._normalize_state(state0)
     b = z.shape[0]
     att = None if attitude is None else _attitude(attitude, b, batched)

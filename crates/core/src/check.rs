@@ -101,6 +101,93 @@ pub fn dense_size(what: &str, rows: usize, cols: usize) -> Result<()> {
     }
 }
 
+/// Largest array of a mapped or batched call (its output, or an input read into memory): 2³² − 1
+/// entries (32 GiB of f64), and never more than the memory available (see [`array_size`]).
+/// Larger requests (e.g. a broadcast input of 10¹⁰ items) are refused with a clear error instead
+/// of aborting the process when the allocation fails or being killed when it is used.
+pub const MAX_ARRAY_ENTRIES: usize = u32::MAX as usize;
+
+/// Arrays up to this many bytes are allocated without asking the system how much memory is left.
+const CHECKED_BYTES: u64 = 1 << 30;
+
+/// The memory available for new allocations in bytes (Linux: `MemAvailable` of /proc/meminfo),
+/// `None` where unknown.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
+/// A shape as numpy prints it: "(3,)", "(2, 3)".
+fn shape_text(shape: &[usize]) -> String {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    match dims.len() {
+        1 => format!("({},)", dims[0]),
+        _ => format!("({})", dims.join(", ")),
+    }
+}
+
+/// The number of entries of an f64 array of shape `shape` (a product without overflow), refused
+/// above [`MAX_ARRAY_ENTRIES`] or when its bytes exceed the memory available (where known):
+/// allocating it would abort the process, or get it killed by the system when the memory is
+/// used. `what` names the argument the array comes from.
+pub fn array_size(what: &str, shape: &[usize]) -> Result<usize> {
+    let gib = |bytes: f64| bytes / (1u64 << 30) as f64;
+    let len = shape
+        .iter()
+        .try_fold(1usize, |k, &d| k.checked_mul(d))
+        .filter(|&k| k <= MAX_ARRAY_ENTRIES)
+        .ok_or_else(|| {
+            let total = shape.iter().map(|&d| d as f64).product::<f64>();
+            Error::invalid(
+                what,
+                format!(
+                    "an array of shape {} ({total:.2e} entries) exceeds the limit of \
+                     {MAX_ARRAY_ENTRIES} entries (32 GiB)",
+                    shape_text(shape)
+                ),
+            )
+        })?;
+    let bytes = len as u64 * 8;
+    if bytes > CHECKED_BYTES {
+        // 7/8 of what is available: the call allocates a little more (its other arrays).
+        if let Some(free) = available_memory().filter(|&free| bytes > free / 8 * 7) {
+            return Err(Error::invalid(
+                what,
+                format!(
+                    "an array of shape {} needs {:.1} GiB, more than the {:.1} GiB of memory \
+                     available",
+                    shape_text(shape),
+                    gib(bytes as f64),
+                    gib(free as f64)
+                ),
+            ));
+        }
+    }
+    Ok(len)
+}
+
+/// A zero-filled buffer for an f64 array of shape `shape` (checked by [`array_size`]),
+/// allocated fallibly: a refused or failed allocation is [`Error::InvalidArgument`] naming
+/// `what`, never an abort.
+pub fn zeros(what: &str, shape: &[usize]) -> Result<Vec<f64>> {
+    let len = array_size(what, shape)?;
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|_| {
+        Error::invalid(
+            what,
+            format!(
+                "cannot allocate an array of shape {} ({:.1} GiB)",
+                shape_text(shape),
+                len as f64 * 8.0 / (1u64 << 30) as f64
+            ),
+        )
+    })?;
+    v.resize(len, 0.0);
+    Ok(v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -120,5 +207,8 @@ mod tests {
         assert!(dense_size("B", 1 << 14, 1 << 14).is_ok());
         assert!(dense_size("B", (1 << 14) + 1, 1 << 14).is_err());
         assert!(dense_size("B", usize::MAX, 2).is_err());
+        assert_eq!(zeros("w", &[2, 3]).map(|v| v.len()), Ok(6));
+        assert!(zeros("w", &[10_000_000_000, 3, 3]).is_err());
+        assert!(array_size("w", &[usize::MAX, 2]).is_err());
     }
 }

@@ -9,7 +9,7 @@ use numpy::{IntoPyArray, PyArrayDyn};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::convert::{shape_str, ArrayIn};
+use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::to_py;
 
 /// A numpy array of floats whose shape depends on whether the input was batched.
@@ -66,10 +66,8 @@ fn read<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, bool)> {
             shape_str(s),
         )));
     };
-    let data: Vec<f64> = match v.as_slice() {
-        Some(c) => c.to_vec(),
-        None => v.iter().copied().collect(),
-    };
+    // Checked and allocated fallibly: a broadcast view of 10¹⁰ items is refused, not an abort.
+    let data = read_all(what, &v)?;
     check::finite_slice(what, &data).map_err(to_py)?;
     Ok((data, batched))
 }
@@ -77,7 +75,15 @@ fn read<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, bool)> {
 /// (…item) or (b, …item) → the items.
 pub fn read_items<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<A>, bool)> {
     let (data, batched) = read::<A>(what, a)?;
-    Ok((data.chunks_exact(A::LEN).map(A::load).collect(), batched))
+    let mut items = Vec::new();
+    items.try_reserve_exact(data.len() / A::LEN).map_err(|_| {
+        to_py(Error::invalid(
+            what,
+            "cannot allocate its items; split the input",
+        ))
+    })?;
+    items.extend(data.chunks_exact(A::LEN).map(A::load));
+    Ok((items, batched))
 }
 
 /// Renames the argument of an error (`what` ↦ `f(what)`), e.g. to add a batch index.
@@ -116,12 +122,20 @@ pub fn relabel(e: Error, f: impl Fn(&str) -> String) -> Error {
 /// Fills a new array of `n` items `f(0), …, f(n − 1)` (shape `B::shape()` when not `batched`)
 /// in parallel with the GIL released, writing straight into the buffer that becomes the numpy
 /// array. The first error (with its batch index when `batched`) becomes the Python exception.
-pub fn par_fill<'py, B, F>(py: Python<'py>, n: usize, batched: bool, f: F) -> PyResult<Out<'py>>
+/// The buffer is checked and allocated fallibly (an oversized batch is an `InvalidArgumentError`
+/// naming the input `what`).
+pub fn par_fill<'py, B, F>(
+    py: Python<'py>,
+    what: &str,
+    n: usize,
+    batched: bool,
+    f: F,
+) -> PyResult<Out<'py>>
 where
     B: Item,
     F: Fn(usize) -> lieflow::Result<B> + Sync + Send,
 {
-    let mut data = vec![0.0; n * B::LEN];
+    let mut data = check::zeros(what, &[n, B::LEN]).map_err(to_py)?;
     py.detach(|| {
         data.par_chunks_mut(B::LEN)
             .with_min_len(256)
@@ -160,7 +174,7 @@ where
 {
     let (data, batched) = read::<A>(what, x)?;
     let n = data.len() / A::LEN;
-    par_fill(py, n, batched, |k| {
+    par_fill(py, what, n, batched, |k| {
         f(&A::load(&data[k * A::LEN..(k + 1) * A::LEN]))
     })
 }

@@ -1,17 +1,123 @@
-//! numpy ⇄ lieflow conversions. Inputs are accepted as any array-like (lists, int arrays) and
-//! cast to float64; shapes are checked here and reported as `ShapeError`; finiteness is checked
-//! by the core functions.
+//! numpy ⇄ lieflow conversions. Inputs are accepted as any array-like of real numbers (lists,
+//! bool/int/float arrays) and cast to float64; anything else (complex, datetime, strings, objects,
+//! ragged lists) is a `TypeError` ([`ArrayIn`]); shapes are checked here and reported as
+//! `ShapeError`; finiteness is checked by the core functions.
 
-use lieflow::{Error, Mat};
+use std::ops::Deref;
+
+use lieflow::{check, Error, Mat};
 use nalgebra::{Matrix3, Vector3};
 use numpy::ndarray::{Array1, Array2, Array3, ArrayViewD};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayLikeDyn};
+use numpy::npyffi::PY_ARRAY_API;
+use numpy::{
+    AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayDescrMethods, PyArrayDyn,
+    PyArrayLikeDyn, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use pyo3::types::{PyByteArray, PyBytes, PyString};
+use pyo3::Borrowed;
 
 use crate::errors::to_py;
 
-/// Any array-like input, cast to float64.
-pub type ArrayIn<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+/// Any array-like input of real numbers (bool, int, uint or float data: arrays, lists, scalars),
+/// cast to float64; a float64 array is borrowed without a copy. Anything else is refused with a
+/// `TypeError` that says what was expected and what came (pyo3 prefixes it with
+/// `argument 'name':`): complex (the imaginary part would be lost), datetime/timedelta, str,
+/// bytes, object arrays and ragged nested lists. The one extractor of every array argument;
+/// derefs to the read-only array (`.as_array()`).
+pub struct ArrayIn<'py>(PyArrayLikeDyn<'py, f64, AllowTypeChange>);
+
+impl<'py> Deref for ArrayIn<'py> {
+    type Target = PyReadonlyArrayDyn<'py, f64>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+const EXPECTED_REAL: &str = "expected an array-like of real numbers (bool, int or float)";
+
+/// numpy dtype kinds cast to float64 without loss of meaning: bool, int, uint, float.
+fn real_kind(kind: u8) -> bool {
+    matches!(kind, b'b' | b'i' | b'u' | b'f')
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for ArrayIn<'py> {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        // Fast path, zero-copy: a float64 array.
+        if ob.cast::<PyArrayDyn<f64>>().is_ok() {
+            return Ok(ArrayIn(ob.extract()?));
+        }
+        let py = ob.py();
+        let type_name = || {
+            ob.get_type()
+                .name()
+                .map_or_else(|_| "object".to_string(), |n| n.to_string())
+        };
+        if ob.is_instance_of::<PyString>()
+            || ob.is_instance_of::<PyBytes>()
+            || ob.is_instance_of::<PyByteArray>()
+        {
+            return Err(PyTypeError::new_err(format!(
+                "{EXPECTED_REAL}, got a {}",
+                type_name()
+            )));
+        }
+        if ob.is_none() {
+            return Err(PyTypeError::new_err(format!("{EXPECTED_REAL}, got None")));
+        }
+        let given_array = ob.cast::<PyUntypedArray>().is_ok();
+        // numpy's own reading of the object (np.asarray, no cast), to look at its dtype.
+        let array: Bound<'py, PyUntypedArray> = if given_array {
+            ob.cast::<PyUntypedArray>()?.to_owned()
+        } else {
+            // SAFETY: PyArray_FromAny with no requested dtype and no flags is np.asarray(ob); it
+            // returns a new reference or NULL with an exception set.
+            let ptr = unsafe {
+                PY_ARRAY_API.PyArray_FromAny(
+                    py,
+                    ob.as_ptr(),
+                    std::ptr::null_mut(),
+                    0,
+                    0,
+                    0,
+                    std::ptr::null_mut(),
+                )
+            };
+            // SAFETY: as above.
+            let any = unsafe { Bound::from_owned_ptr_or_err(py, ptr) }.map_err(|e| {
+                PyTypeError::new_err(format!(
+                    "{EXPECTED_REAL}, got a {} that numpy cannot read as an array: {}",
+                    type_name(),
+                    e.value(py)
+                ))
+            })?;
+            any.cast_into::<PyUntypedArray>()?
+        };
+        let dtype = array.dtype();
+        if !real_kind(dtype.kind()) {
+            let what = if given_array {
+                format!("an array of dtype {}", dtype.str()?)
+            } else if dtype.kind() == b'O' {
+                format!(
+                    "a {} that is ragged or holds non-numbers (numpy reads it as dtype object)",
+                    type_name()
+                )
+            } else {
+                format!(
+                    "a {} (numpy reads it as dtype {})",
+                    type_name(),
+                    dtype.str()?
+                )
+            };
+            return Err(PyTypeError::new_err(format!("{EXPECTED_REAL}, got {what}")));
+        }
+        Ok(ArrayIn(array.as_any().extract()?))
+    }
+}
 
 /// A shape as numpy prints it: "(3,)", "(2, 3)".
 pub fn shape_str(shape: &[usize]) -> String {
@@ -27,17 +133,40 @@ fn shape_err(what: &str, expected: &str, v: &ArrayViewD<'_, f64>) -> PyErr {
     to_py(Error::shape(what, expected, shape_str(v.shape())))
 }
 
-fn view_to_mat(v: &ArrayViewD<'_, f64>) -> Mat {
-    Mat::from_fn(v.shape()[0], v.shape()[1], |i, j| v[[i, j]])
+/// The entries of `v` in row-major order, in a buffer that is size-checked and allocated
+/// fallibly ([`check::zeros`]): the one place inputs are copied, so a huge (e.g. broadcast)
+/// input is an `InvalidArgumentError` naming `what`, never an abort.
+pub fn read_all(what: &str, v: &ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
+    let mut data = check::zeros(what, v.shape()).map_err(to_py)?;
+    match v.as_slice() {
+        Some(c) => data.copy_from_slice(c),
+        None => data.iter_mut().zip(v.iter()).for_each(|(d, x)| *d = *x),
+    }
+    Ok(data)
 }
 
-/// A 2-D array as a matrix.
+/// An empty vector with room for `n` items, allocated fallibly.
+fn try_vec<T>(what: &str, n: usize) -> PyResult<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| to_py(Error::invalid(what, format!("cannot allocate {n} items"))))?;
+    Ok(v)
+}
+
+/// An r×c matrix from row-major data.
+fn to_mat(r: usize, c: usize, x: &[f64]) -> Mat {
+    Mat::from_fn(r, c, |i, j| x[i * c + j])
+}
+
+/// A 2-D array as a matrix (at most [`check::MAX_DENSE_ENTRIES`] entries).
 pub fn mat(what: &str, a: &ArrayIn<'_>) -> PyResult<Mat> {
     let v = a.as_array();
     if v.ndim() != 2 {
         return Err(shape_err(what, "a 2-D array (n, n)", &v));
     }
-    Ok(view_to_mat(&v))
+    let (r, c) = (v.shape()[0], v.shape()[1]);
+    check::dense_size(what, r, c).map_err(to_py)?;
+    Ok(to_mat(r, c, &read_all(what, &v)?))
 }
 
 /// A 2-D array (one matrix) or a 3-D array (a batch along the leading axis).
@@ -45,15 +174,19 @@ pub fn mat(what: &str, a: &ArrayIn<'_>) -> PyResult<Mat> {
 pub fn mats(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<Mat>, bool)> {
     let v = a.as_array();
     match v.ndim() {
-        2 => Ok((vec![view_to_mat(&v)], false)),
+        2 => Ok((vec![mat(what, a)?], false)),
         3 => {
             let (b, r, c) = (v.shape()[0], v.shape()[1], v.shape()[2]);
-            Ok((
-                (0..b)
-                    .map(|k| Mat::from_fn(r, c, |i, j| v[[k, i, j]]))
-                    .collect(),
-                true,
-            ))
+            check::dense_size(what, r, c).map_err(to_py)?;
+            let data = read_all(what, &v)?;
+            let mut out = try_vec(what, b)?;
+            out.extend(
+                data.chunks_exact((r * c).max(1))
+                    .take(b)
+                    .map(|x| to_mat(r, c, x)),
+            );
+            out.resize_with(b, || Mat::zeros(r, c));
+            Ok((out, true))
         }
         _ => Err(shape_err(what, "(n, n) or a batch (b, n, n)", &v)),
     }
@@ -65,20 +198,22 @@ pub fn vector(what: &str, a: &ArrayIn<'_>) -> PyResult<Vec<f64>> {
     if v.ndim() != 1 {
         return Err(shape_err(what, "a 1-D array", &v));
     }
-    Ok(v.iter().copied().collect())
+    read_all(what, &v)
 }
 
 /// A 1-D array (one vector) or a 2-D array (a batch along the leading axis).
 pub fn vectors(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<Vec<f64>>, bool)> {
     let v = a.as_array();
     match v.ndim() {
-        1 => Ok((vec![v.iter().copied().collect()], false)),
-        2 => Ok((
-            v.outer_iter()
-                .map(|r| r.iter().copied().collect())
-                .collect(),
-            true,
-        )),
+        1 => Ok((vec![read_all(what, &v)?], false)),
+        2 => {
+            let (b, d) = (v.shape()[0], v.shape()[1]);
+            let data = read_all(what, &v)?;
+            let mut out = try_vec(what, b)?;
+            out.extend(data.chunks_exact(d.max(1)).take(b).map(|x| x.to_vec()));
+            out.resize_with(b, Vec::new);
+            Ok((out, true))
+        }
         _ => Err(shape_err(what, "(d,) or a batch (b, d)", &v)),
     }
 }
@@ -97,10 +232,25 @@ pub fn py_mat<'py>(py: Python<'py>, m: &Mat) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
 }
 
-/// Matrices of one shape → 3-D numpy array (batch axis first).
-pub fn py_mats<'py>(py: Python<'py>, ms: &[Mat]) -> Bound<'py, PyArray3<f64>> {
+/// Matrices of one shape → 3-D numpy array (batch axis first); the buffer is size-checked and
+/// allocated fallibly (`what` names the argument the batch comes from).
+pub fn py_mats<'py>(
+    py: Python<'py>,
+    what: &str,
+    ms: &[Mat],
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let (r, c) = ms.first().map_or((0, 0), |m| (m.nrows(), m.ncols()));
-    Array3::from_shape_fn((ms.len(), r, c), |(k, i, j)| ms[k][(i, j)]).into_pyarray(py)
+    let mut data = check::zeros(what, &[ms.len(), r, c]).map_err(to_py)?;
+    for (o, m) in data.chunks_exact_mut((r * c).max(1)).zip(ms) {
+        for i in 0..r {
+            for j in 0..c {
+                o[i * c + j] = m[(i, j)];
+            }
+        }
+    }
+    let a = Array3::from_shape_vec((ms.len(), r, c), data)
+        .map_err(|e| to_py(Error::shape(what, "matrices of one shape", e.to_string())))?;
+    Ok(a.into_pyarray(py))
 }
 
 /// Slice → 1-D numpy array.
@@ -108,10 +258,28 @@ pub fn py_vec<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
     Array1::from(v.to_vec()).into_pyarray(py)
 }
 
-/// Equal-length vectors → 2-D numpy array (batch axis first).
-pub fn py_vecs<'py>(py: Python<'py>, vs: &[Vec<f64>]) -> Bound<'py, PyArray2<f64>> {
+/// Equal-length vectors → 2-D numpy array (batch axis first); the buffer is size-checked and
+/// allocated fallibly (`what` names the argument the batch comes from).
+pub fn py_vecs<'py>(
+    py: Python<'py>,
+    what: &str,
+    vs: &[Vec<f64>],
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let d = vs.first().map_or(0, |v| v.len());
-    Array2::from_shape_fn((vs.len(), d), |(k, i)| vs[k][i]).into_pyarray(py)
+    let mut data = check::zeros(what, &[vs.len(), d]).map_err(to_py)?;
+    for (o, v) in data.chunks_exact_mut(d.max(1)).zip(vs) {
+        if v.len() != d {
+            return Err(to_py(Error::shape(
+                what,
+                format!("vectors of one length {d}"),
+                format!("one of length {}", v.len()),
+            )));
+        }
+        o.copy_from_slice(v);
+    }
+    let a = Array2::from_shape_vec((vs.len(), d), data)
+        .map_err(|e| to_py(Error::shape(what, "vectors of one length", e.to_string())))?;
+    Ok(a.into_pyarray(py))
 }
 
 /// 3×3 matrix → numpy.

@@ -6,7 +6,7 @@
 use std::sync::{Arc, Mutex};
 
 use lieflow::integrate::{Run, System};
-use lieflow::Error;
+use lieflow::{check, Error};
 use numpy::{PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
@@ -125,6 +125,10 @@ impl Integration {
             )));
         }
         let b = z.shape()[0];
+        // Each member's run keeps its state several times (buffer, stepper state, scratch) and a
+        // few hundred bytes more: about 64 + 8·d floats measured; check twice that against the
+        // memory available before building any (a huge batch is refused, not killed).
+        check::array_size("state0", &[b, 2 * (64 + 8 * full)]).py()?;
         let mut states: Vec<Vec<f64>> = z
             .outer_iter()
             .map(|r| r.iter().copied().collect())
@@ -178,11 +182,11 @@ impl Integration {
         k: usize,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let full = self.d + if self.attitude { 9 } else { 0 };
-        let mut z = Vec::with_capacity(b * k * self.d);
-        let mut r = Vec::with_capacity(if self.attitude { b * k * 9 } else { 0 });
-        for s in data.chunks_exact(full) {
-            z.extend_from_slice(&s[..self.d]);
-            r.extend_from_slice(&s[self.d..]);
+        let mut z = check::zeros("steps", &[b, k, self.d]).py()?;
+        let mut r = check::zeros("steps", &[b, k, if self.attitude { 9 } else { 0 }]).py()?;
+        for (i, s) in data.chunks_exact(full).enumerate() {
+            z[i * self.d..(i + 1) * self.d].copy_from_slice(&s[..self.d]);
+            r[i * (full - self.d)..(i + 1) * (full - self.d)].copy_from_slice(&s[self.d..]);
         }
         let states = array(py, &[b, k, self.d], z)?;
         let att = if self.attitude {
@@ -231,9 +235,27 @@ impl Integration {
         steps: i64,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let steps = count("steps", steps)? as u64;
+        let k = (self.done + steps) / self.save_every - self.done / self.save_every;
+        let full = self.d + if self.attitude { 9 } else { 0 };
         let sys = &*self.sys;
         let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
         let b = runs.len();
+        // The saved states of this call (b, k, full), checked before any step is taken and then
+        // allocated fallibly (an oversized request is an InvalidArgumentError, not an abort).
+        let per_run = check::array_size(
+            "steps",
+            &[b, usize::try_from(k).unwrap_or(usize::MAX), full],
+        )
+        .map_err(|e| match e {
+            Error::InvalidArgument { what, message } => to_py(Error::invalid(
+                what,
+                format!(
+                    "the {k} states saved by these steps: {message}; save less often \
+                         (save_every) or advance fewer steps at a time"
+                ),
+            )),
+            other => to_py(other),
+        })? / b.max(1);
         let pool = &self.pool;
         let result = py.detach(|| {
             let mut work = move || {
@@ -241,6 +263,15 @@ impl Integration {
                     .enumerate()
                     .map(|(i, run)| {
                         let mut out = Vec::new();
+                        out.try_reserve_exact(per_run).map_err(|_| {
+                            Error::invalid(
+                                "steps",
+                                format!(
+                                    "cannot allocate the {per_run} values these steps save; \
+                                     save less often (save_every) or run in chunks"
+                                ),
+                            )
+                        })?;
                         run.advance(sys, steps, &mut out).map(|_| out).map_err(|e| {
                             if b > 1 {
                                 e.in_member(i)
@@ -260,9 +291,12 @@ impl Integration {
             c.take_error()?;
         }
         let outs = result.py()?;
-        let k = (self.done + steps) / self.save_every - self.done / self.save_every;
         self.done += steps;
-        self.split(py, &outs.concat(), b, k as usize)
+        let mut data = check::zeros("steps", &[b, per_run]).py()?;
+        for (d, o) in data.chunks_exact_mut(per_run.max(1)).zip(&outs) {
+            d.copy_from_slice(o);
+        }
+        self.split(py, &data, b, k as usize)
     }
 
     /// The current states (b, d) and attitudes (b, 3, 3) or None.

@@ -5,7 +5,7 @@
 //! scalar ()), and the leading axes are any batch/time axes: `energy` maps (..., d) to (...),
 //! `spatial_momentum` maps (..., 3) and (..., 3, 3) to (..., 3).
 
-use lieflow::Error;
+use lieflow::{check, Error};
 use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArrayDyn};
 use pyo3::prelude::*;
@@ -96,28 +96,37 @@ where
             got.join(", "),
         ))
     })?;
-    let count: usize = lead.iter().product();
-    let data: Vec<Vec<f64>> = inputs
-        .iter()
-        .zip(&views)
-        .map(|(inp, v)| {
-            let full: Vec<usize> = lead.iter().chain(inp.item).copied().collect();
-            // Broadcasting to a shape computed from this very input cannot fail.
-            v.broadcast(IxDyn(&full))
-                .map(|b| b.iter().copied().collect())
-                .ok_or_else(|| to_py(Error::shape(inp.what, shape_str(&full), "")))
-        })
-        .collect::<PyResult<_>>()?;
-    let lens: Vec<usize> = inputs.iter().map(|i| i.item.iter().product()).collect();
-    let out_len: usize = out_item.iter().product();
-    let mut out = vec![0.0; count * out_len];
-    let mut items: Vec<&[f64]> = Vec::with_capacity(inputs.len());
-    for (k, o) in out.chunks_mut(out_len.max(1)).enumerate().take(count) {
-        items.clear();
-        items.extend(data.iter().zip(&lens).map(|(d, &l)| &d[k * l..(k + 1) * l]));
-        f(&items, &mut o[..out_len]).map_err(to_py)?;
-    }
+    // The one guard of every mapped output: its size is checked and it is allocated fallibly
+    // (a broadcast input of 10¹⁰ items is refused, not an abort of the process).
     let shape: Vec<usize> = lead.iter().chain(out_item).copied().collect();
+    let names: Vec<&str> = inputs.iter().map(|i| i.what).collect();
+    let mut out = check::zeros(&names.join(", "), &shape).map_err(to_py)?;
+    let count: usize = lead.iter().product();
+    // Every input is read item by item from its broadcast view (no broadcast copy in memory).
+    let mut streams = Vec::with_capacity(inputs.len());
+    for (inp, v) in inputs.iter().zip(&views) {
+        let full: Vec<usize> = lead.iter().chain(inp.item).copied().collect();
+        // Broadcasting to a shape computed from this very input cannot fail.
+        let b = v
+            .broadcast(IxDyn(&full))
+            .ok_or_else(|| to_py(Error::shape(inp.what, shape_str(&full), "")))?;
+        streams.push(b.into_iter());
+    }
+    let mut scratch: Vec<Vec<f64>> = inputs
+        .iter()
+        .map(|i| vec![0.0; i.item.iter().product()])
+        .collect();
+    let out_len: usize = out_item.iter().product();
+    for k in 0..count {
+        for (s, it) in scratch.iter_mut().zip(&mut streams) {
+            // `zip` asks the slice first, so the stream is read by exactly one item.
+            for (x, y) in s.iter_mut().zip(it.by_ref()) {
+                *x = *y;
+            }
+        }
+        let items: Vec<&[f64]> = scratch.iter().map(|s| s.as_slice()).collect();
+        f(&items, &mut out[k * out_len..(k + 1) * out_len]).map_err(to_py)?;
+    }
     if shape.is_empty() {
         return Ok(PyFloat::new(py, out[0]).into_any());
     }

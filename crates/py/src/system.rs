@@ -13,7 +13,7 @@ use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple, PyType};
 
-use crate::convert::{shape_str, ArrayIn};
+use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::integrate::{Callbacks, Integration, RunOut};
 use crate::items::{map_items, Input};
@@ -108,7 +108,7 @@ fn block_rows(name: &str, block: Block, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, 
             shape_str(s),
         )));
     }
-    let data: Vec<f64> = v.iter().copied().collect();
+    let data = read_all(name, &v)?;
     check::finite_slice(name, &data).py()?;
     let rows = match block {
         Block::SoDual(n) => {
@@ -162,10 +162,12 @@ fn from_blocks<'py>(
     let lead = lead.unwrap_or_default();
     let b = lead.iter().product::<usize>();
     let d = space.dim();
-    let mut z = Vec::with_capacity(b * d);
+    let mut z = check::zeros("state0", &[b, d]).py()?;
+    let mut at = 0;
     for i in 0..b {
         for (rows, len) in &columns {
-            z.extend_from_slice(&rows[i * len..(i + 1) * len]);
+            z[at..at + len].copy_from_slice(&rows[i * len..(i + 1) * len]);
+            at += len;
         }
     }
     Ok((rows_array(py, z, d)?, !lead.is_empty()))
@@ -235,7 +237,7 @@ impl PySystem {
         if !(v.ndim() == 1 || v.ndim() == 2) || v.shape()[v.ndim() - 1] != d {
             return Err(bad());
         }
-        let data: Vec<f64> = v.iter().copied().collect();
+        let data = read_all("state0", &v)?;
         check::finite_slice("state0", &data).py()?;
         Ok((rows_array(py, data, d)?, v.ndim() == 2))
     }

@@ -290,6 +290,9 @@ impl GeneralizedRigidBody {
             return Err(Error::shape("J", "(n,) with n ≥ 2", format!("({n},)")));
         }
         check::finite_slice("J", j)?;
+        // The body keeps dense n×n tables (and its steppers n×n scratch): refuse what cannot be
+        // allocated instead of aborting.
+        check::dense_size("J", n, n)?;
         for (i, &ji) in j.iter().enumerate() {
             if ji < 0.0 {
                 return Err(Error::invalid("J", format!("J[{i}] = {ji} < 0")));

@@ -91,7 +91,7 @@ fn se3_compose<'py>(py: Python<'py>, g: ArrayIn<'py>, h: ArrayIn<'py>) -> PyResu
             format!("({}, 4, 4)", hs.len()),
         )));
     }
-    par_fill(py, n, bg || bh, |k| {
+    par_fill(py, "g, h", n, bg || bh, |k| {
         let g = SE3::from_matrix4(&gs[k.min(gs.len() - 1)])?;
         let h = SE3::from_matrix4(&hs[k.min(hs.len() - 1)])
             .map_err(|e| relabel(e, |w| format!("h ({w})")))?;

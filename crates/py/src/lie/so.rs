@@ -2,13 +2,13 @@
 //! `lieflow::lie::so` and `lieflow::lie::product`).
 
 use lieflow::lie::{product, so};
-use lieflow::{Mat, Result};
+use lieflow::{check, Mat, Result};
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::convert::{mat, mats, py_mat, py_mats, py_vec, py_vecs, vectors, ArrayIn};
+use crate::convert::{mat, mats, py_mat, py_mats, py_vec, py_vecs, read_all, vectors, ArrayIn};
 use crate::errors::IntoPy;
 
 /// Applies `f` to one matrix or to a batch (b, n, n). A batch is copied once into a contiguous
@@ -29,13 +29,10 @@ fn map_mats<'py>(
         // Let the core report the shape error of an empty matrix.
         f(&Mat::zeros(r, c)).py()?;
     }
-    let data: Vec<f64> = match v.as_slice() {
-        Some(s) => s.to_vec(),
-        None => v.iter().copied().collect(),
-    };
+    let data = read_all(what, &v)?;
+    let mut out = check::zeros(what, v.shape()).py()?;
     let out = py
         .detach(|| -> Result<Vec<f64>> {
-            let mut out = vec![0.0; data.len()];
             if b > 0 {
                 out.par_chunks_mut(r * c)
                     .zip(data.par_chunks(r * c))
@@ -69,13 +66,17 @@ fn map_mats<'py>(
 #[pyfunction]
 fn hat_n<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
     let (cs, batched) = vectors("c", &c)?;
+    // The (b, n, n) output is larger than the (b, d) input: check its size first.
+    let first = cs.first().map(|v| so::hat_n(v)).transpose().py()?;
+    let (rows, cols) = first.as_ref().map_or((0, 0), |m| (m.nrows(), m.ncols()));
+    check::array_size("c", &[cs.len(), rows, cols]).py()?;
     let out = cs
         .iter()
         .map(|v| so::hat_n(v))
         .collect::<Result<Vec<Mat>>>()
         .py()?;
     if batched {
-        Ok(py_mats(py, &out).into_any())
+        Ok(py_mats(py, "c", &out)?.into_any())
     } else {
         Ok(py_mat(py, &out[0]).into_any())
     }
@@ -98,7 +99,7 @@ fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
         .collect::<Result<Vec<Vec<f64>>>>()
         .py()?;
     if batched {
-        Ok(py_vecs(py, &out).into_any())
+        Ok(py_vecs(py, "xi", &out)?.into_any())
     } else {
         Ok(py_vec(py, &out[0]).into_any())
     }

@@ -1,0 +1,177 @@
+"""Hardening of the Python boundary (issue 16): one guard per class of bad input.
+
+- array arguments (`ArrayIn`, crates/py/src/convert.rs): real numbers only, a TypeError otherwise;
+- output and input buffers of mapped/batched calls (`lieflow::check::zeros`): refused with an
+  InvalidArgumentError naming the argument and the size instead of aborting the process;
+- `lf.integrate` arguments (python/lieflow/integrate.py): TypeError for wrong types;
+- states on SO(3)/S² and constructor sizes (core checks): no NaN, no non-rotation, no Γ = 0.
+"""
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import lieflow as lf
+
+BAD_ARRAYS = [
+    pytest.param(np.array([1 + 2j, 0, 0]), "dtype complex128", id="complex-array"),
+    pytest.param([1j, 0, 0], "dtype complex128", id="complex-list"),
+    pytest.param(np.array(["2020-01-01"] * 3, dtype="datetime64[D]"), "datetime64", id="datetime"),
+    pytest.param(np.zeros(3, dtype="m8[s]"), "timedelta64", id="timedelta"),
+    pytest.param("abc", "got a str", id="str"),
+    pytest.param(b"abc", "got a bytes", id="bytes"),
+    pytest.param(np.array(["1", "2", "3"]), "dtype <U1", id="str-array"),
+    pytest.param(np.array([1.0, 2.0, 3.0], dtype=object), "dtype object", id="object-array"),
+    pytest.param([1.0, None, 3.0], "ragged or holds non-numbers", id="list-with-None"),
+    pytest.param([[1.0, 2.0], [3.0]], "cannot read as an array", id="ragged"),
+    pytest.param(None, "got None", id="None"),
+]
+
+
+def _named(exc, name):
+    """pyo3 names the argument in a note (Python >= 3.11 keeps notes on exceptions)."""
+    notes = getattr(exc, "__notes__", None)
+    return notes is None or f"while processing '{name}'" in notes
+
+
+@pytest.mark.parametrize("bad, came", BAD_ARRAYS)
+def test_array_arguments_accept_real_numbers_only(bad, came):
+    calls = [
+        ("w", lambda: lf.lie.so3_exp(bad)),                             # batched (batch.rs)
+        ("states", lambda: lf.RigidBody([1, 2, 3]).energy(bad)),         # mapped (items.rs)
+        ("X", lambda: lf.pseudo_rigid.bi_inertia(bad)),                  # a matrix (convert::mat)
+        ("xi", lambda: lf.lie.so_exp(bad)),                              # so(n) batches
+        ("Gamma", lambda: lf.HeavyTop([1, 2, 3], 1.0).state([1, 2, 3], Gamma=bad)),
+    ]
+    for name, call in calls:
+        if bad is None and name == "Gamma":
+            continue                     # an optional argument: None means "not given"
+        with pytest.raises(TypeError, match="expected an array-like of real numbers") as info:
+            call()
+        assert came in str(info.value), (name, str(info.value))
+        assert not isinstance(info.value, ValueError)
+        assert _named(info.value, name), (name, info.value.__notes__)
+
+
+@pytest.mark.parametrize("good", [
+    [True, False, False], np.array([1, 0, 0], dtype=np.int32), np.array([1, 0, 0], np.uint8),
+    np.array([1, 0, 0], np.float32), np.array([1, 0, 0], np.float16), (1, 0, 0),
+    np.array([1.0, 0, 0], dtype=">f8"), np.array([1.0, 9.0, 0, 9.0, 0, 9.0])[::2],
+])
+def test_real_array_likes_are_cast_to_float64(good):
+    np.testing.assert_array_equal(lf.lie.so3_exp(good), lf.lie.so3_exp(np.array([1.0, 0, 0])))
+
+
+def test_scalars_and_0d_arrays_still_work():
+    assert lf.elliptic.ellipj(0.3, 0.5) == lf.elliptic.ellipj(np.float64(0.3), np.float32(0.5))
+    assert np.allclose(lf.elliptic.ellipj(np.array(0.3), False), lf.elliptic.ellipj(0.3, 0.0))
+    with pytest.raises(TypeError, match="complex"):
+        lf.elliptic.ellipj(0.3 + 0j, 0.5)
+
+
+# ------------------------------------------------- allocation: subprocesses, so an abort fails
+
+
+def _run(code, memory=6 << 30):
+    """Runs `code` in a child limited to `memory` bytes of address space (so that a regression
+    fails the allocation instead of exhausting the machine); returns (returncode, stderr)."""
+    prelude = textwrap.dedent(f"""
+        import resource
+        resource.setrlimit(resource.RLIMIT_AS, ({memory}, {memory}))
+        import numpy as np, lieflow as lf
+    """)
+    p = subprocess.run([sys.executable, "-c", prelude + textwrap.dedent(code)],
+                       capture_output=True, text=True, timeout=120)
+    return p.returncode, p.stderr
+
+
+HUGE = {
+    "so3_exp": ("lf.lie.so3_exp(np.broadcast_to(np.zeros(3), (10**10, 3)))", "w"),
+    "so_exp": ("lf.lie.so_exp(np.broadcast_to(np.zeros((3, 3)), (10**10, 3, 3)))", "xi"),
+    "se3_compose": ("lf.lie.se3_compose(np.eye(4), np.broadcast_to(np.eye(4), (10**10, 4, 4)))",
+                    "h"),
+    "hat_n": ("lf.lie.hat_n(np.broadcast_to(np.zeros(3), (10**10, 3)))", "c"),
+    "energy": ("lf.RigidBody([1, 2, 3]).energy(np.broadcast_to(np.ones(3), (10**10, 3)))",
+               "states"),
+    "spatial_momentum": ("lf.RigidBody([1, 2, 3]).spatial_momentum(np.ones(3), "
+                         "np.broadcast_to(np.eye(3), (10**10, 3, 3)))", "states, attitude"),
+    "ellipj": ("lf.elliptic.ellipj(np.broadcast_to(np.zeros(1), (10**11,)), 0.5)", "u, m"),
+    "GeneralizedRigidBody": ("lf.GeneralizedRigidBody(np.ones(10**5))", "J"),
+    "PseudoRigidBody": ("lf.PseudoRigidBody(10**5)", "n"),
+    "integrate_batch": ("lf.integrate(lf.RigidBody([1, 2, 3]), "
+                        "np.broadcast_to(np.ones(3), (10**10, 3)), dt=0.01, steps=1)", "state0"),
+    "run_steps": ("lf.RigidBody([1, 2, 3])._run(np.ones((1, 3)), None, 0.01, 10**12, 1, None)",
+                  "steps"),
+}
+
+
+@pytest.mark.parametrize("name", HUGE)
+def test_oversized_outputs_are_refused_not_aborted(name):
+    code, arg = HUGE[name]
+    rc, err = _run(f"""
+        try:
+            {code}
+        except lf.InvalidArgumentError as e:
+            print(e, file=__import__("sys").stderr)
+            raise SystemExit(3)
+    """)
+    assert rc == 3, err[-2000:]          # an abort is rc -6, a kill -9, a panic rc 1
+    assert f"invalid {arg}:" in err and ("exceed" in err or "memory" in err
+                                         or "allocate" in err), err
+
+
+def test_oversized_within_the_cap_is_refused_by_memory():
+    """3·10⁹ floats (22 GiB) is within the entry cap: the allocation itself must fail cleanly
+    (here under a 6 GiB address-space limit; without one, by the available-memory check)."""
+    rc, err = _run("""
+        try:
+            lf.lie.hat_n(np.broadcast_to(np.zeros(3), (10**9, 3)))
+        except lf.InvalidArgumentError as e:
+            print(e, file=__import__("sys").stderr)
+            raise SystemExit(3)
+    """)
+    assert rc == 3 and "invalid c:" in err, err[-2000:]
+
+
+# ------------------------------------------------------------ lf.integrate's own arguments
+
+
+@pytest.fixture
+def body():
+    return lf.RigidBody([1, 2, 3])
+
+
+@pytest.mark.parametrize("system, match", [
+    ("rb", "expected a lieflow system"),
+    (None, "expected a lieflow system"),
+    (np.zeros(3), "expected a lieflow system"),
+    (lf.RigidBody, "got the class RigidBody"),
+])
+def test_integrate_wants_a_system(system, match):
+    with pytest.raises(TypeError, match=match):
+        lf.integrate(system, [1, 0.5, -0.3], dt=0.01, steps=2)
+
+
+@pytest.mark.parametrize("kw, name", [
+    (dict(dt="0.01"), "dt"), (dict(dt=b"1"), "dt"), (dict(dt=[0.01]), "dt"),
+    (dict(dt=0.01j), "dt"), (dict(dt=True), "dt"), (dict(dt=None), "dt"),
+    (dict(steps="3"), "steps"), (dict(steps=3.0), "steps"), (dict(steps=None), "steps"),
+    (dict(steps=np.float64(3)), "steps"), (dict(save_every="1"), "save_every"),
+    (dict(save_every=1.5), "save_every"), (dict(chunk_steps="10"), "chunk_steps"),
+    (dict(threads=2.0), "threads"), (dict(method=b"rk4"), "method"),
+])
+def test_integrate_argument_types(body, kw, name):
+    args = dict(dt=0.01, steps=3) | kw
+    with pytest.raises(TypeError, match=f"invalid {name}"):
+        lf.integrate(body, [1, 0.5, -0.3], **args)
+
+
+def test_integrate_accepts_numpy_numbers(body):
+    tr = lf.integrate(body, [1, 0.5, -0.3], dt=np.float32(0.01), steps=np.int64(4),
+                      save_every=np.uint8(2))
+    assert tr.states.shape == (3, 3) and tr.dt == pytest.approx(0.01)
+    tr = lf.integrate(body, [1, 0.5, -0.3], dt=np.array(0.01), steps=2)
+    assert tr.t[-1] == pytest.approx(0.02)
