@@ -315,7 +315,7 @@ impl PySystem {
     ///     ShapeError, NonFiniteError.
     fn energy<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.map_states(py, &states, &[], |z, out| {
-            out[0] = self.sys.energy(z)?;
+            out[0] = lieflow::integrate::energy_checked(&*self.sys, z)?;
             Ok(())
         })
     }
@@ -331,7 +331,7 @@ impl PySystem {
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.map_states(py, &states, &[self.sys.invariant_count()], |z, out| {
-            out.copy_from_slice(&self.sys.invariants(z)?);
+            out.copy_from_slice(&lieflow::integrate::invariants_checked(&*self.sys, z)?);
             Ok(())
         })
     }

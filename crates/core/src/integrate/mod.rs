@@ -262,6 +262,36 @@ fn check_run(dt: f64, save_every: usize, t0: f64) -> Result<()> {
     Ok(())
 }
 
+/// The energy of a state with the guard of every observable: a non-finite value of a finite
+/// state is not passed on but reported as an overflow naming the system (e.g. ½|P|² beyond the
+/// f64 range for a state near 1e160).
+pub fn energy_checked<P: Problem + ?Sized>(problem: &P, z: &[f64]) -> Result<f64> {
+    let h = problem.energy(z)?;
+    if !h.is_finite() {
+        return Err(not_representable(problem.name(), "energy", z));
+    }
+    Ok(h)
+}
+
+/// The invariants (Casimirs, momentum maps) of a state with the guard of [`energy_checked`].
+pub fn invariants_checked<P: Problem + ?Sized>(problem: &P, z: &[f64]) -> Result<Vec<f64>> {
+    let c = problem.invariants(z)?;
+    if c.iter().any(|v| !v.is_finite()) {
+        return Err(not_representable(problem.name(), "invariants", z));
+    }
+    Ok(c)
+}
+
+fn not_representable(name: &str, what: &str, z: &[f64]) -> Error {
+    Error::overflow(
+        "state",
+        format!(
+            "the {what} of this {name} state: beyond the f64 range (largest |entry| {})",
+            crate::error::fmt_num(z.iter().fold(0.0f64, |m, v| m.max(v.abs())))
+        ),
+    )
+}
+
 /// Checks a state (user frame) against the problem's space and constraints.
 pub fn check_state<P: Problem + ?Sized>(problem: &P, z: &[f64]) -> Result<()> {
     problem.space().check("state", z)?;

@@ -105,6 +105,30 @@ pub fn check_det_positive(what: &str, group: &str, x: &Mat) -> Result<()> {
     Ok(())
 }
 
+/// The power of two nearest below max |x_ij| (1 for a zero or non-finite matrix): dividing by it
+/// is exact and brings the largest entry into [1, 2).
+pub fn pow2_scale(x: &Mat) -> f64 {
+    let m = (0..x.ncols())
+        .flat_map(|j| (0..x.nrows()).map(move |i| (i, j)))
+        .fold(0.0f64, |m, (i, j)| m.max(x[(i, j)].abs()));
+    pow2_below(m)
+}
+
+/// The power of two 2^⌊log₂ m⌋ for a finite m > 0 (1 otherwise).
+pub fn pow2_below(m: f64) -> f64 {
+    if !(m.is_finite() && m > 0.0) {
+        return 1.0;
+    }
+    let e = m.log2().floor() as i32;
+    let c = 2f64.powi(e);
+    // powi of a negative exponent below −1022 is subnormal but exact; correct log2 rounding.
+    if c > m {
+        c * 0.5
+    } else {
+        c
+    }
+}
+
 /// SVD coordinates (R, a, S) of X ∈ GL⁺(n): X = R diag(a) Sᵀ (001 (2.4), S⁻¹ = Sᵀ).
 #[derive(Debug, Clone)]
 pub struct SvdCoordinates {
@@ -141,6 +165,14 @@ impl SvdCoordinates {
         Ok(())
     }
 
+    /// The singular values scaled to a₁ ∈ [1, 2): (ã, c) with a = c·ã and c a power of two
+    /// (exact). Formulas homogeneous in a are evaluated on ã and rescaled once at the end, so
+    /// that a_i² or a_i⁴ neither overflow nor underflow where the result is representable.
+    pub fn unit(&self) -> (Vec<f64>, f64) {
+        let c = pow2_below(self.a[0]);
+        (self.a.iter().map(|&v| v / c).collect(), c)
+    }
+
     /// X = R diag(a) Sᵀ.
     pub fn matrix(&self) -> Mat {
         let n = self.a.len();
@@ -158,7 +190,11 @@ impl SvdCoordinates {
 /// Errors: shape, non-finite, or det X ≤ 0 ([`check_gl_plus`]).
 pub fn svd_coordinates(x: &Mat) -> Result<SvdCoordinates> {
     let n = check_gl_plus("X", x)?;
-    let svd = x.svd().map_err(|e| Error::NotConverged {
+    // Scale-safe: the SVD of X/c with c a power of two near max |X_ij| (exact, so nothing
+    // changes for moderate X), then a = c·ã; faer's SVD fails on entries near 1e160 or 1e-170.
+    let c = pow2_scale(x);
+    let xs = x * faer::Scale(1.0 / c);
+    let svd = xs.svd().map_err(|e| Error::NotConverged {
         what: format!("SVD of X ({e:?})"),
         iterations: 0,
         residual: f64::NAN,
@@ -166,7 +202,7 @@ pub fn svd_coordinates(x: &Mat) -> Result<SvdCoordinates> {
     })?;
     let mut r = svd.U().to_owned();
     let mut s = svd.V().to_owned();
-    let a: Vec<f64> = svd.S().column_vector().iter().copied().collect();
+    let a: Vec<f64> = svd.S().column_vector().iter().map(|&v| v * c).collect();
     if det(&r) < 0.0 {
         for i in 0..n {
             r[(i, n - 1)] = -r[(i, n - 1)];

@@ -46,16 +46,22 @@ fn tangent(b: &BiInertia, y: &Mat) -> Result<()> {
 
 /// Left connection ω^L_X(Y) = (A^L_X)⁻¹(YXᵀ − XYᵀ) (001 (2.14)); defined on all of GL⁺(n).
 /// ω^L(ξX) = ξ and ω^L_{gX} = Ad_g ∘ ω^L_X (2.16).
+///
+/// Scale-aware, as every connection here: J is formed with X̃ = X/c (c a power of two near the
+/// largest singular value, [`BiInertia::unit_x`]) and the inverse on the scaled singular values,
+/// ω_X(Y) = ω_X̃(Y/c), so X at 1e-200 or 1e200 gives ω wherever ω is representable.
 pub fn left_connection(b: &BiInertia, y: &Mat) -> Result<Mat> {
     tangent(b, y)?;
-    b.left_solve(&momentum_map_unchecked(b.x(), y).0)
+    let (xs, _) = b.unit_x()?;
+    b.left_solve_scaled(&momentum_map_unchecked(&xs, y).0, 1)
 }
 
 /// Right connection ω^R_X(Y) = (A^R_X)⁻¹(YᵀX − XᵀY) (001 (2.15)); defined on all of GL⁺(n).
 /// ω^R(Xηᵀ) = η and ω^R_{Xh⁻¹} = Ad_h ∘ ω^R_X (2.17).
 pub fn right_connection(b: &BiInertia, y: &Mat) -> Result<Mat> {
     tangent(b, y)?;
-    b.right_solve(&momentum_map_unchecked(b.x(), y).1)
+    let (xs, _) = b.unit_x()?;
+    b.right_solve_scaled(&momentum_map_unchecked(&xs, y).1, 1)
 }
 
 /// Bi-connection ω^B_X(Y) = B_X⁻¹((YXᵀ − XYᵀ) ⊕ (YᵀX − XᵀY)) (001 (6.18)), by the closed-form
@@ -65,8 +71,9 @@ pub fn right_connection(b: &BiInertia, y: &Mat) -> Result<Mat> {
 /// B_X⁻¹ B_X (ξ ⊕ η), since J(X, ξX + Xηᵀ) = B_X(ξ ⊕ η) (checked numerically).
 pub fn bi_connection(b: &BiInertia, y: &Mat) -> Result<(Mat, Mat)> {
     tangent(b, y)?;
-    let (l, g) = momentum_map_unchecked(b.x(), y);
-    b.solve(&l, &g)
+    let (xs, _) = b.unit_x()?;
+    let (l, g) = momentum_map_unchecked(&xs, y);
+    b.solve_scaled(&l, &g, 1)
 }
 
 /// The vertical vector (ξ ⊕ η)_P(X) = ξX + Xηᵀ induced by ξ ⊕ η ∈ so(n) ⊕ so(n) (001 (6.17));
@@ -89,15 +96,17 @@ pub(crate) fn vertical_unchecked(x: &Mat, xi: &Mat, eta: &Mat) -> Mat {
 /// ω^B on the principal one) — the one-sided splits (2.22) likewise.
 pub fn vertical_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
     tangent(b, y)?;
-    let x = b.x();
     let zero = Mat::zeros(b.n(), b.n());
-    let (l, g) = momentum_map_unchecked(x, y);
+    // Scale-aware (see [`left_connection`]): ξ ⊕ η = B_X⁺ J(X, Y) = B_X̃⁺ J(X̃, Y)/c, and the
+    // vertical vector ξX + Xηᵀ = (ξ̃X̃ + X̃η̃ᵀ) with ξ̃ = cξ.
+    let (xs, _) = b.unit_x()?;
+    let (l, g) = momentum_map_unchecked(&xs, y);
     let (xi, eta) = match action {
-        Action::Left => (b.left_solve(&l)?, zero),
-        Action::Right => (zero, b.right_solve(&g)?),
-        Action::TwoSided => b.solve_least_squares(&l, &g)?,
+        Action::Left => (b.left_solve_scaled(&l, 0)?, zero),
+        Action::Right => (zero, b.right_solve_scaled(&g, 0)?),
+        Action::TwoSided => b.solve_least_squares_scaled(&l, &g, 0)?,
     };
-    Ok(vertical_unchecked(x, &xi, &eta))
+    Ok(vertical_unchecked(&xs, &xi, &eta))
 }
 
 /// Horizontal part Y − vertical part (001 (2.20)–(2.22), (6.6), (6.23)): the left one satisfies
@@ -114,7 +123,11 @@ pub fn horizontal_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
 /// ‖ξX + Xηᵀ‖² = 2 tr(ξXηXᵀ) − tr(ξ²XXᵀ) − tr(η²XᵀX) = ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ with the pairing
 /// (6.8), polarised. O(n⁶) (a Gram matrix of n(n−1) vectors in R^{n²}): a check, not a hot
 /// path.
-pub fn locked_inertia(b: &BiInertia, action: Action) -> Mat {
+///
+/// Scale-aware: computed at X̃ = X/c ([`BiInertia::unit_x`]) and multiplied by c² once; an
+/// overflow error (InvalidArgument) where an entry exceeds the f64 range.
+pub fn locked_inertia(b: &BiInertia, action: Action) -> Result<Mat> {
+    let (xs, scale) = b.unit_x()?;
     let (n, d) = (b.n(), so::dim(b.n()));
     let zero = Mat::zeros(n, n);
     let blocks = if action == Action::TwoSided { 2 } else { 1 };
@@ -124,13 +137,13 @@ pub fn locked_inertia(b: &BiInertia, action: Action) -> Mat {
             c[k] = 1.0;
             let e = so::hat_n_unchecked(n, &c[..d]);
             match action {
-                Action::Left => vertical_unchecked(b.x(), &e, &zero),
-                Action::Right => vertical_unchecked(b.x(), &zero, &e),
-                Action::TwoSided => vertical_unchecked(b.x(), &e, &so::hat_n_unchecked(n, &c[d..])),
+                Action::Left => vertical_unchecked(&xs, &e, &zero),
+                Action::Right => vertical_unchecked(&xs, &zero, &e),
+                Action::TwoSided => vertical_unchecked(&xs, &e, &so::hat_n_unchecked(n, &c[d..])),
             }
         })
         .collect();
-    Mat::from_fn(blocks * d, blocks * d, |p, q| {
+    let gram = Mat::from_fn(blocks * d, blocks * d, |p, q| {
         let (u, v) = (&vectors[p], &vectors[q]);
         let mut s = 0.0;
         for j in 0..n {
@@ -139,5 +152,6 @@ pub fn locked_inertia(b: &BiInertia, action: Action) -> Mat {
             }
         }
         s
-    })
+    });
+    super::inertia::rescale("the locked inertia tensor", gram, scale, -2)
 }

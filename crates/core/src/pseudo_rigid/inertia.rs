@@ -8,7 +8,7 @@
 
 use std::sync::OnceLock;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::lie::gl::{self, SvdCoordinates};
 use crate::lie::so;
 use crate::Mat;
@@ -65,6 +65,32 @@ fn operator_matrix(n: usize, blocks: usize, f: impl Fn(&[Mat]) -> Vec<Mat>) -> M
 /// Built by [`BiInertia::new`] (which checks X ∈ GL⁺(n)); computes and caches XXᵀ, XᵀX and the
 /// SVD coordinates X = R A Sᵀ on first use. Operators act on skew-symmetric n×n matrices; matrices are
 /// in the e_ij basis of DESIGN.md with the ξ block first.
+/// m / c^k for a power of two c (exact where representable), or an overflow error naming `what`
+/// where an entry leaves the f64 range (the result of a scale-aware formula that is not
+/// representable).
+pub(crate) fn rescale(what: &str, mut m: Mat, c: f64, k: i32) -> Result<Mat> {
+    let f = 1.0 / c;
+    for _ in 0..k.max(0) {
+        m *= faer::Scale(f);
+    }
+    for _ in 0..(-k).max(0) {
+        m *= faer::Scale(c);
+    }
+    let big = (0..m.ncols())
+        .flat_map(|j| (0..m.nrows()).map(move |i| (i, j)))
+        .any(|(i, j)| !m[(i, j)].is_finite());
+    if big {
+        return Err(Error::overflow(
+            "X",
+            format!(
+                "{what} exceeds the f64 range at this scale of X (it scales like a₁^{}, a₁ ≈ {c:.3e})",
+                -k
+            ),
+        ));
+    }
+    Ok(m)
+}
+
 #[derive(Debug, Clone)]
 pub struct BiInertia {
     x: Mat,
@@ -160,6 +186,20 @@ impl BiInertia {
 
     /// B_X as an n(n−1)×n(n−1) matrix in the e_ij basis, ξ block first (001 (6.9)); its blocks
     /// are the matrices of A^L_X, −2Ad_X, −2Adᵀ_X, A^R_X.
+    /// [`BiInertia::matrix`] scale-safely: c² B_X̃ with X̃ = X/c ([`BiInertia::unit_x`]), and an
+    /// overflow error (InvalidArgument) where an entry exceeds the f64 range (B_X grows like
+    /// a₁², so X beyond ~1e154 has no representable bi-inertia matrix).
+    pub fn try_matrix(&self) -> Result<Mat> {
+        let (xs, c) = self.unit_x()?;
+        let unit = BiInertia {
+            x: xs,
+            xxt: OnceLock::new(),
+            xtx: OnceLock::new(),
+            svd: OnceLock::new(),
+        };
+        rescale("the bi-inertia tensor B_X", unit.matrix(), c, -2)
+    }
+
     pub fn matrix(&self) -> Mat {
         operator_matrix(self.n(), 2, |v| {
             let (a, b) = self.apply_unchecked(&v[0], &v[1]);
@@ -191,15 +231,35 @@ impl BiInertia {
     /// ξ = R ξ' Rᵀ with ξ'_ij = λ'_ij / (a_i² + a_j²) (A^L_A acts entrywise, 001 (8.14)).
     pub fn left_solve(&self, lam: &Mat) -> Result<Mat> {
         self.arg("lam", lam)?;
+        self.left_solve_scaled(lam, 2)
+    }
+
+    /// (A^L_X̃)⁻¹ λ / c^k with X̃ = X/c, c = [`SvdCoordinates::unit`]'s scale: the solve on
+    /// singular values near one, rescaled once (k = 2 for λ itself, k = 1 for a λ computed from
+    /// X̃ as the connections do), with an overflow error where the result is not representable.
+    pub(crate) fn left_solve_scaled(&self, lam: &Mat, k: i32) -> Result<Mat> {
         let c = self.svd()?;
-        Ok(Self::diagonal_solve(&c.r, &c.a, lam))
+        let (u, scale) = c.unit();
+        rescale("(A^L_X)⁻¹ λ", Self::diagonal_solve(&c.r, &u, lam), scale, k)
+    }
+
+    /// The scale c of [`SvdCoordinates::unit`] and X̃ = X/c (exact: c is a power of two).
+    pub(crate) fn unit_x(&self) -> Result<(Mat, f64)> {
+        let (_, c) = self.svd()?.unit();
+        Ok((&self.x * faer::Scale(1.0 / c), c))
     }
 
     /// (A^R_X)⁻¹ γ, on all of GL⁺(n): as [`BiInertia::left_solve`] in the frame S of XᵀX = S A² Sᵀ.
     pub fn right_solve(&self, gam: &Mat) -> Result<Mat> {
         self.arg("gam", gam)?;
+        self.right_solve_scaled(gam, 2)
+    }
+
+    /// The right analogue of [`BiInertia::left_solve_scaled`].
+    pub(crate) fn right_solve_scaled(&self, gam: &Mat, k: i32) -> Result<Mat> {
         let c = self.svd()?;
-        Ok(Self::diagonal_solve(&c.s, &c.a, gam))
+        let (u, scale) = c.unit();
+        rescale("(A^R_X)⁻¹ γ", Self::diagonal_solve(&c.s, &u, gam), scale, k)
     }
 
     fn diagonal_solve(frame: &Mat, a: &[f64], rhs: &Mat) -> Mat {
@@ -220,10 +280,17 @@ impl BiInertia {
     pub fn solve(&self, lam: &Mat, gam: &Mat) -> Result<(Mat, Mat)> {
         self.arg("lam", lam)?;
         self.arg("gam", gam)?;
+        self.solve_scaled(lam, gam, 2)
+    }
+
+    /// B_X̃⁻¹ (λ ⊕ γ) / c^k on the singular values scaled near one (see
+    /// [`BiInertia::left_solve_scaled`]).
+    pub(crate) fn solve_scaled(&self, lam: &Mat, gam: &Mat, k: i32) -> Result<(Mat, Mat)> {
         let c = self.svd()?;
         c.require_principal("bi-inertia inverse B_X⁻¹")?;
         let (l, g) = (conj_t(&c.r, lam), conj_t(&c.s, gam));
-        let a = &c.a;
+        let (a, scale) = c.unit();
+        let a = &a;
         let coef = |i: usize, j: usize| {
             let (s, p) = (a[i] * a[i] + a[j] * a[j], 2.0 * a[i] * a[j]);
             let d = (a[i] * a[i] - a[j] * a[j]).powi(2);
@@ -238,7 +305,11 @@ impl BiInertia {
             let (s, p) = coef(i, j);
             s * g[(i, j)] + p * l[(i, j)]
         });
-        Ok((conj(&c.r, &xi), conj(&c.s, &eta)))
+        let what = "B_X⁻¹ (λ ⊕ γ)";
+        Ok((
+            rescale(what, conj(&c.r, &xi), scale, k)?,
+            rescale(what, conj(&c.s, &eta), scale, k)?,
+        ))
     }
 
     /// The minimum-norm least-squares solution B_X⁺(λ ⊕ γ), defined on every stratum: in the SVD
@@ -249,9 +320,20 @@ impl BiInertia {
     pub fn solve_least_squares(&self, lam: &Mat, gam: &Mat) -> Result<(Mat, Mat)> {
         self.arg("lam", lam)?;
         self.arg("gam", gam)?;
+        self.solve_least_squares_scaled(lam, gam, 2)
+    }
+
+    /// B_X̃⁺ (λ ⊕ γ) / c^k (see [`BiInertia::left_solve_scaled`]).
+    pub(crate) fn solve_least_squares_scaled(
+        &self,
+        lam: &Mat,
+        gam: &Mat,
+        k: i32,
+    ) -> Result<(Mat, Mat)> {
         let c = self.svd()?;
         let (l, g) = (conj_t(&c.r, lam), conj_t(&c.s, gam));
-        let a = &c.a;
+        let (a, scale) = c.unit();
+        let a = &a;
         let tol = gl::STRATUM_TOL * a[0];
         // Halves of the components along (1, 1) and (1, −1), divided by their eigenvalues.
         let parts = |i: usize, j: usize| {
@@ -272,7 +354,11 @@ impl BiInertia {
             let (p, m) = parts(i, j);
             p - m
         });
-        Ok((conj(&c.r, &xi), conj(&c.s, &eta)))
+        let what = "B_X⁻¹ (λ ⊕ γ)";
+        Ok((
+            rescale(what, conj(&c.r, &xi), scale, k)?,
+            rescale(what, conj(&c.s, &eta), scale, k)?,
+        ))
     }
 
     /// Eigen-decomposition of B_X on all of GL⁺(n) (001 (8.14)–(8.15) with (6.11)): the

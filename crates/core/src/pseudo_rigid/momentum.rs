@@ -7,7 +7,7 @@
 use nalgebra::Vector3;
 
 use super::inertia::BiInertia;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::lie::gl::{self, SvdCoordinates};
 use crate::lie::so;
 use crate::{check, Mat};
@@ -73,16 +73,29 @@ pub fn to_body(x: &Mat, v: &Mat) -> Result<Body> {
     let n = check_state(x, v)?;
     let c = gl::svd_coordinates(x)?;
     c.require_principal("body coordinates (Ω, Λ)")?;
+    // Scale-aware: Ω, Λ are of degree −1 in a, so they are formed from ã = a/c (c a power of
+    // two, [`SvdCoordinates::unit`]) and divided by c once; a_j² − a_i² would underflow below
+    // ~1e-154 and overflow above ~1e154.
+    let (u, scale) = c.unit();
     let SvdCoordinates { r, a, s } = c;
     let m = r.transpose() * v * &s;
     let mut omega = Mat::zeros(n, n);
     let mut lambda = Mat::zeros(n, n);
     for i in 0..n {
         for j in i + 1..n {
-            let den = a[j] * a[j] - a[i] * a[i];
+            let den = (u[j] - u[i]) * (u[j] + u[i]);
             let (mij, mji) = (m[(i, j)], m[(j, i)]);
-            let o = (a[j] * mij + a[i] * mji) / den;
-            let l = (a[i] * mij + a[j] * mji) / den;
+            let o = (u[j] * mij + u[i] * mji) / den / scale;
+            let l = (u[i] * mij + u[j] * mji) / den / scale;
+            if !(o.is_finite() && l.is_finite()) {
+                return Err(Error::overflow(
+                    "V",
+                    format!(
+                        "the body velocities Ω, Λ exceed the f64 range (|V| / a ≈ {})",
+                        crate::error::fmt_num(m.norm_l2() / a[n - 1])
+                    ),
+                ));
+            }
             omega[(i, j)] = o;
             omega[(j, i)] = -o;
             lambda[(i, j)] = l;

@@ -132,7 +132,37 @@ pub fn value(pot: &dyn Potential, x: &Mat) -> Result<f64> {
     let n = check::square("X", x, 2)?;
     let mut ws = Workspace::new(n);
     check_point(pot, x, &mut ws)?;
-    Ok(pot.value(x.as_ref(), &mut ws))
+    let u = pot.value(x.as_ref(), &mut ws);
+    if !u.is_finite() {
+        return Err(not_representable("U(X)", x));
+    }
+    Ok(u)
+}
+
+/// The error of the checked evaluations when a finite X in the domain gives a non-finite result:
+/// the quantity exceeds the f64 range there (e.g. U = μ tr E² with E ~ XᵀX/2 beyond 1e77, or a
+/// volumetric det(X)^{1−γ} with a large γ), named with the scale of X.
+fn not_representable(what: &str, x: &Mat) -> Error {
+    Error::overflow(
+        "X",
+        format!(
+            "{what} exceeds the f64 range at this X (‖X‖_F = {:.3e}); rescale the problem",
+            (crate::lie::scaled_norm(
+                (0..x.ncols())
+                    .flat_map(|j| (0..x.nrows()).map(move |i| x[(i, j)]))
+                    .collect::<Vec<_>>()
+                    .iter()
+            ))
+        ),
+    )
+}
+
+/// `m`, or [`not_representable`] if an entry is not finite.
+fn finite_result(what: &str, x: &Mat, m: Mat) -> Result<Mat> {
+    if check::finite_mat(what, &m).is_err() {
+        return Err(not_representable(what, x));
+    }
+    Ok(m)
 }
 
 /// ∂U/∂X, checked like [`value`].
@@ -142,7 +172,7 @@ pub fn gradient(pot: &dyn Potential, x: &Mat) -> Result<Mat> {
     check_point(pot, x, &mut ws)?;
     let mut g = Mat::zeros(n, n);
     pot.add_gradient(x.as_ref(), g.as_mut(), &mut ws);
-    Ok(g)
+    finite_result("the gradient ∂U/∂X", x, g)
 }
 
 /// The Hessian applied to a direction, D²U(X)\[V\] = d/dε ∂U/∂X(X + εV)|_{ε=0}
@@ -154,7 +184,7 @@ pub fn hessian_product(pot: &dyn Potential, x: &Mat, v: &Mat) -> Result<Mat> {
     check_point(pot, x, &mut ws)?;
     let mut h = Mat::zeros(n, n);
     pot.add_hessian(x.as_ref(), v.as_ref(), h.as_mut(), &mut ws);
-    Ok(h)
+    finite_result("the Hessian product D²U(X)[V]", x, h)
 }
 
 /// The Hessian of U at X as an n²×n² matrix in the row-major vec(X) basis: entry
@@ -183,7 +213,7 @@ pub fn hessian(pot: &dyn Potential, x: &Mat) -> Result<Mat> {
             }
         }
     }
-    Ok(h)
+    finite_result("the Hessian D²U(X)", x, h)
 }
 
 /// U = 0: the free pseudo-rigid body, whose motions are straight lines X(t) = X₀ + tP₀.

@@ -78,7 +78,7 @@ pub fn right_inertia<'py>(
 ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
 #[pyfunction]
 pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(py, &at_dense(&X)?.matrix()))
+    Ok(py_mat(py, &at_dense(&X)?.try_matrix().py()?))
 }
 
 /// B_X(xi + eta) = (A^L_X xi - 2 X eta X^T, -2 X^T xi X + A^R_X eta) (001 (6.9), (6.10)).
@@ -252,7 +252,10 @@ pub fn horizontal_part<'py>(
 #[pyo3(signature = (X, action = "two-sided"))]
 pub fn locked_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, action: &str) -> PyResult<Arr2<'py>> {
     let action: Action = action.parse().py()?;
-    Ok(py_mat(py, &cn::locked_inertia(&at_dense(&X)?, action)))
+    Ok(py_mat(
+        py,
+        &cn::locked_inertia(&at_dense(&X)?, action).py()?,
+    ))
 }
 
 /// Angular momentum L = V X^T - X V^T (001 (2.29), (7.3)) of a velocity or momentum V at X.

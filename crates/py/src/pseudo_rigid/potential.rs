@@ -38,8 +38,10 @@ impl PyPotential {
     /// Raises:
     ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0 for a volumetric term).
     fn value(&self, X: ArrayIn<'_>) -> PyResult<f64> {
-        let v = pot::value(&*self.inner, &mat("X", &X)?).py()?;
+        // A callable's own error (exception, non-finite return) first, then the core's.
+        let v = pot::value(&*self.inner, &mat("X", &X)?);
         self.take_callback_error()?;
+        let v = v.py()?;
         Ok(v)
     }
 
@@ -49,8 +51,9 @@ impl PyPotential {
         py: Python<'py>,
         X: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let g = pot::gradient(&*self.inner, &mat("X", &X)?).py()?;
+        let g = pot::gradient(&*self.inner, &mat("X", &X)?);
         self.take_callback_error()?;
+        let g = g.py()?;
         Ok(py_mat(py, &g))
     }
 
@@ -66,8 +69,9 @@ impl PyPotential {
         X: ArrayIn<'py>,
         V: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let h = pot::hessian_product(&*self.inner, &mat("X", &X)?, &mat("V", &V)?).py()?;
+        let h = pot::hessian_product(&*self.inner, &mat("X", &X)?, &mat("V", &V)?);
         self.take_callback_error()?;
+        let h = h.py()?;
         Ok(py_mat(py, &h))
     }
 
@@ -153,25 +157,29 @@ impl CallablePotential {
         f.bind(py).call1((py_mat(py, &x.to_owned()),))
     }
 
-    /// Adds the (n, n) array returned by a callable (`what` names it in errors) to `out`, or
-    /// records the error and fills `out` with NaN.
+    /// Adds the (n, n) array returned by the callable `f` (`what` names the quantity in
+    /// errors) to `out`, or records the error (also for a non-finite entry: NonFiniteError
+    /// naming the callable and the entry) and fills `out` with NaN.
     fn add_returned(
         &self,
         what: &str,
+        f: &Bound<'_, PyAny>,
         returned: PyResult<Bound<'_, PyAny>>,
         mut out: faer::MatMut<'_, f64>,
     ) {
         let n = out.nrows();
+        let what = format!("{what} returned by the callable {}", callable_name(f));
         let m = returned.and_then(|g| {
             let g: ArrayIn<'_> = g.extract()?;
-            let m = mat(what, &g)?;
+            let m = mat(&what, &g)?;
             if m.nrows() != n || m.ncols() != n {
                 return Err(to_py(Error::shape(
-                    what,
+                    &what,
                     format!("({n}, {n})"),
                     format!("({}, {})", m.nrows(), m.ncols()),
                 )));
             }
+            lieflow::check::finite_mat(&what, &m).py()?;
             Ok(m)
         });
         match m {
@@ -184,13 +192,36 @@ impl CallablePotential {
     }
 }
 
+/// A user callable as errors name it: its `__qualname__` (or `__name__`, or repr) in backquotes.
+fn callable_name(f: &Bound<'_, PyAny>) -> String {
+    let name = ["__qualname__", "__name__"]
+        .iter()
+        .find_map(|a| f.getattr(*a).ok().and_then(|n| n.extract::<String>().ok()))
+        .or_else(|| f.repr().ok().map(|r| r.to_string()))
+        .unwrap_or_else(|| "?".into());
+    format!("`{name}`")
+}
+
 impl pot::Potential for CallablePotential {
     fn value(&self, x: faer::MatRef<'_, f64>, _ws: &mut Workspace) -> f64 {
         Python::attach(|py| {
-            match self
+            let value = self
                 .call(py, &self.value, x)
                 .and_then(|v| v.extract::<f64>())
-            {
+                .and_then(|v| {
+                    if v.is_finite() {
+                        return Ok(v);
+                    }
+                    let f = self.value.bind(py);
+                    Err(to_py(Error::NonFinite {
+                        what: format!(
+                            "the value U(X) returned by the callable {}",
+                            callable_name(f)
+                        ),
+                        location: format!("its return value ({v})"),
+                    }))
+                });
+            match value {
                 Ok(v) => v,
                 Err(e) => {
                     self.record(e);
@@ -208,7 +239,7 @@ impl pot::Potential for CallablePotential {
     ) {
         Python::attach(|py| {
             let g = self.call(py, &self.gradient, x);
-            self.add_returned("gradient returned by the callable", g, out);
+            self.add_returned("the gradient", self.gradient.bind(py), g, out);
         });
     }
 
@@ -227,7 +258,7 @@ impl pot::Potential for CallablePotential {
                 let h = hessian
                     .bind(py)
                     .call1((py_mat(py, &x.to_owned()), py_mat(py, &v.to_owned())));
-                self.add_returned("hessian returned by the callable", h, out);
+                self.add_returned("the Hessian product", hessian.bind(py), h, out);
             });
             return;
         }
