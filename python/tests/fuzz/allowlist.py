@@ -1,0 +1,73 @@
+"""What the fuzz suite tolerates, each entry with its reason.
+
+ALLOWED: failing-class results that are intended behaviour (matched by spec id, argument name and
+bad-value name, shell-style patterns, and the outcome). They are counted as `allowed` in the
+summary and never fail a test.
+
+INFINITE_OK: result attributes that may legitimately be infinite (a value, not an overflow).
+
+ISSUE_ITEMS: every failing-result group and the issue item it belongs to.
+
+KNOWN_FAILING: the groups that still fail in the quick tier (open items of issue 16, or found by
+this suite); their tests are xfail(strict=False). Remove a name when its fix lands: the test then
+guards it.
+"""
+
+from fnmatch import fnmatchcase
+
+# (spec id, argument, bad value, outcome, reason)
+ALLOWED = [
+    ("lie.is_rotation", "R", "*inf", "accepted-bad",
+     "is_rotation is a predicate: a non-finite matrix is not a rotation (False), not an error"),
+    ("lie.is_rotation", "R", "nan", "accepted-bad",
+     "is_rotation is a predicate: a non-finite matrix is not a rotation (False), not an error"),
+    ("RollingDisks", "gamma[12]", "complex*", "accepted-bad",
+     "gamma1/gamma2 are points of the plane and may be given as complex numbers"),
+]
+
+INFINITE_OK = {
+    "angular_velocity_range": "RollingDisksEquilibrium: (lo, inf) when the angular velocity is "
+                              "unbounded above",
+}
+
+# group -> the issue item it belongs to (the xfail reason)
+ISSUE_ITEMS = {
+    "panic": "issue 16 'Panic across the FFI' (stratum at large n)",
+    "abort-alloc": "issue 16 'Process abort on allocation failure' (unchecked output allocations)",
+    "silent-nan:integrate": "issue 16 'Silent NaN' - integrate at huge dt / |M|",
+    "silent-nan:lie": "issue 16 'Silent NaN' - exponentials at |w| >= 1e16 (one rule for all)",
+    "silent-nan:pseudo_rigid": "issue 16 'Silent NaN' - pseudo-rigid functions at small/large scales",
+    "silent-nan:systems": "issue 16 'Silent NaN' - system observables at large scales (casimirs ...)",
+    "accepted-nan": "issue 16 'Bad input accepted' - NaN in states/attitudes, callables returning NaN",
+    "accepted-complex": "issue 16 'Bad input accepted' - complex/datetime64 arrays",
+    "accepted-nonrotation": "issue 16 'Bad input accepted' - attitude that is not a rotation",
+    "accepted-str-scalar": "issue 16 'Bad input accepted' - dt='0.01' and other numeric strings",
+    "accepted-shape": "issue 16 'Bad input accepted' - shapes accepted by casting (bi_inertia(eye(1)) ...)",
+    "accepted-conversion": "issue 16 'Bad input accepted' - objects/strings/None cast or ignored",
+    "accepted-range": "issue 16 'Bad input accepted' - out-of-range sizes/parameters",
+    "accepted-nonskew": "issue 16 'Bad input accepted' - non-skew matrix taken as so(n)",
+    "wrong-type:ValueError": "issue 16 'Wrong exception types' - bare numpy ValueError (563 cases)",
+    "wrong-type:TypeError-unnamed": "issue 16 'Wrong exception types' - TypeError not naming the argument",
+    "wrong-type:OverflowError": "issue 16 'Wrong exception types' - OverflowError for huge ints",
+    "wrong-type:integrate-system": "issue 16 'Wrong exception types' - lf.integrate('rb', ...)",
+    "wrong-type:MemoryError": "issue 16 'Process abort on allocation failure' - numpy MemoryError "
+                              "(materialising a broadcast view) instead of a typed size error",
+    "wrong-type:other": "issue 16 'Wrong exception types' - other exception types",
+    "rejected-valid": "found by this suite: WeakFieldTop(...).methods() raises TypeError "
+                      "(_example_args passes gm positionally to a keyword-only argument)",
+    "wrong-result": "found by this suite: a non-contiguous/list/read-only input gives another result",
+    "mutated": "issue 16 'no input was ever mutated' (kept as a guard)",
+    "harness": "an error of the fuzz suite itself",
+}
+
+KNOWN_FAILING = {g: ISSUE_ITEMS[g] for g in [
+    "abort-alloc", "silent-nan:lie", "silent-nan:pseudo_rigid", "silent-nan:systems",
+    "accepted-nan", "accepted-complex", "accepted-nonrotation", "accepted-shape",
+    "accepted-conversion", "wrong-type:ValueError", "wrong-type:TypeError-unnamed",
+    "wrong-type:OverflowError", "wrong-type:MemoryError", "rejected-valid",
+]}
+
+
+def allowed(spec_id: str, arg: str, bad: str, outcome: str) -> bool:
+    return any(fnmatchcase(spec_id, s) and fnmatchcase(arg, a) and fnmatchcase(bad, b) and outcome == o
+               for s, a, b, o, _ in ALLOWED)

@@ -1,0 +1,500 @@
+"""The one table of valid example calls: every public callable of lieflow with a valid value and
+a kind for each of its arguments.
+
+A spec is (id, target, args). The target names the callable: ``"lie.so3_exp"`` (a module
+function), ``"RigidBody"`` (a constructor), ``"@rb.angular_velocity"`` (a method of the receiver
+``rb`` of RECEIVERS) or ``"integrate"``. Each argument has a kind that says which bad values of
+the catalogue apply to it (see catalogue.py):
+
+  vec     numeric array whose trailing shape is fixed (may take leading batch axes)
+  bcast   numeric array or scalar that broadcasts (elliptic arguments, times)
+  mat     general square matrix          gl     matrix of GL+(n) (det > 0)
+  skew    so(n) matrix                   rot    rotation matrix (an attitude, R in SO(n))
+  se3     4x4 homogeneous SE(3) matrix   float  physical scalar     int  integer count/size
+  str     option name                    bool   flag                obj  a lieflow object
+  fn      a Python callable handed to native code (potentials, surfaces)
+
+Flags: ``positive`` (zero/negative must be refused), ``opt`` (None is a valid value),
+``kw`` (passed by keyword), ``complex_ok`` (complex numbers are a valid spelling).
+
+Values may be ``Lazy(f)``: computed from the imported ``lieflow`` module in the process that
+makes the call (states of systems, potentials, surfaces).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Lazy:
+    make: Callable[[Any], Any]
+
+
+@dataclass
+class Arg:
+    name: str
+    value: Any
+    kind: str
+    kw: bool = False
+    opt: bool = False
+    positive: bool = False
+    complex_ok: bool = False
+
+
+@dataclass
+class Spec:
+    id: str
+    target: str
+    args: list = field(default_factory=list)
+    module: str = ""          # lie, pseudo_rigid, potentials, surfaces, elliptic, systems, integrate
+    slow: bool = False        # seconds per call: fewer cases in the quick tier
+
+    def __post_init__(self):
+        if not self.module:
+            head = self.target.lstrip("@").split(".")[0]
+            self.module = {"lie": "lie", "pseudo_rigid": "pseudo_rigid", "potentials": "potentials",
+                           "surfaces": "surfaces", "elliptic": "elliptic",
+                           "integrate": "integrate"}.get(head, "systems")
+            if head in RECEIVER_MODULE:
+                self.module = RECEIVER_MODULE[head]
+
+
+def A(name, value, kind, **flags):
+    return Arg(name, value, kind, **flags)
+
+
+# --- valid values (numpy only: no lieflow needed to build the table) ---
+
+def rodrigues(w):
+    w = np.asarray(w, float)
+    th = np.linalg.norm(w)
+    k = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]) / th
+    return np.eye(3) + math.sin(th) * k + (1 - math.cos(th)) * k @ k
+
+
+def skew3(a, b, c):
+    """so(3) matrix in the e_ij basis: e_12 a + e_13 b + e_23 c."""
+    return np.array([[0.0, a, b], [-a, 0.0, c], [-b, -c, 0.0]])
+
+
+W3 = np.array([0.3, -0.2, 0.5])
+R3 = rodrigues(W3)
+R3B = rodrigues([-0.1, 0.4, 0.2])
+XI = skew3(0.4, 0.1, 0.2)
+ETA = skew3(-0.2, 0.3, 0.1)
+X3 = np.array([[1.3, 0.1, 0.0], [0.05, 1.0, 0.1], [0.0, 0.2, 0.7]])      # GL+, distinct s.v.
+V3 = np.array([[0.1, -0.2, 0.3], [0.0, 0.4, -0.1], [0.2, 0.1, 0.05]])
+G4 = np.block([[R3, np.array([[0.3], [-0.1], [0.2]])], [np.zeros((1, 3)), np.ones((1, 1))]])
+H4 = np.block([[R3B, np.array([[-0.2], [0.4], [0.1]])], [np.zeros((1, 3)), np.ones((1, 1))]])
+SE3XI = np.array([0.3, -0.2, 0.5, 0.1, 0.2, -0.3])
+A3 = np.array([1.3, 1.0, 0.7])
+M3 = np.array([1.0, 0.5, -0.3])
+I_SPH1 = np.array([[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]])
+I_SPH2 = np.array([[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]])
+U_SPH = np.array([0.2, 0.9, -0.3]) / np.linalg.norm([0.2, 0.9, -0.3])
+
+
+# --- user callables (module level: native code calls them; they also pickle) ---
+
+def u_value(X):
+    return 0.5 * float(np.sum(np.asarray(X) ** 2))
+
+
+def u_gradient(X):
+    return np.asarray(X, float)
+
+
+def u_hessian(X, V):
+    return np.asarray(V, float)
+
+
+def torus_r(s):
+    return 2.0 + 0.7 * np.cos(s), -0.7 * np.sin(s), -0.7 * np.cos(s), 0.7 * np.sin(s)
+
+
+def torus_z(s):
+    return 0.7 * np.sin(s), 0.7 * np.cos(s), -0.7 * np.sin(s), -0.7 * np.cos(s)
+
+
+def saddle(x, y):
+    return 0.5 * (0.8 * x * x - 0.5 * y * y), 0.8 * x, -0.5 * y, 0.8, 0.0, -0.5, 0, 0, 0, 0
+
+
+def sphere_metric(t, p):
+    return [[1.0, 0.0], [0.0, math.sin(t) ** 2]]
+
+
+def sphere_frame(t, p):
+    return [[1.0, 0.0], [0.0, 1.0 / math.sin(t)]]
+
+
+def inside(t, p):
+    return 0.0 < t < math.pi
+
+
+def _svk(lf):
+    return lf.potentials.SaintVenantKirchhoff(1.0, 2.0)
+
+
+# --- receivers: the objects whose methods are fuzzed (built in the calling process) ---
+
+RECEIVERS: dict[str, Callable[[Any], Any]] = {
+    "rb": lambda lf: lf.RigidBody([1.0, 2.0, 3.0]),
+    "grb": lambda lf: lf.GeneralizedRigidBody([1.0, 2.0, 3.0, 4.0]),
+    "ht": lambda lf: lf.HeavyTop([1.0, 2.0, 3.0], 0.7),
+    "sp": lambda lf: lf.SphericalPendulum(2.0, 1.5, 9.81),
+    "pend": lambda lf: lf.Pendulum(1.0, 1.0, 9.81),
+    "spart": lambda lf: lf.SphereParticle(2.0, 1.5, 9.81),
+    "disk": lambda lf: lf.RollingDisk(1.0, 0.5, 0.125, 0.0625, spring=0.4),
+    "prb": lambda lf: lf.PseudoRigidBody(3, _svk(lf)),
+    "rtt": lambda lf: lf.RelativisticTangentTop(1.0, 0.2, lf.surfaces.Sphere(1.0)),
+    "wft": lambda lf: lf.WeakFieldTop(1.0, 1e-3, gm=1e-4),
+    "tt": lambda lf: lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
+    "cp": lambda lf: lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5).magnetic_analogue(0.7),
+    "rds": lambda lf: lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6),
+    "rdeq": lambda lf: lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8,
+                                       0.6).relative_equilibria()[0],
+    "releq": lambda lf: lf.pseudo_rigid.relative_equilibria(
+        _svk(lf), velocities=(0.5 * skew3(1, 0, 0), 0.9 * skew3(1, 0, 0)), bounds=(0.05, 3.0),
+        starts=3)[0],
+    "run": lambda lf: lf.RigidBody([1.0, 2.0, 3.0])._start(
+        np.array([[1.0, 0.5, -0.3]]), None, 0.01, None, 1),
+    "traj": lambda lf: lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), [1.0, 0.5, -0.3], dt=0.01,
+                                    steps=10),
+    "rsph": lambda lf: lf.RollingSpheres(0.7, 1.3, [0.1, -0.2, 0.15], [-0.3, 0.2, 0.4], 2.0, 3.5,
+                                         I_SPH1, I_SPH2),
+    "harmonic": lambda lf: lf.potentials.Harmonic(1.3),
+    "svk": _svk,
+    "volumetric": lambda lf: lf.potentials.Volumetric(0.5, 1.4),
+    "stretch": lambda lf: lf.potentials.Stretch(1.1),
+    "zero": lambda lf: lf.potentials.Zero(),
+    "sum": lambda lf: lf.potentials.Harmonic(1.0) + _svk(lf),
+    "callable": lambda lf: lf.potentials.Callable(u_value, u_gradient, u_hessian),
+    "plane": lambda lf: lf.surfaces.Plane(),
+    "sphere": lambda lf: lf.surfaces.Sphere(1.0),
+    "hyp": lambda lf: lf.surfaces.HyperbolicPlane(),
+    "torus": lambda lf: lf.surfaces.Torus(2.0, 0.7),
+    "quadric": lambda lf: lf.surfaces.Quadric(0.8, -0.5),
+    "revolution": lambda lf: lf.surfaces.Revolution(torus_r, torus_z, (-math.pi, math.pi)),
+    "graph": lambda lf: lf.surfaces.Graph(saddle),
+    "metric": lambda lf: lf.surfaces.MetricSurface(sphere_metric, sphere_frame, inside),
+}
+# Receivers with a state of their own (a run advances): built afresh for every call.
+FRESH = {"run"}
+RECEIVER_MODULE = {**{k: "potentials" for k in ("harmonic", "svk", "volumetric", "stretch", "zero",
+                                                  "sum", "callable")},
+                   **{k: "surfaces" for k in ("plane", "sphere", "hyp", "torus", "quadric",
+                                              "revolution", "graph", "metric")},
+                   "releq": "pseudo_rigid"}
+# The point of each surface's chart used for its methods.
+SURFACE_POINT = {"plane": [0.2, -0.1], "sphere": [1.0, 0.3], "hyp": [0.1, 1.0],
+                 "torus": [0.9, 0.4], "quadric": [0.3, -0.4], "revolution": [0.9, 0.4],
+                 "graph": [0.3, -0.4], "metric": [1.2, 0.4]}
+
+
+def state_of(key):
+    """A valid state of receiver `key` (Lazy)."""
+    makers = {
+        "rb": lambda lf, s: M3.copy(),
+        "grb": lambda lf, s: np.array([0.3, -0.2, 0.5, 0.1, 0.4, -0.6]),
+        "ht": lambda lf, s: np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8]),
+        "sp": lambda lf, s: s.state_from_spherical(0.8, 0.1, 0.3, 1.2),
+        "pend": lambda lf, s: np.array([0.4, 0.1]),
+        "spart": lambda lf, s: s.from_spherical(
+            lf.SphericalPendulum(2.0, 1.5, 9.81).state_from_spherical(0.8, 0.1, 0.3, 1.2)),
+        "disk": lambda lf, s: np.asarray(s.state([0.1, -0.2, 0.3, 0.7], 2.0, 0.5)),
+        "prb": lambda lf, s: np.concatenate([X3.ravel(), V3.ravel()]),
+        "rtt": lambda lf, s: np.asarray(s.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)),
+        "wft": lambda lf, s: np.asarray(s.state([1.0, 0.5], 0.1, [0.1, 0.2], 0.3)),
+        "tt": lambda lf, s: np.asarray(s.state([1.0, 0.3], 0.2, [0.1, 0.3], 1.5)),
+        "cp": lambda lf, s: np.asarray(s.state([1.0, 0.3], [0.1, 0.3])),
+        "rds": lambda lf, s: np.asarray(s.state([0.3, -1.1], [0.7, 0.2])),
+        "rsph": lambda lf, s: np.asarray(s.state(R3, R3B, U_SPH, [1.1, -0.6, 0.8], [-0.4, 0.9, 0.5])),
+    }
+    return Lazy(lambda lf: makers[key](lf, RECEIVERS[key](lf)))
+
+
+SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "rtt", "wft", "tt", "cp", "rds",
+           "rsph"]
+CONSTRUCTORS = {  # class name -> receiver key built by it
+    "RigidBody": "rb", "GeneralizedRigidBody": "grb", "HeavyTop": "ht", "SphericalPendulum": "sp",
+    "Pendulum": "pend", "SphereParticle": "spart", "RollingDisk": "disk", "PseudoRigidBody": "prb",
+    "RelativisticTangentTop": "rtt", "WeakFieldTop": "wft", "TangentTop": "tt",
+    "ChargedParticle": "cp", "RollingDisks": "rds", "RollingSpheres": "rsph",
+}
+
+
+def lazy_recv(key):
+    return Lazy(lambda lf: RECEIVERS[key](lf))
+
+
+def build_specs() -> list[Spec]:
+    S: list[Spec] = []
+    add = lambda id, target, *args, **kw: S.append(Spec(id, target, list(args), **kw))  # noqa: E731
+
+    # ---- lieflow.lie: so(n)/SO(n) ----
+    add("lie.hat_n", "lie.hat_n", A("c", np.array([0.4, 0.1, 0.2, -0.3, 0.2, 0.5]), "vec"))
+    add("lie.vee_n", "lie.vee_n", A("xi", XI, "skew"))
+    add("lie.so_exp", "lie.so_exp", A("xi", XI, "skew"))
+    add("lie.so_log", "lie.so_log", A("R", R3, "rot"))
+    add("lie.cayley", "lie.cayley", A("xi", XI, "skew"))
+    add("lie.cayley_inv", "lie.cayley_inv", A("R", R3, "rot"))
+    for f in ("dexp", "dexp_inv", "ad"):
+        add(f"lie.{f}", f"lie.{f}", A("xi", XI, "skew"), A("eta", ETA, "skew"))
+    add("lie.ad_star", "lie.ad_star", A("xi", XI, "skew"), A("mu", ETA, "skew"))
+    add("lie.Ad", "lie.Ad", A("g", R3, "rot"), A("xi", XI, "skew"))
+    add("lie.is_rotation", "lie.is_rotation", A("R", R3, "mat"),
+        A("tol", 1e-10, "float", kw=True, positive=True))
+    add("lie.project_to_so", "lie.project_to_so", A("M", X3, "mat"))
+    add("lie.product_Ad", "lie.product_Ad", A("g", R3, "rot"), A("h", R3B, "rot"),
+        A("xi", XI, "skew"), A("eta", ETA, "skew"))
+    add("lie.product_bracket", "lie.product_bracket", A("xi1", XI, "skew"), A("eta1", ETA, "skew"),
+        A("xi2", ETA, "skew"), A("eta2", XI, "skew"))
+    # SO(3) / SE(3) fast path
+    add("lie.hat", "lie.hat", A("w", W3, "vec"))
+    add("lie.vee", "lie.vee", A("xi", rodrigues(W3) - rodrigues(W3).T, "skew"))
+    for f in ("so3_exp", "so3_cayley"):
+        add(f"lie.{f}", f"lie.{f}", A("w", W3, "vec"))
+    add("lie.so3_log", "lie.so3_log", A("r", R3, "rot"), A("strict", False, "bool", kw=True))
+    add("lie.so3_cayley_inv", "lie.so3_cayley_inv", A("r", R3, "rot"))
+    for f in ("so3_jacobian_right", "so3_jacobian_left"):
+        add(f"lie.{f}", f"lie.{f}", A("w", W3, "vec"), A("inverse", True, "bool", kw=True))
+    add("lie.se3_exp", "lie.se3_exp", A("xi", SE3XI, "vec"))
+    add("lie.se3_log", "lie.se3_log", A("g", G4, "se3"), A("strict", False, "bool", kw=True))
+    add("lie.se3_Ad", "lie.se3_Ad", A("g", G4, "se3"))
+    add("lie.se3_inverse", "lie.se3_inverse", A("g", G4, "se3"))
+    add("lie.se3_compose", "lie.se3_compose", A("g", G4, "se3"), A("h", H4, "se3"))
+    # GL+(n)
+    add("lie.svd_coordinates", "lie.svd_coordinates", A("X", X3, "gl"))
+    add("lie.from_svd", "lie.from_svd", A("R", R3, "rot"), A("a", A3, "vec"), A("S", R3B, "rot"))
+    add("lie.polar", "lie.polar", A("X", X3, "gl"))
+    add("lie.stratum", "lie.stratum", A("X", X3, "gl"), A("tol", 1e-8, "float", kw=True))
+
+    # ---- lieflow.pseudo_rigid ----
+    P = "pseudo_rigid."
+    for f in ("left_inertia", "right_inertia"):
+        add(P + f, P + f, A("X", X3, "gl"), A("xi", XI, "skew"))
+    for f in ("bi_inertia", "bi_inertia_eigen"):
+        add(P + f, P + f, A("X", X3, "gl"))
+    add(P + "locked_inertia", P + "locked_inertia", A("X", X3, "gl"), A("action", "two-sided", "str"))
+    for f in ("bi_inertia_apply", "bi_inertia_quadratic_form", "vertical_vector"):
+        add(P + f, P + f, A("X", X3, "gl"), A("xi", XI, "skew"), A("eta", ETA, "skew"))
+    add(P + "bi_inertia_solve", P + "bi_inertia_solve", A("X", X3, "gl"), A("lam", XI, "skew"),
+        A("gam", ETA, "skew"))
+    for f in ("left_connection", "right_connection", "bi_connection", "angular_momentum",
+              "circulation", "to_body", "kinetic_energy", "riemann_variables"):
+        add(P + f, P + f, A("X", X3, "gl"), A("V" if f in ("angular_momentum", "circulation",
+                                                         "to_body", "kinetic_energy",
+                                                         "riemann_variables") else "Y", V3, "mat"))
+    add(P + "horizontal_part", P + "horizontal_part", A("X", X3, "gl"), A("Y", V3, "mat"),
+        A("action", "left", "str"))
+    add(P + "from_body", P + "from_body", A("R", R3, "rot"), A("a", A3, "vec"), A("S", R3B, "rot"),
+        A("Omega", XI, "skew"), A("adot", np.array([0.1, -0.2, 0.05]), "vec"),
+        A("Lambda", ETA, "skew"))
+    add(P + "stratum", P + "stratum", A("X", X3, "gl"), A("tol", 1e-8, "float", kw=True))
+    Q = X3 @ X3.T
+    add(P + "riemann_bracket", P + "riemann_bracket", A("Q", Q, "mat"), A("N", X3 @ V3.T, "mat"),
+        A("dfdQ", skew3(1, 0, 0) + np.eye(3), "mat"), A("dfdN", V3, "mat"),
+        A("dgdQ", np.eye(3), "mat"), A("dgdN", XI, "mat"))
+    add(P + "reduce", P + "reduce", A("X", X3, "gl"), A("P", V3, "mat"))
+    add(P + "reconstruct", P + "reconstruct", A("R", R3, "rot"), A("S", R3B, "rot"), A("a", A3, "vec"),
+        A("p_a", np.array([0.1, -0.2, 0.05]), "vec"), A("p_Omega", XI, "skew"),
+        A("p_Lambda", ETA, "skew"))
+    add(P + "adjoint_motion", P + "adjoint_motion", A("X", X3, "gl"), A("P", V3, "mat"))
+    svk = Lazy(_svk)
+    for f in ("amended_potential", "amended_hessian"):
+        add(P + f, P + f, A("X", X3, "gl"), A("lam", XI, "skew"), A("gam", ETA, "skew"),
+            A("potential", svk, "obj"))
+    for f in ("augmented_potential", "augmented_gradient", "augmented_hessian"):
+        add(P + f, P + f, A("X", X3, "gl"), A("xi", XI, "skew"), A("eta", ETA, "skew"),
+            A("potential", svk, "obj"))
+    add(P + "augmented_hessian[V]", P + "augmented_hessian", A("X", X3, "gl"), A("xi", XI, "skew"),
+        A("eta", ETA, "skew"), A("potential", svk, "obj"), A("V", V3, "mat", kw=True, opt=True))
+    add(P + "equilibrium_directions", P + "equilibrium_directions", A("a", A3, "vec"))
+    add(P + "relative_equilibria", P + "relative_equilibria", A("potential", svk, "obj"),
+        A("velocities", (0.5 * skew3(1, 0, 0), 0.9 * skew3(1, 0, 0)), "obj", kw=True, opt=True),
+        A("bounds", (0.05, 3.0), "vec", kw=True), A("starts", 2, "int", kw=True, positive=True),
+        slow=True)
+    add(P + "relative_equilibria[shape]", P + "relative_equilibria", A("potential", Lazy(
+        lambda lf: lf.potentials.Stretch(1.0)), "obj"), A("shape", np.array([1.5, 1.2, 1.0]), "vec",
+        kw=True, opt=True), A("plane", (0, 1), "obj", kw=True, opt=True), slow=True)
+    add("RelativeEquilibrium.motion", "@releq.motion", A("t", np.array([0.0, 0.5]), "bcast"))
+    add("RelativeEquilibrium.stability", "@releq.stability")
+
+    # ---- lieflow.potentials ----
+    add("potentials.Harmonic", "potentials.Harmonic", A("k", 1.3, "float"))
+    add("potentials.SaintVenantKirchhoff", "potentials.SaintVenantKirchhoff", A("lam", 1.0, "float"),
+        A("mu", 2.0, "float"))
+    add("potentials.Volumetric", "potentials.Volumetric", A("kappa", 0.5, "float"),
+        A("gamma", 1.4, "float"))
+    add("potentials.Stretch", "potentials.Stretch", A("k", 1.1, "float"))
+    add("potentials.Zero", "potentials.Zero")
+    # Callable is fuzzed through its use (value, gradient, hessian call the Python functions).
+    add("potentials.Callable", "use:potentials.Callable", A("value", u_value, "fn"),
+        A("gradient", u_gradient, "fn"), A("hessian", u_hessian, "fn", opt=True))
+    for p in ("harmonic", "svk", "volumetric", "stretch", "zero", "sum", "callable"):
+        add(f"Potential[{p}].value", f"@{p}.value", A("X", X3, "gl"))
+        add(f"Potential[{p}].gradient", f"@{p}.gradient", A("X", X3, "gl"))
+        add(f"Potential[{p}].hessian", f"@{p}.hessian", A("X", X3, "gl"), A("V", V3, "mat"))
+        add(f"Potential[{p}].__add__", f"@{p}.__add__", A("other", Lazy(
+            lambda lf: lf.potentials.Harmonic(0.5)), "obj"))
+
+    # ---- lieflow.surfaces ----
+    add("surfaces.Plane", "surfaces.Plane")
+    add("surfaces.HyperbolicPlane", "surfaces.HyperbolicPlane")
+    add("surfaces.Sphere", "surfaces.Sphere", A("radius", 1.0, "float", positive=True))
+    add("surfaces.Torus", "surfaces.Torus", A("a", 2.0, "float", positive=True),
+        A("b", 0.7, "float", positive=True))
+    add("surfaces.Quadric", "surfaces.Quadric", A("a", 0.8, "float"), A("b", -0.5, "float"))
+    add("surfaces.Revolution", "use:surfaces.Revolution", A("r", torus_r, "fn"),
+        A("z", torus_z, "fn"), A("s_range", (-math.pi, math.pi), "vec"))
+    add("surfaces.Graph", "use:surfaces.Graph", A("f", saddle, "fn"))
+    add("surfaces.MetricSurface", "use:surfaces.MetricSurface", A("metric", sphere_metric, "fn"),
+        A("frame", sphere_frame, "fn"), A("domain", inside, "fn", opt=True))
+    for s, x in SURFACE_POINT.items():
+        for f in ("curvature", "metric", "frame", "connection"):
+            add(f"Surface[{s}].{f}", f"@{s}.{f}", A("x", np.array(x), "vec"))
+
+    # ---- lieflow.elliptic ----
+    add("elliptic.ellipj", "elliptic.ellipj", A("u", np.array([0.3, 1.2]), "bcast"),
+        A("m", 0.5, "bcast"))
+    add("elliptic.ellipk", "elliptic.ellipk", A("m", np.array([0.25, 0.7]), "bcast"))
+    add("elliptic.ellipf", "elliptic.ellipf", A("phi", np.array([0.3, 1.2]), "bcast"),
+        A("m", 0.5, "bcast"))
+
+    # ---- system constructors ----
+    add("RigidBody", "RigidBody", A("inertia", np.array([1.0, 2.0, 3.0]), "vec"))
+    add("GeneralizedRigidBody", "GeneralizedRigidBody", A("J", np.array([1.0, 2.0, 3.0, 4.0]), "vec"))
+    add("HeavyTop", "HeavyTop", A("inertia", np.array([1.0, 2.0, 3.0]), "vec"), A("mgl", 0.7, "float"),
+        A("chi", np.array([0.2, -0.3, 1.0]), "vec", kw=True))
+    for c in ("SphericalPendulum", "Pendulum", "SphereParticle"):
+        add(c, c, A("mass", 2.0, "float", positive=True), A("length", 1.5, "float", positive=True),
+            A("g", 9.81, "float"))
+    add("RollingDisk", "RollingDisk", A("mass", 1.0, "float", positive=True),
+        A("radius", 0.5, "float", positive=True), A("roll_inertia", 0.125, "float", positive=True),
+        A("turn_inertia", 0.0625, "float", positive=True), A("spring", 0.4, "float", kw=True),
+        A("tilt", 0.1, "float", kw=True))
+    add("PseudoRigidBody", "PseudoRigidBody", A("n", 3, "int", positive=True),
+        A("potential", svk, "obj", opt=True), A("check_det", True, "bool", kw=True))
+    add("RelativisticTangentTop", "RelativisticTangentTop", A("mass", 1.0, "float", positive=True),
+        A("inertia", 0.2, "float", positive=True),
+        A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj", opt=True))
+    add("WeakFieldTop", "WeakFieldTop", A("mass", 1.0, "float", positive=True),
+        A("inertia", 1e-3, "float", positive=True), A("gm", 1e-4, "float", kw=True, opt=True))
+    add("WeakFieldTop[g]", "WeakFieldTop", A("mass", 1.0, "float", positive=True),
+        A("inertia", 1e-3, "float", positive=True), A("g", (0.0, -0.1), "vec", kw=True, opt=True))
+    add("TangentTop", "TangentTop", A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj"),
+        A("mass", 1.0, "float", positive=True), A("inertia", 0.5, "float", positive=True),
+        A("embedded", True, "bool", kw=True))
+    add("ChargedParticle", "ChargedParticle", A("top", lazy_recv("tt"), "obj"),
+        A("charge", 0.7, "float"))
+    add("RollingDisks", "RollingDisks", A("r1", 1.0, "float", positive=True),
+        A("r2", 0.7, "float", positive=True), A("gamma1", 0.3 + 0.1j, "vec", complex_ok=True),
+        A("gamma2", np.array([-0.2, 0.25]), "vec", complex_ok=True),
+        A("m1", 1.0, "float", positive=True), A("m2", 1.5, "float", positive=True),
+        A("inertia1", 0.8, "float", positive=True), A("inertia2", 0.6, "float", positive=True),
+        A("rolling_constant", 0.3, "float", kw=True))
+    add("RollingSpheres", "RollingSpheres", A("r1", 0.7, "float", positive=True),
+        A("r2", 1.3, "float", positive=True), A("gamma1", np.array([0.1, -0.2, 0.15]), "vec"),
+        A("gamma2", np.array([-0.3, 0.2, 0.4]), "vec"), A("m1", 2.0, "float", positive=True),
+        A("m2", 3.5, "float", positive=True), A("inertia1", I_SPH1, "mat"),
+        A("inertia2", I_SPH2, "mat"))
+
+    # ---- methods of every system (the System protocol and each class's own) ----
+    for key in SYSTEMS:
+        st = state_of(key)
+        for f in ("energy", "invariants", "casimirs"):
+            add(f"{key}.{f}", f"@{key}.{f}", A("states", st, "vec"))
+        add(f"{key}.methods", f"@{key}.methods")
+    own = {
+        "rb": [("angular_velocity", [A("states", M3, "vec")]),
+               ("spatial_momentum", [A("states", M3, "vec"), A("attitude", R3, "rot")]),
+               ("exact_solution", [A("M0", M3, "vec"), A("t", np.array([0.0, 0.7, 2.0]), "bcast")])],
+        "grb": [("state", [A("M", np.array([[0, .3, -.2, .5], [-.3, 0, .1, .4], [.2, -.1, 0, -.6],
+                                            [-.5, -.4, .6, 0]]), "skew")]),
+                ("matrix", [A("states", np.array([0.3, -0.2, 0.5, 0.1, 0.4, -0.6]), "vec")])],
+        "ht": [("state", [A("M", M3, "vec"), A("Gamma", np.array([0.0, 0.6, 0.8]), "vec", opt=True)]),
+               ("state[attitude]", [A("M", M3, "vec"), A("attitude", R3, "rot", kw=True, opt=True)]),
+               ("spatial_momentum", [A("states", np.array([1.0, .5, -.3, 0, .6, .8]), "vec"),
+                                     A("attitude", R3, "rot")])],
+        "sp": [("state_from_spherical", [A("theta", 0.8, "bcast"), A("phi", 0.1, "bcast"),
+                                         A("theta_dot", 0.3, "bcast", opt=True),
+                                         A("phi_dot", 1.2, "bcast", opt=True)]),
+               ("vertical_momentum", [A("states", state_of("sp"), "vec")])],
+        "pend": [("exact", [A("amplitude", 0.8, "bcast"), A("t", np.array([0.0, 0.5]), "bcast")])],
+        "spart": [("from_spherical", [A("states", Lazy(lambda lf: lf.SphericalPendulum(
+            2.0, 1.5, 9.81).state_from_spherical(0.8, 0.1, 0.3, 1.2)), "vec")])],
+        "disk": [("state", [A("q", np.array([0.1, -0.2, 0.3, 0.7]), "vec"),
+                            A("theta_dot", 2.0, "float"), A("phi_dot", 0.5, "float")]),
+                 ("constraint_residual", [A("states", state_of("disk"), "vec")])],
+        "prb": [(f, [A("states", state_of("prb"), "vec")])
+                for f in ("angular_momentum", "circulation", "singular_values")],
+        "rtt": [("state", [A("x", np.array([1.2, 0.3]), "vec"), A("theta", 0.5, "float"),
+                           A("xdot", np.array([0.3, 0.4]), "vec"), A("thetadot", 2.0, "float")])]
+        + [(f, [A("states", state_of("rtt"), "vec")])
+           for f in ("velocities", "speed_and_spin", "killing_momenta")],
+        "wft": [("state", [A("x", np.array([1.0, 0.5]), "vec"), A("theta", 0.1, "float"),
+                           A("xdot", np.array([0.1, 0.2]), "vec"), A("thetadot", 0.3, "float")]),
+                ("angular_momentum", [A("states", state_of("wft"), "vec")])],
+        "tt": [("state", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float"),
+                          A("xdot", np.array([0.1, 0.3]), "vec"), A("thetadot", 1.5, "float")]),
+               ("magnetic_analogue", [A("p_theta", 0.7, "float")])]
+        + [(f, [A("states", state_of("tt"), "vec")])
+           for f in ("velocities", "p_theta", "killing_momenta", "ambient_frame")],
+        "cp": [("metric", [A("x", np.array([1.0, 0.3]), "vec")]),
+               ("potential", [A("x", np.array([1.0, 0.3]), "vec")]),
+               ("state", [A("x", np.array([1.0, 0.3]), "vec"), A("xdot", np.array([0.1, 0.3]), "vec")])]
+        + [(f, [A("states", state_of("cp"), "vec")]) for f in ("velocities", "killing_momenta")],
+        "rds": [("state", [A("theta", np.array([0.3, -1.1]), "vec"),
+                           A("thetadot", np.array([0.7, 0.2]), "vec")]),
+                ("mass_matrix", [A("theta", np.array([0.3, -1.1]), "vec")]),
+                ("locked_inertia", [A("theta", np.array([0.3, -1.1]), "vec")]),
+                ("angular_momentum", [A("states", state_of("rds"), "vec")]),
+                ("positions", [A("states", state_of("rds"), "vec")]),
+                ("relative_equilibria", [A("rolling_constant", 0.2, "float", opt=True),
+                                         A("theta1_range", (0.0, 3.0), "vec", kw=True)])],
+        "rsph": [("state", [A("z1", R3, "rot"), A("z2", R3B, "rot"), A("u", U_SPH, "vec"),
+                            A("Omega1", np.array([1.1, -0.6, 0.8]), "vec"),
+                            A("Omega2", np.array([-0.4, 0.9, 0.5]), "vec")]),
+                 ("planar_state", [A("theta", np.array([0.3, -0.4]), "vec"), A("phi", 0.2, "float"),
+                                   A("theta_dot", np.array([0.5, 0.7]), "vec")]),
+                 ("to_planar", [A("state", Lazy(lambda lf: RECEIVERS["rsph"](lf).planar_state(
+                     [0.3, -0.4], 0.2, [0.5, 0.7])), "vec"), A("tol", 1e-9, "float", kw=True)])]
+        + [(f, [A("states", state_of("rsph"), "vec")])
+           for f in ("accelerations", "angular_momentum", "body_momenta", "centres",
+                     "centres_of_mass", "contact_point", "spatial_momenta", "udot")],
+        "rdeq": [("state", [A("omega", 1.0, "float")])],
+        "run": [("advance", [A("steps", 5, "int")]), ("state", [])],
+        "traj": [("energy", []), ("invariants", []), ("casimirs", [])],
+    }
+    for key, methods in own.items():
+        for name, args in methods:
+            attr = name.split("[")[0]
+            add(f"{key}.{name}", f"@{key}.{attr}", *args)
+
+    # ---- lf.integrate with each system ----
+    for key in SYSTEMS:
+        add(f"integrate[{key}]", "integrate", A("system", lazy_recv(key), "obj"),
+            A("state0", state_of(key), "vec"), A("dt", 0.01, "float", kw=True),
+            A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True),
+            slow=key in ("prb", "rtt", "tt", "cp", "rds", "rsph"))
+    ht_att = Lazy(lambda lf: RECEIVERS["ht"](lf).state(M3, attitude=R3))
+    for key, st in (("rb", state_of("rb")), ("ht", ht_att)):
+        add(f"integrate[{key},attitude]", "integrate", A("system", lazy_recv(key), "obj"),
+            A("state0", st, "vec"), A("dt", 0.01, "float", kw=True),
+            A("steps", 10, "int", kw=True), A("attitude", R3, "rot", kw=True, opt=True))
+    add("integrate[rb,options]", "integrate", A("system", lazy_recv("rb"), "obj"),
+        A("state0", np.array([[1.0, 0.5, -0.3], [0.2, -0.4, 0.9]]), "vec"),
+        A("dt", 0.01, "float", kw=True), A("steps", 20, "int", kw=True),
+        A("method", "splitting4", "str", kw=True, opt=True), A("save_every", 5, "int", kw=True, positive=True),
+        A("chunk_steps", 7, "int", kw=True, opt=True, positive=True),
+        A("threads", 1, "int", kw=True, opt=True), A("progress", False, "bool", kw=True))
+    return S
+
+
+SPECS = build_specs()
