@@ -234,7 +234,7 @@ class WeakFieldTop(System):
     """The tangent top in a weak static gravitational field (002 (115)-(120), corrected)."""
 
     def __init__(
-        self, mass: float, inertia: float, *, gm: float | None = None,
+        self, mass: float, inertia: float, gm: float | None = None,
         g: tuple[float, float] | None = None,
     ) -> None: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...

@@ -114,3 +114,11 @@ def test_surface_from_callables_matches_the_sphere_and_raises_their_errors():
     np.testing.assert_allclose(a, b, atol=1e-7)
     with pytest.raises(RuntimeError, match="frame failed"):
         python.state([1.6, 0.0], 0.0, [0.1, 0.0], 1.0)
+
+
+def test_weak_field_top_methods_and_pickling():
+    # methods() on the class and pickling pass the constructor arguments positionally
+    assert lf.WeakFieldTop.methods()[0] == "gauss4"
+    top = lf.WeakFieldTop(1.0, 1e-3, gm=1e-4)
+    copy = pickle.loads(pickle.dumps(top))
+    assert repr(copy) == repr(top) and copy.methods() == top.methods()

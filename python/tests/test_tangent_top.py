@@ -177,3 +177,12 @@ def test_bad_tops_are_rejected():
         lf.TangentTop(S.Plane(), 1.0, [[1.0, 2.0], [2.0, 1.0]])       # not positive
     with pytest.raises(lf.InvalidArgumentError):
         lf.TangentTop(S.HyperbolicPlane(), 1.0, 1.0).ambient_frame(np.zeros(6) + 1)
+
+
+def test_points_next_to_a_coordinate_singularity_are_refused():
+    # the frame 1/(R sin theta) and the metric's inverse would overflow (found by the fuzz suite)
+    with pytest.raises(lf.InvalidArgumentError):
+        S.Sphere(1.0).frame([1e-310, 3e-311])
+    with pytest.raises(lf.InvalidArgumentError):
+        S.HyperbolicPlane().metric([0.0, 1e-200])
+    assert np.isfinite(S.Sphere(1.0).frame([1e-150, 0.0])).all()

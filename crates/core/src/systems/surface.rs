@@ -202,6 +202,12 @@ fn finite2(x: Vec2) -> bool {
     x[0].is_finite() && x[1].is_finite()
 }
 
+/// Whether a length scale s > 0 has s² and 1/s² both normal and finite.
+fn normal_and_invertible(s: f64) -> bool {
+    let s2 = s * s;
+    s2 >= f64::MIN_POSITIVE && (1.0 / s2).is_finite()
+}
+
 /// The Euclidean plane in Cartesian coordinates x = (x, y): g = I, Ê = (∂x, ∂y), α = 0, K = 0,
 /// embedded as z = 0 with n = e_z. Isometries SE(2) (002 (62)–(66)): the generators (translation
 /// along x, along y, rotation about the origin) are (1, 0, 0), (0, 1, 0) and (−y, x, 1) — a
@@ -313,8 +319,13 @@ impl Surface for Sphere {
     fn domain(&self) -> &'static str {
         "0 < ϑ < π (the poles are coordinate singularities)"
     }
+    /// Also refuses points so close to a pole that g₂₂ = R² sin²ϑ or its inverse is not a normal
+    /// finite number (the frame and the metric's inverse would overflow).
     fn contains(&self, x: Vec2) -> bool {
-        finite2(x) && x[0] > 0.0 && x[0] < std::f64::consts::PI && x[0].sin() > 0.0
+        finite2(x)
+            && x[0] > 0.0
+            && x[0] < std::f64::consts::PI
+            && normal_and_invertible(self.radius * x[0].sin())
     }
     fn metric(&self, x: Vec2) -> Mat2 {
         let r2 = self.radius * self.radius;
@@ -420,8 +431,9 @@ impl Surface for HyperbolicPlane {
     fn domain(&self) -> &'static str {
         "y > 0 (the upper half-plane)"
     }
+    /// Also refuses y so small that g = 1/y² overflows.
     fn contains(&self, x: Vec2) -> bool {
-        finite2(x) && x[1] > 0.0
+        finite2(x) && x[1] > 0.0 && normal_and_invertible(x[1])
     }
     fn metric(&self, x: Vec2) -> Mat2 {
         let a = 1.0 / (x[1] * x[1]);
@@ -577,7 +589,10 @@ impl Surface for Revolution {
             return false;
         }
         let (r, dr, ddr, dz, ddz, l) = self.profile(x[0]);
-        r > 0.0 && l > 0.0 && [r, dr, ddr, dz, ddz, l].iter().all(|v| v.is_finite())
+        r > 0.0
+            && normal_and_invertible(r)
+            && normal_and_invertible(l)
+            && [r, dr, ddr, dz, ddz, l].iter().all(|v| v.is_finite())
     }
     fn metric(&self, x: Vec2) -> Mat2 {
         let (r, _, _, _, _, l) = self.profile(x[0]);

@@ -166,7 +166,7 @@ pub struct PyWeakFieldTop {
 #[pymethods]
 impl PyWeakFieldTop {
     #[new]
-    #[pyo3(signature = (mass, inertia, *, gm = None, g = None))]
+    #[pyo3(signature = (mass, inertia, gm = None, g = None))]
     fn new(
         py: Python<'_>,
         mass: f64,
