@@ -151,3 +151,34 @@ def test_gl_plus_membership_survives_determinant_overflow():
     x[0, 0] = -1
     with pytest.raises(lf.NotInGroupError, match="sign of det X"):
         pr.angular_momentum(x, np.zeros((n, n)))
+
+
+# --- 7. messages -------------------------------------------------------------------------------
+
+
+def test_product_group_errors_name_the_arguments():
+    ok = np.zeros((3, 3))
+    bad = np.ones((3, 3))
+    with pytest.raises(lf.NotInGroupError) as e:
+        lf.lie.product_bracket(ok, bad, ok, ok)
+    assert str(e.value).startswith("eta1 ") and "a.1" not in str(e.value)
+    with pytest.raises(lf.NotInGroupError) as e:
+        lf.lie.product_Ad(np.eye(3), np.eye(3), bad, ok)
+    assert str(e.value).startswith("xi ")
+
+
+def test_huge_numbers_are_printed_compactly():
+    with pytest.raises(lf.InvalidArgumentError) as e:
+        lf.integrate(lf.RigidBody([1, 2, 3]), [1, 0.5, -0.3], dt=-1e300, steps=5)
+    assert ("1e300" in str(e.value) or "1e+300" in str(e.value)) and len(str(e.value)) < 200
+
+
+def test_ellipj_names_the_argument():
+    with pytest.raises(lf.NonFiniteError, match="argument u of ellipj"):
+        lf.elliptic.ellipj(np.nan, 0.5)
+
+
+@pytest.mark.parametrize("s", [1e-300, 1e300])
+def test_project_to_so_is_scale_free(s):
+    m = np.array([[1.0, 2, 0.5], [3, 4, -1], [0.2, -0.3, 2]])
+    assert np.allclose(lf.lie.project_to_so(s * m), lf.lie.project_to_so(m), atol=1e-14)

@@ -19,7 +19,10 @@ fn check_m(m: f64) -> Result<()> {
     } else {
         Err(Error::invalid(
             "m",
-            format!("the elliptic parameter m = k² must satisfy 0 ≤ m < 1, got {m}"),
+            format!(
+                "the elliptic parameter m = k² must satisfy 0 ≤ m < 1, got {}",
+                crate::error::fmt_num(m)
+            ),
         ))
     }
 }
@@ -57,7 +60,7 @@ pub fn ellipj(u: f64, m: f64) -> Result<(f64, f64, f64)> {
     if !u.is_finite() {
         return Err(Error::NonFinite {
             what: "u".into(),
-            location: "argument".into(),
+            location: format!("the argument u of ellipj (u = {u})"),
         });
     }
     Ok(ellipj_unchecked(u, m))
@@ -105,7 +108,7 @@ pub fn ellipf(phi: f64, m: f64) -> Result<f64> {
     if !phi.is_finite() {
         return Err(Error::NonFinite {
             what: "phi".into(),
-            location: "argument".into(),
+            location: format!("the argument phi of ellipf (phi = {phi})"),
         });
     }
     Ok(ellipf_unchecked(phi, m))

@@ -283,7 +283,10 @@ pub fn stratum(x: &Mat, rel_tol: f64) -> Result<Stratum> {
     if !(rel_tol.is_finite() && rel_tol >= 0.0) {
         return Err(Error::invalid(
             "rel_tol",
-            format!("expected a finite number ≥ 0, got {rel_tol}"),
+            format!(
+                "expected a finite number ≥ 0, got {}",
+                crate::error::fmt_num(rel_tol)
+            ),
         ));
     }
     let c = svd_coordinates(x)?;

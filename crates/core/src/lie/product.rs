@@ -52,22 +52,30 @@ impl SOnProduct {
     }
 }
 
-/// Checks that (ξ, η) is a pair of n×n skew matrices of one size; returns n.
-pub fn check_pair(what: &str, x: &PairAlgebra) -> Result<usize> {
-    let n = so::check_algebra(&format!("{what}.0"), &x.0)?;
-    so::check_algebra_of(&format!("{what}.1"), &x.1, n)?;
+/// Checks that (ξ, η) is a pair of n×n skew matrices of one size; returns n. `names` are the
+/// names of the two components in errors (the arguments as the caller spells them, e.g.
+/// ("xi", "eta") or ("xi1", "eta1")).
+pub fn check_pair(names: [&str; 2], x: &PairAlgebra) -> Result<usize> {
+    let n = so::check_algebra(names[0], &x.0)?;
+    so::check_algebra_of(names[1], &x.1, n)?;
     Ok(n)
+}
+
+/// [`check_pair`] for a given n.
+fn check_pair_of(names: [&str; 2], x: &PairAlgebra, n: usize) -> Result<()> {
+    so::check_algebra_of(names[0], &x.0, n)?;
+    so::check_algebra_of(names[1], &x.1, n)
 }
 
 /// Ad_(g,h)(ξ, η) = (g ξ gᵀ, h η hᵀ) (001 (7.23): Ad on so(n) ⊕ so(n) is componentwise).
 pub fn adjoint(g: &Mat, h: &Mat, x: &PairAlgebra) -> Result<PairAlgebra> {
-    let n = check_pair("x", x)?;
+    let n = check_pair(["xi", "eta"], x)?;
     let gn = so::check_rotation("g", g)?;
     so::check_rotation("h", h)?;
     if gn != n || h.nrows() != n {
         return Err(Error::shape(
             "(g, h)",
-            format!("two ({n}, {n}) rotations matching x"),
+            format!("two ({n}, {n}) rotations matching (xi, eta)"),
             format!("({gn}, {gn}) and ({0}, {0})", h.nrows()),
         ));
     }
@@ -76,12 +84,12 @@ pub fn adjoint(g: &Mat, h: &Mat, x: &PairAlgebra) -> Result<PairAlgebra> {
 
 /// The bracket on so(n) ⊕ so(n), 001 (7.26): [(ξ', η'), (ξ, η)] = ([ξ', ξ], [η', η]).
 pub fn bracket(a: &PairAlgebra, b: &PairAlgebra) -> Result<PairAlgebra> {
-    let n = check_pair("a", a)?;
-    let m = check_pair("b", b)?;
+    let n = check_pair(["xi1", "eta1"], a)?;
+    let m = check_pair(["xi2", "eta2"], b)?;
     if m != n {
         return Err(Error::shape(
-            "b",
-            format!("two ({n}, {n}) skew matrices like a"),
+            "(xi2, eta2)",
+            format!("two ({n}, {n}) skew matrices like (xi1, eta1)"),
             format!("({m}, {m})"),
         ));
     }
@@ -94,9 +102,8 @@ fn bracket_unchecked(a: &PairAlgebra, b: &PairAlgebra) -> PairAlgebra {
 
 /// The pairing on so(n) ⊕ so(n): ⟨(μ, ν), (ξ, η)⟩ = ⟨μ, ξ⟩ + ⟨ν, η⟩ (001 (6.8)).
 pub fn pairing(a: &PairAlgebra, b: &PairAlgebra) -> Result<f64> {
-    let n = check_pair("a", a)?;
-    so::check_algebra_of("b.0", &b.0, n)?;
-    so::check_algebra_of("b.1", &b.1, n)?;
+    let n = check_pair(["xi1", "eta1"], a)?;
+    check_pair_of(["xi2", "eta2"], b, n)?;
     Ok(pairing_unchecked(a, b))
 }
 

@@ -791,7 +791,10 @@ pub fn dexp_inv(xi: &Mat, eta: &Mat) -> Result<Mat> {
     if nx >= pi {
         return Err(Error::invalid(
             "xi",
-            format!("dexp⁻¹ needs |ξ| < π (where its Bernoulli series converges), got |ξ| = {nx}"),
+            format!(
+                "dexp⁻¹ needs |ξ| < π (where its Bernoulli series converges), got |ξ| = {}",
+                crate::error::fmt_num(nx)
+            ),
         ));
     }
     let b = bernoulli_coefficients();
@@ -850,10 +853,15 @@ pub fn ad_star(xi: &Mat, mu: &Mat) -> Result<Mat> {
 /// D = diag(1, …, 1, sign det(UVᵀ)) (the sign fix acts on the smallest singular value). For
 /// det M > 0 this is the orthogonal polar factor of M. It is unique when the two smallest
 /// singular values (of M with det M < 0: the smallest one) are not both zero/tied.
+///
+/// Scale-free (the nearest rotation to cM is that of M): the SVD is taken of M/c with c a power
+/// of two near max |M_ij| ([`super::gl::pow2_scale`]), so M at 1e300 or 1e-300 is projected
+/// like M at 1.
 pub fn project_to_so(m: &Mat) -> Result<Mat> {
     check::square("M", m, 2)?;
-    let svd = m.svd().map_err(|_| Error::NotConverged {
-        what: "SVD in so::project_to_so".into(),
+    let m = m * faer::Scale(1.0 / super::gl::pow2_scale(m));
+    let svd = m.svd().map_err(|e| Error::NotConverged {
+        what: format!("the SVD of M in so::project_to_so (faer: {e:?})"),
         iterations: 0,
         residual: f64::NAN,
         tol: 0.0,

@@ -274,10 +274,13 @@ pub fn is_rotation(r: &Matrix3<f64>, tol: f64) -> bool {
 /// Errors on non-finite input.
 pub fn project(m: &Matrix3<f64>) -> Result<Matrix3<f64>> {
     check::finite_slice("M", m.as_slice())?;
-    let svd = m.svd(true, true);
+    // Scale-free: the SVD of M/c, c a power of two near max |M_ij| (M at 1e300 is projected
+    // like M at 1).
+    let c = super::gl::pow2_below(m.amax());
+    let svd = (m / c).svd(true, true);
     let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
         return Err(Error::NotConverged {
-            what: "SVD of M".into(),
+            what: "the SVD of M in so3::project (nalgebra returned no singular vectors)".into(),
             iterations: 0,
             residual: f64::NAN,
             tol: 0.0,

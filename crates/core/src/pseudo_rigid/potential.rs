@@ -302,7 +302,10 @@ impl SaintVenantKirchhoff {
         if !(lambda.is_finite() && lambda >= 0.0) {
             return Err(Error::invalid(
                 "lambda",
-                format!("expected a finite Lamé parameter λ ≥ 0, got {lambda}"),
+                format!(
+                    "expected a finite Lamé parameter λ ≥ 0, got {}",
+                    crate::error::fmt_num(lambda)
+                ),
             ));
         }
         Ok(SaintVenantKirchhoff { lambda, mu })
@@ -410,7 +413,10 @@ impl Volumetric {
         if !(gamma.is_finite() && gamma >= 1.0) {
             return Err(Error::invalid(
                 "gamma",
-                format!("expected a finite polytropic exponent γ ≥ 1, got {gamma}"),
+                format!(
+                    "expected a finite polytropic exponent γ ≥ 1, got {}",
+                    crate::error::fmt_num(gamma)
+                ),
             ));
         }
         Ok(Volumetric { kappa, gamma })
