@@ -77,8 +77,19 @@ def _check_system(system):
 
 
 def _attitude(attitude, b, batched):
-    """The initial attitude as a (b, 3, 3) float64 array (one (3, 3) is shared by a batch)."""
-    a = np.asarray(attitude, dtype=np.float64)
+    """The initial attitude as a (b, 3, 3) float64 array (one (3, 3) is shared by a batch).
+
+    The one array argument read here rather than natively: its type is checked by the rule of
+    every native array argument (real numbers only, a TypeError otherwise)."""
+    expected = "invalid attitude: expected an array-like of real numbers (bool, int or float)"
+    try:
+        a = np.asarray(attitude)
+    except ValueError as e:                      # a ragged nested list
+        raise TypeError(f"{expected}, got a {type(attitude).__name__} that numpy cannot read "
+                        f"as an array: {e}") from None
+    if isinstance(attitude, (str, bytes)) or a.dtype.kind not in "biuf":
+        raise TypeError(f"{expected}, got a {type(attitude).__name__} (numpy dtype {a.dtype})")
+    a = a.astype(np.float64, copy=False)
     if a.shape == (3, 3):
         return np.ascontiguousarray(np.broadcast_to(a, (b, 3, 3)))
     if batched and a.shape == (b, 3, 3):

@@ -175,3 +175,82 @@ def test_integrate_accepts_numpy_numbers(body):
     assert tr.states.shape == (3, 3) and tr.dt == pytest.approx(0.01)
     tr = lf.integrate(body, [1, 0.5, -0.3], dt=np.array(0.01), steps=2)
     assert tr.t[-1] == pytest.approx(0.02)
+
+
+# ------------------------------------------------------- states on SO(3) and S², sizes of n
+
+
+@pytest.fixture
+def top():
+    return lf.HeavyTop([1, 2, 3], 1.0)
+
+
+@pytest.mark.parametrize("kw, exc, match", [
+    (dict(Gamma=[0, 0, np.nan]), lf.NonFiniteError, "non-finite"),
+    (dict(Gamma=[0, 0, 0]), lf.InvalidArgumentError, "Γ = 0"),
+    (dict(attitude=np.full((3, 3), np.nan)), lf.NonFiniteError, "attitude"),
+    (dict(attitude=np.zeros((3, 3))), lf.NotInGroupError, "attitude is not in SO"),
+    (dict(attitude=2 * np.eye(3)), lf.NotInGroupError, "attitude is not in SO"),
+    (dict(attitude=np.diag([1.0, 1.0, -1.0])), lf.NotInGroupError, "det"),
+    (dict(attitude=np.stack([np.eye(3), np.zeros((3, 3))])), lf.NotInGroupError, "attitude"),
+])
+def test_heavy_top_state_refuses_what_integrate_refuses(top, kw, exc, match):
+    with pytest.raises(exc, match=match):
+        top.state([1.0, 2.0, 3.0], **kw)
+
+
+def test_heavy_top_state_accepts_rotations(top):
+    r = lf.lie.so3_exp([0.3, -0.2, 0.5])
+    np.testing.assert_array_equal(top.state([1, 2, 3], attitude=r), np.r_[1, 2, 3, r[2]])
+    np.testing.assert_array_equal(top.state([1, 2, 3], Gamma=[0, 0, 2.0]), [1, 2, 3, 0, 0, 2])
+
+
+def test_integrate_heavy_top_refuses_gamma_zero(top):
+    with pytest.raises(lf.InvalidArgumentError, match="Γ = 0"):
+        lf.integrate(top, ([1.0, 0.5, -0.3], [0.0, 0.0, 0.0]), dt=0.01, steps=2)
+    with pytest.raises(lf.InvalidArgumentError, match="batch member 1"):
+        lf.integrate(top, np.array([[1, 0.5, -0.3, 0, 0, 1], [1, 0.5, -0.3, 0, 0, 0.0]]),
+                     dt=0.01, steps=2)
+
+
+@pytest.mark.parametrize("attitude, exc", [
+    (np.full((3, 3), np.nan), lf.NonFiniteError), (np.zeros((3, 3)), lf.NotInGroupError),
+    (2 * np.eye(3), lf.NotInGroupError), (np.diag([1.0, 1.0, -1.0]), lf.NotInGroupError),
+    (np.eye(3) * 1j, TypeError), ([[1, 0, 0], [0, 1]], TypeError), ("abc", TypeError),
+])
+def test_integrate_attitude_must_be_a_rotation(attitude, exc):
+    with pytest.raises(exc):
+        lf.integrate(lf.RigidBody([1, 2, 3]), [1, 0.5, -0.3], dt=0.01, steps=2, attitude=attitude)
+
+
+@pytest.mark.parametrize("system, M", [(lf.RigidBody([1, 2, 3]), [1.0, 2.0, 3.0]),
+                                       (lf.HeavyTop([1, 2, 3], 1.0), [1.0, 2, 3, 0, 0, 1])])
+def test_spatial_momentum_needs_a_rotation(system, M):
+    for bad, exc in [(2 * np.eye(3), lf.NotInGroupError), (np.zeros((3, 3)), lf.NotInGroupError),
+                     (np.diag([1.0, 1.0, -1.0]), lf.NotInGroupError),
+                     (np.full((3, 3), np.nan), lf.NonFiniteError)]:
+        with pytest.raises(exc):
+            system.spatial_momentum(M, bad)
+    r = lf.lie.so3_exp([0.3, -0.2, 0.5])
+    np.testing.assert_allclose(system.spatial_momentum(M, r), r @ np.asarray(M)[:3], atol=1e-15)
+
+
+def test_spatial_momentum_reads_drifted_rk4_attitudes():
+    """rk4 does not keep SO(3): its attitudes drift (~1e-6 here) and observables still read them."""
+    body = lf.RigidBody([1, 2, 3])
+    tr = lf.integrate(body, [1, 0.5, -0.3], dt=0.05, steps=20000, save_every=1000, method="rk4",
+                      attitude=np.eye(3))
+    drift = np.linalg.norm(tr.attitude[-1].T @ tr.attitude[-1] - np.eye(3))
+    assert 1e-10 < drift < 1e-3
+    assert tr.spatial_momentum().shape == (21, 3)
+
+
+@pytest.mark.parametrize("call", [
+    lambda: lf.pseudo_rigid.bi_inertia(np.eye(1)),
+    lambda: lf.pseudo_rigid.bi_connection(np.eye(1), np.eye(1)),
+    lambda: lf.pseudo_rigid.locked_inertia(np.eye(1)),
+    lambda: lf.pseudo_rigid.bi_inertia_eigen(np.eye(1)),
+])
+def test_pseudo_rigid_needs_n_at_least_2(call):
+    with pytest.raises(lf.ShapeError, match="n ≥ 2"):
+        call()

@@ -8,6 +8,7 @@
 
 use std::sync::OnceLock;
 
+use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::gl::{self, SvdCoordinates};
 use crate::lie::so;
@@ -100,8 +101,10 @@ pub struct BiInertia {
 }
 
 impl BiInertia {
-    /// The inertia tensors at X. Errors: X not square, not finite or det X ≤ 0.
+    /// The inertia tensors at X. Errors: X not square with n ≥ 2 (so(1) = {0}: no rotations),
+    /// not finite or det X ≤ 0.
     pub fn new(x: &Mat) -> Result<Self> {
+        check::square("X", x, 2)?;
         gl::check_gl_plus("X", x)?;
         Ok(BiInertia {
             x: x.clone(),

@@ -135,8 +135,16 @@ impl Problem for HeavyTop {
     fn invariant_count(&self) -> usize {
         2
     }
-    /// With the attitude, Γ must equal Rᵀe₃ (to 1e-9).
+    /// Γ ≠ 0 (the vertical seen in the body; its length is a Casimir, and scaling it scales
+    /// mgl), and with the attitude Γ must equal Rᵀe₃ (to 1e-9).
     fn check_state(&self, z: &[f64]) -> Result<()> {
+        if z[3..6].iter().all(|&g| g == 0.0) {
+            return Err(Error::invalid(
+                "state (Gamma)",
+                "Γ = 0 has no direction: expected the vertical seen in the body, Rᵀe₃ (a unit \
+                 vector; its length only scales mgl)",
+            ));
+        }
         if self.top.lifted {
             let d = (0..3)
                 .map(|i| (z[12 + i] - z[3 + i]).powi(2))

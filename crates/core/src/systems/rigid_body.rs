@@ -91,9 +91,12 @@ impl RigidBody {
     }
 
     /// Spatial angular momentum R M (000 Theorem 4.2), conserved, of a state (M, R).
+    ///
+    /// Errors: a non-finite M or R; R not a rotation (to 1e-3, which admits the drift of methods
+    /// that do not keep SO(3), such as rk4, and refuses 0, 2I or a reflection).
     pub fn spatial_momentum(z: &[f64]) -> Result<[f64; 3]> {
         check::len_of("state (M, R)", z, 12)?;
-        let r = Matrix3::from_row_slice(&z[3..]);
+        let r = top::observed_attitude("attitude R", &z[3..])?;
         Ok((r * Vector3::from_column_slice(&z[..3])).into())
     }
 

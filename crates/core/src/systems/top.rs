@@ -42,6 +42,34 @@ pub(crate) fn check_moments(moments: &[f64; 3]) -> Result<()> {
     Ok(())
 }
 
+/// How far from SO(3) an attitude read by an observable may be (‖RᵀR − I‖_F and |det R − 1|).
+/// Initial states are held to [`crate::lie::so3::ROTATION_TOL`]; computed attitudes drift off
+/// SO(3) under methods that do not keep it (rk4: about 4e-5 after 10⁵ steps of 0.05), and
+/// observables still read them, while a matrix that is no rotation (0, 2I, a reflection) is
+/// refused.
+pub(crate) const OBSERVED_ROTATION_TOL: f64 = 1e-3;
+
+/// An attitude (row-major) read by an observable: finite and a rotation to
+/// [`OBSERVED_ROTATION_TOL`] (`Error::NonFinite`, `Error::NotInGroup` naming the defect).
+pub(crate) fn observed_attitude(what: &str, r: &[f64]) -> Result<Matrix3<f64>> {
+    check::len_of(what, r, 9)?;
+    let m = Matrix3::from_row_slice(r);
+    let (orth, det) = crate::lie::so3::rotation_defect(&m);
+    let defect = [("‖RᵀR − I‖_F", orth), ("|det R − 1|", (det - 1.0).abs())]
+        .into_iter()
+        .find(|&(_, d)| !(d <= OBSERVED_ROTATION_TOL));
+    match defect {
+        Some((name, d)) => Err(Error::NotInGroup {
+            what: what.into(),
+            group: "SO(3)".into(),
+            defect_name: name.into(),
+            defect: d,
+            tol: OBSERVED_ROTATION_TOL,
+        }),
+        None => Ok(m),
+    }
+}
+
 /// Diagonalises a symmetric positive-definite inertia matrix (row-major): I = Q diag Qᵀ, Q ∈ SO(3).
 pub(crate) fn principal_frame(inertia: &[f64; 9]) -> Result<([f64; 3], Matrix3<f64>)> {
     check::finite_slice("inertia", inertia)?;

@@ -2,6 +2,7 @@
 //! `lieflow.System`: constructor and observables.
 #![allow(non_snake_case)]
 
+use lieflow::integrate::Block;
 use lieflow::systems as core;
 use lieflow::Error;
 use numpy::PyArray1;
@@ -97,7 +98,8 @@ impl PyHeavyTop {
     /// (..., 3, 3) (then Gamma = R^T e3, the third row of R); leading axes broadcast.
     ///
     /// Raises:
-    ///     InvalidArgumentError (neither or both of Gamma and attitude), ShapeError.
+    ///     InvalidArgumentError (neither or both of Gamma and attitude; Gamma = 0), ShapeError,
+    ///     NonFiniteError, NotInGroupError (the attitude is not a rotation).
     #[pyo3(signature = (M, Gamma = None, attitude = None))]
     fn state<'py>(
         &self,
@@ -113,15 +115,18 @@ impl PyHeavyTop {
                 map_items(py, &[m, g], &[6], |x, out| {
                     out[..3].copy_from_slice(x[0]);
                     out[3..].copy_from_slice(x[1]);
-                    Ok(())
+                    // The checks of an initial state: finite, Γ ≠ 0.
+                    lieflow::integrate::check_state(&self.top, out)
                 })
             }
             (None, Some(r)) => {
                 let r = Input::new("attitude", r, &[3, 3]);
                 map_items(py, &[m, r], &[6], |x, out| {
+                    // The attitude of an initial state: finite and in SO(3) (ROTATION_TOL).
+                    Block::SO3.check("attitude", x[1])?;
                     out[..3].copy_from_slice(x[0]);
                     out[3..].copy_from_slice(&x[1][6..9]); // Γ = Rᵀe₃, the third row of R
-                    Ok(())
+                    lieflow::integrate::check_state(&self.top, out)
                 })
             }
             _ => Err(to_py(Error::invalid(
