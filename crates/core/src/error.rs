@@ -54,8 +54,9 @@ pub enum Error {
     /// The principal logarithm is not unique (a rotation by an angle at or near π).
     #[error(
         "the logarithm of {what} is not unique: it contains a rotation by angle {angle:.15} \
-         (π = 3.141592653589793, distance {distance:.1e}); the principal logarithm needs all \
-         rotation angles < π"
+         (π = 3.141592653589793, distance {distance:.1e}), at π or within round-off of it, \
+         where the logarithms ±θ·axis are equally valid; the principal logarithm needs all \
+         rotation angles below π by more than 1e-12"
     )]
     NoUniqueLog {
         /// The argument.

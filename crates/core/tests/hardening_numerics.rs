@@ -185,3 +185,52 @@ fn gl_plus_membership_by_the_sign_of_the_lu() {
     });
     assert_eq!(gl::det_sign_ln(&q).0, -1.0);
 }
+
+#[test]
+fn so_log_is_accurate_up_to_pi_for_every_n() {
+    use std::f64::consts::PI;
+    for n in 2..=6 {
+        // A conjugating rotation and the angles (π − d, 0.7) in two planes.
+        let q = so::exp(
+            &so::hat_n(
+                &(0..so::dim(n))
+                    .map(|k| 0.3 + 0.1 * k as f64)
+                    .collect::<Vec<_>>(),
+            )
+            .unwrap(),
+        )
+        .unwrap();
+        for d in [1e-5, 1e-7, 1e-9, 1e-11] {
+            let mut c = vec![0.0; so::dim(n)];
+            c[0] = PI - d;
+            if n >= 4 {
+                c[so::dim(n) - 1] = 0.7;
+            }
+            let xi0 = &q * so::hat_n(&c).unwrap() * q.transpose();
+            let r = so::exp(&xi0).unwrap();
+            let xi = so::log(&r).unwrap_or_else(|e| panic!("n = {n}, d = {d:e}: {e}"));
+            let back = so::exp(&xi).unwrap();
+            let be = (&back - &r).norm_l2();
+            eprintln!(
+                "n = {n}, d = {d:e}: backward {be:e}, forward {:e}",
+                (&xi - &xi0).norm_l2()
+            );
+            assert!(be < 1e-12, "n = {n}, d = {d:e}");
+            // Forward error within the problem's condition ~ε/d.
+            assert!(
+                (&xi - &xi0).norm_l2() < 1e-14 / d + 1e-13,
+                "n = {n}, d = {d:e}: {:e}",
+                (&xi - &xi0).norm_l2()
+            );
+        }
+        // At π within round-off: refused, with the angle in the message.
+        let mut c = vec![0.0; so::dim(n)];
+        c[0] = PI;
+        let r = so::exp(&so::hat_n(&c).unwrap()).unwrap();
+        let e = so::log(&r).unwrap_err();
+        assert!(
+            matches!(e, Error::NoUniqueLog { .. }) && e.to_string().contains("round-off"),
+            "{e}"
+        );
+    }
+}

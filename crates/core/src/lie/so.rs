@@ -479,9 +479,12 @@ fn orthogonalize(mut r: Mat) -> Mat {
     r
 }
 
-/// Rotations whose largest angle is within this distance of π are refused by [`log`]: at π the
-/// logarithm is not unique, and within 10⁻⁶ of π its condition number exceeds 10⁶.
-pub const LOG_PI_TOL: f64 = 1e-6;
+/// Rotations whose largest angle is within this distance of π are refused by [`log`] (the same
+/// tolerance as [`so3::LOG_PI_TOL`]): at π the logarithm is not unique, and within round-off of
+/// π a rounding-level change of R decides between the candidates ±θJ. Below it the logarithm
+/// is unique and computed to a backward error at round-off (exp(log R) = R); its forward
+/// condition number grows like 1/(π − θ), which is the problem's, not the method's.
+pub const LOG_PI_TOL: f64 = so3::LOG_PI_TOL;
 
 fn check_angle(what: &str, angle: f64) -> Result<()> {
     let distance = std::f64::consts::PI - angle;
