@@ -196,7 +196,7 @@ def test_error_paths():
     with pytest.raises(lf.InvalidArgumentError):
         lie.is_rotation(R, tol=-1.0)
     huge = lie.hat_n([1e200, -3e199, 2e200, 1e200, 1e200, 1e200])
-    with pytest.raises(lf.InvalidArgumentError, match="1e15"):
+    with pytest.raises(lf.InvalidArgumentError, match="2.252e14.*lost to rounding"):
         lie.so_exp(huge)
     with pytest.raises(lf.InvalidArgumentError):
         lie.so_exp(np.stack([xi, 1e200 * xi]))

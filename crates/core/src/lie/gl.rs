@@ -105,12 +105,17 @@ pub fn check_det_positive(what: &str, group: &str, x: &Mat) -> Result<()> {
     Ok(())
 }
 
-/// The power of two nearest below max |x_ij| (1 for a zero or non-finite matrix): dividing by it
-/// is exact and brings the largest entry into [1, 2).
+/// The power of two nearest below max |x_ij| when that lies outside [1e-100, 1e100], else 1 (and
+/// 1 for a zero or non-finite matrix): dividing by it is exact, brings the largest entry of an
+/// extreme matrix into [1, 2) (where squares neither overflow nor underflow), and leaves
+/// moderate matrices bit for bit alone (faer's SVD is not bitwise scale-equivariant).
 pub fn pow2_scale(x: &Mat) -> f64 {
     let m = (0..x.ncols())
         .flat_map(|j| (0..x.nrows()).map(move |i| (i, j)))
         .fold(0.0f64, |m, (i, j)| m.max(x[(i, j)].abs()));
+    if (1e-100..=1e100).contains(&m) {
+        return 1.0;
+    }
     pow2_below(m)
 }
 

@@ -133,8 +133,9 @@ fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>>
 ///     xi: skew matrix (n, n) or (b, n, n) with so_exp(xi) = R.
 /// Raises:
 ///     NotInGroupError: R not a rotation (the message gives ‖RᵀR − I‖_F and det R).
-///     NoUniqueLogError: a rotation angle within 1e-12 of π, i.e. π within round-off (the
-///     message gives the angle); below it the log is unique and computed accurately.
+///     NoUniqueLogError: a rotation angle within 1e-12 of π for n ≤ 3 (π within round-off;
+///     below it the log is computed accurately), within 1e-6 for n ≥ 4 (the message gives the
+///     angle).
 ///     ShapeError, NonFiniteError.
 #[pyfunction]
 #[allow(non_snake_case)]
