@@ -19,10 +19,13 @@ RollingSpheres                                                  two rolling sphe
 RollingDisks                                                    two rolling disks of 003 §1
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
-Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``).
+Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``); an argument of the
+wrong type (complex, string or object arrays, ragged lists) is an :class:`ArgumentTypeError`
+(a ``TypeError`` naming the argument).
 """
 
 from ._lieflow import (
+    ArgumentTypeError,
     ConvergenceError,
     DegenerateStratumError,
     InvalidArgumentError,
@@ -61,6 +64,7 @@ from .integrate import Trajectory, integrate
 LiePoissonSystem = System
 
 __all__ = [
+    "ArgumentTypeError",
     "ChargedParticle",
     "ConvergenceError",
     "DegenerateStratumError",

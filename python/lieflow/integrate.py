@@ -9,7 +9,8 @@ the whole run, and the result does not depend on the chunking.
 
 Protocol a system implements (``lieflow.System`` implements it once for every system):
 ``methods()`` (the first is the default), ``state_dim``, ``_normalize_state(state0) -> (z0 (b, d),
-batched)``, ``_start(z0, attitude0, dt, method | None, save_every, *, t0, threads) -> run`` with
+batched)``, ``_start(z0, attitude0, dt, method | None, save_every, *, t0, threads, steps) -> run``
+(``steps``: the total, so that a trajectory that cannot be kept is refused first) with
 ``run.method`` (the name), ``run.advance(steps) -> (states (b, k, d), attitude (b, k, 3, 3) |
 None)`` (the states saved in those steps) and ``run.state() -> (z (b, d), attitude (b, 3, 3) |
 None)``, vectorised ``energy``
@@ -36,6 +37,10 @@ CHUNK_WORK = 200_000
 MIN_CHUNK_STEPS = 250
 
 
+#: Counts are passed to native code as 64-bit integers.
+_MAX_COUNT = 2**63 - 1
+
+
 def _count(name, value):
     """An integer >= 1: TypeError for another type (bools and floats included),
     InvalidArgumentError for an integer < 1."""
@@ -49,6 +54,8 @@ def _count(name, value):
         ) from None
     if n < 1:
         raise InvalidArgumentError(f"invalid {name}: expected an integer >= 1, got {n}")
+    if n > _MAX_COUNT:
+        raise InvalidArgumentError(f"invalid {name}: expected an integer <= 2**63 - 1, got {n}")
     return n
 
 
@@ -183,7 +190,8 @@ def integrate(system, state0, dt, steps, method=None, save_every=1, attitude=Non
     if threads is not None:
         threads = _count("threads", threads)
 
-    run = system._start(z, att, dt, method, save_every, threads=threads)
+    # `steps`: the native side refuses, before any step, a trajectory that cannot be kept.
+    run = system._start(z, att, dt, method, save_every, threads=threads, steps=steps)
     method = run.method
     states, atts = [z[:, None, :]], [None if att is None else att[:, None]]
     bar = _Progress(steps, progress, f"{type(system).__name__} {method}")

@@ -13,12 +13,11 @@ use numpy::{
     AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayDescrMethods, PyArrayDyn,
     PyArrayLikeDyn, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
 };
-use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes, PyString};
 use pyo3::Borrowed;
 
-use crate::errors::to_py;
+use crate::errors::{argument_type_error, to_py};
 
 /// Any array-like input of real numbers (bool, int, uint or float data: arrays, lists, scalars),
 /// cast to float64; a float64 array is borrowed without a copy. Anything else is refused with a
@@ -61,13 +60,16 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayIn<'py> {
             || ob.is_instance_of::<PyBytes>()
             || ob.is_instance_of::<PyByteArray>()
         {
-            return Err(PyTypeError::new_err(format!(
-                "{EXPECTED_REAL}, got a {}",
-                type_name()
-            )));
+            return Err(argument_type_error(
+                py,
+                format!("{EXPECTED_REAL}, got a {}", type_name()),
+            ));
         }
         if ob.is_none() {
-            return Err(PyTypeError::new_err(format!("{EXPECTED_REAL}, got None")));
+            return Err(argument_type_error(
+                py,
+                format!("{EXPECTED_REAL}, got None"),
+            ));
         }
         let given_array = ob.cast::<PyUntypedArray>().is_ok();
         // numpy's own reading of the object (np.asarray, no cast), to look at its dtype.
@@ -89,11 +91,14 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayIn<'py> {
             };
             // SAFETY: as above.
             let any = unsafe { Bound::from_owned_ptr_or_err(py, ptr) }.map_err(|e| {
-                PyTypeError::new_err(format!(
-                    "{EXPECTED_REAL}, got a {} that numpy cannot read as an array: {}",
-                    type_name(),
-                    e.value(py)
-                ))
+                argument_type_error(
+                    py,
+                    format!(
+                        "{EXPECTED_REAL}, got a {} that numpy cannot read as an array: {}",
+                        type_name(),
+                        e.value(py)
+                    ),
+                )
             })?;
             any.cast_into::<PyUntypedArray>()?
         };
@@ -113,9 +118,30 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayIn<'py> {
                     dtype.str()?
                 )
             };
-            return Err(PyTypeError::new_err(format!("{EXPECTED_REAL}, got {what}")));
+            return Err(argument_type_error(
+                py,
+                format!("{EXPECTED_REAL}, got {what}"),
+            ));
         }
+        // The float64 copy of a non-float64 array (e.g. an int broadcast view of 10¹⁰ rows) is
+        // checked like every other buffer (check::array_size), not left to numpy's MemoryError.
+        check::array_size("array argument", array.shape()).map_err(to_py)?;
         Ok(ArrayIn(array.as_any().extract()?))
+    }
+}
+
+impl<'py> ArrayIn<'py> {
+    /// Extracts the argument `what` from `ob` outside pyo3's argument parsing (e.g. one part of
+    /// a tuple), naming it the way pyo3 does: a note "while processing 'what'" on the error,
+    /// which an `ArgumentTypeError`'s message repeats.
+    pub fn named(what: &str, ob: &Bound<'py, PyAny>) -> PyResult<Self> {
+        ob.extract().map_err(|e: PyErr| {
+            let py = ob.py();
+            let note = format!("while processing '{what}'");
+            // add_note exists from Python 3.11 on; without it the message stays unnamed.
+            let _ = e.value(py).call_method1("add_note", (note,));
+            e
+        })
     }
 }
 

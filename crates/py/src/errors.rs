@@ -1,8 +1,10 @@
 //! lieflow errors as Python exceptions: `LieflowError` (a `ValueError`) and one subclass per kind.
 
 use pyo3::create_exception;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::PyType;
 
 create_exception!(
     lieflow,
@@ -65,6 +67,51 @@ create_exception!(
     "A trajectory left its configuration space (e.g. det X ≤ 0)."
 );
 
+/// `lieflow.ArgumentTypeError`, a `TypeError` whose message names the argument. pyo3 records the
+/// argument an extraction failed on in a note ("while processing 'w'", Python ≥ 3.11) after the
+/// error is made, so the name is read from the note when the message is shown. (Defined in
+/// Python: with the abi3 feature a native class cannot subclass an exception before 3.12.)
+const ARGUMENT_TYPE_ERROR: &std::ffi::CStr = cr#"
+class ArgumentTypeError(TypeError):
+    """An argument of the wrong type (e.g. a complex or string array where real numbers are
+    expected); str() names the argument: "argument 'w': expected ..., got ..."."""
+
+    __module__ = "lieflow"
+
+    def __str__(self):
+        message = super().__str__()
+        for note in getattr(self, "__notes__", ()):
+            if isinstance(note, str) and note.startswith("while processing '"):
+                return f"argument {note[len('while processing '):]}: {message}"
+        return message
+"#;
+
+static ARGUMENT_TYPE_ERROR_TYPE: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+fn argument_type_error_type(py: Python<'_>) -> PyResult<&Py<PyType>> {
+    ARGUMENT_TYPE_ERROR_TYPE.get_or_try_init(py, || {
+        let module = PyModule::from_code(
+            py,
+            ARGUMENT_TYPE_ERROR,
+            c"lieflow/_argument_type_error.py",
+            c"lieflow._argument_type_error",
+        )?;
+        Ok(module
+            .getattr("ArgumentTypeError")?
+            .cast_into::<PyType>()?
+            .unbind())
+    })
+}
+
+/// An `ArgumentTypeError` (a `TypeError`) with the message `msg`; raised while pyo3 extracts an
+/// argument, its message names that argument.
+pub fn argument_type_error(py: Python<'_>, msg: String) -> PyErr {
+    match argument_type_error_type(py) {
+        Ok(t) => PyErr::from_type(t.bind(py).clone(), msg),
+        Err(_) => PyTypeError::new_err(msg),
+    }
+}
+
 /// Rust spellings in core messages and their Python equivalents (advice in the caller's
 /// language).
 const SPELLINGS: [(&str, &str); 1] = [("check_det = false", "check_det=False")];
@@ -122,5 +169,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("LeftDomainError", py.get_type::<LeftDomainError>())?;
+    m.add("ArgumentTypeError", argument_type_error_type(py)?.bind(py))?;
     Ok(())
 }

@@ -96,6 +96,7 @@ impl Integration {
         save_every: i64,
         t0: f64,
         threads: Option<i64>,
+        steps: Option<i64>,
     ) -> PyResult<Self> {
         let save_every = count("save_every", save_every)?;
         let method = match method {
@@ -129,6 +130,21 @@ impl Integration {
         // few hundred bytes more: about 64 + 8·d floats measured; check twice that against the
         // memory available before building any (a huge batch is refused, not killed).
         check::array_size("state0", &[b, 2 * (64 + 8 * full)]).py()?;
+        // The whole trajectory the caller will keep: (b, steps / save_every + 1, full) floats,
+        // refused before the first step when it cannot be held.
+        if let Some(steps) = steps {
+            let saved = count("steps", steps)? / save_every + 1;
+            check::array_size("steps", &[b, saved, full]).map_err(|e| match e {
+                Error::InvalidArgument { what, message } => to_py(Error::invalid(
+                    what,
+                    format!(
+                        "the {saved} states of the trajectory: {message}; save less often \
+                         (save_every)"
+                    ),
+                )),
+                other => to_py(other),
+            })?;
+        }
         let mut states: Vec<Vec<f64>> = z
             .outer_iter()
             .map(|r| r.iter().copied().collect())

@@ -145,7 +145,7 @@ fn from_blocks<'py>(
     let mut columns = Vec::new();
     let mut lead: Option<Vec<usize>> = None;
     for (k, (name, block, _)) in space.ranges().enumerate() {
-        let a: ArrayIn<'py> = parts.get_item(k)?.extract()?;
+        let a = ArrayIn::named(name, &parts.get_item(k)?)?;
         let (rows, l) = block_rows(name, block, &a)?;
         match &lead {
             Some(first) if *first != l => {
@@ -219,13 +219,13 @@ impl PySystem {
         let sequence = state0.is_instance_of::<PyTuple>() || state0.is_instance_of::<PyList>();
         if sequence && blocks > 1 && state0.len()? == blocks {
             // One array per block, unless these are flat states (a batch of length `blocks`).
-            let first: ArrayIn<'py> = state0.get_item(0)?.extract()?;
+            let first = ArrayIn::named("state0", &state0.get_item(0)?)?;
             let shape = space.blocks()[0].1.shape();
             if first.as_array().shape().ends_with(&shape) {
                 return from_blocks(py, &space, state0);
             }
         }
-        let a: ArrayIn<'py> = state0.extract()?;
+        let a = ArrayIn::named("state0", state0)?;
         let v = a.as_array();
         let bad = || {
             to_py(Error::shape(
@@ -249,11 +249,12 @@ impl PySystem {
     ///     z0: (b, d) initial states; attitude0: (b, 3, 3) rotations or None; dt > 0; method: a
     ///     name from `methods()`, or None for the first (the system's default); save_every >= 1;
     ///     t0 (keyword): the time of z0; threads
-    ///     (keyword): None for all cores, or the number of threads.
+    ///     (keyword): None for all cores, or the number of threads; steps (keyword): the steps
+    ///     the caller will take in all, to refuse a trajectory that cannot be kept before any.
     /// Raises:
     ///     InvalidArgumentError, UnsupportedMethodError, ShapeError, NonFiniteError,
     ///     NotInGroupError (state constraints and attitude).
-    #[pyo3(signature = (z0, attitude0, dt, method, save_every, *, t0 = 0.0, threads = None))]
+    #[pyo3(signature = (z0, attitude0, dt, method, save_every, *, t0 = 0.0, threads = None, steps = None))]
     #[allow(clippy::too_many_arguments)]
     fn _start(
         &self,
@@ -264,6 +265,7 @@ impl PySystem {
         save_every: i64,
         t0: f64,
         threads: Option<i64>,
+        steps: Option<i64>,
     ) -> PyResult<Integration> {
         let sys = self.runner(attitude0.is_some())?.clone();
         let threads = if self.callbacks.is_some() {
@@ -281,6 +283,7 @@ impl PySystem {
             save_every,
             t0,
             threads,
+            steps,
         )
     }
 
@@ -305,7 +308,16 @@ impl PySystem {
         t0: f64,
         threads: Option<i64>,
     ) -> PyResult<RunOut<'py>> {
-        let mut run = self._start(z0, attitude0, dt, method, save_every, t0, threads)?;
+        let mut run = self._start(
+            z0,
+            attitude0,
+            dt,
+            method,
+            save_every,
+            t0,
+            threads,
+            Some(steps),
+        )?;
         run.run_all(py, steps)
     }
 

@@ -170,7 +170,7 @@ impl CallablePotential {
         let n = out.nrows();
         let what = format!("{what} returned by the callable {}", callable_name(f));
         let m = returned.and_then(|g| {
-            let g: ArrayIn<'_> = g.extract()?;
+            let g = ArrayIn::named(&what, &g)?;
             let m = mat(&what, &g)?;
             if m.nrows() != n || m.ncols() != n {
                 return Err(to_py(Error::shape(

@@ -53,7 +53,7 @@ impl PyHeavyTop {
             Some(c) => convert::vec3("chi", &c)?.into(),
             None => [0.0, 0.0, 1.0],
         };
-        let top = match super::inertia(&inertia.extract()?)? {
+        let top = match super::inertia(&ArrayIn::named("inertia", inertia)?)? {
             Inertia::Moments(m) => core::HeavyTop::new(m, mgl, chi),
             Inertia::Matrix(m) => core::HeavyTop::from_matrix(&m, mgl, chi),
         }

@@ -39,7 +39,7 @@ impl PyRigidBody {
     #[new]
     #[pyo3(signature = (inertia))]
     fn new(inertia: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
-        let body = match super::inertia(&inertia.extract()?)? {
+        let body = match super::inertia(&ArrayIn::named("inertia", inertia)?)? {
             Inertia::Moments(m) => core::RigidBody::new(m),
             Inertia::Matrix(m) => core::RigidBody::from_matrix(&m),
         }
@@ -167,7 +167,7 @@ impl PyGeneralizedRigidBody {
     #[new]
     #[pyo3(signature = (J))]
     fn new(J: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
-        let a: ArrayIn<'_> = J.extract()?;
+        let a = ArrayIn::named("J", J)?;
         let v = a.as_array();
         let body = match v.ndim() {
             1 => core::GeneralizedRigidBody::new(&v.iter().copied().collect::<Vec<_>>()),

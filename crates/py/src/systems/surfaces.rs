@@ -150,7 +150,7 @@ fn call_floats<const N: usize>(
         let out = PyTuple::new(py, args)
             .and_then(|a| f.bind(py).call1(a))
             .and_then(|v| {
-                let a: ArrayIn<'_> = v.extract()?;
+                let a = ArrayIn::named("the callable's value", &v)?;
                 let v = a.as_array();
                 if v.shape() != shape {
                     return Err(to_py(Error::shape(

@@ -27,7 +27,7 @@ fn tensor(inertia: &Any<'_>) -> PyResult<[f64; 4]> {
     if let Ok(i) = inertia.extract::<f64>() {
         return Ok([0.5 * i, 0.0, 0.0, 0.5 * i]);
     }
-    let a: ArrayIn<'_> = inertia.extract()?;
+    let a = ArrayIn::named("inertia", inertia)?;
     let m = mat("inertia", &a)?;
     if m.nrows() != 2 || m.ncols() != 2 {
         return Err(to_py(Error::shape(
