@@ -135,12 +135,10 @@ impl<'py> ArrayIn<'py> {
     /// a tuple), naming it the way pyo3 does: a note "while processing 'what'" on the error,
     /// which an `ArgumentTypeError`'s message repeats.
     pub fn named(what: &str, ob: &Bound<'py, PyAny>) -> PyResult<Self> {
-        ob.extract().map_err(|e: PyErr| {
-            let py = ob.py();
+        ob.extract().inspect_err(|e: &PyErr| {
             let note = format!("while processing '{what}'");
             // add_note exists from Python 3.11 on; without it the message stays unnamed.
-            let _ = e.value(py).call_method1("add_note", (note,));
-            e
+            let _ = e.value(ob.py()).call_method1("add_note", (note,));
         })
     }
 }

@@ -57,7 +57,7 @@ pub(crate) fn observed_attitude(what: &str, r: &[f64]) -> Result<Matrix3<f64>> {
     let (orth, det) = crate::lie::so3::rotation_defect(&m);
     let defect = [("‖RᵀR − I‖_F", orth), ("|det R − 1|", (det - 1.0).abs())]
         .into_iter()
-        .find(|&(_, d)| !(d <= OBSERVED_ROTATION_TOL));
+        .find(|&(_, d)| d.is_nan() || d > OBSERVED_ROTATION_TOL);
     match defect {
         Some((name, d)) => Err(Error::NotInGroup {
             what: what.into(),

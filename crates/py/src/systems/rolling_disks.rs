@@ -118,7 +118,7 @@ impl PyRollingDisks {
         let base = slf.as_super().get();
         let fields = base._fields(py, states.extract()?)?;
         let disks = &slf.get().disks;
-        let states = ArrayIn::named("states", &states)?;
+        let states = ArrayIn::named("states", states)?;
         let v = base.map_states(py, &states, &[2], |z, out| {
             out.copy_from_slice(&disks.velocities(z)?);
             Ok(())
