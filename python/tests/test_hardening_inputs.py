@@ -301,3 +301,14 @@ def test_arrays_read_inside_a_call_are_named_too(call, name):
     with pytest.raises(lf.ArgumentTypeError) as info:
         call()
     assert _named(info.value, name), str(info.value)
+
+
+def test_huge_multiples_of_rotations_are_not_rotations():
+    """RᵀR overflows to NaN off the diagonal for 1e160·R: NaN is a defect, not a pass."""
+    r = 1e160 * lf.lie.so3_exp([0.1, 0.2, 0.3])
+    with pytest.raises(lf.NotInGroupError):
+        lf.integrate(lf.RigidBody([1, 2, 3]), [1, 0.5, -0.3], dt=0.01, steps=2, attitude=r)
+    with pytest.raises(lf.NotInGroupError):
+        lf.HeavyTop([1, 2, 3], 1.0).state([1, 2, 3], attitude=r)
+    with pytest.raises(lf.NotInGroupError):
+        lf.RigidBody([1, 2, 3]).spatial_momentum([1, 2, 3], r)

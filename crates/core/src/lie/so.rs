@@ -190,7 +190,8 @@ pub fn check_rotation_of(what: &str, r: &Mat, n: usize) -> Result<()> {
 fn rotation_error(what: &str, r: &Mat, n: usize) -> Result<()> {
     let defect = orthogonality_defect(r);
     let det = r.determinant();
-    if defect > ROTATION_TOL || det <= 0.0 {
+    // NaN (an overflow of RᵀR or det R for a huge matrix) is a defect too.
+    if defect.is_nan() || defect > ROTATION_TOL || det.is_nan() || det <= 0.0 {
         return Err(Error::NotInGroup {
             what: what.into(),
             group: format!("SO({n})"),

@@ -429,10 +429,11 @@ pub fn check_rotation(what: &str, r: &Matrix3<f64>) -> Result<()> {
         defect,
         tol: ROTATION_TOL,
     };
-    if o > ROTATION_TOL {
+    // NaN (an overflow of RᵀR for a huge matrix) is a defect too.
+    if o.is_nan() || o > ROTATION_TOL {
         return Err(not_in("‖RᵀR − I‖_F", o));
     }
-    if (d - 1.0).abs() > ROTATION_TOL {
+    if d.is_nan() || (d - 1.0).abs() > ROTATION_TOL {
         return Err(not_in("|det R − 1|", (d - 1.0).abs()));
     }
     Ok(())
