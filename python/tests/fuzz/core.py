@@ -319,7 +319,10 @@ def _run_case(case: Case, lf, cache, override=None) -> dict:
             return {"o": "typed-error", "d": msg, "e": name}
         if isinstance(exc, TypeError):
             argname = spec.args[case.arg].name if case.arg >= 0 else ""
-            if argname and _names_argument(str(exc), argname):
+            # pyo3 names a parameter whose extraction failed in a note (Python >= 3.11:
+            # "while processing 'tol'"), not in the message
+            text = " ".join([str(exc), *getattr(exc, "__notes__", [])])
+            if argname and _names_argument(text, argname):
                 return {"o": "typed-error", "d": msg, "e": name}
             return {"o": "wrong-type", "d": msg, "e": "TypeError-unnamed"}
         return {"o": "wrong-type", "d": msg, "e": name}
