@@ -312,3 +312,189 @@ def test_huge_multiples_of_rotations_are_not_rotations():
         lf.HeavyTop([1, 2, 3], 1.0).state([1, 2, 3], attitude=r)
     with pytest.raises(lf.NotInGroupError):
         lf.RigidBody([1, 2, 3]).spatial_momentum([1, 2, 3], r)
+
+
+# --- numbers and small fixed-size arrays (convert.rs: Real, Reals, RealMatrix, Int) ---
+
+def _sphere_body():
+    return lf.RollingSpheres(0.7, 1.3, [0.1, -0.2, 0.15], [-0.3, 0.2, 0.4], 2.0, 3.5,
+                             np.diag([1.0, 1.2, 1.4]), np.diag([2.0, 2.1, 2.2]))
+
+
+COMPLEX_SCALARS = [
+    pytest.param(np.complex128(1 + 1j), id="np.complex128"),
+    pytest.param(np.complex64(1 + 1j), id="np.complex64"),
+    pytest.param(np.array(1 + 1j), id="0-d-complex"),
+    pytest.param(1 + 1j, id="complex"),
+    pytest.param(1 + 0j, id="complex-0j"),
+]
+
+
+@pytest.mark.parametrize("z", COMPLEX_SCALARS)
+@pytest.mark.parametrize("call, name", [
+    (lambda z: lf.TangentTop(lf.surfaces.Plane(), z, 1.0), "mass"),
+    (lambda z: lf.HeavyTop([1, 2, 3], z), "mgl"),
+    (lambda z: lf.surfaces.Sphere(z), "radius"),
+    (lambda z: lf.lie.is_rotation(np.eye(3), tol=z), "tol"),
+    (lambda z: lf.potentials.Harmonic(z), "k"),
+])
+def test_real_parameters_refuse_complex_numbers(z, call, name):
+    with pytest.raises(lf.ArgumentTypeError, match="expected a real number") as info:
+        call(z)
+    assert _named(info.value, name) or sys.version_info < (3, 11) or (
+        str(info.value).startswith(f"argument '{name}'")), str(info.value)
+
+
+@pytest.mark.parametrize("bad, exc", [
+    ("1.0", lf.ArgumentTypeError), (b"1", lf.ArgumentTypeError), (None, lf.ArgumentTypeError),
+    (np.array([1.0, 2.0]), lf.ArgumentTypeError), (np.datetime64("2020-01-01"), lf.ArgumentTypeError),
+    (10**400, lf.InvalidArgumentError),
+])
+def test_real_parameters_refuse_non_numbers(bad, exc):
+    with pytest.raises(exc) as info:
+        lf.surfaces.Sphere(bad)
+    assert "radius" in str(info.value), str(info.value)
+
+
+@pytest.mark.parametrize("good", [2.0, 2, np.float32(2.0), np.int64(2), np.array(2.0), np.float64(2)])
+def test_real_parameters_accept_real_numbers(good):
+    assert lf.surfaces.Sphere(good).metric([1.0, 0.3]).shape == (2, 2)
+
+
+@pytest.mark.parametrize("x", [np.array([1.0 + 1j, 0.3]), [1j, 0.3], "ab", b"ab", None])
+def test_fixed_size_points_refuse_non_reals(x):
+    with pytest.raises(lf.ArgumentTypeError) as info:
+        lf.surfaces.Sphere(1.0).metric(x)
+    assert _named(info.value, "x"), str(info.value)
+
+
+@pytest.mark.parametrize("x", [[], [1.0], [1.0, 0.3, 0.2], np.zeros((1, 2)), np.zeros((0, 2))])
+def test_fixed_size_points_of_the_wrong_length_are_shape_errors_naming_the_argument(x):
+    with pytest.raises(lf.ShapeError) as info:
+        lf.surfaces.Plane().metric(x=x)
+    if sys.version_info >= (3, 11):
+        assert str(info.value).startswith("argument 'x' has the wrong shape: expected (2,)"), \
+            str(info.value)
+
+
+def test_fixed_size_vectors_and_matrices_refuse_complex():
+    with pytest.raises(lf.ArgumentTypeError) as info:
+        lf.RollingSpheres(0.7, 1.3, [0.1, -0.2, 0.15j], [-0.3, 0.2, 0.4], 2.0, 3.5,
+                          np.eye(3), np.eye(3))
+    assert _named(info.value, "gamma1"), str(info.value)
+    s = _sphere_body()
+    with pytest.raises(lf.ArgumentTypeError) as info:
+        s.state(np.eye(3) + 0j * np.eye(3) + 1e-3j, np.eye(3), [0, 0, 1], [1, 0, 0], [0, 1, 0])
+    assert _named(info.value, "z1"), str(info.value)
+    with pytest.raises(lf.ShapeError, match="z2"):
+        s.state(np.eye(3), np.eye(2), [0, 0, 1], [1, 0, 0], [0, 1, 0])
+
+
+def test_rolling_disks_points_may_be_complex_but_not_anything():
+    args = dict(r1=1.0, r2=0.5, m1=1.0, m2=2.0, inertia1=0.7, inertia2=0.3)
+    a = lf.RollingDisks(gamma1=0.1 + 0.2j, gamma2=[0.0, -0.1], **args)
+    b = lf.RollingDisks(gamma1=[0.1, 0.2], gamma2=np.complex128(-0.1j), **args)
+    assert a.state([0.1, 0.2], [0.3, 0.4]) == pytest.approx(b.state([0.1, 0.2], [0.3, 0.4]))
+    for bad in (np.zeros((0, 2)), np.array(["1", "2"]), [[0.1, 0.2]]):
+        with pytest.raises((lf.ShapeError, lf.ArgumentTypeError)) as info:
+            lf.RollingDisks(gamma1=[0.1, 0.2], gamma2=bad, **args)
+        assert "gamma2" in str(info.value) + " ".join(getattr(info.value, "__notes__", [])), \
+            str(info.value)
+
+
+@pytest.mark.parametrize("n, exc", [(2**70, lf.InvalidArgumentError), (-(2**70), lf.InvalidArgumentError),
+                                    (2.5, lf.ArgumentTypeError), (float("nan"), lf.ArgumentTypeError),
+                                    ("3", lf.ArgumentTypeError)])
+def test_integer_parameters_out_of_range_or_not_ints(n, exc):
+    with pytest.raises(exc) as info:
+        lf.PseudoRigidBody(n)
+    if sys.version_info >= (3, 11):
+        assert "argument 'n'" in str(info.value), str(info.value)
+
+
+def test_integer_parameters_accept_numpy_ints():
+    assert lf.PseudoRigidBody(np.int64(3)).state_dim == lf.PseudoRigidBody(3).state_dim
+
+
+# --- input size before any cast or copy (ArrayIn) ---
+
+@pytest.mark.parametrize("dtype", [float, np.float32, int, ">f8"])
+@pytest.mark.parametrize("fn, base", [
+    (lambda a: lf.lie.hat_n(a), np.zeros(6)), (lambda a: lf.lie.so3_exp(a), np.zeros(3)),
+    (lambda a: lf.lie.so3_cayley(a), np.zeros(3)), (lambda a: lf.lie.so_exp(a), np.zeros((3, 3))),
+    (lambda a: lf.lie.se3_compose(a, np.eye(4)), np.eye(4)),
+])
+def test_broadcast_inputs_are_size_checked_before_any_copy(fn, base, dtype):
+    a = np.broadcast_to(base.astype(dtype), (10**10,) + base.shape)
+    with pytest.raises(lf.InvalidArgumentError, match="exceeds the limit"):
+        fn(a)
+
+
+def test_a_float64_strided_view_is_borrowed_not_copied():
+    big = np.zeros((4, 3, 2))
+    big[..., 0] = [[0.1, 0.2, 0.3]] * 4
+    view = big[..., 0]
+    assert not view.flags.c_contiguous
+    assert np.allclose(lf.lie.so3_exp(view), lf.lie.so3_exp(np.ascontiguousarray(view)))
+
+
+# --- no silent NaN from finite input: the last line of defence of vectorised results ---
+
+def test_vectorised_results_are_never_non_finite_for_finite_input():
+    body = _sphere_body()
+    with pytest.raises(lf.LieflowError):
+        body.angular_momentum(np.full(body.state_dim, 1.7e308))
+
+
+def test_legitimate_infinity_is_not_refused():
+    eqs = lf.RollingDisks(1.0, 0.5, 0.1 + 0.2j, -0.1j, 1.0, 2.0, 0.7, 0.3).relative_equilibria()
+    for e in eqs:
+        lo, hi = e.angular_velocity_range
+        assert lo <= hi
+
+
+# --- small accepted-bad cases ---
+
+def _inside(x1, x2):
+    return 0.0 < x1 < np.pi
+
+
+def _sphere_metric(x1, x2):
+    return np.diag([1.0, np.sin(x1) ** 2])
+
+
+def _sphere_frame(x1, x2):
+    return np.diag([1.0, 1.0 / np.sin(x1)])
+
+
+@pytest.mark.parametrize("ret", ["yes", float("nan"), 1.0, [True], None])
+def test_metric_surface_domain_must_return_a_bool(ret):
+    s = lf.surfaces.MetricSurface(_sphere_metric, _sphere_frame, lambda x1, x2: ret)
+    with pytest.raises(TypeError, match="domain.*must return a bool"):
+        s.metric([1.0, 0.3])
+
+
+@pytest.mark.parametrize("ret", [True, np.bool_(True)])
+def test_metric_surface_domain_bools_work(ret):
+    s = lf.surfaces.MetricSurface(_sphere_metric, _sphere_frame, lambda x1, x2: ret)
+    assert s.metric([1.0, 0.3]).shape == (2, 2)
+    s = lf.surfaces.MetricSurface(_sphere_metric, _sphere_frame, lambda x1, x2: np.bool_(False))
+    with pytest.raises(lf.InvalidArgumentError):
+        s.metric([1.0, 0.3])
+
+
+@pytest.mark.parametrize("k", [3, 4, 5])
+def test_heavy_top_spatial_momentum_checks_the_whole_state(k):
+    z = np.array([1.0, 2.0, 3.0, 0.0, 0.0, 1.0])
+    z[k] = -np.inf
+    with pytest.raises(lf.NonFiniteError, match="states"):
+        lf.HeavyTop([1, 2, 3], 1.0).spatial_momentum(z, np.eye(3))
+
+
+@pytest.mark.parametrize("tol", [float("nan"), float("inf"), -1e-9])
+def test_rolling_spheres_to_planar_refuses_bad_tolerances(tol):
+    s = _sphere_body()
+    z = s.planar_state([0.1, 0.2], 0.3, [0.4, 0.5])
+    assert len(s.to_planar(z)) == 5
+    with pytest.raises(lf.InvalidArgumentError, match="tol"):
+        s.to_planar(z, tol=tol)

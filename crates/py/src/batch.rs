@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::to_py;
+use crate::items::representable;
 
 /// A numpy array of floats whose shape depends on whether the input was batched.
 pub type Out<'py> = Bound<'py, PyArrayDyn<f64>>;
@@ -141,7 +142,13 @@ where
             .with_min_len(256)
             .enumerate()
             .try_for_each(|(k, out)| {
-                f(k).map(|b| b.store(out)).map_err(|e| {
+                // Every input of a batch is finite (read checks it): a non-finite result is
+                // refused (items::representable).
+                f(k).and_then(|b| {
+                    b.store(out);
+                    representable(what, true, out, None)
+                })
+                .map_err(|e| {
                     if batched {
                         relabel(e, |w| format!("{w}[{k}]"))
                     } else {

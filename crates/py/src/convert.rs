@@ -14,7 +14,7 @@ use numpy::{
     PyArrayLikeDyn, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyBytes, PyString};
+use pyo3::types::{PyBool, PyByteArray, PyBytes, PyComplex, PyFloat, PyInt, PyString};
 use pyo3::Borrowed;
 
 use crate::errors::{argument_type_error, to_py};
@@ -36,6 +36,11 @@ impl<'py> Deref for ArrayIn<'py> {
 }
 
 const EXPECTED_REAL: &str = "expected an array-like of real numbers (bool, int or float)";
+
+/// What errors raised while an argument is extracted call it: pyo3 then notes the argument's
+/// name ("while processing 'x'") and `LieflowError.__str__` puts it in ("argument 'x' has the
+/// wrong shape: …", "invalid argument 'n': …"; see `errors::register`).
+pub const ARGUMENT: &str = "argument";
 
 /// numpy dtype kinds cast to float64 without loss of meaning: bool, int, uint, float.
 fn real_kind(kind: u8) -> bool {
@@ -124,8 +129,9 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayIn<'py> {
             ));
         }
         // The float64 copy of a non-float64 array (e.g. an int broadcast view of 10¹⁰ rows) is
-        // checked like every other buffer (check::array_size), not left to numpy's MemoryError.
-        check::array_size("array argument", array.shape()).map_err(to_py)?;
+        // checked like every other buffer (check::array_size) before it is made, not left to
+        // numpy's MemoryError (a float64 view, strided or broadcast, is borrowed above).
+        check::array_size(ARGUMENT, array.shape()).map_err(to_py)?;
         Ok(ArrayIn(array.as_any().extract()?))
     }
 }
@@ -309,4 +315,275 @@ pub fn py_vecs<'py>(
 /// 3×3 matrix → numpy.
 pub fn py_mat3<'py>(py: Python<'py>, m: &Matrix3<f64>) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_fn((3, 3), |(i, j)| m[(i, j)]).into_pyarray(py)
+}
+
+// ---------------------------------------------------------------- scalars and small arrays
+
+const EXPECTED_NUMBER: &str = "expected a real number (bool, int or float)";
+
+/// The name of `ob`'s type, for messages.
+fn type_name(ob: &Bound<'_, PyAny>) -> String {
+    ob.get_type()
+        .name()
+        .map_or_else(|_| "object".to_string(), |n| n.to_string())
+}
+
+/// A real number argument: a Python or numpy bool, int or float, or a 0-d array of one. The one
+/// extractor of every `f64` parameter. Refused with an `ArgumentTypeError` naming the argument:
+/// complex numbers (numpy's `__float__` would drop the imaginary part), strings, bytes, None,
+/// arrays of other than one element, datetime and other non-numbers; an int too large for a
+/// float is an `InvalidArgumentError`. NaN and inf pass (finiteness is the core's check).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Real(pub f64);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Real {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        // Fast path: float and its subclasses (np.float64).
+        if let Ok(f) = ob.cast::<PyFloat>() {
+            return Ok(Real(f.value()));
+        }
+        let py = ob.py();
+        let ob = ob.to_owned();
+        if ob.is_instance_of::<PyBool>() {
+            return Ok(Real(if ob.is_truthy()? { 1.0 } else { 0.0 }));
+        }
+        if ob.is_instance_of::<PyInt>() {
+            return ob.extract::<f64>().map(Real).map_err(|_| {
+                to_py(Error::invalid(
+                    ARGUMENT,
+                    "an int too large for a float (about ±1.8e308)",
+                ))
+            });
+        }
+        let refuse =
+            |what: String| argument_type_error(py, format!("{EXPECTED_NUMBER}, got {what}"));
+        if ob.is_none() {
+            return Err(refuse("None".into()));
+        }
+        if ob.is_instance_of::<PyString>()
+            || ob.is_instance_of::<PyBytes>()
+            || ob.is_instance_of::<PyByteArray>()
+            || ob.is_instance_of::<PyComplex>()
+        {
+            return Err(refuse(format!("a {}", type_name(&ob))));
+        }
+        // numpy scalars and arrays: look at numpy's reading (np.asarray, no cast).
+        let is_numpy = ob.cast::<PyUntypedArray>().is_ok()
+            || ob
+                .get_type()
+                .module()
+                .is_ok_and(|m| m.to_string().starts_with("numpy"));
+        if is_numpy {
+            // SAFETY: np.asarray(ob) (no dtype, no flags): a new reference or NULL with an
+            // exception set.
+            let ptr = unsafe {
+                PY_ARRAY_API.PyArray_FromAny(
+                    py,
+                    ob.as_ptr(),
+                    std::ptr::null_mut(),
+                    0,
+                    0,
+                    0,
+                    std::ptr::null_mut(),
+                )
+            };
+            // SAFETY: as above.
+            let any = unsafe { Bound::from_owned_ptr_or_err(py, ptr) }?;
+            let array = any.cast_into::<PyUntypedArray>()?;
+            let dtype = array.dtype();
+            if !real_kind(dtype.kind()) {
+                return Err(refuse(format!(
+                    "a {} of dtype {}",
+                    type_name(&ob),
+                    dtype.str()?
+                )));
+            }
+            if array.ndim() != 0 {
+                return Err(refuse(format!(
+                    "an array of shape {}",
+                    shape_str(array.shape())
+                )));
+            }
+            return Ok(Real(array.call_method0("item")?.extract::<f64>()?));
+        }
+        // Other numbers (Fraction, Decimal, …) through __float__; anything else is refused.
+        ob.extract::<f64>()
+            .map(Real)
+            .map_err(|_| refuse(format!("a {}", type_name(&ob))))
+    }
+}
+
+/// Reads a fixed-shape array argument (a point (N,), a matrix (R, C)) through [`ArrayIn`]; a
+/// wrong shape is a `ShapeError` naming the argument.
+fn fixed<const N: usize>(ob: Borrowed<'_, '_, PyAny>, shape: &[usize]) -> PyResult<[f64; N]> {
+    let a: ArrayIn<'_> = ob.extract()?;
+    let v = a.as_array();
+    if v.shape() != shape {
+        return Err(shape_err(ARGUMENT, &shape_str(shape), &v));
+    }
+    let mut out = [0.0; N];
+    for (o, x) in out.iter_mut().zip(v.iter()) {
+        *o = *x;
+    }
+    Ok(out)
+}
+
+/// A fixed-length vector argument (a point x of a surface, a 3-vector), read like every array
+/// ([`ArrayIn`]: complex, strings, None refused); a wrong length is a `ShapeError` naming the
+/// argument.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reals<const N: usize>(pub [f64; N]);
+
+impl<'a, 'py, const N: usize> FromPyObject<'a, 'py> for Reals<N> {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        fixed::<N>(ob, &[N]).map(Reals)
+    }
+}
+
+/// A fixed-shape R×C matrix argument, read like [`Reals`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RealMatrix<const R: usize, const C: usize>(pub [[f64; C]; R]);
+
+impl<'a, 'py, const R: usize, const C: usize> FromPyObject<'a, 'py> for RealMatrix<R, C> {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let a: ArrayIn<'_> = ob.extract()?;
+        let v = a.as_array();
+        if v.shape() != [R, C] {
+            return Err(shape_err(ARGUMENT, &shape_str(&[R, C]), &v));
+        }
+        let mut out = [[0.0; C]; R];
+        for (i, row) in out.iter_mut().enumerate() {
+            for (j, o) in row.iter_mut().enumerate() {
+                *o = v[[i, j]];
+            }
+        }
+        Ok(RealMatrix(out))
+    }
+}
+
+/// An integer argument (a count, a size, an index): a Python or numpy int (a bool is refused
+/// by the parameters that say so, not here). Refused: floats, strings, None and the like
+/// (`ArgumentTypeError`); an int outside i64 is an `InvalidArgumentError` naming the argument
+/// (not an `OverflowError`). The range of the parameter is the core's (or the binding's) check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Int(pub i64);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Int {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let py = ob.py();
+        let ob = ob.to_owned();
+        // Integers are what has __index__ (int, numpy ints, bool).
+        let index = ob.call_method0("__index__").map_err(|_| {
+            argument_type_error(py, format!("expected an int, got a {}", type_name(&ob)))
+        })?;
+        index.extract::<i64>().map(Int).map_err(|_| {
+            to_py(Error::invalid(
+                ARGUMENT,
+                format!(
+                    "{} is out of range (at most {} in magnitude)",
+                    index
+                        .str()
+                        .map_or_else(|_| "the int".into(), |s| s.to_string()),
+                    i64::MAX
+                ),
+            ))
+        })
+    }
+}
+
+// The extractors of `#[pyo3(from_py_with = …)]` parameters: the parameters keep their Rust
+// types (`f64`, `[f64; N]`, `i64`, …) and their literal defaults (shown in the signature), and
+// are read by the newtypes above, so every number of the public API is read in one place.
+
+/// `f64` parameters ([`Real`]).
+pub fn real(ob: &Bound<'_, PyAny>) -> PyResult<f64> {
+    ob.extract::<Real>().map(|r| r.0)
+}
+
+/// `Option<f64>` parameters: None or a [`Real`].
+pub fn real_opt(ob: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+    if ob.is_none() {
+        Ok(None)
+    } else {
+        real(ob).map(Some)
+    }
+}
+
+/// `(f64, f64)` parameters (a range): a pair of [`Real`]s.
+pub fn real_pair(ob: &Bound<'_, PyAny>) -> PyResult<(f64, f64)> {
+    let [a, b] = reals::<2>(ob)?;
+    Ok((a, b))
+}
+
+/// `[f64; N]` parameters ([`Reals`]).
+pub fn reals<const N: usize>(ob: &Bound<'_, PyAny>) -> PyResult<[f64; N]> {
+    ob.extract::<Reals<N>>().map(|r| r.0)
+}
+
+/// `Option<[f64; N]>` parameters: None or [`Reals`].
+pub fn reals_opt<const N: usize>(ob: &Bound<'_, PyAny>) -> PyResult<Option<[f64; N]>> {
+    if ob.is_none() {
+        Ok(None)
+    } else {
+        reals::<N>(ob).map(Some)
+    }
+}
+
+/// `[[f64; C]; R]` parameters ([`RealMatrix`]).
+pub fn real_matrix<const R: usize, const C: usize>(
+    ob: &Bound<'_, PyAny>,
+) -> PyResult<[[f64; C]; R]> {
+    ob.extract::<RealMatrix<R, C>>().map(|m| m.0)
+}
+
+/// `Vec<f64>` parameters: a 1-D array-like of real numbers ([`ArrayIn`]).
+pub fn real_vec(ob: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let a: ArrayIn<'_> = ob.extract()?;
+    vector(ARGUMENT, &a)
+}
+
+/// `i64` parameters ([`Int`]).
+pub fn int(ob: &Bound<'_, PyAny>) -> PyResult<i64> {
+    ob.extract::<Int>().map(|i| i.0)
+}
+
+/// `Option<i64>` parameters: None or an [`Int`].
+pub fn int_opt(ob: &Bound<'_, PyAny>) -> PyResult<Option<i64>> {
+    if ob.is_none() {
+        Ok(None)
+    } else {
+        int(ob).map(Some)
+    }
+}
+
+/// `usize` parameters: an [`Int`] ≥ 0 (a negative one is an `InvalidArgumentError`).
+pub fn size(ob: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let i = int(ob)?;
+    usize::try_from(i).map_err(|_| {
+        to_py(Error::invalid(
+            ARGUMENT,
+            format!("expected an int ≥ 0, got {i}"),
+        ))
+    })
+}
+
+/// Names the argument `what` on an error of reading it outside pyo3's argument parsing (a part
+/// of an argument, a callable's value), the way pyo3 names a parameter: a note
+/// "while processing 'what'" that `ArgumentTypeError` and `LieflowError` messages show.
+pub fn named<T>(what: &str, r: PyResult<T>) -> PyResult<T> {
+    r.inspect_err(|e| {
+        Python::attach(|py| {
+            let note = format!("while processing '{what}'");
+            // add_note exists from Python 3.11 on; without it the message stays unnamed.
+            let _ = e.value(py).call_method1("add_note", (note,));
+        })
+    })
 }

@@ -84,19 +84,43 @@ class ArgumentTypeError(TypeError):
             if isinstance(note, str) and note.startswith("while processing '"):
                 return f"argument {note[len('while processing '):]}: {message}"
         return message
+
+
+def _lieflow_error_str(self):
+    """LieflowError.__str__: an error raised while an argument is read calls it "argument"
+    (convert::ARGUMENT); pyo3 notes which one ("while processing 'x'"), and this puts the name
+    in: "argument 'x' has the wrong shape: ...", "invalid argument 'n': ..."."""
+    message = ValueError.__str__(self)
+    if message.startswith(("argument ", "invalid argument:")):
+        for note in getattr(self, "__notes__", ()):
+            if isinstance(note, str) and note.startswith("while processing '"):
+                name = note[len("while processing "):]
+                return message.replace("argument", f"argument {name}", 1)
+    return message
 "#;
 
+static ARGUMENT_TYPE_ERROR_MODULE: PyOnceLock<Py<PyModule>> = PyOnceLock::new();
 static ARGUMENT_TYPE_ERROR_TYPE: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+fn argument_type_error_module(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
+    ARGUMENT_TYPE_ERROR_MODULE
+        .get_or_try_init(py, || {
+            Ok::<_, PyErr>(
+                PyModule::from_code(
+                    py,
+                    ARGUMENT_TYPE_ERROR,
+                    c"lieflow/_argument_type_error.py",
+                    c"lieflow._argument_type_error",
+                )?
+                .unbind(),
+            )
+        })
+        .map(|m| m.bind(py))
+}
 
 fn argument_type_error_type(py: Python<'_>) -> PyResult<&Py<PyType>> {
     ARGUMENT_TYPE_ERROR_TYPE.get_or_try_init(py, || {
-        let module = PyModule::from_code(
-            py,
-            ARGUMENT_TYPE_ERROR,
-            c"lieflow/_argument_type_error.py",
-            c"lieflow._argument_type_error",
-        )?;
-        Ok(module
+        Ok(argument_type_error_module(py)?
             .getattr("ArgumentTypeError")?
             .cast_into::<PyType>()?
             .unbind())
@@ -150,7 +174,12 @@ impl<T> IntoPy<T> for lieflow::Result<T> {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    m.add("LieflowError", py.get_type::<LieflowError>())?;
+    let base = py.get_type::<LieflowError>();
+    base.setattr(
+        "__str__",
+        argument_type_error_module(py)?.getattr("_lieflow_error_str")?,
+    )?;
+    m.add("LieflowError", base)?;
     m.add("NotInGroupError", py.get_type::<NotInGroupError>())?;
     m.add("ShapeError", py.get_type::<ShapeError>())?;
     m.add("NonFiniteError", py.get_type::<NonFiniteError>())?;

@@ -11,6 +11,7 @@ use numpy::{PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
+use crate::convert::int;
 use crate::convert::{shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{array, Out};
@@ -248,7 +249,7 @@ impl Integration {
     fn advance<'py>(
         &mut self,
         py: Python<'py>,
-        steps: i64,
+        #[pyo3(from_py_with = int)] steps: i64,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let steps = count("steps", steps)? as u64;
         let k = (self.done + steps) / self.save_every - self.done / self.save_every;

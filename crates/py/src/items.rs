@@ -40,6 +40,32 @@ fn expected_str(item: &[usize]) -> String {
     }
 }
 
+/// The last line of defence of "no silent NaN from finite input", shared by every vectorised
+/// result (mapped items here, batched items in `batch`, n×n batches in `lie::so`): an output
+/// item `out` that is not finite although its inputs were is refused with an
+/// `InvalidArgumentError` naming the inputs `what` (and the item `at` of a batch) instead of
+/// being returned. Core functions should refuse such input themselves with a better message;
+/// this catches what they miss. (No mapped function of the API has a legitimate infinite value.)
+pub fn representable(
+    what: &str,
+    inputs_finite: bool,
+    out: &[f64],
+    at: Option<usize>,
+) -> lieflow::Result<()> {
+    if !inputs_finite || out.iter().all(|x| x.is_finite()) {
+        return Ok(());
+    }
+    let what = match at {
+        Some(k) => format!("{what}[{k}]"),
+        None => what.to_string(),
+    };
+    Err(Error::invalid(
+        what,
+        "the result is not representable: it overflows to inf or NaN for this finite input \
+         (its scale is outside the range the computation supports)",
+    ))
+}
+
 /// numpy's broadcasting of several shapes; `None` if they do not broadcast.
 fn broadcast(shapes: &[&[usize]]) -> Option<Vec<usize>> {
     let n = shapes.iter().map(|s| s.len()).max().unwrap_or(0);
@@ -125,7 +151,10 @@ where
             }
         }
         let items: Vec<&[f64]> = scratch.iter().map(|s| s.as_slice()).collect();
-        f(&items, &mut out[k * out_len..(k + 1) * out_len]).map_err(to_py)?;
+        let o = &mut out[k * out_len..(k + 1) * out_len];
+        f(&items, o).map_err(to_py)?;
+        let finite = items.iter().all(|s| s.iter().all(|x| x.is_finite()));
+        representable(&names.join(", "), finite, o, (count > 1).then_some(k)).map_err(to_py)?;
     }
     if shape.is_empty() {
         return Ok(PyFloat::new(py, out[0]).into_any());

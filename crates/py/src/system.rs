@@ -13,6 +13,7 @@ use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple, PyType};
 
+use crate::convert::{int, int_opt, real};
 use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::integrate::{Callbacks, Integration, RunOut};
@@ -260,12 +261,12 @@ impl PySystem {
         &self,
         z0: ArrayIn<'_>,
         attitude0: Option<ArrayIn<'_>>,
-        dt: f64,
+        #[pyo3(from_py_with = real)] dt: f64,
         method: Option<&str>,
-        save_every: i64,
-        t0: f64,
-        threads: Option<i64>,
-        steps: Option<i64>,
+        #[pyo3(from_py_with = int)] save_every: i64,
+        #[pyo3(from_py_with = real)] t0: f64,
+        #[pyo3(from_py_with = int_opt)] threads: Option<i64>,
+        #[pyo3(from_py_with = int_opt)] steps: Option<i64>,
     ) -> PyResult<Integration> {
         let sys = self.runner(attitude0.is_some())?.clone();
         let threads = if self.callbacks.is_some() {
@@ -301,12 +302,12 @@ impl PySystem {
         py: Python<'py>,
         z0: ArrayIn<'py>,
         attitude0: Option<ArrayIn<'py>>,
-        dt: f64,
-        steps: i64,
-        save_every: i64,
+        #[pyo3(from_py_with = real)] dt: f64,
+        #[pyo3(from_py_with = int)] steps: i64,
+        #[pyo3(from_py_with = int)] save_every: i64,
         method: Option<&str>,
-        t0: f64,
-        threads: Option<i64>,
+        #[pyo3(from_py_with = real)] t0: f64,
+        #[pyo3(from_py_with = int_opt)] threads: Option<i64>,
     ) -> PyResult<RunOut<'py>> {
         let mut run = self._start(
             z0,

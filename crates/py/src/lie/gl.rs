@@ -7,6 +7,7 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::convert::real;
 use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
 use crate::errors::IntoPy;
 
@@ -75,7 +76,11 @@ pub fn polar<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr2<'py>, Arr2
 ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (tol < 0).
 #[pyfunction]
 #[pyo3(signature = (X, tol = gl::STRATUM_TOL))]
-pub fn stratum<'py>(py: Python<'py>, X: ArrayIn<'py>, tol: f64) -> PyResult<Bound<'py, PyDict>> {
+pub fn stratum<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    #[pyo3(from_py_with = real)] tol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
     let st = gl::stratum(&mat("X", &X)?, tol).py()?;
     stratum_dict(py, &st)
 }

@@ -8,6 +8,7 @@ use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
+use crate::convert::real;
 use crate::convert::{mat, mats, py_mat, py_mats, py_vec, py_vecs, read_all, vectors, ArrayIn};
 use crate::errors::IntoPy;
 
@@ -22,7 +23,16 @@ fn map_mats<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let v = a.as_array();
     if v.ndim() != 3 {
-        return Ok(py_mat(py, &f(&mat(what, a)?).py()?).into_any());
+        let x = mat(what, a)?;
+        let y = f(&x).py()?;
+        let entries = |m: &Mat| -> Vec<f64> {
+            (0..m.nrows())
+                .flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)]))
+                .collect()
+        };
+        let finite = entries(&x).iter().all(|v| v.is_finite());
+        crate::items::representable(what, finite, &entries(&y), None).py()?;
+        return Ok(py_mat(py, &y).into_any());
     }
     let (b, r, c) = (v.shape()[0], v.shape()[1], v.shape()[2]);
     if r * c == 0 {
@@ -43,7 +53,8 @@ fn map_mats<'py>(
                                 o[i * c + j] = y[(i, j)];
                             }
                         }
-                        Ok(())
+                        let finite = x.iter().all(|v| v.is_finite());
+                        crate::items::representable(what, finite, o, None)
                     })?;
             }
             Ok(out)
@@ -133,9 +144,9 @@ fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>>
 ///     xi: skew matrix (n, n) or (b, n, n) with so_exp(xi) = R.
 /// Raises:
 ///     NotInGroupError: R not a rotation (the message gives ‖RᵀR − I‖_F and det R).
-///     NoUniqueLogError: a rotation angle within 1e-12 of π for n ≤ 3 (π within round-off;
-///     below it the log is computed accurately), within 1e-6 for n ≥ 4 (the message gives the
-///     angle).
+///     NoUniqueLogError: a rotation angle within 1e-12 of π, for every n (π within round-off;
+///     below it the log is computed accurately, also for clustered angles; the message gives
+///     the angle).
 ///     ShapeError, NonFiniteError.
 #[pyfunction]
 #[allow(non_snake_case)]
@@ -276,7 +287,7 @@ fn ad_star<'py>(
 #[pyfunction]
 #[pyo3(signature = (R, tol = so::ROTATION_TOL))]
 #[allow(non_snake_case)]
-fn is_rotation(R: ArrayIn<'_>, tol: f64) -> PyResult<bool> {
+fn is_rotation(R: ArrayIn<'_>, #[pyo3(from_py_with = real)] tol: f64) -> PyResult<bool> {
     so::is_rotation(&mat("R", &R)?, tol).py()
 }
 

@@ -16,6 +16,7 @@ use pyo3::types::PyDict;
 
 use super::potential::PyPotential;
 use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
+use crate::convert::{real_pair, size};
 use crate::errors::{to_py, IntoPy};
 
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
@@ -219,8 +220,8 @@ fn relative_equilibria(
     velocities: Option<Bound<'_, PyAny>>,
     momenta: Option<Bound<'_, PyAny>>,
     plane: Option<(usize, usize)>,
-    bounds: (f64, f64),
-    starts: usize,
+    #[pyo3(from_py_with = real_pair)] bounds: (f64, f64),
+    #[pyo3(from_py_with = size)] starts: usize,
 ) -> PyResult<Vec<RelativeEquilibrium>> {
     let search = match (&shape, &velocities, &momenta, plane) {
         (Some(a), None, None, Some(plane)) => {

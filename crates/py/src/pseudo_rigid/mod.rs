@@ -18,6 +18,7 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::convert::real;
 use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
 use crate::errors::IntoPy;
 
@@ -370,7 +371,11 @@ pub fn kinetic_energy(X: ArrayIn<'_>, V: ArrayIn<'_>) -> PyResult<f64> {
 ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (tol < 0).
 #[pyfunction]
 #[pyo3(signature = (X, tol = STRATUM_TOL))]
-pub fn stratum<'py>(py: Python<'py>, X: ArrayIn<'py>, tol: f64) -> PyResult<Bound<'py, PyDict>> {
+pub fn stratum<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    #[pyo3(from_py_with = real)] tol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
     let info = strata::classify(&mat("X", &X)?, tol).py()?;
     let d = PyDict::new(py);
     d.set_item("singular_values", py_vec(py, &info.stratum.a))?;

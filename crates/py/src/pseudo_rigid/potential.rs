@@ -15,6 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
 use crate::convert::{mat, py_mat, ArrayIn};
+use crate::convert::{named, real, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::integrate::{Callbacks, ErrorSlot};
 
@@ -207,17 +208,20 @@ impl pot::Potential for CallablePotential {
         Python::attach(|py| {
             let value = self
                 .call(py, &self.value, x)
-                .and_then(|v| v.extract::<f64>())
+                .and_then(|v| {
+                    let what = format!(
+                        "the value(X) returned by the callable {}",
+                        callable_name(self.value.bind(py))
+                    );
+                    named(&what, v.extract::<Real>()).map(|r| r.0)
+                })
                 .and_then(|v| {
                     if v.is_finite() {
                         return Ok(v);
                     }
                     let f = self.value.bind(py);
                     Err(to_py(Error::NonFinite {
-                        what: format!(
-                            "the value U(X) returned by the callable {}",
-                            callable_name(f)
-                        ),
+                        what: format!("the value(X) returned by the callable {}", callable_name(f)),
                         location: format!("its return value ({v})"),
                     }))
                 });
@@ -239,7 +243,7 @@ impl pot::Potential for CallablePotential {
     ) {
         Python::attach(|py| {
             let g = self.call(py, &self.gradient, x);
-            self.add_returned("the gradient", self.gradient.bind(py), g, out);
+            self.add_returned("the gradient(X)", self.gradient.bind(py), g, out);
         });
     }
 
@@ -258,7 +262,12 @@ impl pot::Potential for CallablePotential {
                 let h = hessian
                     .bind(py)
                     .call1((py_mat(py, &x.to_owned()), py_mat(py, &v.to_owned())));
-                self.add_returned("the Hessian product", hessian.bind(py), h, out);
+                self.add_returned(
+                    "the Hessian product hessian(X, V)",
+                    hessian.bind(py),
+                    h,
+                    out,
+                );
             });
             return;
         }
@@ -281,7 +290,7 @@ impl pot::Potential for CallablePotential {
 /// Raises:
 ///     InvalidArgumentError: k <= 0 or not finite.
 #[pyfunction]
-fn Harmonic(py: Python<'_>, k: f64) -> PyResult<PyPotential> {
+fn Harmonic(py: Python<'_>, #[pyo3(from_py_with = real)] k: f64) -> PyResult<PyPotential> {
     let inner = Arc::new(CoreHarmonic::new(k).py()?);
     PyPotential::new(py, inner, format!("Harmonic({k})"), "Harmonic", [k])
 }
@@ -291,7 +300,11 @@ fn Harmonic(py: Python<'_>, k: f64) -> PyResult<PyPotential> {
 /// Raises:
 ///     InvalidArgumentError: mu <= 0, lam < 0 or not finite.
 #[pyfunction]
-fn SaintVenantKirchhoff(py: Python<'_>, lam: f64, mu: f64) -> PyResult<PyPotential> {
+fn SaintVenantKirchhoff(
+    py: Python<'_>,
+    #[pyo3(from_py_with = real)] lam: f64,
+    #[pyo3(from_py_with = real)] mu: f64,
+) -> PyResult<PyPotential> {
     let inner = Arc::new(CoreSvk::new(lam, mu).py()?);
     let desc = format!("SaintVenantKirchhoff({lam}, {mu})");
     PyPotential::new(py, inner, desc, "SaintVenantKirchhoff", [lam, mu])
@@ -304,7 +317,11 @@ fn SaintVenantKirchhoff(py: Python<'_>, lam: f64, mu: f64) -> PyResult<PyPotenti
 ///     InvalidArgumentError: kappa <= 0, gamma < 1 or not finite.
 #[pyfunction]
 #[pyo3(signature = (kappa, gamma=1.4))]
-fn Volumetric(py: Python<'_>, kappa: f64, gamma: f64) -> PyResult<PyPotential> {
+fn Volumetric(
+    py: Python<'_>,
+    #[pyo3(from_py_with = real)] kappa: f64,
+    #[pyo3(from_py_with = real)] gamma: f64,
+) -> PyResult<PyPotential> {
     let inner = Arc::new(CoreVolumetric::polytropic(kappa, gamma).py()?);
     let desc = format!("Volumetric({kappa}, {gamma})");
     PyPotential::new(py, inner, desc, "Volumetric", [kappa, gamma])
@@ -317,7 +334,7 @@ fn Volumetric(py: Python<'_>, kappa: f64, gamma: f64) -> PyResult<PyPotential> {
 /// Raises:
 ///     InvalidArgumentError: k <= 0 or not finite.
 #[pyfunction]
-fn Stretch(py: Python<'_>, k: f64) -> PyResult<PyPotential> {
+fn Stretch(py: Python<'_>, #[pyo3(from_py_with = real)] k: f64) -> PyResult<PyPotential> {
     let inner = Arc::new(CoreStretch::new(k).py()?);
     PyPotential::new(py, inner, format!("Stretch({k})"), "Stretch", [k])
 }

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
 use super::potential::{PyPotential, Zero};
+use crate::convert::int;
 use crate::convert::ArrayIn;
 use crate::errors::{to_py, IntoPy};
 use crate::integrate::Callbacks;
@@ -58,7 +59,7 @@ impl PyPseudoRigidBody {
     #[pyo3(signature = (n, potential=None, check_det=true))]
     fn new(
         py: Python<'_>,
-        n: i64,
+        #[pyo3(from_py_with = int)] n: i64,
         potential: Option<Bound<'_, PyPotential>>,
         check_det: bool,
     ) -> PyResult<PyClassInitializer<Self>> {

@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
 use super::Inertia;
+use crate::convert::real;
 use crate::convert::{self, py_vec, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, Input};
@@ -46,7 +47,7 @@ impl PyHeavyTop {
     )]
     fn new(
         inertia: &Bound<'_, PyAny>,
-        mgl: f64,
+        #[pyo3(from_py_with = real)] mgl: f64,
         chi: Option<ArrayIn<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let chi = match chi {

@@ -8,8 +8,8 @@ mod pendulum;
 mod relativistic_top;
 mod rigid_body;
 mod rolling_disk;
-mod rolling_spheres;
 mod rolling_disks;
+mod rolling_spheres;
 mod spherical_pendulum;
 pub mod surfaces;
 pub mod tangent_top;
@@ -62,8 +62,10 @@ fn spatial_momentum<'py>(
         ],
         &[3],
         |x, out| {
+            // The whole state (not only M: a NaN in the heavy top's Gamma is bad input too).
+            lieflow::check::finite_slice("states", x[0])?;
+            lieflow::check::finite_slice("attitude", x[1])?;
             let z = [&x[0][..3], x[1]].concat();
-            lieflow::check::finite_slice("states", &z)?;
             out.copy_from_slice(&RigidBody::spatial_momentum(&z)?);
             Ok(())
         },

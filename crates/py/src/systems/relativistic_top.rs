@@ -7,6 +7,7 @@ use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
 use crate::convert::ArrayIn;
+use crate::convert::{named, real, real_opt, reals, reals_opt, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, Input};
 use crate::system::PySystem;
@@ -37,23 +38,19 @@ impl PyRelativisticTangentTop {
     #[new]
     #[pyo3(signature = (mass, inertia, surface = None))]
     fn new(
-        mass: f64,
+        #[pyo3(from_py_with = real)] mass: f64,
         inertia: &Bound<'_, PyAny>,
         surface: Option<Bound<'_, PySurface>>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let top = match (inertia.extract::<f64>(), &surface) {
+        let top = match (inertia.extract::<Real>().map(|r| r.0), &surface) {
             (Ok(i), None) => core::RelativisticTangentTop::symmetric(mass, i),
             (Ok(i), Some(s)) => {
                 core::RelativisticTangentTop::on_surface(s.get().inner.clone(), mass, i)
             }
-            (Err(_), None) => match inertia.extract::<[f64; 3]>() {
-                Ok(m) => core::RelativisticTangentTop::new(mass, m),
-                Err(_) => Err(Error::shape(
-                    "inertia",
-                    "a float or (I11, I12, I22)",
-                    "other",
-                )),
-            },
+            (Err(_), None) => {
+                let m = named("inertia", reals::<3>(inertia))?;
+                core::RelativisticTangentTop::new(mass, m)
+            }
             (Err(_), Some(_)) => Err(Error::invalid(
                 "inertia",
                 "on a surface only the symmetric top is implemented: give the scalar tr I",
@@ -80,10 +77,10 @@ impl PyRelativisticTangentTop {
     ///     invertible), NonFiniteError.
     fn state(
         slf: &Bound<'_, Self>,
-        x: [f64; 2],
-        theta: f64,
-        xdot: [f64; 2],
-        thetadot: f64,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
         let z = slf.get().top.state(x, theta, xdot, thetadot);
         slf.as_super().get().take_callback_error()?;
@@ -169,10 +166,10 @@ impl PyWeakFieldTop {
     #[pyo3(signature = (mass, inertia, gm = None, g = None))]
     fn new(
         py: Python<'_>,
-        mass: f64,
-        inertia: f64,
-        gm: Option<f64>,
-        g: Option<[f64; 2]>,
+        #[pyo3(from_py_with = real)] mass: f64,
+        #[pyo3(from_py_with = real)] inertia: f64,
+        #[pyo3(from_py_with = real_opt)] gm: Option<f64>,
+        #[pyo3(from_py_with = reals_opt::<2>)] g: Option<[f64; 2]>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let potential = match (gm, g) {
             (Some(gm), None) => core::Potential::point_mass(gm),
@@ -196,7 +193,13 @@ impl PyWeakFieldTop {
     ///
     /// Raises:
     ///     InvalidArgumentError (outside the weak-field domain), NonFiniteError.
-    fn state(&self, x: [f64; 2], theta: f64, xdot: [f64; 2], thetadot: f64) -> PyResult<Vec<f64>> {
+    fn state(
+        &self,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<Vec<f64>> {
         self.top.state(x, theta, xdot, thetadot).py()
     }
 

@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
 use crate::convert::ArrayIn;
+use crate::convert::{real, reals};
 use crate::errors::IntoPy;
 use crate::items::{map_items, Input};
 use crate::system::PySystem;
@@ -32,12 +33,12 @@ impl PyRollingDisk {
     #[pyo3(signature = (mass, radius, roll_inertia, turn_inertia, spring = 0.0, tilt = 0.0))]
     fn new(
         py: Python<'_>,
-        mass: f64,
-        radius: f64,
-        roll_inertia: f64,
-        turn_inertia: f64,
-        spring: f64,
-        tilt: f64,
+        #[pyo3(from_py_with = real)] mass: f64,
+        #[pyo3(from_py_with = real)] radius: f64,
+        #[pyo3(from_py_with = real)] roll_inertia: f64,
+        #[pyo3(from_py_with = real)] turn_inertia: f64,
+        #[pyo3(from_py_with = real)] spring: f64,
+        #[pyo3(from_py_with = real)] tilt: f64,
     ) -> PyResult<PyClassInitializer<Self>> {
         let disk = core::RollingDisk::new(mass, radius, roll_inertia, turn_inertia)
             .and_then(|d| d.with_potential(spring, tilt))
@@ -65,7 +66,12 @@ impl PyRollingDisk {
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.
-    fn state(&self, q: [f64; 4], theta_dot: f64, phi_dot: f64) -> PyResult<Vec<f64>> {
+    fn state(
+        &self,
+        #[pyo3(from_py_with = reals::<4>)] q: [f64; 4],
+        #[pyo3(from_py_with = real)] theta_dot: f64,
+        #[pyo3(from_py_with = real)] phi_dot: f64,
+    ) -> PyResult<Vec<f64>> {
         self.disk.state(q, theta_dot, phi_dot).py()
     }
 

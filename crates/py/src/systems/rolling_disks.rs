@@ -8,22 +8,28 @@ use pyo3::types::PyDict;
 use pyo3::PyClassInitializer;
 
 use crate::convert::ArrayIn;
+use crate::convert::{named, real, real_opt, real_pair, reals, Real};
 use crate::errors::IntoPy;
 use crate::system::PySystem;
+use numpy::{PyArrayDescrMethods, PyUntypedArray, PyUntypedArrayMethods};
+use pyo3::types::PyComplex;
 
 type Any<'py> = Bound<'py, PyAny>;
 
-/// A point of the plane from a complex number or a 2-vector.
+/// A point of the plane from a complex number (a real number is one) or a 2-vector.
 fn point(what: &str, v: &Any<'_>) -> PyResult<[f64; 2]> {
-    if let Ok(p) = v.extract::<[f64; 2]>() {
-        return Ok(p);
+    let complex = v.is_instance_of::<PyComplex>()
+        || v.cast::<PyUntypedArray>()
+            .is_ok_and(|a| a.ndim() == 0 && a.dtype().kind() == b'c');
+    if complex {
+        let part = |name: &str| named(what, real(&v.getattr(name)?));
+        return Ok([part("real")?, part("imag")?]);
     }
-    match (v.getattr("real"), v.getattr("imag")) {
-        (Ok(re), Ok(im)) => Ok([re.extract()?, im.extract()?]),
-        _ => Err(pyo3::exceptions::PyTypeError::new_err(format!(
-            "{what} must be a complex number or a sequence of two numbers"
-        ))),
+    // A real number is the complex number x + 0i.
+    if let Ok(Real(x)) = v.extract::<Real>() {
+        return Ok([x, 0.0]);
     }
+    named(what, reals::<2>(v))
 }
 
 /// Two disks rolling against each other in the plane without slipping (003 §1). Disk k has
@@ -50,15 +56,15 @@ impl PyRollingDisks {
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
-        r1: f64,
-        r2: f64,
+        #[pyo3(from_py_with = real)] r1: f64,
+        #[pyo3(from_py_with = real)] r2: f64,
         gamma1: Any<'_>,
         gamma2: Any<'_>,
-        m1: f64,
-        m2: f64,
-        inertia1: f64,
-        inertia2: f64,
-        rolling_constant: f64,
+        #[pyo3(from_py_with = real)] m1: f64,
+        #[pyo3(from_py_with = real)] m2: f64,
+        #[pyo3(from_py_with = real)] inertia1: f64,
+        #[pyo3(from_py_with = real)] inertia2: f64,
+        #[pyo3(from_py_with = real)] rolling_constant: f64,
     ) -> PyResult<PyClassInitializer<Self>> {
         let (g1, g2) = (point("gamma1", &gamma1)?, point("gamma2", &gamma2)?);
         let disks = RollingDisks::new([r1, r2], [g1, g2], [m1, m2], [inertia1, inertia2])
@@ -97,18 +103,25 @@ impl PyRollingDisks {
     ///
     /// Raises:
     ///     NonFiniteError.
-    fn state(&self, theta: [f64; 2], thetadot: [f64; 2]) -> PyResult<Vec<f64>> {
+    fn state(
+        &self,
+        #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
+        #[pyo3(from_py_with = reals::<2>)] thetadot: [f64; 2],
+    ) -> PyResult<Vec<f64>> {
         self.disks.state(theta, thetadot).py()
     }
 
     /// The mass matrix M(theta) of T = thetadot^T M thetadot / 2 (2, 2).
-    fn mass_matrix(&self, theta: [f64; 2]) -> PyResult<[[f64; 2]; 2]> {
+    fn mass_matrix(
+        &self,
+        #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
+    ) -> PyResult<[[f64; 2]; 2]> {
         self.disks.mass_matrix(theta).py()
     }
 
     /// The locked inertia (1, 1) M(theta) (1, 1)^T: the moment of inertia of the pair rotating
     /// rigidly about its centre of mass.
-    fn locked_inertia(&self, theta: [f64; 2]) -> PyResult<f64> {
+    fn locked_inertia(&self, #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2]) -> PyResult<f64> {
         self.disks.locked_inertia(theta).py()
     }
 
@@ -184,8 +197,8 @@ impl PyRollingDisks {
     #[pyo3(signature = (rolling_constant = None, theta1_range = (0.0, std::f64::consts::TAU)))]
     fn relative_equilibria(
         &self,
-        rolling_constant: Option<f64>,
-        theta1_range: (f64, f64),
+        #[pyo3(from_py_with = real_opt)] rolling_constant: Option<f64>,
+        #[pyo3(from_py_with = real_pair)] theta1_range: (f64, f64),
     ) -> PyResult<Vec<PyDisksEquilibrium>> {
         let disks = match rolling_constant {
             Some(c) => self.disks.clone().with_rolling_constant(c).py()?,
@@ -268,7 +281,7 @@ impl PyDisksEquilibrium {
     /// Raises:
     ///     NonFiniteError.
     #[pyo3(signature = (omega = 1.0))]
-    fn state(&self, omega: f64) -> PyResult<Vec<f64>> {
+    fn state(&self, #[pyo3(from_py_with = real)] omega: f64) -> PyResult<Vec<f64>> {
         self.eq.state(&self.disks, omega).py()
     }
 

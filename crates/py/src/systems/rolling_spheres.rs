@@ -7,8 +7,10 @@ use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
 use crate::convert::ArrayIn;
-use crate::errors::IntoPy;
+use crate::convert::{real, real_matrix, real_vec, reals};
+use crate::errors::{to_py, IntoPy};
 use crate::system::PySystem;
+use lieflow::Error;
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -52,14 +54,14 @@ impl PyRollingSpheres {
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
-        r1: f64,
-        r2: f64,
-        gamma1: [f64; 3],
-        gamma2: [f64; 3],
-        m1: f64,
-        m2: f64,
-        inertia1: [[f64; 3]; 3],
-        inertia2: [[f64; 3]; 3],
+        #[pyo3(from_py_with = real)] r1: f64,
+        #[pyo3(from_py_with = real)] r2: f64,
+        #[pyo3(from_py_with = reals::<3>)] gamma1: [f64; 3],
+        #[pyo3(from_py_with = reals::<3>)] gamma2: [f64; 3],
+        #[pyo3(from_py_with = real)] m1: f64,
+        #[pyo3(from_py_with = real)] m2: f64,
+        #[pyo3(from_py_with = real_matrix::<3, 3>)] inertia1: [[f64; 3]; 3],
+        #[pyo3(from_py_with = real_matrix::<3, 3>)] inertia2: [[f64; 3]; 3],
     ) -> PyResult<PyClassInitializer<Self>> {
         let sys = RollingSpheres::new(r1, r2, gamma1, gamma2, m1, m2, inertia1, inertia2).py()?;
         let args = (r1, r2, gamma1, gamma2, m1, m2, inertia1, inertia2).into_pyobject(py)?;
@@ -105,11 +107,11 @@ impl PyRollingSpheres {
     ///     NotInGroupError, NonFiniteError.
     fn state(
         &self,
-        z1: [[f64; 3]; 3],
-        z2: [[f64; 3]; 3],
-        u: [f64; 3],
-        Omega1: [f64; 3],
-        Omega2: [f64; 3],
+        #[pyo3(from_py_with = real_matrix::<3, 3>)] z1: [[f64; 3]; 3],
+        #[pyo3(from_py_with = real_matrix::<3, 3>)] z2: [[f64; 3]; 3],
+        #[pyo3(from_py_with = reals::<3>)] u: [f64; 3],
+        #[pyo3(from_py_with = reals::<3>)] Omega1: [f64; 3],
+        #[pyo3(from_py_with = reals::<3>)] Omega2: [f64; 3],
     ) -> PyResult<Vec<f64>> {
         self.sys.state(z1, z2, u, Omega1, Omega2).py()
     }
@@ -119,7 +121,12 @@ impl PyRollingSpheres {
     /// (r1 theta_dot_1 + r2 theta_dot_2)/(r1 + r2). It stays planar when gamma_k is
     /// perpendicular to e3 and e3 is an eigenvector of I_k. 003 §1's disk moment of inertia
     /// (about the disk's centre) is I_k[0,0] + I_k[1,1] + m_k |gamma_k|^2.
-    fn planar_state(&self, theta: [f64; 2], phi: f64, theta_dot: [f64; 2]) -> PyResult<Vec<f64>> {
+    fn planar_state(
+        &self,
+        #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
+        #[pyo3(from_py_with = real)] phi: f64,
+        #[pyo3(from_py_with = reals::<2>)] theta_dot: [f64; 2],
+    ) -> PyResult<Vec<f64>> {
         self.sys.planar_state(theta, phi, theta_dot).py()
     }
 
@@ -129,7 +136,17 @@ impl PyRollingSpheres {
     /// Raises:
     ///     InvalidArgumentError (off the planar subbundle), ShapeError.
     #[pyo3(signature = (state, tol = 1e-9))]
-    fn to_planar(&self, state: Vec<f64>, tol: f64) -> PyResult<[f64; 5]> {
+    fn to_planar(
+        &self,
+        #[pyo3(from_py_with = real_vec)] state: Vec<f64>,
+        #[pyo3(from_py_with = real)] tol: f64,
+    ) -> PyResult<[f64; 5]> {
+        if !(tol >= 0.0 && tol.is_finite()) {
+            return Err(to_py(Error::invalid(
+                "tol",
+                format!("expected a finite tolerance ≥ 0, got {tol}"),
+            )));
+        }
         self.sys.to_planar(&state, tol).py()
     }
 

@@ -6,6 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use pyo3::PyClassInitializer;
 
+use crate::convert::real;
 use crate::convert::ArrayIn;
 use crate::errors::IntoPy;
 use crate::items::{map_items, Input};
@@ -37,7 +38,12 @@ pub struct PySphericalPendulum {
 impl PySphericalPendulum {
     #[new]
     #[pyo3(signature = (mass = 1.0, length = 1.0, g = 9.81))]
-    fn new(py: Python<'_>, mass: f64, length: f64, g: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        py: Python<'_>,
+        #[pyo3(from_py_with = real)] mass: f64,
+        #[pyo3(from_py_with = real)] length: f64,
+        #[pyo3(from_py_with = real)] g: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let pendulum = core::SphericalPendulum::new(mass, length, g).py()?;
         let args = (mass, length, g).into_pyobject(py)?;
         let base = PySystem::new(pendulum.clone(), args, &["mass", "length", "g"]);

@@ -10,10 +10,11 @@ use lieflow::Error;
 use numpy::ndarray::arr2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyBool, PyTuple};
 
+use crate::convert::{real, real_pair, reals};
 use crate::convert::{shape_str, ArrayIn};
-use crate::errors::{to_py, IntoPy};
+use crate::errors::{argument_type_error, to_py, IntoPy};
 use crate::integrate::{Callbacks, ErrorSlot};
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -85,7 +86,7 @@ impl PySurface {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn curvature(&self, x: Vec2) -> PyResult<f64> {
+    fn curvature(&self, #[pyo3(from_py_with = reals::<2>)] x: Vec2) -> PyResult<f64> {
         self.at(x, |x| self.inner.curvature(x))
     }
 
@@ -93,7 +94,11 @@ impl PySurface {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn metric<'py>(&self, py: Python<'py>, x: Vec2) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn metric<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = reals::<2>)] x: Vec2,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         Ok(mat2(py, self.at(x, |x| self.inner.metric(x))?))
     }
 
@@ -101,7 +106,11 @@ impl PySurface {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn frame<'py>(&self, py: Python<'py>, x: Vec2) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn frame<'py>(
+        &self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = reals::<2>)] x: Vec2,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         Ok(mat2(py, self.at(x, |x| self.inner.frame(x))?))
     }
 
@@ -109,7 +118,7 @@ impl PySurface {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn connection(&self, x: Vec2) -> PyResult<Vec2> {
+    fn connection(&self, #[pyo3(from_py_with = reals::<2>)] x: Vec2) -> PyResult<Vec2> {
         self.at(x, |x| self.inner.connection(x))
     }
 
@@ -150,7 +159,7 @@ fn call_floats<const N: usize>(
         let out = PyTuple::new(py, args)
             .and_then(|a| f.bind(py).call1(a))
             .and_then(|v| {
-                let a = ArrayIn::named("the callable's value", &v)?;
+                let a = ArrayIn::named(&format!("the value of {what}"), &v)?;
                 let v = a.as_array();
                 if v.shape() != shape {
                     return Err(to_py(Error::shape(
@@ -170,6 +179,35 @@ fn call_floats<const N: usize>(
             [f64::NAN; N]
         })
     })
+}
+
+/// The value of a `domain(x1, x2)` callable: a bool or a numpy bool; anything else (a number,
+/// NaN, a string, a list) is an `ArgumentTypeError` naming `domain`, not read by its truthiness.
+fn domain_value(f: &Any<'_>, v: &Any<'_>) -> PyResult<bool> {
+    if let Ok(b) = v.cast::<PyBool>() {
+        return Ok(b.is_true());
+    }
+    let numpy_bool = v
+        .get_type()
+        .fully_qualified_name()
+        .is_ok_and(|n| n == "numpy.bool" || n == "numpy.bool_");
+    if numpy_bool {
+        return v.is_truthy();
+    }
+    let name = |o: &Any<'_>| {
+        o.getattr("__qualname__")
+            .or_else(|_| o.get_type().name().map(|n| n.into_any()))
+            .map_or_else(|_| "?".to_string(), |n| n.to_string())
+    };
+    Err(argument_type_error(
+        v.py(),
+        format!(
+            "argument 'domain': the callable `{}` must return a bool (or numpy bool), got a {} ({})",
+            name(f),
+            name(&v.get_type().into_any()),
+            v.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+        ),
+    ))
 }
 
 fn callable(what: &str, f: &Any<'_>) -> PyResult<Py<PyAny>> {
@@ -205,7 +243,7 @@ pub(crate) fn Plane(py: Python<'_>) -> PyResult<PySurface> {
 /// Raises:
 ///     InvalidArgumentError (R <= 0).
 #[pyfunction]
-fn Sphere(py: Python<'_>, radius: f64) -> PyResult<PySurface> {
+fn Sphere(py: Python<'_>, #[pyo3(from_py_with = real)] radius: f64) -> PyResult<PySurface> {
     native(py, surface::Sphere::new(radius).py()?, "Sphere", &[radius])
 }
 
@@ -225,7 +263,11 @@ fn HyperbolicPlane(py: Python<'_>) -> PyResult<PySurface> {
 /// Raises:
 ///     TypeError (not callable), InvalidArgumentError (an empty or non-finite range).
 #[pyfunction]
-fn Revolution<'py>(r: Any<'py>, z: Any<'py>, s_range: (f64, f64)) -> PyResult<PySurface> {
+fn Revolution<'py>(
+    r: Any<'py>,
+    z: Any<'py>,
+    #[pyo3(from_py_with = real_pair)] s_range: (f64, f64),
+) -> PyResult<PySurface> {
     let py = r.py();
     let errors = Arc::new(ErrorSlot::default());
     let profile = |what: &'static str, f: Py<PyAny>| {
@@ -248,7 +290,11 @@ fn Revolution<'py>(r: Any<'py>, z: Any<'py>, s_range: (f64, f64)) -> PyResult<Py
 /// Raises:
 ///     InvalidArgumentError (not a > b > 0).
 #[pyfunction]
-fn Torus(py: Python<'_>, a: f64, b: f64) -> PyResult<PySurface> {
+fn Torus(
+    py: Python<'_>,
+    #[pyo3(from_py_with = real)] a: f64,
+    #[pyo3(from_py_with = real)] b: f64,
+) -> PyResult<PySurface> {
     native(py, surface::Revolution::torus(a, b).py()?, "Torus", &[a, b])
 }
 
@@ -281,7 +327,11 @@ fn Graph(f: Any<'_>) -> PyResult<PySurface> {
 /// Raises:
 ///     NonFiniteError.
 #[pyfunction]
-fn Quadric(py: Python<'_>, a: f64, b: f64) -> PyResult<PySurface> {
+fn Quadric(
+    py: Python<'_>,
+    #[pyo3(from_py_with = real)] a: f64,
+    #[pyo3(from_py_with = real)] b: f64,
+) -> PyResult<PySurface> {
     native(py, surface::Graph::quadric(a, b).py()?, "Quadric", &[a, b])
 }
 
@@ -317,9 +367,9 @@ fn MetricSurface<'py>(
             let (slot, d) = (errors.clone(), callable("domain", d)?);
             Some(Arc::new(move |x: Vec2| {
                 Python::attach(|py| {
-                    d.bind(py)
-                        .call1((x[0], x[1]))
-                        .and_then(|v| v.is_truthy())
+                    let f = d.bind(py);
+                    f.call1((x[0], x[1]))
+                        .and_then(|v| domain_value(f, &v))
                         .unwrap_or_else(|e| {
                             slot.record(e);
                             false

@@ -9,6 +9,7 @@ use pyo3::types::{PyDict, PySlice};
 use pyo3::PyClassInitializer;
 
 use crate::convert::{mat, ArrayIn};
+use crate::convert::{real, reals, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::system::PySystem;
 use crate::systems::surfaces::Plane;
@@ -24,7 +25,7 @@ fn pick<'py>(a: &Any<'py>, k: Any<'py>) -> PyResult<Any<'py>> {
 
 /// The Euler tensor from a scalar I = tr I (a symmetric body) or a (2, 2) array.
 fn tensor(inertia: &Any<'_>) -> PyResult<[f64; 4]> {
-    if let Ok(i) = inertia.extract::<f64>() {
+    if let Ok(Real(i)) = inertia.extract::<Real>() {
         return Ok([0.5 * i, 0.0, 0.0, 0.5 * i]);
     }
     let a = ArrayIn::named("inertia", inertia)?;
@@ -68,7 +69,7 @@ impl PyTangentTop {
     #[pyo3(signature = (surface, mass, inertia, embedded=false))]
     fn new(
         surface: Bound<'_, PySurface>,
-        mass: f64,
+        #[pyo3(from_py_with = real)] mass: f64,
         inertia: Any<'_>,
         embedded: bool,
     ) -> PyResult<PyClassInitializer<Self>> {
@@ -106,10 +107,10 @@ impl PyTangentTop {
     ///     InvalidArgumentError (x outside the chart), NonFiniteError.
     fn state(
         slf: &Bound<'_, Self>,
-        x: [f64; 2],
-        theta: f64,
-        xdot: [f64; 2],
-        thetadot: f64,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
         let z = slf.get().top.state(x, theta, xdot, thetadot);
         slf.as_super().get().take_callback_error()?;
@@ -194,7 +195,10 @@ impl PyTangentTop {
     ///
     /// Raises:
     ///     InvalidArgumentError (an anisotropic embedded top depends on theta and has none).
-    fn magnetic_analogue<'py>(slf: &Bound<'py, Self>, p_theta: f64) -> PyResult<Any<'py>> {
+    fn magnetic_analogue<'py>(
+        slf: &Bound<'py, Self>,
+        #[pyo3(from_py_with = real)] p_theta: f64,
+    ) -> PyResult<Any<'py>> {
         let py = slf.py();
         let cls = py.import("lieflow")?.getattr("ChargedParticle")?;
         cls.call1((slf.clone(), p_theta))
@@ -221,7 +225,10 @@ pub struct PyChargedParticle {
 #[pymethods]
 impl PyChargedParticle {
     #[new]
-    fn new(top: Bound<'_, PyTangentTop>, charge: f64) -> PyResult<PyClassInitializer<Self>> {
+    fn new(
+        top: Bound<'_, PyTangentTop>,
+        #[pyo3(from_py_with = real)] charge: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let particle = top.get().top.magnetic_analogue(charge).py()?;
         let callbacks = top.as_super().get().callbacks.clone();
         let args = (top.clone(), charge).into_pyobject(top.py())?;
@@ -252,7 +259,7 @@ impl PyChargedParticle {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn metric(&self, x: [f64; 2]) -> PyResult<[[f64; 2]; 2]> {
+    fn metric(&self, #[pyo3(from_py_with = reals::<2>)] x: [f64; 2]) -> PyResult<[[f64; 2]; 2]> {
         self.particle.metric(x).py()
     }
 
@@ -260,7 +267,7 @@ impl PyChargedParticle {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn potential(&self, x: [f64; 2]) -> PyResult<[f64; 2]> {
+    fn potential(&self, #[pyo3(from_py_with = reals::<2>)] x: [f64; 2]) -> PyResult<[f64; 2]> {
         self.particle.potential(x).py()
     }
 
@@ -268,7 +275,11 @@ impl PyChargedParticle {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart), NonFiniteError.
-    fn state(slf: &Bound<'_, Self>, x: [f64; 2], xdot: [f64; 2]) -> PyResult<Vec<f64>> {
+    fn state(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+    ) -> PyResult<Vec<f64>> {
         let z = slf.get().particle.state(x, xdot);
         slf.as_super().get().take_callback_error()?;
         z.py()
