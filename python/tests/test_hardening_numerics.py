@@ -153,6 +153,48 @@ def test_gl_plus_membership_survives_determinant_overflow():
         pr.angular_momentum(x, np.zeros((n, n)))
 
 
+# --- 6. accuracy gaps: so_log up to π for every n ----------------------------------------------
+
+
+def _rotation_with_angles(angles, n, seed):
+    rng = np.random.default_rng(seed)
+    q, r = np.linalg.qr(rng.normal(size=(n, n)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    b, e = np.zeros((n, n)), np.eye(n)
+    for k, t in enumerate(angles):
+        i, j = 2 * k, 2 * k + 1
+        b[i, j], b[j, i] = t, -t
+        e[i, i] = e[j, j] = np.cos(t)
+        e[i, j], e[j, i] = np.sin(t), -np.sin(t)
+    return q @ b @ q.T, q @ e @ q.T
+
+
+@pytest.mark.parametrize("n", [4, 5, 6, 7, 8])
+@pytest.mark.parametrize("d", [1e-3, 1e-6, 1e-9, 1e-11])
+def test_so_log_is_accurate_up_to_pi_for_every_n(n, d):
+    # Formerly refused within 1e-6 of π for n ≥ 4; now accurate, with every plane near π (a
+    # cluster of equal angles) and with one plane near π beside others.
+    spread = [0.7 + 0.5 * k for k in range(n // 2 - 1)]
+    for angles in ([np.pi - d] * (n // 2), [np.pi - d] + spread):
+        xi0, R = _rotation_with_angles(angles, n, seed=n)
+        xi = lf.lie.so_log(R)
+        assert np.linalg.norm(lf.lie.so_exp(xi) - R) < 1e-13
+        assert np.linalg.norm(xi - xi0) < 1e-13 + 1e-14 / d  # the problem's condition ~ε/d
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 6, 8])
+def test_so_log_refuses_only_at_pi_within_round_off(n):
+    _, R = _rotation_with_angles([np.pi - 1e-11], n, seed=1)
+    lf.lie.so_log(R)
+    for d in [1e-13, 0.0]:
+        _, R = _rotation_with_angles([1.0] * (n // 2 - 1) + [np.pi - d], n, seed=1)
+        with pytest.raises(lf.NoUniqueLogError, match=r"angle 3\.14159265358\d*.*round-off") as e:
+            lf.lie.so_log(R)
+        assert "1e-6" not in str(e.value)
+
+
 # --- 7. messages -------------------------------------------------------------------------------
 
 

@@ -4,7 +4,7 @@ every error path."""
 import numpy as np
 import pytest
 import scipy.linalg
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -215,6 +215,9 @@ skew_coords = st.integers(2, 8).flatmap(
 
 @settings(max_examples=200, deadline=None)
 @given(skew_coords)
+# Two angles 1e-7 apart (2.82842718, 2.82842707): the former plane-by-plane log mis-grouped
+# their cos gap of 3.7e-8 (exp(log R) missed R by 3e-9).
+@example(np.array([2.0, 0.0, 2.0, 2.0, 1.1920928955078125e-07, 2.0]))
 def test_exp_is_rotation_and_log_inverts(c):
     xi = lie.hat_n(c)
     R = lie.so_exp(xi)
@@ -227,7 +230,7 @@ def test_exp_is_rotation_and_log_inverts(c):
         np.testing.assert_allclose(lie.so_log(R), xi, atol=1e-10)
     else:
         try:
-            np.testing.assert_allclose(lie.so_exp(lie.so_log(R)), R, atol=1e-9)
+            np.testing.assert_allclose(lie.so_exp(lie.so_log(R)), R, rtol=0, atol=1e-13)
         except lf.NoUniqueLogError:
             pass
 
@@ -239,3 +242,77 @@ def test_log_of_haar_random_rotations(n):
     logs = lie.so_log(Rs)
     np.testing.assert_array_equal(logs, -np.swapaxes(logs, 1, 2))
     np.testing.assert_allclose(lie.so_exp(logs), Rs, atol=1e-13)
+
+
+# --- the logarithm for clustered angles and up to π (issue 16, accuracy gaps) ------------------
+
+
+def planes(angles, q):
+    """ξ = q B qᵀ with one 2-plane per angle, and R = q exp(B) qᵀ with exp(B) in closed form."""
+    n = q.shape[0]
+    b, e = np.zeros((n, n)), np.eye(n)
+    for k, t in enumerate(angles):
+        i, j = 2 * k, 2 * k + 1
+        b[i, j], b[j, i] = t, -t
+        e[i, i] = e[j, j] = np.cos(t)
+        e[i, j], e[j, i] = np.sin(t), -np.sin(t)
+    return q @ b @ q.T, q @ e @ q.T
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    n=st.integers(3, 8),
+    base_exp=st.floats(-11.0, 0.5),
+    near_pi=st.booleans(),
+    gap_exp=st.floats(-12.0, -3.0),
+    triple=st.booleans(),
+    others=st.lists(st.floats(0.0, 3.1), min_size=4, max_size=4),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_log_backward_error_with_clustered_angles(
+    n, base_exp, near_pi, gap_exp, triple, others, seed
+):
+    # Two or three angles 1e-12 … 1e-3 apart at a base angle from 1e-11 to π − 1e-11 (the former
+    # log refused within 1e-6 of π for n ≥ 4 and missed R by up to 3e-9 at 1e-7 clusters).
+    d, gap = 10.0**base_exp, 10.0**gap_exp
+    base = np.pi - d if near_pi else min(d, 3.0)
+    angles = others[: n // 2]
+    angles[0] = base
+    if n >= 4:
+        angles[1] = max(base - gap, 0.0)
+    if triple and n >= 6:
+        angles[2] = max(base - 2 * gap, 0.0)
+    _, R = planes(angles, rand_rot(n, np.random.default_rng(seed)))
+    xi = lie.so_log(R)
+    np.testing.assert_array_equal(xi, -xi.T)
+    assert np.linalg.norm(lie.so_exp(xi) - R) < 1e-13
+
+
+MP_CASES = [
+    (4, [2.82842718, 2.82842707]),  # the hypothesis example's two angles
+    (5, [np.pi - 1e-9, np.pi - 1e-9 - 1e-12]),
+    (6, [np.pi - 1e-6, 0.3, np.pi - 1e-6 - 1e-10]),
+    (7, [1.0, 1.0 + 1e-8, 1e-9]),
+    (8, [np.pi - 1e-11, 3.0, np.pi - 1e-11, 1.5]),
+]
+
+
+@pytest.mark.parametrize("n, angles", MP_CASES)
+def test_log_forward_error_against_mpmath(n, angles):
+    # R = exp ξ at 40 digits, rounded to doubles; the reference is the principal log of that
+    # rounded R at 40 digits, V diag(log λ) V⁻¹ from mpmath's eigendecomposition (skew part;
+    # mpmath.logm itself lands on another branch near π), so the forward error measures the
+    # method: it must stay within the problem's condition ε·(1 + 1/(π − θ_max)).
+    mpmath = pytest.importorskip("mpmath")
+    with mpmath.workdps(40):
+        xi, _ = planes(angles, rand_rot(n, np.random.default_rng(n)))
+        R = np.array(mpmath.expm(mpmath.matrix(xi.tolist())).tolist(), dtype=float)
+        lam, v = mpmath.eig(mpmath.matrix(R.tolist()))
+        ref = v * mpmath.diag([mpmath.log(x) for x in lam]) * mpmath.inverse(v)
+        ref = np.array(ref.tolist(), dtype=complex)
+    assert np.abs(ref.imag).max() < 1e-25
+    ref = 0.5 * (ref.real - ref.real.T)
+    cond = 1.0 + 1.0 / (np.pi - max(angles))
+    err = np.linalg.norm(lie.so_log(R) - ref)
+    assert err < 2 * n * np.finfo(float).eps * cond, (err, cond)
+    assert np.linalg.norm(lie.so_exp(lie.so_log(R)) - R) < 1e-14 * n

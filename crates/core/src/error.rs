@@ -56,7 +56,7 @@ pub enum Error {
         "the logarithm of {what} is not unique: it contains a rotation by angle {angle:.15} \
          (π = 3.141592653589793, distance {distance:.1e}), at π or within round-off of it, \
          where the logarithms ±θ·axis are equally valid; the principal logarithm needs all \
-         rotation angles below π by more than round-off (1e-12; 1e-6 for n ≥ 4)"
+         rotation angles below π by more than round-off (1e-12)"
     )]
     NoUniqueLog {
         /// The argument.
