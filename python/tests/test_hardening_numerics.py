@@ -224,3 +224,200 @@ def test_ellipj_names_the_argument():
 def test_project_to_so_is_scale_free(s):
     m = np.array([[1.0, 2, 0.5], [3, 4, -1], [0.2, -0.3, 2]])
     assert np.allclose(lf.lie.project_to_so(s * m), lf.lie.project_to_so(m), atol=1e-14)
+
+
+# --- 8. accuracy gaps: the exact rigid body near the separatrix -------------------------------
+
+# M(t) at t = 5, 10, ..., 30 from a 40-digit Taylor integration of Euler's equations (mpmath,
+# order 40, step 0.05; a second step size agrees to 1e-40).
+SEPARATRIX_REFERENCE = {
+    "eps=0.0001": (
+        [1.0, 2.0, 3.0],
+        [0.0001, 1.0, 0.0001],
+        [
+            [0.00010811832785246063, 0.9999999966208544, -0.000122754708475221],
+            [0.00038340747679042826, 0.999999725997376, -0.0006488481176488134],
+            [0.0016061297889101258, 0.9999948606809961, -0.0027783014049007453],
+            [0.0067974589223348605, 0.9999076048359652, -0.01177269482329723],
+            [0.02876353179708064, 0.9983439672548903, -0.04981969775425185],
+            [0.12012789868609715, 0.9707096331184991, -0.20806757586950367],
+        ],
+    ),
+    "eps=1e-05": (
+        [1.0, 2.0, 3.0],
+        [1e-05, 1.0, 1e-05],
+        [
+            [1.0811832744488692e-05, 0.9999999999662086, -1.2275470739828823e-05],
+            [3.834075179242726e-05, 0.9999999972599735, -6.488481905673731e-05],
+            [0.0001606133797639578, 0.9999999486066832, -0.0002778308357213144],
+            [0.0006797769365718284, 0.9999990760062061, -0.0011773232565803408],
+            [0.002878712716664649, 0.9999834260888426, -0.004986056629768689],
+            [0.012189521198792477, 0.9997027871781576, -0.02111286529979845],
+        ],
+    ),
+    "eps=1e-06": (
+        [1.0, 2.0, 3.0],
+        [1e-06, 1.0, 1e-06],
+        [
+            [1.0811832744081117e-06, 0.999999999999662, -1.2275470738751888e-06],
+            [3.83407518335611e-06, 0.9999999999725997, -6.488481912965587e-06],
+            [1.6061338377269724e-05, 0.9999999994860668, -2.778308426736441e-05],
+            [6.797772470295194e-05, 0.9999999907600579, -0.00011773237943476283],
+            [0.0002878736331582355, 0.9999998342595289, -0.0004986097532170495],
+            [0.0012191314776414848, 0.9999970274344624, -0.0021115971868064538],
+        ],
+    ),
+    "eps=1e-07": (
+        [1.0, 2.0, 3.0],
+        [1e-07, 1.0, 1e-07],
+        [
+            [1.0811832744077041e-07, 0.9999999999999967, -1.227547073874112e-07],
+            [3.834075183397244e-07, 0.999999999999726, -6.488481913038506e-07],
+            [1.6061338381278464e-06, 0.9999999999948607, -2.778308427431674e-06],
+            [6.797772501340977e-06, 0.9999999999076006, -1.1773237997253037e-05],
+            [2.8787365677334883e-05, 0.9999999983425951, -4.9860979411979016e-05],
+            [0.00012191332714856538, 0.9999999702743009, -0.00021116002938363924],
+        ],
+    ),
+    "eps=1e-08": (
+        [1.0, 2.0, 3.0],
+        [1e-08, 1.0, 1e-08],
+        [
+            [1.0811832744077001e-08, 1.0, -1.2275470738741012e-08],
+            [3.834075183397655e-08, 0.9999999999999972, -6.488481913039235e-08],
+            [1.6061338381318553e-07, 0.9999999999999486, -2.7783084274386267e-07],
+            [6.797772501651436e-07, 0.999999999999076, -1.1773237997790805e-06],
+            [2.878736570095e-06, 0.9999999999834259, -4.986097945288177e-06],
+            [1.2191332894241223e-05, 0.999999999702743, -2.1116003249067382e-05],
+        ],
+    ),
+    "sep123": (
+        [1.0, 2.0, 3.0],
+        [0.1, 1.0, 0.17320508075688773],
+        [
+            [0.02316056319371657, 1.0187513696924286, 0.04011527218342676],
+            [0.0053173753024125265, 1.0197484503933179, 0.009209964186690258],
+            [0.0012202373993037664, 1.019800982585699, 0.0021135131728891345],
+            [0.0002800146491873404, 1.0198037489474066, 0.0004849995992529963],
+            [6.425643326609504e-05, 1.019803894621139, 0.00011129540711673316],
+            [1.474526048155657e-05, 1.019803902292156, 2.5539540266924596e-05],
+        ],
+    ),
+    "sep236": (
+        [2.0, 3.0, 6.0],
+        [0.1, 1.0, 0.1],
+        [
+            [0.043274516486912204, 1.0080945553099907, 0.043274516486912204],
+            [0.018665687276376953, 1.009605459690567, 0.018665687276376953],
+            [0.008046205519510163, 1.0098863882405167, 0.008046205519510163],
+            [0.003468079721214331, 1.009938584690225, 0.003468079721214331],
+            [0.0014947820876165553, 1.0099482814743639, 0.0014947820876165553],
+            [0.0006442656845599409, 1.0099500828473926, 0.0006442656845599409],
+        ],
+    ),
+    "sep236b": (
+        [2.0, 3.0, 6.0],
+        [1e-06, 1.0, -1e-06],
+        [
+            [2.3009758908898014e-06, 0.9999999999957055, -2.3009758908898014e-06],
+            [5.294490050407294e-06, 0.9999999999729684, -5.294490050407294e-06],
+            [1.2182493959835999e-05, 0.9999999998525868, -1.2182493959835999e-05],
+            [2.8031624883620356e-05, 0.999999999215228, -2.8031624883620356e-05],
+            [6.450009293098811e-05, 0.999999995840738, -6.450009293098811e-05],
+            [0.0001484131574688842, 0.9999999779745344, -0.0001484131574688842],
+        ],
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(SEPARATRIX_REFERENCE))
+def test_exact_solution_near_the_separatrix(case):
+    # Formerly 9e-9 (ε = 1e-4) to 6e-7 (ε = 1e-6) off at t = 30 for M0 = (ε, 1, ε), I = (1, 2, 3),
+    # and ε ≤ 1e-7 and the separatrix itself (sep236: M1² = M3² for I = (2, 3, 6), the
+    # heteroclinic orbit sn = tanh, cn = dn = sech) refused. The problem's own amplification
+    # e^{t/√12} ≈ 6e3 at t = 30 allows 1e-10; the complementary modulus from the components
+    # gives round-off.
+    inertia, m0, want = SEPARATRIX_REFERENCE[case]
+    body = lf.RigidBody(inertia)
+    got = body.exact_solution(m0, [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0])
+    np.testing.assert_allclose(got[0], m0, rtol=1e-14, atol=0)
+    assert np.abs(got[1:] - np.array(want)).max() < 1e-12
+
+
+@pytest.mark.parametrize("m0", [[1e-170, 1.0, 1e-170], [0.0, 1.0, -3e-200], [1e-12, 1.0, 0.0]])
+def test_exact_solution_next_to_the_unstable_axis_is_its_linearization(m0):
+    # Near the middle axis (1 − m ~ 1e-340 is no double; the complementary modulus is), the small
+    # components follow the linearization, exact there to O(|M1|² + |M3|²).
+    m0 = np.array(m0)
+    s = 1 / np.sqrt(12)
+    t = np.array([0.0, 1.0, 30.0, 200.0]) if m0[0] < 1e-100 else np.array([0.0, 1.0, 30.0])
+    got = lf.RigidBody([1, 2, 3]).exact_solution(m0, t)
+    c, h = np.cosh(s * t), np.sinh(s * t)
+    m1 = m0[0] * c - m0[2] * h / (6 * s)
+    m3 = m0[2] * c - m0[0] * h / (2 * s)
+    small = np.maximum(np.abs(m1), np.abs(m3))  # relative to the size of the deviation
+    assert np.all(np.abs(got[:, 0] - m1) <= 1e-12 * small)
+    assert np.all(np.abs(got[:, 2] - m3) <= 1e-12 * small)
+    np.testing.assert_allclose(got[:, 1], 1.0, rtol=1e-15)
+    assert np.array_equal(lf.RigidBody([1, 2, 3]).exact_solution([0, 2.0, 0], 50.0), [0, 2.0, 0])
+
+
+@pytest.mark.parametrize("c", [1e-300, 1e300])
+def test_exact_solution_is_scale_free(c):
+    body, m0, t = lf.RigidBody([1, 2, 3]), np.array([1e-6, 1.0, 1e-6]), np.array([0.0, 7.0, 30.0])
+    np.testing.assert_allclose(body.exact_solution(c * m0, t / c) / c, body.exact_solution(m0, t),
+                               rtol=0, atol=1e-15)
+
+
+# --- 7. silent NaN from finite input: the pseudo-rigid family, strata, the systems ------------
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: pr.right_inertia(1e160 * X, S),
+        lambda: pr.left_inertia(1e160 * X, S),
+        lambda: pr.right_inertia(X, np.finfo(float).max / 4 * S),
+        lambda: pr.bi_inertia_quadratic_form(X, S, 1e300 * S),
+        lambda: pr.bi_inertia_quadratic_form(1e300 * X, S, S),
+        lambda: pr.bi_inertia_eigen(1e300 * X),
+        lambda: pr.equilibrium_directions(1e300 * np.array([3.0, 2.0, 1.0])),
+        lambda: lf.RollingSpheres(1e300, 1.3, [0.1, -0.2, 0.15], [-0.3, 0.2, 0.4], 2.0, 3.5,
+                                  np.diag([0.1, 0.2, 0.3]), np.diag([0.1, 0.2, 0.3])),
+        lambda: lf.WeakFieldTop(1.0, 1e-3, gm=1e-4).angular_momentum(
+            1e300 * np.array([1.0, 0.5, 0.1, 0.2, 1.0, 0.3])),
+    ],
+)
+def test_no_nan_at_the_ends_of_the_range(call):
+    with pytest.raises(lf.InvalidArgumentError, match="overflow"):
+        call()
+
+
+def test_representable_extremes_are_computed():
+    r = pr.right_inertia(1e-170 * X, 1e300 * S)
+    assert finite(r) and np.allclose(r, 1e-40 * pr.right_inertia(X, S), rtol=1e-14)
+    a = np.array([4.480262692850076e-191, 1.828685890397971e-188, 5.854556749629787e-189])
+    x, p = pr.reconstruct(np.eye(3), np.eye(3), a, np.zeros(3), S, 0.5 * S)
+    assert finite(x, p)
+    st = lf.lie.stratum(X, np.finfo(float).max)
+    assert np.isfinite(st["tol"]) and st["multiplicities"] == [3]
+
+
+def test_rolling_spheres_observables_need_a_state():
+    rs = lf.RollingSpheres(0.7, 1.3, [0.1, -0.2, 0.15], [-0.3, 0.2, 0.4], 2.0, 3.5,
+                           np.diag([0.1, 0.2, 0.3]), np.diag([0.1, 0.2, 0.3]))
+    z = np.asarray(rs.state(np.eye(3), np.eye(3), [1.0, 0, 0], [1.1, -0.6, 0.8], [-0.4, 0.9, 0.5]))
+    assert finite(rs.accelerations(z))
+    for bad in (np.zeros(27), 1e-170 * z, 1e300 * z):
+        for f in (rs.accelerations, rs.udot, rs.spatial_momenta, rs.angular_momentum):
+            with pytest.raises(lf.LieflowError):
+                f(bad)
+
+
+def test_pseudo_rigid_momenta_overflow_is_typed():
+    body = lf.PseudoRigidBody(3)
+    z = np.r_[X.ravel(), V.ravel()]
+    for f in (body.angular_momentum, body.circulation):
+        assert finite(f(z))
+        with pytest.raises(lf.InvalidArgumentError, match="overflow"):
+            f(1e300 * z)

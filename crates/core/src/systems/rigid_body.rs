@@ -102,14 +102,22 @@ impl RigidBody {
 
     /// The exact body momentum M(t) from M(0) = `m0` by Jacobi elliptic functions (user frame).
     ///
-    /// With principal moments relabelled so that I₂ is the middle one and D = |M|²/(2H) between
-    /// I₂ and I₃ (a proper rotation of the axes, one sign flip if the relabelling is odd):
-    /// M₁ = a₁ cn u, M₂ = a₂ sn u, M₃ = ε a₃ dn u, u = u₀ + λt, with
-    /// a₁² = (2H − |M|²/I₃)/(1/I₁ − 1/I₃), a₃² = |M|² − a₁², a₂² = a₁²(1/I₁ − 1/I₃)/(1/I₂ − 1/I₃),
-    /// m = k² = a₂²(1/I₁ − 1/I₂)/(a₃²(1/I₁ − 1/I₃)), λ = ε a₁a₃(1/I₁ − 1/I₃)/a₂, ε = sign M₃,
-    /// u₀ = F(atan2(M₂/a₂, M₁/a₁) | m). (Derived by substituting into Ṁ = M × Ω; cf. Landau &
-    /// Lifshitz, *Mechanics* §37.) A symmetric body rotates M uniformly about its symmetry axis.
-    /// Errors: a state on the separatrix |M|² = 2H I₂ (k = 1), non-finite input.
+    /// With principal moments relabelled (1, 2, 3) so that I₂ is the middle one and
+    /// D = |M|²/(2H) lies between I₂ and I₃ (a proper rotation of the axes, one sign flip if the
+    /// relabelling is odd): M₁ = σ a₁ cn u, M₂ = a₂ sn u, M₃ = ε a₃ dn u, u = u₀ + λt, σ = sign M₁,
+    /// ε = sign M₃ (cf. Landau & Lifshitz, *Mechanics* §37). Every quantity is formed from the
+    /// components of M0 and the moments as sums of terms of one sign, never as a difference of the
+    /// invariants 2H·I_k − |M|² (d_ij = 1/I_i − 1/I_j, g = d₂₃/d₁₃, h = d₁₂/d₁₃ > 0):
+    /// a₁² = M₁² + g M₂², a₂² = M₂² + M₁²/g, a₃² = M₃² + h M₂², m = h a₂²/a₃²,
+    /// λ = σε a₃ d₁₃ √g, and the complementary modulus k′ = √(1 − m) = √(e₂ I₃/(I₂ − I₃))/a₃ from
+    /// e₂ = 2H I₂ − |M|² = Σ_k M_k² (I₂ − I_k)/I_k = A² − B² = (A − B)(A + B) (one positive and
+    /// one negative term: the distance to the separatrix, exactly as accurate as the components);
+    /// u₀ = sn₀ R_F(cn₀², dn₀², 1) with sn₀ = M₂/a₂, cn₀ = |M₁|/a₁, dn₀ = |M₃|/a₃ (no amplitude
+    /// angle); sn, cn, dn from k′ ([`elliptic::ellipj_kprime`]), accurate as k′ → 0. On the
+    /// separatrix (k′ = 0) this is the heteroclinic solution sn = tanh, cn = dn = sech. Steady
+    /// rotations about a principal axis (unstable included) are returned unchanged, and a
+    /// symmetric body rotates M uniformly about its symmetry axis.
+    /// Errors: non-finite input.
     pub fn exact_momentum(&self, m0: &[f64], t: f64) -> Result<[f64; 3]> {
         check::len_of("M0", m0, 3)?;
         check::finite_slice("t", &[t])?;
@@ -121,11 +129,9 @@ impl RigidBody {
 
 /// Exact M(t) in the principal frame.
 fn exact_principal(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Result<Vector3<f64>> {
-    let mu2 = m0.norm_squared();
-    if mu2 == 0.0 {
+    if m0.amax() == 0.0 {
         return Ok(*m0);
     }
-    let two_h: f64 = (0..3).map(|i| m0[i] * m0[i] / inertia[i]).sum();
     let mut idx = [0usize, 1, 2];
     idx.sort_by(|&a, &b| inertia[a].total_cmp(&inertia[b]));
     let (lo, mid, hi) = (idx[0], idx[1], idx[2]);
@@ -142,45 +148,68 @@ fn exact_principal(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Result<Vect
         top::rotate_axis(&mut m, s, t * w);
         return Ok(m);
     }
-    let d = mu2 / two_h;
-    if eq(d, imid) {
-        return Err(Error::invalid(
-            "M0",
-            "the state lies on the separatrix |M|² = 2H·I_mid (elliptic modulus k = 1)",
-        ));
-    }
-    // Axes (p, mid, s): s carries dn, D lies between I_mid and I_s.
-    let (p, s) = if d > imid { (lo, hi) } else { (hi, lo) };
+    // Scale-free from here on (the orbit's shape does not depend on |M|, the frequency is
+    // proportional to it), so no square below can overflow or underflow for a finite M0.
+    let scale = m0.amax();
+    let y = m0 / scale;
+    // e₂ = 2H·I_mid − |M|² = Σ_k M_k² (I_mid − I_k)/I_k = A² − B² = (A − B)(A + B) with
+    // A = |M_lo| √((I_mid − I_lo)/I_lo), B = |M_hi| √((I_hi − I_mid)/I_hi): the middle term
+    // vanishes and the other two have fixed signs, so e₂ is formed from the components without
+    // the cancellation of the invariants (error ~ ulp(A², B²), not ulp(|M|²)). Its sign says
+    // which side of the separatrix M0 lies on; e₂ = 0 (A = B) is the separatrix itself.
+    let ea = y[lo].abs() * ((imid - ilo) / ilo).sqrt();
+    let eb = y[hi].abs() * ((ihi - imid) / ihi).sqrt();
+    // Axes (p, mid, s): s carries dn, |M|²/2H lies between I_mid and I_s (e₂ ≥ 0 ⇔ s = lo).
+    let (p, s) = if ea >= eb { (hi, lo) } else { (lo, hi) };
     let perm = [p, mid, s];
     // Sign of the permutation: cyclic ⇔ even. Flip the middle component if odd (proper rotation).
     let even = (perm[1] + 3 - perm[0]) % 3 == 1;
     let sg = if even { 1.0 } else { -1.0 };
-    let y0 = Vector3::new(m0[p], sg * m0[mid], m0[s]);
-    let (i1, i2, i3) = (inertia[p], inertia[mid], inertia[s]);
-    let (d13, d12, d23) = (
-        1.0 / i1 - 1.0 / i3,
-        1.0 / i1 - 1.0 / i2,
-        1.0 / i2 - 1.0 / i3,
-    );
-    let a1s = ((two_h - mu2 / i3) / d13).max(0.0);
-    if a1s <= 1e-30 * mu2 {
-        return Ok(*m0); // steady rotation about the s axis
+    let (y1, y2, y3) = (y[p], sg * y[mid], y[s]);
+    if y1 == 0.0 && (y2 == 0.0 || y3 == 0.0) {
+        return Ok(*m0); // steady rotation about the s axis or the middle axis
     }
-    let a3s = mu2 - a1s;
-    let a2s = a1s * d13 / d23;
-    let mm = a2s * d12 / (a3s * d13);
-    let (a1, a2, a3) = (a1s.sqrt(), a2s.sqrt(), a3s.sqrt());
-    let eps = if y0.z >= 0.0 { 1.0 } else { -1.0 };
-    let lambda = eps * a1 * a3 * d13 / a2;
-    let phi0 = (y0.y / a2).atan2(y0.x / a1);
-    let u0 = elliptic::ellipf(phi0, mm)?;
-    let (sn, cn, dn) = elliptic::ellipj(u0 + lambda * t, mm)?;
-    let y = Vector3::new(a1 * cn, a2 * sn, eps * a3 * dn);
-    let mut m = Vector3::zeros();
-    m[p] = y.x;
-    m[mid] = sg * y.y;
-    m[s] = y.z;
-    Ok(m)
+    let (i1, i2, i3) = (inertia[p], inertia[mid], inertia[s]);
+    // Ratios of the moment differences, all positive since I₂ lies between I₁ and I₃:
+    // g = d₂₃/d₁₃, h = d₁₂/d₁₃ with d_ij = 1/I_i − 1/I_j = (I_j − I_i)/(I_i I_j).
+    let g = i1 * (i3 - i2) / (i2 * (i3 - i1));
+    let h = i3 * (i2 - i1) / (i2 * (i3 - i1));
+    let d13 = (i3 - i1) / (i1 * i3);
+    // Amplitudes from the two conservation laws, each a sum of positive terms:
+    // a₁² = M₁² + g M₂² (M₁ at M₂ = 0), a₂² = M₂² + M₁²/g (M₂ at M₁ = 0),
+    // a₃² = M₃² + h M₂² (M₃ at M₂ = 0).
+    let a1 = y1.hypot(g.sqrt() * y2);
+    let a2 = y2.hypot(y1 / g.sqrt());
+    let a3 = y3.hypot(h.sqrt() * y2);
+    // m = k² = h a₂²/a₃², and its complement directly, as the complementary modulus
+    // k′ = √(1 − m) = √(e₂ I₃/(I₂ − I₃)) / a₃ (1 − m = (M₃² − M₁² d₁₂/d₂₃)/a₃², and
+    // M₃² d₂₃ − M₁² d₁₂ = −e₂/I₂), as a product of square roots: no square that could underflow
+    // (1 − m ~ (M_lo/M_mid)² may lie below the least double near the middle axis).
+    let m = (h * (a2 / a3) * (a2 / a3)).min(1.0);
+    let kp =
+        ((ea - eb).abs().sqrt() * (ea + eb).sqrt() * (i3 / (i2 - i3)).abs().sqrt() / a3).min(1.0);
+    // M₁ = σ a₁ cn u, M₂ = a₂ sn u, M₃ = ε a₃ dn u with σ = sign M₁, ε = sign M₃ (both signs fixed
+    // on the separatrix; elsewhere σ = −1 is the same solution shifted by 2K), u = u₀ + λt,
+    // λ = σε a₁a₃ d₁₃ / a₂ = σε a₃ d₁₃ √g (from Ṁ₂ = d₁₃ M₁M₃), and u₀ ∈ [−K, K] from
+    // sn u₀ = M₂/a₂, cn u₀ = |M₁|/a₁, dn u₀ = |M₃|/a₃ directly (no amplitude angle, no m).
+    let sigma = if y1 >= 0.0 { 1.0 } else { -1.0 };
+    let eps = if y3 >= 0.0 { 1.0 } else { -1.0 };
+    let lambda = sigma * eps * a3 * d13 * g.sqrt() * scale;
+    let (sn0, cn0, dn0) = (
+        (y2 / a2).clamp(-1.0, 1.0),
+        (y1.abs() / a1).min(1.0),
+        (y3.abs() / a3).min(1.0),
+    );
+    let u0 = elliptic::ellipf_from_jacobi(sn0, cn0, dn0);
+    let u = u0 + lambda * t;
+    // k′ carries the parameter near the separatrix (k′ = 0 there: sn = tanh, cn = dn = sech),
+    // m near a stable axis.
+    let (sn, cn, dn) = elliptic::ellipj_kprime_unchecked(u, kp, m);
+    let mut out = Vector3::zeros();
+    out[p] = sigma * a1 * cn * scale;
+    out[mid] = sg * a2 * sn * scale;
+    out[s] = eps * a3 * dn * scale;
+    Ok(out)
 }
 
 impl Problem for RigidBody {
