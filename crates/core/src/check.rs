@@ -188,6 +188,108 @@ pub fn zeros(what: &str, shape: &[usize]) -> Result<Vec<f64>> {
     Ok(v)
 }
 
+// ---------------------------------------------------------------------------------------------
+// Scale-aware evaluation (issue 16: no NaN or inf from finite input). A homogeneous formula is
+// evaluated on arguments divided by exact powers of two 2^e (largest entry in [1, 2)), and its
+// result multiplied back by 2^(Σ degree·e) once, with an overflow error where the result is not
+// representable. Moderate arguments (largest entry in [1e-100, 1e100]) get e = 0, so their
+// results stay bit for bit what the plain formula gives.
+
+/// The exponent e of the power of two 2^e ≤ m < 2^(e+1) when m lies outside [1e-100, 1e100], else
+/// 0 (also for m = 0 or m not finite): dividing by 2^e brings an extreme magnitude into [1, 2).
+pub fn pow2_exponent(m: f64) -> i32 {
+    if !(m.is_finite() && m > 0.0) || (1e-100..=1e100).contains(&m) {
+        return 0;
+    }
+    let e = m.log2().floor() as i32;
+    // log2 may round up across a power of two.
+    if ldexp(1.0, e) > m {
+        e - 1
+    } else {
+        e
+    }
+}
+
+/// [`pow2_exponent`] of the largest |entry| of the values.
+pub fn pow2_exponent_of(values: impl IntoIterator<Item = f64>) -> i32 {
+    pow2_exponent(values.into_iter().fold(0.0f64, |m, x| m.max(x.abs())))
+}
+
+/// The largest |entry| of a matrix (0 for an empty one).
+pub fn max_abs(m: &Mat) -> f64 {
+    (0..m.ncols())
+        .flat_map(|j| (0..m.nrows()).map(move |i| m[(i, j)]))
+        .fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+/// [`pow2_exponent`] of the largest |entry| of a matrix.
+pub fn pow2_exponent_mat(m: &Mat) -> i32 {
+    pow2_exponent(max_abs(m))
+}
+
+/// x·2^e, exact where the result is a normal number; applied in steps so that 2^e itself need
+/// not be representable (e may be far outside ±1022).
+pub fn ldexp(mut x: f64, mut e: i32) -> f64 {
+    const STEP: i32 = 1000;
+    while e > STEP {
+        x *= 2f64.powi(STEP);
+        e -= STEP;
+    }
+    while e < -STEP {
+        x *= 2f64.powi(-STEP);
+        e += STEP;
+    }
+    x * 2f64.powi(e)
+}
+
+/// m·2^e entrywise ([`ldexp`]).
+pub fn ldexp_mat(m: &Mat, e: i32) -> Mat {
+    if e == 0 {
+        return m.clone();
+    }
+    Mat::from_fn(m.nrows(), m.ncols(), |i, j| ldexp(m[(i, j)], e))
+}
+
+/// The overflow error of a scale-aware formula: `what` names the argument(s), `quantity` the
+/// result that exceeds the f64 range.
+pub fn overflow_error(what: &str, quantity: &str) -> Error {
+    Error::overflow(
+        what,
+        format!("{quantity} exceeds the f64 range (about 1.8e308) at this scale of {what}"),
+    )
+}
+
+/// x·2^e ([`ldexp`]), or [`overflow_error`] where it is not finite.
+pub fn unscale(what: &str, quantity: &str, x: f64, e: i32) -> Result<f64> {
+    let v = ldexp(x, e);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(overflow_error(what, quantity))
+    }
+}
+
+/// m·2^e ([`ldexp_mat`]), or [`overflow_error`] where an entry is not finite.
+pub fn unscale_mat(what: &str, quantity: &str, m: &Mat, e: i32) -> Result<Mat> {
+    let v = ldexp_mat(m, e);
+    let finite = (0..v.ncols()).all(|j| (0..v.nrows()).all(|i| v[(i, j)].is_finite()));
+    if finite {
+        Ok(v)
+    } else {
+        Err(overflow_error(what, quantity))
+    }
+}
+
+/// x₀y₁ − x₁y₀ (the planar cross product, e.g. an angular momentum x p_y − y p_x) scale-aware:
+/// exact powers of two are factored out of x and y, and an overflow error naming `what` is
+/// returned where the result is not representable.
+pub fn cross2(what: &str, quantity: &str, x: [f64; 2], y: [f64; 2]) -> Result<f64> {
+    let (ex, ey) = (pow2_exponent_of(x), pow2_exponent_of(y));
+    let (x0, x1) = (ldexp(x[0], -ex), ldexp(x[1], -ex));
+    let (y0, y1) = (ldexp(y[0], -ey), ldexp(y[1], -ey));
+    unscale(what, quantity, x0 * y1 - x1 * y0, ex + ey)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -210,5 +312,20 @@ mod tests {
         assert_eq!(zeros("w", &[2, 3]).map(|v| v.len()), Ok(6));
         assert!(zeros("w", &[10_000_000_000, 3, 3]).is_err());
         assert!(array_size("w", &[usize::MAX, 2]).is_err());
+    }
+
+    #[test]
+    fn scale_helpers() {
+        assert_eq!(pow2_exponent(1.0), 0);
+        assert_eq!(pow2_exponent(1e99), 0);
+        assert_eq!(pow2_exponent(f64::MAX), 1023);
+        assert_eq!(pow2_exponent(1e300), 996);
+        assert_eq!(pow2_exponent(5e-324), -1074);
+        assert_eq!(ldexp(1.0, 1023), 2f64.powi(1023));
+        assert_eq!(ldexp(ldexp(3.0, -1074), 1074), 3.0 * 1.0);
+        assert_eq!(ldexp(1.5, 2000), f64::INFINITY);
+        assert_eq!(cross2("z", "L", [1e300, 0.0], [0.0, 1e-300]), Ok(1.0));
+        assert!(cross2("z", "L", [1e300, 0.0], [0.0, 1e300]).is_err());
+        assert_eq!(cross2("z", "L", [1.0, 2.0], [3.0, 4.0]), Ok(-2.0));
     }
 }

@@ -234,3 +234,290 @@ fn so_log_is_accurate_up_to_pi_for_n_up_to_3() {
         );
     }
 }
+
+// --- Silent NaN from finite input: the pseudo-rigid family, strata, the systems (issue 16) -------
+
+mod no_silent_nan {
+    use super::invalid_naming;
+    use lieflow::lie::gl;
+    use lieflow::pseudo_rigid::equilibria::equilibrium_directions;
+    use lieflow::pseudo_rigid::momentum;
+    use lieflow::pseudo_rigid::potential::Harmonic;
+    use lieflow::pseudo_rigid::reduced::{reconstruct, ReducedState};
+    use lieflow::pseudo_rigid::{BiInertia, PseudoRigidBody};
+    use lieflow::systems::relativistic_top::{Potential, WeakFieldTop};
+    use lieflow::systems::{RollingSpheres, SphereParticle};
+    use lieflow::{Error, Mat};
+    use std::sync::Arc;
+
+    fn m3(r: [[f64; 3]; 3]) -> Mat {
+        Mat::from_fn(3, 3, |i, j| r[i][j])
+    }
+    fn x0() -> Mat {
+        m3([[3.0, 0.2, 0.1], [0.1, 2.0, 0.3], [0.0, 0.2, 1.0]])
+    }
+    fn skew() -> Mat {
+        m3([[0.0, 1.0, -2.0], [-1.0, 0.0, 0.5], [2.0, -0.5, 0.0]])
+    }
+    fn finite(m: &Mat) -> bool {
+        (0..m.nrows()).all(|i| (0..m.ncols()).all(|j| m[(i, j)].is_finite()))
+    }
+    fn close(a: &Mat, b: &Mat, rel: f64) -> bool {
+        (a - b).norm_l2() <= rel * b.norm_l2()
+    }
+    fn overflow(r: Result<impl std::fmt::Debug, Error>) -> bool {
+        match r {
+            Err(e) => invalid_naming(&e, &["overflow", "f64 range"]),
+            Ok(v) => panic!("expected an overflow error, got {v:?}"),
+        }
+    }
+
+    #[test]
+    fn inertia_operators_are_scale_aware() {
+        let (x, xi) = (x0(), skew());
+        let b = BiInertia::new(&x).unwrap();
+        let (l, r) = (b.left(&xi).unwrap(), b.right(&xi).unwrap());
+        // Moderate X: the plain formula, bit for bit.
+        let xxt = &x * x.transpose();
+        assert_eq!(l, &xxt * &xi + &xi * &xxt);
+        // 1e160·X (the fuzz case right_inertia(X=1e160·X)): A^R ~ 1e320, not representable.
+        let big = BiInertia::new(&(&x * faer::Scale(1e160))).unwrap();
+        assert!(overflow(big.right(&xi)));
+        assert!(overflow(big.left(&xi)));
+        assert!(overflow(big.ad_x(&xi)));
+        assert!(overflow(big.apply(&xi, &xi)));
+        // ...representable with a small ξ: the exact scaling.
+        let r2 = big.right(&(&xi * faer::Scale(1e-200))).unwrap();
+        assert!(close(&r2, &(&r * faer::Scale(1e120)), 1e-15));
+        // right_inertia(X=<numeric#1>) of the fuzz table.
+        let n1 = m3([
+            [
+                3.4191949199107441e199,
+                1.7665638650785324e198,
+                -2.3590247469698043e198,
+            ],
+            [
+                -7.3081151741346844e198,
+                3.7958424867123193e199,
+                1.2550647052641494e199,
+            ],
+            [
+                3.1607297152596162e198,
+                -1.3982491943298273e199,
+                3.3152618097405307e199,
+            ],
+        ]);
+        assert!(overflow(BiInertia::new(&n1).unwrap().right(&xi)));
+        // right_inertia(xi=max-float).
+        assert!(overflow(b.right(&(&xi * faer::Scale(f64::MAX / 2.0)))));
+        // Tiny X: underflow-free (XXᵀ alone would be 0 below ~1e-162).
+        let tiny = BiInertia::new(&(&x * faer::Scale(1e-170))).unwrap();
+        let lt = tiny.left(&(&xi * faer::Scale(1e300))).unwrap();
+        assert!(close(&lt, &(&l * faer::Scale(1e-40)), 1e-15));
+        assert!(finite(&tiny.matrix()));
+    }
+
+    #[test]
+    fn quadratic_form_and_eigenvalues_overflow_as_typed_errors() {
+        let (x, xi) = (x0(), skew());
+        let b = BiInertia::new(&x).unwrap();
+        let q = b.quadratic_form(&xi, &xi).unwrap();
+        // bi_inertia_quadratic_form(eta=1e300·…) and (X=1e300·…), bi_inertia_eigen(X=1e300·…).
+        assert!(overflow(b.quadratic_form(&xi, &(&xi * faer::Scale(1e300)))));
+        let huge = BiInertia::new(&(&x * faer::Scale(1e300))).unwrap();
+        assert!(overflow(huge.quadratic_form(&xi, &xi)));
+        assert!(overflow(huge.eigen()));
+        // Representable extremes: exact scaling.
+        let q2 = huge
+            .quadratic_form(&(&xi * faer::Scale(1e-300)), &(&xi * faer::Scale(1e-300)))
+            .unwrap();
+        assert!((q2 - q).abs() <= 1e-13 * q, "{q2} {q}");
+        let (ev, _) = BiInertia::new(&(&x * faer::Scale(1e150)))
+            .unwrap()
+            .eigen()
+            .unwrap();
+        assert!(ev.iter().all(|v| v.is_finite() && *v > 0.0));
+        // equilibrium_directions(a=1e300·…): eigenvalues (a_i ± a_j)² overflow.
+        assert!(overflow(equilibrium_directions(&[3e300, 2e300, 1e300])));
+        let d = equilibrium_directions(&[3e150, 2e150, 1e150]).unwrap();
+        assert!((d[0].eigenvalues[0] - 1e300).abs() < 1e286);
+    }
+
+    #[test]
+    fn reconstruct_at_tiny_semi_axes() {
+        // reconstruct(a=<numeric#0>): (a_i − a_j)² underflows, Ω ~ 1e376 is not representable
+        // but P = R(ΩA − AΛ)Sᵀ ~ 1e188 is.
+        let a = vec![
+            4.480262692850076e-191,
+            1.828685890397971e-188,
+            5.854556749629787e-189,
+        ];
+        let st = |a: Vec<f64>| ReducedState {
+            a,
+            p_a: vec![0.0; 3],
+            p_omega: skew(),
+            p_lambda: skew() * faer::Scale(0.5),
+        };
+        let i3 = Mat::identity(3, 3);
+        let (x, p) = reconstruct(&i3, &i3, &st(a.clone())).unwrap();
+        assert!(finite(&x) && finite(&p));
+        // P is of degree −1 in a: compare with the same state at a·2^600.
+        let c = 2f64.powi(600);
+        let (_, p2) = reconstruct(&i3, &i3, &st(a.iter().map(|v| v * c).collect())).unwrap();
+        assert!(close(&p, &(&p2 * faer::Scale(c)), 1e-12));
+        assert!(overflow(st(a).velocities()));
+    }
+
+    #[test]
+    fn svd_and_stratum_at_the_ends_of_the_range() {
+        // lie.stratum(tol=max-float): the tolerance is clamped to 1 (a₁ bounds every gap).
+        let st = gl::stratum(&x0(), f64::MAX).unwrap();
+        assert!(st.tol.is_finite());
+        assert_eq!(st.multiplicities, vec![3]);
+        // The hypothesis case of svd_coordinates/polar/stratum: a₁ > f64::MAX.
+        let h = m3([
+            [1.7976931348623155e308, -1.407e-294, 6.394e16],
+            [3.729e16, 1.381e-274, -1.311e64],
+            [1e2, 3.525e277, 2.359e16],
+        ]);
+        assert!(overflow(gl::svd_coordinates(&h)));
+        assert!(overflow(gl::polar(&h)));
+    }
+
+    #[test]
+    fn momenta_of_pseudo_rigid_states() {
+        let body = PseudoRigidBody::new(3, Arc::new(Harmonic::new(1.5).unwrap()), true).unwrap();
+        // circulation(states=<numeric#0>): X and P mix 1e148 and 1e308.
+        let z0: Vec<f64> = vec![
+            6.5578099962665044e148,
+            -2.3524343880421662e147,
+            7.4315233624879512e148,
+            -2.4516313376328094e148,
+            1e308,
+            1.0,
+            1.9571858563554551e148,
+            7.2019776270555808e148,
+            -1.6537738041521307e148,
+            -3.1883319606807944e148,
+            -2.0433781241455773e148,
+            -1.4291555800578112e148,
+            3.5053525021861349e148,
+            -1.0137212244042475e149,
+            -1.1790418371131496e147,
+            -1.0,
+            -1.1433022531021249e148,
+            -3.4628117123365280e148,
+        ];
+        assert!(overflow(body.momenta(&z0)));
+        let z: Vec<f64> = (0..18)
+            .map(|k| (k as f64 * 0.7).sin() + if k % 4 == 0 { 2.0 } else { 0.0 })
+            .collect();
+        assert!(overflow(
+            body.momenta(&z.iter().map(|v| v * 1e300).collect::<Vec<_>>())
+        ));
+        // Representable: exact scaling (L is bilinear in X and P).
+        let (l, _) = body.momenta(&z).unwrap();
+        let zs: Vec<f64> = z
+            .iter()
+            .enumerate()
+            .map(|(k, v)| if k < 9 { v * 1e300 } else { v * 1e-300 })
+            .collect();
+        let (ls, _) = body.momenta(&zs).unwrap();
+        assert!(close(&ls, &l, 1e-14));
+        let x = Mat::from_fn(3, 3, |i, j| z[3 * i + j]);
+        let v = Mat::from_fn(3, 3, |i, j| z[9 + 3 * i + j]);
+        let big = |m: &Mat| m * faer::Scale(1e300);
+        assert!(overflow(momentum::angular_momentum(&big(&x), &big(&v))));
+        assert!(overflow(momentum::circulation(&big(&x), &big(&v))));
+    }
+
+    #[test]
+    fn systems_refuse_or_rescale() {
+        let i1 = [[0.1, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.3]];
+        let rs = |r1: f64, m1: f64| {
+            RollingSpheres::new(
+                r1,
+                1.3,
+                [0.1, -0.2, 0.15],
+                [-0.3, 0.2, 0.4],
+                m1,
+                3.5,
+                i1,
+                i1,
+            )
+        };
+        // RollingSpheres(r1 = 1e300 / max-float / 4.8e297): eR² overflows.
+        for r1 in [0.7e300, f64::MAX, 4.768283108120774e297] {
+            assert!(overflow(rs(r1, 2.0)));
+        }
+        // m1 = max-float: e = m₁m₂/(m₁ + m₂) without overflow.
+        let heavy = rs(0.7, f64::MAX).unwrap();
+        assert!((heavy.reduced_mass() - 3.5).abs() < 1e-12);
+        // Observables refuse states outside SO(3)² × S² × R⁶ (zeros, 1e-170·z, 1e300·z).
+        let sys = rs(0.7, 2.0).unwrap();
+        let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let z = sys
+            .state(id, id, [1.0, 0.0, 0.0], [1.1, -0.6, 0.8], [-0.4, 0.9, 0.5])
+            .unwrap();
+        assert!(sys
+            .accelerations(&z)
+            .unwrap()
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite()));
+        for s in [0.0, 1e-170, 1e300] {
+            let zs: Vec<f64> = z.iter().map(|v| v * s).collect();
+            assert!(matches!(
+                sys.accelerations(&zs),
+                Err(Error::NotInGroup { .. })
+            ));
+            assert!(matches!(sys.udot(&zs), Err(Error::NotInGroup { .. })));
+            assert!(matches!(
+                sys.spatial_momenta(&zs),
+                Err(Error::NotInGroup { .. })
+            ));
+            assert!(matches!(
+                sys.angular_momentum(&zs),
+                Err(Error::NotInGroup { .. })
+            ));
+        }
+        // A valid configuration with velocities at the end of the range: finite, or an overflow
+        // error.
+        let mut zb = z.clone();
+        for f in [1e300, 1e307, 1.5e308] {
+            zb[21..].copy_from_slice(&z[21..].iter().map(|v| v * f).collect::<Vec<_>>());
+            zb[21..]
+                .iter_mut()
+                .for_each(|v| *v = v.clamp(-f64::MAX, f64::MAX));
+            match sys.angular_momentum(&zb) {
+                Ok(j) => assert!(j.iter().all(|v| v.is_finite())),
+                Err(e) => assert!(invalid_naming(&e, &["overflow"]), "{e}"),
+            }
+        }
+        // WeakFieldTop.angular_momentum(states=1e300·…), scale-aware.
+        let wf = WeakFieldTop::new(1.0, 1e-3, Potential::point_mass(1e-4).unwrap()).unwrap();
+        assert!(overflow(
+            wf.angular_momentum(&[1e300, 0.5e300, 0.1, 0.2e300, 1e300, 0.3])
+        ));
+        let l = wf
+            .angular_momentum(&[1e300, 0.0, 0.1, 0.0, 1e-300, 0.3])
+            .unwrap();
+        assert_eq!(l, 1.0);
+        // SphereParticle.from_spherical(states=<numeric#0>): u is not a unit vector.
+        let sp = SphereParticle::new(2.0, 1.5, 9.81).unwrap();
+        let u = [
+            1.3220016008497747e282,
+            2.5698777641569983e282,
+            3.2081448633123943e282,
+        ];
+        let l3 = [
+            2.4579397683821775e282,
+            -2.2635960921590879e282,
+            2.6865553957306928e282,
+        ];
+        assert!(matches!(
+            sp.from_spherical(&[u, l3].concat()),
+            Err(Error::InvalidArgument { .. })
+        ));
+    }
+}

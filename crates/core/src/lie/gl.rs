@@ -208,6 +208,14 @@ pub fn svd_coordinates(x: &Mat) -> Result<SvdCoordinates> {
     let mut r = svd.U().to_owned();
     let mut s = svd.V().to_owned();
     let a: Vec<f64> = svd.S().column_vector().iter().map(|&v| v * c).collect();
+    // a₁ ≥ max |X_ij| can exceed the f64 range although every entry is finite (entries near
+    // 1.8e308): the SVD coordinates are not representable.
+    if !a[0].is_finite() {
+        return Err(check::overflow_error(
+            "X",
+            "the largest singular value a₁ of X",
+        ));
+    }
     if det(&r) < 0.0 {
         for i in 0..n {
             r[(i, n - 1)] = -r[(i, n - 1)];
@@ -282,6 +290,10 @@ impl Stratum {
 /// same group when a_i − a_(i+1) ≤ `rel_tol` · a₁ (001 §6.1, (9.2)). Use [`STRATUM_TOL`] as
 /// the default `rel_tol`.
 ///
+/// `rel_tol` ≥ 1 groups every singular value into one group (every gap is below a₁), so it is
+/// clamped to 1: the reported absolute tolerance is min(rel_tol, 1)·a₁, finite for every finite
+/// `rel_tol`.
+///
 /// Errors: as [`svd_coordinates`]; [`Error::InvalidArgument`] if `rel_tol` is negative or not
 /// finite.
 pub fn stratum(x: &Mat, rel_tol: f64) -> Result<Stratum> {
@@ -298,9 +310,10 @@ pub fn stratum(x: &Mat, rel_tol: f64) -> Result<Stratum> {
     Ok(stratum_of(&c.a, rel_tol))
 }
 
-/// [`stratum`] from singular values sorted non-increasingly.
+/// [`stratum`] from singular values sorted non-increasingly (`rel_tol` clamped to 1, see
+/// [`stratum`]).
 pub fn stratum_of(a: &[f64], rel_tol: f64) -> Stratum {
-    let tol = rel_tol * a[0];
+    let tol = rel_tol.min(1.0) * a[0];
     let mut multiplicities = vec![1];
     let mut min_gap = f64::INFINITY;
     for w in a.windows(2) {

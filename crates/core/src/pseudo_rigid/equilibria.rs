@@ -390,7 +390,7 @@ fn basis(n: usize, i: usize, j: usize) -> Mat {
     })
 }
 
-fn direction(n: usize, a: &[f64], planes: &[(usize, usize, f64)]) -> Direction {
+fn direction(n: usize, a: &[f64], planes: &[(usize, usize, f64)]) -> Result<Direction> {
     let (mut xi, mut eta) = (Mat::zeros(n, n), Mat::zeros(n, n));
     let mut text = Vec::new();
     for &(i, j, s) in planes {
@@ -400,17 +400,17 @@ fn direction(n: usize, a: &[f64], planes: &[(usize, usize, f64)]) -> Direction {
         let sign = if s > 0.0 { "" } else { "−" };
         text.push(format!("e_{0}{1} ⊕ {sign}e_{0}{1}", i + 1, j + 1));
     }
-    Direction {
+    Ok(Direction {
         xi,
         eta,
         planes: planes.iter().map(|p| (p.0, p.1)).collect(),
         signs: planes.iter().map(|p| p.2).collect(),
         eigenvalues: planes
             .iter()
-            .map(|&(i, j, s)| (a[i] - s * a[j]).powi(2))
-            .collect(),
+            .map(|&(i, j, s)| crate::pseudo_rigid::inertia::eigenvalue("a", a[i], a[j], s))
+            .collect::<Result<_>>()?,
         description: text.join(" + "),
-    }
+    })
 }
 
 /// The admissible velocity directions for A = diag(a) listed in 001 §8: the eigenvectors
@@ -419,7 +419,8 @@ fn direction(n: usize, a: &[f64], planes: &[(usize, usize, f64)]) -> Direction {
 /// eigenvalues combine when they commute). Each satisfies (8.6) for every a; so does any sum
 /// over pairwise disjoint planes and any ω e_ij ⊕ μ e_ij in one plane (module docs).
 ///
-/// Errors: a not n ≥ 2 positive finite values.
+/// Errors: a not n ≥ 2 positive finite values; an overflow error where an eigenvalue
+/// (a_i ∓ a_j)² exceeds the f64 range.
 pub fn equilibrium_directions(a: &[f64]) -> Result<Vec<Direction>> {
     let n = check_axes(a)?;
     let mut planes = Vec::new();
@@ -431,7 +432,7 @@ pub fn equilibrium_directions(a: &[f64]) -> Result<Vec<Direction>> {
     let mut out = Vec::new();
     for &(i, j) in &planes {
         for s in [1.0, -1.0] {
-            out.push(direction(n, a, &[(i, j, s)]));
+            out.push(direction(n, a, &[(i, j, s)])?);
         }
     }
     for (k, &(i, j)) in planes.iter().enumerate() {
@@ -441,7 +442,7 @@ pub fn equilibrium_directions(a: &[f64]) -> Result<Vec<Direction>> {
             }
             for s in [1.0, -1.0] {
                 for t in [1.0, -1.0] {
-                    out.push(direction(n, a, &[(i, j, s), (p, q, t)]));
+                    out.push(direction(n, a, &[(i, j, s), (p, q, t)])?);
                 }
             }
         }

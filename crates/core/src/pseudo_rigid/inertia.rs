@@ -92,9 +92,29 @@ pub(crate) fn rescale(what: &str, mut m: Mat, c: f64, k: i32) -> Result<Mat> {
     Ok(m)
 }
 
+/// The eigenvalue (a_i − sign·a_j)² of B_X (001 (8.15)) scale-aware: formed from a_i, a_j
+/// divided by a common power of two and multiplied back once; an overflow error naming `what`
+/// where it exceeds the f64 range (a ≳ 1e154). The one place these eigenvalues are computed.
+pub(crate) fn eigenvalue(what: &str, ai: f64, aj: f64, sign: f64) -> Result<f64> {
+    let e = check::pow2_exponent_of([ai, aj]);
+    let d = check::ldexp(ai, -e) - sign * check::ldexp(aj, -e);
+    check::unscale(
+        what,
+        "an eigenvalue (a_i ± a_j)² of the bi-inertia tensor",
+        d * d,
+        2 * e,
+    )
+}
+
 #[derive(Debug, Clone)]
 pub struct BiInertia {
     x: Mat,
+    /// X̃ = X·2^−ex, the largest entry in [1, 2) for extreme X ([`check::pow2_exponent`]; X̃ = X,
+    /// ex = 0, for moderate X). Every operator of degree k in X is evaluated on X̃ and multiplied
+    /// by 2^(k·ex) once, with an overflow error where the result is not representable.
+    xs: Mat,
+    ex: i32,
+    /// X̃X̃ᵀ and X̃ᵀX̃ (of the scaled X̃).
     xxt: OnceLock<Mat>,
     xtx: OnceLock<Mat>,
     svd: OnceLock<SvdCoordinates>,
@@ -106,22 +126,43 @@ impl BiInertia {
     pub fn new(x: &Mat) -> Result<Self> {
         check::square("X", x, 2)?;
         gl::check_gl_plus("X", x)?;
+        let ex = check::pow2_exponent_mat(x);
         Ok(BiInertia {
             x: x.clone(),
+            xs: check::ldexp_mat(x, -ex),
+            ex,
             xxt: OnceLock::new(),
             xtx: OnceLock::new(),
             svd: OnceLock::new(),
         })
     }
 
-    /// XXᵀ, computed once.
+    /// X̃X̃ᵀ (scaled, see the field `xs`), computed once.
     fn xxt(&self) -> &Mat {
-        self.xxt.get_or_init(|| &self.x * self.x.transpose())
+        self.xxt.get_or_init(|| &self.xs * self.xs.transpose())
     }
 
-    /// XᵀX, computed once.
+    /// X̃ᵀX̃ (scaled), computed once.
     fn xtx(&self) -> &Mat {
-        self.xtx.get_or_init(|| self.x.transpose() * &self.x)
+        self.xtx.get_or_init(|| self.xs.transpose() * &self.xs)
+    }
+
+    /// An so(n) argument divided by a power of two 2^e (see [`check::pow2_exponent`]): (ξ̃, e).
+    fn scaled_arg(xi: &Mat) -> (Mat, i32) {
+        let e = check::pow2_exponent_mat(xi);
+        (check::ldexp_mat(xi, -e), e)
+    }
+
+    /// Two so(n) arguments divided by one common power of two: (ξ̃, η̃, e).
+    fn scaled_pair(xi: &Mat, eta: &Mat) -> (Mat, Mat, i32) {
+        let e = check::pow2_exponent(check::max_abs(xi).max(check::max_abs(eta)));
+        (check::ldexp_mat(xi, -e), check::ldexp_mat(eta, -e), e)
+    }
+
+    /// The result of a formula of degree 2 in X evaluated on X̃ and on arguments scaled by 2^e,
+    /// multiplied back, or an overflow error naming `what` and `quantity`.
+    fn unscale(&self, what: &str, quantity: &str, m: &Mat, e: i32) -> Result<Mat> {
+        check::unscale_mat(what, quantity, m, 2 * self.ex + e)
     }
 
     /// n.
@@ -148,42 +189,58 @@ impl BiInertia {
         so::check_algebra_of(what, xi, self.n())
     }
 
-    /// Left inertia tensor A^L_X ξ = XXᵀξ + ξXXᵀ (001 (2.11)).
+    /// Left inertia tensor A^L_X ξ = XXᵀξ + ξXXᵀ (001 (2.11)). Scale-aware (X and ξ divided by
+    /// powers of two, the result multiplied back once); an overflow error
+    /// ([`Error::InvalidArgument`]) where the result exceeds the f64 range.
     pub fn left(&self, xi: &Mat) -> Result<Mat> {
         self.arg("xi", xi)?;
-        Ok(anticommutator(self.xxt(), xi))
+        let (x, e) = Self::scaled_arg(xi);
+        self.unscale("X, xi", "A^L_X ξ", &anticommutator(self.xxt(), &x), e)
     }
 
-    /// Right inertia tensor A^R_X η = XᵀXη + ηXᵀX (001 (2.11)).
+    /// Right inertia tensor A^R_X η = XᵀXη + ηXᵀX (001 (2.11)); scale-aware as
+    /// [`BiInertia::left`].
     pub fn right(&self, eta: &Mat) -> Result<Mat> {
         self.arg("eta", eta)?;
-        Ok(anticommutator(self.xtx(), eta))
+        let (y, e) = Self::scaled_arg(eta);
+        self.unscale("X, eta", "A^R_X η", &anticommutator(self.xtx(), &y), e)
     }
 
-    /// Ad_X η = X η Xᵀ (001 (6.10)).
+    /// Ad_X η = X η Xᵀ (001 (6.10)); scale-aware as [`BiInertia::left`].
     pub fn ad_x(&self, eta: &Mat) -> Result<Mat> {
         self.arg("eta", eta)?;
-        Ok(conj(&self.x, eta))
+        let (y, e) = Self::scaled_arg(eta);
+        self.unscale("X, eta", "Ad_X η", &conj(&self.xs, &y), e)
     }
 
-    /// Adᵀ_X ξ = Xᵀ ξ X (001 (6.10)), the transpose of Ad_X under the pairing (2.8).
+    /// Adᵀ_X ξ = Xᵀ ξ X (001 (6.10)), the transpose of Ad_X under the pairing (2.8);
+    /// scale-aware as [`BiInertia::left`].
     pub fn ad_x_t(&self, xi: &Mat) -> Result<Mat> {
         self.arg("xi", xi)?;
-        Ok(conj_t(&self.x, xi))
+        let (x, e) = Self::scaled_arg(xi);
+        self.unscale("X, xi", "Adᵀ_X ξ", &conj_t(&self.xs, &x), e)
     }
 
     /// The bi-inertia tensor B_X (001 (6.9)):
     /// ξ ⊕ η ↦ (A^L_X ξ − 2 Ad_X η) ⊕ (−2 Adᵀ_X ξ + A^R_X η). Defined on all of GL⁺(n);
-    /// symmetric (6.12), positive definite on the principal stratum (6.14).
+    /// symmetric (6.12), positive definite on the principal stratum (6.14). Scale-aware as
+    /// [`BiInertia::left`] (an overflow error where B_X(ξ ⊕ η) exceeds the f64 range).
     pub fn apply(&self, xi: &Mat, eta: &Mat) -> Result<(Mat, Mat)> {
         self.arg("xi", xi)?;
         self.arg("eta", eta)?;
-        Ok(self.apply_unchecked(xi, eta))
+        let (x, y, e) = Self::scaled_pair(xi, eta);
+        let (top, bottom) = self.apply_scaled(&x, &y);
+        let q = "B_X (ξ ⊕ η)";
+        Ok((
+            self.unscale("X, xi, eta", q, &top, e)?,
+            self.unscale("X, xi, eta", q, &bottom, e)?,
+        ))
     }
 
-    fn apply_unchecked(&self, xi: &Mat, eta: &Mat) -> (Mat, Mat) {
-        let top = anticommutator(self.xxt(), xi) - conj(&self.x, eta) * faer::Scale(2.0);
-        let bottom = anticommutator(self.xtx(), eta) - conj_t(&self.x, xi) * faer::Scale(2.0);
+    /// B_X̃ (ξ ⊕ η) on the scaled X̃ (multiply by 2^(2·ex) for B_X).
+    fn apply_scaled(&self, xi: &Mat, eta: &Mat) -> (Mat, Mat) {
+        let top = anticommutator(self.xxt(), xi) - conj(&self.xs, eta) * faer::Scale(2.0);
+        let bottom = anticommutator(self.xtx(), eta) - conj_t(&self.xs, xi) * faer::Scale(2.0);
         (top, bottom)
     }
 
@@ -193,41 +250,45 @@ impl BiInertia {
     /// overflow error (InvalidArgument) where an entry exceeds the f64 range (B_X grows like
     /// a₁², so X beyond ~1e154 has no representable bi-inertia matrix).
     pub fn try_matrix(&self) -> Result<Mat> {
-        let (xs, c) = self.unit_x()?;
-        let unit = BiInertia {
-            x: xs,
-            xxt: OnceLock::new(),
-            xtx: OnceLock::new(),
-            svd: OnceLock::new(),
-        };
-        rescale("the bi-inertia tensor B_X", unit.matrix(), c, -2)
+        self.unscale("X", "the bi-inertia tensor B_X", &self.matrix_scaled(), 0)
     }
 
-    pub fn matrix(&self) -> Mat {
+    /// B_X̃ of the scaled X̃ (multiply by 2^(2·ex) for B_X).
+    fn matrix_scaled(&self) -> Mat {
         operator_matrix(self.n(), 2, |v| {
-            let (a, b) = self.apply_unchecked(&v[0], &v[1]);
+            let (a, b) = self.apply_scaled(&v[0], &v[1]);
             vec![a, b]
         })
     }
 
+    /// B_X as a matrix (entries ±inf where they exceed the f64 range; see
+    /// [`BiInertia::try_matrix`]).
+    pub fn matrix(&self) -> Mat {
+        check::ldexp_mat(&self.matrix_scaled(), 2 * self.ex)
+    }
+
     /// A^L_X as a matrix in the e_ij basis (001 (2.11)).
     pub fn left_matrix(&self) -> Mat {
-        operator_matrix(self.n(), 1, |v| vec![anticommutator(self.xxt(), &v[0])])
+        let m = operator_matrix(self.n(), 1, |v| vec![anticommutator(self.xxt(), &v[0])]);
+        check::ldexp_mat(&m, 2 * self.ex)
     }
 
     /// A^R_X as a matrix in the e_ij basis (001 (2.11)).
     pub fn right_matrix(&self) -> Mat {
-        operator_matrix(self.n(), 1, |v| vec![anticommutator(self.xtx(), &v[0])])
+        let m = operator_matrix(self.n(), 1, |v| vec![anticommutator(self.xtx(), &v[0])]);
+        check::ldexp_mat(&m, 2 * self.ex)
     }
 
     /// Ad_X as a matrix in the e_ij basis (001 (6.10)).
     pub fn ad_x_matrix(&self) -> Mat {
-        operator_matrix(self.n(), 1, |v| vec![conj(&self.x, &v[0])])
+        let m = operator_matrix(self.n(), 1, |v| vec![conj(&self.xs, &v[0])]);
+        check::ldexp_mat(&m, 2 * self.ex)
     }
 
     /// Adᵀ_X as a matrix in the e_ij basis (001 (6.10)).
     pub fn ad_x_t_matrix(&self) -> Mat {
-        operator_matrix(self.n(), 1, |v| vec![conj_t(&self.x, &v[0])])
+        let m = operator_matrix(self.n(), 1, |v| vec![conj_t(&self.xs, &v[0])]);
+        check::ldexp_mat(&m, 2 * self.ex)
     }
 
     /// (A^L_X)⁻¹ λ, on all of GL⁺(n): with XXᵀ = R A² Rᵀ, λ' = Rᵀλ R, the solution is
@@ -371,14 +432,16 @@ impl BiInertia {
     ///
     /// Returns the eigenvalues in non-decreasing order and the n(n−1)×n(n−1) matrix whose
     /// columns are the eigenvectors in e_ij coordinates (ξ block first), so B = V diag(λ) Vᵀ.
+    /// Errors: an overflow error where an eigenvalue (a_i + a_j)² exceeds the f64 range.
     pub fn eigen(&self) -> Result<(Vec<f64>, Mat)> {
         let c = self.svd()?;
         let (n, d) = (self.n(), so::dim(self.n()));
         let mut pairs: Vec<(f64, usize, usize, f64)> = Vec::with_capacity(2 * d);
         for i in 0..n {
             for j in i + 1..n {
-                pairs.push(((c.a[i] - c.a[j]).powi(2), i, j, 1.0));
-                pairs.push(((c.a[i] + c.a[j]).powi(2), i, j, -1.0));
+                for sign in [1.0, -1.0] {
+                    pairs.push((eigenvalue("X", c.a[i], c.a[j], sign)?, i, j, sign));
+                }
             }
         }
         pairs.sort_by(|p, q| p.0.total_cmp(&q.0));
@@ -402,13 +465,17 @@ impl BiInertia {
     /// The quadratic form ⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩ in SVD coordinates (001 (6.14)): with
     /// ξ' = Rᵀξ R, η' = Sᵀη S,
     /// Σ_{i<j} (a_i − a_j)² ξ'_ij² + 2 a_i a_j (ξ'_ij − η'_ij)² + (a_i − a_j)² η'_ij².
-    /// Checked against the operator: correct as printed.
+    /// Checked against the operator: correct as printed. Scale-aware (evaluated on a/c and on
+    /// ξ, η divided by a common power of two, multiplied back once): an overflow error where the
+    /// value exceeds the f64 range.
     pub fn quadratic_form(&self, xi: &Mat, eta: &Mat) -> Result<f64> {
         self.arg("xi", xi)?;
         self.arg("eta", eta)?;
         let c = self.svd()?;
-        let (x, y) = (conj_t(&c.r, xi), conj_t(&c.s, eta));
-        let a = &c.a;
+        let (xi, eta, e) = Self::scaled_pair(xi, eta);
+        let (x, y) = (conj_t(&c.r, &xi), conj_t(&c.s, &eta));
+        let (a, scale) = c.unit();
+        let a = &a;
         let mut sum = 0.0;
         for i in 0..self.n() {
             for j in i + 1..self.n() {
@@ -417,6 +484,8 @@ impl BiInertia {
                 sum += d2 * u * u + 2.0 * a[i] * a[j] * (u - w).powi(2) + d2 * w * w;
             }
         }
-        Ok(sum)
+        // scale is an exact power of two.
+        let ec = scale.log2() as i32;
+        check::unscale("X, xi, eta", "⟨ξ ⊕ η, B_X(ξ ⊕ η)⟩", sum, 2 * ec + 2 * e)
     }
 }

@@ -26,22 +26,39 @@ pub(crate) fn momentum_map_unchecked(x: &Mat, p: &Mat) -> (Mat, Mat) {
     (&pxt - pxt.transpose(), &ptx - ptx.transpose())
 }
 
+/// J = L ⊕ Γ scale-aware, for finite X and P: evaluated on X and P divided by powers of two
+/// ([`check::pow2_exponent`]; the plain formula for moderate values) and multiplied back once,
+/// each part an overflow error (naming X, P) where it exceeds the f64 range.
+pub(crate) fn momentum_map_scaled(x: &Mat, p: &Mat) -> (Result<Mat>, Result<Mat>) {
+    let (ex, ep) = (check::pow2_exponent_mat(x), check::pow2_exponent_mat(p));
+    let (l, g) = momentum_map_unchecked(&check::ldexp_mat(x, -ex), &check::ldexp_mat(p, -ep));
+    let what = "X, P";
+    (
+        check::unscale_mat(what, "the angular momentum L = PXᵀ − XPᵀ", &l, ex + ep),
+        check::unscale_mat(what, "the circulation Γ = PᵀX − XᵀP", &g, ex + ep),
+    )
+}
+
 /// Angular momentum L = VXᵀ − XVᵀ (001 (2.29), (7.3)) for a velocity or momentum V at X.
+/// Scale-aware; an overflow error where L exceeds the f64 range.
 pub fn angular_momentum(x: &Mat, v: &Mat) -> Result<Mat> {
     check_state(x, v)?;
-    Ok(momentum_map_unchecked(x, v).0)
+    momentum_map_scaled(x, v).0
 }
 
 /// Circulation Γ = VᵀX − XᵀV (001 (2.29), (7.3)) for a velocity or momentum V at X.
+/// Scale-aware; an overflow error where Γ exceeds the f64 range.
 pub fn circulation(x: &Mat, v: &Mat) -> Result<Mat> {
     check_state(x, v)?;
-    Ok(momentum_map_unchecked(x, v).1)
+    momentum_map_scaled(x, v).1
 }
 
 /// Momentum map J(X, P) = L ⊕ Γ of the two-sided SO(n)×SO(n) action (001 (7.2)).
+/// Scale-aware; an overflow error where L or Γ exceeds the f64 range.
 pub fn momentum_map(x: &Mat, p: &Mat) -> Result<(Mat, Mat)> {
     check_state(x, p)?;
-    Ok(momentum_map_unchecked(x, p))
+    let (l, g) = momentum_map_scaled(x, p);
+    Ok((l?, g?))
 }
 
 /// Local coordinates (R, A, S, Ω, Ȧ, Λ) of T GL⁺(n) (001 §4.1, (2.33)): X = R A Sᵀ,
@@ -205,7 +222,10 @@ pub fn body_momenta(a: &[f64], omega: &Mat, lambda: &Mat) -> Result<(Mat, Mat)> 
 /// the kinetic part of the Hamiltonian (3.22).
 pub fn kinetic_energy(x: &Mat, v: &Mat) -> Result<f64> {
     check_state(x, v)?;
-    Ok(0.5 * v.norm_l2().powi(2))
+    // Scale-aware: |V|² from V divided by a power of two, multiplied back once.
+    let e = check::pow2_exponent_mat(v);
+    let n2 = check::ldexp_mat(v, -e).norm_l2().powi(2);
+    check::unscale("V", "the kinetic energy ½|V|²", 0.5 * n2, 2 * e)
 }
 
 /// Kinetic part of the Hamiltonian in reduced coordinates (001 (6.30)):

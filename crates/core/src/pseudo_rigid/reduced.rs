@@ -157,24 +157,53 @@ impl ReducedState {
 
     /// Body velocities Ω ⊕ Λ = B_A⁻¹(p_Ω ⊕ p_Λ) (001 (7.9)), the right-hand side of the
     /// reconstruction equations RᵀṘ = Ω, SᵀṠ = Λ (001 (8.1)-type).
+    ///
+    /// Scale-aware ([`ReducedState::velocities_scaled`]): an overflow error where Ω or Λ exceeds
+    /// the f64 range.
     pub fn velocities(&self) -> Result<(Mat, Mat)> {
         let n = self.validate()?;
-        Ok(self.velocities_unchecked(n))
+        let (o, l, em, ea) = self.velocities_scaled(n);
+        let what = "a, p_Omega, p_Lambda";
+        let q = "the body velocities Ω ⊕ Λ = B_A⁻¹(p_Ω ⊕ p_Λ)";
+        Ok((
+            check::unscale_mat(what, q, &o, em - 2 * ea)?,
+            check::unscale_mat(what, q, &l, em - 2 * ea)?,
+        ))
     }
 
     fn velocities_unchecked(&self, n: usize) -> (Mat, Mat) {
+        let (o, l, em, ea) = self.velocities_scaled(n);
+        (
+            check::ldexp_mat(&o, em - 2 * ea),
+            check::ldexp_mat(&l, em - 2 * ea),
+        )
+    }
+
+    /// (Ω̃, Λ̃, em, ea) with Ω ⊕ Λ = 2^(em − 2ea)(Ω̃ ⊕ Λ̃): the pair formulas evaluated on
+    /// ã = a·2^−ea and (μ, ν)·2^−em ([`check::pow2_exponent`]; both 0, i.e. the plain formula,
+    /// for moderate values), so that (a_i ∓ a_j)² neither underflow nor overflow where Ω ⊕ Λ,
+    /// or the momentum P of [`reconstruct`] (degree −1 in a), is representable.
+    fn velocities_scaled(&self, n: usize) -> (Mat, Mat, i32, i32) {
+        let ea = check::pow2_exponent_of(self.a.iter().copied());
+        let em =
+            check::pow2_exponent(check::max_abs(&self.p_omega).max(check::max_abs(&self.p_lambda)));
         let mut omega = Mat::zeros(n, n);
         let mut lambda = Mat::zeros(n, n);
         for i in 0..n {
             for j in i + 1..n {
-                let q = self.pair(i, j);
+                let q = pair(
+                    check::ldexp(self.a[i], -ea),
+                    check::ldexp(self.a[j], -ea),
+                    check::ldexp(self.p_omega[(i, j)], -em),
+                    check::ldexp(self.p_lambda[(i, j)], -em),
+                );
                 omega[(i, j)] = q.omega;
                 omega[(j, i)] = -q.omega;
                 lambda[(i, j)] = q.lambda;
                 lambda[(j, i)] = -q.lambda;
             }
         }
-        (omega, lambda)
+        (omega, lambda, em, ea)
     }
 
     fn pair(&self, i: usize, j: usize) -> Pair {
@@ -261,17 +290,31 @@ pub fn reduce(x: &Mat, p: &Mat) -> Result<(ReducedState, Mat, Mat)> {
 /// Reconstruction (R, S, a, p_a, p_Ω, p_Λ) ↦ (X, P): X = R A Sᵀ, P = R(ΩA + diag(p_a) − AΛ)Sᵀ
 /// with Ω ⊕ Λ = B_A⁻¹(p_Ω ⊕ p_Λ) (001 §4.1, (7.9)). The inverse of [`reduce`].
 ///
-/// Errors: R, S not rotations, an invalid reduced state ([`ReducedState::validate`]).
+/// Errors: R, S not rotations, an invalid reduced state ([`ReducedState::validate`]), an
+/// overflow error where P exceeds the f64 range. Scale-aware: ΩA − AΛ (degree −1 in a) is
+/// formed from the scaled pair formulas ([`ReducedState::velocities_scaled`]), so tiny or huge
+/// a give the representable P although Ω, Λ alone may not be representable.
 pub fn reconstruct(r: &Mat, s: &Mat, state: &ReducedState) -> Result<(Mat, Mat)> {
     let n = state.validate()?;
     let x = gl::from_svd(r, &state.a, s)?;
-    let (omega, lambda) = state.velocities_unchecked(n);
-    Ok((x, lift_momentum(r, s, state, &omega, &lambda)))
+    let p = lift_momentum(r, s, state, n);
+    check::unscale_mat("a, p_a, p_Omega, p_Lambda", "the momentum P", &p, 0)?;
+    Ok((x, p))
 }
 
-fn lift_momentum(r: &Mat, s: &Mat, state: &ReducedState, omega: &Mat, lambda: &Mat) -> Mat {
-    let a = diag(&state.a);
-    let m = omega * &a + diag(&state.p_a) - &a * lambda;
+/// P = R(ΩA + diag(p_a) − AΛ)Sᵀ with Ω ⊕ Λ = B_A⁻¹(μ ⊕ ν), scale-aware (entries ±inf where P is
+/// not representable).
+fn lift_momentum(r: &Mat, s: &Mat, state: &ReducedState, n: usize) -> Mat {
+    let (omega, lambda, em, ea) = state.velocities_scaled(n);
+    let a = Mat::from_fn(n, n, |i, j| {
+        if i == j {
+            check::ldexp(state.a[i], -ea)
+        } else {
+            0.0
+        }
+    });
+    let rot = check::ldexp_mat(&(&omega * &a - &a * &lambda), em - ea);
+    let m = rot + diag(&state.p_a);
     r * m * s.transpose()
 }
 
@@ -343,9 +386,8 @@ impl ReducedWork {
     /// The current (X, P) (reconstructed).
     pub fn full_state(&self) -> (Mat, Mat) {
         let n = self.state.a.len();
-        let (o, l) = self.state.velocities_unchecked(n);
         let x = &self.r * diag(&self.state.a) * self.s.transpose();
-        (x, lift_momentum(&self.r, &self.s, &self.state, &o, &l))
+        (x, lift_momentum(&self.r, &self.s, &self.state, n))
     }
 
     /// The exact flow i over time τ with potential U: 0 = T, 1 = U, 2 + k = the k-th pair.

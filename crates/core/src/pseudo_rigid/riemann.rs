@@ -10,7 +10,13 @@ use crate::{check, Mat};
 pub fn riemann_variables(x: &Mat, v: &Mat) -> Result<(Mat, Mat)> {
     let n = gl::check_gl_plus("X", x)?;
     check::square_of("V", v, n)?;
-    Ok((x * x.transpose(), x * v.transpose()))
+    // Scale-aware: X and V divided by powers of two, the products multiplied back once.
+    let (ex, ev) = (check::pow2_exponent_mat(x), check::pow2_exponent_mat(v));
+    let (xs, vs) = (check::ldexp_mat(x, -ex), check::ldexp_mat(v, -ev));
+    Ok((
+        check::unscale_mat("X", "Q = XXᵀ", &(&xs * xs.transpose()), 2 * ex)?,
+        check::unscale_mat("X, V", "N = XVᵀ", &(&xs * vs.transpose()), ex + ev)?,
+    ))
 }
 
 /// The symmetric/skew split of N (001 (3.10)): returns (Q̇, L) with Q̇ = N + Nᵀ = ẊXᵀ + XẊᵀ and
@@ -54,6 +60,12 @@ pub fn poisson_bracket(q: &Mat, n_mat: &Mat, df: (&Mat, &Mat), dg: (&Mat, &Mat))
                 }
             }
         }
+    }
+    if !s.is_finite() {
+        return Err(check::overflow_error(
+            "Q, N, dfdQ, dfdN, dgdQ, dgdN",
+            "the Poisson bracket {f, g}",
+        ));
     }
     Ok(s)
 }

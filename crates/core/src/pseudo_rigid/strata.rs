@@ -51,7 +51,7 @@ fn isotropy_name(multiplicities: &[usize]) -> String {
 pub fn classify(x: &Mat, rel_tol: f64) -> Result<StratumInfo> {
     let stratum = gl::stratum(x, rel_tol)?;
     let (a, n) = (&stratum.a, stratum.a.len());
-    let thresh = rel_tol * a[0];
+    let thresh = stratum.tol;
     let dim_vertical = (0..n)
         .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
         .map(|(i, j)| usize::from((a[i] - a[j]).abs() > thresh) + usize::from(a[i] + a[j] > thresh))

@@ -26,7 +26,7 @@
 use std::sync::Arc;
 
 use super::dynamics::FullBody;
-use super::momentum::momentum_map_unchecked;
+use super::momentum::momentum_map_scaled;
 use super::potential::{self, Potential, Workspace};
 use super::reduced::{spectral_invariants, ReducedWork};
 use crate::check;
@@ -97,7 +97,8 @@ impl PseudoRigidBody {
     pub fn momenta(&self, z: &[f64]) -> Result<(Mat, Mat)> {
         let (x, p) = self.split(z)?;
         check::finite_slice("state", z)?;
-        Ok(momentum_map_unchecked(&x, &p))
+        let (l, g) = momentum_map_scaled(&x, &p);
+        Ok((l?, g?))
     }
 
     /// Singular values a₁ ≥ … ≥ aₙ of X (the semi-axes of the ellipsoid X(ball)).

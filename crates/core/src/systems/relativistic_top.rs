@@ -995,7 +995,8 @@ impl WeakFieldTop {
     /// The angular momentum x p_y − y p_x about the origin (conserved for a central potential).
     pub fn angular_momentum(&self, z: &[f64]) -> Result<f64> {
         check::len_of("state", z, 6)?;
-        Ok(z[0] * z[4] - z[1] * z[3])
+        let q = "the angular momentum x p_y − y p_x";
+        check::cross2("state", q, [z[0], z[1]], [z[3], z[4]])
     }
 }
 
@@ -1026,7 +1027,7 @@ impl Problem for WeakFieldTop {
         check::len_of("state", z, 6)?;
         let mut out = vec![z[5]];
         match &self.potential.kind {
-            PotentialKind::PointMass { .. } => out.push(z[0] * z[4] - z[1] * z[3]),
+            PotentialKind::PointMass { .. } => out.push(self.angular_momentum(z)?),
             PotentialKind::Uniform { g } => {
                 let n = g[0].hypot(g[1]);
                 if n > 0.0 {

@@ -49,13 +49,16 @@
 use nalgebra::Complex;
 
 use crate::check;
-use crate::error::{Error, Result};
+use crate::error::{fmt_num, Error, Result};
 use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::{Canonical, Symmetric, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 
 type C = Complex<f64>;
+
+/// The widest θ₁ range [`RollingDisks::relative_equilibria`] searches, in turns of disk 1.
+const MAX_TURNS: f64 = 1000.0;
 
 /// Two disks rolling against each other (module docs); state z = (θ₁, θ₂, p₁, p₂).
 #[derive(Clone, Debug, PartialEq)]
@@ -228,16 +231,21 @@ impl RollingDisks {
         check::finite_slice("state", z)
     }
 
-    /// The state z = (θ, Mθ̇). Errors: non-finite input.
+    /// The state z = (θ, Mθ̇). Errors: non-finite input, an overflow error where Mθ̇ exceeds the
+    /// f64 range.
     pub fn state(&self, theta: [f64; 2], thetadot: [f64; 2]) -> Result<Vec<f64>> {
         check::finite_slice("thetadot", &thetadot)?;
         let m = self.mass_matrix(theta)?;
-        Ok(vec![
+        let z = vec![
             theta[0],
             theta[1],
             m[0][0] * thetadot[0] + m[0][1] * thetadot[1],
             m[1][0] * thetadot[0] + m[1][1] * thetadot[1],
-        ])
+        ];
+        if z.iter().any(|x| !x.is_finite()) {
+            return Err(check::overflow_error("thetadot", "the momentum p = Mθ̇"));
+        }
+        Ok(z)
     }
 
     /// θ̇ = M⁻¹p.
@@ -303,6 +311,16 @@ impl RollingDisks {
         }
         let [r1, r2] = self.r;
         let turns = ((hi - lo) / std::f64::consts::TAU).ceil().max(1.0);
+        if turns > MAX_TURNS {
+            return Err(Error::invalid(
+                "theta1_range",
+                format!(
+                    "the range spans {} turns of disk 1; at most {MAX_TURNS} are searched (the \
+                     equilibria repeat with the rolling constant, see the module docs)",
+                    fmt_num(turns)
+                ),
+            ));
+        }
         let n = (256.0 * turns * (2.0 + r1 / r2)).min(1e7) as usize;
         let h = (hi - lo) / n as f64;
         let mut out = Vec::new();

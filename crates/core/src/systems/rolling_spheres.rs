@@ -277,10 +277,27 @@ impl RollingSpheres {
                 ));
             }
         }
-        let reduced_mass = m1 * m2 / (m1 + m2);
+        // e = m₁m₂/(m₁ + m₂) = lo/(1 + lo/hi): no overflow of m₁m₂ or m₁ + m₂.
+        let (lo, hi) = (m1.min(m2), m1.max(m2));
+        let reduced_mass = lo / (1.0 + lo / hi);
         let big_r = r1 + r2;
         let alpha = [r1 / big_r, r2 / big_r];
         let scale = reduced_mass * big_r * big_r;
+        // The energy scale eR² and the rescaled inertias K_k = J_k⁰/(eR²) must be representable
+        // (positive normal numbers, finite): radii or masses near the ends of the f64 range
+        // make them overflow or underflow, and every observable would be NaN.
+        if !(scale.is_finite() && scale >= f64::MIN_POSITIVE) {
+            return Err(Error::overflow(
+                "r1, r2, m1, m2",
+                format!(
+                    "the energy scale eR² = m₁m₂/(m₁ + m₂)·(r₁ + r₂)² = {} is not a positive \
+                     normal number (outside the f64 range [{:e}, {:e}])",
+                    crate::error::fmt_num(scale),
+                    f64::MIN_POSITIVE,
+                    f64::MAX
+                ),
+            ));
+        }
         let e = [gammas[0] / r1, gammas[1] / r2];
         let sym = |a: Matrix3<f64>| (a + a.transpose()) * 0.5;
         let j0 = [0, 1].map(|i| {
@@ -292,6 +309,25 @@ impl RollingSpheres {
             k[i] + (Matrix3::identity() * e[i].norm_squared() - e[i] * e[i].transpose())
                 * (alpha[i] * alpha[i])
         });
+        for i in 0..2 {
+            let (min, max) = (k[i].symmetric_eigenvalues().min(), k[i].amax());
+            if !(max.is_finite() && j[i].iter().all(|x| x.is_finite()) && min >= f64::MIN_POSITIVE)
+            {
+                return Err(Error::overflow(
+                    format!("inertia{}", i + 1),
+                    format!(
+                        "the rescaled moment of inertia K_{} = J_{}⁰/(eR²) (003 §2) has \
+                         eigenvalues outside the f64 range (smallest {}, largest entry {}): \
+                         the inertia is out of scale with eR² = {}",
+                        i + 1,
+                        i + 1,
+                        crate::error::fmt_num(min),
+                        crate::error::fmt_num(max),
+                        crate::error::fmt_num(scale)
+                    ),
+                ));
+            }
+        }
         Ok(RollingSpheres {
             radii,
             masses,
@@ -435,6 +471,15 @@ impl RollingSpheres {
         })
     }
 
+    /// The configuration and velocity of an observed state, checked as [`RollingSpheres::state`]
+    /// and the integrators check it ([`Space::check`]: length, finite, z_k ∈ SO(3), |u| = 1):
+    /// the observables are defined on the state space only (a zero or scaled z_k is not a
+    /// configuration, and gives NaN or inf).
+    fn observed(&self, z: &[f64]) -> Result<Local> {
+        self.space().check("state", z)?;
+        Ok(local(z))
+    }
+
     fn kin(&self, l: &Local) -> Kin {
         self.kin_spatial(&l.z, &l.u, [l.z[0] * l.omega[0], l.z[1] * l.omega[1]])
     }
@@ -493,55 +538,57 @@ impl RollingSpheres {
     /// Lagrangian L_c(ω) = L with u̇ from (10) (physical units). P₁ + P₂ is the total angular
     /// momentum, and Ṗ_k = ṡ_k × w (module docs).
     pub fn spatial_momenta(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        check::len_of("state", z, STATE_DIM)?;
-        let l = local(z);
+        let l = self.observed(z)?;
         let k = self.kin(&l);
         let w = self.w(&k);
         let sc = self.scale();
-        Ok([0, 1].map(|i| arr(&((l.z[i] * self.k[i] * l.omega[i] + k.s[i].cross(&w)) * sc))))
+        finite2(
+            "the spatial momenta",
+            [0, 1].map(|i| arr(&((l.z[i] * self.k[i] * l.omega[i] + k.s[i].cross(&w)) * sc))),
+        )
     }
 
     /// The rates eR²·(Ṗ₁, Ṗ₂) = eR²·(ṡ₁ × w, ṡ₂ × w) of [`RollingSpheres::spatial_momenta`]
     /// (physical units; they sum to zero).
     pub fn momentum_rates(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        check::len_of("state", z, STATE_DIM)?;
-        let k = self.kin(&local(z));
+        let k = self.kin(&self.observed(z)?);
         let w = self.w(&k);
         let sd = self.sdot(&k);
-        Ok([0, 1].map(|i| arr(&(sd[i].cross(&w) * self.scale()))))
+        finite2(
+            "the momentum rates",
+            [0, 1].map(|i| arr(&(sd[i].cross(&w) * self.scale()))),
+        )
     }
 
-    /// u̇ of the rolling constraint (10), u̇ = (α₁z₁Ω₁ + α₂z₂Ω₂) × u (state unchecked beyond its
-    /// length).
+    /// u̇ of the rolling constraint (10), u̇ = (α₁z₁Ω₁ + α₂z₂Ω₂) × u.
     pub fn udot(&self, z: &[f64]) -> Result<[f64; 3]> {
-        check::len_of("state", z, STATE_DIM)?;
-        Ok(arr(&self.kin(&local(z)).udot))
+        finite1("u̇", arr(&self.kin(&self.observed(z)?).udot))
     }
 
     /// The residual |R u̇ − (r₁z₁Ω₁ + r₂z₂Ω₂) × u| of (7) for a given u̇ (for tests of the
     /// velocities of computed motions).
     pub fn constraint_residual(&self, z: &[f64], udot: [f64; 3]) -> Result<f64> {
-        check::len_of("state", z, STATE_DIM)?;
-        let l = local(z);
+        let l = self.observed(z)?;
+        check::finite_slice("udot", &udot)?;
         let v = Vector3::from(udot) * self.big_r
             - (l.z[0] * l.omega[0] * self.radii[0] + l.z[1] * l.omega[1] * self.radii[1])
                 .cross(&l.u);
-        Ok(v.norm())
+        Ok(finite1("the residual", [v.norm()])?[0])
     }
 
     /// L of (8), evaluated literally (with u̇ from (10)).
     pub fn lagrangian(&self, z: &[f64]) -> Result<f64> {
-        check::len_of("state", z, STATE_DIM)?;
-        let l = local(z);
+        let l = self.observed(z)?;
         let ud = self.kin(&l).udot;
         let [a1, a2] = self.alpha;
         let b1 = l.z[0] * l.omega[0].cross(&self.e[0]);
         let b2 = l.z[1] * l.omega[1].cross(&self.e[1]);
-        Ok(0.5 * l.omega[0].dot(&(self.j[0] * l.omega[0]))
+        let v = 0.5 * l.omega[0].dot(&(self.j[0] * l.omega[0]))
             + 0.5 * l.omega[1].dot(&(self.j[1] * l.omega[1]))
             + 0.5 * ud.norm_squared()
             - ud.dot(&(b1 * a1 - b2 * a2))
-            - a1 * a2 * b1.dot(&b2))
+            - a1 * a2 * b1.dot(&b2);
+        Ok(finite1("the Lagrangian", [v])?[0])
     }
 
     /// w = ∂L/∂u̇ = u̇ − α₁b₁ + α₂b₂ = ω₁ × s₁ + ω₂ × s₂ (the relative velocity of the centres of
@@ -567,40 +614,43 @@ impl RollingSpheres {
     /// The Noether momentum of the diagonal SO(3) symmetry of L (003 §2.1),
     /// J = z₁p₁ + z₂p₂ + u × ∂L/∂u̇ (rescaled units; conserved).
     pub fn noether_momentum(&self, z: &[f64]) -> Result<[f64; 3]> {
-        check::len_of("state", z, STATE_DIM)?;
-        let l = local(z);
-        let k = self.kin(&l);
-        let p = self.momenta(&l, &k);
-        Ok(arr(&(l.z[0] * p[0]
-            + l.z[1] * p[1]
-            + l.u.cross(&self.w(&k)))))
+        let l = self.observed(z)?;
+        finite1("the Noether momentum", arr(&self.noether(&l)))
+    }
+
+    fn noether(&self, l: &Local) -> Vector3<f64> {
+        let k = self.kin(l);
+        let p = self.momenta(l, &k);
+        l.z[0] * p[0] + l.z[1] * p[1] + l.u.cross(&self.w(&k))
     }
 
     /// The total angular momentum about the centre of mass (physical units), eR²·J
     /// ([`RollingSpheres::noether_momentum`]).
     pub fn angular_momentum(&self, z: &[f64]) -> Result<[f64; 3]> {
-        Ok(self.noether_momentum(z)?.map(|x| x * self.scale()))
+        let j = self.noether(&self.observed(z)?) * self.scale();
+        finite1("the angular momentum", arr(&j))
     }
 
     /// The body momenta eR²·p_k = eR²·∂L/∂Ω_k (physical units); p_k·e_k/|e_k| is the Noether
     /// quantity of the material rotation of body k about e_k (not conserved, 003 §2.1).
     pub fn body_momenta(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        check::len_of("state", z, STATE_DIM)?;
-        let l = local(z);
+        let l = self.observed(z)?;
         let p = self.momenta(&l, &self.kin(&l));
-        Ok([arr(&(p[0] * self.scale())), arr(&(p[1] * self.scale()))])
+        finite2(
+            "the body momenta",
+            [arr(&(p[0] * self.scale())), arr(&(p[1] * self.scale()))],
+        )
     }
 
     /// The geometric centres a₁, a₂ of (4) (centre-of-mass frame).
     pub fn centres(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        check::len_of("state", z, STATE_DIM)?;
-        let l = local(z);
+        let l = self.observed(z)?;
         let [m1, m2] = self.masses;
         let m = m1 + m2;
         let g = l.z[0] * self.gammas[0] * m1 + l.z[1] * self.gammas[1] * m2;
         let a1 = -(g + l.u * (self.big_r * m2)) / m;
         let a2 = -(g - l.u * (self.big_r * m1)) / m;
-        Ok([arr(&a1), arr(&a2)])
+        finite2("the centres", [arr(&a1), arr(&a2)])
     }
 
     /// The centres of mass x_k = z_kγ_k + a_k.
@@ -646,9 +696,8 @@ impl RollingSpheres {
     /// The body angular accelerations (Ω̇₁, Ω̇₂) of the Lagrange–d'Alembert equations (module
     /// docs).
     pub fn accelerations(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        check::len_of("state", z, STATE_DIM)?;
-        let a = self.accel(&local(z));
-        Ok([arr(&a[0]), arr(&a[1])])
+        let a = self.accel(&self.observed(z)?);
+        finite2("the accelerations", [arr(&a[0]), arr(&a[1])])
     }
 
     /// 003 §2.2's closed form of the curvature, Δ(X, X̃) = α₁α₂ u × ((z₁Ω₁ − z₂Ω₂) × (z₁Ω̃₁ −
@@ -659,11 +708,12 @@ impl RollingSpheres {
         omega: [[f64; 3]; 2],
         omega_tilde: [[f64; 3]; 2],
     ) -> Result<[f64; 3]> {
-        check::len_of("state", z, STATE_DIM)?;
-        let l = local(z);
+        let l = self.observed(z)?;
+        check::finite_slice("omega", omega.as_flattened())?;
+        check::finite_slice("omega_tilde", omega_tilde.as_flattened())?;
         let v = |o: [[f64; 3]; 2]| l.z[0] * Vector3::from(o[0]) - l.z[1] * Vector3::from(o[1]);
         let d = l.u.cross(&v(omega).cross(&v(omega_tilde))) * (self.alpha[0] * self.alpha[1]);
-        Ok(arr(&d))
+        finite1("the curvature", arr(&d))
     }
 
     /// The curvature Δ(X, X̃) = −ν[X, X̃] (003 §2.2) computed numerically from the Lie bracket of
@@ -684,9 +734,10 @@ impl RollingSpheres {
         omega_tilde: [[f64; 3]; 2],
         s: f64,
     ) -> Result<[f64; 3]> {
-        check::len_of("state", z, STATE_DIM)?;
+        let l = self.observed(z)?;
+        check::finite_slice("omega", omega.as_flattened())?;
+        check::finite_slice("omega_tilde", omega_tilde.as_flattened())?;
         check::positive("s", s)?;
-        let l = local(z);
         let o = omega.map(Vector3::from);
         let ot = omega_tilde.map(Vector3::from);
         let flow = |q: &mut ([Matrix3<f64>; 2], Vector3<f64>), om: &[Vector3<f64>; 2], t: f64| {
@@ -718,8 +769,25 @@ impl RollingSpheres {
         let br = [0, 1, 2].map(|i| (d1[i] * 4.0 - d2[i]) / 3.0);
         let nu =
             br[2] - (l.z[0] * br[0] * self.alpha[0] + l.z[1] * br[1] * self.alpha[1]).cross(&l.u);
-        Ok(arr(&(-nu)))
+        finite1("the curvature", arr(&(-nu)))
     }
+}
+
+/// The values, or an overflow error naming the state where one exceeds the f64 range (a
+/// valid state with velocities near the end of the range).
+fn finite1<const N: usize>(quantity: &str, v: [f64; N]) -> Result<[f64; N]> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(check::overflow_error("state", quantity))
+    }
+}
+
+/// [`finite1`] for a pair of 3-vectors.
+fn finite2(quantity: &str, v: [[f64; 3]; 2]) -> Result<[[f64; 3]; 2]> {
+    finite1(quantity, v[0])?;
+    finite1(quantity, v[1])?;
+    Ok(v)
 }
 
 impl Problem for RollingSpheres {
@@ -753,7 +821,10 @@ impl Problem for RollingSpheres {
     /// of field values keeps P₁ + P₂ to round-off; the methods that also keep SO(3) and S² (all
     /// but RK4) keep J to round-off (measured ~1e-14 relative over 10⁵ steps).
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        Ok(self.angular_momentum(z)?.to_vec())
+        // Not [`RollingSpheres::angular_momentum`]: a run's states are read as they are (RK4
+        // leaves SO(3) and S² slowly; the driver's finiteness guard covers the rest).
+        check::len_of("state", z, STATE_DIM)?;
+        Ok(arr(&(self.noether(&local(z)) * self.scale())).to_vec())
     }
     fn invariant_count(&self) -> usize {
         3

@@ -43,11 +43,20 @@ impl SphereParticle {
     pub fn from_spherical(&self, z: &[f64]) -> Result<Vec<f64>> {
         check::len_of("spherical-pendulum state (u, L)", z, 6)?;
         check::finite_slice("spherical-pendulum state (u, L)", z)?;
+        // (u, L) must be a spherical-pendulum state (|u| = 1, u·L = 0), as its check_state asks.
+        super::spherical_pendulum::check_pendulum_state(z)?;
         let u = Vector3::from_column_slice(&z[..3]);
         let l = Vector3::from_column_slice(&z[3..]);
         let q = u * self.bob.length;
         let p = l.cross(&u) / self.bob.length;
-        Ok([q.as_slice(), p.as_slice()].concat())
+        let out = [q.as_slice(), p.as_slice()].concat();
+        if out.iter().any(|x| !x.is_finite()) {
+            return Err(check::overflow_error(
+                "states",
+                "the momentum p = L × u / l",
+            ));
+        }
+        Ok(out)
     }
 
     /// The [`super::SphericalPendulum`] state (u, L) = (q/l, q × p) of a state (q, p).
@@ -73,7 +82,8 @@ impl Problem for SphereParticle {
     }
     /// [(q × p)₃], the vertical angular momentum.
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        Ok(vec![z[0] * z[4] - z[1] * z[3]])
+        let q = "the angular momentum (q × p)₃";
+        Ok(vec![check::cross2("state", q, [z[0], z[1]], [z[3], z[4]])?])
     }
     fn invariant_count(&self) -> usize {
         1

@@ -99,19 +99,25 @@ impl Problem for SphericalPendulum {
     }
     /// |q| = 1 and q·L = 0 to [`CONSTRAINT_TOL`].
     fn check_state(&self, z: &[f64]) -> Result<()> {
-        let [q2, ql] = Self::casimirs(z);
-        let l = z[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
-        if (q2.sqrt() - 1.0).abs() > CONSTRAINT_TOL || ql.abs() > CONSTRAINT_TOL * l.max(1.0) {
-            return Err(Error::invalid(
-                "state",
-                format!(
-                    "a spherical-pendulum state needs |q| = 1 and q·L = 0; got |q| = {}, q·L = {ql}",
-                    q2.sqrt()
-                ),
-            ));
-        }
-        Ok(())
+        check_pendulum_state(z)
     }
+}
+
+/// The state-space check of a spherical-pendulum state (q, L): |q| = 1 and q·L = 0 to
+/// [`CONSTRAINT_TOL`] (shared with [`super::SphereParticle::from_spherical`]).
+pub(crate) fn check_pendulum_state(z: &[f64]) -> Result<()> {
+    let [q2, ql] = SphericalPendulum::casimirs(z);
+    let l = z[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
+    if (q2.sqrt() - 1.0).abs() > CONSTRAINT_TOL || ql.abs() > CONSTRAINT_TOL * l.max(1.0) {
+        return Err(Error::invalid(
+            "state",
+            format!(
+                "a spherical-pendulum state needs |q| = 1 and q·L = 0; got |q| = {}, q·L = {ql}",
+                q2.sqrt()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Flow 0: the potential kick L ↦ L + t mgl e₃ × q; flow 1: the kinetic rotation of q about L.
