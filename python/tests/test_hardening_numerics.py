@@ -421,3 +421,26 @@ def test_pseudo_rigid_momenta_overflow_is_typed():
         assert finite(f(z))
         with pytest.raises(lf.InvalidArgumentError, match="overflow"):
             f(1e300 * z)
+
+
+def test_cayley_is_accurate_or_refuses_at_every_scale():
+    # n = 3 by the closed form at every scale; n >= 4 refuses where the solve lost accuracy (a
+    # zero angle beside a huge one), never a NaN or a non-rotation (found by the fuzz suite)
+    for n, c in [(3, [0.1, -0.4, 0.3]), (4, [0.1, -0.4, 0.3, 0.2, 0.0, 0.5]),
+                 (5, list(np.linspace(-0.5, 0.5, 10)))]:
+        x = lf.lie.hat_n(c)
+        for s in [1.0, 1e10, 1e160, 1.7e308]:
+            try:
+                r = lf.lie.cayley(s * x)
+            except lf.InvalidArgumentError as e:
+                assert n >= 5 and "lost its accuracy" in str(e)
+                continue
+            assert np.abs(r.T @ r - np.eye(n)).max() < 1e-12 and np.linalg.det(r) > 0
+
+
+def test_huge_broadcast_inputs_are_refused_before_reading():
+    b = np.broadcast_to(np.ones(1), (10**10,))
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.GeneralizedRigidBody(b)
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.RigidBody(b)

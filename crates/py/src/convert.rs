@@ -51,8 +51,11 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayIn<'py> {
     type Error = PyErr;
 
     fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        // Fast path, zero-copy: a float64 array.
-        if ob.cast::<PyArrayDyn<f64>>().is_ok() {
+        // Fast path, zero-copy: a float64 array. Its size is held to the same limit as every
+        // buffer (check::array_size): a broadcast view of 10¹⁰ rows costs nothing to borrow,
+        // but every consumer either makes an output as large or reads it whole.
+        if let Ok(a) = ob.cast::<PyArrayDyn<f64>>() {
+            check::array_size(ARGUMENT, a.shape()).map_err(to_py)?;
             return Ok(ArrayIn(ob.extract()?));
         }
         let py = ob.py();
@@ -130,7 +133,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for ArrayIn<'py> {
         }
         // The float64 copy of a non-float64 array (e.g. an int broadcast view of 10¹⁰ rows) is
         // checked like every other buffer (check::array_size) before it is made, not left to
-        // numpy's MemoryError (a float64 view, strided or broadcast, is borrowed above).
+        // numpy's MemoryError.
         check::array_size(ARGUMENT, array.shape()).map_err(to_py)?;
         Ok(ArrayIn(array.as_any().extract()?))
     }

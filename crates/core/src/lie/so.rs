@@ -702,8 +702,19 @@ fn log_spectral(r: &Mat, a: &Mat) -> Result<Mat> {
 /// Defined for every ξ (its angles 2 atan(θ_j/2) tend to π): both factors are scaled by
 /// c = 1/max(1, max |ξ_ij|), cay ξ = (cI − cξ/2)⁻¹ (cI + cξ/2), so the solve sees entries of
 /// order one and the result is finite and orthogonal for every finite ξ.
+///
+/// For n = 3 the closed form of [`super::so3::cayley`] is used, accurate for every finite ξ. For
+/// n ≥ 4 the solve mixes the scales of the rotation planes: with a zero angle (always present
+/// for odd n) beside a huge one it loses accuracy like ε·|ξ|², so the result is checked, and a
+/// rotation that is not orthogonal to 1e-12 is refused with [`Error::InvalidArgument`] naming the
+/// scale (never a NaN or a wrong rotation).
 pub fn cayley(xi: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
+    if n == 3 {
+        let w = nalgebra::Vector3::new(xi[(2, 1)], xi[(0, 2)], xi[(1, 0)]);
+        let r = super::so3::cayley(&w);
+        return Ok(Mat::from_fn(3, 3, |i, j| r[(i, j)]));
+    }
     let m = (0..n)
         .flat_map(|i| (0..n).map(move |j| (i, j)))
         .fold(1.0f64, |m, (i, j)| m.max(xi[(i, j)].abs()));
@@ -711,7 +722,20 @@ pub fn cayley(xi: &Mat) -> Result<Mat> {
     let half = xi * faer::Scale(0.5 * c);
     let minus = Mat::identity(n, n) * faer::Scale(c) - &half;
     let plus = Mat::identity(n, n) * faer::Scale(c) + &half;
-    Ok(minus.partial_piv_lu().solve(&plus))
+    let r = minus.partial_piv_lu().solve(&plus);
+    let defect = (r.transpose() * &r - Mat::identity(n, n)).norm_max();
+    if !(defect <= 1e-12) {
+        return Err(Error::invalid(
+            "xi",
+            format!(
+                "the Cayley map of a ξ with entries up to {} lost its accuracy (orthogonality \
+                 defect {}): a zero angle beside a huge one; scale ξ down",
+                crate::error::fmt_num(m),
+                crate::error::fmt_num(defect)
+            ),
+        ));
+    }
+    Ok(r)
 }
 
 /// [`cayley_inv`] refuses rotations with σ_min(I + R) below this (an eigenvalue −1 of R, i.e. a
