@@ -444,3 +444,11 @@ def test_huge_broadcast_inputs_are_refused_before_reading():
         lf.GeneralizedRigidBody(b)
     with pytest.raises(lf.InvalidArgumentError):
         lf.RigidBody(b)
+
+
+def test_reduce_refuses_overflowing_momenta():
+    # a hypothesis case of the fuzz suite: R^T P S overflows for entries near the f64 maximum
+    p = np.array([[1.7976e308, -1.407e-294, 6.394e16], [3.729e16, 1.381e-274, -1.311e64],
+                  [1e2, 3.525e277, 2.359e16]])
+    with pytest.raises(lf.InvalidArgumentError, match="exceeds the f64 range"):
+        lf.pseudo_rigid.reduce(np.diag([3.0, 2.0, 1.0]) + 0.1, p)

@@ -269,7 +269,8 @@ impl ReducedState {
 /// X = R A Sᵀ ([`gl::svd_coordinates`], a decreasing), p_a = diag(RᵀPS), p_Ω = RᵀLR,
 /// p_Λ = SᵀΓS. Returns (reduced state, R, S).
 ///
-/// Errors: shapes, non-finite, det X ≤ 0, [`Error::DegenerateStratum`] off the principal stratum.
+/// Errors: shapes, non-finite, det X ≤ 0, [`Error::DegenerateStratum`] off the principal stratum, an
+/// overflow error where a reduced momentum exceeds the f64 range.
 pub fn reduce(x: &Mat, p: &Mat) -> Result<(ReducedState, Mat, Mat)> {
     let n = gl::check_gl_plus("X", x)?;
     check::square_of("P", p, n)?;
@@ -284,6 +285,16 @@ pub fn reduce(x: &Mat, p: &Mat) -> Result<(ReducedState, Mat, Mat)> {
         p_lambda: c.s.transpose() * g * &c.s,
         a: c.a,
     };
+    let finite = |v: &Mat| (0..n).all(|i| (0..n).all(|j| v[(i, j)].is_finite()));
+    if !(state.p_a.iter().all(|v| v.is_finite())
+        && finite(&state.p_omega)
+        && finite(&state.p_lambda))
+    {
+        return Err(check::overflow_error(
+            "X, P",
+            "a reduced momentum (p_a, p_Ω or p_Λ)",
+        ));
+    }
     Ok((state, c.r, c.s))
 }
 
