@@ -275,7 +275,9 @@ fn bad_input_is_rejected() {
     assert!(d.relative_equilibria((1.0, 0.0)).is_err());
     // a range of 1e300 (found by the fuzz suite: a 40 s scan) is refused, 1000 turns are searched
     assert!(d.relative_equilibria((0.0, 1e300)).is_err());
-    assert!(d.relative_equilibria((0.0, 999.0 * std::f64::consts::TAU)).is_ok());
+    assert!(d
+        .relative_equilibria((0.0, 999.0 * std::f64::consts::TAU))
+        .is_ok());
     assert!(d.state([f64::NAN, 0.0], [0.0, 0.0]).is_err());
     assert!(d.energy(&[0.0, 0.0, 1.0]).is_err());
 }
