@@ -724,7 +724,7 @@ pub fn cayley(xi: &Mat) -> Result<Mat> {
     let plus = Mat::identity(n, n) * faer::Scale(c) + &half;
     let r = minus.partial_piv_lu().solve(&plus);
     let defect = (r.transpose() * &r - Mat::identity(n, n)).norm_max();
-    if !(defect <= 1e-12) {
+    if defect.is_nan() || defect > 1e-12 {
         return Err(Error::invalid(
             "xi",
             format!(

@@ -91,7 +91,7 @@ impl Coeffs {
     #[inline]
     fn new(w: &Vector3<f64>) -> Self {
         let t2 = w.norm_squared();
-        if !(t2 <= super::EXP_MAX_NORM * super::EXP_MAX_NORM) {
+        if t2.is_nan() || t2 > super::EXP_MAX_NORM * super::EXP_MAX_NORM {
             let nan = f64::NAN;
             return Coeffs {
                 t2: nan,
