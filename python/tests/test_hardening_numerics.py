@@ -452,3 +452,17 @@ def test_reduce_refuses_overflowing_momenta():
                   [1e2, 3.525e277, 2.359e16]])
     with pytest.raises(lf.InvalidArgumentError, match="exceeds the f64 range"):
         lf.pseudo_rigid.reduce(np.diag([3.0, 2.0, 1.0]) + 0.1, p)
+
+
+def test_dexp_refuses_an_overflowing_result():
+    # linear in eta: a huge eta takes dexp past the f64 range (a hypothesis case of the fuzz suite)
+    xi = lf.lie.hat_n([0.1, -0.4, 0.3, 0.2, 0.0, 0.5])
+    eta = 1.7e308 * lf.lie.hat_n([1.0, 1.0, 1.0, 1.0, 1.0, 1.0])
+    for f in (lf.lie.dexp, lf.lie.dexp_inv):
+        with pytest.raises(lf.InvalidArgumentError, match="exceeds the f64 range"):
+            f(xi, eta)
+
+
+def test_absurd_thread_counts_are_refused():
+    with pytest.raises(lf.InvalidArgumentError, match="threads"):
+        lf.integrate(lf.RigidBody([1, 2, 3]), [1.0, 0.5, -0.3], dt=0.01, steps=2, threads=10**12)

@@ -74,6 +74,10 @@ pub struct Integration {
     done: u64,
 }
 
+/// The most worker threads a run may ask for (a pool of 10¹² threads would never finish
+/// starting).
+const MAX_THREADS: usize = 1024;
+
 /// A count ≥ 1 from a Python integer.
 fn count(what: &str, v: i64) -> PyResult<usize> {
     usize::try_from(v).ok().filter(|&u| u >= 1).ok_or_else(|| {
@@ -108,6 +112,12 @@ impl Integration {
             None => None,
             Some(n) => {
                 let n = count("threads", n)?;
+                if n > MAX_THREADS {
+                    return Err(to_py(Error::invalid(
+                        "threads",
+                        format!("at most {MAX_THREADS} worker threads, got {n}"),
+                    )));
+                }
                 Some(
                     rayon::ThreadPoolBuilder::new()
                         .num_threads(n)

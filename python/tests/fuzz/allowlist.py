@@ -23,6 +23,22 @@ ALLOWED = [
      "is_rotation is a predicate: a non-finite matrix is not a rotation (False), not an error"),
     ("RollingDisks", "gamma[12]", "complex*", "accepted-bad",
      "gamma1/gamma2 are points of the plane and may be given as complex numbers"),
+    ("RollingDisks", "gamma[12]", "dropped-axis", "accepted-bad",
+     "a real number is a point of the plane on the real axis (gamma as a complex number)"),
+    ("GeneralizedRigidBody", "J", "wrong-last-axis", "accepted-bad",
+     "J of another length n is the body of another so(n): valid"),
+    ("pseudo_rigid.equilibrium_directions", "a", "wrong-last-axis", "accepted-bad",
+     "semi-axes of another length n are another dimension: valid"),
+    ("lie.hat_n", "c", "extra-axis", "accepted-bad",
+     "vectorised over leading axes (numpy broadcasting): an extra axis is a batch"),
+    ("HeavyTop", "chi", "None", "accepted-bad",
+     "chi is optional: None selects the default"),
+    ("integrate*", "state0", "broadcast-1e6", "timeout",
+     "a batch of 10^6 initial states is a legitimate run that takes longer than the harness's "
+     "time limit (it is refused only beyond the memory limits)"),
+    ("pseudo_rigid.locked_inertia", "X", "n=60", "timeout",
+     "the locked inertia at n = 60 is a dense n(n-1)/2-dimensional operator built in O(n^6): "
+     "slow, not wrong (performance issue)"),
 ]
 
 INFINITE_OK = {

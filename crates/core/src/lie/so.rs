@@ -777,6 +777,19 @@ pub fn cayley_inv(r: &Mat) -> Result<Mat> {
 // ---------------------------------------------------------------------------------------------
 // dexp and its inverse
 
+/// A result of `what` if it is finite; otherwise an overflow error naming ξ, η (the maps are
+/// linear in η, so a huge η can take the result past the f64 range).
+fn representable(what: &str, m: Mat) -> Result<Mat> {
+    if (0..m.nrows()).all(|i| (0..m.ncols()).all(|j| m[(i, j)].is_finite())) {
+        Ok(m)
+    } else {
+        Err(check::overflow_error(
+            "xi, eta",
+            &format!("{what}(xi, eta)"),
+        ))
+    }
+}
+
 /// Right-trivialized derivative of exp (000 §3): dexp_ξ η = Σ_{k≥0} ad_ξᵏ η / (k+1)!
 /// = ∫₀¹ Ad_{exp(sξ)} η ds, so that
 ///
@@ -788,6 +801,10 @@ pub fn cayley_inv(r: &Mat) -> Result<Mat> {
 /// avoids the cancellation of the raw series for large |ξ|. n = 3: closed form
 /// (see [`dexp3`]).
 pub fn dexp(xi: &Mat, eta: &Mat) -> Result<Mat> {
+    representable("dexp", dexp_raw(xi, eta)?)
+}
+
+fn dexp_raw(xi: &Mat, eta: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
     check_algebra_of("eta", eta, n)?;
     check_exp_norm("dexp", xi)?;
@@ -889,6 +906,10 @@ fn zeta_direct(p: i32) -> f64 {
 /// 10⁻¹⁷ of the sum. n = 3: closed form (see [`dexp3`]). Outside the domain →
 /// [`Error::InvalidArgument`].
 pub fn dexp_inv(xi: &Mat, eta: &Mat) -> Result<Mat> {
+    representable("dexp_inv", dexp_inv_raw(xi, eta)?)
+}
+
+fn dexp_inv_raw(xi: &Mat, eta: &Mat) -> Result<Mat> {
     let n = check_algebra("xi", xi)?;
     check_algebra_of("eta", eta, n)?;
     let nx = norm(xi);

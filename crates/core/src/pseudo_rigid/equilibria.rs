@@ -423,6 +423,12 @@ fn direction(n: usize, a: &[f64], planes: &[(usize, usize, f64)]) -> Result<Dire
 /// (a_i ∓ a_j)² exceeds the f64 range.
 pub fn equilibrium_directions(a: &[f64]) -> Result<Vec<Direction>> {
     let n = check_axes(a)?;
+    // n(n − 1) directions of two n×n blocks each: refuse what cannot be held
+    check::dense_size(
+        "a",
+        n.saturating_mul(n.saturating_sub(1)),
+        n.saturating_mul(2 * n),
+    )?;
     let mut planes = Vec::new();
     for i in 0..n {
         for j in i + 1..n {
