@@ -504,3 +504,10 @@ def test_rolling_spheres_to_planar_refuses_bad_tolerances(tol):
     assert len(s.to_planar(z)) == 5
     with pytest.raises(lf.InvalidArgumentError, match="tol"):
         s.to_planar(z, tol=tol)
+
+
+def test_relative_equilibria_plane_must_be_a_pair():
+    # a tuple of the wrong length gave pyo3's bare ValueError (found by the fuzz suite)
+    with pytest.raises(lf.ShapeError, match="plane"):
+        lf.pseudo_rigid.relative_equilibria(lf.potentials.Harmonic(1.0), shape=[3.0, 2.0, 1.0],
+                                            plane=(0,))

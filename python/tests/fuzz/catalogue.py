@@ -69,7 +69,9 @@ def _ragged(v):
     if a.ndim == 0:
         return [[1.0, 2.0], [3.0]]
     if a.ndim == 1:
-        return [list(a[:-1]), [a[-1]]] if a.size > 1 else [[1.0, 2.0], [3.0]]
+        if a.size == 2:          # [[x], [y]] would be a regular (2, 1) array
+            return [[a[0]], [a[1], a[1]]]
+        return [list(a[:-1]), [a[-1]]] if a.size > 2 else [[1.0, 2.0], [3.0]]
     rows = a.tolist()
     rows[-1] = rows[-1][:-1]
     return rows

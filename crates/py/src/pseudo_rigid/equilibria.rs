@@ -219,10 +219,21 @@ fn relative_equilibria(
     shape: Option<ArrayIn<'_>>,
     velocities: Option<Bound<'_, PyAny>>,
     momenta: Option<Bound<'_, PyAny>>,
-    plane: Option<(usize, usize)>,
+    plane: Option<Bound<'_, PyAny>>,
     #[pyo3(from_py_with = real_pair)] bounds: (f64, f64),
     #[pyo3(from_py_with = size)] starts: usize,
 ) -> PyResult<Vec<RelativeEquilibrium>> {
+    let plane = plane
+        .map(|p| {
+            p.extract::<(usize, usize)>().map_err(|_| {
+                to_py(Error::shape(
+                    "plane",
+                    "a pair (i, j) of axis indices",
+                    p.repr().map_or_else(|_| "?".into(), |r| r.to_string()),
+                ))
+            })
+        })
+        .transpose()?;
     let search = match (&shape, &velocities, &momenta, plane) {
         (Some(a), None, None, Some(plane)) => {
             let a = vector("shape", a)?;
