@@ -281,6 +281,8 @@ def contract_for(bad: Bad, arg) -> str:
         return "neutral" if bad.name != "ragged" else "refuse"
     if arg.complex_ok and bad.name in ("complex", "complex-0j", "complex-scalar"):
         return "neutral"
+    if arg.complex_ok and bad.name in ("wrong-last-axis", "swapped"):
+        return "skip"       # a complex point has no axes to reshape (its 2-vector form is fuzzed)
     if bad.name == "None" and arg.opt:
         return "skip"       # None is a valid value there
     return c
