@@ -198,7 +198,16 @@ pub fn zeros(what: &str, shape: &[usize]) -> Result<Vec<f64>> {
 /// The exponent e of the power of two 2^e ≤ m < 2^(e+1) when m lies outside [1e-100, 1e100], else
 /// 0 (also for m = 0 or m not finite): dividing by 2^e brings an extreme magnitude into [1, 2).
 pub fn pow2_exponent(m: f64) -> i32 {
-    if !(m.is_finite() && m > 0.0) || (1e-100..=1e100).contains(&m) {
+    if (1e-100..=1e100).contains(&m) {
+        return 0;
+    }
+    pow2_floor(m)
+}
+
+/// The exponent e of the power of two 2^e ≤ m < 2^(e+1) for a finite m > 0 (0 otherwise), at
+/// every scale (unlike [`pow2_exponent`], which leaves moderate magnitudes alone).
+pub fn pow2_floor(m: f64) -> i32 {
+    if !(m.is_finite() && m > 0.0) {
         return 0;
     }
     let e = m.log2().floor() as i32;

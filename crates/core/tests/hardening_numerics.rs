@@ -377,14 +377,28 @@ mod no_silent_nan {
         let st = gl::stratum(&x0(), f64::MAX).unwrap();
         assert!(st.tol.is_finite());
         assert_eq!(st.multiplicities, vec![3]);
-        // The hypothesis case of svd_coordinates/polar/stratum: a₁ > f64::MAX.
+        // The hypothesis case of svd_coordinates/polar/stratum: entries up to 2 ulp below
+        // f64::MAX, but a₁ = 1.7976931348623155e308 itself is representable (the other entries
+        // are far below its ulp). It used to be refused only because the scale 2^⌊log₂ a⌋ was
+        // computed as ∞ (log₂ rounds up to 1024); now the SVD is of X/2^1023 and exact.
         let h = m3([
             [1.7976931348623155e308, -1.407e-294, 6.394e16],
             [3.729e16, 1.381e-274, -1.311e64],
             [1e2, 3.525e277, 2.359e16],
         ]);
-        assert!(overflow(gl::svd_coordinates(&h)));
-        assert!(overflow(gl::polar(&h)));
+        let c = gl::svd_coordinates(&h).unwrap();
+        assert!(c.a.iter().all(|a| a.is_finite() && *a > 0.0));
+        assert_eq!(c.a[0], 1.7976931348623155e308);
+        let back = gl::from_svd(&c.r, &c.a, &c.s).unwrap();
+        assert!((0..3).all(|i| (0..3).all(|j| (back[(i, j)] - h[(i, j)]).abs() <= 1e-15 * c.a[0])));
+        // Where a₁ really exceeds f64::MAX (√2·MAX), the overflow is named.
+        let big = m3([
+            [f64::MAX, f64::MAX, 0.0],
+            [-f64::MAX, f64::MAX, 0.0],
+            [0.0, 0.0, 1.0],
+        ]);
+        assert!(overflow(gl::svd_coordinates(&big)));
+        assert!(overflow(gl::polar(&big)));
     }
 
     #[test]

@@ -105,35 +105,6 @@ pub fn check_det_positive(what: &str, group: &str, x: &Mat) -> Result<()> {
     Ok(())
 }
 
-/// The power of two nearest below max |x_ij| when that lies outside [1e-100, 1e100], else 1 (and
-/// 1 for a zero or non-finite matrix): dividing by it is exact, brings the largest entry of an
-/// extreme matrix into [1, 2) (where squares neither overflow nor underflow), and leaves
-/// moderate matrices bit for bit alone (faer's SVD is not bitwise scale-equivariant).
-pub fn pow2_scale(x: &Mat) -> f64 {
-    let m = (0..x.ncols())
-        .flat_map(|j| (0..x.nrows()).map(move |i| (i, j)))
-        .fold(0.0f64, |m, (i, j)| m.max(x[(i, j)].abs()));
-    if (1e-100..=1e100).contains(&m) {
-        return 1.0;
-    }
-    pow2_below(m)
-}
-
-/// The power of two 2^⌊log₂ m⌋ for a finite m > 0 (1 otherwise).
-pub fn pow2_below(m: f64) -> f64 {
-    if !(m.is_finite() && m > 0.0) {
-        return 1.0;
-    }
-    let e = m.log2().floor() as i32;
-    let c = 2f64.powi(e);
-    // powi of a negative exponent below −1022 is subnormal but exact; correct log2 rounding.
-    if c > m {
-        c * 0.5
-    } else {
-        c
-    }
-}
-
 /// SVD coordinates (R, a, S) of X ∈ GL⁺(n): X = R diag(a) Sᵀ (001 (2.4), S⁻¹ = Sᵀ).
 #[derive(Debug, Clone)]
 pub struct SvdCoordinates {
@@ -174,7 +145,7 @@ impl SvdCoordinates {
     /// (exact). Formulas homogeneous in a are evaluated on ã and rescaled once at the end, so
     /// that a_i² or a_i⁴ neither overflow nor underflow where the result is representable.
     pub fn unit(&self) -> (Vec<f64>, f64) {
-        let c = pow2_below(self.a[0]);
+        let c = check::ldexp(1.0, check::pow2_floor(self.a[0]));
         (self.a.iter().map(|&v| v / c).collect(), c)
     }
 
@@ -197,7 +168,7 @@ pub fn svd_coordinates(x: &Mat) -> Result<SvdCoordinates> {
     let n = check_gl_plus("X", x)?;
     // Scale-safe: the SVD of X/c with c a power of two near max |X_ij| (exact, so nothing
     // changes for moderate X), then a = c·ã; faer's SVD fails on entries near 1e160 or 1e-170.
-    let c = pow2_scale(x);
+    let c = check::ldexp(1.0, check::pow2_exponent_mat(x));
     let xs = x * faer::Scale(1.0 / c);
     let svd = xs.svd().map_err(|e| Error::NotConverged {
         what: format!("SVD of X ({e:?})"),

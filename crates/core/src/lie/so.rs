@@ -984,11 +984,11 @@ pub fn ad_star(xi: &Mat, mu: &Mat) -> Result<Mat> {
 /// singular values (of M with det M < 0: the smallest one) are not both zero/tied.
 ///
 /// Scale-free (the nearest rotation to cM is that of M): the SVD is taken of M/c with c a power
-/// of two near max |M_ij| ([`super::gl::pow2_scale`]), so M at 1e300 or 1e-300 is projected
+/// of two near max |M_ij| ([`check::pow2_exponent_mat`]), so M at 1e300 or 1e-300 is projected
 /// like M at 1.
 pub fn project_to_so(m: &Mat) -> Result<Mat> {
     check::square("M", m, 2)?;
-    let m = m * faer::Scale(1.0 / super::gl::pow2_scale(m));
+    let m = check::ldexp_mat(m, -check::pow2_exponent_mat(m));
     let svd = m.svd().map_err(|e| Error::NotConverged {
         what: format!("the SVD of M in so::project_to_so (faer: {e:?})"),
         iterations: 0,

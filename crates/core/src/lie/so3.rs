@@ -276,7 +276,7 @@ pub fn project(m: &Matrix3<f64>) -> Result<Matrix3<f64>> {
     check::finite_slice("M", m.as_slice())?;
     // Scale-free: the SVD of M/c, c a power of two near max |M_ij| (M at 1e300 is projected
     // like M at 1).
-    let c = super::gl::pow2_below(m.amax());
+    let c = check::ldexp(1.0, check::pow2_floor(m.amax()));
     let svd = (m / c).svd(true, true);
     let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
         return Err(Error::NotConverged {
