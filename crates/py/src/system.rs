@@ -62,6 +62,13 @@ impl PySystem {
         self.callbacks.as_ref().map_or(Ok(()), |c| c.take_error())
     }
 
+    /// The result of a core call that may have called Python: a callable's exception first,
+    /// then the core's error, converted.
+    pub(crate) fn checked<T>(&self, r: lieflow::Result<T>) -> PyResult<T> {
+        self.take_callback_error()?;
+        r.py()
+    }
+
     /// The core system of a run: the lifted one when an attitude is given.
     fn runner(&self, attitude: bool) -> PyResult<&Arc<dyn System>> {
         if !attitude {

@@ -82,9 +82,9 @@ impl PyRelativisticTangentTop {
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
-        let z = slf.get().top.state(x, theta, xdot, thetadot);
-        slf.as_super().get().take_callback_error()?;
-        z.py()
+        slf.as_super()
+            .get()
+            .checked(slf.get().top.state(x, theta, xdot, thetadot))
     }
 
     /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).

@@ -112,9 +112,9 @@ impl PyTangentTop {
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
-        let z = slf.get().top.state(x, theta, xdot, thetadot);
-        slf.as_super().get().take_callback_error()?;
-        z.py()
+        slf.as_super()
+            .get()
+            .checked(slf.get().top.state(x, theta, xdot, thetadot))
     }
 
     /// Named views for `Trajectory`: x (..., 2), theta (...), p (..., 3), and the velocities
@@ -280,9 +280,9 @@ impl PyChargedParticle {
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
     ) -> PyResult<Vec<f64>> {
-        let z = slf.get().particle.state(x, xdot);
-        slf.as_super().get().take_callback_error()?;
-        z.py()
+        slf.as_super()
+            .get()
+            .checked(slf.get().particle.state(x, xdot))
     }
 
     /// Named views for `Trajectory`: x (..., 2), p (..., 2), xdot (..., 2).
