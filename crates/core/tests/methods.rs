@@ -467,7 +467,7 @@ fn rattle_agrees_with_the_spherical_pendulum_and_has_order_2() {
         .unwrap()
         .final_state;
     let exact = part.from_spherical(&reference).unwrap();
-    let (e, o) = orders(&part, &Rattle, &z0, t_end, 0.02, &exact);
+    let (e, o) = orders(&part, &Rattle::new(), &z0, t_end, 0.02, &exact);
     assert_order("RATTLE sphere particle", e, o, 2.0);
     // Through the catalog, in the spherical pendulum's coordinates.
     let z = integrate(&part, "rattle", &z0, 0.005, 400, 400)
@@ -482,7 +482,7 @@ fn rattle_agrees_with_the_spherical_pendulum_and_has_order_2() {
 fn rattle_keeps_constraints_momentum_and_energy_over_1e5_steps() {
     let part = particle();
     let z0 = particle_state();
-    let states = trajectory(&part, &Rattle, &z0, 0.02, 100_000, 1);
+    let states = trajectory(&part, &Rattle::new(), &z0, 0.02, 100_000, 1);
     let (mut rq, mut rp, mut rl) = (0.0f64, 0.0f64, 0.0f64);
     let l0 = part.invariants(&z0).unwrap()[0];
     for z in &states[1..] {
@@ -545,7 +545,12 @@ fn rattle_is_symplectic_on_the_constrained_phase_space() {
     for h in [0.05, 0.2] {
         let images: Vec<Vec<f64>> = vs
             .iter()
-            .map(|v| derivative(&|eps| run(&part, &Rattle, &on_manifold(v, eps), h, 1), 1e-3))
+            .map(|v| {
+                derivative(
+                    &|eps| run(&part, &Rattle::new(), &on_manifold(v, eps), h, 1),
+                    1e-3,
+                )
+            })
             .collect();
         let d = symplectic_defect(&vs, &images);
         eprintln!("symplecticity defect RATTLE on T*S², h = {h}: {d:.2e}");
@@ -558,7 +563,7 @@ fn rattle_is_reversible() {
     let part = particle();
     let z0 = particle_state();
     for n in [1, 100] {
-        let r = reversibility(&part, &Rattle, &z0, 0.05, n);
+        let r = reversibility(&part, &Rattle::new(), &z0, 0.05, n);
         eprintln!("reversibility RATTLE, {n} steps: {r:.2e}");
         assert!(r < 1e-13, "{r:e}");
     }

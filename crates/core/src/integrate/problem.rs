@@ -11,7 +11,7 @@
 //! | [`Split`] | H = H₁ + … + H_m with exact flows | `Splitting(Composition)` |
 //! | [`Separable`] | H = T(p) + U(q): velocity ∂T/∂p and force −∂U/∂q | `Verlet(Composition)` |
 //! | [`Canonical`] | H(q, p) and its gradient | `Gauss(s)` (implicit midpoint = `Gauss(1)`) |
-//! | [`Constrained`] | a [`Separable`] with holonomic g(q) = 0 | `Rattle` |
+//! | [`Constrained`] | a [`Separable`] with holonomic g(q) = 0 (or g(q) = g(q₀)) | `Rattle(Composition)` |
 //! | [`Nonholonomic`] | a [`Separable`] with velocity constraints A(q) q̇ = 0 | `NonholonomicRattle` |
 //! | [`GroupField`] | ż = ξ(z)·z for a Lie-algebra valued ξ acting on z | `Rkmk4` |
 //! | [`Symmetric`] | a momentum map J and infinitesimal generators | (equilibria, tests) |
@@ -153,16 +153,38 @@ pub trait Canonical: Problem {
 }
 
 /// A [`Separable`] system with T = ½ pᵀM⁻¹p restricted by holonomic constraints g(q) = 0
-/// (g: ℝᵈ → ℝᵐ, full rank Jacobian G(q) = ∂g/∂q).
+/// (g: ℝᵈ → ℝᵐ, full rank Jacobian G(q) = ∂g/∂q), or, when [`Constrained::level_set`] says so,
+/// to the level set g(q) = g(q₀) through the initial position.
+///
+/// The constrained phase space is T*{g = c} = {g(q) = c, G(q) M⁻¹p = 0}; the second equation
+/// (the *hidden* constraint, the time derivative of the first) is what a state must satisfy on
+/// top of its position. Differentiating it once more along the motion gives the multiplier of
+/// the index-1 formulation ṗ = f − Gᵀλ, λ = (G M⁻¹Gᵀ)⁻¹(G M⁻¹f + D²g(q)[M⁻¹p, M⁻¹p])
+/// ([`crate::integrate::methods::rattle::constrained_field`]).
+///
+/// The kernels take the problem's [`Separable::Scratch`] (the constraint of a matrix-valued q
+/// may need an LU), and do not allocate.
 pub trait Constrained: Separable {
     /// The number m of constraints.
     fn constraints(&self) -> usize;
 
+    /// Whether the constraint manifold is the level set {g(q) = g(q₀)} through the position of
+    /// the state a stepper is set to (e.g. det X = det X₀ for an incompressible body, whose
+    /// volume is fixed by the initial state), rather than {g(q) = 0}. False by default.
+    fn level_set(&self) -> bool {
+        false
+    }
+
     /// g(q) into `g` (m values).
-    fn constraint(&self, q: &[f64], g: &mut [f64]);
+    fn constraint(&self, q: &[f64], g: &mut [f64], s: &mut Self::Scratch);
 
     /// G(q) = ∂g/∂q into `jac` (m × d, row-major).
-    fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64]);
+    fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64], s: &mut Self::Scratch);
+
+    /// The second derivative of g along v: D²g(q)[v, v] = d²/dε² g(q + εv) at ε = 0, into `out`
+    /// (m values) — the curvature term of the acceleration constraint
+    /// d²/dt² g(q(t)) = G(q) q̈ + D²g(q)[q̇, q̇] = 0.
+    fn constraint_curvature(&self, q: &[f64], v: &[f64], out: &mut [f64], s: &mut Self::Scratch);
 }
 
 /// A [`Separable`] system with T = ½ pᵀM⁻¹p restricted by linear velocity constraints

@@ -1,12 +1,21 @@
 //! The pseudo-rigid body as a system of the integration driver ([`crate::integrate`]).
 //!
-//! State layout: z = (X row-major, P row-major), length 2n². The body is two problem kinds:
+//! State layout: z = (X row-major, P row-major), length 2n². The body is three problem kinds:
 //! - [`Separable`] (H = ½ tr(PᵀP) + U(X), 001 (3.22)): methods `verlet`, `verlet4`, `verlet6`
 //!   ([`Verlet`] on all of T*GL⁺(n), or on all n×n matrices with `check_det` off); the force has
 //!   a stack-matrix fast path at n = 3 ([`Potential::gradient3`]);
 //! - [`Split`] with the flows of the reduced system on the principal stratum (001 §7,
 //!   [`super::reduced`]): method `reduced`, a [`Splitting`] whose working state is the reduced
-//!   one, so a run reduces (X, P) once and reconstructs only when a state is read.
+//!   one, so a run reduces (X, P) once and reconstructs only when a state is read;
+//! - [`Constrained`]: the **incompressible** body ([`PseudoRigidBody::incompressible`]), a fluid
+//!   or elastic ellipsoid that keeps its volume: the holonomic constraint det X = det X₀ (a level
+//!   set, [`Constrained::level_set`]) whose multiplier is the pressure. G = ∂ det/∂X = cof X =
+//!   det(X) X⁻ᵀ, so the hidden constraint is ⟨cof X, P⟩ = det(X) tr(X⁻¹P) = 0 (the motion keeps
+//!   the volume) and the constraint force is −λ cof X. Methods `rattle` (the default, order 2),
+//!   `rattle4`, `rattle6` ([`Rattle`] and its Suzuki / Yoshida compositions): symplectic on
+//!   T*{det X = det X₀}, equivariant under SO(n)×SO(n), so L and Γ are kept to round-off as det X
+//!   is. Verlet and the reduced flows ignore the constraint and are not offered. For a body that
+//!   is not incompressible, the constraint set is empty (m = 0).
 //!
 //! ```
 //! use std::sync::Arc;
@@ -22,6 +31,23 @@
 //! assert!((e1 - e0).abs() < 1e-8);
 //! # Ok::<(), lieflow::Error>(())
 //! ```
+//!
+//! The incompressible body, from a momentum projected onto the hidden constraint:
+//!
+//! ```
+//! use std::sync::Arc;
+//! use lieflow::integrate::integrate;
+//! use lieflow::pseudo_rigid::potential::SaintVenantKirchhoff;
+//! use lieflow::pseudo_rigid::system::PseudoRigidBody;
+//! use lieflow::Mat;
+//! let body = PseudoRigidBody::incompressible(3, Arc::new(SaintVenantKirchhoff::new(1.0, 2.0)?))?;
+//! let x0 = Mat::from_fn(3, 3, |i, j| if i == j { 1.0 + 0.2 * i as f64 } else { 0.05 });
+//! let p0 = body.project_momentum(&x0, &Mat::from_fn(3, 3, |i, j| 0.1 * (i + 2 * j) as f64))?;
+//! let traj = integrate(&body, "rattle4", &body.state(&x0, &p0)?, 1e-2, 100, 100)?;
+//! let (d0, d1) = (x0.determinant(), body.split(traj.state(1))?.0.determinant());
+//! assert!((d1 - d0).abs() < 1e-13 * d0);
+//! # Ok::<(), lieflow::Error>(())
+//! ```
 
 use std::sync::Arc;
 
@@ -31,22 +57,28 @@ use super::potential::{self, Potential, Workspace};
 use super::reduced::{spectral_invariants, ReducedWork};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Composition, Splitting, Verlet};
-use crate::integrate::problem::{Separable, Split, Symmetric, Violation};
+use crate::integrate::methods::{Composition, Rattle, Splitting, Verlet};
+use crate::integrate::problem::{Constrained, Separable, Split, Symmetric, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::{gl, so};
 use crate::Mat;
-use faer::{MatMut, MatRef};
+use faer::{Accum, MatMut, MatRef};
 use nalgebra::Matrix3;
 
+/// Relative tolerance of the hidden constraint ⟨cof X, P⟩ = 0 of an incompressible body's state,
+/// relative to ‖cof X‖_F ‖P‖_F.
+pub const VOLUME_RATE_TOL: f64 = 1e-10;
+
 /// A generalized pseudo-rigid body H = ½ tr(PᵀP) + U(X) (001 (3.22)) for the integration
-/// driver, with state z = (X, P) row-major.
+/// driver, with state z = (X, P) row-major; optionally incompressible (det X = det X₀).
 #[derive(Debug, Clone)]
 pub struct PseudoRigidBody {
     body: FullBody,
     /// Whether det X > 0 is enforced (asked for, or required by the potential).
     check_det: bool,
+    /// Whether the volume is held: det X = det X₀ (a holonomic constraint, RATTLE).
+    incompressible: bool,
 }
 
 impl PseudoRigidBody {
@@ -56,7 +88,61 @@ impl PseudoRigidBody {
         Ok(PseudoRigidBody {
             check_det: check_det || potential.needs_positive_det(),
             body: FullBody::new(n, potential)?,
+            incompressible: false,
         })
+    }
+
+    /// The incompressible body in n ≥ 2 dimensions with potential U: H = ½ tr(PᵀP) + U(X) on
+    /// T*{det X = det X₀} (the volume of the ellipsoid X(ball) is that of the initial state; the
+    /// pressure is the multiplier of the constraint). det X > 0 is checked. Its states must
+    /// satisfy the hidden constraint ⟨cof X, P⟩ = 0 ([`PseudoRigidBody::project_momentum`]);
+    /// methods `rattle` (default), `rattle4`, `rattle6`.
+    pub fn incompressible(n: usize, potential: Arc<dyn Potential>) -> Result<Self> {
+        let mut body = Self::new(n, potential, true)?;
+        body.incompressible = true;
+        Ok(body)
+    }
+
+    /// Whether the body is incompressible (det X = det X₀ held by RATTLE).
+    pub fn is_incompressible(&self) -> bool {
+        self.incompressible
+    }
+
+    /// The projection of a momentum P onto the hidden constraint of the incompressible body at
+    /// X ∈ GL⁺(n): P − κ cof X with κ = ⟨cof X, P⟩/‖cof X‖_F² (the orthogonal projection onto
+    /// {⟨cof X, P⟩ = 0} = {tr(X⁻¹P) = 0}, the velocities that keep det X). Checked: n×n,
+    /// finite, det X > 0. Computed from cof X scaled to unit size, so it holds at every scale.
+    pub fn project_momentum(&self, x: &Mat, p: &Mat) -> Result<Mat> {
+        let n = self.n();
+        check::square_of("X", x, n)?;
+        check::square_of("P", p, n)?;
+        check::finite_mat("X", x)?;
+        check::finite_mat("P", p)?;
+        gl::check_gl_plus("X", x)?;
+        let c = unit_cofactor(x);
+        let c2 = potential::frob2(c.as_ref());
+        let mut out = p.clone();
+        // Twice: the second pass removes the round-off of the first.
+        for _ in 0..2 {
+            let k = potential::inner(c.as_ref(), out.as_ref()) / c2;
+            potential::axpy(out.as_mut(), -k, c.as_ref());
+        }
+        check::finite_mat("P", &out)
+            .map_err(|_| check::overflow_error("P", "the projected momentum"))?;
+        Ok(out)
+    }
+
+    /// |⟨cof X, P⟩| / (‖cof X‖_F ‖P‖_F) (0 for P = 0): the relative violation of the hidden
+    /// constraint of the incompressible body, scale-free.
+    fn volume_rate(x: &Mat, p: &Mat) -> f64 {
+        let c = unit_cofactor(x);
+        let e = check::pow2_floor(check::max_abs(p));
+        let p = check::ldexp_mat(p, -e);
+        let pn = potential::frob2(p.as_ref()).sqrt();
+        if pn == 0.0 {
+            return 0.0;
+        }
+        potential::inner(c.as_ref(), p.as_ref()).abs() / (potential::frob2(c.as_ref()).sqrt() * pn)
     }
 
     /// The underlying [`FullBody`] (vector fields, Hamiltonian).
@@ -115,6 +201,21 @@ impl PseudoRigidBody {
     }
 }
 
+/// cof X divided by a positive number so that its largest |entry| is 1 (X ∈ GL⁺(n) finite): the
+/// direction of ∂ det/∂X at every scale of X (X is scaled by a power of two first, which scales
+/// cof X by a positive power).
+fn unit_cofactor(x: &Mat) -> Mat {
+    let n = x.nrows();
+    let x = check::ldexp_mat(x, -check::pow2_floor(check::max_abs(x)));
+    let mut c = Mat::zeros(n, n);
+    potential::det_cofactor(x.as_ref(), c.as_mut(), &mut Workspace::new(n));
+    let m = check::max_abs(&c);
+    if m > 0.0 && m.is_finite() {
+        c *= faer::Scale(1.0 / m);
+    }
+    c
+}
+
 fn split_unchecked(n: usize, z: &[f64]) -> (Mat, Mat) {
     let nn = n * n;
     (
@@ -150,23 +251,45 @@ impl Problem for PseudoRigidBody {
     }
 
     /// The spectral invariants ½tr((LᵀL)^k) then ½tr((ΓᵀΓ)^k), k = 1…⌊n/2⌋: they fix the
-    /// coadjoint orbits of p_Ω = RᵀLR and p_Λ = SᵀΓS (the Casimirs of the reduced space, 001 §7).
+    /// coadjoint orbits of p_Ω = RᵀLR and p_Λ = SᵀΓS (the Casimirs of the reduced space, 001 §7);
+    /// for the incompressible body then det X (the volume, held by the constraint).
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         let (l, g) = self.momenta(z)?;
         let mut c = spectral_invariants(&l);
         c.extend(spectral_invariants(&g));
+        if self.incompressible {
+            let (x, _) = split_unchecked(self.n(), z);
+            c.push(x.determinant());
+        }
         Ok(c)
     }
 
+    /// 2⌊n/2⌋, plus 1 (det X) for the incompressible body.
     fn invariant_count(&self) -> usize {
-        2 * (self.n() / 2)
+        2 * (self.n() / 2) + usize::from(self.incompressible)
     }
 
-    /// det X > 0 when checked.
+    /// det X > 0 when checked; for the incompressible body also the hidden constraint
+    /// ⟨cof X, P⟩ = 0 to [`VOLUME_RATE_TOL`] relative to ‖cof X‖_F ‖P‖_F.
     fn check_state(&self, z: &[f64]) -> Result<()> {
         if self.check_det() {
-            let (x, _) = split_unchecked(self.n(), z);
+            let (x, p) = split_unchecked(self.n(), z);
             gl::check_gl_plus("X0", &x)?;
+            if self.incompressible {
+                let r = Self::volume_rate(&x, &p);
+                if r.is_nan() || r > VOLUME_RATE_TOL {
+                    return Err(Error::invalid(
+                        "state",
+                        format!(
+                            "an incompressible pseudo-rigid body keeps its volume det X, so its \
+                             momentum must satisfy the hidden constraint ⟨cof X, P⟩ = \
+                             det(X) tr(X⁻¹P) = 0; got |⟨cof X, P⟩|/(‖cof X‖‖P‖) = {r:.3e} \
+                             (tolerance {VOLUME_RATE_TOL:.0e}); project P first with \
+                             project_momentum(X, P) (P − κ cof X, κ = ⟨cof X, P⟩/‖cof X‖²)"
+                        ),
+                    ));
+                }
+            }
         }
         Ok(())
     }
@@ -181,10 +304,13 @@ fn mat3(q: &[f64]) -> Option<Matrix3<f64>> {
     ))
 }
 
-/// Scratch of the force: the potential's workspace.
+/// Scratch of the force and the constraint kernels: the potential's workspace, and two n×n
+/// matrices for the curvature of det at n > 3.
 #[derive(Debug)]
 pub struct ForceScratch {
     ws: Workspace,
+    cof: Mat,
+    prod: Mat,
 }
 
 impl Separable for PseudoRigidBody {
@@ -194,6 +320,8 @@ impl Separable for PseudoRigidBody {
         let n = self.n();
         ForceScratch {
             ws: Workspace::new(n),
+            cof: Mat::zeros(n, n),
+            prod: Mat::zeros(n, n),
         }
     }
 
@@ -286,6 +414,80 @@ impl PseudoRigidBody {
     }
 }
 
+/// The incompressible body: g(X) = det X on the level set det X = det X₀ (m = 1; m = 0 for a body
+/// that is not incompressible, where these kernels write nothing). No allocation.
+impl Constrained for PseudoRigidBody {
+    fn constraints(&self) -> usize {
+        usize::from(self.incompressible)
+    }
+
+    /// det X = det X₀: the volume of the initial state.
+    fn level_set(&self) -> bool {
+        self.incompressible
+    }
+
+    /// g(X) = det X (closed forms for n ≤ 3, an LU above).
+    fn constraint(&self, q: &[f64], g: &mut [f64], s: &mut ForceScratch) {
+        if self.incompressible {
+            let n = s.ws.n();
+            g[0] = potential::det(MatRef::from_row_major_slice(q, n, n), &mut s.ws);
+        }
+    }
+
+    /// G(X) = cof X = det(X) X⁻ᵀ row-major (closed forms for n ≤ 3: at n = 3 the columns of
+    /// cof X are cross products of those of X; an LU inverse above, for X ∈ GL⁺(n)).
+    fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64], s: &mut ForceScratch) {
+        if self.incompressible {
+            let n = s.ws.n();
+            potential::det_cofactor(
+                MatRef::from_row_major_slice(q, n, n),
+                MatMut::from_row_major_slice_mut(jac, n, n),
+                &mut s.ws,
+            );
+        }
+    }
+
+    /// D² det(X)[V, V] = d²/dε² det(X + εV) at ε = 0: 2 det V at n = 2; 2⟨X, cof V⟩ at n = 3
+    /// (det(X + εV) = det X + ε⟨cof X, V⟩ + ε²⟨X, cof V⟩ + ε³ det V); 2 det(X) e₂(X⁻¹V) with
+    /// e₂(B) = ½((tr B)² − tr B²) above, i.e. (⟨C, V⟩² − tr((CᵀV)²))/det X with C = cof X.
+    fn constraint_curvature(&self, q: &[f64], v: &[f64], out: &mut [f64], s: &mut ForceScratch) {
+        if !self.incompressible {
+            return;
+        }
+        let n = s.ws.n();
+        out[0] = match n {
+            2 => 2.0 * (v[0] * v[3] - v[1] * v[2]),
+            3 => {
+                // ⟨X, cof V⟩ = Σ_i x_i · (v_{i+1} × v_{i+2}) over the columns (cyclic).
+                let (x, w) = (mat3(q).unwrap_or_default(), mat3(v).unwrap_or_default());
+                let mut t = 0.0;
+                for i in 0..3 {
+                    let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+                    t += x.column(i).dot(&w.column(a).cross(&w.column(b)));
+                }
+                2.0 * t
+            }
+            _ => {
+                let (x, w) = (
+                    MatRef::from_row_major_slice(q, n, n),
+                    MatRef::from_row_major_slice(v, n, n),
+                );
+                let d = potential::det_cofactor(x, s.cof.as_mut(), &mut s.ws);
+                let tr = potential::inner(s.cof.as_ref(), w);
+                potential::mul(s.prod.as_mut(), Accum::Replace, s.cof.transpose(), w, 1.0);
+                let m = &s.prod;
+                let mut tr2 = 0.0;
+                for i in 0..n {
+                    for j in 0..n {
+                        tr2 += m[(i, j)] * m[(j, i)];
+                    }
+                }
+                (tr * tr - tr2) / d
+            }
+        };
+    }
+}
+
 /// The flows of the reduced system on the principal stratum (001 §7, [`super::reduced`]).
 impl Split for PseudoRigidBody {
     type Work = ReducedWork;
@@ -347,8 +549,18 @@ impl Symmetric for PseudoRigidBody {
     }
 }
 
+/// `verlet` (default), `verlet4`, `verlet6`, `reduced`; for the incompressible body `rattle`
+/// (default, as `verlet` is for the free one), `rattle4`, `rattle6` only (Verlet and the reduced
+/// flows would ignore the constraint).
 impl Catalog for PseudoRigidBody {
     fn catalog(&self) -> Vec<Entry<Self>> {
+        if self.incompressible {
+            return vec![
+                Entry::new("rattle", Rattle::new()),
+                Entry::new("rattle4", Rattle(Composition::suzuki4())),
+                Entry::new("rattle6", Rattle(Composition::yoshida6())),
+            ];
+        }
         vec![
             Entry::new("verlet", Verlet::strang()),
             Entry::new("verlet4", Verlet(Composition::suzuki4())),

@@ -133,17 +133,21 @@ impl Constrained for SphereParticle {
         1
     }
     /// g(q) = (|q|² − l²)/2.
-    fn constraint(&self, q: &[f64], g: &mut [f64]) {
+    fn constraint(&self, q: &[f64], g: &mut [f64], _s: &mut ()) {
         g[0] = 0.5 * (q.iter().map(|x| x * x).sum::<f64>() - self.bob.length * self.bob.length);
     }
     /// G(q) = qᵀ.
-    fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64]) {
+    fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64], _s: &mut ()) {
         jac.copy_from_slice(q);
+    }
+    /// D²g(q)[v, v] = |v|² (g is half the squared norm, up to a constant).
+    fn constraint_curvature(&self, _q: &[f64], v: &[f64], out: &mut [f64], _s: &mut ()) {
+        out[0] = v.iter().map(|x| x * x).sum();
     }
 }
 
 impl Catalog for SphereParticle {
     fn catalog(&self) -> Vec<Entry<Self>> {
-        vec![Entry::new("rattle", Rattle)]
+        vec![Entry::new("rattle", Rattle::new())]
     }
 }

@@ -1,33 +1,65 @@
-//! `Rattle`: the RATTLE method for a [`Constrained`] system H = ½ pᵀM⁻¹p + U(q) on the
-//! constraint manifold g(q) = 0 (Andersen, "Rattle: a velocity version of the Shake algorithm",
-//! J. Comput. Phys. 52 (1983); Hairer, Lubich & Wanner, *Geometric Numerical Integration*,
-//! §VII.1.4). With f = −∂U/∂q and G = ∂g/∂q, one step of size h is
+//! `Rattle(Composition)`: the RATTLE method for a [`Constrained`] system H = ½ pᵀM⁻¹p + U(q) on
+//! the constraint manifold g(q) = c (c = 0, or c = g(q₀) for a level-set constraint,
+//! [`Constrained::level_set`]), and its symmetric compositions (Andersen, "Rattle: a velocity
+//! version of the Shake algorithm", J. Comput. Phys. 52 (1983); Hairer, Lubich & Wanner,
+//! *Geometric Numerical Integration*, §VII.1.4). With f = −∂U/∂q and G = ∂g/∂q, one step of
+//! size h is
 //!
 //! p_{n+1/2} = p_n + h/2 (f(q_n) − G(q_n)ᵀλ),
-//! q_{n+1} = q_n + h M⁻¹ p_{n+1/2},   g(q_{n+1}) = 0,
+//! q_{n+1} = q_n + h M⁻¹ p_{n+1/2},   g(q_{n+1}) = c,
 //! p_{n+1} = p_{n+1/2} + h/2 (f(q_{n+1}) − G(q_{n+1})ᵀμ),   G(q_{n+1}) M⁻¹ p_{n+1} = 0.
 //!
 //! It is of order 2, symmetric, and a symplectic map of the constrained phase space
-//! T*{g = 0} = {g(q) = 0, G(q) M⁻¹p = 0} (HLW §VII.1.4); it is equivariant under every
+//! T*{g = c} = {g(q) = c, G(q) M⁻¹p = 0} (HLW §VII.1.4); it is equivariant under every
 //! linear symmetry of M, U and g, so it keeps their momentum maps (the vertical angular momentum of
-//! a particle on a sphere). Both constraints hold at every step end to round-off.
+//! a particle on a sphere; L and Γ of an incompressible pseudo-rigid body). Both constraints hold
+//! at every step end to round-off. The composition S_{γ_s h} ∘ … ∘ S_{γ_1 h} of these steps with
+//! the palindromic weights of a [`Composition`] (HLW §V.3; negative γ are fine: the step is
+//! symmetric and defined for h < 0) is again symmetric and symplectic on T*{g = c}, of the
+//! composition's order: `Rattle(Composition::suzuki4())` order 4,
+//! `Rattle(Composition::yoshida6())` order 6. Every substep solves the constraints, so they hold
+//! to round-off after each substep, not only at the end of a step.
+//!
+//! **Level sets.** When [`Constrained::level_set`] holds, the stepper records c = g(q₀) when it
+//! is set to a state ([`Stepper::set`]) and solves g(q) = c in every substep; c stays fixed for
+//! the run, so the constraint does not drift by accumulated round-off.
 //!
 //! **Solves.** With ν = (h²/2)λ and the rows W_b = M⁻¹G_b(q_n)ᵀ (from [`Separable::velocity`],
 //! linear), the position is q_{n+1} = q̃ − Σ_b ν_b W_b with q̃ = q_n + h M⁻¹(p_n + h/2 f(q_n)), and
-//! ν solves g(q̃ − Σ ν_b W_b) = 0 by Newton's method (the m×m Jacobian G(q_{n+1}^{(k)}) Wᵀ is
+//! ν solves g(q̃ − Σ ν_b W_b) = c by Newton's method (the m×m Jacobian G(q_{n+1}^{(k)}) Wᵀ is
 //! refactored every iteration), until the position update is below [`TOL`]·‖q‖_∞ (or stagnates
 //! below [`STAGNATION_TOL`]·‖q‖_∞); then p_{n+1/2} = p̃ − G(q_n)ᵀν/h. The multiplier μ solves the
 //! linear m×m system (G M⁻¹Gᵀ)(q_{n+1}) κ = G M⁻¹ p̃ (κ = hμ/2). G, W and f at
-//! q_{n+1} are reused by the next step.
+//! q_{n+1} are reused by the next (sub)step.
+//!
+//! **The index-1 field.** [`constrained_field`] (and its allocation-free form
+//! [`constrained_field_into`]) evaluates the vector field of the constrained motion on
+//! T*{g = c}: q̇ = M⁻¹p, ṗ = f − Gᵀλ with λ = (G M⁻¹Gᵀ)⁻¹(G M⁻¹f + D²g(q)[M⁻¹p, M⁻¹p]) (the
+//! multiplier for which d²/dt² g(q(t)) = 0), the limit of RATTLE's λ and μ as h → 0.
 
 use super::gauss::DenseLu;
 use crate::error::Result;
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
+use crate::integrate::methods::Composition;
 use crate::integrate::problem::{Constrained, Separable, Violation};
 
-/// RATTLE (order 2, symplectic on the constraint manifold, symmetric).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct Rattle;
+/// RATTLE composed with the weights of a [`Composition`] (`Composition::strang()`: RATTLE
+/// itself, order 2). Symplectic on the constraint manifold, symmetric.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rattle(pub Composition);
+
+impl Rattle {
+    /// RATTLE itself (order 2).
+    pub fn new() -> Self {
+        Rattle(Composition::strang())
+    }
+}
+
+impl Default for Rattle {
+    fn default() -> Self {
+        Self::new()
+    }
+}
 
 /// Relative tolerance of the Newton iteration for the position multipliers (on the position
 /// update, relative to ‖q‖_∞).
@@ -173,8 +205,10 @@ pub(crate) fn max_abs(v: &[f64]) -> f64 {
 }
 
 impl<P: Constrained + Clone + 'static> Integrator<P> for Rattle {
+    /// The order of the composition; symplectic on T*{g = c}, symmetric, keeps the constraints
+    /// and the invariants of linear symmetries (`invariants`, `manifold`).
     fn properties(&self) -> Properties {
-        Properties::geometric(2)
+        Properties::geometric(self.0.order())
     }
 
     fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
@@ -182,6 +216,7 @@ impl<P: Constrained + Clone + 'static> Integrator<P> for Rattle {
         Ok(Box::new(RattleStepper {
             scratch: problem.scratch(),
             problem: problem.clone(),
+            gammas: self.0.gammas().to_vec(),
             h: dt,
             q: vec![0.0; d],
             p: vec![0.0; d],
@@ -191,6 +226,7 @@ impl<P: Constrained + Clone + 'static> Integrator<P> for Rattle {
             rows: Rows::new(m, d),
             jac: vec![0.0; m * d],
             g: vec![0.0; m],
+            g0: vec![0.0; m],
             nu: vec![0.0; m],
         }))
     }
@@ -199,6 +235,8 @@ impl<P: Constrained + Clone + 'static> Integrator<P> for Rattle {
 struct RattleStepper<P: Separable> {
     problem: P,
     scratch: P::Scratch,
+    /// The weights of the composition.
+    gammas: Vec<f64>,
     h: f64,
     q: Vec<f64>,
     p: Vec<f64>,
@@ -212,6 +250,8 @@ struct RattleStepper<P: Separable> {
     /// G at the Newton iterate, g there, the multipliers ν = (h²/2)λ.
     jac: Vec<f64>,
     g: Vec<f64>,
+    /// The level c of the constraint g(q) = c (0, or g(q₀) for a level set).
+    g0: Vec<f64>,
     nu: Vec<f64>,
 }
 
@@ -220,16 +260,17 @@ impl<P: Constrained> RattleStepper<P> {
     fn load(&mut self) -> std::result::Result<(), Violation> {
         self.problem
             .force(&self.q, &mut self.f, &mut self.scratch)?;
-        self.problem.constraint_jacobian(&self.q, &mut self.rows.c);
+        self.problem
+            .constraint_jacobian(&self.q, &mut self.rows.c, &mut self.scratch);
         self.rows.update_w(&self.problem);
         Ok(())
     }
 
-    fn step(&mut self) -> std::result::Result<(), Failure> {
+    /// One RATTLE step of size h.
+    fn step(&mut self, h: f64) -> std::result::Result<(), Failure> {
         let RattleStepper {
             problem,
             scratch,
-            h,
             q,
             p,
             f,
@@ -238,22 +279,27 @@ impl<P: Constrained> RattleStepper<P> {
             rows,
             jac,
             g,
+            g0,
             nu,
+            ..
         } = self;
-        let (h, d, m) = (*h, q.len(), g.len());
+        let (d, m) = (q.len(), g.len());
         // p̃ = p + h/2 f(q_n); q̃ = q_n + h M⁻¹p̃.
         axpy(p, 0.5 * h, f);
         problem.velocity(p, v);
         qn.copy_from_slice(q);
         axpy(qn, h, v);
-        // Newton for ν: g(q̃ − Σ ν_b W_b) = 0.
+        // Newton for ν: g(q̃ − Σ ν_b W_b) = c.
         nu.fill(0.0);
         if m > 0 {
             let scale = max_abs(q).max(f64::MIN_POSITIVE);
             let mut prev = f64::INFINITY;
             for iter in 1..=MAX_ITER {
-                problem.constraint(qn, g);
-                problem.constraint_jacobian(qn, jac);
+                problem.constraint(qn, g, scratch);
+                for (gb, cb) in g.iter_mut().zip(g0.iter()) {
+                    *gb -= cb;
+                }
+                problem.constraint_jacobian(qn, jac, scratch);
                 if !rows.factor_with(Some(jac)) {
                     return Err(Failure::Domain(singular(problem.name())));
                 }
@@ -283,7 +329,7 @@ impl<P: Constrained> RattleStepper<P> {
         }
         q.copy_from_slice(qn);
         problem.force(q, f, scratch).map_err(Failure::Domain)?;
-        problem.constraint_jacobian(q, &mut rows.c);
+        problem.constraint_jacobian(q, &mut rows.c, scratch);
         rows.update_w(problem);
         // p_{n+1} = p_{n+1/2} + h/2 f(q_{n+1}) − G(q_{n+1})ᵀκ, G M⁻¹p_{n+1} = 0.
         axpy(p, 0.5 * h, f);
@@ -295,11 +341,20 @@ impl<P: Constrained> RattleStepper<P> {
 }
 
 impl<P: Constrained> Stepper for RattleStepper<P> {
+    /// Sets the state; for a level-set constraint ([`Constrained::level_set`]) records
+    /// c = g(q₀), the level the run keeps.
     fn set(&mut self, z: &[f64]) -> Result<()> {
         let d = self.q.len();
         self.q.copy_from_slice(&z[..d]);
         self.p.copy_from_slice(&z[d..]);
-        self.load().map_err(|v| v.at_start())
+        self.load().map_err(|v| v.at_start())?;
+        if self.problem.level_set() {
+            self.problem
+                .constraint(&self.q, &mut self.g0, &mut self.scratch);
+        } else {
+            self.g0.fill(0.0);
+        }
+        Ok(())
     }
 
     fn get(&self, z: &mut [f64]) {
@@ -309,16 +364,109 @@ impl<P: Constrained> Stepper for RattleStepper<P> {
     }
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        let h = self.h;
         for k in 0..steps {
-            self.step().map_err(|e| {
-                e.into_error(
-                    &clock,
-                    k,
-                    "RATTLE position constraint (Newton iteration for the multipliers)",
-                    TOL,
-                )
-            })?;
+            for i in 0..self.gammas.len() {
+                self.step(self.gammas[i] * h).map_err(|e| {
+                    e.into_error(
+                        &clock,
+                        k,
+                        "RATTLE position constraint (Newton iteration for the multipliers)",
+                        TOL,
+                    )
+                })?;
+            }
         }
         Ok(())
     }
+}
+
+/// The workspace of [`constrained_field_into`] (allocated once per problem size): the rows G,
+/// W = M⁻¹Gᵀ and the LU of G M⁻¹Gᵀ, the force and the velocity.
+pub struct FieldWork {
+    rows: Rows,
+    f: Vec<f64>,
+    v: Vec<f64>,
+}
+
+impl FieldWork {
+    /// A workspace for `problem` (its d and m).
+    pub fn new<P: Constrained>(problem: &P) -> Self {
+        let (d, m) = (problem.dof(), problem.constraints());
+        FieldWork {
+            rows: Rows::new(m, d),
+            f: vec![0.0; d],
+            v: vec![0.0; d],
+        }
+    }
+}
+
+/// The index-1 vector field of a [`Constrained`] system on T*{g = c} (HLW §VII.1.1): for
+/// z = (q, p) (2d values, internal frame) writes ż = (M⁻¹p, f − Gᵀλ) into `dz` and the
+/// multipliers into `lambda` (m values), with f = −∂U/∂q, G = G(q) and
+///
+/// λ = (G M⁻¹Gᵀ)⁻¹ (G M⁻¹f + D²g(q)[M⁻¹p, M⁻¹p]),
+///
+/// the multiplier for which the acceleration constraint d²/dt² g(q(t)) = G q̈ + D²g[q̇, q̇] = 0
+/// holds, so the flow keeps g(q) and the hidden constraint G M⁻¹p = 0 of a state on T*{g = c}.
+/// The constraint force −Gᵀλ is the limit of RATTLE's −Gᵀλ and −Gᵀμ as h → 0 (for the particle
+/// on a sphere: the centripetal force m|v|²/l towards the centre plus minus the radial part of
+/// f). The level c plays no part (λ depends on q and p only). No allocation: the scratch `s`
+/// serves the problem's kernels, `w` the linear algebra. A [`Violation`] where q lies outside
+/// the problem's domain or G M⁻¹Gᵀ is singular or not finite.
+pub fn constrained_field_into<P: Constrained>(
+    problem: &P,
+    z: &[f64],
+    dz: &mut [f64],
+    lambda: &mut [f64],
+    s: &mut P::Scratch,
+    w: &mut FieldWork,
+) -> std::result::Result<(), Violation> {
+    let d = problem.dof();
+    let m = problem.constraints();
+    let (q, p) = z.split_at(d);
+    let FieldWork { rows, f, v } = w;
+    problem.force(q, f, s)?;
+    problem.velocity(p, v);
+    problem.constraint_jacobian(q, &mut rows.c, s);
+    rows.update_w(problem);
+    if m > 0 {
+        if !rows.factor_with(None) {
+            return Err(singular(problem.name()));
+        }
+        // λ_a: D²g_a[v, v] + G_a M⁻¹ f = D²g_a[v, v] + W_a · f (M symmetric).
+        problem.constraint_curvature(q, v, lambda, s);
+        for (a, la) in lambda.iter_mut().enumerate() {
+            *la += dot(&rows.w[a * d..(a + 1) * d], f);
+        }
+        rows.solve(lambda);
+        if lambda.iter().any(|x| !x.is_finite()) {
+            return Err(singular(problem.name()));
+        }
+    }
+    let (dq, dp) = dz.split_at_mut(d);
+    dq.copy_from_slice(v);
+    dp.copy_from_slice(f);
+    for (a, &la) in lambda.iter().enumerate() {
+        axpy(dp, -la, &rows.c[a * d..(a + 1) * d]);
+    }
+    Ok(())
+}
+
+/// [`constrained_field_into`] with a workspace of its own: writes ż into `dz` (2d values) and
+/// returns the multipliers λ (m values); a state outside the problem's domain is
+/// [`crate::Error::InvalidArgument`].
+pub fn constrained_field<P: Constrained>(
+    problem: &P,
+    z: &[f64],
+    dz: &mut [f64],
+    s: &mut P::Scratch,
+) -> Result<Vec<f64>> {
+    let d = problem.dof();
+    crate::check::len_of("state (q, p)", z, 2 * d)?;
+    crate::check::len_of("dz", dz, 2 * d)?;
+    let mut lambda = vec![0.0; problem.constraints()];
+    let mut w = FieldWork::new(problem);
+    constrained_field_into(problem, z, dz, &mut lambda, s, &mut w).map_err(|v| v.at_start())?;
+    Ok(lambda)
 }
