@@ -17,6 +17,7 @@
 //! assert!((y - Vector3::y()).norm() < 1e-15);
 //! ```
 
+pub mod analysis;
 pub mod check;
 pub mod elliptic;
 pub mod error;

@@ -513,6 +513,10 @@ pub struct RelativeEquilibrium {
     pub energy: f64,
     /// Residuals of the defining conditions.
     pub residuals: Residuals,
+    /// The multiplier p of the incompressibility constraint det X = det A₀ (the force balance
+    /// is ∂U_{ξ⊕η}/∂X = p cof X, [`RelativeEquilibrium::incompressible`]); 0 for a compressible
+    /// body.
+    pub pressure: f64,
 }
 
 impl RelativeEquilibrium {
@@ -545,7 +549,33 @@ impl RelativeEquilibrium {
             gam,
             energy,
             residuals,
+            pressure: 0.0,
         })
+    }
+
+    /// The candidate with body velocities (Ω, Λ) at A₀ = diag(a) for an incompressible body
+    /// (holonomic constraint det X = det A₀, [`super::PseudoRigidBody::incompressible`]): the
+    /// pressure p is the least-squares multiplier of the force balance ∂U_{ξ⊕η}/∂X(A₀) = p cof A₀
+    /// (cof A₀ = diag(∏_{j≠i} a_j) = ∇_a ∏ a_j), and the residuals are those of
+    /// ∂U_{ξ⊕η}/∂X − p cof A₀.
+    ///
+    /// Errors as [`RelativeEquilibrium::from_velocities`].
+    pub fn incompressible(pot: &dyn Potential, a: &[f64], xi: &Mat, eta: &Mat) -> Result<Self> {
+        let mut re = Self::from_velocities(pot, a, xi, eta)?;
+        let n = a.len();
+        let cof: Vec<f64> = (0..n)
+            .map(|i| (0..n).filter(|&j| j != i).map(|j| a[j]).product())
+            .collect();
+        let mut grad = augmented_gradient(pot, &diag(a), xi, eta)?;
+        let c2: f64 = cof.iter().map(|c| c * c).sum();
+        let p = (0..n).map(|k| grad[(k, k)] * cof[k]).sum::<f64>() / c2;
+        for k in 0..n {
+            grad[(k, k)] -= p * cof[k];
+        }
+        re.residuals.force = (0..n).map(|k| grad[(k, k)].powi(2)).sum::<f64>().sqrt();
+        re.residuals.motion = grad.norm_l2();
+        re.pressure = finite("pressure", p)?;
+        Ok(re)
     }
 
     /// The candidate with body momenta (λ, γ) at A₀ = diag(a): Ω ⊕ Λ = B_A⁻¹(λ ⊕ γ) (001 (7.9)),

@@ -67,7 +67,9 @@ use crate::pseudo_rigid::dynamics::FullBody;
 use crate::pseudo_rigid::momentum;
 use crate::pseudo_rigid::reduced::ReducedState;
 use crate::Mat;
-use faer::Side;
+
+pub use crate::analysis::Verdict;
+use crate::analysis::{general_eigenvalues, sorted};
 
 /// Relative tolerance of the equilibrium check (residual of the reduced vector field relative
 /// to the scales of its terms).
@@ -81,28 +83,6 @@ pub const HESSIAN_TOL: f64 = 1e-8;
 /// radius. Eigenvalues of a Hamiltonian matrix that meet (Krein collisions, Jordan blocks) move
 /// by ~√(error of the matrix), hence the loose value.
 pub const SPECTRAL_TOL: f64 = 1e-6;
-
-/// A verdict of one stability test.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Verdict {
-    /// Eigenvalues (re, im): of the leaf Hessian D²H (energy–momentum, all im = 0, ascending) or
-    /// of the leaf linearisation L = Π D²H (spectral, by descending real part).
-    pub eigenvalues: Vec<(f64, f64)>,
-    /// Energy–momentum: the Hessian is positive definite (⇒ nonlinearly stable on the leaf).
-    /// Spectral: max Re λ ≤ tol (spectrally stable).
-    pub stable: bool,
-    /// Whether the verdict decides nonlinear stability. Energy–momentum: `true` iff `stable`
-    /// (an indefinite or singular Hessian is inconclusive, not unstable). Spectral: `true` iff
-    /// not `stable` (an eigenvalue with positive real part proves instability; spectral stability
-    /// does not prove nonlinear stability).
-    pub conclusive: bool,
-    /// The smallest real part of the eigenvalues.
-    pub min_real_part: f64,
-    /// The largest real part of the eigenvalues.
-    pub max_real_part: f64,
-    /// The absolute tolerance used: [`HESSIAN_TOL`] · max|λ| or [`SPECTRAL_TOL`] · max|λ|.
-    pub tol: f64,
-}
 
 /// Stability analysis of a relative equilibrium ([`stability`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -449,39 +429,11 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
     let gradient = ratio(norm(&rates.p_a_dot), f_scale).max(ratio(norm(&g_orbit), g_scale));
 
     // Energy–momentum verdict.
-    let ev = hess
-        .self_adjoint_eigenvalues(Side::Lower)
-        .map_err(|e| eig_error("symmetric eigenvalues of the leaf Hessian", e))?;
-    let scale = ev.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let tol = HESSIAN_TOL * scale;
-    let stable = ev.iter().all(|&x| x > tol);
-    let energy_momentum = Verdict {
-        eigenvalues: ev.iter().map(|&x| (x, 0.0)).collect(),
-        stable,
-        conclusive: stable,
-        min_real_part: ev.iter().copied().fold(f64::INFINITY, f64::min),
-        max_real_part: ev.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        tol,
-    };
+    let energy_momentum = Verdict::energy_momentum(&hess, HESSIAN_TOL)?;
 
     // Spectral verdict: L = Π D²H on the leaf.
     let lin = leaf.poisson() * &hess;
-    let spec = sorted(general_eigenvalues(&lin)?);
-    let radius = spec
-        .iter()
-        .fold(0.0_f64, |m, &(re, im)| m.max(re.hypot(im)));
-    let tol = SPECTRAL_TOL * radius;
-    let max_re = spec.iter().map(|e| e.0).fold(f64::NEG_INFINITY, f64::max);
-    let min_re = spec.iter().map(|e| e.0).fold(f64::INFINITY, f64::min);
-    let stable = max_re <= tol;
-    let spectral = Verdict {
-        eigenvalues: spec,
-        stable,
-        conclusive: !stable,
-        min_real_part: min_re,
-        max_real_part: max_re,
-        tol,
-    };
+    let spectral = Verdict::spectral(&lin, SPECTRAL_TOL)?;
 
     // Second route: the Jacobian in all coordinates (a, p_a, vee μ, vee ν).
     let z0: Vec<f64> = a
@@ -583,32 +535,6 @@ fn jacobian_steps(f: &dyn Fn(&[f64]) -> Result<Vec<f64>>, x: &[f64], h: &[f64]) 
     }
     let rows = cols.first().map_or(0, Vec::len);
     Ok(Mat::from_fn(rows, x.len(), |i, j| cols[j][i]))
-}
-
-/// Eigenvalues (re, im) of a general real square matrix (faer's real Schur / EVD).
-fn general_eigenvalues(m: &Mat) -> Result<Vec<(f64, f64)>> {
-    if m.nrows() == 0 {
-        return Ok(Vec::new());
-    }
-    let ev = m
-        .eigenvalues()
-        .map_err(|e| eig_error("eigenvalues of the linearisation", e))?;
-    Ok(ev.iter().map(|z| (z.re, z.im)).collect())
-}
-
-fn eig_error(what: &str, e: impl std::fmt::Debug) -> Error {
-    Error::NotConverged {
-        what: format!("{what} ({e:?})"),
-        iterations: 0,
-        residual: f64::NAN,
-        tol: 0.0,
-    }
-}
-
-/// By descending real part, then descending imaginary part.
-fn sorted(mut v: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
-    v.sort_by(|x, y| y.0.total_cmp(&x.0).then(y.1.total_cmp(&x.1)));
-    v
 }
 
 fn norm(v: &[f64]) -> f64 {

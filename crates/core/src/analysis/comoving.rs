@@ -1,0 +1,348 @@
+//! Linear and energy–momentum stability of a relative equilibrium of a (constrained) mechanical
+//! system, in the co-moving frame and without reduction: the route that works where reduced
+//! coordinates do not exist (coincident semi-axes of a Maclaurin spheroid, larger isotropy), and
+//! with holonomic constraints (an incompressible body).
+//!
+//! # Setting
+//! A [`Constrained`] system (H = ½pᵀM⁻¹p + U(q) on T*{g = c}; with m = 0 constraints any
+//! [`Separable`](crate::integrate::problem::Separable) system) with a linear symmetry
+//! ([`Symmetric`]: momentum map J, generators η_Z). A relative equilibrium is a state z₀ and a
+//! ξ ∈ g such that z(t) = exp(tξ)·z₀ is a motion: the co-moving field F(z) = f(z) − ξ_Z(z)
+//! vanishes at z₀, f being the index-1 constrained field ż = (M⁻¹p, f − Gᵀλ(q, p))
+//! ([`constrained_field`]).
+//!
+//! # The symplectic normal space
+//! Variations δz are taken in S = T_{z₀}N ∩ ker dJ(z₀): tangent to the constrained phase space
+//! N = {g(q) = c, G(q)M⁻¹p = 0} and keeping the momentum. The directions η_Z(z₀) with
+//! dJ·η_Z = −ad*_η μ = 0 — the orbit of the isotropy group G_μ of μ = J(z₀) — are neutral (they
+//! lead to the same relative equilibrium, moved by the symmetry), and are removed: C is an
+//! orthonormal basis of the orthogonal complement of span{η_Z(z₀) : η ∈ g_μ} in S. Its dimension
+//! is that of the symplectic normal space of Simo, Lewis & Marsden (1991).
+//!
+//! # Spectral verdict
+//! L = Cᵀ DF(z₀) C. DF maps S into S (J is conserved and equivariant, ξ ∈ g_μ) and the orbit
+//! directions into themselves (DF η_Z = [η, ξ]_Z for η ∈ g_μ, a subalgebra containing ξ), so L
+//! is the linearisation on the quotient. DF by central differences of the analytic field with one
+//! Richardson extrapolation.
+//!
+//! # Energy–momentum verdict
+//! H_ξ = H − ⟨J, ξ⟩ is critical at z₀ on N (z₀ is a relative equilibrium), so
+//! ∇H_ξ(z₀) = dΦᵀκ for the constraint map Φ = (g(q), G(q)M⁻¹p) and multipliers κ (least
+//! squares). The second variation of H_ξ on N is that of the Lagrange function
+//! ℒ = H_ξ − κ·Φ on T_{z₀}N; restricted to C it is the energy–momentum Hessian: positive
+//! definite ⇒ the relative equilibrium is nonlinearly stable modulo G_μ (Patrick 1992; Simo,
+//! Lewis & Marsden 1991). ∇H = (−f(q), M⁻¹p) analytic, ∇⟨J, ξ⟩ by central differences (exact:
+//! J is quadratic), ∇Φ from G and the polarised curvature D²g(q)[v, w]; D²ℒ by central
+//! differences of ∇ℒ with Richardson.
+
+use super::Verdict;
+use crate::check;
+use crate::error::{Error, Result};
+use crate::integrate::methods::rattle::constrained_field;
+use crate::integrate::problem::{Constrained, Symmetric};
+use crate::Mat;
+use faer::linalg::solvers::Solve;
+
+/// Relative tolerance of the relative-equilibrium check: |F(z₀)| ≤ this · (|f(z₀)| + |ξ_Z(z₀)|).
+pub const EQUILIBRIUM_TOL: f64 = 1e-8;
+
+/// Relative tolerance of the energy–momentum verdict (of the Hessian's eigenvalues).
+pub const HESSIAN_TOL: f64 = 1e-7;
+
+/// Relative tolerance of the spectral verdict (of max Re λ against the spectral radius): the
+/// Jacobian carries a finite-difference error of ~1e-11, which moves eigenvalues that meet
+/// (Krein collisions) by its square root.
+pub const SPECTRAL_TOL: f64 = 1e-5;
+
+/// Rank tolerance for the subspaces (singular values below this times the largest are zero).
+const RANK_TOL: f64 = 1e-9;
+
+/// The stability of a relative equilibrium in the co-moving frame ([`stability`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stability {
+    /// Definiteness of the second variation of H − ⟨J, ξ⟩ on the symplectic normal space.
+    pub energy_momentum: Verdict,
+    /// Eigenvalues of the co-moving linearisation on the symplectic normal space.
+    pub spectral: Verdict,
+    /// The dimension of the symplectic normal space (the size of both matrices).
+    pub normal_dim: usize,
+    /// The dimension of the isotropy orbit G_μ·z₀ removed from it.
+    pub isotropy_orbit_dim: usize,
+    /// The multipliers κ of the constraint map (g, G M⁻¹p) at z₀ (for an incompressible body:
+    /// the pressure, with the sign of ∂H_ξ/∂g).
+    pub multipliers: Vec<f64>,
+    /// |F(z₀)| relative to |f(z₀)| + |ξ_Z(z₀)|.
+    pub residual: f64,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// An orthonormal basis (columns) of the null space of `m` (rows × cols), by the SVD.
+fn null_space(m: &Mat) -> Result<Mat> {
+    let (r, c) = (m.nrows(), m.ncols());
+    if r == 0 {
+        return Ok(Mat::identity(c, c));
+    }
+    // Pad with zero rows so that all c right singular vectors are returned.
+    let rows = r.max(c);
+    let mp = Mat::from_fn(rows, c, |i, j| if i < r { m[(i, j)] } else { 0.0 });
+    let svd = mp
+        .svd()
+        .map_err(|e| super::eig_error("SVD (null space)", e))?;
+    let (s, v) = (svd.S().column_vector(), svd.V());
+    let smax = if c > 0 { s[0] } else { 0.0 };
+    let rank = (0..c).filter(|&k| s[k] > RANK_TOL * smax).count();
+    Ok(Mat::from_fn(c, c - rank, |i, j| v[(i, rank + j)]))
+}
+
+/// An orthonormal basis of the column space of `m`.
+fn range(m: &Mat) -> Result<Mat> {
+    if m.ncols() == 0 {
+        return Ok(Mat::zeros(m.nrows(), 0));
+    }
+    let svd = m
+        .thin_svd()
+        .map_err(|e| super::eig_error("SVD (range)", e))?;
+    let (u, s) = (svd.U(), svd.S().column_vector());
+    let smax = s[0];
+    let rank = (0..s.nrows()).filter(|&k| s[k] > RANK_TOL * smax).count();
+    Ok(Mat::from_fn(m.nrows(), rank, |i, j| u[(i, j)]))
+}
+
+/// Jacobian (column l = ∂f/∂z_l) by central differences with one Richardson extrapolation.
+fn jacobian(f: &dyn Fn(&[f64]) -> Result<Vec<f64>>, z: &[f64], h: &[f64]) -> Result<Mat> {
+    let mut cols: Vec<Vec<f64>> = Vec::with_capacity(z.len());
+    let mut zp = z.to_vec();
+    for (l, &hl) in h.iter().enumerate() {
+        let mut diff = |h: f64| -> Result<Vec<f64>> {
+            zp[l] = z[l] + h;
+            let fp = f(&zp)?;
+            zp[l] = z[l] - h;
+            let fm = f(&zp)?;
+            zp[l] = z[l];
+            Ok(fp
+                .iter()
+                .zip(&fm)
+                .map(|(p, m)| (p - m) / (2.0 * h))
+                .collect())
+        };
+        let (d1, d2) = (diff(hl)?, diff(0.5 * hl)?);
+        cols.push(
+            d1.iter()
+                .zip(&d2)
+                .map(|(a, b)| (4.0 * b - a) / 3.0)
+                .collect(),
+        );
+    }
+    let rows = cols.first().map_or(0, Vec::len);
+    Ok(Mat::from_fn(rows, z.len(), |i, j| cols[j][i]))
+}
+
+/// Stability of the relative equilibrium z(t) = exp(tξ)·z₀ (module docs): z₀ a state (user
+/// frame, on the constraint manifold), ξ ∈ g in the coordinates of [`Symmetric`].
+///
+/// Errors: wrong lengths, non-finite input, a state the system refuses, and
+/// [`Error::InvalidArgument`] with the residual when F(z₀) ≠ 0 (relative residual above
+/// [`EQUILIBRIUM_TOL`]: not a relative equilibrium with this ξ).
+pub fn stability<P: Constrained + Symmetric>(
+    problem: &P,
+    z0: &[f64],
+    xi: &[f64],
+) -> Result<Stability> {
+    let d = problem.dof();
+    let m = problem.constraints();
+    let nz = 2 * d;
+    let g = problem.symmetry_dim();
+    check::len_of("state", z0, nz)?;
+    check::finite_slice("state", z0)?;
+    check::len_of("xi", xi, g)?;
+    check::finite_slice("xi", xi)?;
+    problem.check_state(z0)?;
+    let mut scratch = problem.scratch();
+
+    // The co-moving field F = f − ξ_Z (user frame = internal frame is required: see below).
+    let mut probe = z0.to_vec();
+    problem.to_internal(&mut probe);
+    if probe != z0 {
+        return Err(Error::invalid(
+            "system",
+            format!(
+                "{} works in another frame than the user's; the co-moving analysis needs the same",
+                problem.name()
+            ),
+        ));
+    }
+    let field = |z: &[f64], s: &mut P::Scratch| -> Result<Vec<f64>> {
+        let mut dz = vec![0.0; nz];
+        constrained_field(problem, z, &mut dz, s)?;
+        Ok(dz)
+    };
+    let cell = std::cell::RefCell::new(problem.scratch());
+    let comoving = |z: &[f64]| -> Result<Vec<f64>> {
+        let f = field(z, &mut cell.borrow_mut())?;
+        let gen = problem.generator(xi, z)?;
+        Ok(f.iter().zip(&gen).map(|(a, b)| a - b).collect())
+    };
+    let f0 = field(z0, &mut scratch)?;
+    let gen0 = problem.generator(xi, z0)?;
+    let resid: Vec<f64> = f0.iter().zip(&gen0).map(|(a, b)| a - b).collect();
+    let scale = norm(&f0) + norm(&gen0);
+    let residual = if norm(&resid) == 0.0 {
+        0.0
+    } else {
+        norm(&resid) / scale
+    };
+    if !(residual <= EQUILIBRIUM_TOL) {
+        return Err(Error::invalid(
+            "relative equilibrium (state, xi)",
+            format!(
+                "the co-moving field f(z) − ξ_Z(z) does not vanish: relative residual \
+                 {residual:.3e} > {EQUILIBRIUM_TOL:.0e}"
+            ),
+        ));
+    }
+
+    // Constraint map Φ = (g(q), G(q)M⁻¹p) and its gradient rows at z₀.
+    let curvature_rows = |q: &[f64], v: &[f64], s: &mut P::Scratch| -> Vec<Vec<f64>> {
+        // D²g(q)[v, e_k] by polarisation of the quadratic form D²g(q)[w, w].
+        let mut rows = vec![vec![0.0; d]; m];
+        let (mut cp, mut cm) = (vec![0.0; m], vec![0.0; m]);
+        let mut w = v.to_vec();
+        for k in 0..d {
+            w[k] = v[k] + 1.0;
+            problem.constraint_curvature(q, &w, &mut cp, s);
+            w[k] = v[k] - 1.0;
+            problem.constraint_curvature(q, &w, &mut cm, s);
+            w[k] = v[k];
+            for a in 0..m {
+                rows[a][k] = 0.25 * (cp[a] - cm[a]);
+            }
+        }
+        rows
+    };
+    // ∇Φ_a as 2d-vectors: (G_a, 0) and (D²g_a[v, ·], M⁻¹G_a).
+    let grad_phi = |z: &[f64], s: &mut P::Scratch| -> Vec<Vec<f64>> {
+        let (q, p) = z.split_at(d);
+        let mut v = vec![0.0; d];
+        problem.velocity(p, &mut v);
+        let mut jac = vec![0.0; m * d];
+        problem.constraint_jacobian(q, &mut jac, s);
+        let curv = curvature_rows(q, &v, s);
+        let mut out = Vec::with_capacity(2 * m);
+        for a in 0..m {
+            let ga = &jac[a * d..(a + 1) * d];
+            out.push(
+                ga.iter()
+                    .copied()
+                    .chain(std::iter::repeat(0.0).take(d))
+                    .collect(),
+            );
+        }
+        for a in 0..m {
+            let ga = &jac[a * d..(a + 1) * d];
+            let mut wa = vec![0.0; d];
+            problem.velocity(ga, &mut wa);
+            out.push(curv[a].iter().copied().chain(wa).collect());
+        }
+        out
+    };
+    let dphi = grad_phi(z0, &mut scratch);
+
+    // dJ (exact central differences: J is quadratic) and the generators η_Z(z₀).
+    let zscale = norm(z0).max(1.0);
+    let hj = vec![1e-3 * zscale; nz];
+    let jmap = |z: &[f64]| problem.momentum_map(z);
+    let dj = jacobian(&jmap, z0, &hj)?;
+    let mut gens = Mat::zeros(nz, g);
+    let mut e = vec![0.0; g];
+    for k in 0..g {
+        e[k] = 1.0;
+        let col = problem.generator(&e, z0)?;
+        e[k] = 0.0;
+        for (i, x) in col.into_iter().enumerate() {
+            gens[(i, k)] = x;
+        }
+    }
+
+    // S = ker [dΦ; dJ]; the isotropy orbit W = Gen · ker(dJ · Gen); C = S ⊖ W.
+    let rows = 2 * m + g;
+    let stack = Mat::from_fn(rows, nz, |i, j| {
+        if i < 2 * m {
+            dphi[i][j]
+        } else {
+            dj[(i - 2 * m, j)]
+        }
+    });
+    let s_basis = null_space(&stack)?;
+    let iso = null_space(&(&dj * &gens))?;
+    let w_basis = range(&(&gens * &iso))?;
+    // Coordinates of W in S, then the complement inside S.
+    let w_in_s = s_basis.transpose() * &w_basis;
+    let comp = null_space(&w_in_s.transpose().to_owned())?;
+    let c = &s_basis * &comp;
+    let k = c.ncols();
+
+    // Spectral: L = Cᵀ DF C.
+    let hz: Vec<f64> = z0
+        .iter()
+        .map(|x| 1e-4 * x.abs().max(1e-2 * zscale))
+        .collect();
+    let df = jacobian(&comoving, z0, &hz)?;
+    check::finite_mat("co-moving Jacobian", &df)?;
+    let lin = c.transpose() * &df * &c;
+    let spectral = Verdict::spectral(&lin, SPECTRAL_TOL)?;
+
+    // Energy–momentum: multipliers κ from ∇H_ξ = dΦᵀκ, then Cᵀ D²ℒ C.
+    let grad_hxi = |z: &[f64], s: &mut P::Scratch| -> Result<Vec<f64>> {
+        let (q, p) = z.split_at(d);
+        let mut out = vec![0.0; nz];
+        let (gq, gp) = out.split_at_mut(d);
+        problem.force(q, gq, s).map_err(|v| v.at_start())?;
+        gq.iter_mut().for_each(|x| *x = -*x);
+        problem.velocity(p, gp);
+        // ∇⟨J, ξ⟩ (exact central differences of a quadratic).
+        let dj = jacobian(&jmap, z, &hj)?;
+        for l in 0..nz {
+            out[l] -= (0..g).map(|a| xi[a] * dj[(a, l)]).sum::<f64>();
+        }
+        Ok(out)
+    };
+    let gh0 = grad_hxi(z0, &mut scratch)?;
+    let multipliers = if m == 0 {
+        Vec::new()
+    } else {
+        // Least squares by the normal equations (2m unknowns, m small).
+        let a = Mat::from_fn(nz, 2 * m, |i, j| dphi[j][i]);
+        let b = Mat::from_fn(nz, 1, |i, _| gh0[i]);
+        let sol = (a.transpose() * &a)
+            .partial_piv_lu()
+            .solve(&(a.transpose() * &b));
+        (0..2 * m).map(|i| sol[(i, 0)]).collect::<Vec<f64>>()
+    };
+    let grad_lagrange = |z: &[f64]| -> Result<Vec<f64>> {
+        let s = &mut *cell.borrow_mut();
+        let mut gl = grad_hxi(z, s)?;
+        for (a, row) in grad_phi(z, s).iter().enumerate() {
+            for (x, r) in gl.iter_mut().zip(row) {
+                *x -= multipliers[a] * r;
+            }
+        }
+        Ok(gl)
+    };
+    let hess = jacobian(&grad_lagrange, z0, &hz)?;
+    let hc = c.transpose() * &hess * &c;
+    let hsym = Mat::from_fn(k, k, |i, j| 0.5 * (hc[(i, j)] + hc[(j, i)]));
+    check::finite_mat("energy–momentum Hessian", &hsym)?;
+    let energy_momentum = Verdict::energy_momentum(&hsym, HESSIAN_TOL)?;
+
+    Ok(Stability {
+        energy_momentum,
+        spectral,
+        normal_dim: k,
+        isotropy_orbit_dim: w_basis.ncols(),
+        multipliers,
+        residual,
+    })
+}
