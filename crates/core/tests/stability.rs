@@ -513,3 +513,38 @@ fn free_body_at_rest_is_finite_and_marginal() {
         .iter()
         .all(|e| e.0 == 0.0 && e.1 == 0.0));
 }
+
+/// The second, independent route: the co-moving linearisation of the full body on the symplectic
+/// normal space (`analysis::comoving`, no reduced coordinates) gives the same spectrum and the
+/// same verdicts as the reduced leaf.
+#[test]
+fn comoving_route_agrees_with_the_reduced_leaf() {
+    use lieflow::analysis::comoving;
+    for p in [STABLE, UNSTABLE, (0.7, 0.7)] {
+        let ex = example(p);
+        let s = ex.analyse();
+        let body = PseudoRigidBody::new(3, svk(LAME.0, LAME.1), true).unwrap();
+        let x = diag(&ex.a);
+        let pm = &ex.om * &x - &x * &ex.la;
+        let z = body.state(&x, &pm).unwrap();
+        let xi = [p.0, 0.0, 0.0, p.1, 0.0, 0.0];
+        let c = comoving::stability(&body, &z, &xi).unwrap();
+        assert_eq!(c.normal_dim, s.leaf_dim, "{p:?}");
+        assert_eq!(c.spectral.stable, s.spectral.stable, "{p:?}");
+        assert_eq!(c.energy_momentum.stable, s.energy_momentum.stable, "{p:?}");
+        let radius = s
+            .spectral
+            .eigenvalues
+            .iter()
+            .fold(0.0f64, |m, e| m.max(e.0.hypot(e.1)));
+        for &(re, im) in &s.spectral.eigenvalues {
+            let d = c
+                .spectral
+                .eigenvalues
+                .iter()
+                .map(|&(r2, i2)| (r2 - re).hypot(i2 - im))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 1e-6 * radius, "{p:?}: no match for ({re}, {im}): {:?}", c.spectral);
+        }
+    }
+}
