@@ -67,11 +67,14 @@ pub struct LagrangeRates3 {
 
 impl FullBody {
     /// A body in n ≥ 2 dimensions with the given potential (use
-    /// [`potential::Zero`] for the free body).
+    /// [`potential::Zero`] for the free body); a potential defined for another dimension
+    /// ([`Potential::dimension`], e.g. [`potential::SelfGravity`] at n ≠ 3) is refused
+    /// ([`potential::check_dimension`]).
     pub fn new(n: usize, potential: Arc<dyn Potential>) -> Result<Self> {
         if n < 2 {
             return Err(Error::invalid("n", format!("expected n ≥ 2, got {n}")));
         }
+        potential::check_dimension(&*potential, n)?;
         // The state (X, P) holds 2n² floats.
         check::dense_size("n", 2 * n.min(usize::MAX / 2), n)?;
         Ok(FullBody { n, potential })

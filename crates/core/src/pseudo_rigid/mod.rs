@@ -10,7 +10,9 @@
 //!   (R, A, S, Ω, Ȧ, Λ) and the kinetic energy in its several forms;
 //! - [`strata`]: strata and isotropy of the two-sided action;
 //! - [`potential`]: SO(n)×SO(n)-invariant potentials U(X) (harmonic, Saint Venant–Kirchhoff,
-//!   polytropic volumetric, sums);
+//!   polytropic volumetric, stretch, self-gravity, sums);
+//! - [`gravity`]: the self-gravity of a homogeneous ellipsoid (Chandrasekhar's index symbols and
+//!   the potential [`potential::SelfGravity`], n = 3);
 //! - [`equilibria`]: relative equilibria, the augmented and amended potentials (001 §8);
 //! - [`dynamics`]: the full Hamiltonian system on T*GL⁺(n) (001 (3.22)), the Riemann-ellipsoid
 //!   form (3.20), the Lagrangian form (Prop. 4.2) and Dedekind's adjoint motion;
@@ -41,6 +43,7 @@
 pub mod connection;
 pub mod dynamics;
 pub mod equilibria;
+pub mod gravity;
 pub mod inertia;
 pub mod momentum;
 pub mod potential;

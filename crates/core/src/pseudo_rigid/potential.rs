@@ -12,12 +12,16 @@
 //! - [`Volumetric`]: the polytropic gas U = κ (det(X)^{1−γ} − 1)/(γ − 1) (γ > 1), and its γ → 1
 //!   limit U = −κ ln det X (isothermal);
 //! - [`Stretch`]: the isotropic quadratic stretch energy U = (k/2) Σ_i (σ_i(X) − 1)²;
+//! - [`SelfGravity`] (n = 3 only, [`super::gravity`]): the gravitational energy of a homogeneous
+//!   ellipsoid, U = −4πGρ R_F(σ₁², σ₂², σ₃²) (Chandrasekhar, EFE ch. 3);
 //! - [`Sum`] of potentials, and [`Zero`] (the free body).
 //!
 //! Every potential also has an analytic Hessian, as the directional second derivative
 //! D²U(X)\[V\] = d/dε ∂U/∂X(X + εV)|_{ε=0} ([`Potential::add_hessian`]), used for the stability of
 //! relative equilibria (001 §8). The checked entry points for single evaluations are [`value`],
-//! [`gradient`], [`hessian_product`] and [`hessian`] (the n²×n² matrix).
+//! [`gradient`], [`hessian_product`] and [`hessian`] (the n²×n² matrix). A potential may be defined
+//! for one dimension n only ([`Potential::dimension`]); the checked entry points and the body
+//! ([`super::dynamics::FullBody::new`]) refuse it at another n ([`check_dimension`]).
 
 use crate::check;
 use crate::error::{Error, Result};
@@ -28,6 +32,8 @@ use faer::{Accum, MatMut, MatRef, Par};
 use nalgebra::Matrix3;
 use std::fmt::Debug;
 use std::sync::Arc;
+
+pub use super::gravity::SelfGravity;
 
 /// Scratch memory for evaluating potentials of n×n matrices without allocation.
 ///
@@ -111,10 +117,39 @@ pub trait Potential: Send + Sync + Debug {
     fn gradient3(&self, _x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         None
     }
+
+    /// The one dimension n at which U is defined, or `None` if it is defined for every n (the
+    /// default). [`SelfGravity`] is `Some(3)`; a [`Sum`] has the dimension of its terms, and
+    /// `Some(0)` (defined for no n) if two terms disagree. Kernels called at another n return NaN
+    /// (they must not panic); [`check_dimension`] refuses such calls.
+    fn dimension(&self) -> Option<usize> {
+        None
+    }
 }
 
-/// Checks det X > 0 when the potential needs it (shape and finiteness are checked by callers).
+/// Refuses a potential of another dimension than n ([`Potential::dimension`]) with
+/// [`Error::InvalidArgument`] naming the potential, its dimension and n.
+pub fn check_dimension(pot: &dyn Potential, n: usize) -> Result<()> {
+    match pot.dimension() {
+        Some(0) => Err(Error::invalid(
+            "potential",
+            format!(
+                "{pot:?} is a sum of terms defined for different dimensions n, so it is defined \
+                 for none (here n = {n})"
+            ),
+        )),
+        Some(d) if d != n => Err(Error::invalid(
+            "potential",
+            format!("{pot:?} is defined for n = {d} only, not for n = {n}"),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Checks the dimension of the potential ([`check_dimension`]) and det X > 0 when the potential
+/// needs it (shape and finiteness are checked by callers).
 pub(crate) fn check_point(pot: &dyn Potential, x: &Mat, ws: &mut Workspace) -> Result<()> {
+    check_dimension(pot, x.nrows())?;
     if pot.needs_positive_det() {
         // Fast path: a normal positive product of the pivots settles it; otherwise (overflow,
         // underflow, NaN, det ≤ 0) the one membership test of GL⁺(n) decides on the sign.
@@ -663,6 +698,17 @@ impl Potential for Sum {
     }
     fn needs_positive_det(&self) -> bool {
         self.terms.iter().any(|t| t.needs_positive_det())
+    }
+    fn dimension(&self) -> Option<usize> {
+        let mut dim = None;
+        for d in self.terms.iter().filter_map(|t| t.dimension()) {
+            match dim {
+                None => dim = Some(d),
+                Some(e) if e != d => return Some(0),
+                _ => {}
+            }
+        }
+        dim
     }
 }
 
