@@ -203,13 +203,23 @@ class RollingSpheres(System):
 
 
 class PseudoRigidBody(System):
-    """Generalized pseudo-rigid body on T*GL+(n), H = tr(P^T P)/2 + U(X) (001 (3.22))."""
+    """Generalized pseudo-rigid body on T*GL+(n), H = tr(P^T P)/2 + U(X) (001 (3.22)); methods
+    verlet (default), verlet4, verlet6, reduced. With ``incompressible=True`` the volume is held,
+    det X = det X0 (the pressure is the multiplier): methods rattle (default), rattle4, rattle6,
+    states with <cof X, P> = 0 (``project_momentum``), det X appended to the invariants."""
 
-    def __init__(self, n: int, potential: Potential | None = None, check_det: bool = True) -> None: ...
+    def __init__(
+        self, n: int, potential: Potential | None = None, check_det: bool = True,
+        incompressible: bool = False,
+    ) -> None: ...
     @property
     def n(self) -> int: ...
     @property
     def check_det(self) -> bool: ...
+    @property
+    def incompressible(self) -> bool: ...
+    def project_momentum(self, X: ArrayLike, P: ArrayLike) -> F64:
+        """(n, n), (n, n) -> (n, n): P - kappa cof X, kappa = <cof X, P>/|cof X|^2."""
     @property
     def potential(self) -> Potential: ...
     def angular_momentum(self, states: ArrayLike) -> F64: ...

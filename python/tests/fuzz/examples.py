@@ -152,6 +152,7 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "spart": lambda lf: lf.SphereParticle(2.0, 1.5, 9.81),
     "disk": lambda lf: lf.RollingDisk(1.0, 0.5, 0.125, 0.0625, spring=0.4),
     "prb": lambda lf: lf.PseudoRigidBody(3, _svk(lf)),
+    "iprb": lambda lf: lf.PseudoRigidBody(3, _svk(lf), incompressible=True),
     "rtt": lambda lf: lf.RelativisticTangentTop(1.0, 0.2, lf.surfaces.Sphere(1.0)),
     "wft": lambda lf: lf.WeakFieldTop(1.0, 1e-3, gm=1e-4),
     "tt": lambda lf: lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
@@ -172,6 +173,7 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "svk": _svk,
     "volumetric": lambda lf: lf.potentials.Volumetric(0.5, 1.4),
     "stretch": lambda lf: lf.potentials.Stretch(1.1),
+    "selfgrav": lambda lf: lf.potentials.SelfGravity(1.0, 1.0),
     "zero": lambda lf: lf.potentials.Zero(),
     "sum": lambda lf: lf.potentials.Harmonic(1.0) + _svk(lf),
     "callable": lambda lf: lf.potentials.Callable(u_value, u_gradient, u_hessian),
@@ -187,7 +189,7 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
 # Receivers with a state of their own (a run advances): built afresh for every call.
 FRESH = {"run"}
 RECEIVER_MODULE = {**{k: "potentials" for k in ("harmonic", "svk", "volumetric", "stretch", "zero",
-                                                  "sum", "callable")},
+                                                  "sum", "callable", "selfgrav")},
                    **{k: "surfaces" for k in ("plane", "sphere", "hyp", "torus", "quadric",
                                               "revolution", "graph", "metric")},
                    "releq": "pseudo_rigid"}
@@ -209,6 +211,8 @@ def state_of(key):
             lf.SphericalPendulum(2.0, 1.5, 9.81).state_from_spherical(0.8, 0.1, 0.3, 1.2)),
         "disk": lambda lf, s: np.asarray(s.state([0.1, -0.2, 0.3, 0.7], 2.0, 0.5)),
         "prb": lambda lf, s: np.concatenate([X3.ravel(), V3.ravel()]),
+        "iprb": lambda lf, s: np.concatenate([X3.ravel(),
+                                              s.project_momentum(X3, V3).ravel()]),
         "rtt": lambda lf, s: np.asarray(s.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)),
         "wft": lambda lf, s: np.asarray(s.state([1.0, 0.5], 0.1, [0.1, 0.2], 0.3)),
         "tt": lambda lf, s: np.asarray(s.state([1.0, 0.3], 0.2, [0.1, 0.3], 1.5)),
@@ -219,8 +223,8 @@ def state_of(key):
     return Lazy(lambda lf: makers[key](lf, RECEIVERS[key](lf)))
 
 
-SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "rtt", "wft", "tt", "cp", "rds",
-           "rsph"]
+SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "iprb", "rtt", "wft", "tt", "cp",
+           "rds", "rsph"]
 CONSTRUCTORS = {  # class name -> receiver key built by it
     "RigidBody": "rb", "GeneralizedRigidBody": "grb", "HeavyTop": "ht", "SphericalPendulum": "sp",
     "Pendulum": "pend", "SphereParticle": "spart", "RollingDisk": "disk", "PseudoRigidBody": "prb",
@@ -316,6 +320,7 @@ def build_specs() -> list[Spec]:
     add(P + "augmented_hessian[V]", P + "augmented_hessian", A("X", X3, "gl"), A("xi", XI, "skew"),
         A("eta", ETA, "skew"), A("potential", svk, "obj"), A("V", V3, "mat", kw=True, opt=True))
     add(P + "equilibrium_directions", P + "equilibrium_directions", A("a", A3, "vec"))
+    add(P + "index_symbols", P + "index_symbols", A("a", A3, "vec"))
     add(P + "relative_equilibria", P + "relative_equilibria", A("potential", svk, "obj"),
         A("velocities", (0.5 * skew3(1, 0, 0), 0.9 * skew3(1, 0, 0)), "obj", kw=True, opt=True),
         A("bounds", (0.05, 3.0), "vec", kw=True), A("starts", 2, "int", kw=True, positive=True),
@@ -333,11 +338,13 @@ def build_specs() -> list[Spec]:
     add("potentials.Volumetric", "potentials.Volumetric", A("kappa", 0.5, "float"),
         A("gamma", 1.4, "float"))
     add("potentials.Stretch", "potentials.Stretch", A("k", 1.1, "float"))
+    add("potentials.SelfGravity", "potentials.SelfGravity", A("G", 1.0, "float", positive=True),
+        A("rho", 1.0, "float", positive=True))
     add("potentials.Zero", "potentials.Zero")
     # Callable is fuzzed through its use (value, gradient, hessian call the Python functions).
     add("potentials.Callable", "use:potentials.Callable", A("value", u_value, "fn"),
         A("gradient", u_gradient, "fn"), A("hessian", u_hessian, "fn", opt=True))
-    for p in ("harmonic", "svk", "volumetric", "stretch", "zero", "sum", "callable"):
+    for p in ("harmonic", "svk", "volumetric", "stretch", "selfgrav", "zero", "sum", "callable"):
         add(f"Potential[{p}].value", f"@{p}.value", A("X", X3, "gl"))
         add(f"Potential[{p}].gradient", f"@{p}.gradient", A("X", X3, "gl"))
         add(f"Potential[{p}].hessian", f"@{p}.hessian", A("X", X3, "gl"), A("V", V3, "mat"))
@@ -381,6 +388,8 @@ def build_specs() -> list[Spec]:
         A("tilt", 0.1, "float", kw=True))
     add("PseudoRigidBody", "PseudoRigidBody", A("n", 3, "int", positive=True),
         A("potential", svk, "obj", opt=True), A("check_det", True, "bool", kw=True))
+    add("PseudoRigidBody[incompressible]", "PseudoRigidBody", A("n", 3, "int", positive=True),
+        A("potential", svk, "obj", opt=True), A("incompressible", True, "bool", kw=True))
     add("RelativisticTangentTop", "RelativisticTangentTop", A("mass", 1.0, "float", positive=True),
         A("inertia", 0.2, "float", positive=True),
         A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj", opt=True))
@@ -433,7 +442,11 @@ def build_specs() -> list[Spec]:
                             A("theta_dot", 2.0, "float"), A("phi_dot", 0.5, "float")]),
                  ("constraint_residual", [A("states", state_of("disk"), "vec")])],
         "prb": [(f, [A("states", state_of("prb"), "vec")])
-                for f in ("angular_momentum", "circulation", "singular_values")],
+                for f in ("angular_momentum", "circulation", "singular_values")]
+        + [("project_momentum", [A("X", X3, "gl"), A("P", V3, "mat")])],
+        "iprb": [(f, [A("states", state_of("iprb"), "vec")])
+                 for f in ("angular_momentum", "circulation", "singular_values")]
+        + [("project_momentum", [A("X", X3, "gl"), A("P", V3, "mat")])],
         "rtt": [("state", [A("x", np.array([1.2, 0.3]), "vec"), A("theta", 0.5, "float"),
                            A("xdot", np.array([0.3, 0.4]), "vec"), A("thetadot", 2.0, "float")])]
         + [(f, [A("states", state_of("rtt"), "vec")])
@@ -482,7 +495,7 @@ def build_specs() -> list[Spec]:
         add(f"integrate[{key}]", "integrate", A("system", lazy_recv(key), "obj"),
             A("state0", state_of(key), "vec"), A("dt", 0.01, "float", kw=True),
             A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True),
-            slow=key in ("prb", "rtt", "tt", "cp", "rds", "rsph"))
+            slow=key in ("prb", "iprb", "rtt", "tt", "cp", "rds", "rsph"))
     ht_att = Lazy(lambda lf: RECEIVERS["ht"](lf).state(M3, attitude=R3))
     for key, st in (("rb", state_of("rb")), ("ht", ht_att)):
         add(f"integrate[{key},attitude]", "integrate", A("system", lazy_recv(key), "obj"),

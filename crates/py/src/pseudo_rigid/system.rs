@@ -8,11 +8,12 @@ use std::sync::Arc;
 use lieflow::pseudo_rigid::PseudoRigidBody as CoreBody;
 use lieflow::{Error, Mat};
 use pyo3::prelude::*;
+use pyo3::types::{PyCFunction, PyDict, PyTuple};
 use pyo3::PyClassInitializer;
 
 use super::potential::{PyPotential, Zero};
-use crate::convert::int;
 use crate::convert::ArrayIn;
+use crate::convert::{int, mat, py_mat};
 use crate::errors::{to_py, IntoPy};
 use crate::integrate::Callbacks;
 use crate::system::PySystem;
@@ -25,13 +26,22 @@ type Any<'py> = Bound<'py, PyAny>;
 ///     n: dimension (>= 2).
 ///     potential: a `lieflow.potentials` potential (default: Zero(), the free body).
 ///     check_det: stop with LeftDomainError (naming the time) when det X <= 0 (always on for a
-///         volumetric potential; the equations extend to all n×n matrices otherwise).
+///         volumetric potential and for an incompressible body; the equations extend to all n×n
+///         matrices otherwise).
+///     incompressible: hold the volume, det X = det X0 (a fluid or incompressible elastic
+///         ellipsoid; the pressure is the multiplier of the constraint).
 ///
 /// Integrate with `lf.integrate(body, (X0, P0), dt=..., steps=..., method=...)`, methods
 /// "verlet" (the default), "verlet4", "verlet6" (Störmer–Verlet and its order-4/6
 /// compositions) and "reduced" (reduced-space splitting on the principal stratum, 001 §7,
-/// order 2, exact coadjoint orbits). States are flat: z = (X row-major, P row-major), length
-/// 2n²; fields X and P. Invariants: tr((L^T L)^k)/2 then tr((Γ^T Γ)^k)/2, k = 1..n//2.
+/// order 2, exact coadjoint orbits). The incompressible body has its own methods instead:
+/// "rattle" (the default, order 2), "rattle4" and "rattle6" (RATTLE and its Suzuki / Yoshida
+/// compositions, orders 4 and 6): symplectic on T*{det X = det X0}, they keep det X, L and
+/// Gamma to round-off (`body.methods()` on the instance lists them). Its states must move
+/// without changing the volume, <cof X, P> = det(X) tr(X^-1 P) = 0 (InvalidArgumentError
+/// otherwise): make P so with `body.project_momentum(X, P)`. States are flat: z = (X row-major,
+/// P row-major), length 2n²; fields X and P. Invariants: tr((L^T L)^k)/2 then
+/// tr((Γ^T Γ)^k)/2, k = 1..n//2, then det X for the incompressible body.
 #[pyclass(module = "lieflow", name = "PseudoRigidBody", extends = PySystem, frozen)]
 pub struct PyPseudoRigidBody {
     body: CoreBody,
@@ -56,12 +66,13 @@ fn flat(m: &Mat, out: &mut [f64]) -> lieflow::Result<()> {
 #[pymethods]
 impl PyPseudoRigidBody {
     #[new]
-    #[pyo3(signature = (n, potential=None, check_det=true))]
+    #[pyo3(signature = (n, potential=None, check_det=true, incompressible=false))]
     fn new(
         py: Python<'_>,
         #[pyo3(from_py_with = int)] n: i64,
         potential: Option<Bound<'_, PyPotential>>,
         check_det: bool,
+        incompressible: bool,
     ) -> PyResult<PyClassInitializer<Self>> {
         let size = usize::try_from(n)
             .map_err(|_| to_py(Error::invalid("n", format!("expected n ≥ 2, got {n}"))))?;
@@ -70,11 +81,16 @@ impl PyPseudoRigidBody {
             None => Bound::new(py, Zero(py)?)?,
         };
         let pot = potential.get();
-        let body = CoreBody::new(size, pot.inner.clone(), check_det).py()?;
+        let body = if incompressible {
+            CoreBody::incompressible(size, pot.inner.clone())
+        } else {
+            CoreBody::new(size, pot.inner.clone(), check_det)
+        }
+        .py()?;
         let callbacks = pot.callback.clone().map(|c| c as Arc<dyn Callbacks>);
-        let args = (n, potential.clone(), check_det).into_pyobject(py)?;
-        let base = PySystem::new(body.clone(), args, &["n", "potential", "check_det"])
-            .with_callbacks(callbacks);
+        let args = (n, potential.clone(), check_det, incompressible).into_pyobject(py)?;
+        let names = &["n", "potential", "check_det", "incompressible"];
+        let base = PySystem::new(body.clone(), args, names).with_callbacks(callbacks);
         Ok(
             PyClassInitializer::from(base).add_subclass(PyPseudoRigidBody {
                 body,
@@ -99,6 +115,40 @@ impl PyPseudoRigidBody {
     #[getter]
     fn check_det(&self) -> bool {
         self.body.check_det()
+    }
+
+    /// Whether the volume is held (det X = det X0; methods rattle, rattle4, rattle6).
+    #[getter]
+    fn incompressible(&self) -> bool {
+        self.body.is_incompressible()
+    }
+
+    /// The names of the integration methods, the first the default: on the class those of a
+    /// body that is not incompressible ("verlet", "verlet4", "verlet6", "reduced"), on an
+    /// instance its own ("rattle", "rattle4", "rattle6" for an incompressible body).
+    #[classattr]
+    fn methods() -> MethodsOf {
+        MethodsOf
+    }
+
+    /// The projection of a momentum P onto the states of the incompressible body at X:
+    /// P - kappa cof X with kappa = <cof X, P> / |cof X|^2 (cof X = det(X) X^-T), so that
+    /// <cof X, P> = det(X) tr(X^-1 P) = 0 (the motion keeps the volume).
+    ///
+    /// Args:
+    ///     X: (n, n) with det X > 0; P: (n, n).
+    /// Returns:
+    ///     (n, n) array.
+    /// Raises:
+    ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+    fn project_momentum<'py>(
+        &self,
+        py: Python<'py>,
+        X: ArrayIn<'py>,
+        P: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+        let (x, p) = (mat("X", &X)?, mat("P", &P)?);
+        Ok(py_mat(py, &self.body.project_momentum(&x, &p).py()?))
     }
 
     /// The potential.
@@ -130,6 +180,60 @@ impl PyPseudoRigidBody {
             out.copy_from_slice(&b.singular_values(z)?);
             Ok(())
         })
+    }
+}
+
+/// The descriptor of `PseudoRigidBody.methods`: the classmethod of `lieflow.System` on the class
+/// (its example body is not incompressible), the instance's own catalog on an instance (an
+/// incompressible body has other methods).
+#[pyclass(module = "lieflow", name = "_MethodsOf", frozen)]
+pub struct MethodsOf;
+
+#[pymethods]
+impl MethodsOf {
+    fn __get__<'py>(
+        &self,
+        obj: Option<Bound<'py, PyAny>>,
+        owner: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        match obj.filter(|o| !o.is_none()) {
+            Some(obj) => {
+                let py = obj.py();
+                let names: Vec<&'static str> = obj
+                    .cast::<PySystem>()?
+                    .get()
+                    .sys
+                    .methods()
+                    .into_iter()
+                    .map(|(name, _)| name)
+                    .collect();
+                let f = PyCFunction::new_closure(
+                    py,
+                    Some(c"methods"),
+                    Some(
+                        c"The names of this body's integration methods; the first is the default.",
+                    ),
+                    move |args: &Bound<'_, PyTuple>, kwargs: Option<&Bound<'_, PyDict>>| {
+                        if !args.is_empty() || kwargs.is_some_and(|k| !k.is_empty()) {
+                            return Err(pyo3::exceptions::PyTypeError::new_err(
+                                "methods() takes no arguments",
+                            ));
+                        }
+                        Ok(names.clone())
+                    },
+                )?;
+                Ok(f.into_any())
+            }
+            None => {
+                let py = owner
+                    .as_ref()
+                    .map(|o| o.py())
+                    .ok_or_else(|| pyo3::exceptions::PyTypeError::new_err("no owner"))?;
+                let base = py.get_type::<PySystem>();
+                let class_method = base.getattr("__dict__")?.get_item("methods")?;
+                class_method.call_method1("__get__", (py.None(), owner))
+            }
+        }
     }
 }
 
