@@ -130,6 +130,10 @@ def relative_equilibria(
     bounds: tuple[float, float] = (0.05, 5.0), starts: int = 6,
 ) -> list[RelativeEquilibrium]: ...
 
+def index_symbols(a: ArrayLike) -> tuple[F64, F64]:
+    """Chandrasekhar's index symbols (A (3,), A_ij (3, 3)) of the ellipsoid with semi-axes a
+    (EFE ch. 3 §21): A_i by Carlson's R_D, A_ij by the trapezoidal rule in ln u."""
+
 class Verdict:
     eigenvalues: NDArray[np.complex128]
     stable: bool

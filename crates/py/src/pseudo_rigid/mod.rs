@@ -6,6 +6,7 @@
 #![allow(non_snake_case)]
 
 pub mod equilibria;
+pub mod gravity;
 pub mod potential;
 pub mod system;
 
@@ -455,6 +456,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reconstruct, m)?)?;
     m.add_function(wrap_pyfunction!(adjoint_motion, m)?)?;
     equilibria::register(m)?;
+    gravity::register(m)?;
     Ok(())
 }
 

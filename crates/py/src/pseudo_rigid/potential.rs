@@ -6,8 +6,9 @@ use std::fmt;
 use std::sync::Arc;
 
 use lieflow::pseudo_rigid::potential::{
-    self as pot, Harmonic as CoreHarmonic, SaintVenantKirchhoff as CoreSvk, Stretch as CoreStretch,
-    Sum, Volumetric as CoreVolumetric, Workspace, Zero as CoreZero,
+    self as pot, Harmonic as CoreHarmonic, SaintVenantKirchhoff as CoreSvk,
+    SelfGravity as CoreSelfGravity, Stretch as CoreStretch, Sum, Volumetric as CoreVolumetric,
+    Workspace, Zero as CoreZero,
 };
 use lieflow::{Error, Mat};
 use numpy::PyArray2;
@@ -21,7 +22,8 @@ use crate::integrate::{Callbacks, ErrorSlot};
 
 /// An SO(n)×SO(n)-invariant potential U(X) of a pseudo-rigid body (001 §4.1). Build one with
 /// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Stretch(k)`,
-/// `Zero()` or `Callable(U, grad_U, hess_U=None)`; add potentials with `+`.
+/// `SelfGravity(G, rho)` (n = 3 only), `Zero()` or `Callable(U, grad_U, hess_U=None)`; add
+/// potentials with `+`.
 #[pyclass(module = "lieflow.potentials", frozen, name = "Potential")]
 #[derive(Clone)]
 pub struct PyPotential {
@@ -339,6 +341,29 @@ fn Stretch(py: Python<'_>, #[pyo3(from_py_with = real)] k: f64) -> PyResult<PyPo
     PyPotential::new(py, inner, format!("Stretch({k})"), "Stretch", [k])
 }
 
+/// Self-gravity of a homogeneous ellipsoid, U = -4 pi G rho R_F(s1^2, s2^2, s3^2) over the singular
+/// values s_i of X (Chandrasekhar, EFE ch. 3; Carlson's R_F): the potential of the Riemann
+/// ellipsoids, for n = 3 only. The reference configuration is the unit ball of density rho (mass
+/// M = 4 pi rho / 3) and the kinetic energy tr(V^T V)/2, i.e. the physical energy divided by M/5;
+/// a sphere of radius a has U = -4 pi G rho / a, and dU/ds_i = 2 pi G rho' s_i A_i with the actual
+/// density rho' = rho / (s1 s2 s3) and the index symbols A_i (`pseudo_rigid.index_symbols`).
+/// Defined for det X > 0 (integrations always check it); the Hessian is analytic, also at equal
+/// singular values (Maclaurin spheroids).
+///
+/// Raises:
+///     InvalidArgumentError: G or rho <= 0 or not finite; a body or X of another dimension than 3.
+#[pyfunction]
+#[pyo3(signature = (G=1.0, rho=1.0))]
+fn SelfGravity(
+    py: Python<'_>,
+    #[pyo3(from_py_with = real)] G: f64,
+    #[pyo3(from_py_with = real)] rho: f64,
+) -> PyResult<PyPotential> {
+    let inner = Arc::new(CoreSelfGravity::new(G, rho).py()?);
+    let desc = format!("SelfGravity(G={G}, rho={rho})");
+    PyPotential::new(py, inner, desc, "SelfGravity", [G, rho])
+}
+
 /// U = 0, the free body (motions X(t) = X0 + t P0).
 #[pyfunction]
 pub(crate) fn Zero(py: Python<'_>) -> PyResult<PyPotential> {
@@ -405,6 +430,7 @@ pub fn register(p: &Bound<'_, PyModule>) -> PyResult<()> {
     p.add_function(wrap_pyfunction!(SaintVenantKirchhoff, p)?)?;
     p.add_function(wrap_pyfunction!(Volumetric, p)?)?;
     p.add_function(wrap_pyfunction!(Stretch, p)?)?;
+    p.add_function(wrap_pyfunction!(SelfGravity, p)?)?;
     p.add_function(wrap_pyfunction!(Zero, p)?)?;
     p.add_function(wrap_pyfunction!(Callable, p)?)?;
     Ok(())
