@@ -194,7 +194,7 @@ pub fn stability<P: Constrained + Symmetric>(
     } else {
         norm(&resid) / scale
     };
-    if !(residual <= EQUILIBRIUM_TOL) {
+    if residual.is_nan() || residual > EQUILIBRIUM_TOL {
         return Err(Error::invalid(
             "relative equilibrium (state, xi)",
             format!(

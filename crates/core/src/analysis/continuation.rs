@@ -34,6 +34,12 @@ use faer::linalg::solvers::Solve;
 /// (relative to 1 + |π|).
 pub const LOCATE_TOL: f64 = 1e-11;
 
+/// Newton iterations of the corrector.
+const MAX_NEWTON: usize = 12;
+
+/// A corrector whose update stops decreasing is accepted below this relative size.
+const STAGNATION: f64 = 1e-10;
+
 /// A one-parameter family: the zero set of F: ℝᴺ → ℝᴺ⁻¹ near a regular point is a curve.
 pub trait Family {
     /// N, the number of unknowns.
@@ -238,7 +244,8 @@ fn correct(
     let n = u.len();
     let mut v: Vec<f64> = u.iter().zip(t).map(|(a, b)| a + s * b).collect();
     let scale = 1.0 + norm(u);
-    for iter in 1..=12 {
+    let mut prev = f64::INFINITY;
+    for iter in 1..=MAX_NEWTON {
         let f = family.residual(&v)?;
         let j = family.jacobian(&v)?;
         let m = Mat::from_fn(n, n, |r, c| if r + 1 < n { j[(r, c)] } else { t[c] });
@@ -258,18 +265,20 @@ fn correct(
         if !dn.is_finite() {
             break;
         }
-        if dn <= tol * scale {
-            // One more residual check guards against a converged step onto a non-solution.
+        // Converged, or stagnating at the level of round-off (near a branch point the matrix
+        // is ill-conditioned and the update stops decreasing below STAGNATION·scale).
+        if dn <= tol * scale || (dn >= prev && dn <= STAGNATION * scale) {
             let f = family.residual(&v)?;
             if f.iter().all(|x| x.is_finite()) {
                 return Ok((v, iter));
             }
             break;
         }
+        prev = dn;
     }
     Err(Error::NotConverged {
         what: "continuation corrector (Newton on F(u) = 0 with the arclength condition)".into(),
-        iterations: 12,
+        iterations: MAX_NEWTON,
         residual: f64::NAN,
         tol,
     })
@@ -321,49 +330,100 @@ impl Probe<'_> {
         self.probe(v, &from.tangent)
     }
 
-    /// Locates where `test` changes sign between `a` (σ = 0) and `b` (σ = s) by bisection with
-    /// secant steps, until the parameter is known to `rel_tol`·(1 + |π|); returns the points on
-    /// the near and on the far side of the change.
+    /// Locates where `test` changes sign between `a` (σ = 0) and `b` (σ = s): secant steps
+    /// (every third a bisection) on corrected points until the parameter is known to
+    /// `rel_tol`·(1 + |π|) or the corrector fails (within ~1e-9 of a branch point the corrected
+    /// points are ill-determined: the two branches cross). For a `smooth` test the result is the
+    /// root of the test's linear interpolation on the last bracket, the point there by cubic
+    /// Hermite interpolation of the bracket's points and tangents (error O(Δσ⁴)); otherwise
+    /// (a verdict) the corrected point on the far side of the change.
     fn locate(
         &self,
         a: &Probed,
         b: &Probed,
         s: f64,
         rel_tol: f64,
+        smooth: bool,
         test: &dyn Fn(&Probed) -> f64,
-    ) -> Result<(Probed, Probed)> {
+    ) -> Result<Probed> {
         let (mut lo, mut hi) = (0.0, s);
         let (mut flo, mut fhi) = (test(a), test(b));
         let (mut near, mut far) = (a.clone(), b.clone());
         let tol = rel_tol * (1.0 + a.point.parameter.abs());
         let dpds = (b.point.parameter - a.point.parameter).abs() / s.abs().max(f64::MIN_POSITIVE);
+        // A trial where the corrector failed (near a branch point): the next trials approach
+        // it from the two sides of the bracket in turn.
+        let mut bad: Option<f64> = None;
+        let mut failures = 0;
         for iter in 0..200 {
-            if (hi - lo) * dpds.max(1e-3) <= tol {
+            if (hi - lo) * dpds.max(1e-3) <= tol || failures >= 8 {
                 break;
             }
-            // Secant inside the bracket for the smooth tests, bisection every third try.
             let sec = lo - flo * (hi - lo) / (fhi - flo);
-            let mid = if iter % 3 != 2 && sec.is_finite() && sec > lo && sec < hi {
+            let mid = if let Some(x) = bad {
+                if failures % 2 == 1 {
+                    0.5 * (lo + x)
+                } else {
+                    0.5 * (x + hi)
+                }
+            } else if smooth && iter % 3 != 2 && sec.is_finite() && sec > lo && sec < hi {
                 sec.clamp(lo + 0.01 * (hi - lo), hi - 0.01 * (hi - lo))
             } else {
                 0.5 * (lo + hi)
             };
-            let p = self.at(&a.point, mid)?;
-            let fm = test(&p);
-            if fm == 0.0 {
-                return Ok((p.clone(), p));
-            }
-            if (fm > 0.0) == (flo > 0.0) {
-                lo = mid;
-                flo = fm;
-                near = p;
-            } else {
-                hi = mid;
-                fhi = fm;
-                far = p;
+            match self.at(&a.point, mid) {
+                Err(_) => {
+                    bad = Some(mid);
+                    failures += 1;
+                }
+                Ok(p) => {
+                    let fm = test(&p);
+                    if fm == 0.0 {
+                        return Ok(p);
+                    }
+                    if (fm > 0.0) == (flo > 0.0) {
+                        (lo, flo, near) = (mid, fm, p);
+                    } else {
+                        (hi, fhi, far) = (mid, fm, p);
+                    }
+                }
             }
         }
-        Ok((near, far))
+        if !smooth {
+            return Ok(far);
+        }
+        // The root of the interpolated test; the point there by cubic Hermite interpolation
+        // between corrected points at σ ± δ, δ = 10⁻³|s|, away from the ill-determined
+        // neighbourhood of a branch point (error O(δ⁴)); the bracket's ends if those fail. With σ
+        // measured along a's tangent t_a, du/dσ = t/(t·t_a).
+        let root = lo + (flo / (flo - fhi)).clamp(0.0, 1.0) * (hi - lo);
+        let delta = 1e-3 * s.abs();
+        let along = near.point.tangent.clone();
+        let (left, right, w, h) = match (
+            self.at(&a.point, root - delta),
+            self.at(&a.point, root + delta),
+        ) {
+            (Ok(l), Ok(r)) => (l, r, 0.5, 2.0 * delta),
+            _ => (near, far, (root - lo) / (hi - lo), hi - lo),
+        };
+        let ta = &a.point.tangent;
+        let slope = |p: &Probed| -> Vec<f64> {
+            let c = dot(&p.point.tangent, ta);
+            p.point.tangent.iter().map(|x| x / c).collect()
+        };
+        let (d0, d1) = (slope(&left), slope(&right));
+        let (h00, h10, h01, h11) = (
+            (1.0 + 2.0 * w) * (1.0 - w) * (1.0 - w),
+            w * (1.0 - w) * (1.0 - w),
+            w * w * (3.0 - 2.0 * w),
+            w * w * (w - 1.0),
+        );
+        let u: Vec<f64> = (0..left.point.u.len())
+            .map(|k| {
+                h00 * left.point.u[k] + h10 * h * d0[k] + h01 * right.point.u[k] + h11 * h * d1[k]
+            })
+            .collect();
+        self.probe(u, &along)
     }
 }
 
@@ -477,14 +537,14 @@ pub fn follow(
         // Special points between prev and next, in the order of their location.
         let mut found: Vec<(f64, Special)> = Vec::new();
         if sign_change(prev.branch, next.branch) {
-            let (_, p) = probe.locate(&prev, &next, s, LOCATE_TOL, &|q| q.branch)?;
+            let p = probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.branch)?;
             found.push((
                 dist(&prev.point, &p.point),
                 special_at(Kind::Branch, p, index),
             ));
         }
         if sign_change(prev.fold, next.fold) {
-            let (_, p) = probe.locate(&prev, &next, s, LOCATE_TOL, &|q| q.fold)?;
+            let p = probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.fold)?;
             found.push((
                 dist(&prev.point, &p.point),
                 special_at(Kind::Fold, p, index),
@@ -492,7 +552,7 @@ pub fn follow(
         }
         for (w, (&a, &b)) in prev.point.stable.iter().zip(&next.point.stable).enumerate() {
             if a != b {
-                let (_, p) = probe.locate(&prev, &next, s, LOCATE_TOL, &|q| {
+                let p = probe.locate(&prev, &next, s, LOCATE_TOL, false, &|q| {
                     if q.point.stable.get(w) == Some(&a) {
                         1.0
                     } else {
@@ -510,15 +570,20 @@ pub fn follow(
         let (pa, pb) = (prev.point.parameter - stop, next.point.parameter - stop);
         if pa != 0.0 && (pb == 0.0 || sign_change(pa, pb)) {
             let test = |q: &Probed| q.point.parameter - stop;
-            let (a, b) = probe.locate(&prev, &next, s, 1e-15, &test)?;
-            points.push(
-                if test(&a).abs() < test(&b).abs() {
-                    a
+            // The stop is a regular point: the corrected point there (not an interpolation).
+            let p = probe.locate(&prev, &next, s, 1e-15, false, &|q| {
+                if q.point.parameter == stop {
+                    0.0
                 } else {
-                    b
+                    test(q)
                 }
-                .point,
-            );
+            })?;
+            let p = if test(&p).abs() < test(&next).abs() {
+                p
+            } else {
+                next.clone()
+            };
+            points.push(p.point);
             break End::Reached;
         }
         points.push(next.point.clone());

@@ -42,6 +42,7 @@
 
 pub mod connection;
 pub mod dynamics;
+pub mod ellipsoids;
 pub mod equilibria;
 pub mod gravity;
 pub mod inertia;

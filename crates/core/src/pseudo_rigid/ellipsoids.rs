@@ -1,0 +1,616 @@
+//! Self-gravitating incompressible fluid ellipsoids — Maclaurin, Jacobi, Dedekind and Riemann
+//! S-type — as relative equilibria of the incompressible pseudo-rigid body with the potential
+//! [`SelfGravity`] (001 §1, §8; Chandrasekhar, *Ellipsoidal Figures of Equilibrium* (EFE),
+//! ch. 5–7), and their one-parameter families for continuation.
+//!
+//! # The equations (derived again; checked in `tests/ellipsoids.rs`)
+//! All these figures rotate in the (1, 2) plane: Ω = ω e₁₂, Λ = μ e₁₂ at A₀ = diag(a), and
+//! X(t) = e^{tΩ}A₀e^{−tΛ} (001 (8.2)). The force balance of the augmented potential
+//! U − ½‖ΩA − AΛ‖² (001 (8.12)) with the multiplier p of det X = V (the pressure) is, with
+//! g = ∂U/∂a,
+//!
+//! F₁ = g₁ − (ω² + μ²)a₁ + 2ωμ a₂ − p a₂a₃ = 0,
+//! F₂ = g₂ − (ω² + μ²)a₂ + 2ωμ a₁ − p a₁a₃ = 0,
+//! F₃ = g₃ − p a₁a₂ = 0,  F₄ = a₁a₂a₃ − V = 0.
+//!
+//! The (8.6) condition holds for every shape (one plane: [`super::equilibria`]). F₁ − F₂ =
+//! (g₁ − g₂) − (a₁ − a₂)[(ω + μ)² − p a₃] vanishes identically at a₁ = a₂ (g₁ = g₂ by symmetry):
+//! the Maclaurin spheroids, from which the ellipsoids with a₁ ≠ a₂ branch off where the
+//! antisymmetric derivative H₁₁ − H₁₂ − (ω + μ)² + p a₃ vanishes (H = ∂²U/∂a²).
+//!
+//! For [`SelfGravity`], g_i = 2πGρ′ a_i A_i and H_ij = 2πGρ′(δ_ij A_i − (1 + 2δ_ij)a_ia_jA_ij)
+//! (index symbols A_i, A_ij; ρ′ = ρ/det X the density of the figure). With μ = 0, F₁/a₁ and
+//! F₂/a₂ give ω² = 2πGρ′(A₁ − a₃²A₃/a₁²) = 2πGρ′(A₂ − a₃²A₃/a₂²), i.e. EFE §39 (4)
+//! a₁²a₂²A₁₂ = a₃²A₃ and (5) Ω² = 2πGρ′B₁₂, B₁₂ = A₂ − a₁²A₁₂ (using A₁ − A₂ = −(a₁² − a₂²)A₁₂);
+//! at a₁ = a₂ the branch condition is a₁⁴A₁₁ = a₃²A₃.
+//!
+//! # Physical quantities and conventions
+//! The figure turns with the angular velocity Ω₃ = −ω about x₃ (hat(e₃) = −e₁₂ in the e_ij basis
+//! of DESIGN.md). In the frame of the figure the fluid moves with u = −AΛA⁻¹x, whose vorticity is
+//! ζ = μ(a₁² + a₂²)/(a₁a₂); f = ζ/Ω₃ (EFE's ratio): f = 0 Jacobi (rigid rotation), f = ±∞
+//! Dedekind (stationary figure), f = −2 irrotational in the inertial frame. The velocities of a
+//! family with fixed f lie on the ray μ/ω = −f a₁a₂/(a₁² + a₂²); figures are returned with
+//! Ω₃ ≥ 0 (and μ ≤ 0 for Dedekind's, the transpose of Jacobi's: X ↦ Xᵀ swaps Ω and Λ).
+//!
+//! The library's kinetic energy is ½tr(ẊᵀẊ), the fluid's (M/5)·½tr(ẊᵀẊ) with M = 4πρ/3 (the
+//! reference body is the unit ball of density ρ), so energies and momenta are multiplied by
+//! M/5 and reported in EFE's units: L/√(GM³ā), E/(GM²/ā), ā = (a₁a₂a₃)^{1/3}.
+
+use std::sync::Arc;
+
+use super::equilibria::RelativeEquilibrium;
+use super::gravity::SelfGravity;
+use super::potential::{self, Potential};
+use super::system::PseudoRigidBody;
+use crate::analysis::comoving;
+use crate::analysis::continuation::{self, Branch, Family, Options};
+use crate::error::{Error, Result};
+use crate::Mat;
+
+/// The largest number of sign changes scanned for when solving for a₃.
+const SCAN: usize = 400;
+
+/// An ellipsoidal figure of equilibrium rotating in the (1, 2) plane (module docs): semi-axes,
+/// the velocities Ω = ω e₁₂, Λ = μ e₁₂, the pressure multiplier, and the family it belongs to.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Figure {
+    /// Semi-axes (a₁, a₂, a₃).
+    pub a: [f64; 3],
+    /// ω: Ω = ω e₁₂ (the figure turns with Ω₃ = −ω about x₃).
+    pub omega: f64,
+    /// μ: Λ = μ e₁₂ (the internal motion).
+    pub mu: f64,
+    /// The multiplier of det X = a₁a₂a₃ (F₃: p = g₃/(a₁a₂)).
+    pub pressure: f64,
+    /// The family: θ = atan f ∈ (−π/2, π/2] with f = ζ/Ω₃ (θ = π/2 Dedekind).
+    pub theta: f64,
+}
+
+/// Physical quantities of a [`Figure`] (module docs for the units).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quantities {
+    /// √(1 − a₃²/max(a₁, a₂)²) (the meridional eccentricity; NaN if a₃ is the longest axis).
+    pub e: f64,
+    /// a₂/a₁.
+    pub a2_over_a1: f64,
+    /// a₃/a₁.
+    pub a3_over_a1: f64,
+    /// Ω₃ (the figure's angular velocity about x₃).
+    pub omega3: f64,
+    /// ζ = μ(a₁² + a₂²)/(a₁a₂), the vorticity of the internal motion in the figure's frame.
+    pub zeta: f64,
+    /// f = ζ/Ω₃ (±∞ for a stationary figure).
+    pub f: f64,
+    /// Ω₃²/(πGρ′), ρ′ the density of the figure.
+    pub omega2_over_pi_g_rho: f64,
+    /// The angular momentum about x₃ in units of √(GM³ā).
+    pub angular_momentum: f64,
+    /// The circulation Γ of 001 (7.3) (the x₃ component of PᵀX − XᵀP, times M/5) in the same units.
+    pub circulation: f64,
+    /// The energy in units of GM²/ā.
+    pub energy: f64,
+}
+
+/// The fluid: self-gravity with constants G and ρ (the density of the reference unit ball).
+#[derive(Clone, Debug)]
+pub struct Fluid {
+    gravity: Arc<SelfGravity>,
+}
+
+fn e12(w: f64) -> Mat {
+    Mat::from_fn(3, 3, |i, j| match (i, j) {
+        (0, 1) => w,
+        (1, 0) => -w,
+        _ => 0.0,
+    })
+}
+
+fn diag(a: &[f64; 3]) -> Mat {
+    Mat::from_fn(3, 3, |i, j| if i == j { a[i] } else { 0.0 })
+}
+
+/// (sin 2φ, cos φ, sin φ) of the velocity ray (ω, μ) ∝ (cos φ, sin φ), tan φ = −f a₁a₂/(a₁²+a₂²),
+/// f = tan θ.
+fn ray(theta: f64, a: &[f64; 3]) -> (f64, f64) {
+    // (cos φ, sin φ) ∝ (cos θ (a₁² + a₂²), −sin θ a₁a₂); θ = ±π/2 (f = ±∞) is the stationary
+    // figure exactly (cos(π/2) rounds to 6e-17).
+    let ct = if theta.abs() == std::f64::consts::FRAC_PI_2 {
+        0.0
+    } else {
+        theta.cos()
+    };
+    let (c, s) = (ct * (a[0] * a[0] + a[1] * a[1]), -theta.sin() * a[0] * a[1]);
+    let r = c.hypot(s);
+    (c / r, s / r)
+}
+
+fn finite(what: &str, x: f64) -> Result<f64> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(Error::NonFinite {
+            what: what.into(),
+            location: "the result".into(),
+        })
+    }
+}
+
+impl Fluid {
+    /// Self-gravity with G > 0, ρ > 0.
+    pub fn new(g: f64, rho: f64) -> Result<Self> {
+        Ok(Fluid {
+            gravity: Arc::new(SelfGravity::new(g, rho)?),
+        })
+    }
+
+    /// The potential.
+    pub fn potential(&self) -> Arc<dyn Potential> {
+        self.gravity.clone()
+    }
+
+    /// The self-gravity.
+    pub fn gravity(&self) -> &SelfGravity {
+        &self.gravity
+    }
+
+    /// g = ∂U/∂a at diag(a) (the diagonal of ∂U/∂X).
+    fn force(&self, a: &[f64; 3]) -> Result<[f64; 3]> {
+        let g = potential::gradient(self.gravity.as_ref(), &diag(a))?;
+        Ok([g[(0, 0)], g[(1, 1)], g[(2, 2)]])
+    }
+
+    /// H = ∂²U/∂a² at diag(a) (diagonal entries of D²U[E_jj]).
+    fn stiffness(&self, a: &[f64; 3]) -> Result<[[f64; 3]; 3]> {
+        let x = diag(a);
+        let mut h = [[0.0; 3]; 3];
+        for (j, col) in h.iter_mut().enumerate() {
+            let ejj = Mat::from_fn(3, 3, |r, c| if r == j && c == j { 1.0 } else { 0.0 });
+            let d = potential::hessian_product(self.gravity.as_ref(), &x, &ejj)?;
+            *col = [d[(0, 0)], d[(1, 1)], d[(2, 2)]];
+        }
+        Ok(h) // symmetric: h[j][i] = H_ij
+    }
+
+    /// The residuals (F₁, F₂, F₃) of the force balance (module docs) at u = (a, ω, μ, p).
+    fn balance(&self, a: &[f64; 3], omega: f64, mu: f64, p: f64) -> Result<[f64; 3]> {
+        let g = self.force(a)?;
+        let w2 = omega * omega + mu * mu;
+        let c = 2.0 * omega * mu;
+        Ok([
+            g[0] - w2 * a[0] + c * a[1] - p * a[1] * a[2],
+            g[1] - w2 * a[1] + c * a[0] - p * a[0] * a[2],
+            g[2] - p * a[0] * a[1],
+        ])
+    }
+
+    /// The figure of the family θ with equatorial axes (a₁, a₂) and a₃ given: p from F₃, the
+    /// speed s on the ray from F₁ (or F₂), or `None` if s² < 0.
+    fn velocities(&self, a: &[f64; 3], theta: f64) -> Result<Option<Figure>> {
+        let g = self.force(a)?;
+        let p = g[2] / (a[0] * a[1]);
+        let (c, s) = ray(theta, a);
+        let s2c = 2.0 * s * c;
+        let (n1, d1) = (g[0] - p * a[1] * a[2], a[0] - s2c * a[1]);
+        let (n2, d2) = (g[1] - p * a[0] * a[2], a[1] - s2c * a[0]);
+        let speed2 = if d1.abs() >= d2.abs() {
+            n1 / d1
+        } else {
+            n2 / d2
+        };
+        if speed2.is_nan() || speed2 < 0.0 {
+            return Ok(None);
+        }
+        // Ω₃ = −ω ≥ 0; for a stationary figure μ ≤ 0.
+        let sp = -speed2.sqrt();
+        let (omega, mu) = if c.abs() > 0.0 {
+            (sp * c, sp * s)
+        } else {
+            (0.0, sp * s.abs())
+        };
+        Ok(Some(Figure {
+            a: *a,
+            omega,
+            mu,
+            pressure: p,
+            theta,
+        }))
+    }
+
+    /// The mismatch of F₁ and F₂ on the ray of θ at fixed (a₁, a₂) as a function of a₃ (zero
+    /// at a figure; module docs).
+    fn mismatch(&self, a: &[f64; 3], theta: f64) -> Result<f64> {
+        let g = self.force(a)?;
+        let p = g[2] / (a[0] * a[1]);
+        let (c, s) = ray(theta, a);
+        let s2c = 2.0 * s * c;
+        Ok((g[0] - p * a[1] * a[2]) * (a[1] - s2c * a[0])
+            - (g[1] - p * a[0] * a[2]) * (a[0] - s2c * a[1]))
+    }
+
+    /// The figure of the family θ with a₁ = 1, a₂ = r (0 < r < 1): a₃ is the root of the
+    /// mismatch (scanned on a geometric grid in (10⁻⁴, 1.5), refined by bisection to round-off)
+    /// with s² ≥ 0; of several, the one with the largest a₃.
+    fn ellipsoid(&self, r: f64, theta: f64, what: &str) -> Result<Figure> {
+        if !(r > 0.0 && r < 1.0) {
+            return Err(Error::invalid(
+                "a2_over_a1",
+                format!("expected 0 < a2/a1 < 1 for {what} ellipsoids, got {r}"),
+            ));
+        }
+        let at = |a3: f64| self.mismatch(&[1.0, r, a3], theta);
+        let (lo, hi) = (1e-4_f64, 1.5_f64);
+        let grid: Vec<f64> = (0..=SCAN)
+            .map(|k| lo * (hi / lo).powf(k as f64 / SCAN as f64))
+            .collect();
+        let mut best: Option<Figure> = None;
+        let mut prev = at(grid[SCAN])?;
+        for k in (0..SCAN).rev() {
+            let (x0, x1) = (grid[k], grid[k + 1]);
+            let f0 = at(x0)?;
+            if (f0 > 0.0) != (prev > 0.0) && f0 != 0.0 && prev != 0.0 {
+                // Bisection to round-off.
+                let (mut l, mut h, mut fl) = (x0, x1, f0);
+                for _ in 0..200 {
+                    let m = 0.5 * (l + h);
+                    if m <= l || m >= h {
+                        break;
+                    }
+                    let fm = at(m)?;
+                    if (fm > 0.0) == (fl > 0.0) {
+                        l = m;
+                        fl = fm;
+                    } else {
+                        h = m;
+                    }
+                }
+                let a3 = 0.5 * (l + h);
+                if let Some(fig) = self.velocities(&[1.0, r, a3], theta)? {
+                    best = Some(fig);
+                    break;
+                }
+            }
+            prev = f0;
+        }
+        best.ok_or_else(|| {
+            Error::invalid(
+                "ellipsoid",
+                format!(
+                    "no {what} ellipsoid with a2/a1 = {r} (f = {:.6}) for a3/a1 in (1e-4, 1.5)",
+                    theta.tan()
+                ),
+            )
+        })
+    }
+
+    /// The Maclaurin spheroid of eccentricity e ∈ [0, 1): a = (1, 1, √(1 − e²)), rigid rotation
+    /// with Ω₃² = (g₁ − p a₃)/a₁ (EFE ch. 5 §32: Ω²/(πGρ) = 2√(1−e²)(3−2e²) asin(e)/e³ − 6(1−e²)/e²).
+    pub fn maclaurin(&self, e: f64) -> Result<Figure> {
+        if !(0.0..1.0).contains(&e) {
+            return Err(Error::invalid("e", format!("expected 0 ≤ e < 1, got {e}")));
+        }
+        let a = [1.0, 1.0, (1.0 - e * e).sqrt()];
+        self.velocities(&a, 0.0)?.ok_or_else(|| {
+            Error::invalid("e", format!("no rotating Maclaurin spheroid at e = {e}"))
+        })
+    }
+
+    /// The Jacobi ellipsoid with a₁ = 1, a₂ = r ∈ (0, 1) (EFE ch. 6 §39: a₁²a₂²A₁₂ = a₃²A₃).
+    pub fn jacobi(&self, r: f64) -> Result<Figure> {
+        self.ellipsoid(r, 0.0, "Jacobi")
+    }
+
+    /// The Dedekind ellipsoid adjoint to the Jacobi ellipsoid with the same axes (Dedekind's
+    /// theorem: X ↦ Xᵀ swaps Ω and Λ): a stationary figure with internal motion.
+    pub fn dedekind(&self, r: f64) -> Result<Figure> {
+        let j = self.jacobi(r)?;
+        Ok(Figure {
+            omega: j.mu,
+            mu: j.omega,
+            theta: std::f64::consts::FRAC_PI_2,
+            ..j
+        })
+    }
+
+    /// The Riemann S-type ellipsoid with a₁ = 1, a₂ = r ∈ (0, 1) and f = ζ/Ω₃ (EFE ch. 7 §48;
+    /// f = ±∞ gives the Dedekind ellipsoid computed on its own ray).
+    pub fn riemann_s(&self, r: f64, f: f64) -> Result<Figure> {
+        if f.is_nan() {
+            return Err(Error::invalid(
+                "f",
+                "expected a real number or ±inf, got NaN",
+            ));
+        }
+        self.ellipsoid(r, f.atan(), "Riemann S-type")
+    }
+
+    /// The point where the Jacobi ellipsoids branch off the Maclaurin spheroids: the root in
+    /// e of H₁₁ − H₁₂ − ω² + p a₃ = 0 on the Maclaurin sequence (module docs; EFE: e = 0.81267,
+    /// a₁⁴A₁₁ = a₃²A₃), by bisection to round-off.
+    pub fn maclaurin_jacobi_bifurcation(&self) -> Result<Figure> {
+        let test = |e: f64| -> Result<f64> {
+            let m = self.maclaurin(e)?;
+            let h = self.stiffness(&m.a)?;
+            Ok(h[0][0] - h[1][0] - m.omega * m.omega + m.pressure * m.a[2])
+        };
+        let (mut lo, mut hi) = (0.5, 0.95);
+        let flo = test(lo)?;
+        if (flo > 0.0) == (test(hi)? > 0.0) {
+            return Err(Error::invalid(
+                "bifurcation",
+                "the branch test does not change sign on the Maclaurin sequence for e in (0.5, 0.95)",
+            ));
+        }
+        for _ in 0..200 {
+            let m = 0.5 * (lo + hi);
+            if m <= lo || m >= hi {
+                break;
+            }
+            if (test(m)? > 0.0) == (flo > 0.0) {
+                lo = m;
+            } else {
+                hi = m;
+            }
+        }
+        self.maclaurin(0.5 * (lo + hi))
+    }
+
+    /// The relative equilibrium of the incompressible body with this figure (residuals with the
+    /// pressure, [`RelativeEquilibrium::incompressible`]).
+    pub fn relative_equilibrium(&self, fig: &Figure) -> Result<RelativeEquilibrium> {
+        RelativeEquilibrium::incompressible(
+            self.gravity.as_ref(),
+            &fig.a,
+            &e12(fig.omega),
+            &e12(fig.mu),
+        )
+    }
+
+    /// The incompressible body of this fluid ([`PseudoRigidBody::incompressible`]).
+    pub fn body(&self) -> Result<PseudoRigidBody> {
+        PseudoRigidBody::incompressible(3, self.potential())
+    }
+
+    /// The state (X₀, P₀) = (A₀, ΩA₀ − A₀Λ) of a figure, flat, and its ξ ⊕ η = Ω ⊕ Λ in the
+    /// e_ij coordinates of [`crate::integrate::problem::Symmetric`] (ξ block first).
+    pub fn state(fig: &Figure) -> (Vec<f64>, Vec<f64>) {
+        let (x, om, la) = (diag(&fig.a), e12(fig.omega), e12(fig.mu));
+        let p = &om * &x - &x * &la;
+        let z = (0..9)
+            .map(|k| x[(k / 3, k % 3)])
+            .chain((0..9).map(|k| p[(k / 3, k % 3)]))
+            .collect();
+        (z, vec![fig.omega, 0.0, 0.0, fig.mu, 0.0, 0.0])
+    }
+
+    /// The energy–momentum and spectral stability of a figure under the incompressible full
+    /// dynamics, in the co-moving frame ([`comoving::stability`]; valid at coincident axes).
+    pub fn stability(&self, fig: &Figure) -> Result<comoving::Stability> {
+        let (z, xi) = Self::state(fig);
+        comoving::stability(&self.body()?, &z, &xi)
+    }
+
+    /// The residuals (F₁, F₂, F₃) of a figure's force balance (module docs).
+    pub fn residuals(&self, fig: &Figure) -> Result<[f64; 3]> {
+        self.balance(&fig.a, fig.omega, fig.mu, fig.pressure)
+    }
+
+    /// Physical quantities (module docs).
+    pub fn quantities(&self, fig: &Figure) -> Result<Quantities> {
+        let (g, rho) = (self.gravity.g(), self.gravity.rho());
+        let a = &fig.a;
+        let v = a[0] * a[1] * a[2];
+        let rho_fig = rho / v;
+        let mass = 4.0 * std::f64::consts::PI * rho / 3.0;
+        let abar = v.cbrt();
+        let re = self.relative_equilibrium(fig)?;
+        let omega3 = -fig.omega;
+        let zeta = fig.mu * (a[0] * a[0] + a[1] * a[1]) / (a[0] * a[1]);
+        let lunit = (g * mass.powi(3) * abar).sqrt();
+        let amax = a[0].max(a[1]);
+        Ok(Quantities {
+            e: (1.0 - (a[2] / amax).powi(2)).sqrt(),
+            a2_over_a1: a[1] / a[0],
+            a3_over_a1: a[2] / a[0],
+            omega3,
+            zeta,
+            // A stationary figure (Dedekind's) has f = +∞ (θ = π/2).
+            f: match (omega3 == 0.0, zeta == 0.0) {
+                (true, true) => 0.0,
+                (true, false) => f64::INFINITY,
+                _ => zeta / omega3,
+            },
+            omega2_over_pi_g_rho: finite(
+                "Omega²/(πGρ)",
+                omega3 * omega3 / (std::f64::consts::PI * g * rho_fig),
+            )?,
+            angular_momentum: -0.2 * mass * re.lam[(0, 1)] / lunit,
+            circulation: -0.2 * mass * re.gam[(0, 1)] / lunit,
+            energy: 0.2 * mass * re.energy / (g * mass * mass / abar),
+        })
+    }
+}
+
+/// The family of figures with fixed θ = atan f through a given volume, for
+/// [`crate::analysis::continuation`]: unknowns u = (a₁, a₂, a₃, ω, μ, p), equations F₁..F₄ of the
+/// module docs (F₄ relative: a₁a₂a₃/V − 1) and the ray cos θ·μ(a₁² + a₂²) + sin θ·ω a₁a₂ = 0.
+/// The Jacobian is analytic (the potential's Hessian).
+#[derive(Clone, Debug)]
+pub struct EllipsoidFamily {
+    /// The fluid.
+    pub fluid: Fluid,
+    /// θ = atan f.
+    pub theta: f64,
+    /// The volume a₁a₂a₃ along the family.
+    pub volume: f64,
+}
+
+impl EllipsoidFamily {
+    /// The family of `fig` (its θ and volume).
+    pub fn of(fluid: &Fluid, fig: &Figure) -> Self {
+        EllipsoidFamily {
+            fluid: fluid.clone(),
+            theta: fig.theta,
+            volume: fig.a.iter().product(),
+        }
+    }
+
+    /// u of a figure.
+    pub fn unknowns_of(fig: &Figure) -> Vec<f64> {
+        vec![
+            fig.a[0],
+            fig.a[1],
+            fig.a[2],
+            fig.omega,
+            fig.mu,
+            fig.pressure,
+        ]
+    }
+
+    /// The figure at u (checked: semi-axes > 0, finite).
+    pub fn figure(&self, u: &[f64]) -> Result<Figure> {
+        crate::check::len_of("u", u, 6)?;
+        crate::check::finite_slice("u", u)?;
+        if u[..3].iter().any(|&x| x <= 0.0) {
+            return Err(Error::invalid(
+                "semi-axes",
+                format!(
+                    "expected all > 0, got {:?} (the family left GL+(3))",
+                    &u[..3]
+                ),
+            ));
+        }
+        Ok(Figure {
+            a: [u[0], u[1], u[2]],
+            omega: u[3],
+            mu: u[4],
+            pressure: u[5],
+            theta: self.theta,
+        })
+    }
+
+    /// The direction of the branch crossing at a simple branch point
+    /// ([`continuation::switch_direction`]), oriented so that a₁ − a₂ grows (the ellipsoids
+    /// branching off the Maclaurin spheroids are then numbered with a₁ > a₂, as in EFE).
+    pub fn switch_direction(&self, point: &continuation::Point) -> Result<Vec<f64>> {
+        let mut d = continuation::switch_direction(self, point)?;
+        if d[0] - d[1] < 0.0 {
+            d.iter_mut().for_each(|x| *x = -*x);
+        }
+        Ok(d)
+    }
+
+    /// A named parameter of the figure at u: "e", "a2_over_a1", "a3_over_a1",
+    /// "Omega2_over_piGrho", "L" (angular momentum), "f".
+    pub fn parameter(&self, name: &str, u: &[f64]) -> Result<f64> {
+        let q = self.fluid.quantities(&self.figure(u)?)?;
+        Ok(match name {
+            "e" => q.e,
+            "a2_over_a1" => q.a2_over_a1,
+            "a3_over_a1" => q.a3_over_a1,
+            "Omega2_over_piGrho" => q.omega2_over_pi_g_rho,
+            "L" => q.angular_momentum,
+            "f" => q.f,
+            other => {
+                return Err(Error::invalid(
+                    "parameter",
+                    format!(
+                        "unknown parameter {other:?}; expected one of {:?}",
+                        PARAMETERS
+                    ),
+                ))
+            }
+        })
+    }
+}
+
+/// The parameters [`EllipsoidFamily::parameter`] knows.
+pub const PARAMETERS: [&str; 6] = [
+    "e",
+    "a2_over_a1",
+    "a3_over_a1",
+    "Omega2_over_piGrho",
+    "L",
+    "f",
+];
+
+impl Family for EllipsoidFamily {
+    fn unknowns(&self) -> usize {
+        6
+    }
+
+    fn residual(&self, u: &[f64]) -> Result<Vec<f64>> {
+        let f = self.figure(u)?;
+        let a = &f.a;
+        let b = self.fluid.balance(a, f.omega, f.mu, f.pressure)?;
+        let ray = self.theta.cos() * f.mu * (a[0] * a[0] + a[1] * a[1])
+            + self.theta.sin() * f.omega * a[0] * a[1];
+        Ok(vec![
+            b[0],
+            b[1],
+            b[2],
+            a[0] * a[1] * a[2] / self.volume - 1.0,
+            ray,
+        ])
+    }
+
+    fn jacobian(&self, u: &[f64]) -> Result<Mat> {
+        let f = self.figure(u)?;
+        let (a, w, m, p) = (&f.a, f.omega, f.mu, f.pressure);
+        let h = self.fluid.stiffness(a)?;
+        let (w2, c) = (w * w + m * m, 2.0 * w * m);
+        let (ct, st) = (self.theta.cos(), self.theta.sin());
+        let mut j = Mat::zeros(5, 6);
+        // F₁ = g₁ − w2 a₁ + c a₂ − p a₂a₃
+        j[(0, 0)] = h[0][0] - w2;
+        j[(0, 1)] = h[1][0] + c - p * a[2];
+        j[(0, 2)] = h[2][0] - p * a[1];
+        j[(0, 3)] = -2.0 * w * a[0] + 2.0 * m * a[1];
+        j[(0, 4)] = -2.0 * m * a[0] + 2.0 * w * a[1];
+        j[(0, 5)] = -a[1] * a[2];
+        // F₂ = g₂ − w2 a₂ + c a₁ − p a₁a₃
+        j[(1, 0)] = h[0][1] + c - p * a[2];
+        j[(1, 1)] = h[1][1] - w2;
+        j[(1, 2)] = h[2][1] - p * a[0];
+        j[(1, 3)] = -2.0 * w * a[1] + 2.0 * m * a[0];
+        j[(1, 4)] = -2.0 * m * a[1] + 2.0 * w * a[0];
+        j[(1, 5)] = -a[0] * a[2];
+        // F₃ = g₃ − p a₁a₂
+        j[(2, 0)] = h[0][2] - p * a[1];
+        j[(2, 1)] = h[1][2] - p * a[0];
+        j[(2, 2)] = h[2][2];
+        j[(2, 5)] = -a[0] * a[1];
+        // F₄ = a₁a₂a₃/V − 1
+        j[(3, 0)] = a[1] * a[2] / self.volume;
+        j[(3, 1)] = a[0] * a[2] / self.volume;
+        j[(3, 2)] = a[0] * a[1] / self.volume;
+        // ray = cos θ μ(a₁² + a₂²) + sin θ ω a₁a₂
+        j[(4, 0)] = 2.0 * ct * m * a[0] + st * w * a[1];
+        j[(4, 1)] = 2.0 * ct * m * a[1] + st * w * a[0];
+        j[(4, 3)] = st * a[0] * a[1];
+        j[(4, 4)] = ct * (a[0] * a[0] + a[1] * a[1]);
+        Ok(j)
+    }
+}
+
+/// Follows the family of `start` ([`EllipsoidFamily::of`]) in the named parameter
+/// ([`PARAMETERS`]) until it reaches `stop` ([`continuation::follow`]); with `stability`, the
+/// spectral and the energy–momentum verdicts ([`Fluid::stability`], in this order) are monitored
+/// and their changes located. `direction`: the initial tangent in u (branch switching).
+pub fn follow(
+    family: &EllipsoidFamily,
+    start: &[f64],
+    parameter: &str,
+    stop: f64,
+    stability: bool,
+    direction: Option<&[f64]>,
+    opts: &Options,
+) -> Result<Branch> {
+    family.parameter(parameter, start)?;
+    let param = |u: &[f64]| family.parameter(parameter, u);
+    let monitor = |u: &[f64]| -> Result<Vec<bool>> {
+        let s = family.fluid.stability(&family.figure(u)?)?;
+        Ok(vec![s.spectral.stable, s.energy_momentum.stable])
+    };
+    let mon: Option<continuation::Monitor<'_>> = if stability { Some(&monitor) } else { None };
+    continuation::follow(family, start, &param, stop, mon, direction, opts)
+}
