@@ -5,6 +5,8 @@ Submodules
 lie           matrix Lie groups and algebras: SO(n), SO(3), SE(3), GL+(n), SO(n)×SO(n)
 pseudo_rigid  generalized pseudo-rigid bodies on GL+(n) (inertia tensors, connections, momenta)
 elliptic      Jacobi elliptic functions sn, cn, dn and the integrals K(m), F(phi | m)
+ellipsoids    self-gravitating fluid ellipsoids (Maclaurin, Jacobi, Dedekind, Riemann S-type)
+continuation  continuation of families of relative equilibria, branch points, stability
 
 Systems and integration
 -----------------------
@@ -57,7 +59,7 @@ from ._lieflow import (
     TangentTop,
     WeakFieldTop,
 )
-from . import elliptic, lie, potentials, pseudo_rigid, surfaces
+from . import continuation, ellipsoids, elliptic, lie, potentials, pseudo_rigid, surfaces
 from .integrate import Trajectory, integrate
 
 #: The former name of the base class of the Lie–Poisson systems (kept for existing code).

@@ -1,8 +1,9 @@
 //! Python bindings of lieflow: thin PyO3 wrappers that convert arrays and errors and call
 //! `lieflow`. No mathematics lives here. The folders mirror `crates/core/src`: `lie/`,
-//! `pseudo_rigid/`, `systems/`, `integrate.rs` and `elliptic.rs`; `system.rs` is the one base
+//! `pseudo_rigid/`, `systems/`, `analysis.rs`, `integrate.rs` and `elliptic.rs`; `system.rs` is the one base
 //! class of every system class.
 
+mod analysis;
 mod batch;
 mod convert;
 mod elliptic;
@@ -41,6 +42,8 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     systems::surfaces::register(&surfaces)?;
     m.add("surfaces", surfaces)?;
     add_submodule(m, "elliptic", elliptic::register)?;
+    add_submodule(m, "ellipsoids", pseudo_rigid::ellipsoids::register)?;
+    add_submodule(m, "continuation", analysis::register)?;
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;
     systems::register(m)?;

@@ -59,9 +59,19 @@ class Spec:
             head = self.target.lstrip("@").split(".")[0]
             self.module = {"lie": "lie", "pseudo_rigid": "pseudo_rigid", "potentials": "potentials",
                            "surfaces": "surfaces", "elliptic": "elliptic",
+                           "ellipsoids": "pseudo_rigid", "continuation": "pseudo_rigid",
                            "integrate": "integrate"}.get(head, "systems")
             if head in RECEIVER_MODULE:
                 self.module = RECEIVER_MODULE[head]
+
+
+def _maclaurin_branch(lf):
+    """A short Maclaurin branch through the Jacobi branch point (no stability: fast)."""
+    return lf.continuation.follow(lf.ellipsoids.maclaurin(0.8), "e", 0.815, stability=False)
+
+
+def _branch_point(lf):
+    return next(s for s in _maclaurin_branch(lf).special_points if s.kind == "branch")
 
 
 def A(name, value, kind, **flags):
@@ -174,6 +184,7 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "volumetric": lambda lf: lf.potentials.Volumetric(0.5, 1.4),
     "stretch": lambda lf: lf.potentials.Stretch(1.1),
     "selfgrav": lambda lf: lf.potentials.SelfGravity(1.0, 1.0),
+    "branch": lambda lf: _maclaurin_branch(lf),
     "zero": lambda lf: lf.potentials.Zero(),
     "sum": lambda lf: lf.potentials.Harmonic(1.0) + _svk(lf),
     "callable": lambda lf: lf.potentials.Callable(u_value, u_gradient, u_hessian),
@@ -192,7 +203,7 @@ RECEIVER_MODULE = {**{k: "potentials" for k in ("harmonic", "svk", "volumetric",
                                                   "sum", "callable", "selfgrav")},
                    **{k: "surfaces" for k in ("plane", "sphere", "hyp", "torus", "quadric",
                                               "revolution", "graph", "metric")},
-                   "releq": "pseudo_rigid"}
+                   "releq": "pseudo_rigid", "branch": "pseudo_rigid"}
 # The point of each surface's chart used for its methods.
 SURFACE_POINT = {"plane": [0.2, -0.1], "sphere": [1.0, 0.3], "hyp": [0.1, 1.0],
                  "torus": [0.9, 0.4], "quadric": [0.3, -0.4], "revolution": [0.9, 0.4],
@@ -330,6 +341,28 @@ def build_specs() -> list[Spec]:
         kw=True, opt=True), A("plane", (0, 1), "obj", kw=True, opt=True), slow=True)
     add("RelativeEquilibrium.motion", "@releq.motion", A("t", np.array([0.0, 0.5]), "bcast"))
     add("RelativeEquilibrium.stability", "@releq.stability")
+
+    # ---- lieflow.ellipsoids, lieflow.continuation ----
+    E = "ellipsoids."
+    add(E + "maclaurin", E + "maclaurin", A("e", 0.5, "float"),
+        A("G", 1.0, "float", kw=True, positive=True), A("rho", 1.0, "float", kw=True, positive=True))
+    for f in ("jacobi", "dedekind"):
+        add(E + f, E + f, A("a2_over_a1", 0.6, "float", positive=True))
+    add(E + "riemann_s", E + "riemann_s", A("a2_over_a1", 0.6, "float", positive=True),
+        A("f", -1.0, "float"))
+    add(E + "maclaurin_jacobi_bifurcation", E + "maclaurin_jacobi_bifurcation",
+        A("G", 1.0, "float", kw=True, positive=True), A("rho", 1.0, "float", kw=True, positive=True))
+    add(E + "index_symbols", E + "index_symbols", A("a", A3, "vec"))
+    add("continuation.follow", "continuation.follow",
+        A("start", Lazy(lambda lf: lf.ellipsoids.maclaurin(0.3)), "obj"), A("parameter", "e", "str"),
+        A("stop", 0.32, "float"), A("stability", False, "bool", kw=True),
+        A("step", 1e-2, "float", kw=True, positive=True),
+        A("max_points", 50, "int", kw=True, positive=True), slow=True)
+    add("Branch.values_of", "@branch.values_of", A("name", "Omega2_over_piGrho", "str"))
+    add("Branch.switch", "@branch.switch", A("point", Lazy(_branch_point), "obj"),
+        A("stop", 0.82, "float", kw=True, opt=True), A("direction", 1.0, "float", kw=True),
+        slow=True)
+    add("Branch.plot", "@branch.plot", A("y", "L", "str", kw=True), slow=True)
 
     # ---- lieflow.potentials ----
     add("potentials.Harmonic", "potentials.Harmonic", A("k", 1.3, "float"))

@@ -82,15 +82,18 @@ SKIP = {  # public names that are not callables to fuzz, with the reason
     "lieflow.pseudo_rigid.Verdict": "a record (no methods)",
     "lieflow.potentials.Potential": "made by the potential constructors; methods fuzzed on each",
     "lieflow.surfaces.Surface": "made by the surface constructors; methods fuzzed on each",
+    "lieflow.continuation.Branch": "made by follow; its methods are fuzzed on a branch",
+    "lieflow.continuation.SpecialPoint": "made by follow; a record (attributes only)",
 }
 CLASS_RECEIVER = {**CONSTRUCTORS, "Integration": "run", "Trajectory": "traj",
                   "RollingDisksEquilibrium": "rdeq", "RelativeEquilibrium": "releq",
-                  "Potential": "harmonic", "Surface": "sphere"}
+                  "Potential": "harmonic", "Surface": "sphere", "Branch": "branch"}
 
 
 def public_callables():
     out = []
-    for modname in ("", ".lie", ".pseudo_rigid", ".potentials", ".surfaces", ".elliptic"):
+    for modname in ("", ".lie", ".pseudo_rigid", ".potentials", ".surfaces", ".elliptic",
+                    ".ellipsoids", ".continuation"):
         mod = eval("lf" + modname)
         for name in getattr(mod, "__all__", None) or dir(mod):
             if name.startswith("_"):

@@ -118,6 +118,20 @@ pub struct Point {
     pub parameter: f64,
     /// The monitor's verdicts (empty without a monitor).
     pub stable: Vec<bool>,
+    /// The monitor's margins (see [`Indicator`]).
+    pub margins: Vec<f64>,
+}
+
+/// A monitored verdict at a point: whether it holds, and a continuous margin whose change of
+/// sign marks where it changes (e.g. the smallest eigenvalue of a Hessian). Where the margins
+/// of two points have opposite signs the change is located as the root of the margin (a smooth
+/// test); otherwise by bisection on the verdict. A margin of NaN means "no margin": bisection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Indicator {
+    /// The verdict.
+    pub stable: bool,
+    /// The margin (> 0 where stable, up to the verdict's tolerance), or NaN.
+    pub margin: f64,
 }
 
 /// The kind of a special point.
@@ -183,7 +197,7 @@ pub struct Branch {
 pub type Parameter<'a> = &'a dyn Fn(&[f64]) -> Result<f64>;
 /// Verdicts to monitor along the branch (e.g. the spectral and the energy–momentum stability);
 /// the same number at every point.
-pub type Monitor<'a> = &'a dyn Fn(&[f64]) -> Result<Vec<bool>>;
+pub type Monitor<'a> = &'a dyn Fn(&[f64]) -> Result<Vec<Indicator>>;
 
 fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
@@ -262,7 +276,7 @@ fn correct(
             *vk += rhs[(k, 0)];
             dn = dn.max(rhs[(k, 0)].abs());
         }
-        if !dn.is_finite() {
+        if !dn.is_finite() || v.iter().any(|x| !x.is_finite()) {
             break;
         }
         // Converged, or stagnating at the level of round-off (near a branch point the matrix
@@ -308,7 +322,7 @@ impl Probe<'_> {
         let step =
             |sg: f64| -> Vec<f64> { u.iter().zip(&t).map(|(a, b)| a + sg * h * b).collect() };
         let fold = ((self.parameter)(&step(1.0))? - (self.parameter)(&step(-1.0))?) / (2.0 * h);
-        let stable = match self.monitor {
+        let verdicts = match self.monitor {
             Some(m) => m(&u)?,
             None => Vec::new(),
         };
@@ -319,7 +333,8 @@ impl Probe<'_> {
                 u,
                 tangent: t,
                 parameter,
-                stable,
+                stable: verdicts.iter().map(|v| v.stable).collect(),
+                margins: verdicts.iter().map(|v| v.margin).collect(),
             },
         })
     }
@@ -396,9 +411,16 @@ impl Probe<'_> {
         // between corrected points at σ ± δ, δ = 10⁻³|s|, away from the ill-determined
         // neighbourhood of a branch point (error O(δ⁴)); the bracket's ends if those fail. With σ
         // measured along a's tangent t_a, du/dσ = t/(t·t_a).
-        let root = lo + (flo / (flo - fhi)).clamp(0.0, 1.0) * (hi - lo);
+        let frac = flo / (flo - fhi);
+        let root = lo
+            + if frac.is_finite() {
+                frac.clamp(0.0, 1.0)
+            } else {
+                0.5
+            } * (hi - lo);
         let delta = 1e-3 * s.abs();
         let along = near.point.tangent.clone();
+        let far_fallback = far.clone();
         let (left, right, w, h) = match (
             self.at(&a.point, root - delta),
             self.at(&a.point, root + delta),
@@ -423,7 +445,21 @@ impl Probe<'_> {
                 h00 * left.point.u[k] + h10 * h * d0[k] + h01 * right.point.u[k] + h11 * h * d1[k]
             })
             .collect();
-        self.probe(u, &along)
+        // The branch's own direction there (at a branch point the kernel is two-dimensional and
+        // the probe's tangent arbitrary): the interpolated slope.
+        let mut t: Vec<f64> = d0
+            .iter()
+            .zip(&d1)
+            .map(|(x, y)| (1.0 - w) * x + w * y)
+            .collect();
+        let nt = norm(&t);
+        t.iter_mut().for_each(|x| *x /= nt);
+        if u.iter().chain(&t).any(|x| !x.is_finite()) {
+            return Ok(far_fallback);
+        }
+        let mut p = self.probe(u, &along)?;
+        p.point.tangent = t;
+        Ok(p)
     }
 }
 
@@ -552,13 +588,18 @@ pub fn follow(
         }
         for (w, (&a, &b)) in prev.point.stable.iter().zip(&next.point.stable).enumerate() {
             if a != b {
-                let p = probe.locate(&prev, &next, s, LOCATE_TOL, false, &|q| {
-                    if q.point.stable.get(w) == Some(&a) {
-                        1.0
-                    } else {
-                        -1.0
-                    }
-                })?;
+                let (ma, mb) = (prev.point.margins[w], next.point.margins[w]);
+                let p = if sign_change(ma, mb) {
+                    probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.point.margins[w])?
+                } else {
+                    probe.locate(&prev, &next, s, LOCATE_TOL, false, &|q| {
+                        if q.point.stable.get(w) == Some(&a) {
+                            1.0
+                        } else {
+                            -1.0
+                        }
+                    })?
+                };
                 let mut sp = special_at(Kind::Stability, p, index);
                 sp.verdict = Some(w);
                 found.push((dist(&prev.point, &sp.point), sp));

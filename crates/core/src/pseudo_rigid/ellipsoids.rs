@@ -43,7 +43,7 @@ use super::gravity::SelfGravity;
 use super::potential::{self, Potential};
 use super::system::PseudoRigidBody;
 use crate::analysis::comoving;
-use crate::analysis::continuation::{self, Branch, Family, Options};
+use crate::analysis::continuation::{self, Branch, Family, Indicator, Options};
 use crate::error::{Error, Result};
 use crate::Mat;
 
@@ -403,9 +403,11 @@ impl Fluid {
         let mass = 4.0 * std::f64::consts::PI * rho / 3.0;
         let abar = v.cbrt();
         let re = self.relative_equilibrium(fig)?;
-        let omega3 = -fig.omega;
+        let omega3 = 0.0 - fig.omega; // +0 for a stationary figure
         let zeta = fig.mu * (a[0] * a[0] + a[1] * a[1]) / (a[0] * a[1]);
-        let lunit = (g * mass.powi(3) * abar).sqrt();
+        // (M/5)ℓ/√(GM³ā) = ℓ/(5√(GMā)) and (M/5)H/(GM²/ā) = Hā/(5GM): no powers of M that
+        // under- or overflow.
+        let lunit = 5.0 * (g * mass * abar).sqrt();
         let amax = a[0].max(a[1]);
         Ok(Quantities {
             e: (1.0 - (a[2] / amax).powi(2)).sqrt(),
@@ -423,9 +425,9 @@ impl Fluid {
                 "Omega²/(πGρ)",
                 omega3 * omega3 / (std::f64::consts::PI * g * rho_fig),
             )?,
-            angular_momentum: -0.2 * mass * re.lam[(0, 1)] / lunit,
-            circulation: -0.2 * mass * re.gam[(0, 1)] / lunit,
-            energy: 0.2 * mass * re.energy / (g * mass * mass / abar),
+            angular_momentum: -re.lam[(0, 1)] / lunit,
+            circulation: -re.gam[(0, 1)] / lunit,
+            energy: re.energy * abar / (5.0 * g * mass),
         })
     }
 }
@@ -469,7 +471,6 @@ impl EllipsoidFamily {
     /// The figure at u (checked: semi-axes > 0, finite).
     pub fn figure(&self, u: &[f64]) -> Result<Figure> {
         crate::check::len_of("u", u, 6)?;
-        crate::check::finite_slice("u", u)?;
         if u[..3].iter().any(|&x| x <= 0.0) {
             return Err(Error::invalid(
                 "semi-axes",
@@ -607,9 +608,23 @@ pub fn follow(
 ) -> Result<Branch> {
     family.parameter(parameter, start)?;
     let param = |u: &[f64]| family.parameter(parameter, u);
-    let monitor = |u: &[f64]| -> Result<Vec<bool>> {
+    // Margins: none for the spectral verdict (max Re λ leaves 0 like a square root at a Krein
+    // collision: bisection), the smallest Hessian eigenvalue relative to the largest for the
+    // energy–momentum verdict (a smooth crossing of zero).
+    let monitor = |u: &[f64]| -> Result<Vec<Indicator>> {
         let s = family.fluid.stability(&family.figure(u)?)?;
-        Ok(vec![s.spectral.stable, s.energy_momentum.stable])
+        let em = &s.energy_momentum;
+        let scale = em.min_real_part.abs().max(em.max_real_part.abs());
+        Ok(vec![
+            Indicator {
+                stable: s.spectral.stable,
+                margin: f64::NAN,
+            },
+            Indicator {
+                stable: em.stable,
+                margin: em.min_real_part / scale,
+            },
+        ])
     };
     let mon: Option<continuation::Monitor<'_>> = if stability { Some(&monitor) } else { None };
     continuation::follow(family, start, &param, stop, mon, direction, opts)

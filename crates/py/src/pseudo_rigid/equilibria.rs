@@ -5,6 +5,7 @@
 use std::sync::Arc;
 
 use lieflow::pseudo_rigid::dynamics::FullBody;
+use lieflow::pseudo_rigid::ellipsoids as ell;
 use lieflow::pseudo_rigid::equilibria as eq;
 use lieflow::pseudo_rigid::potential::Potential;
 use lieflow::pseudo_rigid::stability as st;
@@ -283,6 +284,7 @@ fn relative_equilibria(
         .map(|inner| RelativeEquilibrium {
             inner,
             potential: pot.clone(),
+            figure: None,
         })
         .collect())
 }
@@ -293,6 +295,35 @@ fn relative_equilibria(
 pub struct RelativeEquilibrium {
     inner: eq::RelativeEquilibrium,
     potential: Arc<dyn Potential>,
+    /// For the ellipsoidal figures of `lieflow.ellipsoids`: the fluid, the figure and its
+    /// physical quantities (the body is then incompressible).
+    figure: Option<(ell::Fluid, ell::Figure, ell::Quantities)>,
+}
+
+impl RelativeEquilibrium {
+    /// The relative equilibrium of an ellipsoidal figure of equilibrium.
+    pub(crate) fn ellipsoid(fluid: &ell::Fluid, fig: ell::Figure) -> PyResult<Self> {
+        Ok(RelativeEquilibrium {
+            inner: fluid.relative_equilibrium(&fig).py()?,
+            potential: fluid.potential(),
+            figure: Some((fluid.clone(), fig.clone(), fluid.quantities(&fig).py()?)),
+        })
+    }
+
+    /// The fluid and figure (ellipsoids only).
+    pub(crate) fn figure(&self) -> Option<(&ell::Fluid, &ell::Figure)> {
+        self.figure.as_ref().map(|(f, g, _)| (f, g))
+    }
+
+    /// A physical quantity of an ellipsoidal figure, or AttributeError naming it.
+    fn quantity(&self, name: &str, pick: fn(&ell::Quantities) -> f64) -> PyResult<f64> {
+        match &self.figure {
+            Some((_, _, q)) => Ok(pick(q)),
+            None => Err(pyo3::exceptions::PyAttributeError::new_err(format!(
+                "'{name}' is defined for the ellipsoidal figures of lieflow.ellipsoids only"
+            ))),
+        }
+    }
 }
 
 #[pymethods]
@@ -301,6 +332,107 @@ impl RelativeEquilibrium {
     #[getter]
     fn shape<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         py_vec(py, &self.inner.a)
+    }
+
+    /// The semi-axes a (n,) (the same as `shape`).
+    #[getter]
+    fn a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        py_vec(py, &self.inner.a)
+    }
+
+    /// The pressure: the multiplier p of det X = det A0 in dU_xi+eta/dX = p cof X (0 for a
+    /// compressible body).
+    #[getter]
+    fn pressure(&self) -> f64 {
+        self.inner.pressure
+    }
+
+    /// Whether this is a relative equilibrium of the incompressible body.
+    #[getter]
+    fn incompressible(&self) -> bool {
+        self.figure.is_some()
+    }
+
+    /// Ellipsoids: the eccentricity sqrt(1 - a3^2/max(a1, a2)^2).
+    #[getter]
+    fn e(&self) -> PyResult<f64> {
+        self.quantity("e", |q| q.e)
+    }
+
+    /// Ellipsoids: a2/a1.
+    #[getter]
+    fn a2_over_a1(&self) -> PyResult<f64> {
+        self.quantity("a2_over_a1", |q| q.a2_over_a1)
+    }
+
+    /// Ellipsoids: a3/a1.
+    #[getter]
+    fn a3_over_a1(&self) -> PyResult<f64> {
+        self.quantity("a3_over_a1", |q| q.a3_over_a1)
+    }
+
+    /// Ellipsoids: the figure's angular velocity Omega about x3.
+    #[getter]
+    fn Omega(&self) -> PyResult<f64> {
+        self.quantity("Omega", |q| q.omega3)
+    }
+
+    /// Ellipsoids: the vorticity zeta of the internal motion in the figure's frame.
+    #[getter]
+    fn zeta(&self) -> PyResult<f64> {
+        self.quantity("zeta", |q| q.zeta)
+    }
+
+    /// Ellipsoids: f = zeta/Omega (0 Jacobi, inf Dedekind, -2 irrotational).
+    #[getter]
+    fn f(&self) -> PyResult<f64> {
+        self.quantity("f", |q| q.f)
+    }
+
+    /// Ellipsoids: Omega^2/(pi G rho), rho the density of the figure.
+    #[getter]
+    fn Omega2_over_piGrho(&self) -> PyResult<f64> {
+        self.quantity("Omega2_over_piGrho", |q| q.omega2_over_pi_g_rho)
+    }
+
+    /// Ellipsoids: the angular momentum about x3 in units of sqrt(G M^3 abar), abar =
+    /// (a1 a2 a3)^(1/3) (EFE's units).
+    #[getter]
+    fn angular_momentum(&self) -> PyResult<f64> {
+        self.quantity("angular_momentum", |q| q.angular_momentum)
+    }
+
+    /// Ellipsoids: the circulation (x3 component of Gamma, 001 (7.3)) in the units of
+    /// `angular_momentum`.
+    #[getter]
+    fn circulation(&self) -> PyResult<f64> {
+        self.quantity("circulation", |q| q.circulation)
+    }
+
+    /// Ellipsoids: all physical quantities as a dict (the energy in units of G M^2/abar).
+    #[getter]
+    fn quantities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let Some((_, _, q)) = &self.figure else {
+            return Err(pyo3::exceptions::PyAttributeError::new_err(
+                "'quantities' is defined for the ellipsoidal figures of lieflow.ellipsoids only",
+            ));
+        };
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("e", q.e),
+            ("a2_over_a1", q.a2_over_a1),
+            ("a3_over_a1", q.a3_over_a1),
+            ("Omega", q.omega3),
+            ("zeta", q.zeta),
+            ("f", q.f),
+            ("Omega2_over_piGrho", q.omega2_over_pi_g_rho),
+            ("angular_momentum", q.angular_momentum),
+            ("circulation", q.circulation),
+            ("energy", q.energy),
+        ] {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
     }
 
     /// The angular velocity xi = Omega (skew (n, n)).
@@ -363,11 +495,20 @@ impl RelativeEquilibrium {
     /// The two stability verdicts (001 §8): `energy_momentum` (the Hessian of the reduced
     /// Hamiltonian on the symplectic leaf: positive definite => nonlinearly stable; indefinite
     /// => inconclusive) and `spectral` (eigenvalues of the linearised reduced equations
-    /// (7.24)–(7.28) on the leaf: a positive real part => unstable).
+    /// (7.24)–(7.28) on the leaf: a positive real part => unstable). For the incompressible
+    /// figures of `lieflow.ellipsoids` both are computed for the full constrained dynamics in
+    /// the co-moving frame, on the symplectic normal space (valid at coincident axes).
     ///
     /// Raises:
     ///     InvalidArgumentError (not a reduced equilibrium to 1e-8), DegenerateStratumError.
     fn stability(&self) -> PyResult<Stability> {
+        if let Some((fluid, fig)) = self.figure() {
+            let s = fluid.stability(fig).py()?;
+            return Ok(Stability {
+                energy_momentum: s.energy_momentum.into(),
+                spectral: s.spectral.into(),
+            });
+        }
         let n = self.inner.n();
         let body = FullBody::new(n, self.potential.clone()).py()?;
         let s = st::stability(&body, &self.inner.a, &self.inner.xi, &self.inner.eta).py()?;
@@ -378,6 +519,13 @@ impl RelativeEquilibrium {
     }
 
     fn __repr__(&self) -> String {
+        if let Some((_, _, q)) = &self.figure {
+            return format!(
+                "RelativeEquilibrium(a={:?}, e={:.6}, f={:.6}, Omega2_over_piGrho={:.6}, \
+                 residual={:.1e})",
+                self.inner.a, q.e, q.f, q.omega2_over_pi_g_rho, self.inner.residuals.motion
+            );
+        }
         format!(
             "RelativeEquilibrium(shape={:?}, energy={:.6e}, residual={:.1e})",
             self.inner.a, self.inner.energy, self.inner.residuals.motion

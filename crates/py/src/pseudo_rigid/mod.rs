@@ -5,6 +5,7 @@
 //! basis (i < j, row by row) with the xi block first; pairing <xi, eta> = tr(xi.T @ eta) / 2.
 #![allow(non_snake_case)]
 
+pub mod ellipsoids;
 pub mod equilibria;
 pub mod gravity;
 pub mod potential;

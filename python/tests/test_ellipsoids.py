@@ -1,0 +1,109 @@
+"""lieflow.ellipsoids and lieflow.continuation: the fluid ellipsoids as relative equilibria of the
+incompressible pseudo-rigid body, against EFE's closed forms and printed values, Dedekind's
+theorem, the full dynamics, and the Maclaurin–Jacobi bifurcation found by continuation."""
+
+import numpy as np
+import pytest
+
+import lieflow as lf
+
+E = lf.ellipsoids
+
+
+def maclaurin_closed(e):
+    """EFE ch. 5 (32)."""
+    s = np.sqrt(1 - e * e)
+    return 2 * s * (3 - 2 * e * e) * np.arcsin(e) / e**3 - 6 * (1 - e * e) / e**2
+
+
+@pytest.mark.parametrize("e", [0.2, 0.5, 0.81267, 0.95])
+def test_maclaurin_closed_form(e):
+    m = E.maclaurin(e)
+    assert m.e == pytest.approx(e, abs=1e-15)
+    assert m.Omega2_over_piGrho == pytest.approx(maclaurin_closed(e), rel=1e-12)
+    np.testing.assert_allclose(m.a, [1, 1, np.sqrt(1 - e * e)], rtol=1e-15)
+    assert m.residuals["motion"] < 1e-12
+    assert m.f == 0.0 and m.incompressible
+
+
+def test_jacobi_defining_equations_and_efe_values():
+    j = E.jacobi(0.432232)  # Poincaré's point on the Jacobi sequence (EFE Table VI)
+    A, Aij = E.index_symbols(j.a)
+    a = j.a
+    assert a[0] ** 2 * a[1] ** 2 * Aij[0, 1] == pytest.approx(a[2] ** 2 * A[2], rel=1e-12)
+    assert j.Omega2_over_piGrho == pytest.approx(2 * (A[1] - a[0] ** 2 * Aij[0, 1]), rel=1e-12)
+    assert a[2] == pytest.approx(0.345069, abs=2e-6)
+    assert j.Omega2_over_piGrho == pytest.approx(0.284030, abs=2e-6)
+    b = E.maclaurin_jacobi_bifurcation()
+    assert b.e == pytest.approx(0.81267, abs=5e-6)
+    assert b.Omega2_over_piGrho == pytest.approx(0.37423, abs=5e-6)
+
+
+def test_dedekind_theorem_and_riemann_s():
+    j, d = E.jacobi(0.5), E.dedekind(0.5)
+    np.testing.assert_allclose(j.a, d.a, rtol=0, atol=0)
+    assert d.Omega == 0.0 and np.isinf(d.f)
+    assert j.angular_momentum == pytest.approx(d.circulation, rel=1e-13)
+    s = E.riemann_s(0.5, -2.0)
+    assert s.f == pytest.approx(-2.0, rel=1e-12)
+    assert s.zeta + 2 * s.Omega == pytest.approx(0.0, abs=1e-12)
+    assert s.residuals["motion"] < 1e-12
+    assert set(s.quantities) >= {"e", "Omega2_over_piGrho", "angular_momentum", "energy", "f"}
+
+
+def test_motion_and_full_dynamics_agree():
+    j = E.jacobi(0.7)
+    body = lf.PseudoRigidBody(3, lf.potentials.SelfGravity(), incompressible=True)
+    period = 2 * np.pi / j.Omega
+    X0, P0 = j.motion([0.0])
+    tr = lf.integrate(body, (X0[0], P0[0]), dt=period / 200, steps=2000, method="rattle6",
+                      save_every=200)
+    X, _ = j.motion(tr.t)
+    np.testing.assert_allclose(tr.X, X, atol=1e-8)
+    assert np.abs(np.linalg.det(tr.X) / np.prod(j.a) - 1).max() < 1e-13
+
+
+def test_stability_verdicts():
+    assert E.maclaurin(0.5).stability().spectral.stable
+    assert not E.maclaurin(0.97).stability().spectral.stable
+    assert E.jacobi(0.6).stability().spectral.stable
+
+
+def test_continuation_diagram():
+    mac = lf.continuation.follow(E.maclaurin(0.3), "e", 0.97)
+    assert mac.end == "reached" and mac.values[-1] == pytest.approx(0.97, abs=1e-12)
+    kinds = [s.kind for s in mac.special_points]
+    assert "branch" in kinds
+    bp = next(s for s in mac.special_points if s.kind == "branch")
+    assert bp.e == pytest.approx(E.maclaurin_jacobi_bifurcation().e, abs=1e-10)
+    lost = [s for s in mac.special_points if s.kind == "stability" and s.verdict == "spectral"]
+    assert len(lost) == 1 and lost[0].e == pytest.approx(0.95289, abs=5e-6)
+    assert mac.stability[0] and not mac.stability[-1]
+    jac = mac.switch(bp, parameter="a2_over_a1", stop=0.5, )
+    assert jac.end == "reached"
+    last = jac.points[-1]
+    assert last.a2_over_a1 == pytest.approx(0.5, abs=1e-12)
+    assert last.a3_over_a1 == pytest.approx(E.jacobi(0.5).a3_over_a1, abs=1e-10)
+    assert jac.stability.all()
+    with pytest.raises(lf.InvalidArgumentError):
+        mac.switch(lost[0])
+
+
+def test_bad_input_is_typed():
+    with pytest.raises(lf.InvalidArgumentError):
+        E.maclaurin(1.0)
+    with pytest.raises(lf.InvalidArgumentError):
+        E.jacobi(1.5)
+    with pytest.raises(lf.InvalidArgumentError):
+        E.riemann_s(0.5, float("nan"))
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.continuation.follow(E.maclaurin(0.3), "nope", 0.5)
+    with pytest.raises(lf.ArgumentTypeError):
+        E.maclaurin("0.3")
+    eq = lf.pseudo_rigid.relative_equilibria(lf.potentials.Stretch(1.0), shape=[1.3, 1.1, 1.0],
+                                             plane=(0, 1))
+    assert eq
+    with pytest.raises(AttributeError):
+        eq[0].Omega2_over_piGrho
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.continuation.follow(eq[0])
