@@ -1,7 +1,9 @@
 //! Pseudo-arclength continuation on families with known geometry: a pitchfork (branch point,
 //! switching), a circle (folds), a monitored verdict (its change located).
 
-use lieflow::analysis::continuation::{follow, switch_direction, End, Family, Kind, Options};
+use lieflow::analysis::continuation::{
+    follow, switch_direction, End, Family, Indicator, Kind, Options,
+};
 use lieflow::{Mat, Result};
 
 /// F(x, λ) = x(λ − x²): the branches x = 0 and λ = x² cross at the pitchfork (0, 0).
@@ -114,7 +116,19 @@ fn circle_folds_located() {
 #[test]
 fn monitor_change_located() {
     let opts = Options::default();
-    let monitor = |u: &[f64]| -> Result<Vec<bool>> { Ok(vec![u[1] < 0.3, true]) };
+    // A verdict with a smooth margin (0.3 − λ) and one without (NaN: bisection).
+    let monitor = |u: &[f64]| -> Result<Vec<Indicator>> {
+        Ok(vec![
+            Indicator {
+                stable: u[1] < 0.3,
+                margin: 0.3 - u[1],
+            },
+            Indicator {
+                stable: u[1] < 0.6,
+                margin: f64::NAN,
+            },
+        ])
+    };
     let b = follow(
         &Pitchfork,
         &[0.0, -1.0],
@@ -130,13 +144,15 @@ fn monitor_change_located() {
         .iter()
         .filter(|s| s.kind == Kind::Stability)
         .collect();
-    assert_eq!(st.len(), 1);
+    assert_eq!(st.len(), 2);
     assert_eq!(st[0].verdict, Some(0));
-    assert!((st[0].point.parameter - 0.3).abs() < 1e-10);
-    assert_eq!(st[0].point.stable, vec![false, true]);
+    assert!((st[0].point.parameter - 0.3).abs() < 1e-12);
+    assert_eq!(st[1].verdict, Some(1));
+    assert!((st[1].point.parameter - 0.6).abs() < 1e-10);
+    assert_eq!(st[1].point.stable, vec![false, false]);
     // Special points come in the order met: the branch point (λ = 0) before λ = 0.3.
     let kinds: Vec<_> = b.special.iter().map(|s| s.kind).collect();
-    assert_eq!(kinds, vec![Kind::Branch, Kind::Stability]);
+    assert_eq!(kinds, vec![Kind::Branch, Kind::Stability, Kind::Stability]);
 }
 
 #[test]
