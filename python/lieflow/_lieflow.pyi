@@ -29,6 +29,8 @@ lie: ModuleType
 pseudo_rigid: ModuleType
 potentials: ModuleType
 elliptic: ModuleType
+ellipsoids: ModuleType
+continuation: ModuleType
 
 
 class Integration:

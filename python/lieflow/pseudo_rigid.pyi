@@ -147,12 +147,26 @@ class Stability:
 
 class RelativeEquilibrium:
     shape: F64
+    a: F64
     xi: F64
     eta: F64
     L: F64
     Gamma: F64
     energy: float
+    pressure: float
+    incompressible: bool
     residuals: dict[str, float]
+    # The figures of lieflow.ellipsoids only (AttributeError otherwise):
+    e: float
+    a2_over_a1: float
+    a3_over_a1: float
+    Omega: float
+    zeta: float
+    f: float
+    Omega2_over_piGrho: float
+    angular_momentum: float
+    circulation: float
+    quantities: dict[str, float]
     def motion(self, t: ArrayLike) -> tuple[F64, F64]:
         """(X(t), P(t)), each (k, n, n)."""
     def stability(self) -> Stability: ...
