@@ -544,7 +544,11 @@ fn comoving_route_agrees_with_the_reduced_leaf() {
                 .iter()
                 .map(|&(r2, i2)| (r2 - re).hypot(i2 - im))
                 .fold(f64::INFINITY, f64::min);
-            assert!(d < 1e-6 * radius, "{p:?}: no match for ({re}, {im}): {:?}", c.spectral);
+            assert!(
+                d < 1e-6 * radius,
+                "{p:?}: no match for ({re}, {im}): {:?}",
+                c.spectral
+            );
         }
     }
 }
