@@ -107,3 +107,66 @@ def test_bad_input_is_typed():
         eq[0].Omega2_over_piGrho
     with pytest.raises(lf.InvalidArgumentError):
         lf.continuation.follow(eq[0])
+
+
+# --- regressions of the review (units, branch location from either side, switching, stops) ---
+
+@pytest.mark.parametrize("G,rho", [(6.674e-11, 1.0), (6.674e-11, 1e3), (1e8, 1.0), (1e-14, 1.0)])
+def test_verdicts_do_not_depend_on_units(G, rho):
+    for e, stable in ((0.5, True), (0.97, False)):
+        s = E.maclaurin(e, G=G, rho=rho).stability()
+        assert s.spectral.stable is stable
+    assert E.maclaurin(0.5, G=G, rho=rho).stability().energy_momentum.stable
+    b = lf.continuation.follow(E.maclaurin(0.3, G=G, rho=rho), "e", 0.9, stability=False)
+    bp = [s for s in b.special_points if s.kind == "branch"]
+    assert len(bp) == 1 and bp[0].e == pytest.approx(0.812670010611743, abs=1e-10)
+
+
+def test_branch_point_from_the_ellipsoid_side_and_switch_back():
+    jb = lf.continuation.follow(E.jacobi(0.8), "a2_over_a1", 1.2, stability=False)
+    (bp,) = jb.special_points
+    assert bp.kind == "branch" and bp.a2_over_a1 == pytest.approx(1.0, abs=1e-8)
+    assert bp.e == pytest.approx(0.812670010611743, abs=1e-9)
+    mac = jb.switch(bp, parameter="e", stop=0.9)
+    assert mac.end == "reached"
+    a = mac.points[-1].a
+    assert a[0] == pytest.approx(a[1], rel=1e-12)  # back on the Maclaurin spheroids
+
+
+def test_no_special_points_past_the_stop_or_at_a_switched_start():
+    mac = lf.continuation.follow(E.maclaurin(0.3), "e", 0.9)
+    bp = next(s for s in mac.special_points if s.kind == "branch")
+    jac = mac.switch(bp)
+    assert jac.special_points == []
+    short = lf.continuation.follow(E.maclaurin(0.5), "e", 0.8, stability=False)
+    assert short.special_points == []
+
+
+def test_families_of_riemann_s_and_dedekind():
+    r = lf.continuation.follow(E.riemann_s(0.6, -2.0), "a2_over_a1", 0.99)
+    assert r.end == "reached"
+    assert np.allclose(r.values_of("f"), -2.0, atol=1e-9)
+    d = lf.continuation.follow(E.dedekind(0.8), "a2_over_a1", 0.4, stability=False)
+    assert all(p.Omega == 0.0 for p in d.points)
+    assert np.isinf(d.values_of("f")).all()
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.continuation.follow(E.jacobi(0.6), "f", 1.0)
+
+
+def test_jacobi_at_and_near_the_bifurcation():
+    a3 = E.maclaurin_jacobi_bifurcation().a[2]
+    for r in (1.0, 1 - 1e-15, 1 - 1e-9):
+        assert E.jacobi(r).a[2] == pytest.approx(a3, abs=1e-8)
+    assert E.riemann_s(0.5, 1e10).zeta == pytest.approx(E.riemann_s(0.5, 1e16).zeta, rel=1e-9)
+    assert E.riemann_s(0.5, -1e10).f == pytest.approx(-1e10, rel=1e-12)
+
+
+def test_argument_validation():
+    m = E.maclaurin(0.3)
+    for kw in (dict(stop=float("nan")), dict(stop=float("inf")), dict(max_points=1),
+               dict(step=1e-12)):
+        with pytest.raises(lf.InvalidArgumentError):
+            lf.continuation.follow(m, "e", **({"stop": 0.5} | kw))
+    b = lf.continuation.follow(E.maclaurin(0.8), "e", 0.82, stability=False)
+    with pytest.raises(lf.InvalidArgumentError):
+        b.switch(b.special_points[0], direction=0.0)

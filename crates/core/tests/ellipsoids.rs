@@ -195,8 +195,8 @@ fn jacobi_stays_on_its_relative_equilibrium_for_100_periods() {
 fn continuation_maclaurin_to_jacobi() {
     let fl = fluid();
     let start = fl.maclaurin(0.3).unwrap();
-    let family = EllipsoidFamily::of(&fl, &start);
-    let u0 = EllipsoidFamily::unknowns_of(&start);
+    let family = EllipsoidFamily::of(&fl, &start).unwrap();
+    let u0 = family.unknowns_of(&start);
     let opts = Options::default();
     let b = match ellipsoids::follow(&family, &u0, "e", 0.99, true, None, &opts) {
         Ok(b) => b,

@@ -81,8 +81,11 @@ fn run(
 /// keeps its f = zeta/Omega and its volume) in the named `parameter` ("e", "a2_over_a1",
 /// "a3_over_a1", "Omega2_over_piGrho", "L", "f") until it reaches `stop`, by pseudo-arclength
 /// continuation of the reduced equations (semi-axes, velocities, pressure: no symmetry
-/// degeneracy). Branch points, folds of the parameter and, with `stability=True`, changes of
-/// the spectral and energy–momentum verdicts are located to ~1e-11.
+/// degeneracy). Branch points and folds of the parameter and, with `stability=True`, changes of
+/// the spectral and energy–momentum verdicts are located (branch points to ~1e-10 in the
+/// parameter, energy–momentum changes to ~1e-8: that Hessian is a finite difference). Special
+/// points are reported up to `stop`. If a point cannot be evaluated the branch ends there
+/// (`end` = "stuck: ...") and what was found is returned. Not picklable.
 ///
 /// Args:
 ///     start: the first point.
@@ -117,20 +120,36 @@ fn follow(
              dedekind, riemann_s)",
         )));
     };
-    if !(step > 0.0 && max_step >= step) {
+    if !stop.is_finite() {
         return Err(to_py(Error::invalid(
-            "step",
-            format!("expected 0 < step <= max_step, got step = {step}, max_step = {max_step}"),
+            "stop",
+            format!("expected a finite value, got {stop}"),
         )));
     }
-    let family = EllipsoidFamily::of(fluid, fig);
+    let min_step = Options::default().min_step;
+    if !(step >= min_step && max_step >= step && max_step.is_finite()) {
+        return Err(to_py(Error::invalid(
+            "step",
+            format!(
+                "expected {min_step:e} <= step <= max_step < inf, got step = {step}, \
+                 max_step = {max_step}"
+            ),
+        )));
+    }
+    if max_points < 2 {
+        return Err(to_py(Error::invalid(
+            "max_points",
+            format!("expected at least 2, got {max_points}"),
+        )));
+    }
+    let family = EllipsoidFamily::of(fluid, fig).py()?;
     let opts = Options {
         step,
         max_step,
-        max_points: max_points.max(2),
+        max_points,
         ..Options::default()
     };
-    let u = EllipsoidFamily::unknowns_of(fig);
+    let u = family.unknowns_of(fig);
     run(
         py,
         family,
@@ -216,20 +235,20 @@ impl Branch {
     }
 
     /// Follows the other branch through a special point of kind "branch" (the kernel direction
-    /// orthogonal to this branch, oriented so that a1 - a2 grows; `direction` = -1 takes the
-    /// opposite sense), in `parameter` (default: this branch's) until `stop` (default: this
-    /// branch's).
+    /// orthogonal to the branch the point was found on), in `parameter` (default: this
+    /// branch's) until `stop` (default: this branch's). `direction`: None (the default) goes
+    /// the way the parameter moves towards `stop`; +1 the way a1 - a2 grows, -1 the other way.
     ///
     /// Raises:
     ///     InvalidArgumentError (not a branch point of this family).
-    #[pyo3(signature = (point, *, stop = None, parameter = None, direction = 1.0))]
+    #[pyo3(signature = (point, *, stop = None, parameter = None, direction = None))]
     fn switch(
         &self,
         py: Python<'_>,
         point: PyRef<'_, SpecialPoint>,
         #[pyo3(from_py_with = real_opt)] stop: Option<f64>,
         parameter: Option<&str>,
-        #[pyo3(from_py_with = real)] direction: f64,
+        #[pyo3(from_py_with = real_opt)] direction: Option<f64>,
     ) -> PyResult<Branch> {
         if point.inner.kind != cont::Kind::Branch {
             return Err(to_py(Error::invalid(
@@ -240,16 +259,50 @@ impl Branch {
                 ),
             )));
         }
-        let mut dir = self.family.switch_direction(&point.inner.point).py()?;
-        if direction < 0.0 {
+        // The family the point was found on (not necessarily this branch's).
+        let family = point.family.clone();
+        let parameter = parameter.unwrap_or(&self.parameter).to_owned();
+        let stop = stop.unwrap_or(self.stop);
+        if !stop.is_finite() {
+            return Err(to_py(Error::invalid(
+                "stop",
+                format!("expected a finite value, got {stop}"),
+            )));
+        }
+        let mut dir = family.switch_direction(&point.inner.point).py()?;
+        let u = &point.inner.point.u;
+        let flip = match direction {
+            Some(1.0) => false,
+            Some(-1.0) => true,
+            Some(d) => {
+                return Err(to_py(Error::invalid(
+                    "direction",
+                    format!("expected None, 1 or -1, got {d}"),
+                )))
+            }
+            None => {
+                // Towards `stop`: the sign of dπ/ds along the direction.
+                let h = 1e-6 * (1.0 + u.iter().map(|x| x * x).sum::<f64>().sqrt());
+                let at = |sg: f64| -> PyResult<f64> {
+                    let v: Vec<f64> = u.iter().zip(&dir).map(|(a, b)| a + sg * h * b).collect();
+                    family.parameter(&parameter, &v).py()
+                };
+                let (pp, pm) = (at(1.0)?, at(-1.0)?);
+                let here = family.parameter(&parameter, u).py()?;
+                // A parameter even in the direction (e at a symmetric pitchfork): a1 - a2 grows.
+                let slope = (pp - pm) / (2.0 * h);
+                slope.abs() > 1e-6 * (1.0 + here.abs()) && slope * (stop - here) < 0.0
+            }
+        };
+        if flip {
             dir.iter_mut().for_each(|x| *x = -*x);
         }
         run(
             py,
-            self.family.clone(),
-            point.inner.point.u.clone(),
-            parameter.unwrap_or(&self.parameter).to_owned(),
-            stop.unwrap_or(self.stop),
+            family,
+            u.clone(),
+            parameter,
+            stop,
             self.monitored,
             Some(dir),
             self.opts.clone(),

@@ -31,7 +31,13 @@
 //! squares). The second variation of H_ξ on N is that of the Lagrange function
 //! ℒ = H_ξ − κ·Φ on T_{z₀}N; restricted to C it is the energy–momentum Hessian: positive
 //! definite ⇒ the relative equilibrium is nonlinearly stable modulo G_μ (Patrick 1992; Simo,
-//! Lewis & Marsden 1991). ∇H = (−f(q), M⁻¹p) analytic, ∇⟨J, ξ⟩ by central differences (exact:
+//! Lewis & Marsden 1991).
+//!
+//! # Units
+//! Positions and momenta have different units. The subspaces are built and orthonormalised in
+//! the scaled coordinates z̃ = (q/ℓ, p/π) (ℓ = ‖q₀‖, π = ‖p₀‖, or ℓ·√(‖∇U‖/ℓ) at rest), the
+//! finite-difference steps follow the same scales, and both matrices are those of the scaled
+//! coordinates: the verdicts and the relative tolerances do not depend on the units. ∇H = (−f(q), M⁻¹p) analytic, ∇⟨J, ξ⟩ by central differences (exact:
 //! J is quadratic), ∇Φ from G and the polarised curvature D²g(q)[v, w]; D²ℒ by central
 //! differences of ∇ℒ with Richardson.
 
@@ -188,7 +194,14 @@ pub fn stability<P: Constrained + Symmetric>(
     let f0 = field(z0, &mut scratch)?;
     let gen0 = problem.generator(xi, z0)?;
     let resid: Vec<f64> = f0.iter().zip(&gen0).map(|(a, b)| a - b).collect();
-    let scale = norm(&f0) + norm(&gen0);
+    // The scale of the terms that cancel at a relative equilibrium: the velocity, the potential
+    // force (balanced by the constraint force: hydrostatic equilibrium of a near-static figure),
+    // and the generator ‖ξ‖‖z₀‖.
+    let mut force0 = vec![0.0; d];
+    problem
+        .force(&z0[..d], &mut force0, &mut scratch)
+        .map_err(|v| v.at_start())?;
+    let scale = norm(&f0) + norm(&gen0) + norm(&force0) + norm(xi) * norm(z0);
     let residual = if norm(&resid) == 0.0 {
         0.0
     } else {
@@ -266,32 +279,52 @@ pub fn stability<P: Constrained + Symmetric>(
         }
     }
 
-    // S = ker [dΦ; dJ]; the isotropy orbit W = Gen · ker(dJ · Gen); C = S ⊖ W.
+    // Positions and momenta have different units: the subspaces are built, and orthonormalised,
+    // in the scaled coordinates z̃ = (q/ℓ, p/π) with ℓ = ‖q‖ and π = ‖p‖, or for a state at
+    // rest the momentum ℓ·√(‖∇U‖/ℓ) the potential's force builds up in unit time. So the
+    // verdicts and their tolerances do not depend on the units (of time, mass or length).
+    let (q0, p0) = z0.split_at(d);
+    let ell = norm(q0).max(f64::MIN_POSITIVE);
+    let pi = norm(p0).max(ell * (norm(&force0) / ell).sqrt());
+    let pi = if pi > 0.0 { pi } else { 1.0 };
+    let wz: Vec<f64> = (0..nz).map(|i| if i < d { ell } else { pi }).collect();
+
+    // S = ker [dΦ; dJ]; the isotropy orbit W = Gen · ker(dJ · Gen); C = S ⊖ W (in z̃: row
+    // vectors times diag(w), generators divided by w).
     let rows = 2 * m + g;
     let stack = Mat::from_fn(rows, nz, |i, j| {
-        if i < 2 * m {
-            dphi[i][j]
-        } else {
-            dj[(i - 2 * m, j)]
-        }
+        wz[j]
+            * if i < 2 * m {
+                dphi[i][j]
+            } else {
+                dj[(i - 2 * m, j)]
+            }
     });
+    let gens_s = Mat::from_fn(nz, g, |i, j| gens[(i, j)] / wz[i]);
     let s_basis = null_space(&stack)?;
     let iso = null_space(&(&dj * &gens))?;
-    let w_basis = range(&(&gens * &iso))?;
+    let w_basis = range(&(&gens_s * &iso))?;
     // Coordinates of W in S, then the complement inside S.
     let w_in_s = s_basis.transpose() * &w_basis;
     let comp = null_space(&w_in_s.transpose().to_owned())?;
-    let c = &s_basis * &comp;
-    let k = c.ncols();
+    let cs = &s_basis * &comp;
+    let k = cs.ncols();
+    // C in z (columns diag(w)·c̃) and its left inverse on the normal space, c̃ᵀ diag(1/w).
+    let c = Mat::from_fn(nz, k, |i, j| wz[i] * cs[(i, j)]);
+    let c_left = Mat::from_fn(k, nz, |i, j| cs[(j, i)] / wz[j]);
 
-    // Spectral: L = Cᵀ DF C.
+    // Spectral: L = C⁺ DF C with C⁺ = c̃ᵀ diag(1/w), the linearisation in z̃ on the normal space.
+    // Steps: positions on the scale of ‖q‖, momenta on that of ‖p‖ or, for a state at rest, of
+    // the momentum ‖q‖·√(‖∇U‖/‖q‖) the potential's force would build up in unit time; the two
+    // blocks have different units, so one scale would misjudge one of them.
     let hz: Vec<f64> = z0
         .iter()
-        .map(|x| 1e-4 * x.abs().max(1e-2 * zscale))
+        .zip(&wz)
+        .map(|(x, w)| 1e-4 * x.abs().max(1e-2 * w))
         .collect();
     let df = jacobian(&comoving, z0, &hz)?;
     check::finite_mat("co-moving Jacobian", &df)?;
-    let lin = c.transpose() * &df * &c;
+    let lin = &c_left * &df * &c;
     let spectral = Verdict::spectral(&lin, SPECTRAL_TOL)?;
 
     // Energy–momentum: multipliers κ from ∇H_ξ = dΦᵀκ, then Cᵀ D²ℒ C.

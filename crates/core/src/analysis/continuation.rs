@@ -17,9 +17,14 @@
 //! - **Test functions** between consecutive points: a simple branch point is where
 //!   τ_B = det [DF(u); tᵀ] changes sign (the augmented Jacobian is singular there and only there
 //!   on a regular branch); a fold in the parameter π is where τ_F = ∇π·t changes sign; a
-//!   monitor change is where the verdict differs. Each is located by bisection (with a secant
-//!   step for the smooth τ) in the arclength σ from the previous point, every trial point being
-//!   a corrected point of the branch, until the parameter is known to [`LOCATE_TOL`].
+//!   monitor change is where the verdict differs. Each is located in the arclength σ from the
+//!   previous point: secant steps and bisection on corrected points (each corrected from the
+//!   Hermite interpolant of the bracket), then, for a smooth test, the root of the cubic through
+//!   the test at four well-determined points around it. The bracket is narrowed to
+//!   [`LOCATE_TOL`]; what is reached depends on the test's own accuracy: branch points of the
+//!   ellipsoid families to ~1e-10 in the parameter, folds in the parameter's value to ~1e-10 (in
+//!   position to ~1e-6: the parameter is flat there), a verdict's margin as well as the
+//!   margin is computed (an energy–momentum Hessian by finite differences: ~1e-8).
 //! - **Switching.** At a simple branch point ker DF is two-dimensional; the direction of the
 //!   other branch is the kernel vector orthogonal to the tangent of the followed one (exact for
 //!   the symmetry-breaking pitchforks of relative equilibria; in general the start of a Newton
@@ -30,8 +35,8 @@ use crate::error::{Error, Result};
 use crate::Mat;
 use faer::linalg::solvers::Solve;
 
-/// How precisely special points are located: the parameter to this relative tolerance
-/// (relative to 1 + |π|).
+/// The bracket of a special point is narrowed until the parameter is known to this relative
+/// tolerance (relative to 1 + |π|); the accuracy reached also depends on the test (module docs).
 pub const LOCATE_TOL: f64 = 1e-11;
 
 /// Newton iterations of the corrector.
@@ -39,6 +44,10 @@ const MAX_NEWTON: usize = 12;
 
 /// A corrector whose update stops decreasing is accepted below this relative size.
 const STAGNATION: f64 = 1e-10;
+
+/// A fold is tested only where |dπ/ds| exceeds this (relative to 1 + |π|) on one side: a
+/// parameter constant along the family has a derivative of round-off size and random sign.
+const FOLD_FLOOR: f64 = 1e-8;
 
 /// A one-parameter family: the zero set of F: ℝᴺ → ℝᴺ⁻¹ near a regular point is a curve.
 pub trait Family {
@@ -49,7 +58,7 @@ pub trait Family {
     fn residual(&self, u: &[f64]) -> Result<Vec<f64>>;
 
     /// DF(u), an (N−1)×N matrix. The default is central differences with steps
-    /// 1e-6·max(1, |u_k|) and one Richardson extrapolation (error ~1e-12 relative for smooth F).
+    /// 1e-4·max(1, |u_k|) and one Richardson extrapolation (error ~1e-12 relative for smooth F).
     fn jacobian(&self, u: &[f64]) -> Result<Mat> {
         let n = u.len();
         let mut cols = Vec::with_capacity(n);
@@ -255,8 +264,20 @@ fn correct(
     s: f64,
     tol: f64,
 ) -> Result<(Vec<f64>, usize)> {
+    let guess: Vec<f64> = u.iter().zip(t).map(|(a, b)| a + s * b).collect();
+    correct_from(family, u, t, s, tol, guess)
+}
+
+/// [`correct`] from the initial guess `v` (on the hyperplane or not).
+fn correct_from(
+    family: &dyn Family,
+    u: &[f64],
+    t: &[f64],
+    s: f64,
+    tol: f64,
+    mut v: Vec<f64>,
+) -> Result<(Vec<f64>, usize)> {
     let n = u.len();
-    let mut v: Vec<f64> = u.iter().zip(t).map(|(a, b)| a + s * b).collect();
     let scale = 1.0 + norm(u);
     let mut prev = f64::INFINITY;
     for iter in 1..=MAX_NEWTON {
@@ -347,11 +368,15 @@ impl Probe<'_> {
 
     /// Locates where `test` changes sign between `a` (σ = 0) and `b` (σ = s): secant steps
     /// (every third a bisection) on corrected points until the parameter is known to
-    /// `rel_tol`·(1 + |π|) or the corrector fails (within ~1e-9 of a branch point the corrected
-    /// points are ill-determined: the two branches cross). For a `smooth` test the result is the
-    /// root of the test's linear interpolation on the last bracket, the point there by cubic
-    /// Hermite interpolation of the bracket's points and tangents (error O(Δσ⁴)); otherwise
-    /// (a verdict) the corrected point on the far side of the change.
+    /// `rel_tol`·(1 + |π|) or the corrector fails repeatedly (within ~1e-9 of a branch point the
+    /// corrected points are ill-determined: the two branches cross). Each trial point is
+    /// corrected from the cubic Hermite interpolant of the current bracket (its error O(Δσ⁴)
+    /// stays inside Newton's basin, which shrinks near a branch point). For a `smooth` test the
+    /// result is the root of the test's linear interpolation on the last bracket, the point
+    /// there by Hermite interpolation between corrected points at σ ± δ, δ = 10⁻³|s|, away from
+    /// the ill-determined neighbourhood (error O(δ⁴)); otherwise (a verdict) the corrected point
+    /// on the far side of the change. A point that cannot be evaluated ends the search with the
+    /// bracket found so far.
     fn locate(
         &self,
         a: &Probed,
@@ -360,12 +385,13 @@ impl Probe<'_> {
         rel_tol: f64,
         smooth: bool,
         test: &dyn Fn(&Probed) -> f64,
-    ) -> Result<Probed> {
+    ) -> Probed {
         let (mut lo, mut hi) = (0.0, s);
         let (mut flo, mut fhi) = (test(a), test(b));
         let (mut near, mut far) = (a.clone(), b.clone());
         let tol = rel_tol * (1.0 + a.point.parameter.abs());
         let dpds = (b.point.parameter - a.point.parameter).abs() / s.abs().max(f64::MIN_POSITIVE);
+        let ta = &a.point.tangent;
         // A trial where the corrector failed (near a branch point): the next trials approach
         // it from the two sides of the bracket in turn.
         let mut bad: Option<f64> = None;
@@ -386,7 +412,10 @@ impl Probe<'_> {
             } else {
                 0.5 * (lo + hi)
             };
-            match self.at(&a.point, mid) {
+            let guess = hermite(&near, &far, ta, (mid - lo) / (hi - lo), hi - lo);
+            let trial = correct_from(self.family, &a.point.u, ta, mid, self.tol, guess)
+                .and_then(|(v, _)| self.probe(v, ta));
+            match trial {
                 Err(_) => {
                     bad = Some(mid);
                     failures += 1;
@@ -394,7 +423,7 @@ impl Probe<'_> {
                 Ok(p) => {
                     let fm = test(&p);
                     if fm == 0.0 {
-                        return Ok(p);
+                        return p;
                     }
                     if (fm > 0.0) == (flo > 0.0) {
                         (lo, flo, near) = (mid, fm, p);
@@ -405,12 +434,8 @@ impl Probe<'_> {
             }
         }
         if !smooth {
-            return Ok(far);
+            return far;
         }
-        // The root of the interpolated test; the point there by cubic Hermite interpolation
-        // between corrected points at σ ± δ, δ = 10⁻³|s|, away from the ill-determined
-        // neighbourhood of a branch point (error O(δ⁴)); the bracket's ends if those fail. With σ
-        // measured along a's tangent t_a, du/dσ = t/(t·t_a).
         let frac = flo / (flo - fhi);
         let root = lo
             + if frac.is_finite() {
@@ -418,35 +443,55 @@ impl Probe<'_> {
             } else {
                 0.5
             } * (hi - lo);
+        // Refine on four well-determined points σ = r + kδ, k = ±1, ±2, around the current
+        // estimate r: the root of the cubic through the test's values there (error O(δ⁴)),
+        // repeated until it settles (the first estimate may come from a wide bracket); the point
+        // by Hermite interpolation between k = −1 and k = 1.
         let delta = 1e-3 * s.abs();
-        let along = near.point.tangent.clone();
-        let far_fallback = far.clone();
-        let (left, right, w, h) = match (
-            self.at(&a.point, root - delta),
-            self.at(&a.point, root + delta),
-        ) {
-            (Ok(l), Ok(r)) => (l, r, 0.5, 2.0 * delta),
-            _ => (near, far, (root - lo) / (hi - lo), hi - lo),
+        let mut r = root;
+        let mut stencil: Option<Vec<Probed>> = None;
+        for _ in 0..6 {
+            let pts: Option<Vec<Probed>> = [-2.0, -1.0, 1.0, 2.0]
+                .iter()
+                .map(|k| self.at(&a.point, r + k * delta).ok())
+                .collect();
+            let Some(pts) = pts else {
+                break;
+            };
+            let xs: Vec<f64> = [-2.0, -1.0, 1.0, 2.0]
+                .iter()
+                .map(|k| r + k * delta)
+                .collect();
+            let ys: Vec<f64> = pts.iter().map(test).collect();
+            let next = cubic_root(&xs, &ys, r);
+            let moved = (next - r).abs();
+            if moved <= 2.0 * delta {
+                stencil = Some(pts);
+                let settled = moved <= 1e-12 * (1.0 + r.abs());
+                r = next;
+                if settled {
+                    break;
+                }
+            } else {
+                stencil = None;
+                r = next;
+            }
+        }
+        let (left, right, w, h) = match stencil {
+            Some(mut c) if (r - root).abs() <= (hi - lo).abs() + 4.0 * delta => {
+                // The stencil was centred at the previous estimate: the Hermite interval
+                // [c₋₁, c₁] contains the root (it moved by at most 2δ; clamp to the interval).
+                let right = c.swap_remove(2);
+                let left = c.swap_remove(1);
+                let w = ((r - sigma_of(&left, &a.point)) / (2.0 * delta)).clamp(0.0, 1.0);
+                (left, right, w, 2.0 * delta)
+            }
+            _ => (near, far.clone(), (root - lo) / (hi - lo), hi - lo),
         };
-        let ta = &a.point.tangent;
-        let slope = |p: &Probed| -> Vec<f64> {
-            let c = dot(&p.point.tangent, ta);
-            p.point.tangent.iter().map(|x| x / c).collect()
-        };
-        let (d0, d1) = (slope(&left), slope(&right));
-        let (h00, h10, h01, h11) = (
-            (1.0 + 2.0 * w) * (1.0 - w) * (1.0 - w),
-            w * (1.0 - w) * (1.0 - w),
-            w * w * (3.0 - 2.0 * w),
-            w * w * (w - 1.0),
-        );
-        let u: Vec<f64> = (0..left.point.u.len())
-            .map(|k| {
-                h00 * left.point.u[k] + h10 * h * d0[k] + h01 * right.point.u[k] + h11 * h * d1[k]
-            })
-            .collect();
+        let u = hermite(&left, &right, ta, w, h);
         // The branch's own direction there (at a branch point the kernel is two-dimensional and
         // the probe's tangent arbitrary): the interpolated slope.
+        let (d0, d1) = (slope(&left, ta), slope(&right, ta));
         let mut t: Vec<f64> = d0
             .iter()
             .zip(&d1)
@@ -455,12 +500,84 @@ impl Probe<'_> {
         let nt = norm(&t);
         t.iter_mut().for_each(|x| *x /= nt);
         if u.iter().chain(&t).any(|x| !x.is_finite()) {
-            return Ok(far_fallback);
+            return far;
         }
-        let mut p = self.probe(u, &along)?;
-        p.point.tangent = t;
-        Ok(p)
+        match self.probe(u, ta) {
+            Ok(mut p) => {
+                p.point.tangent = t;
+                p
+            }
+            Err(_) => far,
+        }
     }
+}
+
+/// The arclength coordinate σ = t_a·(u − u_a) of a point relative to `a`.
+fn sigma_of(p: &Probed, a: &Point) -> f64 {
+    p.point
+        .u
+        .iter()
+        .zip(&a.u)
+        .zip(&a.tangent)
+        .map(|((x, y), t)| (x - y) * t)
+        .sum()
+}
+
+/// The root near `x0` of the cubic through the four points (x_k, y_k) (Lagrange form, Newton's
+/// method); `x0` if it does not converge.
+fn cubic_root(xs: &[f64], ys: &[f64], x0: f64) -> f64 {
+    let eval = |x: f64| -> (f64, f64) {
+        let (mut v, mut dv) = (0.0, 0.0);
+        for i in 0..4 {
+            let (mut l, mut dl) = (1.0, 0.0);
+            for j in (0..4).filter(|&j| j != i) {
+                let d = xs[i] - xs[j];
+                dl = dl * (x - xs[j]) / d + l / d;
+                l *= (x - xs[j]) / d;
+            }
+            v += ys[i] * l;
+            dv += ys[i] * dl;
+        }
+        (v, dv)
+    };
+    let mut x = x0;
+    for _ in 0..30 {
+        let (v, dv) = eval(x);
+        let step = v / dv;
+        if !step.is_finite() {
+            return x0;
+        }
+        x -= step;
+        if step.abs() <= 1e-16 * (1.0 + x.abs()) {
+            return x;
+        }
+    }
+    if x.is_finite() {
+        x
+    } else {
+        x0
+    }
+}
+
+/// du/dσ = t/(t·t_a) at a point, σ measured along t_a.
+fn slope(p: &Probed, ta: &[f64]) -> Vec<f64> {
+    let c = dot(&p.point.tangent, ta);
+    p.point.tangent.iter().map(|x| x / c).collect()
+}
+
+/// The cubic Hermite interpolant between two points of a branch (their u and slopes along t_a)
+/// at the fraction w of the interval of length h in σ.
+fn hermite(p0: &Probed, p1: &Probed, ta: &[f64], w: f64, h: f64) -> Vec<f64> {
+    let (d0, d1) = (slope(p0, ta), slope(p1, ta));
+    let (h00, h10, h01, h11) = (
+        (1.0 + 2.0 * w) * (1.0 - w) * (1.0 - w),
+        w * (1.0 - w) * (1.0 - w),
+        w * w * (3.0 - 2.0 * w),
+        w * w * (w - 1.0),
+    );
+    (0..p0.point.u.len())
+        .map(|k| h00 * p0.point.u[k] + h10 * h * d0[k] + h01 * p1.point.u[k] + h11 * h * d1[k])
+        .collect()
 }
 
 fn sign_change(x: f64, y: f64) -> bool {
@@ -544,6 +661,7 @@ pub fn follow(
         prev.branch = f64::NAN;
         prev.fold = f64::NAN;
     }
+    let mut first_of_switch = direction.is_some();
     let mut points = vec![prev.point.clone()];
     let mut special = Vec::new();
     let mut s = opts.step;
@@ -570,27 +688,52 @@ pub fn follow(
             }
         };
         let index = points.len();
-        // Special points between prev and next, in the order of their location.
+        // The stop, if the parameter crosses it in this step: the corrected point there.
+        let (pa, pb) = (prev.point.parameter - stop, next.point.parameter - stop);
+        let stop_point = if pa != 0.0 && (pb == 0.0 || sign_change(pa, pb)) {
+            let test = |q: &Probed| q.point.parameter - stop;
+            let p = probe.locate(&prev, &next, s, 1e-15, false, &|q| {
+                if q.point.parameter == stop {
+                    0.0
+                } else {
+                    test(q)
+                }
+            });
+            Some(if test(&p).abs() < test(&next).abs() {
+                p
+            } else {
+                next.clone()
+            })
+        } else {
+            None
+        };
+        // Special points between prev and next (and before the stop), in the order met. After
+        // a switch the first step starts at the branch point itself, where the tests are
+        // degenerate: none are compared there.
         let mut found: Vec<(f64, Special)> = Vec::new();
-        if sign_change(prev.branch, next.branch) {
-            let p = probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.branch)?;
-            found.push((
-                dist(&prev.point, &p.point),
-                special_at(Kind::Branch, p, index),
-            ));
-        }
-        if sign_change(prev.fold, next.fold) {
-            let p = probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.fold)?;
-            found.push((
-                dist(&prev.point, &p.point),
-                special_at(Kind::Fold, p, index),
-            ));
-        }
-        for (w, (&a, &b)) in prev.point.stable.iter().zip(&next.point.stable).enumerate() {
-            if a != b {
+        let floor = FOLD_FLOOR * (1.0 + prev.point.parameter.abs());
+        if !first_of_switch {
+            if sign_change(prev.branch, next.branch) {
+                let p = probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.branch);
+                found.push((
+                    dist(&prev.point, &p.point),
+                    special_at(Kind::Branch, p, index),
+                ));
+            }
+            if sign_change(prev.fold, next.fold) && prev.fold.abs().max(next.fold.abs()) > floor {
+                let p = probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.fold);
+                found.push((
+                    dist(&prev.point, &p.point),
+                    special_at(Kind::Fold, p, index),
+                ));
+            }
+            for (w, (&a, &b)) in prev.point.stable.iter().zip(&next.point.stable).enumerate() {
+                if a == b {
+                    continue;
+                }
                 let (ma, mb) = (prev.point.margins[w], next.point.margins[w]);
                 let p = if sign_change(ma, mb) {
-                    probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.point.margins[w])?
+                    probe.locate(&prev, &next, s, LOCATE_TOL, true, &|q| q.point.margins[w])
                 } else {
                     probe.locate(&prev, &next, s, LOCATE_TOL, false, &|q| {
                         if q.point.stable.get(w) == Some(&a) {
@@ -598,32 +741,23 @@ pub fn follow(
                         } else {
                             -1.0
                         }
-                    })?
+                    })
                 };
                 let mut sp = special_at(Kind::Stability, p, index);
                 sp.verdict = Some(w);
+                // The verdicts on the far side of the change.
+                sp.point.stable = next.point.stable.clone();
                 found.push((dist(&prev.point, &sp.point), sp));
             }
         }
+        first_of_switch = false;
+        if let Some(stop_point) = &stop_point {
+            let reach = dist(&prev.point, &stop_point.point);
+            found.retain(|(d, _)| *d <= reach);
+        }
         found.sort_by(|x, y| x.0.total_cmp(&y.0));
         special.extend(found.into_iter().map(|(_, sp)| sp));
-        // Stop where the parameter crosses `stop`.
-        let (pa, pb) = (prev.point.parameter - stop, next.point.parameter - stop);
-        if pa != 0.0 && (pb == 0.0 || sign_change(pa, pb)) {
-            let test = |q: &Probed| q.point.parameter - stop;
-            // The stop is a regular point: the corrected point there (not an interpolation).
-            let p = probe.locate(&prev, &next, s, 1e-15, false, &|q| {
-                if q.point.parameter == stop {
-                    0.0
-                } else {
-                    test(q)
-                }
-            })?;
-            let p = if test(&p).abs() < test(&next).abs() {
-                p
-            } else {
-                next.clone()
-            };
+        if let Some(p) = stop_point {
             points.push(p.point);
             break End::Reached;
         }

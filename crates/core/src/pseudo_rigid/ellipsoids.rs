@@ -62,8 +62,8 @@ pub struct Figure {
     pub mu: f64,
     /// The multiplier of det X = a₁a₂a₃ (F₃: p = g₃/(a₁a₂)).
     pub pressure: f64,
-    /// The family: θ = atan f ∈ (−π/2, π/2] with f = ζ/Ω₃ (θ = π/2 Dedekind).
-    pub theta: f64,
+    /// The family: f = ζ/Ω₃ (0 Jacobi, +∞ Dedekind).
+    pub f: f64,
 }
 
 /// Physical quantities of a [`Figure`] (module docs for the units).
@@ -109,19 +109,50 @@ fn diag(a: &[f64; 3]) -> Mat {
     Mat::from_fn(3, 3, |i, j| if i == j { a[i] } else { 0.0 })
 }
 
-/// (sin 2φ, cos φ, sin φ) of the velocity ray (ω, μ) ∝ (cos φ, sin φ), tan φ = −f a₁a₂/(a₁²+a₂²),
-/// f = tan θ.
-fn ray(theta: f64, a: &[f64; 3]) -> (f64, f64) {
-    // (cos φ, sin φ) ∝ (cos θ (a₁² + a₂²), −sin θ a₁a₂); θ = ±π/2 (f = ±∞) is the stationary
-    // figure exactly (cos(π/2) rounds to 6e-17).
-    let ct = if theta.abs() == std::f64::consts::FRAC_PI_2 {
-        0.0
-    } else {
-        theta.cos()
-    };
-    let (c, s) = (ct * (a[0] * a[0] + a[1] * a[1]), -theta.sin() * a[0] * a[1]);
-    let r = c.hypot(s);
-    (c / r, s / r)
+/// The family of figures with f = ζ/Ω₃ as a ray in the (ω, μ) plane: the figures satisfy
+/// w_μ·μ(a₁² + a₂²) + w_ω·ω a₁a₂ = 0 with (w_μ, w_ω) ∝ (1, f) (∝ (0, 1) for f = ±∞), built from f
+/// directly (no angle, so f = ±∞ and large |f| are exact).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Ray {
+    w_mu: f64,
+    w_omega: f64,
+}
+
+impl Ray {
+    fn new(f: f64) -> Ray {
+        let (p, q) = if f.is_infinite() {
+            (0.0, 1.0)
+        } else if f.abs() <= 1.0 {
+            (1.0, f)
+        } else {
+            (1.0 / f, 1.0)
+        };
+        let r = p.hypot(q);
+        Ray {
+            w_mu: p / r,
+            w_omega: q / r,
+        }
+    }
+
+    /// The ray equation's residual at (a, ω, μ).
+    fn residual(&self, a: &[f64; 3], omega: f64, mu: f64) -> f64 {
+        self.w_mu * mu * (a[0] * a[0] + a[1] * a[1]) + self.w_omega * omega * a[0] * a[1]
+    }
+
+    /// The unit direction (c, s) of (ω, μ) on the ray, with c ≥ 0 (and s ≥ 0 when c = 0), so
+    /// that a negative speed gives Ω₃ = −ω ≥ 0 (and μ ≤ 0 for a stationary figure).
+    fn direction(&self, a: &[f64; 3]) -> (f64, f64) {
+        let (c, s) = (
+            self.w_mu * (a[0] * a[0] + a[1] * a[1]),
+            -self.w_omega * a[0] * a[1],
+        );
+        let r = c.hypot(s);
+        if c < 0.0 || (c == 0.0 && s < 0.0) {
+            (-c / r, -s / r)
+        } else {
+            (c / r, s / r)
+        }
+    }
 }
 
 fn finite(what: &str, x: f64) -> Result<f64> {
@@ -183,12 +214,12 @@ impl Fluid {
         ])
     }
 
-    /// The figure of the family θ with equatorial axes (a₁, a₂) and a₃ given: p from F₃, the
-    /// speed s on the ray from F₁ (or F₂), or `None` if s² < 0.
-    fn velocities(&self, a: &[f64; 3], theta: f64) -> Result<Option<Figure>> {
+    /// The figure of the family f with semi-axes a: p from F₃, the speed on the ray from F₁
+    /// (or F₂), or `None` if its square is negative.
+    fn velocities(&self, a: &[f64; 3], f: f64) -> Result<Option<Figure>> {
         let g = self.force(a)?;
         let p = g[2] / (a[0] * a[1]);
-        let (c, s) = ray(theta, a);
+        let (c, s) = Ray::new(f).direction(a);
         let s2c = 2.0 * s * c;
         let (n1, d1) = (g[0] - p * a[1] * a[2], a[0] - s2c * a[1]);
         let (n2, d2) = (g[1] - p * a[0] * a[2], a[1] - s2c * a[0]);
@@ -200,44 +231,48 @@ impl Fluid {
         if speed2.is_nan() || speed2 < 0.0 {
             return Ok(None);
         }
-        // Ω₃ = −ω ≥ 0; for a stationary figure μ ≤ 0.
+        // Ω₃ = −ω ≥ 0 (Ray::direction has c ≥ 0); 0·c stays +0 for a stationary figure.
         let sp = -speed2.sqrt();
-        let (omega, mu) = if c.abs() > 0.0 {
-            (sp * c, sp * s)
-        } else {
-            (0.0, sp * s.abs())
-        };
         Ok(Some(Figure {
             a: *a,
-            omega,
-            mu,
+            omega: if c == 0.0 { 0.0 } else { sp * c },
+            mu: sp * s,
             pressure: p,
-            theta,
+            f,
         }))
     }
 
-    /// The mismatch of F₁ and F₂ on the ray of θ at fixed (a₁, a₂) as a function of a₃ (zero
-    /// at a figure; module docs).
-    fn mismatch(&self, a: &[f64; 3], theta: f64) -> Result<f64> {
+    /// F₁ and F₂ on the ray of f at fixed (a₁, a₂), divided by a₁ − a₂, as a function of a₃
+    /// (zero at a figure; smooth through a₁ = a₂). With D = (g₁ − g₂)/(a₁ − a₂) from the
+    /// potential's Hessian (the Lewis–Sendov divided difference: the (1, 2) entry of
+    /// D²U(A)[E₁₂ + E₂₁], exact at a₁ = a₂), G_k = g_k − p·(product of the other two axes) and
+    /// c₂ = sin 2φ of the ray direction: G₁ − G₂ = (a₁ − a₂)(D + p a₃), so
+    /// [G₁(a₂ − c₂a₁) − G₂(a₁ − c₂a₂)]/(a₁ − a₂) = a₂(D + pa₃) − G₂ − c₂[a₁(D + pa₃) + G₂].
+    /// At a₁ = a₂, f = 0 its root is the Maclaurin–Jacobi bifurcation.
+    fn mismatch(&self, a: &[f64; 3], f: f64) -> Result<f64> {
         let g = self.force(a)?;
         let p = g[2] / (a[0] * a[1]);
-        let (c, s) = ray(theta, a);
-        let s2c = 2.0 * s * c;
-        Ok((g[0] - p * a[1] * a[2]) * (a[1] - s2c * a[0])
-            - (g[1] - p * a[0] * a[2]) * (a[0] - s2c * a[1]))
+        let v = Mat::from_fn(3, 3, |i, j| if i + j == 1 { 1.0 } else { 0.0 });
+        let d = potential::hessian_product(self.gravity.as_ref(), &diag(a), &v)?[(0, 1)];
+        let (c, s) = Ray::new(f).direction(a);
+        let c2 = 2.0 * s * c;
+        let g2 = g[1] - p * a[0] * a[2];
+        let dp = d + p * a[2];
+        Ok(a[1] * dp - g2 - c2 * (a[0] * dp + g2))
     }
 
-    /// The figure of the family θ with a₁ = 1, a₂ = r (0 < r < 1): a₃ is the root of the
+    /// The figure of the family f with a₁ = 1, a₂ = r (0 < r ≤ 1): a₃ is the root of the
     /// mismatch (scanned on a geometric grid in (10⁻⁴, 1.5), refined by bisection to round-off)
-    /// with s² ≥ 0; of several, the one with the largest a₃.
-    fn ellipsoid(&self, r: f64, theta: f64, what: &str) -> Result<Figure> {
-        if !(r > 0.0 && r < 1.0) {
+    /// with a real speed; of several, the one with the largest a₃. At r = 1 it is the spheroid
+    /// where the family branches off the Maclaurin sequence.
+    fn ellipsoid(&self, r: f64, f: f64, what: &str) -> Result<Figure> {
+        if !(r > 0.0 && r <= 1.0) {
             return Err(Error::invalid(
                 "a2_over_a1",
-                format!("expected 0 < a2/a1 < 1 for {what} ellipsoids, got {r}"),
+                format!("expected 0 < a2/a1 ≤ 1 for {what} ellipsoids, got {r}"),
             ));
         }
-        let at = |a3: f64| self.mismatch(&[1.0, r, a3], theta);
+        let at = |a3: f64| self.mismatch(&[1.0, r, a3], f);
         let (lo, hi) = (1e-4_f64, 1.5_f64);
         let grid: Vec<f64> = (0..=SCAN)
             .map(|k| lo * (hi / lo).powf(k as f64 / SCAN as f64))
@@ -264,7 +299,7 @@ impl Fluid {
                     }
                 }
                 let a3 = 0.5 * (l + h);
-                if let Some(fig) = self.velocities(&[1.0, r, a3], theta)? {
+                if let Some(fig) = self.velocities(&[1.0, r, a3], f)? {
                     best = Some(fig);
                     break;
                 }
@@ -274,10 +309,7 @@ impl Fluid {
         best.ok_or_else(|| {
             Error::invalid(
                 "ellipsoid",
-                format!(
-                    "no {what} ellipsoid with a2/a1 = {r} (f = {:.6}) for a3/a1 in (1e-4, 1.5)",
-                    theta.tan()
-                ),
+                format!("no {what} ellipsoid with a2/a1 = {r} (f = {f}) for a3/a1 in (1e-4, 1.5)"),
             )
         })
     }
@@ -294,7 +326,8 @@ impl Fluid {
         })
     }
 
-    /// The Jacobi ellipsoid with a₁ = 1, a₂ = r ∈ (0, 1) (EFE ch. 6 §39: a₁²a₂²A₁₂ = a₃²A₃).
+    /// The Jacobi ellipsoid with a₁ = 1, a₂ = r ∈ (0, 1] (EFE ch. 6 §39: a₁²a₂²A₁₂ = a₃²A₃;
+    /// r = 1 is the Maclaurin spheroid where the sequence branches off).
     pub fn jacobi(&self, r: f64) -> Result<Figure> {
         self.ellipsoid(r, 0.0, "Jacobi")
     }
@@ -306,7 +339,7 @@ impl Fluid {
         Ok(Figure {
             omega: j.mu,
             mu: j.omega,
-            theta: std::f64::consts::FRAC_PI_2,
+            f: f64::INFINITY,
             ..j
         })
     }
@@ -320,7 +353,9 @@ impl Fluid {
                 "expected a real number or ±inf, got NaN",
             ));
         }
-        self.ellipsoid(r, f.atan(), "Riemann S-type")
+        // f = ±∞ is one family (the stationary figures), recorded as +∞.
+        let f = if f.is_infinite() { f64::INFINITY } else { f };
+        self.ellipsoid(r, f, "Riemann S-type")
     }
 
     /// The point where the Jacobi ellipsoids branch off the Maclaurin spheroids: the root in
@@ -382,11 +417,29 @@ impl Fluid {
         (z, vec![fig.omega, 0.0, 0.0, fig.mu, 0.0, 0.0])
     }
 
+    /// √(Gρ): the rate that scales all velocities (ω, μ ∝ √(Gρ), p ∝ Gρ at fixed shape).
+    fn rate(&self) -> f64 {
+        (self.gravity.g() * self.gravity.rho()).sqrt()
+    }
+
+    /// The same figure of the fluid with G = ρ = 1 (time measured in units of 1/√(Gρ)).
+    fn to_unit(&self, fig: &Figure) -> Figure {
+        let r = self.rate();
+        Figure {
+            omega: fig.omega / r,
+            mu: fig.mu / r,
+            pressure: fig.pressure / r / r,
+            ..fig.clone()
+        }
+    }
+
     /// The energy–momentum and spectral stability of a figure under the incompressible full
     /// dynamics, in the co-moving frame ([`comoving::stability`]; valid at coincident axes).
+    /// Computed for the fluid with G = ρ = 1 and the figure in its units: G and ρ only set the
+    /// unit of time, so the verdicts do not depend on them (eigenvalues are in units of √(Gρ)).
     pub fn stability(&self, fig: &Figure) -> Result<comoving::Stability> {
-        let (z, xi) = Self::state(fig);
-        comoving::stability(&self.body()?, &z, &xi)
+        let (z, xi) = Self::state(&self.to_unit(fig));
+        comoving::stability(&Fluid::new(1.0, 1.0)?.body()?, &z, &xi)
     }
 
     /// The residuals (F₁, F₂, F₃) of a figure's force balance (module docs).
@@ -432,44 +485,56 @@ impl Fluid {
     }
 }
 
-/// The family of figures with fixed θ = atan f through a given volume, for
-/// [`crate::analysis::continuation`]: unknowns u = (a₁, a₂, a₃, ω, μ, p), equations F₁..F₄ of the
-/// module docs (F₄ relative: a₁a₂a₃/V − 1) and the ray cos θ·μ(a₁² + a₂²) + sin θ·ω a₁a₂ = 0.
-/// The Jacobian is analytic (the potential's Hessian).
+/// The family of figures with fixed f = ζ/Ω₃ through a given volume, for
+/// [`crate::analysis::continuation`]: unknowns u = (a₁, a₂, a₃, ω, μ, p) in the units of the fluid
+/// with G = ρ = 1 (ω, μ in units of √(Gρ), p of Gρ, so that the unknowns are of one size whatever
+/// G and ρ), equations F₁..F₄ of the module docs (F₄ relative: a₁a₂a₃/V − 1) and the ray
+/// w_μ·μ(a₁² + a₂²) + w_ω·ω a₁a₂ = 0. The Jacobian is analytic (the potential's Hessian).
 #[derive(Clone, Debug)]
 pub struct EllipsoidFamily {
-    /// The fluid.
+    /// The fluid (its G and ρ are those of the figures returned).
     pub fluid: Fluid,
-    /// θ = atan f.
-    pub theta: f64,
+    /// f = ζ/Ω₃ along the family.
+    pub f: f64,
     /// The volume a₁a₂a₃ along the family.
     pub volume: f64,
+    /// The fluid with G = ρ = 1, in which the equations are solved.
+    unit: Fluid,
+    ray: Ray,
 }
 
 impl EllipsoidFamily {
-    /// The family of `fig` (its θ and volume).
-    pub fn of(fluid: &Fluid, fig: &Figure) -> Self {
-        EllipsoidFamily {
+    /// The family of `fig` (its f and volume).
+    pub fn of(fluid: &Fluid, fig: &Figure) -> Result<Self> {
+        Ok(EllipsoidFamily {
             fluid: fluid.clone(),
-            theta: fig.theta,
+            f: fig.f,
             volume: fig.a.iter().product(),
-        }
+            unit: Fluid::new(1.0, 1.0)?,
+            ray: Ray::new(fig.f),
+        })
     }
 
-    /// u of a figure.
-    pub fn unknowns_of(fig: &Figure) -> Vec<f64> {
-        vec![
-            fig.a[0],
-            fig.a[1],
-            fig.a[2],
-            fig.omega,
-            fig.mu,
-            fig.pressure,
-        ]
+    /// u of a figure of the fluid.
+    pub fn unknowns_of(&self, fig: &Figure) -> Vec<f64> {
+        let g = self.fluid.to_unit(fig);
+        vec![g.a[0], g.a[1], g.a[2], g.omega, g.mu, g.pressure]
     }
 
-    /// The figure at u (checked: semi-axes > 0, finite).
+    /// The figure of the fluid at u (checked: finite, semi-axes > 0).
     pub fn figure(&self, u: &[f64]) -> Result<Figure> {
+        let g = self.unit_figure(u)?;
+        let r = self.fluid.rate();
+        Ok(Figure {
+            omega: g.omega * r,
+            mu: g.mu * r,
+            pressure: g.pressure * r * r,
+            ..g
+        })
+    }
+
+    /// The figure of the unit fluid at u.
+    fn unit_figure(&self, u: &[f64]) -> Result<Figure> {
         crate::check::len_of("u", u, 6)?;
         if u[..3].iter().any(|&x| x <= 0.0) {
             return Err(Error::invalid(
@@ -482,10 +547,11 @@ impl EllipsoidFamily {
         }
         Ok(Figure {
             a: [u[0], u[1], u[2]],
-            omega: u[3],
+            // The stationary family's ray is ω = 0: exactly, not the corrector's round-off.
+            omega: if self.ray.w_mu == 0.0 { 0.0 } else { u[3] },
             mu: u[4],
             pressure: u[5],
-            theta: self.theta,
+            f: self.f,
         })
     }
 
@@ -503,7 +569,7 @@ impl EllipsoidFamily {
     /// A named parameter of the figure at u: "e", "a2_over_a1", "a3_over_a1",
     /// "Omega2_over_piGrho", "L" (angular momentum), "f".
     pub fn parameter(&self, name: &str, u: &[f64]) -> Result<f64> {
-        let q = self.fluid.quantities(&self.figure(u)?)?;
+        let q = self.unit.quantities(&self.unit_figure(u)?)?;
         Ok(match name {
             "e" => q.e,
             "a2_over_a1" => q.a2_over_a1,
@@ -540,11 +606,10 @@ impl Family for EllipsoidFamily {
     }
 
     fn residual(&self, u: &[f64]) -> Result<Vec<f64>> {
-        let f = self.figure(u)?;
+        let f = self.unit_figure(u)?;
         let a = &f.a;
-        let b = self.fluid.balance(a, f.omega, f.mu, f.pressure)?;
-        let ray = self.theta.cos() * f.mu * (a[0] * a[0] + a[1] * a[1])
-            + self.theta.sin() * f.omega * a[0] * a[1];
+        let b = self.unit.balance(a, f.omega, f.mu, f.pressure)?;
+        let ray = self.ray.residual(a, f.omega, f.mu);
         Ok(vec![
             b[0],
             b[1],
@@ -555,11 +620,11 @@ impl Family for EllipsoidFamily {
     }
 
     fn jacobian(&self, u: &[f64]) -> Result<Mat> {
-        let f = self.figure(u)?;
+        let f = self.unit_figure(u)?;
         let (a, w, m, p) = (&f.a, f.omega, f.mu, f.pressure);
-        let h = self.fluid.stiffness(a)?;
+        let h = self.unit.stiffness(a)?;
         let (w2, c) = (w * w + m * m, 2.0 * w * m);
-        let (ct, st) = (self.theta.cos(), self.theta.sin());
+        let (ct, st) = (self.ray.w_mu, self.ray.w_omega);
         let mut j = Mat::zeros(5, 6);
         // F₁ = g₁ − w2 a₁ + c a₂ − p a₂a₃
         j[(0, 0)] = h[0][0] - w2;
@@ -584,7 +649,7 @@ impl Family for EllipsoidFamily {
         j[(3, 0)] = a[1] * a[2] / self.volume;
         j[(3, 1)] = a[0] * a[2] / self.volume;
         j[(3, 2)] = a[0] * a[1] / self.volume;
-        // ray = cos θ μ(a₁² + a₂²) + sin θ ω a₁a₂
+        // ray = w_μ μ(a₁² + a₂²) + w_ω ω a₁a₂
         j[(4, 0)] = 2.0 * ct * m * a[0] + st * w * a[1];
         j[(4, 1)] = 2.0 * ct * m * a[1] + st * w * a[0];
         j[(4, 3)] = st * a[0] * a[1];
@@ -606,13 +671,20 @@ pub fn follow(
     direction: Option<&[f64]>,
     opts: &Options,
 ) -> Result<Branch> {
+    if parameter == "f" {
+        return Err(Error::invalid(
+            "parameter",
+            "f is constant along a family (the family is the set of figures with the f of its \
+             start); follow it in e, a2_over_a1, a3_over_a1, Omega2_over_piGrho or L",
+        ));
+    }
     family.parameter(parameter, start)?;
     let param = |u: &[f64]| family.parameter(parameter, u);
     // Margins: none for the spectral verdict (max Re λ leaves 0 like a square root at a Krein
     // collision: bisection), the smallest Hessian eigenvalue relative to the largest for the
     // energy–momentum verdict (a smooth crossing of zero).
     let monitor = |u: &[f64]| -> Result<Vec<Indicator>> {
-        let s = family.fluid.stability(&family.figure(u)?)?;
+        let s = family.unit.stability(&family.unit_figure(u)?)?;
         let em = &s.energy_momentum;
         let scale = em.min_real_part.abs().max(em.max_real_part.abs());
         Ok(vec![
