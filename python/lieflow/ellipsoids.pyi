@@ -9,7 +9,7 @@ F64 = NDArray[np.float64]
 def maclaurin(e: float, *, G: float = 1.0, rho: float = 1.0) -> RelativeEquilibrium:
     """The Maclaurin spheroid a = (1, 1, sqrt(1 - e^2)), 0 <= e < 1."""
 def jacobi(a2_over_a1: float, *, G: float = 1.0, rho: float = 1.0) -> RelativeEquilibrium:
-    """The Jacobi ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1) (EFE §39)."""
+    """The Jacobi ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1] (EFE §39)."""
 def dedekind(a2_over_a1: float, *, G: float = 1.0, rho: float = 1.0) -> RelativeEquilibrium:
     """The Dedekind ellipsoid adjoint (X -> X^T) to the Jacobi ellipsoid with the same axes."""
 def riemann_s(

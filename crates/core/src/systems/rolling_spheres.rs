@@ -116,8 +116,11 @@
 //! are kept to round-off (in the chart above, ξ_P = (ṡ₁ × w, ṡ₂ × w)) — and "rk4" (classical
 //! RK4 on the flat 27 values, the baseline; it leaves SO(3) and S²). Measured (tests, general
 //! bodies, 10⁵ steps of h = 0.02): max |ΔE|/E 3.1e-5 (first half) and 3.3e-5 (second half) for
-//! the reversible midpoint — bounded; 7.5e-9 then 1.5e-8 for rkmk4 and 2.7e-7 then 8.3e-7 for
-//! rk4 — growing; |ΔJ|/|J| ≤ 2e-14 for the Lie-group methods.
+//! the reversible midpoint — no drift at this length, though longer runs (benches/python,
+//! docs/benchmarks.md) show it rise slowly (×2.4 from t = 20 to 5000 at h = 0.02, ∝ h²) before
+//! levelling off near t ≈ 10⁴: the method is reversible, not symplectic, and the system is
+//! nonholonomic, so no bound is guaranteed; 7.5e-9 then 1.5e-8 for rkmk4 and 2.7e-7 then 8.3e-7
+//! for rk4 — growing; |ΔJ|/|J| ≤ 2e-14 for the Lie-group methods.
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 

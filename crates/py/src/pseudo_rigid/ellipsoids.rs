@@ -35,8 +35,8 @@ fn maclaurin(
     figure(G, rho, |f| f.maclaurin(e))
 }
 
-/// The Jacobi ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1) (EFE ch. 6 §39: rigid rotation,
-/// a1^2 a2^2 A12 = a3^2 A3).
+/// The Jacobi ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1] (EFE ch. 6 §39: rigid rotation,
+/// a1^2 a2^2 A12 = a3^2 A3; a2_over_a1 = 1 is the Maclaurin spheroid where they branch off).
 ///
 /// Raises:
 ///     InvalidArgumentError.
@@ -50,7 +50,7 @@ fn jacobi(
     figure(G, rho, |f| f.jacobi(a2_over_a1))
 }
 
-/// The Dedekind ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1): the adjoint (X -> X^T) of the
+/// The Dedekind ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1]: the adjoint (X -> X^T) of the
 /// Jacobi ellipsoid with the same axes — a stationary figure with internal motion.
 ///
 /// Raises:
@@ -65,7 +65,7 @@ fn dedekind(
     figure(G, rho, |f| f.dedekind(a2_over_a1))
 }
 
-/// The Riemann S-type ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1) and f = zeta/Omega (EFE
+/// The Riemann S-type ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1] and f = zeta/Omega (EFE
 /// ch. 7; f = 0 Jacobi, f = inf Dedekind, f = -2 irrotational).
 ///
 /// Raises:
