@@ -127,8 +127,10 @@ def relative_equilibria(
     potential: Any, *, shape: ArrayLike | None = None,
     velocities: tuple[ArrayLike, ArrayLike] | None = None,
     momenta: tuple[ArrayLike, ArrayLike] | None = None, plane: tuple[int, int] | None = None,
-    bounds: tuple[float, float] = (0.05, 5.0), starts: int = 6,
-) -> list[RelativeEquilibrium]: ...
+    bounds: tuple[float, float] = (0.05, 5.0), starts: int = 6, incompressible: bool = False,
+) -> list[RelativeEquilibrium]:
+    """Relative equilibria by shape and plane, by velocities or by momenta (001 §8);
+    `incompressible=True` (with shape= and plane=) keeps det X with the pressure as multiplier."""
 
 def index_symbols(a: ArrayLike) -> tuple[F64, F64]:
     """Chandrasekhar's index symbols (A (3,), A_ij (3, 3)) of the ellipsoid with semi-axes a

@@ -170,3 +170,18 @@ def test_argument_validation():
     b = lf.continuation.follow(E.maclaurin(0.8), "e", 0.82, stability=False)
     with pytest.raises(lf.InvalidArgumentError):
         b.switch(b.special_points[0], direction=0.0)
+
+
+def test_incompressible_relative_equilibria_by_shape():
+    j = E.jacobi(0.6)
+    eqs = lf.pseudo_rigid.relative_equilibria(lf.potentials.SelfGravity(), shape=j.a, plane=(0, 1),
+                                              incompressible=True)
+    assert len(eqs) == 4 and all(e.incompressible for e in eqs)
+    for e in eqs:
+        assert e.pressure == pytest.approx(j.pressure, rel=1e-12)
+        assert e.residuals["motion"] < 1e-12
+        s = e.stability()
+        assert s.spectral.stable  # Jacobi and Dedekind (either sense) are stable
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.pseudo_rigid.relative_equilibria(lf.potentials.SelfGravity(), velocities=(j.xi, j.eta),
+                                            incompressible=True)

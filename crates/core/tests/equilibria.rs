@@ -274,7 +274,7 @@ fn opposite_senses_have_only_coincident_axes() {
 fn shape_solver_recovers_the_velocities_exactly() {
     let pot = svk();
     let a = svk_closed_form(0.6, 0.4);
-    let sols = equilibria_for_shape(&*pot, &a, (0, 1)).unwrap();
+    let sols = equilibria_for_shape(&*pot, &a, (0, 1), false).unwrap();
     assert_eq!(sols.len(), 4);
     let wm: Vec<(f64, f64)> = sols.iter().map(|s| (s.xi[(0, 1)], s.eta[(0, 1)])).collect();
     for target in [(0.6, 0.4), (0.4, 0.6), (-0.6, -0.4), (-0.4, -0.6)] {
@@ -288,9 +288,9 @@ fn shape_solver_recovers_the_velocities_exactly() {
         assert!(s.residuals.motion < 1e-12 && s.residuals.commutator < 1e-13);
     }
     // Another plane: the force on a₂ is not balanced there.
-    let err = equilibria_for_shape(&*pot, &a, (0, 2)).unwrap_err();
+    let err = equilibria_for_shape(&*pot, &a, (0, 2), false).unwrap_err();
     assert!(matches!(err, Error::InvalidArgument { .. }), "{err}");
-    let err = equilibria_for_shape(&*pot, &[1.0, 1.0, 0.9], (0, 1)).unwrap_err();
+    let err = equilibria_for_shape(&*pot, &[1.0, 1.0, 0.9], (0, 1), false).unwrap_err();
     assert!(matches!(err, Error::DegenerateStratum { .. }), "{err}");
 }
 
@@ -307,7 +307,7 @@ fn shape_solver_closed_form_harmonic_plus_gas_in_two_dimensions() {
     let d: f64 = a[0] * a[1];
     let c = kappa * d.powf(1.0 - gamma);
     let (u, v) = ((k + c / d).sqrt(), (k - c / d).sqrt());
-    let sols = equilibria_for_shape(&*pot, &a, (0, 1)).unwrap();
+    let sols = equilibria_for_shape(&*pot, &a, (0, 1), false).unwrap();
     assert_eq!(sols.len(), 4);
     for s in &sols {
         let (w, m) = (s.xi[(0, 1)], s.eta[(0, 1)]);
@@ -315,7 +315,7 @@ fn shape_solver_closed_form_harmonic_plus_gas_in_two_dimensions() {
         assert!(s.residuals.motion < 1e-12);
     }
     // A small body: the gas pressure wins, (ω − μ)² < 0.
-    let err = equilibria_for_shape(&*pot, &[0.5, 0.3], (0, 1)).unwrap_err();
+    let err = equilibria_for_shape(&*pot, &[0.5, 0.3], (0, 1), false).unwrap_err();
     assert!(matches!(err, Error::InvalidArgument { .. }), "{err}");
 }
 
@@ -331,7 +331,7 @@ fn harmonic_rigid_rotation_is_a_whole_family() {
         e => panic!("{e}"),
     }
     // The shape solver sees the same: (ω, μ) = (±√k, 0), (0, ±√k) for any shape.
-    let sols = equilibria_for_shape(&pot, &[1.7, 0.6], (0, 1)).unwrap();
+    let sols = equilibria_for_shape(&pot, &[1.7, 0.6], (0, 1), false).unwrap();
     assert_eq!(sols.len(), 4);
     // ω² ≠ k: no relative equilibrium at all.
     let xi = scaled(&e(2, 0, 1), 1.0);
@@ -499,7 +499,7 @@ fn check_verlet(pot: &Arc<dyn Potential>, re: &RelativeEquilibrium, dt: f64, ste
 #[test]
 fn verlet4_stays_on_the_relative_equilibrium() {
     let pot = svk();
-    let sols = equilibria_for_shape(&*pot, &svk_closed_form(0.6, 0.4), (0, 1)).unwrap();
+    let sols = equilibria_for_shape(&*pot, &svk_closed_form(0.6, 0.4), (0, 1), false).unwrap();
     let re = &sols[0];
     check_motion(&pot, re);
     let worst = check_verlet(&pot, re, 0.01, 2000);
@@ -517,8 +517,8 @@ fn bad_input_is_rejected() {
     assert!(equilibrium_directions(&[1.0]).is_err());
     assert!(equilibria_for_velocities(&*pot, &z, &z, (1.0, 0.5), 3).is_err());
     assert!(equilibria_for_velocities(&*pot, &z, &z, (0.5, 1.0), 0).is_err());
-    assert!(equilibria_for_shape(&*pot, &[1.0, 0.5, 0.7], (1, 1)).is_err());
-    assert!(equilibria_for_shape(&*pot, &[1.0, f64::NAN, 0.7], (0, 1)).is_err());
+    assert!(equilibria_for_shape(&*pot, &[1.0, 0.5, 0.7], (1, 1), false).is_err());
+    assert!(equilibria_for_shape(&*pot, &[1.0, f64::NAN, 0.7], (0, 1), false).is_err());
     let not_skew = Mat::from_fn(3, 3, |i, j| (i + j) as f64);
     assert!(augmented_potential(&*pot, &sample_x(3), &not_skew, &z).is_err());
 }
@@ -732,7 +732,7 @@ fn amended_hessian_is_augmented_plus_a_positive_term() {
     // Hessians are related as above (λ ⊕ γ = B_A(Ω ⊕ Λ), A = diag(a), body = spatial at t = 0).
     let pot = svk();
     let a = svk_closed_form(0.6, 0.4);
-    let sols = equilibria_for_shape(&*pot, &a, (0, 1)).unwrap();
+    let sols = equilibria_for_shape(&*pot, &a, (0, 1), false).unwrap();
     assert_eq!(sols.len(), 4);
     for re in &sols {
         let x = re.x0();
@@ -794,4 +794,29 @@ fn search_reports_the_coincident_solutions_the_solvers_drop() {
     let sols = equilibria_for_momenta(&*pot, &re.lam, &re.gam, (0.2, 2.0), 5).unwrap();
     assert_eq!(found.equilibria, sols);
     println!("momenta: coincident shapes dropped: {:?}", found.coincident);
+}
+
+/// The incompressible body (det X = ∏a kept; pressure as multiplier): a shape of a
+/// self-gravitating fluid in rigid rotation is a relative equilibrium exactly when it is a
+/// Jacobi ellipsoid (the second route is `pseudo_rigid::ellipsoids`), and the pressure is the
+/// multiplier of the force off the plane.
+#[test]
+fn incompressible_shape_equilibria_are_the_jacobi_ellipsoids() {
+    use lieflow::pseudo_rigid::ellipsoids::Fluid;
+    let fl = Fluid::new(1.0, 1.0).unwrap();
+    let j = fl.jacobi(0.6).unwrap();
+    let pot = fl.potential();
+    let sols = equilibria_for_shape(&*pot, &j.a, (0, 1), true).unwrap();
+    // (ω + μ)² = (ω − μ)² = ω_J²: four sign choices, two of them rigid rotations (μ = 0).
+    let rigid: Vec<_> = sols.iter().filter(|s| s.eta.norm_l2() < 1e-12).collect();
+    assert_eq!(rigid.len(), 2, "{sols:?}");
+    for s in &sols {
+        assert!(s.residuals.motion < 1e-12, "{:?}", s.residuals);
+        assert!((s.pressure - j.pressure).abs() < 1e-12 * j.pressure);
+    }
+    assert!(rigid
+        .iter()
+        .any(|s| (s.xi[(0, 1)] - j.omega).abs() < 1e-12 * j.omega.abs()));
+    // Compressible, the same shape is not an equilibrium of self-gravity alone (no pressure).
+    assert!(equilibria_for_shape(&*pot, &j.a, (0, 1), false).is_err());
 }

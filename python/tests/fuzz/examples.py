@@ -338,7 +338,8 @@ def build_specs() -> list[Spec]:
         slow=True)
     add(P + "relative_equilibria[shape]", P + "relative_equilibria", A("potential", Lazy(
         lambda lf: lf.potentials.Stretch(1.0)), "obj"), A("shape", np.array([1.5, 1.2, 1.0]), "vec",
-        kw=True, opt=True), A("plane", (0, 1), "obj", kw=True, opt=True), slow=True)
+        kw=True, opt=True), A("plane", (0, 1), "obj", kw=True, opt=True),
+        A("incompressible", False, "bool", kw=True), slow=True)
     add("RelativeEquilibrium.motion", "@releq.motion", A("t", np.array([0.0, 0.5]), "bcast"))
     add("RelativeEquilibrium.stability", "@releq.stability")
 

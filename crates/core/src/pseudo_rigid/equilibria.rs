@@ -984,6 +984,11 @@ fn stiffness(pot: &dyn Potential, a: &[f64]) -> Result<f64> {
 /// Returns every real solution, sign-symmetric ones included (up to four; only ω = μ = 0 when
 /// the shape is at rest).
 ///
+/// `incompressible`: the body keeps det X = ∏a (001 §1, the fluid's volume); the pressure p
+/// enters as the multiplier, g ↦ g − p·cof A with cof A = diag(∏_{l≠k} a_l), p fixed by the
+/// force balance off the plane (least squares when n > 3, then checked), and the results are
+/// [`RelativeEquilibrium::incompressible`].
+///
 /// Errors: [`Error::InvalidArgument`] when the shape cannot rotate in that plane (a force off the
 /// plane, or a negative right-hand side), [`Error::DegenerateStratum`] for coincident semi-axes,
 /// bad a or plane.
@@ -991,6 +996,7 @@ pub fn equilibria_for_shape(
     pot: &dyn Potential,
     a: &[f64],
     plane: (usize, usize),
+    incompressible: bool,
 ) -> Result<Vec<RelativeEquilibrium>> {
     let n = check_axes(a)?;
     let (i, j) = plane;
@@ -1001,11 +1007,23 @@ pub fn equilibria_for_shape(
         ));
     }
     require_distinct("relative equilibria for a shape", a)?;
-    let g: Vec<f64> = {
+    let mut g: Vec<f64> = {
         let gm = potential::gradient(pot, &diag(a))?;
         (0..n).map(|k| gm[(k, k)]).collect()
     };
     check::finite_slice("∂U/∂a", &g)?;
+    if incompressible {
+        // The pressure balancing the forces off the plane (least squares), then g − p·cof A.
+        let cof: Vec<f64> = (0..n)
+            .map(|k| (0..n).filter(|&l| l != k).map(|l| a[l]).product())
+            .collect();
+        let off: Vec<usize> = (0..n).filter(|&k| k != i && k != j).collect();
+        let c2: f64 = off.iter().map(|&k| cof[k] * cof[k]).sum();
+        let p = off.iter().map(|&k| g[k] * cof[k]).sum::<f64>() / c2;
+        for (gk, ck) in g.iter_mut().zip(&cof) {
+            *gk -= p * ck;
+        }
+    }
     let gmax = g.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let amax = a.iter().copied().fold(0.0, f64::max);
     let tol = 1e-9 * (gmax + stiffness(pot, a)? * amax);
@@ -1047,12 +1065,12 @@ pub fn equilibria_for_shape(
         for v in roots(v2) {
             let (w, m) = (0.5 * (u + v), 0.5 * (u - v));
             let e = basis(n, i, j);
-            out.push(RelativeEquilibrium::from_velocities(
-                pot,
-                a,
-                &(&e * faer::Scale(w)),
-                &(&e * faer::Scale(m)),
-            )?);
+            let (xi, eta) = (&e * faer::Scale(w), &e * faer::Scale(m));
+            out.push(if incompressible {
+                RelativeEquilibrium::incompressible(pot, a, &xi, &eta)?
+            } else {
+                RelativeEquilibrium::from_velocities(pot, a, &xi, &eta)?
+            });
         }
     }
     Ok(out)

@@ -9,6 +9,7 @@ use lieflow::pseudo_rigid::ellipsoids as ell;
 use lieflow::pseudo_rigid::equilibria as eq;
 use lieflow::pseudo_rigid::potential::Potential;
 use lieflow::pseudo_rigid::stability as st;
+use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::{Error, Mat};
 use numpy::ndarray::Array3;
 use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyArray3};
@@ -213,7 +214,7 @@ fn pair(what: &str, v: &Bound<'_, PyAny>) -> PyResult<(Mat, Mat)> {
 ///     InvalidArgumentError, ShapeError, NonFiniteError, DegenerateStratumError.
 #[pyfunction]
 #[pyo3(signature = (potential, *, shape = None, velocities = None, momenta = None, plane = None,
-                    bounds = (0.05, 5.0), starts = 6))]
+                    bounds = (0.05, 5.0), starts = 6, incompressible = false))]
 #[allow(clippy::too_many_arguments)]
 fn relative_equilibria(
     potential: &Bound<'_, PyPotential>,
@@ -223,7 +224,15 @@ fn relative_equilibria(
     plane: Option<Bound<'_, PyAny>>,
     #[pyo3(from_py_with = real_pair)] bounds: (f64, f64),
     #[pyo3(from_py_with = size)] starts: usize,
+    incompressible: bool,
 ) -> PyResult<Vec<RelativeEquilibrium>> {
+    if incompressible && shape.is_none() {
+        return Err(to_py(Error::invalid(
+            "incompressible",
+            "for the incompressible body give shape= and plane= (the volume is the shape's); the \
+             self-gravitating figures are in lieflow.ellipsoids",
+        )));
+    }
     let plane = plane
         .map(|p| {
             p.extract::<(usize, usize)>().map_err(|_| {
@@ -239,7 +248,9 @@ fn relative_equilibria(
         (Some(a), None, None, Some(plane)) => {
             let a = vector("shape", a)?;
             eq::Search {
-                equilibria: with_potential(potential, |p| eq::equilibria_for_shape(p, &a, plane))?,
+                equilibria: with_potential(potential, |p| {
+                    eq::equilibria_for_shape(p, &a, plane, incompressible)
+                })?,
                 coincident: Vec::new(),
             }
         }
@@ -284,6 +295,7 @@ fn relative_equilibria(
         .map(|inner| RelativeEquilibrium {
             inner,
             potential: pot.clone(),
+            incompressible,
             figure: None,
         })
         .collect())
@@ -295,6 +307,8 @@ fn relative_equilibria(
 pub struct RelativeEquilibrium {
     inner: eq::RelativeEquilibrium,
     potential: Arc<dyn Potential>,
+    /// Whether it is a relative equilibrium of the incompressible body (det X kept).
+    incompressible: bool,
     /// For the ellipsoidal figures of `lieflow.ellipsoids`: the fluid, the figure and its
     /// physical quantities (the body is then incompressible).
     figure: Option<(ell::Fluid, ell::Figure, ell::Quantities)>,
@@ -306,6 +320,7 @@ impl RelativeEquilibrium {
         Ok(RelativeEquilibrium {
             inner: fluid.relative_equilibrium(&fig).py()?,
             potential: fluid.potential(),
+            incompressible: true,
             figure: Some((fluid.clone(), fig.clone(), fluid.quantities(&fig).py()?)),
         })
     }
@@ -350,7 +365,7 @@ impl RelativeEquilibrium {
     /// Whether this is a relative equilibrium of the incompressible body.
     #[getter]
     fn incompressible(&self) -> bool {
-        self.figure.is_some()
+        self.incompressible
     }
 
     /// Ellipsoids: the eccentricity sqrt(1 - a3^2/max(a1, a2)^2).
@@ -504,6 +519,18 @@ impl RelativeEquilibrium {
     fn stability(&self) -> PyResult<Stability> {
         if let Some((fluid, fig)) = self.figure() {
             let s = fluid.stability(fig).py()?;
+            return Ok(Stability {
+                energy_momentum: s.energy_momentum.into(),
+                spectral: s.spectral.into(),
+            });
+        }
+        if self.incompressible {
+            let n = self.inner.n();
+            let body = PseudoRigidBody::incompressible(n, self.potential.clone()).py()?;
+            let z = body.state(&self.inner.x0(), &self.inner.p0()).py()?;
+            let mut xi = lieflow::lie::so::vee_n(&self.inner.xi).py()?;
+            xi.extend(lieflow::lie::so::vee_n(&self.inner.eta).py()?);
+            let s = lieflow::analysis::comoving::stability(&body, &z, &xi).py()?;
             return Ok(Stability {
                 energy_momentum: s.energy_momentum.into(),
                 spectral: s.spectral.into(),
