@@ -34,14 +34,13 @@ save_every=n/10)` and of `solve_ivp(f, (0, T), y0, method, rtol=tol, atol=tol/10
 
 import argparse
 import os
-import platform
 import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 import lieflow as lf
-from timing import best_time
+from timing import best_time, environment, print_ratios
 
 PERIODS = 20
 SAMPLES = 10            # saved samples per period
@@ -119,16 +118,6 @@ def check_rhs(j, y_pert):
     assert e1 < 1e-12 and e2 < 1e-12 and abs(dd) < 1e-5, (e1, e2, dd)
 
 
-def time_to(rows, name, target):
-    """Interpolated (log-log) wall time at which `name` reaches `target` error, or None."""
-    pts = sorted((r["err"], r["sec"]) for r in rows if r["name"] == name and r["err"] > 0)
-    for (e1, s1), (e2, s2) in zip(pts, pts[1:]):
-        if e1 <= target <= e2:
-            w = (np.log(target) - np.log(e1)) / (np.log(e2) - np.log(e1))
-            return float(np.exp(np.log(s1) + w * (np.log(s2) - np.log(s1))))
-    return None
-
-
 def measures(body, states, X_ref, h0, det0):
     X = states[:, :9].reshape(-1, 3, 3)
     err = np.linalg.norm(X - X_ref, axis=(1, 2)).max()
@@ -175,15 +164,10 @@ def run(title, body, X0, P0, period, reference):
         print(f"  {r['name']:17s} {r['setting']:14s} {r['sec'] * 1e3:10.3f} {r['err']:11.2e} "
               f"{r['ddet']:10.2e} {r['de']:10.2e}{extra}")
     print(f"  DOP853 rtol=1e-10, max det drift over [0, t]: {growth}")
-    names = list(dict.fromkeys(r["name"] for r in rows))
-    for target in [1e-4, 1e-6, 1e-8, 1e-10]:
-        base = time_to(rows, "scipy DOP853", target)
-        print(f"  wall time to reach error {target:g}:")
-        for name in names:
-            t = time_to(rows, name, target)
-            if t is not None:
-                ratio = f"  (DOP853 / this = {base / t:.1f}x)" if base else ""
-                print(f"    {name:17s} {t * 1e3:9.3f} ms{ratio}")
+    points = {}
+    for r in rows:
+        points.setdefault(r["name"], []).append((r["err"], r["sec"]))
+    print_ratios(points, [1e-4, 1e-6, 1e-8, 1e-10], width=17)
     return rows
 
 
@@ -222,9 +206,7 @@ def main():
     ap.add_argument("--figure", default=None, help="write a PNG here")
     args = ap.parse_args()
     t_start = time.perf_counter()
-    print(f"python {platform.python_version()}, numpy {np.__version__}, "
-          f"scipy {__import__('scipy').__version__}, lieflow {lf.__version__}, "
-          f"{os.cpu_count()} cpus, load average {os.getloadavg()[0]:.2f}")
+    print(environment())
     body = lf.PseudoRigidBody(3, GRAVITY, incompressible=True)
     j = lf.ellipsoids.jacobi(0.6)
     period = 2 * np.pi / j.Omega

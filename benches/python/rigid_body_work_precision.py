@@ -10,14 +10,12 @@ lieflow's times include the per-call overhead of `lf.integrate` (a few microseco
 """
 
 import argparse
-import os
-import platform
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 import lieflow as lf
-from timing import best_time
+from timing import best_time, environment
 
 I = np.array([1.0, 2.0, 3.0])
 M0 = np.array([1.0, 0.5, -0.3])
@@ -34,9 +32,7 @@ def main():
     parser.add_argument("--plot", default=None, help="save a work-precision figure here")
     args = parser.parse_args()
 
-    print(f"python {platform.python_version()}, numpy {np.__version__}, "
-          f"scipy {__import__('scipy').__version__}, lieflow {lf.__version__}, "
-          f"{os.cpu_count()} cpus, load average {os.getloadavg()[0]:.2f}")
+    print(environment())
     body = lf.RigidBody(inertia=I)
     exact = np.asarray(body.exact_solution(M0, [T]))[-1]
     ref = solve_ivp(euler, (0, T), M0, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]

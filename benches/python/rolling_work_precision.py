@@ -45,14 +45,13 @@ momentum, `invariants`, 3 components), and for the spheres how far the attitudes
 import argparse
 import cmath
 import os
-import platform
 import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 import lieflow as lf
-from timing import best_time
+from timing import best_time, environment, print_ratios
 
 T = 20.0
 SAMPLES = 10
@@ -205,16 +204,6 @@ def spheres_problem():
 
 # ---------------------------------------------------------------------------------------------
 
-def time_to(rows, name, target):
-    """Interpolated (log-log) wall time at which `name` reaches `target` error, or None."""
-    pts = sorted((r["err"], r["sec"]) for r in rows if r["name"] == name and r["err"] > 0)
-    for (e1, s1), (e2, s2) in zip(pts, pts[1:]):
-        if e1 <= target <= e2:
-            w = (np.log(target) - np.log(e1)) / (np.log(e2) - np.log(e1))
-            return float(np.exp(np.log(s1) + w * (np.log(s2) - np.log(s1))))
-    return None
-
-
 def conserved(system, states, relative):
     """(energy error (k,), max |J - J0|) along states."""
     h = np.asarray(system.energy(states))
@@ -254,15 +243,10 @@ def work_precision(title, system, z0, ref, steps_of, rtols_of, rhs, relative):
         extra = f"  ({r['nfev']} evaluations)" if "nfev" in r else ""
         print(f"  {r['name']:18s} {r['setting']:12s} {r['sec'] * 1e3:10.3f} {r['err']:10.2e} "
               f"{r['de']:10.2e} {r['dj']:10.2e}{extra}")
-    names = list(dict.fromkeys(r["name"] for r in rows))
-    for target in [1e-6, 1e-8, 1e-10]:
-        base = time_to(rows, "scipy DOP853", target)
-        print(f"  wall time to reach error {target:g}:")
-        for name in names:
-            t = time_to(rows, name, target)
-            if t is not None:
-                ratio = f"  (DOP853 / this = {base / t:.1f}x)" if base else ""
-                print(f"    {name:18s} {t * 1e3:9.3f} ms{ratio}")
+    points = {}
+    for r in rows:
+        points.setdefault(r["name"], []).append((r["err"], r["sec"]))
+    print_ratios(points, [1e-6, 1e-8, 1e-10])
     return rows
 
 
@@ -342,9 +326,7 @@ def main():
     ap.add_argument("--figure", default=None, help="write a PNG here")
     args = ap.parse_args()
     t_start = time.perf_counter()
-    print(f"python {platform.python_version()}, numpy {np.__version__}, "
-          f"scipy {__import__('scipy').__version__}, lieflow {lf.__version__}, "
-          f"{os.cpu_count()} cpus, load average {os.getloadavg()[0]:.2f}")
+    print(environment())
     panels = {"wp": [], "long": []}
 
     # --- disks

@@ -35,14 +35,13 @@ error over [0, t] for growing t (does it drift?) and the largest error of the Ki
 
 import math
 import os
-import platform
 import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 import lieflow as lf
-from timing import best_time
+from timing import best_time, environment, print_ratios
 
 try:
     import numba
@@ -171,16 +170,6 @@ def check_rhs(top, z0, par):
     assert step_diff < 1e-13 and h_diff < 1e-13, (step_diff, h_diff)
 
 
-def time_to(rows, name, target):
-    """Interpolated (log-log) wall time at which `name` reaches `target` error, or None."""
-    pts = sorted((e, s) for n, _, s, e, _ in rows if n == name and e > 0)
-    for (e1, s1), (e2, s2) in zip(pts, pts[1:]):
-        if e1 <= target <= e2:
-            w = (np.log(target) - np.log(e1)) / (np.log(e2) - np.log(e1))
-            return float(np.exp(np.log(s1) + w * (np.log(s2) - np.log(s1))))
-    return None
-
-
 def run(title, top, z0, par):
     print(f"\n{title}, T = {T:g}")
     z0 = np.asarray(z0, dtype=float)
@@ -233,15 +222,10 @@ def run(title, top, z0, par):
         des = "-" if np.isnan(de) else f"{de:.2e}"
         print(f"  {name:24s} {setting:14s} {sec * 1e3:10.3f} {err:10.2e} {des:>10s}")
 
-    names = list(dict.fromkeys(r[0] for r in rows))
-    for target in [1e-6, 1e-8, 1e-10]:
-        base = time_to(rows, "scipy DOP853", target)
-        print(f"  wall time to reach error {target:g}:")
-        for name in names:
-            t = time_to(rows, name, target)
-            if t is not None:
-                ratio = f"  (DOP853 / this = {base / t:.1f}x)" if base else ""
-                print(f"    {name:24s} {t * 1e3:9.3f} ms{ratio}")
+    points = {}
+    for name, _, sec, err, _ in rows:
+        points.setdefault(name, []).append((err, sec))
+    print_ratios(points, [1e-6, 1e-8, 1e-10], width=24)
     return rows
 
 
@@ -277,10 +261,7 @@ def long_run(top, z0, par, gauss6_steps, rk4_steps):
 
 def main():
     t0 = time.perf_counter()
-    print(f"python {platform.python_version()}, numpy {np.__version__}, "
-          f"scipy {__import__('scipy').__version__}, lieflow {lf.__version__}, "
-          f"numba {numba.__version__ if numba else 'not installed'}, "
-          f"{os.cpu_count()} cpus, load average {os.getloadavg()[0]:.2f}")
+    print(environment(numba=numba.__version__ if numba else "not installed"))
     for title, top, z0, par, long_steps in problems():
         run(title, top, z0, par)
         long_run(top, z0, par, *long_steps)

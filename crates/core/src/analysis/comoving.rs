@@ -41,7 +41,7 @@
 //! J is quadratic), ∇Φ from G and the polarised curvature D²g(q)[v, w]; D²ℒ by central
 //! differences of ∇ℒ with Richardson.
 
-use super::Verdict;
+use super::{jacobian, Verdict};
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::rattle::constrained_field;
@@ -115,35 +115,6 @@ fn range(m: &Mat) -> Result<Mat> {
     let smax = s[0];
     let rank = (0..s.nrows()).filter(|&k| s[k] > RANK_TOL * smax).count();
     Ok(Mat::from_fn(m.nrows(), rank, |i, j| u[(i, j)]))
-}
-
-/// Jacobian (column l = ∂f/∂z_l) by central differences with one Richardson extrapolation.
-fn jacobian(f: &dyn Fn(&[f64]) -> Result<Vec<f64>>, z: &[f64], h: &[f64]) -> Result<Mat> {
-    let mut cols: Vec<Vec<f64>> = Vec::with_capacity(z.len());
-    let mut zp = z.to_vec();
-    for (l, &hl) in h.iter().enumerate() {
-        let mut diff = |h: f64| -> Result<Vec<f64>> {
-            zp[l] = z[l] + h;
-            let fp = f(&zp)?;
-            zp[l] = z[l] - h;
-            let fm = f(&zp)?;
-            zp[l] = z[l];
-            Ok(fp
-                .iter()
-                .zip(&fm)
-                .map(|(p, m)| (p - m) / (2.0 * h))
-                .collect())
-        };
-        let (d1, d2) = (diff(hl)?, diff(0.5 * hl)?);
-        cols.push(
-            d1.iter()
-                .zip(&d2)
-                .map(|(a, b)| (4.0 * b - a) / 3.0)
-                .collect(),
-        );
-    }
-    let rows = cols.first().map_or(0, Vec::len);
-    Ok(Mat::from_fn(rows, z.len(), |i, j| cols[j][i]))
 }
 
 /// Stability of the relative equilibrium z(t) = exp(tξ)·z₀ (module docs): z₀ a state (user

@@ -60,32 +60,8 @@ pub trait Family {
     /// DF(u), an (N−1)×N matrix. The default is central differences with steps
     /// 1e-4·max(1, |u_k|) and one Richardson extrapolation (error ~1e-12 relative for smooth F).
     fn jacobian(&self, u: &[f64]) -> Result<Mat> {
-        let n = u.len();
-        let mut cols = Vec::with_capacity(n);
-        let mut v = u.to_vec();
-        for k in 0..n {
-            let h = 1e-4 * u[k].abs().max(1.0);
-            let mut d = |h: f64| -> Result<Vec<f64>> {
-                v[k] = u[k] + h;
-                let fp = self.residual(&v)?;
-                v[k] = u[k] - h;
-                let fm = self.residual(&v)?;
-                v[k] = u[k];
-                Ok(fp
-                    .iter()
-                    .zip(&fm)
-                    .map(|(p, m)| (p - m) / (2.0 * h))
-                    .collect())
-            };
-            let (d1, d2) = (d(h)?, d(0.5 * h)?);
-            cols.push(
-                d1.iter()
-                    .zip(&d2)
-                    .map(|(a, b)| (4.0 * b - a) / 3.0)
-                    .collect::<Vec<f64>>(),
-            );
-        }
-        Ok(Mat::from_fn(n - 1, n, |i, j| cols[j][i]))
+        let h: Vec<f64> = u.iter().map(|x| 1e-4 * x.abs().max(1.0)).collect();
+        super::jacobian(&|v: &[f64]| self.residual(v), u, &h)
     }
 }
 

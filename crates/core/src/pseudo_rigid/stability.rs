@@ -69,7 +69,7 @@ use crate::pseudo_rigid::reduced::ReducedState;
 use crate::Mat;
 
 pub use crate::analysis::Verdict;
-use crate::analysis::{general_eigenvalues, sorted};
+use crate::analysis::{general_eigenvalues, jacobian, sorted};
 
 /// Relative tolerance of the equilibrium check (residual of the reduced vector field relative
 /// to the scales of its terms).
@@ -304,7 +304,7 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
         };
         Ok(s.vector_field(body)?.p_a_dot.iter().map(|f| -f).collect())
     };
-    let haa = jacobian(&force, a, ha)?;
+    let haa = jacobian(&force, a, &vec![ha; n])?;
     // (δa, c): ∂/∂a_l of the orbit gradients ⟨[v_k, μ], Ω(a)⟩, ⟨[w_k, ν], Λ(a)⟩.
     let tang_mu: Vec<Mat> = leaf
         .basis_omega
@@ -328,7 +328,7 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
             .chain(tang_nu.iter().map(|t| so::pairing(t, &l)))
             .collect())
     };
-    let hac = jacobian(&orbit_grad, a, ha)?; // rows: orbit directions, columns: a_l
+    let hac = jacobian(&orbit_grad, a, &vec![ha; n])?; // rows: orbit directions, columns: a_l
     let g_orbit = orbit_grad(a)?;
 
     // (c, c): exact second variation of K along the orbits.
@@ -471,7 +471,7 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
             }
         })
         .collect();
-    let jac = jacobian_steps(&field, &z0, &steps)?;
+    let jac = jacobian(&field, &z0, &steps)?;
     check::finite_mat("Jacobian of the reduced vector field", &jac)?;
     let mut full = general_eigenvalues(&jac)?;
     let transverse = 2 * d - rr;
@@ -498,43 +498,6 @@ fn potential_gradient(body: &FullBody, a: &[f64]) -> Result<Vec<f64>> {
     let x = Mat::from_fn(n, n, |i, j| if i == j { a[i] } else { 0.0 });
     let g = crate::pseudo_rigid::potential::gradient(body.potential(), &x)?;
     Ok((0..n).map(|i| g[(i, i)]).collect())
-}
-
-/// Jacobian of f at x by central differences with one Richardson extrapolation, step h in
-/// every coordinate.
-fn jacobian(f: &dyn Fn(&[f64]) -> Result<Vec<f64>>, x: &[f64], h: f64) -> Result<Mat> {
-    jacobian_steps(f, x, &vec![h; x.len()])
-}
-
-/// Jacobian of f at x (column l = ∂f/∂x_l) by central differences with steps h_l and one
-/// Richardson extrapolation: (4D(h/2) − D(h))/3, error O(h⁴).
-fn jacobian_steps(f: &dyn Fn(&[f64]) -> Result<Vec<f64>>, x: &[f64], h: &[f64]) -> Result<Mat> {
-    let mut cols: Vec<Vec<f64>> = Vec::with_capacity(x.len());
-    let mut xp = x.to_vec();
-    let mut diff = |l: usize, h: f64| -> Result<Vec<f64>> {
-        xp[l] = x[l] + h;
-        let fp = f(&xp)?;
-        xp[l] = x[l] - h;
-        let fm = f(&xp)?;
-        xp[l] = x[l];
-        Ok(fp
-            .iter()
-            .zip(&fm)
-            .map(|(p, m)| (p - m) / (2.0 * h))
-            .collect())
-    };
-    for (l, &hl) in h.iter().enumerate() {
-        let d1 = diff(l, hl)?;
-        let d2 = diff(l, 0.5 * hl)?;
-        cols.push(
-            d1.iter()
-                .zip(&d2)
-                .map(|(a, b)| (4.0 * b - a) / 3.0)
-                .collect(),
-        );
-    }
-    let rows = cols.first().map_or(0, Vec::len);
-    Ok(Mat::from_fn(rows, x.len(), |i, j| cols[j][i]))
 }
 
 fn norm(v: &[f64]) -> f64 {
