@@ -1,6 +1,6 @@
 """Type stubs of ``lieflow.lie``."""
 
-from typing import Tuple, TypedDict
+from typing import Any, Tuple, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -110,3 +110,28 @@ def polar(X: _In) -> tuple[_F, _F]:
 
 def stratum(X: _In, tol: float = 1e-8) -> GLStratum:
     """Coincidences of the singular values of X (001 §6.1, (9.2))."""
+
+
+# --- rotation interop (scipy.spatial.transform.Rotation conventions) ---
+# Quaternions are Hamilton, R v = q v q̄; scalar_first=True is (w, x, y, z), False is scipy's
+# default (x, y, z, w). Euler sequences: 3 letters of x, y, z, upper case = intrinsic ("XYZ" is
+# Rx(a) @ Ry(b) @ Rz(c)), lower case = extrinsic ("xyz" is Rz(c) @ Ry(b) @ Rx(a)); the 12
+# proper-Euler and Tait–Bryan sequences; radians. All map over any leading axes.
+
+def to_quaternion(R: _In, scalar_first: bool = True) -> _F:
+    """(..., 3, 3) -> (..., 4) unit quaternions, canonical sign (w >= 0; scipy's canonical=True)."""
+
+def from_quaternion(q: _In, scalar_first: bool = True) -> _F:
+    """(..., 4) -> (..., 3, 3); q is normalised (InvalidArgumentError for q = 0)."""
+
+def to_euler(R: _In, seq: str) -> _F:
+    """(..., 3, 3) -> (..., 3) angles as scipy's as_euler(seq) (gimbal lock: third angle 0, no warning)."""
+
+def from_euler(angles: _In, seq: str) -> _F:
+    """(..., 3) -> (..., 3, 3) as scipy's Rotation.from_euler(seq, angles).as_matrix()."""
+
+def to_scipy(R: _In) -> Any:
+    """scipy.spatial.transform.Rotation of R (ImportError without scipy)."""
+
+def from_scipy(rotation: Any) -> _F:
+    """Rotation matrices of a scipy Rotation: (3, 3) or (*rotation.shape, 3, 3)."""

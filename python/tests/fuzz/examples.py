@@ -244,6 +244,13 @@ CONSTRUCTORS = {  # class name -> receiver key built by it
 }
 
 
+def _scipy_rotation(lf):
+    """A scipy Rotation of two rotations (the argument of lf.lie.from_scipy)."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_matrix(np.stack([R3, R3B]))
+
+
 def lazy_recv(key):
     return Lazy(lambda lf: RECEIVERS[key](lf))
 
@@ -289,6 +296,16 @@ def build_specs() -> list[Spec]:
     add("lie.from_svd", "lie.from_svd", A("R", R3, "rot"), A("a", A3, "vec"), A("S", R3B, "rot"))
     add("lie.polar", "lie.polar", A("X", X3, "gl"))
     add("lie.stratum", "lie.stratum", A("X", X3, "gl"), A("tol", 1e-8, "float", kw=True))
+    # rotation interop (issue 15): quaternions, Euler angles, scipy Rotation objects
+    add("lie.to_quaternion", "lie.to_quaternion", A("R", R3, "rot"),
+        A("scalar_first", True, "bool", kw=True))
+    add("lie.from_quaternion", "lie.from_quaternion", A("q", np.array([0.9, 0.1, -0.3, 0.2]), "vec"),
+        A("scalar_first", False, "bool", kw=True))
+    add("lie.to_euler", "lie.to_euler", A("R", R3, "rot"), A("seq", "ZXZ", "str"))
+    add("lie.from_euler", "lie.from_euler", A("angles", np.array([0.3, -1.2, 2.5]), "vec"),
+        A("seq", "xyz", "str"))
+    add("lie.to_scipy", "lie.to_scipy", A("R", R3, "rot"))
+    add("lie.from_scipy", "lie.from_scipy", A("rotation", Lazy(_scipy_rotation), "obj"))
 
     # ---- lieflow.pseudo_rigid ----
     P = "pseudo_rigid."

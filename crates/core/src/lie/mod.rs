@@ -71,6 +71,7 @@ pub fn angle_sin_cos(theta: f64) -> (f64, f64) {
 
 pub mod gl;
 pub mod product;
+pub mod rotations;
 pub mod se3;
 pub mod so;
 pub mod so3;
