@@ -22,6 +22,10 @@
 //!
 //! 003 §1: [`RollingDisks`]: z = (θ₁, θ₂, p₁, p₂) (4), two disks rolling against each other.
 //!
+//! Issue 15, user-defined systems ([`user`]): [`UserCanonical`] z = (q, p) (2d), H(q, p) from
+//! functions; [`UserSeparable`] z = (q, p) (2d), H = ½ pᵀM⁻¹p + U(q); [`LiePoisson`] z = μ ∈ g*
+//! (so(3), se(3), so(n) or structure constants).
+//!
 //! 003 §2: [`RollingSpheres`]: z = (z₁, z₂, u, Ω₁, Ω₂) (27), two spheres rolling against each
 //! other (z_k ∈ SO(3) row-major, u ∈ S²).
 
@@ -39,6 +43,7 @@ pub mod spherical_pendulum;
 pub mod surface;
 pub mod tangent_top;
 mod top;
+pub mod user;
 
 pub use heavy_top::HeavyTop;
 pub use isospectral::Isospectral;
@@ -53,3 +58,4 @@ pub use sphere_particle::SphereParticle;
 pub use spherical_pendulum::SphericalPendulum;
 pub use surface::{Graph, HyperbolicPlane, MetricSurface, Plane, Revolution, Sphere, Surface};
 pub use tangent_top::{ChargedParticle, TangentTop};
+pub use user::{Algebra, KineticMass, LieHamiltonian, LiePoisson, UserCanonical, UserSeparable};
