@@ -1,5 +1,5 @@
 # Type stubs for lieflow.integrate (the integration driver and Trajectory).
-from typing import Any, Callable, Protocol
+from typing import Any, Callable, Iterable, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -12,6 +12,32 @@ class NativeRun(Protocol):
     method: str
     def advance(self, steps: int) -> tuple[F64, F64 | None]: ...
     def state(self) -> tuple[F64, F64 | None]: ...
+
+class OutputControl(NativeRun, Protocol):
+    """What `t_eval`, `events` and `err.partial` use besides `NativeRun` (`lieflow.Integration`
+    has all of it; a duck-typed run without it supports the plain runs only)."""
+
+    time: float
+    ended: float | None
+    stopped_by: int | None
+    steps_done: int
+    def finish(self, t: float) -> tuple[F64, F64 | None]: ...
+    def save_at(self, t_eval: ArrayLike) -> None: ...
+    def set_events(
+        self, functions: list[Callable[[float, F64], float]], directions: list[float],
+        terminal: list[int], tol: float,
+    ) -> None: ...
+    def events_found(self) -> list[tuple[int, float, F64, F64 | None, int]]: ...
+    def steps_to(self, t: float) -> int: ...
+    def take_partial(self) -> tuple[F64, F64 | None] | None: ...
+    def checked_state(self) -> tuple[F64, F64 | None]: ...
+
+class EventFunction(Protocol):
+    """g(t, state) -> float, with the optional attributes of scipy's events: `terminal` (bool,
+    or the number of occurrences that ends the run) and `direction` (> 0 rising, < 0 falling,
+    0 both)."""
+
+    def __call__(self, t: float, state: F64, /) -> float: ...
 
 class IntegrableSystem(Protocol):
     """The protocol `integrate` drives (implemented once by `lieflow.System`)."""
@@ -31,29 +57,63 @@ def integrate(
     system: IntegrableSystem,
     state0: Any,
     dt: float,
-    steps: int,
+    steps: int | None = None,
     method: str | None = None,
     save_every: int = 1,
     attitude: ArrayLike | None = None,
     progress: bool = False,
     chunk_steps: int | None = None,
     threads: int | None = None,
+    *,
+    t0: float = 0.0,
+    t_eval: ArrayLike | None = None,
+    events: EventFunction | list[EventFunction] | None = None,
+    event_tol: float = 0.0,
 ) -> Trajectory:
-    """Integrate `steps` fixed steps of size `dt`; k = steps // save_every + 1 samples."""
+    """Integrate `steps` fixed steps of size `dt` from time `t0`; k = steps // save_every + 1
+    samples, or the states at the times `t_eval` (shortened steps between grid times; with
+    steps=None the run ends at t_eval[-1]). `events`: scipy-style event functions (attributes
+    `terminal`, `direction`), located on the method's trajectory by shortened steps. An
+    exception during the run carries `err.partial`, the trajectory computed before it."""
 
 class Trajectory:
     system: IntegrableSystem
-    method: str
-    dt: float
-    save_every: int
+    method: str | tuple[str, ...]
+    dt: float | None
+    save_every: int | None
+    """None when `t_eval` gave the times (or concatenated parts differ)."""
     t: F64
-    """(k,) sample times."""
+    """(k,) sample times (absolute)."""
+    t0: float | None
+    t_final: float | None
+    """The time of `final_state`."""
+    status: int
+    """0 reached the end, 1 a terminal event ended it, -1 failed (`err.partial`)."""
+    t_events: list[F64] | None
+    """One (n_i,) array of event times per event function, or None without events."""
+    state_events: list[F64] | None
+    """One (n_i, d) array of event states per event function."""
+    attitude_events: list[F64] | None
+    initial_state: F64 | None
+    initial_attitude: F64 | None
     states: F64
     """(k, d), or (b, k, d) for a batch."""
     attitude: F64 | None
     """(k, 3, 3) / (b, k, 3, 3) or None."""
     final_state: F64
     final_attitude: F64 | None
+    def __init__(
+        self, system: IntegrableSystem, method: str | tuple[str, ...], t: F64, states: F64,
+        attitude: F64 | None, final_state: F64, final_attitude: F64 | None, dt: float | None,
+        save_every: int | None, *, t_final: float | None = None, status: int = 0,
+        t_events: list[F64] | None = None, state_events: list[F64] | None = None,
+        attitude_events: list[F64] | None = None, t0: float | None = None,
+        initial_state: F64 | None = None, initial_attitude: F64 | None = None,
+    ) -> None: ...
+    @classmethod
+    def concatenate(cls, trajectories: Iterable[Trajectory]) -> Trajectory:
+        """A run and its continuations (each starting at the previous `t_final` from its
+        `final_state`) as one trajectory; the repeated sample at a seam kept once."""
     @property
     def batched(self) -> bool: ...
     def __len__(self) -> int: ...

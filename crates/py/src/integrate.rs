@@ -5,13 +5,13 @@
 
 use std::sync::{Arc, Mutex};
 
-use lieflow::integrate::{Run, System};
+use lieflow::integrate::{Event, Events, Run, System, Until};
 use lieflow::{check, Error};
-use numpy::{PyArray2, PyArray3, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::convert::int;
+use crate::convert::{int, named, real, vector, Real};
 use crate::convert::{shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{array, Out};
@@ -56,7 +56,22 @@ pub(crate) type RunOut<'py> = (
 /// Current states (b, d) and attitudes (b, 3, 3) or None.
 type States<'py> = (Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>);
 
+/// A located event as Python sees it: (index of the event function, t, state (d,), attitude
+/// (3, 3) or None, absolute step).
+type Found<'py> = (
+    usize,
+    f64,
+    Bound<'py, PyArray1<f64>>,
+    Option<Bound<'py, PyArray2<f64>>>,
+    u64,
+);
+
 /// A native integration in progress (made by `System._start`); `advance(steps)` continues it.
+///
+/// Output control (issue 15): `save_at(t_eval)` saves at given times (shortened steps between
+/// grid times), `set_events(...)` locates the zeros of Python event functions (a single run),
+/// `finish(t)` takes the last shortened step to an end time; after an error `take_partial()` and
+/// `checked_state()` give what was computed before it.
 #[pyclass(module = "lieflow", name = "Integration")]
 pub struct Integration {
     /// The method's name.
@@ -72,6 +87,14 @@ pub struct Integration {
     save_every: u64,
     /// Steps done (the same for every member).
     done: u64,
+    /// Whether the run saves at given times (`save_at`).
+    at: bool,
+    /// The event functions (a single run only).
+    events: Option<Mutex<Events<'static>>>,
+    /// The first exception raised by an event function, re-raised after the native call.
+    event_errors: Arc<ErrorSlot>,
+    /// The states (full, flat) saved by the call that failed, before its error (one run only).
+    partial: Option<Vec<f64>>,
 }
 
 /// The most worker threads a run may ask for (a pool of 10¹² threads would never finish
@@ -197,6 +220,10 @@ impl Integration {
             attitude: attitude0.is_some(),
             save_every: save_every as u64,
             done: 0,
+            at: false,
+            events: None,
+            event_errors: Arc::new(ErrorSlot::default()),
+            partial: None,
         })
     }
 
@@ -222,6 +249,142 @@ impl Integration {
             None
         };
         Ok((states, att))
+    }
+
+    /// (b, d) states and (b, 3, 3) attitudes or None from b full flat states.
+    fn states_of<'py>(&self, py: Python<'py>, data: &[f64], b: usize) -> PyResult<States<'py>> {
+        let (z, r) = self.split(py, data, b, 1)?;
+        let z = z.reshape([b, self.d])?.cast_into::<PyArray2<f64>>()?;
+        let r = match r {
+            Some(r) => Some(r.reshape([b, 3, 3])?.cast_into::<PyArray3<f64>>()?),
+            None => None,
+        };
+        Ok((z, r))
+    }
+
+    /// Advances every member `until` (in parallel with the GIL released; a run with events in
+    /// this thread) and returns the states saved, (b, k, d) and (b, k, 3, 3) or None. After an
+    /// error of a single run, what it saved before the error is kept for `take_partial`.
+    fn drive<'py>(
+        &mut self,
+        py: Python<'py>,
+        until: Until,
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+        let full = self.d + if self.attitude { 9 } else { 0 };
+        let sys = &*self.sys;
+        let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
+        let b = runs.len();
+        // The states saved every save_every-th step (and a terminal event's) by these steps,
+        // checked before any step is taken and then reserved fallibly (an oversized request is
+        // an InvalidArgumentError, not an abort). Output times were checked by `save_at`.
+        let mut per_run = 0;
+        let mut expected = 0;
+        let steps = match until {
+            Until::Steps(n) => Some(n),
+            // To a time: the grid steps there, and the end state saved last.
+            Until::Time(t) => match runs.first() {
+                Some(r) => Some(r.grid_steps(t).py()?.saturating_sub(self.done)),
+                None => None,
+            },
+        };
+        if let (false, Some(steps)) = (self.at, steps) {
+            let k = (self.done + steps) / self.save_every - self.done / self.save_every;
+            expected = k as usize;
+            let k = k + u64::from(self.events.is_some() || matches!(until, Until::Time(_)));
+            per_run = check::array_size(
+                "steps",
+                &[b, usize::try_from(k).unwrap_or(usize::MAX), full],
+            )
+            .map_err(|e| match e {
+                Error::InvalidArgument { what, message } => to_py(Error::invalid(
+                    what,
+                    format!(
+                        "the {k} states saved by these steps: {message}; save less often \
+                         (save_every) or advance fewer steps at a time"
+                    ),
+                )),
+                other => to_py(other),
+            })? / b.max(1);
+        }
+        let plain = !self.at && self.events.is_none();
+        let events = self
+            .events
+            .as_mut()
+            .map(|m| m.get_mut().unwrap_or_else(|p| p.into_inner()));
+        let pool = &self.pool;
+        let outs: Vec<(Vec<f64>, lieflow::Result<usize>)> = py.detach(|| {
+            let one = |i: usize, run: &mut Run, events: Option<&mut Events<'static>>| {
+                let mut out = Vec::new();
+                if out.try_reserve_exact(per_run).is_err() {
+                    let e = Error::invalid(
+                        "steps",
+                        format!(
+                            "cannot allocate the {per_run} values these steps save; save less \
+                             often (save_every) or run in chunks"
+                        ),
+                    );
+                    return (out, Err(e));
+                }
+                let r = match until {
+                    Until::Steps(n) if plain => run.advance(sys, n, &mut out),
+                    _ => run.advance_to(sys, until, &mut out, events),
+                };
+                (out, r.map_err(|e| if b > 1 { e.in_member(i) } else { e }))
+            };
+            match (events, runs.first_mut()) {
+                (Some(ev), Some(run)) => vec![one(0, run, Some(ev))],
+                _ => {
+                    let mut work = || {
+                        runs.par_iter_mut()
+                            .enumerate()
+                            .map(|(i, run)| one(i, run, None))
+                            .collect::<Vec<_>>()
+                    };
+                    match pool {
+                        Some(p) => p.install(work),
+                        None => work(),
+                    }
+                }
+            }
+        });
+        let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
+        self.done = match (runs.first(), until) {
+            (Some(r), _) => r.steps_done(),
+            (None, Until::Steps(n)) => self.done + n,
+            (None, Until::Time(_)) => self.done,
+        };
+        let mut data = Vec::with_capacity(b);
+        let mut error = None;
+        for (out, r) in outs {
+            match r {
+                Ok(_) => data.push(out),
+                Err(e) => {
+                    if b == 1 {
+                        self.partial = Some(out);
+                    }
+                    error.get_or_insert(e);
+                }
+            }
+        }
+        if let Some(c) = &self.callbacks {
+            c.take_error()?;
+        }
+        self.event_errors.take_error()?;
+        if let Some(e) = error {
+            return Err(to_py(e));
+        }
+        let k = data.first().map_or(expected, |o| o.len() / full.max(1));
+        if data.iter().any(|o| o.len() != k * full) {
+            return Err(to_py(Error::invalid(
+                "steps",
+                "the members of the batch saved different numbers of states",
+            )));
+        }
+        let mut flat = check::zeros("steps", &[b, k * full]).py()?;
+        for (d, o) in flat.chunks_exact_mut((k * full).max(1)).zip(&data) {
+            d.copy_from_slice(o);
+        }
+        self.split(py, &flat, b, k)
     }
 
     /// `_run`: the initial states and the states saved in `steps` more steps, and the final
@@ -252,95 +415,216 @@ impl Integration {
     ///
     /// Returns:
     ///     (states (b, k, d), attitude (b, k, 3, 3) or None): the states saved in these steps
-    ///     (every `save_every`-th step counted from the start of the run).
+    ///     (every `save_every`-th step counted from the start of the run, or those at the
+    ///     output times of `save_at`; with events, the terminal event's state last).
     /// Raises:
-    ///     InvalidArgumentError (steps < 1), ConvergenceError, LeftDomainError (naming the
-    ///     absolute time); the exception of a Python callable the system called.
+    ///     InvalidArgumentError (steps < 1, an ended run), ConvergenceError, LeftDomainError
+    ///     (naming the absolute step and time), NonFiniteError (an event function's value); the
+    ///     exception of a Python callable the system or an event function called.
     fn advance<'py>(
         &mut self,
         py: Python<'py>,
         #[pyo3(from_py_with = int)] steps: i64,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let steps = count("steps", steps)? as u64;
-        let k = (self.done + steps) / self.save_every - self.done / self.save_every;
+        self.drive(py, Until::Steps(steps))
+    }
+
+    /// Advances every member to the time `t`: steps of size dt to the last grid time ≤ t, then,
+    /// when t lies between grid times, one shortened step to t, which ends the run there.
+    ///
+    /// Returns and raises as `advance` (InvalidArgumentError for a time before the current one).
+    fn finish<'py>(
+        &mut self,
+        py: Python<'py>,
+        #[pyo3(from_py_with = real)] t: f64,
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+        self.drive(py, Until::Time(t))
+    }
+
+    /// Saves the states at the times `t_eval` (1-D, strictly increasing, none before the
+    /// current time) instead of every `save_every`-th state; a time between grid times is
+    /// reached by one shortened step of the method from the grid state before it.
+    ///
+    /// Raises:
+    ///     ShapeError (not 1-D), NonFiniteError, InvalidArgumentError (unsorted, before the
+    ///     current time, too many to keep).
+    fn save_at(&mut self, t_eval: ArrayIn<'_>) -> PyResult<()> {
+        let times = vector("t_eval", &t_eval)?;
         let full = self.d + if self.attitude { 9 } else { 0 };
-        let sys = &*self.sys;
         let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
-        let b = runs.len();
-        // The saved states of this call (b, k, full), checked before any step is taken and then
-        // allocated fallibly (an oversized request is an InvalidArgumentError, not an abort).
-        let per_run = check::array_size(
-            "steps",
-            &[b, usize::try_from(k).unwrap_or(usize::MAX), full],
-        )
-        .map_err(|e| match e {
-            Error::InvalidArgument { what, message } => to_py(Error::invalid(
-                what,
+        check::array_size("t_eval", &[runs.len(), times.len(), full]).py()?;
+        for run in runs.iter_mut() {
+            run.save_at(&times).py()?;
+        }
+        self.at = true;
+        Ok(())
+    }
+
+    /// Locates the zeros of the event functions `functions[i](t, state)` (state (d,) as in the
+    /// trajectory, without the attitude) after every step, in `directions[i]` (> 0 rising,
+    /// < 0 falling, 0 both); the run ends at the `terminal[i]`-th occurrence (0: never).
+    /// `tol` ≥ 0: an absolute tolerance in time added to round-off. A single run only.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (a batch, lengths that differ, a NaN direction, a bad tol).
+    fn set_events(
+        &mut self,
+        py: Python<'_>,
+        functions: Vec<Py<PyAny>>,
+        directions: ArrayIn<'_>,
+        terminal: Vec<u64>,
+        #[pyo3(from_py_with = real)] tol: f64,
+    ) -> PyResult<()> {
+        let directions = vector("directions", &directions)?;
+        if let Some(i) = functions.iter().position(|f| !f.bind(py).is_callable()) {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "invalid functions: expected callables g(t, state), functions[{i}] is a {}",
+                functions[i]
+                    .bind(py)
+                    .get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_string(), |n| n.to_string())
+            )));
+        }
+        let b = self.runs.get_mut().unwrap_or_else(|p| p.into_inner()).len();
+        if b != 1 {
+            return Err(to_py(Error::invalid(
+                "events",
                 format!(
-                    "the {k} states saved by these steps: {message}; save less often \
-                         (save_every) or advance fewer steps at a time"
+                    "events are located in a single run, got a batch of {b}; integrate the \
+                     members one by one"
                 ),
-            )),
-            other => to_py(other),
-        })? / b.max(1);
-        let pool = &self.pool;
-        let result = py.detach(|| {
-            let mut work = move || {
-                runs.par_iter_mut()
-                    .enumerate()
-                    .map(|(i, run)| {
-                        let mut out = Vec::new();
-                        out.try_reserve_exact(per_run).map_err(|_| {
-                            Error::invalid(
-                                "steps",
-                                format!(
-                                    "cannot allocate the {per_run} values these steps save; \
-                                     save less often (save_every) or run in chunks"
-                                ),
-                            )
-                        })?;
-                        run.advance(sys, steps, &mut out).map(|_| out).map_err(|e| {
-                            if b > 1 {
-                                e.in_member(i)
-                            } else {
-                                e
-                            }
+            )));
+        }
+        if directions.len() != functions.len() || terminal.len() != functions.len() {
+            return Err(to_py(Error::invalid(
+                "events",
+                "one direction and one terminal count per event function",
+            )));
+        }
+        let d = self.d;
+        let list = functions
+            .into_iter()
+            .zip(directions.into_iter().zip(terminal))
+            .enumerate()
+            .map(|(i, (f, (direction, terminal)))| {
+                let slot = self.event_errors.clone();
+                Event::new(move |t: f64, z: &[f64]| {
+                    Python::attach(|py| {
+                        let state = PyArray1::from_slice(py, &z[..d]);
+                        let value = f.bind(py).call1((t, state)).and_then(|v| {
+                            let what = format!("the value returned by events[{i}]");
+                            named(&what, v.extract::<Real>()).map(|r| r.0)
+                        });
+                        value.map_err(|e| {
+                            slot.record(e);
+                            Error::invalid("events", format!("event function {i} raised"))
                         })
                     })
-                    .collect::<lieflow::Result<Vec<Vec<f64>>>>()
-            };
-            match pool {
-                Some(p) => p.install(work),
-                None => work(),
-            }
-        });
-        if let Some(c) = &self.callbacks {
-            c.take_error()?;
+                })
+                .direction(direction)
+                .terminal(terminal)
+            })
+            .collect();
+        self.events = Some(Mutex::new(Events::new(list, tol).py()?));
+        Ok(())
+    }
+
+    /// The events located since the last call (and forgets them), in time order: a list of
+    /// (index of the event function, t, state (d,), attitude (3, 3) or None, absolute step).
+    fn events_found<'py>(&mut self, py: Python<'py>) -> PyResult<Vec<Found<'py>>> {
+        let Some(events) = &mut self.events else {
+            return Ok(Vec::new());
+        };
+        let events = events.get_mut().unwrap_or_else(|p| p.into_inner());
+        let d = self.d;
+        let attitude = self.attitude;
+        std::mem::take(&mut events.hits)
+            .into_iter()
+            .map(|h| {
+                let state = PyArray1::from_slice(py, &h.state[..d]);
+                let att = if attitude {
+                    Some(PyArray1::from_slice(py, &h.state[d..]).reshape([3, 3])?)
+                } else {
+                    None
+                };
+                Ok((h.event, h.t, state, att, h.step))
+            })
+            .collect()
+    }
+
+    /// The terminal event function that ended the run, if one did.
+    #[getter]
+    fn stopped_by(&mut self) -> Option<usize> {
+        let events = self.events.as_mut()?;
+        events
+            .get_mut()
+            .unwrap_or_else(|p| p.into_inner())
+            .stopped_by()
+    }
+
+    /// The time at which the run ended between grid times (a terminal event or `finish`), or
+    /// None.
+    #[getter]
+    fn ended(&self) -> Option<f64> {
+        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        runs.first().and_then(|r| r.ended())
+    }
+
+    /// Grid steps done (after an error: those that passed the checks).
+    #[getter]
+    fn steps_done(&self) -> u64 {
+        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        runs.first().map_or(0, |r| r.steps_done())
+    }
+
+    /// The number of grid steps from the start of the run to the last grid time ≤ t.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (t before t0, non-finite, beyond 2⁶³ steps).
+    fn steps_to(&self, #[pyo3(from_py_with = real)] t: f64) -> PyResult<u64> {
+        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        match runs.first() {
+            Some(r) => r.grid_steps(t).py(),
+            None => Ok(0),
         }
-        let outs = result.py()?;
-        self.done += steps;
-        let mut data = check::zeros("steps", &[b, per_run]).py()?;
-        for (d, o) in data.chunks_exact_mut(per_run.max(1)).zip(&outs) {
-            d.copy_from_slice(o);
-        }
-        self.split(py, &data, b, k as usize)
+    }
+
+    /// After a failed `advance`/`finish` of a single run: the states (1, k, d) and attitudes
+    /// (1, k, 3, 3) or None saved by that call before its error (then forgotten); None otherwise.
+    fn take_partial<'py>(
+        &mut self,
+        py: Python<'py>,
+    ) -> PyResult<Option<(Out<'py>, Option<Out<'py>>)>> {
+        let Some(data) = self.partial.take() else {
+            return Ok(None);
+        };
+        let full = self.d + if self.attitude { 9 } else { 0 };
+        let k = data.len() / full.max(1);
+        self.split(py, &data, 1, k).map(Some)
+    }
+
+    /// The last states that passed the checks (b, d) and attitudes (b, 3, 3) or None: the
+    /// current states, and after an error the states before the failing step (at
+    /// `steps_done`), where the stepper's own `state()` may already be outside the domain.
+    fn checked_state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
+        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        let data: Vec<f64> = runs
+            .iter()
+            .flat_map(|r| r.checked_state(&*self.sys))
+            .collect();
+        self.states_of(py, &data, runs.len())
     }
 
     /// The current states (b, d) and attitudes (b, 3, 3) or None.
     fn state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
         let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        let b = runs.len();
         let data: Vec<f64> = runs.iter().flat_map(|r| r.state(&*self.sys)).collect();
-        let (z, r) = self.split(py, &data, b, 1)?;
-        let z = z.reshape([b, self.d])?.cast_into::<PyArray2<f64>>()?;
-        let r = match r {
-            Some(r) => Some(r.reshape([b, 3, 3])?.cast_into::<PyArray3<f64>>()?),
-            None => None,
-        };
-        Ok((z, r))
+        self.states_of(py, &data, runs.len())
     }
 
-    /// The time of the current states.
+    /// The time of the current states (absolute; the end time of an ended run).
     #[getter]
     fn time(&self) -> f64 {
         let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());

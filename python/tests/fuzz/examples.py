@@ -147,6 +147,26 @@ def inside(t, p):
     return 0.0 < t < math.pi
 
 
+class _Parts(list):
+    """A list that the harness's mutation check compares with itself (its deepcopy is itself):
+    Trajectory has no value equality (== is identity), so a copy would always differ."""
+
+    def __deepcopy__(self, memo):
+        return self
+
+
+def _two_runs(lf):
+    """A run of the rigid body and its continuation (Trajectory.concatenate)."""
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    a = lf.integrate(body, [1.0, 0.5, -0.3], dt=0.01, steps=10)
+    return _Parts([a, lf.integrate(body, a.final_state, dt=0.01, steps=10, t0=a.t_final)])
+
+
+def event_m2(t, state):
+    """An event function of the rigid body (lf.integrate(events=...)): M₂, zero at t ≈ 1.6."""
+    return state[1]
+
+
 def _svk(lf):
     return lf.potentials.SaintVenantKirchhoff(1.0, 2.0)
 
@@ -533,8 +553,15 @@ def build_specs() -> list[Spec]:
            for f in ("accelerations", "angular_momentum", "body_momenta", "centres",
                      "centres_of_mass", "contact_point", "spatial_momenta", "udot")],
         "rdeq": [("state", [A("omega", 1.0, "float")])],
-        "run": [("advance", [A("steps", 5, "int")]), ("state", [])],
-        "traj": [("energy", []), ("invariants", []), ("casimirs", [])],
+        "run": [("advance", [A("steps", 5, "int")]), ("state", [])]
+        # Output control (issue 15).
+        + [("finish", [A("t", 0.123, "float")]), ("steps_to", [A("t", 0.5, "float")]),
+           ("save_at", [A("t_eval", np.array([0.0, 0.013, 0.05]), "vec")]),
+           ("set_events", [A("functions", [event_m2], "obj"), A("directions", [0.0], "vec"),
+                           A("terminal", [1], "obj"), A("tol", 0.0, "float")]),
+           ("events_found", []), ("take_partial", []), ("checked_state", [])],
+        "traj": [("energy", []), ("invariants", []), ("casimirs", []),
+                 ("concatenate", [A("trajectories", Lazy(_two_runs), "obj")])],
     }
     for key, methods in own.items():
         for name, args in methods:
@@ -558,6 +585,19 @@ def build_specs() -> list[Spec]:
         A("method", "splitting4", "str", kw=True, opt=True), A("save_every", 5, "int", kw=True, positive=True),
         A("chunk_steps", 7, "int", kw=True, opt=True, positive=True),
         A("threads", 1, "int", kw=True, opt=True), A("progress", False, "bool", kw=True))
+    # ---- lf.integrate: output control (issue 15): t0, t_eval, events, event_tol ----
+    # `steps` is fuzzed as an int by the specs above, where 10**12 steps are refused by the
+    # memory check of the states they would save; with t_eval or events nothing is saved per
+    # step, so 10**12 steps are a legitimate run beyond the harness's time limit: here it only
+    # gets the wrong-object values ("obj").
+    add("integrate[rb,t_eval]", "integrate", A("system", lazy_recv("rb"), "obj"),
+        A("state0", np.array([1.0, 0.5, -0.3]), "vec"), A("dt", 0.01, "float", kw=True),
+        A("steps", 20, "obj", kw=True, opt=True), A("t0", 0.5, "float", kw=True),
+        A("t_eval", np.array([0.5, 0.513, 0.6, 0.7]), "vec", kw=True, opt=True))
+    add("integrate[rb,events]", "integrate", A("system", lazy_recv("rb"), "obj"),
+        A("state0", np.array([1.0, 0.5, -0.3]), "vec"), A("dt", 0.01, "float", kw=True),
+        A("steps", 200, "obj", kw=True), A("events", event_m2, "fn", kw=True, opt=True),
+        A("event_tol", 0.0, "float", kw=True))
     return S
 
 
