@@ -19,6 +19,8 @@ TangentTop, ChargedParticle, surfaces                           the tangent Eule
 RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
 RollingSpheres                                                  two rolling spheres of 003 §2
 RollingDisks                                                    two rolling disks of 003 §1
+Canonical, Separable, LiePoisson                                user-defined systems from Python
+                                                                callables (docs/user_systems.md)
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``); an argument of the
@@ -41,10 +43,12 @@ from ._lieflow import (
     __version__,
 )
 from ._lieflow import (
+    Canonical,
     ChargedParticle,
     GeneralizedRigidBody,
     HeavyTop,
     Integration,
+    LiePoisson,
     Pendulum,
     PseudoRigidBody,
     RelativisticTangentTop,
@@ -53,6 +57,7 @@ from ._lieflow import (
     RollingDisks,
     RollingDisksEquilibrium,
     RollingSpheres,
+    Separable,
     SphereParticle,
     SphericalPendulum,
     System,
@@ -67,6 +72,7 @@ LiePoissonSystem = System
 
 __all__ = [
     "ArgumentTypeError",
+    "Canonical",
     "ChargedParticle",
     "ConvergenceError",
     "DegenerateStratumError",
@@ -75,6 +81,7 @@ __all__ = [
     "Integration",
     "InvalidArgumentError",
     "LeftDomainError",
+    "LiePoisson",
     "LiePoissonSystem",
     "LieflowError",
     "NoUniqueLogError",
@@ -88,6 +95,7 @@ __all__ = [
     "RollingSpheres",
     "RollingDisks",
     "RollingDisksEquilibrium",
+    "Separable",
     "SphereParticle",
     "ShapeError",
     "SphericalPendulum",

@@ -4,6 +4,7 @@ States of the Lie–Poisson systems are flat float64 vectors z of length ``state
 observables are vectorised over leading axes (..., d) and return a float for a single state.
 """
 
+from collections.abc import Callable, Sequence
 from types import ModuleType
 from typing import Any
 
@@ -322,3 +323,57 @@ class RollingDisksEquilibrium:
     @property
     def curvature(self) -> float: ...
     def state(self, omega: float = 1.0) -> list[float]: ...
+
+# --- user-defined systems (issue 15) ---
+
+class Canonical(System):
+    """H(q, p) on T*R^d from Python callables: z = (q, p) (2d,); gauss4 (default), gauss6,
+    midpoint, rk4. The callables run single-threaded with the GIL; exceptions are re-raised with
+    a note naming the step; wrong shapes are ShapeError, NaN/inf NonFiniteError."""
+
+    def __init__(
+        self, hamiltonian: Callable[[F64, F64], float],
+        gradient: Callable[[F64, F64], Any] | None = None, dim: int | None = None,
+    ) -> None:
+        """hamiltonian(q, p) -> float; gradient(q, p) -> (dH/dq, dH/dp) of shape (2, d), or None
+        for central differences; dim: the number of degrees of freedom (required)."""
+    @property
+    def dof(self) -> int: ...
+    @property
+    def finite_differences(self) -> bool: ...
+
+class Separable(System):
+    """H = p.M^{-1}p/2 + U(q) with U from Python callables: z = (q, p) (2d,); verlet (default),
+    verlet4, verlet6, gauss4, gauss6, midpoint, rk4."""
+
+    def __init__(
+        self, kinetic_mass: ArrayLike, potential: Callable[[F64], float],
+        gradient: Callable[[F64], ArrayLike] | None = None, dim: int | None = None,
+    ) -> None:
+        """kinetic_mass: a number (then dim is required), a vector (d,) or an SPD (d, d) matrix;
+        potential(q) -> float; gradient(q) -> (d,), or None for central differences."""
+    @property
+    def dof(self) -> int: ...
+    @property
+    def finite_differences(self) -> bool: ...
+
+class LiePoisson(System):
+    """A Lie–Poisson system d mu/dt = ad*_{dH/dmu} mu on g* (so3, se3, ("so", n) or structure
+    constants (d, d, d)); rkmk4 (default), midpoint, midpoint4 (keep the coadjoint orbit), rk4.
+    Casimirs: |M|^2 (so3); |Gamma|^2, M.Gamma (se3); tr((M^T M)^k)/2 (so(n)); or `casimirs`."""
+
+    def __init__(
+        self, algebra: str | tuple[str, int] | ArrayLike,
+        hamiltonian: Callable[[F64], float] | ArrayLike,
+        gradient: Callable[[F64], ArrayLike] | None = None,
+        casimirs: Sequence[Callable[[F64], float]] | None = None,
+    ) -> None:
+        """hamiltonian: a callable mu -> float, or a symmetric (d, d) matrix A for H = mu.A mu/2
+        (the native path); gradient: mu -> (d,) or None (finite differences; None for a
+        matrix)."""
+    @property
+    def dim(self) -> int: ...
+    @property
+    def is_quadratic(self) -> bool: ...
+    def structure_constants(self) -> F64:
+        """C (d, d, d) with [e_i, e_j] = C[i, j, k] e_k."""

@@ -179,9 +179,9 @@ impl Failure {
                 expected,
                 got,
             } => Error::Shape {
-                what: format!("{what} ({place})"),
+                what,
                 expected,
-                got,
+                got: format!("{got}, {place}"),
             },
             Error::NotInGroup {
                 what,

@@ -1,6 +1,7 @@
 //! The system classes of `lieflow::systems`: the Lie–Poisson systems of 000 §3–§5 (`RigidBody`,
 //! `GeneralizedRigidBody`, `HeavyTop`, `SphericalPendulum`) and the test problems of the
-//! mechanics core (`Pendulum`, `SphereParticle`, `RollingDisk`), thin subclasses of
+//! mechanics core (`Pendulum`, `SphereParticle`, `RollingDisk`), the user-defined systems
+//! (`Canonical`, `Separable`, `LiePoisson`: `user.rs`), thin subclasses of
 //! `lieflow.System`, and the helpers the bodies on SO(3) share.
 
 mod heavy_top;
@@ -13,6 +14,7 @@ mod rolling_spheres;
 mod spherical_pendulum;
 pub mod surfaces;
 pub mod tangent_top;
+mod user;
 
 use lieflow::systems::RigidBody;
 use lieflow::Error;
@@ -87,5 +89,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<relativistic_top::PyWeakFieldTop>()?;
     m.add_class::<tangent_top::PyTangentTop>()?;
     m.add_class::<tangent_top::PyChargedParticle>()?;
+    m.add_class::<user::PyCanonical>()?;
+    m.add_class::<user::PySeparable>()?;
+    m.add_class::<user::PyLiePoisson>()?;
     Ok(())
 }
