@@ -264,6 +264,82 @@ CONSTRUCTORS = {  # class name -> receiver key built by it
 }
 
 
+# --- user-defined systems (issue 15): lf.Canonical, lf.Separable, lf.LiePoisson ---
+# Their callables are "obj" arguments of the constructors (a constructor does not call them; the
+# bad return values of the "fn" kind are tested through runs in test_user_systems.py).
+
+def user_h(q, p):
+    return 0.5 * float(p @ p + q @ q)
+
+
+def user_grad(q, p):
+    return q, p
+
+
+def user_u(q):
+    return 0.5 * float(q @ q)
+
+
+def user_du(q):
+    return np.asarray(q, float)
+
+
+def user_lp_h(mu):
+    return 0.5 * float(mu @ (mu / A3))
+
+
+def user_lp_grad(mu):
+    return np.asarray(mu, float) / A3
+
+
+def user_casimir(mu):
+    return float(mu @ mu)
+
+
+KIRCHHOFF = np.diag([1.0, 0.7, 0.4, 2.0, 1.5, 1.2])
+KIRCHHOFF[0, 4] = KIRCHHOFF[4, 0] = 0.1
+
+RECEIVERS.update({
+    "ucan": lambda lf: lf.Canonical(user_h, user_grad, 2),
+    "usep": lambda lf: lf.Separable([1.0, 2.0], user_u, user_du),
+    "ulp": lambda lf: lf.LiePoisson("so3", user_lp_h, user_lp_grad, [user_casimir]),
+    "ulpq": lambda lf: lf.LiePoisson("se3", KIRCHHOFF),
+})
+CONSTRUCTORS.update({"Canonical": "ucan", "Separable": "usep", "LiePoisson": "ulp"})
+USER_STATES = {"ucan": np.array([0.3, -0.2, 0.1, 0.4]), "usep": np.array([0.3, -0.2, 0.1, 0.4]),
+               "ulp": M3, "ulpq": np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8])}
+
+
+def user_specs(add):
+    """The specs of the user-defined systems (issue 15)."""
+    add("Canonical", "Canonical", A("hamiltonian", user_h, "obj"),
+        A("gradient", user_grad, "obj", opt=True), A("dim", 2, "int", positive=True))
+    add("Separable", "Separable", A("kinetic_mass", 1.5, "float", positive=True),
+        A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True),
+        A("dim", 1, "int", kw=True, positive=True))
+    add("Separable[matrix]", "Separable", A("kinetic_mass", I_SPH2, "mat"),
+        A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True))
+    add("LiePoisson", "LiePoisson", A("algebra", "so3", "str"), A("hamiltonian", user_lp_h, "obj"),
+        A("gradient", user_lp_grad, "obj", opt=True),
+        A("casimirs", [user_casimir], "obj", opt=True))
+    add("LiePoisson[quadratic]", "LiePoisson", A("algebra", "se3", "str"),
+        A("hamiltonian", KIRCHHOFF, "mat"))
+    add("LiePoisson[so(n)]", "LiePoisson", A("algebra", ("so", 4), "obj"),
+        A("hamiltonian", np.eye(6), "mat"))
+    add("LiePoisson[constants]", "LiePoisson", A("algebra", Lazy(
+        lambda lf: lf.LiePoisson(("so", 3), np.eye(3)).structure_constants()), "vec"),
+        A("hamiltonian", np.diag(A3), "mat"))
+    for key, st in USER_STATES.items():
+        for f in ("energy", "invariants", "casimirs"):
+            add(f"{key}.{f}", f"@{key}.{f}", A("states", st, "vec"))
+        add(f"{key}.methods", f"@{key}.methods")
+        add(f"integrate[{key}]", "integrate", A("system", lazy_recv(key), "obj"),
+            A("state0", st, "vec"), A("dt", 0.01, "float", kw=True),
+            A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True))
+    add("ulpq.structure_constants", "@ulpq.structure_constants")
+    add("ulp.structure_constants", "@ulp.structure_constants")
+
+
 def _scipy_rotation(lf):
     """A scipy Rotation of two rotations (the argument of lf.lie.from_scipy)."""
     from scipy.spatial.transform import Rotation
@@ -598,6 +674,8 @@ def build_specs() -> list[Spec]:
         A("state0", np.array([1.0, 0.5, -0.3]), "vec"), A("dt", 0.01, "float", kw=True),
         A("steps", 200, "obj", kw=True), A("events", event_m2, "fn", kw=True, opt=True),
         A("event_tol", 0.0, "float", kw=True))
+    # ---- user-defined systems (issue 15) ----
+    user_specs(add)
     return S
 
 

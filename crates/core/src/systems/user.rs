@@ -1400,12 +1400,13 @@ impl LiePoisson {
         s.term.copy_from_slice(v);
         let two_pi = 2.0 * std::f64::consts::PI;
         let mut bound = 1.0;
-        for k in 1..s.bernoulli.len() {
+        let bernoulli = bernoulli();
+        for k in 1..bernoulli.len() {
             self.algebra.bracket(u, &s.term, &mut s.next);
             std::mem::swap(&mut s.term, &mut s.next);
             let mut pn = 0.0f64;
             for (o, t) in out.iter_mut().zip(&s.term) {
-                *o += s.bernoulli[k] * t;
+                *o += bernoulli[k] * t;
                 pn = pn.max(t.abs());
             }
             // |b_j| ≤ 4/(2π)^j (j ≥ 2) and ‖ad_u‖ ≤ β < π: the rest is below 4‖p_k‖/(2π)^k.
@@ -1450,6 +1451,12 @@ fn bernoulli_coefficients(len: usize) -> Vec<f64> {
     b
 }
 
+/// The 64 coefficients B_k/k! of the dexp⁻¹ series, computed once.
+fn bernoulli() -> &'static [f64] {
+    static B: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    B.get_or_init(|| bernoulli_coefficients(64))
+}
+
 /// Per-thread scratch of the [`LiePoisson`] kernels.
 pub struct LieScratch {
     so: Option<SoScratch>,
@@ -1459,7 +1466,6 @@ pub struct LieScratch {
     sum: Vec<f64>,
     term: Vec<f64>,
     next: Vec<f64>,
-    bernoulli: Vec<f64>,
 }
 
 impl Problem for LiePoisson {
@@ -1530,7 +1536,6 @@ impl GroupField for LiePoisson {
             sum: vec![0.0; d],
             term: vec![0.0; d],
             next: vec![0.0; d],
-            bernoulli: bernoulli_coefficients(64),
         }
     }
     fn algebra_dim(&self) -> usize {

@@ -28,7 +28,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use pyo3::PyClassInitializer;
 
-use crate::convert::{int_opt, mat, read_all, shape_str, ArrayIn, Real};
+use crate::convert::{int_opt, mat, named, read_all, shape_str, ArrayIn, Real};
 use crate::errors::{argument_type_error, to_py, IntoPy};
 use crate::integrate::{Callbacks, ErrorSlot};
 use crate::system::PySystem;
@@ -241,7 +241,7 @@ impl PyCanonical {
             .map(|g| Callee::new("gradient", g, &calls))
             .transpose()?;
         let d = match optional(dim.as_ref()) {
-            Some(v) => count("dim", int_opt(v)?.unwrap_or(0))?,
+            Some(v) => count("dim", named("dim", int_opt(v))?.unwrap_or(0))?,
             None => {
                 return Err(missing(
                     py,
@@ -373,7 +373,7 @@ impl PySeparable {
             .map(|g| Callee::new("gradient", g, &calls))
             .transpose()?;
         let d = match optional(dim.as_ref()) {
-            Some(v) => Some(count("dim", int_opt(v)?.unwrap_or(0))?),
+            Some(v) => Some(count("dim", named("dim", int_opt(v))?.unwrap_or(0))?),
             None => None,
         };
         if matches!(mass, KineticMass::Scalar(_)) && d.is_none() {
@@ -463,7 +463,7 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
                 format!("unknown algebra ({name:?}, n); expected {names}"),
             )));
         }
-        let n = int_opt(&a.get_item(1)?)?.unwrap_or(0);
+        let n = named("algebra", int_opt(&a.get_item(1)?))?.unwrap_or(0);
         let n = usize::try_from(n).map_err(|_| {
             to_py(Error::invalid(
                 "algebra",
