@@ -245,11 +245,28 @@ impl FailureLog {
     }
 }
 
-/// The fault of one stepper and the log of the system.
-#[derive(Clone, Debug, Default)]
+/// Runs its argument inside whatever context the functions need: a binding to an interpreter
+/// enters it once around a whole call of a stepper instead of once per function call (the
+/// Python bindings hold the GIL for the chunk, which on a worker thread saves creating and
+/// destroying a thread state per call, ~7 µs).
+pub type Session = Arc<dyn Fn(&mut dyn FnMut()) + Send + Sync>;
+
+/// The fault of one stepper, the log and the session of the system.
+#[derive(Clone, Default)]
 struct Hooks {
     fault: Arc<Fault>,
     log: Arc<FailureLog>,
+    session: Option<Session>,
+}
+
+impl fmt::Debug for Hooks {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Hooks")
+            .field("fault", &self.fault)
+            .field("log", &self.log)
+            .field("session", &self.session.is_some())
+            .finish()
+    }
 }
 
 impl Hooks {
@@ -259,6 +276,21 @@ impl Hooks {
         Hooks {
             fault: Arc::new(Fault::default()),
             log: self.log.clone(),
+            session: self.session.clone(),
+        }
+    }
+
+    /// `f()` inside the session, if any.
+    fn within<T>(&self, f: impl FnOnce() -> T) -> T {
+        match &self.session {
+            None => f(),
+            Some(s) => {
+                let mut f = Some(f);
+                let mut out = None;
+                s(&mut || out = f.take().map(|f| f()));
+                // A session must call its argument; if it did not, call it here.
+                out.unwrap_or_else(|| f.take().map(|f| f()).expect("called once"))
+            }
         }
     }
 
@@ -338,7 +370,8 @@ impl GuardStepper {
 
 impl Stepper for GuardStepper {
     fn set(&mut self, z: &[f64]) -> Result<()> {
-        let r = self.inner.set(z);
+        let hooks = self.hooks.clone();
+        let r = hooks.within(|| self.inner.set(z));
         match self.hooks.fault.take() {
             Some(e) => Err(self.failed(e, 0, f64::NAN)),
             None => r,
@@ -350,18 +383,21 @@ impl Stepper for GuardStepper {
     }
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
-        for k in 0..steps {
-            let c = Clock {
-                done: clock.done + k as u64,
-                ..clock
-            };
-            let r = self.inner.advance(1, c);
-            if let Some(e) = self.hooks.fault.take() {
-                return Err(self.failed(e, c.done + 1, c.time(1)));
+        let hooks = self.hooks.clone();
+        hooks.within(|| {
+            for k in 0..steps {
+                let c = Clock {
+                    done: clock.done + k as u64,
+                    ..clock
+                };
+                let r = self.inner.advance(1, c);
+                if let Some(e) = self.hooks.fault.take() {
+                    return Err(self.failed(e, c.done + 1, c.time(1)));
+                }
+                r?;
             }
-            r?;
-        }
-        Ok(())
+            Ok(())
+        })
     }
 }
 
@@ -451,6 +487,12 @@ impl UserCanonical {
     /// The log of the first failure of the functions in a run (see [`Failure`]).
     pub fn failures(&self) -> Arc<FailureLog> {
         self.hooks.log.clone()
+    }
+
+    /// The same system whose steppers run inside `session` (see [`Session`]).
+    pub fn with_session(mut self, session: Session) -> Self {
+        self.hooks.session = Some(session);
+        self
     }
 
     /// H(q, p), checked finite.
@@ -716,6 +758,12 @@ impl UserSeparable {
     /// The log of the first failure of the functions in a run (see [`Failure`]).
     pub fn failures(&self) -> Arc<FailureLog> {
         self.hooks.log.clone()
+    }
+
+    /// The same system whose steppers run inside `session` (see [`Session`]).
+    pub fn with_session(mut self, session: Session) -> Self {
+        self.hooks.session = Some(session);
+        self
     }
 
     /// U(q), checked finite.
@@ -1292,6 +1340,12 @@ impl LiePoisson {
         self.hooks.log.clone()
     }
 
+    /// The same system whose steppers run inside `session` (see [`Session`]).
+    pub fn with_session(mut self, session: Session) -> Self {
+        self.hooks.session = Some(session);
+        self
+    }
+
     /// H(μ), checked finite.
     pub fn value(&self, mu: &[f64]) -> Result<f64> {
         match &self.hamiltonian {
@@ -1400,13 +1454,12 @@ impl LiePoisson {
         s.term.copy_from_slice(v);
         let two_pi = 2.0 * std::f64::consts::PI;
         let mut bound = 1.0;
-        let bernoulli = bernoulli();
-        for k in 1..bernoulli.len() {
+        for &b in &bernoulli()[1..] {
             self.algebra.bracket(u, &s.term, &mut s.next);
             std::mem::swap(&mut s.term, &mut s.next);
             let mut pn = 0.0f64;
             for (o, t) in out.iter_mut().zip(&s.term) {
-                *o += bernoulli[k] * t;
+                *o += b * t;
                 pn = pn.max(t.abs());
             }
             // |b_j| ≤ 4/(2π)^j (j ≥ 2) and ‖ad_u‖ ≤ β < π: the rest is below 4‖p_k‖/(2π)^k.

@@ -3,8 +3,10 @@
 //! matrix: the native quadratic path). Thin subclasses of `lieflow.System`.
 //!
 //! The callables are called from the native kernels the way the callable surfaces are
-//! (`surfaces.rs`): with the GIL taken for each call, in a run that is single-threaded (a batch
-//! of states is allowed and runs member after member); an exception is kept (`ErrorSlot`), the
+//! (`surfaces.rs`), with one difference: the GIL is taken once for each chunk of steps (the
+//! systems' session, `lieflow::systems::user::Session`), not for each call, which on the run's
+//! worker thread costs ~7 µs a call. A run is single-threaded (a batch of states is allowed and
+//! runs member after member); an exception is kept (`ErrorSlot`), the
 //! kernel goes on with NaN, the core stops the run after that step and the exception is re-raised
 //! with a note naming the step ("lieflow: raised in step 17 of gauss4 (t = …, dt = …)"). A value
 //! of the wrong shape is a `ShapeError`, a non-finite one a `NonFiniteError`, both naming the
@@ -16,16 +18,18 @@
 use std::sync::{Arc, OnceLock};
 
 use lieflow::integrate::problem::Canonical;
-use lieflow::systems::user::{CanonicalFn, CanonicalGradientFn, FailureLog, GradientFn, ScalarFn};
+use lieflow::systems::user::{
+    CanonicalFn, CanonicalGradientFn, FailureLog, GradientFn, ScalarFn, Session,
+};
 use lieflow::systems::{
     Algebra, KineticMass, LieHamiltonian, LiePoisson as CoreLiePoisson, UserCanonical,
     UserSeparable,
 };
 use lieflow::Error;
 use numpy::ndarray::Array3;
-use numpy::{IntoPyArray, PyArray1, PyArray3};
+use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString, PyTuple};
+use pyo3::types::{PyDict, PyFloat, PyList, PyString, PyTuple};
 use pyo3::PyClassInitializer;
 
 use crate::convert::{int_opt, mat, named, read_all, shape_str, ArrayIn, Real};
@@ -112,17 +116,16 @@ impl Callee {
             let called = PyTuple::new(py, args.iter().map(|x| PyArray1::from_slice(py, x)))
                 .and_then(|a| self.f.bind(py).call1(a));
             let value = called.map_err(|e| self.raised(e))?;
-            let a = ArrayIn::named(&self.what, &value).map_err(|e| self.raised(e))?;
-            let v = a.as_array();
-            if v.shape() != shape {
-                return Err(Error::shape(
-                    &*self.what,
-                    shape_str(shape),
-                    shape_str(v.shape()),
-                ));
-            }
-            for (o, x) in out.iter_mut().zip(v.iter()) {
-                *o = *x;
+            // Fast paths: a float, a float64 array; anything else is read like every argument.
+            match (shape.is_empty(), value.cast::<PyFloat>()) {
+                (true, Ok(f)) => out[0] = f.value(),
+                _ => match value.cast::<PyArrayDyn<f64>>().map(|a| a.try_readonly()) {
+                    Ok(Ok(a)) => self.copy(&a.as_array(), shape, out)?,
+                    _ => {
+                        let a = ArrayIn::named(&self.what, &value).map_err(|e| self.raised(e))?;
+                        self.copy(&a.as_array(), shape, out)?
+                    }
+                },
             }
             match out.iter().position(|x| !x.is_finite()) {
                 None => Ok(()),
@@ -146,11 +149,38 @@ impl Callee {
         })
     }
 
+    /// `v` into `out` if it has `shape`, else a ShapeError.
+    fn copy(
+        &self,
+        v: &numpy::ndarray::ArrayViewD<'_, f64>,
+        shape: &[usize],
+        out: &mut [f64],
+    ) -> lieflow::Result<()> {
+        if v.shape() != shape {
+            return Err(Error::shape(
+                &*self.what,
+                shape_str(shape),
+                shape_str(v.shape()),
+            ));
+        }
+        for (o, x) in out.iter_mut().zip(v.iter()) {
+            *o = *x;
+        }
+        Ok(())
+    }
+
     fn scalar(&self, args: &[&[f64]]) -> lieflow::Result<f64> {
         let mut out = [0.0];
         self.call(args, &[], &mut out)?;
         Ok(out[0])
     }
+}
+
+/// The session of the systems that call Python: the GIL held for a whole call of a stepper (a
+/// chunk of steps), so that the callables' own `Python::attach` reuses the thread's state (on a
+/// worker thread each separate attach would create and destroy one, about 7 µs per call).
+fn gil() -> Session {
+    Arc::new(|f: &mut dyn FnMut()| Python::attach(|_| f()))
 }
 
 fn optional<'a, 'py>(a: Option<&'a Any<'py>>) -> Option<&'a Any<'py>> {
@@ -264,7 +294,9 @@ impl PyCanonical {
                 },
             ) as CanonicalGradientFn
         });
-        let sys = UserCanonical::new(d, value, grad_fn).py()?;
+        let sys = UserCanonical::new(d, value, grad_fn)
+            .py()?
+            .with_session(gil());
         let _ = calls.log.set(sys.failures());
         let args = (hamiltonian, gradient, dim).into_pyobject(py)?;
         let base = PySystem::new(sys.clone(), args, &["hamiltonian", "gradient", "dim"])
@@ -388,7 +420,9 @@ impl PySeparable {
         let grad_fn: Option<GradientFn> = g.map(|g| {
             Arc::new(move |q: &[f64], out: &mut [f64]| g.call(&[q], &[q.len()], out)) as GradientFn
         });
-        let sys = UserSeparable::new(mass, d, value, grad_fn).py()?;
+        let sys = UserSeparable::new(mass, d, value, grad_fn)
+            .py()?
+            .with_session(gil());
         let _ = calls.log.set(sys.failures());
         let args = (kinetic_mass, potential, gradient, dim).into_pyobject(py)?;
         let base = PySystem::new(
@@ -590,7 +624,10 @@ impl PyLiePoisson {
                 Some(fs)
             }
         };
-        let sys = CoreLiePoisson::new(alg, ham, cas).py()?;
+        let mut sys = CoreLiePoisson::new(alg, ham, cas).py()?;
+        if python {
+            sys = sys.with_session(gil());
+        }
         let _ = calls.log.set(sys.failures());
         let args = (algebra, hamiltonian, gradient, casimirs).into_pyobject(py)?;
         let base = PySystem::new(
