@@ -56,6 +56,8 @@
 //! Python bindings read to name the step on the exception a Python callable raised. Values are
 //! checked: a non-finite H or gradient entry is [`Error::NonFinite`] naming the entry.
 //! Evaluation of H outside the kernels ([`Problem::energy`], the Casimirs) returns the error.
+//! A binding may give the system a [`Session`], entered once around every call of a stepper (the
+//! Python bindings hold the GIL there, for a chunk of steps, instead of taking it per call).
 //!
 //! **Finite differences** (a function given without its gradient): each derivative is a central
 //! difference with one Richardson extrapolation ([`crate::analysis`]'s Jacobian, four
