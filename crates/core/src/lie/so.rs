@@ -867,8 +867,10 @@ fn dexp3(xi: &Mat, eta: &Mat, inverse: bool) -> Mat {
 }
 
 /// Coefficients b_k = B_k / k! of z / (eᶻ − 1) = Σ b_k zᵏ (B_1 = −½), from
-/// b_2m = (−1)^{m+1} 2 ζ(2m) / (2π)^{2m} (odd b_k = 0 for k ≥ 3).
-fn bernoulli_coefficients() -> &'static [f64] {
+/// b_2m = (−1)^{m+1} 2 ζ(2m) / (2π)^{2m} (odd b_k = 0 for k ≥ 3), computed once: the series
+/// dexp⁻¹_u = Σ b_k ad_uᵏ of [`dexp_inv`] and of the RKMK kernels of the so(n) rigid body and
+/// of user Lie–Poisson systems.
+pub(crate) fn bernoulli_coefficients() -> &'static [f64] {
     static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
     TABLE.get_or_init(|| {
         let two_pi = 2.0 * std::f64::consts::PI;

@@ -571,7 +571,7 @@ impl GroupField for GeneralizedRigidBody {
         out.copy_from_slice(v);
         let two_pi = 2.0 * std::f64::consts::PI;
         let mut bound = 1.0;
-        for k in 1..s.bernoulli.len() {
+        for &ck in &so::bernoulli_coefficients()[1..] {
             // p ← [u, p] = u p − (u p)ᵀ for skew u, p.
             matmul(n, &s.a, &s.m, &mut s.b);
             let mut c = 0;
@@ -582,7 +582,7 @@ impl GroupField for GeneralizedRigidBody {
                     let x = s.b[i * n + j] - s.b[j * n + i];
                     s.m[i * n + j] = x;
                     s.m[j * n + i] = -x;
-                    out[c] += s.bernoulli[k] * x;
+                    out[c] += ck * x;
                     pn += x * x;
                     c += 1;
                 }
@@ -599,7 +599,7 @@ impl GroupField for GeneralizedRigidBody {
 }
 
 /// Scratch of the so(n) kernels of [`GeneralizedRigidBody`]'s [`GroupField`]: dense n×n
-/// matrices (row-major) and the Bernoulli coefficients B_k/k!.
+/// matrices (row-major).
 #[derive(Clone, Debug)]
 pub struct SoScratch {
     n: usize,
@@ -608,7 +608,6 @@ pub struct SoScratch {
     g: Vec<f64>,
     m: Vec<f64>,
     t: Vec<f64>,
-    bernoulli: Vec<f64>,
 }
 
 impl SoScratch {
@@ -620,7 +619,6 @@ impl SoScratch {
             g: vec![0.0; n * n],
             m: vec![0.0; n * n],
             t: vec![0.0; n * n],
-            bernoulli: bernoulli_coefficients(64),
         }
     }
 
@@ -664,36 +662,6 @@ impl SoScratch {
             }
         }
     }
-}
-
-/// b_k = B_k/k!, k = 0…len−1, the coefficients of z/(eᶻ − 1): b₀ = 1, b₁ = −½, odd b_k = 0 for
-/// k ≥ 3, b_2m = (−1)^{m+1} 2ζ(2m)/(2π)^{2m} (ζ(2), ζ(4), ζ(6) in closed form, then the direct
-/// sum Σ j^{−2m} up to j^{−2m} < 10⁻²⁰).
-fn bernoulli_coefficients(len: usize) -> Vec<f64> {
-    let pi = std::f64::consts::PI;
-    let pi2 = pi * pi;
-    let mut b = vec![0.0; len];
-    b[0] = 1.0;
-    if len > 1 {
-        b[1] = -0.5;
-    }
-    for m in 1..len.div_ceil(2) {
-        let p = 2 * m as i32;
-        let zeta = match m {
-            1 => pi2 / 6.0,
-            2 => pi2 * pi2 / 90.0,
-            3 => pi2 * pi2 * pi2 / 945.0,
-            _ => {
-                let last = 1e20f64.powf(1.0 / f64::from(p)).ceil() as i32;
-                (2..=last).rev().map(|j| f64::from(j).powi(-p)).sum::<f64>() + 1.0
-            }
-        };
-        let sign = if m % 2 == 1 { 1.0 } else { -1.0 };
-        if 2 * m < len {
-            b[2 * m] = sign * 2.0 * zeta / (2.0 * pi).powi(p);
-        }
-    }
-    b
 }
 
 /// c = a·b for dense row-major n×n matrices.

@@ -1456,7 +1456,7 @@ impl LiePoisson {
         s.term.copy_from_slice(v);
         let two_pi = 2.0 * std::f64::consts::PI;
         let mut bound = 1.0;
-        for &b in &bernoulli()[1..] {
+        for &b in &so::bernoulli_coefficients()[1..] {
             self.algebra.bracket(u, &s.term, &mut s.next);
             std::mem::swap(&mut s.term, &mut s.next);
             let mut pn = 0.0f64;
@@ -1472,44 +1472,6 @@ impl LiePoisson {
             }
         }
     }
-}
-
-/// b_k = B_k/k!, k = 0…len−1, the coefficients of x/(eˣ − 1) (the same closed forms as the
-/// so(n) kernels of [`super::rigid_body`]): b₀ = 1, b₁ = −½, odd b_k = 0 for k ≥ 3,
-/// b_2m = (−1)^{m+1} 2ζ(2m)/(2π)^{2m}.
-fn bernoulli_coefficients(len: usize) -> Vec<f64> {
-    let pi = std::f64::consts::PI;
-    let mut b = vec![0.0; len];
-    b[0] = 1.0;
-    if len > 1 {
-        b[1] = -0.5;
-    }
-    for m in 1..len.div_ceil(2) {
-        let p = 2 * m as i32;
-        // ζ(2), ζ(4), ζ(6) in closed form, then the series summed from the small terms up
-        // (to j^{−2m} < 1e-20).
-        let pi2 = pi * pi;
-        let zeta = match m {
-            1 => pi2 / 6.0,
-            2 => pi2 * pi2 / 90.0,
-            3 => pi2 * pi2 * pi2 / 945.0,
-            _ => {
-                let last = 1e20f64.powf(1.0 / f64::from(p)).ceil() as i32;
-                (2..=last).rev().map(|j| f64::from(j).powi(-p)).sum::<f64>() + 1.0
-            }
-        };
-        let sign = if m % 2 == 1 { 1.0 } else { -1.0 };
-        if 2 * m < len {
-            b[2 * m] = sign * 2.0 * zeta / (2.0 * pi).powi(p);
-        }
-    }
-    b
-}
-
-/// The 64 coefficients B_k/k! of the dexp⁻¹ series, computed once.
-fn bernoulli() -> &'static [f64] {
-    static B: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
-    B.get_or_init(|| bernoulli_coefficients(64))
 }
 
 /// Per-thread scratch of the [`LiePoisson`] kernels.
@@ -1657,25 +1619,6 @@ impl Catalog for LiePoisson {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn bernoulli_coefficients_match_the_rational_values() {
-        let b = bernoulli_coefficients(9);
-        let want = [
-            1.0,
-            -0.5,
-            1.0 / 12.0,
-            0.0,
-            -1.0 / 720.0,
-            0.0,
-            1.0 / 30240.0,
-            0.0,
-            -1.0 / 1209600.0,
-        ];
-        for (x, y) in b.iter().zip(want) {
-            assert!((x - y).abs() <= 4e-16 * y.abs(), "{x} vs {y}");
-        }
-    }
 
     #[test]
     fn failures_are_located() {
