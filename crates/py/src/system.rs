@@ -281,7 +281,9 @@ impl PySystem {
         } else {
             threads
         };
-        Integration::start(
+        // A callable's exception (raised when the state is set and the first forces are
+        // evaluated) is raised in place of the core's error.
+        let run = Integration::start(
             sys,
             self.callbacks.clone(),
             &z0,
@@ -292,7 +294,11 @@ impl PySystem {
             t0,
             threads,
             steps,
-        )
+        );
+        if run.is_err() {
+            self.take_callback_error()?;
+        }
+        run
     }
 
     /// Integrates every row of `z0` by `steps` steps in one native run (see `_start`).

@@ -29,7 +29,7 @@ use lieflow::Error;
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyFloat, PyList, PyString, PyTuple};
+use pyo3::types::{PyFloat, PyList, PyString, PyTuple};
 use pyo3::PyClassInitializer;
 
 use crate::convert::{int_opt, mat, named, read_all, shape_str, ArrayIn, Real};
@@ -187,26 +187,6 @@ fn optional<'a, 'py>(a: Option<&'a Any<'py>>) -> Option<&'a Any<'py>> {
     a.filter(|x| !x.is_none())
 }
 
-/// Calls the base class's `name` (`_start`, `_run`) on `slf` with the given arguments; a
-/// callable's exception (e.g. raised by the first force evaluation when the state is set) is
-/// raised in place of the core's error.
-fn base_call<'py>(
-    slf: &Bound<'py, PySystem>,
-    name: &str,
-    args: &Bound<'py, PyTuple>,
-    kwargs: Option<&Bound<'py, PyDict>>,
-) -> PyResult<Any<'py>> {
-    let py = slf.py();
-    let method = py.get_type::<PySystem>().getattr(name)?;
-    let mut all: Vec<Any<'py>> = vec![slf.clone().into_any()];
-    all.extend(args.iter());
-    let r = method.call(PyTuple::new(py, all)?, kwargs);
-    if r.is_err() {
-        slf.get().take_callback_error()?;
-    }
-    r
-}
-
 /// A missing required argument: a TypeError naming it, as Python's own.
 fn missing(py: Python<'_>, class: &str, name: &str, what: &str) -> PyErr {
     argument_type_error(
@@ -321,26 +301,6 @@ impl PyCanonical {
     fn finite_differences(&self) -> bool {
         self.sys.finite_differences()
     }
-
-    /// See `System._start` (a callable's exception at the initial state is re-raised).
-    #[pyo3(signature = (*args, **kwargs))]
-    fn _start<'py>(
-        slf: &Bound<'py, Self>,
-        args: &Bound<'py, PyTuple>,
-        kwargs: Option<&Bound<'py, PyDict>>,
-    ) -> PyResult<Any<'py>> {
-        base_call(slf.as_super(), "_start", args, kwargs)
-    }
-
-    /// See `System._run` (a callable's exception is re-raised, naming the step).
-    #[pyo3(signature = (*args, **kwargs))]
-    fn _run<'py>(
-        slf: &Bound<'py, Self>,
-        args: &Bound<'py, PyTuple>,
-        kwargs: Option<&Bound<'py, PyDict>>,
-    ) -> PyResult<Any<'py>> {
-        base_call(slf.as_super(), "_run", args, kwargs)
-    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -450,26 +410,6 @@ impl PySeparable {
     #[getter]
     fn finite_differences(&self) -> bool {
         self.sys.finite_differences()
-    }
-
-    /// See `System._start` (a callable's exception at the initial state is re-raised).
-    #[pyo3(signature = (*args, **kwargs))]
-    fn _start<'py>(
-        slf: &Bound<'py, Self>,
-        args: &Bound<'py, PyTuple>,
-        kwargs: Option<&Bound<'py, PyDict>>,
-    ) -> PyResult<Any<'py>> {
-        base_call(slf.as_super(), "_start", args, kwargs)
-    }
-
-    /// See `System._run` (a callable's exception is re-raised, naming the step).
-    #[pyo3(signature = (*args, **kwargs))]
-    fn _run<'py>(
-        slf: &Bound<'py, Self>,
-        args: &Bound<'py, PyTuple>,
-        kwargs: Option<&Bound<'py, PyDict>>,
-    ) -> PyResult<Any<'py>> {
-        base_call(slf.as_super(), "_run", args, kwargs)
     }
 }
 
@@ -672,25 +612,5 @@ impl PyLiePoisson {
             ))
         })?;
         Ok(a.into_pyarray(py))
-    }
-
-    /// See `System._start` (a callable's exception at the initial state is re-raised).
-    #[pyo3(signature = (*args, **kwargs))]
-    fn _start<'py>(
-        slf: &Bound<'py, Self>,
-        args: &Bound<'py, PyTuple>,
-        kwargs: Option<&Bound<'py, PyDict>>,
-    ) -> PyResult<Any<'py>> {
-        base_call(slf.as_super(), "_start", args, kwargs)
-    }
-
-    /// See `System._run` (a callable's exception is re-raised, naming the step).
-    #[pyo3(signature = (*args, **kwargs))]
-    fn _run<'py>(
-        slf: &Bound<'py, Self>,
-        args: &Bound<'py, PyTuple>,
-        kwargs: Option<&Bound<'py, PyDict>>,
-    ) -> PyResult<Any<'py>> {
-        base_call(slf.as_super(), "_run", args, kwargs)
     }
 }
