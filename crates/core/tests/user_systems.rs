@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use lieflow::integrate::{integrate, Problem, System, Trajectory};
 use lieflow::lie::{se3, so};
-use lieflow::systems::user::{CanonicalFn, CanonicalGradientFn, GradientFn, ScalarFn};
+use lieflow::systems::user::{CanonicalFn, CanonicalGradientFn, GradientFn, Hooked, ScalarFn};
 use lieflow::systems::{
     Algebra, GeneralizedRigidBody, KineticMass, LieHamiltonian, LiePoisson, Pendulum, RigidBody,
     UserCanonical, UserSeparable,

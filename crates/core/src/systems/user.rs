@@ -253,9 +253,9 @@ impl FailureLog {
 /// destroying a thread state per call, ~7 µs).
 pub type Session = Arc<dyn Fn(&mut dyn FnMut()) + Send + Sync>;
 
-/// The fault of one stepper, the log and the session of the system.
+/// The fault of one stepper, the log and the session of the system (opaque).
 #[derive(Clone, Default)]
-struct Hooks {
+pub struct Hooks {
     fault: Arc<Fault>,
     log: Arc<FailureLog>,
     session: Option<Session>,
@@ -303,10 +303,26 @@ impl Hooks {
     }
 }
 
-/// The user systems: the hooks through which their kernels report failures.
-trait Hooked: Problem + Clone + 'static {
+/// The user systems: the hooks through which their kernels report failures, and the session
+/// their steppers run in.
+pub trait Hooked: Problem + Clone + 'static {
+    /// The hooks.
     fn hooks(&self) -> &Hooks;
+
+    /// The same system with other hooks.
     fn with_hooks(&self, hooks: Hooks) -> Self;
+
+    /// The log of the first failure of the functions in a run (see [`Failure`]).
+    fn failures(&self) -> Arc<FailureLog> {
+        self.hooks().log.clone()
+    }
+
+    /// The same system whose steppers run inside `session` (see [`Session`]).
+    fn with_session(&self, session: Session) -> Self {
+        let mut hooks = self.hooks().clone();
+        hooks.session = Some(session);
+        self.with_hooks(hooks)
+    }
 }
 
 /// A method of a user system, advanced one step at a time so that a failure of a user function
@@ -484,17 +500,6 @@ impl UserCanonical {
     /// Whether the gradient is computed by finite differences.
     pub fn finite_differences(&self) -> bool {
         self.gradient.is_none()
-    }
-
-    /// The log of the first failure of the functions in a run (see [`Failure`]).
-    pub fn failures(&self) -> Arc<FailureLog> {
-        self.hooks.log.clone()
-    }
-
-    /// The same system whose steppers run inside `session` (see [`Session`]).
-    pub fn with_session(mut self, session: Session) -> Self {
-        self.hooks.session = Some(session);
-        self
     }
 
     /// H(q, p), checked finite.
@@ -755,17 +760,6 @@ impl UserSeparable {
     /// Whether ∇U is computed by finite differences.
     pub fn finite_differences(&self) -> bool {
         self.gradient.is_none()
-    }
-
-    /// The log of the first failure of the functions in a run (see [`Failure`]).
-    pub fn failures(&self) -> Arc<FailureLog> {
-        self.hooks.log.clone()
-    }
-
-    /// The same system whose steppers run inside `session` (see [`Session`]).
-    pub fn with_session(mut self, session: Session) -> Self {
-        self.hooks.session = Some(session);
-        self
     }
 
     /// U(q), checked finite.
@@ -1335,17 +1329,6 @@ impl LiePoisson {
     /// Whether H is the native quadratic form.
     pub fn is_quadratic(&self) -> bool {
         matches!(self.hamiltonian, LieHamiltonian::Quadratic(_))
-    }
-
-    /// The log of the first failure of the functions in a run (see [`Failure`]).
-    pub fn failures(&self) -> Arc<FailureLog> {
-        self.hooks.log.clone()
-    }
-
-    /// The same system whose steppers run inside `session` (see [`Session`]).
-    pub fn with_session(mut self, session: Session) -> Self {
-        self.hooks.session = Some(session);
-        self
     }
 
     /// H(μ), checked finite.

@@ -19,7 +19,7 @@ use std::sync::{Arc, OnceLock};
 
 use lieflow::integrate::problem::Canonical;
 use lieflow::systems::user::{
-    CanonicalFn, CanonicalGradientFn, FailureLog, GradientFn, ScalarFn, Session,
+    CanonicalFn, CanonicalGradientFn, FailureLog, GradientFn, Hooked, ScalarFn, Session,
 };
 use lieflow::systems::{
     Algebra, KineticMass, LieHamiltonian, LiePoisson as CoreLiePoisson, UserCanonical,
