@@ -224,7 +224,9 @@ fn continuation_maclaurin_to_jacobi() {
     let e_lost = lost[0].point.parameter;
     assert!((e_lost - 0.95289).abs() < 5e-6, "{e_lost}");
     // Switch onto the Jacobi branch and follow it to a₂/a₁ = 0.3.
-    let dir = family.switch_direction(&branch[0].point).unwrap();
+    let dir = family
+        .switch_direction(&branch[0].point, ellipsoids::Sense::Splitting)
+        .unwrap();
     assert!(dir[0] > dir[1]);
     let jb = ellipsoids::follow(
         &family,
@@ -284,4 +286,56 @@ fn every_kind_of_figure_stays_on_its_relative_equilibrium() {
         // rattle6 at 200 steps per period: the phase error of an order-6 method.
         assert!(worst < 5e-8, "{name}: {worst:.2e}");
     }
+}
+
+#[test]
+fn comoving_refuses_a_state_that_is_not_a_relative_equilibrium() {
+    use lieflow::analysis::comoving;
+    let fl = fluid();
+    let j = fl.jacobi(0.6).unwrap();
+    let (z, xi) = Fluid::state(&j);
+    let body = fl.body().unwrap();
+    // The right velocities at the wrong speed: the co-moving field does not vanish.
+    let slow: Vec<f64> = xi.iter().map(|x| 0.9 * x).collect();
+    let e = comoving::stability(&body, &z, &slow).unwrap_err();
+    assert!(matches!(e, lieflow::Error::InvalidArgument { .. }), "{e}");
+    assert!(e.to_string().contains("does not vanish"), "{e}");
+    // Wrong lengths and non-finite input.
+    assert!(comoving::stability(&body, &z[..17], &xi).is_err());
+    assert!(comoving::stability(&body, &z, &xi[..5]).is_err());
+    let mut bad = z.clone();
+    bad[0] = f64::NAN;
+    assert!(comoving::stability(&body, &bad, &xi).is_err());
+}
+
+#[test]
+fn switching_senses() {
+    let fl = fluid();
+    let start = fl.maclaurin(0.8).unwrap();
+    let family = EllipsoidFamily::of(&fl, &start).unwrap();
+    let u0 = family.unknowns_of(&start);
+    let b = ellipsoids::follow(&family, &u0, "e", 0.82, false, None, &Options::default()).unwrap();
+    let bp = &b
+        .special
+        .iter()
+        .find(|s| s.kind == Kind::Branch)
+        .unwrap()
+        .point;
+    let split = family
+        .switch_direction(bp, ellipsoids::Sense::Splitting)
+        .unwrap();
+    let join = family
+        .switch_direction(bp, ellipsoids::Sense::Joining)
+        .unwrap();
+    assert!(split[0] > split[1]);
+    assert!(split.iter().zip(&join).all(|(a, b)| a == &-b));
+    // Towards a smaller a₂/a₁ is the splitting sense; towards a larger one the other.
+    let down = family
+        .switch_direction(bp, ellipsoids::Sense::Towards("a2_over_a1", 0.5))
+        .unwrap();
+    let up = family
+        .switch_direction(bp, ellipsoids::Sense::Towards("a2_over_a1", 1.5))
+        .unwrap();
+    assert_eq!(down, split);
+    assert_eq!(up, join);
 }

@@ -5,7 +5,7 @@
 #![allow(non_snake_case)]
 
 use lieflow::analysis::continuation::{self as cont, End, Options};
-use lieflow::pseudo_rigid::ellipsoids::{self as ell, EllipsoidFamily};
+use lieflow::pseudo_rigid::ellipsoids::{self as ell, EllipsoidFamily, Sense};
 use lieflow::Error;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -269,34 +269,19 @@ impl Branch {
                 format!("expected a finite value, got {stop}"),
             )));
         }
-        let mut dir = family.switch_direction(&point.inner.point).py()?;
-        let u = &point.inner.point.u;
-        let flip = match direction {
-            Some(1.0) => false,
-            Some(-1.0) => true,
+        let sense = match direction {
+            None => Sense::Towards(&parameter, stop),
+            Some(1.0) => Sense::Splitting,
+            Some(-1.0) => Sense::Joining,
             Some(d) => {
                 return Err(to_py(Error::invalid(
                     "direction",
                     format!("expected None, 1 or -1, got {d}"),
                 )))
             }
-            None => {
-                // Towards `stop`: the sign of dπ/ds along the direction.
-                let h = 1e-6 * (1.0 + u.iter().map(|x| x * x).sum::<f64>().sqrt());
-                let at = |sg: f64| -> PyResult<f64> {
-                    let v: Vec<f64> = u.iter().zip(&dir).map(|(a, b)| a + sg * h * b).collect();
-                    family.parameter(&parameter, &v).py()
-                };
-                let (pp, pm) = (at(1.0)?, at(-1.0)?);
-                let here = family.parameter(&parameter, u).py()?;
-                // A parameter even in the direction (e at a symmetric pitchfork): a1 - a2 grows.
-                let slope = (pp - pm) / (2.0 * h);
-                slope.abs() > 1e-6 * (1.0 + here.abs()) && slope * (stop - here) < 0.0
-            }
         };
-        if flip {
-            dir.iter_mut().for_each(|x| *x = -*x);
-        }
+        let dir = family.switch_direction(&point.inner.point, sense).py()?;
+        let u = &point.inner.point.u;
         run(
             py,
             family,

@@ -556,11 +556,36 @@ impl EllipsoidFamily {
     }
 
     /// The direction of the branch crossing at a simple branch point
-    /// ([`continuation::switch_direction`]), oriented so that a₁ − a₂ grows (the ellipsoids
-    /// branching off the Maclaurin spheroids are then numbered with a₁ > a₂, as in EFE).
-    pub fn switch_direction(&self, point: &continuation::Point) -> Result<Vec<f64>> {
+    /// ([`continuation::switch_direction`]) in the given [`Sense`].
+    pub fn switch_direction(
+        &self,
+        point: &continuation::Point,
+        sense: Sense<'_>,
+    ) -> Result<Vec<f64>> {
         let mut d = continuation::switch_direction(self, point)?;
+        // Splitting: a₁ − a₂ grows (the ellipsoids branching off the Maclaurin spheroids are
+        // then numbered with a₁ > a₂, as in EFE).
         if d[0] - d[1] < 0.0 {
+            d.iter_mut().for_each(|x| *x = -*x);
+        }
+        let flip = match sense {
+            Sense::Splitting => false,
+            Sense::Joining => true,
+            Sense::Towards(name, stop) => {
+                // The sign of dπ/ds along d; a parameter even in d (e at a symmetric
+                // pitchfork) keeps the splitting sense.
+                let u = &point.u;
+                let h = 1e-6 * (1.0 + u.iter().map(|x| x * x).sum::<f64>().sqrt());
+                let at = |sg: f64| -> Result<f64> {
+                    let v: Vec<f64> = u.iter().zip(&d).map(|(a, b)| a + sg * h * b).collect();
+                    self.parameter(name, &v)
+                };
+                let here = self.parameter(name, u)?;
+                let slope = (at(1.0)? - at(-1.0)?) / (2.0 * h);
+                slope.abs() > 1e-6 * (1.0 + here.abs()) && slope * (stop - here) < 0.0
+            }
+        };
+        if flip {
             d.iter_mut().for_each(|x| *x = -*x);
         }
         Ok(d)
@@ -588,6 +613,17 @@ impl EllipsoidFamily {
             }
         })
     }
+}
+
+/// The sense of the branch taken at a branch point ([`EllipsoidFamily::switch_direction`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Sense<'a> {
+    /// The way a₁ − a₂ grows.
+    Splitting,
+    /// The other way.
+    Joining,
+    /// The way the named parameter moves towards the value (or `Splitting` where it is even).
+    Towards(&'a str, f64),
 }
 
 /// The parameters [`EllipsoidFamily::parameter`] knows.
