@@ -159,6 +159,16 @@ pub trait Catalog: Problem + Clone + 'static {
     fn lifted(&self) -> Option<Self> {
         None
     }
+
+    /// The system's own dissipative term of kind `d` (Rayleigh damping of a canonical system,
+    /// double-bracket dissipation of a Lie–Poisson system), for
+    /// [`crate::integrate::forcing::Forced`]; by default none.
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> Result<Arc<dyn crate::integrate::forcing::Perturbation>> {
+        Err(d.unsupported(self.name()))
+    }
 }
 
 /// A system the driver integrates by method name: every [`Catalog`] problem, as a trait object.
@@ -172,6 +182,12 @@ pub trait System: Problem {
 
     /// The system carrying its attitude along ([`Catalog::lifted`]).
     fn lift(&self) -> Option<Arc<dyn System>>;
+
+    /// The system's own dissipative term of kind `d` ([`Catalog::dissipation`]).
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> Result<Arc<dyn crate::integrate::forcing::Perturbation>>;
 }
 
 impl<P: Catalog> System for P {
@@ -196,6 +212,13 @@ impl<P: Catalog> System for P {
 
     fn lift(&self) -> Option<Arc<dyn System>> {
         self.lifted().map(|s| Arc::new(s) as Arc<dyn System>)
+    }
+
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> Result<Arc<dyn crate::integrate::forcing::Perturbation>> {
+        Catalog::dissipation(self, d)
     }
 }
 

@@ -28,6 +28,8 @@
 //! # Ok::<(), lieflow::Error>(())
 //! ```
 
+pub mod forcing;
+pub mod hooks;
 pub mod method;
 pub mod methods;
 pub mod problem;

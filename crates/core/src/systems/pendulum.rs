@@ -165,4 +165,11 @@ impl Catalog for Pendulum {
             Entry::new("rk4", Rk4),
         ]
     }
+
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        crate::integrate::forcing::rayleigh(self, d)
+    }
 }

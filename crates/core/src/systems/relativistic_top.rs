@@ -330,6 +330,13 @@ macro_rules! legendre_kinds {
             fn catalog(&self) -> Vec<Entry<Self>> {
                 canonical_catalog()
             }
+
+            fn dissipation(
+                &self,
+                d: &$crate::integrate::forcing::Dissipation,
+            ) -> $crate::Result<std::sync::Arc<dyn $crate::integrate::forcing::Perturbation>> {
+                $crate::integrate::forcing::rayleigh(self, d)
+            }
         }
     };
 }

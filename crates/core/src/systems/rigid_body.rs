@@ -297,6 +297,13 @@ impl Catalog for RigidBody {
         ]
     }
 
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        crate::integrate::forcing::double_bracket(self, d)
+    }
+
     fn lifted(&self) -> Option<Self> {
         Some(self.with_attitude())
     }
@@ -511,6 +518,13 @@ impl Catalog for GeneralizedRigidBody {
             Entry::new("rk4", Rk4),
             Entry::new("rkmk4", Rkmk4),
         ]
+    }
+
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        crate::integrate::forcing::double_bracket(self, d)
     }
 }
 

@@ -482,4 +482,11 @@ impl Catalog for RollingDisks {
     fn catalog(&self) -> Vec<Entry<Self>> {
         canonical_catalog()
     }
+
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        crate::integrate::forcing::rayleigh(self, d)
+    }
 }

@@ -428,6 +428,13 @@ impl Catalog for TangentTop {
     fn catalog(&self) -> Vec<Entry<Self>> {
         canonical_catalog()
     }
+
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        crate::integrate::forcing::rayleigh(self, d)
+    }
 }
 
 /// The charged particle equivalent to a tangent top (002 §III.B): with p_θ fixed, the centre of
@@ -617,5 +624,12 @@ impl VectorField for ChargedParticle {
 impl Catalog for ChargedParticle {
     fn catalog(&self) -> Vec<Entry<Self>> {
         canonical_catalog()
+    }
+
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        crate::integrate::forcing::rayleigh(self, d)
     }
 }
