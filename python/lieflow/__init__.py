@@ -21,6 +21,9 @@ RollingSpheres                                                  two rolling sphe
 RollingDisks                                                    two rolling disks of 003 §1
 Canonical, Separable, LiePoisson                                user-defined systems from Python
                                                                 callables (docs/user_systems.md)
+Forced                                                          any system with a force or torque,
+                                                                Rayleigh damping or double-bracket
+                                                                dissipation (docs/forcing.md)
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``); an argument of the
@@ -45,6 +48,7 @@ from ._lieflow import (
 from ._lieflow import (
     Canonical,
     ChargedParticle,
+    Forced,
     GeneralizedRigidBody,
     HeavyTop,
     Integration,
@@ -76,6 +80,7 @@ __all__ = [
     "ChargedParticle",
     "ConvergenceError",
     "DegenerateStratumError",
+    "Forced",
     "GeneralizedRigidBody",
     "HeavyTop",
     "Integration",

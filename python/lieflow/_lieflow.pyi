@@ -357,6 +357,27 @@ class Separable(System):
     @property
     def finite_differences(self) -> bool: ...
 
+class Forced(System):
+    """A system with a force or torque F(t, state) on one momentum block, Rayleigh damping
+    (canonical systems) or double-bracket dissipation (Lie-Poisson systems without attitude).
+    Methods: m, m4, m6 for every symmetric second-order method m of `system` (kicks around it,
+    orders 2, 4, 6). A force callable runs single-threaded with the GIL."""
+
+    def __init__(
+        self, system: System, force: Callable[[float, F64], ArrayLike] | None = None,
+        block: str | None = None, depends_on_block: bool | None = None,
+        damping: float | ArrayLike | None = None, dissipation: float | None = None,
+    ) -> None:
+        """force(t, state) -> the block's shape; block: None for the first of M, P, p, L, mu;
+        depends_on_block=False: one call per kick (exact for a force free of its block);
+        damping: c >= 0 or a symmetric PSD (d, d) matrix; dissipation: alpha >= 0."""
+    @property
+    def block(self) -> str | None: ...
+    @property
+    def terms(self) -> list[str]: ...
+    @property
+    def system(self) -> System: ...
+
 class LiePoisson(System):
     """A Lie–Poisson system d mu/dt = ad*_{dH/dmu} mu on g* (so3, se3, ("so", n) or structure
     constants (d, d, d)); rkmk4 (default), midpoint, midpoint4 (keep the coadjoint orbit), rk4.

@@ -185,7 +185,10 @@ fn double_bracket_goes_to_the_major_axis() {
             let z = traj.state(k);
             let dc = (sys.invariants(z).unwrap()[0] - c0).abs() / c0;
             // Round-off of ~10⁵ group actions (4000 steps of up to 7 stages).
-            assert!(dc < 2000.0 * f64::EPSILON, "{method}: relative |M|² drift {dc:e} at sample {k}");
+            assert!(
+                dc < 2000.0 * f64::EPSILON,
+                "{method}: relative |M|² drift {dc:e} at sample {k}"
+            );
             worst = worst.max(dc);
             let e = sys.energy(z).unwrap();
             assert!(

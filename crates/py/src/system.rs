@@ -11,7 +11,7 @@ use lieflow::{check, Error};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyTuple, PyType};
+use pyo3::types::{PyCFunction, PyDict, PyList, PyTuple, PyType};
 
 use crate::convert::{int, int_opt, real};
 use crate::convert::{read_all, shape_str, ArrayIn};
@@ -29,7 +29,7 @@ use crate::items::{map_items, Input};
 pub struct PySystem {
     pub(crate) sys: Arc<dyn System>,
     lifted: Option<Arc<dyn System>>,
-    args: Py<PyTuple>,
+    pub(crate) args: Py<PyTuple>,
     names: &'static [&'static str],
     pub(crate) callbacks: Option<Arc<dyn Callbacks>>,
 }
@@ -399,6 +399,60 @@ impl PySystem {
         for (name, value) in this.names.iter().zip(args.iter()) {
             parts.push(format!("{name}={}", value.repr()?));
         }
-        Ok(format!("{}({})", this.sys.name(), parts.join(", ")))
+        Ok(format!("{}({})", slf.get_type().name()?, parts.join(", ")))
+    }
+}
+
+/// The descriptor `methods` of a system class whose instances may have other methods than its
+/// example (`PseudoRigidBody`: an incompressible body; `Forced`: those of the wrapped system):
+/// the classmethod of `lieflow.System` on the class, the instance's own catalog on an instance.
+#[pyclass(module = "lieflow", name = "_MethodsOf", frozen)]
+pub(crate) struct MethodsOf;
+
+#[pymethods]
+impl MethodsOf {
+    fn __get__<'py>(
+        &self,
+        obj: Option<Bound<'py, PyAny>>,
+        owner: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        match obj.filter(|o| !o.is_none()) {
+            Some(obj) => {
+                let py = obj.py();
+                let names: Vec<&'static str> = obj
+                    .cast::<PySystem>()?
+                    .get()
+                    .sys
+                    .methods()
+                    .into_iter()
+                    .map(|(name, _)| name)
+                    .collect();
+                let f = PyCFunction::new_closure(
+                    py,
+                    Some(c"methods"),
+                    Some(
+                        c"The names of this system's integration methods; the first is the default.",
+                    ),
+                    move |args: &Bound<'_, PyTuple>, kwargs: Option<&Bound<'_, PyDict>>| {
+                        if !args.is_empty() || kwargs.is_some_and(|k| !k.is_empty()) {
+                            return Err(pyo3::exceptions::PyTypeError::new_err(
+                                "methods() takes no arguments",
+                            ));
+                        }
+                        Ok(names.clone())
+                    },
+                )?;
+                Ok(f.into_any())
+            }
+            None => {
+                let py = owner
+                    .as_ref()
+                    .map(|o| o.py())
+                    .ok_or_else(|| pyo3::exceptions::PyTypeError::new_err("no owner"))?;
+                let base = py.get_type::<PySystem>();
+                let class_method = base.getattr("__dict__")?.get_item("methods")?;
+                class_method.call_method1("__get__", (py.None(), owner))
+            }
+        }
     }
 }

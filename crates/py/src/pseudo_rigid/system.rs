@@ -8,7 +8,6 @@ use std::sync::Arc;
 use lieflow::pseudo_rigid::PseudoRigidBody as CoreBody;
 use lieflow::{Error, Mat};
 use pyo3::prelude::*;
-use pyo3::types::{PyCFunction, PyDict, PyTuple};
 use pyo3::PyClassInitializer;
 
 use super::potential::{PyPotential, Zero};
@@ -16,7 +15,7 @@ use crate::convert::ArrayIn;
 use crate::convert::{int, mat, py_mat};
 use crate::errors::{to_py, IntoPy};
 use crate::integrate::Callbacks;
-use crate::system::PySystem;
+use crate::system::{MethodsOf, PySystem};
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -180,60 +179,6 @@ impl PyPseudoRigidBody {
             out.copy_from_slice(&b.singular_values(z)?);
             Ok(())
         })
-    }
-}
-
-/// The descriptor of `PseudoRigidBody.methods`: the classmethod of `lieflow.System` on the class
-/// (its example body is not incompressible), the instance's own catalog on an instance (an
-/// incompressible body has other methods).
-#[pyclass(module = "lieflow", name = "_MethodsOf", frozen)]
-pub struct MethodsOf;
-
-#[pymethods]
-impl MethodsOf {
-    fn __get__<'py>(
-        &self,
-        obj: Option<Bound<'py, PyAny>>,
-        owner: Option<Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        match obj.filter(|o| !o.is_none()) {
-            Some(obj) => {
-                let py = obj.py();
-                let names: Vec<&'static str> = obj
-                    .cast::<PySystem>()?
-                    .get()
-                    .sys
-                    .methods()
-                    .into_iter()
-                    .map(|(name, _)| name)
-                    .collect();
-                let f = PyCFunction::new_closure(
-                    py,
-                    Some(c"methods"),
-                    Some(
-                        c"The names of this body's integration methods; the first is the default.",
-                    ),
-                    move |args: &Bound<'_, PyTuple>, kwargs: Option<&Bound<'_, PyDict>>| {
-                        if !args.is_empty() || kwargs.is_some_and(|k| !k.is_empty()) {
-                            return Err(pyo3::exceptions::PyTypeError::new_err(
-                                "methods() takes no arguments",
-                            ));
-                        }
-                        Ok(names.clone())
-                    },
-                )?;
-                Ok(f.into_any())
-            }
-            None => {
-                let py = owner
-                    .as_ref()
-                    .map(|o| o.py())
-                    .ok_or_else(|| pyo3::exceptions::PyTypeError::new_err("no owner"))?;
-                let base = py.get_type::<PySystem>();
-                let class_method = base.getattr("__dict__")?.get_item("methods")?;
-                class_method.call_method1("__get__", (py.None(), owner))
-            }
-        }
     }
 }
 

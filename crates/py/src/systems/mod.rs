@@ -4,8 +4,9 @@
 //! (`Canonical`, `Separable`, `LiePoisson`: `user.rs`), thin subclasses of
 //! `lieflow.System`, and the helpers the bodies on SO(3) share.
 
+mod forced;
 mod heavy_top;
-mod pendulum;
+pub(crate) mod pendulum;
 mod relativistic_top;
 mod rigid_body;
 mod rolling_disk;
@@ -92,5 +93,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<user::PyCanonical>()?;
     m.add_class::<user::PySeparable>()?;
     m.add_class::<user::PyLiePoisson>()?;
+    m.add_class::<forced::PyForced>()?;
     Ok(())
 }

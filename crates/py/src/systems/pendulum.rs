@@ -30,7 +30,7 @@ pub struct PyPendulum {
 impl PyPendulum {
     #[new]
     #[pyo3(signature = (mass = 1.0, length = 1.0, g = 9.81))]
-    fn new(
+    pub(crate) fn new(
         py: Python<'_>,
         #[pyo3(from_py_with = real)] mass: f64,
         #[pyo3(from_py_with = real)] length: f64,

@@ -41,9 +41,9 @@ type Any<'py> = Bound<'py, PyAny>;
 
 /// The exceptions of a system's callables and where its runs failed.
 #[derive(Default)]
-struct UserCallbacks {
-    slot: ErrorSlot,
-    log: OnceLock<Arc<FailureLog>>,
+pub(crate) struct UserCallbacks {
+    pub(crate) slot: ErrorSlot,
+    pub(crate) log: OnceLock<Arc<FailureLog>>,
 }
 
 impl Callbacks for UserCallbacks {
@@ -64,7 +64,7 @@ impl Callbacks for UserCallbacks {
 }
 
 /// A user callable as errors name it: its `__qualname__` (or `__name__`, or repr).
-fn callable_name(f: &Any<'_>) -> String {
+pub(crate) fn callable_name(f: &Any<'_>) -> String {
     ["__qualname__", "__name__"]
         .iter()
         .find_map(|a| f.getattr(*a).ok().and_then(|n| n.extract::<String>().ok()))
@@ -74,7 +74,7 @@ fn callable_name(f: &Any<'_>) -> String {
 
 /// A Python callable of a user system: `f(*arrays)` must return an array of a fixed shape.
 #[derive(Clone)]
-struct Callee {
+pub(crate) struct Callee {
     f: Arc<Py<PyAny>>,
     /// "the value of the hamiltonian `H`", for errors.
     what: Arc<str>,
@@ -84,7 +84,7 @@ struct Callee {
 impl Callee {
     /// The argument `arg` (named `name`, e.g. "hamiltonian") if it is callable; otherwise an
     /// `ArgumentTypeError` naming it.
-    fn new(name: &str, arg: &Any<'_>, calls: &Arc<UserCallbacks>) -> PyResult<Self> {
+    pub(crate) fn new(name: &str, arg: &Any<'_>, calls: &Arc<UserCallbacks>) -> PyResult<Self> {
         if !arg.is_callable() {
             return Err(argument_type_error(
                 arg.py(),
@@ -115,38 +115,63 @@ impl Callee {
         Python::attach(|py| {
             let called = PyTuple::new(py, args.iter().map(|x| PyArray1::from_slice(py, x)))
                 .and_then(|a| self.f.bind(py).call1(a));
-            let value = called.map_err(|e| self.raised(e))?;
-            // Fast paths: a float, a float64 array; anything else is read like every argument.
-            match (shape.is_empty(), value.cast::<PyFloat>()) {
-                (true, Ok(f)) => out[0] = f.value(),
-                _ => match value.cast::<PyArrayDyn<f64>>().map(|a| a.try_readonly()) {
-                    Ok(Ok(a)) => self.copy(&a.as_array(), shape, out)?,
-                    _ => {
-                        let a = ArrayIn::named(&self.what, &value).map_err(|e| self.raised(e))?;
-                        self.copy(&a.as_array(), shape, out)?
-                    }
-                },
-            }
-            match out.iter().position(|x| !x.is_finite()) {
-                None => Ok(()),
-                Some(i) => Err(Error::NonFinite {
-                    what: self.what.to_string(),
-                    location: if shape.is_empty() {
-                        format!("its value ({})", out[i])
-                    } else {
-                        let mut idx = Vec::new();
-                        let mut r = i;
-                        for s in shape.iter().rev() {
-                            idx.push(r % s);
-                            r /= s;
-                        }
-                        idx.reverse();
-                        let idx: Vec<String> = idx.iter().map(|k| k.to_string()).collect();
-                        format!("entry [{}] = {}", idx.join(", "), out[i])
-                    },
-                }),
-            }
+            self.read(called, shape, out)
         })
+    }
+
+    /// Calls f(t, z) (a float and a float64 array) and reads its value like [`Callee::call`].
+    pub(crate) fn call_at(
+        &self,
+        t: f64,
+        z: &[f64],
+        shape: &[usize],
+        out: &mut [f64],
+    ) -> lieflow::Result<()> {
+        Python::attach(|py| {
+            let called = self.f.bind(py).call1((t, PyArray1::from_slice(py, z)));
+            self.read(called, shape, out)
+        })
+    }
+
+    /// Reads the value of a call of `shape` into `out`, checked finite (or keeps its exception).
+    fn read(
+        &self,
+        called: PyResult<Any<'_>>,
+        shape: &[usize],
+        out: &mut [f64],
+    ) -> lieflow::Result<()> {
+        let value = called.map_err(|e| self.raised(e))?;
+
+        // Fast paths: a float, a float64 array; anything else is read like every argument.
+        match (shape.is_empty(), value.cast::<PyFloat>()) {
+            (true, Ok(f)) => out[0] = f.value(),
+            _ => match value.cast::<PyArrayDyn<f64>>().map(|a| a.try_readonly()) {
+                Ok(Ok(a)) => self.copy(&a.as_array(), shape, out)?,
+                _ => {
+                    let a = ArrayIn::named(&self.what, &value).map_err(|e| self.raised(e))?;
+                    self.copy(&a.as_array(), shape, out)?
+                }
+            },
+        }
+        match out.iter().position(|x| !x.is_finite()) {
+            None => Ok(()),
+            Some(i) => Err(Error::NonFinite {
+                what: self.what.to_string(),
+                location: if shape.is_empty() {
+                    format!("its value ({})", out[i])
+                } else {
+                    let mut idx = Vec::new();
+                    let mut r = i;
+                    for s in shape.iter().rev() {
+                        idx.push(r % s);
+                        r /= s;
+                    }
+                    idx.reverse();
+                    let idx: Vec<String> = idx.iter().map(|k| k.to_string()).collect();
+                    format!("entry [{}] = {}", idx.join(", "), out[i])
+                },
+            }),
+        }
     }
 
     /// `v` into `out` if it has `shape`, else a ShapeError.
@@ -179,7 +204,7 @@ impl Callee {
 /// The session of the systems that call Python: the GIL held for a whole call of a stepper (a
 /// chunk of steps), so that the callables' own `Python::attach` reuses the thread's state (on a
 /// worker thread each separate attach would create and destroy one, about 7 µs per call).
-fn gil() -> Session {
+pub(crate) fn gil() -> Session {
     Arc::new(|f: &mut dyn FnMut()| Python::attach(|_| f()))
 }
 
