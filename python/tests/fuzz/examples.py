@@ -340,6 +340,39 @@ def user_specs(add):
     add("ulp.structure_constants", "@ulp.structure_constants")
 
 
+# --- forced systems (issue 15): lf.Forced with a torque, damping or dissipation ---
+
+def forced_torque(t, z):
+    return np.array([0.3, -0.2, 0.1 * np.cos(t)])
+
+
+RECEIVERS.update({
+    "frc": lambda lf: lf.Forced(lf.RigidBody([1.0, 2.0, 3.0]), forced_torque),
+    "fdamp": lambda lf: lf.Forced(lf.Pendulum(1.0, 1.0, 9.81), damping=0.3),
+    "fdiss": lambda lf: lf.Forced(lf.RigidBody([1.0, 2.0, 3.0]), dissipation=0.5),
+})
+CONSTRUCTORS.update({"Forced": "frc"})
+FORCED_STATES = {"frc": M3, "fdamp": np.array([0.4, 0.1]), "fdiss": M3}
+
+
+def forced_specs(add):
+    """The specs of lf.Forced (issue 15)."""
+    add("Forced", "Forced", A("system", lazy_recv("rb"), "obj"),
+        A("force", forced_torque, "obj", opt=True), A("block", "M", "str", opt=True),
+        A("depends_on_block", False, "obj", opt=True))
+    add("Forced[damping]", "Forced", A("system", lazy_recv("pend"), "obj"),
+        A("damping", 0.3, "float", kw=True))
+    add("Forced[dissipation]", "Forced", A("system", lazy_recv("rb"), "obj"),
+        A("dissipation", 0.5, "float", kw=True))
+    for key, st in FORCED_STATES.items():
+        for f in ("energy", "invariants"):
+            add(f"{key}.{f}", f"@{key}.{f}", A("states", st, "vec"))
+        add(f"{key}.methods", f"@{key}.methods")
+        add(f"integrate[{key}]", "integrate", A("system", lazy_recv(key), "obj"),
+            A("state0", st, "vec"), A("dt", 0.01, "float", kw=True),
+            A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True))
+
+
 def _scipy_rotation(lf):
     """A scipy Rotation of two rotations (the argument of lf.lie.from_scipy)."""
     from scipy.spatial.transform import Rotation
@@ -676,6 +709,7 @@ def build_specs() -> list[Spec]:
         A("event_tol", 0.0, "float", kw=True))
     # ---- user-defined systems (issue 15) ----
     user_specs(add)
+    forced_specs(add)
     return S
 
 
