@@ -35,6 +35,17 @@ impl Callbacks for ForcedCallbacks {
     }
 }
 
+/// The constructor arguments of the example instance (system, force, block, depends_on_block,
+/// damping, dissipation).
+type ExampleArgs<'py> = (
+    Bound<'py, PyAny>,
+    Option<f64>,
+    Option<f64>,
+    Option<bool>,
+    f64,
+    Option<f64>,
+);
+
 /// An optional argument that is given and not None.
 fn given<'py>(a: &Option<Bound<'py, PyAny>>) -> Option<Bound<'py, PyAny>> {
     a.as_ref().filter(|x| !x.is_none()).cloned()
@@ -229,16 +240,7 @@ impl PyForced {
 
     /// Constructor arguments of an example instance (for `methods()` on the class).
     #[classattr]
-    fn _example_args(
-        py: Python<'_>,
-    ) -> PyResult<(
-        Bound<'_, PyAny>,
-        Option<f64>,
-        Option<f64>,
-        Option<bool>,
-        f64,
-        Option<f64>,
-    )> {
+    fn _example_args(py: Python<'_>) -> PyResult<ExampleArgs<'_>> {
         let pendulum =
             Bound::new(py, super::pendulum::PyPendulum::new(py, 1.0, 1.0, 9.81)?)?.into_any();
         Ok((pendulum, None, None, None, 0.1, None))
