@@ -193,7 +193,8 @@ impl Kick for BlockKick {
                         },
                     ));
                 }
-                if d == 0.0 || (d >= last && last <= tol) {
+                // Converged: the update is at round-off, or has stopped decreasing below tol.
+                if d <= f64::EPSILON * size || (d >= last && last <= tol) {
                     break;
                 }
                 if iter >= MAX_ITER {
