@@ -186,6 +186,12 @@ def test_forced_systems_pickle_and_repr():
                                    "verlet6"]
 
 
+def test_the_default_block_is_the_momentum():
+    assert lf.Forced(lf.Pendulum(), lambda t, z: np.zeros(1)).block == "p"
+    assert lf.Forced(lf.HeavyTop([1, 2, 3], 0.5, [0, 0, 1]), body_torque).block == "M"
+    assert lf.Forced(lf.Pendulum(), damping=0.1).block is None
+
+
 def test_a_batch_runs_member_after_member():
     body = lf.Forced(lf.RigidBody(inertia=I), body_torque)
     batch = np.stack([M0, 2 * M0])
@@ -209,6 +215,14 @@ def test_errors():
         lf.Forced(spheres, lambda t, z: np.zeros(3), block="u")
     with pytest.raises(lf.ArgumentTypeError, match="callable"):
         lf.Forced(body, 3.0)
+    with pytest.raises(lf.ArgumentTypeError, match="depends_on_block"):
+        lf.Forced(body, body_torque, depends_on_block="yes")
+    with pytest.raises(lf.ArgumentTypeError, match="'block'"):
+        lf.Forced(body, body_torque, block=3)
+    with pytest.raises(lf.ArgumentTypeError, match="dissipation"):
+        lf.Forced(body, dissipation="strong")
+    with pytest.raises(lf.InvalidArgumentError, match="none of the momentum blocks"):
+        lf.Forced(lf.RollingSpheres(*lf.RollingSpheres._example_args), body_torque)
     with pytest.raises(lf.ArgumentTypeError, match="lieflow system"):
         lf.Forced("RigidBody", body_torque)
     with pytest.raises(lf.InvalidArgumentError, match="positive semi-definite"):

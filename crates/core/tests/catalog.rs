@@ -16,6 +16,9 @@ use lieflow::systems::{
 };
 use nalgebra::Vector3;
 
+mod common;
+use common::distance;
+
 /// A system with an initial state, a time span, a base step and its time-reversal map ρ
 /// (t ↦ ρ z(−t) maps solutions to solutions).
 struct Case {
@@ -304,14 +307,6 @@ fn cases() -> Vec<Case> {
             long_skip: &["reduced"],
         },
     ]
-}
-
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 /// The state at t_end by `method` in `steps` steps.

@@ -6,24 +6,19 @@
 
 use std::sync::Arc;
 
-use lieflow::integrate::forcing::{Dissipation, ForceFn, Forced};
-use lieflow::integrate::{integrate, Problem, Run, System};
+use lieflow::integrate::forcing::{momentum_block, Dissipation, ForceFn, Forced};
+use lieflow::integrate::{integrate, Block, Clock, Problem, Run, Space, System};
 use lieflow::systems::{
     Algebra, GeneralizedRigidBody, LieHamiltonian, LiePoisson, Pendulum, RigidBody,
 };
 use lieflow::Error;
 use nalgebra::{Matrix3, Vector3};
 
+mod common;
+use common::distance as dist;
+
 const I: [f64; 3] = [1.0, 2.0, 3.0];
 const M0: [f64; 3] = [1.0, 0.5, -0.3];
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
 
 /// The torque of the tests: a constant body torque plus a time-dependent one and, when
 /// `damped`, the momentum-dependent −0.2 M.
@@ -408,5 +403,77 @@ fn errors() {
             && msg.contains("step 3")
             && msg.contains("force on M"),
         "{msg}"
+    );
+}
+
+/// The forced methods are symmetric, Φ_{−h} ∘ Φ_h = id, with a time-dependent and
+/// momentum-dependent torque and with dissipation (the step back starts at t + h).
+#[test]
+fn forced_methods_are_symmetric() {
+    let free: Arc<dyn System> = Arc::new(RigidBody::new(I).unwrap());
+    let systems = [
+        Forced::new(free.clone())
+            .with_force("M", torque(true), true)
+            .unwrap(),
+        Forced::new(free)
+            .with_dissipation(&Dissipation::DoubleBracket(0.7))
+            .unwrap(),
+    ];
+    let h = 0.1;
+    for sys in &systems {
+        for (name, p) in sys.methods() {
+            assert!(p.symmetric);
+            let mut z = M0.to_vec();
+            for (dt, t0) in [(h, 0.3), (-h, 0.3 + h)] {
+                let (mut stepper, _) = sys.stepper(name, dt).unwrap();
+                stepper.set(&z).unwrap();
+                stepper.advance(1, Clock { t0, dt, done: 0 }).unwrap();
+                stepper.get(&mut z);
+            }
+            let defect = dist(&z, &M0);
+            assert!(
+                defect < 1e-14,
+                "{:?} {name}: Φ_−h ∘ Φ_h defect {defect:e}",
+                sys.terms()
+            );
+        }
+    }
+}
+
+/// An implicit kick whose fixed-point iteration cannot converge (h·|∂F/∂M|/2 > 1) stops with
+/// a ConvergenceError naming the step instead of returning a wrong state.
+#[test]
+fn an_implicit_kick_that_does_not_converge_is_an_error() {
+    let stiff: ForceFn = Arc::new(|_, z: &[f64], out: &mut [f64]| {
+        for i in 0..3 {
+            out[i] = -100.0 * z[i];
+        }
+        Ok(())
+    });
+    let free: Arc<dyn System> = Arc::new(RigidBody::new(I).unwrap());
+    let sys = Forced::new(free).with_force("M", stiff, true).unwrap();
+    let e = integrate(&sys, "splitting", &M0, 0.1, 5, 1).unwrap_err();
+    assert!(matches!(e, Error::NotConverged { .. }), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("implicit midpoint kick of the force on M in step 1"),
+        "{msg}"
+    );
+    // The same force with a step inside the contraction range runs.
+    assert!(integrate(&sys, "splitting", &M0, 0.005, 5, 1).is_ok());
+}
+
+/// The default block of a force: the first of M, P, p, L, mu the state has.
+#[test]
+fn the_default_block_is_the_momentum() {
+    let block = |s: &dyn System| momentum_block(s.name(), &s.space());
+    assert_eq!(block(&RigidBody::new(I).unwrap()).unwrap(), "M");
+    assert_eq!(block(&Pendulum::new(1.0, 1.0, 1.0).unwrap()).unwrap(), "p");
+    let other = Space::new([("u", Block::Sphere), ("w", Block::Real(3))]);
+    let e = momentum_block("Some", &other).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("none of the momentum blocks M, P, p, L, mu (its blocks are u, w)"),
+        "{e}"
     );
 }

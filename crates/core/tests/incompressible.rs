@@ -18,6 +18,9 @@ use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::systems::{SphereParticle, SphericalPendulum};
 use lieflow::{Error, Mat};
 
+mod common;
+use common::distance as dist;
+
 // ---------------------------------------------------------------------------------------------
 // Helpers
 
@@ -62,14 +65,6 @@ fn state(body: &PseudoRigidBody, seed: u64, p_scale: f64) -> Vec<f64> {
     ) + rng.mat(n, 0.15);
     let p = body.project_momentum(&x, &rng.mat(n, p_scale)).unwrap();
     body.state(&x, &p).unwrap()
-}
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 fn norm(a: &[f64]) -> f64 {

@@ -16,6 +16,9 @@ use lieflow::systems::{
 use lieflow::{Error, Mat};
 use nalgebra::{Matrix3, Vector3};
 
+mod common;
+use common::distance as dist;
+
 // ---------------------------------------------------------------------------------------------
 // Helpers
 
@@ -37,14 +40,6 @@ fn trajectory<P: Problem, M: Integrator<P>>(
 ) -> Vec<Vec<f64>> {
     let t = integrate_with(p, m, z0, dt, steps, every).unwrap();
     (0..t.len()).map(|k| t.state(k).to_vec()).collect()
-}
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 fn norm(a: &[f64]) -> f64 {

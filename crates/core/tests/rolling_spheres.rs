@@ -13,6 +13,9 @@ use lieflow::systems::{RigidBody, RollingSpheres};
 use lieflow::Error;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
+mod common;
+use common::distance as dist;
+
 // ---------------------------------------------------------------------------------------------
 // Helpers
 
@@ -196,14 +199,6 @@ fn rel(a: &[f64], b: &[f64]) -> f64 {
         .sqrt();
     let n: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
     d / n.max(1e-300)
-}
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 // ---------------------------------------------------------------------------------------------

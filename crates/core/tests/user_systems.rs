@@ -21,16 +21,11 @@ use lieflow::systems::{
 use lieflow::{Error, Mat};
 use nalgebra::Vector6;
 
+mod common;
+use common::distance as dist;
+
 const INERTIA: [f64; 3] = [1.0, 2.0, 3.0];
 const M0: [f64; 3] = [1.0, 0.5, -0.3];
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
 
 fn max_dist(a: &Trajectory, b: &Trajectory) -> f64 {
     (0..a.len())

@@ -16,8 +16,8 @@
 //! the sphere, exact sub-flows).
 //!
 //! The perturbations:
-//! * [`Force`]: a generalised force F(t, z) on one block of the state (the body torque on `M`,
-//!   a force matrix on a pseudo-rigid body's `P`, a force on `p`), a function of the time and
+//! * [`Force`]: a generalised force F(t, z) on one block of the state (a body torque on `M`, a
+//!   force matrix on a matrix momentum `P`, a force on `p`), a function of the time and
 //!   the whole state (user frame). Its flow with t and the other blocks frozen is the kick
 //!   y ← y + τF when F does not depend on the block y it changes (then exact, one evaluation);
 //!   otherwise the implicit midpoint y' = y + τF(t, (y + y')/2), solved by fixed-point iteration
@@ -47,44 +47,19 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use super::hooks::{Failure, FailureLog, Session};
 use super::method::{Catalog, Clock, Entry, Integrator, Properties, Stepper, System};
+// The fixed-point iterations of the implicit kicks stop by the Lie midpoint's rule.
+use super::methods::lie_midpoint::{MAX_ITER, STAGNATION_TOL};
 use super::methods::{Composition, LieMidpoint};
 use super::problem::{Canonical, GroupField, Problem, VectorField};
+pub use super::problem::{Dissipation, Kick, Perturbation};
 use super::space::{Block, Space};
 use crate::error::{fmt_num, Error, Result};
 
 /// A force F(t, z, out): time, the whole state (user frame), the force on the block (flat).
 pub type ForceFn = Arc<dyn Fn(f64, &[f64], &mut [f64]) -> Result<()> + Send + Sync>;
 
-/// A non-conservative term g(t, z) of a [`Forced`] system.
-pub trait Perturbation: Send + Sync {
-    /// What it is, for messages ("force on M", "Rayleigh damping", …).
-    fn describe(&self) -> String;
-
-    /// Whether its flow keeps the free system's [`Problem::invariants`] (Casimirs).
-    fn keeps_invariants(&self) -> bool;
-
-    /// The same term for the free system carrying its attitude (`lifted`), or `None` where it
-    /// does not apply there.
-    fn lifted(&self, lifted: &Arc<dyn System>) -> Option<Arc<dyn Perturbation>>;
-
-    /// A symmetric second-order map of the term's flow over τ with the time frozen, for the
-    /// free system `base` (whose frames it may need).
-    fn kick(&self, base: &Arc<dyn System>, tau: f64) -> Result<Box<dyn Kick>>;
-}
-
-/// A prepared map of a [`Perturbation`]'s flow over one fixed τ (owns its scratch).
-pub trait Kick: Send {
-    /// Applies it at time t to the state z (internal frame); `clock` names the step for errors.
-    fn apply(&mut self, t: f64, z: &mut [f64], clock: Clock) -> Result<()>;
-}
-
 // ---------------------------------------------------------------------------------------------
 // kicks of a momentum block
-
-/// Maximal fixed-point iterations of an implicit kick.
-const MAX_ITER: usize = 60;
-/// Acceptance of a stagnated iteration, relative to max(‖y‖_∞, 1).
-const STAGNATION_TOL: f64 = 1e-12;
 
 /// Evaluates g on the block at (t, z) (internal frame) into `out`.
 type BlockField = Box<dyn FnMut(f64, &[f64], &mut [f64]) -> Result<()> + Send>;
@@ -244,6 +219,27 @@ impl Force {
     }
 }
 
+/// The blocks a force acts on when none is named, in this order.
+pub const MOMENTA: [&str; 5] = ["M", "P", "p", "L", "mu"];
+
+/// The block a force of `system` (state space `space`) acts on when none is named: the first of
+/// [`MOMENTA`] it has.
+pub fn momentum_block(system: &str, space: &Space) -> Result<&'static str> {
+    MOMENTA
+        .into_iter()
+        .find(|m| space.range(m).is_some())
+        .ok_or_else(|| {
+            Error::invalid(
+                "block",
+                format!(
+                    "{system} has none of the momentum blocks {} (its blocks are {}): name the block",
+                    MOMENTA.join(", "),
+                    names(space)
+                ),
+            )
+        })
+}
+
 fn names(space: &Space) -> String {
     space
         .blocks()
@@ -262,11 +258,11 @@ impl Perturbation for Force {
         false
     }
 
-    fn lifted(&self, _lifted: &Arc<dyn System>) -> Option<Arc<dyn Perturbation>> {
+    fn lifted(&self) -> Option<Arc<dyn Perturbation>> {
         Some(Arc::new(self.clone()))
     }
 
-    fn kick(&self, base: &Arc<dyn System>, tau: f64) -> Result<Box<dyn Kick>> {
+    fn kick(&self, base: &Arc<dyn Problem>, tau: f64) -> Result<Box<dyn Kick>> {
         let space = base.space();
         let at = space.range(self.block).ok_or_else(|| {
             Error::invalid(
@@ -294,43 +290,6 @@ impl Perturbation for Force {
 
 // ---------------------------------------------------------------------------------------------
 // dissipation
-
-/// A dissipative term a system may support (through [`Catalog::dissipation`]).
-#[derive(Clone, Debug, PartialEq)]
-pub enum Dissipation {
-    /// Rayleigh damping ṗ = −C ∂H/∂p of a canonical system: C = c·I (one value c ≥ 0) or a
-    /// symmetric positive semi-definite d×d matrix (row-major).
-    Rayleigh(Vec<f64>),
-    /// Double-bracket dissipation of a Lie–Poisson system with the coefficient α ≥ 0.
-    DoubleBracket(f64),
-}
-
-impl Dissipation {
-    /// Its name in messages.
-    pub fn describe(&self) -> &'static str {
-        match self {
-            Dissipation::Rayleigh(_) => "Rayleigh damping",
-            Dissipation::DoubleBracket(_) => "double-bracket dissipation",
-        }
-    }
-
-    /// The error of a system without this kind of dissipation.
-    pub fn unsupported(&self, system: &str) -> Error {
-        let which = match self {
-            Dissipation::Rayleigh(_) => "canonical systems (state (q, p))",
-            Dissipation::DoubleBracket(_) => {
-                "Lie–Poisson systems without attitude (RigidBody, GeneralizedRigidBody, LiePoisson)"
-            }
-        };
-        Error::invalid(
-            "dissipation",
-            format!(
-                "{system} has no {}: it is defined for {which}",
-                self.describe()
-            ),
-        )
-    }
-}
 
 /// Rayleigh damping ṗ = −C ∂H/∂p of a canonical system `P` ([`Dissipation::Rayleigh`]).
 pub fn rayleigh<P: Canonical + Clone + 'static>(
@@ -403,11 +362,11 @@ impl<P: Canonical + Clone + 'static> Perturbation for Rayleigh<P> {
         false
     }
 
-    fn lifted(&self, _lifted: &Arc<dyn System>) -> Option<Arc<dyn Perturbation>> {
+    fn lifted(&self) -> Option<Arc<dyn Perturbation>> {
         None
     }
 
-    fn kick(&self, base: &Arc<dyn System>, tau: f64) -> Result<Box<dyn Kick>> {
+    fn kick(&self, base: &Arc<dyn Problem>, tau: f64) -> Result<Box<dyn Kick>> {
         let n = self.problem.dof();
         let me = self.clone();
         let (mut hq, mut hp) = (vec![0.0; n], vec![0.0; n]);
@@ -516,11 +475,11 @@ impl<P: GroupField + VectorField + Clone + 'static> Perturbation for DoubleBrack
         true
     }
 
-    fn lifted(&self, _lifted: &Arc<dyn System>) -> Option<Arc<dyn Perturbation>> {
+    fn lifted(&self) -> Option<Arc<dyn Perturbation>> {
         None
     }
 
-    fn kick(&self, _base: &Arc<dyn System>, tau: f64) -> Result<Box<dyn Kick>> {
+    fn kick(&self, _base: &Arc<dyn Problem>, tau: f64) -> Result<Box<dyn Kick>> {
         struct Midpoint(Box<dyn Stepper>);
         impl Kick for Midpoint {
             fn apply(&mut self, _t: f64, z: &mut [f64], clock: Clock) -> Result<()> {
@@ -686,7 +645,7 @@ impl Catalog for Forced {
         let terms = self
             .terms
             .iter()
-            .map(|t| t.lifted(&base))
+            .map(|t| t.lifted())
             .collect::<Option<Vec<_>>>()?;
         Some(Forced {
             base,
@@ -740,13 +699,15 @@ impl Integrator<Forced> for Kicked {
             .iter()
             .map(|g| Ok(problem.base.stepper(self.base, g * dt)?.0))
             .collect::<Result<Vec<_>>>()?;
+        // The kicks see the free system as a problem (its space and frames).
+        let free_problem: Arc<dyn Problem> = problem.base.clone();
         let kicks = sizes
             .iter()
             .map(|g| {
                 problem
                     .terms
                     .iter()
-                    .map(|t| t.kick(&problem.base, 0.5 * g * dt))
+                    .map(|t| t.kick(&free_problem, 0.5 * g * dt))
                     .collect::<Result<Vec<_>>>()
             })
             .collect::<Result<Vec<_>>>()?;

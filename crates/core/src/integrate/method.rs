@@ -12,7 +12,8 @@
 
 use std::sync::Arc;
 
-use super::problem::{Problem, Violation};
+pub use super::clock::Clock;
+use super::problem::Problem;
 use crate::error::{Error, Result};
 
 /// What a method claims, for a given problem; the generic test suite checks every claim.
@@ -52,61 +53,6 @@ impl Properties {
             symmetric: false,
             invariants: false,
             manifold: false,
-        }
-    }
-}
-
-/// The one clock of a run: the time t₀ of step 0, the step size and the steps already done.
-/// Steppers name absolute times in their errors through it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Clock {
-    /// Time of step 0 of the whole run.
-    pub t0: f64,
-    /// The step size.
-    pub dt: f64,
-    /// Steps done before the current call of [`Stepper::advance`].
-    pub done: u64,
-}
-
-impl Clock {
-    /// The time after `k` more steps.
-    pub fn time(&self, k: usize) -> f64 {
-        self.t0 + (self.done + k as u64) as f64 * self.dt
-    }
-
-    /// The error for a domain violation found during step `k + 1` of this call (k steps done).
-    pub fn left_domain(&self, k: usize, v: Violation) -> Error {
-        let step = self.done + k as u64 + 1;
-        Error::LeftDomain {
-            what: v.what,
-            t: self.time(k + 1),
-            message: format!(
-                "{} (found in step {step}, dt = {})",
-                v.message,
-                crate::error::fmt_num(self.dt)
-            ),
-        }
-    }
-
-    /// The error for a non-converged implicit solve in step `k + 1` of this call.
-    pub fn not_converged(
-        &self,
-        k: usize,
-        what: &str,
-        iterations: usize,
-        residual: f64,
-        tol: f64,
-    ) -> Error {
-        Error::NotConverged {
-            what: format!(
-                "{what} in step {} (t = {}, dt = {}; reduce dt)",
-                self.done + k as u64 + 1,
-                crate::error::fmt_num(self.time(k + 1)),
-                crate::error::fmt_num(self.dt)
-            ),
-            iterations,
-            residual,
-            tol,
         }
     }
 }
@@ -165,8 +111,8 @@ pub trait Catalog: Problem + Clone + 'static {
     /// [`crate::integrate::forcing::Forced`]; by default none.
     fn dissipation(
         &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> Result<Arc<dyn crate::integrate::forcing::Perturbation>> {
+        d: &crate::integrate::problem::Dissipation,
+    ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>> {
         Err(d.unsupported(self.name()))
     }
 }
@@ -186,8 +132,8 @@ pub trait System: Problem {
     /// The system's own dissipative term of kind `d` ([`Catalog::dissipation`]).
     fn dissipation(
         &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> Result<Arc<dyn crate::integrate::forcing::Perturbation>>;
+        d: &crate::integrate::problem::Dissipation,
+    ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>>;
 }
 
 impl<P: Catalog> System for P {
@@ -216,8 +162,8 @@ impl<P: Catalog> System for P {
 
     fn dissipation(
         &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> Result<Arc<dyn crate::integrate::forcing::Perturbation>> {
+        d: &crate::integrate::problem::Dissipation,
+    ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>> {
         Catalog::dissipation(self, d)
     }
 }

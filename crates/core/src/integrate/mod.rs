@@ -28,6 +28,7 @@
 //! # Ok::<(), lieflow::Error>(())
 //! ```
 
+pub mod clock;
 pub mod forcing;
 pub mod hooks;
 pub mod method;

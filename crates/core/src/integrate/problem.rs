@@ -15,13 +15,17 @@
 //! | [`Nonholonomic`] | a [`Separable`] with velocity constraints A(q) q̇ = 0 | `NonholonomicRattle` |
 //! | [`GroupField`] | ż = ξ(z)·z for a Lie-algebra valued ξ acting on z | `Rkmk4` |
 //! | [`Symmetric`] | a momentum map J and infinitesimal generators | (equilibria, tests) |
+//! | [`Perturbation`] | a non-conservative term g(t, z) with a symmetric map of its flow | `forcing::Forced` |
 //!
 //! Kernels work on flat slices of the state in the internal frame; they do not check lengths (the
 //! driver checks a state once, against [`Problem::space`]) and do not allocate (per-thread
 //! scratch comes from the kind's `Scratch` type).
 
+use std::sync::Arc;
+
+pub use super::clock::{Clock, Violation};
 use super::space::Space;
-use crate::error::Result;
+use crate::error::{Error, Result};
 
 /// What every system offers: its state space, energy and invariants.
 pub trait Problem: Send + Sync {
@@ -52,23 +56,6 @@ pub trait Problem: Send + Sync {
 
     /// Inverse of [`Problem::to_internal`].
     fn to_user(&self, _z: &mut [f64]) {}
-}
-
-/// A state found outside the domain of a problem during a step (det X ≤ 0, a coordinate
-/// singularity, …); the method turns it into [`crate::Error::LeftDomain`] with the time.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Violation {
-    /// What left the domain.
-    pub what: String,
-    /// Why, and what to do about it (in words that suit every caller).
-    pub message: String,
-}
-
-impl Violation {
-    /// The error for a state handed to a stepper (not reached by a step) outside the domain.
-    pub fn at_start(self) -> crate::Error {
-        crate::Error::invalid("state", format!("{}: {}", self.what, self.message))
-    }
 }
 
 /// An ordinary differential equation ż = f(z) (internal frame).
@@ -236,4 +223,65 @@ pub trait Symmetric: Problem {
     /// The infinitesimal generator ξ_Z(z) (the velocity of the state under the one-parameter
     /// group exp(tξ)), user frame.
     fn generator(&self, xi: &[f64], z: &[f64]) -> Result<Vec<f64>>;
+}
+
+/// A non-conservative term g(t, z) of an open system
+/// ([`crate::integrate::forcing::Forced`]): a force, damping or dissipation.
+pub trait Perturbation: Send + Sync {
+    /// What it is, for messages ("force on M", "Rayleigh damping", …).
+    fn describe(&self) -> String;
+
+    /// Whether its flow keeps the free system's [`Problem::invariants`] (Casimirs).
+    fn keeps_invariants(&self) -> bool;
+
+    /// The same term for the free system carrying its attitude, or `None` where it does not
+    /// apply there.
+    fn lifted(&self) -> Option<Arc<dyn Perturbation>>;
+
+    /// A symmetric second-order map of the term's flow over τ with the time frozen, for the
+    /// free system `base` (whose frames it may need).
+    fn kick(&self, base: &Arc<dyn Problem>, tau: f64) -> Result<Box<dyn Kick>>;
+}
+
+/// A prepared map of a [`Perturbation`]'s flow over one fixed τ (owns its scratch).
+pub trait Kick: Send {
+    /// Applies it at time t to the state z (internal frame); `clock` names the step for errors.
+    fn apply(&mut self, t: f64, z: &mut [f64], clock: Clock) -> Result<()>;
+}
+
+/// A dissipative term a system may support (through [`crate::integrate::Catalog::dissipation`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Dissipation {
+    /// Rayleigh damping ṗ = −C ∂H/∂p of a canonical system: C = c·I (one value c ≥ 0) or a
+    /// symmetric positive semi-definite d×d matrix (row-major).
+    Rayleigh(Vec<f64>),
+    /// Double-bracket dissipation of a Lie–Poisson system with the coefficient α ≥ 0.
+    DoubleBracket(f64),
+}
+
+impl Dissipation {
+    /// Its name in messages.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            Dissipation::Rayleigh(_) => "Rayleigh damping",
+            Dissipation::DoubleBracket(_) => "double-bracket dissipation",
+        }
+    }
+
+    /// The error of a system without this kind of dissipation.
+    pub fn unsupported(&self, system: &str) -> Error {
+        let which = match self {
+            Dissipation::Rayleigh(_) => "canonical systems (state (q, p))",
+            Dissipation::DoubleBracket(_) => {
+                "Lie–Poisson systems whose state is the momentum alone (no attitude)"
+            }
+        };
+        Error::invalid(
+            "dissipation",
+            format!(
+                "{system} has no {}: it is defined for {which}",
+                self.describe()
+            ),
+        )
+    }
 }

@@ -7,6 +7,15 @@ use lieflow::integrate::System;
 use lieflow::lie::gl;
 use lieflow::Mat;
 
+/// Euclidean distance between two flat states of the same length.
+pub fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
 /// Frobenius distance between two matrices of the same shape.
 pub fn dist(a: &Mat, b: &Mat) -> f64 {
     (a - b).norm_l2()

@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use lieflow::integrate::forcing::{Dissipation, ForceFn, Forced};
+use lieflow::integrate::forcing::{momentum_block, Dissipation, ForceFn, Forced};
 use lieflow::integrate::Block;
 use lieflow::Error;
 use pyo3::prelude::*;
@@ -18,9 +18,6 @@ use crate::convert::{read_all, real, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::integrate::Callbacks;
 use crate::system::{MethodsOf, PySystem};
-
-/// The momentum blocks a force acts on when `block` is not given, in this order.
-const MOMENTA: [&str; 5] = ["M", "P", "p", "L", "mu"];
 
 /// The exceptions of the force callable first, then those of the wrapped system's callables.
 struct ForcedCallbacks {
@@ -165,20 +162,7 @@ impl PyForced {
                         "argument 'block': expected a str".into(),
                     )
                 })?,
-                None => MOMENTA
-                    .iter()
-                    .find(|m| space.range(m).is_some())
-                    .map(|m| m.to_string())
-                    .ok_or_else(|| {
-                        to_py(Error::invalid(
-                            "block",
-                            format!(
-                                "{} has none of the momentum blocks {}: name the block",
-                                base.sys.name(),
-                                MOMENTA.join(", ")
-                            ),
-                        ))
-                    })?,
+                None => momentum_block(base.sys.name(), &space).py()?.to_string(),
             };
             let shape = match space.blocks().iter().find(|(n, _)| *n == name) {
                 Some((_, Block::SoDual(n))) => vec![lieflow::lie::so::dim(*n)],

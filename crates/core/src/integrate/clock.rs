@@ -1,0 +1,76 @@
+//! The one clock of a run: which step a stepper is taking and at what time, and the errors that
+//! name them (a [`Violation`] of the domain found in a step, a solver that did not converge).
+
+use crate::error::Error;
+
+/// The one clock of a run: the time t₀ of step 0, the step size and the steps already done.
+/// Steppers name absolute times in their errors through it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clock {
+    /// Time of step 0 of the whole run.
+    pub t0: f64,
+    /// The step size.
+    pub dt: f64,
+    /// Steps done before the current call of [`Stepper::advance`].
+    pub done: u64,
+}
+
+impl Clock {
+    /// The time after `k` more steps.
+    pub fn time(&self, k: usize) -> f64 {
+        self.t0 + (self.done + k as u64) as f64 * self.dt
+    }
+
+    /// The error for a domain violation found during step `k + 1` of this call (k steps done).
+    pub fn left_domain(&self, k: usize, v: Violation) -> Error {
+        let step = self.done + k as u64 + 1;
+        Error::LeftDomain {
+            what: v.what,
+            t: self.time(k + 1),
+            message: format!(
+                "{} (found in step {step}, dt = {})",
+                v.message,
+                crate::error::fmt_num(self.dt)
+            ),
+        }
+    }
+
+    /// The error for a non-converged implicit solve in step `k + 1` of this call.
+    pub fn not_converged(
+        &self,
+        k: usize,
+        what: &str,
+        iterations: usize,
+        residual: f64,
+        tol: f64,
+    ) -> Error {
+        Error::NotConverged {
+            what: format!(
+                "{what} in step {} (t = {}, dt = {}; reduce dt)",
+                self.done + k as u64 + 1,
+                crate::error::fmt_num(self.time(k + 1)),
+                crate::error::fmt_num(self.dt)
+            ),
+            iterations,
+            residual,
+            tol,
+        }
+    }
+}
+
+/// A state found outside the domain of a problem during a step (det X ≤ 0, a coordinate
+/// singularity, …); the method turns it into [`crate::Error::LeftDomain`] with the time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Violation {
+    /// What left the domain.
+    pub what: String,
+    /// Why, and what to do about it (in words that suit every caller).
+    pub message: String,
+}
+
+impl Violation {
+    /// The error for a state handed to a stepper (not reached by a step) outside the domain.
+    pub fn at_start(self) -> crate::Error {
+        crate::Error::invalid("state", format!("{}: {}", self.what, self.message))
+    }
+}
