@@ -8,10 +8,25 @@ from collections.abc import Callable, Sequence
 from types import ModuleType
 from typing import Any
 
+from typing_extensions import Self, disjoint_base, final
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-F64 = NDArray[np.float64]
+from .potentials import Potential
+
+_F64 = NDArray[np.float64]
+
+__all__ = [
+    "LieflowError", "NotInGroupError", "ShapeError", "NonFiniteError", "DegenerateStratumError",
+    "NoUniqueLogError", "InvalidArgumentError", "UnsupportedMethodError", "ConvergenceError",
+    "LeftDomainError", "ArgumentTypeError", "lie", "pseudo_rigid", "potentials", "surfaces",
+    "elliptic", "ellipsoids", "continuation", "System", "Integration", "RigidBody",
+    "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
+    "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
+    "RelativisticTangentTop", "WeakFieldTop", "TangentTop", "ChargedParticle", "Canonical",
+    "Separable", "LiePoisson", "Forced", "PseudoRigidBody", "__version__",
+]
 
 class LieflowError(ValueError): ...
 class NotInGroupError(LieflowError): ...
@@ -32,19 +47,42 @@ potentials: ModuleType
 elliptic: ModuleType
 ellipsoids: ModuleType
 continuation: ModuleType
+surfaces: ModuleType
 
 
+@final
 class Integration:
     """A native run in progress (from `System._start`); `advance` continues it."""
 
     method: str
     @property
     def time(self) -> float: ...
-    def advance(self, steps: int) -> tuple[F64, F64 | None]:
+    def advance(self, steps: int) -> tuple[_F64, _F64 | None]:
         """The states (b, k, d) and attitudes (b, k, 3, 3) | None saved in `steps` more steps."""
-    def state(self) -> tuple[F64, F64 | None]:
+    def state(self) -> tuple[_F64, _F64 | None]:
         """The current states (b, d) and attitudes (b, 3, 3) | None."""
+    def finish(self, t: float) -> tuple[_F64, _F64 | None]:
+        """Advances to the time `t` (a last shortened step between grid times ends the run)."""
+    def save_at(self, t_eval: ArrayLike) -> None:
+        """Saves the states at the times `t_eval` instead of every `save_every`-th state."""
+    def set_events(
+        self, functions: list[Callable[[float, _F64], float]], directions: ArrayLike,
+        terminal: list[int], tol: float,
+    ) -> None:
+        """Event functions g(t, state), their directions and terminal counts (a single run)."""
+    def events_found(self) -> list[tuple[int, float, _F64, _F64 | None, int]]:
+        """(event index, t, state (d,), attitude (3, 3) | None, absolute step) since the last call."""
+    @property
+    def stopped_by(self) -> int | None: ...
+    @property
+    def ended(self) -> float | None: ...
+    @property
+    def steps_done(self) -> int: ...
+    def steps_to(self, t: float) -> int: ...
+    def take_partial(self) -> tuple[_F64, _F64 | None] | None: ...
+    def checked_state(self) -> tuple[_F64, _F64 | None]: ...
 
+@disjoint_base
 class System:
     """Base class of every system: the protocol `lieflow.integrate` drives, pickling, repr."""
 
@@ -58,7 +96,7 @@ class System:
         """Names of the state's blocks."""
     @property
     def has_attitude(self) -> bool: ...
-    def _normalize_state(self, state0: Any) -> tuple[F64, bool]: ...
+    def _normalize_state(self, state0: Any) -> tuple[_F64, bool]: ...
     def _start(
         self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, method: str | None,
         save_every: int, *, t0: float = 0.0, threads: int | None = None, steps: int | None = None,
@@ -66,68 +104,71 @@ class System:
     def _run(
         self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, steps: int,
         save_every: int, method: str, *, t0: float = 0.0, threads: int | None = None,
-    ) -> tuple[F64, F64 | None, F64, F64 | None]: ...
-    def energy(self, states: ArrayLike) -> F64 | float:
+    ) -> tuple[_F64, _F64 | None, _F64, _F64 | None]: ...
+    def energy(self, states: ArrayLike) -> _F64 | float:
         """(..., d) -> (...)."""
-    def invariants(self, states: ArrayLike) -> F64:
+    def invariants(self, states: ArrayLike) -> _F64:
         """(..., d) -> (..., c): what the geometric methods keep exactly."""
-    def casimirs(self, states: ArrayLike) -> F64:
+    def casimirs(self, states: ArrayLike) -> _F64:
         """The same as `invariants`."""
     def __reduce__(self) -> tuple[type, tuple[Any, ...]]: ...
 
-LiePoissonSystem = System
 
+@final
 class RigidBody(System):
     """Free rigid body on so(3)*: z = M (3,); Casimir [|M|^2]; all six methods."""
 
-    def __init__(self, inertia: ArrayLike) -> None:
+    def __new__(cls, inertia: ArrayLike) -> Self:
         """inertia: principal moments (3,) or a (3, 3) SPD matrix."""
     @property
-    def moments(self) -> F64: ...
+    def moments(self) -> _F64: ...
     @property
-    def frame(self) -> F64 | None: ...
-    def angular_velocity(self, states: ArrayLike) -> F64:
+    def frame(self) -> _F64 | None: ...
+    def angular_velocity(self, states: ArrayLike) -> _F64:
         """Omega = I^{-1} M: (..., 3) -> (..., 3)."""
-    def spatial_momentum(self, states: ArrayLike, attitude: ArrayLike) -> F64:
+    def spatial_momentum(self, states: ArrayLike, attitude: ArrayLike) -> _F64:
         """R M: (..., 3), (..., 3, 3) -> (..., 3)."""
-    def exact_solution(self, M0: ArrayLike, t: ArrayLike) -> F64:
+    def exact_solution(self, M0: ArrayLike, t: ArrayLike) -> _F64:
         """Jacobi-elliptic M(t): (..., 3) and (k,) -> (..., k, 3); scalar t -> (..., 3)."""
 
+@final
 class GeneralizedRigidBody(System):
     """Euler–Arnold body on so(n)*: z = e_ij coordinates of M; methods isospectral, rk4."""
 
-    def __init__(self, J: ArrayLike) -> None:
+    def __new__(cls, J: ArrayLike) -> Self:
         """J: principal entries (n,) or a symmetric PSD (n, n) matrix."""
     @property
     def n(self) -> int: ...
     @property
-    def moments(self) -> F64: ...
-    def state(self, M: ArrayLike) -> F64:
+    def moments(self) -> _F64: ...
+    def state(self, M: ArrayLike) -> _F64:
         """Skew (..., n, n) -> (..., n(n-1)/2)."""
-    def matrix(self, states: ArrayLike) -> F64:
+    def matrix(self, states: ArrayLike) -> _F64:
         """(..., n(n-1)/2) -> skew (..., n, n)."""
 
+@final
 class HeavyTop(System):
     """Heavy top: z = (M, Gamma) (6,); Casimirs [|Gamma|^2, M . Gamma]."""
 
-    def __init__(self, inertia: ArrayLike, mgl: float, chi: ArrayLike = ...) -> None: ...
+    def __new__(cls, inertia: ArrayLike, mgl: float, chi: ArrayLike = ...) -> Self: ...
     @property
-    def moments(self) -> F64: ...
+    def moments(self) -> _F64: ...
     @property
     def mgl(self) -> float: ...
     @property
-    def chi(self) -> F64: ...
+    def chi(self) -> _F64: ...
     def state(
         self, M: ArrayLike, Gamma: ArrayLike | None = None, attitude: ArrayLike | None = None
-    ) -> F64:
+    ) -> _F64:
         """(M, Gamma) or (M, R^T e3) -> (..., 6)."""
-    def spatial_momentum(self, states: ArrayLike, attitude: ArrayLike) -> F64:
+    def spatial_momentum(self, states: ArrayLike, attitude: ArrayLike) -> _F64:
         """R M: (..., 6), (..., 3, 3) -> (..., 3)."""
 
+@final
 class SphericalPendulum(System):
     """Spherical pendulum on se(3)*: z = (q, L) (6,), |q| = 1, q . L = 0."""
 
-    def __init__(self, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> None: ...
+    def __new__(cls, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> Self: ...
     @property
     def mass(self) -> float: ...
     @property
@@ -137,44 +178,48 @@ class SphericalPendulum(System):
     def state_from_spherical(
         self, theta: ArrayLike, phi: ArrayLike, theta_dot: ArrayLike | None = None,
         phi_dot: ArrayLike | None = None,
-    ) -> F64:
+    ) -> _F64:
         """theta from the downward vertical; broadcasts; -> (..., 6)."""
-    def vertical_momentum(self, states: ArrayLike) -> F64 | float:
+    def vertical_momentum(self, states: ArrayLike) -> _F64 | float:
         """L3: (..., 6) -> (...)."""
 
 
+@final
 class Pendulum(System):
     """Planar pendulum in canonical coordinates (q, p); methods midpoint, gauss4, gauss6, verlet, rk4."""
 
-    def __init__(self, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> None: ...
-    def exact(self, amplitude: ArrayLike, t: ArrayLike) -> F64:
+    def __new__(cls, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> Self: ...
+    def exact(self, amplitude: ArrayLike, t: ArrayLike) -> _F64:
         """(...) -> (..., 2): the elliptic solution released at rest from `amplitude`."""
 
+@final
 class SphereParticle(System):
     """Particle on the sphere |q| = l in gravity (RATTLE)."""
 
-    def __init__(self, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> None: ...
-    def from_spherical(self, states: ArrayLike) -> F64:
+    def __new__(cls, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> Self: ...
+    def from_spherical(self, states: ArrayLike) -> _F64:
         """SphericalPendulum states (..., 6) -> (q, p) (..., 6)."""
 
+@final
 class RollingDisk(System):
     """Vertical rolling disk (nonholonomic)."""
 
-    def __init__(
-        self, mass: float, radius: float, roll_inertia: float, turn_inertia: float,
+    def __new__(
+        cls, mass: float, radius: float, roll_inertia: float, turn_inertia: float,
         spring: float = 0.0, tilt: float = 0.0,
-    ) -> None: ...
+    ) -> Self: ...
     def state(self, q: ArrayLike, theta_dot: float, phi_dot: float) -> list[float]: ...
-    def constraint_residual(self, states: ArrayLike) -> F64 | float: ...
+    def constraint_residual(self, states: ArrayLike) -> _F64 | float: ...
 
+@final
 class RollingSpheres(System):
     """Two spheres rolling against each other without slipping (003 §2); state
     (z1, z2, u, Omega1, Omega2) (27,); midpoint, midpoint4, rkmk4, rk4."""
 
-    def __init__(
-        self, r1: float, r2: float, gamma1: ArrayLike, gamma2: ArrayLike, m1: float, m2: float,
+    def __new__(
+        cls, r1: float, r2: float, gamma1: ArrayLike, gamma2: ArrayLike, m1: float, m2: float,
         inertia1: ArrayLike, inertia2: ArrayLike,
-    ) -> None: ...
+    ) -> Self: ...
     @property
     def scale(self) -> float: ...
     @property
@@ -184,125 +229,132 @@ class RollingSpheres(System):
     ) -> list[float]: ...
     def planar_state(self, theta: ArrayLike, phi: float, theta_dot: ArrayLike) -> list[float]: ...
     def to_planar(self, state: ArrayLike, tol: float = 1e-9) -> tuple[float, float, float, float, float]: ...
-    def angular_momentum(self, states: ArrayLike) -> F64:
+    def angular_momentum(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 3): total angular momentum about the centre of mass (conserved)."""
-    def body_momenta(self, states: ArrayLike) -> F64:
+    def body_momenta(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 2, 3)."""
-    def spatial_momenta(self, states: ArrayLike) -> F64:
+    def spatial_momenta(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 2, 3); P1 + P2 = angular_momentum."""
-    def udot(self, states: ArrayLike) -> F64:
+    def udot(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 3): du/dt of 003 (10)."""
-    def contact_point(self, states: ArrayLike) -> F64:
+    def contact_point(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 3)."""
-    def centres(self, states: ArrayLike) -> F64:
+    def centres(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 2, 3): geometric centres."""
-    def centres_of_mass(self, states: ArrayLike) -> F64:
+    def centres_of_mass(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 2, 3)."""
-    def accelerations(self, states: ArrayLike) -> F64:
+    def accelerations(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 2, 3): (dOmega1/dt, dOmega2/dt)."""
 
 
 # --- the pseudo-rigid body on T*GL+(n): z = (X row-major, P row-major), d = 2 n^2 ---
 
 
+@final
 class PseudoRigidBody(System):
     """Generalized pseudo-rigid body on T*GL+(n), H = tr(P^T P)/2 + U(X) (001 (3.22)); methods
     verlet (default), verlet4, verlet6, reduced. With ``incompressible=True`` the volume is held,
     det X = det X0 (the pressure is the multiplier): methods rattle (default), rattle4, rattle6,
     states with <cof X, P> = 0 (``project_momentum``), det X appended to the invariants."""
 
-    def __init__(
-        self, n: int, potential: Potential | None = None, check_det: bool = True,
+    def __new__(
+        cls, n: int, potential: Potential | None = None, check_det: bool = True,
         incompressible: bool = False,
-    ) -> None: ...
+    ) -> Self: ...
     @property
     def n(self) -> int: ...
     @property
     def check_det(self) -> bool: ...
     @property
     def incompressible(self) -> bool: ...
-    def project_momentum(self, X: ArrayLike, P: ArrayLike) -> F64:
+    def project_momentum(self, X: ArrayLike, P: ArrayLike) -> _F64:
         """(n, n), (n, n) -> (n, n): P - kappa cof X, kappa = <cof X, P>/|cof X|^2."""
     @property
     def potential(self) -> Potential: ...
-    def angular_momentum(self, states: ArrayLike) -> F64: ...
-    def circulation(self, states: ArrayLike) -> F64: ...
-    def singular_values(self, states: ArrayLike) -> F64: ...
+    def angular_momentum(self, states: ArrayLike) -> _F64: ...
+    def circulation(self, states: ArrayLike) -> _F64: ...
+    def singular_values(self, states: ArrayLike) -> _F64: ...
 
+@final
 class RelativisticTangentTop(System):
     """The relativistic tangent top in Minkowski space (002 (87)-(96)), or with `surface` the
     symmetric top on -dt^2 + g over that surface (002 (97)-(103)); gauss4, gauss6, midpoint, rk4."""
 
-    def __init__(
-        self, mass: float, inertia: float | tuple[float, float, float], surface: Any | None = None,
-    ) -> None: ...
+    def __new__(
+        cls, mass: float, inertia: float | tuple[float, float, float], surface: Any | None = None,
+    ) -> Self: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
-    def velocities(self, states: ArrayLike) -> F64:
+    def velocities(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
-    def speed_and_spin(self, states: ArrayLike) -> F64:
+    def speed_and_spin(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 2): v = sqrt(g(xdot, xdot)), s = thetadot + w(xdot)."""
-    def killing_momenta(self, states: ArrayLike) -> F64:
+    def killing_momenta(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., k): the Killing momenta of the surface (the plane's by default)."""
 
+@final
 class WeakFieldTop(System):
     """The tangent top in a weak static gravitational field (002 (115)-(120), corrected)."""
 
-    def __init__(
-        self, mass: float, inertia: float, gm: float | None = None,
+    def __new__(
+        cls, mass: float, inertia: float, gm: float | None = None,
         g: tuple[float, float] | None = None,
-    ) -> None: ...
+    ) -> Self: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
-    def angular_momentum(self, states: ArrayLike) -> F64 | float: ...
+    def angular_momentum(self, states: ArrayLike) -> _F64 | float: ...
 
+@final
 class TangentTop(System):
     """The tangent Euler top on a surface (002 §II-III), intrinsic or embedded ((37)/(39));
     midpoint, gauss4, gauss6, rk4."""
 
-    def __init__(
-        self, surface: Any, mass: float, inertia: float | ArrayLike, embedded: bool = False,
-    ) -> None: ...
+    def __new__(
+        cls, surface: Any, mass: float, inertia: float | ArrayLike, embedded: bool = False,
+    ) -> Self: ...
     @property
     def tensor(self) -> list[list[float]]: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
-    def velocities(self, states: ArrayLike) -> F64: ...
-    def p_theta(self, states: ArrayLike) -> F64 | float: ...
-    def killing_momenta(self, states: ArrayLike) -> F64: ...
-    def ambient_frame(self, states: ArrayLike) -> F64:
+    def velocities(self, states: ArrayLike) -> _F64: ...
+    def p_theta(self, states: ArrayLike) -> _F64 | float: ...
+    def killing_momenta(self, states: ArrayLike) -> _F64: ...
+    def ambient_frame(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 3, 3): rows c, E1, E2 in R^3."""
     def magnetic_analogue(self, p_theta: float) -> ChargedParticle: ...
 
+@final
 class ChargedParticle(System):
     """The charged particle of 002 §III.B equivalent to a tangent top (Routh form)."""
 
-    def __init__(self, top: TangentTop, charge: float) -> None: ...
+    def __new__(cls, top: TangentTop, charge: float) -> Self: ...
     @property
     def charge(self) -> float: ...
     def metric(self, x: ArrayLike) -> list[list[float]]: ...
     def potential(self, x: ArrayLike) -> list[float]: ...
     def state(self, x: ArrayLike, xdot: ArrayLike) -> list[float]: ...
-    def velocities(self, states: ArrayLike) -> F64: ...
-    def killing_momenta(self, states: ArrayLike) -> F64: ...
+    def velocities(self, states: ArrayLike) -> _F64: ...
+    def killing_momenta(self, states: ArrayLike) -> _F64: ...
 
+@final
 class RollingDisks(System):
     """Two disks rolling against each other in the plane (003 §1); gauss4, gauss6, midpoint, rk4."""
 
-    def __init__(
-        self, r1: float, r2: float, gamma1: complex | ArrayLike, gamma2: complex | ArrayLike,
+    def __new__(
+        cls, r1: float, r2: float, gamma1: complex | ArrayLike, gamma2: complex | ArrayLike,
         m1: float, m2: float, inertia1: float, inertia2: float, rolling_constant: float = 0.0,
-    ) -> None: ...
+    ) -> Self: ...
     @property
     def rolling_constant(self) -> float: ...
     def state(self, theta: ArrayLike, thetadot: ArrayLike) -> list[float]: ...
     def mass_matrix(self, theta: ArrayLike) -> list[list[float]]: ...
     def locked_inertia(self, theta: ArrayLike) -> float: ...
-    def angular_momentum(self, states: ArrayLike) -> F64 | float: ...
-    def positions(self, states: ArrayLike) -> dict[str, F64]:
+    def angular_momentum(self, states: ArrayLike) -> _F64 | float: ...
+    def positions(self, states: ArrayLike) -> dict[str, _F64]:
         """(..., 4) -> {"centres": (..., 2, 2), "masses": (..., 2, 2), "contact": (..., 2)}."""
     def relative_equilibria(
         self, rolling_constant: float | None = None,
         theta1_range: tuple[float, float] = (0.0, 6.283185307179586),
     ) -> list[RollingDisksEquilibrium]: ...
 
+@final
 class RollingDisksEquilibrium:
     """A rotational relative equilibrium of RollingDisks (any angular velocity)."""
 
@@ -326,15 +378,16 @@ class RollingDisksEquilibrium:
 
 # --- user-defined systems (issue 15) ---
 
+@final
 class Canonical(System):
     """H(q, p) on T*R^d from Python callables: z = (q, p) (2d,); gauss4 (default), gauss6,
     midpoint, rk4. The callables run single-threaded with the GIL; exceptions are re-raised with
     a note naming the step; wrong shapes are ShapeError, NaN/inf NonFiniteError."""
 
-    def __init__(
-        self, hamiltonian: Callable[[F64, F64], float],
-        gradient: Callable[[F64, F64], Any] | None = None, dim: int | None = None,
-    ) -> None:
+    def __new__(
+        cls, hamiltonian: Callable[[_F64, _F64], float],
+        gradient: Callable[[_F64, _F64], Any] | None = None, dim: int | None = None,
+    ) -> Self:
         """hamiltonian(q, p) -> float; gradient(q, p) -> (dH/dq, dH/dp) of shape (2, d), or None
         for central differences; dim: the number of degrees of freedom (required)."""
     @property
@@ -342,14 +395,15 @@ class Canonical(System):
     @property
     def finite_differences(self) -> bool: ...
 
+@final
 class Separable(System):
     """H = p.M^{-1}p/2 + U(q) with U from Python callables: z = (q, p) (2d,); verlet (default),
     verlet4, verlet6, gauss4, gauss6, midpoint, rk4."""
 
-    def __init__(
-        self, kinetic_mass: ArrayLike, potential: Callable[[F64], float],
-        gradient: Callable[[F64], ArrayLike] | None = None, dim: int | None = None,
-    ) -> None:
+    def __new__(
+        cls, kinetic_mass: ArrayLike, potential: Callable[[_F64], float],
+        gradient: Callable[[_F64], ArrayLike] | None = None, dim: int | None = None,
+    ) -> Self:
         """kinetic_mass: a number (then dim is required), a vector (d,) or an SPD (d, d) matrix;
         potential(q) -> float; gradient(q) -> (d,), or None for central differences."""
     @property
@@ -357,17 +411,18 @@ class Separable(System):
     @property
     def finite_differences(self) -> bool: ...
 
+@final
 class Forced(System):
     """A system with a force or torque F(t, state) on one momentum block, Rayleigh damping
     (canonical systems) or double-bracket dissipation (Lie-Poisson systems without attitude).
     Methods: m, m4, m6 for every symmetric second-order method m of `system` (kicks around it,
     orders 2, 4, 6). A force callable runs single-threaded with the GIL."""
 
-    def __init__(
-        self, system: System, force: Callable[[float, F64], ArrayLike] | None = None,
+    def __new__(
+        cls, system: System, force: Callable[[float, _F64], ArrayLike] | None = None,
         block: str | None = None, depends_on_block: bool | None = None,
         damping: float | ArrayLike | None = None, dissipation: float | None = None,
-    ) -> None:
+    ) -> Self:
         """force(t, state) -> the block's shape; block: None for the first of M, P, p, L, mu;
         depends_on_block=False: one call per kick (exact for a force free of its block);
         damping: c >= 0 or a symmetric PSD (d, d) matrix; dissipation: alpha >= 0."""
@@ -378,17 +433,18 @@ class Forced(System):
     @property
     def system(self) -> System: ...
 
+@final
 class LiePoisson(System):
     """A Lie–Poisson system d mu/dt = ad*_{dH/dmu} mu on g* (so3, se3, ("so", n) or structure
     constants (d, d, d)); rkmk4 (default), midpoint, midpoint4 (keep the coadjoint orbit), rk4.
     Casimirs: |M|^2 (so3); |Gamma|^2, M.Gamma (se3); tr((M^T M)^k)/2 (so(n)); or `casimirs`."""
 
-    def __init__(
-        self, algebra: str | tuple[str, int] | ArrayLike,
-        hamiltonian: Callable[[F64], float] | ArrayLike,
-        gradient: Callable[[F64], ArrayLike] | None = None,
-        casimirs: Sequence[Callable[[F64], float]] | None = None,
-    ) -> None:
+    def __new__(
+        cls, algebra: str | tuple[str, int] | ArrayLike,
+        hamiltonian: Callable[[_F64], float] | ArrayLike,
+        gradient: Callable[[_F64], ArrayLike] | None = None,
+        casimirs: Sequence[Callable[[_F64], float]] | None = None,
+    ) -> Self:
         """hamiltonian: a callable mu -> float, or a symmetric (d, d) matrix A for H = mu.A mu/2
         (the native path); gradient: mu -> (d,) or None (finite differences; None for a
         matrix)."""
@@ -396,5 +452,5 @@ class LiePoisson(System):
     def dim(self) -> int: ...
     @property
     def is_quadratic(self) -> bool: ...
-    def structure_constants(self) -> F64:
+    def structure_constants(self) -> _F64:
         """C (d, d, d) with [e_i, e_j] = C[i, j, k] e_k."""

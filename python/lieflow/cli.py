@@ -33,7 +33,7 @@ def demo(figure="lieflow-demo.png") -> None:
     t0 = time.perf_counter()
     t, states = _integrate(body, (X0, P0), dt, steps, 20, "verlet4")
     elapsed = time.perf_counter() - t0
-    E = body.energy(states)
+    E = np.asarray(body.energy(states))
     L = body.angular_momentum(states)
     G = body.circulation(states)
 

@@ -1,13 +1,18 @@
 # Type stubs for lieflow.continuation (families of relative equilibria).
 from typing import Any
 
+from typing_extensions import final
+
 import numpy as np
 from numpy.typing import NDArray
 
 from .pseudo_rigid import RelativeEquilibrium
 
-F64 = NDArray[np.float64]
+_F64 = NDArray[np.float64]
 
+__all__ = ["Branch", "SpecialPoint", "follow"]
+
+@final
 class SpecialPoint:
     kind: str
     """"branch", "fold" or "stability"."""
@@ -19,15 +24,16 @@ class SpecialPoint:
     def __getattr__(self, name: str) -> float:
         """The family's parameters by name: e, a2_over_a1, a3_over_a1, Omega2_over_piGrho, L, f."""
 
+@final
 class Branch:
     points: list[RelativeEquilibrium]
     parameter: str
-    values: F64
+    values: _F64
     stability: NDArray[np.bool_]
     energy_momentum: NDArray[np.bool_]
     special_points: list[SpecialPoint]
     end: str
-    def values_of(self, name: str) -> F64: ...
+    def values_of(self, name: str) -> _F64: ...
     def switch(
         self, point: SpecialPoint, *, stop: float | None = None, parameter: str | None = None,
         direction: float | None = None,

@@ -4,57 +4,60 @@ from typing import Any, Callable, Iterable, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-F64 = NDArray[np.float64]
+_F64 = NDArray[np.float64]
+
+__all__ = ["integrate", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
 CHUNK_WORK: int
+MIN_CHUNK_STEPS: int
 
-class NativeRun(Protocol):
+class _NativeRun(Protocol):
     method: str
-    def advance(self, steps: int) -> tuple[F64, F64 | None]: ...
-    def state(self) -> tuple[F64, F64 | None]: ...
+    def advance(self, steps: int) -> tuple[_F64, _F64 | None]: ...
+    def state(self) -> tuple[_F64, _F64 | None]: ...
 
-class OutputControl(NativeRun, Protocol):
-    """What `t_eval`, `events` and `err.partial` use besides `NativeRun` (`lieflow.Integration`
+class _OutputControl(_NativeRun, Protocol):
+    """What `t_eval`, `events` and `err.partial` use besides `_NativeRun` (`lieflow.Integration`
     has all of it; a duck-typed run without it supports the plain runs only)."""
 
     time: float
     ended: float | None
     stopped_by: int | None
     steps_done: int
-    def finish(self, t: float) -> tuple[F64, F64 | None]: ...
+    def finish(self, t: float) -> tuple[_F64, _F64 | None]: ...
     def save_at(self, t_eval: ArrayLike) -> None: ...
     def set_events(
-        self, functions: list[Callable[[float, F64], float]], directions: list[float],
+        self, functions: list[Callable[[float, _F64], float]], directions: list[float],
         terminal: list[int], tol: float,
     ) -> None: ...
-    def events_found(self) -> list[tuple[int, float, F64, F64 | None, int]]: ...
+    def events_found(self) -> list[tuple[int, float, _F64, _F64 | None, int]]: ...
     def steps_to(self, t: float) -> int: ...
-    def take_partial(self) -> tuple[F64, F64 | None] | None: ...
-    def checked_state(self) -> tuple[F64, F64 | None]: ...
+    def take_partial(self) -> tuple[_F64, _F64 | None] | None: ...
+    def checked_state(self) -> tuple[_F64, _F64 | None]: ...
 
-class EventFunction(Protocol):
+class _EventFunction(Protocol):
     """g(t, state) -> float, with the optional attributes of scipy's events: `terminal` (bool,
     or the number of occurrences that ends the run) and `direction` (> 0 rising, < 0 falling,
     0 both)."""
 
-    def __call__(self, t: float, state: F64, /) -> float: ...
+    def __call__(self, t: float, state: _F64, /) -> float: ...
 
-class IntegrableSystem(Protocol):
+class _IntegrableSystem(Protocol):
     """The protocol `integrate` drives (implemented once by `lieflow.System`)."""
 
     @property
     def state_dim(self) -> int: ...
     def methods(self) -> list[str]: ...
-    def _normalize_state(self, state0: Any) -> tuple[F64, bool]: ...
+    def _normalize_state(self, state0: Any) -> tuple[_F64, bool]: ...
     def _start(
-        self, z0: F64, attitude0: F64 | None, dt: float, method: str | None, save_every: int, *,
+        self, z0: _F64, attitude0: _F64 | None, dt: float, method: str | None, save_every: int, *,
         t0: float = 0.0, threads: int | None = None, steps: int | None = None,
-    ) -> NativeRun: ...
-    def energy(self, states: ArrayLike) -> F64 | float: ...
-    def invariants(self, states: ArrayLike) -> F64: ...
+    ) -> _NativeRun: ...
+    def energy(self, states: ArrayLike) -> _F64 | float: ...
+    def invariants(self, states: ArrayLike) -> _F64: ...
 
 def integrate(
-    system: IntegrableSystem,
+    system: _IntegrableSystem,
     state0: Any,
     dt: float,
     steps: int | None = None,
@@ -67,7 +70,7 @@ def integrate(
     *,
     t0: float = 0.0,
     t_eval: ArrayLike | None = None,
-    events: EventFunction | list[EventFunction] | None = None,
+    events: _EventFunction | list[_EventFunction] | None = None,
     event_tol: float = 0.0,
 ) -> Trajectory:
     """Integrate `steps` fixed steps of size `dt` from time `t0`; k = steps // save_every + 1
@@ -77,38 +80,38 @@ def integrate(
     exception during the run carries `err.partial`, the trajectory computed before it."""
 
 class Trajectory:
-    system: IntegrableSystem
+    system: _IntegrableSystem
     method: str | tuple[str, ...]
     dt: float | None
     save_every: int | None
     """None when `t_eval` gave the times (or concatenated parts differ)."""
-    t: F64
+    t: _F64
     """(k,) sample times (absolute)."""
     t0: float | None
     t_final: float | None
     """The time of `final_state`."""
     status: int
     """0 reached the end, 1 a terminal event ended it, -1 failed (`err.partial`)."""
-    t_events: list[F64] | None
+    t_events: list[_F64] | None
     """One (n_i,) array of event times per event function, or None without events."""
-    state_events: list[F64] | None
+    state_events: list[_F64] | None
     """One (n_i, d) array of event states per event function."""
-    attitude_events: list[F64] | None
-    initial_state: F64 | None
-    initial_attitude: F64 | None
-    states: F64
+    attitude_events: list[_F64] | None
+    initial_state: _F64 | None
+    initial_attitude: _F64 | None
+    states: _F64
     """(k, d), or (b, k, d) for a batch."""
-    attitude: F64 | None
+    attitude: _F64 | None
     """(k, 3, 3) / (b, k, 3, 3) or None."""
-    final_state: F64
-    final_attitude: F64 | None
+    final_state: _F64
+    final_attitude: _F64 | None
     def __init__(
-        self, system: IntegrableSystem, method: str | tuple[str, ...], t: F64, states: F64,
-        attitude: F64 | None, final_state: F64, final_attitude: F64 | None, dt: float | None,
+        self, system: _IntegrableSystem, method: str | tuple[str, ...], t: _F64, states: _F64,
+        attitude: _F64 | None, final_state: _F64, final_attitude: _F64 | None, dt: float | None,
         save_every: int | None, *, t_final: float | None = None, status: int = 0,
-        t_events: list[F64] | None = None, state_events: list[F64] | None = None,
-        attitude_events: list[F64] | None = None, t0: float | None = None,
-        initial_state: F64 | None = None, initial_attitude: F64 | None = None,
+        t_events: list[_F64] | None = None, state_events: list[_F64] | None = None,
+        attitude_events: list[_F64] | None = None, t0: float | None = None,
+        initial_state: _F64 | None = None, initial_attitude: _F64 | None = None,
     ) -> None: ...
     @classmethod
     def concatenate(cls, trajectories: Iterable[Trajectory]) -> Trajectory:
@@ -117,11 +120,11 @@ class Trajectory:
     @property
     def batched(self) -> bool: ...
     def __len__(self) -> int: ...
-    def energy(self) -> F64:
+    def energy(self) -> _F64:
         """(k,) or (b, k)."""
-    def invariants(self) -> F64:
+    def invariants(self) -> _F64:
         """(k, c) or (b, k, c)."""
-    def casimirs(self) -> F64:
+    def casimirs(self) -> _F64:
         """The same as `invariants()`."""
     def __getattr__(self, name: str) -> Any:
         """Named fields of the system (M, Gamma, q, L, ...) or an observable

@@ -8,6 +8,15 @@ import numpy.typing as npt
 _F = npt.NDArray[np.float64]
 _In = npt.ArrayLike
 
+__all__ = [
+    "Ad", "ad", "ad_star", "cayley", "cayley_inv", "dexp", "dexp_inv", "from_euler",
+    "from_quaternion", "from_scipy", "from_svd", "hat", "hat_n", "is_rotation", "polar",
+    "product_Ad", "product_bracket", "project_to_so", "se3_Ad", "se3_compose", "se3_exp",
+    "se3_inverse", "se3_log", "so3_cayley", "so3_cayley_inv", "so3_exp", "so3_jacobian_left",
+    "so3_jacobian_right", "so3_log", "so_exp", "so_log", "stratum", "svd_coordinates", "to_euler",
+    "to_quaternion", "to_scipy", "vee", "vee_n",
+]
+
 # --- so(n) / SO(n) for any n >= 2 (e_ij basis, pairing ½ tr(ξᵀη)) ---
 
 def hat_n(c: _In) -> _F:
@@ -92,7 +101,7 @@ def se3_compose(g: _In, h: _In) -> _F:
 
 # --- GL+(n) ---
 
-class GLStratum(TypedDict):
+class _GLStratum(TypedDict):
     singular_values: _F
     multiplicities: list[int]
     min_gap: float
@@ -108,7 +117,7 @@ def from_svd(R: _In, a: _In, S: _In) -> _F:
 def polar(X: _In) -> tuple[_F, _F]:
     """Polar decomposition X = R @ P, R in SO(n), P symmetric positive definite."""
 
-def stratum(X: _In, tol: float = 1e-8) -> GLStratum:
+def stratum(X: _In, tol: float = 1e-8) -> _GLStratum:
     """Coincidences of the singular values of X (001 §6.1, (9.2))."""
 
 

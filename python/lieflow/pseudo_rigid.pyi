@@ -3,14 +3,27 @@
 # xi block first.
 from typing import Any, Literal, TypedDict
 
+from typing_extensions import final
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-F64 = NDArray[np.float64]
-Action = Literal["two-sided", "left", "right"]
+_F64 = NDArray[np.float64]
+__all__ = [
+    "RelativeEquilibrium", "Stability", "Verdict", "adjoint_motion", "amended_hessian",
+    "amended_potential", "angular_momentum", "augmented_gradient", "augmented_hessian",
+    "augmented_potential", "bi_connection", "bi_inertia", "bi_inertia_apply", "bi_inertia_eigen",
+    "bi_inertia_quadratic_form", "bi_inertia_solve", "circulation", "equilibrium_directions",
+    "from_body", "horizontal_part", "index_symbols", "kinetic_energy", "left_connection",
+    "left_inertia", "locked_inertia", "reconstruct", "reduce", "relative_equilibria",
+    "riemann_bracket", "riemann_variables", "right_connection", "right_inertia", "stratum",
+    "to_body", "vertical_vector",
+]
 
-class StratumInfo(TypedDict):
-    singular_values: F64
+_Action = Literal["two-sided", "left", "right"]
+
+class _StratumInfo(TypedDict):
+    singular_values: _F64
     multiplicities: list[int]
     min_gap: float
     principal: bool
@@ -19,66 +32,66 @@ class StratumInfo(TypedDict):
     isotropy: str
     isotropy_dim: int
 
-def left_inertia(X: ArrayLike, xi: ArrayLike) -> F64:
+def left_inertia(X: ArrayLike, xi: ArrayLike) -> _F64:
     """A^L_X xi = X X^T xi + xi X X^T (001 (2.11))."""
 
-def right_inertia(X: ArrayLike, xi: ArrayLike) -> F64:
+def right_inertia(X: ArrayLike, xi: ArrayLike) -> _F64:
     """A^R_X xi = X^T X xi + xi X^T X (001 (2.11))."""
 
-def bi_inertia(X: ArrayLike) -> F64:
+def bi_inertia(X: ArrayLike) -> _F64:
     """B_X as an (n(n-1), n(n-1)) matrix (001 (6.9))."""
 
-def bi_inertia_apply(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> tuple[F64, F64]:
+def bi_inertia_apply(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> tuple[_F64, _F64]:
     """B_X(xi + eta) (001 (6.9))."""
 
-def bi_inertia_solve(X: ArrayLike, lam: ArrayLike, gam: ArrayLike) -> tuple[F64, F64]:
+def bi_inertia_solve(X: ArrayLike, lam: ArrayLike, gam: ArrayLike) -> tuple[_F64, _F64]:
     """B_X^{-1}(lam + gam) by the closed form (001 (7.6)-(7.9)); principal stratum only."""
 
-def bi_inertia_eigen(X: ArrayLike) -> tuple[F64, F64]:
+def bi_inertia_eigen(X: ArrayLike) -> tuple[_F64, _F64]:
     """Eigenvalues (non-decreasing) and eigenvectors (columns) of B_X (001 (8.14)-(8.15))."""
 
 def bi_inertia_quadratic_form(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> float:
     """<xi + eta, B_X(xi + eta)> in SVD coordinates (001 (6.14))."""
 
-def left_connection(X: ArrayLike, Y: ArrayLike) -> F64:
+def left_connection(X: ArrayLike, Y: ArrayLike) -> _F64:
     """omega^L_X(Y) (001 (2.14))."""
 
-def right_connection(X: ArrayLike, Y: ArrayLike) -> F64:
+def right_connection(X: ArrayLike, Y: ArrayLike) -> _F64:
     """omega^R_X(Y) (001 (2.15))."""
 
-def bi_connection(X: ArrayLike, Y: ArrayLike) -> tuple[F64, F64]:
+def bi_connection(X: ArrayLike, Y: ArrayLike) -> tuple[_F64, _F64]:
     """omega^B_X(Y) (001 (6.18)); principal stratum only."""
 
-def vertical_vector(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> F64:
+def vertical_vector(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> _F64:
     """xi X + X eta^T (001 (6.17))."""
 
-def horizontal_part(X: ArrayLike, Y: ArrayLike, action: Action = "two-sided") -> F64:
+def horizontal_part(X: ArrayLike, Y: ArrayLike, action: _Action = "two-sided") -> _F64:
     """Horizontal part of Y for the action (001 (2.20)-(2.22), (6.6), (6.23))."""
 
-def locked_inertia(X: ArrayLike, action: Action = "two-sided") -> F64:
+def locked_inertia(X: ArrayLike, action: _Action = "two-sided") -> _F64:
     """Locked inertia tensor from the metric tr(Y^T Z) (001 (2.27), (6.24))."""
 
-def angular_momentum(X: ArrayLike, V: ArrayLike) -> F64:
+def angular_momentum(X: ArrayLike, V: ArrayLike) -> _F64:
     """L = V X^T - X V^T (001 (2.29), (7.3))."""
 
-def circulation(X: ArrayLike, V: ArrayLike) -> F64:
+def circulation(X: ArrayLike, V: ArrayLike) -> _F64:
     """Gamma = V^T X - X^T V (001 (2.29), (7.3))."""
 
-def to_body(X: ArrayLike, V: ArrayLike) -> tuple[F64, F64, F64, F64, F64, F64]:
+def to_body(X: ArrayLike, V: ArrayLike) -> tuple[_F64, _F64, _F64, _F64, _F64, _F64]:
     """(R, a, S, Omega, adot, Lambda) (001 §4.1); principal stratum only."""
 
 def from_body(
     R: ArrayLike, a: ArrayLike, S: ArrayLike, Omega: ArrayLike, adot: ArrayLike, Lambda: ArrayLike
-) -> tuple[F64, F64]:
+) -> tuple[_F64, _F64]:
     """(X, V) from body coordinates (001 §4.1)."""
 
 def kinetic_energy(X: ArrayLike, V: ArrayLike) -> float:
     """tr(V^T V) / 2 (001 (3.2), (4.5), (6.28))."""
 
-def stratum(X: ArrayLike, tol: float = 1e-8) -> StratumInfo:
+def stratum(X: ArrayLike, tol: float = 1e-8) -> _StratumInfo:
     """Stratum, dim V_X, dim H_X and isotropy (001 (6.2), (9.2), (9.3))."""
 
-def riemann_variables(X: ArrayLike, V: ArrayLike) -> tuple[F64, F64]:
+def riemann_variables(X: ArrayLike, V: ArrayLike) -> tuple[_F64, _F64]:
     """(Q, N) = (X X^T, X V^T) (001 (3.4))."""
 
 def riemann_bracket(
@@ -86,23 +99,23 @@ def riemann_bracket(
 ) -> float:
     """Poisson bracket of functions of (Q, N) (001 (9.1))."""
 
-class Reduced(TypedDict):
-    a: F64
-    p_a: F64
-    p_Omega: F64
-    p_Lambda: F64
-    R: F64
-    S: F64
+class _Reduced(TypedDict):
+    a: _F64
+    p_a: _F64
+    p_Omega: _F64
+    p_Lambda: _F64
+    R: _F64
+    S: _F64
 
-def reduce(X: ArrayLike, P: ArrayLike) -> Reduced:
+def reduce(X: ArrayLike, P: ArrayLike) -> _Reduced:
     """(X, P) -> (a, p_a, p_Omega, p_Lambda) and the frames R, S (001 §7)."""
 
 def reconstruct(
     R: ArrayLike, S: ArrayLike, a: ArrayLike, p_a: ArrayLike, p_Omega: ArrayLike, p_Lambda: ArrayLike
-) -> tuple[F64, F64]:
+) -> tuple[_F64, _F64]:
     """(X, P) from reduced coordinates and frames (001 (7.9)); inverse of `reduce`."""
 
-def adjoint_motion(X: ArrayLike, P: ArrayLike) -> tuple[F64, F64]:
+def adjoint_motion(X: ArrayLike, P: ArrayLike) -> tuple[_F64, _F64]:
     """Dedekind's adjoint motion (X^T, P^T) of stacked frames (..., n, n)."""
 
 # --- relative equilibria and their stability (001 §8) ---
@@ -111,15 +124,15 @@ def amended_potential(X: ArrayLike, lam: ArrayLike, gam: ArrayLike, potential: A
     """V_{lam+gam}(X) = U(X) + <lam+gam, B_X^{-1}(lam+gam)>/2 (001 (8.11))."""
 def augmented_potential(X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any) -> float:
     """U_{xi+eta}(X) = U(X) - <xi+eta, B_X(xi+eta)>/2 (001 (8.12))."""
-def augmented_gradient(X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any) -> F64:
+def augmented_gradient(X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any) -> _F64:
     """dU_{xi+eta}/dX, (n, n)."""
 def augmented_hessian(
     X: ArrayLike, xi: ArrayLike, eta: ArrayLike, potential: Any, V: ArrayLike | None = None
-) -> F64:
+) -> _F64:
     """D^2U_{xi+eta}(X)[V], (n, n); without V the (n^2, n^2) row-major vec(X) matrix (001 (8.12))."""
 def amended_hessian(
     X: ArrayLike, lam: ArrayLike, gam: ArrayLike, potential: Any, V: ArrayLike | None = None
-) -> F64:
+) -> _F64:
     """D^2V_{lam+gam}(X)[V], (n, n); without V the (n^2, n^2) row-major vec(X) matrix (001 (8.11))."""
 def equilibrium_directions(a: ArrayLike) -> list[dict[str, Any]]:
     """Velocity directions satisfying (8.6) for A = diag(a): (8.15), (8.17)-(8.18)."""
@@ -132,10 +145,11 @@ def relative_equilibria(
     """Relative equilibria by shape and plane, by velocities or by momenta (001 §8);
     `incompressible=True` (with shape= and plane=) keeps det X with the pressure as multiplier."""
 
-def index_symbols(a: ArrayLike) -> tuple[F64, F64]:
+def index_symbols(a: ArrayLike) -> tuple[_F64, _F64]:
     """Chandrasekhar's index symbols (A (3,), A_ij (3, 3)) of the ellipsoid with semi-axes a
     (EFE ch. 3 §21): A_i by Carlson's R_D, A_ij by the trapezoidal rule in ln u."""
 
+@final
 class Verdict:
     eigenvalues: NDArray[np.complex128]
     stable: bool
@@ -143,17 +157,19 @@ class Verdict:
     max_real_part: float
     tol: float
 
+@final
 class Stability:
     energy_momentum: Verdict
     spectral: Verdict
 
+@final
 class RelativeEquilibrium:
-    shape: F64
-    a: F64
-    xi: F64
-    eta: F64
-    L: F64
-    Gamma: F64
+    shape: _F64
+    a: _F64
+    xi: _F64
+    eta: _F64
+    L: _F64
+    Gamma: _F64
     energy: float
     pressure: float
     incompressible: bool
@@ -169,6 +185,6 @@ class RelativeEquilibrium:
     angular_momentum: float
     circulation: float
     quantities: dict[str, float]
-    def motion(self, t: ArrayLike) -> tuple[F64, F64]:
+    def motion(self, t: ArrayLike) -> tuple[_F64, _F64]:
         """(X(t), P(t)), each (k, n, n)."""
     def stability(self) -> Stability: ...

@@ -1,15 +1,23 @@
 # Type stubs for lieflow.surfaces (002 §II-III).
 from typing import Any, Callable
 
+from typing_extensions import final
+
 import numpy as np
 import numpy.typing as npt
 
-F64 = npt.NDArray[np.float64]
+_F64 = npt.NDArray[np.float64]
 
+__all__ = [
+    "Graph", "HyperbolicPlane", "MetricSurface", "Plane", "Quadric", "Revolution", "Sphere",
+    "Surface", "Torus",
+]
+
+@final
 class Surface:
     def curvature(self, x: tuple[float, float]) -> float: ...
-    def metric(self, x: tuple[float, float]) -> F64: ...
-    def frame(self, x: tuple[float, float]) -> F64: ...
+    def metric(self, x: tuple[float, float]) -> _F64: ...
+    def frame(self, x: tuple[float, float]) -> _F64: ...
     def connection(self, x: tuple[float, float]) -> tuple[float, float]: ...
     @property
     def killing_names(self) -> list[str]: ...
