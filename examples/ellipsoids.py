@@ -1,9 +1,14 @@
-"""The Maclaurin–Jacobi bifurcation diagram of self-gravitating fluid ellipsoids, computed by
+"""The Maclaurin–Jacobi bifurcation diagram
+========================================
+
+The Maclaurin–Jacobi bifurcation diagram of self-gravitating fluid ellipsoids, computed by
 continuation of the relative equilibria of the incompressible pseudo-rigid body (001 §8; EFE
 ch. 5–6): start on the Maclaurin sequence, locate where the Jacobi family branches off and where
 the spheroids lose spectral stability, switch onto the Jacobi branch and follow it.
 
-    python examples/ellipsoids.py [--figure docs/ellipsoids.png]
+Run it with (``--figure`` alone draws the figure, a path saves it)::
+
+    python examples/ellipsoids.py [--figure [docs/ellipsoids.png]]
 """
 
 import sys
@@ -40,7 +45,7 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    path = sys.argv[sys.argv.index("--figure") + 1]
+    path = (sys.argv[sys.argv.index("--figure") + 1:] or [None])[0]  # None: only draw
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.3))
     for ax, x in zip(axes, ("e", "L")):
         mac.plot(ax, x=x, label="Maclaurin spheroids", color="C0")
@@ -58,8 +63,9 @@ def main():
     fig.suptitle("Self-gravitating fluid ellipsoids: relative equilibria of the incompressible "
                  "pseudo-rigid body, by continuation")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    print(f"wrote {path}")
+    if path:  # the docs gallery draws the figure without saving it
+        fig.savefig(path, dpi=120)
+        print(f"wrote {path}")
 
 
 if __name__ == "__main__":

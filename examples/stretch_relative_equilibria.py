@@ -1,4 +1,7 @@
-"""Relative equilibria of a Stretch body (U = (k/2) sum (sigma_i - 1)^2) rotating in the (1, 2)
+"""Relative equilibria of a stretch body
+=====================================
+
+Relative equilibria of a Stretch body (U = (k/2) sum (sigma_i - 1)^2) rotating in the (1, 2)
 plane (001 §8), and their stability.
 
 For this potential the shear stiffness is k for every shape, so a rotation xi = w e_12,
@@ -8,7 +11,9 @@ The family below keeps a1 - a2 = 2.5 (elongated shapes) and lets a1 + a2 grow, s
 member is judged by the energy-momentum and the spectral test, and one stable and one unstable
 member are simulated (verlet4, perturbation 1e-4) to t = 200.
 
-    python examples/stretch_relative_equilibria.py [--figure docs/stretch_relative_equilibria.png]
+Run it with (``--figure`` alone draws the figure, a path saves it)::
+
+    python examples/stretch_relative_equilibria.py [--figure [docs/stretch_relative_equilibria.png]]
 """
 
 import sys
@@ -67,7 +72,7 @@ def main():
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        path = sys.argv[sys.argv.index("--figure") + 1]
+        path = (sys.argv[sys.argv.index("--figure") + 1:] or [None])[0]  # None: only draw
         fig, ax = plt.subplots(1, 3, figsize=(14, 4))
         w = np.array([r[0] for r in rows])
         colour = np.array(["tab:blue" if r[7] else "tab:red" for r in rows])
@@ -82,8 +87,9 @@ def main():
         ax[2].set(xlabel="t", ylabel="a1(t) - a1(0)", title="perturbed by 1e-4 (verlet4)")
         ax[2].legend()
         fig.tight_layout()
-        fig.savefig(path, dpi=110)
-        print("figure:", path)
+        if path:  # the docs gallery draws the figure without saving it
+            fig.savefig(path, dpi=110)
+            print("figure:", path)
 
 
 if __name__ == "__main__":

@@ -1,9 +1,14 @@
-"""The tangent Euler top on a sphere and on the hyperbolic plane (002 §II–III): the path of the
+"""The tangent Euler top
+=====================
+
+The tangent Euler top on a sphere and on the hyperbolic plane (002 §II–III): the path of the
 centre with the body frame drawn along it, the path of the equivalent charged particle
 (002 §III.B, `TangentTop.magnetic_analogue`) overlaid, and the invariants against time (energy,
 p_theta and the Killing momenta, kept by the symplectic Gauss–Legendre method).
 
-    python examples/tangent_top.py [--figure docs/tangent_top.png]
+Run it with (``--figure`` alone draws the figure, a path saves it)::
+
+    python examples/tangent_top.py [--figure [docs/tangent_top.png]]
 """
 
 import sys
@@ -38,7 +43,7 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    path = sys.argv[sys.argv.index("--figure") + 1]
+    path = (sys.argv[sys.argv.index("--figure") + 1:] or [None])[0]  # None: only draw
     fig = plt.figure(figsize=(14, 4.2))
     # Sphere: the centre in R^3 and the body axis E1 (every 20 samples), from ambient_frame;
     # the charged particle's path (dashed) lies on the centre's.
@@ -73,8 +78,9 @@ def main():
     ax.set(xlabel="t", title="invariants, gauss6, dt = 0.01")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    print("figure:", path)
+    if path:  # the docs gallery draws the figure without saving it
+        fig.savefig(path, dpi=110)
+        print("figure:", path)
 
 
 if __name__ == "__main__":
