@@ -32,7 +32,7 @@ def to_scipy(R):
     """The rotations ``R`` as a ``scipy.spatial.transform.Rotation``.
 
     Args:
-        R: (3, 3) or (..., 3, 3) rotation matrices (checked: ‖RᵀR − I‖_F and |det R − 1|
+        R: (3, 3) or (..., 3, 3) rotation matrices (checked: ‖RᵀR − I‖_F and abs(det R − 1)
             at most 1e-10).
     Returns:
         ``Rotation.from_quat(to_quaternion(R, scalar_first=False))``: a single rotation for a

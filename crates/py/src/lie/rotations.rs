@@ -30,7 +30,7 @@ fn store(m: &Matrix3<f64>, out: &mut [f64]) {
 /// Args: R — (..., 3, 3) rotations (any leading axes); scalar_first — (w, x, y, z) if True
 /// (default), scipy's default order (x, y, z, w) if False.
 /// Returns: (..., 4). Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or
-/// |det R − 1| > 1e-10).
+/// abs(det R − 1) > 1e-10).
 #[pyfunction]
 #[pyo3(signature = (R, scalar_first = true))]
 fn to_quaternion<'py>(

@@ -12,11 +12,11 @@ use crate::convert::ArrayIn;
 use crate::errors::to_py;
 
 /// `se3_exp(xi)`: exp of ξ = (ω, v) (rotation first) as the 4×4 matrix [[exp(ω̂), V(ω) v], [0, 1]],
-/// V(ω) = I + ((1 − cos θ)/θ²) ω̂ + ((θ − sin θ)/θ³) ω̂² (the left Jacobian of SO(3)), θ = |ω|;
+/// V(ω) = I + ((1 − cos θ)/θ²) ω̂ + ((θ − sin θ)/θ³) ω̂² (the left Jacobian of SO(3)), θ = ‖ω‖;
 /// equal to scipy.linalg.expm([[ω̂, v], [0, 0]]).
 ///
 /// Args: xi — (6,) or (b, 6). Returns (4, 4) or (b, 4, 4). Raises ShapeError, NonFiniteError,
-/// InvalidArgumentError (|ω| > 2.25e14, the rule of so3_exp; a translation beyond the f64 range).
+/// InvalidArgumentError (‖ω‖ > 2.25e14, the rule of so3_exp; a translation beyond the f64 range).
 #[pyfunction]
 fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "xi", &xi, |x: &Vector6<f64>| {
@@ -25,7 +25,7 @@ fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 }
 
 /// `se3_log(g, strict=False)`: the logarithm ξ = (ω, v) of g = [[R, t], [0, 1]]: ω = so3_log(R)
-/// (|ω| ≤ π) and v = V(ω)⁻¹ t. At a rotation angle of π exactly, `strict=False` returns one of the
+/// (‖ω‖ ≤ π) and v = V(ω)⁻¹ t. At a rotation angle of π exactly, `strict=False` returns one of the
 /// two logarithms and `strict=True` raises NoUniqueLogError (when π − θ ≤ 1e-12).
 ///
 /// Args: g — (4, 4) or (b, 4, 4). Returns (6,) or (b, 6).

@@ -120,7 +120,7 @@ fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
 ///
 /// Closed form for n = 2, Rodrigues for n = 3, and for n > 3
 /// exp ξ = cos(√S) + ξ sinc(√S) with S = ξᵀξ (symmetric eigendecomposition), orthogonal to
-/// round-off even for |ξ| ~ 1e3.
+/// round-off even for ‖ξ‖ ~ 1e3.
 ///
 /// Args:
 ///     xi: skew matrix (n, n), or a batch (b, n, n) computed in parallel without the GIL.
@@ -128,7 +128,7 @@ fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
 ///     R: shape (n, n) or (b, n, n), in SO(n).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (xi not skew),
-///     InvalidArgumentError (|ξ| > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of
+///     InvalidArgumentError (‖ξ‖ > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of
 ///     the angles is lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
 fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -191,7 +191,7 @@ fn cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAr
 /// Returns:
 ///     skew matrix (n, n).
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (|ξ| > 2.25e14).
+///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (‖ξ‖ > 2.25e14).
 #[pyfunction]
 fn dexp<'py>(
     py: Python<'py>,
@@ -202,14 +202,14 @@ fn dexp<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// Inverse of `dexp` (Bernoulli series Σ_k B_k/k! ad_ξᵏ η), for |ξ| < π where |ξ|² = ½ tr(ξᵀξ).
+/// Inverse of `dexp` (Bernoulli series Σ_k B_k/k! ad_ξᵏ η), for ‖ξ‖ < π where ‖ξ‖² = ½ tr(ξᵀξ).
 ///
 /// Args:
 ///     xi, eta: skew matrices (n, n).
 /// Returns:
 ///     skew matrix (n, n) with dexp(xi, result) = eta.
 /// Raises:
-///     InvalidArgumentError: |ξ| ≥ π. ShapeError, NonFiniteError, NotInGroupError.
+///     InvalidArgumentError: ‖ξ‖ ≥ π. ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 fn dexp_inv<'py>(
     py: Python<'py>,

@@ -30,17 +30,17 @@ fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 }
 
 /// `so3_exp(w)`: the rotation exp(ŵ) by Rodrigues' formula
-/// R = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = |w| (rotation by θ about w/θ).
+/// R = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = ‖w‖ (rotation by θ about w/θ).
 ///
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError,
-/// InvalidArgumentError (|w| > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of the angle is
+/// InvalidArgumentError (‖w‖ > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of the angle is
 /// lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
 fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "w", &w, so3::try_exp)
 }
 
-/// `so3_log(r, strict=False)`: the principal logarithm w (|w| = θ ∈ [0, π], exp(ŵ) = R),
+/// `so3_log(r, strict=False)`: the principal logarithm w (‖w‖ = θ ∈ [0, π], exp(ŵ) = R),
 /// accurate near θ = 0 and near θ = π (axis from the symmetric part of R there).
 ///
 /// At θ = π exactly both ±π·axis are logarithms: with `strict=False` one of them is returned
@@ -48,7 +48,7 @@ fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// NoUniqueLogError is raised when π − θ ≤ 1e-12.
 ///
 /// Args: r — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
-/// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or |det R − 1| > 1e-10),
+/// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or abs(det R − 1) > 1e-10),
 /// NoUniqueLogError (strict only).
 #[pyfunction]
 #[pyo3(signature = (r, strict = false))]
@@ -63,9 +63,9 @@ fn so3_log<'py>(py: Python<'py>, r: ArrayIn<'py>, strict: bool) -> PyResult<Out<
     })
 }
 
-/// `so3_cayley(w)`: the Cayley map cay(w) = (I − ŵ/2)⁻¹ (I + ŵ/2) = I + 4/(4 + |w|²)(ŵ + ŵ²/2),
-/// a rotation about w by the angle 2·atan(|w|/2) (agrees with exp to second order); defined and
-/// computed scale-safely for every finite w (the angle tends to π as |w| → ∞).
+/// `so3_cayley(w)`: the Cayley map cay(w) = (I − ŵ/2)⁻¹ (I + ŵ/2) = I + 4/(4 + ‖w‖²)(ŵ + ŵ²/2),
+/// a rotation about w by the angle 2·atan(‖w‖/2) (agrees with exp to second order); defined and
+/// computed scale-safely for every finite w (the angle tends to π as ‖w‖ → ∞).
 ///
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
 #[pyfunction]
@@ -102,8 +102,8 @@ fn jacobian<'py>(
 /// J_r⁻¹ = I + ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
 ///
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
-/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1;
-/// |w| > 2.25e14, the rule of so3_exp).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at ‖w‖ = 2πk, k ≥ 1;
+/// ‖w‖ > 2.25e14, the rule of so3_exp).
 #[pyfunction]
 #[pyo3(signature = (w, inverse = false))]
 fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
@@ -122,8 +122,8 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
 /// J_l⁻¹ = I − ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
 ///
 /// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
-/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at |w| = 2πk, k ≥ 1;
-/// |w| > 2.25e14, the rule of so3_exp).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at ‖w‖ = 2πk, k ≥ 1;
+/// ‖w‖ > 2.25e14, the rule of so3_exp).
 #[pyfunction]
 #[pyo3(signature = (w, inverse = false))]
 fn so3_jacobian_left<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {

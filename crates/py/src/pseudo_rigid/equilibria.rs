@@ -54,7 +54,7 @@ fn amended_potential(
 }
 
 /// The augmented potential U_{xi+eta}(X) = U(X) - <xi+eta, B_X(xi+eta)>/2 (001 (8.12)), with
-/// <xi+eta, B_X(xi+eta)> = |xi X - X eta|^2, for angular velocities xi, eta (skew (n, n)).
+/// <xi+eta, B_X(xi+eta)> = ‖xi X - X eta‖^2, for angular velocities xi, eta (skew (n, n)).
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
@@ -89,7 +89,7 @@ fn augmented_gradient<'py>(
 
 /// The Hessian of the augmented potential U_{xi+eta} (001 (8.12)) at X, pairing tr(A^T B):
 /// D^2U_{xi+eta}(X)[V] = D^2U(X)[V] + xi W_V - W_V eta with W_V = xi V - V eta (the kinetic
-/// part -|xi X - X eta|^2/2 is quadratic in X).
+/// part -‖xi X - X eta‖^2/2 is quadratic in X).
 ///
 /// Returns:
 ///     with V an (n, n) direction: D^2U_{xi+eta}(X)[V], (n, n); without V: the symmetric
@@ -195,7 +195,7 @@ fn pair(what: &str, v: &Bound<'_, PyAny>) -> PyResult<(Mat, Mat)> {
 /// the diagonal shape X0 = diag(a) (so body and spatial quantities agree at t = 0). Exactly one
 /// way of asking:
 ///
-/// * ``velocities=(xi, eta)``: the shapes a in the box ``bounds`` (Newton from ``starts``^n grid
+/// * ``velocities=(xi, eta)``: the shapes a in the box ``bounds`` (Newton from ``starts ** n`` grid
 ///   points) for which the angular velocities xi, eta (skew (n, n)) give a relative equilibrium;
 /// * ``shape=a, plane=(i, j)``: every rotation xi = w e_ij, eta = m e_ij in that plane (0-based)
 ///   that makes diag(a) a relative equilibrium, solved exactly;
@@ -343,7 +343,7 @@ impl RelativeEquilibrium {
 
 #[pymethods]
 impl RelativeEquilibrium {
-    /// The semi-axes a (n,): A0 = diag(a).
+    /// The semi-axes a, of shape (n,); A0 = diag(a).
     #[getter]
     fn shape<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         py_vec(py, &self.inner.a)
@@ -480,8 +480,8 @@ impl RelativeEquilibrium {
         self.inner.energy
     }
 
-    /// {"force": |grad_a U_xi+eta|, "commutator": the (8.6) residual, "motion":
-    /// |dU_xi+eta/dX (A0)|}.
+    /// {"force": ‖grad_a U_xi+eta‖, "commutator": the (8.6) residual, "motion":
+    /// ‖dU_xi+eta/dX (A0)‖}.
     #[getter]
     fn residuals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let r = &self.inner.residuals;

@@ -138,7 +138,7 @@ pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr1
 }
 
 /// The quadratic form <xi + eta, B_X(xi + eta)> in SVD coordinates (001 (6.14)); equals
-/// |xi X + X eta^T|_F^2.
+/// ‖xi X + X eta^T‖_F^2.
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.

@@ -374,7 +374,7 @@ pub(crate) fn Zero(py: Python<'_>) -> PyResult<PyPotential> {
 /// optionally `hessian(X, V) -> (n, n) array`, the Hessian applied to a direction,
 /// d/de gradient(X + e V) at e = 0; all are called with (n, n) float64 arrays. Without `hessian`,
 /// `Potential.hessian` uses central differences of `gradient`:
-/// (gradient(X + h V/|V|) - gradient(X - h V/|V|)) |V| / (2h) with h = 1e-6 max(1, |X|)
+/// (gradient(X + h V/‖V‖) - gradient(X - h V/‖V‖)) ‖V‖ / (2h) with h = 1e-6 max(1, ‖X‖)
 /// (Frobenius norms), accurate to about 1e-6 relative for a smooth gradient.
 /// This is the slow path (each call takes the GIL); U must be SO(n)×SO(n)-invariant (a function
 /// of the singular values of X) for L and Γ to be conserved. Exceptions raised by the callables

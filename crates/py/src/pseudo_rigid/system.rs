@@ -131,7 +131,7 @@ impl PyPseudoRigidBody {
     }
 
     /// The projection of a momentum P onto the states of the incompressible body at X:
-    /// P - kappa cof X with kappa = <cof X, P> / |cof X|^2 (cof X = det(X) X^-T), so that
+    /// P - kappa cof X with kappa = <cof X, P> / ‖cof X‖^2 (cof X = det(X) X^-T), so that
     /// <cof X, P> = det(X) tr(X^-1 P) = 0 (the motion keeps the volume).
     ///
     /// Args:

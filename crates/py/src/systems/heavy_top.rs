@@ -22,7 +22,7 @@ type Any<'py> = Bound<'py, PyAny>;
 ///
 /// State z = (M, Gamma) (6,): body angular momentum M and Gamma = R^T e3, the upward vertical
 /// seen in the body. dM/dt = M x Omega + mgl Gamma x chi, dGamma/dt = Gamma x Omega,
-/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2 + mgl Gamma . chi; Casimirs [|Gamma|^2,
+/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2 + mgl Gamma . chi; Casimirs [‖Gamma‖^2,
 /// M . Gamma]; for the Lagrange top (I1 = I2, chi = e3) also M3 is conserved. With an attitude
 /// R, Gamma must equal R^T e3 (use `state(M, attitude=R)`).
 /// Methods: splitting, splitting4, splitting6, lgvi, rk4.

@@ -49,7 +49,7 @@ impl PyPendulum {
     }
 
     /// The exact state (q, p) at times t of the pendulum released at rest from the angle
-    /// `amplitude` (|amplitude| < pi), by Jacobi elliptic functions; broadcast: (...) -> (..., 2).
+    /// `amplitude` (abs(amplitude) < pi), by Jacobi elliptic functions; broadcast: (...) -> (..., 2).
     ///
     /// Raises:
     ///     InvalidArgumentError, NonFiniteError, ShapeError.
@@ -70,9 +70,9 @@ impl PyPendulum {
     }
 }
 
-/// A particle of mass m on the sphere |q| = l in gravity g (the spherical pendulum in Cartesian
-/// coordinates), H = |p|^2 / (2m) + m g q3 with the constraint (|q|^2 - l^2) / 2 = 0. State
-/// (q, p) with |q| = l and q . p = 0; fields q, p. Invariant: the vertical angular momentum
+/// A particle of mass m on the sphere ‖q‖ = l in gravity g (the spherical pendulum in Cartesian
+/// coordinates), H = ‖p‖^2 / (2m) + m g q3 with the constraint (‖q‖^2 - l^2) / 2 = 0. State
+/// (q, p) with ‖q‖ = l and q . p = 0; fields q, p. Invariant: the vertical angular momentum
 /// (q x p)_3. Method: rattle (RATTLE: constraints kept to round-off, symplectic).
 ///
 /// Args:

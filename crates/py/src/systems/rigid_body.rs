@@ -20,7 +20,7 @@ type Any<'py> = Bound<'py, PyAny>;
 /// A free rigid body (Euler top) on so(3)* (000 §3–§4).
 ///
 /// State z = M, the body angular momentum (3,). Euler's equation dM/dt = M x Omega with
-/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2; Casimir [|M|^2]. Carries an attitude R
+/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2; Casimir [‖M‖^2]. Carries an attitude R
 /// (dR/dt = R hat(Omega)) when `integrate(..., attitude=R0)` is given; R M is conserved.
 /// Methods: splitting, splitting4, splitting6, isospectral, lgvi, rk4.
 ///
@@ -116,7 +116,7 @@ impl PyRigidBody {
     /// Returns:
     ///     (..., 3) for a scalar t, (..., k, 3) for an array of times.
     /// Raises:
-    ///     InvalidArgumentError (M0 on the separatrix |M|^2 = 2 H I_mid, where the elliptic
+    ///     InvalidArgumentError (M0 on the separatrix ‖M‖^2 = 2 H I_mid, where the elliptic
     ///     modulus is 1), ShapeError, NonFiniteError.
     fn exact_solution<'py>(
         &self,

@@ -75,7 +75,7 @@ impl PyRollingDisk {
         self.disk.state(q, theta_dot, phi_dot).py()
     }
 
-    /// The relative residual |A(q) M^-1 p| / |M^-1 p| of the rolling constraints, vectorised:
+    /// The relative residual ‖A(q) M^-1 p‖ / ‖M^-1 p‖ of the rolling constraints, vectorised:
     /// (..., 8) -> (...).
     ///
     /// Raises:

@@ -34,7 +34,7 @@ fn point(what: &str, v: &Any<'_>) -> PyResult<[f64; 2]> {
 
 /// Two disks rolling against each other in the plane without slipping (003 §1). Disk k has
 /// radius r_k, centre of mass gamma_k in its reference disk (a complex number or a 2-vector),
-/// mass m_k and moment of inertia I_k about its centre (003 (6): the integral of |p|^2). The
+/// mass m_k and moment of inertia I_k about its centre (003 (6): the integral of ‖p‖^2). The
 /// rolling constraint integrates to R phi - r1 theta1 - r2 theta2 = c (R = r1 + r2, c the
 /// rolling constant), leaving the two disk angles theta = (theta1, theta2); the centre of mass
 /// of the pair is at the origin. State (theta1, theta2, p1, p2); fields theta (2), p (2),
@@ -43,7 +43,7 @@ fn point(what: &str, v: &Any<'_>) -> PyResult<[f64; 2]> {
 /// (default), gauss6, midpoint (symplectic Gauss–Legendre), rk4.
 ///
 /// Raises:
-///     InvalidArgumentError (r, m <= 0, |gamma| >= r, I <= m |gamma|^2), TypeError.
+///     InvalidArgumentError (r, m <= 0, ‖gamma‖ >= r, I <= m ‖gamma‖^2), TypeError.
 #[pyclass(name = "RollingDisks", module = "lieflow", extends = PySystem, frozen)]
 pub struct PyRollingDisks {
     disks: RollingDisks,
@@ -257,7 +257,7 @@ impl PyDisksEquilibrium {
         self.eq.contact
     }
 
-    /// The range of |omega| for which it is a relative equilibrium: (0, inf), every rotation.
+    /// The range of abs(omega) for which it is a relative equilibrium: (0, inf), every rotation.
     #[getter]
     fn angular_velocity_range(&self) -> (f64, f64) {
         (0.0, f64::INFINITY)

@@ -16,7 +16,7 @@ type Any<'py> = Bound<'py, PyAny>;
 
 /// Two rigid spheres rolling against each other without slipping, free in space (003 §2).
 ///
-/// Sphere k has radius r_k, mass m_k, centre of mass gamma_k (|gamma_k| < r_k, in the reference
+/// Sphere k has radius r_k, mass m_k, centre of mass gamma_k (‖gamma_k‖ < r_k, in the reference
 /// sphere centred at 0) and second-moment matrix about its centre of mass
 /// I_k = int (p - gamma_k)(p - gamma_k)^T dm (symmetric positive semi-definite; the moment of
 /// inertia tensor is tr(I_k) 1 - I_k). State (z1, z2, u, Omega1, Omega2) (27,): attitudes
@@ -120,7 +120,7 @@ impl PyRollingSpheres {
     /// u = (cos phi, sin phi, 0), Omega_k = (0, 0, theta_dot_k); then dphi/dt =
     /// (r1 theta_dot_1 + r2 theta_dot_2)/(r1 + r2). It stays planar when gamma_k is
     /// perpendicular to e3 and e3 is an eigenvector of I_k. 003 §1's disk moment of inertia
-    /// (about the disk's centre) is I_k[0,0] + I_k[1,1] + m_k |gamma_k|^2.
+    /// (about the disk's centre) is I_k[0,0] + I_k[1,1] + m_k ‖gamma_k‖^2.
     fn planar_state(
         &self,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],

@@ -18,8 +18,8 @@ type Any<'py> = Bound<'py, PyAny>;
 ///
 /// State z = (q, L) (6,): q the unit vector from the pivot to the bob (e3 up) and
 /// L = m l^2 q x dq/dt the angular momentum about the pivot. dq/dt = L x q / (m l^2),
-/// dL/dt = m g l e3 x q; energy H = |L|^2 / (2 m l^2) + m g l q3; Casimirs [|q|^2, q . L]
-/// (a state needs |q| = 1 and q . L = 0); the vertical momentum L3 is conserved.
+/// dL/dt = m g l e3 x q; energy H = ‖L‖^2 / (2 m l^2) + m g l q3; Casimirs [‖q‖^2, q . L]
+/// (a state needs ‖q‖ = 1 and q . L = 0); the vertical momentum L3 is conserved.
 /// Methods: splitting, splitting4, splitting6, rk4.
 ///
 /// Args:

@@ -255,7 +255,7 @@ fn HyperbolicPlane(py: Python<'_>) -> PyResult<PySurface> {
 }
 
 /// The surface of revolution X(s, phi) = (r(s) cos phi, r(s) sin phi, z(s)) about the z axis on
-/// s_min < s < s_max (where r > 0), coordinates x = (s, phi), E1 = d/ds / |X_s|,
+/// s_min < s < s_max (where r > 0), coordinates x = (s, phi), E1 = d/ds / ‖X_s‖,
 /// E2 = d/dphi / r. `r` and `z` are callables s -> (f, f', f'', f''') (the third derivative
 /// enters only the embedded top). Killing generator: the rotation about z (momentum p_phi).
 /// Slow path: every evaluation calls Python; exceptions raised by the callables are re-raised.

@@ -210,7 +210,7 @@ impl PyTangentTop {
 /// top), magnetic potential A = alpha (the frame's connection 1-form) and charge p_theta. The
 /// Routhian of the top gives it; 002 (58) prints a different metric, potential and charge (a
 /// slip: it is p_theta, not thetadot, that is conserved). State (x1, x2, p1, p2); fields x, p,
-/// xdot. H = |p - p_theta A|^2_G / 2 (the top's energy minus p_theta^2 / (2 I)).
+/// xdot. H = ‖p - p_theta A‖^2_G / 2 (the top's energy minus p_theta^2 / (2 I)).
 ///
 /// Args:
 ///     top: a `TangentTop` (not an anisotropic embedded one).

@@ -488,7 +488,7 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
 /// (se3: dM/dt = M x Omega + Gamma x V, dGamma/dt = Gamma x Omega with (Omega, V) = dH/dmu,
 /// Kirchhoff's equations with Gamma the impulse), M (so(n)*, e_ij coordinates as
 /// `GeneralizedRigidBody`; fields show the skew matrix), mu (structure constants).
-/// Casimirs (`invariants`): |M|^2 (so3); |Gamma|^2, M . Gamma (se3); tr((M^T M)^k)/2,
+/// Casimirs (`invariants`): ‖M‖^2 (so3); ‖Gamma‖^2, M . Gamma (se3); tr((M^T M)^k)/2,
 /// k = 1..n//2 (so(n)); none for structure constants; or the `casimirs` given.
 /// Methods: rkmk4 (default; Runge–Kutta–Munthe-Kaas, order 4, explicit), midpoint (the Lie
 /// midpoint, symmetric, order 2), midpoint4 (its Suzuki composition, order 4): all advance by
