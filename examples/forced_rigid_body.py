@@ -6,8 +6,8 @@ A rigid body with a torque and a rigid body that spins down (docs/forcing.md).
 1. A body driven by a body-fixed torque τ(t) = (0.3, −0.2, 0.25 cos 2t), carried with its
    attitude: `lf.Forced(lf.RigidBody(I), torque)` with `splitting6`, against scipy's DOP853 on
    the same equations; the attitude stays in SO(3) to round-off.
-2. Double-bracket dissipation Ṁ = M × Ω + α M × (M × Ω): the energy falls to |M|²/(2I₃) while
-   |M| stays fixed to round-off; the body ends spinning about its major axis.
+2. Double-bracket dissipation Ṁ = M × Ω + α M × (M × Ω): the energy falls to ‖M‖²/(2I₃) while
+   ‖M‖ stays fixed to round-off; the body ends spinning about its major axis.
 
 Run it with (``--figure`` alone draws the figure, a path saves it)::
 

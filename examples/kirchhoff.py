@@ -7,10 +7,10 @@ Lie–Poisson system on se(3)* with a quadratic Hamiltonian (docs/user_systems.m
 The body's impulse is (M, P) (angular, linear) and H = ½ (M·AM + P·BP) (A, B diagonal: the body's
 added-mass tensors in its principal frame). Kirchhoff's equations Ṁ = M × Ω + P × V, Ṗ = P × Ω
 with (Ω, V) = ∇H are the Lie–Poisson equations of se(3)*: `lf.LiePoisson("se3", H)` with H the
-6×6 matrix diag(A, B) (the native quadratic path), fields M and Gamma (= P). Casimirs |P|² and M·P.
+6×6 matrix diag(A, B) (the native quadratic path), fields M and Gamma (= P). Casimirs ‖P‖² and M·P.
 
 Clebsch's integrable case: B_i = θ A₁A₂A₃/A_i + c (i.e. (B₂ − B₃)/A₁ + (B₃ − B₁)/A₂ +
-(B₁ − B₂)/A₃ = 0); its extra integral is F = ½|M|² − ½θ Σ A_i P_i². No method keeps F exactly:
+(B₁ − B₂)/A₃ = 0); its extra integral is F = ½‖M‖² − ½θ Σ A_i P_i². No method keeps F exactly:
 the Lie midpoint (symmetric) keeps its error bounded, RKMK4 and RK4 let it drift; all but RK4
 keep the Casimirs to round-off. The same H as a Python callable gives the same motion, slower.
 
