@@ -7,6 +7,8 @@ pseudo_rigid  generalized pseudo-rigid bodies on GL+(n) (inertia tensors, connec
 elliptic      Jacobi elliptic functions sn, cn, dn and the integrals K(m), F(phi | m)
 ellipsoids    self-gravitating fluid ellipsoids (Maclaurin, Jacobi, Dedekind, Riemann S-type)
 continuation  continuation of families of relative equilibria, branch points, stability
+io            trajectories as xarray Datasets and NetCDF files (Trajectory.save, load)
+plot          plots and animations of trajectories (matplotlib)
 
 Systems and integration
 -----------------------
@@ -25,6 +27,8 @@ Forced                                                          any system with 
                                                                 Rayleigh damping or double-bracket
                                                                 dissipation (docs/forcing.md)
 integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
+load(path)                                                      a Trajectory saved with
+                                                                Trajectory.save (NetCDF)
 
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``); an argument of the
 wrong type (complex, string or object arrays, ragged lists) is an :class:`ArgumentTypeError`
@@ -68,8 +72,9 @@ from ._lieflow import (
     TangentTop,
     WeakFieldTop,
 )
-from . import continuation, ellipsoids, elliptic, lie, potentials, pseudo_rigid, surfaces
+from . import continuation, ellipsoids, elliptic, io, lie, plot, potentials, pseudo_rigid, surfaces
 from .integrate import Trajectory, integrate
+from .io import FileFormatError, load
 
 #: The former name of the base class of the Lie–Poisson systems (kept for existing code).
 LiePoissonSystem = System
@@ -80,6 +85,7 @@ __all__ = [
     "ChargedParticle",
     "ConvergenceError",
     "DegenerateStratumError",
+    "FileFormatError",
     "Forced",
     "GeneralizedRigidBody",
     "HeavyTop",
@@ -112,7 +118,10 @@ __all__ = [
     "__version__",
     "elliptic",
     "integrate",
+    "io",
     "lie",
+    "load",
+    "plot",
     "potentials",
     "pseudo_rigid",
     "surfaces",

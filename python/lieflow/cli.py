@@ -6,20 +6,10 @@ import time
 import numpy as np
 
 
-def _integrate(body, state0, dt, steps, save_every, method):
-    """``lf.integrate`` when available, else the protocol's ``_run`` directly."""
-    import lieflow as lf
-
-    if hasattr(lf, "integrate"):
-        traj = lf.integrate(body, state0, dt=dt, steps=steps, method=method, save_every=save_every)
-        return np.asarray(traj.t), np.asarray(traj.states)
-    z0, _ = body._normalize_state(state0)
-    states, _, _, _ = body._run(z0, None, dt, steps, save_every, method)
-    return np.arange(states.shape[1]) * save_every * dt, states[0]
-
-
-def demo(figure="lieflow-demo.png") -> None:
-    """Simulate a spinning 3-D elastic pseudo-rigid body (SVK + gas) and report its invariants."""
+def demo(figure=None, animation=None) -> None:
+    """Simulate a spinning 3-D elastic pseudo-rigid body (SVK + gas) and report its invariants;
+    on request save a figure (semi-axes and invariant drifts) and an animation (the ellipsoid
+    X·ball, GIF or MP4)."""
     import lieflow as lf
 
     print(f"lieflow {lf.__version__}: an elastic pseudo-rigid body in 3-D (001 §3–§7)")
@@ -31,11 +21,10 @@ def demo(figure="lieflow-demo.png") -> None:
     P0 = W @ X0 + X0 @ V.T + np.diag([0.1, -0.05, 0.0])
     dt, steps = 2e-3, 20_000
     t0 = time.perf_counter()
-    t, states = _integrate(body, (X0, P0), dt, steps, 20, "verlet4")
+    traj = lf.integrate(body, (X0, P0), dt=dt, steps=steps, method="verlet4", save_every=20)
     elapsed = time.perf_counter() - t0
-    E = np.asarray(body.energy(states))
-    L = body.angular_momentum(states)
-    G = body.circulation(states)
+    t, E = traj.t, traj.energy()
+    L, G = traj.angular_momentum(), traj.circulation()
 
     def drift(q):
         q0 = q[0]
@@ -50,35 +39,45 @@ def demo(figure="lieflow-demo.png") -> None:
     print(f"{'quantity':<26}{'start':>16}{'end':>16}{'max rel. drift':>16}")
     for name, a, b, d in rows:
         print(f"{name:<26}{a:>16.10f}{b:>16.10f}{d:>16.2e}")
-    a = body.singular_values(states)
+    a = traj.singular_values()
     print("semi-axes a_i: start", np.round(a[0], 4), " min", np.round(a.min(0), 4),
           " max", np.round(a.max(0), 4))
+    if figure is None and animation is None:
+        return
     try:
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        print("(install the plot extra, pip install .[plot], for a figure of a_i(t))")
+        print("(the figure and the animation need matplotlib: pip install lieflow[plot])")
         return
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    for i in range(3):
-        ax.plot(t, a[:, i], label=f"$a_{i + 1}$")
-    ax.set_xlabel("t")
-    ax.set_ylabel("semi-axes")
-    ax.legend()
-    ax.set_title("Elastic pseudo-rigid body: semi-axes a_i(t)")
-    fig.tight_layout()
-    fig.savefig(figure, dpi=120)
-    print(f"figure of the semi-axes saved to {figure}")
+    from . import plot
+
+    if figure is not None:
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+        for i in range(3):
+            top.plot(t, a[:, i], label=f"$a_{i + 1}$")
+        top.set(ylabel="semi-axes", title="Elastic pseudo-rigid body: semi-axes a_i(t)")
+        top.legend()
+        plot.invariants(traj, ax=bottom)
+        fig.tight_layout()
+        fig.savefig(figure, dpi=120)
+        print(f"figure (semi-axes and invariant drifts) saved to {figure}")
+    if animation is not None:
+        plot.animate(traj, animation, every=10, interval=50)
+        print(f"animation of the ellipsoid X·ball saved to {animation}")
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="lieflow", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     d = sub.add_parser("demo", help="run the main demo (a spinning elastic pseudo-rigid body)")
-    d.add_argument("--figure", default="lieflow-demo.png", help="where to save the figure")
+    d.add_argument("--figure", metavar="PATH", help="save a figure of the semi-axes and the "
+                   "invariant drifts (.png, .pdf, ...)")
+    d.add_argument("--animation", metavar="PATH", help="save an animation of the body (.gif, or "
+                   ".mp4 with ffmpeg)")
     args = parser.parse_args(argv)
     if args.command == "demo":
-        demo(args.figure)
+        demo(args.figure, args.animation)
     return 0

@@ -515,7 +515,8 @@ class Trajectory:
             attitude); None without events.
         Named views from the system (e.g. ``M``, ``Gamma``, ``q``, ``L``) as attributes.
 
-    Methods ``energy()`` and ``casimirs()``, and every observable of the system:
+    Methods ``energy()`` and ``casimirs()``, ``to_xarray()`` and ``save(path)`` (read back with
+    ``lf.load(path)``), and every observable of the system:
     ``traj.NAME(...)`` is ``system.NAME(traj.states, ...)`` (with the attitude passed as well for
     observables such as ``spatial_momentum`` that need it). ``Trajectory.concatenate([a, b])``
     joins a run and its continuation.
@@ -659,6 +660,25 @@ class Trajectory:
     def casimirs(self):
         """The same as ``invariants()`` (the Casimirs of the Lie–Poisson systems)."""
         return self.invariants()
+
+    def to_xarray(self, *, observables=True):
+        """The trajectory as an ``xarray.Dataset``: coordinates ``time`` (and ``member`` for a
+        batch), ``states``, the named fields (``M``, ``Gamma``, ``X``, ...), ``energy`` and
+        ``invariants`` (unless ``observables=False``), the attitude, the initial and final
+        states, events; attributes the system and its parameters, the method, dt, save_every,
+        times and the lieflow version (layout: :mod:`lieflow.io`). Needs xarray."""
+        from .io import to_xarray
+
+        return to_xarray(self, observables=observables)
+
+    def save(self, path, *, allow_pickle=False):
+        """Writes the trajectory to the NetCDF file `path` (read it with ``lf.load(path)``;
+        the round trip is exact). A system built from Python callables is stored only with
+        ``allow_pickle=True`` (see :func:`lieflow.io.save`). Needs xarray and a NetCDF backend
+        (``pip install lieflow[io]``)."""
+        from .io import save
+
+        save(self, path, allow_pickle=allow_pickle)
 
     def _fields(self):
         if self._field_cache is None:

@@ -12,11 +12,13 @@ def test_error_hierarchy():
     assert issubclass(lf.LieflowError, ValueError)
 
 
-def test_demo_runs(capsys):
+def test_demo_runs_and_writes_nothing_unasked(tmp_path, monkeypatch, capsys):
     from lieflow.cli import main
 
+    monkeypatch.chdir(tmp_path)
     assert main(["demo"]) == 0
     assert "lieflow" in capsys.readouterr().out
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_shape_error_from_binding():

@@ -196,6 +196,7 @@ def test_demo_runs(tmp_path, capsys):
     assert main(["demo", "--figure", str(tmp_path / "demo.png")]) == 0
     out = capsys.readouterr().out
     assert "energy" in out and "circulation" in out
+    assert (tmp_path / "demo.png").stat().st_size > 10_000
 
 
 def test_run_t0_offsets_the_exit_time():

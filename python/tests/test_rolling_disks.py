@@ -1,5 +1,5 @@
 """Two rolling disks (003 §1) from Python: conservation, positions, the relative equilibria and
-their stability, pickling, the animation helper."""
+their stability, pickling."""
 
 import pickle
 
@@ -70,17 +70,3 @@ def test_bad_input():
         lf.RollingDisks(1.0, 0.7, "x", 0.0, 1.0, 1.0, 1.0, 1.0)
     with pytest.raises(lf.InvalidArgumentError):
         pair().relative_equilibria(theta1_range=(1.0, 0.0))
-
-
-def test_animation():
-    matplotlib = pytest.importorskip("matplotlib")
-    matplotlib.use("Agg")
-    from lieflow.animation import rolling_disks
-    d = pair()
-    tr = lf.integrate(d, d.state([0.3, -1.1], [0.7, 0.2]), dt=0.05, steps=40, save_every=4)
-    anim = rolling_disks(d, tr)
-    anim._init_draw()
-    artists = anim._func(5)
-    assert len(artists) == 7
-    with pytest.raises(ValueError):
-        rolling_disks(d, tr, every=0)

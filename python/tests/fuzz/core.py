@@ -260,7 +260,11 @@ def run_case(case: Case, lf, cache, override=None) -> dict:
     parent sees)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return _run_case(case, lf, cache, override)
+        try:
+            return _run_case(case, lf, cache, override)
+        finally:
+            if "matplotlib.pyplot" in sys.modules:     # lieflow.plot's figures
+                sys.modules["matplotlib.pyplot"].close("all")
 
 
 def _run_case(case: Case, lf, cache, override=None) -> dict:

@@ -13,6 +13,7 @@ the catalogue apply to it (see catalogue.py):
   se3     4x4 homogeneous SE(3) matrix   float  physical scalar     int  integer count/size
   str     option name                    bool   flag                obj  a lieflow object
   fn      a Python callable handed to native code (potentials, surfaces)
+  path    a file path (only non-path values are fuzzed: a bad string would write a file)
 
 Flags: ``positive`` (zero/negative must be refused), ``opt`` (None is a valid value),
 ``kw`` (passed by keyword), ``complex_ok`` (complex numbers are a valid spelling).
@@ -160,6 +161,37 @@ def _two_runs(lf):
     body = lf.RigidBody([1.0, 2.0, 3.0])
     a = lf.integrate(body, [1.0, 0.5, -0.3], dt=0.01, steps=10)
     return _Parts([a, lf.integrate(body, a.final_state, dt=0.01, steps=10, t0=a.t_final)])
+
+
+def _shared(traj):
+    """A trajectory the harness's mutation check compares with itself (see _Parts)."""
+    traj.__deepcopy__ = lambda memo: traj
+    return traj
+
+
+def _scratch_path(name):
+    """A path in a temporary directory of this process (removed at exit)."""
+    import atexit
+    import os
+    import shutil
+    import tempfile
+
+    d = tempfile.mkdtemp(prefix="lieflow-fuzz-")
+    atexit.register(shutil.rmtree, d, True)
+    return os.path.join(d, name)
+
+
+def _saved_run(lf):
+    """A NetCDF file of a short rigid-body run (lf.load)."""
+    path = _scratch_path("run.nc")
+    lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), [1.0, 0.5, -0.3], dt=0.01, steps=10).save(path)
+    return path
+
+
+def _turning_box(lf):
+    """A rigid-body run with its attitude (lieflow.plot.animate draws the box)."""
+    return _shared(lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), [3.0, 1.5, -0.9], dt=0.05,
+                                steps=4, attitude=np.eye(3)))
 
 
 def event_m2(t, state):
@@ -670,12 +702,24 @@ def build_specs() -> list[Spec]:
                            A("terminal", [1], "obj"), A("tol", 0.0, "float")]),
            ("events_found", []), ("take_partial", []), ("checked_state", [])],
         "traj": [("energy", []), ("invariants", []), ("casimirs", []),
-                 ("concatenate", [A("trajectories", Lazy(_two_runs), "obj")])],
+                 ("concatenate", [A("trajectories", Lazy(_two_runs), "obj")]),
+                 ("to_xarray", [A("observables", True, "bool", kw=True)]),
+                 ("save", [A("path", Lazy(lambda lf: _scratch_path("save.nc")), "path")])],
     }
     for key, methods in own.items():
         for name, args in methods:
             attr = name.split("[")[0]
             add(f"{key}.{name}", f"@{key}.{attr}", *args)
+
+    # ---- results that live on: NetCDF (lf.load) and lieflow.plot (issue 13) ----
+    add("load", "load", A("path", Lazy(_saved_run), "path"))
+    add("plot.invariants", "plot.invariants", A("traj", Lazy(_turning_box), "obj"), slow=True)
+    add("plot.states", "plot.states", A("traj", Lazy(_turning_box), "obj"),
+        A("fields", ["M"], "obj", kw=True, opt=True), slow=True)
+    add("plot.work_precision", "plot.work_precision",
+        A("results", {"splitting": ([1e-4, 1e-6], [0.01, 0.1])}, "obj"), slow=True)
+    add("plot.animate", "plot.animate", A("traj", Lazy(_turning_box), "obj"),
+        A("every", 2, "int", kw=True, positive=True), slow=True)
 
     # ---- lf.integrate with each system ----
     for key in SYSTEMS:

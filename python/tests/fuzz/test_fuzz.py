@@ -93,7 +93,7 @@ CLASS_RECEIVER = {**CONSTRUCTORS, "Integration": "run", "Trajectory": "traj",
 def public_callables():
     out = []
     for modname in ("", ".lie", ".pseudo_rigid", ".potentials", ".surfaces", ".elliptic",
-                    ".ellipsoids", ".continuation"):
+                    ".ellipsoids", ".continuation", ".plot"):
         mod = eval("lf" + modname)
         for name in getattr(mod, "__all__", None) or dir(mod):
             if name.startswith("_"):

@@ -1,0 +1,205 @@
+"""Trajectories as xarray Datasets and NetCDF files (issue 13): ``Trajectory.to_xarray``,
+``Trajectory.save`` and ``lf.load`` — the round trip is exact for every kind of run, the system
+is rebuilt (so a run continues bit for bit from the loaded final state), systems are stored as
+data (never code unless ``allow_pickle``), and bad files give clear errors."""
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import lieflow as lf
+from lieflow import potentials as pot
+
+xr = pytest.importorskip("xarray")
+
+M0 = np.array([1.0, 0.5, -0.3])
+
+
+def osc_h(q, p):
+    return 0.5 * float(q @ q + p @ p)
+
+
+def runs():
+    """(name, system, integrate kwargs) covering the kinds of trajectory."""
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    svk = pot.SaintVenantKirchhoff(1.0, 2.0) + pot.Volumetric(0.5, 1.4)
+    X0 = np.diag([1.3, 1.0, 0.8])
+    P0 = lf.lie.hat([0.1, 0.3, 1.0]) @ X0
+    g = lambda t, s: s[1]  # noqa: E731
+    g.direction, g.terminal = -1.0, True
+    return [
+        ("rigid body", rb, dict(state0=M0, dt=0.01, steps=105, save_every=10)),
+        ("attitude", rb, dict(state0=M0, dt=0.01, steps=50, attitude=np.eye(3))),
+        ("batch", rb, dict(state0=np.stack([M0, 2 * M0, -M0]), dt=0.01, steps=20,
+                           save_every=3, attitude=np.eye(3))),
+        ("t_eval", rb, dict(state0=M0, dt=0.01, t_eval=[0.0, 0.123, 0.5])),
+        ("events", rb, dict(state0=M0, dt=0.01, steps=600, events=g, attitude=np.eye(3))),
+        ("heavy top", lf.HeavyTop([1.0, 2.0, 3.0], 0.7),
+         dict(state0=(M0, [0.0, 0.6, 0.8]), dt=0.01, steps=30, method="splitting4")),
+        ("pseudo-rigid", lf.PseudoRigidBody(3, potential=svk),
+         dict(state0=(X0, P0), dt=0.01, steps=20, method="verlet4")),
+        ("tangent top", lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
+         dict(state0=[0.3, 0.2, 0.1, 0.4, -0.2, 0.3], dt=0.01, steps=20)),
+        ("rolling disks", lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6),
+         dict(state0=[0.1, 0.2, 0.5, -0.3], dt=0.01, steps=20)),
+        ("damped pendulum", lf.Forced(lf.Pendulum(1.0, 1.0, 9.81), damping=0.3),
+         dict(state0=[1.0, 0.0], dt=0.01, steps=30)),
+    ]
+
+
+def assert_same(a, b):
+    """Every attribute of two trajectories equal (arrays bit for bit)."""
+    assert type(a.system) is type(b.system) and repr(a.system) == repr(b.system)
+    assert (a.method, a.dt, a.save_every, a.t0, a.t_final, a.status) == \
+           (b.method, b.dt, b.save_every, b.t0, b.t_final, b.status)
+    for name in ("t", "states", "attitude", "final_state", "final_attitude", "initial_state",
+                 "initial_attitude"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert (x is None) == (y is None), name
+        if x is not None:
+            assert np.asarray(x).dtype == np.asarray(y).dtype == np.float64, name
+            np.testing.assert_array_equal(x, y, err_msg=name)
+    for name in ("t_events", "state_events", "attitude_events"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert (x is None) == (y is None), name
+        if x is not None:
+            assert len(x) == len(y)
+            for u, v in zip(x, y):
+                np.testing.assert_array_equal(u, v, err_msg=name)
+
+
+@pytest.mark.parametrize("name,system,kw", runs(), ids=[r[0] for r in runs()])
+def test_save_load_round_trip_is_exact(tmp_path, name, system, kw):
+    kw = dict(kw)
+    traj = lf.integrate(system, kw.pop("state0"), **kw)
+    path = tmp_path / "run.nc"
+    traj.save(path)
+    back = lf.load(path)
+    assert_same(traj, back)
+    assert_same(traj, lf.load(traj.to_xarray()))
+    if name == "events":
+        assert traj.status == 1 and len(back.t_events[0]) == 1
+
+
+@pytest.mark.parametrize("name,system,kw", runs()[:3] + runs()[5:7],
+                         ids=[r[0] for r in runs()[:3] + runs()[5:7]])
+def test_a_loaded_run_continues_bit_for_bit(tmp_path, name, system, kw):
+    """A run continued from the loaded file equals the continuation of the original."""
+    kw = dict(kw)
+    state0 = kw.pop("state0")
+    first = lf.integrate(system, state0, **kw)
+    kw.pop("attitude", None)
+    first.save(tmp_path / "first.nc")
+    loaded = lf.load(tmp_path / "first.nc")
+    assert loaded.system is not system and repr(loaded.system) == repr(system)
+    runs = [lf.integrate(t.system, t.final_state, attitude=t.final_attitude, t0=t.t_final, **kw)
+            for t in (first, loaded)]
+    assert_same(*runs)
+    assert runs[1].t0 == first.t_final
+
+
+def test_to_xarray_layout_fields_and_attributes():
+    hv = lf.HeavyTop([1.0, 2.0, 3.0], 0.7)
+    batch = (np.stack([M0, 2 * M0]), np.array([[0.0, 0.6, 0.8], [0.6, 0.0, 0.8]]))
+    traj = lf.integrate(hv, batch, dt=0.01, steps=40, save_every=4)
+    ds = traj.to_xarray()
+    assert ds["states"].dims == ("member", "time", "component")
+    assert ds.sizes == {"member": 2, "time": 11, "component": 6, "M_component": 3,
+                        "Gamma_component": 3, "invariant": ds.sizes["invariant"]}
+    np.testing.assert_array_equal(ds["time"], traj.t)
+    np.testing.assert_array_equal(ds["member"], [0, 1])
+    np.testing.assert_array_equal(ds["M"], traj.M)
+    np.testing.assert_array_equal(ds["Gamma"], traj.Gamma)
+    np.testing.assert_array_equal(ds["energy"], traj.energy())
+    np.testing.assert_array_equal(ds["invariants"], traj.invariants())
+    assert ds["energy"].dims == ("member", "time")
+    a = ds.attrs
+    assert a["system"] == repr(hv) and a["system_class"] == "HeavyTop"
+    assert a["method"] == traj.method and a["dt"] == 0.01 and a["save_every"] == 4
+    assert a["lieflow_version"] == lf.__version__ and a["lieflow_format"] == lf.io.FORMAT
+    np.testing.assert_array_equal(a["system_inertia"], [1.0, 2.0, 3.0])
+    assert a["system_mgl"] == 0.7
+    assert json.loads(a["system_spec"])["call"] == "lieflow:HeavyTop"
+    assert "energy" not in traj.to_xarray(observables=False)
+    # a pseudo-rigid body's fields are matrices
+    prb = lf.PseudoRigidBody(3, potential=pot.Harmonic(1.0))
+    x = np.diag([1.2, 1.0, 0.9])
+    ds = lf.integrate(prb, (x, 0 * x), dt=0.01, steps=5).to_xarray()
+    assert ds["X"].dims == ("time", "X_row", "X_col")
+    np.testing.assert_array_equal(ds["X"][0], x)
+
+
+@settings(max_examples=15, deadline=None)
+@given(b=st.integers(0, 3), steps=st.integers(1, 30), every=st.integers(1, 7),
+       t0=st.floats(-1e3, 1e3, allow_nan=False))
+def test_round_trip_property(tmp_path_factory, b, steps, every, t0):
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    state0 = M0 if b == 0 else np.outer(np.arange(1, b + 1), M0)
+    traj = lf.integrate(rb, state0, dt=0.02, steps=steps, save_every=every, t0=t0)
+    path = tmp_path_factory.mktemp("p") / "run.nc"
+    traj.save(path)
+    assert_same(traj, lf.load(path))
+
+
+# --- systems from Python callables: data or, on request, a pickle ---
+
+
+def test_a_system_with_callables_is_stored_only_pickled_on_request(tmp_path):
+    sys = lf.Canonical(osc_h, dof=1)
+    traj = lf.integrate(sys, [1.0, 0.0], dt=0.05, steps=10)
+    path = tmp_path / "osc.nc"
+    with pytest.raises(lf.InvalidArgumentError, match="allow_pickle=True"):
+        traj.save(path)
+    assert not path.exists()
+    traj.save(path, allow_pickle=True)
+    with pytest.raises(lf.FileFormatError, match="pickled.*allow_pickle=True"):
+        lf.load(path)
+    back = lf.load(path, allow_pickle=True)
+    np.testing.assert_array_equal(back.states, traj.states)
+    np.testing.assert_array_equal(back.energy(), traj.energy())
+
+
+def test_a_spec_never_calls_anything_outside_lieflow(tmp_path):
+    traj = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), M0, dt=0.01, steps=3)
+    ds = traj.to_xarray()
+    ds.attrs["system_spec"] = json.dumps({"call": "os:system", "args": ["echo pwned"]})
+    path = tmp_path / "evil.nc"
+    ds.to_netcdf(path)
+    with pytest.raises(lf.FileFormatError, match="not a lieflow callable"):
+        lf.load(path)
+
+
+# --- bad files ---
+
+
+def test_bad_files_give_clear_errors(tmp_path):
+    traj = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), M0, dt=0.01, steps=3)
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        lf.load(tmp_path / "missing.nc")
+    junk = tmp_path / "junk.nc"
+    junk.write_bytes(b"this is not a NetCDF file" * 10)
+    with pytest.raises(lf.FileFormatError, match="cannot read.*NetCDF"):
+        lf.load(junk)
+    good = tmp_path / "good.nc"
+    traj.save(good)
+    cut = tmp_path / "cut.nc"
+    cut.write_bytes(good.read_bytes()[: good.stat().st_size // 2])
+    with pytest.raises(lf.FileFormatError):
+        lf.load(cut)
+    ds = traj.to_xarray()
+    ds.attrs["lieflow_format"] = lf.io.FORMAT + 1
+    ds.attrs["lieflow_version"] = "9.0.0"
+    newer = tmp_path / "newer.nc"
+    ds.to_netcdf(newer)
+    with pytest.raises(lf.FileFormatError, match=r"lieflow 9\.0\.0 in format 2.*upgrade"):
+        lf.load(newer)
+    other = tmp_path / "other.nc"
+    xr.Dataset({"x": ("t", np.arange(3.0))}).to_netcdf(other)
+    with pytest.raises(lf.FileFormatError, match="not a lieflow trajectory"):
+        lf.load(other)
+    ds = traj.to_xarray().drop_vars("states")
+    with pytest.raises(lf.FileFormatError, match="no states"):
+        lf.load(ds)
+    assert issubclass(lf.FileFormatError, lf.LieflowError)

@@ -1,0 +1,141 @@
+"""lieflow.plot (issue 13): the drawn data are the trajectory's (drifts, fields, work–precision
+points, box corners turned by the attitude), animations have one frame per saved sample (checked
+in a written GIF), and bad input is a typed error."""
+
+import numpy as np
+import pytest
+
+import lieflow as lf
+
+matplotlib = pytest.importorskip("matplotlib")
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from lieflow import plot  # noqa: E402
+
+M0 = np.array([1.0, 0.5, -0.3])
+# Animations built and inspected frame by frame without being shown or saved.
+pytestmark = pytest.mark.filterwarnings("ignore:Animation was deleted without rendering")
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+def spinning(steps=12, every=1):
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    return lf.integrate(rb, 3 * M0, dt=0.05, steps=steps, save_every=every, attitude=np.eye(3))
+
+
+def test_invariants_draws_the_relative_drifts():
+    traj = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), M0, dt=0.1, steps=200, method="rk4")
+    ax = plot.invariants(traj)
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    assert set(lines) == {"energy", "invariant 0", "machine ε"}
+    e = traj.energy()
+    expected = np.abs(e - e[0]) / abs(e[0])
+    x, y = lines["energy"].get_data()
+    np.testing.assert_array_equal(x, traj.t)
+    np.testing.assert_allclose(y[1:], expected[1:], rtol=1e-15)
+    assert np.isnan(y[0])                    # no drift at t0: left out of the log plot
+    assert ax.get_yscale() == "log"
+    # a batch: the largest drift over the members
+    batch = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), np.stack([M0, 2 * M0]), dt=0.1,
+                         steps=50, method="rk4")
+    _, ax = plt.subplots()
+    assert plot.invariants(batch, ax=ax) is ax
+    e = batch.energy()
+    d = (np.abs(e - e[:, :1]) / np.abs(e[:, :1])).max(axis=0)
+    np.testing.assert_allclose(ax.get_lines()[0].get_ydata()[1:], d[1:], rtol=1e-15)
+    assert "max over 2 members" in ax.get_title()
+
+
+def test_states_one_panel_per_field():
+    hv = lf.HeavyTop([1.0, 2.0, 3.0], 0.7)
+    traj = lf.integrate(hv, (M0, [0.0, 0.6, 0.8]), dt=0.01, steps=30)
+    axes = plot.states(traj)
+    assert len(axes) == 2 and [a.get_ylabel() for a in axes] == ["M", "Gamma"]
+    np.testing.assert_array_equal(axes[1].get_lines()[2].get_ydata(), traj.Gamma[:, 2])
+    prb = lf.PseudoRigidBody(2, potential=lf.potentials.Harmonic(1.0))
+    x = np.diag([1.2, 0.9])
+    traj = lf.integrate(prb, np.stack([(x, 0 * x)[0].ravel().tolist() + [0.0] * 4] * 2),
+                        dt=0.01, steps=10)
+    axes = plot.states(traj, fields=["X"], member=1)
+    assert len(axes) == 1 and len(axes[0].get_lines()) == 4
+    np.testing.assert_array_equal(axes[0].get_lines()[3].get_ydata(), traj.X[1, :, 1, 1])
+    with pytest.raises(lf.InvalidArgumentError, match="fields"):
+        plot.states(traj, fields=["Q"])
+    with pytest.raises(lf.InvalidArgumentError, match="axes"):
+        plot.states(traj, axes=[])
+
+
+def test_work_precision():
+    ax = plot.work_precision({"a": ([1e-3, 1e-6], [0.2, 0.1]), "b": ((1e-4,), (0.3,))})
+    x, y = ax.get_lines()[0].get_data()
+    np.testing.assert_array_equal(x, [1e-6, 1e-3])       # sorted by error
+    np.testing.assert_array_equal(y, [0.1, 0.2])
+    assert ax.get_xscale() == ax.get_yscale() == "log"
+    for bad in ({}, [1, 2], {"a": ([1, 2], [1])}, {"a": "xy"}):
+        with pytest.raises(lf.InvalidArgumentError, match="results"):
+            plot.work_precision(bad)
+
+
+def test_animate_rigid_body_writes_one_gif_frame_per_sample(tmp_path):
+    from PIL import Image
+
+    traj = spinning(steps=12, every=2)
+    path = tmp_path / "body.gif"
+    anim = plot.animate(traj, path, interval=50)
+    with Image.open(path) as gif:
+        assert gif.n_frames == len(traj) == 7
+    # the box is the body's: at frame i its corners are R_i times those of frame 0
+    anim._func(0)
+    box = [c for c in anim._fig.axes[0].collections][0]
+    v0 = np.array(box._faces, copy=True)
+    anim._func(4)
+    np.testing.assert_allclose(box._faces, v0 @ traj.attitude[4].T, atol=1e-12)
+
+
+def test_animate_heavy_top_pseudo_rigid_and_disks(tmp_path):
+    from PIL import Image
+
+    hv = lf.HeavyTop([1.0, 1.0, 0.5], 0.7)
+    R0 = lf.lie.so3_exp([0.4, 0.0, 0.0])
+    traj = lf.integrate(hv, hv.state([0.0, 0.0, 3.0], attitude=R0), dt=0.05, steps=4,
+                        attitude=R0)
+    anim = plot.animate(traj)
+    rod = anim._fig.axes[0].get_lines()[1]
+    anim._func(3)
+    np.testing.assert_allclose(np.array(rod.get_data_3d())[:, 1], traj.attitude[3] @ hv.chi)
+    for n in (2, 3):
+        prb = lf.PseudoRigidBody(n, potential=lf.potentials.Harmonic(1.0))
+        x = np.diag([1.3, 1.0, 0.8][:n])
+        traj = lf.integrate(prb, (x, lf.lie.hat_n([0.5, 0.1, 0.2][: n * (n - 1) // 2]) @ x),
+                            dt=0.1, steps=5)
+        path = tmp_path / f"prb{n}.gif"
+        plot.animate(traj, path)
+        with Image.open(path) as gif:
+            assert gif.n_frames == 6
+    disks = lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6)
+    traj = lf.integrate(disks, disks.state([0.3, -1.1], [0.7, 0.2]), dt=0.05, steps=40,
+                        save_every=4)
+    anim = plot.animate(traj, every=2)
+    anim._init_draw()
+    assert len(anim._func(5)) == 7
+
+
+def test_animate_errors(tmp_path):
+    traj = spinning()
+    no_attitude = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), M0, dt=0.1, steps=3)
+    with pytest.raises(lf.InvalidArgumentError, match="attitude=R0"):
+        plot.animate(no_attitude)
+    with pytest.raises(lf.InvalidArgumentError, match="no animation for Pendulum"):
+        plot.animate(lf.integrate(lf.Pendulum(1.0, 1.0, 9.81), [1.0, 0.0], dt=0.1, steps=3))
+    for every in (0, 1.5, True):
+        with pytest.raises(lf.InvalidArgumentError, match="every"):
+            plot.animate(traj, every=every)
+    with pytest.raises(lf.InvalidArgumentError, match=".gif or .mp4"):
+        plot.animate(traj, tmp_path / "a.avi")
+    assert not (tmp_path / "a.avi").exists()
