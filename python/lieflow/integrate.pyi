@@ -1,4 +1,5 @@
 # Type stubs for lieflow.integrate (the integration driver and Trajectory).
+import os
 from typing import Any, Callable, Iterable, Protocol
 
 import numpy as np
@@ -10,6 +11,13 @@ __all__ = ["integrate", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
 CHUNK_WORK: int
 MIN_CHUNK_STEPS: int
+
+# The driver's argument checks, shared with lieflow.ensemble (private).
+def _count(name: str, value: Any) -> int: ...
+def _step(dt: Any) -> float: ...
+def _time(name: str, value: Any) -> float: ...
+def _check_system(system: Any) -> None: ...
+def _attitude(attitude: ArrayLike, b: int, batched: bool) -> _F64: ...
 
 class _NativeRun(Protocol):
     method: str
@@ -126,6 +134,10 @@ class Trajectory:
         """(k, c) or (b, k, c)."""
     def casimirs(self) -> _F64:
         """The same as `invariants()`."""
+    def to_xarray(self, *, observables: bool = True) -> Any:
+        """An `xarray.Dataset` (layout: `lieflow.io`)."""
+    def save(self, path: str | os.PathLike[str], *, allow_pickle: bool = False) -> None:
+        """Writes a NetCDF file; read it back with `lieflow.load`."""
     def __getattr__(self, name: str) -> Any:
         """Named fields of the system (M, Gamma, q, L, ...) or an observable
         `traj.NAME(...) == system.NAME(traj.states, ...)`."""
