@@ -205,6 +205,10 @@ def animate(traj, path=None, *, every=1, interval=40, ax=None):
     * ``PseudoRigidBody``: the ellipsoid X·ball (an ellipse in 2-D).
     * ``RollingDisks``: both disks, a spoke to each centre of mass, the contact point and the
       trails of the centres of mass.
+    * ``RollingSpheres``: both spheres (wireframes), a spoke to each centre of mass and the
+      contact point.
+    * ``TangentTop`` on a surface with an embedding in R³: the centre's path and the body's
+      frame (E1, E2) carried along it.
 
     For a batch, the first member.
 
@@ -254,7 +258,8 @@ def animate(traj, path=None, *, every=1, interval=40, ax=None):
         system = system.system
     kind = type(system).__name__
     drawers = {"RigidBody": _box, "HeavyTop": _box, "PseudoRigidBody": _ellipsoid,
-               "RollingDisks": _rolling_disks}
+               "RollingDisks": _rolling_disks, "RollingSpheres": _rolling_spheres,
+               "TangentTop": _tangent_top}
     if kind not in drawers:
         raise InvalidArgumentError(f"invalid trajectory: no animation for {kind}; there is one "
                                    f"for {', '.join(drawers)}")
@@ -393,3 +398,77 @@ def _rolling_disks(system, traj, every, interval, ax):
         return (*disks, *spokes, *trails, point)
 
     return FuncAnimation(ax.figure, draw, frames=len(states), interval=interval, blit=True)
+
+
+def _new_3d(ax):
+    if ax is None:
+        fig = _pyplot().figure(figsize=(5, 5))
+        ax = fig.add_subplot(projection="3d")
+    ax.set_box_aspect((1, 1, 1))
+    return ax
+
+
+def _rolling_spheres(system, traj, every, interval, ax):
+    """Both spheres as wireframes about their centres, a spoke from each centre to its centre
+    of mass and the contact point (003 §2), in the frame of the computation."""
+    from matplotlib.animation import FuncAnimation
+
+    states, _ = _samples(traj, every)
+    centres = system.centres(states)
+    masses = system.centres_of_mass(states)
+    contact = system.contact_point(states)
+    radii = np.linalg.norm(contact[0] - centres[0], axis=1)
+    ax = _new_3d(ax)
+    lo, hi = centres.min() - radii.max(), centres.max() + radii.max()
+    ax.set(xlim=(lo, hi), ylim=(lo, hi), zlim=(lo, hi))
+    ax.set_title(f"RollingSpheres ({_method(traj)})")
+    u, v = np.mgrid[0:2 * np.pi:16j, 0:np.pi:9j]
+    ball = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)])
+    colours = ("tab:blue", "tab:orange")
+    spokes = [ax.plot([], [], [], color=c, lw=2)[0] for c in colours]
+    point, = ax.plot([], [], [], "ko", ms=4)
+    wires = [None, None]
+
+    def draw(i):
+        for k in range(2):
+            if wires[k] is not None:
+                wires[k].remove()
+            x = centres[i, k][:, None, None] + radii[k] * ball
+            wires[k] = ax.plot_wireframe(*x, color=colours[k], lw=0.3)
+            spokes[k].set_data_3d(*np.stack([centres[i, k], masses[i, k]]).T)
+        point.set_data_3d(*contact[i][:, None])
+        return (*wires, *spokes, point)
+
+    return FuncAnimation(ax.figure, draw, frames=len(states), interval=interval, blit=False)
+
+
+def _tangent_top(system, traj, every, interval, ax):
+    """The centre's path on the embedded surface and the body frame E1, E2 at the centre
+    (002 §II)."""
+    from matplotlib.animation import FuncAnimation
+
+    states, _ = _samples(traj, every)
+    try:
+        body = np.asarray(system.ambient_frame(states))
+    except InvalidArgumentError:
+        raise InvalidArgumentError("invalid trajectory: the tangent top is drawn on a surface "
+                                   "with an embedding in R³; this one has none") from None
+    centre, e1, e2 = body[:, 0], body[:, 1], body[:, 2]
+    ax = _new_3d(ax)
+    size = 0.15 * max(np.ptp(centre, axis=0).max(), 1e-3)
+    lo, hi = centre.min() - 2 * size, centre.max() + 2 * size
+    ax.set(xlim=(lo, hi), ylim=(lo, hi), zlim=(lo, hi))
+    surface = system.__reduce__()[1][0]           # the constructor's first argument
+    ax.set_title(f"TangentTop on {surface!r} ({_method(traj)})")
+    trail, = ax.plot([], [], [], color="0.4", lw=0.8)
+    axes = [ax.plot([], [], [], color=c, lw=2, label=n)[0]
+            for c, n in (("tab:red", "E1"), ("tab:blue", "E2"))]
+    ax.legend(loc="upper left", fontsize="small")
+
+    def draw(i):
+        trail.set_data_3d(*centre[: i + 1].T)
+        for line, e in zip(axes, (e1, e2)):
+            line.set_data_3d(*np.stack([centre[i], centre[i] + size * e[i]]).T)
+        return (trail, *axes)
+
+    return FuncAnimation(ax.figure, draw, frames=len(states), interval=interval, blit=False)

@@ -126,6 +126,34 @@ def test_animate_heavy_top_pseudo_rigid_and_disks(tmp_path):
     assert len(anim._func(5)) == 7
 
 
+def test_animate_rolling_spheres_and_tangent_top():
+    spheres = lf.RollingSpheres(0.7, 1.3, [0.1, -0.2, 0.15], [-0.3, 0.2, 0.4], 2.0, 3.5,
+                                np.diag([1.0, 1.2, 1.4]), np.diag([2.0, 2.2, 2.4]))
+    z = spheres.state(np.eye(3), np.eye(3), [0.0, 0.0, 1.0], [1.1, -0.6, 0.8], [-0.4, 0.9, 0.5])
+    traj = lf.integrate(spheres, z, dt=0.01, steps=30, save_every=10)
+    anim = plot.animate(traj)
+    assert anim._save_count == len(traj) == 4
+    anim._func(2)
+    spoke = anim._fig.axes[0].get_lines()[1]
+    np.testing.assert_allclose(np.array(spoke.get_data_3d()).T,
+                               [spheres.centres(traj.states[2])[1],
+                                spheres.centres_of_mass(traj.states[2])[1]])
+    top = lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5)
+    traj = lf.integrate(top, top.state([0.3, 0.2], 0.1, [0.4, -0.2], 0.3), dt=0.01, steps=40,
+                        save_every=10)
+    anim = plot.animate(traj)
+    anim._func(3)
+    c, e1 = top.ambient_frame(traj.states[3])[:2]
+    seg = np.array(anim._fig.axes[0].get_lines()[1].get_data_3d()).T
+    np.testing.assert_allclose(seg[0], c)
+    direction = seg[1] - seg[0]
+    np.testing.assert_allclose(direction / np.linalg.norm(direction), e1, atol=1e-12)
+    flat = lf.TangentTop(lf.surfaces.HyperbolicPlane(), 1.0, 0.5)
+    traj = lf.integrate(flat, flat.state([0.3, 1.2], 0.1, [0.4, -0.2], 0.3), dt=0.01, steps=3)
+    with pytest.raises(lf.InvalidArgumentError, match="embedding"):
+        plot.animate(traj)
+
+
 def test_animate_errors(tmp_path):
     traj = spinning()
     no_attitude = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), M0, dt=0.1, steps=3)
