@@ -9,6 +9,7 @@ ellipsoids    self-gravitating fluid ellipsoids (Maclaurin, Jacobi, Dedekind, Ri
 continuation  continuation of families of relative equilibria, branch points, stability
 io            trajectories as xarray Datasets and NetCDF files (Trajectory.save, load)
 plot          plots and animations of trajectories (matplotlib)
+ensemble      ensembles and parameter sweeps as Dask tasks (lazy xarray Datasets; needs dask)
 
 Systems and integration
 -----------------------
@@ -73,6 +74,7 @@ from ._lieflow import (
     WeakFieldTop,
 )
 from . import continuation, ellipsoids, elliptic, io, lie, plot, potentials, pseudo_rigid, surfaces
+from . import ensemble  # imports dask and xarray only when its functions are called
 from .integrate import Trajectory, integrate
 from .io import FileFormatError, load
 
@@ -117,6 +119,7 @@ __all__ = [
     "WeakFieldTop",
     "__version__",
     "elliptic",
+    "ensemble",
     "integrate",
     "io",
     "lie",

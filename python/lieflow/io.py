@@ -39,9 +39,16 @@ import numbers
 import operator
 import os
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ._lieflow import InvalidArgumentError, LieflowError, __version__
+
+if TYPE_CHECKING:
+    import xarray
+
+    from .integrate import Trajectory
 
 __all__ = ["FileFormatError", "FORMAT", "load", "save", "to_xarray"]
 
@@ -189,7 +196,7 @@ _RESERVED = {"states", "energy", "invariants", "attitude", "initial_state", "fin
              "initial_attitude", "final_attitude", "time", "member"}
 
 
-def to_xarray(traj, *, observables=True):
+def to_xarray(traj: Trajectory, *, observables: bool = True) -> xarray.Dataset:
     """The trajectory as an :class:`xarray.Dataset` (layout in the module docstring).
 
     Parameters
@@ -230,7 +237,7 @@ def to_xarray(traj, *, observables=True):
         value = getattr(traj, name)
         if value is not None:
             ds[name] = (lead + square, np.asarray(value))
-    if traj.t_events is not None:
+    if traj.t_events is not None and traj.state_events is not None:
         for i, te in enumerate(traj.t_events):
             ds[f"t_events_{i}"] = (f"event_{i}",), np.asarray(te, dtype=np.float64)
             ds[f"state_events_{i}"] = ((f"event_{i}", "component"),
@@ -265,7 +272,7 @@ def _attributes(traj):
     return attrs
 
 
-def save(traj, path, *, allow_pickle=False):
+def save(traj: Trajectory, path: str | os.PathLike[str], *, allow_pickle: bool = False) -> None:
     """Writes the trajectory to a NetCDF file at `path` (the Dataset of :func:`to_xarray`).
 
     Parameters
@@ -293,7 +300,7 @@ def save(traj, path, *, allow_pickle=False):
                 f"stored as data; pass allow_pickle=True to store it pickled (lf.load then "
                 f"needs allow_pickle=True too)")
         try:
-            import cloudpickle as pickler
+            import cloudpickle as pickler  # type: ignore[import-untyped]
         except ImportError:
             import pickle as pickler
         try:
@@ -305,7 +312,8 @@ def save(traj, path, *, allow_pickle=False):
     ds.to_netcdf(path)
 
 
-def load(path, *, allow_pickle=False):
+def load(path: str | os.PathLike[str] | xarray.Dataset, *,
+         allow_pickle: bool = False) -> Trajectory:
     """Reads a trajectory written by ``Trajectory.save`` (or a Dataset of ``to_xarray``).
 
     The system is rebuilt from the file, so ``lf.integrate(traj.system, traj.final_state, ...,

@@ -13,11 +13,19 @@ objects it made, so they can be restyled:
 
 from __future__ import annotations
 
+import os
 import shutil
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
 from ._lieflow import InvalidArgumentError
+
+if TYPE_CHECKING:
+    from matplotlib.animation import FuncAnimation
+    from matplotlib.axes import Axes
+
+    from .integrate import Trajectory
 
 __all__ = ["animate", "invariants", "states", "work_precision"]
 
@@ -55,7 +63,7 @@ def _relative_drift(q):
     return d.reshape((-1,) + d.shape[-2:]).max(axis=0)
 
 
-def invariants(traj, *, ax=None):
+def invariants(traj: Trajectory, *, ax: Axes | None = None) -> Axes:
     """Relative drift of the energy and of each invariant against time, on a log scale.
 
     For a batch, the largest drift over the members at each time. Samples with no drift at all
@@ -74,9 +82,8 @@ def invariants(traj, *, ax=None):
     _trajectory(traj)
     ax = _axes(ax, figsize=(6, 3.5))
     t = np.asarray(traj.t)
-    energy = np.asarray(traj.energy(), dtype=float)[..., None]
-    inv = np.asarray(traj.invariants(), dtype=float)
-    inv = inv.reshape(inv.shape[: energy.ndim - 1] + (-1,))
+    energy: Any = np.asarray(traj.energy(), dtype=float)[..., None]
+    inv: Any = np.asarray(traj.invariants(), dtype=float).reshape(energy.shape[:-1] + (-1,))
     labels = ["energy"] + [f"invariant {i}" for i in range(inv.shape[-1])]
     drift = _relative_drift(np.concatenate([energy, inv], axis=-1))
     for label, d in zip(labels, drift.T):
@@ -95,7 +102,8 @@ def _method(traj):
     return m if isinstance(m, str) else "+".join(m)
 
 
-def states(traj, *, fields=None, member=0, axes=None):
+def states(traj: Trajectory, *, fields: str | Sequence[str] | None = None, member: int = 0,
+           axes: Sequence[Axes] | None = None) -> np.ndarray:
     """The named fields of the state (``M``, ``Gamma``, ``X``, ``q``, ...) against time, one
     panel per field (every component of a vector or matrix field).
 
@@ -128,8 +136,8 @@ def states(traj, *, fields=None, member=0, axes=None):
         plt = _pyplot()
         _, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False,
                                figsize=(6, 1.2 + 1.6 * len(names)))
-    axes = np.asarray(axes).ravel()
-    if len(axes) != len(names):
+    panels = np.asarray(axes).ravel()
+    if len(panels) != len(names):
         raise InvalidArgumentError(f"invalid axes: expected {len(names)} (one per field), got "
                                    f"{len(axes)}")
     if traj.batched:
@@ -139,7 +147,7 @@ def states(traj, *, fields=None, member=0, axes=None):
             raise InvalidArgumentError(f"invalid member: expected an integer in [0, {b}), got "
                                        f"{member!r:.60}")
     t = np.asarray(traj.t)
-    for ax, name in zip(axes, names):
+    for ax, name in zip(panels, names):
         v = np.asarray(views[name])
         if traj.batched:
             v = v[member]
@@ -151,11 +159,12 @@ def states(traj, *, fields=None, member=0, axes=None):
         ax.set_ylabel(name)
         if v.shape[1] <= 9:
             ax.legend(fontsize="x-small", ncol=min(v.shape[1], 3), loc="upper right")
-    axes[-1].set_xlabel("t")
-    return axes
+    panels[-1].set_xlabel("t")
+    return panels
 
 
-def work_precision(results, *, ax=None, cost="time [s]"):
+def work_precision(results: Mapping[str, tuple[Any, Any]], *, ax: Axes | None = None,
+                   cost: str = "time [s]") -> Axes:
     """Work–precision diagram: for each method, its cost against its error (log-log), one
     point per step size, as in scipy's and DifferentialEquations.jl's benchmarks.
 
@@ -195,7 +204,8 @@ def work_precision(results, *, ax=None, cost="time [s]"):
 
 # --- animations -------------------------------------------------------------------------------
 
-def animate(traj, path=None, *, every=1, interval=40, ax=None):
+def animate(traj: Trajectory, path: str | os.PathLike[str] | None = None, *, every: int = 1,
+            interval: float = 40, ax: Axes | None = None) -> FuncAnimation:
     """An animation of the trajectory, one frame per saved sample (or per ``every`` samples).
 
     * ``RigidBody``, ``HeavyTop`` (also wrapped in ``lf.Forced``): a box with the body's
@@ -253,7 +263,7 @@ def animate(traj, path=None, *, every=1, interval=40, ax=None):
         if suffix == "mp4" and shutil.which("ffmpeg") is None:
             raise InvalidArgumentError("invalid path: MP4 needs ffmpeg, which is not on PATH; "
                                        "save as .gif instead")
-    system = traj.system
+    system: Any = traj.system
     while type(system).__name__ == "Forced":
         system = system.system
     kind = type(system).__name__
@@ -281,7 +291,7 @@ def _samples(traj, every, field=None):
 
 def _box(system, traj, every, interval, ax):
     from matplotlib.animation import FuncAnimation
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # type: ignore[import-untyped]
 
     momentum, att = _samples(traj, every, "M")
     if att is None:
