@@ -46,7 +46,7 @@ def ratio_at(rows_a, rows_b, err):
 def pendulum():
     p = lf.Pendulum(1.0, 1.0, 9.81)
     t_end, z0 = 20.0, [2.0, 0.0]
-    exact = p.exact(2.0, t_end)
+    exact = p.exact_solution(2.0, t_end)
     runs = {}
     for method, steps in [("midpoint", [2000, 8000, 32000, 128000]),
                           ("gauss4", [250, 500, 1000, 2000, 4000]),

@@ -49,11 +49,11 @@ def main():
         ("rigid body", 'lf.LiePoisson("so3", H) (finite differences)', lf.LiePoisson("so3", h_rb),
          M0, ["rkmk4"]),
         ("pendulum", "lf.Pendulum()", lf.Pendulum(), [0.5, 0.0], ["verlet", "gauss4"]),
-        ("pendulum", "lf.Separable(1.0, U, dU, dim=1)", lf.Separable(1.0, u_pend, du_pend, dim=1),
+        ("pendulum", "lf.Separable(1.0, U, dU, dof=1)", lf.Separable(1.0, u_pend, du_pend, dof=1),
          [0.5, 0.0], ["verlet", "gauss4"]),
-        ("pendulum", "lf.Canonical(H, grad, dim=1)", lf.Canonical(h_pend, grad_pend, 1),
+        ("pendulum", "lf.Canonical(H, grad, dof=1)", lf.Canonical(h_pend, grad_pend, 1),
          [0.5, 0.0], ["gauss4"]),
-        ("pendulum", "lf.Canonical(H, dim=1) (finite differences)", lf.Canonical(h_pend, None, 1),
+        ("pendulum", "lf.Canonical(H, dof=1) (finite differences)", lf.Canonical(h_pend, None, 1),
          [0.5, 0.0], ["gauss4"]),
     ]
     print(f"{'system':11s} {'constructed as':46s} {'method':10s} {'us/step':>8s}")

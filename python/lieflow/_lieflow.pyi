@@ -176,8 +176,8 @@ class SphericalPendulum(System):
     @property
     def g(self) -> float: ...
     def state_from_spherical(
-        self, theta: ArrayLike, phi: ArrayLike, theta_dot: ArrayLike | None = None,
-        phi_dot: ArrayLike | None = None,
+        self, theta: ArrayLike, phi: ArrayLike, thetadot: ArrayLike | None = None,
+        phidot: ArrayLike | None = None,
     ) -> _F64:
         """theta from the downward vertical; broadcasts; -> (..., 6)."""
     def vertical_momentum(self, states: ArrayLike) -> _F64 | float:
@@ -189,7 +189,7 @@ class Pendulum(System):
     """Planar pendulum in canonical coordinates (q, p); methods midpoint, gauss4, gauss6, verlet, rk4."""
 
     def __new__(cls, mass: float = 1.0, length: float = 1.0, g: float = 9.81) -> Self: ...
-    def exact(self, amplitude: ArrayLike, t: ArrayLike) -> _F64:
+    def exact_solution(self, amplitude: ArrayLike, t: ArrayLike) -> _F64:
         """(...) -> (..., 2): the elliptic solution released at rest from `amplitude`."""
 
 @final
@@ -208,7 +208,7 @@ class RollingDisk(System):
         cls, mass: float, radius: float, roll_inertia: float, turn_inertia: float,
         spring: float = 0.0, tilt: float = 0.0,
     ) -> Self: ...
-    def state(self, q: ArrayLike, theta_dot: float, phi_dot: float) -> list[float]: ...
+    def state(self, q: ArrayLike, thetadot: float, phidot: float) -> list[float]: ...
     def constraint_residual(self, states: ArrayLike) -> _F64 | float: ...
 
 @final
@@ -227,7 +227,7 @@ class RollingSpheres(System):
     def state(
         self, z1: ArrayLike, z2: ArrayLike, u: ArrayLike, Omega1: ArrayLike, Omega2: ArrayLike,
     ) -> list[float]: ...
-    def planar_state(self, theta: ArrayLike, phi: float, theta_dot: ArrayLike) -> list[float]: ...
+    def planar_state(self, theta: ArrayLike, phi: float, thetadot: ArrayLike) -> list[float]: ...
     def to_planar(self, state: ArrayLike, tol: float = 1e-9) -> tuple[float, float, float, float, float]: ...
     def angular_momentum(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 3): total angular momentum about the centre of mass (conserved)."""
@@ -386,10 +386,10 @@ class Canonical(System):
 
     def __new__(
         cls, hamiltonian: Callable[[_F64, _F64], float],
-        gradient: Callable[[_F64, _F64], Any] | None = None, dim: int | None = None,
+        gradient: Callable[[_F64, _F64], Any] | None = None, dof: int | None = None,
     ) -> Self:
         """hamiltonian(q, p) -> float; gradient(q, p) -> (dH/dq, dH/dp) of shape (2, d), or None
-        for central differences; dim: the number of degrees of freedom (required)."""
+        for central differences; dof: the number of degrees of freedom (required)."""
     @property
     def dof(self) -> int: ...
     @property
@@ -401,10 +401,10 @@ class Separable(System):
     verlet4, verlet6, gauss4, gauss6, midpoint, rk4."""
 
     def __new__(
-        cls, kinetic_mass: ArrayLike, potential: Callable[[_F64], float],
-        gradient: Callable[[_F64], ArrayLike] | None = None, dim: int | None = None,
+        cls, mass: ArrayLike, potential: Callable[[_F64], float],
+        gradient: Callable[[_F64], ArrayLike] | None = None, dof: int | None = None,
     ) -> Self:
-        """kinetic_mass: a number (then dim is required), a vector (d,) or an SPD (d, d) matrix;
+        """mass: a number (then dof is required), a vector (d,) or an SPD (d, d) matrix;
         potential(q) -> float; gradient(q) -> (d,), or None for central differences."""
     @property
     def dof(self) -> int: ...

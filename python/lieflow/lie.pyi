@@ -68,13 +68,13 @@ def vee(xi: _In) -> _F:
 def so3_exp(w: _In) -> _F:
     """Rodrigues: (3,) -> (3, 3) or (b, 3) -> (b, 3, 3)."""
 
-def so3_log(r: _In, strict: bool = False) -> _F:
+def so3_log(R: _In, strict: bool = False) -> _F:
     """Principal log |w| <= pi: (3, 3) -> (3,) or (b, 3, 3) -> (b, 3); strict raises at pi."""
 
 def so3_cayley(w: _In) -> _F:
     """cay(w) = (I - hat(w)/2)^-1 (I + hat(w)/2): (3,) -> (3, 3), batched."""
 
-def so3_cayley_inv(r: _In) -> _F:
+def so3_cayley_inv(R: _In) -> _F:
     """Inverse Cayley map: (3, 3) -> (3,), batched; InvalidArgumentError at a half turn."""
 
 def so3_jacobian_right(w: _In, inverse: bool = False) -> _F:

@@ -162,7 +162,7 @@ def test_rayleigh_damping_of_the_pendulum_against_scipy():
 
 def test_rayleigh_damping_matrix_on_a_user_separable_system():
     C = np.array([[0.3, 0.1], [0.1, 0.2]])
-    osc = lf.Separable(1.0, lambda q: 0.5 * q @ q, lambda q: q, dim=2)
+    osc = lf.Separable(1.0, lambda q: 0.5 * q @ q, lambda q: q, dof=2)
     damped = lf.Forced(osc, damping=C)
     z0 = np.array([1.0, -0.5, 0.2, 0.4])
 
@@ -226,7 +226,7 @@ def test_errors():
     with pytest.raises(lf.ArgumentTypeError, match="lieflow system"):
         lf.Forced("RigidBody", body_torque)
     with pytest.raises(lf.InvalidArgumentError, match="positive semi-definite"):
-        lf.Forced(lf.Separable(1.0, lambda q: 0.0, dim=2), damping=[[1.0, 2.0], [0.0, 1.0]])
+        lf.Forced(lf.Separable(1.0, lambda q: 0.0, dof=2), damping=[[1.0, 2.0], [0.0, 1.0]])
     with pytest.raises(lf.ShapeError, match=r"expected \(3,\), got \(4,\), in step 1"):
         lf.integrate(lf.Forced(body, lambda t, z: np.zeros(4)), M0, dt=0.1, steps=3)
     with pytest.raises(lf.NonFiniteError, match="in step 1"):

@@ -161,7 +161,7 @@ def test_batch_errors_name_the_member():
 def test_the_methods_of_the_mechanics_core_from_python():
     # Gauss–Legendre on the canonical pendulum: orders 2, 4, 6 against the elliptic solution.
     pendulum = lf.Pendulum()
-    exact = pendulum.exact(1.2, 2.0)
+    exact = pendulum.exact_solution(1.2, 2.0)
     for method, order, n in [("midpoint", 2, 200), ("gauss4", 4, 20), ("gauss6", 6, 10)]:
         err = [np.abs(lf.integrate(pendulum, [1.2, 0.0], dt=2.0 / k, steps=k,
                                    method=method).final_state - exact).max() for k in (n, 2 * n)]

@@ -180,7 +180,7 @@ def test_lie_poisson_arguments():
 # --- canonical and separable systems ---
 
 def test_canonical_oscillator_closed_form_and_orders():
-    sys = lf.Canonical(osc_h, osc_grad, dim=1)
+    sys = lf.Canonical(osc_h, osc_grad, dof=1)
     assert sys.dof == 1 and sys.fields == ["q", "p"] and not sys.finite_differences
     t = 4.0
     exact = np.array([np.cos(t), -np.sin(t)])
@@ -194,12 +194,12 @@ def test_canonical_oscillator_closed_form_and_orders():
 
 def test_canonical_pendulum_by_finite_differences():
     pend = lf.Pendulum(1.0, 1.0, 9.81)
-    fd = lf.Canonical(pend_h, dim=1)
+    fd = lf.Canonical(pend_h, dof=1)
     assert fd.finite_differences
     ref = lf.integrate(pend, [1.2, 0.0], dt=0.01, steps=500, method="gauss4").states
     got = lf.integrate(fd, [1.2, 0.0], dt=0.01, steps=500, method="gauss4").states
     np.testing.assert_allclose(got, ref, atol=1e-9)
-    exact = pend.exact(1.2, 5.0)
+    exact = pend.exact_solution(1.2, 5.0)
     got = lf.integrate(fd, [1.2, 0.0], dt=0.01, steps=500, method="gauss6").final_state
     np.testing.assert_allclose(got, exact, atol=1e-9)
 
@@ -207,12 +207,12 @@ def test_canonical_pendulum_by_finite_differences():
 @pytest.mark.parametrize("mass", [1.0, [1.0], [[1.0]]])
 def test_separable_equals_the_pendulum(mass):
     pend = lf.Pendulum(1.0, 1.0, 9.81)
-    sys = lf.Separable(mass, pend_u, pend_du, dim=1)
+    sys = lf.Separable(mass, pend_u, pend_du, dof=1)
     for method in ("verlet", "gauss4", "rk4"):
         ref = lf.integrate(pend, [1.2, 0.0], dt=0.01, steps=1000, method=method).states
         got = lf.integrate(sys, [1.2, 0.0], dt=0.01, steps=1000, method=method).states
         np.testing.assert_allclose(got, ref, atol=1e-12, rtol=0)
-    exact = pend.exact(1.2, 2.0)
+    exact = pend.exact_solution(1.2, 2.0)
     for method, order in [("verlet", 2), ("verlet4", 4), ("verlet6", 6)]:
         err = [np.abs(lf.integrate(sys, [1.2, 0.0], dt=2.0 / n, steps=n, method=method)
                       .final_state - exact).max() for n in (40, 80)]
@@ -220,19 +220,19 @@ def test_separable_equals_the_pendulum(mass):
 
 
 def test_separable_arguments():
-    with pytest.raises(TypeError, match="dim"):
+    with pytest.raises(TypeError, match="dof"):
         lf.Separable(1.0, pend_u)
     with pytest.raises(lf.InvalidArgumentError):
-        lf.Separable(-1.0, pend_u, dim=1)
+        lf.Separable(-1.0, pend_u, dof=1)
     with pytest.raises(lf.InvalidArgumentError, match="positive definite"):
         lf.Separable([[1.0, 2.0], [2.0, 1.0]], pend_u)
     with pytest.raises(lf.ShapeError):
-        lf.Separable([1.0, 2.0], pend_u, dim=3)
+        lf.Separable([1.0, 2.0], pend_u, dof=3)
     with pytest.raises(TypeError, match="potential"):
-        lf.Separable(1.0, 2.0, dim=1)
+        lf.Separable(1.0, 2.0, dof=1)
     with pytest.raises(lf.InvalidArgumentError):
-        lf.Canonical(osc_h, dim=0)
-    with pytest.raises(TypeError, match="dim"):
+        lf.Canonical(osc_h, dof=0)
+    with pytest.raises(TypeError, match="dof"):
         lf.Canonical(osc_h)
     assert lf.Separable.methods()[:3] == ["verlet", "verlet4", "verlet6"]
     assert lf.Canonical.methods() == ["gauss4", "gauss6", "midpoint", "rk4"]
@@ -242,7 +242,7 @@ def test_separable_arguments():
 
 @pytest.mark.parametrize("method", ["gauss4", "midpoint", "rk4"])
 def test_an_exception_is_re_raised_naming_the_step(method):
-    sys = lf.Canonical(osc_h, fails_below, dim=1)
+    sys = lf.Canonical(osc_h, fails_below, dof=1)
     with pytest.raises(ZeroDivisionError, match="q below") as info:
         lf.integrate(sys, [1.0, 0.0], dt=0.01, steps=1000, method=method)
     notes = " ".join(getattr(info.value, "__notes__", []))
@@ -256,7 +256,7 @@ def test_an_exception_at_the_initial_state():
     def du(q):
         raise KeyError("no force")
 
-    sys = lf.Separable(1.0, pend_u, du, dim=1)
+    sys = lf.Separable(1.0, pend_u, du, dof=1)
     with pytest.raises(KeyError, match="no force") as info:
         lf.integrate(sys, [0.1, 0.0], dt=0.01, steps=10)
     assert "at the initial state of verlet" in " ".join(info.value.__notes__)
@@ -277,9 +277,9 @@ def test_nan_and_wrong_shapes_are_typed_errors():
         lf.integrate(sys, M0, dt=0.01, steps=10)
     with pytest.raises(lf.ShapeError, match=r"returns_short.*expected \(2, 1\), got \(1,\), "
                                             r"in step 1 of gauss4"):
-        lf.integrate(lf.Canonical(osc_h, returns_short, dim=1), [1.0, 0.0], dt=0.1, steps=3)
+        lf.integrate(lf.Canonical(osc_h, returns_short, dof=1), [1.0, 0.0], dt=0.1, steps=3)
     with pytest.raises(TypeError):
-        lf.integrate(lf.Canonical(osc_h, returns_str, dim=1), [1.0, 0.0], dt=0.1, steps=3)
+        lf.integrate(lf.Canonical(osc_h, returns_str, dof=1), [1.0, 0.0], dt=0.1, steps=3)
     with pytest.raises(lf.NonFiniteError):
         lf.LiePoisson("so3", lambda m: float("nan")).energy(M0)
     with pytest.raises(lf.ShapeError):
@@ -296,7 +296,7 @@ def test_batches_run_single_threaded_and_in_order():
 
 
 def test_pickling_and_repr():
-    for sys, z0 in [(lf.Canonical(osc_h, osc_grad, dim=1), [1.0, 0.0]),
+    for sys, z0 in [(lf.Canonical(osc_h, osc_grad, dof=1), [1.0, 0.0]),
                     (lf.Separable([[2.0]], pend_u, pend_du), [0.3, 0.0]),
                     (lf.LiePoisson("so3", rb_h, rb_grad, casimirs=[casimir]), M0),
                     (lf.LiePoisson(("so", 4), np.eye(6)), np.arange(6.0) / 6)]:
@@ -305,4 +305,4 @@ def test_pickling_and_repr():
         a = lf.integrate(sys, z0, dt=0.01, steps=50).states
         b = lf.integrate(copy, z0, dt=0.01, steps=50).states
         np.testing.assert_array_equal(a, b)
-    assert repr(lf.Canonical(osc_h, dim=1)).startswith("Canonical(hamiltonian=<function osc_h")
+    assert repr(lf.Canonical(osc_h, dof=1)).startswith("Canonical(hamiltonian=<function osc_h")

@@ -345,11 +345,11 @@ USER_STATES = {"ucan": np.array([0.3, -0.2, 0.1, 0.4]), "usep": np.array([0.3, -
 def user_specs(add):
     """The specs of the user-defined systems (issue 15)."""
     add("Canonical", "Canonical", A("hamiltonian", user_h, "obj"),
-        A("gradient", user_grad, "obj", opt=True), A("dim", 2, "int", positive=True))
-    add("Separable", "Separable", A("kinetic_mass", 1.5, "float", positive=True),
+        A("gradient", user_grad, "obj", opt=True), A("dof", 2, "int", positive=True))
+    add("Separable", "Separable", A("mass", 1.5, "float", positive=True),
         A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True),
-        A("dim", 1, "int", kw=True, positive=True))
-    add("Separable[matrix]", "Separable", A("kinetic_mass", I_SPH2, "mat"),
+        A("dof", 1, "int", kw=True, positive=True))
+    add("Separable[matrix]", "Separable", A("mass", I_SPH2, "mat"),
         A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True))
     add("LiePoisson", "LiePoisson", A("algebra", "so3", "str"), A("hamiltonian", user_lp_h, "obj"),
         A("gradient", user_lp_grad, "obj", opt=True),
@@ -443,8 +443,8 @@ def build_specs() -> list[Spec]:
     add("lie.vee", "lie.vee", A("xi", rodrigues(W3) - rodrigues(W3).T, "skew"))
     for f in ("so3_exp", "so3_cayley"):
         add(f"lie.{f}", f"lie.{f}", A("w", W3, "vec"))
-    add("lie.so3_log", "lie.so3_log", A("r", R3, "rot"), A("strict", False, "bool", kw=True))
-    add("lie.so3_cayley_inv", "lie.so3_cayley_inv", A("r", R3, "rot"))
+    add("lie.so3_log", "lie.so3_log", A("R", R3, "rot"), A("strict", False, "bool", kw=True))
+    add("lie.so3_cayley_inv", "lie.so3_cayley_inv", A("R", R3, "rot"))
     for f in ("so3_jacobian_right", "so3_jacobian_left"):
         add(f"lie.{f}", f"lie.{f}", A("w", W3, "vec"), A("inverse", True, "bool", kw=True))
     add("lie.se3_exp", "lie.se3_exp", A("xi", SE3XI, "vec"))
@@ -644,14 +644,15 @@ def build_specs() -> list[Spec]:
                ("spatial_momentum", [A("states", np.array([1.0, .5, -.3, 0, .6, .8]), "vec"),
                                      A("attitude", R3, "rot")])],
         "sp": [("state_from_spherical", [A("theta", 0.8, "bcast"), A("phi", 0.1, "bcast"),
-                                         A("theta_dot", 0.3, "bcast", opt=True),
-                                         A("phi_dot", 1.2, "bcast", opt=True)]),
+                                         A("thetadot", 0.3, "bcast", opt=True),
+                                         A("phidot", 1.2, "bcast", opt=True)]),
                ("vertical_momentum", [A("states", state_of("sp"), "vec")])],
-        "pend": [("exact", [A("amplitude", 0.8, "bcast"), A("t", np.array([0.0, 0.5]), "bcast")])],
+        "pend": [("exact_solution", [A("amplitude", 0.8, "bcast"),
+                                     A("t", np.array([0.0, 0.5]), "bcast")])],
         "spart": [("from_spherical", [A("states", Lazy(lambda lf: lf.SphericalPendulum(
             2.0, 1.5, 9.81).state_from_spherical(0.8, 0.1, 0.3, 1.2)), "vec")])],
         "disk": [("state", [A("q", np.array([0.1, -0.2, 0.3, 0.7]), "vec"),
-                            A("theta_dot", 2.0, "float"), A("phi_dot", 0.5, "float")]),
+                            A("thetadot", 2.0, "float"), A("phidot", 0.5, "float")]),
                  ("constraint_residual", [A("states", state_of("disk"), "vec")])],
         "prb": [(f, [A("states", state_of("prb"), "vec")])
                 for f in ("angular_momentum", "circulation", "singular_values")]
@@ -687,7 +688,7 @@ def build_specs() -> list[Spec]:
                             A("Omega1", np.array([1.1, -0.6, 0.8]), "vec"),
                             A("Omega2", np.array([-0.4, 0.9, 0.5]), "vec")]),
                  ("planar_state", [A("theta", np.array([0.3, -0.4]), "vec"), A("phi", 0.2, "float"),
-                                   A("theta_dot", np.array([0.5, 0.7]), "vec")]),
+                                   A("thetadot", np.array([0.5, 0.7]), "vec")]),
                  ("to_planar", [A("state", Lazy(lambda lf: RECEIVERS["rsph"](lf).planar_state(
                      [0.3, -0.4], 0.2, [0.5, 0.7])), "vec"), A("tol", 1e-9, "float", kw=True)])]
         + [(f, [A("states", state_of("rsph"), "vec")])

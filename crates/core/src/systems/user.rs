@@ -363,7 +363,7 @@ impl fmt::Debug for UserCanonical {
 impl UserCanonical {
     /// H with `dof` ≥ 1 degrees of freedom and its gradient, or `None` for finite differences.
     pub fn new(dof: usize, h: CanonicalFn, gradient: Option<CanonicalGradientFn>) -> Result<Self> {
-        check_dof("dim", dof)?;
+        check_dof("dof", dof)?;
         Ok(UserCanonical {
             dof,
             h,
@@ -590,18 +590,18 @@ impl UserSeparable {
     ) -> Result<Self> {
         let (d, inverse) = match mass {
             KineticMass::Scalar(m) => {
-                check::positive("kinetic_mass", m)?;
+                check::positive("mass", m)?;
                 let d = dof.ok_or_else(|| {
                     Error::invalid(
-                        "dim",
-                        "a scalar kinetic mass needs the number of degrees of freedom (dim)",
+                        "dof",
+                        "a scalar mass needs the number of degrees of freedom (dof)",
                     )
                 })?;
                 (d, InverseMass::Scalar(1.0 / m))
             }
             KineticMass::Diagonal(m) => {
                 for (i, &mi) in m.iter().enumerate() {
-                    check::positive(&format!("kinetic_mass[{i}]"), mi)?;
+                    check::positive(&format!("mass[{i}]"), mi)?;
                 }
                 (
                     m.len(),
@@ -609,26 +609,26 @@ impl UserSeparable {
                 )
             }
             KineticMass::Matrix(m) => {
-                let d = check::square("kinetic_mass", &m, 1)?;
-                (d, InverseMass::Dense(spd_inverse("kinetic_mass", &m)?))
+                let d = check::square("mass", &m, 1)?;
+                (d, InverseMass::Dense(spd_inverse("mass", &m)?))
             }
         };
         if let Some(k) = dof {
             if k != d {
                 return Err(Error::shape(
-                    "kinetic_mass",
-                    format!("a scalar, ({k},) or ({k}, {k}) for dim = {k}"),
+                    "mass",
+                    format!("a scalar, ({k},) or ({k}, {k}) for dof = {k}"),
                     format!("a mass of {d} degrees of freedom"),
                 ));
             }
         }
-        check_dof("dim", d)?;
+        check_dof("dof", d)?;
         if let InverseMass::Diagonal(w) | InverseMass::Dense(w) = &inverse {
             // 1/m of a subnormal mass overflows.
-            check::finite_slice("the inverse of kinetic_mass", w)?;
+            check::finite_slice("the inverse of mass", w)?;
         }
         if let InverseMass::Scalar(w) = inverse {
-            check::finite_slice("the inverse of kinetic_mass", &[w])?;
+            check::finite_slice("the inverse of mass", &[w])?;
         }
         Ok(UserSeparable {
             dof: d,

@@ -75,7 +75,7 @@ pub fn polar<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr2<'py>, Arr2
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (tol < 0).
 #[pyfunction]
-#[pyo3(signature = (X, tol = gl::STRATUM_TOL))]
+#[pyo3(signature = (X, tol = gl::STRATUM_TOL), text_signature = "(X, tol=1e-8)")]
 pub fn stratum<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
@@ -84,6 +84,8 @@ pub fn stratum<'py>(
     let st = gl::stratum(&mat("X", &X)?, tol).py()?;
     stratum_dict(py, &st)
 }
+// The text_signature above spells the default out for help() and the stubs.
+const _: () = assert!(gl::STRATUM_TOL == 1e-8);
 
 /// The dict returned by `stratum`.
 fn stratum_dict<'py>(py: Python<'py>, st: &gl::Stratum) -> PyResult<Bound<'py, PyDict>> {

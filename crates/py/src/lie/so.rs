@@ -285,11 +285,13 @@ fn ad_star<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError, InvalidArgumentError (tol not a positive number).
 #[pyfunction]
-#[pyo3(signature = (R, tol = so::ROTATION_TOL))]
+#[pyo3(signature = (R, tol = so::ROTATION_TOL), text_signature = "(R, tol=1e-10)")]
 #[allow(non_snake_case)]
 fn is_rotation(R: ArrayIn<'_>, #[pyo3(from_py_with = real)] tol: f64) -> PyResult<bool> {
     so::is_rotation(&mat("R", &R)?, tol).py()
 }
+// The text_signature above spells the default out for help() and the stubs.
+const _: () = assert!(so::ROTATION_TOL == 1e-10);
 
 /// Nearest rotation to M in the Frobenius norm: U D Vᵀ from the SVD M = U Σ Vᵀ with
 /// D = diag(1, …, 1, sign det(UVᵀ)) (the polar factor when det M > 0).

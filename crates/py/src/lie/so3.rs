@@ -40,20 +40,21 @@ fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "w", &w, so3::try_exp)
 }
 
-/// `so3_log(r, strict=False)`: the principal logarithm w (‖w‖ = θ ∈ [0, π], exp(ŵ) = R),
+/// `so3_log(R, strict=False)`: the principal logarithm w (‖w‖ = θ ∈ [0, π], exp(ŵ) = R),
 /// accurate near θ = 0 and near θ = π (axis from the symmetric part of R there).
 ///
 /// At θ = π exactly both ±π·axis are logarithms: with `strict=False` one of them is returned
 /// (the one whose component at the largest diagonal entry of R is positive); with `strict=True`
 /// NoUniqueLogError is raised when π − θ ≤ 1e-12.
 ///
-/// Args: r — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Args: R — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or abs(det R − 1) > 1e-10),
 /// NoUniqueLogError (strict only).
 #[pyfunction]
-#[pyo3(signature = (r, strict = false))]
-fn so3_log<'py>(py: Python<'py>, r: ArrayIn<'py>, strict: bool) -> PyResult<Out<'py>> {
-    map_batch(py, "R", &r, |m: &Matrix3<f64>| {
+#[pyo3(signature = (R, strict = false))]
+#[allow(non_snake_case)]
+fn so3_log<'py>(py: Python<'py>, R: ArrayIn<'py>, strict: bool) -> PyResult<Out<'py>> {
+    map_batch(py, "R", &R, |m: &Matrix3<f64>| {
         let g = SO3::new(*m)?;
         if strict {
             g.log()
@@ -73,14 +74,15 @@ fn so3_cayley<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::cayley(w)))
 }
 
-/// `so3_cayley_inv(r)`: the inverse Cayley map, w = 2·vee(R − Rᵀ)/(1 + tr R).
+/// `so3_cayley_inv(R)`: the inverse Cayley map, w = 2·vee(R − Rᵀ)/(1 + tr R).
 ///
-/// Args: r — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Args: R — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (rotation by π:
 /// 1 + tr R ≤ 1e-12, where R + I is singular).
 #[pyfunction]
-fn so3_cayley_inv<'py>(py: Python<'py>, r: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "R", &r, |m: &Matrix3<f64>| {
+#[allow(non_snake_case)]
+fn so3_cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "R", &R, |m: &Matrix3<f64>| {
         so3::cayley_inv(SO3::new(*m)?.matrix3())
     })
 }

@@ -214,7 +214,9 @@ fn pair(what: &str, v: &Bound<'_, PyAny>) -> PyResult<(Mat, Mat)> {
 ///     InvalidArgumentError, ShapeError, NonFiniteError, DegenerateStratumError.
 #[pyfunction]
 #[pyo3(signature = (potential, *, shape = None, velocities = None, momenta = None, plane = None,
-                    bounds = (0.05, 5.0), starts = 6, incompressible = false))]
+                    bounds = (0.05, 5.0), starts = 6, incompressible = false),
+       text_signature = "(potential, *, shape=None, velocities=None, momenta=None, plane=None, \
+                         bounds=(0.05, 5.0), starts=6, incompressible=False)")]
 #[allow(clippy::too_many_arguments)]
 fn relative_equilibria(
     potential: &Bound<'_, PyPotential>,

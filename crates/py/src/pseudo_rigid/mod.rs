@@ -372,7 +372,7 @@ pub fn kinetic_energy(X: ArrayIn<'_>, V: ArrayIn<'_>) -> PyResult<f64> {
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (tol < 0).
 #[pyfunction]
-#[pyo3(signature = (X, tol = STRATUM_TOL))]
+#[pyo3(signature = (X, tol = STRATUM_TOL), text_signature = "(X, tol=1e-8)")]
 pub fn stratum<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
@@ -390,6 +390,8 @@ pub fn stratum<'py>(
     d.set_item("isotropy_dim", info.isotropy_dim)?;
     Ok(d)
 }
+// The text_signature above spells the default out for help() and the stubs.
+const _: () = assert!(STRATUM_TOL == 1e-8);
 
 /// Riemann-ellipsoid variables (001 (3.4)): Q = X X^T (quadrupole), N = X V^T (shear);
 /// N = (-L + dQ/dt) / 2 (3.10).

@@ -53,7 +53,7 @@ impl PyPendulum {
     ///
     /// Raises:
     ///     InvalidArgumentError, NonFiniteError, ShapeError.
-    fn exact<'py>(
+    fn exact_solution<'py>(
         &self,
         py: Python<'py>,
         amplitude: ArrayIn<'py>,

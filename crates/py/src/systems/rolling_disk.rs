@@ -69,10 +69,10 @@ impl PyRollingDisk {
     fn state(
         &self,
         #[pyo3(from_py_with = reals::<4>)] q: [f64; 4],
-        #[pyo3(from_py_with = real)] theta_dot: f64,
-        #[pyo3(from_py_with = real)] phi_dot: f64,
+        #[pyo3(from_py_with = real)] thetadot: f64,
+        #[pyo3(from_py_with = real)] phidot: f64,
     ) -> PyResult<Vec<f64>> {
-        self.disk.state(q, theta_dot, phi_dot).py()
+        self.disk.state(q, thetadot, phidot).py()
     }
 
     /// The relative residual ‖A(q) M^-1 p‖ / ‖M^-1 p‖ of the rolling constraints, vectorised:

@@ -194,7 +194,8 @@ impl PyRollingDisks {
     ///
     /// Raises:
     ///     InvalidArgumentError (an empty range), NonFiniteError.
-    #[pyo3(signature = (rolling_constant = None, theta1_range = (0.0, std::f64::consts::TAU)))]
+    #[pyo3(signature = (rolling_constant = None, theta1_range = (0.0, std::f64::consts::TAU)),
+           text_signature = "($self, rolling_constant=None, theta1_range=(0.0, 6.283185307179586))")]
     fn relative_equilibria(
         &self,
         #[pyo3(from_py_with = real_opt)] rolling_constant: Option<f64>,

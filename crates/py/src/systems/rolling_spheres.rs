@@ -117,20 +117,20 @@ impl PyRollingSpheres {
     }
 
     /// The planar state (003 §2.4 <-> §1): z_k the rotation by theta_k about e3,
-    /// u = (cos phi, sin phi, 0), Omega_k = (0, 0, theta_dot_k); then dphi/dt =
-    /// (r1 theta_dot_1 + r2 theta_dot_2)/(r1 + r2). It stays planar when gamma_k is
+    /// u = (cos phi, sin phi, 0), Omega_k = (0, 0, thetadot_k); then dphi/dt =
+    /// (r1 thetadot_1 + r2 thetadot_2)/(r1 + r2). It stays planar when gamma_k is
     /// perpendicular to e3 and e3 is an eigenvector of I_k. 003 §1's disk moment of inertia
     /// (about the disk's centre) is I_k[0,0] + I_k[1,1] + m_k ‖gamma_k‖^2.
     fn planar_state(
         &self,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
         #[pyo3(from_py_with = real)] phi: f64,
-        #[pyo3(from_py_with = reals::<2>)] theta_dot: [f64; 2],
+        #[pyo3(from_py_with = reals::<2>)] thetadot: [f64; 2],
     ) -> PyResult<Vec<f64>> {
-        self.sys.planar_state(theta, phi, theta_dot).py()
+        self.sys.planar_state(theta, phi, thetadot).py()
     }
 
-    /// The planar coordinates (theta1, theta2, phi, theta_dot_1, theta_dot_2) of one state on
+    /// The planar coordinates (theta1, theta2, phi, thetadot_1, thetadot_2) of one state on
     /// the planar subbundle (to `tol`).
     ///
     /// Raises:

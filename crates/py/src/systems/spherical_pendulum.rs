@@ -87,25 +87,25 @@ impl PySphericalPendulum {
     ///
     /// Raises:
     ///     ShapeError (shapes that do not broadcast), NonFiniteError.
-    #[pyo3(signature = (theta, phi, theta_dot = None, phi_dot = None))]
+    #[pyo3(signature = (theta, phi, thetadot = None, phidot = None))]
     fn state_from_spherical<'py>(
         &self,
         py: Python<'py>,
         theta: ArrayIn<'py>,
         phi: ArrayIn<'py>,
-        theta_dot: Option<ArrayIn<'py>>,
-        phi_dot: Option<ArrayIn<'py>>,
+        thetadot: Option<ArrayIn<'py>>,
+        phidot: Option<ArrayIn<'py>>,
     ) -> PyResult<Any<'py>> {
         let zero = || -> PyResult<ArrayIn<'py>> { 0.0f64.into_pyobject(py)?.extract() };
-        let theta_dot = theta_dot.map_or_else(zero, Ok)?;
-        let phi_dot = phi_dot.map_or_else(zero, Ok)?;
+        let thetadot = thetadot.map_or_else(zero, Ok)?;
+        let phidot = phidot.map_or_else(zero, Ok)?;
         map_items(
             py,
             &[
                 Input::new("theta", &theta, &[]),
                 Input::new("phi", &phi, &[]),
-                Input::new("theta_dot", &theta_dot, &[]),
-                Input::new("phi_dot", &phi_dot, &[]),
+                Input::new("thetadot", &thetadot, &[]),
+                Input::new("phidot", &phidot, &[]),
             ],
             &[6],
             |x, out| {

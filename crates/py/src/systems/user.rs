@@ -220,7 +220,7 @@ fn missing(py: Python<'_>, class: &str, name: &str, what: &str) -> PyErr {
     )
 }
 
-/// A count argument (`dim`) as usize; negative is an `InvalidArgumentError`.
+/// A count argument (`dof`) as usize; negative is an `InvalidArgumentError`.
 fn count(name: &str, v: i64) -> PyResult<usize> {
     usize::try_from(v).map_err(|_| {
         to_py(Error::invalid(
@@ -247,9 +247,9 @@ fn example_callable(py: Python<'_>) -> PyResult<Any<'_>> {
 ///         None for central differences of H with one Richardson extrapolation (4 calls of H per
 ///         coordinate, 8d per gradient; relative accuracy about 1e-12 for smooth H varying on
 ///         the scale of the state; the methods are then symplectic only to that accuracy).
-///     dim: the number d >= 1 of degrees of freedom (required).
+///     dof: the number d >= 1 of degrees of freedom (required).
 /// Raises:
-///     ArgumentTypeError (not callable, no dim), InvalidArgumentError (dim < 1).
+///     ArgumentTypeError (not callable, no dof), InvalidArgumentError (dof < 1).
 ///
 /// The callables run in the integrating thread with the GIL (runs of this system are single-
 /// threaded; a batch of states runs member after member). An exception they raise is re-raised
@@ -263,11 +263,11 @@ pub struct PyCanonical {
 #[pymethods]
 impl PyCanonical {
     #[new]
-    #[pyo3(signature = (hamiltonian, gradient=None, dim=None))]
+    #[pyo3(signature = (hamiltonian, gradient=None, dof=None))]
     fn new(
         hamiltonian: Any<'_>,
         gradient: Option<Any<'_>>,
-        dim: Option<Any<'_>>,
+        dof: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = hamiltonian.py();
         let calls = Arc::new(UserCallbacks::default());
@@ -275,13 +275,13 @@ impl PyCanonical {
         let g = optional(gradient.as_ref())
             .map(|g| Callee::new("gradient", g, &calls))
             .transpose()?;
-        let d = match optional(dim.as_ref()) {
-            Some(v) => count("dim", named("dim", int_opt(v))?.unwrap_or(0))?,
+        let d = match optional(dof.as_ref()) {
+            Some(v) => count("dof", named("dof", int_opt(v))?.unwrap_or(0))?,
             None => {
                 return Err(missing(
                     py,
                     "Canonical",
-                    "dim",
+                    "dof",
                     "the number of degrees of freedom",
                 ))
             }
@@ -303,8 +303,8 @@ impl PyCanonical {
             .py()?
             .with_session(gil());
         let _ = calls.log.set(sys.failures());
-        let args = (hamiltonian, gradient, dim).into_pyobject(py)?;
-        let base = PySystem::new(sys.clone(), args, &["hamiltonian", "gradient", "dim"])
+        let args = (hamiltonian, gradient, dof).into_pyobject(py)?;
+        let base = PySystem::new(sys.clone(), args, &["hamiltonian", "gradient", "dof"])
             .with_callbacks(Some(calls as Arc<dyn Callbacks>));
         Ok(PyClassInitializer::from(base).add_subclass(PyCanonical { sys }))
     }
@@ -330,18 +330,18 @@ impl PyCanonical {
 
 // ---------------------------------------------------------------------------------------------
 
-/// The kinetic mass: a number, a vector (diagonal) or a matrix.
+/// The mass argument: a number, a vector (diagonal) or a matrix.
 fn kinetic_mass(m: &Any<'_>) -> PyResult<KineticMass> {
     if let Ok(Real(x)) = m.extract::<Real>() {
         return Ok(KineticMass::Scalar(x));
     }
-    let a = ArrayIn::named("kinetic_mass", m)?;
+    let a = ArrayIn::named("mass", m)?;
     let v = a.as_array();
     match v.ndim() {
-        1 => Ok(KineticMass::Diagonal(read_all("kinetic_mass", &v)?)),
-        2 => Ok(KineticMass::Matrix(mat("kinetic_mass", &a)?)),
+        1 => Ok(KineticMass::Diagonal(read_all("mass", &v)?)),
+        2 => Ok(KineticMass::Matrix(mat("mass", &a)?)),
         _ => Err(to_py(Error::shape(
-            "kinetic_mass",
+            "mass",
             "a number, a vector (d,) (diagonal) or a matrix (d, d)",
             shape_str(v.shape()),
         ))),
@@ -356,14 +356,14 @@ fn kinetic_mass(m: &Any<'_>) -> PyResult<KineticMass> {
 /// of the gradient per stage), gauss4, gauss6, midpoint, rk4. No invariants.
 ///
 /// Args:
-///     kinetic_mass: M > 0 as a number (M = m I; then `dim` is required), a vector (d,) of
+///     mass: M > 0 as a number (M = m I; then `dof` is required), a vector (d,) of
 ///         positive entries (diagonal M) or a symmetric positive-definite matrix (d, d).
 ///     potential: callable q -> U(q), q a float64 array (d,).
 ///     gradient: callable q -> grad U (d,), or None for central differences (see `Canonical`).
-///     dim: the number of degrees of freedom (needed for a scalar mass; must agree otherwise).
+///     dof: the number of degrees of freedom (needed for a scalar mass; must agree otherwise).
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError (a mass that is not positive definite),
-///     ShapeError (a mass of the wrong shape, a dim that disagrees).
+///     ShapeError (a mass of the wrong shape, a dof that disagrees).
 ///
 /// The callables are called as those of `Canonical` (exceptions re-raised naming the step, also
 /// at the initial state: Verlet evaluates the force when it starts).
@@ -375,47 +375,43 @@ pub struct PySeparable {
 #[pymethods]
 impl PySeparable {
     #[new]
-    #[pyo3(signature = (kinetic_mass, potential, gradient=None, dim=None))]
+    #[pyo3(signature = (mass, potential, gradient=None, dof=None))]
     fn new(
-        kinetic_mass: Any<'_>,
+        mass: Any<'_>,
         potential: Any<'_>,
         gradient: Option<Any<'_>>,
-        dim: Option<Any<'_>>,
+        dof: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = potential.py();
         let calls = Arc::new(UserCallbacks::default());
-        let mass = self::kinetic_mass(&kinetic_mass)?;
+        let kinetic = self::kinetic_mass(&mass)?;
         let u = Callee::new("potential", &potential, &calls)?;
         let g = optional(gradient.as_ref())
             .map(|g| Callee::new("gradient", g, &calls))
             .transpose()?;
-        let d = match optional(dim.as_ref()) {
-            Some(v) => Some(count("dim", named("dim", int_opt(v))?.unwrap_or(0))?),
+        let d = match optional(dof.as_ref()) {
+            Some(v) => Some(count("dof", named("dof", int_opt(v))?.unwrap_or(0))?),
             None => None,
         };
-        if matches!(mass, KineticMass::Scalar(_)) && d.is_none() {
+        if matches!(kinetic, KineticMass::Scalar(_)) && d.is_none() {
             return Err(missing(
                 py,
                 "Separable",
-                "dim",
-                "the number of degrees of freedom, needed with a scalar kinetic_mass",
+                "dof",
+                "the number of degrees of freedom, needed with a scalar mass",
             ));
         }
         let value: ScalarFn = Arc::new(move |q: &[f64]| u.scalar(&[q]));
         let grad_fn: Option<GradientFn> = g.map(|g| {
             Arc::new(move |q: &[f64], out: &mut [f64]| g.call(&[q], &[q.len()], out)) as GradientFn
         });
-        let sys = UserSeparable::new(mass, d, value, grad_fn)
+        let sys = UserSeparable::new(kinetic, d, value, grad_fn)
             .py()?
             .with_session(gil());
         let _ = calls.log.set(sys.failures());
-        let args = (kinetic_mass, potential, gradient, dim).into_pyobject(py)?;
-        let base = PySystem::new(
-            sys.clone(),
-            args,
-            &["kinetic_mass", "potential", "gradient", "dim"],
-        )
-        .with_callbacks(Some(calls as Arc<dyn Callbacks>));
+        let args = (mass, potential, gradient, dof).into_pyobject(py)?;
+        let base = PySystem::new(sys.clone(), args, &["mass", "potential", "gradient", "dof"])
+            .with_callbacks(Some(calls as Arc<dyn Callbacks>));
         Ok(PyClassInitializer::from(base).add_subclass(PySeparable { sys }))
     }
 
