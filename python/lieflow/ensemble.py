@@ -22,6 +22,7 @@ when a function of this module is called, not when ``lieflow`` is imported.
 
 from __future__ import annotations
 
+import copy
 import operator
 import sys
 from typing import TYPE_CHECKING, Any, Callable, Sequence
@@ -58,12 +59,18 @@ def _require():
 
 
 def _cores() -> int:
-    """The cores the tasks will run on: the threads of the active ``dask.distributed`` client's
-    workers if there is a client, else the local cores (``dask.system.CPU_COUNT``)."""
+    """The cores the tasks will run on, by Dask's choice of scheduler: the worker threads of
+    the current ``dask.distributed`` client if there is one (and ``dask.config`` names no other
+    scheduler), else the local cores (``num_workers`` of ``dask.config``, or
+    ``dask.system.CPU_COUNT``)."""
+    import dask
+    from dask.system import CPU_COUNT
+
+    named = dask.config.get("scheduler", None)
     dist = sys.modules.get("distributed")   # a client exists only if distributed was imported
-    if dist is not None:
+    if dist is not None and named in (None, "distributed", "dask.distributed"):
         try:
-            client = dist.default_client()
+            client = dist.Client.current(allow_global=True)
         except ValueError:                   # no client
             client = None
         if client is not None and not getattr(client, "asynchronous", False):
@@ -73,8 +80,7 @@ def _cores() -> int:
                 n = 0
             if n > 0:
                 return n
-    from dask.system import CPU_COUNT
-    return max(1, int(CPU_COUNT))
+    return max(1, int(dask.config.get("num_workers", None) or CPU_COUNT))
 
 
 def default_chunks(members: int, cores: int | None = None) -> int:
@@ -89,7 +95,8 @@ def default_chunks(members: int, cores: int | None = None) -> int:
         The number of members of the ensemble.
     cores : int, optional
         The cores to spread the tasks over. Default: the total threads of the workers of the
-        active ``dask.distributed`` client if there is one, else the local cores.
+        current ``dask.distributed`` client if there is one, else the local cores (Dask's
+        ``num_workers`` setting if given).
 
     Returns
     -------
@@ -112,12 +119,23 @@ def _note(err: BaseException, text: str) -> None:
         err.add_note(text)
 
 
+def _own(system):
+    """A copy of ``system`` for one task (rebuilt from its constructor arguments, as pickling
+    does). The tasks of one process then share no system object: a system built from Python
+    callables keeps the exception of a callable, and where its run failed, on the object until
+    the run raises it, so two concurrent runs of one object could take each other's errors."""
+    try:
+        return copy.deepcopy(system)
+    except Exception:        # a system that cannot be copied is used as it is
+        return system
+
+
 def _integrate_chunk(system, z, att, dt, steps, method, save_every, t0, lo):
     """One task of :func:`integrate`: the members ``lo ..`` of the ensemble, states ``z``
-    (c, d), as one native batch run on one thread."""
+    (c, d), as one native batch run on one thread, of the task's own copy of ``system``."""
     try:
-        traj = _integrate(system, z, dt=dt, steps=steps, method=method, save_every=save_every,
-                          attitude=att, threads=1, t0=t0, progress=False)
+        traj = _integrate(_own(system), z, dt=dt, steps=steps, method=method,
+                          save_every=save_every, attitude=att, threads=1, t0=t0, progress=False)
         out = {"states": traj.states, "energy": np.asarray(traj.energy(), dtype=np.float64),
                "invariants": np.asarray(traj.invariants(), dtype=np.float64),
                "final_state": traj.final_state}
@@ -136,8 +154,8 @@ def _sweep_task(make_system, value, index, z0, dt, steps, method, save_every, t0
     try:
         system = make_system(value)
         _check_system(system)
-        traj = _integrate(system, z0, dt=dt, steps=steps, method=method, save_every=save_every,
-                          threads=1, t0=t0, progress=False)
+        traj = _integrate(_own(system), z0, dt=dt, steps=steps, method=method,
+                          save_every=save_every, threads=1, t0=t0, progress=False)
         inv = np.asarray(traj.invariants(), dtype=np.float64)
         if traj.states.shape[-1] != d or inv.shape[-1] != c:
             raise ShapeError(f"make_system(params[{index}]) made a system with states of "
@@ -239,11 +257,12 @@ def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str
         ``energy`` (``member``, ``time``), ``invariants`` (``member``, ``time``,
         ``invariant``) and ``final_state`` (``member``, ``component``), the state after all
         steps (also when ``steps`` is not a multiple of ``save_every``); with an attitude also
-        ``attitude`` (``member``, ``time``, ``row``, ``col``) and ``final_attitude``
-        (``member``, ``row``, ``col``). Coordinates ``member`` (0 .. b-1) and ``time`` (the
-        sample times, exactly ``lieflow.integrate``'s ``traj.t``). Attributes ``system`` (its
-        repr), ``method`` (the resolved name), ``dt``, ``save_every``, ``t0``, ``steps`` and
-        ``lieflow_version``.
+        ``attitude`` (``member``, ``time``, ``attitude_row``, ``attitude_col``) and
+        ``final_attitude`` (``member``, ``attitude_row``, ``attitude_col``). Coordinates
+        ``member`` (0 .. b-1) and ``time`` (the sample times, exactly ``lieflow.integrate``'s
+        ``traj.t``). Attributes ``system`` (its repr), ``method`` (the resolved name), ``dt``,
+        ``save_every``, ``t0``, ``steps`` and ``lieflow_version``. The names are those of
+        ``Trajectory.to_xarray()``.
 
     Raises
     ------
@@ -322,8 +341,8 @@ def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str
     dims = {"states": ("member", "time", "component"), "energy": ("member", "time"),
             "invariants": ("member", "time", "invariant"),
             "final_state": ("member", "component"),
-            "attitude": ("member", "time", "row", "col"),
-            "final_attitude": ("member", "row", "col")}
+            "attitude": ("member", "time", "attitude_row", "attitude_col"),
+            "final_attitude": ("member", "attitude_row", "attitude_col")}
     import xarray as xr
     return xr.Dataset({v: (dims[v], a) for v, a in arrays.items()},
                       coords={"member": np.arange(b), "time": t},
