@@ -11,7 +11,7 @@ step() { printf '\n== %s (%ds)\n' "$*" "$((SECONDS - t0))"; }
 
 step "python environment"
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
-"$venv/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.9.4,<2" numpy scipy pytest hypothesis tqdm matplotlib pillow xarray h5netcdf
+"$venv/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.9.4,<2" numpy scipy pytest hypothesis tqdm matplotlib pillow xarray h5netcdf mypy
 
 step "cargo fmt --check"
 cargo fmt --all -- --check
@@ -28,5 +28,11 @@ VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --release
 
 step "pytest"
 "$venv/bin/python" -m pytest -q python/tests
+
+step "typing (mypy.stubtest, mypy examples)"
+# The .pyi stubs against the built module (allow-list: only what stubtest cannot see, each entry
+# with its reason), then the examples type-checked with those stubs ([tool.mypy] in pyproject.toml).
+"$venv/bin/python" -m mypy.stubtest lieflow --allowlist python/stubtest-allowlist.txt --mypy-config-file pyproject.toml
+"$venv/bin/python" -m mypy examples/
 
 step "done"
