@@ -62,6 +62,7 @@ for name, m12 in cases.items():
 
 fig, axes = plt.subplots(1, 3, figsize=(12, 4.2))
 for ax, (name, tr) in zip(axes, runs.items()):
+    assert tr.attitude is not None  # integrated with attitude=R0
     tip = tr.attitude[:, :, 2]  # third column of R: the body axis e3 in space
     ax.plot(tip[:, 0], tip[:, 1], lw=1)
     ax.plot(*tip[0, :2], "ko", ms=4)

@@ -45,7 +45,7 @@ def euler(t, m):
     return np.cross(m, m / inertia)
 
 
-points = {}  # method -> list of (seconds, error)
+points: dict[str, list[tuple[float, float]]] = {}  # method -> (seconds, error) pairs
 for method in ("splitting", "splitting4", "splitting6", "rkmk4", "rk4"):
     for steps in (50, 100, 200, 400, 800, 1600, 3200):
         sec, tr = best_time(lambda: lf.integrate(body, M0, dt=T / steps, steps=steps,
