@@ -9,7 +9,7 @@ Every task is one native batch run, ``lieflow.integrate(..., threads=1, progress
 native run releases the GIL, so the tasks of Dask's local threaded scheduler run in parallel,
 and one thread per task does not oversubscribe the cores of a ``dask.distributed`` worker. The
 members of a batch are independent, so the results equal those of one
-``lieflow.integrate(system, states, ...)`` call bit for bit, whatever the chunking and wherever
+``lieflow.integrate(system, state0, ...)`` call bit for bit, whatever the chunking and wherever
 the tasks run.
 
 Which scheduler runs the tasks is Dask's usual rule, decided when the Dataset is computed: the
@@ -23,6 +23,7 @@ when a function of this module is called, not when ``lieflow`` is imported.
 from __future__ import annotations
 
 import copy
+import numbers
 import operator
 import sys
 from typing import TYPE_CHECKING, Any, Callable, Sequence
@@ -30,7 +31,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from ._lieflow import InvalidArgumentError, ShapeError, __version__
-from .integrate import _attitude, _check_system, _count, _step, _time
+from .integrate import _MAX_COUNT, _attitude, _check_system, _count, _step, _time
 from .integrate import integrate as _integrate
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -102,8 +103,21 @@ def default_chunks(members: int, cores: int | None = None) -> int:
     -------
     int
         Members per task.
+
+    Raises
+    ------
+    TypeError
+        ``members`` or ``cores`` not an integer.
+    lieflow.InvalidArgumentError
+        ``members`` < 0 or ``cores`` < 1.
     """
+    if isinstance(members, bool) or not isinstance(members, (numbers.Integral, np.integer)):
+        raise TypeError(f"invalid members: expected an integer >= 0, got "
+                        f"{type(members).__name__} {members!r:.60}")
     members = operator.index(members)
+    if not 0 <= members <= _MAX_COUNT:
+        raise InvalidArgumentError(f"invalid members: expected an integer in [0, 2**63 - 1], "
+                                   f"got {members}")
     cores = _cores() if cores is None else _count("cores", cores)
     return max(1, -(-members // (TASKS_PER_CORE * cores)))
 
@@ -192,13 +206,13 @@ def _attrs(method, dt, save_every, t0, steps):
             "lieflow_version": __version__}
 
 
-def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str | None = None,
+def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str | None = None,
               save_every: int = 1, *, chunks: int | None = None, t0: float = 0.0,
               attitude: ArrayLike | None = None) -> xarray.Dataset:
     """Integrates an ensemble of initial states as Dask tasks; a lazy :class:`xarray.Dataset`.
 
     The members are split into chunks of ``chunks`` members, and each chunk becomes one Dask
-    task: a native batch run ``lieflow.integrate(system, states[chunk], dt=dt, steps=steps,
+    task: a native batch run ``lieflow.integrate(system, state0[chunk], dt=dt, steps=steps,
     method=method, save_every=save_every, threads=1, t0=t0, progress=False)`` that returns the
     chunk's states, energy and invariants. The native run releases the GIL, so the tasks run
     in parallel on Dask's threaded scheduler too; one thread per task keeps the cores of
@@ -219,7 +233,7 @@ def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str
     Every argument is checked in the calling process before any task is made: all initial
     states (and attitudes) and the method by the native ``system._start`` (which validates
     without stepping), and the size of one task's trajectory by the rule of
-    ``lieflow.integrate``. The results equal those of ``lieflow.integrate(system, states,
+    ``lieflow.integrate``. The results equal those of ``lieflow.integrate(system, state0,
     ...)`` bit for bit.
 
     Parameters
@@ -227,7 +241,7 @@ def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str
     system : lieflow.System
         A system object, e.g. ``lieflow.RigidBody([1, 2, 3])`` (it is pickled into every task
         for ``dask.distributed``; the systems of lieflow pickle).
-    states : array_like
+    state0 : array_like
         The initial states, a batch along a leading axis in the system's layout, as
         ``lieflow.integrate`` takes them (one state is an ensemble of one member).
     dt : float
@@ -270,7 +284,7 @@ def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str
         Dask or xarray is not installed.
     TypeError
         ``system`` is not a system; ``dt`` or ``t0`` not a real number; ``steps``,
-        ``save_every`` or ``chunks`` not an integer; ``method`` not a str; ``states`` or
+        ``save_every`` or ``chunks`` not an integer; ``method`` not a str; ``state0`` or
         ``attitude`` not real numbers.
     lieflow.InvalidArgumentError
         ``dt`` <= 0 or not finite, ``steps``, ``save_every`` or ``chunks`` < 1, a state
@@ -279,9 +293,9 @@ def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str
     lieflow.UnsupportedMethodError
         ``method`` is not one of ``system.methods()``.
     lieflow.ShapeError
-        ``states`` or ``attitude`` of the wrong shape.
+        ``state0`` or ``attitude`` of the wrong shape.
     lieflow.NonFiniteError
-        A NaN or infinity in ``states``.
+        A NaN or infinity in ``state0``.
     lieflow.NotInGroupError
         An attitude that is not a rotation.
 
@@ -305,7 +319,7 @@ def integrate(system: Any, states: ArrayLike, dt: float, steps: int, method: str
     _check_method(method)
     if chunks is not None:
         chunks = _count("chunks", chunks)
-    z, batched = system._normalize_state(states)
+    z, batched = system._normalize_state(state0)
     b, d = z.shape
     att = None if attitude is None else _attitude(attitude, b, batched)
     # Every member's state (and attitude) and the method, without stepping; the members are
@@ -438,7 +452,7 @@ def sweep(make_system: Callable[[Any], Any], params: Sequence[Any], state0: Arra
     lieflow.NonFiniteError
         A NaN or infinity in ``state0``.
 
-    An exception of ``make_system(params[0])`` propagates as it is.
+    An exception of ``make_system(params[0])`` propagates, with a note naming the value.
 
     Examples
     --------
@@ -464,7 +478,11 @@ def sweep(make_system: Callable[[Any], Any], params: Sequence[Any], state0: Arra
     dt = _step(dt)
     t0 = _time("t0", t0)
     _check_method(method)
-    system = make_system(values[0])
+    try:
+        system = make_system(values[0])
+    except Exception as e:
+        _note(e, f"raised by make_system(params[0]) with params[0] = {values[0]!r:.80}")
+        raise
     try:
         _check_system(system)
     except TypeError as e:

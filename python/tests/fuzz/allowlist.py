@@ -36,6 +36,9 @@ ALLOWED = [
     ("integrate*", "state0", "broadcast-1e6", "timeout",
      "a batch of 10^6 initial states is a legitimate run that takes longer than the harness's "
      "time limit (it is refused only beyond the memory limits)"),
+    ("ensemble.sweep", "params", "tuple-1", "accepted-bad",
+     "(1.0,) is a valid sequence of one parameter value (the catalogue's 'obj' values assume a "
+     "lieflow object)"),
     ("lie.to_scipy", "R", "*", "wrong-result",
      "the result is a scipy Rotation, which has no value equality (== is identity), so the harness "
      "cannot compare it with the valid call's; to_scipy is Rotation.from_quat(to_quaternion(R)) "

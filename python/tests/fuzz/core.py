@@ -121,6 +121,9 @@ def _resolve_target(target: str, lf, cache):
 
 def _exercise(obj, target, lf):
     """What a constructor of Python-callable-backed objects is fuzzed through: their use."""
+    if target.startswith("use:ensemble."):      # a lazy Dataset: computed here, in this process
+        ds = obj.compute(scheduler="sync")
+        return {**{k: v.values for k, v in ds.variables.items()}, "attrs": dict(ds.attrs)}
     if "potentials" in target:
         return obj.value(X3), obj.gradient(X3), obj.hessian(X3, V3)
     key = {"Revolution": "revolution", "Graph": "graph", "MetricSurface": "metric"}[target.split(".")[-1]]

@@ -405,6 +405,46 @@ def forced_specs(add):
             A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True))
 
 
+# --- lieflow.ensemble: Dask ensembles and sweeps (fuzzed when dask and xarray are installed) ---
+
+def _has_dask():
+    import importlib.util
+
+    return all(importlib.util.find_spec(m) is not None for m in ("dask", "xarray"))
+
+
+def ensemble_body(i3):
+    """make_system of the lf.ensemble.sweep spec: a rigid body with I3 = i3."""
+    import lieflow
+
+    return lieflow.RigidBody([1.0, 2.0, i3])
+
+
+def ensemble_specs(add):
+    """lf.ensemble.integrate / sweep (the lazy Dataset is computed by the harness on Dask's
+    synchronous scheduler, see core._exercise) and default_chunks. Their arguments are checked
+    before any task is made, with lf.integrate's helpers and errors."""
+    if not _has_dask():
+        return
+    batch = np.array([[1.0, 0.5, -0.3], [0.2, -0.4, 0.9]])
+    add("ensemble.integrate[rb]", "use:ensemble.integrate", A("system", lazy_recv("rb"), "obj"),
+        A("state0", batch, "vec"), A("dt", 0.01, "float", positive=True),
+        A("steps", 12, "int", positive=True), A("method", "splitting4", "str", opt=True),
+        A("save_every", 5, "int", positive=True), A("chunks", 1, "int", kw=True, opt=True,
+                                                     positive=True),
+        A("t0", 0.5, "float", kw=True), module="integrate")
+    add("ensemble.integrate[rb,attitude]", "use:ensemble.integrate",
+        A("system", lazy_recv("rb"), "obj"), A("state0", batch, "vec"), A("dt", 0.01, "float"),
+        A("steps", 10, "int"), A("attitude", R3, "rot", kw=True, opt=True), module="integrate")
+    add("ensemble.sweep", "use:ensemble.sweep", A("make_system", ensemble_body, "fn"),
+        A("params", [2.5, 3.5], "obj"), A("state0", M3.copy(), "vec"),
+        A("dt", 0.01, "float", positive=True), A("steps", 10, "int", positive=True),
+        A("method", None, "str", opt=True), A("save_every", 3, "int", positive=True),
+        A("t0", 0.0, "float", kw=True), module="integrate")
+    add("ensemble.default_chunks", "ensemble.default_chunks", A("members", 1000, "int"),
+        A("cores", 2, "int", kw=True, opt=True, positive=True), module="integrate")
+
+
 def _scipy_rotation(lf):
     """A scipy Rotation of two rotations (the argument of lf.lie.from_scipy)."""
     from scipy.spatial.transform import Rotation
@@ -755,6 +795,7 @@ def build_specs() -> list[Spec]:
     # ---- user-defined systems (issue 15) ----
     user_specs(add)
     forced_specs(add)
+    ensemble_specs(add)
     return S
 
 

@@ -21,7 +21,7 @@ import lieflow as lf
 from .allowlist import KNOWN_FAILING
 from .catalogue import CATALOGUE
 from .core import SPECS, build_cases, describe, run_cases, summarize
-from .examples import CONSTRUCTORS, RECEIVERS
+from .examples import CONSTRUCTORS, RECEIVERS, _has_dask
 
 TIER = os.environ.get("LIEFLOW_FUZZ", "quick")
 TIMEOUT = float(os.environ.get("LIEFLOW_FUZZ_TIMEOUT", "5" if TIER == "quick" else "10"))
@@ -93,7 +93,8 @@ CLASS_RECEIVER = {**CONSTRUCTORS, "Integration": "run", "Trajectory": "traj",
 def public_callables():
     out = []
     for modname in ("", ".lie", ".pseudo_rigid", ".potentials", ".surfaces", ".elliptic",
-                    ".ellipsoids", ".continuation", ".plot"):
+                    ".ellipsoids", ".continuation", ".plot",
+                    *((".ensemble",) if _has_dask() else ())):
         mod = eval("lf" + modname)
         for name in getattr(mod, "__all__", None) or dir(mod):
             if name.startswith("_"):
