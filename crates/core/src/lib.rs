@@ -16,6 +16,26 @@
 //! let y = r * Vector3::x();
 //! assert!((y - Vector3::y()).norm() < 1e-15);
 //! ```
+//!
+//! A free rigid body integrated by a 4th-order Lie–Poisson splitting (methods are chosen by name
+//! from the system's catalog, or passed as values to `integrate_with`): the Casimir ‖M‖² and the
+//! energy are kept to round-off level over 10⁴ steps, and the motion agrees with the exact
+//! Jacobi-elliptic solution.
+//!
+//! ```
+//! use lieflow::integrate::{integrate, Problem};
+//! use lieflow::systems::RigidBody;
+//!
+//! let body = RigidBody::new([1.0, 2.0, 3.0])?;
+//! let m0 = [1.0, 0.5, -0.3];
+//! let traj = integrate(&body, "splitting4", &m0, 1e-2, 10_000, 100)?; // to t = 100
+//! let (first, last) = (traj.state(0), traj.state(traj.len() - 1));
+//! assert!((body.energy(last)? - body.energy(first)?).abs() < 1e-12);
+//! assert!((body.invariants(last)?[0] - body.invariants(first)?[0]).abs() < 1e-12);
+//! let exact = body.exact_momentum(&m0, traj.t[traj.len() - 1])?;
+//! assert!(last.iter().zip(exact).all(|(a, b)| (a - b).abs() < 1e-7));
+//! # Ok::<(), lieflow::Error>(())
+//! ```
 
 pub mod analysis;
 pub mod check;

@@ -11,7 +11,8 @@ pub struct Clock {
     pub t0: f64,
     /// The step size.
     pub dt: f64,
-    /// Steps done before the current call of [`Stepper::advance`].
+    /// Steps done before the current call of
+    /// [`Stepper::advance`](crate::integrate::Stepper::advance).
     pub done: u64,
 }
 

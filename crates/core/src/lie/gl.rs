@@ -198,8 +198,9 @@ pub fn svd_coordinates(x: &Mat) -> Result<SvdCoordinates> {
 
 /// X = R diag(a) Sᵀ from SVD coordinates (the inverse of [`svd_coordinates`], 001 (2.6)).
 ///
-/// Errors: R, S not n×n rotations ([`check_rotation`]), a not of length n, non-finite, or some
-/// a_i ≤ 0 ([`Error::InvalidArgument`]). The a_i need not be ordered.
+/// Errors: R, S not n×n rotations ([`check_rotation`](crate::lie::so::check_rotation)), a not of
+/// length n, non-finite, or some a_i ≤ 0 ([`Error::InvalidArgument`]). The a_i need not be
+/// ordered.
 pub fn from_svd(r: &Mat, a: &[f64], s: &Mat) -> Result<Mat> {
     let n = a.len();
     if n == 0 {

@@ -799,7 +799,7 @@ fn representable(what: &str, m: Mat) -> Result<Mat> {
 /// ξ/2ˢ with |ξ|/2ˢ ≤ ½ (terms fall at least like 0.71ᵏ/(k+1)!, truncated when below 10⁻¹⁷ of
 /// the sum) and doubled back s times with dexp_{2y} = ½ (dexp_y + Ad_{exp y} dexp_y), which
 /// avoids the cancellation of the raw series for large |ξ|. n = 3: closed form
-/// (see [`dexp3`]).
+/// (see `dexp3`).
 pub fn dexp(xi: &Mat, eta: &Mat) -> Result<Mat> {
     representable("dexp", dexp_raw(xi, eta)?)
 }
@@ -905,7 +905,7 @@ fn zeta_direct(p: i32) -> f64 {
 /// Domain |ξ| < π (|ξ| the pairing norm, [`norm`]): the eigenvalues of ad_ξ are ±i(θ_j ± θ_k)
 /// and ±iθ_j, of modulus ≤ √2|ξ| < 2π, inside the radius of convergence 2π; the terms then fall
 /// at least like (√2|ξ|/2π)ᵏ ≤ 0.71ᵏ and the sum is truncated when a bound of the tail is below
-/// 10⁻¹⁷ of the sum. n = 3: closed form (see [`dexp3`]). Outside the domain →
+/// 10⁻¹⁷ of the sum. n = 3: closed form (see `dexp3`). Outside the domain →
 /// [`Error::InvalidArgument`].
 pub fn dexp_inv(xi: &Mat, eta: &Mat) -> Result<Mat> {
     representable("dexp_inv", dexp_inv_raw(xi, eta)?)

@@ -48,7 +48,7 @@ fn tangent(b: &BiInertia, y: &Mat) -> Result<()> {
 /// ω^L(ξX) = ξ and ω^L_{gX} = Ad_g ∘ ω^L_X (2.16).
 ///
 /// Scale-aware, as every connection here: J is formed with X̃ = X/c (c a power of two near the
-/// largest singular value, [`BiInertia::unit_x`]) and the inverse on the scaled singular values,
+/// largest singular value, `BiInertia::unit_x`) and the inverse on the scaled singular values,
 /// ω_X(Y) = ω_X̃(Y/c), so X at 1e-200 or 1e200 gives ω wherever ω is representable.
 pub fn left_connection(b: &BiInertia, y: &Mat) -> Result<Mat> {
     tangent(b, y)?;
@@ -124,7 +124,7 @@ pub fn horizontal_part(b: &BiInertia, y: &Mat, action: Action) -> Result<Mat> {
 /// (6.8), polarised. O(n⁶) (a Gram matrix of n(n−1) vectors in R^{n²}): a check, not a hot
 /// path.
 ///
-/// Scale-aware: computed at X̃ = X/c ([`BiInertia::unit_x`]) and multiplied by c² once; an
+/// Scale-aware: computed at X̃ = X/c (`BiInertia::unit_x`) and multiplied by c² once; an
 /// overflow error (InvalidArgument) where an entry exceeds the f64 range.
 pub fn locked_inertia(b: &BiInertia, action: Action) -> Result<Mat> {
     let (xs, scale) = b.unit_x()?;

@@ -10,7 +10,7 @@
 //! - Dedekind's reciprocity: X ↦ Xᵀ maps motions to motions and swaps L and Γ,
 //!   [`adjoint_motion`].
 //!
-//! Time stepping of the full system is [`crate::integrate::verlet`].
+//! Time stepping of the full system is [`crate::integrate::methods::verlet`].
 
 use crate::check;
 use crate::error::{Error, Result};

@@ -182,7 +182,7 @@ fn velocity_derivative(b: &BiInertia, xi: &Mat, eta: &Mat, v: &Mat) -> Result<(M
     Ok((-dxi, -deta))
 }
 
-/// The derivative D_κ κ(X)[V] of the velocities κ(X) = B_X⁻¹(λ ⊕ γ) at fixed momenta, as the
+/// The derivative D_κ κ(X)\[V\] of the velocities κ(X) = B_X⁻¹(λ ⊕ γ) at fixed momenta, as the
 /// pair (δξ, δη) = −B_X⁻¹(L_V*L_X κ + L_X*L_V κ) (module notes on the Hessians; L_X κ = ξX − Xη,
 /// L_X*Y = J(X, Y) = (YXᵀ − XYᵀ) ⊕ (YᵀX − XᵀY)).
 ///
@@ -212,13 +212,13 @@ pub fn augmented_hessian(
 }
 
 /// D²V_{λ⊕γ}(X)\[V\] (001 (8.11)), analytic (module notes on the Hessians): with
-/// κ = ξ ⊕ η = B_X⁻¹(λ ⊕ γ), W = ξX − Xη, W_V = ξV − Vη, δξ ⊕ δη = Dκ[V]
+/// κ = ξ ⊕ η = B_X⁻¹(λ ⊕ γ), W = ξX − Xη, W_V = ξV − Vη, δξ ⊕ δη = Dκ\[V\]
 /// ([`amended_velocity_derivative`]) and W' = δξX − Xδη,
 ///
-/// D²V[V] = D²U(X)[V] + (ξW_V − W_Vη) + (ξW' − W'η) + (δξW − Wδη)
+/// D²V\[V\] = D²U(X)\[V\] + (ξW_V − W_Vη) + (ξW' − W'η) + (δξW − Wδη)
 ///        = [`augmented_hessian`] at κ + (ξW' − W'η) + (δξW − Wδη).
 ///
-/// Symmetric, and ⟨Y, D²V[V]⟩ = ⟨Y, D²U_κ[V]⟩ + ⟨Dκ[Y], B_X Dκ[V]⟩.
+/// Symmetric, and ⟨Y, D²V\[V\]⟩ = ⟨Y, D²U_κ\[V\]⟩ + ⟨Dκ\[Y\], B_X Dκ\[V\]⟩.
 ///
 /// Errors as [`amended_potential`], and V not n×n or not finite.
 pub fn amended_hessian(pot: &dyn Potential, x: &Mat, lam: &Mat, gam: &Mat, v: &Mat) -> Result<Mat> {

@@ -246,7 +246,7 @@ impl BiInertia {
 
     /// B_X as an n(n−1)×n(n−1) matrix in the e_ij basis, ξ block first (001 (6.9)); its blocks
     /// are the matrices of A^L_X, −2Ad_X, −2Adᵀ_X, A^R_X.
-    /// [`BiInertia::matrix`] scale-safely: c² B_X̃ with X̃ = X/c ([`BiInertia::unit_x`]), and an
+    /// [`BiInertia::matrix`] scale-safely: c² B_X̃ with X̃ = X/c (`BiInertia::unit_x`), and an
     /// overflow error (InvalidArgument) where an entry exceeds the f64 range (B_X grows like
     /// a₁², so X beyond ~1e154 has no representable bi-inertia matrix).
     pub fn try_matrix(&self) -> Result<Mat> {

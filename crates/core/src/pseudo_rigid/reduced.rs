@@ -158,7 +158,7 @@ impl ReducedState {
     /// Body velocities Ω ⊕ Λ = B_A⁻¹(p_Ω ⊕ p_Λ) (001 (7.9)), the right-hand side of the
     /// reconstruction equations RᵀṘ = Ω, SᵀṠ = Λ (001 (8.1)-type).
     ///
-    /// Scale-aware ([`ReducedState::velocities_scaled`]): an overflow error where Ω or Λ exceeds
+    /// Scale-aware (`ReducedState::velocities_scaled`): an overflow error where Ω or Λ exceeds
     /// the f64 range.
     pub fn velocities(&self) -> Result<(Mat, Mat)> {
         let n = self.validate()?;
@@ -303,7 +303,7 @@ pub fn reduce(x: &Mat, p: &Mat) -> Result<(ReducedState, Mat, Mat)> {
 ///
 /// Errors: R, S not rotations, an invalid reduced state ([`ReducedState::validate`]), an
 /// overflow error where P exceeds the f64 range. Scale-aware: ΩA − AΛ (degree −1 in a) is
-/// formed from the scaled pair formulas ([`ReducedState::velocities_scaled`]), so tiny or huge
+/// formed from the scaled pair formulas (`ReducedState::velocities_scaled`), so tiny or huge
 /// a give the representable P although Ω, Λ alone may not be representable.
 pub fn reconstruct(r: &Mat, s: &Mat, state: &ReducedState) -> Result<(Mat, Mat)> {
     let n = state.validate()?;

@@ -841,7 +841,7 @@ pub enum Algebra {
     Se3,
     /// so(n) in the e_ij coordinates of [`so::vee_n`] (n ≥ 2): μ = M ∈ so(n)*.
     So(usize),
-    /// Structure constants C (d×d×d, row-major C[i][j][k] = C_ij^k: [e_i, e_j] = C_ij^k e_k),
+    /// Structure constants C (d×d×d, row-major C\[i\]\[j\]\[k\] = C_ij^k: [e_i, e_j] = C_ij^k e_k),
     /// antisymmetric in (i, j) and satisfying the Jacobi identity (both checked).
     Constants(Vec<f64>),
 }
@@ -1206,7 +1206,7 @@ impl LiePoisson {
         self.algebra.dim
     }
 
-    /// The structure constants C[i][j][k] = C_ij^k, row-major (d, d, d).
+    /// The structure constants C\[i\]\[j\]\[k\] = C_ij^k, row-major (d, d, d).
     ///
     /// Errors: an array too large to hold (so(n) for large n).
     pub fn structure_constants(&self) -> Result<Vec<f64>> {

@@ -10,8 +10,8 @@
 //!
 //! The force at the end of a substep is reused at the start of the next (first same as last), so
 //! a step costs one force evaluation per stage. After every drift the position is checked
-//! ([`Separable::admissible`]); a position outside the domain stops the run with
-//! [`crate::Error::LeftDomain`] naming the step and the time at its end.
+//! (by [`Separable::force`], which checks and evaluates in one call); a position outside the
+//! domain stops the run with [`crate::Error::LeftDomain`] naming the step and the time at its end.
 
 use super::composition::Composition;
 use crate::error::Result;
