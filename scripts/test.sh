@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of lieflow: format and lint checks, the Rust tests (with proptest properties and
-# a smoke run of each criterion bench), then builds the Python extension once and runs pytest.
+# a smoke run of each criterion bench) and the rustdoc build, then builds the Python extension once
+# and runs pytest and the documentation build (Sphinx, warnings as errors; it runs the gallery).
 # Makes its own virtual environment (.venv, or $LIEFLOW_VENV).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +12,7 @@ step() { printf '\n== %s (%ds)\n' "$*" "$((SECONDS - t0))"; }
 
 step "python environment"
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
-"$venv/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.9.4,<2" numpy scipy pytest hypothesis tqdm matplotlib pillow xarray h5netcdf mypy dask distributed
+"$venv/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.9.4,<2" numpy scipy pytest hypothesis tqdm matplotlib pillow xarray h5netcdf mypy dask distributed sphinx sphinx-gallery myst-parser pydata-sphinx-theme
 
 step "cargo fmt --check"
 cargo fmt --all -- --check
@@ -23,11 +24,19 @@ step "cargo test (release; benches run once in test mode)"
 cargo test --workspace --exclude lieflow-py --release --all-targets
 cargo test --workspace --exclude lieflow-py --release --doc
 
+step "cargo doc (-D warnings)"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --workspace
+
 step "build the extension (maturin develop --release)"
 VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --release -q
 
 step "pytest"
 "$venv/bin/python" -m pytest -q python/tests
+
+step "docs (sphinx-build -W)"
+# docs/ -> docs/_build/html: MyST pages, the API reference from the built package, and the
+# gallery, which executes every script in examples/ (docs/conf.py).
+"$venv/bin/python" -m sphinx -W --keep-going -b html docs docs/_build/html
 
 step "typing (mypy.stubtest, mypy examples)"
 # The .pyi stubs against the built module (allow-list: only what stubtest cannot see, each entry
