@@ -58,6 +58,10 @@ napoleon_google_docstring = True  # "Args:" / "Returns:" / "Raises:"
 napoleon_numpy_docstring = True  # "Parameters\n----------"
 napoleon_use_rtype = False
 napoleon_use_ivar = True
+# The "Raises:" sections of lieflow's docstrings are sentences ("ShapeError, NonFiniteError,
+# InvalidArgumentError (dt <= 0)."), often continued over several lines, not one exception per
+# line: show them as written (a generic section) instead of splitting them into entries.
+napoleon_custom_sections = ["Raises"]
 # Single backticks in docstrings name code (`lf.integrate`, `dt`): render them as code.
 default_role = "code"
 
