@@ -51,6 +51,8 @@ myst_heading_anchors = 3
 autosummary_generate = True
 autosummary_ignore_module_all = False  # a module's public names are its __all__
 autosummary_imported_members = True  # the submodules re-export the native functions
+# lie.Ad and lie.ad would share a file name on case-insensitive file systems (macOS, Windows).
+autosummary_filename_map = {"lieflow.lie.Ad": "lieflow.lie.Ad_group"}
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"  # signatures come from the native text signatures and the docstrings
 autodoc_default_options = {"show-inheritance": True}
