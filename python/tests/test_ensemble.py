@@ -143,7 +143,8 @@ def test_other_systems(system, state):
 def test_single_state_and_empty_ensemble():
     ds = ensemble.integrate(BODY, [1.0, 0.5, -0.3], 0.01, 10).compute()
     assert ds.states.shape == (1, 11, 3)
-    assert np.array_equal(ds.states.values[0], lf.integrate(BODY, [1.0, 0.5, -0.3], 0.01, 10).states)
+    single = lf.integrate(BODY, [1.0, 0.5, -0.3], 0.01, 10)
+    assert np.array_equal(ds.states.values[0], single.states)
     empty = ensemble.integrate(BODY, np.zeros((0, 3)), 0.01, 10, save_every=5).compute()
     assert empty.states.shape == (0, 3, 3) and empty.energy.shape == (0, 3)
 
@@ -240,17 +241,21 @@ def test_run_error_is_raised_by_compute_naming_the_members():
         assert any("members 2 to 3" in n for n in getattr(err.value, "__notes__", []))
 
 
-def test_threaded_ctrl_c_stops_promptly():
+def test_threaded_ctrl_c_stops_promptly(calls):
     m = members(16_000)       # 16 tasks of 1000 bodies x 10^4 steps: ~0.4 s each, ~3 s in all
     ds = ensemble.integrate(BODY, m, 0.01, 10_000, save_every=10_000, chunks=1000)
     t = _interrupted_compute(ds.compute, after=0.3)
     assert t < 2.0                                      # not the whole run
-    time.sleep(0.5)                                     # the running tasks end their chunk
+    time.sleep(1.0)                                     # the running tasks end their chunk
+    started = len(calls)
+    time.sleep(0.5)
+    assert len(calls) == started < 16                   # and no further task starts
 
 
-def _interrupted_compute(compute, after):
-    """Runs compute() in the main thread, delivers SIGINT after `after` s; asserts that a
-    KeyboardInterrupt ended it, returns the seconds from the start to the interrupt."""
+def _interrupted_compute(compute, after, before=None):
+    """Runs compute() in the main thread, delivers SIGINT after `after` s (calling `before()`
+    first, in the timer's thread); asserts that a KeyboardInterrupt ended it, returns the
+    seconds from the start to the interrupt."""
     state = {"inside": True, "late": False}
 
     def handler(signum, frame):
@@ -259,7 +264,13 @@ def _interrupted_compute(compute, after):
         state["late"] = True
 
     main = threading.main_thread().ident
-    timer = threading.Timer(after, lambda: signal.pthread_kill(main, signal.SIGINT))
+
+    def interrupt():
+        if before is not None:
+            before()
+        signal.pthread_kill(main, signal.SIGINT)
+
+    timer = threading.Timer(after, interrupt)
     old = signal.signal(signal.SIGINT, handler)
     try:
         t = time.monotonic()
@@ -447,7 +458,7 @@ def test_distributed_sweep(client):
 
 
 def _long_ensemble(b=48_000, steps=1500, chunks=6000):
-    """8 tasks of 6000 bodies x 1500 steps: ~0.3-1 s each."""
+    """8 tasks of 6000 bodies x `steps` steps: ~0.3-1 s each for 1500 steps."""
     m = members(b, seed=3)
     return m, ensemble.integrate(BODY, m, 0.01, steps, save_every=500, chunks=chunks)
 
@@ -475,9 +486,11 @@ def test_distributed_worker_killed_mid_run(client):
 
 def test_distributed_ctrl_c_cancels_the_tasks(client):
     client.wait_for_workers(2, timeout=60)
-    _, ds = _long_ensemble()
+    _, ds = _long_ensemble(steps=4000)      # ~4 s of work on 2 workers: interrupted at 0.5 s
+    busy = []
     with client.as_current():
-        _interrupted_compute(ds.compute, after=0.5)
+        _interrupted_compute(ds.compute, after=0.5, before=lambda: busy.append(processing(client)))
+    assert busy[0] > 0                                 # tasks were running when Ctrl-C came
     deadline = time.monotonic() + 5
     while processing(client) and time.monotonic() < deadline:
         time.sleep(0.05)
