@@ -310,7 +310,7 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     ...                            save_every=100)
     >>> ds = ds.compute()                                  # doctest: +SKIP
     """
-    dask, da, _ = _require()
+    dask, da, xr = _require()
     _check_system(system)
     steps = _count("steps", steps)
     save_every = _count("save_every", save_every)
@@ -357,7 +357,6 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
             "final_state": ("member", "component"),
             "attitude": ("member", "time", "attitude_row", "attitude_col"),
             "final_attitude": ("member", "attitude_row", "attitude_col")}
-    import xarray as xr
     return xr.Dataset({v: (dims[v], a) for v, a in arrays.items()},
                       coords={"member": np.arange(b), "time": t},
                       attrs={"system": repr(system), **_attrs(method, dt, save_every, t0, steps)})
