@@ -22,7 +22,6 @@ when a function of this module is called, not when ``lieflow`` is imported.
 
 from __future__ import annotations
 
-import copy
 import numbers
 import operator
 import sys
@@ -133,22 +132,11 @@ def _note(err: BaseException, text: str) -> None:
         err.add_note(text)
 
 
-def _own(system):
-    """A copy of ``system`` for one task (rebuilt from its constructor arguments, as pickling
-    does). The tasks of one process then share no system object: a system built from Python
-    callables keeps the exception of a callable, and where its run failed, on the object until
-    the run raises it, so two concurrent runs of one object could take each other's errors."""
-    try:
-        return copy.deepcopy(system)
-    except Exception:        # a system that cannot be copied is used as it is
-        return system
-
-
 def _integrate_chunk(system, z, att, dt, steps, method, save_every, t0, lo):
     """One task of :func:`integrate`: the members ``lo ..`` of the ensemble, states ``z``
-    (c, d), as one native batch run on one thread, of the task's own copy of ``system``."""
+    (c, d), as one native batch run on one thread."""
     try:
-        traj = _integrate(_own(system), z, dt=dt, steps=steps, method=method,
+        traj = _integrate(system, z, dt=dt, steps=steps, method=method,
                           save_every=save_every, attitude=att, threads=1, t0=t0, progress=False)
         out = {"states": traj.states, "energy": np.asarray(traj.energy(), dtype=np.float64),
                "invariants": np.asarray(traj.invariants(), dtype=np.float64),
@@ -168,7 +156,7 @@ def _sweep_task(make_system, value, index, z0, dt, steps, method, save_every, t0
     try:
         system = make_system(value)
         _check_system(system)
-        traj = _integrate(_own(system), z0, dt=dt, steps=steps, method=method,
+        traj = _integrate(system, z0, dt=dt, steps=steps, method=method,
                           save_every=save_every, threads=1, t0=t0, progress=False)
         inv = np.asarray(traj.invariants(), dtype=np.float64)
         if traj.states.shape[-1] != d or inv.shape[-1] != c:

@@ -235,8 +235,8 @@ def test_run_error_is_raised_by_compute_naming_the_members():
     system = lf.Canonical(_h, _explodes, 1)
     state = np.array([[0.1, 0.0], [0.2, 0.0], [0.3, 0.0], [0.0, 1.5]])   # member 3 leaves
     ds = ensemble.integrate(system, state, 0.1, 30, chunks=2)             # no error yet
-    for _ in range(5):   # each task runs its own copy of the system: the error is never taken
-        with pytest.raises(RuntimeError, match="left the box") as err:   # by the other task
+    for _ in range(5):   # concurrent tasks of one system: the error is never taken by the other
+        with pytest.raises(RuntimeError, match="left the box") as err:
             ds.compute()
         assert any("members 2 to 3" in n for n in getattr(err.value, "__notes__", []))
 

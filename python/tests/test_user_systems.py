@@ -306,3 +306,38 @@ def test_pickling_and_repr():
         b = lf.integrate(copy, z0, dt=0.01, steps=50).states
         np.testing.assert_array_equal(a, b)
     assert repr(lf.Canonical(osc_h, dof=1)).startswith("Canonical(hamiltonian=<function osc_h")
+
+
+def grad_raising(q, p):
+    """The oscillator's gradient, raising once q turns negative (at t = π/2 from (q0, 0), where
+    p = −q0: the message tells the runs apart)."""
+    if q[0] < 0.0:
+        raise ValueError(f"gradient raised at p = {p[0]:.1f}")
+    return q, p
+
+
+def test_concurrent_runs_of_one_system_keep_their_own_exceptions():
+    """Three threads integrating the same callable system, all failing: each raises its own
+    exception with its own step (the system's exception slot is taken by the run that filled
+    it, not by another thread's run)."""
+    import threading
+
+    sys = lf.Canonical(osc_h, grad_raising, dof=1)
+    for _ in range(5):
+        out = {}
+
+        def run(q0):
+            try:
+                lf.integrate(sys, [q0, 0.0], dt=0.01, steps=2000, chunk_steps=7)
+            except ValueError as e:
+                out[q0] = (str(e), e.partial.t_final)
+
+        threads = [threading.Thread(target=run, args=(q0,)) for q0 in (1.0, 2.0, 3.0)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert sorted(out) == [1.0, 2.0, 3.0]
+        for q0, (msg, t_final) in out.items():
+            assert f"raised at p = {-q0:.1f}" in msg, (q0, msg)
+            assert abs(t_final - np.pi / 2) < 0.02

@@ -17,8 +17,8 @@ use crate::errors::{to_py, IntoPy};
 use crate::items::{array, Out};
 
 /// Errors raised by Python callables that a system calls from native code (a callable
-/// potential or surface): such a system runs single-threaded, and the first error is re-raised
-/// afterwards.
+/// potential or surface, a user system, a force): such a system runs on the calling thread with
+/// the GIL held, and the first error is re-raised afterwards by the run that met it.
 pub(crate) trait Callbacks: Send + Sync {
     /// The first recorded exception, if any (and forget it).
     fn take_error(&self) -> PyResult<()>;
@@ -262,8 +262,8 @@ impl Integration {
         Ok((z, r))
     }
 
-    /// Advances every member `until` (in parallel with the GIL released; a run with events in
-    /// this thread) and returns the states saved, (b, k, d) and (b, k, 3, 3) or None. After an
+    /// Advances every member `until` (in parallel with the GIL released; a run with events, or
+    /// of a system that calls Python, in this thread) and returns the states saved, (b, k, d) and (b, k, 3, 3) or None. After an
     /// error of a single run, what it saved before the error is kept for `take_partial`.
     fn drive<'py>(
         &mut self,
@@ -312,41 +312,50 @@ impl Integration {
             .as_mut()
             .map(|m| m.get_mut().unwrap_or_else(|p| p.into_inner()));
         let pool = &self.pool;
-        let outs: Vec<(Vec<f64>, lieflow::Result<usize>)> = py.detach(|| {
-            let one = |i: usize, run: &mut Run, events: Option<&mut Events<'static>>| {
-                let mut out = Vec::new();
-                if out.try_reserve_exact(per_run).is_err() {
-                    let e = Error::invalid(
-                        "steps",
-                        format!(
-                            "cannot allocate the {per_run} values these steps save; save less \
-                             often (save_every) or run in chunks"
-                        ),
-                    );
-                    return (out, Err(e));
-                }
-                let r = match until {
-                    Until::Steps(n) if plain => run.advance(sys, n, &mut out),
-                    _ => run.advance_to(sys, until, &mut out, events),
-                };
-                (out, r.map_err(|e| if b > 1 { e.in_member(i) } else { e }))
-            };
-            match (events, runs.first_mut()) {
-                (Some(ev), Some(run)) => vec![one(0, run, Some(ev))],
-                _ => {
-                    let mut work = || {
-                        runs.par_iter_mut()
-                            .enumerate()
-                            .map(|(i, run)| one(i, run, None))
-                            .collect::<Vec<_>>()
-                    };
-                    match pool {
-                        Some(p) => p.install(work),
-                        None => work(),
-                    }
-                }
+        let one = |i: usize, run: &mut Run, events: Option<&mut Events<'static>>| {
+            let mut out = Vec::new();
+            if out.try_reserve_exact(per_run).is_err() {
+                let e = Error::invalid(
+                    "steps",
+                    format!(
+                        "cannot allocate the {per_run} values these steps save; save less \
+                         often (save_every) or run in chunks"
+                    ),
+                );
+                return (out, Err(e));
             }
-        });
+            let r = match until {
+                Until::Steps(n) if plain => run.advance(sys, n, &mut out),
+                _ => run.advance_to(sys, until, &mut out, events),
+            };
+            (out, r.map_err(|e| if b > 1 { e.in_member(i) } else { e }))
+        };
+        let parallel = |runs: &mut Vec<Run>| {
+            let mut work = || {
+                runs.par_iter_mut()
+                    .enumerate()
+                    .map(|(i, run)| one(i, run, None))
+                    .collect::<Vec<_>>()
+            };
+            match pool {
+                Some(p) => p.install(work),
+                None => work(),
+            }
+        };
+        let outs: Vec<(Vec<f64>, lieflow::Result<usize>)> = match (events, runs.first_mut()) {
+            (Some(ev), Some(run)) if self.callbacks.is_some() => vec![one(0, run, Some(ev))],
+            (Some(ev), Some(run)) => py.detach(|| vec![one(0, run, Some(ev))]),
+            // A system that calls Python keeps its callables' exceptions in one slot for all
+            // its runs; its runs stay on this thread with the GIL held (the callables need it
+            // for the whole chunk anyway), so that the exception taken below is this run's,
+            // never one of another thread's run of the same system.
+            _ if self.callbacks.is_some() => runs
+                .iter_mut()
+                .enumerate()
+                .map(|(i, run)| one(i, run, None))
+                .collect(),
+            _ => py.detach(|| parallel(runs)),
+        };
         let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
         self.done = match (runs.first(), until) {
             (Some(r), _) => r.steps_done(),
