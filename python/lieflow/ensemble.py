@@ -30,7 +30,8 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from ._lieflow import InvalidArgumentError, ShapeError, __version__
-from .integrate import _MAX_COUNT, _attitude, _check_system, _count, _step, _time
+from .integrate import (_MAX_COUNT, _attitude, _check_method, _check_system, _count,
+                        _sample_times, _step, _time)
 from .integrate import integrate as _integrate
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -119,12 +120,6 @@ def default_chunks(members: int, cores: int | None = None) -> int:
                                    f"got {members}")
     cores = _cores() if cores is None else _count("cores", cores)
     return max(1, -(-members // (TASKS_PER_CORE * cores)))
-
-
-def _check_method(method):
-    if method is not None and not isinstance(method, str):
-        raise TypeError(f"invalid method: expected a name (str), got {type(method).__name__} "
-                        f"{method!r}")
 
 
 def _note(err: BaseException, text: str) -> None:
@@ -325,7 +320,7 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
         raise
     n_inv = np.asarray(system.invariants(z[:1])).shape[-1]
     k = steps // save_every + 1
-    t = t0 + np.arange(k) * (save_every * dt)      # lieflow.integrate's traj.t
+    t = _sample_times(t0, dt, save_every, k)      # lieflow.integrate's traj.t
 
     from dask.base import tokenize
     token = tokenize("lieflow.ensemble.integrate", __version__, type(system).__name__,
@@ -486,7 +481,7 @@ def sweep(make_system: Callable[[Any], Any], params: Sequence[Any], state0: Arra
     d = z.shape[1]
     n_inv = np.asarray(system.invariants(z)).shape[-1]
     k = steps // save_every + 1
-    t = t0 + np.arange(k) * (save_every * dt)
+    t = _sample_times(t0, dt, save_every, k)
     coord, extra = _param_coords(values)
 
     from dask.base import tokenize

@@ -76,6 +76,18 @@ def _step(dt):
     return dt
 
 
+def _check_method(method):
+    """TypeError unless ``method`` is None or a name."""
+    if method is not None and not isinstance(method, str):
+        raise TypeError(f"invalid method: expected a name (str), got {type(method).__name__} "
+                        f"{method!r}")
+
+
+def _sample_times(t0, dt, save_every, k):
+    """The times of the first k samples of a run saving every ``save_every``-th step."""
+    return t0 + np.arange(k) * (save_every * dt)
+
+
 def _check_system(system):
     """TypeError unless ``system`` speaks the protocol (a ``lieflow.System`` instance or alike)."""
     if isinstance(system, type):
@@ -314,9 +326,7 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
     save_every = _count("save_every", save_every)
     dt = _step(dt)
     t0 = _time("t0", t0)
-    if method is not None and not isinstance(method, str):
-        raise TypeError(f"invalid method: expected a name (str), got {type(method).__name__} "
-                        f"{method!r}")
+    _check_method(method)
     times = None if t_eval is None else _times(t_eval)
     if times is not None and save_every != 1:
         raise InvalidArgumentError("invalid save_every: t_eval gives the output times; leave "
@@ -427,7 +437,7 @@ class _Context:
         else:
             terminated = status == 1
             grid = k - 1 if terminated else k
-            t = t0 + np.arange(grid) * (every * dt)
+            t = _sample_times(t0, dt, every, grid)
             if terminated:
                 t = np.append(t, ended)
         # The time of the final state: the last sample's when it is the final state (so that a
