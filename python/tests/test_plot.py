@@ -2,6 +2,9 @@
 points, box corners turned by the attitude), animations have one frame per saved sample (checked
 in a written GIF), and bad input is a typed error."""
 
+import gc
+import warnings
+
 import numpy as np
 import pytest
 
@@ -14,14 +17,15 @@ import matplotlib.pyplot as plt  # noqa: E402
 from lieflow import plot  # noqa: E402
 
 M0 = np.array([1.0, 0.5, -0.3])
-# Animations built and inspected frame by frame without being shown or saved.
-pytestmark = pytest.mark.filterwarnings("ignore:Animation was deleted without rendering")
 
 
 @pytest.fixture(autouse=True)
 def close_figures():
     yield
     plt.close("all")
+    with warnings.catch_warnings():      # the animations inspected here, never shown or saved
+        warnings.simplefilter("ignore")
+        gc.collect()
 
 
 def spinning(steps=12, every=1):
