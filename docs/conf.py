@@ -85,7 +85,7 @@ sphinx_gallery_conf = {
     "min_reported_time": 0,
     "show_memory": False,
     "backreferences_dir": None,
-    "matplotlib_animations": False,
+    "matplotlib_animations": True,  # FuncAnimations are embedded (JavaScript player)
 }
 
 # -- HTML ------------------------------------------------------------------------------------

@@ -98,9 +98,10 @@ class Trajectory:
     """None when `t_eval` gave the times (or concatenated parts differ)."""
     t: _F64
     """(k,) sample times (absolute)."""
-    t0: float | None
-    t_final: float | None
-    """The time of `final_state`."""
+    t0: float
+    """The time of `initial_state` (a Trajectory built by hand without times: None)."""
+    t_final: float
+    """The time of `final_state` (a Trajectory built by hand without times: None)."""
     status: int
     """0 reached the end, 1 a terminal event ended it, -1 failed (`err.partial`)."""
     t_events: list[_F64] | None

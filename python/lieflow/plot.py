@@ -155,7 +155,8 @@ def states(traj: Trajectory, *, fields: str | Sequence[str] | None = None, membe
         shape = np.asarray(views[name]).shape[traj.states.ndim - 1:]
         for j in range(v.shape[1]):
             index = np.unravel_index(j, shape) if shape else ()
-            ax.plot(t, v[:, j], lw=1, label=f"{name}{list(index)}" if shape else name)
+            label = f"{name}[{', '.join(str(int(i)) for i in index)}]" if shape else name
+            ax.plot(t, v[:, j], lw=1, label=label)
         ax.set_ylabel(name)
         if v.shape[1] <= 9:
             ax.legend(fontsize="x-small", ncol=min(v.shape[1], 3), loc="upper right")
