@@ -12,7 +12,7 @@ step() { printf '\n== %s (%ds)\n' "$*" "$((SECONDS - t0))"; }
 
 step "python environment"
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
-"$venv/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.9.4,<2" numpy scipy pytest hypothesis tqdm matplotlib pillow xarray h5netcdf mypy dask distributed sphinx sphinx-gallery myst-parser pydata-sphinx-theme sphinx-mathjax-offline
+"$venv/bin/python" -m pip install -q --disable-pip-version-check "maturin>=1.9.4,<2" numpy scipy pytest hypothesis tqdm matplotlib pillow xarray netCDF4 mypy dask distributed sphinx sphinx-gallery myst-parser pydata-sphinx-theme sphinx-mathjax-offline
 
 step "cargo fmt --check"
 cargo fmt --all -- --check

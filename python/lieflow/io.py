@@ -2,8 +2,8 @@
 
 ``Trajectory.to_xarray()`` gives a :class:`xarray.Dataset`; ``Trajectory.save(path)`` writes it to
 a NetCDF file and :func:`load` reads it back as a ``Trajectory`` whose ``system`` is rebuilt, so
-that a run can be continued from its ``final_state``. Needs xarray and a NetCDF backend
-(``pip install lieflow[io]``).
+that a run can be continued from its ``final_state``. Needs xarray and a NetCDF-4 backend
+(``pip install lieflow[io]``: netCDF4).
 
 Layout of the Dataset (format 1):
 
@@ -68,6 +68,20 @@ def _xarray():
         raise ImportError("lieflow's NetCDF and xarray output needs xarray and a NetCDF "
                           "backend: pip install lieflow[io]") from None
     return xarray
+
+
+def _engine():
+    """The NetCDF-4 backend for xarray: netCDF4 (the reference library), else h5netcdf with
+    h5py; an ImportError saying what to install otherwise. (NetCDF-3, xarray's scipy backend,
+    cannot store the UTF-8 attributes lieflow writes.)"""
+    import importlib.util
+
+    if importlib.util.find_spec("netCDF4") is not None:
+        return "netcdf4"
+    if all(importlib.util.find_spec(m) is not None for m in ("h5netcdf", "h5py")):
+        return "h5netcdf"
+    raise ImportError("lieflow's NetCDF files need a NetCDF-4 backend for xarray: "
+                      "pip install lieflow[io] (netCDF4), or h5netcdf with h5py")
 
 
 # --- systems as data -----------------------------------------------------------------------
@@ -287,11 +301,14 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, allow_pickle: bool =
 
     Raises
     ------
+    ImportError
+        xarray or a NetCDF-4 backend (netCDF4, or h5netcdf with h5py) is not installed.
     lieflow.InvalidArgumentError
         The system holds Python callables and ``allow_pickle`` is False, or it cannot be
         pickled.
     """
     path = _path(path)
+    engine = _engine()
     ds = to_xarray(traj)
     if "system_spec" not in ds.attrs:
         if not allow_pickle:
@@ -309,7 +326,7 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, allow_pickle: bool =
             raise InvalidArgumentError(f"invalid system: cannot pickle {traj.system!r:.80}: "
                                        f"{e}") from None
         ds.attrs["system_pickle"] = base64.b64encode(blob).decode("ascii")
-    ds.to_netcdf(path)
+    ds.to_netcdf(path, engine=engine)
 
 
 def load(path: str | os.PathLike[str] | xarray.Dataset, *,
@@ -333,6 +350,8 @@ def load(path: str | os.PathLike[str] | xarray.Dataset, *,
 
     Raises
     ------
+    ImportError
+        xarray or a NetCDF-4 backend (netCDF4, or h5netcdf with h5py) is not installed.
     FileNotFoundError
         No file at `path`.
     lieflow.FileFormatError
@@ -346,8 +365,9 @@ def load(path: str | os.PathLike[str] | xarray.Dataset, *,
         path = _path(path)
         if not os.path.exists(path):
             raise FileNotFoundError(f"no such file: {path!r}")
+        engine = _engine()
         try:
-            with xr.open_dataset(path) as f:
+            with xr.open_dataset(path, engine=engine) as f:
                 ds = f.load()
         except Exception as e:
             raise FileFormatError(f"cannot read {path!r} as a NetCDF file (damaged, or not "

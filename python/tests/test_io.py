@@ -203,3 +203,19 @@ def test_bad_files_give_clear_errors(tmp_path):
     with pytest.raises(lf.FileFormatError, match="no states"):
         lf.load(ds)
     assert issubclass(lf.FileFormatError, lf.LieflowError)
+
+
+def test_no_netcdf4_backend_is_a_clear_import_error(tmp_path, monkeypatch):
+    import importlib.util
+
+    traj = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), M0, dt=0.01, steps=3)
+    saved = tmp_path / "saved.nc"
+    traj.save(saved)
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name in ("netCDF4", "h5py") else real(name, *a))
+    with pytest.raises(ImportError, match=r"NetCDF-4 backend.*pip install lieflow\[io\]"):
+        traj.save(tmp_path / "x.nc")
+    assert not (tmp_path / "x.nc").exists()
+    with pytest.raises(ImportError, match="NetCDF-4 backend"):
+        lf.load(saved)
