@@ -679,6 +679,7 @@ impl Integrator<Forced> for Kicked {
             symmetric: true,
             invariants: self.invariants,
             manifold: self.manifold,
+            exact: false,
         }
     }
 

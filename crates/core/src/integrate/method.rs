@@ -31,6 +31,9 @@ pub struct Properties {
     /// them now and then so that round-off does not accumulate. A method without this claim
     /// (RK4) is left to drift off, as it does.
     pub manifold: bool,
+    /// The exact flow of the system, to round-off at every step size (no truncation error): the
+    /// generic suite checks its error instead of an order, and `order` is `u32::MAX`.
+    pub exact: bool,
 }
 
 impl Properties {
@@ -42,6 +45,7 @@ impl Properties {
             symmetric: true,
             invariants: true,
             manifold: true,
+            exact: false,
         }
     }
 
@@ -53,6 +57,16 @@ impl Properties {
             symmetric: false,
             invariants: false,
             manifold: false,
+            exact: false,
+        }
+    }
+
+    /// The exact flow of a system: every claim true, "every order" (`u32::MAX`).
+    pub fn exact() -> Self {
+        Properties {
+            order: u32::MAX,
+            exact: true,
+            ..Properties::geometric(0)
         }
     }
 }

@@ -68,6 +68,7 @@ impl<P: GroupField + Clone + 'static> Integrator<P> for LieMidpoint {
             symmetric: true,
             invariants: true,
             manifold: true,
+            exact: false,
         }
     }
 

@@ -55,6 +55,7 @@ impl<P: Nonholonomic + Clone + 'static> Integrator<P> for NonholonomicRattle {
             symmetric: true,
             invariants: false,
             manifold: true,
+            exact: false,
         }
     }
 

@@ -36,6 +36,7 @@ impl<P: GroupField + Clone + 'static> Integrator<P> for Rkmk4 {
             symmetric: false,
             invariants: true,
             manifold: true,
+            exact: false,
         }
     }
 
