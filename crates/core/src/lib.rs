@@ -43,6 +43,7 @@ pub mod elliptic;
 pub mod error;
 pub mod integrate;
 pub mod lie;
+pub(crate) mod linalg;
 pub mod pseudo_rigid;
 pub mod systems;
 

@@ -467,6 +467,30 @@ fn exp_every_pade_degree_against_reference() {
     }
 }
 
+/// `exp_into` with one `ExpWork` reused across sizes' calls and every Padé degree gives the bits
+/// of `exp` (the same kernel), and a wrongly sized output or work gives NaN, not a panic.
+#[test]
+fn exp_into_reuses_its_storage_and_equals_exp() {
+    for n in [4, 7, 50] {
+        let mut work = so::ExpWork::new(n);
+        let mut out = Mat::zeros(n, n);
+        let c: Vec<f64> = (0..so::dim(n))
+            .map(|k| ((k * 13 % 11) as f64 - 5.0) / 5.0)
+            .collect();
+        let unit = hat(&c) * faer::Scale(1.0 / so::norm(&hat(&c)));
+        for scale in [1e-4, 0.05, 0.8, 2.0, 40.0, 900.0] {
+            let xi = &unit * faer::Scale(scale);
+            so::exp_into(&xi, &mut out, &mut work);
+            assert_eq!(out, so::exp(&xi).unwrap(), "n={n} |ξ|={scale}");
+        }
+        let mut wrong = Mat::zeros(n + 1, n + 1);
+        so::exp_into(&unit, &mut wrong, &mut work);
+        assert!(wrong[(0, 0)].is_nan());
+        so::exp_into(&Mat::zeros(n + 1, n + 1), &mut out, &mut work);
+        assert!(out[(0, 0)].is_nan());
+    }
+}
+
 /// The closed forms of dexp and dexp⁻¹ at n = 3 agree with the series route, run at n = 4 on
 /// the same matrices embedded in the upper-left 3×3 block (an invariant subalgebra).
 #[test]

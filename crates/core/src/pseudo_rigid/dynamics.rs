@@ -15,6 +15,7 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::so;
+use crate::linalg;
 use crate::pseudo_rigid::momentum;
 use crate::pseudo_rigid::potential::{self, Potential, Workspace};
 use crate::Mat;
@@ -111,7 +112,7 @@ impl FullBody {
         let mut ws = self.workspace();
         self.check_x(x, &mut ws)?;
         check::square_of("P", p, self.n)?;
-        Ok(0.5 * potential::frob2(p.as_ref()) + self.potential.value(x.as_ref(), &mut ws))
+        Ok(0.5 * linalg::frob2(p.as_ref()) + self.potential.value(x.as_ref(), &mut ws))
     }
 
     /// Hamilton's vector field (Ẋ, Ṗ) = (P, −∂U/∂X) of H (001 (3.21)–(3.22)).

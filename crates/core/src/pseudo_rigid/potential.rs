@@ -25,6 +25,7 @@
 
 use crate::check;
 use crate::error::{Error, Result};
+use crate::linalg::{axpy, frob2, inner, mul};
 use crate::Mat;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, inverse};
@@ -709,71 +710,6 @@ impl Potential for Sum {
             }
         }
         dim
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Small dense kernels shared with the integrators (no allocation; hand loops for tiny n where
-// faer's general machinery costs more than the arithmetic).
-
-/// Below this size products use plain loops (faer's matmul has ~90 ns fixed cost at 3×3).
-const SMALL: usize = 4;
-
-/// ‖X‖_F² = tr(XᵀX).
-pub(crate) fn frob2(x: MatRef<'_, f64>) -> f64 {
-    let mut s = 0.0;
-    for j in 0..x.ncols() {
-        for i in 0..x.nrows() {
-            s += x[(i, j)] * x[(i, j)];
-        }
-    }
-    s
-}
-
-/// ⟨A, B⟩ = tr(AᵀB).
-pub(crate) fn inner(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {
-    let mut s = 0.0;
-    for j in 0..a.ncols() {
-        for i in 0..a.nrows() {
-            s += a[(i, j)] * b[(i, j)];
-        }
-    }
-    s
-}
-
-/// y += a x (same shapes).
-pub(crate) fn axpy(mut y: MatMut<'_, f64>, a: f64, x: MatRef<'_, f64>) {
-    for j in 0..y.ncols() {
-        for i in 0..y.nrows() {
-            y[(i, j)] += a * x[(i, j)];
-        }
-    }
-}
-
-/// dst = (or +=) alpha · lhs · rhs for square n×n operands (lhs may be a transposed view).
-pub(crate) fn mul(
-    mut dst: MatMut<'_, f64>,
-    accum: Accum,
-    lhs: MatRef<'_, f64>,
-    rhs: MatRef<'_, f64>,
-    alpha: f64,
-) {
-    let n = dst.nrows();
-    if n > SMALL {
-        faer::linalg::matmul::matmul(dst, accum, lhs, rhs, alpha, Par::Seq);
-        return;
-    }
-    for j in 0..n {
-        for i in 0..n {
-            let mut s = 0.0;
-            for k in 0..n {
-                s += lhs[(i, k)] * rhs[(k, j)];
-            }
-            match accum {
-                Accum::Replace => dst[(i, j)] = alpha * s,
-                Accum::Add => dst[(i, j)] += alpha * s,
-            }
-        }
     }
 }
 

@@ -62,6 +62,7 @@ use crate::integrate::problem::{Constrained, Separable, Split, Symmetric, Violat
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::{gl, so};
+use crate::linalg;
 use crate::Mat;
 use faer::{Accum, MatMut, MatRef};
 use nalgebra::Matrix3;
@@ -120,12 +121,12 @@ impl PseudoRigidBody {
         check::finite_mat("P", p)?;
         gl::check_gl_plus("X", x)?;
         let c = unit_cofactor(x);
-        let c2 = potential::frob2(c.as_ref());
+        let c2 = linalg::frob2(c.as_ref());
         let mut out = p.clone();
         // Twice: the second pass removes the round-off of the first.
         for _ in 0..2 {
-            let k = potential::inner(c.as_ref(), out.as_ref()) / c2;
-            potential::axpy(out.as_mut(), -k, c.as_ref());
+            let k = linalg::inner(c.as_ref(), out.as_ref()) / c2;
+            linalg::axpy(out.as_mut(), -k, c.as_ref());
         }
         check::finite_mat("P", &out)
             .map_err(|_| check::overflow_error("P", "the projected momentum"))?;
@@ -138,11 +139,11 @@ impl PseudoRigidBody {
         let c = unit_cofactor(x);
         let e = check::pow2_floor(check::max_abs(p));
         let p = check::ldexp_mat(p, -e);
-        let pn = potential::frob2(p.as_ref()).sqrt();
+        let pn = linalg::frob2(p.as_ref()).sqrt();
         if pn == 0.0 {
             return 0.0;
         }
-        potential::inner(c.as_ref(), p.as_ref()).abs() / (potential::frob2(c.as_ref()).sqrt() * pn)
+        linalg::inner(c.as_ref(), p.as_ref()).abs() / (linalg::frob2(c.as_ref()).sqrt() * pn)
     }
 
     /// The underlying [`FullBody`] (vector fields, Hamiltonian).
@@ -473,8 +474,8 @@ impl Constrained for PseudoRigidBody {
                     MatRef::from_row_major_slice(v, n, n),
                 );
                 let d = potential::det_cofactor(x, s.cof.as_mut(), &mut s.ws);
-                let tr = potential::inner(s.cof.as_ref(), w);
-                potential::mul(s.prod.as_mut(), Accum::Replace, s.cof.transpose(), w, 1.0);
+                let tr = linalg::inner(s.cof.as_ref(), w);
+                linalg::mul(s.prod.as_mut(), Accum::Replace, s.cof.transpose(), w, 1.0);
                 let m = &s.prod;
                 let mut tr2 = 0.0;
                 for i in 0..n {

@@ -118,9 +118,10 @@ fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
 
 /// Exponential map so(n) → SO(n).
 ///
-/// Closed form for n = 2, Rodrigues for n = 3, and for n > 3
-/// exp ξ = cos(√S) + ξ sinc(√S) with S = ξᵀξ (symmetric eigendecomposition), orthogonal to
-/// round-off even for ‖ξ‖ ~ 1e3.
+/// Closed form for n = 2, Rodrigues for n = 3, and for n > 3 scaling and squaring with diagonal
+/// Padé approximants (Al-Mohy & Higham 2009, as scipy's expm) followed by one Newton–Schulz
+/// step, orthogonal to round-off even for ‖ξ‖ ~ 1e3; the kernel allocates its storage once per
+/// thread and size, so repeated calls cost the same.
 ///
 /// Args:
 ///     xi: skew matrix (n, n), or a batch (b, n, n) computed in parallel without the GIL.

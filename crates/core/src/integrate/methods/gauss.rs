@@ -31,11 +31,7 @@
 use crate::error::{Error, Result};
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::Canonical;
-use crate::Mat;
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::perm::PermRef;
-use faer::{MatMut, Par};
+pub(crate) use crate::linalg::DenseLu;
 
 /// The s-stage Gauss–Legendre method, s = 1, 2, 3 (orders 2, 4, 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -313,77 +309,6 @@ impl<P: Canonical> Stepper for GaussStepper<P> {
     }
 }
 
-/// A dense n×n LU factorization with partial pivoting (faer) whose storage is allocated once:
-/// fill [`DenseLu::matrix`], [`DenseLu::factor`], then [`DenseLu::solve`] any number of times.
-/// Shared by the implicit methods (Gauss, RATTLE, the nonholonomic RATTLE).
-pub(crate) struct DenseLu {
-    lu: Mat,
-    perm: Vec<usize>,
-    perm_inv: Vec<usize>,
-    mem: MemBuffer,
-}
-
-impl DenseLu {
-    /// Storage for n×n systems.
-    pub(crate) fn new(n: usize) -> Self {
-        let req = StackReq::any_of(&[
-            factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()),
-            solve::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
-        ]);
-        DenseLu {
-            lu: Mat::zeros(n, n),
-            perm: (0..n).collect(),
-            perm_inv: (0..n).collect(),
-            mem: MemBuffer::new(req),
-        }
-    }
-
-    /// The matrix to fill before [`DenseLu::factor`].
-    pub(crate) fn matrix(&mut self) -> &mut Mat {
-        &mut self.lu
-    }
-
-    /// Factors the matrix in place; false when it is not finite or a pivot is zero (singular).
-    pub(crate) fn factor(&mut self) -> bool {
-        let n = self.lu.nrows();
-        for j in 0..n {
-            for i in 0..n {
-                if !self.lu[(i, j)].is_finite() {
-                    return false;
-                }
-            }
-        }
-        factor::lu_in_place(
-            self.lu.as_mut(),
-            &mut self.perm,
-            &mut self.perm_inv,
-            Par::Seq,
-            MemStack::new(&mut self.mem),
-            Default::default(),
-        );
-        (0..n).all(|i| {
-            let u = self.lu[(i, i)];
-            u != 0.0 && u.is_finite()
-        })
-    }
-
-    /// Solves the factored system in place (`b` has n values).
-    pub(crate) fn solve(&mut self, b: &mut [f64]) {
-        let n = b.len();
-        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
-        // `solve_in_place` reads the unit lower triangle of its L argument and the upper
-        // triangle of its U argument, so the packed factor serves as both.
-        solve::solve_in_place(
-            self.lu.as_ref(),
-            self.lu.as_ref(),
-            perm,
-            MatMut::from_column_major_slice_mut(b, n, 1),
-            Par::Seq,
-            MemStack::new(&mut self.mem),
-        );
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -414,30 +339,5 @@ mod tests {
             }
         }
         assert!(tableau(4).is_none() && tableau(0).is_none());
-    }
-
-    #[test]
-    fn dense_lu_solves_and_detects_singular_matrices() {
-        let mut lu = DenseLu::new(3);
-        let a = [[0.0, 2.0, 1.0], [1.0, 1.0, 0.0], [3.0, 0.0, 1.0]];
-        for (i, row) in a.iter().enumerate() {
-            for (j, v) in row.iter().enumerate() {
-                lu.matrix()[(i, j)] = *v;
-            }
-        }
-        assert!(lu.factor());
-        let x = [1.0, -2.0, 0.5];
-        let mut b: Vec<f64> = a
-            .iter()
-            .map(|r| r.iter().zip(&x).map(|(p, q)| p * q).sum())
-            .collect();
-        lu.solve(&mut b);
-        for (u, v) in b.iter().zip(&x) {
-            assert!((u - v).abs() < 1e-15);
-        }
-        *lu.matrix() = Mat::zeros(3, 3);
-        assert!(!lu.factor());
-        lu.matrix()[(0, 0)] = f64::NAN;
-        assert!(!lu.factor());
     }
 }
