@@ -27,7 +27,7 @@ import sys
 
 import numpy as np
 
-from ._lieflow import InvalidArgumentError, NonFiniteError, ShapeError
+from ._lieflow import InvalidArgumentError, NonFiniteError, ShapeError, System
 
 __all__ = ["integrate", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
@@ -48,9 +48,9 @@ def _count(name, value):
     """An integer >= 1: TypeError for another type (bools and floats included),
     InvalidArgumentError for an integer < 1."""
     try:
-        if isinstance(value, bool):
+        if type(value) is bool:
             raise TypeError
-        n = operator.index(value)
+        n = value if type(value) is int else operator.index(value)
     except TypeError:
         raise TypeError(
             f"invalid {name}: expected an integer >= 1, got {type(value).__name__} {value!r}"
@@ -62,16 +62,24 @@ def _count(name, value):
     return n
 
 
+def _real(value):
+    """Whether `value` is a real number (bool excluded) or a 0-d numpy array of one; the common
+    float and int first (the ABC check of numbers.Real costs a microsecond)."""
+    if type(value) is float or type(value) is int:
+        return True
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    return ok or (isinstance(value, np.ndarray) and value.shape == ()
+                  and value.dtype.kind in "iuf")
+
+
 def _step(dt):
     """The time step as a float: TypeError unless a real number (str, bool, complex and arrays
     of size > 1 refused), InvalidArgumentError unless finite and > 0."""
-    ok = isinstance(dt, numbers.Real) and not isinstance(dt, bool)
-    if not ok and isinstance(dt, np.ndarray) and dt.shape == () and dt.dtype.kind in "iuf":
-        ok = True  # a 0-d numpy array of a real number
+    ok = _real(dt)
     if not ok:
         raise TypeError(f"invalid dt: expected a real number > 0, got {type(dt).__name__} {dt!r}")
     dt = float(dt)
-    if not (np.isfinite(dt) and dt > 0):
+    if not (0 < dt < np.inf):
         raise InvalidArgumentError(f"invalid dt: expected a finite number > 0, got {dt!r}")
     return dt
 
@@ -90,6 +98,8 @@ def _sample_times(t0, dt, save_every, k):
 
 def _check_system(system):
     """TypeError unless ``system`` speaks the protocol (a ``lieflow.System`` instance or alike)."""
+    if isinstance(system, System):
+        return
     if isinstance(system, type):
         raise TypeError(f"expected a lieflow system, got the class {system.__name__}; make one "
                         f"first, e.g. {system.__name__}(...)")
@@ -113,7 +123,9 @@ def _attitude(attitude, b, batched):
         raise TypeError(f"{expected}, got a {type(attitude).__name__} (numpy dtype {a.dtype})")
     a = a.astype(np.float64, copy=False)
     if a.shape == (3, 3):
-        return np.ascontiguousarray(np.broadcast_to(a, (b, 3, 3)))
+        out = np.empty((b, 3, 3))
+        out[...] = a
+        return out
     if batched and a.shape == (b, 3, 3):
         return np.ascontiguousarray(a)
     expected = f"(3, 3) or ({b}, 3, 3)" if batched else "(3, 3)"
@@ -157,14 +169,11 @@ class _Progress:
 
 def _time(name, value):
     """A time as a float: TypeError unless a real number, InvalidArgumentError unless finite."""
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
-    if not ok and isinstance(value, np.ndarray) and value.shape == () and value.dtype.kind in "iuf":
-        ok = True
-    if not ok:
+    if not _real(value):
         raise TypeError(f"invalid {name}: expected a real number, got {type(value).__name__} "
                         f"{value!r:.60}")
     value = float(value)
-    if not np.isfinite(value):
+    if not -np.inf < value < np.inf:
         raise InvalidArgumentError(f"invalid {name}: expected a finite number, got {value!r}")
     return value
 
