@@ -97,11 +97,13 @@ fn work_precision() {
     let s0 = M0;
     println!("| method | dt | steps | error at T=100 | time (µs) |");
     println!("|---|---|---|---|---|");
-    let grid: [(&str, &[usize]); 6] = [
+    let grid: [(&str, &[usize]); 8] = [
         ("splitting", &[10_000, 20_000, 50_000, 100_000]),
         ("splitting4", &[1000, 1250, 2000, 4000]),
         ("splitting6", &[300, 400, 500, 1000]),
         ("lgvi", &[10_000, 100_000]),
+        ("dmv", &[10_000, 100_000]),
+        ("dmv10", &[200, 250, 400, 500]),
         ("isospectral", &[10_000, 100_000]),
         ("rk4", &[2000, 4000, 5000, 10_000]),
     ];

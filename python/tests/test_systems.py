@@ -70,7 +70,8 @@ def test_rigid_body_basics():
     assert isinstance(body, lf.LiePoissonSystem)
     assert body.state_dim == 3 and body.has_attitude
     assert lf.RigidBody.methods() == body.methods() == [
-        "splitting", "splitting4", "splitting6", "isospectral", "lgvi", "rk4", "rkmk4"]
+        "splitting", "splitting4", "splitting6", "isospectral", "lgvi", "dmv", "dmv4", "dmv6",
+        "dmv8", "dmv10", "rk4", "rkmk4"]
     np.testing.assert_array_equal(body.moments, I)
     assert body.frame is None
     assert "RigidBody" in repr(body)

@@ -29,6 +29,7 @@
 //! 003 §2: [`RollingSpheres`]: z = (z₁, z₂, u, Ω₁, Ω₂) (27), two spheres rolling against each
 //! other (z_k ∈ SO(3) row-major, u ∈ S²).
 
+pub mod dmv;
 pub mod heavy_top;
 pub mod isospectral;
 pub mod lgvi;
@@ -45,6 +46,7 @@ pub mod tangent_top;
 mod top;
 pub mod user;
 
+pub use dmv::Dmv;
 pub use heavy_top::HeavyTop;
 pub use isospectral::Isospectral;
 pub use lgvi::Lgvi;

@@ -16,6 +16,7 @@
 //! satisfies [hat M, hat Ω] = hat(M × Ω), so Ṁ = [M, Ω] is Euler's equation; in e_ij coordinates
 //! c = (−w₃, w₂, −w₁), and with J_i + J_j = I_k ({i, j, k} = {1, 2, 3}) the energies agree (tested).
 
+use super::dmv::Dmv;
 use super::isospectral::Isospectral;
 use super::lgvi::Lgvi;
 use super::top::{self, top_kinds, Top};
@@ -292,6 +293,11 @@ impl Catalog for RigidBody {
             Entry::new("splitting6", Splitting(Composition::yoshida6())),
             Entry::new("isospectral", Isospectral),
             Entry::new("lgvi", Lgvi),
+            Entry::new("dmv", Dmv(2)),
+            Entry::new("dmv4", Dmv(4)),
+            Entry::new("dmv6", Dmv(6)),
+            Entry::new("dmv8", Dmv(8)),
+            Entry::new("dmv10", Dmv(10)),
             Entry::new("rk4", Rk4),
             Entry::new("rkmk4", Rkmk4),
         ]

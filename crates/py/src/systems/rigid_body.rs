@@ -22,7 +22,8 @@ type Any<'py> = Bound<'py, PyAny>;
 /// State z = M, the body angular momentum (3,). Euler's equation dM/dt = M x Omega with
 /// Omega = I^{-1} M; energy H = M . I^{-1} M / 2; Casimir [‖M‖^2]. Carries an attitude R
 /// (dR/dt = R hat(Omega)) when `integrate(..., attitude=R0)` is given; R M is conserved.
-/// Methods: splitting, splitting4, splitting6, isospectral, lgvi, rk4.
+/// Methods: splitting, splitting4, splitting6, isospectral, lgvi, dmv (discrete Moser-Veselov),
+/// dmv4, dmv6, dmv8, dmv10 (preprocessed DMV, Hairer & Vilmart 2006), rk4, rkmk4.
 ///
 /// Args:
 ///     inertia: principal moments (3,) > 0, or a (3, 3) symmetric positive-definite matrix

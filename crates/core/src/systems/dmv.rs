@@ -1,0 +1,544 @@
+//! The discrete Moser–Veselov algorithm (DMV) for the free rigid body with its attitude, and its
+//! preprocessed versions of orders 4, 6, 8 and 10 (J. Moser & A. P. Veselov, "Discrete versions
+//! of some classical integrable systems and factorization of matrix polynomials", Comm. Math.
+//! Phys. 139 (1991); E. Hairer & G. Vilmart, "Preprocessed discrete Moser–Veselov algorithm for
+//! the full dynamics of a rigid body", J. Phys. A 39 (2006) 13225, cited as HV06 below).
+//!
+//! **The DMV step.** The discrete Lagrangian L_d(R_n, R_{n+1}) = (1/h) tr((1 − F_n) D) with the
+//! relative rotation F_n = R_nᵀR_{n+1} ∈ SO(3) and the mass matrix D = ½ tr(I)·1 − I (so that
+//! tr(ŵ D ŵᵀ) = w·Iw and L_d = h·½ w·Iw + O(h³) for F = exp(hŵ)) gives the discrete
+//! Euler–Lagrange equations in the body momentum M (principal frame, I = diag(I₁, I₂, I₃)):
+//!
+//! h M̂_n = F_n D − D F_nᵀ,   M̂_{n+1} = F_nᵀ M̂_n F_n (M_{n+1} = F_nᵀ M_n),   R_{n+1} = R_n F_n
+//!
+//! (HV06 (3)–(5) with their Ω_n = F_nᵀ; for the free body this is the same map as the LGVI of
+//! [`super::lgvi`], solved differently). With the Cayley parametrisation
+//! F = (1 − ê)⁻¹(1 + ê) = 1 + 2(ê + ê²)/α, α = 1 + |e|² (the unit quaternion (1, e)/√α), and the
+//! identities ê D + D ê = (Ie)^ and ê² D − D ê² = (e × Ie)^ (D is diagonal with
+//! D_j + D_k = I_i), the two momenta are h α M_n = 2(Ie + e × Ie) and
+//! h α M_{n+1} = 2(Ie − e × Ie). Hence, for (i, j, k) cyclic,
+//!
+//! e_i = α (h/2) M_i / I_i + ((I_j − I_k)/I_i) e_j e_k,   M_{n+1,i} = M_{n,i} + 4(I_j − I_k) e_j e_k / (hα),
+//!
+//! and the attitude, carried as a unit quaternion q (R = R(q)), is q_{n+1} = q_n (1, e)/|q_n (1, e)|
+//! (Hamilton product; the normalisation keeps |q| = 1 to round-off). This is HV06 (16)–(18) with
+//! e = (h/2) I⁻¹Y. The implicit equation for e is solved to round-off by Gauss–Seidel sweeps
+//! (a contraction with factor O(|e|) = O(h|Ω|)) from a predictor accurate to O(|e|³), or, where
+//! they contract slowly (large steps), by Newton's method on the same 3-vector equation
+//! ([`DmvStepper::solve`]); a step whose equation has no solution nearby is
+//! [`crate::Error::NotConverged`] naming the step. The momentum increments are added with
+//! compensated (Kahan) summation.
+//!
+//! **Preprocessing (HV06 §2).** DMV applied to a body with the modified inverse moments
+//!
+//! 1/Ĩ_j = s/I_j + d,   s = 1 + h²s₃ + h⁴s₅ + …,   d = h²d₃ + h⁴d₅ + …,
+//!
+//! where s_{2k+1}, d_{2k+1} are homogeneous polynomials of degree k in H = ½ Σ M_j²/I_j and
+//! C = ½|M|² (HV06 Theorem 2.1), reproduces the exact flow of (M, R) as a formal series in h;
+//! truncated after h^{2r−2} it is of order 2r (HV06 Algorithm 2.2). No map of the initial data is
+//! needed: the state is used as it is, and every state a stepper reports is the method's own.
+//! The coefficients here were derived anew (by the construction of HV06 §6: the Taylor series of
+//! one DMV step with the modified moments against that of the exact flow, for M and for R, the
+//! terms of order h^{2k+1} fixing s_{2k+1} from M and then d_{2k+1} from R, at many rational
+//! inertias, then fitted exactly as symmetric polynomials): in the inverse moments u_j = 1/I_j,
+//! the coefficient of H^{k−i} C^i in s_{2k+1} is a symmetric polynomial of degree k + i, in d_{2k+1}
+//! of degree k + i + 1, written in the elementary symmetric polynomials p₁ = Σ u_j,
+//! p₂ = Σ_{i<j} u_i u_j, p₃ = u₁u₂u₃ ([`S`], [`D`]). They agree exactly with Table 1 of HV06
+//! (s₃ … d₇) and with the Fortran code DMV10 of the authors (up to s₉, d₉); no published formula
+//! needed a correction. They are evaluated scale-free: with u_ref = max u_j, μ_j = u_j/u_ref,
+//! p̂ the elementary polynomials of μ, X = h² H u_ref and Y = h² C u_ref²,
+//! s = 1 + Σ S_{k,i}(p̂) X^{k−i} Y^i and d = u_ref Σ D_{k,i}(p̂) X^{k−i} Y^i.
+//!
+//! For the free body H and C are invariants of the method, so the modified moments are computed
+//! once, when a stepper's state is set (at the start of a run; the driver sets it again only after
+//! its retractions of R, every 256 steps, from a state with the same invariants to round-off).
+//!
+//! **Properties** (HV06 Proposition 2.3, Table 2): order 2r; |M|² and the spatial momentum R M
+//! are kept (the step is a rotation of M and R M is unchanged by it), R ∈ SO(3) to round-off;
+//! the energy H too: DMV with the constant Ĩ keeps H̃ = ½ Σ M_j²/Ĩ_j = sH + dC and C, hence H;
+//! symmetric (Ĩ depends on M only through H and C). DMV itself is symplectic on T*SO(3); the
+//! preprocessed methods are Poisson integrators for M on so(3)* but not symplectic for the full
+//! system with the attitude — their [`Properties::symplectic`] claim is the Poisson one.
+
+use super::rigid_body::RigidBody;
+use crate::error::{Error, Result};
+use crate::integrate::{Clock, Integrator, Properties, Stepper};
+use crate::lie::rotations::{matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix};
+use nalgebra::{Matrix3, Vector3};
+
+/// The DMV algorithm (`Dmv(2)`) and its preprocessed versions `Dmv(4)`, `Dmv(6)`, `Dmv(8)`,
+/// `Dmv(10)` (a method value; the number is the order), for [`RigidBody`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Dmv(pub u32);
+
+/// The orders there are.
+pub const ORDERS: [u32; 5] = [2, 4, 6, 8, 10];
+
+/// Gauss–Seidel sweeps of the fixed-point iteration at most before Newton's method takes over.
+pub const MAX_FIXED_POINT: usize = 40;
+/// Newton's method takes over when successive fixed-point updates shrink by less than this
+/// factor (steps with |e| ≳ 0.1, where Newton needs fewer iterations).
+pub const SLOW_CONTRACTION: f64 = 0.05;
+/// Newton iterations after the fixed-point iteration.
+pub const MAX_NEWTON: usize = 30;
+/// An iteration that stops decreasing is accepted when its last update is below
+/// `STAGNATION_TOL`·|e| (1-norms).
+pub const STAGNATION_TOL: f64 = 1e-12;
+/// An update below ε²·|e| ends the iteration at once.
+const NEGLIGIBLE: f64 = f64::EPSILON * f64::EPSILON;
+
+/// One term num/den · p̂₁^a p̂₂^b p̂₃^c · X^{k−i} Y^i of s or d at h^{2k} (`p` = [a, b, c]).
+#[derive(Clone, Copy, Debug)]
+struct Term {
+    k: u8,
+    i: u8,
+    p: [u8; 3],
+    num: i32,
+    den: i32,
+}
+
+const fn t(k: u8, i: u8, p: [u8; 3], num: i32, den: i32) -> Term {
+    Term { k, i, p, num, den }
+}
+
+/// s_{2k+1} (k = 1…4) in the inverse moments: the coefficient of H^{k−i} C^i is
+/// Σ num/den · p₁^a p₂^b p₃^c (module docs).
+#[rustfmt::skip]
+const S: [Term; 41] = [
+    t(1, 0, [1, 0, 0], -1, 3),
+    t(1, 1, [0, 1, 0], 1, 6),
+    t(2, 0, [2, 0, 0], 1, 30),
+    t(2, 0, [0, 1, 0], -1, 60),
+    t(2, 1, [1, 1, 0], -1, 30),
+    t(2, 1, [0, 0, 1], 2, 15),
+    t(2, 2, [0, 2, 0], 1, 30),
+    t(2, 2, [1, 0, 1], -1, 10),
+    t(3, 0, [3, 0, 0], -1, 630),
+    t(3, 0, [1, 1, 0], 1, 630),
+    t(3, 0, [0, 0, 1], 1, 35),
+    t(3, 1, [2, 1, 0], 1, 420),
+    t(3, 1, [0, 2, 0], 41, 2520),
+    t(3, 1, [1, 0, 1], -53, 630),
+    t(3, 2, [1, 2, 0], -1, 70),
+    t(3, 2, [2, 0, 1], 11, 210),
+    t(3, 2, [0, 1, 1], -1, 84),
+    t(3, 3, [0, 3, 0], 17, 2520),
+    t(3, 3, [1, 1, 1], -11, 420),
+    t(3, 3, [0, 0, 2], 5, 126),
+    t(4, 0, [4, 0, 0], 1, 22680),
+    t(4, 0, [2, 1, 0], -1, 15120),
+    t(4, 0, [0, 2, 0], 17, 5040),
+    t(4, 0, [1, 0, 1], -3, 280),
+    t(4, 1, [3, 1, 0], -1, 11340),
+    t(4, 1, [1, 2, 0], -11, 1890),
+    t(4, 1, [2, 0, 1], 23, 945),
+    t(4, 1, [0, 1, 1], -23, 1260),
+    t(4, 2, [2, 2, 0], 13, 3780),
+    t(4, 2, [0, 3, 0], 1, 2520),
+    t(4, 2, [3, 0, 1], -17, 1260),
+    t(4, 2, [1, 1, 1], 1, 252),
+    t(4, 2, [0, 0, 2], 53, 1260),
+    t(4, 3, [1, 3, 0], -11, 3240),
+    t(4, 3, [2, 1, 1], 17, 1260),
+    t(4, 3, [0, 2, 1], 47, 7560),
+    t(4, 3, [1, 0, 2], -47, 945),
+    t(4, 4, [0, 4, 0], 31, 22680),
+    t(4, 4, [1, 2, 1], -19, 2520),
+    t(4, 4, [2, 0, 2], 1, 120),
+    t(4, 4, [0, 1, 2], 97, 15120),
+];
+
+/// d_{2k+1} (k = 1…4) in the inverse moments, as [`S`].
+#[rustfmt::skip]
+const D: [Term; 38] = [
+    t(1, 0, [0, 1, 0], 1, 6),
+    t(1, 1, [0, 0, 1], -1, 3),
+    t(2, 0, [1, 1, 0], -1, 60),
+    t(2, 0, [0, 0, 1], -1, 10),
+    t(2, 1, [0, 2, 0], -1, 60),
+    t(2, 1, [1, 0, 1], 2, 15),
+    t(2, 2, [0, 1, 1], -1, 60),
+    t(3, 0, [2, 1, 0], 1, 1260),
+    t(3, 0, [0, 2, 0], -13, 1260),
+    t(3, 0, [1, 0, 1], 1, 42),
+    t(3, 1, [1, 2, 0], 13, 2520),
+    t(3, 1, [2, 0, 1], -8, 315),
+    t(3, 1, [0, 1, 1], 11, 252),
+    t(3, 2, [0, 3, 0], 1, 1260),
+    t(3, 2, [1, 1, 1], -1, 1260),
+    t(3, 2, [0, 0, 2], -22, 315),
+    t(3, 3, [0, 2, 1], -19, 2520),
+    t(3, 3, [1, 0, 2], 1, 35),
+    t(4, 0, [3, 1, 0], -1, 45360),
+    t(4, 0, [1, 2, 0], -1, 7560),
+    t(4, 0, [2, 0, 1], -1, 360),
+    t(4, 0, [0, 1, 1], 17, 1680),
+    t(4, 1, [2, 2, 0], -1, 1512),
+    t(4, 1, [0, 3, 0], 97, 22680),
+    t(4, 1, [3, 0, 1], 8, 2835),
+    t(4, 1, [1, 1, 1], -23, 1890),
+    t(4, 1, [0, 0, 2], -1, 35),
+    t(4, 2, [1, 3, 0], -1, 1512),
+    t(4, 2, [2, 1, 1], 19, 7560),
+    t(4, 2, [0, 2, 1], -19, 1080),
+    t(4, 2, [1, 0, 2], 89, 1890),
+    t(4, 3, [0, 4, 0], -1, 45360),
+    t(4, 3, [1, 2, 1], 37, 7560),
+    t(4, 3, [2, 0, 2], -2, 105),
+    t(4, 3, [0, 1, 2], 19, 1260),
+    t(4, 4, [0, 3, 1], -61, 45360),
+    t(4, 4, [1, 1, 2], 3, 560),
+    t(4, 4, [0, 0, 3], -61, 4536),
+];
+
+/// The elementary symmetric polynomials (p₁, p₂, p₃) of v.
+fn elementary(v: [f64; 3]) -> [f64; 3] {
+    [
+        v[0] + v[1] + v[2],
+        v[0] * v[1] + v[1] * v[2] + v[2] * v[0],
+        v[0] * v[1] * v[2],
+    ]
+}
+
+/// Σ num/den · p₁^a p₂^b p₃^c over the terms of `terms` at h^{2k}, by the power i of C.
+fn coefficients(terms: &[Term], p: [f64; 3], k: usize) -> [f64; 5] {
+    let mut out = [0.0; 5];
+    for t in terms.iter().filter(|t| usize::from(t.k) == k) {
+        let pp: f64 = (0..3).map(|a| p[a].powi(i32::from(t.p[a]))).product();
+        out[usize::from(t.i)] += f64::from(t.num) / f64::from(t.den) * pp;
+    }
+    out
+}
+
+/// The coefficients of H^{k−i} C^i (i = 0…k) in s_{2k+1} and d_{2k+1}, k = 1…4, of principal
+/// moments I (unscaled: s = 1 + Σ_k h^{2k} Σ_i s[i] H^{k−i} C^i, likewise d); for tests against
+/// HV06 Table 1. Zeros for other k.
+pub fn series_coefficients(moments: &[f64; 3], k: usize) -> ([f64; 5], [f64; 5]) {
+    let p = elementary(moments.map(|m| 1.0 / m));
+    (coefficients(&S, p, k), coefficients(&D, p, k))
+}
+
+/// The series s, d of one body and order, scale-free (module docs): the coefficients of
+/// X^{k−i} Y^i at k = 1…r−1 in s and d/u_ref, computed once per stepper.
+#[derive(Clone, Copy, Debug)]
+struct Series {
+    order: u32,
+    u_ref: f64,
+    mu: [f64; 3],
+    s: [[f64; 5]; 4],
+    d: [[f64; 5]; 4],
+}
+
+impl Series {
+    /// Errors: an order not in [`ORDERS`]; moments not positive and finite.
+    fn new(moments: &[f64; 3], order: u32) -> Result<Self> {
+        if !ORDERS.contains(&order) {
+            return Err(Error::invalid(
+                "order",
+                format!("the DMV methods have orders 2, 4, 6, 8, 10, got {order}"),
+            ));
+        }
+        super::top::check_moments(moments)?;
+        let u = moments.map(|i| 1.0 / i);
+        let u_ref = u.iter().fold(0.0f64, |a, &b| a.max(b));
+        let mu = u.map(|x| x / u_ref);
+        let p = elementary(mu);
+        let mut series = Series {
+            order,
+            u_ref,
+            mu,
+            s: [[0.0; 5]; 4],
+            d: [[0.0; 5]; 4],
+        };
+        for k in 1..(order as usize / 2) {
+            series.s[k - 1] = coefficients(&S, p, k);
+            series.d[k - 1] = coefficients(&D, p, k);
+        }
+        Ok(series)
+    }
+
+    /// The modified moments for the body momentum m (principal frame) and the step h.
+    fn moments(&self, m: &[f64; 3], h: f64) -> Result<[f64; 3]> {
+        let (mu, u_ref) = (self.mu, self.u_ref);
+        // v = h u_ref M: X = h²H u_ref = ½ Σ μ_j v_j², Y = h²C u_ref² = ½ Σ v_j².
+        let v = [0, 1, 2].map(|j| h * u_ref * m[j]);
+        let x = 0.5 * (0..3).map(|j| mu[j] * v[j] * v[j]).sum::<f64>();
+        let y = 0.5 * v.iter().map(|a| a * a).sum::<f64>();
+        // Σ_k Σ_i c[k][i] x^{k−i} y^i, highest order (smallest) first.
+        let sum = |c: &[[f64; 5]; 4]| {
+            (1..(self.order as usize / 2))
+                .rev()
+                .map(|k| {
+                    (0..=k)
+                        .map(|i| c[k - 1][i] * x.powi((k - i) as i32) * y.powi(i as i32))
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+        };
+        let s = 1.0 + sum(&self.s);
+        let d = sum(&self.d);
+        let mut out = [0.0; 3];
+        for j in 0..3 {
+            let inv = u_ref * (s * mu[j] + d);
+            if !(inv.is_finite() && inv > 0.0) {
+                return Err(Error::invalid(
+                    "dt",
+                    format!(
+                        "dt = {} is too large for dmv{} at this state: the modified inverse \
+                         moment 1/Ĩ[{j}] = {} is not positive and finite (h²H·max(1/I) = {}; \
+                         reduce dt)",
+                        crate::error::fmt_num(h),
+                        self.order,
+                        crate::error::fmt_num(inv),
+                        crate::error::fmt_num(x),
+                    ),
+                ));
+            }
+            out[j] = 1.0 / inv;
+        }
+        Ok(out)
+    }
+}
+
+/// The modified principal moments Ĩ of the preprocessed DMV of `order` (2 returns I) for the
+/// step `h` and the body momentum `m` (principal frame): 1/Ĩ_j = s/I_j + d with s and d
+/// truncated after h^{order−2} (module docs, HV06 (6) and Algorithm 2.2).
+///
+/// Errors: an order not in [`ORDERS`], moments not positive, non-finite input, and a step so
+/// large that some 1/Ĩ_j is not positive and finite ([`Error::InvalidArgument`] naming dt).
+pub fn modified_moments(moments: &[f64; 3], m: &[f64; 3], h: f64, order: u32) -> Result<[f64; 3]> {
+    let series = Series::new(moments, order)?;
+    crate::check::finite_slice("M", m)?;
+    crate::check::finite_slice("dt", &[h])?;
+    if order == 2 {
+        return Ok(*moments);
+    }
+    series.moments(m, h)
+}
+
+impl Integrator<RigidBody> for Dmv {
+    /// Order `self.0`; symplectic (for the preprocessed orders: Poisson on so(3)*, module docs),
+    /// symmetric, keeps |M|², R M and SO(3).
+    fn properties(&self) -> Properties {
+        Properties::geometric(self.0)
+    }
+
+    /// Errors: an order not in [`ORDERS`] ([`Error::InvalidArgument`]).
+    fn stepper(&self, body: &RigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
+        let moments = body.top.moments;
+        Ok(Box::new(DmvStepper {
+            series: Series::new(&moments, self.0)?,
+            moments,
+            h: dt,
+            lifted: body.top.lifted,
+            m: Vector3::zeros(),
+            carry: Vector3::zeros(),
+            q: [1.0, 0.0, 0.0, 0.0],
+            kernel: Kernel::new(&moments, dt),
+        }))
+    }
+}
+
+/// The constants of a DMV step for the (modified) moments Ĩ: a_j = (h/2)/Ĩ_j,
+/// fac_i = (Ĩ_j − Ĩ_k)/Ĩ_i and fad_i = 4(Ĩ_j − Ĩ_k)/h, (i, j, k) cyclic.
+#[derive(Clone, Copy, Debug)]
+struct Kernel {
+    a: [f64; 3],
+    fac: [f64; 3],
+    fad: [f64; 3],
+}
+
+impl Kernel {
+    fn new(inertia: &[f64; 3], h: f64) -> Self {
+        let cyc = |i: usize| ((i + 1) % 3, (i + 2) % 3);
+        Kernel {
+            a: inertia.map(|i| 0.5 * h / i),
+            fac: [0, 1, 2].map(|i| {
+                let (j, k) = cyc(i);
+                (inertia[j] - inertia[k]) / inertia[i]
+            }),
+            fad: [0, 1, 2].map(|i| {
+                let (j, k) = cyc(i);
+                4.0 * (inertia[j] - inertia[k]) / h
+            }),
+        }
+    }
+}
+
+/// Why a solve failed: iterations taken and the last relative update.
+struct Failed(usize, f64);
+
+/// The DMV stepper on M (principal frame) and the attitude quaternion.
+struct DmvStepper {
+    series: Series,
+    moments: [f64; 3],
+    h: f64,
+    lifted: bool,
+    m: Vector3<f64>,
+    carry: Vector3<f64>,
+    /// The attitude (w, x, y, z), |q| = 1.
+    q: [f64; 4],
+    kernel: Kernel,
+}
+
+impl DmvStepper {
+    /// Solves e_i = α b_i + fac_i e_j e_k, α = 1 + |e|² ((i, j, k) cyclic): Gauss–Seidel sweeps
+    /// from the predictor while they contract fast (ratio of successive updates ρ ≤
+    /// [`SLOW_CONTRACTION`]), until the update vanishes, or the error left after it
+    /// (≤ ρ/(1 − ρ) times the update) is below ε/8, or it stops decreasing at round-off; a slow
+    /// contraction (large steps) hands the iterate to Newton's method.
+    fn solve(&self, b: [f64; 3]) -> std::result::Result<[f64; 3], Failed> {
+        let f = self.kernel.fac;
+        // Predictor: the first sweep from e = b (error O(|e|³)).
+        let mut e = [0.0; 3];
+        e[0] = b[0] + f[0] * b[1] * b[2];
+        e[1] = b[1] + f[1] * e[0] * b[2];
+        e[2] = b[2] + f[2] * e[0] * e[1];
+        let mut prev = f64::INFINITY;
+        for sweep in 1..=MAX_FIXED_POINT {
+            let alpha = 1.0 + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+            let n0 = alpha * b[0] + f[0] * e[1] * e[2];
+            let n1 = alpha * b[1] + f[1] * n0 * e[2];
+            let n2 = alpha * b[2] + f[2] * n0 * n1;
+            let diff = (n0 - e[0]).abs() + (n1 - e[1]).abs() + (n2 - e[2]).abs();
+            let size = n0.abs() + n1.abs() + n2.abs();
+            e = [n0, n1, n2];
+            if !diff.is_finite() {
+                break;
+            }
+            let rho = diff / prev;
+            if diff <= NEGLIGIBLE * size
+                || (sweep >= 2
+                    && rho <= SLOW_CONTRACTION
+                    && diff * rho <= 0.125 * f64::EPSILON * size * (1.0 - rho))
+                || (diff >= prev && diff <= STAGNATION_TOL * size)
+            {
+                return Ok(e);
+            }
+            if sweep >= 2 && rho > SLOW_CONTRACTION {
+                return self.newton(b, e);
+            }
+            prev = diff;
+        }
+        // Not finite, or no contraction: Newton from the predictor.
+        let mut e = [0.0; 3];
+        e[0] = b[0] + f[0] * b[1] * b[2];
+        e[1] = b[1] + f[1] * e[0] * b[2];
+        e[2] = b[2] + f[2] * e[0] * e[1];
+        self.newton(b, e)
+    }
+
+    /// Newton's method for the same equation from `e`, until the update vanishes, or is below
+    /// 10⁻⁹|e| in the quadratic regime (below 10⁻⁴ of the one before: what is left is of the
+    /// order of its square), or stops decreasing at round-off.
+    fn newton(&self, b: [f64; 3], mut e: [f64; 3]) -> std::result::Result<[f64; 3], Failed> {
+        let f = self.kernel.fac;
+        let mut prev = f64::INFINITY;
+        for iter in 1..=MAX_NEWTON {
+            let alpha = 1.0 + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+            let g = [
+                e[0] - alpha * b[0] - f[0] * e[1] * e[2],
+                e[1] - alpha * b[1] - f[1] * e[2] * e[0],
+                e[2] - alpha * b[2] - f[2] * e[0] * e[1],
+            ];
+            // J = 1 − 2 b eᵀ − ∂(fac ∘ (e_j e_k))/∂e.
+            let j = Matrix3::new(
+                1.0 - 2.0 * b[0] * e[0],
+                -2.0 * b[0] * e[1] - f[0] * e[2],
+                -2.0 * b[0] * e[2] - f[0] * e[1],
+                -2.0 * b[1] * e[0] - f[1] * e[2],
+                1.0 - 2.0 * b[1] * e[1],
+                -2.0 * b[1] * e[2] - f[1] * e[0],
+                -2.0 * b[2] * e[0] - f[2] * e[1],
+                -2.0 * b[2] * e[1] - f[2] * e[0],
+                1.0 - 2.0 * b[2] * e[2],
+            );
+            let size = e[0].abs() + e[1].abs() + e[2].abs();
+            let Some(inv) = j.try_inverse() else {
+                return Err(Failed(iter, (g[0].abs() + g[1].abs() + g[2].abs()) / size));
+            };
+            let de = inv * Vector3::from(g);
+            e = [e[0] - de[0], e[1] - de[1], e[2] - de[2]];
+            let diff = de.lp_norm(1);
+            let size = e[0].abs() + e[1].abs() + e[2].abs();
+            if !diff.is_finite() {
+                return Err(Failed(iter, f64::INFINITY));
+            }
+            if diff <= NEGLIGIBLE * size
+                || (diff <= 1e-9 * size && diff <= 1e-4 * prev)
+                || (diff >= prev && diff <= STAGNATION_TOL * size)
+            {
+                return Ok(e);
+            }
+            prev = diff;
+        }
+        Err(Failed(
+            MAX_NEWTON,
+            prev / (e[0].abs() + e[1].abs() + e[2].abs()),
+        ))
+    }
+
+    fn step(&mut self) -> std::result::Result<(), Failed> {
+        let k = &self.kernel;
+        let b = [0, 1, 2].map(|j| k.a[j] * self.m[j]);
+        let e = self.solve(b)?;
+        let alpha = 1.0 + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        let inc = Vector3::new(
+            k.fad[0] * (e[1] * e[2]),
+            k.fad[1] * (e[2] * e[0]),
+            k.fad[2] * (e[0] * e[1]),
+        ) / alpha;
+        // Kahan's compensated m += inc.
+        let y = inc - self.carry;
+        let t = self.m + y;
+        self.carry = (t - self.m) - y;
+        self.m = t;
+        if self.lifted {
+            let p = quaternion_multiply(&self.q, &[1.0, e[0], e[1], e[2]]);
+            let inv = 1.0 / (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
+            self.q = p.map(|c| c * inv);
+        }
+        Ok(())
+    }
+}
+
+impl Stepper for DmvStepper {
+    /// M (and R), and the modified moments from the invariants of M.
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        self.m = Vector3::from_column_slice(&z[..3]);
+        self.carry = Vector3::zeros();
+        if self.lifted {
+            self.q = matrix_to_quaternion(&Matrix3::from_row_slice(&z[3..12]));
+        }
+        let inertia = if self.series.order == 2 {
+            self.moments
+        } else {
+            self.series.moments(&self.m.into(), self.h)?
+        };
+        self.kernel = Kernel::new(&inertia, self.h);
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        z[..3].copy_from_slice(self.m.as_slice());
+        if self.lifted {
+            let r = quaternion_to_matrix(&self.q);
+            z[3..12].copy_from_slice(&super::top::row_major(&r));
+        }
+    }
+
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        for k in 0..steps {
+            self.step().map_err(|Failed(iterations, residual)| {
+                clock.not_converged(
+                    k,
+                    "DMV iteration for the relative rotation",
+                    iterations,
+                    residual,
+                    STAGNATION_TOL,
+                )
+            })?;
+        }
+        Ok(())
+    }
+}
