@@ -2,6 +2,8 @@
 through lf.integrate with the attitude, against scipy's DOP853 (rtol = atol = 1e-14) on Euler's
 equation with dR/dt = R hat(Omega), at T = 100 (I = (1, 2, 3), M0 = (1, 0.5, -0.3))."""
 
+import warnings
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -26,8 +28,12 @@ def rhs(t, y):
 
 @pytest.fixture(scope="module")
 def reference():
+    # scipy raises an rtol below 100 eps to 2.2e-14 (with a warning); the error at T = 100 is
+    # ~1e-12, below every tolerance here but the one at round-off.
     y0 = np.concatenate([M0, np.eye(3).ravel()])
-    sol = solve_ivp(rhs, (0.0, T), y0, method="DOP853", rtol=1e-14, atol=1e-14)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "At least one element of `rtol` is too small")
+        sol = solve_ivp(rhs, (0.0, T), y0, method="DOP853", rtol=1e-14, atol=1e-14)
     assert sol.success
     return sol.y[:3, -1], sol.y[3:, -1].reshape(3, 3)
 
@@ -38,11 +44,11 @@ def test_methods_are_listed():
     assert methods[at + 1:at + 6] == DMV
 
 
-# dt and the measured error of lieflow against DOP853 (max over M and R), with a margin; the
-# last one is at the accuracy of the reference.
+# dt and a bound of the error against DOP853 (max over M and R; measured 1.6e-3, 5.6e-6,
+# 2.5e-8, 1.0e-9, 4.9e-12 and 3.4e-13, the last at the accuracy of the reference).
 @pytest.mark.parametrize("method, dt, tol", [
-    ("dmv", 0.01, 6e-3), ("dmv4", 0.05, 2e-5), ("dmv6", 0.1, 1e-7), ("dmv8", 0.2, 4e-9),
-    ("dmv10", 0.25, 2e-10), ("dmv10", 0.1, 2e-10)])
+    ("dmv", 0.01, 4e-3), ("dmv4", 0.05, 1.2e-5), ("dmv6", 0.1, 5e-8), ("dmv8", 0.2, 2e-9),
+    ("dmv10", 0.25, 1e-11), ("dmv10", 0.1, 2e-12)])
 def test_against_dop853(reference, method, dt, tol):
     m_ref, r_ref = reference
     body = lf.RigidBody(I)
@@ -54,10 +60,10 @@ def test_against_dop853(reference, method, dt, tol):
     # What the methods keep: |M|, R M, R in SO(3), and the energy.
     r = traj.attitude
     assert np.abs(np.einsum("kji,kjl->kil", r, r) - np.eye(3)).max() < 1e-14
-    np.testing.assert_allclose(np.einsum("kij,kj->ki", r, traj.states), np.eye(3) @ M0,
-                               rtol=0, atol=1e-14)
-    np.testing.assert_allclose(np.linalg.norm(traj.states, axis=-1), np.linalg.norm(M0),
-                               rtol=0, atol=1e-14)
+    spatial = np.einsum("kij,kj->ki", r, traj.states)
+    np.testing.assert_allclose(spatial, np.broadcast_to(M0, spatial.shape), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(np.linalg.norm(traj.states, axis=-1),
+                               np.full(len(traj.states), np.linalg.norm(M0)), rtol=0, atol=1e-14)
     np.testing.assert_allclose(traj.energy(), body.energy(M0), rtol=1e-14, atol=0)
 
 
