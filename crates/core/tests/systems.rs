@@ -517,6 +517,11 @@ fn bad_input_gets_typed_errors() {
             "splitting6",
             "isospectral",
             "lgvi",
+            "dmv",
+            "dmv4",
+            "dmv6",
+            "dmv8",
+            "dmv10",
             "rk4",
             "rkmk4"
         ]

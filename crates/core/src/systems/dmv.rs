@@ -25,7 +25,7 @@
 //! e = (h/2) I⁻¹Y. The implicit equation for e is solved to round-off by Gauss–Seidel sweeps
 //! (a contraction with factor O(|e|) = O(h|Ω|)) from a predictor accurate to O(|e|³), or, where
 //! they contract slowly (large steps), by Newton's method on the same 3-vector equation
-//! ([`DmvStepper::solve`]); a step whose equation has no solution nearby is
+//! (`DmvStepper::solve`); a step whose equation has no solution nearby is
 //! [`crate::Error::NotConverged`] naming the step. The momentum increments are added with
 //! compensated (Kahan) summation.
 //!
@@ -43,7 +43,7 @@
 //! inertias, then fitted exactly as symmetric polynomials): in the inverse moments u_j = 1/I_j,
 //! the coefficient of H^{k−i} C^i in s_{2k+1} is a symmetric polynomial of degree k + i, in d_{2k+1}
 //! of degree k + i + 1, written in the elementary symmetric polynomials p₁ = Σ u_j,
-//! p₂ = Σ_{i<j} u_i u_j, p₃ = u₁u₂u₃ ([`S`], [`D`]). They agree exactly with Table 1 of HV06
+//! p₂ = Σ_{i<j} u_i u_j, p₃ = u₁u₂u₃ (the tables `S`, `D`). They agree exactly with Table 1 of HV06
 //! (s₃ … d₇) and with the Fortran code DMV10 of the authors (up to s₉, d₉); no published formula
 //! needed a correction. They are evaluated scale-free: with u_ref = max u_j, μ_j = u_j/u_ref,
 //! p̂ the elementary polynomials of μ, X = h² H u_ref and Y = h² C u_ref²,
