@@ -75,8 +75,8 @@ from ._lieflow import (
 )
 from . import continuation, ellipsoids, elliptic, io, lie, plot, potentials, pseudo_rigid, surfaces
 from . import ensemble  # imports dask and xarray only when its functions are called
-from .integrate import Trajectory, integrate
-from .io import FileFormatError, load
+from .integrate import Trajectory, integrate, load
+from .io import FileFormatError
 
 #: The former name of the base class of the Lie–Poisson systems (kept for existing code).
 LiePoissonSystem = System

@@ -29,7 +29,7 @@ import numpy as np
 
 from ._lieflow import InvalidArgumentError, NonFiniteError, ShapeError, System
 
-__all__ = ["integrate", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
+__all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
 #: Steps x bodies per native call. Between two calls Python checks for Ctrl-C and updates the
 #: progress bar; at 30 ns - 1 us per body-step a chunk takes well under a second. The chunking
@@ -729,3 +729,21 @@ class Trajectory:
         names = set(super().__dir__()) | set(self._fields())
         names |= {n for n in dir(self.system) if not n.startswith("_")}
         return sorted(names)
+
+
+def load(path, *, allow_pickle=False):
+    """Reads a trajectory written by ``Trajectory.save`` (or a Dataset of
+    ``Trajectory.to_xarray()``), its system rebuilt from the file, so that
+    ``lf.integrate(traj.system, traj.final_state, ..., t0=traj.t_final)`` continues the run.
+    The round trip is exact. ``allow_pickle=True`` allows a system stored pickled (a system
+    built from Python callables; loading runs code from the file, so only for files you
+    trust). Needs xarray and a NetCDF-4 backend (``pip install lieflow[io]``).
+
+    Raises:
+        ImportError (no xarray or NetCDF-4 backend), FileNotFoundError, FileFormatError (not a
+        lieflow trajectory file, damaged, a newer format, a pickled system without
+        ``allow_pickle``).
+    """
+    from .io import read
+
+    return Trajectory(**read(path, allow_pickle=allow_pickle))

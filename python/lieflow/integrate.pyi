@@ -7,7 +7,7 @@ from numpy.typing import ArrayLike, NDArray
 
 _F64 = NDArray[np.float64]
 
-__all__ = ["integrate", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
+__all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
 CHUNK_WORK: int
 MIN_CHUNK_STEPS: int
@@ -145,3 +145,7 @@ class Trajectory:
     def __getattr__(self, name: str) -> Any:
         """Named fields of the system (M, Gamma, q, L, ...) or an observable
         `traj.NAME(...) == system.NAME(traj.states, ...)`."""
+
+def load(path: str | os.PathLike[str] | Any, *, allow_pickle: bool = False) -> Trajectory:
+    """A trajectory written by `Trajectory.save` (or a Dataset of `to_xarray()`), its system
+    rebuilt."""

@@ -1,8 +1,10 @@
 """Trajectories as xarray Datasets and NetCDF files.
 
 ``Trajectory.to_xarray()`` gives a :class:`xarray.Dataset`; ``Trajectory.save(path)`` writes it to
-a NetCDF file and :func:`load` reads it back as a ``Trajectory`` whose ``system`` is rebuilt, so
-that a run can be continued from its ``final_state``. Needs xarray and a NetCDF-4 backend
+a NetCDF file and ``lieflow.load`` reads it back as a ``Trajectory`` whose ``system`` is rebuilt,
+so that a run can be continued from its ``final_state`` (:func:`read` gives its parts). This
+module works on any object with a Trajectory's attributes and never imports the class: the
+driver (``lieflow.integrate``) builds the Trajectory. Needs xarray and a NetCDF-4 backend
 (``pip install lieflow[io]``: netCDF4).
 
 Layout of the Dataset (format 1):
@@ -39,7 +41,7 @@ import numbers
 import operator
 import os
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -48,11 +50,9 @@ from ._lieflow import InvalidArgumentError, LieflowError, __version__
 if TYPE_CHECKING:
     import xarray
 
-    from .integrate import Trajectory
+__all__ = ["FileFormatError", "FORMAT", "read", "save", "to_xarray"]
 
-__all__ = ["FileFormatError", "FORMAT", "load", "save", "to_xarray"]
-
-#: The version of the file layout written by :func:`save`; :func:`load` reads every version
+#: The version of the file layout written by :func:`save`; :func:`read` reads every version
 #: up to it.
 FORMAT = 1
 
@@ -210,7 +210,7 @@ _RESERVED = {"states", "energy", "invariants", "attitude", "initial_state", "fin
              "initial_attitude", "final_attitude", "time", "member"}
 
 
-def to_xarray(traj: Trajectory, *, observables: bool = True) -> xarray.Dataset:
+def to_xarray(traj: Any, *, observables: bool = True) -> xarray.Dataset:
     """The trajectory as an :class:`xarray.Dataset` (layout in the module docstring).
 
     Parameters
@@ -286,7 +286,7 @@ def _attributes(traj):
     return attrs
 
 
-def save(traj: Trajectory, path: str | os.PathLike[str], *, allow_pickle: bool = False) -> None:
+def save(traj: Any, path: str | os.PathLike[str], *, allow_pickle: bool = False) -> None:
     """Writes the trajectory to a NetCDF file at `path` (the Dataset of :func:`to_xarray`).
 
     Parameters
@@ -329,12 +329,13 @@ def save(traj: Trajectory, path: str | os.PathLike[str], *, allow_pickle: bool =
     ds.to_netcdf(path, engine=engine)
 
 
-def load(path: str | os.PathLike[str] | xarray.Dataset, *,
-         allow_pickle: bool = False) -> Trajectory:
-    """Reads a trajectory written by ``Trajectory.save`` (or a Dataset of ``to_xarray``).
-
-    The system is rebuilt from the file, so ``lf.integrate(traj.system, traj.final_state, ...,
-    t0=traj.t_final)`` continues the run.
+def read(path: str | os.PathLike[str] | xarray.Dataset, *,
+         allow_pickle: bool = False) -> dict[str, Any]:
+    """The parts of a trajectory written by ``Trajectory.save`` (or of a Dataset of
+    ``to_xarray``): the keyword arguments of ``lieflow.Trajectory`` (``system`` rebuilt,
+    ``method``, ``t``, ``states``, ``attitude``, ``final_state``, ``final_attitude``, ``dt``,
+    ``save_every``, ``t_final``, ``status``, ``t0``, ``initial_state``, ``initial_attitude`` and
+    the events). ``lieflow.load(path)`` is ``Trajectory(**read(path))``.
 
     Parameters
     ----------
@@ -346,7 +347,7 @@ def load(path: str | os.PathLike[str] | xarray.Dataset, *,
 
     Returns
     -------
-    lieflow.Trajectory
+    dict
 
     Raises
     ------
@@ -382,7 +383,7 @@ def load(path: str | os.PathLike[str] | xarray.Dataset, *,
             f"{where} was written by lieflow {ds.attrs.get('lieflow_version', '?')} in format "
             f"{version}; lieflow {__version__} reads formats 1 to {FORMAT}: upgrade lieflow")
     try:
-        return _trajectory(ds, allow_pickle)
+        return _arguments(ds, allow_pickle)
     except FileFormatError:
         raise
     except Exception as e:
@@ -403,9 +404,7 @@ def _system(attrs, allow_pickle):
     raise FileFormatError("the file does not say how to rebuild its system (no system_spec)")
 
 
-def _trajectory(ds, allow_pickle):
-    from .integrate import Trajectory
-
+def _arguments(ds, allow_pickle):
     a = ds.attrs
     system = _system(a, allow_pickle)
 
@@ -430,8 +429,9 @@ def _trajectory(ds, allow_pickle):
     def attr(name, kind):
         return kind(a[name]) if name in a else None
 
-    return Trajectory(system, method, t, states, var("attitude"), var("final_state"),
-                      var("final_attitude"), attr("dt", float), attr("save_every", int),
-                      t_final=attr("t_final", float), status=int(a.get("status", 0)),
-                      t0=attr("t0", float), initial_state=var("initial_state"),
-                      initial_attitude=var("initial_attitude"), **events)
+    return dict(system=system, method=method, t=t, states=states, attitude=var("attitude"),
+                final_state=var("final_state"), final_attitude=var("final_attitude"),
+                dt=attr("dt", float), save_every=attr("save_every", int),
+                t_final=attr("t_final", float), status=int(a.get("status", 0)),
+                t0=attr("t0", float), initial_state=var("initial_state"),
+                initial_attitude=var("initial_attitude"), **events)
