@@ -45,7 +45,9 @@
 //! of degree k + i + 1, written in the elementary symmetric polynomials p₁ = Σ u_j,
 //! p₂ = Σ_{i<j} u_i u_j, p₃ = u₁u₂u₃ (the tables `S`, `D`). They agree exactly with Table 1 of HV06
 //! (s₃ … d₇) and with the Fortran code DMV10 of the authors (up to s₉, d₉); no published formula
-//! needed a correction. They are evaluated scale-free: with u_ref = max u_j, μ_j = u_j/u_ref,
+//! needed a correction; `scripts/dmv_coefficients.py` (sympy) re-derives them and checks
+//! the tables (and `dmv10` agrees with that code's DMV10 to 1e-13 at T = 100 in M and R on the
+//! test of tests/dmv.rs, dt = 0.1 … 0.8). They are evaluated scale-free: with u_ref = max u_j, μ_j = u_j/u_ref,
 //! p̂ the elementary polynomials of μ, X = h² H u_ref and Y = h² C u_ref²,
 //! s = 1 + Σ S_{k,i}(p̂) X^{k−i} Y^i and d = u_ref Σ D_{k,i}(p̂) X^{k−i} Y^i.
 //!
@@ -211,7 +213,7 @@ fn coefficients(terms: &[Term], p: [f64; 3], k: usize) -> [f64; 5] {
 }
 
 /// The coefficients of H^{k−i} C^i (i = 0…k) in s_{2k+1} and d_{2k+1}, k = 1…4, of principal
-/// moments I (unscaled: s = 1 + Σ_k h^{2k} Σ_i s[i] H^{k−i} C^i, likewise d); for tests against
+/// moments I (unscaled: s = 1 + Σ_k h^{2k} Σ_i s_i H^{k−i} C^i, likewise d); for tests against
 /// HV06 Table 1. Zeros for other k.
 pub fn series_coefficients(moments: &[f64; 3], k: usize) -> ([f64; 5], [f64; 5]) {
     let p = elementary(moments.map(|m| 1.0 / m));
