@@ -126,7 +126,7 @@ fn agm_kprime(kp: f64) -> f64 {
 }
 
 /// K = π / (2 AGM(1, k′)), +∞ at k′ = 0.
-fn ellipk_kprime(kp: f64) -> f64 {
+pub(crate) fn ellipk_kprime(kp: f64) -> f64 {
     if kp == 0.0 {
         f64::INFINITY
     } else {
@@ -228,7 +228,7 @@ pub fn ellipj_kprime_unchecked(u: f64, kp: f64, m: f64) -> (f64, f64, f64) {
 /// (sn, cn, dn)(x | m) with k′ = √(1 − m) by the descending Landen transformation in
 /// complementary form; see [`ellipj_complement`]. Relative accuracy for 0 ≤ x ≤ K/2, where
 /// cn, dn ≥ √(k′/2).
-fn landen(x: f64, kp: f64, m: f64) -> (f64, f64, f64) {
+pub(crate) fn landen(x: f64, kp: f64, m: f64) -> (f64, f64, f64) {
     let mut r = [0.0; LANDEN_MAX];
     let mut omr = [0.0; LANDEN_MAX];
     let mut s = kp; // √(1 − μ) at the current level
@@ -541,11 +541,17 @@ pub fn carlson_rj(x: f64, y: f64, z: f64, p: f64) -> Result<f64> {
 #[inline]
 fn rc_one(e: f64, y: f64) -> f64 {
     if e.abs() < 1e-2 {
-        let mut s = 1.0 / 15.0;
-        for k in (0..7).rev() {
-            s = 1.0 / (2 * k + 1) as f64 - e * s;
-        }
-        s
+        const C: [f64; 8] = [
+            1.0,
+            1.0 / 3.0,
+            1.0 / 5.0,
+            1.0 / 7.0,
+            1.0 / 9.0,
+            1.0 / 11.0,
+            1.0 / 13.0,
+            1.0 / 15.0,
+        ];
+        C.iter().rev().fold(0.0, |s, &c| c - e * s)
     } else if e > 0.0 {
         let r = e.sqrt();
         r.atan() / r
@@ -589,9 +595,19 @@ pub(crate) fn rj_from_roots(sx: f64, sy: f64, sz: f64, sp: f64) -> f64 {
         let (hx, hy, hz) = (0.5 * rx, 0.5 * ry, 0.5 * rz);
         let lam = hx * (hy + hz) + hy * hz;
         let (ax, ay, az) = (rp + rx, rp + ry, rp + rz);
-        let e = (rp - rx) / ax * ((rp - ry) / ay) * ((rp - rz) / az);
-        let one_e = 8.0 * (rp / ax) * ((0.25 * p + lam) / ay) / az;
-        sum += fac * rc_one(e, one_e) / ax / ay / az;
+        let d = ax * ay * az;
+        let (e, one_e, inv) = if d <= 1e300 {
+            // One division per step.
+            let inv = 1.0 / d;
+            let e = (rp - rx) * (rp - ry) * (rp - rz) * inv;
+            (e, 8.0 * rp * (0.25 * p + lam) * inv, inv)
+        } else {
+            // Huge arguments: ratios, no overflow (the term itself may underflow).
+            let e = (rp - rx) / ax * ((rp - ry) / ay) * ((rp - rz) / az);
+            let one_e = 8.0 * (rp / ax) * ((0.25 * p + lam) / ay) / az;
+            (e, one_e, 1.0 / ax / ay / az)
+        };
+        sum += fac * rc_one(e, one_e) * inv;
         fac *= 0.25;
         x = 0.25 * x + lam;
         y = 0.25 * y + lam;

@@ -328,4 +328,10 @@ fn rj_matches_mpmath_and_its_special_values() {
     let tiny = f64::from_bits(1);
     assert!(carlson_rj(0.0, tiny, f64::MAX, 1.0).unwrap().is_finite());
     assert!(carlson_rj(f64::MAX, f64::MAX, f64::MAX, f64::MAX).unwrap() >= 0.0);
+    // Large arguments: R_J(λx, λy, λz, λp) = λ^{−3/2} R_J(x, y, z, p).
+    for (lambda, scale) in [(1e200, 1e300), (1e204, 1e306)] {
+        let got = carlson_rj(lambda, 2.0 * lambda, 3.0 * lambda, 4.0 * lambda).unwrap();
+        let e = rel(got * scale, 0.23984809974956775);
+        assert!(e < 2e-15, "λ = {lambda:e}: {e:e}");
+    }
 }

@@ -887,7 +887,7 @@ fn rkmk4_keeps_the_orbit_over_1e4_steps() {
 fn rkmk4_catalog_entries_and_errors() {
     let b = body();
     let names: Vec<_> = b.methods().iter().map(|(n, _)| *n).collect();
-    assert_eq!(names.last(), Some(&"rkmk4"));
+    assert!(names.contains(&"rkmk4"));
     let gb = GeneralizedRigidBody::from_matrix(&Mat::from_fn(4, 4, |i, j| {
         if i == j {
             1.0 + i as f64

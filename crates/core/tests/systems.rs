@@ -499,7 +499,11 @@ fn bad_input_gets_typed_errors() {
     let t = top();
     match integrate(&t, "isospectral", &t.state(M0, [0.0, 0.0, 1.0]), 0.1, 10, 1) {
         Err(Error::UnsupportedMethod { supported, .. }) => {
-            assert_eq!(supported, "splitting, splitting4, splitting6, lgvi, rk4")
+            assert_eq!(
+                supported,
+                "splitting, splitting4, splitting6, lgvi, rk4, exact_splitting, exact_splitting4, \
+                 exact_splitting6"
+            )
         }
         other => panic!("expected UnsupportedMethod, got {other:?}"),
     }

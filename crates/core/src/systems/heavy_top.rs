@@ -13,6 +13,7 @@
 //! Lagrangian with Γ = R⁻¹e₃ and obtains IΩ̇ = IΩ × Ω + gΓ × X_b: the same equations with
 //! mgl χ = g X_b (mass absorbed in X_b).
 
+use super::exact_flow::ExactSplitting;
 use super::lgvi::Lgvi;
 use super::top::{self, top_kinds, Top};
 use crate::check;
@@ -177,6 +178,9 @@ impl Catalog for HeavyTop {
             Entry::new("splitting6", Splitting(Composition::yoshida6())),
             Entry::new("lgvi", Lgvi),
             Entry::new("rk4", Rk4),
+            Entry::new("exact_splitting", ExactSplitting(Composition::strang())),
+            Entry::new("exact_splitting4", ExactSplitting(Composition::suzuki4())),
+            Entry::new("exact_splitting6", ExactSplitting(Composition::yoshida6())),
         ]
     }
 

@@ -30,6 +30,7 @@
 //! other (z_k ∈ SO(3) row-major, u ∈ S²).
 
 pub mod dmv;
+pub mod exact_flow;
 pub mod heavy_top;
 pub mod isospectral;
 pub mod lgvi;
@@ -47,6 +48,7 @@ mod top;
 pub mod user;
 
 pub use dmv::Dmv;
+pub use exact_flow::{Exact, ExactSplitting};
 pub use heavy_top::HeavyTop;
 pub use isospectral::Isospectral;
 pub use lgvi::Lgvi;

@@ -17,11 +17,11 @@
 //! c = (−w₃, w₂, −w₁), and with J_i + J_j = I_k ({i, j, k} = {1, 2, 3}) the energies agree (tested).
 
 use super::dmv::Dmv;
+use super::exact_flow::{Exact, FreeFlow};
 use super::isospectral::Isospectral;
 use super::lgvi::Lgvi;
 use super::top::{self, top_kinds, Top};
 use crate::check;
-use crate::elliptic;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Rkmk4, Splitting};
 use crate::integrate::problem::{GroupField, VectorField};
@@ -114,103 +114,19 @@ impl RigidBody {
     /// e₂ = 2H I₂ − |M|² = Σ_k M_k² (I₂ − I_k)/I_k = A² − B² = (A − B)(A + B) (one positive and
     /// one negative term: the distance to the separatrix, exactly as accurate as the components);
     /// u₀ = sn₀ R_F(cn₀², dn₀², 1) with sn₀ = M₂/a₂, cn₀ = |M₁|/a₁, dn₀ = |M₃|/a₃ (no amplitude
-    /// angle); sn, cn, dn from k′ ([`elliptic::ellipj_kprime`]), accurate as k′ → 0. On the
+    /// angle); sn, cn, dn from k′ ([`crate::elliptic::ellipj_kprime`]), accurate as k′ → 0. On the
     /// separatrix (k′ = 0) this is the heteroclinic solution sn = tanh, cn = dn = sech. Steady
     /// rotations about a principal axis (unstable included) are returned unchanged, and a
     /// symmetric body rotates M uniformly about its symmetry axis.
     /// Errors: non-finite input.
     pub fn exact_momentum(&self, m0: &[f64], t: f64) -> Result<[f64; 3]> {
         check::len_of("M0", m0, 3)?;
+        check::finite_slice("M0", m0)?;
         check::finite_slice("t", &[t])?;
         let mi = top::to_frame(&self.top.frame, m0);
-        let m = exact_principal(&self.top.moments, &mi, t)?;
+        let m = FreeFlow::new(&self.top.moments, &mi).momentum(t);
         Ok(top::from_frame(&self.top.frame, &m).into())
     }
-}
-
-/// Exact M(t) in the principal frame.
-fn exact_principal(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Result<Vector3<f64>> {
-    if m0.amax() == 0.0 {
-        return Ok(*m0);
-    }
-    let mut idx = [0usize, 1, 2];
-    idx.sort_by(|&a, &b| inertia[a].total_cmp(&inertia[b]));
-    let (lo, mid, hi) = (idx[0], idx[1], idx[2]);
-    let (ilo, imid, ihi) = (inertia[lo], inertia[mid], inertia[hi]);
-    let eq = |a: f64, b: f64| (a - b).abs() <= 1e-14 * a.max(b);
-    if eq(ilo, ihi) {
-        return Ok(*m0);
-    }
-    if eq(ilo, imid) || eq(imid, ihi) {
-        // Symmetric top: H = ½|M|²/I_o + ½ M_s²(1/I_s − 1/I_o), a uniform rotation about e_s.
-        let (s, io) = if eq(ilo, imid) { (hi, ilo) } else { (lo, ihi) };
-        let w = m0[s] * (1.0 / inertia[s] - 1.0 / io);
-        let mut m = *m0;
-        top::rotate_axis(&mut m, s, t * w);
-        return Ok(m);
-    }
-    // Scale-free from here on (the orbit's shape does not depend on |M|, the frequency is
-    // proportional to it), so no square below can overflow or underflow for a finite M0.
-    let scale = m0.amax();
-    let y = m0 / scale;
-    // e₂ = 2H·I_mid − |M|² = Σ_k M_k² (I_mid − I_k)/I_k = A² − B² = (A − B)(A + B) with
-    // A = |M_lo| √((I_mid − I_lo)/I_lo), B = |M_hi| √((I_hi − I_mid)/I_hi): the middle term
-    // vanishes and the other two have fixed signs, so e₂ is formed from the components without
-    // the cancellation of the invariants (error ~ ulp(A², B²), not ulp(|M|²)). Its sign says
-    // which side of the separatrix M0 lies on; e₂ = 0 (A = B) is the separatrix itself.
-    let ea = y[lo].abs() * ((imid - ilo) / ilo).sqrt();
-    let eb = y[hi].abs() * ((ihi - imid) / ihi).sqrt();
-    // Axes (p, mid, s): s carries dn, |M|²/2H lies between I_mid and I_s (e₂ ≥ 0 ⇔ s = lo).
-    let (p, s) = if ea >= eb { (hi, lo) } else { (lo, hi) };
-    let perm = [p, mid, s];
-    // Sign of the permutation: cyclic ⇔ even. Flip the middle component if odd (proper rotation).
-    let even = (perm[1] + 3 - perm[0]) % 3 == 1;
-    let sg = if even { 1.0 } else { -1.0 };
-    let (y1, y2, y3) = (y[p], sg * y[mid], y[s]);
-    if y1 == 0.0 && (y2 == 0.0 || y3 == 0.0) {
-        return Ok(*m0); // steady rotation about the s axis or the middle axis
-    }
-    let (i1, i2, i3) = (inertia[p], inertia[mid], inertia[s]);
-    // Ratios of the moment differences, all positive since I₂ lies between I₁ and I₃:
-    // g = d₂₃/d₁₃, h = d₁₂/d₁₃ with d_ij = 1/I_i − 1/I_j = (I_j − I_i)/(I_i I_j).
-    let g = i1 * (i3 - i2) / (i2 * (i3 - i1));
-    let h = i3 * (i2 - i1) / (i2 * (i3 - i1));
-    let d13 = (i3 - i1) / (i1 * i3);
-    // Amplitudes from the two conservation laws, each a sum of positive terms:
-    // a₁² = M₁² + g M₂² (M₁ at M₂ = 0), a₂² = M₂² + M₁²/g (M₂ at M₁ = 0),
-    // a₃² = M₃² + h M₂² (M₃ at M₂ = 0).
-    let a1 = y1.hypot(g.sqrt() * y2);
-    let a2 = y2.hypot(y1 / g.sqrt());
-    let a3 = y3.hypot(h.sqrt() * y2);
-    // m = k² = h a₂²/a₃², and its complement directly, as the complementary modulus
-    // k′ = √(1 − m) = √(e₂ I₃/(I₂ − I₃)) / a₃ (1 − m = (M₃² − M₁² d₁₂/d₂₃)/a₃², and
-    // M₃² d₂₃ − M₁² d₁₂ = −e₂/I₂), as a product of square roots: no square that could underflow
-    // (1 − m ~ (M_lo/M_mid)² may lie below the least double near the middle axis).
-    let m = (h * (a2 / a3) * (a2 / a3)).min(1.0);
-    let kp =
-        ((ea - eb).abs().sqrt() * (ea + eb).sqrt() * (i3 / (i2 - i3)).abs().sqrt() / a3).min(1.0);
-    // M₁ = σ a₁ cn u, M₂ = a₂ sn u, M₃ = ε a₃ dn u with σ = sign M₁, ε = sign M₃ (both signs fixed
-    // on the separatrix; elsewhere σ = −1 is the same solution shifted by 2K), u = u₀ + λt,
-    // λ = σε a₁a₃ d₁₃ / a₂ = σε a₃ d₁₃ √g (from Ṁ₂ = d₁₃ M₁M₃), and u₀ ∈ [−K, K] from
-    // sn u₀ = M₂/a₂, cn u₀ = |M₁|/a₁, dn u₀ = |M₃|/a₃ directly (no amplitude angle, no m).
-    let sigma = if y1 >= 0.0 { 1.0 } else { -1.0 };
-    let eps = if y3 >= 0.0 { 1.0 } else { -1.0 };
-    let lambda = sigma * eps * a3 * d13 * g.sqrt() * scale;
-    let (sn0, cn0, dn0) = (
-        (y2 / a2).clamp(-1.0, 1.0),
-        (y1.abs() / a1).min(1.0),
-        (y3.abs() / a3).min(1.0),
-    );
-    let u0 = elliptic::ellipf_from_jacobi(sn0, cn0, dn0);
-    let u = u0 + lambda * t;
-    // k′ carries the parameter near the separatrix (k′ = 0 there: sn = tanh, cn = dn = sech),
-    // m near a stable axis.
-    let (sn, cn, dn) = elliptic::ellipj_kprime_unchecked(u, kp, m);
-    let mut out = Vector3::zeros();
-    out[p] = sigma * a1 * cn * scale;
-    out[mid] = sg * a2 * sn * scale;
-    out[s] = eps * a3 * dn * scale;
-    Ok(out)
 }
 
 impl Problem for RigidBody {
@@ -300,6 +216,7 @@ impl Catalog for RigidBody {
             Entry::new("dmv10", Dmv(10)),
             Entry::new("rk4", Rk4),
             Entry::new("rkmk4", Rkmk4),
+            Entry::new("exact", Exact),
         ]
     }
 

@@ -323,11 +323,15 @@ impl Top {
                     *r *= e;
                 }
             }
-            Flow::Kick => {
-                if let (Some(g), Some(c)) = (b.g, self.c) {
-                    b.m += g.cross(&c) * tau;
-                }
-            }
+            Flow::Kick => self.kick(tau, b),
+        }
+    }
+
+    /// The exact flow of the heavy-top potential V = Γ·c over time τ: M ↦ M + τ Γ × c.
+    #[inline]
+    pub(crate) fn kick(&self, tau: f64, b: &mut TopWork) {
+        if let (Some(g), Some(c)) = (b.g, self.c) {
+            b.m += g.cross(&c) * tau;
         }
     }
 
