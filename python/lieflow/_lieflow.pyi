@@ -6,7 +6,7 @@ observables are vectorised over leading axes (..., d) and return a float for a s
 
 from collections.abc import Callable, Sequence
 from types import ModuleType
-from typing import Any
+from typing import Any, overload
 
 from typing_extensions import Self, disjoint_base, final
 
@@ -128,8 +128,14 @@ class RigidBody(System):
         """Omega = I^{-1} M: (..., 3) -> (..., 3)."""
     def spatial_momentum(self, states: ArrayLike, attitude: ArrayLike) -> _F64:
         """R M: (..., 3), (..., 3, 3) -> (..., 3)."""
-    def exact_solution(self, M0: ArrayLike, t: ArrayLike) -> _F64:
+    @overload
+    def exact_solution(self, M0: ArrayLike, t: ArrayLike, attitude: None = None) -> _F64:
         """Jacobi-elliptic M(t): (..., 3) and (k,) -> (..., k, 3); scalar t -> (..., 3)."""
+    @overload
+    def exact_solution(
+        self, M0: ArrayLike, t: ArrayLike, attitude: ArrayLike
+    ) -> tuple[_F64, _F64]:
+        """(M(t), R(t)) from (M0, R0 = attitude): (..., [k,] 3) and (..., [k,] 3, 3)."""
 
 @final
 class GeneralizedRigidBody(System):

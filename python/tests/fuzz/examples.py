@@ -675,7 +675,9 @@ def build_specs() -> list[Spec]:
     own = {
         "rb": [("angular_velocity", [A("states", M3, "vec")]),
                ("spatial_momentum", [A("states", M3, "vec"), A("attitude", R3, "rot")]),
-               ("exact_solution", [A("M0", M3, "vec"), A("t", np.array([0.0, 0.7, 2.0]), "bcast")])],
+               ("exact_solution", [A("M0", M3, "vec"), A("t", np.array([0.0, 0.7, 2.0]), "bcast")]),
+               ("exact_solution[attitude]", [A("M0", M3, "vec"), A("t", np.array([0.0, 0.7, 2.0]), "bcast"),
+                                             A("attitude", R3, "rot", kw=True, opt=True)])],
         "grb": [("state", [A("M", np.array([[0, .3, -.2, .5], [-.3, 0, .1, .4], [.2, -.1, 0, -.6],
                                             [-.5, -.4, .6, 0]]), "skew")]),
                 ("matrix", [A("states", np.array([0.3, -0.2, 0.5, 0.1, 0.4, -0.6]), "vec")])],

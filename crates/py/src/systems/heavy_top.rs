@@ -25,7 +25,9 @@ type Any<'py> = Bound<'py, PyAny>;
 /// Omega = I^{-1} M; energy H = M . I^{-1} M / 2 + mgl Gamma . chi; Casimirs [‖Gamma‖^2,
 /// M . Gamma]; for the Lagrange top (I1 = I2, chi = e3) also M3 is conserved. With an attitude
 /// R, Gamma must equal R^T e3 (use `state(M, attitude=R)`).
-/// Methods: splitting, splitting4, splitting6, lgvi, rk4.
+/// Methods: splitting, splitting4, splitting6, lgvi, rk4, exact_splitting, exact_splitting4,
+/// exact_splitting6 (the exact free rigid body flow and the gravity kick: Strang, Suzuki 4,
+/// Yoshida 6; best for fast tops).
 ///
 /// Args:
 ///     inertia: principal moments (3,) or a (3, 3) symmetric positive-definite matrix;

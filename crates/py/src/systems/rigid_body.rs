@@ -5,14 +5,14 @@
 use lieflow::lie::so;
 use lieflow::systems as core;
 use lieflow::{Error, Mat};
-use numpy::{PyArray1, PyArray2};
+use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
 use super::Inertia;
 use crate::convert::{py_mat3, py_vec, shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
-use crate::items::{map_items, Input};
+use crate::items::{array, map_items, Input};
 use crate::system::PySystem;
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -23,7 +23,8 @@ type Any<'py> = Bound<'py, PyAny>;
 /// Omega = I^{-1} M; energy H = M . I^{-1} M / 2; Casimir [‖M‖^2]. Carries an attitude R
 /// (dR/dt = R hat(Omega)) when `integrate(..., attitude=R0)` is given; R M is conserved.
 /// Methods: splitting, splitting4, splitting6, isospectral, lgvi, dmv (discrete Moser-Veselov),
-/// dmv4, dmv6, dmv8, dmv10 (preprocessed DMV, Hairer & Vilmart 2006), rk4, rkmk4.
+/// dmv4, dmv6, dmv8, dmv10 (preprocessed DMV, Hairer & Vilmart 2006), rk4, rkmk4, exact (the
+/// exact flow, to round-off at any dt).
 ///
 /// Args:
 ///     inertia: principal moments (3,) > 0, or a (3, 3) symmetric positive-definite matrix
@@ -110,20 +111,28 @@ impl PyRigidBody {
 
     /// The exact body momentum M(t) from M(0) = M0 by Jacobi elliptic functions (000 §4; the
     /// classical solution M1 = a1 cn u, M2 = a2 sn u, M3 = a3 dn u in suitably ordered principal
-    /// axes, u = u0 + lambda t; see `lieflow::systems::RigidBody::exact_momentum`).
+    /// axes, u = u0 + lambda t; see `lieflow::systems::RigidBody::exact_momentum`), and with
+    /// `attitude` = R0 also the attitude R(t): R(t) = R0 B0^T Z(phi(t)) B(t) through the conserved
+    /// spatial momentum R M (Celledoni, Fassò, Säfström & Zanna 2008), the angle phi from
+    /// Carlson's R_J (`lieflow::systems::RigidBody::exact_motion`); accurate to a few
+    /// eps (1 + omega t) at every t.
     ///
     /// Args:
-    ///     M0: (3,) or (..., 3); t: a time or a 1-D array of times (k,).
+    ///     M0: (3,) or (..., 3); t: a time or a 1-D array of times (k,);
+    ///     attitude: None, or R0 (3, 3) or (..., 3, 3) (broadcast with M0), a rotation.
     /// Returns:
-    ///     (..., 3) for a scalar t, (..., k, 3) for an array of times.
+    ///     M: (..., 3) for a scalar t, (..., k, 3) for an array of times; with `attitude`
+    ///     the pair (M, R) with R (..., 3, 3) or (..., k, 3, 3).
     /// Raises:
-    ///     InvalidArgumentError (M0 on the separatrix ‖M‖^2 = 2 H I_mid, where the elliptic
-    ///     modulus is 1), ShapeError, NonFiniteError.
+    ///     ShapeError, NonFiniteError, NotInGroupError (R0 not a rotation),
+    ///     InvalidArgumentError (t so large that a phase of the motion is lost to rounding).
+    #[pyo3(signature = (M0, t, attitude=None))]
     fn exact_solution<'py>(
         &self,
         py: Python<'py>,
         M0: ArrayIn<'py>,
         t: ArrayIn<'py>,
+        attitude: Option<ArrayIn<'py>>,
     ) -> PyResult<Any<'py>> {
         let tv = t.as_array();
         if tv.ndim() > 1 {
@@ -134,13 +143,45 @@ impl PyRigidBody {
             )));
         }
         let times: Vec<f64> = tv.iter().copied().collect();
-        let out_item: Vec<usize> = tv.shape().iter().copied().chain([3]).collect();
-        map_items(py, &[Input::new("M0", &M0, &[3])], &out_item, |m, out| {
-            for (o, &ti) in out.chunks_exact_mut(3).zip(&times) {
-                o.copy_from_slice(&self.body.exact_momentum(m[0], ti)?);
-            }
-            Ok(())
-        })
+        let Some(r0) = attitude else {
+            let out_item: Vec<usize> = tv.shape().iter().copied().chain([3]).collect();
+            return map_items(py, &[Input::new("M0", &M0, &[3])], &out_item, |m, out| {
+                for (o, &ti) in out.chunks_exact_mut(3).zip(&times) {
+                    o.copy_from_slice(&self.body.exact_momentum(m[0], ti)?);
+                }
+                Ok(())
+            });
+        };
+        // (M, R) of each item side by side, then split into the two arrays.
+        let out_item: Vec<usize> = tv.shape().iter().copied().chain([12]).collect();
+        let both = map_items(
+            py,
+            &[
+                Input::new("M0", &M0, &[3]),
+                Input::new("attitude", &r0, &[3, 3]),
+            ],
+            &out_item,
+            |x, out| {
+                for (o, &ti) in out.chunks_exact_mut(12).zip(&times) {
+                    let (m, r) = self.body.exact_motion(x[0], x[1], ti)?;
+                    o[..3].copy_from_slice(&m);
+                    o[3..].copy_from_slice(&r);
+                }
+                Ok(())
+            },
+        )?;
+        let both = both.cast::<PyArrayDyn<f64>>()?.readonly();
+        let v = both.as_array();
+        let lead = &v.shape()[..v.ndim() - 1];
+        let (mut m, mut r) = (Vec::new(), Vec::new());
+        for item in v.iter().copied().collect::<Vec<f64>>().chunks_exact(12) {
+            m.extend_from_slice(&item[..3]);
+            r.extend_from_slice(&item[3..]);
+        }
+        let shape = |tail: &[usize]| lead.iter().chain(tail).copied().collect::<Vec<usize>>();
+        let m = array(py, &shape(&[3]), m)?;
+        let r = array(py, &shape(&[3, 3]), r)?;
+        Ok((m, r).into_pyobject(py)?.into_any())
     }
 }
 
