@@ -67,6 +67,33 @@ fn steps(c: &mut Criterion) {
     }
 }
 
+/// The exact free flow with the attitude: a run to T = 100 in one step (dt = 100) and in 100
+/// steps (dt = 1, one evaluation: the method evaluates at the end of each chunk), the cost of
+/// one evaluated step (every step saved, dt = 0.01), and `RigidBody::exact_motion` itself.
+fn exact(c: &mut Criterion) {
+    let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
+    let lifted = body.with_attitude();
+    let z = lifted.state_with_attitude(M0, I3);
+    let mut g = c.benchmark_group("exact");
+    for (name, dt, n) in [("T100_dt100", 100.0, 1), ("T100_dt1", 1.0, 100)] {
+        g.bench_function(name, |b| {
+            b.iter(|| integrate(&lifted, "exact", black_box(&z), dt, n, n).unwrap())
+        });
+    }
+    g.throughput(criterion::Throughput::Elements(STEPS as u64));
+    g.bench_function("every_step_saved", |b| {
+        b.iter(|| integrate(&lifted, "exact", black_box(&z), 0.01, STEPS, 1).unwrap())
+    });
+    g.throughput(criterion::Throughput::Elements(1));
+    g.bench_function("exact_motion", |b| {
+        b.iter(|| {
+            body.exact_motion(black_box(&M0), &I3, black_box(100.0))
+                .unwrap()
+        })
+    });
+    g.finish();
+}
+
 fn batch(c: &mut Criterion) {
     let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
     let states: Vec<Vec<f64>> = (0..10_000)
@@ -134,6 +161,7 @@ fn main() {
     }
     let mut c = Criterion::default().configure_from_args();
     steps(&mut c);
+    exact(&mut c);
     batch(&mut c);
     c.final_summary();
 }

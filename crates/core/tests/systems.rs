@@ -527,7 +527,8 @@ fn bad_input_gets_typed_errors() {
             "dmv8",
             "dmv10",
             "rk4",
-            "rkmk4"
+            "rkmk4",
+            "exact"
         ]
     );
     assert_eq!(order(&b, "splitting6"), 6);

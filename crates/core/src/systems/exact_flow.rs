@@ -52,9 +52,9 @@
 //!
 //! With the attitude, M(t) is returned as S(t)ᵀM₀ (which R M = R₀M₀ makes exact), a rotation of
 //! M₀: |M| and R M stay at the rounding of orthogonal products even when evaluations are composed
-//! step after step, instead of drifting by the rounding of the amplitudes (~0.05 ulp per step,
-//! measured). Without it, M(t) = M₀ + (M̃(t) − M̃(0)) from the elliptic formula M̃, so that
-//! M(0) = M₀ exactly and the formula's own rounding cancels in short steps.
+//! step after step, instead of drifting by the rounding of the amplitudes (~0.5 ulp per step,
+//! measured, for the elliptic formula of M); S is evaluated relative to its own value at t = 0
+//! (a base point), so S(0) = I exactly and the rounding of the formulas cancels in short steps.
 //!
 //! **Heavy top.** The flow of T(M) on se(3)* carries Γ with the attitude, the spatial vertical
 //! RΓ being fixed: Γ(t) = R(t)ᵀR₀Γ₀ = S(t)ᵀΓ₀ (then Γ̇ = −hat(Ω)Γ = Γ × Ω), R(t) = R₀S(t).
@@ -141,8 +141,7 @@ struct Elliptic {
     jk: f64,
     /// ω̄ (absolute units).
     omega: f64,
-    /// The base point (the formulas at t = 0): M (scaled), P(u₀) and B(W₀)ᵀ.
-    y0: Vector3<f64>,
+    /// The base point (the formulas at t = 0): P(u₀) and B(W₀)ᵀ.
     p0: f64,
     b0t: Matrix3<f64>,
 }
@@ -158,6 +157,19 @@ impl FreeFlow {
         FreeFlow { m0: *m0, kind }
     }
 
+    /// M(t) alone (principal frame), without the constants of the attitude: the elliptic formula
+    /// at u₀ + λt (the arithmetic of [`RigidBody::exact_momentum`] before the attitude existed).
+    pub(crate) fn momentum_at(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Vector3<f64> {
+        match shape(inertia, m0) {
+            Shape::Closed(kind) => FreeFlow { m0: *m0, kind }.momentum(t),
+            Shape::Elliptic(o) => {
+                let (sn0, cn0, dn0) = o.jac0;
+                let u = elliptic::ellipf_from_jacobi(sn0, cn0, dn0) + o.lambda * t;
+                o.momentum(elliptic::ellipj_kprime_unchecked(u, o.kp, o.m)) * o.scale
+            }
+        }
+    }
+
     /// M(t) (principal frame).
     pub(crate) fn momentum(&self, t: f64) -> Vector3<f64> {
         match &self.kind {
@@ -167,7 +179,7 @@ impl FreeFlow {
                 top::rotate_axis(&mut m, *s, t * w);
                 m
             }
-            Kind::Elliptic(e) => self.m0 + (e.scaled(t).0 - e.y0) * e.o.scale,
+            Kind::Elliptic(e) => e.scaled(t).0 * e.o.scale,
         }
     }
 
@@ -413,18 +425,15 @@ impl Elliptic {
             two_k,
             jk,
             omega: o.norm * o.scale * (jk / o.ia + (1.0 - jk) / o.ib),
-            y0: Vector3::zeros(),
             p0: 0.0,
             b0t: Matrix3::identity(),
         };
-        // The base point: the formulas evaluated at t = 0 (M0 to a few ulp), so that M(t) is M0
-        // plus an increment and S(0) = I, P(u) − P(u₀) = 0 exactly: the rounding of the formulas
-        // cancels in small steps instead of biasing every step the same way (composed steps
-        // drift in |M| and H by ~0.5 ulp per step without it).
+        // The base point: the formulas evaluated at t = 0, so that S(0) = I and P(u) − P(u₀) = 0
+        // exactly: the rounding of the formulas cancels in short steps instead of biasing every
+        // step the same way.
         let (y0, jac) = e.scaled(0.0);
         e.p0 = e.periodic_at(u0, jac);
         e.b0t = body_frame(&o.polar(&y0)).transpose();
-        e.y0 = y0;
         e
     }
 }

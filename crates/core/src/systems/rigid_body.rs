@@ -124,7 +124,7 @@ impl RigidBody {
         check::finite_slice("M0", m0)?;
         check::finite_slice("t", &[t])?;
         let mi = top::to_frame(&self.top.frame, m0);
-        let m = FreeFlow::new(&self.top.moments, &mi).momentum(t);
+        let m = FreeFlow::momentum_at(&self.top.moments, &mi, t);
         Ok(top::from_frame(&self.top.frame, &m).into())
     }
 }
