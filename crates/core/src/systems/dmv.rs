@@ -62,14 +62,14 @@
 //! preprocessed methods are Poisson integrators for M on so(3)* but not symplectic for the full
 //! system with the attitude — their [`Properties::symplectic`] claim is the Poisson one.
 
-use super::rigid_body::RigidBody;
+use super::top::Top;
 use crate::error::{Error, Result};
-use crate::integrate::{Clock, Integrator, Properties, Stepper};
+use crate::integrate::{Clock, Properties, Stepper};
 use crate::lie::rotations::{matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix};
 use nalgebra::{Matrix3, Vector3};
 
 /// The DMV algorithm (`Dmv(2)`) and its preprocessed versions `Dmv(4)`, `Dmv(6)`, `Dmv(8)`,
-/// `Dmv(10)` (a method value; the number is the order), for [`RigidBody`].
+/// `Dmv(10)` (a method value; the number is the order), for [`super::RigidBody`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Dmv(pub u32);
 
@@ -318,21 +318,23 @@ pub fn modified_moments(moments: &[f64; 3], m: &[f64; 3], h: f64, order: u32) ->
     series.moments(m, h)
 }
 
-impl Integrator<RigidBody> for Dmv {
+impl Dmv {
     /// Order `self.0`; symplectic (for the preprocessed orders: Poisson on so(3)*, module docs),
     /// symmetric, keeps |M|², R M and SO(3).
-    fn properties(&self) -> Properties {
+    pub(crate) fn properties(&self) -> Properties {
         Properties::geometric(self.0)
     }
 
+    /// The stepper for a free body `top` (M, or (M, R) when lifted).
+    ///
     /// Errors: an order not in [`ORDERS`] ([`Error::InvalidArgument`]).
-    fn stepper(&self, body: &RigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
-        let moments = body.top.moments;
+    pub(crate) fn stepper_for(&self, top: &Top, dt: f64) -> Result<Box<dyn Stepper>> {
+        let moments = top.moments;
         Ok(Box::new(DmvStepper {
             series: Series::new(&moments, self.0)?,
             moments,
             h: dt,
-            lifted: body.top.lifted,
+            lifted: top.lifted,
             m: Vector3::zeros(),
             carry: Vector3::zeros(),
             q: [1.0, 0.0, 0.0, 0.0],

@@ -26,7 +26,7 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Rkmk4, Splitting};
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
-use crate::integrate::{Catalog, Entry, Problem};
+use crate::integrate::{Catalog, Entry, Integrator, Problem, Properties, Stepper};
 use crate::lie::{so, so3};
 use crate::Mat;
 use nalgebra::{Matrix3, Vector3};
@@ -198,6 +198,16 @@ impl GroupField for RigidBody {
             Ok(j) => out.copy_from_slice((j * Vector3::from_column_slice(v)).as_slice()),
             Err(_) => out.fill(f64::NAN),
         }
+    }
+}
+
+impl Integrator<RigidBody> for Dmv {
+    fn properties(&self) -> Properties {
+        Dmv::properties(self)
+    }
+
+    fn stepper(&self, body: &RigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
+        self.stepper_for(&body.top, dt)
     }
 }
 
