@@ -65,15 +65,12 @@
 //! Π̃(u) − Π̃(u₀) = λτ − (ν/3)(sn³u R_J(u) − sn³u₀ R_J(u₀)) while u stays in [−K, K]
 //! (`Orbit::short_step`; about half the cost of a general evaluation).
 
-use super::heavy_top::HeavyTop;
-use super::rigid_body::RigidBody;
-use super::top::{self, TopWork};
+use super::top::{self, Top};
 use crate::check;
 use crate::elliptic;
 use crate::error::Result;
-use crate::integrate::methods::{Composition, Splitting};
-use crate::integrate::problem::Split;
-use crate::integrate::{Clock, Integrator, Problem, Properties, Space, Stepper};
+use crate::integrate::methods::Composition;
+use crate::integrate::{Clock, Stepper};
 use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
 
@@ -499,35 +496,6 @@ fn body_frame(w: &Vector3<f64>) -> Matrix3<f64> {
     )
 }
 
-impl RigidBody {
-    /// The exact motion (M(t), R(t)) from (M0, R0) (user frame, R row-major): M by Jacobi
-    /// elliptic functions ([`RigidBody::exact_momentum`]) and R(t) = R₀ B₀ᵀ Z(φ(t)) B(t), the
-    /// factorisation of Celledoni et al. (2008) through the conserved spatial momentum R M, with
-    /// the precession angle φ from Carlson's R_J split into ω̄t and a periodic part evaluated on
-    /// the reduced argument (module docs of `systems::exact_flow`). Accurate to a few ε·(1 + ω t)
-    /// for every t, near the separatrix, for symmetric bodies (closed form) and steady rotations.
-    ///
-    /// Errors: non-finite input; R0 not a rotation (to [`so3::ROTATION_TOL`]); |t| so large that
-    /// a phase of the motion exceeds [`crate::lie::EXP_MAX_NORM`] (lost to rounding).
-    pub fn exact_motion(&self, m0: &[f64], r0: &[f64], t: f64) -> Result<([f64; 3], [f64; 9])> {
-        check::len_of("M0", m0, 3)?;
-        check::len_of("R0", r0, 9)?;
-        check::finite_slice("M0", m0)?;
-        check::finite_slice("t", &[t])?;
-        let r0 = Matrix3::from_row_slice(r0);
-        so3::check_rotation("R0", &r0)?;
-        let mi = top::to_frame(&self.top.frame, m0);
-        let flow = FreeFlow::new(&self.top.moments, &mi);
-        crate::lie::check_exp_norm("t", "the exact free rigid body flow", t.abs() * flow.rate())?;
-        let (m, s) = flow.motion(t);
-        let (m, r) = match &self.top.frame {
-            Some(q) => (q * m, r0 * q * s * q.transpose()),
-            None => (m, r0 * s),
-        };
-        Ok((m.into(), top::row_major(&r)))
-    }
-}
-
 /// The exact flow of the free rigid body as a method (catalog name `exact`): each step is the
 /// exact flow over dt, evaluated from the state last handed to the stepper (the start of the run,
 /// or the last retraction of R, every [`crate::integrate::RETRACT_EVERY`] steps) at the time
@@ -536,22 +504,19 @@ impl RigidBody {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Exact;
 
-impl Integrator<RigidBody> for Exact {
-    fn properties(&self) -> Properties {
-        Properties::exact()
-    }
-
-    fn stepper(&self, problem: &RigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
-        Ok(Box::new(ExactStepper {
-            moments: problem.top.moments,
-            lifted: problem.has_attitude(),
+impl Exact {
+    /// The stepper for a free body `top` (M, or (M, R) when lifted).
+    pub(crate) fn stepper_for(&self, top: &Top, dt: f64) -> Box<dyn Stepper> {
+        Box::new(ExactStepper {
+            moments: top.moments,
+            lifted: top.lifted,
             dt,
             flow: None,
             r_ref: Matrix3::identity(),
             steps: 0,
             m: Vector3::zeros(),
             r: Matrix3::identity(),
-        }))
+        })
     }
 }
 
@@ -615,69 +580,6 @@ impl Stepper for ExactStepper {
 /// consecutive stages fuse); Poisson, symplectic with R, keeps |Γ|² and M·Γ to round-off.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExactSplitting(pub Composition);
-
-impl Integrator<HeavyTop> for ExactSplitting {
-    fn properties(&self) -> Properties {
-        Properties::geometric(self.0.order())
-    }
-
-    fn stepper(&self, problem: &HeavyTop, dt: f64) -> Result<Box<dyn Stepper>> {
-        Splitting(self.0.clone()).stepper(&FreeKick(problem.clone()), dt)
-    }
-}
-
-/// The heavy top as a [`Split`] problem of two flows: 0 the kick of V, 1 the exact free flow.
-#[derive(Clone, Debug)]
-struct FreeKick(HeavyTop);
-
-impl Problem for FreeKick {
-    fn name(&self) -> &'static str {
-        self.0.name()
-    }
-    fn space(&self) -> Space {
-        self.0.space()
-    }
-    fn energy(&self, z: &[f64]) -> Result<f64> {
-        self.0.energy(z)
-    }
-    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        self.0.invariants(z)
-    }
-    fn invariant_count(&self) -> usize {
-        self.0.invariant_count()
-    }
-}
-
-impl Split for FreeKick {
-    type Work = TopWork;
-    fn load(&self, z: &[f64]) -> Result<TopWork> {
-        Ok(self.0.top.load(z))
-    }
-    fn store(&self, w: &TopWork, z: &mut [f64]) {
-        self.0.top.store(w, z)
-    }
-    fn flows(&self) -> usize {
-        2
-    }
-    #[inline]
-    fn flow(&self, i: usize, tau: f64, w: &mut TopWork) {
-        if i == 0 {
-            self.0.top.kick(tau, w);
-            return;
-        }
-        // M(τ) = S(τ)ᵀM₀ (R M conserved) rather than the elliptic formula for M: a rotation of
-        // M₀, so |M| and M·Γ keep their values to the rounding of an orthogonal product, with no
-        // bias from the amplitudes' rounding repeated in every step.
-        let s = relative_attitude(&self.0.top.moments, &w.m, tau);
-        w.m = s.transpose() * w.m;
-        if let Some(g) = w.g.as_mut() {
-            *g = s.transpose() * *g;
-        }
-        if let Some(r) = w.r.as_mut() {
-            *r *= s;
-        }
-    }
-}
 
 #[cfg(test)]
 mod tests {
