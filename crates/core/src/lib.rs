@@ -45,6 +45,7 @@ pub mod integrate;
 pub mod lie;
 pub(crate) mod linalg;
 pub mod pseudo_rigid;
+pub mod simd;
 pub mod systems;
 
 pub use error::{Error, Result};

@@ -83,6 +83,33 @@ pub trait Stepper: Send {
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()>;
 }
 
+/// Advances a block of members of one problem together (their states side by side, in SIMD
+/// lanes): the optional batch capability of a method/problem pair
+/// ([`Integrator::batch_stepper`]), which the driver uses for batches
+/// ([`crate::integrate::batch::Batch`]) instead of one [`Stepper`] per member.
+///
+/// The contract is reproducibility: member i advanced by a batch stepper ends, bit for bit,
+/// where a [`Stepper`] of the same method set to the same state and advanced by the same calls
+/// ends, whatever the other members, their number and i. No allocation in `advance`.
+pub trait BatchStepper: Send {
+    /// The number of members.
+    fn members(&self) -> usize;
+
+    /// Sets member `member`'s state from a flat state (internal frame), as [`Stepper::set`].
+    fn set(&mut self, member: usize, z: &[f64]) -> Result<()>;
+
+    /// Writes member `member`'s current state (internal frame) to `z`, as [`Stepper::get`].
+    fn get(&self, member: usize, z: &mut [f64]);
+
+    /// Advances every member by `steps` steps; `clock` says which steps these are. An error is
+    /// the block's: the driver then takes the members one by one from their checked states.
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()>;
+
+    /// A one-member stepper that continues member `member` exactly (bit for bit) as this block
+    /// would, for the driver's work that needs one (shortened steps, events, replays).
+    fn detach(&self, member: usize) -> Result<Box<dyn Stepper>>;
+}
+
 /// A method for problems of kind `P`.
 pub trait Integrator<P: ?Sized>: Send + Sync {
     /// What the method claims for `P`.
@@ -90,6 +117,17 @@ pub trait Integrator<P: ?Sized>: Send + Sync {
 
     /// A stepper of step size `dt` (> 0, finite; checked by the driver) for `problem`.
     fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>>;
+
+    /// A [`BatchStepper`] of `members` members and step size `dt`, where the method has one for
+    /// `problem`; None (the default) steps a batch one member at a time.
+    fn batch_stepper(
+        &self,
+        _problem: &P,
+        _dt: f64,
+        _members: usize,
+    ) -> Option<Result<Box<dyn BatchStepper>>> {
+        None
+    }
 }
 
 /// A named method of a system's catalog.
@@ -140,6 +178,16 @@ pub trait System: Problem {
     /// system's methods (with a suggestion when the name is close to one of them).
     fn stepper(&self, method: &str, dt: f64) -> Result<(Box<dyn Stepper>, Properties)>;
 
+    /// A [`BatchStepper`] of `members` members for the method called `method`, where the method
+    /// has one for this system ([`Integrator::batch_stepper`]); None otherwise (also for an
+    /// unknown name: [`System::stepper`] reports it).
+    fn batch_stepper(
+        &self,
+        method: &str,
+        dt: f64,
+        members: usize,
+    ) -> Option<Result<Box<dyn BatchStepper>>>;
+
     /// The system carrying its attitude along ([`Catalog::lifted`]).
     fn lift(&self) -> Option<Arc<dyn System>>;
 
@@ -168,6 +216,17 @@ impl<P: Catalog> System for P {
                 &catalog.iter().map(|e| e.name).collect::<Vec<_>>(),
             )),
         }
+    }
+
+    fn batch_stepper(
+        &self,
+        method: &str,
+        dt: f64,
+        members: usize,
+    ) -> Option<Result<Box<dyn BatchStepper>>> {
+        let catalog = self.catalog();
+        let e = catalog.iter().find(|e| e.name == method)?;
+        e.method.batch_stepper(self, dt, members)
     }
 
     fn lift(&self) -> Option<Arc<dyn System>> {

@@ -28,6 +28,7 @@
 //! # Ok::<(), lieflow::Error>(())
 //! ```
 
+pub mod batch;
 pub mod clock;
 pub mod forcing;
 pub mod hooks;
@@ -36,13 +37,13 @@ pub mod methods;
 pub mod problem;
 pub mod space;
 
-pub use method::{Catalog, Clock, Entry, Integrator, Properties, Stepper, System};
+pub use batch::Batch;
+pub use method::{BatchStepper, Catalog, Clock, Entry, Integrator, Properties, Stepper, System};
 pub use problem::Problem;
 pub use space::{Block, Space};
 
 use crate::check;
 use crate::error::{Error, Result};
-use rayon::prelude::*;
 
 /// Steps between two retractions of the curved blocks (SO(3), S²) of a state. A retraction moves
 /// the state by round-off (‖RᵀR − I‖ ~ 1e-15) and keeps the rounding errors of many products of
@@ -641,13 +642,35 @@ impl Run {
         end: u64,
         out: &mut Vec<f64>,
     ) -> Result<()> {
-        self.clock.done = stop;
-        if let Some(space) = &self.retract {
-            if stop % RETRACT_EVERY == 0 {
-                space.retract(&mut self.buf);
-                self.stepper.set(&self.buf)?;
-            }
+        if self.retract_at(stop) {
+            self.stepper.set(&self.buf)?;
         }
+        self.save(problem, from, stop, end, out)
+    }
+
+    /// Moves the clock to `stop` and retracts the checked state when a retraction is due there;
+    /// returns whether it did (the stepper must then be set to it).
+    fn retract_at(&mut self, stop: u64) -> bool {
+        self.clock.done = stop;
+        match &self.retract {
+            Some(space) if stop % RETRACT_EVERY == 0 => {
+                space.retract(&mut self.buf);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Saves the checked state at step `stop` (reached from `from`) when it is a saved step,
+    /// checking it at `end`.
+    fn save<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        from: u64,
+        stop: u64,
+        end: u64,
+        out: &mut Vec<f64>,
+    ) -> Result<()> {
         let save = self.at.is_none() && stop % self.save_every == 0;
         if save || stop == end {
             self.user.copy_from_slice(&self.buf);
@@ -1192,10 +1215,13 @@ pub fn with_threads<T: Send>(
     }
 }
 
-/// Integrates many initial states in parallel (rayon), each exactly as [`integrate`] would.
+/// Integrates many initial states in parallel (rayon), each exactly as [`integrate`] would (bit
+/// for bit), as a [`Batch`]: in blocks of SIMD lanes where the method has a batch stepper for the
+/// system, one member at a time otherwise.
 ///
 /// `threads`: `None` uses rayon's global pool (all cores); `Some(n)` a pool of n threads. Every
-/// input is validated before any work starts; an error names the batch member.
+/// input is validated before any work starts; an error names the batch member (the first
+/// member that failed, with its step).
 pub fn integrate_batch<S: System + ?Sized>(
     system: &S,
     method: &str,
@@ -1211,11 +1237,34 @@ pub fn integrate_batch<S: System + ?Sized>(
         .enumerate()
         .map(|(i, z)| Run::new(system, method, z, dt, save_every, 0.0).map_err(|e| e.in_member(i)))
         .collect::<Result<Vec<_>>>()?;
-    with_threads(threads, || {
-        runs.into_par_iter()
-            .zip(states0.par_iter())
-            .enumerate()
-            .map(|(i, (run, z0))| collect(system, run, z0, steps).map_err(|e| e.in_member(i)))
-            .collect()
-    })
+    let mut batch = Batch::new(system, method, runs)?;
+    let n_saved = steps / save_every + 1;
+    let mut outs = states0
+        .iter()
+        .map(|z0| {
+            let mut states = Vec::new();
+            let values = n_saved.checked_mul(z0.len()).ok_or_else(too_many)?;
+            states.try_reserve_exact(values).map_err(|_| too_many())?;
+            states.extend_from_slice(z0);
+            Ok(states)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let results = with_threads(threads, || {
+        Ok(batch.advance(system, steps as u64, &mut outs))
+    })?;
+    for (i, r) in results.into_iter().enumerate() {
+        r.map_err(|e| e.in_member(i))?;
+    }
+    let every = save_every as f64 * dt;
+    let t: Vec<f64> = (0..n_saved).map(|k| k as f64 * every).collect();
+    Ok(outs
+        .into_iter()
+        .enumerate()
+        .map(|(i, states)| Trajectory {
+            t: t.clone(),
+            final_state: batch.state(system, i),
+            states,
+            dim: states0[i].len(),
+        })
+        .collect())
 }

@@ -91,6 +91,48 @@ pub trait Split: Problem {
     fn check_step(&self, _w: &mut Self::Work) -> std::result::Result<(), Violation> {
         Ok(())
     }
+
+    /// The flows applied to many members at once ([`SplitLanes`]: SIMD lanes over a block of
+    /// states), if the problem has them: the batch path of
+    /// [`crate::integrate::methods::Splitting`]. None by default (the members are then stepped
+    /// one by one).
+    fn lanes(&self) -> Option<Arc<dyn SplitLanes>> {
+        None
+    }
+}
+
+/// What a batch of one [`Split`] problem's members does in one call of
+/// [`SplitLanes::run`]: the flattened, fused sequence of a splitting method
+/// ([`crate::integrate::methods::Composition::sequence`]) over `steps` steps. Member j gets
+/// φ_outer(first[j]), then the `inner` flows, then `steps − 1` times φ_outer(`fused`) and the
+/// `inner` flows (the lazy first-same-as-last fusion of the splitting stepper: the times are
+/// the very floating-point values its one-member stepper uses).
+#[derive(Clone, Copy, Debug)]
+pub struct Program<'a> {
+    /// The outer flow (first and last of a step).
+    pub outer: usize,
+    /// The time of the fused outer flow between two steps (last of one, first of the next).
+    pub fused: f64,
+    /// The flows between (index, time), in order.
+    pub inner: &'a [(usize, f64)],
+    /// The number of steps (≥ 1).
+    pub steps: usize,
+}
+
+/// The exact flows of a [`Split`] problem on a block of members at once (structure of arrays,
+/// typically in SIMD lanes): an optional capability ([`Split::lanes`]).
+///
+/// The contract is reproducibility: every member's result must be, bit for bit, what
+/// [`Split::load`], [`Split::flow`] and [`Split::store`] give for it alone, whatever the other
+/// members, their number and the member's position in the block. Kernels do not allocate.
+pub trait SplitLanes: Send + Sync {
+    /// The length d of a member's flat state (internal frame).
+    fn dim(&self) -> usize;
+
+    /// Applies `program` to the n = `first.len()` members of `block`, which holds their flat
+    /// states (internal frame) component by component: `block[c·n + j]` is component c of
+    /// member j (d·n values). `first[j]` is member j's time of the first outer flow.
+    fn run(&self, block: &mut [f64], first: &[f64], program: &Program<'_>);
 }
 
 /// A separable Hamiltonian H(q, p) = T(p) + U(q) on T*ℝᵈ with state z = (q, p), d = [`Separable::dof`].

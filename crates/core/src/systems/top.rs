@@ -301,8 +301,10 @@ impl Top {
         match self.kinds[i] {
             Flow::Axis(a) => {
                 let k = self.axes[a];
-                // NaN where the angle is lost to rounding (see `rotate_axis`).
-                let (s, co) = crate::lie::angle_sin_cos(tau * self.coef[a] * b.m[k]);
+                // One lane of the batch kernel (`TopLanes`): the same sin/cos and operations, so
+                // a body gives the same bits alone and in a batch. NaN where the angle is lost
+                // to rounding (see `rotate_axis`).
+                let (s, co) = crate::simd::angle_sin_cos(tau * self.coef[a] * b.m[k]);
                 rotate_axis_sc(&mut b.m, k, s, co);
                 if let Some(g) = b.g.as_mut() {
                     rotate_axis_sc(g, k, s, co);
@@ -335,6 +337,19 @@ impl Top {
         }
     }
 
+    /// The flows on many bodies at once, for the free body without attitude (whose flows are
+    /// the two axis rotations of M): [`TopLanes`].
+    pub(crate) fn lanes(
+        &self,
+    ) -> Option<std::sync::Arc<dyn crate::integrate::problem::SplitLanes>> {
+        (self.c.is_none() && !self.lifted).then(|| {
+            std::sync::Arc::new(TopLanes {
+                axes: self.axes,
+                coef: self.coef,
+            }) as std::sync::Arc<dyn crate::integrate::problem::SplitLanes>
+        })
+    }
+
     /// The Euler–Poisson field on (M, [Γ], [R]): Ṁ = M × Ω + Γ × c, Γ̇ = Γ × Ω, Ṙ = R hat(Ω),
     /// Ω = I⁻¹M (principal frame).
     pub(crate) fn field(&self, y: &[f64], dy: &mut [f64]) {
@@ -351,6 +366,132 @@ impl Top {
             let at = self.r_at();
             dy[at..at + 9].copy_from_slice(&row_major(&(r * crate::lie::so3::hat(&w))));
         }
+    }
+}
+
+/// The axis flows of the free rigid body without attitude on a block of bodies, in SIMD lanes
+/// ([`crate::simd`]): flow a rotates M about e_k, k = `axes[a]`, by the angle −τ·`coef[a]`·M_k,
+/// with exactly the operations of [`Top::flow`] (which is one lane of this kernel).
+///
+/// Each group of [`GROUP`] vectors of bodies is loaded into registers once and stepped through
+/// the whole program there (the vectors interleaved, so that the latency of one sin/cos is hidden
+/// behind the others), then stored.
+struct TopLanes {
+    axes: [usize; 2],
+    coef: [f64; 2],
+}
+
+/// Vectors of bodies stepped together by [`TopLanes`].
+const GROUP: usize = 4;
+
+impl crate::integrate::problem::SplitLanes for TopLanes {
+    fn dim(&self) -> usize {
+        3
+    }
+
+    fn run(
+        &self,
+        block: &mut [f64],
+        first: &[f64],
+        program: &crate::integrate::problem::Program<'_>,
+    ) {
+        pulp::Arch::new().dispatch(LanesRun {
+            lanes: self,
+            block,
+            first,
+            program,
+        });
+    }
+}
+
+struct LanesRun<'a> {
+    lanes: &'a TopLanes,
+    block: &'a mut [f64],
+    first: &'a [f64],
+    program: &'a crate::integrate::problem::Program<'a>,
+}
+
+impl pulp::WithSimd for LanesRun<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        let n = self.first.len();
+        let lanes = S::F64_LANES;
+        let (m0, rest) = self.block.split_at_mut(n);
+        let (m1, m2) = rest.split_at_mut(n);
+        let mut rows: [&mut [f64]; 3] = [m0, m1, m2];
+        let mut start = 0;
+        while start < n {
+            // Loads GROUP vectors of bodies (zeros past the end: lanes of no body).
+            let part = |j: usize| {
+                let lo = (start + j * lanes).min(n);
+                lo..(lo + lanes).min(n)
+            };
+            let mut m = [[simd.splat_f64s(0.0); GROUP]; 3];
+            let mut tau = [simd.splat_f64s(0.0); GROUP];
+            for j in 0..GROUP {
+                for (c, row) in rows.iter().enumerate() {
+                    m[c][j] = simd.partial_load_f64s(&row[part(j)]);
+                }
+                tau[j] = simd.partial_load_f64s(&self.first[part(j)]);
+            }
+            let p = self.program;
+            let lanes_of = self.lanes;
+            // The first outer flow, with each body's own time.
+            let a = p.outer;
+            let coef = simd.splat_f64s(lanes_of.coef[a]);
+            let tc = tau.map(|t| simd.mul_f64s(t, coef));
+            rotate(simd, &mut m, lanes_of.axes[a], tc);
+            for &(i, t) in p.inner {
+                let tc = simd.splat_f64s(t * lanes_of.coef[i]);
+                rotate(simd, &mut m, lanes_of.axes[i], [tc; GROUP]);
+            }
+            let fused = simd.splat_f64s(p.fused * lanes_of.coef[a]);
+            for _ in 1..p.steps {
+                rotate(simd, &mut m, lanes_of.axes[a], [fused; GROUP]);
+                for &(i, t) in p.inner {
+                    let tc = simd.splat_f64s(t * lanes_of.coef[i]);
+                    rotate(simd, &mut m, lanes_of.axes[i], [tc; GROUP]);
+                }
+            }
+            for j in 0..GROUP {
+                let range = part(j);
+                for (c, row) in rows.iter_mut().enumerate() {
+                    simd.partial_store_f64s(&mut row[range.clone()], m[c][j]);
+                }
+            }
+            start += GROUP * lanes;
+        }
+    }
+}
+
+/// The rotation of every body of a group about e_k by the angle −tc·M_k (tc = τ·a per lane):
+/// M_i ← c M_i + s M_j, M_j ← c M_j − s M_i with (i, j, k) cyclic, as `rotate_axis_sc`.
+#[inline(always)]
+fn rotate<S: pulp::Simd>(simd: S, m: &mut [[S::f64s; GROUP]; 3], k: usize, tc: [S::f64s; GROUP]) {
+    match k {
+        0 => rotate_about::<S, 0, 1, 2>(simd, m, tc),
+        1 => rotate_about::<S, 1, 2, 0>(simd, m, tc),
+        _ => rotate_about::<S, 2, 0, 1>(simd, m, tc),
+    }
+}
+
+#[inline(always)]
+fn rotate_about<S: pulp::Simd, const K: usize, const I: usize, const J: usize>(
+    simd: S,
+    m: &mut [[S::f64s; GROUP]; 3],
+    tc: [S::f64s; GROUP],
+) {
+    let mut s = [simd.splat_f64s(0.0); GROUP];
+    let mut c = [simd.splat_f64s(0.0); GROUP];
+    for g in 0..GROUP {
+        (s[g], c[g]) = crate::simd::sin_cos_lanes(simd, simd.mul_f64s(tc[g], m[K][g]));
+    }
+    for g in 0..GROUP {
+        let (vi, vj) = (m[I][g], m[J][g]);
+        m[I][g] = simd.add_f64s(simd.mul_f64s(c[g], vi), simd.mul_f64s(s[g], vj));
+        m[J][g] = simd.sub_f64s(simd.mul_f64s(c[g], vj), simd.mul_f64s(s[g], vi));
     }
 }
 
@@ -372,6 +513,9 @@ macro_rules! top_kinds {
             #[inline]
             fn flow(&self, i: usize, tau: f64, w: &mut Self::Work) {
                 self.top.flow(i, tau, w)
+            }
+            fn lanes(&self) -> Option<std::sync::Arc<dyn $crate::integrate::problem::SplitLanes>> {
+                self.top.lanes()
             }
         }
 

@@ -9,11 +9,18 @@
 //! pending and applied with the next step (or, on a copy, when the state is read), so the
 //! sequence of operations — and the result, bit for bit — does not depend on how a run is cut
 //! into calls of [`Stepper::advance`].
+//!
+//! A problem whose flows also run on many members at once ([`Split::lanes`]) gets a
+//! [`BatchStepper`] for batches: the members' states side by side in one block, the same fused
+//! sequence, each member's lazy outer flow kept apart, so that a member ends bit for bit where
+//! its one-member stepper would.
+
+use std::sync::Arc;
 
 use super::composition::{run_sequence, Composition};
 use crate::error::Result;
-use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
-use crate::integrate::problem::Split;
+use crate::integrate::method::{BatchStepper, Clock, Integrator, Properties, Stepper};
+use crate::integrate::problem::{Program, Split, SplitLanes};
 
 /// The splitting method of a [`Split`] problem with the given composition.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,6 +45,135 @@ impl<P: Split + Clone + 'static> Integrator<P> for Splitting {
             h: dt,
             work: None,
             pending: 0.0,
+        }))
+    }
+
+    fn batch_stepper(
+        &self,
+        problem: &P,
+        dt: f64,
+        members: usize,
+    ) -> Option<Result<Box<dyn BatchStepper>>> {
+        if P::CHECKED {
+            return None;
+        }
+        let lanes = problem.lanes()?;
+        let d = lanes.dim();
+        let seq = self.0.sequence(problem.flows());
+        let c_last = if seq.len() > 1 {
+            seq[seq.len() - 1].1
+        } else {
+            0.0
+        };
+        let inner = seq[1..seq.len().saturating_sub(1)]
+            .iter()
+            .map(|&(i, c)| (i, c * dt))
+            .collect();
+        Some(Ok(Box::new(SplittingBatch {
+            problem: problem.clone(),
+            lanes,
+            d,
+            n: members,
+            block: vec![0.0; d * members],
+            pending: vec![0.0; members],
+            first: vec![0.0; members],
+            inner,
+            seq,
+            h: dt,
+            c_last,
+        })))
+    }
+}
+
+/// The batch stepper of a [`Splitting`] over a problem with [`Split::lanes`]: the members'
+/// flat states component by component in `block`, each member's pending outer-flow time.
+struct SplittingBatch<P: Split> {
+    problem: P,
+    lanes: Arc<dyn SplitLanes>,
+    d: usize,
+    n: usize,
+    block: Vec<f64>,
+    /// Per member: the time of the outer flow not yet applied (as `SplittingStepper::pending`).
+    pending: Vec<f64>,
+    /// Scratch: the time of each member's first outer flow in a call.
+    first: Vec<f64>,
+    /// The inner flows with their times c·h.
+    inner: Vec<(usize, f64)>,
+    seq: Vec<(usize, f64)>,
+    h: f64,
+    c_last: f64,
+}
+
+impl<P: Split> SplittingBatch<P> {
+    fn column(&self, member: usize) -> impl Iterator<Item = f64> + '_ {
+        (0..self.d).map(move |c| self.block[c * self.n + member])
+    }
+}
+
+impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
+    fn members(&self) -> usize {
+        self.n
+    }
+
+    fn set(&mut self, member: usize, z: &[f64]) -> Result<()> {
+        self.problem.load(z)?;
+        for (c, &v) in z.iter().enumerate().take(self.d) {
+            self.block[c * self.n + member] = v;
+        }
+        self.pending[member] = 0.0;
+        Ok(())
+    }
+
+    fn get(&self, member: usize, z: &mut [f64]) {
+        for (zc, v) in z.iter_mut().zip(self.column(member)) {
+            *zc = v;
+        }
+        let pending = self.pending[member];
+        if pending != 0.0 {
+            // What the one-member stepper's `get` does: the pending outer flow on a copy.
+            if let Ok(mut w) = self.problem.load(z) {
+                self.problem.flow(self.seq[0].0, pending, &mut w);
+                self.problem.store(&w, z);
+            }
+        }
+    }
+
+    fn advance(&mut self, steps: usize, _clock: Clock) -> Result<()> {
+        if steps == 0 {
+            return Ok(());
+        }
+        let (h, (outer, c0)) = (self.h, self.seq[0]);
+        if self.seq.len() == 1 {
+            // A single flow: its times add up until the state is read (as the stepper does).
+            for p in &mut self.pending {
+                for _ in 0..steps {
+                    *p += c0 * h;
+                }
+            }
+            return Ok(());
+        }
+        for (f, &p) in self.first.iter_mut().zip(&self.pending) {
+            *f = p + c0 * h;
+        }
+        let program = Program {
+            outer,
+            fused: self.c_last * h + c0 * h,
+            inner: &self.inner,
+            steps,
+        };
+        self.lanes.run(&mut self.block, &self.first, &program);
+        self.pending.fill(self.c_last * h);
+        Ok(())
+    }
+
+    fn detach(&self, member: usize) -> Result<Box<dyn Stepper>> {
+        let z: Vec<f64> = self.column(member).collect();
+        Ok(Box::new(SplittingStepper {
+            problem: self.problem.clone(),
+            seq: self.seq.clone(),
+            h: self.h,
+            work: Some(self.problem.load(&z)?),
+            pending: self.pending[member],
         }))
     }
 }

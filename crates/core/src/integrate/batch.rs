@@ -1,0 +1,304 @@
+//! Batches: many runs of one problem with one method, started together and advanced together.
+//!
+//! A [`Batch`] holds one [`Run`] per member (its clock, its checked state, what it saves, its
+//! errors) and, where the method offers one for the problem ([`Integrator::batch_stepper`],
+//! e.g. a splitting whose flows run in SIMD lanes), one [`BatchStepper`] per group of
+//! [`GROUP`] members, which then holds the members' states and steps them together. The driver
+//! does for every member what [`Run::advance`] does (saves, retractions, the finiteness guard
+//! after every chunk, the replay that names the failing step), with the members' states read
+//! from the block. A member that fails, or that needs work a block does not do (output times,
+//! events, a shortened last step: [`Batch::runs_mut`]), goes on with a one-member stepper that
+//! continues it exactly ([`BatchStepper::detach`]), so its results never depend on the path.
+//! Groups are advanced in parallel (rayon, on the current pool); without a batch stepper every
+//! member is its own task, as before.
+//!
+//! Reproducibility: a member's states are, bit for bit, those of the same run alone, whatever
+//! the batch size, the member's position, the threads, and the chunks in which the batch is
+//! advanced (the tests check it for the rigid body's splittings).
+
+use rayon::prelude::*;
+
+use super::method::{BatchStepper, Integrator, System};
+use super::problem::Problem;
+use super::Run;
+use crate::check;
+use crate::error::{Error, Result};
+
+/// Members per batch stepper (and per parallel task of the lanes): large enough for the SIMD
+/// kernels, small enough that a block stays in the L1 cache and that two threads get many tasks.
+pub const GROUP: usize = 256;
+
+/// A block of members stepped together.
+struct Lanes {
+    stepper: Box<dyn BatchStepper>,
+    /// Whether member j's state is in the block (false once it goes on alone: its run's own
+    /// stepper then holds it).
+    live: Vec<bool>,
+}
+
+/// Runs of one problem advanced together (module docs).
+pub struct Batch {
+    runs: Vec<Run>,
+    /// One entry per group of [`GROUP`] runs: its block, if the method has a batch stepper.
+    lanes: Vec<Option<Lanes>>,
+}
+
+impl Batch {
+    /// The runs `runs` (made by [`Run::new`] for `system` with its method called `method`, all
+    /// with the same dt, t₀ and saving, not yet advanced) as one batch, in blocks where the
+    /// method has a batch stepper for the system.
+    ///
+    /// Errors: those of the batch stepper's `set` (the runs' states were checked already).
+    pub fn new<S: System + ?Sized>(system: &S, method: &str, runs: Vec<Run>) -> Result<Batch> {
+        Batch::build(runs, |n, dt| system.batch_stepper(method, dt, n))
+    }
+
+    /// [`Batch::new`] for runs made with a method value ([`Run::with`]).
+    pub fn with<P: Problem, M: Integrator<P> + ?Sized>(
+        problem: &P,
+        method: &M,
+        runs: Vec<Run>,
+    ) -> Result<Batch> {
+        Batch::build(runs, |n, dt| method.batch_stepper(problem, dt, n))
+    }
+
+    fn build(
+        runs: Vec<Run>,
+        make: impl Fn(usize, f64) -> Option<Result<Box<dyn BatchStepper>>>,
+    ) -> Result<Batch> {
+        let mut lanes = Vec::with_capacity(runs.len().div_ceil(GROUP));
+        for chunk in runs.chunks(GROUP) {
+            let lead = &chunk[0];
+            let together = chunk.iter().all(|r| {
+                r.clock == lead.clock
+                    && r.save_every == lead.save_every
+                    && r.retract == lead.retract
+                    && r.at.is_none()
+                    && r.ended.is_none()
+            });
+            let block = match make(chunk.len(), lead.clock.dt).filter(|_| together) {
+                None => None,
+                Some(stepper) => {
+                    let mut stepper = stepper?;
+                    for (j, run) in chunk.iter().enumerate() {
+                        stepper.set(j, &run.buf)?;
+                    }
+                    Some(Lanes {
+                        stepper,
+                        live: vec![true; chunk.len()],
+                    })
+                }
+            };
+            lanes.push(block);
+        }
+        Ok(Batch { runs, lanes })
+    }
+
+    /// The number of members.
+    pub fn len(&self) -> usize {
+        self.runs.len()
+    }
+
+    /// Whether the batch has no member.
+    pub fn is_empty(&self) -> bool {
+        self.runs.is_empty()
+    }
+
+    /// Whether some members are stepped in blocks (a batch stepper is in use).
+    pub fn in_lanes(&self) -> bool {
+        self.lanes.iter().any(Option::is_some)
+    }
+
+    /// The members' runs, for their clocks, times and checked states. [`Run::state`] of a
+    /// member in a block is not current: read the current state with [`Batch::state`].
+    pub fn runs(&self) -> &[Run] {
+        &self.runs
+    }
+
+    /// The members' runs, to advance them one by one (output times, events, shortened steps):
+    /// every member in a block first goes on with a one-member stepper that continues it
+    /// exactly ([`BatchStepper::detach`]); the batch steps no block after that.
+    pub fn runs_mut(&mut self) -> Result<&mut [Run]> {
+        for (g, slot) in self.lanes.iter_mut().enumerate() {
+            if let Some(lanes) = slot.take() {
+                for (j, &live) in lanes.live.iter().enumerate() {
+                    if live {
+                        self.runs[g * GROUP + j].stepper = lanes.stepper.detach(j)?;
+                    }
+                }
+            }
+        }
+        Ok(&mut self.runs)
+    }
+
+    /// The current state of member `i` (user frame), as [`Run::state`].
+    pub fn state<P: Problem + ?Sized>(&self, problem: &P, i: usize) -> Vec<f64> {
+        let run = &self.runs[i];
+        match &self.lanes[i / GROUP] {
+            Some(l) if l.live[i % GROUP] => {
+                let mut z = run.buf.clone();
+                l.stepper.get(i % GROUP, &mut z);
+                problem.to_user(&mut z);
+                z
+            }
+            _ => run.state(problem),
+        }
+    }
+
+    /// Advances every member by `steps` steps as [`Run::advance`] does, appending member i's
+    /// saved states to `outs[i]`; member i's result is what its `Run::advance` would return
+    /// (the error names its failing step; the caller names the member). Groups run in parallel
+    /// on the current rayon pool.
+    pub fn advance<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        steps: u64,
+        outs: &mut [Vec<f64>],
+    ) -> Vec<Result<usize>> {
+        assert_eq!(outs.len(), self.runs.len(), "one output per member");
+        let groups: Vec<Vec<Result<usize>>> = self
+            .runs
+            .par_chunks_mut(GROUP)
+            .zip(outs.par_chunks_mut(GROUP))
+            .zip(self.lanes.par_iter_mut())
+            .map(|((runs, outs), lanes)| match lanes {
+                Some(l) if runs.iter().all(|r| r.at.is_none() && r.ended.is_none()) => {
+                    advance_lanes(l, runs, problem, steps, outs)
+                }
+                _ => runs
+                    .par_iter_mut()
+                    .zip(outs.par_iter_mut())
+                    .map(|(run, out)| run.advance(problem, steps, out))
+                    .collect(),
+            })
+            .collect();
+        groups.into_iter().flatten().collect()
+    }
+}
+
+/// [`Batch::advance`] of one group in a block.
+fn advance_lanes<P: Problem + ?Sized>(
+    lanes: &mut Lanes,
+    runs: &mut [Run],
+    problem: &P,
+    steps: u64,
+    outs: &mut [Vec<f64>],
+) -> Vec<Result<usize>> {
+    let before: Vec<usize> = outs.iter().map(Vec::len).collect();
+    let mut results: Vec<Result<()>> = runs.iter().map(|_| Ok(())).collect();
+    let was_live = lanes.live.clone();
+    // Members that go on alone (they left the block before this call).
+    for (j, run) in runs.iter_mut().enumerate() {
+        if !lanes.live[j] {
+            results[j] = run.advance(problem, steps, &mut outs[j]).map(|_| ());
+        }
+    }
+    let mut end = None;
+    if let Some(lead) = lanes.live.iter().position(|&l| l) {
+        let start = runs[lead].clock.done;
+        match start.checked_add(steps) {
+            None => {
+                for (j, r) in results.iter_mut().enumerate() {
+                    if lanes.live[j] {
+                        *r = Err(Error::invalid(
+                            "steps",
+                            format!("{steps} more steps overflow the step count"),
+                        ));
+                    }
+                }
+            }
+            Some(e) => {
+                end = Some(e);
+                step_block(lanes, runs, problem, start, e, outs, &mut results);
+            }
+        }
+    }
+    // Members that left the block during this call without an error finish alone.
+    if let Some(end) = end {
+        for (j, run) in runs.iter_mut().enumerate() {
+            if was_live[j] && !lanes.live[j] && results[j].is_ok() && run.clock.done < end {
+                let left = end - run.clock.done;
+                results[j] = run.advance(problem, left, &mut outs[j]).map(|_| ());
+            }
+        }
+    }
+    let dim = runs.first().map_or(1, |r| r.buf.len().max(1));
+    results
+        .into_iter()
+        .zip(outs.iter().zip(before))
+        .map(|(r, (o, b))| r.map(|()| (o.len() - b) / dim))
+        .collect()
+}
+
+/// The block's steps from `start` to `end` for its live members.
+#[allow(clippy::too_many_arguments)]
+fn step_block<P: Problem + ?Sized>(
+    lanes: &mut Lanes,
+    runs: &mut [Run],
+    problem: &P,
+    start: u64,
+    end: u64,
+    outs: &mut [Vec<f64>],
+    results: &mut [Result<()>],
+) {
+    let mut done = start;
+    while done < end {
+        let Some(lead) = lanes.live.iter().position(|&l| l) else {
+            return;
+        };
+        let n = runs[lead].whole_steps(end);
+        let clock = runs[lead].clock;
+        let stop = done + n;
+        if lanes.stepper.advance(n as usize, clock).is_err() {
+            // The block failed: every live member goes on alone from its checked state.
+            for (j, run) in runs.iter_mut().enumerate() {
+                if lanes.live[j] {
+                    lanes.live[j] = false;
+                    if let Err(e) = run.stepper.set(&run.buf) {
+                        results[j] = Err(e);
+                    }
+                }
+            }
+            return;
+        }
+        for (j, run) in runs.iter_mut().enumerate() {
+            if !lanes.live[j] {
+                continue;
+            }
+            lanes.stepper.get(j, &mut run.next);
+            let r = match check::finite_slice("state", &run.next) {
+                Ok(()) => {
+                    std::mem::swap(&mut run.buf, &mut run.next);
+                    let retracted = run.retract_at(stop);
+                    let set = if retracted {
+                        lanes.stepper.set(j, &run.buf)
+                    } else {
+                        Ok(())
+                    };
+                    set.and_then(|()| run.save(problem, done, stop, end, &mut outs[j]))
+                }
+                Err(e) => {
+                    // The member leaves the block: its own stepper takes the steps again one by
+                    // one from the checked state (naming the failing step), or, for a single
+                    // step, stands where the block stopped.
+                    lanes.live[j] = false;
+                    let e = run.non_finite(problem.name(), done, stop, e);
+                    if n > 1 {
+                        run.replay(problem, n, e)
+                            .and_then(|()| run.commit(problem, done, stop, end, &mut outs[j]))
+                    } else {
+                        lanes.stepper.detach(j).and_then(|s| {
+                            run.stepper = s;
+                            Err(e)
+                        })
+                    }
+                }
+            };
+            if let Err(e) = r {
+                lanes.live[j] = false;
+                results[j] = Err(e);
+            }
+        }
+        done = stop;
+    }
+}

@@ -1,0 +1,347 @@
+//! SIMD lanes for the batch paths, and the lane-wise (sin θ, cos θ) of the exact rotation flows.
+//!
+//! **Why `pulp`.** The batch kernels are written once, generic over [`pulp::Simd`], and run
+//! through [`pulp::Arch::dispatch`], which picks the widest instruction set of the machine at run
+//! time (AVX2 on x86-64 v3 processors, SSE2/scalar below it; NEON on aarch64). The wheel and the
+//! crate are built for the baseline target (no `-C target-cpu`), so compile-time SIMD (`wide`,
+//! which follows the compile-time target features) would run 2-lane SSE2 code on every machine.
+//! pulp is already in the build (faer uses it), so it costs no new dependency.
+//!
+//! **Reproducibility.** The same generic kernel runs with `S = pulp::Scalar` (one lane) for the
+//! single-member steppers and with the dispatched vector type for batches, and it uses only
+//! operations that IEEE 754 rounds correctly and identically in every lane and instruction set:
+//! `+`, `−`, `×`, comparisons, selects and bit operations — **no FMA** (a fused multiply-add
+//! rounds once where `a·b + c` rounds twice, so an FMA path and a non-FMA path differ in the last
+//! bit). A member's result is therefore the same bits whatever lane, block, batch size,
+//! instruction set or thread computes it. Lanes that need the slow path (below) are taken one by
+//! one by the same scalar function, again independent of their neighbours.
+//!
+//! **sin/cos** ([`sin_cos_lanes`], scalar [`angle_sin_cos`]): the angle x is reduced to
+//! r = x − kπ/2, |r| ≲ π/4, k = round(2x/π) (rounding by adding and subtracting 1.5·2⁵², whose
+//! low mantissa bits then hold k mod 4), by a three-part Cody–Waite reduction: π/2 = C₁ + C₂ + C₃
+//! with C₁, C₂ of 33 significant bits, so that k·C₁ and k·C₂ are exact for |k| ≤ 2¹⁹, C₃ the
+//! rounded rest (π/2 − C₁ − C₂ − C₃ ≈ 1e-37); the result is a double-double r = r_hi + r_lo with
+//! an absolute error below 2⁻⁹⁸. sin r and cos r are the Taylor polynomials through r¹⁷ and r¹⁶
+//! (their remainders are below 1e-19 and 3e-18 of the result on |r| ≤ π/4), coefficients 1/n!
+//! correctly rounded, evaluated by Horner's rule in z = r² with the first-order correction for
+//! r_lo; cos r = w + ((1 − w) − z/2) + (z²Q(z) − r·r_lo) with w = 1 − z/2 keeps the rounding error
+//! of w. The quadrant k mod 4 swaps and negates the pair.
+//!
+//! The range: the flows of the rigid bodies rotate by θ = τ·a_k·M_k per sub-step
+//! (a_k = 1/I_k − 1/I_r), |θ| ≪ 1 whenever the step resolves the motion; the fast path covers
+//! |θ| ≤ [`FAST_MAX`] = 2¹⁹·π/2 ≈ 8.2e5 rad. Lanes beyond it, and lanes within 2⁻⁴⁰ of a
+//! non-zero multiple of π/2 (where the reduction loses more bits than the three parts carry),
+//! take the platform's `sin_cos` (an exact reduction), so every finite angle gets a correct
+//! value; beyond [`crate::lie::EXP_MAX_NORM`] the flows' rule of [`crate::lie::angle_sin_cos`]
+//! applies (NaN: the angle is lost to rounding), and a non-finite angle gives NaN. The error
+//! against libm is at most 2 ulp (tests: a large random sample over the fast range, angles near
+//! multiples of π/2, tiny and huge angles).
+
+use pulp::Simd;
+
+/// The largest |θ| reduced by the fast path: 2¹⁹·π/2 (|k| ≤ 2¹⁹, so k·C₁ and k·C₂ are exact).
+pub const FAST_MAX: f64 = 524_288.0 * std::f64::consts::FRAC_PI_2;
+
+/// Below this |r| (for k ≠ 0) the three-part reduction is not accurate enough (its absolute error
+/// is below 2⁻⁹⁸): such lanes take the exact slow path.
+const TINY: f64 = 1.0 / 1_099_511_627_776.0; // 2⁻⁴⁰
+
+/// 1.5·2⁵²: x + MAGIC − MAGIC rounds x to the nearest integer (|x| < 2⁵¹), and the low bits of
+/// x + MAGIC are that integer modulo 2⁵¹.
+const MAGIC: f64 = 6_755_399_441_055_744.0;
+
+/// 2/π, correctly rounded.
+const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;
+/// π/2 to 33 significant bits.
+const C1: f64 = f64::from_bits(0x3FF9_21FB_5440_0000);
+/// The next 33 bits of π/2.
+const C2: f64 = f64::from_bits(0x3DD0_B461_1A60_0000);
+/// π/2 − C₁ − C₂, rounded.
+const C3: f64 = f64::from_bits(0x3BA3_198A_2E03_7073);
+
+// Taylor coefficients: sin r = r + r³·P(r²), P = −1/3! + z/5! − … + z⁷/17!;
+// cos r = 1 − r²/2 + r⁴·Q(r²), Q = 1/4! − z/6! + … + z⁶/16!.
+const S: [f64; 8] = [
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5_040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0,
+    -1.0 / 1_307_674_368_000.0,
+    1.0 / 355_687_428_096_000.0,
+];
+const C: [f64; 7] = [
+    1.0 / 24.0,
+    -1.0 / 720.0,
+    1.0 / 40_320.0,
+    -1.0 / 3_628_800.0,
+    1.0 / 479_001_600.0,
+    -1.0 / 87_178_291_200.0,
+    1.0 / 20_922_789_888_000.0,
+];
+
+/// (sin x, cos x) in every lane by the fast path (module docs), and the mask of the lanes that
+/// must be recomputed by [`slow_sin_cos`] (|x| > [`FAST_MAX`], non-finite, or too close to a
+/// non-zero multiple of π/2).
+#[inline(always)]
+pub fn sin_cos_fast<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s, S::m64s) {
+    let splat = |v: f64| simd.splat_f64s(v);
+    let ax = simd.abs_f64s(x);
+    // k = round(2x/π) and its low bits.
+    let t = simd.add_f64s(simd.mul_f64s(x, splat(TWO_OVER_PI)), splat(MAGIC));
+    let k = simd.sub_f64s(t, splat(MAGIC));
+    let bits = simd.transmute_u64s_f64s(t);
+    // r = x − k·C₁ (exact) − k·C₂ (exact product, exact two-sum) − k·C₃.
+    let a = simd.sub_f64s(x, simd.mul_f64s(k, splat(C1)));
+    let b = simd.mul_f64s(k, splat(C2));
+    let r1 = simd.sub_f64s(a, b);
+    // Two-sum of a and −b: r1 + e1 = a − b exactly.
+    let bb = simd.sub_f64s(r1, a);
+    let e1 = simd.sub_f64s(
+        simd.sub_f64s(a, simd.sub_f64s(r1, bb)),
+        simd.add_f64s(b, bb),
+    );
+    let tail = simd.sub_f64s(e1, simd.mul_f64s(k, splat(C3)));
+    let r = simd.add_f64s(r1, tail);
+    let r_lo = simd.add_f64s(simd.sub_f64s(r1, r), tail);
+    // Polynomials in z = r².
+    let z = simd.mul_f64s(r, r);
+    let mut p = splat(S[7]);
+    for &s in S[..7].iter().rev() {
+        p = simd.add_f64s(simd.mul_f64s(p, z), splat(s));
+    }
+    let mut q = splat(C[6]);
+    for &c in C[..6].iter().rev() {
+        q = simd.add_f64s(simd.mul_f64s(q, z), splat(c));
+    }
+    let hz = simd.mul_f64s(splat(0.5), z);
+    // sin(r + r_lo) ≈ r + (r³P + r_lo·(1 − z/2)).
+    let sin_corr = simd.add_f64s(
+        simd.mul_f64s(simd.mul_f64s(r, z), p),
+        simd.sub_f64s(r_lo, simd.mul_f64s(hz, r_lo)),
+    );
+    let sin_r = simd.add_f64s(r, sin_corr);
+    // cos(r + r_lo) ≈ w + (((1 − w) − z/2) + (z²Q − r·r_lo)), w = 1 − z/2.
+    let one = splat(1.0);
+    let w = simd.sub_f64s(one, hz);
+    let cos_corr = simd.add_f64s(
+        simd.sub_f64s(simd.sub_f64s(one, w), hz),
+        simd.sub_f64s(
+            simd.mul_f64s(simd.mul_f64s(z, z), q),
+            simd.mul_f64s(r, r_lo),
+        ),
+    );
+    let cos_r = simd.add_f64s(w, cos_corr);
+    // Quadrant k mod 4: odd k swaps, k ∈ {2, 3} negates sin, k ∈ {1, 2} negates cos.
+    let u = |v: u64| simd.splat_u64s(v);
+    let odd = simd.equal_u64s(simd.and_u64s(bits, u(1)), u(1));
+    let neg_s = simd.equal_u64s(simd.and_u64s(bits, u(2)), u(2));
+    let neg_c = simd.equal_u64s(simd.and_u64s(simd.add_u64s(bits, u(1)), u(2)), u(2));
+    let s = simd.select_f64s(odd, cos_r, sin_r);
+    let c = simd.select_f64s(odd, sin_r, cos_r);
+    let sign = splat(-0.0);
+    let s = simd.select_f64s(neg_s, simd.xor_f64s(s, sign), s);
+    let c = simd.select_f64s(neg_c, simd.xor_f64s(c, sign), c);
+    // Lanes for the slow path: |x| beyond the fast range (or NaN), or deep cancellation.
+    let in_range = simd.less_than_or_equal_f64s(ax, splat(FAST_MAX));
+    let cancel = simd.and_m64s(
+        simd.less_than_f64s(simd.abs_f64s(r), splat(TINY)),
+        simd.greater_than_f64s(ax, splat(0.5)),
+    );
+    let slow = simd.or_m64s(simd.not_m64s(in_range), cancel);
+    (s, c, slow)
+}
+
+/// The slow path of one lane: the platform's `sin_cos` (exact argument reduction) for
+/// |x| ≤ [`crate::lie::EXP_MAX_NORM`], NaN beyond it and for a non-finite x (the rule of
+/// [`crate::lie::angle_sin_cos`]).
+#[cold]
+#[inline(never)]
+pub fn slow_sin_cos(x: f64) -> (f64, f64) {
+    crate::lie::angle_sin_cos(x)
+}
+
+/// (sin θ, cos θ) of the rotation angles θ in every lane (module docs): the fast path, and the
+/// slow path for the lanes that need it, each lane independent of the others.
+#[inline(always)]
+pub fn sin_cos_lanes<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s) {
+    let (mut s, mut c, slow) = sin_cos_fast(simd, x);
+    if simd.first_true_m64s(slow) < S::F64_LANES {
+        fix_slow(simd, x, slow, &mut s, &mut c);
+    }
+    (s, c)
+}
+
+/// Overwrites the lanes of `slow` with [`slow_sin_cos`].
+#[cold]
+#[inline(never)]
+fn fix_slow<S: Simd>(simd: S, x: S::f64s, slow: S::m64s, s: &mut S::f64s, c: &mut S::f64s) {
+    let slow = simd.select_u64s(slow, simd.splat_u64s(1), simd.splat_u64s(0));
+    let flags: &[u64] = pulp::bytemuck::cast_slice(std::slice::from_ref(&slow));
+    let xs: &[f64] = pulp::bytemuck::cast_slice(std::slice::from_ref(&x));
+    let ss: &mut [f64] = pulp::bytemuck::cast_slice_mut(std::slice::from_mut(s));
+    let cs: &mut [f64] = pulp::bytemuck::cast_slice_mut(std::slice::from_mut(c));
+    for (i, &f) in flags.iter().enumerate() {
+        if f != 0 {
+            (ss[i], cs[i]) = slow_sin_cos(xs[i]);
+        }
+    }
+}
+
+/// (sin θ, cos θ) of a rotation angle: one lane of [`sin_cos_lanes`], bit for bit what every
+/// lane of a batch computes for the same θ. NaN beyond [`crate::lie::EXP_MAX_NORM`] and for a
+/// non-finite θ.
+#[inline]
+pub fn angle_sin_cos(theta: f64) -> (f64, f64) {
+    sin_cos_lanes(pulp::Scalar::new(), theta)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// |a − b| in units of the spacing of doubles at b (±0 equal; NaN against NaN is 0).
+    fn ulps(a: f64, b: f64) -> f64 {
+        if a.is_nan() && b.is_nan() {
+            return 0.0;
+        }
+        if a == b {
+            return 0.0;
+        }
+        let e = b.abs().max(f64::MIN_POSITIVE);
+        let ulp = f64::from_bits(e.to_bits() + 1) - e;
+        (a - b).abs() / ulp
+    }
+
+    fn check(x: f64) -> f64 {
+        let (s, c) = angle_sin_cos(x);
+        let (s0, c0) = crate::lie::angle_sin_cos(x);
+        let u = ulps(s, s0).max(ulps(c, c0));
+        assert!(
+            u <= 2.0,
+            "x = {x:e}: ({s:e}, {c:e}) vs libm ({s0:e}, {c0:e}): {u} ulp"
+        );
+        u
+    }
+
+    /// A deterministic sample (SplitMix64) of angles: uniform on [−4π, 4π], log-uniform
+    /// magnitudes from 2⁻⁶⁰ to FAST_MAX·4, and doubles next to multiples of π/2.
+    fn sample(n: usize) -> Vec<f64> {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        };
+        let unit = |v: u64| (v >> 11) as f64 / (1u64 << 53) as f64;
+        let mut out = Vec::with_capacity(3 * n);
+        for _ in 0..n {
+            let sign = if next() & 1 == 0 { 1.0 } else { -1.0 };
+            out.push(sign * 4.0 * std::f64::consts::PI * unit(next()));
+            let e = -60.0 + unit(next()) * (60.0 + (FAST_MAX * 4.0).log2());
+            out.push(sign * e.exp2());
+            let k = (next() % 2_000_000) as f64 - 1_000_000.0;
+            let base = k * std::f64::consts::FRAC_PI_2;
+            let step = (next() % 64) as i64 - 32;
+            let bits = (base.to_bits() as i64 + step) as u64;
+            out.push(f64::from_bits(bits));
+        }
+        out
+    }
+
+    #[test]
+    fn within_two_ulp_of_libm_on_a_large_sample() {
+        let n = if cfg!(debug_assertions) {
+            30_000
+        } else {
+            1_000_000
+        };
+        let worst = sample(n).into_iter().map(check).fold(0.0, f64::max);
+        assert!(worst <= 2.0, "worst {worst} ulp");
+    }
+
+    #[test]
+    fn special_angles() {
+        for x in [
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+            5e-324,
+            1e-300,
+            1e-8,
+            std::f64::consts::FRAC_PI_4,
+            std::f64::consts::FRAC_PI_2,
+            std::f64::consts::PI,
+            1.5 * std::f64::consts::PI,
+            FAST_MAX,
+            FAST_MAX * 1.000_001,
+            1e10,
+            crate::lie::EXP_MAX_NORM,
+            6381956970095103.0 * 2f64.powi(-5),
+        ] {
+            check(x);
+            check(-x);
+        }
+        let nan = |(s, c): (f64, f64)| s.is_nan() && c.is_nan();
+        assert!(nan(angle_sin_cos(f64::NAN)));
+        assert!(nan(angle_sin_cos(f64::INFINITY)));
+        assert!(nan(angle_sin_cos(-f64::INFINITY)));
+        assert!(nan(angle_sin_cos(crate::lie::EXP_MAX_NORM * 2.0)));
+    }
+
+    /// Every lane of the dispatched SIMD kernel gives the bits of the scalar kernel, whatever
+    /// its neighbours (slow lanes included).
+    #[test]
+    fn lanes_match_the_scalar_kernel_bit_for_bit() {
+        struct Run<'a>(&'a [f64], &'a mut Vec<(f64, f64)>);
+        impl pulp::WithSimd for Run<'_> {
+            type Output = ();
+            fn with_simd<S: Simd>(self, simd: S) {
+                for chunk in self.0.chunks(S::F64_LANES) {
+                    let x = simd.partial_load_f64s(chunk);
+                    let (s, c) = sin_cos_lanes(simd, x);
+                    let mut sv = vec![0.0; S::F64_LANES];
+                    let mut cv = vec![0.0; S::F64_LANES];
+                    simd.partial_store_f64s(&mut sv, s);
+                    simd.partial_store_f64s(&mut cv, c);
+                    self.1.extend(sv.into_iter().zip(cv).take(chunk.len()));
+                }
+            }
+        }
+        let mut xs = sample(2000);
+        xs.extend([f64::NAN, 1e12, -3e300, 0.0, FAST_MAX * 2.0, 1e-310]);
+        let mut got = Vec::new();
+        pulp::Arch::new().dispatch(Run(&xs, &mut got));
+        for (x, (s, c)) in xs.iter().zip(got) {
+            let (s0, c0) = angle_sin_cos(*x);
+            assert_eq!(
+                (s.to_bits(), c.to_bits()),
+                (s0.to_bits(), c0.to_bits()),
+                "x = {x:e}"
+            );
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn within_two_ulp_anywhere_in_the_fast_range(x in -FAST_MAX..FAST_MAX) {
+            check(x);
+        }
+
+        #[test]
+        fn within_two_ulp_for_small_angles(e in -80.0f64..1.0, negative: bool) {
+            let x = e.exp2();
+            check(if negative { -x } else { x });
+        }
+
+        #[test]
+        fn pythagoras_to_round_off(x in -100.0f64..100.0) {
+            let (s, c) = angle_sin_cos(x);
+            prop_assert!((s * s + c * c - 1.0).abs() <= 4.0 * f64::EPSILON);
+        }
+    }
+}
