@@ -105,6 +105,31 @@ pub fn sin_cos_fast<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s, S::m64s)
     let tail = simd.sub_f64s(e1, simd.mul_f64s(k, splat(C3)));
     let r = simd.add_f64s(r1, tail);
     let r_lo = simd.add_f64s(simd.sub_f64s(r1, r), tail);
+    let (sin_r, cos_r) = sin_cos_reduced(simd, r, r_lo);
+    // Quadrant k mod 4: odd k swaps, k ∈ {2, 3} negates sin, k ∈ {1, 2} negates cos.
+    let u = |v: u64| simd.splat_u64s(v);
+    let odd = simd.equal_u64s(simd.and_u64s(bits, u(1)), u(1));
+    let neg_s = simd.equal_u64s(simd.and_u64s(bits, u(2)), u(2));
+    let neg_c = simd.equal_u64s(simd.and_u64s(simd.add_u64s(bits, u(1)), u(2)), u(2));
+    let s = simd.select_f64s(odd, cos_r, sin_r);
+    let c = simd.select_f64s(odd, sin_r, cos_r);
+    let sign = splat(-0.0);
+    let s = simd.select_f64s(neg_s, simd.xor_f64s(s, sign), s);
+    let c = simd.select_f64s(neg_c, simd.xor_f64s(c, sign), c);
+    // Lanes for the slow path: |x| beyond the fast range (or NaN), or deep cancellation.
+    let in_range = simd.less_than_or_equal_f64s(ax, splat(FAST_MAX));
+    let cancel = simd.and_m64s(
+        simd.less_than_f64s(simd.abs_f64s(r), splat(TINY)),
+        simd.greater_than_f64s(ax, splat(0.5)),
+    );
+    let slow = simd.or_m64s(simd.not_m64s(in_range), cancel);
+    (s, c, slow)
+}
+
+/// (sin, cos) of r + r_lo, |r| ≲ π/4, |r_lo| ≤ ulp(r)/2: the polynomials (module docs).
+#[inline(always)]
+fn sin_cos_reduced<S: Simd>(simd: S, r: S::f64s, r_lo: S::f64s) -> (S::f64s, S::f64s) {
+    let splat = |v: f64| simd.splat_f64s(v);
     // Polynomials in z = r².
     let z = simd.mul_f64s(r, r);
     let mut p = splat(S[7]);
@@ -133,24 +158,30 @@ pub fn sin_cos_fast<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s, S::m64s)
         ),
     );
     let cos_r = simd.add_f64s(w, cos_corr);
-    // Quadrant k mod 4: odd k swaps, k ∈ {2, 3} negates sin, k ∈ {1, 2} negates cos.
-    let u = |v: u64| simd.splat_u64s(v);
-    let odd = simd.equal_u64s(simd.and_u64s(bits, u(1)), u(1));
-    let neg_s = simd.equal_u64s(simd.and_u64s(bits, u(2)), u(2));
-    let neg_c = simd.equal_u64s(simd.and_u64s(simd.add_u64s(bits, u(1)), u(2)), u(2));
-    let s = simd.select_f64s(odd, cos_r, sin_r);
-    let c = simd.select_f64s(odd, sin_r, cos_r);
-    let sign = splat(-0.0);
-    let s = simd.select_f64s(neg_s, simd.xor_f64s(s, sign), s);
-    let c = simd.select_f64s(neg_c, simd.xor_f64s(c, sign), c);
-    // Lanes for the slow path: |x| beyond the fast range (or NaN), or deep cancellation.
-    let in_range = simd.less_than_or_equal_f64s(ax, splat(FAST_MAX));
-    let cancel = simd.and_m64s(
-        simd.less_than_f64s(simd.abs_f64s(r), splat(TINY)),
-        simd.greater_than_f64s(ax, splat(0.5)),
-    );
-    let slow = simd.or_m64s(simd.not_m64s(in_range), cancel);
-    (s, c, slow)
+    (sin_r, cos_r)
+}
+
+/// The largest |x| for which k = round(2x/π) is 0 whatever the rounding of 2x/π
+/// (0.78·2/π < 0.4966 < ½): there the reduction is the identity.
+pub const SMALL_MAX: f64 = 0.78;
+
+/// [`sin_cos_fast`] for lanes that all have |x| ≤ [`SMALL_MAX`] (k = 0): the same bits, without
+/// the reduction, the quadrant and the slow-lane mask. For k = 0 the reduction computes
+/// r = x + (+0) and r_lo = +0 exactly (x − 0·C₁ = x, the two-sum error and k·C₃ are +0), and
+/// the quadrant leaves the pair as it is, so the operations below are the same ones.
+#[inline(always)]
+pub fn sin_cos_small<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s) {
+    let zero = simd.splat_f64s(0.0);
+    sin_cos_reduced(simd, simd.add_f64s(x, zero), zero)
+}
+
+/// Whether every lane of `x` has |x| ≤ [`SMALL_MAX`] (so [`sin_cos_small`] applies; false for
+/// NaN lanes).
+#[inline(always)]
+pub fn all_small<S: Simd>(simd: S, x: S::f64s) -> bool {
+    let big =
+        simd.not_m64s(simd.less_than_or_equal_f64s(simd.abs_f64s(x), simd.splat_f64s(SMALL_MAX)));
+    simd.first_true_m64s(big) >= S::F64_LANES
 }
 
 /// The slow path of one lane: the platform's `sin_cos` (exact argument reduction) for
@@ -261,6 +292,7 @@ mod tests {
             1_000_000
         };
         let worst = sample(n).into_iter().map(check).fold(0.0, f64::max);
+        println!("worst error against libm: {worst} ulp");
         assert!(worst <= 2.0, "worst {worst} ulp");
     }
 
@@ -321,6 +353,26 @@ mod tests {
             assert_eq!(
                 (s.to_bits(), c.to_bits()),
                 (s0.to_bits(), c0.to_bits()),
+                "x = {x:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_small_path_gives_the_bits_of_the_full_path() {
+        let simd = pulp::Scalar::new();
+        let mut xs: Vec<f64> = sample(20_000)
+            .into_iter()
+            .filter(|x| x.abs() <= SMALL_MAX)
+            .collect();
+        xs.extend([0.0, -0.0, SMALL_MAX, -SMALL_MAX, 5e-324, -5e-324, 1e-200]);
+        for x in xs {
+            let (s, c, slow) = sin_cos_fast(simd, x);
+            assert!(!slow);
+            let (s1, c1) = sin_cos_small(simd, x);
+            assert_eq!(
+                (s.to_bits(), c.to_bits()),
+                (s1.to_bits(), c1.to_bits()),
                 "x = {x:e}"
             );
         }

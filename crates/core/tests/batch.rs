@@ -12,7 +12,9 @@ fn body() -> RigidBody {
     RigidBody::new([1.0, 2.0, 3.0]).unwrap()
 }
 
-/// Initial momenta of various sizes and signs (a few with zero components).
+/// Initial momenta of various sizes and signs (a few with zero components, some fast enough
+/// that a sub-step turns by more than 0.78 rad, so that groups of lanes mix the kernel's small
+/// and general paths).
 fn states(n: usize) -> Vec<Vec<f64>> {
     (0..n)
         .map(|k| {
@@ -20,6 +22,7 @@ fn states(n: usize) -> Vec<Vec<f64>> {
             match k % 7 {
                 0 => vec![0.0, 0.0, 1.0 + a * 1e-3],
                 1 => vec![(a * 0.37).sin() * 40.0, 0.5, -(a * 0.11).cos()],
+                2 => vec![300.0 + a, -200.0, 150.0 * (a * 0.3).sin()],
                 _ => vec![(a * 1.3).sin(), 0.5 + (a * 0.7).cos(), -0.3 + 0.01 * a],
             }
         })

@@ -485,8 +485,17 @@ fn rotate_about<S: pulp::Simd, const K: usize, const I: usize, const J: usize>(
 ) {
     let mut s = [simd.splat_f64s(0.0); GROUP];
     let mut c = [simd.splat_f64s(0.0); GROUP];
-    for g in 0..GROUP {
-        (s[g], c[g]) = crate::simd::sin_cos_lanes(simd, simd.mul_f64s(tc[g], m[K][g]));
+    let angle: [S::f64s; GROUP] = std::array::from_fn(|g| simd.mul_f64s(tc[g], m[K][g]));
+    // Small angles (the usual case) skip the argument reduction: the same bits
+    // (`simd::sin_cos_small`), so the choice, made per group, changes no result.
+    if angle.iter().all(|&a| crate::simd::all_small(simd, a)) {
+        for g in 0..GROUP {
+            (s[g], c[g]) = crate::simd::sin_cos_small(simd, angle[g]);
+        }
+    } else {
+        for g in 0..GROUP {
+            (s[g], c[g]) = crate::simd::sin_cos_lanes(simd, angle[g]);
+        }
     }
     for g in 0..GROUP {
         let (vi, vj) = (m[I][g], m[J][g]);
