@@ -5,7 +5,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use lieflow::integrate::{Event, Events, Run, System, Until};
+use lieflow::integrate::{Batch, Event, Events, Run, System, Until};
 use lieflow::{check, Error};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
@@ -79,7 +79,8 @@ pub struct Integration {
     method: String,
     sys: Arc<dyn System>,
     callbacks: Option<Arc<dyn Callbacks>>,
-    runs: Mutex<Vec<Run>>,
+    /// One run per member, in SIMD lanes where the method has them for the system.
+    runs: Mutex<Batch>,
     pool: Option<rayon::ThreadPool>,
     /// Length of a state without the attitude.
     d: usize,
@@ -210,6 +211,7 @@ impl Integration {
             })
             .collect::<lieflow::Result<Vec<_>>>()
             .py()?;
+        let runs = Batch::new(&*sys, method, runs).py()?;
         Ok(Integration {
             method: method.to_string(),
             sys,
@@ -272,8 +274,8 @@ impl Integration {
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let full = self.d + if self.attitude { 9 } else { 0 };
         let sys = &*self.sys;
-        let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
-        let b = runs.len();
+        let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
+        let b = batch.len();
         // The states saved every save_every-th step (and a terminal event's) by these steps,
         // checked before any step is taken and then reserved fallibly (an oversized request is
         // an InvalidArgumentError, not an abort). Output times were checked by `save_at`.
@@ -282,7 +284,7 @@ impl Integration {
         let steps = match until {
             Until::Steps(n) => Some(n),
             // To a time: the grid steps there, and the end state saved last.
-            Until::Time(t) => match runs.first() {
+            Until::Time(t) => match batch.runs().first() {
                 Some(r) => Some(r.grid_steps(t).py()?.saturating_sub(self.done)),
                 None => None,
             },
@@ -330,7 +332,7 @@ impl Integration {
             };
             (out, r.map_err(|e| if b > 1 { e.in_member(i) } else { e }))
         };
-        let parallel = |runs: &mut Vec<Run>| {
+        let parallel = |runs: &mut [Run]| {
             let mut work = || {
                 runs.par_iter_mut()
                     .enumerate()
@@ -342,22 +344,59 @@ impl Integration {
                 None => work(),
             }
         };
-        let outs: Vec<(Vec<f64>, lieflow::Result<usize>)> = match (events, runs.first_mut()) {
-            (Some(ev), Some(run)) if self.callbacks.is_some() => vec![one(0, run, Some(ev))],
-            (Some(ev), Some(run)) => py.detach(|| vec![one(0, run, Some(ev))]),
-            // A system that calls Python keeps its callables' exceptions in one slot for all
-            // its runs; its runs stay on this thread with the GIL held (the callables need it
-            // for the whole chunk anyway), so that the exception taken below is this run's,
-            // never one of another thread's run of the same system.
-            _ if self.callbacks.is_some() => runs
-                .iter_mut()
-                .enumerate()
-                .map(|(i, run)| one(i, run, None))
-                .collect(),
-            _ => py.detach(|| parallel(runs)),
+        // Plain steps of a batch in SIMD lanes: the core's batch driver (groups of members in
+        // parallel, the same results bit for bit as one run per member).
+        let outs: Vec<(Vec<f64>, lieflow::Result<usize>)> = match until {
+            Until::Steps(n) if plain && self.callbacks.is_none() && batch.in_lanes() => {
+                let mut outs = Vec::with_capacity(b);
+                for i in 0..b {
+                    let mut out = Vec::new();
+                    if out.try_reserve_exact(per_run).is_err() {
+                        let e = Error::invalid(
+                            "steps",
+                            format!(
+                                "cannot allocate the {per_run} values these steps save; save \
+                                 less often (save_every) or run in chunks"
+                            ),
+                        );
+                        return Err(to_py(if b > 1 { e.in_member(i) } else { e }));
+                    }
+                    outs.push(out);
+                }
+                let results = py.detach(|| match pool {
+                    Some(p) => p.install(|| batch.advance(sys, n, &mut outs)),
+                    None => batch.advance(sys, n, &mut outs),
+                });
+                outs.into_iter()
+                    .zip(results)
+                    .enumerate()
+                    .map(|(i, (out, r))| {
+                        (out, r.map_err(|e| if b > 1 { e.in_member(i) } else { e }))
+                    })
+                    .collect()
+            }
+            _ => {
+                let runs = batch.runs_mut().py()?;
+                match (events, runs.first_mut()) {
+                    (Some(ev), Some(run)) if self.callbacks.is_some() => {
+                        vec![one(0, run, Some(ev))]
+                    }
+                    (Some(ev), Some(run)) => py.detach(|| vec![one(0, run, Some(ev))]),
+                    // A system that calls Python keeps its callables' exceptions in one slot for
+                    // all its runs; its runs stay on this thread with the GIL held (the
+                    // callables need it for the whole chunk anyway), so that the exception taken
+                    // below is this run's, never one of another thread's run of the same system.
+                    _ if self.callbacks.is_some() => runs
+                        .iter_mut()
+                        .enumerate()
+                        .map(|(i, run)| one(i, run, None))
+                        .collect(),
+                    _ => py.detach(|| parallel(runs)),
+                }
+            }
         };
-        let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
-        self.done = match (runs.first(), until) {
+        let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
+        self.done = match (batch.runs().first(), until) {
             (Some(r), _) => r.steps_done(),
             (None, Until::Steps(n)) => self.done + n,
             (None, Until::Time(_)) => self.done,
@@ -461,9 +500,10 @@ impl Integration {
     fn save_at(&mut self, t_eval: ArrayIn<'_>) -> PyResult<()> {
         let times = vector("t_eval", &t_eval)?;
         let full = self.d + if self.attitude { 9 } else { 0 };
-        let runs = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
-        check::array_size("t_eval", &[runs.len(), times.len(), full]).py()?;
-        for run in runs.iter_mut() {
+        let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
+        check::array_size("t_eval", &[batch.len(), times.len(), full]).py()?;
+        // Output times need the members' own steppers (shortened steps).
+        for run in batch.runs_mut().py()?.iter_mut() {
             run.save_at(&times).py()?;
         }
         self.at = true;
@@ -577,15 +617,15 @@ impl Integration {
     /// None.
     #[getter]
     fn ended(&self) -> Option<f64> {
-        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        runs.first().and_then(|r| r.ended())
+        let batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        batch.runs().first().and_then(|r| r.ended())
     }
 
     /// Grid steps done (after an error: those that passed the checks).
     #[getter]
     fn steps_done(&self) -> u64 {
-        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        runs.first().map_or(0, |r| r.steps_done())
+        let batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        batch.runs().first().map_or(0, |r| r.steps_done())
     }
 
     /// The number of grid steps from the start of the run to the last grid time ≤ t.
@@ -593,8 +633,8 @@ impl Integration {
     /// Raises:
     ///     InvalidArgumentError (t before t0, non-finite, beyond 2⁶³ steps).
     fn steps_to(&self, #[pyo3(from_py_with = real)] t: f64) -> PyResult<u64> {
-        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        match runs.first() {
+        let batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        match batch.runs().first() {
             Some(r) => r.grid_steps(t).py(),
             None => Ok(0),
         }
@@ -618,7 +658,8 @@ impl Integration {
     /// current states, and after an error the states before the failing step (at
     /// `steps_done`), where the stepper's own `state()` may already be outside the domain.
     fn checked_state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
-        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        let batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        let runs = batch.runs();
         let data: Vec<f64> = runs
             .iter()
             .flat_map(|r| r.checked_state(&*self.sys))
@@ -628,15 +669,17 @@ impl Integration {
 
     /// The current states (b, d) and attitudes (b, 3, 3) or None.
     fn state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
-        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        let data: Vec<f64> = runs.iter().flat_map(|r| r.state(&*self.sys)).collect();
-        self.states_of(py, &data, runs.len())
+        let batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        let data: Vec<f64> = (0..batch.len())
+            .flat_map(|i| batch.state(&*self.sys, i))
+            .collect();
+        self.states_of(py, &data, batch.len())
     }
 
     /// The time of the current states (absolute; the end time of an ended run).
     #[getter]
     fn time(&self) -> f64 {
-        let runs = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        runs.first().map_or(0.0, |r| r.time())
+        let batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        batch.runs().first().map_or(0.0, |r| r.time())
     }
 }
