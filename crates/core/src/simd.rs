@@ -52,12 +52,12 @@ const MAGIC: f64 = 6_755_399_441_055_744.0;
 
 /// 2/π, correctly rounded.
 const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;
-/// π/2 to 33 significant bits.
-const C1: f64 = f64::from_bits(0x3FF9_21FB_5440_0000);
-/// The next 33 bits of π/2.
-const C2: f64 = f64::from_bits(0x3DD0_B461_1A60_0000);
-/// π/2 − C₁ − C₂, rounded.
-const C3: f64 = f64::from_bits(0x3BA3_198A_2E03_7073);
+/// π/2 to 33 significant bits (0x1.921fb544p0; the bits are tested).
+const C1: f64 = 1.570_796_326_734_125_6;
+/// The next 33 bits of π/2 (0x1.0b4611a6p-34).
+const C2: f64 = 6.077_100_506_303_966e-11;
+/// π/2 − C₁ − C₂, rounded (0x1.3198a2e037073p-69).
+const C3: f64 = 2.022_266_248_795_950_6e-21;
 
 // Taylor coefficients: sin r = r + r³·P(r²), P = −1/3! + z/5! − … + z⁷/17!;
 // cos r = 1 − r²/2 + r⁴·Q(r²), Q = 1/4! − z/6! + … + z⁶/16!.
@@ -356,6 +356,18 @@ mod tests {
                 "x = {x:e}"
             );
         }
+    }
+
+    #[test]
+    fn reduction_constants() {
+        assert_eq!(C1.to_bits(), 0x3FF9_21FB_5440_0000);
+        assert_eq!(C2.to_bits(), 0x3DD0_B461_1A60_0000);
+        assert_eq!(C3.to_bits(), 0x3BA3_198A_2E03_7073);
+        // C₁ and C₂ carry 33 significant bits: k·C₁, k·C₂ are exact for |k| ≤ 2¹⁹.
+        assert_eq!(C1.to_bits() & 0xF_FFFF, 0);
+        assert_eq!(C2.to_bits() & 0xF_FFFF, 0);
+        // C₁ + C₂ + C₃ is π/2 to far beyond double precision.
+        assert_eq!(C1 + (C2 + C3), std::f64::consts::FRAC_PI_2);
     }
 
     #[test]

@@ -415,6 +415,7 @@ impl pulp::WithSimd for LanesRun<'_> {
     type Output = ();
 
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // the group's vectors index several arrays
     fn with_simd<S: pulp::Simd>(self, simd: S) {
         let n = self.first.len();
         let lanes = S::F64_LANES;
