@@ -119,14 +119,8 @@ impl Batch {
     /// every member in a block first goes on with a one-member stepper that continues it
     /// exactly ([`BatchStepper::detach`]); the batch steps no block after that.
     pub fn runs_mut(&mut self) -> Result<&mut [Run]> {
-        for (g, slot) in self.lanes.iter_mut().enumerate() {
-            if let Some(lanes) = slot.take() {
-                for (j, &live) in lanes.live.iter().enumerate() {
-                    if live {
-                        self.runs[g * GROUP + j].stepper = lanes.stepper.detach(j)?;
-                    }
-                }
-            }
+        for (slot, runs) in self.lanes.iter_mut().zip(self.runs.chunks_mut(GROUP)) {
+            leave_lanes(slot, runs)?;
         }
         Ok(&mut self.runs)
     }
@@ -161,19 +155,38 @@ impl Batch {
             .par_chunks_mut(GROUP)
             .zip(outs.par_chunks_mut(GROUP))
             .zip(self.lanes.par_iter_mut())
-            .map(|((runs, outs), lanes)| match lanes {
-                Some(l) if runs.iter().all(|r| r.at.is_none() && r.ended.is_none()) => {
-                    advance_lanes(l, runs, problem, steps, outs)
+            .map(|((runs, outs), lanes)| {
+                if runs.iter().any(|r| r.at.is_some() || r.ended.is_some()) {
+                    // Not a block's work (runs_mut() lets no such run stay in a block).
+                    if let Err(e) = leave_lanes(lanes, runs) {
+                        return runs.iter().map(|_| Err(e.clone())).collect();
+                    }
                 }
-                _ => runs
-                    .par_iter_mut()
-                    .zip(outs.par_iter_mut())
-                    .map(|(run, out)| run.advance(problem, steps, out))
-                    .collect(),
+                match lanes {
+                    Some(l) => advance_lanes(l, runs, problem, steps, outs),
+                    None => runs
+                        .par_iter_mut()
+                        .zip(outs.par_iter_mut())
+                        .map(|(run, out)| run.advance(problem, steps, out))
+                        .collect(),
+                }
             })
             .collect();
         groups.into_iter().flatten().collect()
     }
+}
+
+/// Ends a group's block: each member still in it goes on with a one-member stepper that
+/// continues it exactly.
+fn leave_lanes(slot: &mut Option<Lanes>, runs: &mut [Run]) -> Result<()> {
+    if let Some(lanes) = slot.take() {
+        for (j, run) in runs.iter_mut().enumerate() {
+            if lanes.live[j] {
+                run.stepper = lanes.stepper.detach(j)?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// [`Batch::advance`] of one group in a block.
