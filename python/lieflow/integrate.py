@@ -32,7 +32,8 @@ from ._lieflow import InvalidArgumentError, NonFiniteError, ShapeError, System
 __all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
 #: Steps x bodies per native call. Between two calls Python checks for Ctrl-C and updates the
-#: progress bar; at 30 ns - 1 us per body-step a chunk takes well under a second. The chunking
+#: progress bar; at 5 ns (rigid bodies in SIMD lanes) to 1 us per body-step a chunk takes well
+#: under a second. The chunking
 #: depends only on the arguments (not on timings), so a run is reproducible bit for bit.
 CHUNK_WORK = 200_000
 #: Minimal steps per native call for large batches: each call costs ~1 us per body (stepper

@@ -104,7 +104,7 @@ pub trait Split: Problem {
 /// What a batch of one [`Split`] problem's members does in one call of
 /// [`SplitLanes::run`]: the flattened, fused sequence of a splitting method
 /// ([`crate::integrate::methods::Composition::sequence`]) over `steps` steps. Member j gets
-/// φ_outer(first[j]), then the `inner` flows, then `steps − 1` times φ_outer(`fused`) and the
+/// φ_outer(`first[j]`), then the `inner` flows, then `steps − 1` times φ_outer(`fused`) and the
 /// `inner` flows (the lazy first-same-as-last fusion of the splitting stepper: the times are
 /// the very floating-point values its one-member stepper uses).
 #[derive(Clone, Copy, Debug)]
