@@ -201,12 +201,10 @@ fn errors_name_the_member_and_the_step() {
             other => panic!("{other:?}"),
         }
     }
-    // The checked state and the step count of a failed member are those of the run alone.
-    let runs = all
-        .iter()
-        .map(|z| Run::new(&b, "splitting", z, 1.0, 10, 0.0).unwrap())
-        .collect();
-    let mut batch = Batch::new(&b, "splitting", runs).unwrap();
+    // The checked state and the step count of a failed member are those of the run alone
+    // (members started in blocks without steppers of their own: Batch::start).
+    let mut batch = Batch::start(&b, "splitting", &all, 1.0, 10, 0.0).unwrap();
+    assert!(batch.in_lanes());
     let mut outs = vec![Vec::new(); all.len()];
     let results = batch.advance(&b, 200, &mut outs);
     let mut alone = Run::new(&b, "splitting", &all[5], 1.0, 10, 0.0).unwrap();
@@ -226,4 +224,20 @@ fn errors_name_the_member_and_the_step() {
     assert_eq!(bits(&run.checked_state(&b)), bits(&alone.checked_state(&b)));
     assert_eq!(bits(&outs[5]), bits(&out));
     assert_eq!(bits(&batch.state(&b, 5)), bits(&alone.state(&b)));
+    // The others went on, each as alone.
+    let other = integrate(&b, "splitting", &all[7], 1.0, 200, 10).unwrap();
+    assert_eq!(bits(&batch.state(&b, 7)), bits(&other.final_state));
+    assert_eq!(bits(&outs[7]), bits(&other.states[3..]));
+    // Bad input is refused naming the first member that has it.
+    let mut bad = states(5);
+    bad[3][1] = f64::NAN;
+    let (i, e) = Batch::start(&b, "splitting", &bad, 0.1, 1, 0.0)
+        .err()
+        .unwrap();
+    assert_eq!(i, 3);
+    assert!(matches!(e, Error::NonFinite { .. }), "{e:?}");
+    let (_, e) = Batch::start(&b, "splitting9", &bad, 0.1, 1, 0.0)
+        .err()
+        .unwrap();
+    assert!(matches!(e, Error::UnsupportedMethod { .. }), "{e:?}");
 }

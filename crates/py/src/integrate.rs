@@ -197,21 +197,9 @@ impl Integration {
                 s.extend(r.iter());
             }
         }
-        let runs = states
-            .iter()
-            .enumerate()
-            .map(|(i, z)| {
-                Run::new(&*sys, method, z, dt, save_every, t0).map_err(|e| {
-                    if b > 1 {
-                        e.in_member(i)
-                    } else {
-                        e
-                    }
-                })
-            })
-            .collect::<lieflow::Result<Vec<_>>>()
+        let runs = Batch::start(&*sys, method, &states, dt, save_every, t0)
+            .map_err(|(i, e)| if b > 1 { e.in_member(i) } else { e })
             .py()?;
-        let runs = Batch::new(&*sys, method, runs).py()?;
         Ok(Integration {
             method: method.to_string(),
             sys,

@@ -18,7 +18,7 @@
 
 use rayon::prelude::*;
 
-use super::method::{BatchStepper, Integrator, System};
+use super::method::{BatchStepper, Clock, Integrator, Stepper, System};
 use super::problem::Problem;
 use super::Run;
 use crate::check;
@@ -43,7 +43,83 @@ pub struct Batch {
     lanes: Vec<Option<Lanes>>,
 }
 
+/// The one-member stepper of a member whose state is in a block: it holds nothing (the block
+/// does); a member that leaves the block gets the block's exact copy ([`BatchStepper::detach`])
+/// instead. Saves the set-up of one stepper per member of a large batch.
+struct InBlock;
+
+impl Stepper for InBlock {
+    fn set(&mut self, _z: &[f64]) -> Result<()> {
+        Ok(())
+    }
+
+    fn get(&self, _z: &mut [f64]) {}
+
+    fn advance(&mut self, _steps: usize, _clock: Clock) -> Result<()> {
+        Err(Error::invalid(
+            "steps",
+            "internal: a member in a block of lanes was stepped alone",
+        ))
+    }
+}
+
 impl Batch {
+    /// Starts one run per initial state of `states0` (user frame) of `system` with its method
+    /// called `method` at time `t0`, step `dt`, saving every `save_every`-th state, each exactly
+    /// as [`Run::new`] would, as one batch: in blocks where the method has a batch stepper for
+    /// the system (the members then get no one-member stepper of their own until they leave
+    /// the block).
+    ///
+    /// Errors: those of [`Run::new`] and of the batch stepper's `set`, with the index of the
+    /// first member that has one.
+    pub fn start<S: System + ?Sized>(
+        system: &S,
+        method: &str,
+        states0: &[Vec<f64>],
+        dt: f64,
+        save_every: usize,
+        t0: f64,
+    ) -> std::result::Result<Batch, (usize, Error)> {
+        let properties = system
+            .methods()
+            .into_iter()
+            .find(|(m, _)| *m == method)
+            .map(|(_, p)| p);
+        let mut runs = Vec::with_capacity(states0.len());
+        let mut lanes = Vec::with_capacity(states0.len().div_ceil(GROUP));
+        for (g, chunk) in states0.chunks(GROUP).enumerate() {
+            let first = g * GROUP;
+            let block = match properties {
+                Some(p) if dt.is_finite() && dt > 0.0 => system
+                    .batch_stepper(method, dt, chunk.len())
+                    .map(|b| b.map(|b| (p, b)).map_err(|e| (first, e)))
+                    .transpose()?,
+                _ => None,
+            };
+            let Some((p, mut stepper)) = block else {
+                for (j, z) in chunk.iter().enumerate() {
+                    let run = Run::new(system, method, z, dt, save_every, t0);
+                    runs.push(run.map_err(|e| (first + j, e))?);
+                }
+                lanes.push(None);
+                continue;
+            };
+            for (j, z) in chunk.iter().enumerate() {
+                let placeholder = || Ok((Box::new(InBlock) as Box<dyn Stepper>, p));
+                let mut run = Run::start(system, z, dt, save_every, t0, placeholder)
+                    .map_err(|e| (first + j, e))?;
+                run.method = Some(method.to_string());
+                stepper.set(j, &run.buf).map_err(|e| (first + j, e))?;
+                runs.push(run);
+            }
+            lanes.push(Some(Lanes {
+                stepper,
+                live: vec![true; chunk.len()],
+            }));
+        }
+        Ok(Batch { runs, lanes })
+    }
+
     /// The runs `runs` (made by [`Run::new`] for `system` with its method called `method`, all
     /// with the same dt, t₀ and saving, not yet advanced) as one batch, in blocks where the
     /// method has a batch stepper for the system.
@@ -110,7 +186,8 @@ impl Batch {
     }
 
     /// The members' runs, for their clocks, times and checked states. [`Run::state`] of a
-    /// member in a block is not current: read the current state with [`Batch::state`].
+    /// member in a block is not current (it is the checked state): read the current state with
+    /// [`Batch::state`].
     pub fn runs(&self) -> &[Run] {
         &self.runs
     }
@@ -267,7 +344,12 @@ fn step_block<P: Problem + ?Sized>(
             for (j, run) in runs.iter_mut().enumerate() {
                 if lanes.live[j] {
                     lanes.live[j] = false;
-                    if let Err(e) = run.stepper.set(&run.buf) {
+                    let set = lanes.stepper.detach(j).and_then(|mut s| {
+                        s.set(&run.buf)?;
+                        run.stepper = s;
+                        Ok(())
+                    });
+                    if let Err(e) = set {
                         results[j] = Err(e);
                     }
                 }
@@ -296,14 +378,18 @@ fn step_block<P: Problem + ?Sized>(
                     // step, stands where the block stopped.
                     lanes.live[j] = false;
                     let e = run.non_finite(problem.name(), done, stop, e);
-                    if n > 1 {
-                        run.replay(problem, n, e)
-                            .and_then(|()| run.commit(problem, done, stop, end, &mut outs[j]))
-                    } else {
-                        lanes.stepper.detach(j).and_then(|s| {
+                    match lanes.stepper.detach(j) {
+                        Err(d) => Err(d),
+                        Ok(s) => {
                             run.stepper = s;
-                            Err(e)
-                        })
+                            if n > 1 {
+                                run.replay(problem, n, e).and_then(|()| {
+                                    run.commit(problem, done, stop, end, &mut outs[j])
+                                })
+                            } else {
+                                Err(e)
+                            }
+                        }
                     }
                 }
             };

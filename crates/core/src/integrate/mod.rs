@@ -1232,12 +1232,8 @@ pub fn integrate_batch<S: System + ?Sized>(
     threads: Option<usize>,
 ) -> Result<Vec<Trajectory>> {
     check_steps(steps)?;
-    let runs = states0
-        .iter()
-        .enumerate()
-        .map(|(i, z)| Run::new(system, method, z, dt, save_every, 0.0).map_err(|e| e.in_member(i)))
-        .collect::<Result<Vec<_>>>()?;
-    let mut batch = Batch::new(system, method, runs)?;
+    let mut batch = Batch::start(system, method, states0, dt, save_every, 0.0)
+        .map_err(|(i, e)| e.in_member(i))?;
     let n_saved = steps / save_every + 1;
     let mut outs = states0
         .iter()
