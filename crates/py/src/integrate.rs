@@ -197,9 +197,14 @@ impl Integration {
                 s.extend(r.iter());
             }
         }
-        let runs = Batch::start(&*sys, method, &states, dt, save_every, t0)
-            .map_err(|(i, e)| if b > 1 { e.in_member(i) } else { e })
-            .py()?;
+        // Set up on the run's threads (members validated in parallel, the first error kept).
+        let start = || Batch::start(&*sys, method, &states, dt, save_every, t0);
+        let runs = match &pool {
+            Some(p) => p.install(start),
+            None => start(),
+        }
+        .map_err(|(i, e)| if b > 1 { e.in_member(i) } else { e })
+        .py()?;
         Ok(Integration {
             method: method.to_string(),
             sys,

@@ -18,7 +18,7 @@
 
 use rayon::prelude::*;
 
-use super::method::{BatchStepper, Clock, Integrator, Stepper, System};
+use super::method::{BatchStepper, Clock, Integrator, Properties, Stepper, System};
 use super::problem::Problem;
 use super::Run;
 use crate::check;
@@ -85,37 +85,30 @@ impl Batch {
             .into_iter()
             .find(|(m, _)| *m == method)
             .map(|(_, p)| p);
+        // The groups are set up in parallel (on the current rayon pool); the error is the one of
+        // the first member that has one.
+        let groups: Vec<_> = states0
+            .par_chunks(GROUP)
+            .enumerate()
+            .map(|(g, chunk)| {
+                start_group(
+                    system,
+                    method,
+                    properties,
+                    chunk,
+                    g * GROUP,
+                    dt,
+                    save_every,
+                    t0,
+                )
+            })
+            .collect();
         let mut runs = Vec::with_capacity(states0.len());
-        let mut lanes = Vec::with_capacity(states0.len().div_ceil(GROUP));
-        for (g, chunk) in states0.chunks(GROUP).enumerate() {
-            let first = g * GROUP;
-            let block = match properties {
-                Some(p) if dt.is_finite() && dt > 0.0 => system
-                    .batch_stepper(method, dt, chunk.len())
-                    .map(|b| b.map(|b| (p, b)).map_err(|e| (first, e)))
-                    .transpose()?,
-                _ => None,
-            };
-            let Some((p, mut stepper)) = block else {
-                for (j, z) in chunk.iter().enumerate() {
-                    let run = Run::new(system, method, z, dt, save_every, t0);
-                    runs.push(run.map_err(|e| (first + j, e))?);
-                }
-                lanes.push(None);
-                continue;
-            };
-            for (j, z) in chunk.iter().enumerate() {
-                let placeholder = || Ok((Box::new(InBlock) as Box<dyn Stepper>, p));
-                let mut run = Run::start(system, z, dt, save_every, t0, placeholder)
-                    .map_err(|e| (first + j, e))?;
-                run.method = Some(method.to_string());
-                stepper.set(j, &run.buf).map_err(|e| (first + j, e))?;
-                runs.push(run);
-            }
-            lanes.push(Some(Lanes {
-                stepper,
-                live: vec![true; chunk.len()],
-            }));
+        let mut lanes = Vec::with_capacity(groups.len());
+        for group in groups {
+            let (r, l) = group?;
+            runs.extend(r);
+            lanes.push(l);
         }
         Ok(Batch { runs, lanes })
     }
@@ -251,6 +244,45 @@ impl Batch {
             .collect();
         groups.into_iter().flatten().collect()
     }
+}
+
+/// The runs of one group of [`Batch::start`] (members `first`…) and its block, if any.
+#[allow(clippy::too_many_arguments)]
+fn start_group<S: System + ?Sized>(
+    system: &S,
+    method: &str,
+    properties: Option<Properties>,
+    chunk: &[Vec<f64>],
+    first: usize,
+    dt: f64,
+    save_every: usize,
+    t0: f64,
+) -> std::result::Result<(Vec<Run>, Option<Lanes>), (usize, Error)> {
+    let mut runs = Vec::with_capacity(chunk.len());
+    let block = match properties {
+        Some(p) if dt.is_finite() && dt > 0.0 => system
+            .batch_stepper(method, dt, chunk.len())
+            .map(|b| b.map(|b| (p, b)).map_err(|e| (first, e)))
+            .transpose()?,
+        _ => None,
+    };
+    let Some((p, mut stepper)) = block else {
+        for (j, z) in chunk.iter().enumerate() {
+            let run = Run::new(system, method, z, dt, save_every, t0);
+            runs.push(run.map_err(|e| (first + j, e))?);
+        }
+        return Ok((runs, None));
+    };
+    for (j, z) in chunk.iter().enumerate() {
+        let placeholder = || Ok((Box::new(InBlock) as Box<dyn Stepper>, p));
+        let mut run =
+            Run::start(system, z, dt, save_every, t0, placeholder).map_err(|e| (first + j, e))?;
+        run.method = Some(method.to_string());
+        stepper.set(j, &run.buf).map_err(|e| (first + j, e))?;
+        runs.push(run);
+    }
+    let live = vec![true; chunk.len()];
+    Ok((runs, Some(Lanes { stepper, live })))
 }
 
 /// Ends a group's block: each member still in it goes on with a one-member stepper that

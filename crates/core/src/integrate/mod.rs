@@ -1232,8 +1232,10 @@ pub fn integrate_batch<S: System + ?Sized>(
     threads: Option<usize>,
 ) -> Result<Vec<Trajectory>> {
     check_steps(steps)?;
-    let mut batch = Batch::start(system, method, states0, dt, save_every, 0.0)
-        .map_err(|(i, e)| e.in_member(i))?;
+    let start = || {
+        Batch::start(system, method, states0, dt, save_every, 0.0).map_err(|(i, e)| e.in_member(i))
+    };
+    let mut batch = with_threads(threads, start)?;
     let n_saved = steps / save_every + 1;
     let mut outs = states0
         .iter()
