@@ -426,7 +426,13 @@ fn step_block<P: Problem + ?Sized>(
                 }
             };
             if let Err(e) = r {
-                lanes.live[j] = false;
+                if lanes.live[j] {
+                    // A save or a retraction failed: the member leaves the block where it is.
+                    lanes.live[j] = false;
+                    if let Ok(s) = lanes.stepper.detach(j) {
+                        run.stepper = s;
+                    }
+                }
                 results[j] = Err(e);
             }
         }
