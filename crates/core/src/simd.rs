@@ -22,7 +22,7 @@
 //! with C₁, C₂ of 33 significant bits, so that k·C₁ and k·C₂ are exact for |k| ≤ 2¹⁹, C₃ the
 //! rounded rest (π/2 − C₁ − C₂ − C₃ ≈ 1e-37); the result is a double-double r = r_hi + r_lo with
 //! an absolute error below 2⁻⁹⁸. sin r and cos r are the Taylor polynomials through r¹⁷ and r¹⁶
-//! (their remainders are below 1e-19 and 3e-18 of the result on |r| ≤ π/4), coefficients 1/n!
+//! (their remainders are about 1e-19 and 3e-18 of the result at |r| = π/4), coefficients 1/n!
 //! correctly rounded, evaluated by Horner's rule in z = r² with the first-order correction for
 //! r_lo; cos r = w + ((1 − w) − z/2) + (z²Q(z) − r·r_lo) with w = 1 − z/2 keeps the rounding error
 //! of w. The quadrant k mod 4 swaps and negates the pair.

@@ -197,11 +197,12 @@ impl Integration {
                 s.extend(r.iter());
             }
         }
-        // Set up on the run's threads (members validated in parallel, the first error kept).
+        // Set up on the run's threads (members in blocks validated in parallel, the first error
+        // kept); a system that calls Python is set up on this thread, which holds the GIL.
         let start = || Batch::start(&*sys, method, &states, dt, save_every, t0);
         let runs = match &pool {
-            Some(p) => p.install(start),
-            None => start(),
+            Some(p) if callbacks.is_none() => p.install(start),
+            _ => start(),
         }
         .map_err(|(i, e)| if b > 1 { e.in_member(i) } else { e })
         .py()?;

@@ -85,24 +85,31 @@ impl Batch {
             .into_iter()
             .find(|(m, _)| *m == method)
             .map(|(_, p)| p);
-        // The groups are set up in parallel (on the current rayon pool); the error is the one of
-        // the first member that has one.
-        let groups: Vec<_> = states0
-            .par_chunks(GROUP)
-            .enumerate()
-            .map(|(g, chunk)| {
-                start_group(
-                    system,
-                    method,
-                    properties,
-                    chunk,
-                    g * GROUP,
-                    dt,
-                    save_every,
-                    t0,
-                )
-            })
-            .collect();
+        // With blocks the groups are set up in parallel (on the current rayon pool); without,
+        // member after member on the calling thread, as before (a system may call back into
+        // a host language that this thread holds locked, such as Python's GIL). The error is
+        // the one of the first member that has one.
+        let group = |(g, chunk): (usize, &[Vec<f64>])| {
+            start_group(
+                system,
+                method,
+                properties,
+                chunk,
+                g * GROUP,
+                dt,
+                save_every,
+                t0,
+            )
+        };
+        let in_lanes = properties.is_some()
+            && dt.is_finite()
+            && dt > 0.0
+            && system.batch_stepper(method, dt, 0).is_some();
+        let groups: Vec<_> = if in_lanes {
+            states0.par_chunks(GROUP).enumerate().map(group).collect()
+        } else {
+            states0.chunks(GROUP).enumerate().map(group).collect()
+        };
         let mut runs = Vec::with_capacity(states0.len());
         let mut lanes = Vec::with_capacity(groups.len());
         for group in groups {
