@@ -663,11 +663,21 @@ impl Integration {
 
     /// The current states (b, d) and attitudes (b, 3, 3) or None.
     fn state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
-        let batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        let data: Vec<f64> = (0..batch.len())
-            .flat_map(|i| batch.state(&*self.sys, i))
-            .collect();
-        self.states_of(py, &data, batch.len())
+        let mut batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        let b = batch.len();
+        let sys = &*self.sys;
+        let data: Vec<f64> = if self.callbacks.is_none() && batch.in_lanes() {
+            // Batches in lanes: read in parallel on the run's threads, GIL released.
+            let batch = &mut *batch;
+            let states = py.detach(|| match &self.pool {
+                Some(p) => p.install(|| batch.states(sys)),
+                None => batch.states(sys),
+            });
+            states.into_iter().flatten().collect()
+        } else {
+            (0..b).flat_map(|i| batch.state(sys, i)).collect()
+        };
+        self.states_of(py, &data, b)
     }
 
     /// The time of the current states (absolute; the end time of an ended run).

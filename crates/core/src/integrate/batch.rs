@@ -216,6 +216,31 @@ impl Batch {
         }
     }
 
+    /// The current states of all members (user frame), as [`Batch::state`], computed in
+    /// parallel by groups on the current rayon pool.
+    pub fn states<P: Problem + ?Sized>(&mut self, problem: &P) -> Vec<Vec<f64>> {
+        let groups: Vec<Vec<Vec<f64>>> = self
+            .runs
+            .par_chunks_mut(GROUP)
+            .zip(self.lanes.par_iter_mut())
+            .map(|(runs, lanes)| {
+                runs.iter()
+                    .enumerate()
+                    .map(|(j, run)| match lanes {
+                        Some(l) if l.live[j] => {
+                            let mut z = run.buf.clone();
+                            l.stepper.get(j, &mut z);
+                            problem.to_user(&mut z);
+                            z
+                        }
+                        _ => run.state(problem),
+                    })
+                    .collect()
+            })
+            .collect();
+        groups.into_iter().flatten().collect()
+    }
+
     /// Advances every member by `steps` steps as [`Run::advance`] does, appending member i's
     /// saved states to `outs[i]`; member i's result is what its `Run::advance` would return
     /// (the error names its failing step; the caller names the member). Groups run in parallel
