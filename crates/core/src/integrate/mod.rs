@@ -44,7 +44,6 @@ pub use space::{Block, Space};
 
 use crate::check;
 use crate::error::{Error, Result};
-use rayon::prelude::*;
 
 /// Steps between two retractions of the curved blocks (SO(3), S²) of a state. A retraction moves
 /// the state by round-off (‖RᵀR − I‖ ~ 1e-15) and keeps the rounding errors of many products of
@@ -1233,38 +1232,38 @@ pub fn integrate_batch<S: System + ?Sized>(
     threads: Option<usize>,
 ) -> Result<Vec<Trajectory>> {
     check_steps(steps)?;
+    let start = || {
+        Batch::start(system, method, states0, dt, save_every, 0.0).map_err(|(i, e)| e.in_member(i))
+    };
+    let mut batch = with_threads(threads, start)?;
     let n_saved = steps / save_every + 1;
+    let mut outs = states0
+        .iter()
+        .map(|z0| {
+            let mut states = Vec::new();
+            let values = n_saved.checked_mul(z0.len()).ok_or_else(too_many)?;
+            states.try_reserve_exact(values).map_err(|_| too_many())?;
+            states.extend_from_slice(z0);
+            Ok(states)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let (results, finals) = with_threads(threads, || {
+        let results = batch.advance(system, steps as u64, &mut outs);
+        Ok((results, batch.states(system)))
+    })?;
+    for (i, r) in results.into_iter().enumerate() {
+        r.map_err(|e| e.in_member(i))?;
+    }
     let every = save_every as f64 * dt;
     let t: Vec<f64> = (0..n_saved).map(|k| k as f64 * every).collect();
-    // Everything on the run's threads, member by member in parallel: the set-up, the output
-    // buffers, the steps, the trajectories.
-    with_threads(threads, || {
-        let mut batch = Batch::start(system, method, states0, dt, save_every, 0.0)
-            .map_err(|(i, e)| e.in_member(i))?;
-        let mut outs = states0
-            .par_iter()
-            .map(|z0| {
-                let mut states = Vec::new();
-                let values = n_saved.checked_mul(z0.len()).ok_or_else(too_many)?;
-                states.try_reserve_exact(values).map_err(|_| too_many())?;
-                states.extend_from_slice(z0);
-                Ok(states)
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let results = batch.advance(system, steps as u64, &mut outs);
-        for (i, r) in results.into_iter().enumerate() {
-            r.map_err(|e| e.in_member(i))?;
-        }
-        let finals = batch.states(system);
-        Ok(outs
-            .into_par_iter()
-            .zip(finals)
-            .map(|(states, final_state)| Trajectory {
-                t: t.clone(),
-                dim: final_state.len(),
-                final_state,
-                states,
-            })
-            .collect())
-    })
+    Ok(outs
+        .into_iter()
+        .zip(finals)
+        .map(|(states, final_state)| Trajectory {
+            t: t.clone(),
+            dim: final_state.len(),
+            final_state,
+            states,
+        })
+        .collect())
 }
