@@ -33,7 +33,7 @@ fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
 }
 
-const METHODS: [&str; 3] = ["splitting", "splitting4", "splitting6"];
+const METHODS: [&str; 4] = ["splitting", "splitting4", "splitting6", "processed8"];
 
 #[test]
 fn the_free_body_offers_lanes_and_the_others_do_not() {

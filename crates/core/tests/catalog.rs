@@ -376,13 +376,32 @@ fn observed_orders_match_the_claims() {
                 n /= 2;
                 e = [n, 2 * n].map(|k| distance(&end_state(&c, name, k), &zref));
             }
+            if e[1] < 1e-13 {
+                // At round-off already at the coarsest pair of steps (processed10 over T = 2:
+                // 2e-12 and 3e-15 at h = T/4, T/8): too accurate for an order to show here; a
+                // method of a lower order than claimed would not be (tests/integrators.rs
+                // measures it over T = 4).
+                eprintln!(
+                    "{}: {name}: errors {:.2e} {:.2e} at {n} and {} steps, below the floor",
+                    c.name,
+                    e[0],
+                    e[1],
+                    2 * n
+                );
+                assert!(e[0] < 1e-10, "{} {name}: errors {e:?}", c.name);
+                continue;
+            }
             let observed = (e[0] / e[1]).log2();
             eprintln!(
                 "{}: {name}: errors {:.2e} {:.2e}, order {observed:.2} (nominal {})",
                 c.name, e[0], e[1], p.order
             );
+            // The claim is a lower bound: a method whose leading error constant is small (the
+            // processed compositions, optimised for it) shows a steeper slope before its
+            // asymptotic range (processed8 on the heavy top: 10.9 at h = T/3;
+            // tests/integrators.rs measures their orders in their asymptotic range).
             assert!(
-                (observed - p.order as f64).abs() < tol,
+                observed > p.order as f64 - tol,
                 "{} {name}: observed order {observed}, nominal {}",
                 c.name,
                 p.order

@@ -501,8 +501,8 @@ fn bad_input_gets_typed_errors() {
         Err(Error::UnsupportedMethod { supported, .. }) => {
             assert_eq!(
                 supported,
-                "splitting, splitting4, splitting6, lgvi, rk4, exact_splitting, exact_splitting4, \
-                 exact_splitting6"
+                "splitting, splitting4, splitting6, splitting8, processed6, processed8, \
+                 processed10, lgvi, rk4, exact_splitting, exact_splitting4, exact_splitting6"
             )
         }
         other => panic!("expected UnsupportedMethod, got {other:?}"),
@@ -519,6 +519,10 @@ fn bad_input_gets_typed_errors() {
             "splitting",
             "splitting4",
             "splitting6",
+            "splitting8",
+            "processed6",
+            "processed8",
+            "processed10",
             "isospectral",
             "lgvi",
             "dmv",

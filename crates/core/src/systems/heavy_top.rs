@@ -19,7 +19,7 @@ use super::top::TopWork;
 use super::top::{self, top_kinds, Top};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Composition, Rk4, Splitting};
+use crate::integrate::methods::{Composition, Processed, ProcessedSplitting, Rk4, Splitting};
 use crate::integrate::problem::Split;
 use crate::integrate::space::Space;
 use crate::integrate::{Catalog, Entry, Integrator, Problem, Properties, Stepper};
@@ -178,6 +178,10 @@ impl Catalog for HeavyTop {
             Entry::new("splitting", Splitting::strang()),
             Entry::new("splitting4", Splitting(Composition::suzuki4())),
             Entry::new("splitting6", Splitting(Composition::yoshida6())),
+            Entry::new("splitting8", Splitting(Composition::kahan_li8())),
+            Entry::new("processed6", ProcessedSplitting(Processed::bcm6())),
+            Entry::new("processed8", ProcessedSplitting(Processed::bcm8())),
+            Entry::new("processed10", ProcessedSplitting(Processed::bcm10())),
             Entry::new("lgvi", Lgvi),
             Entry::new("rk4", Rk4),
             Entry::new("exact_splitting", ExactSplitting(Composition::strang())),

@@ -23,7 +23,9 @@ use super::lgvi::Lgvi;
 use super::top::{self, top_kinds, Top};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Composition, Rk4, Rkmk4, Splitting};
+use crate::integrate::methods::{
+    Composition, Processed, ProcessedSplitting, Rk4, Rkmk4, Splitting,
+};
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Integrator, Problem, Properties, Stepper};
@@ -256,6 +258,10 @@ impl Catalog for RigidBody {
             Entry::new("splitting", Splitting::strang()),
             Entry::new("splitting4", Splitting(Composition::suzuki4())),
             Entry::new("splitting6", Splitting(Composition::yoshida6())),
+            Entry::new("splitting8", Splitting(Composition::kahan_li8())),
+            Entry::new("processed6", ProcessedSplitting(Processed::bcm6())),
+            Entry::new("processed8", ProcessedSplitting(Processed::bcm8())),
+            Entry::new("processed10", ProcessedSplitting(Processed::bcm10())),
             Entry::new("isospectral", Isospectral),
             Entry::new("lgvi", Lgvi),
             Entry::new("dmv", Dmv(2)),

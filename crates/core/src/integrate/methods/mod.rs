@@ -11,14 +11,14 @@ pub mod rkmk;
 pub mod splitting;
 pub mod verlet;
 
-pub use composition::Composition;
+pub use composition::{Composition, Processed};
 pub use gauss::{Gauss, IMPLICIT_MIDPOINT};
 pub use lie_midpoint::LieMidpoint;
 pub use nonholonomic::NonholonomicRattle;
 pub use rattle::Rattle;
 pub use rk4::Rk4;
 pub use rkmk::Rkmk4;
-pub use splitting::Splitting;
+pub use splitting::{ProcessedSplitting, Splitting};
 pub use verlet::Verlet;
 
 use crate::integrate::method::Entry;

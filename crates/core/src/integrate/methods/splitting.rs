@@ -1,5 +1,6 @@
 //! `Splitting(Composition)`: the palindromic Strang step of a [`Split`] problem's exact flows,
-//! composed to order 2, 4 or 6 ([`Composition`]).
+//! composed to order 2, 4, 6 or 8 ([`Composition`]); `ProcessedSplitting(Processed)`: the same
+//! kernel conjugated by a processor ([`Processed`]), effective order 6, 8 or 10.
 //!
 //! Each flow is the exact flow of a piece of the Hamiltonian, so the method is a Poisson map: it
 //! keeps every Casimir of the bracket and every momentum map the pieces share, and is symplectic
@@ -8,7 +9,8 @@
 //! ([`Split::CHECKED`]). The fusion is lazy: the time of the outer flow that ends a step is kept
 //! pending and applied with the next step (or, on a copy, when the state is read), so the
 //! sequence of operations — and the result, bit for bit — does not depend on how a run is cut
-//! into calls of [`Stepper::advance`].
+//! into calls of [`Stepper::advance`]. A processed method keeps the kernel's variable
+//! y = P(x): the processor runs when a state is set, its inverse on a copy when one is read.
 //!
 //! A problem whose flows also run on many members at once ([`Split::lanes`]) gets a
 //! [`BatchStepper`] for batches: the members' states side by side in one block, the same fused
@@ -17,7 +19,7 @@
 
 use std::sync::Arc;
 
-use super::composition::{run_sequence, Composition};
+use super::composition::{run_sequence, Composition, Processed};
 use crate::error::Result;
 use crate::integrate::method::{BatchStepper, Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::{Program, Split, SplitLanes};
@@ -33,23 +35,73 @@ impl Splitting {
     }
 }
 
-impl<P: Split + Clone + 'static> Integrator<P> for Splitting {
-    fn properties(&self) -> Properties {
-        Properties::geometric(self.0.order())
+/// The processed splitting method of a [`Split`] problem: the kernel of the [`Processed`]
+/// composition every step, its processor when a state is set and read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProcessedSplitting(pub Processed);
+
+/// A splitting scheme as flow sequences: the kernel's step (fractions of h, from
+/// [`Composition::sequence`]) and the processor P and P⁻¹ (times; empty without processing).
+#[derive(Clone, Debug)]
+struct Scheme {
+    seq: Vec<(usize, f64)>,
+    pre: Vec<(usize, f64)>,
+    post: Vec<(usize, f64)>,
+}
+
+impl Scheme {
+    fn plain(c: &Composition, flows: usize) -> Self {
+        Scheme {
+            seq: c.sequence(flows),
+            pre: Vec::new(),
+            post: Vec::new(),
+        }
     }
 
-    fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
-        Ok(Box::new(SplittingStepper {
-            seq: self.0.sequence(problem.flows()),
+    fn processed(p: &Processed, flows: usize, h: f64) -> Self {
+        let (pre, post) = p.sequences(flows);
+        let times = |s: Vec<(usize, f64)>| s.into_iter().map(|(i, c)| (i, c * h)).collect();
+        Scheme {
+            seq: p.kernel().sequence(flows),
+            pre: times(pre),
+            post: times(post),
+        }
+    }
+
+    /// The flows of P on a state just loaded.
+    fn enter<P: Split>(&self, problem: &P, w: &mut P::Work) {
+        for &(i, tau) in &self.pre {
+            problem.flow(i, tau, w);
+        }
+    }
+
+    /// A kernel state with `pending` outer-flow time, as the method's state in `z`.
+    fn leave<P: Split>(&self, problem: &P, w: &P::Work, pending: f64, z: &mut [f64]) {
+        if pending == 0.0 && self.post.is_empty() {
+            return problem.store(w, z);
+        }
+        let mut w = w.clone();
+        if pending != 0.0 {
+            problem.flow(self.seq[0].0, pending, &mut w);
+        }
+        for &(i, tau) in &self.post {
+            problem.flow(i, tau, &mut w);
+        }
+        problem.store(&w, z);
+    }
+
+    fn stepper<P: Split + Clone + 'static>(self, problem: &P, dt: f64) -> Box<dyn Stepper> {
+        Box::new(SplittingStepper {
+            scheme: self,
             problem: problem.clone(),
             h: dt,
             work: None,
             pending: 0.0,
-        }))
+        })
     }
 
-    fn batch_stepper(
-        &self,
+    fn batch<P: Split + Clone + 'static>(
+        self,
         problem: &P,
         dt: f64,
         members: usize,
@@ -59,7 +111,7 @@ impl<P: Split + Clone + 'static> Integrator<P> for Splitting {
         }
         let lanes = problem.lanes()?;
         let d = lanes.dim();
-        let seq = self.0.sequence(problem.flows());
+        let seq = &self.seq;
         let c_last = if seq.len() > 1 {
             seq[seq.len() - 1].1
         } else {
@@ -78,10 +130,48 @@ impl<P: Split + Clone + 'static> Integrator<P> for Splitting {
             pending: vec![0.0; members],
             first: vec![0.0; members],
             inner,
-            seq,
+            scheme: self,
             h: dt,
             c_last,
         })))
+    }
+}
+
+impl<P: Split + Clone + 'static> Integrator<P> for Splitting {
+    fn properties(&self) -> Properties {
+        Properties::geometric(self.0.order())
+    }
+
+    fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
+        Ok(Scheme::plain(&self.0, problem.flows()).stepper(problem, dt))
+    }
+
+    fn batch_stepper(
+        &self,
+        problem: &P,
+        dt: f64,
+        members: usize,
+    ) -> Option<Result<Box<dyn BatchStepper>>> {
+        Scheme::plain(&self.0, problem.flows()).batch(problem, dt, members)
+    }
+}
+
+impl<P: Split + Clone + 'static> Integrator<P> for ProcessedSplitting {
+    fn properties(&self) -> Properties {
+        Properties::geometric(self.0.order())
+    }
+
+    fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
+        Ok(Scheme::processed(&self.0, problem.flows(), dt).stepper(problem, dt))
+    }
+
+    fn batch_stepper(
+        &self,
+        problem: &P,
+        dt: f64,
+        members: usize,
+    ) -> Option<Result<Box<dyn BatchStepper>>> {
+        Scheme::processed(&self.0, problem.flows(), dt).batch(problem, dt, members)
     }
 }
 
@@ -99,7 +189,7 @@ struct SplittingBatch<P: Split> {
     first: Vec<f64>,
     /// The inner flows with their times c·h.
     inner: Vec<(usize, f64)>,
-    seq: Vec<(usize, f64)>,
+    scheme: Scheme,
     h: f64,
     c_last: f64,
 }
@@ -116,8 +206,13 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
     }
 
     fn set(&mut self, member: usize, z: &[f64]) -> Result<()> {
-        self.problem.load(z)?;
-        for (c, &v) in z.iter().enumerate().take(self.d) {
+        let mut w = self.problem.load(z)?;
+        let mut y = z.to_vec();
+        if !self.scheme.pre.is_empty() {
+            self.scheme.enter(&self.problem, &mut w);
+            self.problem.store(&w, &mut y);
+        }
+        for (c, &v) in y.iter().enumerate().take(self.d) {
             self.block[c * self.n + member] = v;
         }
         self.pending[member] = 0.0;
@@ -129,11 +224,10 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
             *zc = v;
         }
         let pending = self.pending[member];
-        if pending != 0.0 {
-            // What the one-member stepper's `get` does: the pending outer flow on a copy.
-            if let Ok(mut w) = self.problem.load(z) {
-                self.problem.flow(self.seq[0].0, pending, &mut w);
-                self.problem.store(&w, z);
+        if pending != 0.0 || !self.scheme.post.is_empty() {
+            // What the one-member stepper's `get` does, on a copy.
+            if let Ok(w) = self.problem.load(z) {
+                self.scheme.leave(&self.problem, &w, pending, z);
             }
         }
     }
@@ -142,8 +236,8 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
         if steps == 0 {
             return Ok(());
         }
-        let (h, (outer, c0)) = (self.h, self.seq[0]);
-        if self.seq.len() == 1 {
+        let (h, (outer, c0)) = (self.h, self.scheme.seq[0]);
+        if self.scheme.seq.len() == 1 {
             // A single flow: its times add up until the state is read (as the stepper does).
             for p in &mut self.pending {
                 for _ in 0..steps {
@@ -170,7 +264,7 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
         let z: Vec<f64> = self.column(member).collect();
         Ok(Box::new(SplittingStepper {
             problem: self.problem.clone(),
-            seq: self.seq.clone(),
+            scheme: self.scheme.clone(),
             h: self.h,
             work: Some(self.problem.load(&z)?),
             pending: self.pending[member],
@@ -180,7 +274,7 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
 
 struct SplittingStepper<P: Split> {
     problem: P,
-    seq: Vec<(usize, f64)>,
+    scheme: Scheme,
     h: f64,
     work: Option<P::Work>,
     /// Time of the outer flow `seq[0]` not yet applied (lazy first-same-as-last fusion).
@@ -189,20 +283,16 @@ struct SplittingStepper<P: Split> {
 
 impl<P: Split> Stepper for SplittingStepper<P> {
     fn set(&mut self, z: &[f64]) -> Result<()> {
-        self.work = Some(self.problem.load(z)?);
+        let mut w = self.problem.load(z)?;
+        self.scheme.enter(&self.problem, &mut w);
+        self.work = Some(w);
         self.pending = 0.0;
         Ok(())
     }
 
     fn get(&self, z: &mut [f64]) {
         if let Some(w) = &self.work {
-            if self.pending == 0.0 {
-                self.problem.store(w, z);
-            } else {
-                let mut w = w.clone();
-                self.problem.flow(self.seq[0].0, self.pending, &mut w);
-                self.problem.store(&w, z);
-            }
+            self.scheme.leave(&self.problem, w, self.pending, z);
         }
     }
 
@@ -214,12 +304,12 @@ impl<P: Split> Stepper for SplittingStepper<P> {
         let flow = |i: usize, tau: f64, w: &mut P::Work| p.flow(i, tau, w);
         if P::CHECKED {
             for k in 0..steps {
-                run_sequence(&self.seq, self.h, 1, w, flow);
+                run_sequence(&self.scheme.seq, self.h, 1, w, flow);
                 p.check_step(w).map_err(|v| clock.left_domain(k, v))?;
             }
             return Ok(());
         }
-        let (h, seq) = (self.h, &self.seq);
+        let (h, seq) = (self.h, &self.scheme.seq);
         let (outer, c0) = seq[0];
         let inner = &seq[1..seq.len().saturating_sub(1)];
         let c_last = if seq.len() > 1 {
