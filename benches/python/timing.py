@@ -34,11 +34,13 @@ def environment(**extra):
 
 
 def time_to(points, target):
-    """Interpolated (log-log) wall time at which a method reaches error ``target``, from its
-    (error, seconds) points, or None."""
-    pts = sorted((e, s) for e, s in points if e > 0)
-    for (e1, s1), (e2, s2) in zip(pts, pts[1:]):
-        if e1 <= target <= e2:
+    """Interpolated (log-log) wall time at which a method first reaches error ``target``, from
+    its (error, seconds) points, or None: the first pair of points, in order of time, whose
+    errors bracket the target (near round-off the errors stop falling, and pairing points by
+    error would join runs far apart in time)."""
+    pts = sorted((s, e) for e, s in points if e > 0)
+    for (s1, e1), (s2, e2) in zip(pts, pts[1:]):
+        if e2 <= target < e1:
             w = (np.log(target) - np.log(e1)) / (np.log(e2) - np.log(e1))
             return float(np.exp(np.log(s1) + w * (np.log(s2) - np.log(s1))))
     return None

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 import lieflow as lf
 
 BODY = lf.RigidBody([1, 2, 3])
-METHODS = ["splitting", "splitting4", "splitting6"]
+METHODS = ["splitting", "splitting4", "splitting6", "processed8"]
 
 
 def momenta(n, seed=0):

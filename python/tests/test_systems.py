@@ -70,8 +70,9 @@ def test_rigid_body_basics():
     assert isinstance(body, lf.LiePoissonSystem)
     assert body.state_dim == 3 and body.has_attitude
     assert lf.RigidBody.methods() == body.methods() == [
-        "splitting", "splitting4", "splitting6", "isospectral", "lgvi", "dmv", "dmv4", "dmv6",
-        "dmv8", "dmv10", "rk4", "rkmk4", "exact"]
+        "splitting", "splitting4", "splitting6", "splitting8", "processed6", "processed8",
+        "processed10", "isospectral", "lgvi", "dmv", "dmv4", "dmv6", "dmv8", "dmv10", "rk4", "rkmk4",
+        "exact"]
     np.testing.assert_array_equal(body.moments, I)
     assert body.frame is None
     assert "RigidBody" in repr(body)
@@ -282,7 +283,8 @@ def test_heavy_top():
     top = lf.HeavyTop([1.0, 2.0, 3.0], 0.7, chi=[0.0, 2.0, 0.0])
     assert top.state_dim == 6 and top.has_attitude and top.mgl == 0.7
     np.testing.assert_allclose(top.chi, [0.0, 1.0, 0.0])
-    assert lf.HeavyTop.methods() == ["splitting", "splitting4", "splitting6", "lgvi", "rk4",
+    assert lf.HeavyTop.methods() == ["splitting", "splitting4", "splitting6", "splitting8",
+                                     "processed6", "processed8", "processed10", "lgvi", "rk4",
                                      "exact_splitting", "exact_splitting4", "exact_splitting6"]
     np.testing.assert_array_equal(lf.HeavyTop(I, 1.0).chi, [0.0, 0.0, 1.0])
     m, g = rng.standard_normal((5, 3)), rng.standard_normal((5, 3))
