@@ -148,7 +148,13 @@ impl Error {
     }
 
     /// The same error about member `i` of a batch ("batch member i: " before what it names).
-    pub fn in_member(mut self, i: usize) -> Self {
+    pub fn in_member(self, i: usize) -> Self {
+        self.map_what(|what| format!("batch member {i}: {what}"))
+    }
+
+    /// The same error with what it names renamed to `f(what)` (a variant that names nothing,
+    /// [`Error::UnsupportedMethod`] or [`Error::Interrupted`], is returned as it is).
+    pub fn map_what(mut self, f: impl FnOnce(&str) -> String) -> Self {
         match &mut self {
             Error::NotInGroup { what, .. }
             | Error::Shape { what, .. }
@@ -157,7 +163,7 @@ impl Error {
             | Error::NoUniqueLog { what, .. }
             | Error::InvalidArgument { what, .. }
             | Error::NotConverged { what, .. }
-            | Error::LeftDomain { what, .. } => *what = format!("batch member {i}: {what}"),
+            | Error::LeftDomain { what, .. } => *what = f(what),
             Error::UnsupportedMethod { .. } | Error::Interrupted { .. } => {}
         }
         self

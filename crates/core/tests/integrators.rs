@@ -409,7 +409,9 @@ fn processed_compositions_reach_their_effective_orders() {
     let b = body();
     let exact = Vector3::from(b.exact_momentum(&M0, 4.0).unwrap());
     let error = |method: &str, n: usize| {
-        let z = integrate(&b, method, &M0, 4.0 / n as f64, n, n).unwrap().final_state;
+        let z = integrate(&b, method, &M0, 4.0 / n as f64, n, n)
+            .unwrap()
+            .final_state;
         (Vector3::from_column_slice(&z) - exact).norm()
     };
     for (method, [n1, n2], order, tol) in [
@@ -431,7 +433,10 @@ fn processed_compositions_reach_their_effective_orders() {
         (Vector3::from_column_slice(&z) - exact).norm()
     };
     let observed = (plain(8) / plain(32)).ln() / 4f64.ln();
-    assert!((observed - 4.0).abs() < 0.1, "kernel alone: order {observed}");
+    assert!(
+        (observed - 4.0).abs() < 0.1,
+        "kernel alone: order {observed}"
+    );
 }
 
 /// Kahan–Li's sixth-order composition: order 6, and at the same step an error more than five

@@ -87,39 +87,6 @@ pub fn read_items<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<A>, boo
     Ok((items, batched))
 }
 
-/// Renames the argument of an error (`what` ↦ `f(what)`), e.g. to add a batch index.
-pub fn relabel(e: Error, f: impl Fn(&str) -> String) -> Error {
-    match e {
-        Error::NotInGroup {
-            what,
-            group,
-            defect_name,
-            defect,
-            tol,
-        } => Error::NotInGroup {
-            what: f(&what),
-            group,
-            defect_name,
-            defect,
-            tol,
-        },
-        Error::NoUniqueLog {
-            what,
-            angle,
-            distance,
-        } => Error::NoUniqueLog {
-            what: f(&what),
-            angle,
-            distance,
-        },
-        Error::InvalidArgument { what, message } => Error::InvalidArgument {
-            what: f(&what),
-            message,
-        },
-        other => other,
-    }
-}
-
 /// Fills a new array of `n` items `f(0), …, f(n − 1)` (shape `B::shape()` when not `batched`)
 /// in parallel with the GIL released, writing straight into the buffer that becomes the numpy
 /// array. The first error (with its batch index when `batched`) becomes the Python exception.
@@ -150,7 +117,7 @@ where
                 })
                 .map_err(|e| {
                     if batched {
-                        relabel(e, |w| format!("{w}[{k}]"))
+                        e.map_what(|w| format!("{w}[{k}]"))
                     } else {
                         e
                     }

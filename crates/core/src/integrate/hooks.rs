@@ -41,69 +41,16 @@ impl Failure {
     /// The error located at its step.
     pub fn located(&self) -> Error {
         let place = self.place();
-        match self.error.clone() {
-            Error::NonFinite { what, location } => Error::NonFinite {
-                what,
-                location: format!("{location}, {place}"),
-            },
-            Error::InvalidArgument { what, message } => Error::InvalidArgument {
-                what,
-                message: format!("{message} ({place})"),
-            },
-            Error::LeftDomain { what, t, message } => Error::LeftDomain {
-                what,
-                t,
-                message: format!("{message} ({place})"),
-            },
-            Error::Shape {
-                what,
-                expected,
-                got,
-            } => Error::Shape {
-                what,
-                expected,
-                got: format!("{got}, {place}"),
-            },
-            Error::NotInGroup {
-                what,
-                group,
-                defect_name,
-                defect,
-                tol,
-            } => Error::NotInGroup {
-                what: format!("{what} ({place})"),
-                group,
-                defect_name,
-                defect,
-                tol,
-            },
-            Error::DegenerateStratum { what, gap, tol } => Error::DegenerateStratum {
-                what: format!("{what} ({place})"),
-                gap,
-                tol,
-            },
-            Error::NoUniqueLog {
-                what,
-                angle,
-                distance,
-            } => Error::NoUniqueLog {
-                what: format!("{what} ({place})"),
-                angle,
-                distance,
-            },
-            Error::NotConverged {
-                what,
-                iterations,
-                residual,
-                tol,
-            } => Error::NotConverged {
-                what: format!("{what} ({place})"),
-                iterations,
-                residual,
-                tol,
-            },
-            other => other,
+        let mut e = self.error.clone();
+        match &mut e {
+            Error::NonFinite { location, .. } => *location = format!("{location}, {place}"),
+            Error::InvalidArgument { message, .. } | Error::LeftDomain { message, .. } => {
+                *message = format!("{message} ({place})")
+            }
+            Error::Shape { got, .. } => *got = format!("{got}, {place}"),
+            _ => return e.map_what(|what| format!("{what} ({place})")),
         }
+        e
     }
 }
 

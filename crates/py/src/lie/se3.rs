@@ -7,7 +7,7 @@ use lieflow::Error;
 use nalgebra::{Matrix4, Vector6};
 use pyo3::prelude::*;
 
-use crate::batch::{map_batch, par_fill, read_items, relabel, Out};
+use crate::batch::{map_batch, par_fill, read_items, Out};
 use crate::convert::ArrayIn;
 use crate::errors::to_py;
 
@@ -94,7 +94,7 @@ fn se3_compose<'py>(py: Python<'py>, g: ArrayIn<'py>, h: ArrayIn<'py>) -> PyResu
     par_fill(py, "g, h", n, bg || bh, |k| {
         let g = SE3::from_matrix4(&gs[k.min(gs.len() - 1)])?;
         let h = SE3::from_matrix4(&hs[k.min(hs.len() - 1)])
-            .map_err(|e| relabel(e, |w| format!("h ({w})")))?;
+            .map_err(|e| e.map_what(|w| format!("h ({w})")))?;
         Ok(g.compose(&h).matrix4())
     })
 }

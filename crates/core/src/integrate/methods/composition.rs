@@ -17,7 +17,12 @@
 //! [`Composition::compose`] composes any symmetric base step (not necessarily a flow), e.g. an
 //! implicit or Störmer–Verlet step.
 
+#![allow(clippy::excessive_precision)] // the coefficients with the digits they are published with
+
 use crate::error::{Error, Result};
+
+/// A flattened sequence of exact flows: (flow index, fraction of h), in the order applied.
+pub type Sequence = Vec<(usize, f64)>;
 
 /// Weights of a symmetric composition of a symmetric second-order method.
 #[derive(Clone, Debug, PartialEq)]
@@ -163,16 +168,16 @@ impl Composition {
     /// a list of (flow index, fraction of h). Flow 0 is the outermost, flow n−1 the middle one.
     /// Adjacent occurrences of flow 0 between stages are merged. The list is palindromic, starts
     /// and ends with flow 0.
-    pub fn sequence(&self, n_flows: usize) -> Vec<(usize, f64)> {
+    pub fn sequence(&self, n_flows: usize) -> Sequence {
         flatten(&self.gammas, n_flows)
     }
 }
 
 /// The Strang steps S_{w₁h}, …, S_{w_s h} (in this order) of an `n_flows`-flow splitting as one
 /// list of (flow index, fraction of h), adjacent occurrences of flow 0 merged.
-fn flatten(weights: &[f64], n_flows: usize) -> Vec<(usize, f64)> {
+fn flatten(weights: &[f64], n_flows: usize) -> Sequence {
     assert!(n_flows >= 1, "a splitting needs at least one flow");
-    let mut seq: Vec<(usize, f64)> = Vec::new();
+    let mut seq = Sequence::new();
     for &g in weights {
         let mut stage: Vec<(usize, f64)> = (0..n_flows - 1).map(|i| (i, 0.5 * g)).collect();
         stage.push((n_flows - 1, g));
@@ -344,7 +349,7 @@ impl Processed {
     /// The processor P and its inverse P⁻¹ of an `n_flows`-flow splitting as flattened lists of
     /// (flow index, fraction of h), like [`Composition::sequence`]: P = flatten(p), and P⁻¹ the
     /// same flows in reverse order with negated times (φ_i(τ)⁻¹ = φ_i(−τ)).
-    pub fn sequences(&self, n_flows: usize) -> (Vec<(usize, f64)>, Vec<(usize, f64)>) {
+    pub fn sequences(&self, n_flows: usize) -> (Sequence, Sequence) {
         let p = flatten(&self.processor, n_flows);
         let inverse = p.iter().rev().map(|&(i, c)| (i, -c)).collect();
         (p, inverse)

@@ -19,7 +19,7 @@
 
 use std::sync::Arc;
 
-use super::composition::{run_sequence, Composition, Processed};
+use super::composition::{run_sequence, Composition, Processed, Sequence};
 use crate::error::Result;
 use crate::integrate::method::{BatchStepper, Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::{Program, Split, SplitLanes};
@@ -44,9 +44,9 @@ pub struct ProcessedSplitting(pub Processed);
 /// [`Composition::sequence`]) and the processor P and P⁻¹ (times; empty without processing).
 #[derive(Clone, Debug)]
 struct Scheme {
-    seq: Vec<(usize, f64)>,
-    pre: Vec<(usize, f64)>,
-    post: Vec<(usize, f64)>,
+    seq: Sequence,
+    pre: Sequence,
+    post: Sequence,
 }
 
 impl Scheme {
@@ -60,7 +60,7 @@ impl Scheme {
 
     fn processed(p: &Processed, flows: usize, h: f64) -> Self {
         let (pre, post) = p.sequences(flows);
-        let times = |s: Vec<(usize, f64)>| s.into_iter().map(|(i, c)| (i, c * h)).collect();
+        let times = |s: Sequence| s.into_iter().map(|(i, c)| (i, c * h)).collect();
         Scheme {
             seq: p.kernel().sequence(flows),
             pre: times(pre),
