@@ -118,6 +118,23 @@ fn batch(c: &mut Criterion) {
         }
     }
     g.finish();
+    // The heavy top (M, Γ) in lanes too: the kick, two axis rotations and the Rodrigues turn of Γ.
+    let top = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
+    let tops: Vec<Vec<f64>> = states
+        .iter()
+        .map(|m| top.state([m[0], m[1], m[2]], [0.0, 0.6, 0.8]))
+        .collect();
+    let mut g = c.benchmark_group("batch_heavy_top_1e4x1e3");
+    g.sample_size(10);
+    g.throughput(criterion::Throughput::Elements(10_000 * 1000));
+    for threads in [1, 2] {
+        g.bench_function(format!("splitting_{threads}_threads"), |b| {
+            b.iter(|| {
+                integrate_batch(&top, "splitting", &tops, 0.01, 1000, 1000, Some(threads)).unwrap()
+            })
+        });
+    }
+    g.finish();
 }
 
 /// Error at T = 100 against the exact solution and the best of 7 wall times, for each method

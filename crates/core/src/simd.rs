@@ -126,20 +126,49 @@ pub fn sin_cos_fast<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s, S::m64s)
     (s, c, slow)
 }
 
+/// P(z) and Q(z) of the Taylor polynomials (sin r = r + r³P(r²), cos r = 1 − r²/2 + r⁴Q(r²)),
+/// by Estrin's scheme (pairs, then z², z⁴: a chain of 4 multiply-adds instead of Horner's 7, for
+/// the one-body path, which waits on it), and z².
+#[inline(always)]
+fn taylor_pq<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s, S::f64s) {
+    let splat = |v: f64| simd.splat_f64s(v);
+    let z2 = simd.mul_f64s(z, z);
+    let z4 = simd.mul_f64s(z2, z2);
+    let pair = |a: f64, b: f64| simd.add_f64s(splat(a), simd.mul_f64s(splat(b), z));
+    let p = simd.add_f64s(
+        simd.add_f64s(pair(S[0], S[1]), simd.mul_f64s(pair(S[2], S[3]), z2)),
+        simd.mul_f64s(
+            simd.add_f64s(pair(S[4], S[5]), simd.mul_f64s(pair(S[6], S[7]), z2)),
+            z4,
+        ),
+    );
+    let q = simd.add_f64s(
+        simd.add_f64s(pair(C[0], C[1]), simd.mul_f64s(pair(C[2], C[3]), z2)),
+        simd.mul_f64s(
+            simd.add_f64s(pair(C[4], C[5]), simd.mul_f64s(splat(C[6]), z2)),
+            z4,
+        ),
+    );
+    (p, q, z2)
+}
+
+/// (sin θ/θ, (1 − cos θ)/θ²) from z = θ² for θ ≤ [`SMALL_MAX`]: 1 + z P(z) and ½ − z Q(z), the
+/// polynomials of [`sin_cos_small`] (no square root, no division, no cancellation at small θ).
+#[inline(always)]
+pub fn sinc_versinc_small<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s) {
+    let (p, q, _) = taylor_pq(simd, z);
+    (
+        simd.add_f64s(simd.splat_f64s(1.0), simd.mul_f64s(z, p)),
+        simd.sub_f64s(simd.splat_f64s(0.5), simd.mul_f64s(z, q)),
+    )
+}
+
 /// (sin, cos) of r + r_lo, |r| ≲ π/4, |r_lo| ≤ ulp(r)/2: the polynomials (module docs).
 #[inline(always)]
 fn sin_cos_reduced<S: Simd>(simd: S, r: S::f64s, r_lo: S::f64s) -> (S::f64s, S::f64s) {
     let splat = |v: f64| simd.splat_f64s(v);
-    // Polynomials in z = r².
     let z = simd.mul_f64s(r, r);
-    let mut p = splat(S[7]);
-    for &s in S[..7].iter().rev() {
-        p = simd.add_f64s(simd.mul_f64s(p, z), splat(s));
-    }
-    let mut q = splat(C[6]);
-    for &c in C[..6].iter().rev() {
-        q = simd.add_f64s(simd.mul_f64s(q, z), splat(c));
-    }
+    let (p, q, z2) = taylor_pq(simd, z);
     let hz = simd.mul_f64s(splat(0.5), z);
     // sin(r + r_lo) ≈ r + (r³P + r_lo·(1 − z/2)).
     let sin_corr = simd.add_f64s(
@@ -152,10 +181,7 @@ fn sin_cos_reduced<S: Simd>(simd: S, r: S::f64s, r_lo: S::f64s) -> (S::f64s, S::
     let w = simd.sub_f64s(one, hz);
     let cos_corr = simd.add_f64s(
         simd.sub_f64s(simd.sub_f64s(one, w), hz),
-        simd.sub_f64s(
-            simd.mul_f64s(simd.mul_f64s(z, z), q),
-            simd.mul_f64s(r, r_lo),
-        ),
+        simd.sub_f64s(simd.mul_f64s(z2, q), simd.mul_f64s(r, r_lo)),
     );
     let cos_r = simd.add_f64s(w, cos_corr);
     (sin_r, cos_r)
@@ -221,11 +247,17 @@ fn fix_slow<S: Simd>(simd: S, x: S::f64s, slow: S::m64s, s: &mut S::f64s, c: &mu
 }
 
 /// (sin θ, cos θ) of a rotation angle: one lane of [`sin_cos_lanes`], bit for bit what every
-/// lane of a batch computes for the same θ. NaN beyond [`crate::lie::EXP_MAX_NORM`] and for a
-/// non-finite θ.
+/// lane of a batch computes for the same θ (for |θ| ≤ [`SMALL_MAX`], the usual angle of a
+/// step, by [`sin_cos_small`]: the same bits without the reduction). NaN beyond
+/// [`crate::lie::EXP_MAX_NORM`] and for a non-finite θ.
 #[inline]
 pub fn angle_sin_cos(theta: f64) -> (f64, f64) {
-    sin_cos_lanes(pulp::Scalar::new(), theta)
+    let s = pulp::Scalar::new();
+    if all_small(s, theta) {
+        sin_cos_small(s, theta)
+    } else {
+        sin_cos_lanes(s, theta)
+    }
 }
 
 #[cfg(test)]

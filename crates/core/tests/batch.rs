@@ -1,11 +1,11 @@
-//! Batches in SIMD lanes (issue 14): the rigid body's splittings step a batch in blocks of lanes
-//! ([`Batch`], the `BatchStepper` of `Splitting`), and a body's trajectory is bit for bit the
-//! same alone and in a batch, whatever the batch size, its position, the threads and the chunks
+//! Batches in SIMD lanes (issue 14): the splittings of the rigid body and of the heavy top step a
+//! batch in blocks of lanes ([`Batch`], the `BatchStepper` of `Splitting`), and a body's
+//! trajectory is bit for bit the same alone and in a batch, whatever the batch size, its position, the threads and the chunks
 //! in which the run is advanced; errors still name the member and the step.
 
 use lieflow::integrate::methods::{Composition, Splitting};
 use lieflow::integrate::{integrate, integrate_batch, integrate_with, Batch, Run, System};
-use lieflow::systems::RigidBody;
+use lieflow::systems::{HeavyTop, RigidBody};
 use lieflow::Error;
 
 fn body() -> RigidBody {
@@ -36,12 +36,19 @@ fn bits(v: &[f64]) -> Vec<u64> {
 const METHODS: [&str; 4] = ["splitting", "splitting4", "splitting6", "processed8"];
 
 #[test]
-fn the_free_body_offers_lanes_and_the_others_do_not() {
+fn the_free_body_and_the_heavy_top_offer_lanes_and_the_others_do_not() {
     let b = body();
     assert!(b.batch_stepper("splitting", 0.01, 5).is_some());
     assert!(b.batch_stepper("splitting6", 0.01, 5).is_some());
     assert!(b.batch_stepper("rk4", 0.01, 5).is_none());
     assert!(b
+        .with_attitude()
+        .batch_stepper("splitting", 0.01, 5)
+        .is_none());
+    let top = heavy_top();
+    assert!(top.batch_stepper("splitting4", 0.01, 5).is_some());
+    assert!(top.batch_stepper("exact_splitting", 0.01, 5).is_none());
+    assert!(top
         .with_attitude()
         .batch_stepper("splitting", 0.01, 5)
         .is_none());
@@ -76,6 +83,45 @@ fn a_body_alone_and_in_batches_of_any_size_position_and_threads_gives_the_same_b
         let batch = integrate_batch(&b, m, &few, 0.01, 300, 7, None).unwrap();
         for (a, t) in alone[3..6].iter().zip(&batch) {
             assert_eq!(bits(&a.final_state), bits(&t.final_state), "{m} few");
+        }
+    }
+}
+
+fn heavy_top() -> HeavyTop {
+    HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap()
+}
+
+/// The heavy top in lanes (M and Γ; the kick, the axis rotations and the Rodrigues turn of Γ):
+/// the same bits alone and in a batch, on 1 and 2 threads, for tops slow and fast (Casimir
+/// angles beyond the small-angle path) and at rest (θ = 0).
+#[test]
+fn a_heavy_top_alone_and_in_a_batch_gives_the_same_bits() {
+    let top = heavy_top();
+    let all: Vec<Vec<f64>> = states(300)
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let a = k as f64;
+            let g = [(a * 0.3).sin(), (a * 0.5).cos(), 0.4];
+            let m = if k % 11 == 0 {
+                [0.0; 3]
+            } else {
+                [m[0], m[1], m[2]]
+            };
+            top.state(m, g)
+        })
+        .collect();
+    for m in ["splitting", "splitting4", "processed6"] {
+        let alone: Vec<_> = all
+            .iter()
+            .map(|z| integrate(&top, m, z, 0.01, 200, 9).unwrap())
+            .collect();
+        for threads in [1, 2] {
+            let batch = integrate_batch(&top, m, &all, 0.01, 200, 9, Some(threads)).unwrap();
+            for (a, t) in alone.iter().zip(&batch) {
+                assert_eq!(bits(&a.states), bits(&t.states), "{m}");
+                assert_eq!(bits(&a.final_state), bits(&t.final_state), "{m}");
+            }
         }
     }
 }

@@ -317,35 +317,51 @@ impl Top {
                 }
             }
             Flow::Casimir => {
-                let e = crate::lie::so3::exp(&(b.m * (tau * self.inv_ir)));
+                let t = tau * self.inv_ir;
                 if let Some(g) = b.g.as_mut() {
-                    *g = e.transpose() * *g;
+                    // One lane of `TopLanes` (as the axis flows).
+                    let mut v = [g[0], g[1], g[2]];
+                    let (s, m) = (pulp::Scalar::new(), [b.m[0], b.m[1], b.m[2]]);
+                    casimir_turn(s, t, m, &mut v);
+                    *g = Vector3::from(v);
                 }
                 if let Some(r) = b.r.as_mut() {
-                    *r *= e;
+                    *r *= crate::lie::so3::exp(&(b.m * t));
                 }
             }
             Flow::Kick => self.kick(tau, b),
         }
     }
 
-    /// The exact flow of the heavy-top potential V = Γ·c over time τ: M ↦ M + τ Γ × c.
+    /// The exact flow of the heavy-top potential V = Γ·c over time τ: M ↦ M + τ Γ × c (one lane
+    /// of `TopLanes`).
     #[inline]
     pub(crate) fn kick(&self, tau: f64, b: &mut TopWork) {
         if let (Some(g), Some(c)) = (b.g, self.c) {
-            b.m += g.cross(&c) * tau;
+            let mut m = [b.m[0], b.m[1], b.m[2]];
+            kick_lanes(
+                pulp::Scalar::new(),
+                tau,
+                &mut m,
+                [g[0], g[1], g[2]],
+                c.into(),
+            );
+            b.m = Vector3::from(m);
         }
     }
 
-    /// The flows on many bodies at once, for the free body without attitude (whose flows are
-    /// the two axis rotations of M): [`TopLanes`].
+    /// The flows on many bodies at once, for the free body and the heavy top without attitude:
+    /// [`TopLanes`].
     pub(crate) fn lanes(
         &self,
     ) -> Option<std::sync::Arc<dyn crate::integrate::problem::SplitLanes>> {
-        (self.c.is_none() && !self.lifted).then(|| {
+        (!self.lifted).then(|| {
             std::sync::Arc::new(TopLanes {
+                kinds: self.kinds,
                 axes: self.axes,
                 coef: self.coef,
+                inv_ir: self.inv_ir,
+                c: self.c.map(Into::into),
             }) as std::sync::Arc<dyn crate::integrate::problem::SplitLanes>
         })
     }
@@ -369,16 +385,22 @@ impl Top {
     }
 }
 
-/// The axis flows of the free rigid body without attitude on a block of bodies, in SIMD lanes
-/// ([`crate::simd`]): flow a rotates M about e_k, k = `axes[a]`, by the angle −τ·`coef[a]`·M_k,
-/// with exactly the operations of [`Top::flow`] (which is one lane of this kernel).
+/// The flows of the free rigid body (M) and of the heavy top (M, Γ) without attitude on a block
+/// of bodies, in SIMD lanes ([`crate::simd`]), with exactly the operations of [`Top::flow`]
+/// (which is one lane of this kernel): flow `Axis(a)` rotates M (and Γ) about e_k,
+/// k = `axes[a]`, by the angle −τ·`coef[a]`·M_k; `Casimir` turns Γ by exp(−τ M̂/I_r)
+/// ([`casimir_turn`]); `Kick` adds τ Γ × c to M ([`kick_lanes`]).
 ///
 /// Each group of [`GROUP`] vectors of bodies is loaded into registers once and stepped through
 /// the whole program there (the vectors interleaved, so that the latency of one sin/cos is hidden
 /// behind the others), then stored.
 struct TopLanes {
+    kinds: [Flow; 4],
     axes: [usize; 2],
     coef: [f64; 2],
+    inv_ir: f64,
+    /// c = mgl χ of a heavy top (then the block holds M and Γ).
+    c: Option<[f64; 3]>,
 }
 
 /// Vectors of bodies stepped together by [`TopLanes`].
@@ -386,7 +408,11 @@ const GROUP: usize = 4;
 
 impl crate::integrate::problem::SplitLanes for TopLanes {
     fn dim(&self) -> usize {
-        3
+        if self.c.is_some() {
+            6
+        } else {
+            3
+        }
     }
 
     fn run(
@@ -395,33 +421,46 @@ impl crate::integrate::problem::SplitLanes for TopLanes {
         first: &[f64],
         program: &crate::integrate::problem::Program<'_>,
     ) {
-        pulp::Arch::new().dispatch(LanesRun {
-            lanes: self,
-            block,
-            first,
-            program,
-        });
+        let arch = pulp::Arch::new();
+        if self.c.is_some() {
+            arch.dispatch(LanesRun::<6> {
+                lanes: self,
+                block,
+                first,
+                program,
+            });
+        } else {
+            arch.dispatch(LanesRun::<3> {
+                lanes: self,
+                block,
+                first,
+                program,
+            });
+        }
     }
 }
 
-struct LanesRun<'a> {
+/// A run of [`TopLanes`] on a block of D components (3: M; 6: M and Γ).
+struct LanesRun<'a, const D: usize> {
     lanes: &'a TopLanes,
     block: &'a mut [f64],
     first: &'a [f64],
     program: &'a crate::integrate::problem::Program<'a>,
 }
 
-impl pulp::WithSimd for LanesRun<'_> {
+impl<const D: usize> pulp::WithSimd for LanesRun<'_, D> {
     type Output = ();
 
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // the group's vectors index several arrays
     fn with_simd<S: pulp::Simd>(self, simd: S) {
         let n = self.first.len();
+        if n == 0 {
+            return;
+        }
         let lanes = S::F64_LANES;
-        let (m0, rest) = self.block.split_at_mut(n);
-        let (m1, m2) = rest.split_at_mut(n);
-        let mut rows: [&mut [f64]; 3] = [m0, m1, m2];
+        let mut chunks = self.block.chunks_exact_mut(n);
+        let mut rows: [&mut [f64]; D] = std::array::from_fn(|_| chunks.next().unwrap_or_default());
         let mut start = 0;
         while start < n {
             // Loads GROUP vectors of bodies (zeros past the end: lanes of no body).
@@ -429,37 +468,31 @@ impl pulp::WithSimd for LanesRun<'_> {
                 let lo = (start + j * lanes).min(n);
                 lo..(lo + lanes).min(n)
             };
-            let mut m = [[simd.splat_f64s(0.0); GROUP]; 3];
+            let mut z = [[simd.splat_f64s(0.0); GROUP]; D];
             let mut tau = [simd.splat_f64s(0.0); GROUP];
             for j in 0..GROUP {
                 for (c, row) in rows.iter().enumerate() {
-                    m[c][j] = simd.partial_load_f64s(&row[part(j)]);
+                    z[c][j] = simd.partial_load_f64s(&row[part(j)]);
                 }
                 tau[j] = simd.partial_load_f64s(&self.first[part(j)]);
             }
-            let p = self.program;
-            let lanes_of = self.lanes;
+            let (p, top) = (self.program, self.lanes);
             // The first outer flow, with each body's own time.
-            let a = p.outer;
-            let coef = simd.splat_f64s(lanes_of.coef[a]);
-            let tc = tau.map(|t| simd.mul_f64s(t, coef));
-            rotate(simd, &mut m, lanes_of.axes[a], tc);
+            top.apply(simd, p.outer, tau, &mut z);
             for &(i, t) in p.inner {
-                let tc = simd.splat_f64s(t * lanes_of.coef[i]);
-                rotate(simd, &mut m, lanes_of.axes[i], [tc; GROUP]);
+                top.apply(simd, i, [simd.splat_f64s(t); GROUP], &mut z);
             }
-            let fused = simd.splat_f64s(p.fused * lanes_of.coef[a]);
+            let fused = [simd.splat_f64s(p.fused); GROUP];
             for _ in 1..p.steps {
-                rotate(simd, &mut m, lanes_of.axes[a], [fused; GROUP]);
+                top.apply(simd, p.outer, fused, &mut z);
                 for &(i, t) in p.inner {
-                    let tc = simd.splat_f64s(t * lanes_of.coef[i]);
-                    rotate(simd, &mut m, lanes_of.axes[i], [tc; GROUP]);
+                    top.apply(simd, i, [simd.splat_f64s(t); GROUP], &mut z);
                 }
             }
             for j in 0..GROUP {
                 let range = part(j);
                 for (c, row) in rows.iter_mut().enumerate() {
-                    simd.partial_store_f64s(&mut row[range.clone()], m[c][j]);
+                    simd.partial_store_f64s(&mut row[range.clone()], z[c][j]);
                 }
             }
             start += GROUP * lanes;
@@ -467,26 +500,127 @@ impl pulp::WithSimd for LanesRun<'_> {
     }
 }
 
-/// The rotation of every body of a group about e_k by the angle −tc·M_k (tc = τ·a per lane):
-/// M_i ← c M_i + s M_j, M_j ← c M_j − s M_i with (i, j, k) cyclic, as `rotate_axis_sc`.
+impl TopLanes {
+    /// Flow i over the times `tau` on a group (M in rows 0–2, Γ in rows 3–5 when D = 6).
+    #[inline(always)]
+    fn apply<S: pulp::Simd, const D: usize>(
+        &self,
+        simd: S,
+        i: usize,
+        tau: [S::f64s; GROUP],
+        z: &mut [[S::f64s; GROUP]; D],
+    ) {
+        match self.kinds[i] {
+            Flow::Axis(a) => {
+                let coef = simd.splat_f64s(self.coef[a]);
+                rotate(simd, z, self.axes[a], tau.map(|t| simd.mul_f64s(t, coef)));
+            }
+            Flow::Casimir => {
+                let inv_ir = simd.splat_f64s(self.inv_ir);
+                for g in 0..GROUP {
+                    let m = [z[0][g], z[1][g], z[2][g]];
+                    let mut v = [z[3 % D][g], z[4 % D][g], z[5 % D][g]];
+                    casimir_turn(simd, simd.mul_f64s(tau[g], inv_ir), m, &mut v);
+                    for c in 0..3 {
+                        z[(3 + c) % D][g] = v[c];
+                    }
+                }
+            }
+            Flow::Kick => {
+                if let Some(c) = self.c {
+                    for g in 0..GROUP {
+                        let mut m = [z[0][g], z[1][g], z[2][g]];
+                        let v = [z[3 % D][g], z[4 % D][g], z[5 % D][g]];
+                        kick_lanes(simd, tau[g], &mut m, v, c);
+                        for k in 0..3 {
+                            z[k][g] = m[k];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Γ ↦ exp(−v̂) Γ = Γ − A v × Γ + B v × (v × Γ) with v = t M, θ = |v|, A = sin θ/θ and
+/// B = (1 − cos θ)/θ² (Rodrigues): the flow of ½|M|²/I_r on Γ over τ = t I_r. For θ ≤
+/// [`crate::simd::SMALL_MAX`] (the usual step) A and B are polynomials in θ²
+/// ([`crate::simd::sinc_versinc_small`]: no square root, no division); a lane beyond it takes
+/// sin θ/θ and (1 − cos θ)/θ², chosen per lane, so a body gives the same bits in any vector.
 #[inline(always)]
-fn rotate<S: pulp::Simd>(simd: S, m: &mut [[S::f64s; GROUP]; 3], k: usize, tc: [S::f64s; GROUP]) {
+fn casimir_turn<S: pulp::Simd>(simd: S, t: S::f64s, m: [S::f64s; 3], g: &mut [S::f64s; 3]) {
+    let (add, sub, mul) = (
+        |a, b| simd.add_f64s(a, b),
+        |a, b| simd.sub_f64s(a, b),
+        |a, b| simd.mul_f64s(a, b),
+    );
+    let v = m.map(|x| mul(x, t));
+    let th2 = add(add(mul(v[0], v[0]), mul(v[1], v[1])), mul(v[2], v[2]));
+    let small_max = crate::simd::SMALL_MAX * crate::simd::SMALL_MAX;
+    let small = simd.less_than_or_equal_f64s(th2, simd.splat_f64s(small_max));
+    let (mut a, mut b) = crate::simd::sinc_versinc_small(simd, th2);
+    if simd.first_true_m64s(simd.not_m64s(small)) < S::F64_LANES {
+        let th = simd.sqrt_f64s(th2);
+        let (s, c) = crate::simd::sin_cos_lanes(simd, th);
+        a = simd.select_f64s(small, a, simd.div_f64s(s, th));
+        b = simd.select_f64s(small, b, simd.div_f64s(sub(simd.splat_f64s(1.0), c), th2));
+    }
+    let w = cross(simd, v, *g);
+    let u = cross(simd, v, w);
+    for k in 0..3 {
+        g[k] = add(sub(g[k], mul(a, w[k])), mul(b, u[k]));
+    }
+}
+
+/// M ↦ M + τ Γ × c: the flow of the heavy-top potential Γ·c.
+#[inline(always)]
+fn kick_lanes<S: pulp::Simd>(
+    simd: S,
+    tau: S::f64s,
+    m: &mut [S::f64s; 3],
+    g: [S::f64s; 3],
+    c: [f64; 3],
+) {
+    let gc = cross(simd, g, c.map(|x| simd.splat_f64s(x)));
+    for k in 0..3 {
+        m[k] = simd.add_f64s(m[k], simd.mul_f64s(gc[k], tau));
+    }
+}
+
+/// a × b.
+#[inline(always)]
+fn cross<S: pulp::Simd>(simd: S, a: [S::f64s; 3], b: [S::f64s; 3]) -> [S::f64s; 3] {
+    let d =
+        |i: usize, j: usize| simd.sub_f64s(simd.mul_f64s(a[i], b[j]), simd.mul_f64s(a[j], b[i]));
+    [d(1, 2), d(2, 0), d(0, 1)]
+}
+
+/// The rotation of every body of a group about e_k by the angle −tc·M_k (tc = τ·a per lane):
+/// V_i ← c V_i + s V_j, V_j ← c V_j − s V_i with (i, j, k) cyclic for V = M (and Γ when D = 6),
+/// as `rotate_axis_sc`.
+#[inline(always)]
+fn rotate<S: pulp::Simd, const D: usize>(
+    simd: S,
+    z: &mut [[S::f64s; GROUP]; D],
+    k: usize,
+    tc: [S::f64s; GROUP],
+) {
     match k {
-        0 => rotate_about::<S, 0, 1, 2>(simd, m, tc),
-        1 => rotate_about::<S, 1, 2, 0>(simd, m, tc),
-        _ => rotate_about::<S, 2, 0, 1>(simd, m, tc),
+        0 => rotate_about::<S, D, 0, 1, 2>(simd, z, tc),
+        1 => rotate_about::<S, D, 1, 2, 0>(simd, z, tc),
+        _ => rotate_about::<S, D, 2, 0, 1>(simd, z, tc),
     }
 }
 
 #[inline(always)]
-fn rotate_about<S: pulp::Simd, const K: usize, const I: usize, const J: usize>(
+fn rotate_about<S: pulp::Simd, const D: usize, const K: usize, const I: usize, const J: usize>(
     simd: S,
-    m: &mut [[S::f64s; GROUP]; 3],
+    z: &mut [[S::f64s; GROUP]; D],
     tc: [S::f64s; GROUP],
 ) {
     let mut s = [simd.splat_f64s(0.0); GROUP];
     let mut c = [simd.splat_f64s(0.0); GROUP];
-    let angle: [S::f64s; GROUP] = std::array::from_fn(|g| simd.mul_f64s(tc[g], m[K][g]));
+    let angle: [S::f64s; GROUP] = std::array::from_fn(|g| simd.mul_f64s(tc[g], z[K][g]));
     // Small angles (the usual case) skip the argument reduction: the same bits
     // (`simd::sin_cos_small`), so the choice, made per group, changes no result.
     if angle.iter().all(|&a| crate::simd::all_small(simd, a)) {
@@ -498,10 +632,12 @@ fn rotate_about<S: pulp::Simd, const K: usize, const I: usize, const J: usize>(
             (s[g], c[g]) = crate::simd::sin_cos_lanes(simd, angle[g]);
         }
     }
-    for g in 0..GROUP {
-        let (vi, vj) = (m[I][g], m[J][g]);
-        m[I][g] = simd.add_f64s(simd.mul_f64s(c[g], vi), simd.mul_f64s(s[g], vj));
-        m[J][g] = simd.sub_f64s(simd.mul_f64s(c[g], vj), simd.mul_f64s(s[g], vi));
+    for base in (0..D).step_by(3) {
+        for g in 0..GROUP {
+            let (vi, vj) = (z[base + I][g], z[base + J][g]);
+            z[base + I][g] = simd.add_f64s(simd.mul_f64s(c[g], vi), simd.mul_f64s(s[g], vj));
+            z[base + J][g] = simd.sub_f64s(simd.mul_f64s(c[g], vj), simd.mul_f64s(s[g], vi));
+        }
     }
 }
 
@@ -550,3 +686,40 @@ macro_rules! top_kinds {
     };
 }
 pub(crate) use top_kinds;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The Rodrigues turn of the lanes is exp(−t M̂) Γ (so3::exp), at angles up to 5 rad
+        /// (the polynomials below 0.78, sin θ/θ beyond).
+        #[test]
+        fn casimir_turn_is_the_exponential(
+            m in prop::array::uniform3(-2.0f64..2.0),
+            g in prop::array::uniform3(-1.0f64..1.0),
+            t in prop_oneof![-1e-6f64..1e-6, -0.2f64..0.2, -1.5f64..1.5],
+        ) {
+            let mut v = g;
+            casimir_turn(pulp::Scalar::new(), t, m, &mut v);
+            let e = crate::lie::so3::exp(&(Vector3::from(m) * t));
+            let want = e.transpose() * Vector3::from(g);
+            prop_assert!((Vector3::from(v) - want).norm() < 4e-16 * (1.0 + want.norm()));
+        }
+
+        /// The kick is M + τ Γ × c.
+        #[test]
+        fn kick_lanes_is_the_cross_product(
+            m in prop::array::uniform3(-2.0f64..2.0),
+            g in prop::array::uniform3(-1.0f64..1.0),
+            c in prop::array::uniform3(-1.0f64..1.0),
+            tau in -1.0f64..1.0,
+        ) {
+            let mut out = m;
+            kick_lanes(pulp::Scalar::new(), tau, &mut out, g, c);
+            let want = Vector3::from(m) + Vector3::from(g).cross(&Vector3::from(c)) * tau;
+            prop_assert!((Vector3::from(out) - want).norm() < 1e-15);
+        }
+    }
+}
