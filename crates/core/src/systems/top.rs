@@ -461,6 +461,13 @@ impl<const D: usize> pulp::WithSimd for LanesRun<'_, D> {
         let lanes = S::F64_LANES;
         let mut chunks = self.block.chunks_exact_mut(n);
         let mut rows: [&mut [f64]; D] = std::array::from_fn(|_| chunks.next().unwrap_or_default());
+        let (p, top) = (self.program, self.lanes);
+        // The inner flows' times, scaled as each flow uses them (once per call, not per step).
+        let inner: Vec<(usize, f64)> = p
+            .inner
+            .iter()
+            .map(|&(i, t)| (i, t * top.factor(i)))
+            .collect();
         let mut start = 0;
         while start < n {
             // Loads GROUP vectors of bodies (zeros past the end: lanes of no body).
@@ -476,16 +483,16 @@ impl<const D: usize> pulp::WithSimd for LanesRun<'_, D> {
                 }
                 tau[j] = simd.partial_load_f64s(&self.first[part(j)]);
             }
-            let (p, top) = (self.program, self.lanes);
             // The first outer flow, with each body's own time.
-            top.apply(simd, p.outer, tau, &mut z);
-            for &(i, t) in p.inner {
+            let outer = simd.splat_f64s(top.factor(p.outer));
+            top.apply(simd, p.outer, tau.map(|t| simd.mul_f64s(t, outer)), &mut z);
+            for &(i, t) in &inner {
                 top.apply(simd, i, [simd.splat_f64s(t); GROUP], &mut z);
             }
-            let fused = [simd.splat_f64s(p.fused); GROUP];
+            let fused = [simd.splat_f64s(p.fused * top.factor(p.outer)); GROUP];
             for _ in 1..p.steps {
                 top.apply(simd, p.outer, fused, &mut z);
-                for &(i, t) in p.inner {
+                for &(i, t) in &inner {
                     top.apply(simd, i, [simd.splat_f64s(t); GROUP], &mut z);
                 }
             }
@@ -501,7 +508,18 @@ impl<const D: usize> pulp::WithSimd for LanesRun<'_, D> {
 }
 
 impl TopLanes {
-    /// Flow i over the times `tau` on a group (M in rows 0–2, Γ in rows 3–5 when D = 6).
+    /// The factor by which flow i scales its time, as [`Top::flow`] does: a_k for an axis flow
+    /// (the angle is τ a_k M_k), 1/I_r for the Casimir flow, 1 for the kick.
+    fn factor(&self, i: usize) -> f64 {
+        match self.kinds[i] {
+            Flow::Axis(a) => self.coef[a],
+            Flow::Casimir => self.inv_ir,
+            Flow::Kick => 1.0,
+        }
+    }
+
+    /// Flow i over the scaled times `tau` (τ·[`TopLanes::factor`]) on a group (M in rows 0–2, Γ
+    /// in rows 3–5 when D = 6).
     #[inline(always)]
     fn apply<S: pulp::Simd, const D: usize>(
         &self,
@@ -511,16 +529,12 @@ impl TopLanes {
         z: &mut [[S::f64s; GROUP]; D],
     ) {
         match self.kinds[i] {
-            Flow::Axis(a) => {
-                let coef = simd.splat_f64s(self.coef[a]);
-                rotate(simd, z, self.axes[a], tau.map(|t| simd.mul_f64s(t, coef)));
-            }
+            Flow::Axis(a) => rotate(simd, z, self.axes[a], tau),
             Flow::Casimir => {
-                let inv_ir = simd.splat_f64s(self.inv_ir);
                 for g in 0..GROUP {
                     let m = [z[0][g], z[1][g], z[2][g]];
                     let mut v = [z[3 % D][g], z[4 % D][g], z[5 % D][g]];
-                    casimir_turn(simd, simd.mul_f64s(tau[g], inv_ir), m, &mut v);
+                    casimir_turn(simd, tau[g], m, &mut v);
                     for c in 0..3 {
                         z[(3 + c) % D][g] = v[c];
                     }
