@@ -118,6 +118,36 @@ fn batch(c: &mut Criterion) {
         }
     }
     g.finish();
+    // The free body with its attitude (M, R) in lanes: R's columns rotated, its rows turned.
+    let lifted = body.with_attitude();
+    let with_r: Vec<Vec<f64>> = states
+        .iter()
+        .map(|m| {
+            let mut z = m.clone();
+            z.extend([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+            z
+        })
+        .collect();
+    let mut g = c.benchmark_group("batch_rigid_body_attitude_1e4x1e3");
+    g.sample_size(10);
+    g.throughput(criterion::Throughput::Elements(10_000 * 1000));
+    for threads in [1, 2] {
+        g.bench_function(format!("splitting_{threads}_threads"), |b| {
+            b.iter(|| {
+                integrate_batch(
+                    &lifted,
+                    "splitting",
+                    &with_r,
+                    0.01,
+                    1000,
+                    1000,
+                    Some(threads),
+                )
+                .unwrap()
+            })
+        });
+    }
+    g.finish();
     // The heavy top (M, Γ) in lanes too: the kick, two axis rotations and the Rodrigues turn of Γ.
     let top = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
     let tops: Vec<Vec<f64>> = states

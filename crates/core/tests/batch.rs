@@ -36,22 +36,23 @@ fn bits(v: &[f64]) -> Vec<u64> {
 const METHODS: [&str; 4] = ["splitting", "splitting4", "splitting6", "processed8"];
 
 #[test]
-fn the_free_body_and_the_heavy_top_offer_lanes_and_the_others_do_not() {
+fn the_splittings_of_the_so3_bodies_offer_lanes_and_the_others_do_not() {
     let b = body();
     assert!(b.batch_stepper("splitting", 0.01, 5).is_some());
     assert!(b.batch_stepper("splitting6", 0.01, 5).is_some());
     assert!(b.batch_stepper("rk4", 0.01, 5).is_none());
+    assert!(b.batch_stepper("dmv10", 0.01, 5).is_none());
     assert!(b
         .with_attitude()
         .batch_stepper("splitting", 0.01, 5)
-        .is_none());
+        .is_some());
     let top = heavy_top();
     assert!(top.batch_stepper("splitting4", 0.01, 5).is_some());
     assert!(top.batch_stepper("exact_splitting", 0.01, 5).is_none());
     assert!(top
         .with_attitude()
-        .batch_stepper("splitting", 0.01, 5)
-        .is_none());
+        .batch_stepper("processed6", 0.01, 5)
+        .is_some());
     let runs = vec![Run::new(&b, "splitting", &[1.0, 2.0, 3.0], 0.01, 1, 0.0).unwrap()];
     assert!(Batch::new(&b, "splitting", runs).unwrap().in_lanes());
 }
@@ -91,9 +92,38 @@ fn heavy_top() -> HeavyTop {
     HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap()
 }
 
-/// The heavy top in lanes (M and Γ; the kick, the axis rotations and the Rodrigues turn of Γ):
-/// the same bits alone and in a batch, on 1 and 2 threads, for tops slow and fast (Casimir
-/// angles beyond the small-angle path) and at rest (θ = 0).
+/// `system` alone and in batches on 1 and 2 threads, for `methods`: the same bits.
+fn same_bits_alone_and_in_a_batch<S: System>(system: &S, all: &[Vec<f64>], methods: &[&str]) {
+    for &m in methods {
+        let alone: Vec<_> = all
+            .iter()
+            .map(|z| integrate(system, m, z, 0.01, 300, 9).unwrap())
+            .collect();
+        for threads in [1, 2] {
+            let batch = integrate_batch(system, m, all, 0.01, 300, 9, Some(threads)).unwrap();
+            for (a, t) in alone.iter().zip(&batch) {
+                assert_eq!(bits(&a.states), bits(&t.states), "{m}");
+                assert_eq!(bits(&a.final_state), bits(&t.final_state), "{m}");
+            }
+        }
+    }
+}
+
+/// A rotation R for member k (row-major, an exponential: a state of SO(3)).
+fn attitude(k: usize) -> [f64; 9] {
+    let a = k as f64;
+    let r = lieflow::lie::so3::exp(&nalgebra::Vector3::new(
+        (a * 0.7).sin(),
+        0.3,
+        -0.2 * a.cos(),
+    ));
+    std::array::from_fn(|i| r[(i / 3, i % 3)])
+}
+
+/// The heavy top in lanes (M and Γ; the kick, the axis rotations and the Rodrigues turn of Γ),
+/// and with its attitude (R's columns rotated, its rows turned): the same bits alone and in a
+/// batch, for tops slow and fast (Casimir angles beyond the small-angle path) and at rest
+/// (θ = 0), over 300 steps (a retraction of R at step 256).
 #[test]
 fn a_heavy_top_alone_and_in_a_batch_gives_the_same_bits() {
     let top = heavy_top();
@@ -111,19 +141,29 @@ fn a_heavy_top_alone_and_in_a_batch_gives_the_same_bits() {
             top.state(m, g)
         })
         .collect();
-    for m in ["splitting", "splitting4", "processed6"] {
-        let alone: Vec<_> = all
-            .iter()
-            .map(|z| integrate(&top, m, z, 0.01, 200, 9).unwrap())
-            .collect();
-        for threads in [1, 2] {
-            let batch = integrate_batch(&top, m, &all, 0.01, 200, 9, Some(threads)).unwrap();
-            for (a, t) in alone.iter().zip(&batch) {
-                assert_eq!(bits(&a.states), bits(&t.states), "{m}");
-                assert_eq!(bits(&a.final_state), bits(&t.final_state), "{m}");
-            }
-        }
-    }
+    same_bits_alone_and_in_a_batch(&top, &all, &["splitting", "splitting4", "processed6"]);
+    let with_r: Vec<Vec<f64>> = all
+        .iter()
+        .enumerate()
+        .map(|(k, z)| {
+            // Γ = Rᵀe₃, the third row of R.
+            let r = attitude(k);
+            z[..3].iter().chain(&r[6..]).chain(&r).copied().collect()
+        })
+        .collect();
+    same_bits_alone_and_in_a_batch(&top.with_attitude(), &with_r, &["splitting", "processed6"]);
+}
+
+/// The free body with its attitude in lanes: the same bits alone and in a batch.
+#[test]
+fn a_body_with_attitude_alone_and_in_a_batch_gives_the_same_bits() {
+    let all: Vec<Vec<f64>> = states(150)
+        .iter()
+        .enumerate()
+        .map(|(k, m)| m.iter().copied().chain(attitude(k)).collect())
+        .collect();
+    let methods = ["splitting", "splitting4", "processed8"];
+    same_bits_alone_and_in_a_batch(&body().with_attitude(), &all, &methods);
 }
 
 #[test]

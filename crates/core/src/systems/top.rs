@@ -317,16 +317,22 @@ impl Top {
                 }
             }
             Flow::Casimir => {
-                let t = tau * self.inv_ir;
+                // One lane of `TopLanes` (as the axis flows): Γ and the rows of R turned.
+                let m = [b.m[0], b.m[1], b.m[2]];
+                let turn = Turn::new(pulp::Scalar::new(), tau * self.inv_ir, m);
                 if let Some(g) = b.g.as_mut() {
-                    // One lane of `TopLanes` (as the axis flows).
-                    let mut v = [g[0], g[1], g[2]];
-                    let (s, m) = (pulp::Scalar::new(), [b.m[0], b.m[1], b.m[2]]);
-                    casimir_turn(s, t, m, &mut v);
-                    *g = Vector3::from(v);
+                    let mut x = [g[0], g[1], g[2]];
+                    turn.apply(&mut x);
+                    *g = Vector3::from(x);
                 }
                 if let Some(r) = b.r.as_mut() {
-                    *r *= crate::lie::so3::exp(&(b.m * t));
+                    for i in 0..3 {
+                        let mut x = [r[(i, 0)], r[(i, 1)], r[(i, 2)]];
+                        turn.apply(&mut x);
+                        for (j, xj) in x.into_iter().enumerate() {
+                            r[(i, j)] = xj;
+                        }
+                    }
                 }
             }
             Flow::Kick => self.kick(tau, b),
@@ -350,20 +356,18 @@ impl Top {
         }
     }
 
-    /// The flows on many bodies at once, for the free body and the heavy top without attitude:
-    /// [`TopLanes`].
+    /// The flows on many bodies at once: [`TopLanes`].
     pub(crate) fn lanes(
         &self,
     ) -> Option<std::sync::Arc<dyn crate::integrate::problem::SplitLanes>> {
-        (!self.lifted).then(|| {
-            std::sync::Arc::new(TopLanes {
-                kinds: self.kinds,
-                axes: self.axes,
-                coef: self.coef,
-                inv_ir: self.inv_ir,
-                c: self.c.map(Into::into),
-            }) as std::sync::Arc<dyn crate::integrate::problem::SplitLanes>
-        })
+        Some(std::sync::Arc::new(TopLanes {
+            kinds: self.kinds,
+            axes: self.axes,
+            coef: self.coef,
+            inv_ir: self.inv_ir,
+            c: self.c.map(Into::into),
+            lifted: self.lifted,
+        }))
     }
 
     /// The Euler–Poisson field on (M, [Γ], [R]): Ṁ = M × Ω + Γ × c, Γ̇ = Γ × Ω, Ṙ = R hat(Ω),
@@ -385,11 +389,12 @@ impl Top {
     }
 }
 
-/// The flows of the free rigid body (M) and of the heavy top (M, Γ) without attitude on a block
-/// of bodies, in SIMD lanes ([`crate::simd`]), with exactly the operations of [`Top::flow`]
+/// The flows of the free rigid body (M) and of the heavy top (M, Γ), with or without the attitude
+/// R, on a block of bodies, in SIMD lanes ([`crate::simd`]), with exactly the operations of [`Top::flow`]
 /// (which is one lane of this kernel): flow `Axis(a)` rotates M (and Γ) about e_k,
-/// k = `axes[a]`, by the angle −τ·`coef[a]`·M_k; `Casimir` turns Γ by exp(−τ M̂/I_r)
-/// ([`casimir_turn`]); `Kick` adds τ Γ × c to M ([`kick_lanes`]).
+/// k = `axes[a]`, by the angle −τ·`coef[a]`·M_k (and the columns i, j of R by the same angle);
+/// `Casimir` turns Γ and the rows of R by exp(−τ M̂/I_r) ([`Turn`]); `Kick` adds τ Γ × c to M
+/// ([`kick_lanes`]).
 ///
 /// Each group of [`GROUP`] vectors of bodies is loaded into registers once and stepped through
 /// the whole program there (the vectors interleaved, so that the latency of one sin/cos is hidden
@@ -401,6 +406,8 @@ struct TopLanes {
     inv_ir: f64,
     /// c = mgl χ of a heavy top (then the block holds M and Γ).
     c: Option<[f64; 3]>,
+    /// Whether the block also holds R (row-major, after M and Γ).
+    lifted: bool,
 }
 
 /// Vectors of bodies stepped together by [`TopLanes`].
@@ -408,11 +415,7 @@ const GROUP: usize = 4;
 
 impl crate::integrate::problem::SplitLanes for TopLanes {
     fn dim(&self) -> usize {
-        if self.c.is_some() {
-            6
-        } else {
-            3
-        }
+        3 + if self.c.is_some() { 3 } else { 0 } + if self.lifted { 9 } else { 0 }
     }
 
     fn run(
@@ -421,26 +424,30 @@ impl crate::integrate::problem::SplitLanes for TopLanes {
         first: &[f64],
         program: &crate::integrate::problem::Program<'_>,
     ) {
-        let arch = pulp::Arch::new();
-        if self.c.is_some() {
-            arch.dispatch(LanesRun::<6> {
-                lanes: self,
-                block,
-                first,
-                program,
-            });
-        } else {
-            arch.dispatch(LanesRun::<3> {
-                lanes: self,
+        fn go<const D: usize>(
+            lanes: &TopLanes,
+            block: &mut [f64],
+            first: &[f64],
+            program: &crate::integrate::problem::Program<'_>,
+        ) {
+            pulp::Arch::new().dispatch(LanesRun::<D> {
+                lanes,
                 block,
                 first,
                 program,
             });
         }
+        match self.dim() {
+            3 => go::<3>(self, block, first, program),
+            6 => go::<6>(self, block, first, program),
+            12 => go::<12>(self, block, first, program),
+            _ => go::<15>(self, block, first, program),
+        }
     }
 }
 
-/// A run of [`TopLanes`] on a block of D components (3: M; 6: M and Γ).
+/// A run of [`TopLanes`] on a block of D components: M, then Γ (heavy top), then the rows of R
+/// (with attitude): 3, 6, 12 or 15.
 struct LanesRun<'a, const D: usize> {
     lanes: &'a TopLanes,
     block: &'a mut [f64],
@@ -518,8 +525,8 @@ impl TopLanes {
         }
     }
 
-    /// Flow i over the scaled times `tau` (τ·[`TopLanes::factor`]) on a group (M in rows 0–2, Γ
-    /// in rows 3–5 when D = 6).
+    /// Flow i over the scaled times `tau` (τ·[`TopLanes::factor`]) on a group (the block's rows
+    /// as in [`LanesRun`]).
     #[inline(always)]
     fn apply<S: pulp::Simd, const D: usize>(
         &self,
@@ -531,12 +538,15 @@ impl TopLanes {
         match self.kinds[i] {
             Flow::Axis(a) => rotate(simd, z, self.axes[a], tau),
             Flow::Casimir => {
+                // Every block after M (Γ, the rows of R) turns with the same exp(−v̂).
                 for g in 0..GROUP {
-                    let m = [z[0][g], z[1][g], z[2][g]];
-                    let mut v = [z[3 % D][g], z[4 % D][g], z[5 % D][g]];
-                    casimir_turn(simd, tau[g], m, &mut v);
-                    for c in 0..3 {
-                        z[(3 + c) % D][g] = v[c];
+                    let turn = Turn::new(simd, tau[g], [z[0][g], z[1][g], z[2][g]]);
+                    for base in (3..D).step_by(3) {
+                        let mut x = [z[base][g], z[base + 1][g], z[base + 2][g]];
+                        turn.apply(&mut x);
+                        for (c, xc) in x.into_iter().enumerate() {
+                            z[base + c][g] = xc;
+                        }
                     }
                 }
             }
@@ -556,33 +566,48 @@ impl TopLanes {
     }
 }
 
-/// Γ ↦ exp(−v̂) Γ = Γ − A v × Γ + B v × (v × Γ) with v = t M, θ = |v|, A = sin θ/θ and
-/// B = (1 − cos θ)/θ² (Rodrigues): the flow of ½|M|²/I_r on Γ over τ = t I_r. For θ ≤
-/// [`crate::simd::SMALL_MAX`] (the usual step) A and B are polynomials in θ²
-/// ([`crate::simd::sinc_versinc_small`]: no square root, no division); a lane beyond it takes
-/// sin θ/θ and (1 − cos θ)/θ², chosen per lane, so a body gives the same bits in any vector.
-#[inline(always)]
-fn casimir_turn<S: pulp::Simd>(simd: S, t: S::f64s, m: [S::f64s; 3], g: &mut [S::f64s; 3]) {
-    let (add, sub, mul) = (
-        |a, b| simd.add_f64s(a, b),
-        |a, b| simd.sub_f64s(a, b),
-        |a, b| simd.mul_f64s(a, b),
-    );
-    let v = m.map(|x| mul(x, t));
-    let th2 = add(add(mul(v[0], v[0]), mul(v[1], v[1])), mul(v[2], v[2]));
-    let small_max = crate::simd::SMALL_MAX * crate::simd::SMALL_MAX;
-    let small = simd.less_than_or_equal_f64s(th2, simd.splat_f64s(small_max));
-    let (mut a, mut b) = crate::simd::sinc_versinc_small(simd, th2);
-    if simd.first_true_m64s(simd.not_m64s(small)) < S::F64_LANES {
-        let th = simd.sqrt_f64s(th2);
-        let (s, c) = crate::simd::sin_cos_lanes(simd, th);
-        a = simd.select_f64s(small, a, simd.div_f64s(s, th));
-        b = simd.select_f64s(small, b, simd.div_f64s(sub(simd.splat_f64s(1.0), c), th2));
+/// The turn exp(−v̂) for v = t M (Rodrigues: exp(−v̂) x = x − A v × x + B v × (v × x), θ = |v|,
+/// A = sin θ/θ, B = (1 − cos θ)/θ²): the flow of ½|M|²/I_r over τ = t I_r on Γ, and on the rows
+/// of R (R exp(v̂) has the rows exp(−v̂) r). For θ ≤ [`crate::simd::SMALL_MAX`] (the usual step)
+/// A and B are polynomials in θ² ([`crate::simd::sinc_versinc_small`]: no square root, no
+/// division); a lane beyond it takes sin θ/θ and (1 − cos θ)/θ², chosen per lane, so a body
+/// gives the same bits in any vector.
+struct Turn<S: pulp::Simd> {
+    simd: S,
+    v: [S::f64s; 3],
+    a: S::f64s,
+    b: S::f64s,
+}
+
+impl<S: pulp::Simd> Turn<S> {
+    #[inline(always)]
+    fn new(simd: S, t: S::f64s, m: [S::f64s; 3]) -> Self {
+        let (add, mul) = (|a, b| simd.add_f64s(a, b), |a, b| simd.mul_f64s(a, b));
+        let v = m.map(|x| mul(x, t));
+        let th2 = add(add(mul(v[0], v[0]), mul(v[1], v[1])), mul(v[2], v[2]));
+        let small_max = crate::simd::SMALL_MAX * crate::simd::SMALL_MAX;
+        let small = simd.less_than_or_equal_f64s(th2, simd.splat_f64s(small_max));
+        let (mut a, mut b) = crate::simd::sinc_versinc_small(simd, th2);
+        if simd.first_true_m64s(simd.not_m64s(small)) < S::F64_LANES {
+            let th = simd.sqrt_f64s(th2);
+            let (s, c) = crate::simd::sin_cos_lanes(simd, th);
+            let versin = simd.sub_f64s(simd.splat_f64s(1.0), c);
+            a = simd.select_f64s(small, a, simd.div_f64s(s, th));
+            b = simd.select_f64s(small, b, simd.div_f64s(versin, th2));
+        }
+        Turn { simd, v, a, b }
     }
-    let w = cross(simd, v, *g);
-    let u = cross(simd, v, w);
-    for k in 0..3 {
-        g[k] = add(sub(g[k], mul(a, w[k])), mul(b, u[k]));
+
+    /// x ↦ exp(−v̂) x.
+    #[inline(always)]
+    fn apply(&self, x: &mut [S::f64s; 3]) {
+        let simd = self.simd;
+        let w = cross(simd, self.v, *x);
+        let u = cross(simd, self.v, w);
+        for k in 0..3 {
+            let x_aw = simd.sub_f64s(x[k], simd.mul_f64s(self.a, w[k]));
+            x[k] = simd.add_f64s(x_aw, simd.mul_f64s(self.b, u[k]));
+        }
     }
 }
 
@@ -710,13 +735,13 @@ mod tests {
         /// The Rodrigues turn of the lanes is exp(−t M̂) Γ (so3::exp), at angles up to 5 rad
         /// (the polynomials below 0.78, sin θ/θ beyond).
         #[test]
-        fn casimir_turn_is_the_exponential(
+        fn the_turn_is_the_exponential(
             m in prop::array::uniform3(-2.0f64..2.0),
             g in prop::array::uniform3(-1.0f64..1.0),
             t in prop_oneof![-1e-6f64..1e-6, -0.2f64..0.2, -1.5f64..1.5],
         ) {
             let mut v = g;
-            casimir_turn(pulp::Scalar::new(), t, m, &mut v);
+            Turn::new(pulp::Scalar::new(), t, m).apply(&mut v);
             let e = crate::lie::so3::exp(&(Vector3::from(m) * t));
             let want = e.transpose() * Vector3::from(g);
             prop_assert!((Vector3::from(v) - want).norm() < 4e-16 * (1.0 + want.norm()));
