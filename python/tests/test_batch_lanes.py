@@ -1,5 +1,5 @@
-"""Batches in SIMD lanes (issue 14): the free rigid body's splittings step a batch in blocks of
-lanes, and a body's trajectory is bit for bit the same alone and in a batch, whatever the batch
+"""Batches in SIMD lanes (issue 14): the splittings of the rigid body and the heavy top (with or
+without attitude) step a batch in blocks of lanes, and a body's trajectory is bit for bit the same alone and in a batch, whatever the batch
 size, its position, the threads and the chunks; errors still name the member and the step."""
 
 import numpy as np
@@ -31,6 +31,27 @@ def test_alone_equals_in_batch_bit_for_bit(method):
         alone = lf.integrate(BODY, m[i], dt=0.01, steps=200, save_every=20, method=method)
         np.testing.assert_array_equal(alone.states, batch.states[i])
         np.testing.assert_array_equal(alone.final_state, batch.final_state[i])
+
+
+@pytest.mark.parametrize("method", ["splitting", "processed6"])
+def test_with_attitude_and_heavy_tops_alone_equals_in_batch_bit_for_bit(method):
+    """Bodies with attitude (over 300 steps: a retraction of R at 256) and heavy tops."""
+    m = momenta(40, seed=3)
+    r = np.stack([lf.lie.so3_exp(v) for v in np.random.default_rng(4).normal(size=(40, 3))])
+    batch = lf.integrate(BODY, m, dt=0.01, steps=300, save_every=30, method=method, attitude=r,
+                         threads=2)
+    top = lf.HeavyTop([1, 2, 3], 0.7)
+    g = r[:, 2, :]                                      # Γ = Rᵀe₃, the third row of R
+    tops = lf.integrate(top, np.hstack([m, g]), dt=0.01, steps=300, save_every=30,
+                        method=method, threads=2)
+    for i in [0, 3, 5, 17, 39]:
+        alone = lf.integrate(BODY, m[i], dt=0.01, steps=300, save_every=30, method=method,
+                             attitude=r[i])
+        np.testing.assert_array_equal(alone.states, batch.states[i])
+        np.testing.assert_array_equal(alone.attitude, batch.attitude[i])
+        one = lf.integrate(top, np.hstack([m[i], g[i]]), dt=0.01, steps=300, save_every=30,
+                           method=method)
+        np.testing.assert_array_equal(one.states, tops.states[i])
 
 
 @pytest.mark.parametrize("method", METHODS)
