@@ -207,11 +207,16 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
 
     fn set(&mut self, member: usize, z: &[f64]) -> Result<()> {
         let mut w = self.problem.load(z)?;
-        let mut y = z.to_vec();
-        if !self.scheme.pre.is_empty() {
+        let processed;
+        let y = if self.scheme.pre.is_empty() {
+            z
+        } else {
             self.scheme.enter(&self.problem, &mut w);
+            let mut y = z.to_vec();
             self.problem.store(&w, &mut y);
-        }
+            processed = y;
+            &processed[..]
+        };
         for (c, &v) in y.iter().enumerate().take(self.d) {
             self.block[c * self.n + member] = v;
         }
