@@ -94,6 +94,34 @@ fn exact(c: &mut Criterion) {
     g.finish();
 }
 
+/// One criterion group: `integrate_batch` of `states` (10⁴ members × 1000 steps) with each of
+/// `methods` on 1 and 2 threads.
+fn batch_group<S: System>(
+    c: &mut Criterion,
+    name: &str,
+    system: &S,
+    states: &[Vec<f64>],
+    methods: &[&str],
+) {
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10);
+    g.throughput(criterion::Throughput::Elements(states.len() as u64 * 1000));
+    for &method in methods {
+        for threads in [1, 2] {
+            g.bench_function(format!("{method}_{threads}_threads"), |b| {
+                b.iter(|| {
+                    integrate_batch(system, method, states, 0.01, 1000, 1000, Some(threads))
+                        .unwrap()
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+/// Batches in SIMD lanes (issue 14): the free body (splitting4 runs five Strang stages per
+/// step), the body with its attitude (R's columns rotated, its rows turned) and the heavy top
+/// (the kick, two axis rotations and the Rodrigues turn of Γ).
 fn batch(c: &mut Criterion) {
     let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
     let states: Vec<Vec<f64>> = (0..10_000)
@@ -102,69 +130,27 @@ fn batch(c: &mut Criterion) {
             vec![1.0 - a, 0.5 + a, -0.3 + 0.5 * a]
         })
         .collect();
-    let mut g = c.benchmark_group("batch_rigid_body_1e4x1e3");
-    g.sample_size(10);
-    g.throughput(criterion::Throughput::Elements(10_000 * 1000));
-    // The free body's splittings step a batch in SIMD lanes (issue 14); splitting4 runs five
-    // Strang stages per step.
-    for method in ["splitting", "splitting4"] {
-        for threads in [1, 2] {
-            g.bench_function(format!("{method}_{threads}_threads"), |b| {
-                b.iter(|| {
-                    integrate_batch(&body, method, &states, 0.01, 1000, 1000, Some(threads))
-                        .unwrap()
-                })
-            });
-        }
-    }
-    g.finish();
-    // The free body with its attitude (M, R) in lanes: R's columns rotated, its rows turned.
-    let lifted = body.with_attitude();
+    let methods = ["splitting", "splitting4"];
+    batch_group(c, "batch_rigid_body_1e4x1e3", &body, &states, &methods);
+    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
     let with_r: Vec<Vec<f64>> = states
         .iter()
-        .map(|m| {
-            let mut z = m.clone();
-            z.extend([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
-            z
-        })
+        .map(|m| m.iter().chain(&identity).copied().collect())
         .collect();
-    let mut g = c.benchmark_group("batch_rigid_body_attitude_1e4x1e3");
-    g.sample_size(10);
-    g.throughput(criterion::Throughput::Elements(10_000 * 1000));
-    for threads in [1, 2] {
-        g.bench_function(format!("splitting_{threads}_threads"), |b| {
-            b.iter(|| {
-                integrate_batch(
-                    &lifted,
-                    "splitting",
-                    &with_r,
-                    0.01,
-                    1000,
-                    1000,
-                    Some(threads),
-                )
-                .unwrap()
-            })
-        });
-    }
-    g.finish();
-    // The heavy top (M, Γ) in lanes too: the kick, two axis rotations and the Rodrigues turn of Γ.
+    let lifted = body.with_attitude();
+    batch_group(
+        c,
+        "batch_rigid_body_attitude_1e4x1e3",
+        &lifted,
+        &with_r,
+        &["splitting"],
+    );
     let top = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
     let tops: Vec<Vec<f64>> = states
         .iter()
         .map(|m| top.state([m[0], m[1], m[2]], [0.0, 0.6, 0.8]))
         .collect();
-    let mut g = c.benchmark_group("batch_heavy_top_1e4x1e3");
-    g.sample_size(10);
-    g.throughput(criterion::Throughput::Elements(10_000 * 1000));
-    for threads in [1, 2] {
-        g.bench_function(format!("splitting_{threads}_threads"), |b| {
-            b.iter(|| {
-                integrate_batch(&top, "splitting", &tops, 0.01, 1000, 1000, Some(threads)).unwrap()
-            })
-        });
-    }
-    g.finish();
+    batch_group(c, "batch_heavy_top_1e4x1e3", &top, &tops, &["splitting"]);
 }
 
 /// Error at T = 100 against the exact solution and the best of 7 wall times, for each method
