@@ -32,7 +32,7 @@ def numbers(body):
 
 
 def function(name):
-    """The numbers in the body of `pub fn name()` of composition.rs, and the local bindings."""
+    """The source text of `pub fn name()` of composition.rs."""
     start = SOURCE.index(f"pub fn {name}()")
     end = SOURCE.index("\n    }\n", start)
     return SOURCE[start:end]

@@ -437,6 +437,7 @@ impl crate::integrate::problem::SplitLanes for TopLanes {
                 program,
             });
         }
+        // dim() is 3 + 3·[heavy top] + 9·[attitude]: one of these four.
         match self.dim() {
             3 => go::<3>(self, block, first, program),
             6 => go::<6>(self, block, first, program),
