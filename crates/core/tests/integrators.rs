@@ -428,7 +428,9 @@ fn processed_compositions_reach_their_effective_orders() {
     // splitting6: 41 steps of 7) the processed method is far more accurate (its doc says so).
     let exact10 = Vector3::from(b.exact_momentum(&M0, 10.0).unwrap());
     let at10 = |method: &str, n: usize| {
-        let z = integrate(&b, method, &M0, 10.0 / n as f64, n, n).unwrap().final_state;
+        let z = integrate(&b, method, &M0, 10.0 / n as f64, n, n)
+            .unwrap()
+            .final_state;
         (Vector3::from_column_slice(&z) - exact10).norm()
     };
     let ratio = at10("splitting6", 41) / at10("processed6", 26);
