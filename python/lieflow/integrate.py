@@ -401,8 +401,7 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             ended = run.ended
             chunks.append((s, a, hits) + run.state() + (done, ended))
     except BaseException as e:
-        if isinstance(e, (Exception, KeyboardInterrupt)):
-            _attach_partial(e, ctx, run, chunks)
+        _attach_partial(e, ctx, run, chunks)
         raise
     finally:
         bar.close()
@@ -488,21 +487,19 @@ class _Context:
 def _attach_partial(err, ctx, run, chunks):
     """Attaches the trajectory computed before `err` as ``err.partial`` and a note naming it.
 
-    A single native run that failed in a native call knows its last checked state exactly (the
-    step before the one its error names) and the states that call saved; otherwise (Ctrl-C,
-    batches, duck-typed runs) the trajectory ends after the last completed call."""
+    A single native run whose native call failed (also by an exception of a Python callable it
+    called, KeyboardInterrupt included) knows its last checked state exactly (the step before
+    the one that failed) and the states that call saved; otherwise (Ctrl-C between calls,
+    batches, duck-typed runs) the trajectory ends after the last completed call, whose samples,
+    final state and time the chunks hold together."""
     try:
         extra = final = None
-        exact = (not ctx.batched and not isinstance(err, KeyboardInterrupt)
-                 and hasattr(run, "take_partial") and hasattr(run, "checked_state"))
-        if exact:
-            p = run.take_partial()
+        native = (not ctx.batched and hasattr(run, "take_partial")
+                  and hasattr(run, "checked_state"))
+        p = run.take_partial() if native else None
+        if p is not None:
             hits = run.events_found() if ctx.ev is not None else ()
-            if p is not None:
-                extra = (p[0], p[1], hits)
-            elif hits:
-                extra = (np.zeros((1, 0, ctx.z0.shape[1])),
-                         None if ctx.att0 is None else np.zeros((1, 0, 3, 3)), hits)
+            extra = (p[0], p[1], hits)
             final = run.checked_state() + (run.steps_done, None)
         traj = ctx.trajectory(chunks, status=-1, extra=extra, final=final)
         err.partial = traj

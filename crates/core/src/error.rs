@@ -112,6 +112,34 @@ pub enum Error {
         /// Steps completed before the interruption.
         steps_done: usize,
     },
+    /// A function from outside lieflow (a binding's callable: a Python function) raised an
+    /// error of its own, carried unchanged in `payload` for the binding to raise again.
+    #[error("{what} raised an exception{}", if place.is_empty() { String::new() } else { format!(" {place}") })]
+    Raised {
+        /// The function, e.g. "the value of force `torque`".
+        what: String,
+        /// Where it was raised in a run ("in step 17 of gauss4 (t = …, dt = …)"), or empty.
+        place: String,
+        /// The error itself, opaque to lieflow.
+        payload: Payload,
+    },
+}
+
+/// The error of a foreign function inside an [`Error::Raised`]: opaque to lieflow, shared (an
+/// error is cloned as it is passed on), equal only to itself.
+#[derive(Clone)]
+pub struct Payload(pub std::sync::Arc<dyn std::any::Any + Send + Sync>);
+
+impl std::fmt::Debug for Payload {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Payload(..)")
+    }
+}
+
+impl PartialEq for Payload {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 /// A number for a message: the shortest round-trip form (`0.01`, `123.5`) where that is short,
@@ -163,7 +191,8 @@ impl Error {
             | Error::NoUniqueLog { what, .. }
             | Error::InvalidArgument { what, .. }
             | Error::NotConverged { what, .. }
-            | Error::LeftDomain { what, .. } => *what = f(what),
+            | Error::LeftDomain { what, .. }
+            | Error::Raised { what, .. } => *what = f(what),
             Error::UnsupportedMethod { .. } | Error::Interrupted { .. } => {}
         }
         self

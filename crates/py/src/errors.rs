@@ -140,9 +140,46 @@ pub fn argument_type_error(py: Python<'_>, msg: String) -> PyErr {
 /// language).
 const SPELLINGS: [(&str, &str); 1] = [("check_det = false", "check_det=False")];
 
-/// Converts a core error into the matching Python exception.
+/// A Python exception raised by the callable `what` as the core error that carries it
+/// ([`lieflow::Error::Raised`]): it travels with the run it ended and [`to_py`] raises it again.
+pub fn raised(what: impl Into<String>, e: PyErr) -> lieflow::Error {
+    lieflow::Error::Raised {
+        what: what.into(),
+        place: String::new(),
+        payload: lieflow::error::Payload(std::sync::Arc::new(e)),
+    }
+}
+
+/// `f()`, a native call outside a run that may call Python callables: the first failure a
+/// callable recorded on this thread meanwhile ([`lieflow::integrate::hooks`]) is raised in place
+/// of the core's result (the NaN it caused), else the result converted.
+pub fn checked<T>(f: impl FnOnce() -> lieflow::Result<T>) -> PyResult<T> {
+    use lieflow::integrate::hooks::take_failure;
+    let _ = take_failure();
+    let r = f();
+    match take_failure() {
+        Some(e) => Err(to_py(e)),
+        None => r.py(),
+    }
+}
+
+/// Converts a core error into the matching Python exception (a Python exception carried by
+/// [`lieflow::Error::Raised`] is raised again, with a note naming the step of the run it ended).
 pub fn to_py(e: lieflow::Error) -> PyErr {
     use lieflow::Error as E;
+    if let E::Raised { payload, place, .. } = &e {
+        if let Some(err) = payload.0.downcast_ref::<PyErr>() {
+            return Python::attach(|py| {
+                let err = err.clone_ref(py);
+                if !place.is_empty() {
+                    let note = format!("lieflow: raised {place}; the run stopped there");
+                    // add_note exists from Python 3.11 on.
+                    let _ = err.value(py).call_method1("add_note", (note,));
+                }
+                err
+            });
+        }
+    }
     let msg = SPELLINGS
         .iter()
         .fold(e.to_string(), |m, (rust, python)| m.replace(rust, python));
@@ -157,6 +194,7 @@ pub fn to_py(e: lieflow::Error) -> PyErr {
         E::NotConverged { .. } => ConvergenceError::new_err(msg),
         E::LeftDomain { .. } => LeftDomainError::new_err(msg),
         E::Interrupted { .. } => pyo3::exceptions::PyKeyboardInterrupt::new_err(msg),
+        E::Raised { .. } => pyo3::exceptions::PyRuntimeError::new_err(msg),
     }
 }
 

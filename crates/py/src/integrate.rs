@@ -13,36 +13,8 @@ use rayon::prelude::*;
 
 use crate::convert::{int, named, real, vector, Real};
 use crate::convert::{shape_str, ArrayIn};
-use crate::errors::{to_py, IntoPy};
+use crate::errors::{raised, to_py, IntoPy};
 use crate::items::{array, Out};
-
-/// Errors raised by Python callables that a system calls from native code (a callable
-/// potential or surface, a user system, a force): such a system runs on the calling thread with
-/// the GIL held, and the first error is re-raised afterwards by the run that met it.
-pub(crate) trait Callbacks: Send + Sync {
-    /// The first recorded exception, if any (and forget it).
-    fn take_error(&self) -> PyResult<()>;
-}
-
-/// Where native code that called Python keeps the first exception until it can be raised (the
-/// native side goes on with NaN, which stops the computation at the next check).
-#[derive(Default)]
-pub(crate) struct ErrorSlot(Mutex<Option<PyErr>>);
-
-impl ErrorSlot {
-    /// Keeps `e` unless an earlier error is waiting.
-    pub(crate) fn record(&self, e: PyErr) {
-        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
-        slot.get_or_insert(e);
-    }
-}
-
-impl Callbacks for ErrorSlot {
-    fn take_error(&self) -> PyResult<()> {
-        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
-        slot.take().map_or(Ok(()), Err)
-    }
-}
 
 /// The result of `System._run`: states (b, k, d), attitude (b, k, 3, 3) or None, final states
 /// (b, d), final attitude (b, 3, 3) or None.
@@ -78,7 +50,9 @@ pub struct Integration {
     #[pyo3(get)]
     method: String,
     sys: Arc<dyn System>,
-    callbacks: Option<Arc<dyn Callbacks>>,
+    /// The system calls Python callables (`Problem::calls_out`): its runs stay on the calling
+    /// thread, which holds the GIL, and an exception ends the run that raised it.
+    calls_out: bool,
     /// One run per member, in SIMD lanes where the method has them for the system.
     runs: Mutex<Batch>,
     pool: Option<rayon::ThreadPool>,
@@ -92,8 +66,6 @@ pub struct Integration {
     at: bool,
     /// The event functions (a single run only).
     events: Option<Mutex<Events<'static>>>,
-    /// The first exception raised by an event function, re-raised after the native call.
-    event_errors: Arc<ErrorSlot>,
     /// The states (full, flat) saved by the call that failed, before its error (one run only).
     partial: Option<Vec<f64>>,
 }
@@ -117,7 +89,6 @@ impl Integration {
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn start(
         sys: Arc<dyn System>,
-        callbacks: Option<Arc<dyn Callbacks>>,
         z0: &ArrayIn<'_>,
         attitude0: Option<&ArrayIn<'_>>,
         dt: f64,
@@ -128,6 +99,8 @@ impl Integration {
         steps: Option<i64>,
     ) -> PyResult<Self> {
         let save_every = count("save_every", save_every)?;
+        let calls_out = sys.calls_out();
+        let threads = if calls_out { Some(1) } else { threads };
         let method = match method {
             Some(m) => m,
             None => sys.methods().first().map_or("", |(name, _)| name),
@@ -201,7 +174,7 @@ impl Integration {
         // kept); a system that calls Python is set up on this thread, which holds the GIL.
         let start = || Batch::start(&*sys, method, &states, dt, save_every, t0);
         let runs = match &pool {
-            Some(p) if callbacks.is_none() => p.install(start),
+            Some(p) if !calls_out => p.install(start),
             _ => start(),
         }
         .map_err(|(i, e)| if b > 1 { e.in_member(i) } else { e })
@@ -209,7 +182,7 @@ impl Integration {
         Ok(Integration {
             method: method.to_string(),
             sys,
-            callbacks,
+            calls_out,
             runs: Mutex::new(runs),
             pool,
             d,
@@ -218,7 +191,6 @@ impl Integration {
             done: 0,
             at: false,
             events: None,
-            event_errors: Arc::new(ErrorSlot::default()),
             partial: None,
         })
     }
@@ -341,7 +313,7 @@ impl Integration {
         // Plain steps of a batch in SIMD lanes: the core's batch driver (groups of members in
         // parallel, the same results bit for bit as one run per member).
         let outs: Vec<(Vec<f64>, lieflow::Result<usize>)> = match until {
-            Until::Steps(n) if plain && self.callbacks.is_none() && batch.in_lanes() => {
+            Until::Steps(n) if plain && !self.calls_out && batch.in_lanes() => {
                 let mut outs = Vec::with_capacity(b);
                 for i in 0..b {
                     let mut out = Vec::new();
@@ -372,15 +344,13 @@ impl Integration {
             _ => {
                 let runs = batch.runs_mut().py()?;
                 match (events, runs.first_mut()) {
-                    (Some(ev), Some(run)) if self.callbacks.is_some() => {
+                    (Some(ev), Some(run)) if self.calls_out => {
                         vec![one(0, run, Some(ev))]
                     }
                     (Some(ev), Some(run)) => py.detach(|| vec![one(0, run, Some(ev))]),
-                    // A system that calls Python keeps its callables' exceptions in one slot for
-                    // all its runs; its runs stay on this thread with the GIL held (the
-                    // callables need it for the whole chunk anyway), so that the exception taken
-                    // below is this run's, never one of another thread's run of the same system.
-                    _ if self.callbacks.is_some() => runs
+                    // A system that calls Python runs on this thread with the GIL held (its
+                    // callables need it for the whole chunk anyway).
+                    _ if self.calls_out => runs
                         .iter_mut()
                         .enumerate()
                         .map(|(i, run)| one(i, run, None))
@@ -408,10 +378,6 @@ impl Integration {
                 }
             }
         }
-        if let Some(c) = &self.callbacks {
-            c.take_error()?;
-        }
-        self.event_errors.take_error()?;
         if let Some(e) = error {
             return Err(to_py(e));
         }
@@ -552,7 +518,6 @@ impl Integration {
             .zip(directions.into_iter().zip(terminal))
             .enumerate()
             .map(|(i, (f, (direction, terminal)))| {
-                let slot = self.event_errors.clone();
                 Event::new(move |t: f64, z: &[f64]| {
                     Python::attach(|py| {
                         let state = PyArray1::from_slice(py, &z[..d]);
@@ -560,10 +525,7 @@ impl Integration {
                             let what = format!("the value returned by events[{i}]");
                             named(&what, v.extract::<Real>()).map(|r| r.0)
                         });
-                        value.map_err(|e| {
-                            slot.record(e);
-                            Error::invalid("events", format!("event function {i} raised"))
-                        })
+                        value.map_err(|e| raised(format!("event function {i}"), e))
                     })
                 })
                 .direction(direction)
@@ -666,7 +628,7 @@ impl Integration {
         let mut batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
         let b = batch.len();
         let sys = &*self.sys;
-        let data: Vec<f64> = if self.callbacks.is_none() && batch.in_lanes() {
+        let data: Vec<f64> = if !self.calls_out && batch.in_lanes() {
             // Batches in lanes: read in parallel on the run's threads, GIL released.
             let batch = &mut *batch;
             let states = py.detach(|| match &self.pool {

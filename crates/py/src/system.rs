@@ -15,8 +15,8 @@ use pyo3::types::{PyCFunction, PyDict, PyList, PyTuple, PyType};
 
 use crate::convert::{int, int_opt, real};
 use crate::convert::{read_all, shape_str, ArrayIn};
-use crate::errors::{to_py, IntoPy};
-use crate::integrate::{Callbacks, Integration, RunOut};
+use crate::errors::{checked, to_py, IntoPy};
+use crate::integrate::{Integration, RunOut};
 use crate::items::{map_items, Input};
 
 /// Base class of every lieflow system (RigidBody, HeavyTop, PseudoRigidBody, …): the
@@ -31,7 +31,6 @@ pub struct PySystem {
     lifted: Option<Arc<dyn System>>,
     pub(crate) args: Py<PyTuple>,
     names: &'static [&'static str],
-    pub(crate) callbacks: Option<Arc<dyn Callbacks>>,
 }
 
 impl PySystem {
@@ -47,26 +46,7 @@ impl PySystem {
             sys: Arc::new(sys),
             args: args.unbind(),
             names,
-            callbacks: None,
         }
-    }
-
-    /// The same, for a system that calls Python callables.
-    pub(crate) fn with_callbacks(mut self, callbacks: Option<Arc<dyn Callbacks>>) -> Self {
-        self.callbacks = callbacks;
-        self
-    }
-
-    /// Re-raises the first exception of a Python callable, if any.
-    pub(crate) fn take_callback_error(&self) -> PyResult<()> {
-        self.callbacks.as_ref().map_or(Ok(()), |c| c.take_error())
-    }
-
-    /// The result of a core call that may have called Python: a callable's exception first,
-    /// then the core's error, converted.
-    pub(crate) fn checked<T>(&self, r: lieflow::Result<T>) -> PyResult<T> {
-        self.take_callback_error()?;
-        r.py()
     }
 
     /// The core system of a run: the lifted one when an attitude is given.
@@ -93,12 +73,13 @@ impl PySystem {
     ) -> PyResult<Bound<'py, PyAny>> {
         let d = [self.sys.space().dim()];
         let inputs = [Input::new("states", states, &d)];
-        let out = map_items(py, &inputs, out_item, |z, out| {
-            check::finite_slice("states", z[0])?;
-            f(z[0], out)
-        });
-        self.take_callback_error()?;
-        out
+        // A callable's exception (recorded on this thread) comes before the NaN it caused.
+        checked(|| {
+            Ok(map_items(py, &inputs, out_item, |z, out| {
+                check::finite_slice("states", z[0])?;
+                f(z[0], out)
+            }))
+        })?
     }
 }
 
@@ -276,16 +257,8 @@ impl PySystem {
         #[pyo3(from_py_with = int_opt)] steps: Option<i64>,
     ) -> PyResult<Integration> {
         let sys = self.runner(attitude0.is_some())?.clone();
-        let threads = if self.callbacks.is_some() {
-            Some(1)
-        } else {
-            threads
-        };
-        // A callable's exception (raised when the state is set and the first forces are
-        // evaluated) is raised in place of the core's error.
-        let run = Integration::start(
+        Integration::start(
             sys,
-            self.callbacks.clone(),
             &z0,
             attitude0.as_ref(),
             dt,
@@ -294,11 +267,7 @@ impl PySystem {
             t0,
             threads,
             steps,
-        );
-        if run.is_err() {
-            self.take_callback_error()?;
-        }
-        run
+        )
     }
 
     /// Integrates every row of `z0` by `steps` steps in one native run (see `_start`).

@@ -307,9 +307,8 @@ fn start_group<S: System + ?Sized>(
     };
     for (j, z) in chunk.iter().enumerate() {
         let placeholder = || Ok((Box::new(InBlock) as Box<dyn Stepper>, p));
-        let mut run =
-            Run::start(system, z, dt, save_every, t0, placeholder).map_err(|e| (first + j, e))?;
-        run.method = Some(method.to_string());
+        let run = Run::start(system, Some(method), z, dt, save_every, t0, placeholder)
+            .map_err(|e| (first + j, e))?;
         stepper.set(j, &run.buf).map_err(|e| (first + j, e))?;
         runs.push(run);
     }

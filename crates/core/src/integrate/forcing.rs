@@ -45,7 +45,6 @@
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::hooks::{Failure, FailureLog, Session};
 use super::method::{Catalog, Clock, Entry, Integrator, Properties, Stepper, System};
 // The fixed-point iterations of the implicit kicks stop by the Lie midpoint's rule.
 use super::methods::lie_midpoint::{MAX_ITER, STAGNATION_TOL};
@@ -254,6 +253,11 @@ impl Perturbation for Force {
         format!("force on {}", self.block)
     }
 
+    /// F is a user function.
+    fn calls_out(&self) -> bool {
+        true
+    }
+
     fn keeps_invariants(&self) -> bool {
         false
     }
@@ -432,6 +436,9 @@ impl<P: Problem> Problem for DoubleBracket<P> {
     fn name(&self) -> &'static str {
         self.problem.name()
     }
+    fn calls_out(&self) -> bool {
+        self.problem.calls_out()
+    }
     fn space(&self) -> Space {
         self.problem.space()
     }
@@ -501,8 +508,6 @@ impl<P: GroupField + VectorField + Clone + 'static> Perturbation for DoubleBrack
 pub struct Forced {
     base: Arc<dyn System>,
     terms: Vec<Arc<dyn Perturbation>>,
-    log: Arc<FailureLog>,
-    session: Option<Session>,
 }
 
 impl std::fmt::Debug for Forced {
@@ -521,21 +526,7 @@ impl Forced {
         Forced {
             base,
             terms: Vec::new(),
-            log: Arc::default(),
-            session: None,
         }
-    }
-
-    /// The same whose steppers run inside `session` (see [`Session`]; for forces that call an
-    /// interpreter).
-    pub fn with_session(mut self, session: Session) -> Self {
-        self.session = Some(session);
-        self
-    }
-
-    /// The first failure of a force function in its runs (where it happened).
-    pub fn failures(&self) -> Arc<FailureLog> {
-        self.log.clone()
     }
 
     /// The same with one more perturbation (applied inside the ones before it).
@@ -570,6 +561,9 @@ impl Forced {
 impl Problem for Forced {
     fn name(&self) -> &'static str {
         self.base.name()
+    }
+    fn calls_out(&self) -> bool {
+        self.base.calls_out() || self.terms.iter().any(|t| t.calls_out())
     }
     fn space(&self) -> Space {
         self.base.space()
@@ -628,7 +622,6 @@ impl Catalog for Forced {
                 out.push(Entry::new(
                     name,
                     Kicked {
-                        name,
                         base: name_of(name, suffix),
                         manifold: p.manifold,
                         invariants,
@@ -647,17 +640,12 @@ impl Catalog for Forced {
             .iter()
             .map(|t| t.lifted())
             .collect::<Option<Vec<_>>>()?;
-        Some(Forced {
-            base,
-            terms,
-            ..self.clone()
-        })
+        Some(Forced { base, terms })
     }
 }
 
 /// The method of [`Forced`]: the composition of the kicked step of the free method `base`.
 struct Kicked {
-    name: &'static str,
     base: &'static str,
     manifold: bool,
     invariants: bool,
@@ -720,9 +708,6 @@ impl Integrator<Forced> for Kicked {
             h: dt,
             z: vec![0.0; problem.space().dim()],
             set: false,
-            method: self.name,
-            log: problem.log.clone(),
-            session: problem.session.clone(),
         }))
     }
 }
@@ -737,32 +722,9 @@ struct KickedStepper {
     h: f64,
     z: Vec<f64>,
     set: bool,
-    method: &'static str,
-    log: Arc<FailureLog>,
-    session: Option<Session>,
 }
 
 impl KickedStepper {
-    /// The error of a term in the step after `c`, located (a failure of a force function is
-    /// also kept in the log; the clock's own errors already name the step).
-    fn failed(&self, e: Error, c: Clock) -> Error {
-        match e {
-            Error::NotConverged { .. } | Error::LeftDomain { .. } => e,
-            error => {
-                let f = Failure {
-                    error,
-                    method: self.method,
-                    step: c.done + 1,
-                    t: c.time(1),
-                    dt: self.h,
-                };
-                let out = f.located();
-                self.log.record(f);
-                out
-            }
-        }
-    }
-
     fn run(&mut self, steps: usize, clock: Clock) -> Result<()> {
         for k in 0..steps {
             let c = Clock {
@@ -772,20 +734,16 @@ impl KickedStepper {
             let mut t = clock.time(k);
             for s in 0..self.stages.len() {
                 let i = self.stages[s];
-                for j in 0..self.kicks[i].len() {
-                    if let Err(e) = self.kicks[i][j].apply(t, &mut self.z, c) {
-                        return Err(self.failed(e, c));
-                    }
+                for kick in self.kicks[i].iter_mut() {
+                    kick.apply(t, &mut self.z, c)?;
                 }
                 let free = &mut self.free[i];
                 free.set(&self.z)?;
                 free.advance(1, c)?;
                 free.get(&mut self.z);
                 t += self.sizes[i] * self.h;
-                for j in (0..self.kicks[i].len()).rev() {
-                    if let Err(e) = self.kicks[i][j].apply(t, &mut self.z, c) {
-                        return Err(self.failed(e, c));
-                    }
+                for kick in self.kicks[i].iter_mut().rev() {
+                    kick.apply(t, &mut self.z, c)?;
                 }
             }
         }
@@ -810,13 +768,6 @@ impl Stepper for KickedStepper {
         if !self.set {
             return Ok(());
         }
-        match self.session.clone() {
-            None => self.run(steps, clock),
-            Some(session) => {
-                let mut out = None;
-                session(&mut || out = Some(self.run(steps, clock)));
-                out.unwrap_or_else(|| self.run(steps, clock))
-            }
-        }
+        self.run(steps, clock)
     }
 }

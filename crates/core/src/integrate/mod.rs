@@ -260,8 +260,11 @@ pub struct Run {
     next: Vec<f64>,
     /// Scratch: a state in the user frame.
     user: Vec<f64>,
-    /// The method's name (a run of a catalogued system), for shortened steps.
+    /// The method's name (a run of a catalogued system), for shortened steps and errors.
     method: Option<String>,
+    /// The problem calls functions from outside lieflow ([`Problem::calls_out`]): one step per
+    /// call of the stepper, a failure ends the run at its step, no step is taken twice.
+    single: bool,
     at: Option<Outputs>,
     /// The time at which the run ended between grid times (a terminal event, [`Until::Time`]).
     ended: Option<f64>,
@@ -282,11 +285,9 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        let mut run = Run::start(system, z0, dt, save_every, t0, || {
+        Run::start(system, Some(method), z0, dt, save_every, t0, || {
             system.stepper(method, dt)
-        })?;
-        run.method = Some(method.to_string());
-        Ok(run)
+        })
     }
 
     /// Starts a run of `problem` with a method value (see [`Run::new`]).
@@ -298,7 +299,7 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        Run::start(problem, z0, dt, save_every, t0, || {
+        Run::start(problem, None, z0, dt, save_every, t0, || {
             Ok((method.stepper(problem, dt)?, method.properties()))
         })
     }
@@ -306,6 +307,7 @@ impl Run {
     /// Validates the arguments and the state once, then builds the stepper and sets its state.
     fn start<P: Problem + ?Sized>(
         problem: &P,
+        method: Option<&str>,
         z0: &[f64],
         dt: f64,
         save_every: usize,
@@ -314,23 +316,64 @@ impl Run {
     ) -> Result<Run> {
         check_run(dt, save_every, t0)?;
         check_state(problem, z0)?;
-        let (mut stepper, properties) = stepper()?;
+        // A failure recorded on this thread that no caller took belongs to no run.
+        let _ = hooks::take_failure();
+        let (stepper, properties) = stepper()?;
         let space = problem.space();
         let mut buf = z0.to_vec();
         problem.to_internal(&mut buf);
-        stepper.set(&buf)?;
-        Ok(Run {
+        let mut run = Run {
             stepper,
             retract: (properties.manifold && space.is_curved()).then_some(space),
             save_every: save_every as u64,
             clock: Clock { t0, dt, done: 0 },
             next: buf.clone(),
             user: buf.clone(),
-            buf,
-            method: None,
+            method: method.map(str::to_string),
+            single: problem.calls_out(),
             at: None,
             ended: None,
-        })
+            buf,
+        };
+        let r = run.stepper.set(&run.buf);
+        run.failed(r, 0)?;
+        Ok(run)
+    }
+
+    /// `r`, with a failure a foreign function recorded meanwhile ([`hooks`]) in its place, located
+    /// at step `step` (0: the initial state) in a run that steps one step at a time.
+    fn failed<T>(&self, r: Result<T>, step: u64) -> Result<T> {
+        self.failed_at(r, step, self.clock.t0 + step as f64 * self.clock.dt)
+    }
+
+    /// [`Run::failed`] for a step that ends at time `t` (a shortened step).
+    fn failed_at<T>(&self, r: Result<T>, step: u64, t: f64) -> Result<T> {
+        let e = match (hooks::take_failure(), r) {
+            (Some(e), _) => e,
+            (None, Ok(v)) => return Ok(v),
+            (None, Err(e)) if self.single => e,
+            (None, Err(e)) => return Err(e),
+        };
+        if !self.single {
+            // A function of a problem that does not declare it ([`Problem::calls_out`]): its
+            // step is not known, and no step is taken again.
+            return Err(e);
+        }
+        let f = hooks::Failure {
+            error: e,
+            method: self.method.clone().unwrap_or_else(|| "the method".into()),
+            step,
+            t,
+            dt: self.clock.dt,
+        };
+        Err(f.located())
+    }
+
+    /// Sets the stepper back to the checked state after an error (whatever that costs: the run
+    /// is over; a failure it records is dropped).
+    fn reset(&mut self) {
+        let _ = self.stepper.set(&self.buf);
+        let _ = hooks::take_failure();
     }
 
     /// Steps done so far on the grid (after an error: the steps that passed the checks).
@@ -581,13 +624,17 @@ impl Run {
         end: u64,
         out: &mut Vec<f64>,
     ) -> Result<()> {
+        if self.single {
+            return self.single_steps(problem, n, end, out);
+        }
         let done = self.clock.done;
         let stop = done + n;
         // The one finiteness guard of every method and system: after each chunk (at most
         // RETRACT_EVERY or save_every steps), before the state is retracted, saved or handed on,
         // so a NaN/inf is reported with the step that made it and never passed on as the next
         // chunk's input.
-        let mut r = self.stepper.advance(n as usize, self.clock);
+        let r = self.stepper.advance(n as usize, self.clock);
+        let mut r = self.failed(r, 0);
         if r.is_ok() {
             self.stepper.get(&mut self.next);
             if let Err(e) = check::finite_slice("state", &self.next) {
@@ -596,10 +643,34 @@ impl Run {
         }
         match r {
             Ok(()) => std::mem::swap(&mut self.buf, &mut self.next),
+            Err(e @ Error::Raised { .. }) => return Err(e),
             Err(e) if n > 1 => self.replay(problem, n, e)?,
             Err(e) => return Err(e),
         }
         self.commit(problem, done, stop, end, out)
+    }
+
+    /// [`Run::steps`] of a problem that calls out: one step at a time, each checked and
+    /// committed; the first failure ends the run with the checked state before its step.
+    fn single_steps<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        n: u64,
+        end: u64,
+        out: &mut Vec<f64>,
+    ) -> Result<()> {
+        for _ in 0..n {
+            let done = self.clock.done;
+            let r = self.stepper.advance(1, self.clock);
+            self.failed(r, done + 1)?;
+            self.stepper.get(&mut self.next);
+            if let Err(e) = check::finite_slice("state", &self.next) {
+                return Err(self.non_finite(problem.name(), done, done + 1, e));
+            }
+            std::mem::swap(&mut self.buf, &mut self.next);
+            self.commit(problem, done, done + 1, end, out)?;
+        }
+        Ok(())
     }
 
     /// After the error `first` in `n` steps from the checked state: the same steps one at a
@@ -643,7 +714,8 @@ impl Run {
         out: &mut Vec<f64>,
     ) -> Result<()> {
         if self.retract_at(stop) {
-            self.stepper.set(&self.buf)?;
+            let r = self.stepper.set(&self.buf);
+            self.failed(r, stop)?;
         }
         self.save(problem, from, stop, end, out)
     }
@@ -702,7 +774,8 @@ impl Run {
         let t_j = self.clock.time(0);
         let t_next = match finish {
             None => {
-                let mut r = self.stepper.advance(1, self.clock);
+                let r = self.stepper.advance(1, self.clock);
+                let mut r = self.failed(r, j + 1);
                 if r.is_ok() {
                     self.stepper.get(&mut self.next);
                     if let Err(e) = check::finite_slice("state", &self.next) {
@@ -723,7 +796,7 @@ impl Run {
         let stop = match self.events_in_step(problem, make, t_j, t_next, events) {
             Ok(stop) => stop.or_else(|| finish.map(|t| (t, self.next.clone()))),
             Err(e) => {
-                let _ = self.stepper.set(&self.buf);
+                self.reset();
                 return Err(e);
             }
         };
@@ -731,10 +804,11 @@ impl Run {
             let mut user = z.clone();
             problem.to_user(&mut user);
             if let Err(e) = self.emit_before(problem, make, t_end, Some(&user), out) {
-                let _ = self.stepper.set(&self.buf);
+                self.reset();
                 return Err(e);
             }
-            self.stepper.set(&z)?;
+            let r = self.stepper.set(&z);
+            self.failed(r, j + 1)?;
             self.buf.copy_from_slice(&z);
             self.ended = Some(t_end);
             if self.at.is_none() {
@@ -744,7 +818,7 @@ impl Run {
             return Ok(());
         }
         if let Err(e) = self.emit_before(problem, make, t_next, None, out) {
-            let _ = self.stepper.set(&self.buf);
+            self.reset();
             return Err(e);
         }
         std::mem::swap(&mut self.buf, &mut self.next);
@@ -919,14 +993,16 @@ impl Run {
         let j = self.clock.done;
         let t_j = self.clock.time(0);
         let mut stepper = make(h)?;
-        stepper.set(&self.buf)?;
+        let r = stepper.set(&self.buf);
+        self.failed_at(r, j + 1, t_j + h)?;
         // A clock whose step j + 1 ends at t_j + h (errors name that step and time).
         let clock = Clock {
             t0: t_j - j as f64 * h,
             dt: h,
             done: j,
         };
-        stepper.advance(1, clock)?;
+        let r = stepper.advance(1, clock);
+        self.failed_at(r, j + 1, t_j + h)?;
         let mut z = self.buf.clone();
         stepper.get(&mut z);
         if let Err(e) = check::finite_slice("state", &z) {

@@ -56,6 +56,13 @@ pub trait Problem: Send + Sync {
 
     /// Inverse of [`Problem::to_internal`].
     fn to_user(&self, _z: &mut [f64]) {}
+
+    /// Whether the kernels call functions from outside lieflow (user closures, a binding's
+    /// callables), which may fail or have side effects: a run then steps one step at a time and
+    /// ends at the first failure without taking any step again ([`super::hooks`]).
+    fn calls_out(&self) -> bool {
+        false
+    }
 }
 
 /// An ordinary differential equation ż = f(z) (internal frame).
@@ -275,6 +282,11 @@ pub trait Perturbation: Send + Sync {
 
     /// Whether its flow keeps the free system's [`Problem::invariants`] (Casimirs).
     fn keeps_invariants(&self) -> bool;
+
+    /// Whether it calls a function from outside lieflow ([`Problem::calls_out`]).
+    fn calls_out(&self) -> bool {
+        false
+    }
 
     /// The same term for the free system carrying its attitude, or `None` where it does not
     /// apply there.

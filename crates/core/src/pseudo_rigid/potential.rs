@@ -112,6 +112,12 @@ pub trait Potential: Send + Sync + Debug {
         false
     }
 
+    /// Whether U is given by functions from outside lieflow (a binding's callables), which a
+    /// body with this potential then calls ([`crate::integrate::Problem::calls_out`]).
+    fn calls_out(&self) -> bool {
+        false
+    }
+
     /// Fixed-size fast path for n = 3: ∂U/∂X at a 3×3 X, or `None` if the potential has none
     /// (callers then use [`Potential::add_gradient`]). Must equal `add_gradient` (tested); lets
     /// the n = 3 Verlet loop run on stack matrices.
@@ -699,6 +705,9 @@ impl Potential for Sum {
     }
     fn needs_positive_det(&self) -> bool {
         self.terms.iter().any(|t| t.needs_positive_det())
+    }
+    fn calls_out(&self) -> bool {
+        self.terms.iter().any(|t| t.calls_out())
     }
     fn dimension(&self) -> Option<usize> {
         let mut dim = None;

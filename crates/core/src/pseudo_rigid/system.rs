@@ -236,6 +236,9 @@ fn write_back(n: usize, x: &Mat, p: &Mat, z: &mut [f64]) {
 }
 
 impl Problem for PseudoRigidBody {
+    fn calls_out(&self) -> bool {
+        self.body.potential().calls_out()
+    }
     fn name(&self) -> &'static str {
         "PseudoRigidBody"
     }

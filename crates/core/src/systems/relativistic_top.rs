@@ -613,6 +613,9 @@ fn gradient_of(sol: Option<(Vector3<f64>, Derivs)>, hq: &mut [f64], hp: &mut [f6
 }
 
 impl Problem for RelativisticTangentTop {
+    fn calls_out(&self) -> bool {
+        self.surface.as_ref().is_some_and(|s| s.calls_out())
+    }
     fn name(&self) -> &'static str {
         "RelativisticTangentTop"
     }
@@ -1018,6 +1021,9 @@ fn outside_potential(q: [f64; 3]) -> Error {
 }
 
 impl Problem for WeakFieldTop {
+    fn calls_out(&self) -> bool {
+        matches!(self.potential.kind, PotentialKind::Custom(_))
+    }
     fn name(&self) -> &'static str {
         "WeakFieldTop"
     }

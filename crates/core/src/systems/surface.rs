@@ -113,6 +113,12 @@ pub trait Surface: Send + Sync + fmt::Debug {
     /// The metric g_ij(x).
     fn metric(&self, x: Vec2) -> Mat2;
 
+    /// Whether the surface is given by functions from outside lieflow (closures of a user or
+    /// of a binding), which a system on it then calls ([`crate::integrate::Problem::calls_out`]).
+    fn calls_out(&self) -> bool {
+        false
+    }
+
     /// `[k][i][j]` = ∂_k g_ij(x).
     fn metric_derivatives(&self, x: Vec2) -> [Mat2; 2];
 
@@ -496,6 +502,8 @@ pub struct Revolution {
     r: Profile,
     z: Profile,
     range: (f64, f64),
+    /// Made by [`Revolution::new`] from the caller's functions.
+    user: bool,
 }
 
 impl fmt::Debug for Revolution {
@@ -514,6 +522,18 @@ impl Revolution {
         z: impl Fn(f64) -> [f64; 4] + Send + Sync + 'static,
         range: (f64, f64),
     ) -> Result<Self> {
+        Ok(Revolution {
+            user: true,
+            ..Revolution::built_in(r, z, range)?
+        })
+    }
+
+    /// [`Revolution::new`] for the profiles of lieflow's own surfaces.
+    fn built_in(
+        r: impl Fn(f64) -> [f64; 4] + Send + Sync + 'static,
+        z: impl Fn(f64) -> [f64; 4] + Send + Sync + 'static,
+        range: (f64, f64),
+    ) -> Result<Self> {
         check::finite_slice("range", &[range.0, range.1])?;
         if range.0 >= range.1 {
             return Err(Error::invalid(
@@ -525,6 +545,7 @@ impl Revolution {
             r: Arc::new(r),
             z: Arc::new(z),
             range,
+            user: false,
         })
     }
 
@@ -532,7 +553,7 @@ impl Revolution {
     pub fn sphere(radius: f64) -> Result<Self> {
         check::positive("radius", radius)?;
         let rr = radius;
-        Revolution::new(
+        Revolution::built_in(
             move |s| {
                 let (sn, cs) = s.sin_cos();
                 [rr * sn, rr * cs, -rr * sn, -rr * cs]
@@ -556,7 +577,7 @@ impl Revolution {
                 format!("a torus needs b < a, got a = {a}, b = {b}"),
             ));
         }
-        Revolution::new(
+        Revolution::built_in(
             move |s| {
                 let (sn, cs) = s.sin_cos();
                 [a + b * cs, -b * sn, -b * cs, b * sn]
@@ -580,6 +601,9 @@ impl Revolution {
 impl Surface for Revolution {
     fn name(&self) -> &'static str {
         "Revolution"
+    }
+    fn calls_out(&self) -> bool {
+        self.user
     }
     fn domain(&self) -> &'static str {
         "s_min < s < s_max with r(s) > 0 and a regular profile"
@@ -743,6 +767,8 @@ impl Jet {
 #[derive(Clone)]
 pub struct Graph {
     jet: Arc<dyn Fn(Vec2) -> Jet + Send + Sync>,
+    /// Made by [`Graph::new`] from the caller's function.
+    user: bool,
 }
 
 impl fmt::Debug for Graph {
@@ -764,19 +790,25 @@ struct GraphLocal {
 impl Graph {
     /// The graph of f given by its jet (module docs of [`Graph`]).
     pub fn new(jet: impl Fn(Vec2) -> Jet + Send + Sync + 'static) -> Self {
-        Graph { jet: Arc::new(jet) }
+        Graph {
+            jet: Arc::new(jet),
+            user: true,
+        }
     }
 
     /// The quadric z = (a x² + b y²)/2: a paraboloid for ab > 0, a saddle for ab < 0, a cylinder
     /// when one is zero. Errors: a non-finite coefficient.
     pub fn quadric(a: f64, b: f64) -> Result<Self> {
         check::finite_slice("a and b", &[a, b])?;
-        Ok(Graph::new(move |x| Jet {
-            value: 0.5 * (a * x[0] * x[0] + b * x[1] * x[1]),
-            gradient: [a * x[0], b * x[1]],
-            hessian: [[a, 0.0], [0.0, b]],
-            third: [0.0; 4],
-        }))
+        Ok(Graph {
+            user: false,
+            ..Graph::new(move |x| Jet {
+                value: 0.5 * (a * x[0] * x[0] + b * x[1] * x[1]),
+                gradient: [a * x[0], b * x[1]],
+                hessian: [[a, 0.0], [0.0, b]],
+                third: [0.0; 4],
+            })
+        })
     }
 
     fn local(&self, x: Vec2) -> GraphLocal {
@@ -811,6 +843,9 @@ impl Graph {
 impl Surface for Graph {
     fn name(&self) -> &'static str {
         "Graph"
+    }
+    fn calls_out(&self) -> bool {
+        self.user
     }
     fn domain(&self) -> &'static str {
         "the points where f and its derivatives are finite"
@@ -1045,6 +1080,9 @@ pub fn inner(g: &Mat2, u: Vec2, v: Vec2) -> f64 {
 impl Surface for MetricSurface {
     fn name(&self) -> &'static str {
         "MetricSurface"
+    }
+    fn calls_out(&self) -> bool {
+        true
     }
     fn domain(&self) -> &'static str {
         "the given domain, where g is positive definite"

@@ -322,6 +322,9 @@ impl TangentTop {
 }
 
 impl Problem for TangentTop {
+    fn calls_out(&self) -> bool {
+        self.surface.calls_out()
+    }
     fn name(&self) -> &'static str {
         "TangentTop"
     }
@@ -555,6 +558,9 @@ impl ChargedParticle {
 }
 
 impl Problem for ChargedParticle {
+    fn calls_out(&self) -> bool {
+        self.top.calls_out()
+    }
     fn name(&self) -> &'static str {
         "ChargedParticle"
     }

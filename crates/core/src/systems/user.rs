@@ -49,15 +49,12 @@
 //! map; it is not offered here. RK4 is the non-geometric baseline.
 //!
 //! **Failures of user functions.** The functions return [`Result`]; a kernel that cannot return
-//! an error (the problem kinds' kernels do not) records the first error, hands NaN to the method,
-//! and every method of these systems is wrapped so that it advances one step at a time and stops
-//! after the step in which a function failed, with that function's error located ("in step k of
-//! gauss4, t = …, dt = …"). The error is also kept in the system's [`FailureLog`], which the
-//! Python bindings read to name the step on the exception a Python callable raised. Values are
-//! checked: a non-finite H or gradient entry is [`Error::NonFinite`] naming the entry.
-//! Evaluation of H outside the kernels ([`Problem::energy`], the Casimirs) returns the error.
-//! A binding may give the system a [`Session`], entered once around every call of a stepper (the
-//! Python bindings hold the GIL there, for a chunk of steps, instead of taking it per call).
+//! an error (the problem kinds' kernels do not) records it ([`hooks::fail`]) and hands NaN to the
+//! method. These systems [call out](Problem::calls_out), so a run steps them one step at a time
+//! and ends after the step in which a function failed, with that function's error located ("in
+//! step k of gauss4, t = …, dt = …"), never taking a step twice. Values are checked: a
+//! non-finite H or gradient entry is [`Error::NonFinite`] naming the entry. Evaluation of H
+//! outside the kernels ([`Problem::energy`], the Casimirs) returns the error.
 //!
 //! **Finite differences** (a function given without its gradient): each derivative is a central
 //! difference with one Richardson extrapolation ([`crate::analysis`]'s Jacobian, four
@@ -70,16 +67,14 @@
 //! where long runs or non-smooth scales matter.
 
 use std::fmt;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use nalgebra::{Vector3, Vector6};
 
 use super::rigid_body::{GeneralizedRigidBody, SoScratch};
 use crate::check;
 use crate::error::{fmt_num, Error, Result};
-pub use crate::integrate::hooks::{Failure, FailureLog, Session};
-use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
+use crate::integrate::hooks;
 use crate::integrate::methods::{canonical_catalog, Composition, LieMidpoint, Rk4, Rkmk4, Verlet};
 use crate::integrate::problem::{Canonical, GroupField, Separable, VectorField, Violation};
 use crate::integrate::space::{Block, Space};
@@ -100,199 +95,6 @@ pub type GradientFn = Arc<dyn Fn(&[f64], &mut [f64]) -> Result<()> + Send + Sync
 /// The base step of the finite differences, ε^{1/5} ≈ 7.4e-4 (the step that balances the O(h⁴)
 /// truncation of the Richardson-extrapolated central difference against its O(ε/h) round-off).
 pub const FD_STEP: f64 = 7.4e-4;
-
-// ---------------------------------------------------------------------------------------------
-// failures of user functions
-
-/// The first error of a user function in a kernel (which cannot return it), per stepper.
-#[derive(Debug, Default)]
-struct Fault {
-    failed: AtomicBool,
-    first: Mutex<Option<Error>>,
-}
-
-impl Fault {
-    fn record(&self, e: Error) {
-        let mut slot = self.first.lock().unwrap_or_else(|p| p.into_inner());
-        if slot.is_none() {
-            *slot = Some(e);
-        }
-        self.failed.store(true, Ordering::Release);
-    }
-
-    fn take(&self) -> Option<Error> {
-        if !self.failed.swap(false, Ordering::AcqRel) {
-            return None;
-        }
-        self.first.lock().unwrap_or_else(|p| p.into_inner()).take()
-    }
-}
-
-/// The fault of one stepper, the log and the session of the system (opaque).
-#[derive(Clone, Default)]
-pub struct Hooks {
-    fault: Arc<Fault>,
-    log: Arc<FailureLog>,
-    session: Option<Session>,
-}
-
-impl fmt::Debug for Hooks {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Hooks")
-            .field("fault", &self.fault)
-            .field("log", &self.log)
-            .field("session", &self.session.is_some())
-            .finish()
-    }
-}
-
-impl Hooks {
-    /// The same log with a fault of its own (one per stepper: members of a parallel batch do
-    /// not see each other's failures).
-    fn fresh(&self) -> Hooks {
-        Hooks {
-            fault: Arc::new(Fault::default()),
-            log: self.log.clone(),
-            session: self.session.clone(),
-        }
-    }
-
-    /// `f()` inside the session, if any.
-    fn within<T>(&self, f: impl FnOnce() -> T) -> T {
-        match &self.session {
-            None => f(),
-            Some(s) => {
-                let mut f = Some(f);
-                let mut out = None;
-                s(&mut || out = f.take().map(|f| f()));
-                // A session must call its argument; if it did not, call it here.
-                out.unwrap_or_else(|| f.take().map(|f| f()).expect("called once"))
-            }
-        }
-    }
-
-    /// Records `e` and returns `fill` (the kernel's stand-in value).
-    fn fail<T>(&self, e: Error, fill: T) -> T {
-        self.fault.record(e);
-        fill
-    }
-}
-
-/// The user systems: the hooks through which their kernels report failures, and the session
-/// their steppers run in.
-pub trait Hooked: Problem + Clone + 'static {
-    /// The hooks.
-    fn hooks(&self) -> &Hooks;
-
-    /// The same system with other hooks.
-    fn with_hooks(&self, hooks: Hooks) -> Self;
-
-    /// The log of the first failure of the functions in a run (see [`Failure`]).
-    fn failures(&self) -> Arc<FailureLog> {
-        self.hooks().log.clone()
-    }
-
-    /// The same system whose steppers run inside `session` (see [`Session`]).
-    fn with_session(&self, session: Session) -> Self {
-        let mut hooks = self.hooks().clone();
-        hooks.session = Some(session);
-        self.with_hooks(hooks)
-    }
-}
-
-/// A method of a user system, advanced one step at a time so that a failure of a user function
-/// stops the run after the step in which it happened, with the step named.
-struct Guard<P: ?Sized> {
-    name: &'static str,
-    method: Box<dyn Integrator<P>>,
-}
-
-fn guarded<P: Hooked>(entries: Vec<Entry<P>>) -> Vec<Entry<P>> {
-    entries
-        .into_iter()
-        .map(|e| Entry {
-            name: e.name,
-            method: Box::new(Guard {
-                name: e.name,
-                method: e.method,
-            }),
-        })
-        .collect()
-}
-
-impl<P: Hooked> Integrator<P> for Guard<P> {
-    fn properties(&self) -> Properties {
-        self.method.properties()
-    }
-
-    fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
-        let hooks = problem.hooks().fresh();
-        let inner = self
-            .method
-            .stepper(&problem.with_hooks(hooks.clone()), dt)?;
-        Ok(Box::new(GuardStepper {
-            inner,
-            hooks,
-            method: self.name,
-            dt,
-        }))
-    }
-}
-
-struct GuardStepper {
-    inner: Box<dyn Stepper>,
-    hooks: Hooks,
-    method: &'static str,
-    dt: f64,
-}
-
-impl GuardStepper {
-    fn failed(&self, error: Error, step: u64, t: f64) -> Error {
-        let f = Failure {
-            error,
-            method: self.method,
-            step,
-            t,
-            dt: self.dt,
-        };
-        let e = f.located();
-        self.hooks.log.record(f);
-        e
-    }
-}
-
-impl Stepper for GuardStepper {
-    fn set(&mut self, z: &[f64]) -> Result<()> {
-        let hooks = self.hooks.clone();
-        let r = hooks.within(|| self.inner.set(z));
-        match self.hooks.fault.take() {
-            Some(e) => Err(self.failed(e, 0, f64::NAN)),
-            None => r,
-        }
-    }
-
-    fn get(&self, z: &mut [f64]) {
-        self.inner.get(z)
-    }
-
-    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
-        let hooks = self.hooks.clone();
-        hooks.within(|| {
-            for k in 0..steps {
-                let c = Clock {
-                    done: clock.done + k as u64,
-                    ..clock
-                };
-                let r = self.inner.advance(1, c);
-                if let Some(e) = self.hooks.fault.take() {
-                    return Err(self.failed(e, c.done + 1, c.time(1)));
-                }
-                r?;
-            }
-            Ok(())
-        })
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // value checks and finite differences
@@ -348,7 +150,6 @@ pub struct UserCanonical {
     dof: usize,
     h: CanonicalFn,
     gradient: Option<CanonicalGradientFn>,
-    hooks: Hooks,
 }
 
 impl fmt::Debug for UserCanonical {
@@ -364,12 +165,7 @@ impl UserCanonical {
     /// H with `dof` ≥ 1 degrees of freedom and its gradient, or `None` for finite differences.
     pub fn new(dof: usize, h: CanonicalFn, gradient: Option<CanonicalGradientFn>) -> Result<Self> {
         check_dof("dof", dof)?;
-        Ok(UserCanonical {
-            dof,
-            h,
-            gradient,
-            hooks: Hooks::default(),
-        })
+        Ok(UserCanonical { dof, h, gradient })
     }
 
     /// Whether the gradient is computed by finite differences.
@@ -422,6 +218,10 @@ fn qp_space(d: usize) -> Space {
 }
 
 impl Problem for UserCanonical {
+    /// H (or U) is a user function.
+    fn calls_out(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "Canonical"
     }
@@ -446,14 +246,14 @@ impl Canonical for UserCanonical {
         self.dof
     }
     fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
-        self.value(q, p)
-            .unwrap_or_else(|e| self.hooks.fail(e, f64::NAN))
+        let mut h = f64::NAN;
+        hooks::call(|| self.value(q, p).map(|v| h = v));
+        h
     }
     fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
-        if let Err(e) = self.eval_gradient(q, p, hq, hp) {
+        if !hooks::call(|| self.eval_gradient(q, p, hq, hp)) {
             hq.fill(f64::NAN);
             hp.fill(f64::NAN);
-            self.hooks.fail(e, ());
         }
     }
 }
@@ -468,21 +268,9 @@ impl VectorField for UserCanonical {
     }
 }
 
-impl Hooked for UserCanonical {
-    fn hooks(&self) -> &Hooks {
-        &self.hooks
-    }
-    fn with_hooks(&self, hooks: Hooks) -> Self {
-        UserCanonical {
-            hooks,
-            ..self.clone()
-        }
-    }
-}
-
 impl Catalog for UserCanonical {
     fn catalog(&self) -> Vec<Entry<Self>> {
-        guarded(canonical_catalog())
+        canonical_catalog()
     }
 
     fn dissipation(
@@ -562,7 +350,6 @@ pub struct UserSeparable {
     inverse: Arc<InverseMass>,
     u: ScalarFn,
     gradient: Option<GradientFn>,
-    hooks: Hooks,
 }
 
 impl fmt::Debug for UserSeparable {
@@ -635,7 +422,6 @@ impl UserSeparable {
             inverse: Arc::new(inverse),
             u,
             gradient,
-            hooks: Hooks::default(),
         })
     }
 
@@ -717,6 +503,10 @@ fn spd_inverse(what: &str, m: &Mat) -> Result<Vec<f64>> {
 }
 
 impl Problem for UserSeparable {
+    /// H (or U) is a user function.
+    fn calls_out(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "Separable"
     }
@@ -750,20 +540,15 @@ impl Separable for UserSeparable {
     /// f = −∇U(q); a failure of the functions is recorded (the method's step then stops the run)
     /// and reported as a violation.
     fn force(&self, q: &[f64], f: &mut [f64], _s: &mut ()) -> std::result::Result<(), Violation> {
-        match self.potential_gradient(q, f) {
-            Ok(()) => {
-                f.iter_mut().for_each(|x| *x = -*x);
-                Ok(())
-            }
-            Err(e) => {
-                let message = e.to_string();
-                f.fill(f64::NAN);
-                self.hooks.fail(e, ());
-                Err(Violation {
-                    what: "the gradient of U".into(),
-                    message,
-                })
-            }
+        if hooks::call(|| self.potential_gradient(q, f)) {
+            f.iter_mut().for_each(|x| *x = -*x);
+            Ok(())
+        } else {
+            f.fill(f64::NAN);
+            Err(Violation {
+                what: "the gradient of U".into(),
+                message: "the function failed".into(),
+            })
         }
     }
 }
@@ -773,16 +558,14 @@ impl Canonical for UserSeparable {
         self.dof
     }
     fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
-        match self.potential(q) {
-            Ok(u) => u + self.inverse.kinetic(p),
-            Err(e) => self.hooks.fail(e, f64::NAN),
-        }
+        let mut u = f64::NAN;
+        hooks::call(|| self.potential(q).map(|v| u = v));
+        u + self.inverse.kinetic(p)
     }
     fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
         self.inverse.apply(p, hp);
-        if let Err(e) = self.potential_gradient(q, hq) {
+        if !hooks::call(|| self.potential_gradient(q, hq)) {
             hq.fill(f64::NAN);
-            self.hooks.fail(e, ());
         }
     }
 }
@@ -797,18 +580,6 @@ impl VectorField for UserSeparable {
     }
 }
 
-impl Hooked for UserSeparable {
-    fn hooks(&self) -> &Hooks {
-        &self.hooks
-    }
-    fn with_hooks(&self, hooks: Hooks) -> Self {
-        UserSeparable {
-            hooks,
-            ..self.clone()
-        }
-    }
-}
-
 impl Catalog for UserSeparable {
     /// verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
     fn catalog(&self) -> Vec<Entry<Self>> {
@@ -818,7 +589,7 @@ impl Catalog for UserSeparable {
             Entry::new("verlet6", Verlet(Composition::yoshida6())),
         ];
         entries.extend(canonical_catalog());
-        guarded(entries)
+        entries
     }
 
     fn dissipation(
@@ -1133,7 +904,6 @@ pub struct LiePoisson {
     casimirs: Option<Vec<ScalarFn>>,
     /// The so(n) kernels (of a generalized rigid body; only its group action is used).
     so_kernels: Option<GeneralizedRigidBody>,
-    hooks: Hooks,
 }
 
 impl fmt::Debug for LiePoisson {
@@ -1197,7 +967,6 @@ impl LiePoisson {
             hamiltonian,
             casimirs,
             so_kernels,
-            hooks: Hooks::default(),
         })
     }
 
@@ -1255,9 +1024,8 @@ impl LiePoisson {
 
     /// ∇H(μ) for a kernel: on failure NaN and the error recorded.
     fn kernel_gradient(&self, mu: &[f64], out: &mut [f64]) {
-        if let Err(e) = self.eval_gradient(mu, out) {
+        if !hooks::call(|| self.eval_gradient(mu, out)) {
             out.fill(f64::NAN);
-            self.hooks.fail(e, ());
         }
     }
 
@@ -1358,6 +1126,10 @@ pub struct LieScratch {
 }
 
 impl Problem for LiePoisson {
+    /// H is a user function (not the quadratic form).
+    fn calls_out(&self) -> bool {
+        matches!(self.hamiltonian, LieHamiltonian::Function { .. })
+    }
     fn name(&self) -> &'static str {
         "LiePoisson"
     }
@@ -1463,28 +1235,16 @@ impl GroupField for LiePoisson {
     }
 }
 
-impl Hooked for LiePoisson {
-    fn hooks(&self) -> &Hooks {
-        &self.hooks
-    }
-    fn with_hooks(&self, hooks: Hooks) -> Self {
-        LiePoisson {
-            hooks,
-            ..self.clone()
-        }
-    }
-}
-
 impl Catalog for LiePoisson {
     /// rkmk4 (default), midpoint, midpoint4 (the Lie midpoint and its Suzuki composition),
     /// rk4.
     fn catalog(&self) -> Vec<Entry<Self>> {
-        guarded(vec![
+        vec![
             Entry::new("rkmk4", Rkmk4),
             Entry::new("midpoint", LieMidpoint::new()),
             Entry::new("midpoint4", LieMidpoint(Composition::suzuki4())),
             Entry::new("rk4", Rk4),
-        ])
+        ]
     }
 
     fn dissipation(
@@ -1492,26 +1252,5 @@ impl Catalog for LiePoisson {
         d: &crate::integrate::forcing::Dissipation,
     ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
         crate::integrate::forcing::double_bracket(self, d)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn failures_are_located() {
-        let f = Failure {
-            error: Error::NonFinite {
-                what: "the gradient of H".into(),
-                location: "dH/dq[0] = NaN".into(),
-            },
-            method: "gauss4",
-            step: 17,
-            t: 0.17,
-            dt: 0.01,
-        };
-        let msg = f.located().to_string();
-        assert!(msg.contains("dH/dq[0] = NaN, in step 17 of gauss4 (t = 0.17, dt = 0.01)"));
     }
 }

@@ -19,7 +19,7 @@ use pyo3::types::PyDict;
 use super::potential::PyPotential;
 use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
 use crate::convert::{real_pair, size};
-use crate::errors::{to_py, IntoPy};
+use crate::errors::{checked, to_py, IntoPy};
 
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
 type Arr3<'py> = Bound<'py, PyArray3<f64>>;
@@ -29,12 +29,7 @@ fn with_potential<T>(
     potential: &Bound<'_, PyPotential>,
     f: impl FnOnce(&dyn Potential) -> lieflow::Result<T>,
 ) -> PyResult<T> {
-    let p = potential.get();
-    let out = f(&*p.inner);
-    if let Some(c) = &p.callback {
-        c.take_error()?;
-    }
-    out.py()
+    checked(|| f(&*potential.get().inner))
 }
 
 /// The amended potential V_{lam+gam}(X) = U(X) + <lam+gam, B_X^{-1}(lam+gam)>/2 (001 (8.11)) for

@@ -17,8 +17,7 @@ use pyo3::types::PyTuple;
 
 use crate::convert::{mat, py_mat, ArrayIn};
 use crate::convert::{named, real, Real};
-use crate::errors::{to_py, IntoPy};
-use crate::integrate::{Callbacks, ErrorSlot};
+use crate::errors::{checked, raised, to_py, IntoPy};
 
 /// An SO(n)×SO(n)-invariant potential U(X) of a pseudo-rigid body (001 §4.1). Build one with
 /// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Stretch(k)`,
@@ -31,7 +30,6 @@ pub struct PyPotential {
     desc: String,
     /// How to rebuild it, (callable, args), for `__reduce__` (pickling).
     recipe: Arc<(Py<PyAny>, Py<PyTuple>)>,
-    pub(crate) callback: Option<Arc<CallablePotential>>,
 }
 
 #[pymethods]
@@ -42,10 +40,8 @@ impl PyPotential {
     ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0 for a volumetric term).
     fn value(&self, X: ArrayIn<'_>) -> PyResult<f64> {
         // A callable's own error (exception, non-finite return) first, then the core's.
-        let v = pot::value(&*self.inner, &mat("X", &X)?);
-        self.take_callback_error()?;
-        let v = v.py()?;
-        Ok(v)
+        let x = mat("X", &X)?;
+        checked(|| pot::value(&*self.inner, &x))
     }
 
     /// The gradient dU/dX (pairing tr(A^T B)) at an (n, n) array X, as an (n, n) array.
@@ -54,9 +50,8 @@ impl PyPotential {
         py: Python<'py>,
         X: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let g = pot::gradient(&*self.inner, &mat("X", &X)?);
-        self.take_callback_error()?;
-        let g = g.py()?;
+        let x = mat("X", &X)?;
+        let g = checked(|| pot::gradient(&*self.inner, &x))?;
         Ok(py_mat(py, &g))
     }
 
@@ -72,9 +67,8 @@ impl PyPotential {
         X: ArrayIn<'py>,
         V: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let h = pot::hessian_product(&*self.inner, &mat("X", &X)?, &mat("V", &V)?);
-        self.take_callback_error()?;
-        let h = h.py()?;
+        let (x, v) = (mat("X", &X)?, mat("V", &V)?);
+        let h = checked(|| pot::hessian_product(&*self.inner, &x, &v))?;
         Ok(py_mat(py, &h))
     }
 
@@ -87,7 +81,6 @@ impl PyPotential {
             inner: Arc::new(Sum::new(vec![a.inner.clone(), b.inner.clone()])),
             desc: format!("{} + {}", a.desc, b.desc),
             recipe: Arc::new((add.unbind(), PyTuple::new(py, [slf, other])?.unbind())),
-            callback: a.callback.clone().or_else(|| b.callback.clone()),
         })
     }
 
@@ -114,16 +107,7 @@ impl PyPotential {
             inner,
             desc,
             recipe: Arc::new((f.unbind(), PyTuple::new(py, args)?.unbind())),
-            callback: None,
         })
-    }
-
-    /// Re-raises the first Python exception raised by a callable potential, if any.
-    fn take_callback_error(&self) -> PyResult<()> {
-        match &self.callback {
-            Some(c) => c.take_error(),
-            None => Ok(()),
-        }
     }
 }
 
@@ -133,7 +117,6 @@ pub(crate) struct CallablePotential {
     gradient: Py<PyAny>,
     /// `hessian(X, V)`, or `None` for central differences of `gradient`.
     hessian: Option<Py<PyAny>>,
-    error: ErrorSlot,
 }
 
 impl fmt::Debug for CallablePotential {
@@ -143,12 +126,10 @@ impl fmt::Debug for CallablePotential {
 }
 
 impl CallablePotential {
+    /// Records the error `e` of a callable on this thread (`lieflow::integrate::hooks`): a run
+    /// ends after that step, a direct call raises it.
     fn record(&self, e: PyErr) {
-        self.error.record(e);
-    }
-
-    pub(crate) fn take_error(&self) -> PyResult<()> {
-        self.error.take_error()
+        lieflow::integrate::hooks::fail(raised("a callable potential", e));
     }
 
     fn call<'py>(
@@ -206,7 +187,14 @@ fn callable_name(f: &Bound<'_, PyAny>) -> String {
 }
 
 impl pot::Potential for CallablePotential {
+    fn calls_out(&self) -> bool {
+        true
+    }
+
     fn value(&self, x: faer::MatRef<'_, f64>, _ws: &mut Workspace) -> f64 {
+        if lieflow::integrate::hooks::pending() {
+            return f64::NAN;
+        }
         Python::attach(|py| {
             let value = self
                 .call(py, &self.value, x)
@@ -240,9 +228,12 @@ impl pot::Potential for CallablePotential {
     fn add_gradient(
         &self,
         x: faer::MatRef<'_, f64>,
-        out: faer::MatMut<'_, f64>,
+        mut out: faer::MatMut<'_, f64>,
         _ws: &mut Workspace,
     ) {
+        if lieflow::integrate::hooks::pending() {
+            return out.fill(f64::NAN);
+        }
         Python::attach(|py| {
             let g = self.call(py, &self.gradient, x);
             self.add_returned("the gradient(X)", self.gradient.bind(py), g, out);
@@ -259,6 +250,9 @@ impl pot::Potential for CallablePotential {
         mut out: faer::MatMut<'_, f64>,
         ws: &mut Workspace,
     ) {
+        if lieflow::integrate::hooks::pending() {
+            return out.fill(f64::NAN);
+        }
         if let Some(hessian) = &self.hessian {
             Python::attach(|py| {
                 let h = hessian
@@ -402,7 +396,6 @@ fn Callable<'py>(
         value: value.clone().unbind(),
         gradient: gradient.clone().unbind(),
         hessian: hessian.as_ref().map(|h| h.clone().unbind()),
-        error: ErrorSlot::default(),
     });
     let py = value.py();
     let f = py.import("lieflow.potentials")?.getattr("Callable")?;
@@ -410,17 +403,10 @@ fn Callable<'py>(
     args.extend(hessian);
     let args = PyTuple::new(py, args)?.unbind();
     Ok(PyPotential {
-        inner: cb.clone(),
+        inner: cb,
         desc: "Callable(...)".into(),
         recipe: Arc::new((f.unbind(), args)),
-        callback: Some(cb),
     })
-}
-
-impl Callbacks for CallablePotential {
-    fn take_error(&self) -> PyResult<()> {
-        CallablePotential::take_error(self)
-    }
 }
 
 /// Fills the `potentials` submodule.

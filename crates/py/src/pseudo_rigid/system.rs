@@ -3,8 +3,6 @@
 //! P row-major), d = 2n².
 #![allow(non_snake_case)]
 
-use std::sync::Arc;
-
 use lieflow::pseudo_rigid::PseudoRigidBody as CoreBody;
 use lieflow::{Error, Mat};
 use pyo3::prelude::*;
@@ -14,7 +12,6 @@ use super::potential::{PyPotential, Zero};
 use crate::convert::ArrayIn;
 use crate::convert::{int, mat, py_mat};
 use crate::errors::{to_py, IntoPy};
-use crate::integrate::Callbacks;
 use crate::system::{MethodsOf, PySystem};
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -86,10 +83,9 @@ impl PyPseudoRigidBody {
             CoreBody::new(size, pot.inner.clone(), check_det)
         }
         .py()?;
-        let callbacks = pot.callback.clone().map(|c| c as Arc<dyn Callbacks>);
         let args = (n, potential.clone(), check_det, incompressible).into_pyobject(py)?;
         let names = &["n", "potential", "check_det", "incompressible"];
-        let base = PySystem::new(body.clone(), args, names).with_callbacks(callbacks);
+        let base = PySystem::new(body.clone(), args, names);
         Ok(
             PyClassInitializer::from(base).add_subclass(PyPseudoRigidBody {
                 body,

@@ -1,7 +1,7 @@
 //! `lieflow.Forced`: a system with an external force or torque, Rayleigh damping or double-bracket
 //! dissipation (issue 15), the binding of `lieflow::integrate::forcing::Forced`. A thin subclass
 //! of `lieflow.System` over the wrapped system's core; the force callable is called like the
-//! user systems' callables (`user.rs`: the GIL once per chunk, exceptions re-raised naming the
+//! user systems' callables (`user.rs`: on the integrating thread, exceptions re-raised naming the
 //! step, wrong shapes and NaN typed errors).
 
 use std::sync::Arc;
@@ -13,24 +13,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use pyo3::PyClassInitializer;
 
-use super::user::{gil, Callee, UserCallbacks};
+use super::user::Callee;
 use crate::convert::{read_all, real, ArrayIn};
 use crate::errors::{to_py, IntoPy};
-use crate::integrate::Callbacks;
 use crate::system::{MethodsOf, PySystem};
-
-/// The exceptions of the force callable first, then those of the wrapped system's callables.
-struct ForcedCallbacks {
-    own: Arc<UserCallbacks>,
-    base: Option<Arc<dyn Callbacks>>,
-}
-
-impl Callbacks for ForcedCallbacks {
-    fn take_error(&self) -> PyResult<()> {
-        self.own.take_error()?;
-        self.base.as_ref().map_or(Ok(()), |b| b.take_error())
-    }
-}
 
 /// The constructor arguments of the example instance (system, force, block, depends_on_block,
 /// damping, dissipation).
@@ -151,7 +137,6 @@ impl PyForced {
             })?,
         };
         let space = base.sys.space();
-        let calls = Arc::new(UserCallbacks::default());
         let mut sys = Forced::new(base.sys.clone());
         let mut chosen = None;
         if let Some(f) = &force_fn {
@@ -169,14 +154,11 @@ impl PyForced {
                 Some((_, b)) => b.shape(),
                 None => vec![],
             };
-            let callee = Callee::new("force", f, &calls)?;
+            let callee = Callee::new("force", f)?;
             let force: ForceFn = Arc::new(move |t: f64, z: &[f64], out: &mut [f64]| {
                 callee.call_at(t, z, &shape, out)
             });
-            sys = sys
-                .with_force(&name, force, depends)
-                .py()?
-                .with_session(gil());
+            sys = sys.with_force(&name, force, depends).py()?;
             chosen = Some(name);
         }
         if let Some(d) = &damping_arg {
@@ -195,11 +177,6 @@ impl PyForced {
                 .with_dissipation(&Dissipation::DoubleBracket(alpha))
                 .py()?;
         }
-        let _ = calls.log.set(sys.failures());
-        let callbacks = ForcedCallbacks {
-            own: calls,
-            base: base.callbacks.clone(),
-        };
         let args = (
             system.clone(),
             force,
@@ -217,8 +194,7 @@ impl PyForced {
             "damping",
             "dissipation",
         ];
-        let cls = PySystem::new(sys.clone(), args.cast_into::<PyTuple>()?, names)
-            .with_callbacks(Some(Arc::new(callbacks) as Arc<dyn Callbacks>));
+        let cls = PySystem::new(sys.clone(), args.cast_into::<PyTuple>()?, names);
         Ok(PyClassInitializer::from(cls).add_subclass(PyForced { sys, block: chosen }))
     }
 

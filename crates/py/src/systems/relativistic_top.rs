@@ -57,10 +57,8 @@ impl PyRelativisticTangentTop {
             )),
         }
         .py()?;
-        let callbacks = surface.as_ref().and_then(|s| s.get().callbacks());
         let args = (mass, inertia, surface).into_pyobject(inertia.py())?;
-        let base = PySystem::new(top.clone(), args, &["mass", "inertia", "surface"])
-            .with_callbacks(callbacks);
+        let base = PySystem::new(top.clone(), args, &["mass", "inertia", "surface"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyRelativisticTangentTop { top }))
     }
 
@@ -82,9 +80,7 @@ impl PyRelativisticTangentTop {
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
-        slf.as_super()
-            .get()
-            .checked(slf.get().top.state(x, theta, xdot, thetadot))
+        crate::errors::checked(|| slf.get().top.state(x, theta, xdot, thetadot))
     }
 
     /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).

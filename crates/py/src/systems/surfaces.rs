@@ -14,8 +14,7 @@ use pyo3::types::{PyBool, PyTuple};
 
 use crate::convert::{real, real_pair, reals};
 use crate::convert::{shape_str, ArrayIn};
-use crate::errors::{argument_type_error, to_py, IntoPy};
-use crate::integrate::{Callbacks, ErrorSlot};
+use crate::errors::{argument_type_error, checked, raised, IntoPy};
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -29,8 +28,6 @@ pub struct PySurface {
     /// (function of `lieflow.surfaces`, its arguments), for pickling.
     recipe: (&'static str, Py<PyTuple>),
     desc: String,
-    /// The first exception of the Python callables, for the surfaces made from them.
-    errors: Option<Arc<ErrorSlot>>,
 }
 
 impl PySurface {
@@ -38,41 +35,19 @@ impl PySurface {
         inner: Arc<dyn Surface>,
         name: &'static str,
         args: Bound<'_, PyTuple>,
-        errors: Option<Arc<ErrorSlot>>,
     ) -> PyResult<Self> {
         let desc = format!("{name}{}", args.repr()?);
         Ok(PySurface {
             inner,
             recipe: (name, args.unbind()),
             desc: desc.replace(",)", ")"),
-            errors,
         })
     }
 
-    /// Where a system on this surface finds the exceptions of its callables.
-    pub(crate) fn callbacks(&self) -> Option<Arc<dyn Callbacks>> {
-        self.errors.clone().map(|e| e as Arc<dyn Callbacks>)
-    }
-
-    /// Re-raises a callable's exception, if any.
-    fn take_error(&self) -> PyResult<()> {
-        self.errors.as_ref().map_or(Ok(()), |e| e.take_error())
-    }
-
-    /// x, checked to lie in the chart (a callable's exception comes first).
-    fn point(&self, x: Vec2) -> PyResult<Vec2> {
-        let inside = self.inner.check(x);
-        self.take_error()?;
-        inside.map_err(|v| v.at_start()).py()?;
-        Ok(x)
-    }
-
-    /// `f(x)` for a checked x, re-raising a callable's exception.
+    /// `f(x)` for an x checked to lie in the chart, re-raising a callable's exception.
     fn at<T>(&self, x: Vec2, f: impl FnOnce(Vec2) -> T) -> PyResult<T> {
-        let x = self.point(x)?;
-        let v = f(x);
-        self.take_error()?;
-        Ok(v)
+        checked(|| self.inner.check(x).map_err(|v| v.at_start()))?;
+        checked(|| Ok(f(x)))
     }
 }
 
@@ -146,27 +121,26 @@ impl PySurface {
 }
 
 /// Calls `f(*args)` and reads the array it returns, which must have `shape` (row-major); on an
-/// exception or a wrong return records the error and gives NaN (native code then stops at its
-/// next check and the error is raised).
+/// exception or a wrong return records the error on this thread (`lieflow::integrate::hooks`)
+/// and gives NaN (a run ends after that step; a direct call raises the error).
 fn call_floats<const N: usize>(
-    errors: &ErrorSlot,
     f: &Py<PyAny>,
     args: &[f64],
     what: &str,
     shape: &[usize],
 ) -> [f64; N] {
+    if lieflow::integrate::hooks::pending() {
+        return [f64::NAN; N];
+    }
     Python::attach(|py| {
         let out = PyTuple::new(py, args)
             .and_then(|a| f.bind(py).call1(a))
-            .and_then(|v| {
-                let a = ArrayIn::named(&format!("the value of {what}"), &v)?;
+            .and_then(|v| ArrayIn::named(&format!("the value of {what}"), &v))
+            .map_err(|e| raised(what, e))
+            .and_then(|a| {
                 let v = a.as_array();
                 if v.shape() != shape {
-                    return Err(to_py(Error::shape(
-                        what,
-                        shape_str(shape),
-                        shape_str(v.shape()),
-                    )));
+                    return Err(Error::shape(what, shape_str(shape), shape_str(v.shape())));
                 }
                 let mut out = [0.0; N];
                 for (o, x) in out.iter_mut().zip(v.iter()) {
@@ -175,7 +149,7 @@ fn call_floats<const N: usize>(
                 Ok(out)
             });
         out.unwrap_or_else(|e| {
-            errors.record(e);
+            lieflow::integrate::hooks::fail(e);
             [f64::NAN; N]
         })
     })
@@ -227,7 +201,7 @@ fn native(
     name: &'static str,
     args: &[f64],
 ) -> PyResult<PySurface> {
-    PySurface::new(Arc::new(inner), name, PyTuple::new(py, args)?, None)
+    PySurface::new(Arc::new(inner), name, PyTuple::new(py, args)?)
 }
 
 /// The Euclidean plane, Cartesian x = (x, y), E = (d/dx, d/dy). Killing generators: translations
@@ -269,11 +243,8 @@ fn Revolution<'py>(
     #[pyo3(from_py_with = real_pair)] s_range: (f64, f64),
 ) -> PyResult<PySurface> {
     let py = r.py();
-    let errors = Arc::new(ErrorSlot::default());
-    let profile = |what: &'static str, f: Py<PyAny>| {
-        let errors = errors.clone();
-        move |s: f64| call_floats::<4>(&errors, &f, &[s], what, &[4])
-    };
+    let profile =
+        |what: &'static str, f: Py<PyAny>| move |s: f64| call_floats::<4>(&f, &[s], what, &[4]);
     let inner = surface::Revolution::new(
         profile("r(s)", callable("r", &r)?),
         profile("z(s)", callable("z", &z)?),
@@ -281,7 +252,7 @@ fn Revolution<'py>(
     )
     .py()?;
     let args = (r, z, s_range).into_pyobject(py)?;
-    PySurface::new(Arc::new(inner), "Revolution", args, Some(errors))
+    PySurface::new(Arc::new(inner), "Revolution", args)
 }
 
 /// The torus of radii a > b > 0 as a surface of revolution: r = a + b cos s, z = b sin s,
@@ -307,10 +278,9 @@ fn Torus(
 #[pyfunction]
 fn Graph(f: Any<'_>) -> PyResult<PySurface> {
     let py = f.py();
-    let errors = Arc::new(ErrorSlot::default());
-    let (slot, call) = (errors.clone(), callable("f", &f)?);
+    let call = callable("f", &f)?;
     let inner = surface::Graph::new(move |x: Vec2| {
-        let v = call_floats::<10>(&slot, &call, &x, "f(x, y)", &[10]);
+        let v = call_floats::<10>(&call, &x, "f(x, y)", &[10]);
         Jet {
             value: v[0],
             gradient: [v[1], v[2]],
@@ -319,7 +289,7 @@ fn Graph(f: Any<'_>) -> PyResult<PySurface> {
         }
     });
     let args = (f,).into_pyobject(py)?;
-    PySurface::new(Arc::new(inner), "Graph", args, Some(errors))
+    PySurface::new(Arc::new(inner), "Graph", args)
 }
 
 /// The quadric z = (a x^2 + b y^2)/2 as a graph (paraboloid for ab > 0, saddle for ab < 0).
@@ -354,24 +324,25 @@ fn MetricSurface<'py>(
     domain: Option<Any<'py>>,
 ) -> PyResult<PySurface> {
     let py = metric.py();
-    let errors = Arc::new(ErrorSlot::default());
     let field = |what: &'static str, f: Py<PyAny>| {
-        let errors = errors.clone();
         move |x: Vec2| {
-            let v = call_floats::<4>(&errors, &f, &x, what, &[2, 2]);
+            let v = call_floats::<4>(&f, &x, what, &[2, 2]);
             [[v[0], v[1]], [v[2], v[3]]]
         }
     };
     let dom: Option<surface::DomainFn> = match &domain {
         Some(d) => {
-            let (slot, d) = (errors.clone(), callable("domain", d)?);
+            let d = callable("domain", d)?;
             Some(Arc::new(move |x: Vec2| {
+                if lieflow::integrate::hooks::pending() {
+                    return false;
+                }
                 Python::attach(|py| {
                     let f = d.bind(py);
                     f.call1((x[0], x[1]))
                         .and_then(|v| domain_value(f, &v))
                         .unwrap_or_else(|e| {
-                            slot.record(e);
+                            lieflow::integrate::hooks::fail(raised("domain(x1, x2)", e));
                             false
                         })
                 })
@@ -385,7 +356,7 @@ fn MetricSurface<'py>(
         dom,
     );
     let args = (metric, frame, domain).into_pyobject(py)?;
-    PySurface::new(Arc::new(inner), "MetricSurface", args, Some(errors))
+    PySurface::new(Arc::new(inner), "MetricSurface", args)
 }
 
 /// Fills the `surfaces` submodule.

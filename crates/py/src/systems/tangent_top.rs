@@ -83,8 +83,7 @@ impl PyTangentTop {
             top.clone(),
             args,
             &["surface", "mass", "inertia", "embedded"],
-        )
-        .with_callbacks(s.callbacks());
+        );
         Ok(PyClassInitializer::from(base).add_subclass(PyTangentTop { top }))
     }
 
@@ -112,9 +111,7 @@ impl PyTangentTop {
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
-        slf.as_super()
-            .get()
-            .checked(slf.get().top.state(x, theta, xdot, thetadot))
+        crate::errors::checked(|| slf.get().top.state(x, theta, xdot, thetadot))
     }
 
     /// Named views for `Trajectory`: x (..., 2), theta (...), p (..., 3), and the velocities
@@ -230,10 +227,8 @@ impl PyChargedParticle {
         #[pyo3(from_py_with = real)] charge: f64,
     ) -> PyResult<PyClassInitializer<Self>> {
         let particle = top.get().top.magnetic_analogue(charge).py()?;
-        let callbacks = top.as_super().get().callbacks.clone();
         let args = (top.clone(), charge).into_pyobject(top.py())?;
-        let base =
-            PySystem::new(particle.clone(), args, &["top", "charge"]).with_callbacks(callbacks);
+        let base = PySystem::new(particle.clone(), args, &["top", "charge"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyChargedParticle { particle }))
     }
 
@@ -260,7 +255,7 @@ impl PyChargedParticle {
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
     fn metric(&self, #[pyo3(from_py_with = reals::<2>)] x: [f64; 2]) -> PyResult<[[f64; 2]; 2]> {
-        self.particle.metric(x).py()
+        crate::errors::checked(|| self.particle.metric(x))
     }
 
     /// The magnetic potential A = alpha at x.
@@ -268,7 +263,7 @@ impl PyChargedParticle {
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
     fn potential(&self, #[pyo3(from_py_with = reals::<2>)] x: [f64; 2]) -> PyResult<[f64; 2]> {
-        self.particle.potential(x).py()
+        crate::errors::checked(|| self.particle.potential(x))
     }
 
     /// The canonical state (x, p = m G xdot + charge A) from x and xdot.
@@ -280,9 +275,7 @@ impl PyChargedParticle {
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
     ) -> PyResult<Vec<f64>> {
-        slf.as_super()
-            .get()
-            .checked(slf.get().particle.state(x, xdot))
+        crate::errors::checked(|| slf.get().particle.state(x, xdot))
     }
 
     /// Named views for `Trajectory`: x (..., 2), p (..., 2), xdot (..., 2).

@@ -2,25 +2,22 @@
 //! systems whose Hamiltonian is given by Python callables (or, for `LiePoisson`, by a symmetric
 //! matrix: the native quadratic path). Thin subclasses of `lieflow.System`.
 //!
-//! The callables are called from the native kernels the way the callable surfaces are
-//! (`surfaces.rs`), with one difference: the GIL is taken once for each chunk of steps (the
-//! systems' session, `lieflow::systems::user::Session`), not for each call, which on the run's
-//! worker thread costs ~7 µs a call. A run is single-threaded (a batch of states is allowed and
-//! runs member after member); an exception is kept (`ErrorSlot`), the
-//! kernel goes on with NaN, the core stops the run after that step and the exception is re-raised
-//! with a note naming the step ("lieflow: raised in step 17 of gauss4 (t = …, dt = …)"). A value
-//! of the wrong shape is a `ShapeError`, a non-finite one a `NonFiniteError`, both naming the
+//! The callables are called from the native kernels on the thread that integrates, which holds
+//! the GIL (a run of these systems is single-threaded; a batch of states runs member after
+//! member). An exception travels as the core's `Error::Raised` (recorded on the thread when the
+//! kernel cannot return it, `lieflow::integrate::hooks`): the kernel goes on with NaN, the core
+//! ends the run after that step, never taking a step twice, and the exception is re-raised with
+//! a note naming the step ("lieflow: raised in step 17 of gauss4 (t = …, dt = …)"). A value of
+//! the wrong shape is a `ShapeError`, a non-finite one a `NonFiniteError`, both naming the
 //! callable and the step; a value that is not a real array (a string, None) is the
 //! `ArgumentTypeError` of reading it, re-raised like an exception. The systems pickle by their
 //! constructor arguments (callables by reference: pass module-level functions).
 #![allow(non_snake_case)]
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use lieflow::integrate::problem::Canonical;
-use lieflow::systems::user::{
-    CanonicalFn, CanonicalGradientFn, FailureLog, GradientFn, Hooked, ScalarFn, Session,
-};
+use lieflow::systems::user::{CanonicalFn, CanonicalGradientFn, GradientFn, ScalarFn};
 use lieflow::systems::{
     Algebra, KineticMass, LieHamiltonian, LiePoisson as CoreLiePoisson, UserCanonical,
     UserSeparable,
@@ -33,35 +30,10 @@ use pyo3::types::{PyFloat, PyList, PyString, PyTuple};
 use pyo3::PyClassInitializer;
 
 use crate::convert::{int_opt, mat, named, read_all, shape_str, ArrayIn, Real};
-use crate::errors::{argument_type_error, to_py, IntoPy};
-use crate::integrate::{Callbacks, ErrorSlot};
+use crate::errors::{argument_type_error, raised, to_py, IntoPy};
 use crate::system::PySystem;
 
 type Any<'py> = Bound<'py, PyAny>;
-
-/// The exceptions of a system's callables and where its runs failed.
-#[derive(Default)]
-pub(crate) struct UserCallbacks {
-    pub(crate) slot: ErrorSlot,
-    pub(crate) log: OnceLock<Arc<FailureLog>>,
-}
-
-impl Callbacks for UserCallbacks {
-    /// The first exception, with a note naming the step of the run it stopped (if it was raised
-    /// in a run).
-    fn take_error(&self) -> PyResult<()> {
-        let failure = self.log.get().and_then(|l| l.take());
-        self.slot.take_error().inspect_err(|e| {
-            if let Some(f) = failure {
-                Python::attach(|py| {
-                    let note = format!("lieflow: raised {}; the run stopped there", f.place());
-                    // add_note exists from Python 3.11 on.
-                    let _ = e.value(py).call_method1("add_note", (note,));
-                });
-            }
-        })
-    }
-}
 
 /// A user callable as errors name it: its `__qualname__` (or `__name__`, or repr).
 pub(crate) fn callable_name(f: &Any<'_>) -> String {
@@ -78,13 +50,12 @@ pub(crate) struct Callee {
     f: Arc<Py<PyAny>>,
     /// "the value of the hamiltonian `H`", for errors.
     what: Arc<str>,
-    calls: Arc<UserCallbacks>,
 }
 
 impl Callee {
     /// The argument `arg` (named `name`, e.g. "hamiltonian") if it is callable; otherwise an
     /// `ArgumentTypeError` naming it.
-    pub(crate) fn new(name: &str, arg: &Any<'_>, calls: &Arc<UserCallbacks>) -> PyResult<Self> {
+    pub(crate) fn new(name: &str, arg: &Any<'_>) -> PyResult<Self> {
         if !arg.is_callable() {
             return Err(argument_type_error(
                 arg.py(),
@@ -99,14 +70,12 @@ impl Callee {
         Ok(Callee {
             f: Arc::new(arg.clone().unbind()),
             what: format!("the value of {name} `{}`", callable_name(arg)).into(),
-            calls: calls.clone(),
         })
     }
 
-    /// Keeps the exception `e` (re-raised by lieflow) and returns the core's stand-in error.
+    /// The exception `e` as the core error that carries it.
     fn raised(&self, e: PyErr) -> Error {
-        self.calls.slot.record(e);
-        Error::invalid(&*self.what, "the callable raised an exception")
+        raised(&*self.what, e)
     }
 
     /// Calls f with one float64 array per slice of `args` and reads its value of `shape` into
@@ -201,13 +170,6 @@ impl Callee {
     }
 }
 
-/// The session of the systems that call Python: the GIL held for a whole call of a stepper (a
-/// chunk of steps), so that the callables' own `Python::attach` reuses the thread's state (on a
-/// worker thread each separate attach would create and destroy one, about 7 µs per call).
-pub(crate) fn gil() -> Session {
-    Arc::new(|f: &mut dyn FnMut()| Python::attach(|_| f()))
-}
-
 fn optional<'a, 'py>(a: Option<&'a Any<'py>>) -> Option<&'a Any<'py>> {
     a.filter(|x| !x.is_none())
 }
@@ -270,10 +232,9 @@ impl PyCanonical {
         dof: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = hamiltonian.py();
-        let calls = Arc::new(UserCallbacks::default());
-        let h = Callee::new("hamiltonian", &hamiltonian, &calls)?;
+        let h = Callee::new("hamiltonian", &hamiltonian)?;
         let g = optional(gradient.as_ref())
-            .map(|g| Callee::new("gradient", g, &calls))
+            .map(|g| Callee::new("gradient", g))
             .transpose()?;
         let d = match optional(dof.as_ref()) {
             Some(v) => count("dof", named("dof", int_opt(v))?.unwrap_or(0))?,
@@ -299,13 +260,9 @@ impl PyCanonical {
                 },
             ) as CanonicalGradientFn
         });
-        let sys = UserCanonical::new(d, value, grad_fn)
-            .py()?
-            .with_session(gil());
-        let _ = calls.log.set(sys.failures());
+        let sys = UserCanonical::new(d, value, grad_fn).py()?;
         let args = (hamiltonian, gradient, dof).into_pyobject(py)?;
-        let base = PySystem::new(sys.clone(), args, &["hamiltonian", "gradient", "dof"])
-            .with_callbacks(Some(calls as Arc<dyn Callbacks>));
+        let base = PySystem::new(sys.clone(), args, &["hamiltonian", "gradient", "dof"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyCanonical { sys }))
     }
 
@@ -383,11 +340,10 @@ impl PySeparable {
         dof: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = potential.py();
-        let calls = Arc::new(UserCallbacks::default());
         let kinetic = self::kinetic_mass(&mass)?;
-        let u = Callee::new("potential", &potential, &calls)?;
+        let u = Callee::new("potential", &potential)?;
         let g = optional(gradient.as_ref())
-            .map(|g| Callee::new("gradient", g, &calls))
+            .map(|g| Callee::new("gradient", g))
             .transpose()?;
         let d = match optional(dof.as_ref()) {
             Some(v) => Some(count("dof", named("dof", int_opt(v))?.unwrap_or(0))?),
@@ -405,13 +361,9 @@ impl PySeparable {
         let grad_fn: Option<GradientFn> = g.map(|g| {
             Arc::new(move |q: &[f64], out: &mut [f64]| g.call(&[q], &[q.len()], out)) as GradientFn
         });
-        let sys = UserSeparable::new(kinetic, d, value, grad_fn)
-            .py()?
-            .with_session(gil());
-        let _ = calls.log.set(sys.failures());
+        let sys = UserSeparable::new(kinetic, d, value, grad_fn).py()?;
         let args = (mass, potential, gradient, dof).into_pyobject(py)?;
-        let base = PySystem::new(sys.clone(), args, &["mass", "potential", "gradient", "dof"])
-            .with_callbacks(Some(calls as Arc<dyn Callbacks>));
+        let base = PySystem::new(sys.clone(), args, &["mass", "potential", "gradient", "dof"]);
         Ok(PyClassInitializer::from(base).add_subclass(PySeparable { sys }))
     }
 
@@ -518,14 +470,11 @@ impl PyLiePoisson {
         casimirs: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = hamiltonian.py();
-        let calls = Arc::new(UserCallbacks::default());
         let alg = self::algebra(&algebra)?;
-        let mut python = false;
         let ham = if hamiltonian.is_callable() {
-            python = true;
-            let h = Callee::new("hamiltonian", &hamiltonian, &calls)?;
+            let h = Callee::new("hamiltonian", &hamiltonian)?;
             let g = optional(gradient.as_ref())
-                .map(|g| Callee::new("gradient", g, &calls))
+                .map(|g| Callee::new("gradient", g))
                 .transpose()?;
             LieHamiltonian::Function {
                 value: Arc::new(move |mu: &[f64]| h.scalar(&[mu])),
@@ -570,7 +519,6 @@ impl PyLiePoisson {
         let cas = match optional(casimirs.as_ref()) {
             None => None,
             Some(c) => {
-                python = true;
                 let mut fs: Vec<ScalarFn> = Vec::new();
                 let items = c.try_iter().map_err(|_| {
                     argument_type_error(
@@ -579,24 +527,19 @@ impl PyLiePoisson {
                     )
                 })?;
                 for (k, f) in items.enumerate() {
-                    let f = Callee::new(&format!("casimirs[{k}]"), &f?, &calls)?;
+                    let f = Callee::new(&format!("casimirs[{k}]"), &f?)?;
                     fs.push(Arc::new(move |mu: &[f64]| f.scalar(&[mu])));
                 }
                 Some(fs)
             }
         };
-        let mut sys = CoreLiePoisson::new(alg, ham, cas).py()?;
-        if python {
-            sys = sys.with_session(gil());
-        }
-        let _ = calls.log.set(sys.failures());
+        let sys = CoreLiePoisson::new(alg, ham, cas).py()?;
         let args = (algebra, hamiltonian, gradient, casimirs).into_pyobject(py)?;
         let base = PySystem::new(
             sys.clone(),
             args,
             &["algebra", "hamiltonian", "gradient", "casimirs"],
-        )
-        .with_callbacks(python.then_some(calls as Arc<dyn Callbacks>));
+        );
         Ok(PyClassInitializer::from(base).add_subclass(PyLiePoisson { sys }))
     }
 
