@@ -166,6 +166,25 @@ def test_an_exception_in_one_thread_is_raised_in_that_thread():
         assert calls_in_a[0] == 100
 
 
+def test_a_batch_stops_at_the_first_member_whose_callable_raises():
+    # Members run one after the other on the calling thread; after member 1's exception no
+    # callable is called again (member 2 never starts), and Ctrl-C is not delayed by the rest.
+    calls = []
+
+    def torque(t, s):
+        calls.append(t)
+        if s[0] > 5.0 and t > 0.505:
+            raise RuntimeError("member 1")
+        return torque_of(t)
+
+    forced = lf.Forced(lf.RigidBody([1, 2, 3]), torque, depends_on_block=False)
+    with pytest.raises(RuntimeError, match="member 1") as info:
+        lf.integrate(forced, [M0, [6.0, 0.0, 0.1], M0], dt=0.01, steps=100)
+    assert len(calls) == 200 + 103          # member 0 whole, member 1 to its 52nd step
+    part = info.value.partial
+    assert part.states.shape == (3, 1, 3) and part.t_final == 0.0
+
+
 def test_an_event_function_that_raises_ends_the_run_with_a_consistent_partial():
     body = lf.RigidBody([1, 2, 3])
     calls = [0]

@@ -349,12 +349,20 @@ impl Integration {
                     }
                     (Some(ev), Some(run)) => py.detach(|| vec![one(0, run, Some(ev))]),
                     // A system that calls Python runs on this thread with the GIL held (its
-                    // callables need it for the whole chunk anyway).
-                    _ if self.calls_out => runs
-                        .iter_mut()
-                        .enumerate()
-                        .map(|(i, run)| one(i, run, None))
-                        .collect(),
+                    // callables need it for the whole chunk anyway), member after member; the
+                    // first failure ends the call (no callable runs after an exception).
+                    _ if self.calls_out => {
+                        let mut outs = Vec::with_capacity(b);
+                        for (i, run) in runs.iter_mut().enumerate() {
+                            let (out, r) = one(i, run, None);
+                            let failed = r.is_err();
+                            outs.push((out, r));
+                            if failed {
+                                break;
+                            }
+                        }
+                        outs
+                    }
                     _ => py.detach(|| parallel(runs)),
                 }
             }
