@@ -23,12 +23,16 @@ Layout of the Dataset (format 1):
   system, as JSON), ``method``, ``dt``, ``save_every``, ``t0``, ``t_final``, ``status``,
   ``lieflow_version`` and ``lieflow_format``.
 
-A system is stored as data: its class and constructor arguments (numbers, strings, arrays and
-other lieflow objects such as potentials and surfaces), never as code. A system built from
-Python callables (``lf.Canonical``, ``lf.Forced`` with a force function, ``Callable``
-potentials) can be stored only pickled, with ``allow_pickle=True`` on both ``save`` and
-``load`` (as ``numpy.load``): loading a pickle runs code from the file, so pass it only for
-files you trust.
+A system is stored as data: its class and constructor arguments (None, booleans, numbers,
+strings, numeric arrays, complex numbers, lists and tuples, and other lieflow objects such as
+potentials and surfaces, in the same form), never as code. Loading calls only the entries of
+:data:`ALLOWED_CALLS` (the constructors of lieflow's systems, its potentials and surfaces, and
+``operator.add`` for a sum of potentials), within the :data:`SPEC_LIMITS`; any other name or
+value is a FileFormatError naming its place in the spec (e.g. ``system_spec.args[1].call``).
+A system built from Python callables (``lf.Canonical``, ``lf.Forced`` with a force function,
+``Callable`` potentials) can be stored only pickled, with ``allow_pickle=True`` on both
+``save`` and ``load`` (as ``numpy.load``): loading a pickle runs code from the file, so pass it
+only for files you trust.
 """
 
 from __future__ import annotations
@@ -38,19 +42,20 @@ import importlib
 import inspect
 import json
 import numbers
-import operator
 import os
+import re
 
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._lieflow import InvalidArgumentError, LieflowError, __version__
+from ._lieflow import InvalidArgumentError, LieflowError, System, __version__
 
 if TYPE_CHECKING:
     import xarray
 
-__all__ = ["FileFormatError", "FORMAT", "read", "save", "to_xarray"]
+__all__ = ["ALLOWED_CALLS", "FileFormatError", "FORMAT", "SPEC_LIMITS", "read", "save",
+           "to_xarray"]
 
 #: The version of the file layout written by :func:`save`; :func:`read` reads every version
 #: up to it.
@@ -86,9 +91,59 @@ def _engine():
 
 # --- systems as data -----------------------------------------------------------------------
 
-#: Callables outside lieflow that may appear in a system's reduction (sums of potentials).
-_OPERATORS = {"add": operator.add, "mul": operator.mul, "sub": operator.sub,
-              "neg": operator.neg, "truediv": operator.truediv}
+#: Everything a ``system_spec`` may call, as "module:qualname": the constructors of the lieflow
+#: systems that can be stored as data, the factories of the potentials and surfaces they take,
+#: and ``operator:add`` (a sum of potentials, ``Potential.__add__``'s reduction). :func:`read`
+#: calls nothing else: a spec naming another callable, or holding anything but None, booleans,
+#: numbers, strings, numeric arrays, complex numbers, lists, tuples and calls of these, is a
+#: FileFormatError. The systems built from Python callables (``Canonical``, ``Separable``, the
+#: ``Callable`` potential, the ``Revolution``, ``Graph`` and ``MetricSurface`` surfaces, a
+#: ``Forced`` force function) are never data and are not listed.
+ALLOWED_CALLS = frozenset({
+    "lieflow:ChargedParticle",
+    "lieflow:Forced",
+    "lieflow:GeneralizedRigidBody",
+    "lieflow:HeavyTop",
+    "lieflow:LiePoisson",
+    "lieflow:Pendulum",
+    "lieflow:PseudoRigidBody",
+    "lieflow:RelativisticTangentTop",
+    "lieflow:RigidBody",
+    "lieflow:RollingDisk",
+    "lieflow:RollingDisks",
+    "lieflow:RollingSpheres",
+    "lieflow:SphereParticle",
+    "lieflow:SphericalPendulum",
+    "lieflow:TangentTop",
+    "lieflow:WeakFieldTop",
+    "lieflow.potentials:Harmonic",
+    "lieflow.potentials:SaintVenantKirchhoff",
+    "lieflow.potentials:SelfGravity",
+    "lieflow.potentials:Stretch",
+    "lieflow.potentials:Volumetric",
+    "lieflow.potentials:Zero",
+    "lieflow.surfaces:HyperbolicPlane",
+    "lieflow.surfaces:Plane",
+    "lieflow.surfaces:Quadric",
+    "lieflow.surfaces:Sphere",
+    "lieflow.surfaces:Torus",
+    "operator:add",
+})
+
+#: Limits of a system spec, checked before anything is allocated for it or called: its JSON
+#: text (characters), the nesting of its JSON lists and objects, its JSON values (array entries
+#: and the lists holding them included), the entries of all its arrays, the dimensions of one
+#: array, and the magnitude of an integer. A lieflow system's spec is a few hundred
+#: characters; its arrays are inertia tensors and the like (the largest, a LiePoisson
+#: Hamiltonian on so(10), 45 x 45 = 2025 entries). The entries are limited because a
+#: constructor may cost more than its arguments: ``GeneralizedRigidBody(J)`` allocates dense
+#: (m, m) matrices for m = len(J), 178 MB for m = 1770 and 14 GB for m = 16290. A system above
+#: the limits is saved only pickled (``allow_pickle=True``).
+SPEC_LIMITS = {"chars": 1 << 20, "depth": 100, "values": 1 << 14, "entries": 2048, "ndim": 8,
+               "int": 2**63 - 1}
+
+_SUM = "operator:add"
+_DTYPE = re.compile(r"[<>|=]?(b1|[iu][1248]|f(2|4|8|12|16))")
 
 
 class _NotData(Exception):
@@ -106,63 +161,200 @@ def _encode(value):
     if isinstance(value, numbers.Complex):
         return {"complex": [value.real, value.imag]}
     if isinstance(value, np.ndarray):
-        if value.dtype.kind not in "biuf":
+        if not _DTYPE.fullmatch(value.dtype.str):
             raise _NotData(f"an array of dtype {value.dtype}")
         return {"array": value.tolist(), "dtype": value.dtype.str}
     if isinstance(value, (list, tuple)):
         items = [_encode(v) for v in value]
         return items if isinstance(value, list) else {"tuple": items}
-    reduce = getattr(type(value), "__reduce__", None)
-    fn = callable(reduce) and _lieflow_callable_name(value)
-    if fn:
-        _, args = value.__reduce__()[:2]
-        return {"call": fn, "args": [_encode(a) for a in args]}
-    raise _NotData(f"{type(value).__name__} {value!r:.60}")
+    name = _allowed_name(value)
+    if name is None:
+        raise _NotData(f"{type(value).__name__} {value!r:.60}")
+    return {"call": name, "args": [_encode(a) for a in value.__reduce__()[1]]}
 
 
-def _lieflow_callable_name(value):
-    """'module:name' of the callable that rebuilds `value`, when it is lieflow's or an operator."""
+def _allowed_name(value):
+    """The entry of ALLOWED_CALLS whose call rebuilds `value` (by its ``__reduce__``), or
+    None."""
     if not type(value).__module__.startswith("lieflow"):
         return None
     try:
         fn = value.__reduce__()[0]
-    except Exception:
+    except Exception:        # an object that does not pickle is not data
         return None
-    module, name = getattr(fn, "__module__", "") or "", getattr(fn, "__qualname__", "")
-    if module.startswith("lieflow") and _resolve(f"{module}:{name}") is fn:
-        return f"{module}:{name}"
-    if module in ("_operator", "operator") and _OPERATORS.get(name) is fn:
-        return f"operator:{name}"
-    return None
+    module, name = getattr(fn, "__module__", None), getattr(fn, "__qualname__", None)
+    if module == "_operator":
+        module = "operator"
+    spelled = f"{module}:{name}"
+    return spelled if spelled in ALLOWED_CALLS and _allowed(spelled) is fn else None
 
 
-def _resolve(name):
-    """The callable 'module:qualname' names: lieflow's own or an operator, nothing else."""
-    module, _, qualname = name.partition(":")
-    if module == "operator" and qualname in _OPERATORS:
-        return _OPERATORS[qualname]
-    if not (module == "lieflow" or module.startswith("lieflow.")):
-        raise FileFormatError(f"the system spec names {name!r}, which is not a lieflow callable")
-    obj = importlib.import_module(module)
-    for part in qualname.split("."):
-        obj = getattr(obj, part)
-    return obj
+def _allowed(name):
+    """The callable of an entry of ALLOWED_CALLS."""
+    module, _, attr = name.partition(":")
+    return getattr(importlib.import_module(module), attr)
 
 
-def _decode(data):
-    if isinstance(data, list):
-        return [_decode(v) for v in data]
-    if not isinstance(data, dict):
+class _Call:
+    """A call in a parsed spec: an entry of ALLOWED_CALLS, its parsed arguments and where it
+    stands in the spec (for messages)."""
+
+    __slots__ = ("name", "args", "path")
+
+    def __init__(self, name, args, path):
+        self.name, self.args, self.path = name, args, path
+
+
+class _Budget:
+    """The JSON values and array entries a spec may still hold."""
+
+    def __init__(self):
+        self.left = {"values": SPEC_LIMITS["values"], "entries": SPEC_LIMITS["entries"]}
+
+    def take(self, n, path, what="values"):
+        self.left[what] -= n
+        if self.left[what] < 0:
+            raise FileFormatError(f"{path}: the system spec holds more than "
+                                  f"{SPEC_LIMITS[what]} {what}{' of arrays' * (what == 'entries')}"
+                                  f"; lieflow's systems have far fewer (lieflow.io.SPEC_LIMITS)")
+
+
+def _parse_spec(text, where="system_spec"):
+    """The spec `text` (JSON) checked and parsed into a tree of _Call, arrays and plain values;
+    nothing is called. FileFormatError naming the offending entry otherwise."""
+    if not isinstance(text, str):
+        raise FileFormatError(f"{where}: expected a JSON string, got {type(text).__name__}")
+    if len(text) > SPEC_LIMITS["chars"]:
+        raise FileFormatError(f"{where}: {len(text)} characters, more than the limit of "
+                              f"{SPEC_LIMITS['chars']} for a system spec")
+    try:
+        data = json.loads(text)
+    except RecursionError as e:
+        raise FileFormatError(f"{where}: nested too deeply to parse (at most "
+                              f"{SPEC_LIMITS['depth']} levels)") from e
+    except ValueError as e:
+        raise FileFormatError(f"{where}: not valid JSON: {e}") from e
+    if not (isinstance(data, dict) and "call" in data):
+        raise FileFormatError(f"{where}: expected a call of a lieflow system's constructor "
+                              f"({{\"call\": ..., \"args\": [...]}}), got {_show(data)}")
+    return _parse(data, where, 0, _Budget())
+
+
+def _show(value):
+    return f"{type(value).__name__} {json.dumps(value)[:60]}"
+
+
+def _parse(data, path, depth, budget):
+    budget.take(1, path)
+    if depth > SPEC_LIMITS["depth"]:
+        raise FileFormatError(f"{path}: nested deeper than {SPEC_LIMITS['depth']} levels")
+    if data is None or isinstance(data, (bool, str, float)):
         return data
-    if "tuple" in data:
-        return tuple(_decode(v) for v in data["tuple"])
-    if "complex" in data:
-        return complex(*data["complex"])
-    if "array" in data:
-        return np.array(data["array"], dtype=np.dtype(data["dtype"]))
-    if "call" in data:
-        return _resolve(data["call"])(*[_decode(a) for a in data["args"]])
-    raise FileFormatError(f"unknown entry in the system spec: {sorted(data)}")
+    if isinstance(data, int):
+        if abs(data) > SPEC_LIMITS["int"]:
+            raise FileFormatError(f"{path}: an integer of {len(str(abs(data)))} digits is out "
+                                  f"of range (at most 2**63 - 1 in magnitude)")
+        return data
+    if isinstance(data, list):
+        return [_parse(v, f"{path}[{i}]", depth + 1, budget) for i, v in enumerate(data)]
+    assert isinstance(data, dict), type(data)         # what json.loads makes
+    keys = set(data)
+    if keys == {"call", "args"}:
+        name = data["call"]
+        if not isinstance(name, str) or name not in ALLOWED_CALLS:
+            raise FileFormatError(
+                f"{path}.call: {name!r:.80} is not a lieflow callable that rebuilds systems "
+                f"(a system spec may call only the entries of lieflow.io.ALLOWED_CALLS)")
+        args = data["args"]
+        if not isinstance(args, list):
+            raise FileFormatError(f"{path}.args: expected a list of arguments, got "
+                                  f"{_show(args)}")
+        return _Call(name, [_parse(v, f"{path}.args[{i}]", depth + 2, budget)
+                            for i, v in enumerate(args)], path)
+    if keys == {"tuple"}:
+        items = data["tuple"]
+        if not isinstance(items, list):
+            raise FileFormatError(f"{path}.tuple: expected a list, got {_show(items)}")
+        return tuple(_parse(v, f"{path}.tuple[{i}]", depth + 2, budget)
+                     for i, v in enumerate(items))
+    if keys == {"complex"}:
+        parts = data["complex"]
+        if not (isinstance(parts, list) and len(parts) == 2
+                and all(isinstance(p, (int, float)) and not isinstance(p, bool)
+                        for p in parts)):
+            raise FileFormatError(f"{path}.complex: expected [real, imag], got {_show(parts)}")
+        try:
+            return complex(*parts)
+        except OverflowError as e:
+            raise FileFormatError(f"{path}.complex: {e}") from e
+    if keys == {"array", "dtype"}:
+        return _parse_array(data, path, budget)
+    raise FileFormatError(
+        f"{path}: an entry with the keys {sorted(keys)!r:.80}; expected one of "
+        f"{{call, args}}, {{array, dtype}}, {{tuple}}, {{complex}}")
+
+
+def _parse_array(data, path, budget):
+    """The numeric array of an {"array", "dtype"} entry, its shape and entries counted before
+    it is made."""
+    spelled = data["dtype"]
+    if not (isinstance(spelled, str) and _DTYPE.fullmatch(spelled)):
+        raise FileFormatError(f"{path}.dtype: {spelled!r:.40} is not the dtype of a numeric "
+                              f"array (booleans, integers or floats, e.g. '<f8')")
+    dtype = np.dtype(spelled)
+    top = data["array"]
+    level, shape = [top], []
+    while level and isinstance(level[0], list):
+        n = len(level[0])
+        if not all(isinstance(v, list) and len(v) == n for v in level):
+            raise FileFormatError(f"{path}.array: ragged (its lists at depth {len(shape)} "
+                                  f"differ in length or mix lists and numbers)")
+        shape.append(n)
+        if len(shape) > SPEC_LIMITS["ndim"]:
+            raise FileFormatError(f"{path}.array: more than {SPEC_LIMITS['ndim']} dimensions")
+        budget.take(len(level) * n, f"{path}.array")
+        level = [x for v in level for x in v]
+    budget.take(len(level), f"{path}.array", "entries")
+    kinds = {"b": (bool,), "i": (int,), "u": (int,), "f": (int, float)}[dtype.kind]
+    for x in level:
+        if not isinstance(x, kinds) or (isinstance(x, bool) and dtype.kind != "b"):
+            raise FileFormatError(f"{path}.array: an entry {_show(x)} in an array of dtype "
+                                  f"{dtype} (expected {' or '.join(k.__name__ for k in kinds)})")
+    try:
+        out = np.array(top, dtype=dtype)
+    except (OverflowError, ValueError) as e:
+        raise FileFormatError(f"{path}.array: not representable as {dtype}: {e}") from e
+    if out.shape != tuple(shape):
+        raise FileFormatError(f"{path}.array: of shape {out.shape}, expected {tuple(shape)}")
+    return out
+
+
+def _build(node):
+    """The object of a parsed spec: the allowed calls made, innermost first."""
+    if isinstance(node, list):
+        return [_build(v) for v in node]
+    if isinstance(node, tuple):
+        return tuple(_build(v) for v in node)
+    if not isinstance(node, _Call):
+        return node
+    args = [_build(a) for a in node.args]
+    if node.name == _SUM:
+        from .potentials import Potential
+
+        if len(args) != 2 or not all(isinstance(a, Potential) for a in args):
+            raise FileFormatError(
+                f"{node.path}: operator:add adds two potentials, got "
+                f"({', '.join(type(a).__name__ for a in args)})")
+    try:
+        return _allowed(node.name)(*args)
+    except Exception as e:
+        raise FileFormatError(f"{node.path}: {node.name} refused the arguments stored for it: "
+                              f"{type(e).__name__}: {e}") from e
+
+
+def _decode(data, where="system_spec"):
+    """The system of a spec already parsed from JSON (tests; :func:`read` parses the text)."""
+    return _build(_parse_spec(json.dumps(data), where))
 
 
 def _parameters(system):
@@ -269,8 +461,10 @@ def _attributes(traj):
     for name, value in _parameters(traj.system).items():
         attrs[f"system_{name}"] = value
     try:
-        attrs["system_spec"] = json.dumps(_encode(traj.system))
-    except _NotData:
+        spec = json.dumps(_encode(traj.system))
+        _parse_spec(spec)           # within the limits read() applies, or stored pickled only
+        attrs["system_spec"] = spec
+    except (_NotData, FileFormatError):
         pass
     if isinstance(traj.method, str):
         attrs["method"] = traj.method
@@ -313,9 +507,9 @@ def save(traj: Any, path: str | os.PathLike[str], *, allow_pickle: bool = False)
     if "system_spec" not in ds.attrs:
         if not allow_pickle:
             raise InvalidArgumentError(
-                f"invalid system: {traj.system!r:.80} holds Python callables and cannot be "
-                f"stored as data; pass allow_pickle=True to store it pickled (lf.load then "
-                f"needs allow_pickle=True too)")
+                f"invalid system: {traj.system!r:.80} holds Python callables (or arrays beyond "
+                f"lieflow.io.SPEC_LIMITS) and cannot be stored as data; pass allow_pickle=True "
+                f"to store it pickled (lf.load then needs allow_pickle=True too)")
         try:
             import cloudpickle as pickler  # type: ignore[import-untyped]
         except ImportError:
@@ -392,7 +586,11 @@ def read(path: str | os.PathLike[str] | xarray.Dataset, *,
 
 def _system(attrs, allow_pickle):
     if "system_spec" in attrs:
-        return _decode(json.loads(attrs["system_spec"]))
+        system = _build(_parse_spec(attrs["system_spec"]))
+        if not isinstance(system, System):
+            raise FileFormatError(f"system_spec: builds a {type(system).__name__}, not a "
+                                  f"lieflow system")
+        return system
     if "system_pickle" in attrs:
         if not allow_pickle:
             raise FileFormatError(
