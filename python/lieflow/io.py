@@ -41,6 +41,7 @@ import base64
 import importlib
 import inspect
 import json
+import math
 import numbers
 import os
 import re
@@ -430,8 +431,9 @@ def to_xarray(traj: Any, *, observables: bool = True) -> xarray.Dataset:
     if observables and len(traj.t):
         ds["energy"] = (lead + ("time",), np.asarray(traj.energy(), dtype=np.float64))
         inv = np.asarray(traj.invariants(), dtype=np.float64)
-        ds["invariants"] = (lead + ("time", "invariant"), inv.reshape(inv.shape[:len(lead) + 1]
-                                                                      + (-1,)))
+        head = inv.shape[:len(lead) + 1]      # (-1 cannot size an empty batch's)
+        ds["invariants"] = (lead + ("time", "invariant"),
+                            inv.reshape(head + (math.prod(inv.shape[len(head):]),)))
     square = ("attitude_row", "attitude_col")
     if traj.attitude is not None:
         ds["attitude"] = (lead + ("time",) + square, np.asarray(traj.attitude))
