@@ -1043,8 +1043,9 @@ def _check_times(a, t, t0, t_final, dt, save_every, status):
         error = _grid_error(t, t0, dt, save_every, status, t_final)
         if error and inferred:
             error += ("; a run with save_every is taken to be on this grid (a joined run of "
-                      "Trajectory.concatenate whose grids do not line up is not: set the "
-                      "attribute sampling to 'irregular' to load it)")
+                      "Trajectory.concatenate whose grids do not line up is not: load it with "
+                      "ds = xarray.open_dataset(path).load(); ds.attrs['sampling'] = "
+                      "'irregular'; lf.load(ds))")
         if error:
             raise FileFormatError(error)
     return sampling

@@ -594,6 +594,11 @@ def test_irregular_runs_round_trip_in_both_formats(tmp_path):
         np.testing.assert_array_equal(back.states, traj.states, err_msg=name)
     assert joined.to_xarray().attrs["sampling"] == "irregular"
     assert aligned.to_xarray().attrs["sampling"] == "grid"
+    # a format-1 file of a joined run off the grid: refused, saying how to load it
+    with pytest.raises(lf.FileFormatError, match=r"t\[3\] = 0\.07 is not .*sampling'\] = "
+                       r"'irregular'"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        lf.load(as_format_1(joined.to_xarray()))
 
 
 def _with_sampling(ds, value):
