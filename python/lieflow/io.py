@@ -656,13 +656,14 @@ def read(path: str | os.PathLike[str] | xarray.Dataset, *,
     ``save_every``, ``t_final``, ``status``, ``t0``, ``initial_state``, ``initial_attitude`` and
     the events). ``lieflow.load(path)`` is ``Trajectory(**read(path))``.
 
-    What is checked, in this order, before the system is rebuilt: the format; that the system
-    spec is data naming only :data:`ALLOWED_CALLS` (within :data:`SPEC_LIMITS`); the
+    What is checked, in this order, before the system is rebuilt: for a file, that its header
+    declares no more data than the file holds (before xarray opens it); the format; that the
+    system spec is data naming only :data:`ALLOWED_CALLS` (within :data:`SPEC_LIMITS`); the
     checksums (format 2; a format-1 file has none and loads with a ``UserWarning``); the
     metadata against the data (dimensions and shapes, finite increasing times on the grid
-    ``t0 + j * save_every * dt`` when ``sampling`` is ``"grid"``, ``t_final``, the initial and
-    final states against the first and last samples, ``status``, ``dt``, ``save_every``, the
-    events). Then the system is built and the method checked against ``system.methods()``.
+    ``t0 + j * save_every * dt`` when ``sampling`` is ``"grid"``, ``t_final``, the initial and final
+    states against the first and last samples, ``status``, ``dt``, ``save_every``, the events).
+    Then the system is built and the method checked against ``system.methods()``.
 
     Parameters
     ----------
