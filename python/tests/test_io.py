@@ -193,7 +193,8 @@ def test_bad_files_give_clear_errors(tmp_path):
     ds.attrs["lieflow_version"] = "9.0.0"
     newer = tmp_path / "newer.nc"
     ds.to_netcdf(newer)
-    with pytest.raises(lf.FileFormatError, match=r"lieflow 9\.0\.0 in format 2.*upgrade"):
+    with pytest.raises(lf.FileFormatError,
+                       match=rf"lieflow 9\.0\.0 in format {lf.io.FORMAT + 1}.*upgrade"):
         lf.load(newer)
     other = tmp_path / "other.nc"
     xr.Dataset({"x": ("t", np.arange(3.0))}).to_netcdf(other)
