@@ -21,6 +21,12 @@
 //! energy drift over long runs). A solve never fails with its last update below the tolerance (a
 //! sequence still shrinking far below it at max_iter is a solution), and every failure reports
 //! its true last update d_k/s (∞ for a diverged iteration) with the tolerance.
+//!
+//! The floor is where a solver's own iteration has nothing left to gain: ε² for the simplified
+//! Newton iteration of Gauss, a few ε for the Newton iterations of RATTLE and the LGVI (whose next
+//! update would be round-off), 0 (an exactly zero update) for the Lie midpoint. DMV also stops
+//! where its contraction rate bounds the error left below round-off (always below the tolerance),
+//! and the Legendre inversion takes one more Newton step after converging.
 
 /// The acceptance tolerance of the step solves of the integrators, relative to their scale.
 pub const TOL: f64 = 1e-12;
