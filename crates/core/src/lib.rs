@@ -39,6 +39,7 @@
 
 pub mod analysis;
 pub mod check;
+pub mod convergence;
 pub mod elliptic;
 pub mod error;
 pub mod integrate;

@@ -31,6 +31,7 @@
 //!   correction that lands on the other branch), and continuation starts from the branch point
 //!   along it.
 
+use crate::convergence::{self, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::Mat;
 use faer::linalg::solvers::Solve;
@@ -42,7 +43,8 @@ pub const LOCATE_TOL: f64 = 1e-11;
 /// Newton iterations of the corrector.
 const MAX_NEWTON: usize = 12;
 
-/// A corrector whose update stops decreasing is accepted below this relative size.
+/// A corrector whose update stops decreasing is accepted below this relative size (near a
+/// branch point the matrix is ill-conditioned and the update stagnates above round-off).
 const STAGNATION: f64 = 1e-10;
 
 /// A fold is tested only where |dπ/ds| exceeds this (relative to 1 + |π|) on one side: a
@@ -255,8 +257,14 @@ fn correct_from(
 ) -> Result<(Vec<f64>, usize)> {
     let n = u.len();
     let scale = 1.0 + norm(u);
-    let mut prev = f64::INFINITY;
-    for iter in 1..=MAX_NEWTON {
+    // The rule of crate::convergence: done at once below `tol`, accepted below STAGNATION.
+    let rule = Rule {
+        tol: STAGNATION.max(tol),
+        floor: tol,
+        max_iter: MAX_NEWTON,
+    };
+    let mut monitor = convergence::Monitor::new(rule);
+    let failed = loop {
         let f = family.residual(&v)?;
         let j = family.jacobian(&v)?;
         let m = Mat::from_fn(n, n, |r, c| if r + 1 < n { j[(r, c)] } else { t[c] });
@@ -273,25 +281,26 @@ fn correct_from(
             *vk += rhs[(k, 0)];
             dn = dn.max(rhs[(k, 0)].abs());
         }
-        if !dn.is_finite() || v.iter().any(|x| !x.is_finite()) {
-            break;
+        if v.iter().any(|x| !x.is_finite()) {
+            dn = f64::INFINITY;
         }
-        // Converged, or stagnating at the level of round-off (near a branch point the matrix
-        // is ill-conditioned and the update stops decreasing below STAGNATION·scale).
-        if dn <= tol * scale || (dn >= prev && dn <= STAGNATION * scale) {
-            let f = family.residual(&v)?;
-            if f.iter().all(|x| x.is_finite()) {
-                return Ok((v, iter));
+        match monitor.check(dn, scale) {
+            Verdict::Continue => {}
+            Verdict::Converged => {
+                let f = family.residual(&v)?;
+                if f.iter().all(|x| x.is_finite()) {
+                    return Ok((v, monitor.iterations()));
+                }
+                break monitor.failed(f64::INFINITY);
             }
-            break;
+            Verdict::Failed(failed) => break failed,
         }
-        prev = dn;
-    }
+    };
     Err(Error::NotConverged {
         what: "continuation corrector (Newton on F(u) = 0 with the arclength condition)".into(),
-        iterations: MAX_NEWTON,
-        residual: f64::NAN,
-        tol,
+        iterations: failed.iterations,
+        residual: failed.residual,
+        tol: rule.tol,
     })
 }
 

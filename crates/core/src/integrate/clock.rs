@@ -1,6 +1,7 @@
 //! The one clock of a run: which step a stepper is taking and at what time, and the errors that
 //! name them (a [`Violation`] of the domain found in a step, a solver that did not converge).
 
+use crate::convergence::Failed;
 use crate::error::Error;
 
 /// The one clock of a run: the time t₀ of step 0, the step size and the steps already done.
@@ -36,15 +37,10 @@ impl Clock {
         }
     }
 
-    /// The error for a non-converged implicit solve in step `k + 1` of this call.
-    pub fn not_converged(
-        &self,
-        k: usize,
-        what: &str,
-        iterations: usize,
-        residual: f64,
-        tol: f64,
-    ) -> Error {
+    /// The error for an implicit solve of step `k + 1` of this call that failed under the
+    /// [`crate::convergence`] rule with tolerance `tol` (its last update is above it, or not
+    /// finite: the iteration does not contract at this step size).
+    pub fn not_converged(&self, k: usize, what: &str, failed: Failed, tol: f64) -> Error {
         Error::NotConverged {
             what: format!(
                 "{what} in step {} (t = {}, dt = {}; reduce dt)",
@@ -52,8 +48,8 @@ impl Clock {
                 crate::error::fmt_num(self.time(k + 1)),
                 crate::error::fmt_num(self.dt)
             ),
-            iterations,
-            residual,
+            iterations: failed.iterations,
+            residual: failed.residual,
             tol,
         }
     }

@@ -46,12 +46,11 @@ use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use super::method::{Catalog, Clock, Entry, Integrator, Properties, Stepper, System};
-// The fixed-point iterations of the implicit kicks stop by the Lie midpoint's rule.
-use super::methods::lie_midpoint::{MAX_ITER, STAGNATION_TOL};
 use super::methods::{Composition, LieMidpoint};
 use super::problem::{Canonical, GroupField, Problem, VectorField};
 pub use super::problem::{Dissipation, Kick, Perturbation};
 use super::space::{Block, Space};
+use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::{fmt_num, Error, Result};
 
 /// A force F(t, z, out): time, the whole state (user frame), the force on the block (flat).
@@ -62,6 +61,14 @@ pub type ForceFn = Arc<dyn Fn(f64, &[f64], &mut [f64]) -> Result<()> + Send + Sy
 
 /// Evaluates g on the block at (t, z) (internal frame) into `out`.
 type BlockField = Box<dyn FnMut(f64, &[f64], &mut [f64]) -> Result<()> + Send>;
+
+/// The stopping rule of the fixed-point iteration of an implicit kick ([`crate::convergence`];
+/// ‖Δy'‖_∞ relative to max(‖y'‖_∞, 1); ended at once by an update at round-off).
+const KICK_RULE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: f64::EPSILON,
+    max_iter: 60,
+};
 
 /// The kick of a block y of z: y' = y + τ g(t, z with y ← (y + y')/2), by fixed-point iteration;
 /// exact and explicit (one evaluation) when g does not depend on y.
@@ -131,8 +138,7 @@ impl Kick for BlockKick {
         }
         if self.depends {
             mid.copy_from_slice(z);
-            let mut last = f64::INFINITY;
-            let mut iter = 1;
+            let mut monitor = Monitor::new(KICK_RULE);
             loop {
                 prev.copy_from_slice(f);
                 for ((m, y0), y1) in mid[at.clone()]
@@ -143,7 +149,6 @@ impl Kick for BlockKick {
                     *m = 0.5 * (y0 + y1);
                 }
                 g(t, mid, f)?;
-                iter += 1;
                 if f == prev {
                     break; // the same force: y1 is the fixed point (always so for a y-free g)
                 }
@@ -155,7 +160,6 @@ impl Kick for BlockKick {
                     size = size.max(new.abs());
                     *y1 = new;
                 }
-                let tol = STAGNATION_TOL * size;
                 if !d.is_finite() {
                     return Err(clock.left_domain(
                         0,
@@ -167,20 +171,18 @@ impl Kick for BlockKick {
                         },
                     ));
                 }
-                // Converged: the update is at round-off, or has stopped decreasing below tol.
-                if d <= f64::EPSILON * size || (d >= last && last <= tol) {
-                    break;
+                match monitor.check(d, size) {
+                    Verdict::Continue => {}
+                    Verdict::Converged => break,
+                    Verdict::Failed(failed) => {
+                        return Err(clock.not_converged(
+                            0,
+                            &format!("implicit midpoint kick of the {what}"),
+                            failed,
+                            KICK_RULE.tol,
+                        ))
+                    }
                 }
-                if iter >= MAX_ITER {
-                    return Err(clock.not_converged(
-                        0,
-                        &format!("implicit midpoint kick of the {what}"),
-                        MAX_ITER,
-                        d,
-                        tol,
-                    ));
-                }
-                last = d;
             }
         }
         z[at.clone()].copy_from_slice(y1);

@@ -25,8 +25,8 @@
 //! e = (h/2) I⁻¹Y. The implicit equation for e is solved to round-off by Gauss–Seidel sweeps
 //! (a contraction with factor O(|e|) = O(h|Ω|)) from a predictor accurate to O(|e|³), or, where
 //! they contract slowly (large steps), by Newton's method on the same 3-vector equation
-//! (`DmvStepper::solve`); a step whose equation has no solution nearby is
-//! [`crate::Error::NotConverged`] naming the step. The momentum increments are added with
+//! (`DmvStepper::solve`), both under the rule of [`crate::convergence`]; a step whose equation has
+//! no solution nearby is [`crate::Error::NotConverged`] naming the step. The momentum increments are added with
 //! compensated (Kahan) summation.
 //!
 //! **Preprocessing (HV06 §2).** DMV applied to a body with the modified inverse moments
@@ -63,6 +63,7 @@
 //! system with the attitude — their [`Properties::symplectic`] claim is the Poisson one.
 
 use super::top::Top;
+use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::integrate::{Clock, Properties, Stepper};
 use crate::lie::rotations::{matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix};
@@ -76,18 +77,21 @@ pub struct Dmv(pub u32);
 /// The orders there are.
 pub const ORDERS: [u32; 5] = [2, 4, 6, 8, 10];
 
-/// Gauss–Seidel sweeps of the fixed-point iteration at most before Newton's method takes over.
-pub const MAX_FIXED_POINT: usize = 40;
+/// The stopping rule of the Gauss–Seidel sweeps ([`crate::convergence`]; the update relative to
+/// |e|, 1-norms; ended at once at ε²); after `max_iter` sweeps Newton's method takes over.
+pub const FIXED_POINT: Rule = Rule {
+    tol: convergence::TOL,
+    floor: f64::EPSILON * f64::EPSILON,
+    max_iter: 40,
+};
 /// Newton's method takes over when successive fixed-point updates shrink by less than this
 /// factor (steps with |e| ≳ 0.1, where Newton needs fewer iterations).
 pub const SLOW_CONTRACTION: f64 = 0.05;
-/// Newton iterations after the fixed-point iteration.
-pub const MAX_NEWTON: usize = 30;
-/// An iteration that stops decreasing is accepted when its last update is below
-/// `STAGNATION_TOL`·|e| (1-norms).
-pub const STAGNATION_TOL: f64 = 1e-12;
-/// An update below ε²·|e| ends the iteration at once.
-const NEGLIGIBLE: f64 = f64::EPSILON * f64::EPSILON;
+/// The stopping rule of Newton's method after the sweeps (as [`FIXED_POINT`]).
+pub const NEWTON: Rule = Rule {
+    max_iter: 30,
+    ..FIXED_POINT
+};
 
 /// One term num/den · p̂₁^a p̂₂^b p̂₃^c · X^{k−i} Y^i of s or d at h^{2k} (`p` = [a, b, c]).
 #[derive(Clone, Copy, Debug)]
@@ -369,9 +373,6 @@ impl Kernel {
     }
 }
 
-/// Why a solve failed: iterations taken and the last relative update.
-struct Failed(usize, f64);
-
 /// The DMV stepper on M (principal frame) and the attitude quaternion.
 struct DmvStepper {
     series: Series,
@@ -387,10 +388,11 @@ struct DmvStepper {
 
 impl DmvStepper {
     /// Solves e_i = α b_i + fac_i e_j e_k, α = 1 + |e|² ((i, j, k) cyclic): Gauss–Seidel sweeps
-    /// from the predictor while they contract fast (ratio of successive updates ρ ≤
-    /// [`SLOW_CONTRACTION`]), until the update vanishes, or the error left after it
-    /// (≤ ρ/(1 − ρ) times the update) is below ε/8, or it stops decreasing at round-off; a slow
-    /// contraction (large steps) hands the iterate to Newton's method.
+    /// from the predictor under the rule [`FIXED_POINT`] while they contract fast (ratio of
+    /// successive updates ρ ≤ [`SLOW_CONTRACTION`]), ended early where the error left after an
+    /// update (≤ ρ/(1 − ρ) times it) is below ε/8 (round-off reached one sweep before the
+    /// update shows it); a slow contraction (large steps), a non-finite update or no convergence
+    /// hands the solve to Newton's method.
     fn solve(&self, b: [f64; 3]) -> std::result::Result<[f64; 3], Failed> {
         let f = self.kernel.fac;
         // Predictor: the first sweep from e = b (error O(|e|³)).
@@ -398,8 +400,8 @@ impl DmvStepper {
         e[0] = b[0] + f[0] * b[1] * b[2];
         e[1] = b[1] + f[1] * e[0] * b[2];
         e[2] = b[2] + f[2] * e[0] * e[1];
-        let mut prev = f64::INFINITY;
-        for sweep in 1..=MAX_FIXED_POINT {
+        let mut monitor = Monitor::new(FIXED_POINT);
+        loop {
             let alpha = 1.0 + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
             let n0 = alpha * b[0] + f[0] * e[1] * e[2];
             let n1 = alpha * b[1] + f[1] * n0 * e[2];
@@ -407,24 +409,21 @@ impl DmvStepper {
             let diff = (n0 - e[0]).abs() + (n1 - e[1]).abs() + (n2 - e[2]).abs();
             let size = n0.abs() + n1.abs() + n2.abs();
             e = [n0, n1, n2];
-            if !diff.is_finite() {
-                break;
-            }
-            let rho = diff / prev;
-            if diff <= NEGLIGIBLE * size
-                || (sweep >= 2
-                    && rho <= SLOW_CONTRACTION
-                    && diff * rho <= 0.125 * f64::EPSILON * size * (1.0 - rho))
-                || (diff >= prev && diff <= STAGNATION_TOL * size)
-            {
+            let rho = diff / monitor.last();
+            let fast = monitor.iterations() >= 1 && rho <= SLOW_CONTRACTION;
+            if fast && diff * rho <= 0.125 * f64::EPSILON * size * (1.0 - rho) {
                 return Ok(e);
             }
-            if sweep >= 2 && rho > SLOW_CONTRACTION {
-                return self.newton(b, e);
+            match monitor.check(diff, size) {
+                Verdict::Converged => return Ok(e),
+                Verdict::Failed(_) => break,
+                Verdict::Continue if monitor.iterations() >= 2 && rho > SLOW_CONTRACTION => {
+                    return self.newton(b, e)
+                }
+                Verdict::Continue => {}
             }
-            prev = diff;
         }
-        // Not finite, or no contraction: Newton from the predictor.
+        // Not finite, or no convergence: Newton from the predictor.
         let mut e = [0.0; 3];
         e[0] = b[0] + f[0] * b[1] * b[2];
         e[1] = b[1] + f[1] * e[0] * b[2];
@@ -432,13 +431,13 @@ impl DmvStepper {
         self.newton(b, e)
     }
 
-    /// Newton's method for the same equation from `e`, until the update vanishes, or is below
-    /// 10⁻⁹|e| in the quadratic regime (below 10⁻⁴ of the one before: what is left is of the
-    /// order of its square), or stops decreasing at round-off.
+    /// Newton's method for the same equation from `e` under the rule [`NEWTON`], ended early in
+    /// the quadratic regime (an update below 10⁻⁹|e| and 10⁻⁴ of the one before: what is left is
+    /// of the order of its square).
     fn newton(&self, b: [f64; 3], mut e: [f64; 3]) -> std::result::Result<[f64; 3], Failed> {
         let f = self.kernel.fac;
-        let mut prev = f64::INFINITY;
-        for iter in 1..=MAX_NEWTON {
+        let mut monitor = Monitor::new(NEWTON);
+        loop {
             let alpha = 1.0 + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
             let g = [
                 e[0] - alpha * b[0] - f[0] * e[1] * e[2],
@@ -457,29 +456,23 @@ impl DmvStepper {
                 -2.0 * b[2] * e[1] - f[2] * e[0],
                 1.0 - 2.0 * b[2] * e[2],
             );
-            let size = e[0].abs() + e[1].abs() + e[2].abs();
             let Some(inv) = j.try_inverse() else {
-                return Err(Failed(iter, (g[0].abs() + g[1].abs() + g[2].abs()) / size));
+                let size = e[0].abs() + e[1].abs() + e[2].abs();
+                return Err(monitor.failed((g[0].abs() + g[1].abs() + g[2].abs()) / size));
             };
             let de = inv * Vector3::from(g);
             e = [e[0] - de[0], e[1] - de[1], e[2] - de[2]];
             let diff = de.lp_norm(1);
             let size = e[0].abs() + e[1].abs() + e[2].abs();
-            if !diff.is_finite() {
-                return Err(Failed(iter, f64::INFINITY));
-            }
-            if diff <= NEGLIGIBLE * size
-                || (diff <= 1e-9 * size && diff <= 1e-4 * prev)
-                || (diff >= prev && diff <= STAGNATION_TOL * size)
-            {
+            if diff <= 1e-9 * size && diff <= 1e-4 * monitor.last() {
                 return Ok(e);
             }
-            prev = diff;
+            match monitor.check(diff, size) {
+                Verdict::Continue => {}
+                Verdict::Converged => return Ok(e),
+                Verdict::Failed(failed) => return Err(failed),
+            }
         }
-        Err(Failed(
-            MAX_NEWTON,
-            prev / (e[0].abs() + e[1].abs() + e[2].abs()),
-        ))
     }
 
     fn step(&mut self) -> std::result::Result<(), Failed> {
@@ -533,13 +526,12 @@ impl Stepper for DmvStepper {
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
         for k in 0..steps {
-            self.step().map_err(|Failed(iterations, residual)| {
+            self.step().map_err(|failed| {
                 clock.not_converged(
                     k,
                     "DMV iteration for the relative rotation",
-                    iterations,
-                    residual,
-                    STAGNATION_TOL,
+                    failed,
+                    NEWTON.tol,
                 )
             })?;
         }

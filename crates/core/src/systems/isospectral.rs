@@ -14,24 +14,28 @@
 //! The attitude is reconstructed by R_{n+1} = R_n Qᵀ = R_n cay(h Ω̃), which keeps R M Rᵀ.
 //!
 //! The implicit equation for M̃ is solved by the fixed-point iteration
-//! M̃ ← M_n − h/2 [Ω̃, M̃] + h²/4 Ω̃ M̃ Ω̃ (a contraction for h‖Ω‖ small), stopped when the update
-//! is below [`TOL`] relative to max|M_n| (or stagnates at round-off below 1e-12); otherwise
-//! [`crate::Error::NotConverged`] naming the step.
+//! M̃ ← M_n − h/2 [Ω̃, M̃] + h²/4 Ω̃ M̃ Ω̃ (a contraction for h‖Ω‖ small) under the rule of
+//! [`crate::convergence`] ([`RULE`]: the update relative to max|M_n|); a step whose update is still
+//! above the tolerance after [`RULE`]`.max_iter` iterations is [`crate::Error::NotConverged`].
 //!
 //! The method value is [`Isospectral`], in the catalogs of [`super::RigidBody`] (through the
 //! so(3) matrix hat(M), with the attitude) and [`super::GeneralizedRigidBody`].
 
 use super::top;
 use super::{GeneralizedRigidBody, RigidBody};
+use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::{Clock, Integrator, Properties, Stepper};
 use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
 
-/// Relative tolerance of the fixed-point iteration (a few units of round-off).
-pub const TOL: f64 = 4.0 * f64::EPSILON;
-/// Maximal number of fixed-point iterations per step.
-pub const MAX_ITER: usize = 100;
+/// The stopping rule of the fixed-point iteration ([`crate::convergence`]; the update of M̃
+/// relative to max|M_n|; ended at once at 4ε).
+pub const RULE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 4.0 * f64::EPSILON,
+    max_iter: 100,
+};
 
 /// The isospectral midpoint for Ω(M)_ij = M_ij / d_ij, with d_ij = J_i + J_j for the generalized
 /// rigid body M = JΩ + ΩJ. Matrices are dense row-major n×n; all scratch is allocated once.
@@ -79,7 +83,7 @@ impl IsospectralMidpoint {
 
     /// One step on the skew matrix `m` (row-major n×n), in place; on failure the iterations
     /// taken and the last relative update (∞ for a diverged iteration).
-    pub fn step(&mut self, m: &mut [f64]) -> std::result::Result<(), (usize, f64)> {
+    pub fn step(&mut self, m: &mut [f64]) -> std::result::Result<(), Failed> {
         let n = self.n;
         let (a, a2) = (0.5 * self.h, 0.25 * self.h * self.h);
         self.m0.copy_from_slice(m);
@@ -88,8 +92,7 @@ impl IsospectralMidpoint {
             .iter()
             .fold(0.0f64, |s, x| s.max(x.abs()))
             .max(f64::MIN_POSITIVE);
-        let mut prev = f64::INFINITY;
-        let mut iter = 0;
+        let mut monitor = Monitor::new(RULE);
         loop {
             for k in 0..n * n {
                 self.w[k] = self.mt[k] * self.inv_d[k];
@@ -108,17 +111,12 @@ impl IsospectralMidpoint {
                     self.mt[j * n + i] = -v;
                 }
             }
-            iter += 1;
-            if !finite || !diff.is_finite() {
-                return Err((iter, f64::INFINITY));
+            let update = if finite { diff } else { f64::INFINITY };
+            match monitor.check(update, scale) {
+                Verdict::Continue => {}
+                Verdict::Converged => break,
+                Verdict::Failed(failed) => return Err(failed),
             }
-            if diff <= TOL * scale || (diff >= prev && diff <= 1e-12 * scale) {
-                break;
-            }
-            if iter >= MAX_ITER {
-                return Err((iter, diff / scale));
-            }
-            prev = diff;
         }
         for k in 0..n * n {
             self.w[k] = self.mt[k] * self.inv_d[k];
@@ -155,13 +153,12 @@ fn matmul(n: usize, a: &[f64], b: &[f64], c: &mut [f64]) {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Isospectral;
 
-fn failed(clock: &Clock, k: usize, (iterations, residual): (usize, f64)) -> crate::Error {
+fn failed(clock: &Clock, k: usize, failed: Failed) -> crate::Error {
     clock.not_converged(
         k,
         "isospectral midpoint fixed-point iteration",
-        iterations,
-        residual,
-        TOL,
+        failed,
+        RULE.tol,
     )
 }
 

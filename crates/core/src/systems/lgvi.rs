@@ -13,7 +13,8 @@
 //! F = (I − ĝ)⁻¹(I + ĝ) = I + 2(ĝ + ĝ²)/(1 + |g|²) one has (derived here, using
 //! ĝJ_d + J_dĝ = (Jg)^ and [ĝ², J_d] = (g × Jg)^)
 //! F J_d − J_d Fᵀ = 2 (Jg + g × Jg)^ / (1 + |g|²), so the implicit equation is the 3-vector
-//! equation 2(Jg + g × Jg) = h P (1 + |g|²), P = Π_k + (h/2)τ_k, solved by Newton's method.
+//! equation 2(Jg + g × Jg) = h P (1 + |g|²), P = Π_k + (h/2)τ_k, solved by Newton's method under
+//! the rule of [`crate::convergence`] ([`RULE`]: |Δg| relative to 1 + |g|).
 //!
 //! The method value is [`Lgvi`], in the catalogs of [`super::RigidBody`] and [`super::HeavyTop`]
 //! (as `lgvi`); it works on the same state layout as the splitting (the private `top::Top`).
@@ -23,15 +24,19 @@
 //! rotation Fᵀ and by kicks orthogonal to Γ.
 
 use super::top::{Top, TopWork};
+use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::{Clock, Stepper};
 use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
 
-/// Newton tolerance on |Δg| relative to 1 + |g|.
-pub const TOL: f64 = 2.0 * f64::EPSILON;
-/// Maximal Newton iterations per step.
-pub const MAX_ITER: usize = 30;
+/// The stopping rule of the Newton iteration ([`crate::convergence`]; |Δg| relative to 1 + |g|;
+/// ended at once at 2ε, where the next update would be round-off).
+pub const RULE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 2.0 * f64::EPSILON,
+    max_iter: 30,
+};
 
 /// The Lie group variational integrator (a method value), order 2.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -77,29 +82,27 @@ struct LgviStepper {
     carry_g: Vector3<f64>,
 }
 
-/// Why a Newton solve stopped: iterations and last residual.
-struct Failed(usize, f64);
-
 impl LgviStepper {
     /// Solves 2(Jg + g × Jg) = P (1 + |g|²) for the Cayley vector g of F (P = h·momentum).
     fn solve(&self, p: &Vector3<f64>) -> std::result::Result<Vector3<f64>, Failed> {
         let j = Matrix3::from_diagonal(&self.j);
         let mut g = p.component_div(&self.j) * 0.5;
-        for iter in 1..=MAX_ITER {
+        let mut monitor = Monitor::new(RULE);
+        loop {
             let jg = j * g;
             let phi = (jg + g.cross(&jg)) * 2.0 - p * (1.0 + g.norm_squared());
             let jac = (j + so3::hat(&g) * j - so3::hat(&jg)) * 2.0 - p * g.transpose() * 2.0;
-            let dg = jac.lu().solve(&phi).ok_or(Failed(iter, phi.norm()))?;
+            let dg = jac
+                .lu()
+                .solve(&phi)
+                .ok_or_else(|| monitor.failed(f64::INFINITY))?;
             g -= dg;
-            let size = dg.norm();
-            if !size.is_finite() {
-                return Err(Failed(iter, f64::INFINITY));
-            }
-            if size <= TOL * (1.0 + g.norm()) {
-                return Ok(g);
+            match monitor.check(dg.norm(), 1.0 + g.norm()) {
+                Verdict::Continue => {}
+                Verdict::Converged => return Ok(g),
+                Verdict::Failed(failed) => return Err(failed),
             }
         }
-        Err(Failed(MAX_ITER, f64::NAN))
     }
 
     fn torque(&self, gamma: &Option<Vector3<f64>>) -> Vector3<f64> {
@@ -157,15 +160,9 @@ impl Stepper for LgviStepper {
         for k in 0..steps {
             match self.step(w) {
                 Ok(next) => w = next,
-                Err(Failed(iterations, residual)) => {
+                Err(failed) => {
                     self.w = Some(w);
-                    return Err(clock.not_converged(
-                        k,
-                        "LGVI Newton iteration",
-                        iterations,
-                        residual,
-                        TOL,
-                    ));
+                    return Err(clock.not_converged(k, "LGVI Newton iteration", failed, RULE.tol));
                 }
             }
         }

@@ -157,6 +157,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::surface::{self, inverse, Geometry, Plane, Surface};
 use super::tangent_top::TangentTop;
 use crate::check;
+use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::{Canonical, VectorField};
@@ -171,13 +172,18 @@ struct Derivs {
     hess: Matrix3<f64>,
 }
 
-/// Maximal Newton iterations of the Legendre inversion.
-const LEGENDRE_MAX_ITER: usize = 60;
+/// The stopping rule of the Legendre inversion ([`crate::convergence`]; the Newton step relative
+/// to 1 + |q̇|_∞; ended at once at 10⁻¹³, after which one more step brings q̇ to round-off).
+const LEGENDRE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 1e-13,
+    max_iter: 60,
+};
 
 /// Solves ∂L/∂q̇(q, q̇) = p for q̇ by Newton's method with a Cholesky-factored Hessian (so that the
 /// Hessian is positive definite at the answer), halving steps that leave the domain (`derivs`
-/// returns None there). Starts from `guess`; iterates until the step reaches round-off, then takes
-/// one more step. None when it fails (singular or indefinite Hessian, no convergence).
+/// returns None there), from `guess`, under the rule [`LEGENDRE`], then takes one more step. None
+/// when it fails (singular or indefinite Hessian, no convergence).
 fn legendre_inverse(
     p: &[f64],
     guess: Vector3<f64>,
@@ -186,8 +192,9 @@ fn legendre_inverse(
     let p = Vector3::new(p[0], p[1], p[2]);
     let mut v = guess;
     let mut d = derivs(&v)?;
+    let mut monitor = Monitor::new(LEGENDRE);
     let mut polish = false;
-    for _ in 0..LEGENDRE_MAX_ITER {
+    loop {
         let chol = d.hess.cholesky()?;
         let step = chol.solve(&(p - d.lv));
         let mut t = 1.0;
@@ -204,14 +211,14 @@ fn legendre_inverse(
         v = nv;
         d = nd;
         if polish {
-            return (d.hess.cholesky().is_some()).then_some((v, d));
+            return d.hess.cholesky().is_some().then_some((v, d));
         }
-        let scale = 1.0 + v.amax();
-        if step.amax() * t <= 1e-13 * scale {
-            polish = true;
+        match monitor.check(step.amax() * t, 1.0 + v.amax()) {
+            Verdict::Continue => {}
+            Verdict::Converged => polish = true,
+            Verdict::Failed(_) => return None,
         }
     }
-    None
 }
 
 /// The state layout shared by both systems.

@@ -11,13 +11,14 @@
 //! symmetric (a_ij + a_{s+1−i, s+1−j} = b_j), so time-reversible for reversible problems.
 //!
 //! **The implicit solve** (HLW §VIII.6, simplified Newton): with J ≈ f'(y), by forward
-//! differences of [`Canonical::gradient`] at the start of each step (step δ_j = √ε·max(|y_j|,
-//! ‖y‖_∞)), the s·d̂ × s·d̂ matrix I − h A⊗J (d̂ = 2·dof) is LU-factored once per step (faer,
-//! partial pivoting, storage allocated with the stepper), and
+//! differences of [`Canonical::gradient`] at the start of each step, the s·d̂ × s·d̂ matrix
+//! I − h A⊗J (d̂ = 2·dof) is LU-factored once per step (faer, partial pivoting, storage allocated
+//! with the stepper), and
 //! (I − h A⊗J) ΔZ = −Z + h (A⊗I) F(Z),  Z ← Z + ΔZ
-//! is iterated from Z_i = h c_i f(y) until ‖ΔZ‖_∞ falls below ε²‖y‖_∞ or stops decreasing
-//! (round-off reached) below [`STAGNATION_TOL`]·‖y‖_∞; otherwise [`crate::Error::NotConverged`] names the
-//! step after [`MAX_ITER`] iterations. The update uses the stage derivatives F of the last
+//! is iterated from Z_i = h c_i f(y) under the rule of [`crate::convergence`] ([`RULE`]: ‖ΔZ‖_∞
+//! relative to ‖y‖_∞, accepted below 10⁻¹², then on while it decreases, at once below ε²);
+//! [`crate::Error::NotConverged`] names a step whose update is still above the tolerance after
+//! [`RULE`]`.max_iter` iterations. The update uses the stage derivatives F of the last
 //! iteration (they differ from those at the final Z by round-off) and compensated (Kahan)
 //! summation. Both the stopping rule and the summation follow Hairer, McLachlan & Razakarivony,
 //! "Achieving Brouwer's law with implicit Runge–Kutta methods", BIT 48 (2008), and matter: with a
@@ -25,9 +26,18 @@
 //! h = 0.02 showed a linear energy drift of 2.4e-13 (relative) over 10⁵ steps; with it, the
 //! energy error stays at 2e-15.
 //!
+//! **The difference steps** are δ_j = √ε‖y‖_∞, except for a component whose own scale
+//! s_j = max(|y_j|, |h f_j(y)|) (its size and its motion in one step) is smaller than that: then
+//! δ_j = √ε s_j, so that a component far smaller than ‖y‖ that moves on its own scale (y → 0 on
+//! the hyperbolic plane, where p_y ~ 1/y) is not perturbed beyond it — √ε‖y‖_∞ made J wrong by
+//! orders of magnitude there, and the iteration contract so slowly that it failed. Where the
+//! effect of √ε s_j on f is lost in the rounding of f (a component at round-off level while f is
+//! not), the step is √ε‖y‖_∞ again.
+//!
 //! The coefficients are the closed forms of HLW §II.1.3, evaluated in double precision
 //! (√3 and √15 correctly rounded; every coefficient within an ulp or two of its exact value).
 
+use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::Canonical;
@@ -40,14 +50,15 @@ pub struct Gauss(pub usize);
 /// The implicit midpoint rule y_{n+1} = y_n + h f((y_n + y_{n+1})/2), the one-stage Gauss method.
 pub const IMPLICIT_MIDPOINT: Gauss = Gauss(1);
 
-/// The simplified Newton iteration stops when its update ΔZ vanishes or stops decreasing
-/// (round-off reached), and is accepted then if ‖ΔZ‖_∞ ≤ `STAGNATION_TOL`·‖y‖_∞.
-pub const STAGNATION_TOL: f64 = 1e-12;
-/// Maximal number of simplified Newton iterations per step.
-pub const MAX_ITER: usize = 50;
-
-/// ‖ΔZ‖_∞ ≤ ε²·‖y‖_∞ ends the iteration whether or not it still decreases.
-const NEGLIGIBLE: f64 = f64::EPSILON * f64::EPSILON;
+/// The stopping rule of the simplified Newton iteration ([`crate::convergence`]; ‖ΔZ‖_∞
+/// relative to ‖y‖_∞). The floor ε² ends it once ΔZ is far below round-off, where a sequence
+/// that keeps shrinking in components far smaller than ‖y‖ (as at a relative equilibrium where ṗ
+/// is round-off) would otherwise run to `max_iter`.
+pub const RULE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: f64::EPSILON * f64::EPSILON,
+    max_iter: 50,
+};
 
 /// Butcher tableau (A row-major s×s, b, c) of the s-stage Gauss method, HLW §II.1.3.
 fn tableau(s: usize) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
@@ -166,7 +177,7 @@ fn max_abs(v: &[f64]) -> f64 {
 impl<P: Canonical> GaussStepper<P> {
     /// One step; on failure the iterations taken and the last relative update (∞ when the
     /// iteration diverged or the stage matrix is singular).
-    fn step(&mut self) -> std::result::Result<(), (usize, f64)> {
+    fn step(&mut self) -> std::result::Result<(), Failed> {
         let GaussStepper {
             problem,
             s,
@@ -189,19 +200,31 @@ impl<P: Canonical> GaussStepper<P> {
         } = self;
         let (s, h, n) = (*s, *h, y.len());
         field(problem, y, f0, hq, hp);
-        // J ≈ f'(y) by forward differences, column by column.
+        // J ≈ f'(y) by forward differences, column by column (module docs: the steps).
         let ynorm = max_abs(y);
+        let root = f64::EPSILON.sqrt();
+        let wide = root * if ynorm > 0.0 { ynorm } else { 1.0 };
         for j in 0..n {
-            yt.copy_from_slice(y);
-            let mut delta = f64::EPSILON.sqrt() * y[j].abs().max(ynorm);
-            if delta == 0.0 {
-                delta = f64::EPSILON.sqrt();
-            }
-            yt[j] += delta;
-            let delta = yt[j] - y[j];
-            field(problem, yt, ft, hq, hp);
-            for r in 0..n {
-                jac[r * n + j] = (ft[r] - f0[r]) / delta;
+            // The component's own scale (its size and its motion in one step), and √ε‖y‖_∞.
+            let own = y[j].abs().max((h * f0[j]).abs());
+            let steps = [root * own, wide];
+            let first = if own > 0.0 && own < wide { 0 } else { 1 };
+            for (k, &step) in steps.iter().enumerate().skip(first) {
+                yt.copy_from_slice(y);
+                yt[j] += step;
+                field(problem, yt, ft, hq, hp);
+                let lost = k == 0
+                    && (0..n).any(|r| ft[r] != f0[r])
+                    && (0..n).all(|r| {
+                        (ft[r] - f0[r]).abs() <= 4.0 * f64::EPSILON * f0[r].abs().max(ft[r].abs())
+                    });
+                if !lost {
+                    let delta = yt[j] - y[j];
+                    for r in 0..n {
+                        jac[r * n + j] = (ft[r] - f0[r]) / delta;
+                    }
+                    break;
+                }
             }
         }
         // I − h A⊗J.
@@ -218,7 +241,10 @@ impl<P: Canonical> GaussStepper<P> {
             }
         }
         if !lu.factor() {
-            return Err((0, f64::INFINITY));
+            return Err(Failed {
+                iterations: 0,
+                residual: f64::INFINITY,
+            });
         }
         for i in 0..s {
             for k in 0..n {
@@ -226,10 +252,8 @@ impl<P: Canonical> GaussStepper<P> {
             }
         }
         let scale = ynorm.max(f64::MIN_POSITIVE);
-        let mut prev = f64::INFINITY;
-        let mut iter = 0;
+        let mut monitor = Monitor::new(RULE);
         loop {
-            iter += 1;
             for i in 0..s {
                 for k in 0..n {
                     yt[k] = y[k] + z[i * n + k];
@@ -247,22 +271,14 @@ impl<P: Canonical> GaussStepper<P> {
             }
             lu.solve(dz);
             let norm = max_abs(dz);
-            if !norm.is_finite() {
-                return Err((iter, f64::INFINITY));
-            }
             for (zk, dk) in z.iter_mut().zip(dz.iter()) {
                 *zk += dk;
             }
-            // Done when ΔZ vanishes, stagnates at round-off, or has fallen far below it (a
-            // sequence that keeps shrinking in components far smaller than ‖y‖, as at a
-            // relative equilibrium where ṗ is round-off, would otherwise run out of iterations).
-            if norm <= NEGLIGIBLE * scale || (norm >= prev && norm <= STAGNATION_TOL * scale) {
-                break;
+            match monitor.check(norm, scale) {
+                Verdict::Continue => {}
+                Verdict::Converged => break,
+                Verdict::Failed(failed) => return Err(failed),
             }
-            if iter >= MAX_ITER {
-                return Err((iter, norm / scale));
-            }
-            prev = norm;
         }
         // y ← y + h Σ b_i F_i, Kahan-compensated.
         for k in 0..n {
@@ -292,16 +308,15 @@ impl<P: Canonical> Stepper for GaussStepper<P> {
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
         for k in 0..steps {
-            self.step().map_err(|(iterations, residual)| {
+            self.step().map_err(|failed| {
                 clock.not_converged(
                     k,
                     &format!(
                         "Gauss–Legendre ({} stages) simplified Newton iteration",
                         self.s
                     ),
-                    iterations,
-                    residual,
-                    STAGNATION_TOL,
+                    failed,
+                    RULE.tol,
                 )
             })?;
         }

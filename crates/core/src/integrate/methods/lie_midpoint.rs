@@ -21,22 +21,26 @@
 //! (HLW §XI, reversible perturbation theory) where the method is not symplectic.
 //!
 //! **The implicit solve** is a fixed-point iteration from k = h ξ(z) (a contraction for
-//! h·Lip(ξ) < 2), continued until the update vanishes or stops decreasing (round-off reached,
-//! the stopping rule of [`crate::integrate::methods::gauss`] after Hairer, McLachlan &
-//! Razakarivony 2008, so that an early stop does not leave a systematic O(tol) energy drift);
-//! it is accepted then if ‖Δk‖_∞ ≤ [`STAGNATION_TOL`]·max(‖k‖_∞, 1), else
-//! [`crate::Error::NotConverged`] names the step after [`MAX_ITER`] iterations. A non-finite
-//! increment stops the run with [`crate::Error::LeftDomain`].
+//! h·Lip(ξ) < 2) under the rule of [`crate::convergence`] ([`RULE`]: ‖Δk‖_∞ relative to
+//! max(‖k‖_∞, 1), accepted below 10⁻¹², then on until the update vanishes or stops decreasing,
+//! so that an early stop does not leave a systematic O(tol) energy drift);
+//! [`crate::Error::NotConverged`] names a step whose update is still above the tolerance after
+//! [`RULE`]`.max_iter` iterations. A non-finite increment stops the run with
+//! [`crate::Error::LeftDomain`].
 
+use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::methods::Composition;
 use crate::integrate::problem::{GroupField, Violation};
 
-/// Acceptance threshold of the fixed-point iteration at stagnation, relative to max(‖k‖_∞, 1).
-pub const STAGNATION_TOL: f64 = 1e-12;
-/// Maximal number of fixed-point iterations per (sub)step.
-pub const MAX_ITER: usize = 60;
+/// The stopping rule of the fixed-point iteration ([`crate::convergence`]; ‖Δk‖_∞ relative to
+/// max(‖k‖_∞, 1); ended at once by a zero update only).
+pub const RULE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 0.0,
+    max_iter: 60,
+};
 
 /// The implicit Lie-group midpoint rule composed with the weights of a [`Composition`]
 /// (`Composition::strang()`: the rule itself, order 2). Symmetric; keeps the group orbit.
@@ -104,7 +108,7 @@ struct MidpointStepper<P: GroupField> {
 /// Why a substep failed.
 enum Failure {
     NotFinite,
-    NotConverged(f64, f64),
+    NotConverged(Failed),
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
@@ -126,8 +130,7 @@ impl<P: GroupField> MidpointStepper<P> {
         } = self;
         problem.generator(y, k, scratch);
         k.iter_mut().for_each(|x| *x *= h);
-        let mut prev = f64::INFINITY;
-        let mut iter = 0;
+        let mut monitor = Monitor::new(RULE);
         loop {
             for (hi, ki) in half.iter_mut().zip(k.iter()) {
                 *hi = 0.5 * ki;
@@ -144,15 +147,11 @@ impl<P: GroupField> MidpointStepper<P> {
             if !d.is_finite() {
                 return Err(Failure::NotFinite);
             }
-            iter += 1;
-            let tol = STAGNATION_TOL * inf_norm(k).max(1.0);
-            if d == 0.0 || (d >= prev && prev <= tol) {
-                break;
+            match monitor.check(d, inf_norm(k).max(1.0)) {
+                Verdict::Continue => {}
+                Verdict::Converged => break,
+                Verdict::Failed(failed) => return Err(Failure::NotConverged(failed)),
             }
-            if iter >= MAX_ITER {
-                return Err(Failure::NotConverged(d, tol));
-            }
-            prev = d;
         }
         problem.act(k, y, scratch);
         Ok(())
@@ -187,13 +186,12 @@ impl<P: GroupField> Stepper for MidpointStepper<P> {
                             },
                         ))
                     }
-                    Err(Failure::NotConverged(d, tol)) => {
+                    Err(Failure::NotConverged(failed)) => {
                         return Err(clock.not_converged(
                             s,
                             "Lie midpoint fixed-point iteration",
-                            MAX_ITER,
-                            d,
-                            tol,
+                            failed,
+                            RULE.tol,
                         ))
                     }
                 }

@@ -27,11 +27,12 @@
 //!
 //! **Solves.** With w = (h/2)μ and the rows W_b = M⁻¹A_b(q_n)ᵀ, the midpoint condition
 //! F(w) = A(q̄(w)) M⁻¹(p̃ − A(q_n)ᵀw) = 0 (p̃ = p_n + h/2 f(q_n)) is solved by a simplified Newton
-//! iteration with the matrix A(q̄^{(k)}) Wᵀ (the neglected derivative of A along q̄ is O(h)), until
-//! the momentum update is below [`TOL`]·‖p̃‖_∞ (or stagnates below [`STAGNATION_TOL`]·‖p̃‖_∞);
-//! the last substep is the linear projection of RATTLE ([`super::rattle`]).
+//! iteration with the matrix A(q̄^{(k)}) Wᵀ (the neglected derivative of A along q̄ is O(h)), under
+//! the rule of [`crate::convergence`] ([`RULE`]: the momentum update relative to ‖p̃‖_∞); the
+//! last substep is the linear projection of RATTLE ([`super::rattle`]).
 
 use super::rattle::{axpy, dot, max_abs, singular, Failure, Rows};
+use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::{Nonholonomic, Separable, Violation};
@@ -40,12 +41,13 @@ use crate::integrate::problem::{Nonholonomic, Separable, Violation};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct NonholonomicRattle;
 
-/// Relative tolerance of the multiplier iteration (momentum update relative to ‖p̃‖_∞).
-pub const TOL: f64 = 4.0 * f64::EPSILON;
-/// An iteration whose update stops decreasing is accepted below this relative bound.
-pub const STAGNATION_TOL: f64 = 1e-12;
-/// Maximal number of iterations per step.
-pub const MAX_ITER: usize = 50;
+/// The stopping rule of the multiplier iteration ([`crate::convergence`]; the momentum update
+/// relative to ‖p̃‖_∞; ended at once at 4ε).
+pub const RULE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 4.0 * f64::EPSILON,
+    max_iter: 50,
+};
 
 impl<P: Nonholonomic + Clone + 'static> Integrator<P> for NonholonomicRattle {
     fn properties(&self) -> Properties {
@@ -129,8 +131,8 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
         self.half_step();
         if m > 0 {
             let scale = max_abs(&self.p).max(f64::MIN_POSITIVE);
-            let mut prev = f64::INFINITY;
-            for iter in 1..=MAX_ITER {
+            let mut monitor = Monitor::new(RULE);
+            loop {
                 self.problem.constraint_matrix(&self.qbar, &mut self.abar);
                 for a in 0..m {
                     self.r[a] = dot(&self.abar[a * d..(a + 1) * d], &self.v);
@@ -146,16 +148,11 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
                     norm = norm.max(dp.abs());
                 }
                 self.half_step();
-                if !norm.is_finite() {
-                    return Err(Failure::NotConverged(iter, f64::INFINITY));
+                match monitor.check(norm, scale) {
+                    Verdict::Continue => {}
+                    Verdict::Converged => break,
+                    Verdict::Failed(failed) => return Err(Failure::NotConverged(failed)),
                 }
-                if norm <= TOL * scale || (norm >= prev && norm <= STAGNATION_TOL * scale) {
-                    break;
-                }
-                if iter == MAX_ITER {
-                    return Err(Failure::NotConverged(iter, norm / scale));
-                }
-                prev = norm;
             }
         }
         // q_{n+1} = q_n + h M⁻¹p_{n+1/2}.
@@ -192,7 +189,7 @@ impl<P: Nonholonomic> Stepper for NonholonomicStepper<P> {
                     &clock,
                     k,
                     "nonholonomic RATTLE midpoint constraint (iteration for the multipliers)",
-                    TOL,
+                    RULE.tol,
                 )
             })?;
         }

@@ -27,8 +27,8 @@
 //! **Solves.** With ν = (h²/2)λ and the rows W_b = M⁻¹G_b(q_n)ᵀ (from [`Separable::velocity`],
 //! linear), the position is q_{n+1} = q̃ − Σ_b ν_b W_b with q̃ = q_n + h M⁻¹(p_n + h/2 f(q_n)), and
 //! ν solves g(q̃ − Σ ν_b W_b) = c by Newton's method (the m×m Jacobian G(q_{n+1}^{(k)}) Wᵀ is
-//! refactored every iteration), until the position update is below [`TOL`]·‖q‖_∞ (or stagnates
-//! below [`STAGNATION_TOL`]·‖q‖_∞); then p_{n+1/2} = p̃ − G(q_n)ᵀν/h. The multiplier μ solves the
+//! refactored every iteration) under the rule of [`crate::convergence`] ([`RULE`]: the position
+//! update relative to ‖q‖_∞); then p_{n+1/2} = p̃ − G(q_n)ᵀν/h. The multiplier μ solves the
 //! linear m×m system (G M⁻¹Gᵀ)(q_{n+1}) κ = G M⁻¹ p̃ (κ = hμ/2). G, W and f at
 //! q_{n+1} are reused by the next (sub)step.
 //!
@@ -38,6 +38,7 @@
 //! multiplier for which d²/dt² g(q(t)) = 0), the limit of RATTLE's λ and μ as h → 0.
 
 use super::gauss::DenseLu;
+use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::methods::Composition;
@@ -61,18 +62,19 @@ impl Default for Rattle {
     }
 }
 
-/// Relative tolerance of the Newton iteration for the position multipliers (on the position
-/// update, relative to ‖q‖_∞).
-pub const TOL: f64 = 4.0 * f64::EPSILON;
-/// An iteration whose update stops decreasing is accepted below this relative bound.
-pub const STAGNATION_TOL: f64 = 1e-12;
-/// Maximal number of Newton iterations per step.
-pub const MAX_ITER: usize = 50;
+/// The stopping rule of the Newton iteration for the position multipliers
+/// ([`crate::convergence`]; the position update relative to ‖q‖_∞; ended at once at 4ε, where
+/// the next Newton update would be round-off).
+pub const RULE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 4.0 * f64::EPSILON,
+    max_iter: 50,
+};
 
 /// Why a constrained step failed.
 pub(crate) enum Failure {
-    /// The multiplier iteration did not converge: (iterations, last relative update).
-    NotConverged(usize, f64),
+    /// The multiplier iteration did not converge.
+    NotConverged(Failed),
     /// A state outside the problem's domain, or constraints that lost rank.
     Domain(Violation),
 }
@@ -82,9 +84,7 @@ impl Failure {
     /// tolerance.
     pub(crate) fn into_error(self, clock: &Clock, k: usize, solve: &str, tol: f64) -> crate::Error {
         match self {
-            Failure::NotConverged(iterations, residual) => {
-                clock.not_converged(k, solve, iterations, residual, tol)
-            }
+            Failure::NotConverged(failed) => clock.not_converged(k, solve, failed, tol),
             Failure::Domain(v) => clock.left_domain(k, v),
         }
     }
@@ -293,8 +293,8 @@ impl<P: Constrained> RattleStepper<P> {
         nu.fill(0.0);
         if m > 0 {
             let scale = max_abs(q).max(f64::MIN_POSITIVE);
-            let mut prev = f64::INFINITY;
-            for iter in 1..=MAX_ITER {
+            let mut monitor = Monitor::new(RULE);
+            loop {
                 problem.constraint(qn, g, scratch);
                 for (gb, cb) in g.iter_mut().zip(g0.iter()) {
                     *gb -= cb;
@@ -311,16 +311,11 @@ impl<P: Constrained> RattleStepper<P> {
                     norm = norm.max(dq.abs());
                 }
                 axpy(nu, 1.0, g);
-                if !norm.is_finite() {
-                    return Err(Failure::NotConverged(iter, f64::INFINITY));
+                match monitor.check(norm, scale) {
+                    Verdict::Continue => {}
+                    Verdict::Converged => break,
+                    Verdict::Failed(failed) => return Err(Failure::NotConverged(failed)),
                 }
-                if norm <= TOL * scale || (norm >= prev && norm <= STAGNATION_TOL * scale) {
-                    break;
-                }
-                if iter == MAX_ITER {
-                    return Err(Failure::NotConverged(iter, norm / scale));
-                }
-                prev = norm;
             }
         }
         // p_{n+1/2} = p̃ − G(q_n)ᵀν/h.
@@ -372,7 +367,7 @@ impl<P: Constrained> Stepper for RattleStepper<P> {
                         &clock,
                         k,
                         "RATTLE position constraint (Newton iteration for the multipliers)",
-                        TOL,
+                        RULE.tol,
                     )
                 })?;
             }
