@@ -198,3 +198,12 @@ def test_a_flattened_spheroid_reaches_its_stop():
     assert len(b.points) < 300
     assert b.points[-1].pressure > 10 * b.points[0].pressure
 
+
+@pytest.mark.parametrize("G", [1e290, 1e305])
+def test_residuals_at_a_huge_G_are_finite(G):
+    # The force residual was the square root of a sum of squares of ~1e275: inf.
+    for fig in (E.maclaurin(0.5, G=G), E.maclaurin(0.5, rho=G),
+                E.maclaurin_jacobi_bifurcation(G=G)):
+        r = fig.residuals
+        assert np.isfinite(list(r.values())).all(), r
+        assert r["force"] <= 1e-12 * fig.pressure      # round-off of forces of size G
