@@ -228,8 +228,9 @@ def _events(events):
             raise TypeError(f"invalid events[{i}].direction: expected a real number, got "
                             f"{type(d).__name__} {d!r:.60}")
         d = float(d)
-        if np.isnan(d):
-            raise InvalidArgumentError(f"invalid events[{i}].direction: expected a number, got nan")
+        if not np.isfinite(d):
+            raise InvalidArgumentError(f"invalid events[{i}].direction: expected a finite number "
+                                       f"(its sign: > 0 rising, < 0 falling, 0 both), got {d}")
         n = getattr(f, "terminal", False)
         if n is None:
             n = False

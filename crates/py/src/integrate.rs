@@ -469,8 +469,8 @@ impl Integration {
     /// reached by one shortened step of the method from the grid state before it.
     ///
     /// Raises:
-    ///     ShapeError (not 1-D), NonFiniteError, InvalidArgumentError (unsorted, before the
-    ///     current time, too many to keep).
+    ///     ShapeError (not 1-D, empty), NonFiniteError, InvalidArgumentError (unsorted, before
+    ///     the current time, too many to keep).
     fn save_at(&mut self, t_eval: ArrayIn<'_>) -> PyResult<()> {
         let times = vector("t_eval", &t_eval)?;
         let full = self.d + if self.attitude { 9 } else { 0 };
@@ -490,7 +490,8 @@ impl Integration {
     /// `tol` ≥ 0: an absolute tolerance in time added to round-off. A single run only.
     ///
     /// Raises:
-    ///     InvalidArgumentError (a batch, lengths that differ, a NaN direction, a bad tol).
+    ///     InvalidArgumentError (a batch, lengths that differ, a NaN or infinite direction, a
+    ///     bad tol).
     fn set_events(
         &mut self,
         py: Python<'_>,
