@@ -131,18 +131,23 @@ def _integrate_chunk(system, z, att, dt, steps, method, save_every, t0, lo):
     """One task of :func:`integrate`: the members ``lo ..`` of the ensemble, states ``z``
     (c, d), as one native batch run on one thread (the run of ``lieflow.integrate``, whose
     errors name the members by their index in the ensemble: ``first_member=lo``)."""
+    task = f"in the lieflow.ensemble task of members {lo} to {lo + len(z) - 1}"
     try:
         states, attitude, final, final_att = system._run(
             z, att, dt, steps, save_every, method, t0=t0, threads=1, first_member=lo)
+    except Exception as e:
+        _note(e, task)
+        raise
+    try:   # the observables of the task's states (c, k, d), whose items are named [i, j]
         out = {"states": states, "energy": np.asarray(system.energy(states), dtype=np.float64),
                "invariants": np.asarray(system.invariants(states), dtype=np.float64),
                "final_state": final}
-        if att is not None:
-            out["attitude"] = attitude
-            out["final_attitude"] = final_att
     except Exception as e:
-        _note(e, f"in the lieflow.ensemble task of members {lo} to {lo + len(z) - 1}")
+        _note(e, f"{task}, of its states: states[i, j] is sample j of member {lo} + i")
         raise
+    if att is not None:
+        out["attitude"] = attitude
+        out["final_attitude"] = final_att
     return out
 
 

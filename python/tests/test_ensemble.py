@@ -266,6 +266,12 @@ def test_errors_name_the_member_by_its_index_in_the_ensemble():
     states[7, 2, 1] = np.nan
     with pytest.raises(lf.NonFiniteError, match=r"^states\[7, 2\] contains .* at index 1$"):
         BODY.energy(states)
+    # an observable of a task's states that overflows: its item, and the member it belongs to
+    m = members(10)
+    m[7] = [1e155, 2e155, 1e155]          # its energy overflows, its tiny steps do not
+    with pytest.raises(lf.InvalidArgumentError, match=r"^invalid states\[1, 0\]: state: ") as e:
+        ensemble.integrate(BODY, m, 1e-160, 2, chunks=6).compute()
+    assert "states[i, j] is sample j of member 6 + i" in e.value.__notes__[-1]
 
 
 def test_threaded_ctrl_c_stops_promptly(calls):

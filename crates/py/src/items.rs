@@ -86,8 +86,9 @@ fn broadcast(shapes: &[&[usize]]) -> Option<Vec<usize>> {
 /// Applies `f(items, out)` to every combination of items along the (broadcast) leading axes of
 /// the inputs; `out` has `out_item` shape. Returns an array of shape (...lead, ...out_item), or a
 /// Python float when that shape is () (one scalar-valued item, like numpy's scalar results).
-/// Shape mismatches become `ShapeError`; an error of `f` about an input of a batch names the
-/// item by its index along the leading axes (`states[7, 12]`), others are returned unchanged.
+/// Shape mismatches become `ShapeError`; an error of `f` in a batch names the item by its index
+/// along the leading axes (`states[7, 12]`, or `states[7, 12]: state` where it names another
+/// thing than an input).
 pub fn map_items<'py, F>(
     py: Python<'py>,
     inputs: &[Input<'_, 'py>],
@@ -169,7 +170,7 @@ where
             to_py(if count > 1 {
                 e.map_what(|w| match names.contains(&w) {
                     true => format!("{w}[{}]", at()),
-                    false => w.to_string(),
+                    false => format!("{}[{}]: {w}", names.join(", "), at()),
                 })
             } else {
                 e
