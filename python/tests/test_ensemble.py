@@ -261,6 +261,13 @@ def test_errors_name_the_member_by_its_index_in_the_ensemble():
     expected = r"^batch member 7: state0 contains a non-finite value \(NaN or inf\) at index 2$"
     with pytest.raises(lf.NonFiniteError, match=expected):
         ensemble.integrate(BODY, m, 0.01, 10, chunks=3)
+    r = rotations(10)
+    r[7, 1, 2] = np.nan                   # not "state ... at index 8" of the lifted state
+    expected = r"^batch member 7: attitude contains a non-finite value \(NaN or inf\) at \(1, 2\)$"
+    with pytest.raises(lf.NonFiniteError, match=expected):
+        ensemble.integrate(BODY, members(10), 0.01, 10, chunks=3, attitude=r)
+    with pytest.raises(lf.NonFiniteError, match=expected):
+        lf.integrate(BODY, members(10), 0.01, 10, attitude=r)
     # observables of a (member, time) array name the item by both indices
     states = np.ones((10, 4, 3))
     states[7, 2, 1] = np.nan
