@@ -273,7 +273,7 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     ImportError
         Dask or xarray is not installed.
     TypeError
-        ``system`` is not a system; ``dt`` or ``t0`` not a real number; ``steps``,
+        ``system`` is not a ``lieflow.System``; ``dt`` or ``t0`` not a real number; ``steps``,
         ``save_every`` or ``chunks`` not an integer; ``method`` not a str; ``state0`` or
         ``attitude`` not real numbers.
     lieflow.InvalidArgumentError
@@ -302,6 +302,9 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     """
     dask, da, xr = _require()
     _check_system(system)
+    if not callable(getattr(system, "_run", None)):   # a task runs System._run
+        raise TypeError(f"invalid system: expected a lieflow.System (e.g. lf.RigidBody([1, 2, "
+                        f"3])), got {type(system).__name__} {system!r:.60}, which has no _run")
     steps = _count("steps", steps)
     save_every = _count("save_every", save_every)
     dt = _step(dt)

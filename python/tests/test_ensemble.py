@@ -281,6 +281,15 @@ def test_errors_name_the_member_by_its_index_in_the_ensemble():
     assert "states[i, j] is sample j of member 6 + i" in e.value.__notes__[-1]
 
 
+def test_a_duck_typed_system_is_refused_before_any_task(calls):
+    class Duck:        # speaks lf.integrate's protocol, but a task runs System._run
+        _normalize_state, _start = BODY._normalize_state, BODY._start
+
+    with pytest.raises(TypeError, match="expected a lieflow.System"):
+        ensemble.integrate(Duck(), members(4), 0.01, 10)
+    assert calls == []
+
+
 def test_threaded_ctrl_c_stops_promptly(calls):
     m = members(16_000)       # 16 tasks of 1000 bodies x 10^4 steps: ~0.4 s each, ~3 s in all
     ds = ensemble.integrate(BODY, m, 0.01, 10_000, save_every=10_000, chunks=1000)
