@@ -31,8 +31,9 @@ pub fn finite_slice(what: &str, v: &[f64]) -> Result<()> {
 
 /// Checks that every entry of a batch of items is finite: `data` holds the items of shape `item`
 /// one after another (row-major). The first non-finite entry is `Err((k, e))`: it lies in item k,
-/// and `e` names its place in the item ("index i" in a vector, "(i, j)" in a matrix), so that the
-/// caller names the item its own way (a batch member, `R[k]`), never by a flat index.
+/// and `e` names its place in the item ("index i" in a vector, "(i, j)" in a matrix, numpy's
+/// index otherwise), so that the caller names the item its own way (a batch member, `R[k]`),
+/// never by a flat index.
 pub fn finite_items(
     what: &str,
     data: &[f64],
@@ -49,7 +50,6 @@ pub fn finite_items(
     }
     let location = match place.as_slice() {
         [i] => format!("index {i}"),
-        [] => "its value".into(),
         p => format!(
             "({})",
             p.iter()
