@@ -100,10 +100,12 @@ class System:
     def _start(
         self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, method: str | None,
         save_every: int, *, t0: float = 0.0, threads: int | None = None, steps: int | None = None,
+        first_member: int | None = None,
     ) -> Integration: ...
     def _run(
         self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, steps: int,
         save_every: int, method: str, *, t0: float = 0.0, threads: int | None = None,
+        first_member: int | None = None,
     ) -> tuple[_F64, _F64 | None, _F64, _F64 | None]: ...
     def energy(self, states: ArrayLike) -> _F64 | float:
         """(..., d) -> (...)."""

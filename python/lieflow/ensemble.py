@@ -5,7 +5,7 @@ task per chunk; :func:`sweep` runs one task per parameter value, each integratin
 ``make_system(value)``. Both return a lazy :class:`xarray.Dataset` backed by Dask arrays:
 nothing runs until ``.compute()``, ``.load()`` or ``.persist()``.
 
-Every task is one native batch run, ``lieflow.integrate(..., threads=1, progress=False)``: the
+Every task is one native batch run, that of ``lieflow.integrate(..., threads=1)``: the
 native run releases the GIL, so the tasks of Dask's local threaded scheduler run in parallel,
 and one thread per task does not oversubscribe the cores of a ``dask.distributed`` worker. The
 members of a batch are independent, so the results equal those of one
@@ -129,19 +129,25 @@ def _note(err: BaseException, text: str) -> None:
 
 def _integrate_chunk(system, z, att, dt, steps, method, save_every, t0, lo):
     """One task of :func:`integrate`: the members ``lo ..`` of the ensemble, states ``z``
-    (c, d), as one native batch run on one thread."""
+    (c, d), as one native batch run on one thread (the run of ``lieflow.integrate``, whose
+    errors name the members by their index in the ensemble: ``first_member=lo``)."""
+    task = f"in the lieflow.ensemble task of members {lo} to {lo + len(z) - 1}"
     try:
-        traj = _integrate(system, z, dt=dt, steps=steps, method=method,
-                          save_every=save_every, attitude=att, threads=1, t0=t0, progress=False)
-        out = {"states": traj.states, "energy": np.asarray(traj.energy(), dtype=np.float64),
-               "invariants": np.asarray(traj.invariants(), dtype=np.float64),
-               "final_state": traj.final_state}
-        if att is not None:
-            out["attitude"] = traj.attitude
-            out["final_attitude"] = traj.final_attitude
+        states, attitude, final, final_att = system._run(
+            z, att, dt, steps, save_every, method, t0=t0, threads=1, first_member=lo)
     except Exception as e:
-        _note(e, f"in the lieflow.ensemble task of members {lo} to {lo + len(z) - 1}")
+        _note(e, task)
         raise
+    try:   # the observables of the task's states (c, k, d), whose items are named [i, j]
+        out = {"states": states, "energy": np.asarray(system.energy(states), dtype=np.float64),
+               "invariants": np.asarray(system.invariants(states), dtype=np.float64),
+               "final_state": final}
+    except Exception as e:
+        _note(e, f"{task}, of its states: states[i, j] is sample j of member {lo} + i")
+        raise
+    if att is not None:
+        out["attitude"] = attitude
+        out["final_attitude"] = final_att
     return out
 
 
@@ -195,9 +201,10 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     """Integrates an ensemble of initial states as Dask tasks; a lazy :class:`xarray.Dataset`.
 
     The members are split into chunks of ``chunks`` members, and each chunk becomes one Dask
-    task: a native batch run ``lieflow.integrate(system, state0[chunk], dt=dt, steps=steps,
-    method=method, save_every=save_every, threads=1, t0=t0, progress=False)`` that returns the
-    chunk's states, energy and invariants. The native run releases the GIL, so the tasks run
+    task: the native batch run of ``lieflow.integrate(system, state0[chunk], dt=dt,
+    steps=steps, method=method, save_every=save_every, threads=1, t0=t0, progress=False)``
+    that returns the chunk's states, energy and invariants; its errors name a member by its
+    index in the ensemble. The native run releases the GIL, so the tasks run
     in parallel on Dask's threaded scheduler too; one thread per task keeps the cores of
     ``dask.distributed`` workers from being oversubscribed. Nothing runs until the Dataset is
     computed (``.compute()``, ``.load()``, ``.persist()``, or e.g. ``ds.energy.max().compute()``,
@@ -266,7 +273,7 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     ImportError
         Dask or xarray is not installed.
     TypeError
-        ``system`` is not a system; ``dt`` or ``t0`` not a real number; ``steps``,
+        ``system`` is not a ``lieflow.System``; ``dt`` or ``t0`` not a real number; ``steps``,
         ``save_every`` or ``chunks`` not an integer; ``method`` not a str; ``state0`` or
         ``attitude`` not real numbers.
     lieflow.InvalidArgumentError
@@ -283,7 +290,7 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
         An attitude that is not a rotation.
 
     Errors of the run itself (e.g. ``lieflow.ConvergenceError``) are raised by ``.compute()``,
-    with a note naming the task's members.
+    naming the member by its index in the ensemble, with a note naming the task's members.
 
     Examples
     --------
@@ -295,6 +302,9 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     """
     dask, da, xr = _require()
     _check_system(system)
+    if not callable(getattr(system, "_run", None)):   # a task runs System._run
+        raise TypeError(f"invalid system: expected a lieflow.System (e.g. lf.RigidBody([1, 2, "
+                        f"3])), got {type(system).__name__} {system!r:.60}, which has no _run")
     steps = _count("steps", steps)
     save_every = _count("save_every", save_every)
     dt = _step(dt)

@@ -123,14 +123,20 @@ def _attitude(attitude, b, batched):
     if isinstance(attitude, (str, bytes)) or a.dtype.kind not in "biuf":
         raise TypeError(f"{expected}, got a {type(attitude).__name__} (numpy dtype {a.dtype})")
     a = a.astype(np.float64, copy=False)
+    if not (a.shape == (3, 3) or batched and a.shape == (b, 3, 3)):
+        expected = f"(3, 3) or ({b}, 3, 3)" if batched else "(3, 3)"
+        raise ShapeError(f"attitude has the wrong shape: expected {expected}, got {a.shape}")
+    bad = np.argwhere(~np.isfinite(a))
+    if len(bad):     # named by its member and its entry (not by its place in the state)
+        *k, i, j = bad[0]
+        member = f"batch member {k[0]}: " if k else ""
+        raise NonFiniteError(f"{member}attitude contains a non-finite value (NaN or inf) at "
+                             f"({i}, {j})")
     if a.shape == (3, 3):
         out = np.empty((b, 3, 3))
         out[...] = a
         return out
-    if batched and a.shape == (b, 3, 3):
-        return np.ascontiguousarray(a)
-    expected = f"(3, 3) or ({b}, 3, 3)" if batched else "(3, 3)"
-    raise ShapeError(f"attitude has the wrong shape: expected {expected}, got {a.shape}")
+    return np.ascontiguousarray(a)
 
 
 class _Progress:
@@ -228,8 +234,9 @@ def _events(events):
             raise TypeError(f"invalid events[{i}].direction: expected a real number, got "
                             f"{type(d).__name__} {d!r:.60}")
         d = float(d)
-        if np.isnan(d):
-            raise InvalidArgumentError(f"invalid events[{i}].direction: expected a number, got nan")
+        if not np.isfinite(d):
+            raise InvalidArgumentError(f"invalid events[{i}].direction: expected a finite number "
+                                       f"(its sign: > 0 rising, < 0 falling, 0 both), got {d}")
         n = getattr(f, "terminal", False)
         if n is None:
             n = False

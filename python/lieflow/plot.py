@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 import numpy as np
 
 from ._lieflow import InvalidArgumentError
+from .integrate import _MAX_COUNT
 
 if TYPE_CHECKING:
     from matplotlib.animation import FuncAnimation
@@ -244,12 +245,15 @@ def animate(traj: Trajectory, path: str | os.PathLike[str] | None = None, *, eve
     Raises
     ------
     lieflow.InvalidArgumentError
-        No animation for this system, no attitude where one is needed, ``every`` < 1, an
-        unknown file type, MP4 without ffmpeg.
+        No animation for this system, no attitude where one is needed, ``every`` not in
+        [1, 2**63 - 1], an unknown file type, MP4 without ffmpeg.
     """
     _trajectory(traj)
-    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
-        raise InvalidArgumentError(f"invalid every: expected an integer >= 1, got {every!r}")
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) \
+            or not 1 <= every <= _MAX_COUNT:
+        raise InvalidArgumentError(f"invalid every: expected an integer in [1, 2**63 - 1], "
+                                   f"got {every!r:.60}")
+    every = int(every)
     if isinstance(interval, bool) or not isinstance(interval, (int, float, np.integer,
                                                                np.floating)) \
             or not 0 < interval < np.inf:

@@ -185,3 +185,25 @@ def test_incompressible_relative_equilibria_by_shape():
     with pytest.raises(lf.InvalidArgumentError):
         lf.pseudo_rigid.relative_equilibria(lf.potentials.SelfGravity(), velocities=(j.xi, j.eta),
                                             incompressible=True)
+
+
+# --- issue 29 'Smaller' ---
+
+def test_a_flattened_spheroid_reaches_its_stop():
+    # From e = 0.999 the pressure grows from 12 to 150 (same volume) while the semi-axes change
+    # by less than one: in the unscaled unknowns it took up the whole arclength, and the branch
+    # ended at max_points = 2000 near e = 0.948.
+    b = lf.continuation.follow(E.maclaurin(0.999), "e", 0.9, stability=False)
+    assert b.end == "reached" and b.values[-1] == pytest.approx(0.9, abs=1e-12)
+    assert len(b.points) < 300
+    assert b.points[-1].pressure > 10 * b.points[0].pressure
+
+
+@pytest.mark.parametrize("G", [1e290, 1e305])
+def test_residuals_at_a_huge_G_are_finite(G):
+    # The force residual was the square root of a sum of squares of ~1e275: inf.
+    for fig in (E.maclaurin(0.5, G=G), E.maclaurin(0.5, rho=G),
+                E.maclaurin_jacobi_bifurcation(G=G)):
+        r = fig.residuals
+        assert np.isfinite(list(r.values())).all(), r
+        assert r["force"] <= 1e-12 * fig.pressure      # round-off of forces of size G

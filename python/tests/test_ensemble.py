@@ -60,13 +60,13 @@ def assert_equal_to_batch(ds, traj):
 def calls(monkeypatch):
     """Counts the native batch runs of the tasks (threaded scheduler: same process)."""
     n = []
-    real = ensemble._integrate
+    real = ensemble._integrate_chunk
 
-    def counting(*args, **kwargs):
-        n.append(len(args[1]))
-        return real(*args, **kwargs)
+    def counting(**kwargs):
+        n.append(len(kwargs["z"]))
+        return real(**kwargs)
 
-    monkeypatch.setattr(ensemble, "_integrate", counting)
+    monkeypatch.setattr(ensemble, "_integrate_chunk", counting)
     return n
 
 
@@ -239,6 +239,55 @@ def test_run_error_is_raised_by_compute_naming_the_members():
         with pytest.raises(RuntimeError, match="left the box") as err:
             ds.compute()
         assert any("members 2 to 3" in n for n in getattr(err.value, "__notes__", []))
+
+
+def test_errors_name_the_member_by_its_index_in_the_ensemble():
+    m = members(10)
+    m[7] = [1e155, 2e155, 1e155]          # overflows in the first step
+    for chunks in (6, 1, 10):             # member 7 is member 1 of its task, alone, or member 7
+        with pytest.raises(lf.LeftDomainError, match=r"^batch member 7: RigidBody state"):
+            ensemble.integrate(BODY, m, 0.01, 10, chunks=chunks).compute()
+    # a NaN in a state: its member and its entry there (not the flat index 63 of (X, P))
+    body = lf.PseudoRigidBody(3, lf.potentials.Harmonic(1.0))
+    X, P = np.tile(np.eye(3), (10, 1, 1)), np.zeros((10, 3, 3))
+    P[7, 0, 1] = np.nan
+    expected = r"^batch member 7: P contains a non-finite value \(NaN or inf\) at \(0, 1\)$"
+    with pytest.raises(lf.NonFiniteError, match=expected):
+        ensemble.integrate(body, (X, P), 0.01, 10, chunks=3)
+    with pytest.raises(lf.NonFiniteError, match=expected):
+        lf.integrate(body, (X, P), 0.01, 10)
+    m = members(10)
+    m[7, 2] = np.inf
+    expected = r"^batch member 7: state0 contains a non-finite value \(NaN or inf\) at index 2$"
+    with pytest.raises(lf.NonFiniteError, match=expected):
+        ensemble.integrate(BODY, m, 0.01, 10, chunks=3)
+    r = rotations(10)
+    r[7, 1, 2] = np.nan                   # not "state ... at index 8" of the lifted state
+    expected = r"^batch member 7: attitude contains a non-finite value \(NaN or inf\) at \(1, 2\)$"
+    with pytest.raises(lf.NonFiniteError, match=expected):
+        ensemble.integrate(BODY, members(10), 0.01, 10, chunks=3, attitude=r)
+    with pytest.raises(lf.NonFiniteError, match=expected):
+        lf.integrate(BODY, members(10), 0.01, 10, attitude=r)
+    # observables of a (member, time) array name the item by both indices
+    states = np.ones((10, 4, 3))
+    states[7, 2, 1] = np.nan
+    with pytest.raises(lf.NonFiniteError, match=r"^states\[7, 2\] contains .* at index 1$"):
+        BODY.energy(states)
+    # an observable of a task's states that overflows: its item, and the member it belongs to
+    m = members(10)
+    m[7] = [1e155, 2e155, 1e155]          # its energy overflows, its tiny steps do not
+    with pytest.raises(lf.InvalidArgumentError, match=r"^invalid states\[1, 0\]: state: ") as e:
+        ensemble.integrate(BODY, m, 1e-160, 2, chunks=6).compute()
+    assert "states[i, j] is sample j of member 6 + i" in e.value.__notes__[-1]
+
+
+def test_a_duck_typed_system_is_refused_before_any_task(calls):
+    class Duck:        # speaks lf.integrate's protocol, but a task runs System._run
+        _normalize_state, _start = BODY._normalize_state, BODY._start
+
+    with pytest.raises(TypeError, match="expected a lieflow.System"):
+        ensemble.integrate(Duck(), members(4), 0.01, 10)
+    assert calls == []
 
 
 def test_threaded_ctrl_c_stops_promptly(calls):

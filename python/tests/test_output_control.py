@@ -254,6 +254,15 @@ def test_event_errors(body):
     bad.terminal, bad.direction = 1, "up"
     with pytest.raises(TypeError, match="direction"):
         lf.integrate(body, M0, dt=0.01, steps=10, events=bad)
+    for d in (np.inf, -np.inf, np.nan):      # a direction is a finite number (its sign)
+        bad.direction = d
+        with pytest.raises(lf.InvalidArgumentError, match="direction: expected a finite number"):
+            lf.integrate(body, M0, dt=0.01, steps=10, events=bad)
+        run = body._start(np.array([M0]), None, 0.01, None, 1)
+        with pytest.raises(lf.InvalidArgumentError, match="expected a finite number"):
+            run.set_events([g_m2], [d], [0], 0.0)
+    with pytest.raises(lf.ShapeError, match=r"t_eval .*expected \(k,\) with k ≥ 1"):
+        body._start(np.array([M0]), None, 0.01, None, 1).save_at([])   # as t_eval=[] is
     with pytest.raises(lf.InvalidArgumentError, match="batch"):
         lf.integrate(body, np.tile(M0, (2, 1)), dt=0.01, steps=10, events=g_m2)
     with pytest.raises(lf.InvalidArgumentError, match="event_tol"):

@@ -165,9 +165,13 @@ def test_animate_errors(tmp_path):
         plot.animate(no_attitude)
     with pytest.raises(lf.InvalidArgumentError, match="no animation for Pendulum"):
         plot.animate(lf.integrate(lf.Pendulum(1.0, 1.0, 9.81), [1.0, 0.0], dt=0.1, steps=3))
-    for every in (0, 1.5, True):
-        with pytest.raises(lf.InvalidArgumentError, match="every"):
+    for every in (0, 1.5, True, 2**63, 2**70):      # counts are 64-bit, as everywhere
+        with pytest.raises(lf.InvalidArgumentError, match=r"every: expected an integer in \[1, "):
             plot.animate(traj, every=every)
+    anims = [plot.animate(traj, every=e) for e in (2, np.int64(2), 2**63 - 1)]
+    for a in anims:
+        a._init_draw()
+    assert [len(list(a.new_frame_seq())) for a in anims] == [7, 7, 1]
     with pytest.raises(lf.InvalidArgumentError, match=".gif or .mp4"):
         plot.animate(traj, tmp_path / "a.avi")
     assert not (tmp_path / "a.avi").exists()

@@ -29,6 +29,44 @@ pub fn finite_slice(what: &str, v: &[f64]) -> Result<()> {
     }
 }
 
+/// Checks that every entry of a batch of items is finite: `data` holds the items of shape `item`
+/// one after another (row-major). The first non-finite entry is `Err((k, e))`: it lies in item k,
+/// and `e` names its place in the item ("index i" in a vector, "(i, j)" in a matrix, numpy's
+/// index otherwise), so that the caller names the item its own way (a batch member, `R[k]`),
+/// never by a flat index.
+pub fn finite_items(
+    what: &str,
+    data: &[f64],
+    item: &[usize],
+) -> std::result::Result<(), (usize, Error)> {
+    let Some(at) = data.iter().position(|x| !x.is_finite()) else {
+        return Ok(());
+    };
+    let len: usize = item.iter().product();
+    let (k, mut r) = (at / len.max(1), at % len.max(1));
+    let mut place = vec![0; item.len()];
+    for (p, &n) in place.iter_mut().zip(item).rev() {
+        (*p, r) = (r % n.max(1), r / n.max(1));
+    }
+    let location = match place.as_slice() {
+        [i] => format!("index {i}"),
+        p => format!(
+            "({})",
+            p.iter()
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    Err((
+        k,
+        Error::NonFinite {
+            what: what.into(),
+            location,
+        },
+    ))
+}
+
 /// Checks that `m` is square n×n with n ≥ `min_n` and finite; returns n.
 pub fn square(what: &str, m: &Mat, min_n: usize) -> Result<usize> {
     let (r, c) = (m.nrows(), m.ncols());

@@ -156,6 +156,8 @@ fn save_at_refuses_bad_times() {
         run.save_at(&[2.0, f64::NAN]),
         Err(Error::NonFinite { .. })
     ));
+    // No output time at all is refused, as lf.integrate(t_eval=[]) is.
+    assert!(matches!(run.save_at(&[]), Err(Error::Shape { .. })));
     assert_eq!(run.grid_steps(2.0).unwrap(), 0);
     assert_eq!(run.grid_steps(2.3).unwrap(), 3);
     assert_eq!(run.grid_steps(2.35).unwrap(), 3);

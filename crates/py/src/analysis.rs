@@ -92,7 +92,9 @@ fn run(
 ///     parameter: the parameter to follow and stop on.
 ///     stop: its final value.
 ///     stability: evaluate both stability verdicts at every point (slower).
-///     step, max_step: the first and the largest arclength step; max_points: a bound.
+///     step, max_step: the first and the largest arclength step (in the unknowns a, Omega,
+///         Lambda, p scaled by their magnitudes at the start, max(|u_k|, 1)); max_points: a
+///         bound.
 ///
 /// Returns:
 ///     Branch.

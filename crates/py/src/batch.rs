@@ -49,8 +49,8 @@ impl<const R: usize, const C: usize> Item for SMatrix<f64, R, C> {
 }
 
 /// Reads an array of shape `item` or (b, *item) into flat row-major data, checking finiteness
-/// (the location of a non-finite entry is its flat index). Returns the data and whether the
-/// input was batched.
+/// (a non-finite entry is named by its item, `what[k]`, and its place in the item). Returns the
+/// data and whether the input was batched.
 fn read<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, bool)> {
     let item = A::shape();
     let v = a.as_array();
@@ -69,7 +69,13 @@ fn read<A: Item>(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, bool)> {
     };
     // Checked and allocated fallibly: a broadcast view of 10¹⁰ items is refused, not an abort.
     let data = read_all(what, &v)?;
-    check::finite_slice(what, &data).map_err(to_py)?;
+    check::finite_items(what, &data, &item).map_err(|(k, e)| {
+        to_py(if batched {
+            e.map_what(|w| format!("{w}[{k}]"))
+        } else {
+            e
+        })
+    })?;
     Ok((data, batched))
 }
 

@@ -578,6 +578,15 @@ pub fn size(ob: &Bound<'_, PyAny>) -> PyResult<usize> {
     })
 }
 
+/// `Option<usize>` parameters: None or a [`size`].
+pub fn size_opt(ob: &Bound<'_, PyAny>) -> PyResult<Option<usize>> {
+    if ob.is_none() {
+        Ok(None)
+    } else {
+        size(ob).map(Some)
+    }
+}
+
 /// Names the argument `what` on an error of reading it outside pyo3's argument parsing (a part
 /// of an argument, a callable's value), the way pyo3 names a parameter: a note
 /// "while processing 'what'" that `ArgumentTypeError` and `LieflowError` messages show.

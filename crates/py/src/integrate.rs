@@ -68,6 +68,19 @@ pub struct Integration {
     events: Option<Mutex<Events<'static>>>,
     /// The states (full, flat) saved by the call that failed, before its error (one run only).
     partial: Option<Vec<f64>>,
+    /// The index of the first member in the ensemble the batch is a part of (`lieflow.ensemble`
+    /// runs one batch per task), if given: errors name members by their ensemble index.
+    first_member: Option<usize>,
+}
+
+/// Error `e` of member `i` of a batch of `b` named by its member: its index in the ensemble
+/// (`first + i`) when the batch is a part of one, its index in the batch when `b` > 1.
+fn of_member(e: Error, i: usize, b: usize, first: Option<usize>) -> Error {
+    match first {
+        Some(f) => e.in_member(f + i),
+        None if b > 1 => e.in_member(i),
+        None => e,
+    }
 }
 
 /// The most worker threads a run may ask for (a pool of 10¹² threads would never finish
@@ -97,6 +110,7 @@ impl Integration {
         t0: f64,
         threads: Option<i64>,
         steps: Option<i64>,
+        first_member: Option<usize>,
     ) -> PyResult<Self> {
         let save_every = count("save_every", save_every)?;
         let calls_out = sys.calls_out();
@@ -177,7 +191,7 @@ impl Integration {
             Some(p) if !calls_out => p.install(start),
             _ => start(),
         }
-        .map_err(|(i, e)| if b > 1 { e.in_member(i) } else { e })
+        .map_err(|(i, e)| of_member(e, i, b, first_member))
         .py()?;
         Ok(Integration {
             method: method.to_string(),
@@ -192,6 +206,7 @@ impl Integration {
             at: false,
             events: None,
             partial: None,
+            first_member,
         })
     }
 
@@ -280,6 +295,7 @@ impl Integration {
             .as_mut()
             .map(|m| m.get_mut().unwrap_or_else(|p| p.into_inner()));
         let pool = &self.pool;
+        let first = self.first_member;
         let one = |i: usize, run: &mut Run, events: Option<&mut Events<'static>>| {
             let mut out = Vec::new();
             if out.try_reserve_exact(per_run).is_err() {
@@ -296,7 +312,7 @@ impl Integration {
                 Until::Steps(n) if plain => run.advance(sys, n, &mut out),
                 _ => run.advance_to(sys, until, &mut out, events),
             };
-            (out, r.map_err(|e| if b > 1 { e.in_member(i) } else { e }))
+            (out, r.map_err(|e| of_member(e, i, b, first)))
         };
         let parallel = |runs: &mut [Run]| {
             let mut work = || {
@@ -325,7 +341,7 @@ impl Integration {
                                  less often (save_every) or run in chunks"
                             ),
                         );
-                        return Err(to_py(if b > 1 { e.in_member(i) } else { e }));
+                        return Err(to_py(of_member(e, i, b, first)));
                     }
                     outs.push(out);
                 }
@@ -336,9 +352,7 @@ impl Integration {
                 outs.into_iter()
                     .zip(results)
                     .enumerate()
-                    .map(|(i, (out, r))| {
-                        (out, r.map_err(|e| if b > 1 { e.in_member(i) } else { e }))
-                    })
+                    .map(|(i, (out, r))| (out, r.map_err(|e| of_member(e, i, b, first))))
                     .collect()
             }
             _ => {
@@ -463,8 +477,8 @@ impl Integration {
     /// reached by one shortened step of the method from the grid state before it.
     ///
     /// Raises:
-    ///     ShapeError (not 1-D), NonFiniteError, InvalidArgumentError (unsorted, before the
-    ///     current time, too many to keep).
+    ///     ShapeError (not 1-D, empty), NonFiniteError, InvalidArgumentError (unsorted, before
+    ///     the current time, too many to keep).
     fn save_at(&mut self, t_eval: ArrayIn<'_>) -> PyResult<()> {
         let times = vector("t_eval", &t_eval)?;
         let full = self.d + if self.attitude { 9 } else { 0 };
@@ -484,7 +498,8 @@ impl Integration {
     /// `tol` ≥ 0: an absolute tolerance in time added to round-off. A single run only.
     ///
     /// Raises:
-    ///     InvalidArgumentError (a batch, lengths that differ, a NaN direction, a bad tol).
+    ///     InvalidArgumentError (a batch, lengths that differ, a NaN or infinite direction, a
+    ///     bad tol).
     fn set_events(
         &mut self,
         py: Python<'_>,

@@ -50,7 +50,7 @@ pub fn representable(
     what: &str,
     inputs_finite: bool,
     out: &[f64],
-    at: Option<usize>,
+    at: Option<&str>,
 ) -> lieflow::Result<()> {
     if !inputs_finite || out.iter().all(|x| x.is_finite()) {
         return Ok(());
@@ -86,7 +86,9 @@ fn broadcast(shapes: &[&[usize]]) -> Option<Vec<usize>> {
 /// Applies `f(items, out)` to every combination of items along the (broadcast) leading axes of
 /// the inputs; `out` has `out_item` shape. Returns an array of shape (...lead, ...out_item), or a
 /// Python float when that shape is () (one scalar-valued item, like numpy's scalar results).
-/// Shape mismatches become `ShapeError`; errors of `f` are returned unchanged.
+/// Shape mismatches become `ShapeError`; an error of `f` in a batch names the item by its index
+/// along the leading axes (`states[7, 12]`, or `states[7, 12]: state` where it names another
+/// thing than an input).
 pub fn map_items<'py, F>(
     py: Python<'py>,
     inputs: &[Input<'_, 'py>],
@@ -152,9 +154,31 @@ where
         }
         let items: Vec<&[f64]> = scratch.iter().map(|s| s.as_slice()).collect();
         let o = &mut out[k * out_len..(k + 1) * out_len];
-        f(&items, o).map_err(to_py)?;
+        // The item's index along the leading axes, for errors in a batch.
+        let at = || {
+            let mut r = k;
+            let mut idx = vec![0; lead.len()];
+            for (i, &n) in idx.iter_mut().zip(&lead).rev() {
+                (*i, r) = (r % n, r / n);
+            }
+            idx.iter()
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        f(&items, o).map_err(|e| {
+            to_py(if count > 1 {
+                e.map_what(|w| match names.contains(&w) {
+                    true => format!("{w}[{}]", at()),
+                    false => format!("{}[{}]: {w}", names.join(", "), at()),
+                })
+            } else {
+                e
+            })
+        })?;
         let finite = items.iter().all(|s| s.iter().all(|x| x.is_finite()));
-        representable(&names.join(", "), finite, o, (count > 1).then_some(k)).map_err(to_py)?;
+        let at = (count > 1).then(at);
+        representable(&names.join(", "), finite, o, at.as_deref()).map_err(to_py)?;
     }
     if shape.is_empty() {
         return Ok(PyFloat::new(py, out[0]).into_any());

@@ -13,7 +13,7 @@ use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyCFunction, PyDict, PyList, PyTuple, PyType};
 
-use crate::convert::{int, int_opt, real};
+use crate::convert::{int, int_opt, real, size_opt};
 use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::{checked, to_py, IntoPy};
 use crate::integrate::{Integration, RunOut};
@@ -83,6 +83,13 @@ impl PySystem {
     }
 }
 
+/// Checks that the states (or state blocks of shape `item`) in `data` are finite; a NaN or inf is
+/// named by its batch member (when `batched`) and its entry in the item.
+fn finite_members(what: &str, data: &[f64], item: &[usize], batched: bool) -> PyResult<()> {
+    check::finite_items(what, data, item)
+        .map_err(|(k, e)| to_py(if batched { e.in_member(k) } else { e }))
+}
+
 /// Reads one block of a tuple-form state: an array whose trailing shape is the block's view
 /// shape; returns the rows of block values and the leading shape.
 fn block_rows(name: &str, block: Block, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, Vec<usize>)> {
@@ -98,7 +105,7 @@ fn block_rows(name: &str, block: Block, a: &ArrayIn<'_>) -> PyResult<(Vec<f64>, 
         )));
     }
     let data = read_all(name, &v)?;
-    check::finite_slice(name, &data).py()?;
+    finite_members(name, &data, &item, s.len() > k)?;
     let rows = match block {
         Block::SoDual(n) => {
             let mut out = Vec::new();
@@ -227,7 +234,7 @@ impl PySystem {
             return Err(bad());
         }
         let data = read_all("state0", &v)?;
-        check::finite_slice("state0", &data).py()?;
+        finite_members("state0", &data, &[d], v.ndim() == 2)?;
         Ok((rows_array(py, data, d)?, v.ndim() == 2))
     }
 
@@ -239,11 +246,13 @@ impl PySystem {
     ///     name from `methods()`, or None for the first (the system's default); save_every >= 1;
     ///     t0 (keyword): the time of z0; threads
     ///     (keyword): None for all cores, or the number of threads; steps (keyword): the steps
-    ///     the caller will take in all, to refuse a trajectory that cannot be kept before any.
+    ///     the caller will take in all, to refuse a trajectory that cannot be kept before any;
+    ///     first_member (keyword): the ensemble index of z0's first row when z0 is a part of an
+    ///     ensemble (`lieflow.ensemble`): errors then name members by it ("batch member 7").
     /// Raises:
     ///     InvalidArgumentError, UnsupportedMethodError, ShapeError, NonFiniteError,
     ///     NotInGroupError (state constraints and attitude).
-    #[pyo3(signature = (z0, attitude0, dt, method, save_every, *, t0 = 0.0, threads = None, steps = None))]
+    #[pyo3(signature = (z0, attitude0, dt, method, save_every, *, t0 = 0.0, threads = None, steps = None, first_member = None))]
     #[allow(clippy::too_many_arguments)]
     fn _start(
         &self,
@@ -255,6 +264,7 @@ impl PySystem {
         #[pyo3(from_py_with = real)] t0: f64,
         #[pyo3(from_py_with = int_opt)] threads: Option<i64>,
         #[pyo3(from_py_with = int_opt)] steps: Option<i64>,
+        #[pyo3(from_py_with = size_opt)] first_member: Option<usize>,
     ) -> PyResult<Integration> {
         let sys = self.runner(attitude0.is_some())?.clone();
         Integration::start(
@@ -267,6 +277,7 @@ impl PySystem {
             t0,
             threads,
             steps,
+            first_member,
         )
     }
 
@@ -277,7 +288,7 @@ impl PySystem {
     ///     (b, 3, 3) or None), k = steps // save_every + 1.
     /// Raises:
     ///     as `_start`, and ConvergenceError, LeftDomainError (naming the time) during the run.
-    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method, *, t0 = 0.0, threads = None))]
+    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method, *, t0 = 0.0, threads = None, first_member = None))]
     #[allow(clippy::too_many_arguments)]
     fn _run<'py>(
         &self,
@@ -290,6 +301,7 @@ impl PySystem {
         method: Option<&str>,
         #[pyo3(from_py_with = real)] t0: f64,
         #[pyo3(from_py_with = int_opt)] threads: Option<i64>,
+        #[pyo3(from_py_with = size_opt)] first_member: Option<usize>,
     ) -> PyResult<RunOut<'py>> {
         let mut run = self._start(
             z0,
@@ -300,6 +312,7 @@ impl PySystem {
             t0,
             threads,
             Some(steps),
+            first_member,
         )?;
         run.run_all(py, steps)
     }

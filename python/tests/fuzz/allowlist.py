@@ -29,6 +29,12 @@ ALLOWED = [
      "J of another length n is the body of another so(n): valid"),
     ("pseudo_rigid.equilibrium_directions", "a", "wrong-last-axis", "accepted-bad",
      "semi-axes of another length n are another dimension: valid"),
+    ("run.save_at", "t_eval", "wrong-last-axis", "accepted-bad",
+     "t_eval is any number of output times: one more (still increasing, and a run has no end) "
+     "is valid"),
+    ("ellipsoids.riemann_s", "f", "*inf", "accepted-bad",
+     "f = zeta/Omega = +-inf is the family of stationary figures (Dedekind's ellipsoids, EFE's "
+     "f = inf), documented and computed on its own ray"),
     ("lie.hat_n", "c", "extra-axis", "accepted-bad",
      "vectorised over leading axes (numpy broadcasting): an extra axis is a batch"),
     ("HeavyTop", "chi", "None", "accepted-bad",

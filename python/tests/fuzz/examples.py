@@ -579,7 +579,8 @@ def build_specs() -> list[Spec]:
         A("max_points", 50, "int", kw=True, positive=True), slow=True)
     add("Branch.values_of", "@branch.values_of", A("name", "Omega2_over_piGrho", "str"))
     add("Branch.switch", "@branch.switch", A("point", Lazy(_branch_point), "obj"),
-        A("stop", 0.82, "float", kw=True, opt=True), A("direction", 1.0, "float", kw=True),
+        A("stop", 0.82, "float", kw=True, opt=True),
+        A("direction", 1.0, "float", kw=True, opt=True),
         slow=True)
     add("Branch.plot", "@branch.plot", A("y", "L", "str", kw=True), slow=True)
 

@@ -20,7 +20,7 @@ import lieflow as lf
 
 from .allowlist import KNOWN_FAILING
 from .catalogue import CATALOGUE
-from .core import SPECS, build_cases, describe, run_cases, summarize
+from .core import SPECS, Case, annotate, build_cases, describe, run_case, run_cases, summarize
 from .examples import CONSTRUCTORS, RECEIVERS, _has_dask
 
 TIER = os.environ.get("LIEFLOW_FUZZ", "quick")
@@ -146,3 +146,25 @@ def test_table_covers_every_public_callable():
                 uncovered.append(full)
     assert not uncovered, uncovered
     assert set(RECEIVERS) >= set(CONSTRUCTORS.values())
+
+
+# --- issue 29 'Smaller': the full tier's failures outside the allow-list, one call each ---
+
+def _classified(spec_id, arg, bad):
+    """The outcome class of one fuzz call, made in this process (the allow-list applied)."""
+    si = next(i for i, s in enumerate(SPECS) if s.id == spec_id)
+    case = Case(si, next(i for i, a in enumerate(SPECS[si].args) if a.name == arg), bad)
+    return annotate([case], {"0": run_case(case, lf, {})})["0"]["c"]
+
+
+@pytest.mark.parametrize("spec_id, arg, bad", [
+    ("ellipsoids.maclaurin", "G", "numeric#7"),   # a huge G: residuals["force"] was inf
+    ("plot.animate", "every", "np-int"),       # animations compared by their frames
+    ("plot.animate", "every", "2**70"),        # refused like every count of the API
+    ("run.set_events", "directions", "inf"),   # a direction is a finite number
+    ("run.save_at", "t_eval", "empty"),        # refused, as lf.integrate(t_eval=[]) is
+    ("ellipsoids.riemann_s", "f", "inf"),      # f = inf is Dedekind's family (allowed)
+    ("run.save_at", "t_eval", "wrong-last-axis"),   # one more output time is valid (allowed)
+])
+def test_issue29_findings(spec_id, arg, bad):
+    assert _classified(spec_id, arg, bad) in ("ok", "typed-error", "allowed")

@@ -569,11 +569,60 @@ fn sign_change(x: f64, y: f64) -> bool {
     (x > 0.0 && y < 0.0) || (x < 0.0 && y > 0.0)
 }
 
+/// A family in the scaled unknowns w = D⁻¹u, D = diag(`scale`): F(Dw), with the Jacobian
+/// DF(Dw)·D.
+struct Scaled<'a> {
+    family: &'a dyn Family,
+    scale: &'a [f64],
+}
+
+impl Scaled<'_> {
+    /// u = Dw.
+    fn unscale(&self, w: &[f64]) -> Vec<f64> {
+        w.iter().zip(self.scale).map(|(x, d)| x * d).collect()
+    }
+
+    /// A point of the scaled family in the unknowns u: u = Dw, the unit tangent along Dt.
+    fn point(&self, mut p: Point) -> Point {
+        p.u = self.unscale(&p.u);
+        let t = self.unscale(&p.tangent);
+        let nt = norm(&t);
+        p.tangent = t.iter().map(|x| x / nt).collect();
+        p
+    }
+}
+
+impl Family for Scaled<'_> {
+    fn unknowns(&self) -> usize {
+        self.family.unknowns()
+    }
+
+    fn residual(&self, w: &[f64]) -> Result<Vec<f64>> {
+        self.family.residual(&self.unscale(w))
+    }
+
+    fn jacobian(&self, w: &[f64]) -> Result<Mat> {
+        let mut j = self.family.jacobian(&self.unscale(w))?;
+        for (c, d) in self.scale.iter().enumerate() {
+            for r in 0..j.nrows() {
+                j[(r, c)] *= d;
+            }
+        }
+        Ok(j)
+    }
+}
+
 /// Follows the family through `start` (a solution, corrected first) until the parameter π
 /// reaches `stop`, the corrector fails at the smallest step, or `max_points` points are found.
 /// The direction: along `direction` if given (branch switching), else the one in which π moves
 /// towards `stop`. Special points (branch points, folds of π, changes of the monitor's verdict)
 /// are located to [`LOCATE_TOL`] and listed in order.
+///
+/// The arclength (the steps of [`Options`], the tangents' normalisation and the arclength
+/// condition) is measured in the unknowns scaled by their magnitudes at the start, u_k/d_k with
+/// d_k = max(|start_k|, 1): an unknown that is large where the others are of order one (the
+/// pressure of a flattened ellipsoid) does not take up the whole step. The points and tangents
+/// returned are in u.
 ///
 /// Errors: `start` of the wrong length or not finite, the first correction failing (start is
 /// not near the family), a parameter or monitor error.
@@ -589,6 +638,52 @@ pub fn follow(
     let n = family.unknowns();
     crate::check::len_of("start", start, n)?;
     crate::check::finite_slice("start", start)?;
+    if let Some(d) = direction {
+        crate::check::len_of("direction", d, n)?;
+    }
+    let scale: Vec<f64> = start.iter().map(|x| x.abs().max(1.0)).collect();
+    let scaled = Scaled {
+        family,
+        scale: &scale,
+    };
+    let to_w = |u: &[f64]| -> Vec<f64> { u.iter().zip(&scale).map(|(x, d)| x / d).collect() };
+    let scaled = &scaled;
+    let param = |w: &[f64]| parameter(&scaled.unscale(w));
+    let mon = monitor.map(|m| move |w: &[f64]| m(&scaled.unscale(w)));
+    let branch = follow_unscaled(
+        scaled,
+        &to_w(start),
+        &param,
+        stop,
+        mon.as_ref().map(|m| m as Monitor<'_>),
+        direction.map(to_w).as_deref(),
+        opts,
+    )?;
+    Ok(Branch {
+        points: branch.points.into_iter().map(|p| scaled.point(p)).collect(),
+        special: branch
+            .special
+            .into_iter()
+            .map(|sp| Special {
+                point: scaled.point(sp.point),
+                ..sp
+            })
+            .collect(),
+        end: branch.end,
+    })
+}
+
+/// [`follow`] with the arclength measured in the unknowns as they are.
+fn follow_unscaled(
+    family: &dyn Family,
+    start: &[f64],
+    parameter: Parameter<'_>,
+    stop: f64,
+    monitor: Option<Monitor<'_>>,
+    direction: Option<&[f64]>,
+    opts: &Options,
+) -> Result<Branch> {
+    let n = family.unknowns();
     if n < 2 {
         return Err(Error::invalid(
             "family",
@@ -605,7 +700,6 @@ pub fn follow(
     // direction is used as it is (at a branch point the kernel is two-dimensional).
     let mut t = match direction {
         Some(d) => {
-            crate::check::len_of("direction", d, n)?;
             let nd = norm(d);
             if !(nd > 0.0 && nd.is_finite()) {
                 return Err(Error::invalid(

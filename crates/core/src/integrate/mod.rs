@@ -168,7 +168,7 @@ impl<'a> Events<'a> {
     /// The event functions `events`; `tol` ≥ 0: an absolute tolerance in time added to
     /// round-off (0 locates the zeros to round-off).
     ///
-    /// Errors: a non-finite or negative `tol`, a NaN direction ([`Error::InvalidArgument`]).
+    /// Errors: a non-finite or negative `tol`, a non-finite direction ([`Error::InvalidArgument`]).
     pub fn new(events: Vec<Event<'a>>, tol: f64) -> Result<Self> {
         if !(tol.is_finite() && tol >= 0.0) {
             return Err(Error::invalid(
@@ -176,10 +176,18 @@ impl<'a> Events<'a> {
                 format!("expected a finite tolerance ≥ 0, got {tol}"),
             ));
         }
-        if let Some(i) = events.iter().position(|e| e.direction.is_nan()) {
+        if let Some((i, e)) = events
+            .iter()
+            .enumerate()
+            .find(|(_, e)| !e.direction.is_finite())
+        {
             return Err(Error::invalid(
                 "direction",
-                format!("event {i}: expected a number (its sign), got NaN"),
+                format!(
+                    "event {i}: expected a finite number (its sign: > 0 rising, < 0 falling, 0 \
+                     both), got {}",
+                    e.direction
+                ),
             ));
         }
         let n = events.len();
@@ -416,10 +424,13 @@ impl Run {
     /// from the grid state before it when the time is not a grid time (within round-off,
     /// 8ε·max(|t|, |t₀|)).
     ///
-    /// Errors: non-finite times ([`Error::NonFinite`]), unsorted times or one before the
-    /// current time ([`Error::InvalidArgument`]).
+    /// Errors: no time ([`Error::Shape`]), non-finite times ([`Error::NonFinite`]), unsorted
+    /// times or one before the current time ([`Error::InvalidArgument`]).
     pub fn save_at(&mut self, times: &[f64]) -> Result<()> {
         use crate::error::fmt_num;
+        if times.is_empty() {
+            return Err(Error::shape("t_eval", "(k,) with k ≥ 1", "(0,)"));
+        }
         check::finite_slice("t_eval", times)?;
         if let Some(i) = times.windows(2).position(|w| w[1] <= w[0]) {
             return Err(Error::invalid(

@@ -483,6 +483,12 @@ fn is_matching(planes: &[(usize, usize)]) -> bool {
 // ---------------------------------------------------------------------------------------------
 // Relative equilibria
 
+/// The Euclidean norm of the diagonal of `m`, without overflow of the squares (entries beyond
+/// 1e154 have a representable norm).
+fn diagonal_norm(m: &Mat) -> f64 {
+    (0..m.nrows().min(m.ncols())).fold(0.0, |r: f64, k| r.hypot(m[(k, k)]))
+}
+
 /// How well a [`RelativeEquilibrium`] satisfies its conditions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Residuals {
@@ -535,9 +541,8 @@ impl RelativeEquilibrium {
             "energy",
             0.5 * p0.norm_l2().powi(2) + potential::value(pot, &x0)?,
         )?;
-        let force = (0..n).map(|k| grad[(k, k)].powi(2)).sum::<f64>().sqrt();
         let residuals = Residuals {
-            force,
+            force: diagonal_norm(&grad),
             commutator: equilibrium_residual(a, xi, eta)?,
             motion: grad.norm_l2(),
         };
@@ -572,7 +577,7 @@ impl RelativeEquilibrium {
         for k in 0..n {
             grad[(k, k)] -= p * cof[k];
         }
-        re.residuals.force = (0..n).map(|k| grad[(k, k)].powi(2)).sum::<f64>().sqrt();
+        re.residuals.force = diagonal_norm(&grad);
         re.residuals.motion = grad.norm_l2();
         re.pressure = finite("pressure", p)?;
         Ok(re)
