@@ -511,3 +511,26 @@ def test_relative_equilibria_plane_must_be_a_pair():
     with pytest.raises(lf.ShapeError, match="plane"):
         lf.pseudo_rigid.relative_equilibria(lf.potentials.Harmonic(1.0), shape=[3.0, 2.0, 1.0],
                                             plane=(0,))
+
+
+def test_a_batch_whose_runs_do_not_fit_is_refused_not_aborted():
+    # Each member of a relativistic top's batch holds a stepper of about 5 KiB, more than the
+    # up-front estimate per member: under an address-space limit of 6 GiB a batch of 10⁶ used to
+    # abort the process in an allocation. The memory its runs take is now watched as they are
+    # built (check::BuildBudget, which also reads `ulimit -v`).
+    code = (
+        "import resource, numpy as np, lieflow as lf\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (6 << 30, 6 << 30))\n"
+        "top = lf.RelativisticTangentTop(1.0, 0.5)\n"
+        "z = np.tile(top.state([0.1, 0.2], 0.0, [0.1, 0.0], 1.0), (10**6, 1))\n"
+        "try:\n"
+        "    lf.integrate(top, z, dt=0.01, steps=2)\n"
+        "    print('ran')\n"
+        "except lf.InvalidArgumentError as e:\n"
+        "    print('refused:', e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.startswith("refused: invalid state0: the 1000000 members need about"), \
+        out.stdout

@@ -148,13 +148,86 @@ pub const MAX_ARRAY_ENTRIES: usize = u32::MAX as usize;
 /// Arrays up to this many bytes are allocated without asking the system how much memory is left.
 const CHECKED_BYTES: u64 = 1 << 30;
 
-/// The memory available for new allocations in bytes (Linux: `MemAvailable` of /proc/meminfo),
+/// The memory available for new allocations in bytes (Linux: the smaller of `MemAvailable` of
+/// /proc/meminfo and the room left under the process's address-space limit, `ulimit -v`),
 /// `None` where unknown.
 fn available_memory() -> Option<u64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib.saturating_mul(1024))
+    let free = kib.saturating_mul(1024);
+    Some(address_space_room().map_or(free, |room| room.min(free)))
+}
+
+/// The bytes left under the soft address-space limit (`RLIMIT_AS`: /proc/self/limits against
+/// `VmSize` of /proc/self/status), `None` without a limit.
+fn address_space_room() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    let limit: u64 = line["Max address space".len()..]
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmSize:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(limit.saturating_sub(kib.saturating_mul(1024)))
+}
+
+/// Watches the memory that building `total` items one after another takes (the runs of a
+/// batch, whose size per item no formula gives: it depends on the system and the method): after
+/// `built` items, [`BuildBudget::check`] refuses to go on when the items left, at the average
+/// cost so far, would not fit in what is still available, instead of letting an allocation
+/// abort the process.
+pub struct BuildBudget {
+    what: &'static str,
+    total: usize,
+    start: Option<u64>,
+}
+
+impl BuildBudget {
+    /// Below this much memory taken so far no estimate is made (other processes' noise).
+    const MIN_MEASURED: u64 = 256 << 20;
+
+    /// A budget for `total` items, named `what` in errors.
+    pub fn new(what: &'static str, total: usize) -> Self {
+        BuildBudget {
+            what,
+            total,
+            start: available_memory(),
+        }
+    }
+
+    /// Ok unless the `total − built` items left, at the cost per item measured over the first
+    /// `built`, need more than 7/8 of the memory still available ([`Error::InvalidArgument`]).
+    pub fn check(&self, built: usize) -> Result<()> {
+        let (Some(start), Some(now)) = (self.start, available_memory()) else {
+            return Ok(());
+        };
+        let used = start.saturating_sub(now);
+        if built == 0 || used < Self::MIN_MEASURED {
+            return Ok(());
+        }
+        let per = used as f64 / built as f64;
+        let need = per * self.total.saturating_sub(built) as f64;
+        if need <= (now / 8 * 7) as f64 {
+            return Ok(());
+        }
+        let gib = |b: f64| b / (1u64 << 30) as f64;
+        Err(Error::invalid(
+            self.what,
+            format!(
+                "the {} members need about {:.1} GiB ({:.1} KiB each, measured over the first \
+                 {built}), more than the memory available; integrate fewer at a time",
+                self.total,
+                gib(per * self.total as f64),
+                per / 1024.0
+            ),
+        ))
+    }
 }
 
 /// A shape as numpy prints it: "(3,)", "(2, 3)".

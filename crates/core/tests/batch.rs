@@ -320,7 +320,7 @@ fn errors_name_the_member_and_the_step() {
     let (i, e) = Batch::start(&b, "splitting", &bad, 0.1, 1, 0.0)
         .err()
         .unwrap();
-    assert_eq!(i, 3);
+    assert_eq!(i, Some(3));
     assert!(matches!(e, Error::NonFinite { .. }), "{e:?}");
     let (_, e) = Batch::start(&b, "splitting9", &bad, 0.1, 1, 0.0)
         .err()

@@ -191,7 +191,10 @@ impl Integration {
             Some(p) if !calls_out => p.install(start),
             _ => start(),
         }
-        .map_err(|(i, e)| of_member(e, i, b, first_member))
+        .map_err(|(i, e)| match i {
+            Some(i) => of_member(e, i, b, first_member),
+            None => e,
+        })
         .py()?;
         Ok(Integration {
             method: method.to_string(),

@@ -71,7 +71,8 @@ impl Batch {
     /// the block).
     ///
     /// Errors: those of [`Run::new`] and of the batch stepper's `set`, with the index of the
-    /// first member that has one.
+    /// first member that has one; a batch whose runs would not fit in the memory available
+    /// ([`check::BuildBudget`], no member named).
     pub fn start<S: System + ?Sized>(
         system: &S,
         method: &str,
@@ -79,7 +80,7 @@ impl Batch {
         dt: f64,
         save_every: usize,
         t0: f64,
-    ) -> std::result::Result<Batch, (usize, Error)> {
+    ) -> std::result::Result<Batch, (Option<usize>, Error)> {
         let properties = system
             .methods()
             .into_iter()
@@ -108,12 +109,20 @@ impl Batch {
         let groups: Vec<_> = if in_lanes {
             states0.par_chunks(GROUP).enumerate().map(group).collect()
         } else {
-            states0.chunks(GROUP).enumerate().map(group).collect()
+            // Each member's run holds a stepper of its own, of a size no formula gives: the
+            // memory taken is watched as they are built.
+            let budget = check::BuildBudget::new("state0", states0.len());
+            let mut groups = Vec::with_capacity(states0.len().div_ceil(GROUP));
+            for (g, chunk) in states0.chunks(GROUP).enumerate() {
+                budget.check(g * GROUP).map_err(|e| (None, e))?;
+                groups.push(group((g, chunk)));
+            }
+            groups
         };
         let mut runs = Vec::with_capacity(states0.len());
         let mut lanes = Vec::with_capacity(groups.len());
         for group in groups {
-            let (r, l) = group?;
+            let (r, l) = group.map_err(|(i, e)| (Some(i), e))?;
             runs.extend(r);
             lanes.push(l);
         }

@@ -1320,7 +1320,10 @@ pub fn integrate_batch<S: System + ?Sized>(
 ) -> Result<Vec<Trajectory>> {
     check_steps(steps)?;
     let start = || {
-        Batch::start(system, method, states0, dt, save_every, 0.0).map_err(|(i, e)| e.in_member(i))
+        Batch::start(system, method, states0, dt, save_every, 0.0).map_err(|(i, e)| match i {
+            Some(i) => e.in_member(i),
+            None => e,
+        })
     };
     let mut batch = with_threads(threads, start)?;
     let n_saved = steps / save_every + 1;
