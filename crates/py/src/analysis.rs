@@ -93,7 +93,7 @@ fn run(
 ///     stop: its final value.
 ///     stability: evaluate both stability verdicts at every point (slower).
 ///     step, max_step: the first and the largest arclength step (in the unknowns a, Omega,
-///         Lambda, p scaled by their magnitudes at the start, max(|u_k|, 1)); max_points: a
+///         Lambda, p scaled by their magnitudes at the start, max(abs(u_k), 1)); max_points: a
 ///         bound.
 ///
 /// Returns:
