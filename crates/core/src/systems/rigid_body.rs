@@ -185,14 +185,22 @@ impl GroupField for RigidBody {
             *x = -z[i] / self.top.moments[i];
         }
     }
-    fn act(&self, xi: &[f64], z: &mut [f64], _s: &mut ()) {
-        let g = so3::exp(&Vector3::from_column_slice(xi));
-        let m = g * Vector3::from_column_slice(&z[..3]);
-        z[..3].copy_from_slice(m.as_slice());
-        if self.top.lifted {
-            let r = Matrix3::from_row_slice(&z[3..12]) * g.transpose();
-            z[3..12].copy_from_slice(&top::row_major(&r));
+    /// By increments (`so3::Rodrigues`: exp(ξ̂) formed as a matrix biases |M|² and RᵀR the same
+    /// way at every step of a steady rotation).
+    fn act(&self, xi: &[f64], z: &mut [f64], s: &mut ()) {
+        let mut dz = [0.0; 12];
+        let n = z.len();
+        self.act_increment(xi, z, &mut dz[..n], s);
+        z.iter_mut().zip(dz).for_each(|(zi, d)| *zi += d);
+    }
+    /// (exp(ξ̂)M − M, rows exp(ξ̂)r − r): [`so3::Rodrigues::increment`].
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], _s: &mut ()) -> bool {
+        let g = so3::Rodrigues::exp(&Vector3::from_column_slice(xi));
+        let n = if self.top.lifted { 4 } else { 1 };
+        for (v, d) in z.chunks_exact(3).zip(dz.chunks_exact_mut(3)).take(n) {
+            d.copy_from_slice(g.increment(&Vector3::from_column_slice(v)).as_slice());
         }
+        true
     }
     /// J_l(u)⁻¹ v; NaN where J_l is singular (|u| = 2πk, k ≥ 1).
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], _s: &mut ()) {
