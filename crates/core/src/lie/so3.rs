@@ -405,6 +405,16 @@ impl Rodrigues {
     pub fn right_mul(&self, r: &mut Matrix3<f64>) {
         self.inverse().right_mul_transpose(r);
     }
+
+    /// (M − I) R, the increment of R ↦ M R (every column c of R becomes M c).
+    #[inline]
+    pub fn left_increment(&self, r: &Matrix3<f64>) -> Matrix3<f64> {
+        let mut d = Matrix3::zeros();
+        for j in 0..3 {
+            d.set_column(j, &self.increment(&r.column(j).into_owned()));
+        }
+        d
+    }
 }
 
 /// Inverse Cayley map: ŵ = 2 (R + I)⁻¹ (R − I), in closed form w = 2 vee(R − Rᵀ) / (1 + tr R)

@@ -542,6 +542,13 @@ impl GroupField for GeneralizedRigidBody {
     /// g − I (summed apart from I), so its rounding errors are relative to |ξ||M| rather than
     /// |M| (with g itself the spectrum drifts by ~1e-16 per step, systematically).
     fn act(&self, xi: &[f64], z: &mut [f64], s: &mut SoScratch) {
+        let mut dz = std::mem::take(&mut s.dz);
+        self.act_increment(xi, z, &mut dz, s);
+        z.iter_mut().zip(&dz).for_each(|(zi, d)| *zi += d);
+        s.dz = dz;
+    }
+    /// gMgᵀ − M = (G M + M Gᵀ) + G M Gᵀ with G = exp(ξ) − I, in e_ij coordinates.
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], s: &mut SoScratch) -> bool {
         let n = self.n;
         self.dense(xi, &mut s.a);
         s.expm1();
@@ -551,10 +558,11 @@ impl GroupField for GeneralizedRigidBody {
         for i in 0..n {
             for j in i + 1..n {
                 let q: f64 = (0..n).map(|k| s.b[i * n + k] * s.g[j * n + k]).sum();
-                z[c] += (s.b[i * n + j] - s.b[j * n + i]) + q;
+                dz[c] = (s.b[i * n + j] - s.b[j * n + i]) + q;
                 c += 1;
             }
         }
+        true
     }
     /// Σ_k B_k/k! ad_uᵏ v, summed until a bound of the tail is below 10⁻¹⁷ of the sum; NaN for
     /// |u| ≥ π/2 (the series converges for |u| < π; the bound keeps the number of terms ≤ 64).
@@ -608,6 +616,8 @@ pub struct SoScratch {
     g: Vec<f64>,
     m: Vec<f64>,
     t: Vec<f64>,
+    /// The increment of [`GroupField::act`] (e_ij coordinates).
+    dz: Vec<f64>,
 }
 
 impl SoScratch {
@@ -619,6 +629,7 @@ impl SoScratch {
             g: vec![0.0; n * n],
             m: vec![0.0; n * n],
             t: vec![0.0; n * n],
+            dz: vec![0.0; n * (n - 1) / 2],
         }
     }
 
