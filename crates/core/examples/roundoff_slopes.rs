@@ -22,8 +22,8 @@
 use lieflow::integrate::{Clock, System};
 use lieflow::lie::so3;
 use lieflow::systems::{
-    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisks, Sphere, SphereParticle,
-    SphericalPendulum, TangentTop,
+    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisks, RollingSpheres, Sphere,
+    SphereParticle, SphericalPendulum, TangentTop,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::sync::{Arc, Mutex};
@@ -36,8 +36,8 @@ struct Case {
     dt: f64,
     states: Vec<Vec<f64>>,
     labels: Vec<&'static str>,
-    /// Offset of R (row-major) in the state, for ‖RᵀR − I‖.
-    attitude: Option<usize>,
+    /// Offsets of the attitudes R (row-major) in the state, for ‖RᵀR − I‖.
+    attitude: &'static [usize],
     /// Costly per step (implicit methods): run to 10^`--slow-max` only.
     slow: bool,
 }
@@ -90,7 +90,7 @@ fn cases(seeds: usize) -> Vec<Case> {
         dt: 1e-3,
         states: seeds_of(&|k| lagrange.state(nudge(m0, k, 0.01), unit(nudge(g0, k, 0.01)))),
         labels: vec!["‖Γ‖²", "M·Γ"],
-        attitude: None,
+        attitude: &[],
         slow: false,
     });
     let lifted = lagrange.with_attitude();
@@ -103,7 +103,7 @@ fn cases(seeds: usize) -> Vec<Case> {
             lifted.state_with_attitude(nudge(m0, k, 0.01), r)
         }),
         labels: vec!["‖Γ‖²", "M·Γ"],
-        attitude: Some(6),
+        attitude: &[6],
         slow: false,
     });
     // Its steady precession (a relative equilibrium): M = (a, 0, m₃), Γ = (sin β, 0, cos β)
@@ -120,7 +120,7 @@ fn cases(seeds: usize) -> Vec<Case> {
             lagrange.state([a, 0.0, m3], [sb, 0.0, cb])
         }),
         labels: vec!["‖Γ‖²", "M·Γ"],
-        attitude: None,
+        attitude: &[],
         slow: false,
     });
 
@@ -137,7 +137,7 @@ fn cases(seeds: usize) -> Vec<Case> {
             )
         }),
         labels: vec!["‖Γ‖²", "M·Γ"],
-        attitude: None,
+        attitude: &[],
         slow: false,
     });
 
@@ -150,7 +150,7 @@ fn cases(seeds: usize) -> Vec<Case> {
         dt: 1e-2,
         states: seeds_of(&|k| nudge(msym, k, 0.01).to_vec()),
         labels: vec!["‖M‖²"],
-        attitude: None,
+        attitude: &[],
         slow: false,
     });
     let sym_l = sym.with_attitude();
@@ -163,7 +163,7 @@ fn cases(seeds: usize) -> Vec<Case> {
             sym_l.state_with_attitude(nudge(msym, k, 0.01), rows(&r))
         }),
         labels: vec!["‖M‖²", "(RM)₁", "(RM)₂", "(RM)₃"],
-        attitude: Some(3),
+        attitude: &[3],
         slow: false,
     });
     // A generic body (1, 2, 3).
@@ -174,7 +174,7 @@ fn cases(seeds: usize) -> Vec<Case> {
         dt: 1e-2,
         states: seeds_of(&|k| nudge([1.0, 0.5, -0.3], k, 0.01).to_vec()),
         labels: vec!["‖M‖²"],
-        attitude: None,
+        attitude: &[],
         slow: false,
     });
     // Steady rotation about the major axis (a relative equilibrium): M = e₃ is a fixed point of
@@ -189,7 +189,7 @@ fn cases(seeds: usize) -> Vec<Case> {
             body_l.state_with_attitude([0.0, 0.0, 1.0 + 0.01 * k as f64], rows(&r))
         }),
         labels: vec!["‖M‖²", "(RM)₁", "(RM)₂", "(RM)₃"],
-        attitude: Some(3),
+        attitude: &[3],
         slow: false,
     });
 
@@ -205,7 +205,7 @@ fn cases(seeds: usize) -> Vec<Case> {
                 .unwrap()
         }),
         labels: vec!["‖q‖²", "q·L"],
-        attitude: None,
+        attitude: &[],
         slow: false,
     });
     out.push(Case {
@@ -218,7 +218,7 @@ fn cases(seeds: usize) -> Vec<Case> {
             pend.state_from_spherical(th, 0.1, 0.0, w).unwrap()
         }),
         labels: vec!["‖q‖²", "q·L"],
-        attitude: None,
+        attitude: &[],
         slow: false,
     });
 
@@ -237,7 +237,7 @@ fn cases(seeds: usize) -> Vec<Case> {
                 vec![0.3, -0.2 + 0.01 * k, 0.5, 0.1, 0.4 - 0.01 * k, -0.6]
             }),
             labels: vec!["C₁", "C₂"],
-            attitude: None,
+            attitude: &[],
             slow: true,
         });
     }
@@ -255,7 +255,7 @@ fn cases(seeds: usize) -> Vec<Case> {
             particle.from_spherical(&s).unwrap()
         }),
         labels: vec!["(q × p)₃"],
-        attitude: None,
+        attitude: &[],
         slow: true,
     });
     let disks = RollingDisks::new(
@@ -277,7 +277,7 @@ fn cases(seeds: usize) -> Vec<Case> {
                 .unwrap()
         }),
         labels: vec!["J"],
-        attitude: None,
+        attitude: &[],
         slow: true,
     });
     let tangent = TangentTop::new(Arc::new(Sphere::new(1.0).unwrap()), 1.0, 0.6).unwrap();
@@ -291,7 +291,40 @@ fn cases(seeds: usize) -> Vec<Case> {
                 .unwrap()
         }),
         labels: vec!["θ̇-momentum", "K₁", "K₂", "K₃"],
-        attitude: None,
+        attitude: &[],
+        slow: true,
+    });
+    let spheres = RollingSpheres::new(
+        0.7,
+        1.3,
+        [0.1, -0.2, 0.15],
+        [-0.3, 0.2, 0.4],
+        2.0,
+        3.5,
+        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
+        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
+    )
+    .unwrap();
+    out.push(Case {
+        name: "rolling spheres".into(),
+        system: Arc::new(spheres.clone()),
+        dt: 1e-2,
+        states: seeds_of(&|k| {
+            let r1 = so3::exp(&Vector3::new(0.3, -0.2, 0.5 + 0.01 * k as f64));
+            let r2 = so3::exp(&Vector3::new(-0.4, 0.1, 0.2));
+            let m = |r: Matrix3<f64>| std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]));
+            spheres
+                .state(
+                    m(r1),
+                    m(r2),
+                    [0.6, 0.0, 0.8],
+                    [0.5, -0.3, 0.8],
+                    [-0.2, 0.4, 0.1],
+                )
+                .unwrap()
+        }),
+        labels: vec!["L₁", "L₂", "L₃"],
+        attitude: &[0, 9],
         slow: true,
     });
     let pendulum = Pendulum::new(1.0, 1.0, 9.81).unwrap();
@@ -301,7 +334,7 @@ fn cases(seeds: usize) -> Vec<Case> {
         dt: 1e-2,
         states: seeds_of(&|k| vec![1.2 + 0.01 * k as f64, 0.3]),
         labels: vec![],
-        attitude: None,
+        attitude: &[],
         slow: true,
     });
     out
@@ -313,7 +346,7 @@ fn quantities(case: &Case, energy: bool, z: &[f64]) -> Vec<f64> {
     if energy {
         q.push(case.system.energy(z).expect("energy"));
     }
-    if let Some(at) = case.attitude {
+    for &at in case.attitude {
         let r = Matrix3::from_row_slice(&z[at..at + 9]);
         q.push((r.transpose() * r - Matrix3::identity()).norm());
     }
@@ -327,7 +360,7 @@ fn run_one(case: &Case, method: &str, energy: bool, z0: &[f64], max_exp: u32) ->
     case.system.to_internal(&mut z);
     stepper.set(&z).expect("set");
     let q0 = quantities(case, energy, z0);
-    let is_defect = |i: usize| case.attitude.is_some() && i == q0.len() - 1;
+    let is_defect = |i: usize| i + case.attitude.len() >= q0.len();
     let mut worst = vec![0.0f64; q0.len()];
     let mut out = Vec::new();
     let mut done = 0u64;
@@ -507,8 +540,11 @@ fn main() {
             if first.energy {
                 labels.push("H".into());
             }
-            if c.attitude.is_some() {
-                labels.push("‖RᵀR − I‖".into());
+            for (i, _) in c.attitude.iter().enumerate() {
+                labels.push(match c.attitude.len() {
+                    1 => "‖RᵀR − I‖".into(),
+                    _ => format!("‖R{}ᵀR{} − I‖", i + 1, i + 1),
+                });
             }
             let decades = first.errors.len();
             let ns = 1e9 * runs.iter().map(|r| r.secs).sum::<f64>()
