@@ -470,6 +470,9 @@ impl<P: GroupField + VectorField> GroupField for DoubleBracket<P> {
     fn act(&self, xi: &[f64], z: &mut [f64], s: &mut P::Scratch) {
         self.problem.act(xi, z, s)
     }
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], s: &mut P::Scratch) -> bool {
+        self.problem.act_increment(xi, z, dz, s)
+    }
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut P::Scratch) {
         self.problem.dexp_inv(u, v, out, s)
     }

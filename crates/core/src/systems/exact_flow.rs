@@ -391,16 +391,74 @@ impl Orbit {
 }
 
 /// S(τ) = R₀ᵀR(τ) of the free motion from M₀ (principal frame), for a step of the heavy-top
-/// splittings: [`Orbit::short_step`] where it applies, else [`FreeFlow::motion`].
-pub(crate) fn relative_attitude(inertia: &[f64; 3], m0: &Vector3<f64>, tau: f64) -> Matrix3<f64> {
+/// splittings, as it acts on body vectors x ↦ Sᵀx (M, Γ, the rows of R).
+pub(crate) enum Relative {
+    /// The closed forms (a symmetric body, a uniform rotation): Sᵀx = the turn exp(−v̂)x
+    /// (v = τM₀/I_o, or τω) followed by the rotation about e_s by −θ, each by increments
+    /// (`so3::Rodrigues`, `top::rotate_axis_sc`). A matrix S would be orthogonal only to ~ε, and
+    /// for a symmetric body its defect is nearly the same at every step (the Lagrange top's |Γ|²
+    /// and M·Γ drifted linearly with `exact_splitting`). The turn leaves M itself fixed (v ∥ M).
+    Closed {
+        turn: so3::Rodrigues,
+        /// (s, θ): the rotation about e_s by −θ, as (s, sin θ, cos θ − 1).
+        spin: Option<(usize, f64, f64)>,
+    },
+    /// The elliptic motion: [`Orbit::short_step`] where it applies, else [`FreeFlow::motion`].
+    Matrix(Matrix3<f64>),
+}
+
+impl Relative {
+    /// x ↦ Sᵀx for a body vector other than M (Γ, a row of R).
+    #[inline]
+    pub(crate) fn apply(&self, x: &mut Vector3<f64>) {
+        match self {
+            Relative::Closed { turn, spin } => {
+                turn.apply(x);
+                if let Some((k, s, cm1)) = *spin {
+                    top::rotate_axis_sc(x, k, s, cm1);
+                }
+            }
+            Relative::Matrix(s) => *x = s.transpose() * *x,
+        }
+    }
+
+    /// M ↦ SᵀM (R M conserved).
+    #[inline]
+    pub(crate) fn apply_momentum(&self, m: &mut Vector3<f64>) {
+        match self {
+            Relative::Closed { spin, .. } => {
+                if let Some((k, s, cm1)) = *spin {
+                    top::rotate_axis_sc(m, k, s, cm1);
+                }
+            }
+            Relative::Matrix(s) => *m = s.transpose() * *m,
+        }
+    }
+}
+
+/// The relative attitude S(τ) of the free motion from M₀ (principal frame) over τ ([`Relative`]).
+pub(crate) fn relative_attitude(inertia: &[f64; 3], m0: &Vector3<f64>, tau: f64) -> Relative {
     let kind = match shape(inertia, m0) {
+        Shape::Closed(Kind::Uniform(w)) => {
+            return Relative::Closed {
+                turn: so3::Rodrigues::exp(&-(w * tau)),
+                spin: None,
+            }
+        }
+        Shape::Closed(Kind::Symmetric { s, w, inv_io }) => {
+            let (sin, cm1) = crate::simd::angle_sin_cosm1(tau * w);
+            return Relative::Closed {
+                turn: so3::Rodrigues::exp(&-(m0 * (tau * inv_io))),
+                spin: Some((s, sin, cm1)),
+            };
+        }
         Shape::Closed(k) => k,
         Shape::Elliptic(o) => match o.short_step(tau) {
-            Some(s) => return s,
+            Some(s) => return Relative::Matrix(s),
             None => Kind::Elliptic(Elliptic::new(o)),
         },
     };
-    FreeFlow { m0: *m0, kind }.motion(tau).1
+    Relative::Matrix(FreeFlow { m0: *m0, kind }.motion(tau).1)
 }
 
 impl Elliptic {

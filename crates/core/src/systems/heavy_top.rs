@@ -246,14 +246,21 @@ impl Split for FreeKick {
         }
         // M(τ) = S(τ)ᵀM₀ (R M conserved) rather than the elliptic formula for M: a rotation of
         // M₀, so |M| and M·Γ keep their values to the rounding of an orthogonal product, with no
-        // bias from the amplitudes' rounding repeated in every step.
+        // bias from the amplitudes' rounding repeated in every step; R S row by row (rows
+        // r ↦ Sᵀr). The closed forms act by increments (`Relative`).
         let s = relative_attitude(&self.0.top.moments, &w.m, tau);
-        w.m = s.transpose() * w.m;
+        s.apply_momentum(&mut w.m);
         if let Some(g) = w.g.as_mut() {
-            *g = s.transpose() * *g;
+            s.apply(g);
         }
         if let Some(r) = w.r.as_mut() {
-            *r *= s;
+            for i in 0..3 {
+                let mut row = Vector3::new(r[(i, 0)], r[(i, 1)], r[(i, 2)]);
+                s.apply(&mut row);
+                for j in 0..3 {
+                    r[(i, j)] = row[j];
+                }
+            }
         }
     }
 }

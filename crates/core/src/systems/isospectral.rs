@@ -211,7 +211,9 @@ impl Stepper for So3Stepper {
                 .map_err(|e| failed(&clock, k, e))?;
             if let Some(r) = self.r.as_mut() {
                 let w = self.kernel.omega();
-                *r *= so3::cayley(&(Vector3::new(w[7], w[2], w[3]) * self.h));
+                // R cay(hΩ̃) by increments of R's rows (no bias at a steady rotation:
+                // `so3::Rodrigues`).
+                so3::Rodrigues::cayley(&(Vector3::new(w[7], w[2], w[3]) * self.h)).right_mul(r);
             }
         }
         Ok(())

@@ -133,7 +133,10 @@ impl LgviStepper {
         let kick = self.torque(&s.g) * (0.5 * h);
         compensated_add(&mut s.m, &mut self.carry_m, kick);
         if let Some(r) = s.r.as_mut() {
-            *r *= so3::cayley(&(g * 2.0)); // (I − ĝ)⁻¹(I + ĝ) = cay(2g)
+            // R F with F = (I − ĝ)⁻¹(I + ĝ) = cay(2g), by increments of R's rows: F formed as a
+            // matrix is orthogonal only to ~ε, the same defect at every step of a steady rotation
+            // (RᵀR drifted linearly); see `so3::Rodrigues`.
+            so3::Rodrigues::cayley(&(g * 2.0)).right_mul(r);
         }
         Ok(s)
     }

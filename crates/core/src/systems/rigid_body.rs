@@ -185,14 +185,22 @@ impl GroupField for RigidBody {
             *x = -z[i] / self.top.moments[i];
         }
     }
-    fn act(&self, xi: &[f64], z: &mut [f64], _s: &mut ()) {
-        let g = so3::exp(&Vector3::from_column_slice(xi));
-        let m = g * Vector3::from_column_slice(&z[..3]);
-        z[..3].copy_from_slice(m.as_slice());
-        if self.top.lifted {
-            let r = Matrix3::from_row_slice(&z[3..12]) * g.transpose();
-            z[3..12].copy_from_slice(&top::row_major(&r));
+    /// By increments (`so3::Rodrigues`: exp(ξ̂) formed as a matrix biases |M|² and RᵀR the same
+    /// way at every step of a steady rotation).
+    fn act(&self, xi: &[f64], z: &mut [f64], s: &mut ()) {
+        let mut dz = [0.0; 12];
+        let n = z.len();
+        self.act_increment(xi, z, &mut dz[..n], s);
+        z.iter_mut().zip(dz).for_each(|(zi, d)| *zi += d);
+    }
+    /// (exp(ξ̂)M − M, rows exp(ξ̂)r − r): [`so3::Rodrigues::increment`].
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], _s: &mut ()) -> bool {
+        let g = so3::Rodrigues::exp(&Vector3::from_column_slice(xi));
+        let n = if self.top.lifted { 4 } else { 1 };
+        for (v, d) in z.chunks_exact(3).zip(dz.chunks_exact_mut(3)).take(n) {
+            d.copy_from_slice(g.increment(&Vector3::from_column_slice(v)).as_slice());
         }
+        true
     }
     /// J_l(u)⁻¹ v; NaN where J_l is singular (|u| = 2πk, k ≥ 1).
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], _s: &mut ()) {
@@ -534,6 +542,13 @@ impl GroupField for GeneralizedRigidBody {
     /// g − I (summed apart from I), so its rounding errors are relative to |ξ||M| rather than
     /// |M| (with g itself the spectrum drifts by ~1e-16 per step, systematically).
     fn act(&self, xi: &[f64], z: &mut [f64], s: &mut SoScratch) {
+        let mut dz = std::mem::take(&mut s.dz);
+        self.act_increment(xi, z, &mut dz, s);
+        z.iter_mut().zip(&dz).for_each(|(zi, d)| *zi += d);
+        s.dz = dz;
+    }
+    /// gMgᵀ − M = (G M + M Gᵀ) + G M Gᵀ with G = exp(ξ) − I, in e_ij coordinates.
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], s: &mut SoScratch) -> bool {
         let n = self.n;
         self.dense(xi, &mut s.a);
         s.expm1();
@@ -543,10 +558,11 @@ impl GroupField for GeneralizedRigidBody {
         for i in 0..n {
             for j in i + 1..n {
                 let q: f64 = (0..n).map(|k| s.b[i * n + k] * s.g[j * n + k]).sum();
-                z[c] += (s.b[i * n + j] - s.b[j * n + i]) + q;
+                dz[c] = (s.b[i * n + j] - s.b[j * n + i]) + q;
                 c += 1;
             }
         }
+        true
     }
     /// Σ_k B_k/k! ad_uᵏ v, summed until a bound of the tail is below 10⁻¹⁷ of the sum; NaN for
     /// |u| ≥ π/2 (the series converges for |u| < π; the bound keeps the number of terms ≤ 64).
@@ -600,6 +616,8 @@ pub struct SoScratch {
     g: Vec<f64>,
     m: Vec<f64>,
     t: Vec<f64>,
+    /// The increment of [`GroupField::act`] (e_ij coordinates).
+    dz: Vec<f64>,
 }
 
 impl SoScratch {
@@ -611,6 +629,7 @@ impl SoScratch {
             g: vec![0.0; n * n],
             m: vec![0.0; n * n],
             t: vec![0.0; n * n],
+            dz: vec![0.0; n * (n - 1) / 2],
         }
     }
 

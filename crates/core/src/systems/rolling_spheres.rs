@@ -899,18 +899,24 @@ impl GroupField for RollingSpheres {
         xi[9..12].copy_from_slice(rates[0].as_slice());
         xi[12..15].copy_from_slice(rates[1].as_slice());
     }
-    fn act(&self, xi: &[f64], z: &mut [f64], _s: &mut ()) {
+    fn act(&self, xi: &[f64], z: &mut [f64], s: &mut ()) {
+        let mut dz = [0.0; STATE_DIM];
+        self.act_increment(xi, z, &mut dz, s);
+        z.iter_mut().zip(dz).for_each(|(zi, d)| *zi += d);
+    }
+    /// The increments (exp(ξ̂_k) − I)z_k, (exp(ξ̂_u) − I)u and ξ_P (`so3::Rodrigues`: no bias per
+    /// step from a rotation matrix rounded to an ulp of 1).
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], _s: &mut ()) -> bool {
         for i in 0..2 {
-            let g = so3::exp(&Vector3::from_column_slice(&xi[3 * i..3 * i + 3]));
-            let r = g * Matrix3::from_row_slice(&z[9 * i..9 * i + 9]);
-            put_rows(&r, &mut z[9 * i..9 * i + 9]);
+            let g = so3::Rodrigues::exp(&Vector3::from_column_slice(&xi[3 * i..3 * i + 3]));
+            let d = g.left_increment(&Matrix3::from_row_slice(&z[9 * i..9 * i + 9]));
+            put_rows(&d, &mut dz[9 * i..9 * i + 9]);
         }
-        let g = so3::exp(&Vector3::from_column_slice(&xi[6..9]));
-        let u = g * Vector3::from_column_slice(&z[18..21]);
-        z[18..21].copy_from_slice(u.as_slice());
-        for (zi, x) in z[21..27].iter_mut().zip(&xi[9..15]) {
-            *zi += x;
-        }
+        let g = so3::Rodrigues::exp(&Vector3::from_column_slice(&xi[6..9]));
+        let d = g.increment(&Vector3::from_column_slice(&z[18..21]));
+        dz[18..21].copy_from_slice(d.as_slice());
+        dz[21..27].copy_from_slice(&xi[9..15]);
+        true
     }
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], _s: &mut ()) {
         for i in 0..3 {

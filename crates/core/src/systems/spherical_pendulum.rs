@@ -140,7 +140,10 @@ impl Split for SphericalPendulum {
         if i == 0 {
             *l += Vector3::new(-q.y, q.x, 0.0) * (tau * self.bob.mgl());
         } else {
-            *q = crate::lie::so3::exp(&(*l * (tau / self.bob.inertia()))) * *q;
+            // q + (exp(ŵ) − I) q: the matrix exp(ŵ) is orthogonal only to ~ε, and on the
+            // conical pendulum (a steady rotation) its defect biased |q|² and q·L the same way at
+            // every step (`so3::Rodrigues`).
+            crate::lie::so3::Rodrigues::exp(&(*l * (tau / self.bob.inertia()))).apply(q);
         }
     }
 }

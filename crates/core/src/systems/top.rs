@@ -130,16 +130,20 @@ pub(crate) fn row_major(r: &Matrix3<f64>) -> [f64; 9] {
 /// finiteness guard reports with the step.
 #[inline]
 pub(crate) fn rotate_axis(v: &mut Vector3<f64>, k: usize, theta: f64) {
-    let (s, c) = crate::lie::angle_sin_cos(theta);
-    rotate_axis_sc(v, k, s, c);
+    let (s, cm1) = crate::simd::angle_sin_cosm1(theta);
+    rotate_axis_sc(v, k, s, cm1);
 }
 
+/// v ↦ v + ((cos θ − 1)v + sin θ Jv) in the plane (i, j) ⊥ e_k, from `s` = sin θ and
+/// `cm1` = cos θ − 1: orthogonal to O(θ²ε), where (cos θ)v + sin θ Jv with cos θ rounded is off
+/// by up to an ulp of 1 and, at the same angle every step (a symmetric body), biases |v|² the
+/// same way every step ([`crate::simd`], "Rotations").
 #[inline]
-fn rotate_axis_sc(v: &mut Vector3<f64>, k: usize, s: f64, c: f64) {
+pub(crate) fn rotate_axis_sc(v: &mut Vector3<f64>, k: usize, s: f64, cm1: f64) {
     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
     let (vi, vj) = (v[i], v[j]);
-    v[i] = c * vi + s * vj;
-    v[j] = c * vj - s * vi;
+    v[i] = vi + (cm1 * vi + s * vj);
+    v[j] = vj + (cm1 * vj - s * vi);
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -304,16 +308,16 @@ impl Top {
                 // One lane of the batch kernel (`TopLanes`): the same sin/cos and operations, so
                 // a body gives the same bits alone and in a batch. NaN where the angle is lost
                 // to rounding (see `rotate_axis`).
-                let (s, co) = crate::simd::angle_sin_cos(tau * self.coef[a] * b.m[k]);
-                rotate_axis_sc(&mut b.m, k, s, co);
+                let (s, cm1) = crate::simd::angle_sin_cosm1(tau * self.coef[a] * b.m[k]);
+                rotate_axis_sc(&mut b.m, k, s, cm1);
                 if let Some(g) = b.g.as_mut() {
-                    rotate_axis_sc(g, k, s, co);
+                    rotate_axis_sc(g, k, s, cm1);
                 }
                 if let Some(r) = b.r.as_mut() {
                     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
                     let (ci, cj) = (r.column(i).into_owned(), r.column(j).into_owned());
-                    r.set_column(i, &(ci * co + cj * s));
-                    r.set_column(j, &(cj * co - ci * s));
+                    r.set_column(i, &(ci + (ci * cm1 + cj * s)));
+                    r.set_column(j, &(cj + (cj * cm1 - ci * s)));
                 }
             }
             Flow::Casimir => {
@@ -590,24 +594,31 @@ impl<S: pulp::Simd> Turn<S> {
         let small = simd.less_than_or_equal_f64s(th2, simd.splat_f64s(small_max));
         let (mut a, mut b) = crate::simd::sinc_versinc_small(simd, th2);
         if simd.first_true_m64s(simd.not_m64s(small)) < S::F64_LANES {
+            // 1 − cos θ as −(cos θ − 1): no cancellation near multiples of 2π.
             let th = simd.sqrt_f64s(th2);
-            let (s, c) = crate::simd::sin_cos_lanes(simd, th);
-            let versin = simd.sub_f64s(simd.splat_f64s(1.0), c);
+            let (s, cm1) = crate::simd::sin_cosm1_lanes(simd, th);
+            let versin = simd.xor_f64s(cm1, simd.splat_f64s(-0.0));
             a = simd.select_f64s(small, a, simd.div_f64s(s, th));
             b = simd.select_f64s(small, b, simd.div_f64s(versin, th2));
         }
         Turn { simd, v, a, b }
     }
 
-    /// x ↦ exp(−v̂) x.
+    /// x ↦ exp(−v̂) x = x + (B v × (v × x) − A v × x): the increment formed first and added to
+    /// x once. Adding A v × x and then B v × (v × x) rounds x twice, and at a relative
+    /// equilibrium (a steady precession) the second addend is the same to far below an ulp of x
+    /// at every step, so its rounding onto x is the same every step: a bias (|Γ|² of the Lagrange
+    /// top's steady precession drifted by 0.6 ulp per step with `splitting4`). The increment as a
+    /// whole varies from step to step by many of its own ulps, and its one rounding onto x is
+    /// unbiased.
     #[inline(always)]
     fn apply(&self, x: &mut [S::f64s; 3]) {
         let simd = self.simd;
         let w = cross(simd, self.v, *x);
         let u = cross(simd, self.v, w);
         for k in 0..3 {
-            let x_aw = simd.sub_f64s(x[k], simd.mul_f64s(self.a, w[k]));
-            x[k] = simd.add_f64s(x_aw, simd.mul_f64s(self.b, u[k]));
+            let d = simd.sub_f64s(simd.mul_f64s(self.b, u[k]), simd.mul_f64s(self.a, w[k]));
+            x[k] = simd.add_f64s(x[k], d);
         }
     }
 }
@@ -636,8 +647,9 @@ fn cross<S: pulp::Simd>(simd: S, a: [S::f64s; 3], b: [S::f64s; 3]) -> [S::f64s; 
 }
 
 /// The rotation of every body of a group about e_k by the angle −tc·M_k (tc = τ·a per lane):
-/// V_i ← c V_i + s V_j, V_j ← c V_j − s V_i with (i, j, k) cyclic for V = M (and Γ when D = 6),
-/// as `rotate_axis_sc`.
+/// V_i ← V_i + ((c − 1)V_i + s V_j), V_j ← V_j + ((c − 1)V_j − s V_i) with (i, j, k) cyclic for
+/// V = M, Γ and the rows of R, as `rotate_axis_sc` (c − 1 carried to its own precision: no bias
+/// per step).
 #[inline(always)]
 fn rotate<S: pulp::Simd, const D: usize>(
     simd: S,
@@ -659,24 +671,26 @@ fn rotate_about<S: pulp::Simd, const D: usize, const K: usize, const I: usize, c
     tc: [S::f64s; GROUP],
 ) {
     let mut s = [simd.splat_f64s(0.0); GROUP];
-    let mut c = [simd.splat_f64s(0.0); GROUP];
+    let mut cm1 = [simd.splat_f64s(0.0); GROUP];
     let angle: [S::f64s; GROUP] = std::array::from_fn(|g| simd.mul_f64s(tc[g], z[K][g]));
     // Small angles (the usual case) skip the argument reduction: the same bits
-    // (`simd::sin_cos_small`), so the choice, made per group, changes no result.
+    // (`simd::sin_cosm1_small`), so the choice, made per group, changes no result.
     if angle.iter().all(|&a| crate::simd::all_small(simd, a)) {
         for g in 0..GROUP {
-            (s[g], c[g]) = crate::simd::sin_cos_small(simd, angle[g]);
+            (s[g], cm1[g]) = crate::simd::sin_cosm1_small(simd, angle[g]);
         }
     } else {
         for g in 0..GROUP {
-            (s[g], c[g]) = crate::simd::sin_cos_lanes(simd, angle[g]);
+            (s[g], cm1[g]) = crate::simd::sin_cosm1_lanes(simd, angle[g]);
         }
     }
     for base in (0..D).step_by(3) {
         for g in 0..GROUP {
             let (vi, vj) = (z[base + I][g], z[base + J][g]);
-            z[base + I][g] = simd.add_f64s(simd.mul_f64s(c[g], vi), simd.mul_f64s(s[g], vj));
-            z[base + J][g] = simd.sub_f64s(simd.mul_f64s(c[g], vj), simd.mul_f64s(s[g], vi));
+            let di = simd.add_f64s(simd.mul_f64s(cm1[g], vi), simd.mul_f64s(s[g], vj));
+            let dj = simd.sub_f64s(simd.mul_f64s(cm1[g], vj), simd.mul_f64s(s[g], vi));
+            z[base + I][g] = simd.add_f64s(vi, di);
+            z[base + J][g] = simd.add_f64s(vj, dj);
         }
     }
 }

@@ -51,6 +51,8 @@ impl<P: GroupField + Clone + 'static> Integrator<P> for Rkmk4 {
             u: vec![0.0; g],
             xi: vec![0.0; g],
             k: [vec![0.0; g], vec![0.0; g], vec![0.0; g], vec![0.0; g]],
+            dz: vec![0.0; n],
+            carry: vec![0.0; n],
         }))
     }
 }
@@ -64,6 +66,11 @@ struct RkmkStepper<P: GroupField> {
     u: Vec<f64>,
     xi: Vec<f64>,
     k: [Vec<f64>; 4],
+    /// The step's increment exp(u)·y − y, where the problem forms it
+    /// ([`GroupField::act_increment`]).
+    dz: Vec<f64>,
+    /// The low-order part lost in adding the increments (Kahan's compensated summation).
+    carry: Vec<f64>,
 }
 
 impl<P: GroupField> RkmkStepper<P> {
@@ -78,6 +85,8 @@ impl<P: GroupField> RkmkStepper<P> {
             u,
             xi,
             k: [k1, k2, k3, k4],
+            dz,
+            carry,
         } = self;
         let h = *h;
         problem.generator(y, k1, scratch);
@@ -102,7 +111,18 @@ impl<P: GroupField> RkmkStepper<P> {
             finite &= u[i].is_finite();
         }
         if finite {
-            problem.act(u, y, scratch);
+            if problem.act_increment(u, y, dz, scratch) {
+                // Kahan's compensated y += dz: a step's rounding is carried into the next
+                // instead of repeating itself at a steady motion (GroupField::act_increment).
+                for ((yi, ci), &di) in y.iter_mut().zip(carry.iter_mut()).zip(dz.iter()) {
+                    let d = di - *ci;
+                    let t = *yi + d;
+                    *ci = (t - *yi) - d;
+                    *yi = t;
+                }
+            } else {
+                problem.act(u, y, scratch);
+            }
         }
         finite
     }
@@ -111,6 +131,7 @@ impl<P: GroupField> RkmkStepper<P> {
 impl<P: GroupField> Stepper for RkmkStepper<P> {
     fn set(&mut self, z: &[f64]) -> Result<()> {
         self.y.copy_from_slice(z);
+        self.carry.fill(0.0);
         Ok(())
     }
 
