@@ -290,7 +290,7 @@ fn cases(seeds: usize) -> Vec<Case> {
                 .state([1.2, 0.3 + 0.01 * k as f64], 0.4, [0.5, -0.3], 0.8)
                 .unwrap()
         }),
-        labels: vec!["θ̇-momentum", "K₁", "K₂", "K₃"],
+        labels: vec!["θ̇-momentum", "p_φ (rotation about z)"],
         attitude: &[],
         slow: true,
     });
@@ -546,6 +546,12 @@ fn main() {
                     _ => format!("‖R{}ᵀR{} − I‖", i + 1, i + 1),
                 });
             }
+            assert_eq!(
+                labels.len(),
+                first.errors[0].len(),
+                "{}: one label per measured quantity",
+                c.name
+            );
             let decades = first.errors.len();
             let ns = 1e9 * runs.iter().map(|r| r.secs).sum::<f64>()
                 / runs.len() as f64
