@@ -40,13 +40,14 @@
 pub mod analysis;
 pub mod check;
 pub mod convergence;
-pub mod elliptic;
+
 pub mod error;
 pub mod integrate;
 pub mod lie;
-pub(crate) mod linalg;
+pub mod numerics;
+
 pub mod pseudo_rigid;
-pub mod simd;
+
 pub mod systems;
 
 pub use error::{Error, Result};

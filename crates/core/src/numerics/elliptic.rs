@@ -20,7 +20,7 @@
 //! E(φ | m) = sin φ R_F − (m/3) sin³φ R_D(cos²φ, 1 − m sin²φ, 1) and the index symbols of a
 //! homogeneous ellipsoid ([`crate::pseudo_rigid::gravity`]).
 //!
-//! These serve the exact solution of the free rigid body ([`crate::systems::rigid_body`]), the
+//! These serve the exact solution of the free rigid body ([`crate::systems::tops::rigid_body`]), the
 //! pendulum ([`crate::systems::pendulum`]) and the self-gravity of an ellipsoid.
 
 use crate::error::{Error, Result};

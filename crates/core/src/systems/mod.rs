@@ -29,37 +29,18 @@
 //! 003 §2: [`RollingSpheres`]: z = (z₁, z₂, u, Ω₁, Ω₂) (27), two spheres rolling against each
 //! other (z_k ∈ SO(3) row-major, u ∈ S²).
 
-pub mod dmv;
-pub mod exact_flow;
-pub mod heavy_top;
-pub mod isospectral;
-pub mod lgvi;
-pub mod pendulum;
-pub mod relativistic_top;
-pub mod rigid_body;
-pub mod rolling_disk;
-pub mod rolling_disks;
-pub mod rolling_spheres;
-pub mod sphere_particle;
-pub mod spherical_pendulum;
-pub mod surface;
+pub mod rolling;
 pub mod tangent_top;
-mod top;
+pub mod test_problems;
+pub mod tops;
 pub mod user;
 
-pub use dmv::Dmv;
-pub use exact_flow::{Exact, ExactSplitting};
-pub use heavy_top::HeavyTop;
-pub use isospectral::Isospectral;
-pub use lgvi::Lgvi;
-pub use pendulum::Pendulum;
-pub use relativistic_top::{Potential, PotentialValue, RelativisticTangentTop, WeakFieldTop};
-pub use rigid_body::{GeneralizedRigidBody, RigidBody};
-pub use rolling_disk::RollingDisk;
-pub use rolling_disks::RollingDisks;
-pub use rolling_spheres::RollingSpheres;
-pub use sphere_particle::SphereParticle;
-pub use spherical_pendulum::SphericalPendulum;
-pub use surface::{Graph, HyperbolicPlane, MetricSurface, Plane, Revolution, Sphere, Surface};
-pub use tangent_top::{ChargedParticle, TangentTop};
+pub use rolling::{RollingDisks, RollingSpheres};
+pub use tangent_top::{
+    ChargedParticle, Graph, HyperbolicPlane, MetricSurface, Plane, Potential, PotentialValue,
+    RelativisticTangentTop, Revolution, Sphere, Surface, TangentTop, WeakFieldTop,
+};
+pub use test_problems::{Pendulum, RollingDisk, SphereParticle};
+pub use tops::methods::{Dmv, Exact, ExactSplitting, Isospectral, Lgvi};
+pub use tops::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
 pub use user::{Algebra, KineticMass, LieHamiltonian, LiePoisson, UserCanonical, UserSeparable};

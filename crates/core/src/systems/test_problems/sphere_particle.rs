@@ -44,7 +44,7 @@ impl SphereParticle {
         check::len_of("spherical-pendulum state (u, L)", z, 6)?;
         check::finite_slice("spherical-pendulum state (u, L)", z)?;
         // (u, L) must be a spherical-pendulum state (|u| = 1, u·L = 0), as its check_state asks.
-        super::spherical_pendulum::check_pendulum_state(z)?;
+        crate::systems::tops::spherical_pendulum::check_pendulum_state(z)?;
         let u = Vector3::from_column_slice(&z[..3]);
         let l = Vector3::from_column_slice(&z[3..]);
         let q = u * self.bob.length;

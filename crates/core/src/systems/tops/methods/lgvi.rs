@@ -23,7 +23,7 @@
 //! R Π (free body), |Γ|² and Π·Γ (heavy top) are kept to round-off: Π and Γ move only by the
 //! rotation Fᵀ and by kicks orthogonal to Γ.
 
-use super::top::{Top, TopWork};
+use super::super::top::{Top, TopWork};
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::{Clock, Stepper};
