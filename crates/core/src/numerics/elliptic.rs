@@ -21,7 +21,7 @@
 //! homogeneous ellipsoid ([`crate::pseudo_rigid::gravity`]).
 //!
 //! These serve the exact solution of the free rigid body ([`crate::systems::tops::rigid_body`]), the
-//! pendulum ([`crate::systems::pendulum`]) and the self-gravity of an ellipsoid.
+//! pendulum ([`crate::systems::test_problems::pendulum`]) and the self-gravity of an ellipsoid.
 
 use crate::error::{Error, Result};
 

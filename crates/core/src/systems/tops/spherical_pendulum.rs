@@ -104,7 +104,7 @@ impl Problem for SphericalPendulum {
 }
 
 /// The state-space check of a spherical-pendulum state (q, L): |q| = 1 and q·L = 0 to
-/// [`CONSTRAINT_TOL`] (shared with [`super::SphereParticle::from_spherical`]).
+/// [`CONSTRAINT_TOL`] (shared with [`crate::systems::SphereParticle::from_spherical`]).
 pub(crate) fn check_pendulum_state(z: &[f64]) -> Result<()> {
     let [q2, ql] = SphericalPendulum::casimirs(z);
     let l = z[3..].iter().map(|x| x * x).sum::<f64>().sqrt();

@@ -1,4 +1,4 @@
-//! What the bodies on SO(3) share ([`super::RigidBody`], [`super::HeavyTop`]): principal frames,
+//! What the bodies on SO(3) share ([`crate::systems::RigidBody`], [`crate::systems::HeavyTop`]): principal frames,
 //! the state layout (M, [Γ], [R]), the exact sub-flows of the Lie–Poisson splitting (the
 //! [`Split`] kind), and the Euler(–Poisson) vector field (the [`VectorField`] kind).
 //!

@@ -70,7 +70,7 @@ use crate::lie::rotations::{matrix_to_quaternion, quaternion_multiply, quaternio
 use nalgebra::{Matrix3, Vector3};
 
 /// The DMV algorithm (`Dmv(2)`) and its preprocessed versions `Dmv(4)`, `Dmv(6)`, `Dmv(8)`,
-/// `Dmv(10)` (a method value; the number is the order), for [`super::RigidBody`].
+/// `Dmv(10)` (a method value; the number is the order), for [`crate::systems::RigidBody`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Dmv(pub u32);
 

@@ -1,6 +1,6 @@
-//! The exact flow (M(t), R(t)) of the free rigid body, the method `exact` of [`super::RigidBody`], and
+//! The exact flow (M(t), R(t)) of the free rigid body, the method `exact` of [`crate::systems::RigidBody`], and
 //! the splittings of the heavy top whose kinetic flow is this exact flow (`exact_splitting*` of
-//! [`super::HeavyTop`]). After Celledoni, Fassò, Säfström & Zanna, "The exact computation of the free
+//! [`crate::systems::HeavyTop`]). After Celledoni, Fassò, Säfström & Zanna, "The exact computation of the free
 //! rigid body motion and its use in splitting methods", SIAM J. Sci. Comput. 30 (2008), and van
 //! Zon & Schofield, J. Comput. Phys. 225 (2007): the same factorisation of the attitude through
 //! the conserved spatial momentum. The formulas below were derived independently (the body factor
@@ -9,7 +9,7 @@
 //! checked numerically in `tests/rigid_body_exact.rs` (RK4 and DOP853 references, finite
 //! differences, 50-digit values).
 //!
-//! **Momentum.** As in [`super::RigidBody::exact_momentum`]: in working axes (p, mid, s) (a proper
+//! **Momentum.** As in [`crate::systems::RigidBody::exact_momentum`]: in working axes (p, mid, s) (a proper
 //! relabelling of the principal axes with I_mid the middle moment and the orbit of M encircling
 //! e_s), M = (σa₁ cn u, a₂ sn u, εa₃ dn u), u = u₀ + λt; g = d₂₃/d₁₃, h = d₁₂/d₁₃ = 1 − g
 //! (d_ij = 1/I_i − 1/I_j), a₁² = g a₂², |M|² = a₁² + a₃², m = h a₂²/a₃².
@@ -155,7 +155,7 @@ impl FreeFlow {
     }
 
     /// M(t) alone (principal frame), without the constants of the attitude: the elliptic formula
-    /// at u₀ + λt (the arithmetic of [`super::RigidBody::exact_momentum`] before the attitude existed).
+    /// at u₀ + λt (the arithmetic of [`crate::systems::RigidBody::exact_momentum`] before the attitude existed).
     pub(crate) fn momentum_at(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Vector3<f64> {
         match shape(inertia, m0) {
             Shape::Closed(kind) => FreeFlow { m0: *m0, kind }.momentum(t),

@@ -18,8 +18,8 @@
 //! [`crate::convergence`] ([`RULE`]: the update relative to max|M_n|); a step whose update is still
 //! above the tolerance after [`RULE`]`.max_iter` iterations is [`crate::Error::NotConverged`].
 //!
-//! The method value is [`Isospectral`], in the catalogs of [`super::RigidBody`] (through the
-//! so(3) matrix hat(M), with the attitude) and [`super::GeneralizedRigidBody`].
+//! The method value is [`Isospectral`], in the catalogs of [`crate::systems::RigidBody`] (through the
+//! so(3) matrix hat(M), with the attitude) and [`crate::systems::GeneralizedRigidBody`].
 
 use super::super::top;
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
