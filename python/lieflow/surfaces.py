@@ -1,4 +1,4 @@
-"""Surfaces for the tangent Euler top (bindings of ``lieflow::systems::surface``, 002 §II):
+"""Surfaces for the tangent Euler top (bindings of ``lieflow::systems::tangent_top::surface``, 002 §II):
 ``Plane()``, ``Sphere(radius)``, ``HyperbolicPlane()``. They pickle."""
 
 from . import _lieflow

@@ -2,8 +2,12 @@
 //!
 //! Geometry and structure-preserving simulation of mechanical systems on Lie groups: matrix Lie
 //! groups and algebras ([`lie`]), generalized pseudo-rigid bodies on GL⁺(n) ([`pseudo_rigid`]),
-//! Lie–Poisson systems such as the free rigid body and the heavy top ([`systems`]), and integrators
-//! that keep momentum maps, Casimirs and the group itself ([`integrate`]).
+//! the systems of the source texts such as the free rigid body, the heavy top, the tangent top
+//! and rolling bodies ([`systems`]), and integrators that keep momentum maps, Casimirs and the
+//! group itself ([`integrate`]). Around them: stability of relative equilibria and continuation of
+//! their families ([`analysis`]), numerical kernels that know no mechanics (elliptic functions,
+//! SIMD lanes, rotation angles, finite differences: [`numerics`]), the one stopping rule of every
+//! iterative solve ([`convergence`]) and the input validation shared by every module ([`check`]).
 //!
 //! Equation numbers such as `001 (6.9)` refer to the source documents listed in the repository's
 //! `DESIGN.md`.
@@ -40,13 +44,14 @@
 pub mod analysis;
 pub mod check;
 pub mod convergence;
-pub mod elliptic;
+
 pub mod error;
 pub mod integrate;
 pub mod lie;
-pub(crate) mod linalg;
+pub mod numerics;
+
 pub mod pseudo_rigid;
-pub mod simd;
+
 pub mod systems;
 
 pub use error::{Error, Result};

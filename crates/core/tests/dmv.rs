@@ -1,5 +1,5 @@
 //! The discrete Moser–Veselov algorithm and its preprocessed versions (`dmv`, `dmv4` … `dmv10`,
-//! `lieflow::systems::dmv`) on the free rigid body with its attitude: the step against the
+//! `lieflow::systems::tops::methods::dmv`) on the free rigid body with its attitude: the step against the
 //! discrete Euler–Lagrange equations it solves, the modified moments against Hairer & Vilmart
 //! (2006) Table 1 and an independent derivation, observed orders for M and R against the exact
 //! momentum and an attitude reference by quadrature, the kept quantities over long runs, the
@@ -8,7 +8,7 @@
 
 use lieflow::integrate::{integrate, integrate_with, Integrator, Problem, Run, System};
 use lieflow::lie::so3;
-use lieflow::systems::dmv::{self, Dmv};
+use lieflow::systems::tops::methods::dmv::{self, Dmv};
 use lieflow::systems::{Lgvi, RigidBody};
 use lieflow::Error;
 use nalgebra::{Matrix3, Vector3};

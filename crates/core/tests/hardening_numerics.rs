@@ -5,7 +5,8 @@
 #![allow(clippy::excessive_precision)]
 
 use lieflow::integrate::integrate;
-use lieflow::lie::{gl, se3, so, so3, EXP_MAX_NORM};
+use lieflow::lie::{gl, se3, so, so3};
+use lieflow::numerics::angle::EXP_MAX_NORM;
 use lieflow::systems::RigidBody;
 use lieflow::{Error, Mat};
 use nalgebra::{Matrix3, Vector3, Vector6};
@@ -248,7 +249,7 @@ mod no_silent_nan {
     use lieflow::pseudo_rigid::potential::Harmonic;
     use lieflow::pseudo_rigid::reduced::{reconstruct, ReducedState};
     use lieflow::pseudo_rigid::{BiInertia, PseudoRigidBody};
-    use lieflow::systems::relativistic_top::{Potential, WeakFieldTop};
+    use lieflow::systems::tangent_top::relativistic::{Potential, WeakFieldTop};
     use lieflow::systems::{RollingSpheres, SphereParticle};
     use lieflow::{Error, Mat};
     use std::sync::Arc;

@@ -6,9 +6,9 @@
 mod common;
 
 use common::order;
-use lieflow::elliptic::{ellipf, ellipj, ellipk};
 use lieflow::integrate::methods::{Composition, Processed, Splitting};
 use lieflow::integrate::{integrate, integrate_with, Problem, Trajectory};
+use lieflow::numerics::elliptic::{ellipf, ellipj, ellipk};
 use lieflow::systems::RigidBody;
 use nalgebra::{Matrix3, Vector3};
 

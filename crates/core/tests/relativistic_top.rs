@@ -647,7 +647,7 @@ fn exact_82_on(surface: &dyn Surface, body: &[(f64, [f64; 2])], q: [f64; 3], v: 
         .map(|&(mk, xi)| {
             let w: [f64; 2] =
                 std::array::from_fn(|k| v[k] + xi[0] * nabla[0][k] + xi[1] * nabla[1][k]);
-            let ww = lieflow::systems::surface::inner(&g, w, w);
+            let ww = lieflow::systems::tangent_top::surface::inner(&g, w, w);
             -mk * (1.0 - ww).sqrt()
         })
         .sum()

@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use lieflow::integrate::{integrate, Problem};
 use lieflow::lie::so3;
-use lieflow::systems::surface::{inverse, Geometry, Jet, Mat2, Vec2};
+use lieflow::systems::tangent_top::surface::{inverse, Geometry, Jet, Mat2, Vec2};
 use lieflow::systems::{
     Graph, HyperbolicPlane, MetricSurface, Plane, Revolution, RigidBody, Sphere, Surface,
     TangentTop,
@@ -188,7 +188,7 @@ fn closed_forms_match_their_definitions() {
             let e = s.frame(x);
             for a in 0..2 {
                 for b in 0..2 {
-                    let gab = lieflow::systems::surface::inner(&g, e[a], e[b]);
+                    let gab = lieflow::systems::tangent_top::surface::inner(&g, e[a], e[b]);
                     assert!((gab - f64::from(u8::from(a == b))).abs() < 1e-14);
                 }
             }
@@ -208,7 +208,8 @@ fn closed_forms_match_their_definitions() {
             }
             // K: closed form = −dα/dA = Brioschi
             let k = s.curvature(x);
-            let k_conn = -(da[0][1] - da[1][0]) / lieflow::systems::surface::det(&g).sqrt();
+            let k_conn =
+                -(da[0][1] - da[1][0]) / lieflow::systems::tangent_top::surface::det(&g).sqrt();
             assert!((k - k_conn).abs() < 1e-12 * (1.0 + k.abs()), "{name} K");
             if g[0][1] == 0.0 {
                 let k_b = brioschi_orthogonal(&*s, x);
@@ -305,7 +306,8 @@ fn sphere_frame(x: Vec2) -> Mat2 {
 
 #[test]
 fn metric_surface_reproduces_the_sphere_and_a_graph() {
-    let domain: lieflow::systems::surface::DomainFn = Arc::new(|x: Vec2| x[0] > 0.0 && x[0] < PI);
+    let domain: lieflow::systems::tangent_top::surface::DomainFn =
+        Arc::new(|x: Vec2| x[0] > 0.0 && x[0] < PI);
     let ms = MetricSurface::new(sphere_metric, sphere_frame, Some(domain));
     let sp = Sphere::new(1.0).unwrap();
     ms.check_frame([1.0, 0.5], 1e-14).unwrap();
@@ -345,7 +347,7 @@ fn metric_surface_reproduces_the_sphere_and_a_graph() {
         // e₂ = (∂y − ⟨∂y, e₁⟩ e₁)/|…|
         let c = g[0][1] * e1[0];
         let v = [-c * e1[0], 1.0];
-        let n = lieflow::systems::surface::inner(&g, v, v).sqrt();
+        let n = lieflow::systems::tangent_top::surface::inner(&g, v, v).sqrt();
         [e1, [v[0] / n, v[1] / n]]
     };
     let ms = MetricSurface::new(metric, frame, None);
@@ -537,7 +539,8 @@ fn frame_independence() {
             [-s * e[0][0] + c * e[1][0], -s * e[0][1] + c * e[1][1]],
         ]
     };
-    let domain: lieflow::systems::surface::DomainFn = Arc::new(|x: Vec2| x[0] > 0.0 && x[0] < PI);
+    let domain: lieflow::systems::tangent_top::surface::DomainFn =
+        Arc::new(|x: Vec2| x[0] > 0.0 && x[0] < PI);
     let ms = MetricSurface::new(sphere_metric, rotated, Some(domain));
     let sp = Sphere::new(1.0).unwrap();
     for x in [[1.0, 0.4], [2.0, -1.0]] {
@@ -827,7 +830,7 @@ fn loop_and_area(s: &dyn Surface, c: Vec2, a: f64, b: f64) -> (f64, f64) {
             for i in 0..n {
                 let t = 2.0 * PI * i as f64 / n as f64;
                 let x = [c[0] + a * r * t.cos(), c[1] + b * r * t.sin()];
-                let da = lieflow::systems::surface::det(&s.metric(x)).sqrt();
+                let da = lieflow::systems::tangent_top::surface::det(&s.metric(x)).sqrt();
                 area += 0.25 * wi * s.curvature(x) * da * a * b * r * 2.0 * PI / n as f64;
             }
         }

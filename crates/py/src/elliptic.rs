@@ -1,8 +1,8 @@
-//! `lieflow.elliptic`: bindings of `lieflow::elliptic` (Jacobi elliptic functions and the
+//! `lieflow.elliptic`: bindings of `lieflow::numerics::elliptic` (Jacobi elliptic functions and the
 //! elliptic integrals of the first kind, parameter m = k^2 as in scipy.special), vectorised with
 //! numpy broadcasting.
 
-use lieflow::elliptic;
+use lieflow::numerics::elliptic;
 use pyo3::prelude::*;
 
 use crate::convert::ArrayIn;

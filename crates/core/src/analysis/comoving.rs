@@ -41,11 +41,13 @@
 //! J is quadratic), ∇Φ from G and the polarised curvature D²g(q)[v, w]; D²ℒ by central
 //! differences of ∇ℒ with Richardson.
 
-use super::{jacobian, Verdict};
+use super::Verdict;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::rattle::constrained_field;
 use crate::integrate::problem::{Constrained, Symmetric};
+use crate::numerics::fd::{self, Scheme::Richardson};
+use crate::numerics::linalg::norm;
 use crate::Mat;
 use faer::linalg::solvers::Solve;
 
@@ -79,10 +81,6 @@ pub struct Stability {
     pub multipliers: Vec<f64>,
     /// |F(z₀)| relative to |f(z₀)| + |ξ_Z(z₀)|.
     pub residual: f64,
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// An orthonormal basis (columns) of the null space of `m` (rows × cols), by the SVD.
@@ -238,7 +236,7 @@ pub fn stability<P: Constrained + Symmetric>(
     let zscale = norm(z0).max(1.0);
     let hj = vec![1e-3 * zscale; nz];
     let jmap = |z: &[f64]| problem.momentum_map(z);
-    let dj = jacobian(&jmap, z0, &hj)?;
+    let dj = fd::jacobian(&jmap, z0, &hj, Richardson)?;
     let mut gens = Mat::zeros(nz, g);
     let mut e = vec![0.0; g];
     for k in 0..g {
@@ -293,7 +291,7 @@ pub fn stability<P: Constrained + Symmetric>(
         .zip(&wz)
         .map(|(x, w)| 1e-4 * x.abs().max(1e-2 * w))
         .collect();
-    let df = jacobian(&comoving, z0, &hz)?;
+    let df = fd::jacobian(&comoving, z0, &hz, Richardson)?;
     check::finite_mat("co-moving Jacobian", &df)?;
     let lin = &c_left * &df * &c;
     let spectral = Verdict::spectral(&lin, SPECTRAL_TOL)?;
@@ -307,7 +305,7 @@ pub fn stability<P: Constrained + Symmetric>(
         gq.iter_mut().for_each(|x| *x = -*x);
         problem.velocity(p, gp);
         // ∇⟨J, ξ⟩ (exact central differences of a quadratic).
-        let dj = jacobian(&jmap, z, &hj)?;
+        let dj = fd::jacobian(&jmap, z, &hj, Richardson)?;
         for l in 0..nz {
             out[l] -= (0..g).map(|a| xi[a] * dj[(a, l)]).sum::<f64>();
         }
@@ -335,7 +333,7 @@ pub fn stability<P: Constrained + Symmetric>(
         }
         Ok(gl)
     };
-    let hess = jacobian(&grad_lagrange, z0, &hz)?;
+    let hess = fd::jacobian(&grad_lagrange, z0, &hz, Richardson)?;
     let hc = c.transpose() * &hess * &c;
     let hsym = Mat::from_fn(k, k, |i, j| 0.5 * (hc[(i, j)] + hc[(j, i)]));
     check::finite_mat("energy–momentum Hessian", &hsym)?;

@@ -33,6 +33,8 @@
 
 use crate::convergence::{self, Rule, Verdict};
 use crate::error::{Error, Result};
+use crate::numerics::fd::{self, Scheme::Richardson};
+use crate::numerics::linalg::norm;
 use crate::Mat;
 use faer::linalg::solvers::Solve;
 
@@ -63,7 +65,7 @@ pub trait Family {
     /// 1e-4·max(1, |u_k|) and one Richardson extrapolation (error ~1e-12 relative for smooth F).
     fn jacobian(&self, u: &[f64]) -> Result<Mat> {
         let h: Vec<f64> = u.iter().map(|x| 1e-4 * x.abs().max(1.0)).collect();
-        super::jacobian(&|v: &[f64]| self.residual(v), u, &h)
+        fd::jacobian(&|v: &[f64]| self.residual(v), u, &h, Richardson)
     }
 }
 
@@ -188,10 +190,6 @@ pub type Monitor<'a> = &'a dyn Fn(&[f64]) -> Result<Vec<Indicator>>;
 
 fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
-}
-
-fn norm(x: &[f64]) -> f64 {
-    dot(x, x).sqrt()
 }
 
 /// The unit vectors spanning ker DF(u) (the `k` right singular vectors with the smallest

@@ -80,40 +80,6 @@ impl Verdict {
     }
 }
 
-/// Jacobian of f at x (column l = ∂f/∂x_l) by central differences with steps h_l and one
-/// Richardson extrapolation: (4D(h/2) − D(h))/3, error O(h⁴).
-pub(crate) fn jacobian(
-    f: &dyn Fn(&[f64]) -> Result<Vec<f64>>,
-    x: &[f64],
-    h: &[f64],
-) -> Result<Mat> {
-    let mut cols: Vec<Vec<f64>> = Vec::with_capacity(x.len());
-    let mut xp = x.to_vec();
-    for (l, &hl) in h.iter().enumerate() {
-        let mut diff = |h: f64| -> Result<Vec<f64>> {
-            xp[l] = x[l] + h;
-            let fp = f(&xp)?;
-            xp[l] = x[l] - h;
-            let fm = f(&xp)?;
-            xp[l] = x[l];
-            Ok(fp
-                .iter()
-                .zip(&fm)
-                .map(|(p, m)| (p - m) / (2.0 * h))
-                .collect())
-        };
-        let (d1, d2) = (diff(hl)?, diff(0.5 * hl)?);
-        cols.push(
-            d1.iter()
-                .zip(&d2)
-                .map(|(a, b)| (4.0 * b - a) / 3.0)
-                .collect(),
-        );
-    }
-    let rows = cols.first().map_or(0, Vec::len);
-    Ok(Mat::from_fn(rows, x.len(), |i, j| cols[j][i]))
-}
-
 /// Eigenvalues (re, im) of a general real square matrix (faer's real Schur / EVD).
 pub(crate) fn general_eigenvalues(m: &Mat) -> Result<Vec<(f64, f64)>> {
     if m.nrows() == 0 {

@@ -184,8 +184,17 @@ pub trait Canonical: Problem {
     /// H(q, p) (internal frame).
     fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64;
 
-    /// The gradient: `hq` = ∂H/∂q, `hp` = ∂H/∂p.
+    /// The gradient: `hq` = ∂H/∂q, `hp` = ∂H/∂p (every entry written).
     fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]);
+
+    /// Hamilton's equations ż = (∂H/∂p, −∂H/∂q) into `dz`: the [`VectorField`] of a canonical
+    /// system.
+    fn hamilton_field(&self, z: &[f64], dz: &mut [f64]) {
+        let d = self.dof();
+        let (qdot, pdot) = dz.split_at_mut(d);
+        self.gradient(&z[..d], &z[d..2 * d], pdot, qdot);
+        pdot.iter_mut().for_each(|x| *x = -*x);
+    }
 }
 
 /// A [`Separable`] system with T = ½ pᵀM⁻¹p restricted by holonomic constraints g(q) = 0

@@ -11,20 +11,6 @@
 /// and so(3) alike).
 pub const SKEW_TOL: f64 = 1e-10;
 
-/// The one rule of every exponential-type map (so(n) and so(3) exp, dexp, the so(3) Jacobians
-/// and their inverses, the SE(3) exp): a rotation angle θ is only determined by its floating-point
-/// input to about ε_mach·θ (a relative change of one rounding unit in ξ turns exp ξ by that much,
-/// and every evaluation of |ξ| makes such a change), so the maps refuse |ξ| >
-/// [`EXP_MAX_NORM`] = [`ANGLE_ROUNDING_TOL`]/ε_mach ≈ 2.25e14, where more than
-/// [`ANGLE_ROUNDING_TOL`] rad of the angle is lost to rounding, and compute scale-safely below
-/// it. Maps that stay well defined for every |ξ| (the Cayley maps, whose angle 2 atan(|ξ|/2)
-/// tends to π) are computed scale-safely for every finite ξ instead.
-pub const ANGLE_ROUNDING_TOL: f64 = 0.05;
-
-/// Largest |ξ| accepted by the exponential-type maps (see [`ANGLE_ROUNDING_TOL`]):
-/// 0.05/ε_mach ≈ 2.25e14.
-pub const EXP_MAX_NORM: f64 = ANGLE_ROUNDING_TOL / f64::EPSILON;
-
 /// The rule of [`ANGLE_ROUNDING_TOL`]: `Ok` when |ξ| = `norm` ≤ [`EXP_MAX_NORM`], else
 /// [`crate::Error::InvalidArgument`] about `what` naming the map, |ξ| and the angle lost.
 /// `norm` should come from [`scaled_norm`] so that it is finite for every finite input.
@@ -57,25 +43,15 @@ pub fn scaled_norm<'a>(x: impl IntoIterator<Item = &'a f64> + Clone) -> f64 {
     m * s.sqrt()
 }
 
-/// (sin θ, cos θ) of a rotation angle for unchecked inner loops (exact sub-flows): NaN beyond
-/// [`EXP_MAX_NORM`] (where the angle is lost to rounding, see [`ANGLE_ROUNDING_TOL`]), so that
-/// the integration driver's finiteness guard reports the step instead of a meaningless rotation.
-#[inline]
-pub fn angle_sin_cos(theta: f64) -> (f64, f64) {
-    if theta.abs() <= EXP_MAX_NORM {
-        theta.sin_cos()
-    } else {
-        (f64::NAN, f64::NAN)
-    }
-}
-
 pub mod gl;
 pub mod product;
 pub mod rotations;
 pub mod se3;
 pub mod so;
 pub mod so3;
+pub mod structure;
 
+use crate::numerics::angle::{ANGLE_ROUNDING_TOL, EXP_MAX_NORM};
 use crate::{Mat, Result};
 
 /// A matrix Lie group G with Lie algebra 𝔤, the dual 𝔤* identified with 𝔤 through

@@ -259,10 +259,6 @@ pub fn exp(xi: &Mat) -> Result<Mat> {
     Ok(exp_unchecked(xi))
 }
 
-/// Largest |ξ| accepted by [`exp`] and [`dexp`]: the one rule of all exponentials,
-/// [`super::EXP_MAX_NORM`] ≈ 2.25e14 (see [`super::ANGLE_ROUNDING_TOL`]).
-pub use super::EXP_MAX_NORM;
-
 /// [`norm`] without overflow: finite for every finite ξ (1e300 stays 1e300).
 fn scaled_norm(xi: &Mat) -> f64 {
     let n = xi.nrows().min(xi.ncols());
@@ -287,7 +283,7 @@ pub fn exp_unchecked(xi: &Mat) -> Mat {
     match n {
         0 | 1 => Mat::identity(n, n),
         2 => {
-            let (s, c) = super::angle_sin_cos(0.5 * (xi[(0, 1)] - xi[(1, 0)]));
+            let (s, c) = crate::numerics::angle::angle_sin_cos(0.5 * (xi[(0, 1)] - xi[(1, 0)]));
             Mat::from_fn(2, 2, |i, j| match (i, j) {
                 (0, 1) => s,
                 (1, 0) => -s,
@@ -371,7 +367,7 @@ fn lin_comb(out: &mut Mat, terms: &[(f64, &Mat)], c0: f64, add: bool) {
 
 /// dst = a b (sequential faer product; no allocation).
 fn mul_into(dst: &mut Mat, a: &Mat, b: &Mat) {
-    crate::linalg::mul(
+    crate::numerics::linalg::mul(
         dst.as_mut(),
         faer::Accum::Replace,
         a.as_ref(),
@@ -391,7 +387,7 @@ pub struct ExpWork {
     u: Mat,
     v: Mat,
     t: Mat,
-    lu: crate::linalg::DenseLu,
+    lu: crate::numerics::linalg::DenseLu,
 }
 
 impl ExpWork {
@@ -406,7 +402,7 @@ impl ExpWork {
             u: z(),
             v: z(),
             t: z(),
-            lu: crate::linalg::DenseLu::new(n),
+            lu: crate::numerics::linalg::DenseLu::new(n),
         }
     }
 
@@ -544,12 +540,12 @@ pub fn exp_into(xi: &Mat, out: &mut Mat, work: &mut ExpWork) {
 /// Newton–Schulz steps toward the orthogonal polar factor, R ← R (3I − RᵀR)/2, each squaring
 /// the orthogonality defect δ = ‖RᵀR − I‖_F, until a step starts from δ ≤ 1e-8 (so it ends at
 /// round-off). One step after the usual few squarings (δ ~ 1e-14); up to four after the ~45
-/// squarings of |ξ| near [`EXP_MAX_NORM`], where the defect doubles with every squaring
+/// squarings of |ξ| near [`super::EXP_MAX_NORM`], where the defect doubles with every squaring
 /// (2⁴⁵ ε ≈ 1e-2). `g` and `p` are n×n scratch.
 fn orthogonalize_in(r: &mut Mat, g: &mut Mat, p: &mut Mat) {
     let n = r.nrows();
     for _ in 0..8 {
-        crate::linalg::mul(
+        crate::numerics::linalg::mul(
             g.as_mut(),
             faer::Accum::Replace,
             r.transpose(),

@@ -15,7 +15,7 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::so;
-use crate::linalg;
+use crate::numerics::linalg;
 use crate::pseudo_rigid::momentum;
 use crate::pseudo_rigid::potential::{self, Potential, Workspace};
 use crate::Mat;

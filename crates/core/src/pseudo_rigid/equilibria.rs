@@ -54,6 +54,8 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::{gl, so};
+use crate::numerics::fd::{self, Scheme::Central};
+use crate::numerics::linalg::norm;
 use crate::pseudo_rigid::inertia::BiInertia;
 use crate::pseudo_rigid::momentum::momentum_map_unchecked;
 use crate::pseudo_rigid::potential::{self, Potential};
@@ -613,7 +615,7 @@ impl RelativeEquilibrium {
     /// (X(t), P(t)) = (e^{tΩ} A₀ e^{−tΛ}, e^{tΩ}(ΩA₀ − A₀Λ) e^{−tΛ}) at the given times
     /// (001 (8.3); R(t) = e^{tΩ}, S(t) = e^{tΛ} solve Ṙ = RΩ, Ṡ = SΛ).
     ///
-    /// Errors: a non-finite time or |tΩ|, |tΛ| beyond [`so::EXP_MAX_NORM`].
+    /// Errors: a non-finite time or |tΩ|, |tΛ| beyond [`crate::numerics::angle::EXP_MAX_NORM`].
     pub fn motion(&self, times: &[f64]) -> Result<Vec<(Mat, Mat)>> {
         check::finite_slice("times", times)?;
         let (x0, p0) = (self.x0(), self.p0());
@@ -673,27 +675,10 @@ type Residual<'a> = dyn Fn(&[f64]) -> Option<(Vec<f64>, f64)> + 'a;
 /// Relative tolerance of the solvers: converged when ‖r‖ ≤ TOL·scale.
 const TOL: f64 = 1e-11;
 
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-/// Central-difference Jacobian of r at a (m×n).
-fn jacobian(f: &Residual<'_>, a: &[f64], m: usize) -> Option<Mat> {
-    let n = a.len();
-    let mut jac = Mat::zeros(m, n);
-    let mut y = a.to_vec();
-    for k in 0..n {
-        let h = 1e-6 * a[k].abs().max(1e-3);
-        y[k] = a[k] + h;
-        let (rp, _) = f(&y)?;
-        y[k] = a[k] - h;
-        let (rm, _) = f(&y)?;
-        y[k] = a[k];
-        for i in 0..m {
-            jac[(i, k)] = (rp[i] - rm[i]) / (2.0 * h);
-        }
-    }
-    Some(jac)
+/// Central-difference Jacobian of r at a, steps 1e-6·max(|a_k|, 1e-3).
+fn jacobian(f: &Residual<'_>, a: &[f64]) -> Option<Mat> {
+    let h: Vec<f64> = a.iter().map(|x| 1e-6 * x.abs().max(1e-3)).collect();
+    fd::jacobian(&|y| f(y).map(|(r, _)| r).ok_or(()), a, &h, Central).ok()
 }
 
 /// Levenberg–Marquardt (Newton for square well-conditioned systems) from `a0`, iterates kept in
@@ -709,7 +694,7 @@ fn solve_from(f: &Residual<'_>, a0: &[f64]) -> Option<Vec<f64>> {
         if rn <= TOL * scale.max(f64::MIN_POSITIVE) {
             return Some(a);
         }
-        let jac = jacobian(f, &a, m)?;
+        let jac = jacobian(f, &a)?;
         let jtj = jac.transpose() * &jac;
         let rv = Mat::from_fn(m, 1, |i, _| r[i]);
         let jtr = jac.transpose() * &rv;
@@ -832,8 +817,7 @@ fn multistart(f: &Residual<'_>, n: usize, bounds: (f64, f64), starts: usize) -> 
 
 /// Rejects a continuum of solutions: the Jacobian of r at a solution has a null direction.
 fn check_isolated(f: &Residual<'_>, a: &[f64], what: &str) -> Result<()> {
-    let m = f(a).map(|r| r.0.len()).unwrap_or(0);
-    let jac = jacobian(f, a, m).ok_or_else(|| Error::NonFinite {
+    let jac = jacobian(f, a).ok_or_else(|| Error::NonFinite {
         what: format!("{what}: Jacobian of the equilibrium conditions"),
         location: format!("a = {a:?}"),
     })?;

@@ -15,7 +15,7 @@
 //! = −∫ du/((a_i²+u)Δ) by parts); a sphere of radius a has A_i = 2/3 and A_ij = 2/(5a²).
 //!
 //! *Routes.* A_i = (2/3) a₁a₂a₃ R_D(a_j², a_k², a_i²) with Carlson's R_D
-//! ([`crate::elliptic::carlson_rd`], a few ulp). The A_ij are not taken from the divided
+//! ([`crate::numerics::elliptic::carlson_rd`], a few ulp). The A_ij are not taken from the divided
 //! difference −(A_i − A_j)/(a_i² − a_j²), which loses all digits as a_i → a_j (at a relative
 //! difference 1e-12 it keeps about 4), nor from 3A_ii = 2/a_i² − Σ_{j≠i} A_ij, which cancels for a
 //! needle; all six are computed directly by the trapezoidal rule in s = ln u (u = e^s,
@@ -88,8 +88,8 @@
 //! D²U ∝ 2^{−3e}), so no intermediate overflows.
 
 use crate::check;
-use crate::elliptic::{rd_kernel, rf_kernel};
 use crate::error::{Error, Result};
+use crate::numerics::elliptic::{rd_kernel, rf_kernel};
 use crate::pseudo_rigid::potential::{Potential, Workspace};
 use faer::{MatMut, MatRef};
 use nalgebra::{Matrix3, Vector3};

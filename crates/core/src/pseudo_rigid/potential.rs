@@ -25,7 +25,7 @@
 
 use crate::check;
 use crate::error::{Error, Result};
-use crate::linalg::{axpy, frob2, inner, mul};
+use crate::numerics::linalg::{axpy, frob2, inner, mul};
 use crate::Mat;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, inverse};

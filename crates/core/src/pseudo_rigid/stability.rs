@@ -63,13 +63,15 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::so;
+use crate::numerics::linalg::norm;
 use crate::pseudo_rigid::dynamics::FullBody;
 use crate::pseudo_rigid::momentum;
 use crate::pseudo_rigid::reduced::ReducedState;
 use crate::Mat;
 
 pub use crate::analysis::Verdict;
-use crate::analysis::{general_eigenvalues, jacobian, sorted};
+use crate::analysis::{general_eigenvalues, sorted};
+use crate::numerics::fd::{self, Scheme::Richardson};
 
 /// Relative tolerance of the equilibrium check (residual of the reduced vector field relative
 /// to the scales of its terms).
@@ -304,7 +306,7 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
         };
         Ok(s.vector_field(body)?.p_a_dot.iter().map(|f| -f).collect())
     };
-    let haa = jacobian(&force, a, &vec![ha; n])?;
+    let haa = fd::jacobian(&force, a, &vec![ha; n], Richardson)?;
     // (δa, c): ∂/∂a_l of the orbit gradients ⟨[v_k, μ], Ω(a)⟩, ⟨[w_k, ν], Λ(a)⟩.
     let tang_mu: Vec<Mat> = leaf
         .basis_omega
@@ -328,7 +330,7 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
             .chain(tang_nu.iter().map(|t| so::pairing(t, &l)))
             .collect())
     };
-    let hac = jacobian(&orbit_grad, a, &vec![ha; n])?; // rows: orbit directions, columns: a_l
+    let hac = fd::jacobian(&orbit_grad, a, &vec![ha; n], Richardson)?; // rows: orbit directions, columns: a_l
     let g_orbit = orbit_grad(a)?;
 
     // (c, c): exact second variation of K along the orbits.
@@ -471,7 +473,7 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
             }
         })
         .collect();
-    let jac = jacobian(&field, &z0, &steps)?;
+    let jac = fd::jacobian(&field, &z0, &steps, Richardson)?;
     check::finite_mat("Jacobian of the reduced vector field", &jac)?;
     let mut full = general_eigenvalues(&jac)?;
     let transverse = 2 * d - rr;
@@ -498,10 +500,6 @@ fn potential_gradient(body: &FullBody, a: &[f64]) -> Result<Vec<f64>> {
     let x = Mat::from_fn(n, n, |i, j| if i == j { a[i] } else { 0.0 });
     let g = crate::pseudo_rigid::potential::gradient(body.potential(), &x)?;
     Ok((0..n).map(|i| g[(i, i)]).collect())
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 fn max_abs(m: &Mat) -> f64 {

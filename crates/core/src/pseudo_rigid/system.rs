@@ -62,7 +62,7 @@ use crate::integrate::problem::{Constrained, Separable, Split, Symmetric, Violat
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::{gl, so};
-use crate::linalg;
+use crate::numerics::linalg;
 use crate::Mat;
 use faer::{Accum, MatMut, MatRef};
 use nalgebra::Matrix3;

@@ -1,4 +1,4 @@
-//! `HeavyTop`: binding of `lieflow::systems::heavy_top` (000 §5.2). A thin subclass of
+//! `HeavyTop`: binding of `lieflow::systems::tops::heavy_top` (000 §5.2). A thin subclass of
 //! `lieflow.System`: constructor and observables.
 #![allow(non_snake_case)]
 

@@ -1,7 +1,7 @@
-//! `RelativisticTangentTop` and `WeakFieldTop`: bindings of `lieflow::systems::relativistic_top`
+//! `RelativisticTangentTop` and `WeakFieldTop`: bindings of `lieflow::systems::tangent_top::relativistic`
 //! (002 §IV). Thin subclasses of `lieflow.System`.
 
-use lieflow::systems::relativistic_top as core;
+use lieflow::systems::tangent_top::relativistic as core;
 use lieflow::Error;
 use pyo3::prelude::*;
 use pyo3::PyClassInitializer;

@@ -1,4 +1,4 @@
-//! `RigidBody` and `GeneralizedRigidBody`: bindings of `lieflow::systems::rigid_body` (000 §3–§4,
+//! `RigidBody` and `GeneralizedRigidBody`: bindings of `lieflow::systems::tops` (000 §3–§4,
 //! the so(n) body). Thin subclasses of `lieflow.System`: constructors and observables.
 #![allow(non_snake_case)]
 

@@ -1,4 +1,4 @@
-//! `RollingDisk`: binding of `lieflow::systems::rolling_disk`, the nonholonomic test problem of
+//! `RollingDisk`: binding of `lieflow::systems::test_problems::rolling_disk`, the nonholonomic test problem of
 //! the mechanics core. A thin subclass of `lieflow.System`.
 
 use lieflow::systems as core;

@@ -1,7 +1,7 @@
-//! `RollingDisks`: binding of `lieflow::systems::rolling_disks` (003 §1), a thin subclass of
+//! `RollingDisks`: binding of `lieflow::systems::rolling::disks` (003 §1), a thin subclass of
 //! `lieflow.System`, and its relative equilibria.
 
-use lieflow::systems::rolling_disks::DisksEquilibrium;
+use lieflow::systems::rolling::disks::DisksEquilibrium;
 use lieflow::systems::RollingDisks;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -190,7 +190,7 @@ impl PyRollingDisks {
     /// constant `rolling_constant` (default: the system's). They are the configurations in
     /// which both centres of mass and the contact point are collinear; stable where the locked
     /// inertia is maximal along the rolling direction (003 §1, corrected; see the module docs
-    /// of `lieflow::systems::rolling_disks`).
+    /// of `lieflow::systems::rolling::disks`).
     ///
     /// Raises:
     ///     InvalidArgumentError (an empty range), NonFiniteError.

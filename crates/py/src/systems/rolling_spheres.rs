@@ -1,4 +1,4 @@
-//! `RollingSpheres`: binding of `lieflow::systems::rolling_spheres` (003 §2), a thin subclass of
+//! `RollingSpheres`: binding of `lieflow::systems::rolling::spheres` (003 §2), a thin subclass of
 //! `lieflow.System`: constructor, states and observables.
 #![allow(non_snake_case)]
 

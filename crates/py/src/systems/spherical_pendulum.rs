@@ -1,4 +1,4 @@
-//! `SphericalPendulum`: binding of `lieflow::systems::spherical_pendulum` (000 §5.1). A thin
+//! `SphericalPendulum`: binding of `lieflow::systems::tops::spherical_pendulum` (000 §5.1). A thin
 //! subclass of `lieflow.System`: constructor and observables.
 
 use lieflow::systems as core;

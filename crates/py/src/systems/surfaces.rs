@@ -1,11 +1,11 @@
-//! `lieflow.surfaces`: the surfaces of `lieflow::systems::surface` (002 §II–III), built in or
+//! `lieflow.surfaces`: the surfaces of `lieflow::systems::tangent_top::surface` (002 §II–III), built in or
 //! from Python callables. A surface pickles by the function of this module and the arguments that
 //! made it (callables pickle by reference, so pass module-level functions).
 #![allow(non_snake_case)]
 
 use std::sync::Arc;
 
-use lieflow::systems::surface::{self, Jet, Mat2, Surface, Vec2};
+use lieflow::systems::tangent_top::surface::{self, Jet, Mat2, Surface, Vec2};
 use lieflow::Error;
 use numpy::ndarray::arr2;
 use numpy::{IntoPyArray, PyArray2};

@@ -1,4 +1,4 @@
-//! `TangentTop` and `ChargedParticle`: bindings of `lieflow::systems::tangent_top` (002 §II–III),
+//! `TangentTop` and `ChargedParticle`: bindings of `lieflow::systems::tangent_top::classical` (002 §II–III),
 //! thin subclasses of `lieflow.System`.
 #![allow(non_snake_case)]
 

@@ -41,7 +41,7 @@ use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::Canonical;
-pub(crate) use crate::linalg::DenseLu;
+pub(crate) use crate::numerics::linalg::DenseLu;
 
 /// The s-stage Gauss–Legendre method, s = 1, 2, 3 (orders 2, 4, 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -16,7 +16,7 @@
 //! instruction set or thread computes it. Lanes that need the slow path (below) are taken one by
 //! one by the same scalar function, again independent of their neighbours.
 //!
-//! **sin/cos** ([`sin_cos_lanes`], scalar [`angle_sin_cos`]): the angle x is reduced to
+//! **sin/cos** ([`sin_cos_lanes`], scalar [`lane_sin_cos`]): the angle x is reduced to
 //! r = x − kπ/2, |r| ≲ π/4, k = round(2x/π) (rounding by adding and subtracting 1.5·2⁵², whose
 //! low mantissa bits then hold k mod 4), by a three-part Cody–Waite reduction: π/2 = C₁ + C₂ + C₃
 //! with C₁, C₂ of 33 significant bits, so that k·C₁ and k·C₂ are exact for |k| ≤ 2¹⁹, C₃ the
@@ -32,7 +32,7 @@
 //! |θ| ≤ [`FAST_MAX`] = 2¹⁹·π/2 ≈ 8.2e5 rad. Lanes beyond it, and lanes within 2⁻⁴⁰ of a
 //! non-zero multiple of π/2 (where the reduction loses more bits than the three parts carry),
 //! take the platform's `sin_cos` (an exact reduction), so every finite angle gets a correct
-//! value; beyond [`crate::lie::EXP_MAX_NORM`] the flows' rule of [`crate::lie::angle_sin_cos`]
+//! value; beyond [`crate::numerics::angle::EXP_MAX_NORM`] the flows' rule of [`crate::numerics::angle::angle_sin_cos`]
 //! applies (NaN: the angle is lost to rounding), and a non-finite angle gives NaN. The error
 //! against libm is at most 2 ulp (tests: a large random sample over the fast range, angles near
 //! multiples of π/2, tiny and huge angles).
@@ -254,12 +254,12 @@ pub fn all_small<S: Simd>(simd: S, x: S::f64s) -> bool {
 }
 
 /// The slow path of one lane: the platform's `sin_cos` (exact argument reduction) for
-/// |x| ≤ [`crate::lie::EXP_MAX_NORM`], NaN beyond it and for a non-finite x (the rule of
-/// [`crate::lie::angle_sin_cos`]).
+/// |x| ≤ [`crate::numerics::angle::EXP_MAX_NORM`], NaN beyond it and for a non-finite x (the rule of
+/// [`crate::numerics::angle::angle_sin_cos`]).
 #[cold]
 #[inline(never)]
 pub fn slow_sin_cos(x: f64) -> (f64, f64) {
-    crate::lie::angle_sin_cos(x)
+    crate::numerics::angle::angle_sin_cos(x)
 }
 
 /// The slow path of [`sin_cosm1_lanes`] for one lane: sin x and cos x − 1 = −2 sin²(x/2) by the
@@ -268,7 +268,7 @@ pub fn slow_sin_cos(x: f64) -> (f64, f64) {
 #[cold]
 #[inline(never)]
 pub fn slow_sin_cosm1(x: f64) -> (f64, f64) {
-    let (s, _) = crate::lie::angle_sin_cos(x);
+    let (s, _) = crate::numerics::angle::angle_sin_cos(x);
     if s.is_nan() {
         return (f64::NAN, f64::NAN);
     }
@@ -325,9 +325,9 @@ fn fix_slow<S: Simd>(
 /// (sin θ, cos θ) of a rotation angle: one lane of [`sin_cos_lanes`], bit for bit what every
 /// lane of a batch computes for the same θ (for |θ| ≤ [`SMALL_MAX`], the usual angle of a
 /// step, by [`sin_cos_small`]: the same bits without the reduction). NaN beyond
-/// [`crate::lie::EXP_MAX_NORM`] and for a non-finite θ.
+/// [`crate::numerics::angle::EXP_MAX_NORM`] and for a non-finite θ.
 #[inline]
-pub fn angle_sin_cos(theta: f64) -> (f64, f64) {
+pub fn lane_sin_cos(theta: f64) -> (f64, f64) {
     let s = pulp::Scalar::new();
     if all_small(s, theta) {
         sin_cos_small(s, theta)
@@ -337,7 +337,7 @@ pub fn angle_sin_cos(theta: f64) -> (f64, f64) {
 }
 
 /// (sin θ, cos θ − 1) of a rotation angle: one lane of [`sin_cosm1_lanes`], bit for bit (as
-/// [`angle_sin_cos`]).
+/// [`lane_sin_cos`]).
 #[inline]
 pub fn angle_sin_cosm1(theta: f64) -> (f64, f64) {
     let s = pulp::Scalar::new();
@@ -367,8 +367,8 @@ mod tests {
     }
 
     fn check(x: f64) -> f64 {
-        let (s, c) = angle_sin_cos(x);
-        let (s0, c0) = crate::lie::angle_sin_cos(x);
+        let (s, c) = lane_sin_cos(x);
+        let (s0, c0) = crate::numerics::angle::angle_sin_cos(x);
         let u = ulps(s, s0).max(ulps(c, c0));
         assert!(
             u <= 2.0,
@@ -432,17 +432,19 @@ mod tests {
             FAST_MAX,
             FAST_MAX * 1.000_001,
             1e10,
-            crate::lie::EXP_MAX_NORM,
+            crate::numerics::angle::EXP_MAX_NORM,
             6381956970095103.0 * 2f64.powi(-5),
         ] {
             check(x);
             check(-x);
         }
         let nan = |(s, c): (f64, f64)| s.is_nan() && c.is_nan();
-        assert!(nan(angle_sin_cos(f64::NAN)));
-        assert!(nan(angle_sin_cos(f64::INFINITY)));
-        assert!(nan(angle_sin_cos(-f64::INFINITY)));
-        assert!(nan(angle_sin_cos(crate::lie::EXP_MAX_NORM * 2.0)));
+        assert!(nan(lane_sin_cos(f64::NAN)));
+        assert!(nan(lane_sin_cos(f64::INFINITY)));
+        assert!(nan(lane_sin_cos(-f64::INFINITY)));
+        assert!(nan(lane_sin_cos(
+            crate::numerics::angle::EXP_MAX_NORM * 2.0
+        )));
     }
 
     /// Every lane of the dispatched SIMD kernel gives the bits of the scalar kernel, whatever
@@ -469,7 +471,7 @@ mod tests {
         let mut got = Vec::new();
         pulp::Arch::new().dispatch(Run(&xs, &mut got));
         for (x, (s, c)) in xs.iter().zip(got) {
-            let (s0, c0) = angle_sin_cos(*x);
+            let (s0, c0) = lane_sin_cos(*x);
             assert_eq!(
                 (s.to_bits(), c.to_bits()),
                 (s0.to_bits(), c0.to_bits()),
@@ -523,11 +525,11 @@ mod tests {
         -2.0 * (p + e)
     }
 
-    /// (sin x, cos x − 1): sin the bits of [`angle_sin_cos`], cos x − 1 within 5 ulp of itself
+    /// (sin x, cos x − 1): sin the bits of [`lane_sin_cos`], cos x − 1 within 5 ulp of itself
     /// (4 ulp of the reference's rounding, and cos x − 1 = c − 1 off the first quadrant).
     fn check_cosm1(x: f64) -> f64 {
         let (s, cm1) = angle_sin_cosm1(x);
-        let (s0, _) = angle_sin_cos(x);
+        let (s0, _) = lane_sin_cos(x);
         assert_eq!(s.to_bits(), s0.to_bits(), "x = {x:e}");
         let want = cosm1_reference(x);
         // Below the normal range cos x − 1 = −x²/2 underflows: absolute comparison there.
@@ -571,7 +573,9 @@ mod tests {
         let nan = |(s, c): (f64, f64)| s.is_nan() && c.is_nan();
         assert!(nan(angle_sin_cosm1(f64::NAN)));
         assert!(nan(angle_sin_cosm1(f64::INFINITY)));
-        assert!(nan(angle_sin_cosm1(crate::lie::EXP_MAX_NORM * 2.0)));
+        assert!(nan(angle_sin_cosm1(
+            crate::numerics::angle::EXP_MAX_NORM * 2.0
+        )));
     }
 
     /// The rotation (1 + (c − 1), s) is orthogonal to O(θ²ε): (1 + m)² + s² − 1 = 2m + m² + s²
@@ -589,7 +593,7 @@ mod tests {
             if x != 0.0 {
                 worst = worst.max(defect.abs() / (x * x * f64::EPSILON));
             }
-            let (s, c) = angle_sin_cos(x);
+            let (s, c) = lane_sin_cos(x);
             let (c2, c2e) = two_prod(c, c);
             let (s2, s2e) = two_prod(s, s);
             worst_cs = worst_cs.max((((c2 - 1.0) + s2) + (c2e + s2e)).abs() / f64::EPSILON);
@@ -654,7 +658,7 @@ mod tests {
 
         #[test]
         fn pythagoras_to_round_off(x in -100.0f64..100.0) {
-            let (s, c) = angle_sin_cos(x);
+            let (s, c) = lane_sin_cos(x);
             prop_assert!((s * s + c * c - 1.0).abs() <= 4.0 * f64::EPSILON);
         }
     }

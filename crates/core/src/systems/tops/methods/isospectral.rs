@@ -2,7 +2,7 @@
 //! "Lie–Poisson methods for isospectral flows", Found. Comput. Math. 20 (2020), eq. (9)).
 //!
 //! For Ṁ = [M, Ω(M)] with Ω = ∂H/∂M (lieflow's sign, 000 §3.3 and the so(3) check
-//! [`crate::systems::rigid_body`]), one step of size h is
+//! [`crate::systems::tops::rigid_body`]), one step of size h is
 //!
 //! M_n = (I + h/2 Ω̃) M̃ (I − h/2 Ω̃),   M_{n+1} = (I − h/2 Ω̃) M̃ (I + h/2 Ω̃),   Ω̃ = Ω(M̃).
 //!
@@ -18,15 +18,15 @@
 //! [`crate::convergence`] ([`RULE`]: the update relative to max|M_n|); a step whose update is still
 //! above the tolerance after [`RULE`]`.max_iter` iterations is [`crate::Error::NotConverged`].
 //!
-//! The method value is [`Isospectral`], in the catalogs of [`super::RigidBody`] (through the
-//! so(3) matrix hat(M), with the attitude) and [`super::GeneralizedRigidBody`].
+//! The method value is [`Isospectral`], in the catalogs of [`crate::systems::RigidBody`] (through the
+//! so(3) matrix hat(M), with the attitude) and [`crate::systems::GeneralizedRigidBody`].
 
-use super::top;
-use super::{GeneralizedRigidBody, RigidBody};
+use super::super::top;
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::{Clock, Integrator, Properties, Stepper};
 use crate::lie::so3;
+use crate::systems::tops::{GeneralizedRigidBody, RigidBody};
 use nalgebra::{Matrix3, Vector3};
 
 /// The stopping rule of the fixed-point iteration ([`crate::convergence`]; the update of M̃

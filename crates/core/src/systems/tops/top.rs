@@ -1,4 +1,4 @@
-//! What the bodies on SO(3) share ([`super::RigidBody`], [`super::HeavyTop`]): principal frames,
+//! What the bodies on SO(3) share ([`crate::systems::RigidBody`], [`crate::systems::HeavyTop`]): principal frames,
 //! the state layout (M, [Γ], [R]), the exact sub-flows of the Lie–Poisson splitting (the
 //! [`Split`] kind), and the Euler(–Poisson) vector field (the [`VectorField`] kind).
 //!
@@ -24,7 +24,10 @@
 
 use crate::check;
 use crate::error::{Error, Result};
+use crate::integrate::methods::{Composition, Processed, ProcessedSplitting, Splitting};
+use crate::integrate::problem::Split;
 use crate::integrate::space::{Block, Space};
+use crate::integrate::Entry;
 use nalgebra::{Matrix3, Vector3};
 
 /// Checks principal moments: finite and > 0.
@@ -126,18 +129,18 @@ pub(crate) fn row_major(r: &Matrix3<f64>) -> [f64; 9] {
 }
 
 /// Rotates v about e_k by the angle −θ: the flow of v̇ = v × (θ/t) e_k over time t. NaN beyond
-/// the angle range of every exponential ([`crate::lie::angle_sin_cos`]), which the driver's
+/// the angle range of every exponential ([`crate::numerics::angle::angle_sin_cos`]), which the driver's
 /// finiteness guard reports with the step.
 #[inline]
 pub(crate) fn rotate_axis(v: &mut Vector3<f64>, k: usize, theta: f64) {
-    let (s, cm1) = crate::simd::angle_sin_cosm1(theta);
+    let (s, cm1) = crate::numerics::simd::angle_sin_cosm1(theta);
     rotate_axis_sc(v, k, s, cm1);
 }
 
 /// v ↦ v + ((cos θ − 1)v + sin θ Jv) in the plane (i, j) ⊥ e_k, from `s` = sin θ and
 /// `cm1` = cos θ − 1: orthogonal to O(θ²ε), where (cos θ)v + sin θ Jv with cos θ rounded is off
 /// by up to an ulp of 1 and, at the same angle every step (a symmetric body), biases |v|² the
-/// same way every step ([`crate::simd`], "Rotations").
+/// same way every step ([`crate::numerics::simd`], "Rotations").
 #[inline]
 pub(crate) fn rotate_axis_sc(v: &mut Vector3<f64>, k: usize, s: f64, cm1: f64) {
     let (i, j) = ((k + 1) % 3, (k + 2) % 3);
@@ -308,7 +311,7 @@ impl Top {
                 // One lane of the batch kernel (`TopLanes`): the same sin/cos and operations, so
                 // a body gives the same bits alone and in a batch. NaN where the angle is lost
                 // to rounding (see `rotate_axis`).
-                let (s, cm1) = crate::simd::angle_sin_cosm1(tau * self.coef[a] * b.m[k]);
+                let (s, cm1) = crate::numerics::simd::angle_sin_cosm1(tau * self.coef[a] * b.m[k]);
                 rotate_axis_sc(&mut b.m, k, s, cm1);
                 if let Some(g) = b.g.as_mut() {
                     rotate_axis_sc(g, k, s, cm1);
@@ -394,7 +397,7 @@ impl Top {
 }
 
 /// The flows of the free rigid body (M) and of the heavy top (M, Γ), with or without the attitude
-/// R, on a block of bodies, in SIMD lanes ([`crate::simd`]), with exactly the operations of [`Top::flow`]
+/// R, on a block of bodies, in SIMD lanes ([`crate::numerics::simd`]), with exactly the operations of [`Top::flow`]
 /// (which is one lane of this kernel): flow `Axis(a)` rotates M (and Γ) about e_k,
 /// k = `axes[a]`, by the angle −τ·`coef[a]`·M_k (and the columns i, j of R by the same angle);
 /// `Casimir` turns Γ and the rows of R by exp(−τ M̂/I_r) ([`Turn`]); `Kick` adds τ Γ × c to M
@@ -573,8 +576,8 @@ impl TopLanes {
 
 /// The turn exp(−v̂) for v = t M (Rodrigues: exp(−v̂) x = x − A v × x + B v × (v × x), θ = |v|,
 /// A = sin θ/θ, B = (1 − cos θ)/θ²): the flow of ½|M|²/I_r over τ = t I_r on Γ, and on the rows
-/// of R (R exp(v̂) has the rows exp(−v̂) r). For θ ≤ [`crate::simd::SMALL_MAX`] (the usual step)
-/// A and B are polynomials in θ² ([`crate::simd::sinc_versinc_small`]: no square root, no
+/// of R (R exp(v̂) has the rows exp(−v̂) r). For θ ≤ [`crate::numerics::simd::SMALL_MAX`] (the usual step)
+/// A and B are polynomials in θ² ([`crate::numerics::simd::sinc_versinc_small`]: no square root, no
 /// division); a lane beyond it takes sin θ/θ and (1 − cos θ)/θ², chosen per lane, so a body
 /// gives the same bits in any vector.
 struct Turn<S: pulp::Simd> {
@@ -590,13 +593,13 @@ impl<S: pulp::Simd> Turn<S> {
         let (add, mul) = (|a, b| simd.add_f64s(a, b), |a, b| simd.mul_f64s(a, b));
         let v = m.map(|x| mul(x, t));
         let th2 = add(add(mul(v[0], v[0]), mul(v[1], v[1])), mul(v[2], v[2]));
-        let small_max = crate::simd::SMALL_MAX * crate::simd::SMALL_MAX;
+        let small_max = crate::numerics::simd::SMALL_MAX * crate::numerics::simd::SMALL_MAX;
         let small = simd.less_than_or_equal_f64s(th2, simd.splat_f64s(small_max));
-        let (mut a, mut b) = crate::simd::sinc_versinc_small(simd, th2);
+        let (mut a, mut b) = crate::numerics::simd::sinc_versinc_small(simd, th2);
         if simd.first_true_m64s(simd.not_m64s(small)) < S::F64_LANES {
             // 1 − cos θ as −(cos θ − 1): no cancellation near multiples of 2π.
             let th = simd.sqrt_f64s(th2);
-            let (s, cm1) = crate::simd::sin_cosm1_lanes(simd, th);
+            let (s, cm1) = crate::numerics::simd::sin_cosm1_lanes(simd, th);
             let versin = simd.xor_f64s(cm1, simd.splat_f64s(-0.0));
             a = simd.select_f64s(small, a, simd.div_f64s(s, th));
             b = simd.select_f64s(small, b, simd.div_f64s(versin, th2));
@@ -675,13 +678,16 @@ fn rotate_about<S: pulp::Simd, const D: usize, const K: usize, const I: usize, c
     let angle: [S::f64s; GROUP] = std::array::from_fn(|g| simd.mul_f64s(tc[g], z[K][g]));
     // Small angles (the usual case) skip the argument reduction: the same bits
     // (`simd::sin_cosm1_small`), so the choice, made per group, changes no result.
-    if angle.iter().all(|&a| crate::simd::all_small(simd, a)) {
+    if angle
+        .iter()
+        .all(|&a| crate::numerics::simd::all_small(simd, a))
+    {
         for g in 0..GROUP {
-            (s[g], cm1[g]) = crate::simd::sin_cosm1_small(simd, angle[g]);
+            (s[g], cm1[g]) = crate::numerics::simd::sin_cosm1_small(simd, angle[g]);
         }
     } else {
         for g in 0..GROUP {
-            (s[g], cm1[g]) = crate::simd::sin_cosm1_lanes(simd, angle[g]);
+            (s[g], cm1[g]) = crate::numerics::simd::sin_cosm1_lanes(simd, angle[g]);
         }
     }
     for base in (0..D).step_by(3) {
@@ -695,12 +701,27 @@ fn rotate_about<S: pulp::Simd, const D: usize, const K: usize, const I: usize, c
     }
 }
 
+/// The Lie–Poisson splittings the SO(3) bodies share (the first entries of their catalogs, in
+/// this order): symmetric compositions of the sub-flows (Strang, Suzuki 4, Yoshida 6,
+/// Kahan–Li 8) and the processed ones (Blanes–Casas–Murua, effective orders 6, 8, 10).
+pub(super) fn splittings<P: Split + Clone + 'static>() -> Vec<Entry<P>> {
+    vec![
+        Entry::new("splitting", Splitting::strang()),
+        Entry::new("splitting4", Splitting(Composition::suzuki4())),
+        Entry::new("splitting6", Splitting(Composition::yoshida6())),
+        Entry::new("splitting8", Splitting(Composition::kahan_li8())),
+        Entry::new("processed6", ProcessedSplitting(Processed::bcm6())),
+        Entry::new("processed8", ProcessedSplitting(Processed::bcm8())),
+        Entry::new("processed10", ProcessedSplitting(Processed::bcm10())),
+    ]
+}
+
 /// The problem kinds of a body on SO(3) with a field `top: Top`: [`Split`] (the Lie–Poisson
-/// splitting), [`VectorField`] (RK4) and the [`super::lgvi::Lgvi`] method.
+/// splitting), [`VectorField`] (RK4) and the [`super::methods::lgvi::Lgvi`] method.
 macro_rules! top_kinds {
     ($t:ty) => {
         impl $crate::integrate::problem::Split for $t {
-            type Work = $crate::systems::top::TopWork;
+            type Work = $crate::systems::tops::top::TopWork;
             fn load(&self, z: &[f64]) -> $crate::Result<Self::Work> {
                 Ok(self.top.load(z))
             }
@@ -725,7 +746,7 @@ macro_rules! top_kinds {
             }
         }
 
-        impl $crate::integrate::Integrator<$t> for $crate::systems::lgvi::Lgvi {
+        impl $crate::integrate::Integrator<$t> for $crate::systems::tops::methods::lgvi::Lgvi {
             fn properties(&self) -> $crate::integrate::Properties {
                 $crate::integrate::Properties::geometric(2)
             }

@@ -8,7 +8,7 @@
 //!
 //! so the constrained phase space is {|q| = l, q·p = 0}. Rotations about e₃ are a symmetry: the
 //! vertical angular momentum (q × p)₃ is conserved, and kept exactly by RATTLE (equivariant under
-//! these rotations). The same motion as [`super::SphericalPendulum`] with u = q/l and
+//! these rotations). The same motion as [`crate::systems::SphericalPendulum`] with u = q/l and
 //! L = q × p ([`SphereParticle::from_spherical`], [`SphereParticle::to_spherical`]): since L ⊥ u,
 //! p = m l u̇ = L × u / l, and |p|²/(2m) = |L|²/(2ml²).
 
@@ -38,13 +38,13 @@ impl SphereParticle {
         })
     }
 
-    /// The state (q, p) = (l u, L × u / l) of a [`super::SphericalPendulum`] state (u, L) with the
+    /// The state (q, p) = (l u, L × u / l) of a [`crate::systems::SphericalPendulum`] state (u, L) with the
     /// same m, l, g.
     pub fn from_spherical(&self, z: &[f64]) -> Result<Vec<f64>> {
         check::len_of("spherical-pendulum state (u, L)", z, 6)?;
         check::finite_slice("spherical-pendulum state (u, L)", z)?;
         // (u, L) must be a spherical-pendulum state (|u| = 1, u·L = 0), as its check_state asks.
-        super::spherical_pendulum::check_pendulum_state(z)?;
+        crate::systems::tops::spherical_pendulum::check_pendulum_state(z)?;
         let u = Vector3::from_column_slice(&z[..3]);
         let l = Vector3::from_column_slice(&z[3..]);
         let q = u * self.bob.length;
@@ -59,7 +59,7 @@ impl SphereParticle {
         Ok(out)
     }
 
-    /// The [`super::SphericalPendulum`] state (u, L) = (q/l, q × p) of a state (q, p).
+    /// The [`crate::systems::SphericalPendulum`] state (u, L) = (q/l, q × p) of a state (q, p).
     pub fn to_spherical(&self, z: &[f64]) -> Result<Vec<f64>> {
         check::len_of("state (q, p)", z, 6)?;
         let q = Vector3::from_column_slice(&z[..3]);

@@ -1,6 +1,6 @@
-//! The exact flow (M(t), R(t)) of the free rigid body, the method `exact` of [`super::RigidBody`], and
+//! The exact flow (M(t), R(t)) of the free rigid body, the method `exact` of [`crate::systems::RigidBody`], and
 //! the splittings of the heavy top whose kinetic flow is this exact flow (`exact_splitting*` of
-//! [`super::HeavyTop`]). After Celledoni, Fassò, Säfström & Zanna, "The exact computation of the free
+//! [`crate::systems::HeavyTop`]). After Celledoni, Fassò, Säfström & Zanna, "The exact computation of the free
 //! rigid body motion and its use in splitting methods", SIAM J. Sci. Comput. 30 (2008), and van
 //! Zon & Schofield, J. Comput. Phys. 225 (2007): the same factorisation of the attitude through
 //! the conserved spatial momentum. The formulas below were derived independently (the body factor
@@ -9,7 +9,7 @@
 //! checked numerically in `tests/rigid_body_exact.rs` (RK4 and DOP853 references, finite
 //! differences, 50-digit values).
 //!
-//! **Momentum.** As in [`super::RigidBody::exact_momentum`]: in working axes (p, mid, s) (a proper
+//! **Momentum.** As in [`crate::systems::RigidBody::exact_momentum`]: in working axes (p, mid, s) (a proper
 //! relabelling of the principal axes with I_mid the middle moment and the orbit of M encircling
 //! e_s), M = (σa₁ cn u, a₂ sn u, εa₃ dn u), u = u₀ + λt; g = d₂₃/d₁₃, h = d₁₂/d₁₃ = 1 − g
 //! (d_ij = 1/I_i − 1/I_j), a₁² = g a₂², |M|² = a₁² + a₃², m = h a₂²/a₃².
@@ -65,13 +65,13 @@
 //! Π̃(u) − Π̃(u₀) = λτ − (ν/3)(sn³u R_J(u) − sn³u₀ R_J(u₀)) while u stays in [−K, K]
 //! (`Orbit::short_step`; about half the cost of a general evaluation).
 
-use super::top::{self, Top};
+use super::super::top::{self, Top};
 use crate::check;
-use crate::elliptic;
 use crate::error::Result;
 use crate::integrate::methods::Composition;
 use crate::integrate::{Clock, Stepper};
 use crate::lie::so3;
+use crate::numerics::elliptic;
 use nalgebra::{Matrix3, Vector3};
 
 /// The motion of a free rigid body from one momentum M₀ (principal frame): its constants,
@@ -155,7 +155,7 @@ impl FreeFlow {
     }
 
     /// M(t) alone (principal frame), without the constants of the attitude: the elliptic formula
-    /// at u₀ + λt (the arithmetic of [`super::RigidBody::exact_momentum`] before the attitude existed).
+    /// at u₀ + λt (the arithmetic of [`crate::systems::RigidBody::exact_momentum`] before the attitude existed).
     pub(crate) fn momentum_at(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> Vector3<f64> {
         match shape(inertia, m0) {
             Shape::Closed(kind) => FreeFlow { m0: *m0, kind }.momentum(t),
@@ -181,7 +181,7 @@ impl FreeFlow {
     }
 
     /// (M(t), S(t)) with S(t) = R₀ᵀR(t), the attitude relative to the start (principal frame).
-    /// NaN where an angle exceeds [`crate::lie::EXP_MAX_NORM`] (lost to rounding).
+    /// NaN where an angle exceeds [`crate::numerics::angle::EXP_MAX_NORM`] (lost to rounding).
     pub(crate) fn motion(&self, t: f64) -> (Vector3<f64>, Matrix3<f64>) {
         match &self.kind {
             Kind::Uniform(w) => (self.m0, so3::exp(&(w * t))),
@@ -205,7 +205,7 @@ impl FreeFlow {
     }
 
     /// The largest rate at which a phase of the motion grows (|λ| + ω̄, or |Ω|): t·rate beyond
-    /// [`crate::lie::EXP_MAX_NORM`] loses the angle to rounding.
+    /// [`crate::numerics::angle::EXP_MAX_NORM`] loses the angle to rounding.
     pub(crate) fn rate(&self) -> f64 {
         match &self.kind {
             Kind::Uniform(w) => w.amax() * 3f64.sqrt(),
@@ -341,7 +341,7 @@ impl Orbit {
     #[inline]
     fn relative(&self, b0t: &Matrix3<f64>, phi: f64, y: &Vector3<f64>) -> Matrix3<f64> {
         let b = body_frame(&self.polar(y));
-        let (sp, cp) = crate::lie::angle_sin_cos(phi);
+        let (sp, cp) = crate::numerics::angle::angle_sin_cos(phi);
         // Z(φ) B: rows c b₁ − s b₂, s b₁ + c b₂, b₃.
         let mut zb = b;
         for j in 0..3 {
@@ -446,7 +446,7 @@ pub(crate) fn relative_attitude(inertia: &[f64; 3], m0: &Vector3<f64>, tau: f64)
             }
         }
         Shape::Closed(Kind::Symmetric { s, w, inv_io }) => {
-            let (sin, cm1) = crate::simd::angle_sin_cosm1(tau * w);
+            let (sin, cm1) = crate::numerics::simd::angle_sin_cosm1(tau * w);
             return Relative::Closed {
                 turn: so3::Rodrigues::exp(&-(m0 * (tau * inv_io))),
                 spin: Some((s, sin, cm1)),

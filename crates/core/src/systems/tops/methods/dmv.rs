@@ -62,7 +62,7 @@
 //! preprocessed methods are Poisson integrators for M on so(3)* but not symplectic for the full
 //! system with the attitude — their [`Properties::symplectic`] claim is the Poisson one.
 
-use super::top::Top;
+use super::super::top::Top;
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::integrate::{Clock, Properties, Stepper};
@@ -70,7 +70,7 @@ use crate::lie::rotations::{matrix_to_quaternion, quaternion_multiply, quaternio
 use nalgebra::{Matrix3, Vector3};
 
 /// The DMV algorithm (`Dmv(2)`) and its preprocessed versions `Dmv(4)`, `Dmv(6)`, `Dmv(8)`,
-/// `Dmv(10)` (a method value; the number is the order), for [`super::RigidBody`].
+/// `Dmv(10)` (a method value; the number is the order), for [`crate::systems::RigidBody`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Dmv(pub u32);
 
@@ -244,7 +244,7 @@ impl Series {
                 format!("the DMV methods have orders 2, 4, 6, 8, 10, got {order}"),
             ));
         }
-        super::top::check_moments(moments)?;
+        super::super::top::check_moments(moments)?;
         let u = moments.map(|i| 1.0 / i);
         let u_ref = u.iter().fold(0.0f64, |a, &b| a.max(b));
         let mu = u.map(|x| x / u_ref);
@@ -520,7 +520,7 @@ impl Stepper for DmvStepper {
         z[..3].copy_from_slice(self.m.as_slice());
         if self.lifted {
             let r = quaternion_to_matrix(&self.q);
-            z[3..12].copy_from_slice(&super::top::row_major(&r));
+            z[3..12].copy_from_slice(&super::super::top::row_major(&r));
         }
     }
 

@@ -13,6 +13,12 @@ use faer::{Accum, MatMut, MatRef, Par};
 /// Below this size products use plain loops (faer's matmul has ~90 ns fixed cost at 3×3).
 const SMALL: usize = 4;
 
+/// The Euclidean norm √(Σ vᵢ²) of a slice (not scaled: the residuals and tangents of the
+/// solvers, far from overflow).
+pub(crate) fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
 /// ‖X‖_F² = tr(XᵀX).
 pub(crate) fn frob2(x: MatRef<'_, f64>) -> f64 {
     let mut s = 0.0;

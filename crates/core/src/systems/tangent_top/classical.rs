@@ -34,7 +34,7 @@
 //!
 //! **Conserved quantities.** H; p_θ = 𝕀(θ̇ + α·ẋ), the body's angular momentum (002 (47):
 //! ∂L/∂θ = 0), linear in z so every Gauss method keeps it to round-off; for every Killing field of
-//! the surface, lifted to (x, θ) as in [`crate::systems::surface`], the momentum J = p_A X^A
+//! the surface, lifted to (x, θ) as in [`crate::systems::tangent_top::surface`], the momentum J = p_A X^A
 //! (Noether; it generates the isometry that moves the frame along, 002 §III.A, §III.C).
 //!
 //! **Embedded surfaces** (002 §II.D, (29)–(39), derived again). On a surface in ℝ³ a body point
@@ -418,12 +418,7 @@ fn charged_particle(l: &Local, p: Vec2, e: f64) -> (Vec2, Vec2) {
 impl VectorField for TangentTop {
     /// ż = (∂H/∂p, −∂H/∂q).
     fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let (mut hq, mut hp) = ([0.0; 3], [0.0; 3]);
-        self.gradient(&z[..3], &z[3..6], &mut hq, &mut hp);
-        for a in 0..3 {
-            dz[a] = hp[a];
-            dz[3 + a] = -hq[a];
-        }
+        self.hamilton_field(z, dz);
     }
 }
 
@@ -619,11 +614,7 @@ impl Canonical for ChargedParticle {
 impl VectorField for ChargedParticle {
     /// ż = (∂H/∂p, −∂H/∂q).
     fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let (mut hq, mut hp) = ([0.0; 2], [0.0; 2]);
-        self.gradient(&z[..2], &z[2..4], &mut hq, &mut hp);
-        dz[..2].copy_from_slice(&hp);
-        dz[2] = -hq[0];
-        dz[3] = -hq[1];
+        self.hamilton_field(z, dz);
     }
 }
 

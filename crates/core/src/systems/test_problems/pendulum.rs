@@ -15,12 +15,12 @@
 //! sn K = 1 and cn K = 0 give q = q₀, p = 0.
 
 use crate::check;
-use crate::elliptic::{ellipj, ellipk};
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Gauss, Rk4, Verlet, IMPLICIT_MIDPOINT};
 use crate::integrate::problem::{Canonical, Separable, VectorField, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
+use crate::numerics::elliptic::{ellipj, ellipk};
 
 /// The parameters every pendulum shares: a bob of mass m > 0 on a massless rod of length l > 0 in
 /// gravity g ≥ 0.
@@ -150,8 +150,7 @@ impl Separable for Pendulum {
 impl VectorField for Pendulum {
     /// q̇ = p/(ml²), ṗ = −mgl sin q.
     fn field(&self, z: &[f64], dz: &mut [f64]) {
-        dz[0] = z[1] / self.bob.inertia();
-        dz[1] = -self.bob.mgl() * z[0].sin();
+        self.hamilton_field(z, dz);
     }
 }
 

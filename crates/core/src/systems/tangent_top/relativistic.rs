@@ -56,7 +56,7 @@
 //!
 //! # Curved static space-time (002 (97)–(111))
 //! The metric ds² = −dt² + γ_ij dxⁱdxʲ with γ = g the metric of a [`Surface`] (orthonormal frame
-//! Ê_a, connection 1-form w(v) = ⟨∇_vÊ₁, Ê₂⟩ = α·v, see [`crate::systems::surface`]). The lapse is
+//! Ê_a, connection 1-form w(v) = ⟨∇_vÊ₁, Ê₂⟩ = α·v, see [`crate::systems::tangent_top::surface`]). The lapse is
 //! 1, so ∂_t is parallel and no Christoffel symbol carries a t (002 (86)): with ċ = ∂_t + ẋ and
 //! E₁ = cos θ Ê₁ + sin θ Ê₂, E₂ = −sin θ Ê₁ + cos θ Ê₂,
 //!
@@ -85,7 +85,7 @@
 //!
 //! **Conserved.** E = p·q̇ − L = mγ + ½𝕀s²(γ + (5/2)v²γ³ + (3/2)v⁴γ⁵) (002 (96) with θ̇ → s);
 //! p_θ = 𝕀 s f(v²) (θ is cyclic); and for every Killing field X of the surface, lifted to
-//! (x, θ) as in [`crate::systems::surface`], J = p_A X^A (v², s and so L are invariant under the
+//! (x, θ) as in [`crate::systems::tangent_top::surface`], J = p_A X^A (v², s and so L are invariant under the
 //! lifted isometries; [`RelativisticTangentTop::killing_momenta`], computed by
 //! [`crate::systems::TangentTop::killing_momenta`]). Since E and p_θ are functions of (v, s) only,
 //! v and s are constant along a motion (where (v, s) ↦ (E, p_θ) is locally invertible, as for
@@ -154,8 +154,8 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::classical::TangentTop;
 use super::surface::{self, inverse, Geometry, Plane, Surface};
-use super::tangent_top::TangentTop;
 use crate::check;
 use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
@@ -323,13 +323,7 @@ macro_rules! legendre_kinds {
         impl VectorField for $t {
             /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
             fn field(&self, z: &[f64], dz: &mut [f64]) {
-                let (hq, hp) = dz.split_at_mut(3);
-                gradient_of(self.solve(&z[..3], &z[3..]), hq, hp);
-                for (qd, pd) in hq.iter_mut().zip(hp.iter_mut()) {
-                    let h_q = *qd;
-                    *qd = *pd;
-                    *pd = -h_q;
-                }
+                self.hamilton_field(z, dz);
             }
         }
 

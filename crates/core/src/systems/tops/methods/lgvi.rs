@@ -16,14 +16,14 @@
 //! equation 2(Jg + g × Jg) = h P (1 + |g|²), P = Π_k + (h/2)τ_k, solved by Newton's method under
 //! the rule of [`crate::convergence`] ([`RULE`]: |Δg| relative to 1 + |g|).
 //!
-//! The method value is [`Lgvi`], in the catalogs of [`super::RigidBody`] and [`super::HeavyTop`]
+//! The method value is [`Lgvi`], in the catalogs of [`crate::systems::RigidBody`] and [`crate::systems::HeavyTop`]
 //! (as `lgvi`); it works on the same state layout as the splitting (the private `top::Top`).
 //!
 //! Order 2, symplectic on T*SO(3) (resp. the heavy-top phase space), R stays in SO(3) and |Π|²,
 //! R Π (free body), |Γ|² and Π·Γ (heavy top) are kept to round-off: Π and Γ move only by the
 //! rotation Fᵀ and by kicks orthogonal to Γ.
 
-use super::top::{Top, TopWork};
+use super::super::top::{Top, TopWork};
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::{Clock, Stepper};

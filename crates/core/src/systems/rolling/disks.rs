@@ -454,11 +454,7 @@ impl Canonical for RollingDisks {
 impl VectorField for RollingDisks {
     /// ż = (∂H/∂p, −∂H/∂θ).
     fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let (mut hq, mut hp) = ([0.0; 2], [0.0; 2]);
-        self.gradient(&z[..2], &z[2..], &mut hq, &mut hp);
-        dz[..2].copy_from_slice(&hp);
-        dz[2] = -hq[0];
-        dz[3] = -hq[1];
+        self.hamilton_field(z, dz);
     }
 }
 

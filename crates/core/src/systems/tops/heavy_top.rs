@@ -13,13 +13,13 @@
 //! Lagrangian with Γ = R⁻¹e₃ and obtains IΩ̇ = IΩ × Ω + gΓ × X_b: the same equations with
 //! mgl χ = g X_b (mass absorbed in X_b).
 
-use super::exact_flow::{relative_attitude, ExactSplitting};
-use super::lgvi::Lgvi;
+use super::methods::exact::{relative_attitude, ExactSplitting};
+use super::methods::lgvi::Lgvi;
 use super::top::TopWork;
 use super::top::{self, top_kinds, Top};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Composition, Processed, ProcessedSplitting, Rk4, Splitting};
+use crate::integrate::methods::{Composition, Rk4, Splitting};
 use crate::integrate::problem::Split;
 use crate::integrate::space::Space;
 use crate::integrate::{Catalog, Entry, Integrator, Problem, Properties, Stepper};
@@ -174,20 +174,15 @@ top_kinds!(HeavyTop);
 
 impl Catalog for HeavyTop {
     fn catalog(&self) -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("splitting", Splitting::strang()),
-            Entry::new("splitting4", Splitting(Composition::suzuki4())),
-            Entry::new("splitting6", Splitting(Composition::yoshida6())),
-            Entry::new("splitting8", Splitting(Composition::kahan_li8())),
-            Entry::new("processed6", ProcessedSplitting(Processed::bcm6())),
-            Entry::new("processed8", ProcessedSplitting(Processed::bcm8())),
-            Entry::new("processed10", ProcessedSplitting(Processed::bcm10())),
+        let mut catalog = top::splittings();
+        catalog.extend([
             Entry::new("lgvi", Lgvi),
             Entry::new("rk4", Rk4),
             Entry::new("exact_splitting", ExactSplitting(Composition::strang())),
             Entry::new("exact_splitting4", ExactSplitting(Composition::suzuki4())),
             Entry::new("exact_splitting6", ExactSplitting(Composition::yoshida6())),
-        ]
+        ]);
+        catalog
     }
 
     fn lifted(&self) -> Option<Self> {

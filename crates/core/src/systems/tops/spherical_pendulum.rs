@@ -19,13 +19,13 @@
 //! Splitting: the kinetic flow rotates q about the fixed L by the angle t|L|/(ml²); the potential
 //! flow kicks L ↦ L + t mgl e₃ × q. Both are exact, keep |q|², q·L and L₃ exactly.
 
-use super::pendulum::Bob;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Splitting};
 use crate::integrate::problem::{Split, Symmetric, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
+use crate::systems::test_problems::pendulum::Bob;
 use nalgebra::Vector3;
 
 /// Tolerance of the constraints |q| = 1 and q·L = 0 on an initial state.
@@ -104,7 +104,7 @@ impl Problem for SphericalPendulum {
 }
 
 /// The state-space check of a spherical-pendulum state (q, L): |q| = 1 and q·L = 0 to
-/// [`CONSTRAINT_TOL`] (shared with [`super::SphereParticle::from_spherical`]).
+/// [`CONSTRAINT_TOL`] (shared with [`crate::systems::SphereParticle::from_spherical`]).
 pub(crate) fn check_pendulum_state(z: &[f64]) -> Result<()> {
     let [q2, ql] = SphericalPendulum::casimirs(z);
     let l = z[3..].iter().map(|x| x * x).sum::<f64>().sqrt();

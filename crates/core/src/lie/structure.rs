@@ -1,0 +1,288 @@
+//! Lie algebras given by structure constants, as the user-defined Lie–Poisson systems use them
+//! ([`crate::systems::LiePoisson`]): a basis e_k with [e_i, e_j] = C_ij^k e_k, kept as the list of
+//! non-zero constants, with ad*, the bracket and a bound of ‖ad_u‖; so(3), se(3) and so(n) (in the
+//! e_ij coordinates of [`so::vee_n`]) built in, others from a validated array (antisymmetric,
+//! Jacobi).
+
+use crate::check;
+use crate::error::{Error, Result};
+use crate::lie::so;
+
+/// The Lie algebra g of a [`crate::systems::LiePoisson`] system.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Algebra {
+    /// so(3) in the physics basis (ℝ³, [û, v̂] = (u × v)^): μ = M.
+    So3,
+    /// se(3) = so(3) ⋉ ℝ³ with ξ = (ω, v) ([`crate::lie::se3::ad_matrix`]): μ = (M, Γ).
+    Se3,
+    /// so(n) in the e_ij coordinates of [`so::vee_n`] (n ≥ 2): μ = M ∈ so(n)*.
+    So(usize),
+    /// Structure constants C (d×d×d, row-major C\[i\]\[j\]\[k\] = C_ij^k: [e_i, e_j] = C_ij^k e_k),
+    /// antisymmetric in (i, j) and satisfying the Jacobi identity (both checked).
+    Constants(Vec<f64>),
+}
+
+/// One non-zero structure constant: [e_i, e_j] has c along e_k.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Term {
+    i: u32,
+    j: u32,
+    k: u32,
+    c: f64,
+}
+
+/// Which group maps the kernels of [`crate::integrate::problem::GroupField`] use.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Kind {
+    So3,
+    Se3,
+    So(usize),
+    Generic,
+}
+
+/// The algebra as the kernels use it.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Structure {
+    pub(crate) kind: Kind,
+    pub(crate) dim: usize,
+    terms: Vec<Term>,
+}
+
+impl Structure {
+    pub(crate) fn new(algebra: Algebra) -> Result<Self> {
+        let t = |i: usize, j: usize, k: usize, c: f64| Term {
+            i: i as u32,
+            j: j as u32,
+            k: k as u32,
+            c,
+        };
+        const CYCLIC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
+        match algebra {
+            Algebra::So3 => {
+                // [e_i, e_j] = ε_ijk e_k.
+                let mut terms = Vec::new();
+                for (i, j, k) in CYCLIC {
+                    terms.push(t(i, j, k, 1.0));
+                    terms.push(t(j, i, k, -1.0));
+                }
+                Ok(Structure {
+                    kind: Kind::So3,
+                    dim: 3,
+                    terms,
+                })
+            }
+            Algebra::Se3 => {
+                // [e_i, e_j] = ε_ijk e_k, [e_i, e_{3+j}] = ε_ijk e_{3+k} = −[e_{3+j}, e_i],
+                // [e_{3+i}, e_{3+j}] = 0.
+                let mut terms = Vec::new();
+                for (i, j, k) in CYCLIC {
+                    terms.push(t(i, j, k, 1.0));
+                    terms.push(t(j, i, k, -1.0));
+                    terms.push(t(i, 3 + j, 3 + k, 1.0));
+                    terms.push(t(3 + j, i, 3 + k, -1.0));
+                    terms.push(t(j, 3 + i, 3 + k, -1.0));
+                    terms.push(t(3 + i, j, 3 + k, 1.0));
+                }
+                Ok(Structure {
+                    kind: Kind::Se3,
+                    dim: 6,
+                    terms,
+                })
+            }
+            Algebra::So(n) => {
+                if n < 2 {
+                    return Err(Error::invalid(
+                        "algebra",
+                        format!("so(n) needs n ≥ 2, got n = {n}"),
+                    ));
+                }
+                // O(n³) non-zero constants, kept as (i, j, k, c): refuse what cannot be held.
+                check::array_size("algebra so(n)", &[n, n, n, 4])?;
+                Ok(Structure {
+                    kind: Kind::So(n),
+                    dim: so::dim(n),
+                    terms: so_terms(n),
+                })
+            }
+            Algebra::Constants(c) => Self::from_constants(&c),
+        }
+    }
+
+    /// Structure constants given as an array: validated (finite, antisymmetric, Jacobi).
+    pub(crate) fn from_constants(c: &[f64]) -> Result<Self> {
+        let d = (c.len() as f64).cbrt().round() as usize;
+        if d == 0 || d * d * d != c.len() {
+            return Err(Error::shape(
+                "algebra",
+                "structure constants (d, d, d) with d ≥ 1",
+                format!("{} values", c.len()),
+            ));
+        }
+        check::finite_slice("algebra (structure constants)", c)?;
+        let at = |i: usize, j: usize, k: usize| c[(i * d + j) * d + k];
+        let cmax = c.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for i in 0..d {
+            for j in 0..d {
+                for k in 0..d {
+                    let s = at(i, j, k) + at(j, i, k);
+                    if s.abs() > 1e-12 * cmax {
+                        return Err(Error::invalid(
+                            "algebra",
+                            format!(
+                                "structure constants not antisymmetric: C[{i}, {j}, {k}] + \
+                                 C[{j}, {i}, {k}] = {s:.3e}"
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        // Rows: the non-zero (k, C_ab^k) of each bracket [e_a, e_b].
+        let rows: Vec<Vec<(usize, f64)>> = (0..d * d)
+            .map(|ab| {
+                (0..d)
+                    .filter_map(|k| {
+                        let v = c[ab * d + k];
+                        (v != 0.0).then_some((k, v))
+                    })
+                    .collect()
+            })
+            .collect();
+        // Jacobi: [[e_i, e_j], e_l] + [[e_j, e_l], e_i] + [[e_l, e_i], e_j] = 0.
+        let mut acc = vec![0.0; d];
+        let tol = 1e-10 * cmax * cmax;
+        let nested = |a: usize, b: usize, l: usize, acc: &mut [f64]| {
+            for &(k, x) in &rows[a * d + b] {
+                for &(m, y) in &rows[k * d + l] {
+                    acc[m] += x * y;
+                }
+            }
+        };
+        for i in 0..d {
+            for j in i + 1..d {
+                for l in j + 1..d {
+                    acc.fill(0.0);
+                    nested(i, j, l, &mut acc);
+                    nested(j, l, i, &mut acc);
+                    nested(l, i, j, &mut acc);
+                    if let Some(m) = acc.iter().position(|x| x.abs() > tol) {
+                        return Err(Error::invalid(
+                            "algebra",
+                            format!(
+                                "structure constants violate the Jacobi identity: component {m} \
+                                 of [[e_{i}, e_{j}], e_{l}] + cyclic = {:.3e}",
+                                acc[m]
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        let mut terms = Vec::new();
+        for i in 0..d {
+            for j in 0..d {
+                for &(k, v) in &rows[i * d + j] {
+                    terms.push(Term {
+                        i: i as u32,
+                        j: j as u32,
+                        k: k as u32,
+                        c: v,
+                    });
+                }
+            }
+        }
+        Ok(Structure {
+            kind: Kind::Generic,
+            dim: d,
+            terms,
+        })
+    }
+
+    /// out ← ad*_g μ, (ad*_g μ)_j = Σ C_ij^k g_i μ_k.
+    pub(crate) fn ad_star(&self, g: &[f64], mu: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        for t in &self.terms {
+            out[t.j as usize] += t.c * g[t.i as usize] * mu[t.k as usize];
+        }
+    }
+
+    /// out ← [u, v] = ad_u v, [u, v]_k = Σ C_ij^k u_i v_j.
+    pub(crate) fn bracket(&self, u: &[f64], v: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        for t in &self.terms {
+            out[t.k as usize] += t.c * u[t.i as usize] * v[t.j as usize];
+        }
+    }
+
+    /// A bound of ‖ad_u‖_∞ (and of ‖ad_uᵀ‖_∞): max over rows of Σ |C_ij^k u_i| for the two
+    /// index placements.
+    pub(crate) fn ad_bound(&self, u: &[f64], rows: &mut [f64], cols: &mut [f64]) -> f64 {
+        rows.fill(0.0);
+        cols.fill(0.0);
+        for t in &self.terms {
+            let a = (t.c * u[t.i as usize]).abs();
+            rows[t.k as usize] += a;
+            cols[t.j as usize] += a;
+        }
+        rows.iter()
+            .chain(cols.iter())
+            .fold(0.0f64, |m, x| m.max(*x))
+    }
+
+    /// The dense (d, d, d) array C[i][j][k].
+    pub(crate) fn dense(&self) -> Vec<f64> {
+        let d = self.dim;
+        let mut c = vec![0.0; d * d * d];
+        for t in &self.terms {
+            c[(t.i as usize * d + t.j as usize) * d + t.k as usize] += t.c;
+        }
+        c
+    }
+}
+
+/// The structure constants of so(n) in the e_ij basis: with E_ab = −E_ba,
+/// [E_ab, E_cd] = δ_bc E_ad − δ_bd E_ac − δ_ac E_bd + δ_ad E_bc.
+fn so_terms(n: usize) -> Vec<Term> {
+    // index[a][b]: (coordinate, sign) of E_ab.
+    let mut index = vec![(0usize, 0.0f64); n * n];
+    let mut c = 0;
+    for a in 0..n {
+        for b in a + 1..n {
+            index[a * n + b] = (c, 1.0);
+            index[b * n + a] = (c, -1.0);
+            c += 1;
+        }
+    }
+    let pairs: Vec<(usize, usize)> = (0..n)
+        .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+        .collect();
+    let mut terms = Vec::new();
+    let add = |i: usize, j: usize, x: usize, y: usize, s: f64, terms: &mut Vec<Term>| {
+        let (k, sign) = index[x * n + y];
+        if sign != 0.0 {
+            terms.push(Term {
+                i: i as u32,
+                j: j as u32,
+                k: k as u32,
+                c: s * sign,
+            });
+        }
+    };
+    for (i, &(a, b)) in pairs.iter().enumerate() {
+        for (j, &(cc, dd)) in pairs.iter().enumerate() {
+            if b == cc {
+                add(i, j, a, dd, 1.0, &mut terms);
+            }
+            if b == dd {
+                add(i, j, a, cc, -1.0, &mut terms);
+            }
+            if a == cc {
+                add(i, j, b, dd, -1.0, &mut terms);
+            }
+            if a == dd {
+                add(i, j, b, cc, 1.0, &mut terms);
+            }
+        }
+    }
+    terms
+}

@@ -1,0 +1,389 @@
+use std::fmt;
+use std::sync::Arc;
+
+use nalgebra::{Vector3, Vector6};
+
+use super::*;
+use crate::check;
+use crate::error::{Error, Result};
+use crate::integrate::hooks;
+use crate::integrate::methods::{Composition, LieMidpoint, Rk4, Rkmk4};
+use crate::integrate::problem::{GroupField, VectorField};
+use crate::integrate::space::{Block, Space};
+use crate::integrate::{Catalog, Entry, Problem};
+use crate::lie::structure::{Algebra, Kind, Structure};
+use crate::lie::{se3, so, so3};
+use crate::systems::tops::generalized::{GeneralizedRigidBody, SoScratch};
+
+/// The Hamiltonian of a [`LiePoisson`] system.
+#[derive(Clone)]
+pub enum LieHamiltonian {
+    /// H = ½ μᵀAμ with A symmetric (d×d, row-major): ∇H = Aμ, the native path.
+    Quadratic(Vec<f64>),
+    /// H and its gradient (or `None` for finite differences) as functions of μ.
+    Function {
+        /// H(μ).
+        value: ScalarFn,
+        /// ∇H(μ), or `None`.
+        gradient: Option<GradientFn>,
+    },
+}
+
+/// A Lie–Poisson system μ̇ = ad*_{∇H} μ on g* (module docs).
+#[derive(Clone)]
+pub struct LiePoisson {
+    algebra: Arc<Structure>,
+    hamiltonian: LieHamiltonian,
+    casimirs: Option<Vec<ScalarFn>>,
+    /// The so(n) kernels (of a generalized rigid body; only its group action is used).
+    so_kernels: Option<GeneralizedRigidBody>,
+}
+
+impl fmt::Debug for LiePoisson {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("LiePoisson")
+            .field("kind", &self.algebra.kind)
+            .field("dim", &self.algebra.dim)
+            .field(
+                "quadratic",
+                &matches!(self.hamiltonian, LieHamiltonian::Quadratic(_)),
+            )
+            .finish()
+    }
+}
+
+impl LiePoisson {
+    /// The system on g* with Hamiltonian `hamiltonian` and, optionally, Casimirs given as
+    /// functions (replacing the built-in ones: |M|² on so(3); |Γ|², M·Γ on se(3); ½ tr((MᵀM)^k)
+    /// on so(n); none for structure constants).
+    ///
+    /// Errors: invalid structure constants (shape, non-finite, not antisymmetric, Jacobi), n < 2,
+    /// a quadratic form of the wrong size, non-finite or not symmetric.
+    pub fn new(
+        algebra: Algebra,
+        hamiltonian: LieHamiltonian,
+        casimirs: Option<Vec<ScalarFn>>,
+    ) -> Result<Self> {
+        let algebra = Structure::new(algebra)?;
+        let d = algebra.dim;
+        if let LieHamiltonian::Quadratic(a) = &hamiltonian {
+            if a.len() != d * d {
+                return Err(Error::shape(
+                    "hamiltonian",
+                    format!("a symmetric ({d}, {d}) matrix (H = ½ μᵀAμ on a {d}-dimensional g*)"),
+                    format!("{} values", a.len()),
+                ));
+            }
+            check::finite_slice("hamiltonian", a)?;
+            let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for i in 0..d {
+                for j in i + 1..d {
+                    let s = (a[i * d + j] - a[j * d + i]).abs();
+                    if s > 1e-12 * scale {
+                        return Err(Error::invalid(
+                            "hamiltonian",
+                            format!(
+                                "the quadratic form must be symmetric: |A[{i}, {j}] − A[{j}, {i}]| \
+                                 = {s:.3e}"
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        let so_kernels = match algebra.kind {
+            Kind::So(n) => Some(GeneralizedRigidBody::new(&vec![1.0; n])?),
+            _ => None,
+        };
+        Ok(LiePoisson {
+            algebra: Arc::new(algebra),
+            hamiltonian,
+            casimirs,
+            so_kernels,
+        })
+    }
+
+    /// dim g.
+    pub fn dim(&self) -> usize {
+        self.algebra.dim
+    }
+
+    /// The structure constants C\[i\]\[j\]\[k\] = C_ij^k, row-major (d, d, d).
+    ///
+    /// Errors: an array too large to hold (so(n) for large n).
+    pub fn structure_constants(&self) -> Result<Vec<f64>> {
+        let d = self.algebra.dim;
+        check::array_size("structure_constants", &[d, d, d])?;
+        Ok(self.algebra.dense())
+    }
+
+    /// Whether H is the native quadratic form.
+    pub fn is_quadratic(&self) -> bool {
+        matches!(self.hamiltonian, LieHamiltonian::Quadratic(_))
+    }
+
+    /// H(μ), checked finite.
+    pub fn value(&self, mu: &[f64]) -> Result<f64> {
+        match &self.hamiltonian {
+            LieHamiltonian::Quadratic(a) => {
+                let d = self.algebra.dim;
+                let h: f64 = (0..d)
+                    .map(|i| mu[i] * (0..d).map(|j| a[i * d + j] * mu[j]).sum::<f64>())
+                    .sum();
+                finite_value("the Hamiltonian H(mu)", 0.5 * h)
+            }
+            LieHamiltonian::Function { value, .. } => {
+                finite_value("the Hamiltonian H(mu)", value(mu)?)
+            }
+        }
+    }
+
+    /// ∇H(μ) into `out`, checked finite.
+    pub fn eval_gradient(&self, mu: &[f64], out: &mut [f64]) -> Result<()> {
+        match &self.hamiltonian {
+            LieHamiltonian::Quadratic(a) => {
+                let d = self.algebra.dim;
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = (0..d).map(|j| a[i * d + j] * mu[j]).sum();
+                }
+            }
+            LieHamiltonian::Function { gradient, .. } => match gradient {
+                Some(g) => g(mu, out)?,
+                None => fd_gradient(&|y| self.value(y), mu, out)?,
+            },
+        }
+        finite_entries("the gradient of H", "dH/dmu", out)
+    }
+
+    /// ∇H(μ) for a kernel: on failure NaN and the error recorded.
+    fn kernel_gradient(&self, mu: &[f64], out: &mut [f64]) {
+        if !hooks::call(|| self.eval_gradient(mu, out)) {
+            out.fill(f64::NAN);
+        }
+    }
+
+    /// The built-in Casimirs of the algebra.
+    fn builtin_casimirs(&self, mu: &[f64]) -> Vec<f64> {
+        match self.algebra.kind {
+            Kind::So3 => vec![mu.iter().map(|x| x * x).sum()],
+            Kind::Se3 => vec![
+                mu[3..].iter().map(|x| x * x).sum(),
+                (0..3).map(|i| mu[i] * mu[3 + i]).sum(),
+            ],
+            Kind::So(n) => {
+                crate::pseudo_rigid::reduced::spectral_invariants(&so::hat_n_unchecked(n, mu))
+            }
+            Kind::Generic => Vec::new(),
+        }
+    }
+
+    /// exp(ξ)·μ = exp(−ad_ξᵀ) μ for structure constants (module docs): the Taylor series of the
+    /// exponential applied to μ, in s factors with ‖ad_ξ/s‖ ≤ ½.
+    fn act_generic(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
+        let beta = self.algebra.ad_bound(xi, &mut s.a, &mut s.b);
+        if !beta.is_finite() {
+            z.fill(f64::NAN);
+            return;
+        }
+        let factors = (beta / 0.5).ceil().max(1.0);
+        if factors > 1e6 {
+            z.fill(f64::NAN);
+            return;
+        }
+        for (x, y) in s.xi.iter_mut().zip(xi) {
+            *x = -y / factors;
+        }
+        for _ in 0..factors as usize {
+            // The increment Σ_{m≥1} B^m z / m! (B v = −ad*_ξ v, the scaled ξ is negated), summed
+            // apart from z so that its rounding errors are relative to |ξ||z|, not |z|.
+            s.sum.fill(0.0);
+            s.term.copy_from_slice(z);
+            let zn = z.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            for m in 1..=40 {
+                self.algebra.ad_star(&s.xi, &s.term, &mut s.next);
+                let inv = 1.0 / m as f64;
+                let mut tn = 0.0f64;
+                for ((t, nx), sm) in s.term.iter_mut().zip(&s.next).zip(s.sum.iter_mut()) {
+                    *t = nx * inv;
+                    *sm += *t;
+                    tn = tn.max(t.abs());
+                }
+                if tn <= 1e-18 * zn || tn == 0.0 {
+                    break;
+                }
+            }
+            for (zi, inc) in z.iter_mut().zip(&s.sum) {
+                *zi += inc;
+            }
+        }
+    }
+
+    /// dexp⁻¹_u v = Σ_k B_k/k! ad_uᵏ v (module docs); NaN when the bound of ‖ad_u‖ reaches π.
+    fn dexp_inv_generic(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut LieScratch) {
+        let beta = self.algebra.ad_bound(u, &mut s.a, &mut s.b);
+        if beta.is_nan() || beta >= std::f64::consts::PI || v.iter().any(|x| !x.is_finite()) {
+            out.fill(f64::NAN);
+            return;
+        }
+        out.copy_from_slice(v);
+        s.term.copy_from_slice(v);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let mut bound = 1.0;
+        for &b in &so::bernoulli_coefficients()[1..] {
+            self.algebra.bracket(u, &s.term, &mut s.next);
+            std::mem::swap(&mut s.term, &mut s.next);
+            let mut pn = 0.0f64;
+            for (o, t) in out.iter_mut().zip(&s.term) {
+                *o += b * t;
+                pn = pn.max(t.abs());
+            }
+            // |b_j| ≤ 4/(2π)^j (j ≥ 2) and ‖ad_u‖ ≤ β < π: the rest is below 4‖p_k‖/(2π)^k.
+            bound /= two_pi;
+            let sum = out.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if pn == 0.0 || 4.0 * pn * bound <= 1e-17 * sum {
+                return;
+            }
+        }
+    }
+}
+
+/// Per-thread scratch of the [`LiePoisson`] kernels.
+pub struct LieScratch {
+    so: Option<SoScratch>,
+    xi: Vec<f64>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    sum: Vec<f64>,
+    term: Vec<f64>,
+    next: Vec<f64>,
+}
+
+impl Problem for LiePoisson {
+    /// H is a user function (not the quadratic form).
+    fn calls_out(&self) -> bool {
+        matches!(self.hamiltonian, LieHamiltonian::Function { .. })
+    }
+    fn name(&self) -> &'static str {
+        "LiePoisson"
+    }
+    fn space(&self) -> Space {
+        match self.algebra.kind {
+            Kind::So3 => Space::new([("M", Block::Real(3))]),
+            Kind::Se3 => Space::new([("M", Block::Real(3)), ("Gamma", Block::Real(3))]),
+            Kind::So(n) => Space::new([("M", Block::SoDual(n))]),
+            Kind::Generic => Space::new([("mu", Block::Real(self.algebra.dim))]),
+        }
+    }
+    /// H(μ).
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        self.value(z)
+    }
+    /// The Casimirs: the functions given, or the built-in ones of the algebra.
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        match &self.casimirs {
+            Some(fs) => fs
+                .iter()
+                .enumerate()
+                .map(|(k, f)| finite_value(&format!("casimir {k}"), f(z)?))
+                .collect(),
+            None => Ok(self.builtin_casimirs(z)),
+        }
+    }
+    fn invariant_count(&self) -> usize {
+        match (&self.casimirs, &self.algebra.kind) {
+            (Some(fs), _) => fs.len(),
+            (None, Kind::So3) => 1,
+            (None, Kind::Se3) => 2,
+            (None, Kind::So(n)) => n / 2,
+            (None, Kind::Generic) => 0,
+        }
+    }
+}
+
+impl VectorField for LiePoisson {
+    /// μ̇ = ad*_{∇H} μ.
+    fn field(&self, z: &[f64], dz: &mut [f64]) {
+        let d = self.algebra.dim;
+        let mut stack = [0.0; 32];
+        let mut heap = Vec::new();
+        let g = if d <= stack.len() {
+            &mut stack[..d]
+        } else {
+            heap.resize(d, 0.0);
+            &mut heap[..]
+        };
+        self.kernel_gradient(z, g);
+        self.algebra.ad_star(g, z, dz);
+    }
+}
+
+/// The coadjoint action (module docs): ξ(μ) = −∇H(μ), exp(ξ)·μ = Ad*_{exp(−ξ)} μ.
+impl GroupField for LiePoisson {
+    type Scratch = LieScratch;
+    fn scratch(&self) -> LieScratch {
+        let d = self.algebra.dim;
+        LieScratch {
+            so: self.so_kernels.as_ref().map(GroupField::scratch),
+            xi: vec![0.0; d],
+            a: vec![0.0; d],
+            b: vec![0.0; d],
+            sum: vec![0.0; d],
+            term: vec![0.0; d],
+            next: vec![0.0; d],
+        }
+    }
+    fn algebra_dim(&self) -> usize {
+        self.algebra.dim
+    }
+    fn generator(&self, z: &[f64], xi: &mut [f64], _s: &mut LieScratch) {
+        self.kernel_gradient(z, xi);
+        xi.iter_mut().for_each(|x| *x = -*x);
+    }
+    fn act(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
+        match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
+            (Kind::So3, _, _) => {
+                let g = so3::exp(&Vector3::from_column_slice(xi));
+                let m = g * Vector3::from_column_slice(z);
+                z.copy_from_slice(m.as_slice());
+            }
+            (Kind::Se3, _, _) => {
+                let x = Vector6::from_column_slice(xi);
+                let ad = se3::exp(&(-x)).adjoint_matrix();
+                let m = ad.transpose() * Vector6::from_column_slice(z);
+                z.copy_from_slice(m.as_slice());
+            }
+            (Kind::So(_), Some(body), Some(so)) => body.act(xi, z, so),
+            _ => self.act_generic(xi, z, s),
+        }
+    }
+    fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut LieScratch) {
+        match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
+            (Kind::So3, _, _) => match so3::jacobian_left_inv(&Vector3::from_column_slice(u)) {
+                Ok(j) => out.copy_from_slice((j * Vector3::from_column_slice(v)).as_slice()),
+                Err(_) => out.fill(f64::NAN),
+            },
+            (Kind::So(_), Some(body), Some(so)) => body.dexp_inv(u, v, out, so),
+            _ => self.dexp_inv_generic(u, v, out, s),
+        }
+    }
+}
+
+impl Catalog for LiePoisson {
+    /// rkmk4 (default), midpoint, midpoint4 (the Lie midpoint and its Suzuki composition),
+    /// rk4.
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("rkmk4", Rkmk4),
+            Entry::new("midpoint", LieMidpoint::new()),
+            Entry::new("midpoint4", LieMidpoint(Composition::suzuki4())),
+            Entry::new("rk4", Rk4),
+        ]
+    }
+
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        crate::integrate::forcing::double_bracket(self, d)
+    }
+}
