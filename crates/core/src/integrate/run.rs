@@ -1,47 +1,10 @@
-//! Structure-preserving integration: state spaces, problem kinds, methods as values, and the one
-//! driver that owns time.
-//!
-//! - [`space`]: a state is one flat vector cut into named blocks ([`Space`]: ℝᵏ, SO(3), S², n×n
-//!   matrices, so(n)*) with membership checks, retraction and named views;
-//! - [`problem`]: the kinds a system can implement ([`problem::VectorField`], [`problem::Split`],
-//!   [`problem::Separable`], [`problem::Canonical`], [`problem::Constrained`],
-//!   [`problem::Nonholonomic`], [`problem::GroupField`], [`problem::Symmetric`]);
-//! - [`methods`]: one file per method family, each generic over the kind it needs;
-//! - [`method`]: the [`Integrator`] and [`Stepper`] traits, each system's [`Catalog`] of named
-//!   methods, and [`System`], any catalogued problem as a trait object;
-//! - this module: the driver. A [`Run`] validates once, owns the clock and the stepper for the
-//!   whole run (callers that work in chunks resume the same run), retracts curved blocks every
-//!   [`RETRACT_EVERY`] steps for methods that keep the manifold, and saves every
-//!   `save_every`-th state, or the states at given times ([`Run::save_at`]); it locates
-//!   [`Events`] and ends at a time ([`Until::Time`]), off its grid always by a shortened step of
-//!   the method, never by interpolation; [`integrate`] and [`integrate_batch`] (rayon) are built
-//!   on it.
-//!
-//! ```
-//! use lieflow::integrate::{integrate, Problem};
-//! use lieflow::systems::RigidBody;
-//! let body = RigidBody::new([1.0, 2.0, 3.0])?;
-//! let traj = integrate(&body, "splitting4", &[1.0, 0.5, -0.3], 1e-2, 1000, 100)?;
-//! assert_eq!(traj.len(), 11);
-//! let (h0, h1) = (body.energy(traj.state(0))?, body.energy(traj.state(10))?);
-//! assert!((h1 - h0).abs() < 1e-9);
-//! # Ok::<(), lieflow::Error>(())
-//! ```
+//! The driver: a [`Run`] validates once, owns the clock and the stepper for the whole run,
+//! retracts, saves, takes shortened steps to output times and end times, and guards every chunk.
 
-pub mod batch;
-pub mod clock;
-pub mod forcing;
-pub mod hooks;
-pub mod method;
-pub mod methods;
-pub mod problem;
-pub mod space;
-
-pub use batch::Batch;
-pub use method::{BatchStepper, Catalog, Clock, Entry, Integrator, Properties, Stepper, System};
-pub use problem::Problem;
-pub use space::{Block, Space};
-
+use super::events::Events;
+use super::method::{Clock, Integrator, Properties, Stepper, System};
+use super::problem::Problem;
+use super::{hooks, space};
 use crate::check;
 use crate::error::{Error, Result};
 
@@ -49,36 +12,6 @@ use crate::error::{Error, Result};
 /// the state by round-off (‖RᵀR − I‖ ~ 1e-15) and keeps the rounding errors of many products of
 /// rotations from accumulating (without it ‖RᵀR − I‖ reaches ~6e-12 after 10⁶ steps).
 pub const RETRACT_EVERY: u64 = 256;
-
-/// A computed trajectory: the saved samples and the final state.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Trajectory {
-    /// Sample times t₀ + k·save_every·dt.
-    pub t: Vec<f64>,
-    /// The saved states (user frame), row-major (len × dim).
-    pub states: Vec<f64>,
-    /// Length of one state.
-    pub dim: usize,
-    /// The state after all steps (also when `steps` is not a multiple of `save_every`).
-    pub final_state: Vec<f64>,
-}
-
-impl Trajectory {
-    /// Number of saved samples.
-    pub fn len(&self) -> usize {
-        self.t.len()
-    }
-
-    /// Whether no sample was saved (never the case for a trajectory returned by [`integrate`]).
-    pub fn is_empty(&self) -> bool {
-        self.t.is_empty()
-    }
-
-    /// The k-th saved state.
-    pub fn state(&self, k: usize) -> &[f64] {
-        &self.states[k * self.dim..(k + 1) * self.dim]
-    }
-}
 
 /// How far [`Run::advance_to`] goes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,157 +24,13 @@ pub enum Until {
     Time(f64),
 }
 
-/// The function g(t, z) of an [`Event`].
-type EventFn<'a> = Box<dyn FnMut(f64, &[f64]) -> Result<f64> + Send + 'a>;
-
-/// An event function g(t, z) of a run (scipy's `solve_ivp(events=…)`): its zeros are located
-/// on the run's trajectory; z is a state in the user frame.
-pub struct Event<'a> {
-    g: EventFn<'a>,
-    direction: f64,
-    terminal: u64,
-}
-
-impl<'a> Event<'a> {
-    /// The event function `g`, not terminal, counted in either direction.
-    pub fn new(g: impl FnMut(f64, &[f64]) -> Result<f64> + Send + 'a) -> Self {
-        Event {
-            g: Box::new(g),
-            direction: 0.0,
-            terminal: 0,
-        }
-    }
-
-    /// The run ends at the `count`-th occurrence of this event (0: never; scipy's
-    /// `terminal = True` is 1).
-    pub fn terminal(mut self, count: u64) -> Self {
-        self.terminal = count;
-        self
-    }
-
-    /// Only zeros where g increases (`direction` > 0: from g < 0 to g ≥ 0) or decreases (< 0);
-    /// 0 counts both, as in scipy.
-    pub fn direction(mut self, direction: f64) -> Self {
-        self.direction = direction;
-        self
-    }
-}
-
-/// A located event: the zero of event function `event` at time `t`, with the state there
-/// (user frame), found in step `step` (absolute, counted from the start of the run).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Hit {
-    /// Index of the event function.
-    pub event: usize,
-    /// The time of the zero.
-    pub t: f64,
-    /// The state at `t` (user frame): one step of the method, of size t − tⱼ, from the state at
-    /// the start tⱼ of the step in which g changed sign.
-    pub state: Vec<f64>,
-    /// The absolute number of that step.
-    pub step: u64,
-}
-
-/// The event functions of a run and what they found (passed to every [`Run::advance_to`] of
-/// the run).
-///
-/// After every step the functions are evaluated on the new state; where one changes sign (in
-/// its direction) between two steps, its zero is located on the method's own trajectory: the
-/// step from the state at its start tⱼ is taken again with shortened sizes h ∈ (0, dt) and
-/// g(tⱼ + h, Φ_h(zⱼ)) is solved for h by Brent's method (bisection, secant and inverse
-/// quadratic interpolation) to round-off in t (plus `tol`). No interpolation: the state at an
-/// event is a state of the method (it keeps what the method keeps). A value of g exactly 0 at a
-/// step is an event at that step (at most once: a start at g = 0 is no event). When several
-/// events fall in one step they are reported in time order, and a terminal one drops the later
-/// ones.
-pub struct Events<'a> {
-    events: Vec<Event<'a>>,
-    tol: f64,
-    last: Option<Vec<f64>>,
-    counts: Vec<u64>,
-    stopped_by: Option<usize>,
-    /// The events located so far, in time order (take them as they are read).
-    pub hits: Vec<Hit>,
-}
-
-impl<'a> Events<'a> {
-    /// The event functions `events`; `tol` ≥ 0: an absolute tolerance in time added to
-    /// round-off (0 locates the zeros to round-off).
-    ///
-    /// Errors: a non-finite or negative `tol`, a non-finite direction ([`Error::InvalidArgument`]).
-    pub fn new(events: Vec<Event<'a>>, tol: f64) -> Result<Self> {
-        if !(tol.is_finite() && tol >= 0.0) {
-            return Err(Error::invalid(
-                "event_tol",
-                format!("expected a finite tolerance ≥ 0, got {tol}"),
-            ));
-        }
-        if let Some((i, e)) = events
-            .iter()
-            .enumerate()
-            .find(|(_, e)| !e.direction.is_finite())
-        {
-            return Err(Error::invalid(
-                "direction",
-                format!(
-                    "event {i}: expected a finite number (its sign: > 0 rising, < 0 falling, 0 \
-                     both), got {}",
-                    e.direction
-                ),
-            ));
-        }
-        let n = events.len();
-        Ok(Events {
-            events,
-            tol,
-            last: None,
-            counts: vec![0; n],
-            stopped_by: None,
-            hits: Vec::new(),
-        })
-    }
-
-    /// How many times each event occurred.
-    pub fn counts(&self) -> &[u64] {
-        &self.counts
-    }
-
-    /// The terminal event that ended the run, if one did.
-    pub fn stopped_by(&self) -> Option<usize> {
-        self.stopped_by
-    }
-
-    /// g_i(t, z), checked finite.
-    fn eval(&mut self, i: usize, t: f64, z: &[f64]) -> Result<f64> {
-        let g = (self.events[i].g)(t, z)?;
-        if !g.is_finite() {
-            return Err(Error::NonFinite {
-                what: format!("the value of event function {i}"),
-                location: format!("t = {} (it returned {g})", crate::error::fmt_num(t)),
-            });
-        }
-        Ok(g)
-    }
-
-    fn eval_all(&mut self, t: f64, z: &[f64]) -> Result<Vec<f64>> {
-        (0..self.events.len()).map(|i| self.eval(i, t, z)).collect()
-    }
-}
-
-/// Whether g going from `a` to `b` over a step is an event of the given direction.
-fn crosses(a: f64, b: f64, direction: f64) -> bool {
-    let up = a < 0.0 && b >= 0.0;
-    let down = a > 0.0 && b <= 0.0;
-    (up && direction >= 0.0) || (down && direction <= 0.0)
-}
-
 /// The steppers of a run's shortened steps: its method, built for a step size.
-type Make<'m> = Option<&'m dyn Fn(f64) -> Result<Box<dyn Stepper>>>;
+pub(super) type Make<'m> = Option<&'m dyn Fn(f64) -> Result<Box<dyn Stepper>>>;
 
 /// Output times of a run that saves at given times.
-struct Outputs {
-    times: Vec<f64>,
-    next: usize,
+pub(super) struct Outputs {
+    pub(super) times: Vec<f64>,
+    pub(super) next: usize,
 }
 
 /// An integration in progress: one stepper, one clock, states validated once.
@@ -258,24 +47,24 @@ struct Outputs {
 /// from a method value); [`Run::advance`] takes none. Events ([`Events`]) are located the same
 /// way.
 pub struct Run {
-    stepper: Box<dyn Stepper>,
-    retract: Option<space::Space>,
-    save_every: u64,
-    clock: Clock,
+    pub(super) stepper: Box<dyn Stepper>,
+    pub(super) retract: Option<space::Space>,
+    pub(super) save_every: u64,
+    pub(super) clock: Clock,
     /// The state (internal frame) at `clock.done`, the last that passed the checks.
-    buf: Vec<f64>,
+    pub(super) buf: Vec<f64>,
     /// Scratch: the state after the steps in progress (internal frame).
-    next: Vec<f64>,
+    pub(super) next: Vec<f64>,
     /// Scratch: a state in the user frame.
-    user: Vec<f64>,
+    pub(super) user: Vec<f64>,
     /// The method's name (a run of a catalogued system), for shortened steps and errors.
-    method: Option<String>,
+    pub(super) method: Option<String>,
     /// The problem calls functions from outside lieflow ([`Problem::calls_out`]): one step per
     /// call of the stepper, a failure ends the run at its step, no step is taken twice.
-    single: bool,
-    at: Option<Outputs>,
+    pub(super) single: bool,
+    pub(super) at: Option<Outputs>,
     /// The time at which the run ended between grid times (a terminal event, [`Until::Time`]).
-    ended: Option<f64>,
+    pub(super) ended: Option<f64>,
 }
 
 impl Run {
@@ -313,7 +102,7 @@ impl Run {
     }
 
     /// Validates the arguments and the state once, then builds the stepper and sets its state.
-    fn start<P: Problem + ?Sized>(
+    pub(super) fn start<P: Problem + ?Sized>(
         problem: &P,
         method: Option<&str>,
         z0: &[f64],
@@ -350,12 +139,12 @@ impl Run {
 
     /// `r`, with a failure a foreign function recorded meanwhile ([`hooks`]) in its place, located
     /// at step `step` (0: the initial state) in a run that steps one step at a time.
-    fn failed<T>(&self, r: Result<T>, step: u64) -> Result<T> {
+    pub(super) fn failed<T>(&self, r: Result<T>, step: u64) -> Result<T> {
         self.failed_at(r, step, self.clock.t0 + step as f64 * self.clock.dt)
     }
 
     /// [`Run::failed`] for a step that ends at time `t` (a shortened step).
-    fn failed_at<T>(&self, r: Result<T>, step: u64, t: f64) -> Result<T> {
+    pub(super) fn failed_at<T>(&self, r: Result<T>, step: u64, t: f64) -> Result<T> {
         let e = match (hooks::take_failure(), r) {
             (Some(e), _) => e,
             (None, Ok(v)) => return Ok(v),
@@ -379,7 +168,7 @@ impl Run {
 
     /// Sets the stepper back to the checked state after an error (whatever that costs: the run
     /// is over; a failure it records is dropped).
-    fn reset(&mut self) {
+    pub(super) fn reset(&mut self) {
         let _ = self.stepper.set(&self.buf);
         let _ = hooks::take_failure();
     }
@@ -445,7 +234,7 @@ impl Run {
         }
         let now = self.time();
         if let Some(&first) = times.first() {
-            if first < now - self.grid_tol(first) {
+            if first < now - self.clock.grid_tol(first) {
                 return Err(Error::invalid(
                     "t_eval",
                     format!(
@@ -607,14 +396,14 @@ impl Run {
 
     /// Steps of size dt from `clock.done` to the next stop: `end`, a save, a retraction or the
     /// grid step at or before the next output time.
-    fn whole_steps(&self, end: u64) -> u64 {
+    pub(super) fn whole_steps(&self, end: u64) -> u64 {
         let done = self.clock.done;
         let mut stop = end;
         match &self.at {
             None => stop = stop.min((done / self.save_every + 1) * self.save_every),
             Some(o) => {
                 if let Some(&t) = o.times.get(o.next) {
-                    let (k, _) = self.grid_of(t);
+                    let (k, _) = self.clock.grid_of(t);
                     stop = stop.min(k.max(done + 1));
                 }
             }
@@ -688,7 +477,12 @@ impl Run {
     /// time from it. Returns the error of the failing step (the clock and the checked state at
     /// the step before it, the stepper where it stopped), or Ok with the state after the `n`
     /// steps checked (steps that failed together but pass one by one).
-    fn replay<P: Problem + ?Sized>(&mut self, problem: &P, n: u64, first: Error) -> Result<()> {
+    pub(super) fn replay<P: Problem + ?Sized>(
+        &mut self,
+        problem: &P,
+        n: u64,
+        first: Error,
+    ) -> Result<()> {
         let done = self.clock.done;
         if self.stepper.set(&self.buf).is_err() {
             return Err(first);
@@ -716,7 +510,7 @@ impl Run {
 
     /// The checked state in `buf` is the state at step `stop` (reached from `from`): moves the
     /// clock, retracts, saves.
-    fn commit<P: Problem + ?Sized>(
+    pub(super) fn commit<P: Problem + ?Sized>(
         &mut self,
         problem: &P,
         from: u64,
@@ -733,7 +527,7 @@ impl Run {
 
     /// Moves the clock to `stop` and retracts the checked state when a retraction is due there;
     /// returns whether it did (the stepper must then be set to it).
-    fn retract_at(&mut self, stop: u64) -> bool {
+    pub(super) fn retract_at(&mut self, stop: u64) -> bool {
         self.clock.done = stop;
         match &self.retract {
             Some(space) if stop % RETRACT_EVERY == 0 => {
@@ -746,7 +540,7 @@ impl Run {
 
     /// Saves the checked state at step `stop` (reached from `from`) when it is a saved step,
     /// checking it at `end`.
-    fn save<P: Problem + ?Sized>(
+    pub(super) fn save<P: Problem + ?Sized>(
         &mut self,
         problem: &P,
         from: u64,
@@ -838,158 +632,15 @@ impl Run {
         self.emit_before(problem, make, now, None, out)
     }
 
-    /// The events of the step from the checked state (time `t_j`) to `next` (time `t_next`):
-    /// located, recorded, and the time and state (internal frame) of a terminal one.
-    fn events_in_step<P: Problem + ?Sized>(
-        &mut self,
-        problem: &P,
-        make: Make<'_>,
-        t_j: f64,
-        t_next: f64,
-        events: Option<&mut Events<'_>>,
-    ) -> Result<Option<(f64, Vec<f64>)>> {
-        self.user.copy_from_slice(&self.next);
-        problem.to_user(&mut self.user);
-        if let Err(e) = check::finite_slice("state", &self.user) {
-            let j = self.clock.done;
-            return Err(self.non_finite(problem.name(), j, j + 1, e));
-        }
-        let Some(ev) = events else {
-            return Ok(None);
-        };
-        let user = self.user.clone();
-        let g_new = ev.eval_all(t_next, &user)?;
-        let last = ev.last.clone().unwrap_or_else(|| g_new.clone());
-        let mut found = Vec::new();
-        for i in 0..g_new.len() {
-            if crosses(last[i], g_new[i], ev.events[i].direction) {
-                let (h, z) = self.locate(problem, make, ev, i, t_j, t_next, last[i], g_new[i])?;
-                found.push((i, if h == t_next - t_j { t_next } else { t_j + h }, z));
-            }
-        }
-        found.sort_by(|a, b| a.1.total_cmp(&b.1));
-        ev.last = Some(g_new);
-        let step = self.clock.done + 1;
-        for (i, t, z) in found {
-            let mut state = z.clone();
-            problem.to_user(&mut state);
-            ev.counts[i] += 1;
-            ev.hits.push(Hit {
-                event: i,
-                t,
-                state,
-                step,
-            });
-            let terminal = ev.events[i].terminal;
-            if terminal > 0 && ev.counts[i] >= terminal {
-                ev.stopped_by = Some(i);
-                return Ok(Some((t, z)));
-            }
-        }
-        Ok(None)
-    }
-
-    /// The zero of event `i` in the step from the checked state (time `t_j`, g = `ga`) to
-    /// `next` (time `t_next`, g = `gb`, opposite sign or 0): Brent's method (zeroin) on the
-    /// shortened step size h ∈ [0, t_next − t_j]. Returns h and the state (internal frame).
-    #[allow(clippy::too_many_arguments)]
-    fn locate<P: Problem + ?Sized>(
-        &self,
-        problem: &P,
-        make: Make<'_>,
-        ev: &mut Events<'_>,
-        i: usize,
-        t_j: f64,
-        t_next: f64,
-        ga: f64,
-        gb: f64,
-    ) -> Result<(f64, Vec<f64>)> {
-        let len = t_next - t_j;
-        if gb == 0.0 {
-            return Ok((len, self.next.clone()));
-        }
-        let xtol = ev.tol;
-        let mut evaluated: (f64, Vec<f64>) = (len, self.next.clone());
-        let mut phi = |h: f64, ev: &mut Events<'_>| -> Result<f64> {
-            let z = self.branch(problem, make, h)?;
-            let mut user = z.clone();
-            problem.to_user(&mut user);
-            let g = ev.eval(i, t_j + h, &user)?;
-            evaluated = (h, z);
-            Ok(g)
-        };
-        // zeroin (Brent 1973, ch. 4): b is the best estimate, [b, c] brackets the zero.
-        let (mut a, mut fa, mut b, mut fb) = (0.0, ga, len, gb);
-        let (mut c, mut fc) = (a, fa);
-        let (mut d, mut e) = (b - a, b - a);
-        for _ in 0..200 {
-            if (fb > 0.0 && fc > 0.0) || (fb < 0.0 && fc < 0.0) {
-                c = a;
-                fc = fa;
-                d = b - a;
-                e = d;
-            }
-            if fc.abs() < fb.abs() {
-                a = b;
-                b = c;
-                c = a;
-                fa = fb;
-                fb = fc;
-                fc = fa;
-            }
-            let tol1 = 2.0 * f64::EPSILON * (t_j + b).abs().max(len) + 0.5 * xtol;
-            let xm = 0.5 * (c - b);
-            if xm.abs() <= tol1 || fb == 0.0 {
-                break;
-            }
-            if e.abs() >= tol1 && fa.abs() > fb.abs() {
-                let s = fb / fa;
-                let (mut p, mut q);
-                if a == c {
-                    p = 2.0 * xm * s;
-                    q = 1.0 - s;
-                } else {
-                    let qq = fa / fc;
-                    let r = fb / fc;
-                    p = s * (2.0 * xm * qq * (qq - r) - (b - a) * (r - 1.0));
-                    q = (qq - 1.0) * (r - 1.0) * (s - 1.0);
-                }
-                if p > 0.0 {
-                    q = -q;
-                } else {
-                    p = -p;
-                }
-                if 2.0 * p < (3.0 * xm * q - (tol1 * q).abs()).min((e * q).abs()) {
-                    e = d;
-                    d = p / q;
-                } else {
-                    d = xm;
-                    e = d;
-                }
-            } else {
-                d = xm;
-                e = d;
-            }
-            a = b;
-            fa = fb;
-            b += if d.abs() > tol1 { d } else { tol1.copysign(xm) };
-            b = b.clamp(0.0, len);
-            fb = phi(b, ev)?;
-        }
-        if b == evaluated.0 {
-            return Ok(evaluated);
-        }
-        if b == 0.0 {
-            return Ok((0.0, self.buf.clone()));
-        }
-        let z = self.branch(problem, make, b)?;
-        Ok((b, z))
-    }
-
     /// The state (internal frame) one step of size `h` (≥ 0) from the checked state: a stepper
     /// of the run's method built for h. Its errors name the step (steps_done + 1) and the time
     /// it reaches.
-    fn branch<P: Problem + ?Sized>(&self, problem: &P, make: Make<'_>, h: f64) -> Result<Vec<f64>> {
+    pub(super) fn branch<P: Problem + ?Sized>(
+        &self,
+        problem: &P,
+        make: Make<'_>,
+        h: f64,
+    ) -> Result<Vec<f64>> {
         use crate::error::fmt_num;
         if h <= 0.0 {
             return Ok(self.buf.clone());
@@ -1034,7 +685,7 @@ impl Run {
 
     /// Saves the pending output times τ ≤ now (within round-off: the checked state), τ < `hi`
     /// (shortened steps from the checked state) and, when the state at `hi` is given, τ = hi.
-    fn emit_before<P: Problem + ?Sized>(
+    pub(super) fn emit_before<P: Problem + ?Sized>(
         &mut self,
         problem: &P,
         make: Make<'_>,
@@ -1048,7 +699,7 @@ impl Run {
         let now = self.clock.time(0);
         let mut next = o.next;
         while let Some(&t) = self.at.as_ref().and_then(|o| o.times.get(next)) {
-            let tol = self.grid_tol(t);
+            let tol = self.clock.grid_tol(t);
             let z = if t <= now + tol {
                 let mut z = self.buf.clone();
                 problem.to_user(&mut z);
@@ -1076,41 +727,9 @@ impl Run {
         Ok(())
     }
 
-    /// Round-off of grid times near `t`.
-    fn grid_tol(&self, t: f64) -> f64 {
-        8.0 * f64::EPSILON * t.abs().max(self.clock.t0.abs())
-    }
-
-    /// The grid step k with t₀ + k·dt = t within round-off (true) or t₀ + k·dt < t < t₀ +
-    /// (k+1)·dt (false); k = 0 for t ≤ t₀.
-    fn grid_of(&self, t: f64) -> (u64, bool) {
-        let c = self.clock;
-        let time = |k: u64| c.t0 + k as f64 * c.dt;
-        let tol = self.grid_tol(t);
-        let x = ((t - c.t0) / c.dt).floor();
-        let mut k = if x.is_nan() || x <= 0.0 {
-            0
-        } else if x >= 9.2e18 {
-            u64::MAX / 2
-        } else {
-            x as u64
-        };
-        for _ in 0..4 {
-            if k > 0 && time(k) > t + tol {
-                k -= 1;
-            }
-        }
-        for _ in 0..4 {
-            if time(k + 1) <= t + tol {
-                k += 1;
-            }
-        }
-        (k, (time(k) - t).abs() <= tol)
-    }
-
-    /// [`Run::grid_of`] of a time argument `what`, checked (finite, not before t₀, fewer than
+    /// [`Clock::grid_of`] of a time argument `what`, checked (finite, not before t₀, fewer than
     /// 2⁶³ steps away).
-    fn grid_index(&self, what: &str, t: f64) -> Result<(u64, bool)> {
+    pub(super) fn grid_index(&self, what: &str, t: f64) -> Result<(u64, bool)> {
         use crate::error::fmt_num;
         if !t.is_finite() {
             return Err(Error::invalid(
@@ -1119,7 +738,7 @@ impl Run {
             ));
         }
         let t0 = self.clock.t0;
-        if t < t0 - self.grid_tol(t) {
+        if t < t0 - self.clock.grid_tol(t) {
             return Err(Error::invalid(
                 what,
                 format!("expected a time ≥ t0 = {}, got {}", fmt_num(t0), fmt_num(t)),
@@ -1136,12 +755,12 @@ impl Run {
                 ),
             ));
         }
-        Ok(self.grid_of(t))
+        Ok(self.clock.grid_of(t))
     }
 
     /// The error of the finiteness guard: the state after steps `done + 1 ..= stop` (absolute
     /// step numbers) is not finite.
-    fn non_finite(&self, name: &str, done: u64, stop: u64, e: Error) -> Error {
+    pub(super) fn non_finite(&self, name: &str, done: u64, stop: u64, e: Error) -> Error {
         use crate::error::fmt_num;
         let steps = if stop == done + 1 {
             format!("step {stop}")
@@ -1162,7 +781,7 @@ impl Run {
     }
 }
 
-fn too_many() -> Error {
+pub(super) fn too_many() -> Error {
     Error::invalid(
         "save_every",
         "the saved states do not fit in memory; save less often",
@@ -1220,140 +839,4 @@ fn not_representable(name: &str, what: &str, z: &[f64]) -> Error {
 pub fn check_state<P: Problem + ?Sized>(problem: &P, z: &[f64]) -> Result<()> {
     problem.space().check("state", z)?;
     problem.check_state(z)
-}
-
-fn check_steps(steps: usize) -> Result<()> {
-    if steps < 1 {
-        return Err(Error::invalid("steps", "expected steps ≥ 1, got 0"));
-    }
-    Ok(())
-}
-
-/// Runs `run` for `steps` steps from its start and collects the trajectory.
-fn collect<P: Problem + ?Sized>(
-    problem: &P,
-    mut run: Run,
-    z0: &[f64],
-    steps: usize,
-) -> Result<Trajectory> {
-    let dim = z0.len();
-    let n_saved = steps / run.save_every as usize + 1;
-    let mut states = Vec::new();
-    let values = n_saved.checked_mul(dim).ok_or_else(too_many)?;
-    states.try_reserve_exact(values).map_err(|_| too_many())?;
-    states.extend_from_slice(z0);
-    run.advance(problem, steps as u64, &mut states)?;
-    let every = run.save_every as f64 * run.clock.dt;
-    Ok(Trajectory {
-        t: (0..n_saved)
-            .map(|k| run.clock.t0 + k as f64 * every)
-            .collect(),
-        final_state: run.state(problem),
-        states,
-        dim,
-    })
-}
-
-/// Integrates `system` from `z0` (user frame) by `steps` steps of size `dt` with its method called
-/// `method`, saving every `save_every`-th state and the initial one (t₀ = 0).
-///
-/// Errors: those of [`Run::new`] and [`Run::advance`], and `steps` < 1.
-pub fn integrate<S: System + ?Sized>(
-    system: &S,
-    method: &str,
-    z0: &[f64],
-    dt: f64,
-    steps: usize,
-    save_every: usize,
-) -> Result<Trajectory> {
-    check_steps(steps)?;
-    let run = Run::new(system, method, z0, dt, save_every, 0.0)?;
-    collect(system, run, z0, steps)
-}
-
-/// [`integrate`] with a method value (`&Splitting(Composition::suzuki4())`, `&Gauss(2)`, …)
-/// instead of a catalogued name: any method of the right kind, with any coefficients.
-pub fn integrate_with<P: Problem, M: Integrator<P> + ?Sized>(
-    problem: &P,
-    method: &M,
-    z0: &[f64],
-    dt: f64,
-    steps: usize,
-    save_every: usize,
-) -> Result<Trajectory> {
-    check_steps(steps)?;
-    let run = Run::with(problem, method, z0, dt, save_every, 0.0)?;
-    collect(problem, run, z0, steps)
-}
-
-/// Runs `work` on rayon's global pool (`threads` = None) or on a pool of `threads` threads.
-pub fn with_threads<T: Send>(
-    threads: Option<usize>,
-    work: impl FnOnce() -> Result<T> + Send,
-) -> Result<T> {
-    match threads {
-        None => work(),
-        Some(0) => Err(Error::invalid("threads", "expected threads ≥ 1, got 0")),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| Error::invalid("threads", format!("cannot build a pool of {n}: {e}")))?
-            .install(work),
-    }
-}
-
-/// Integrates many initial states in parallel (rayon), each exactly as [`integrate`] would (bit
-/// for bit), as a [`Batch`]: in blocks of SIMD lanes where the method has a batch stepper for the
-/// system, one member at a time otherwise.
-///
-/// `threads`: `None` uses rayon's global pool (all cores); `Some(n)` a pool of n threads. Every
-/// input is validated before any work starts; an error names the batch member (the first
-/// member that failed, with its step).
-pub fn integrate_batch<S: System + ?Sized>(
-    system: &S,
-    method: &str,
-    states0: &[Vec<f64>],
-    dt: f64,
-    steps: usize,
-    save_every: usize,
-    threads: Option<usize>,
-) -> Result<Vec<Trajectory>> {
-    check_steps(steps)?;
-    let start = || {
-        Batch::start(system, method, states0, dt, save_every, 0.0).map_err(|(i, e)| match i {
-            Some(i) => e.in_member(i),
-            None => e,
-        })
-    };
-    let mut batch = with_threads(threads, start)?;
-    let n_saved = steps / save_every + 1;
-    let mut outs = states0
-        .iter()
-        .map(|z0| {
-            let mut states = Vec::new();
-            let values = n_saved.checked_mul(z0.len()).ok_or_else(too_many)?;
-            states.try_reserve_exact(values).map_err(|_| too_many())?;
-            states.extend_from_slice(z0);
-            Ok(states)
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let (results, finals) = with_threads(threads, || {
-        let results = batch.advance(system, steps as u64, &mut outs);
-        Ok((results, batch.states(system)))
-    })?;
-    for (i, r) in results.into_iter().enumerate() {
-        r.map_err(|e| e.in_member(i))?;
-    }
-    let every = save_every as f64 * dt;
-    let t: Vec<f64> = (0..n_saved).map(|k| k as f64 * every).collect();
-    Ok(outs
-        .into_iter()
-        .zip(finals)
-        .map(|(states, final_state)| Trajectory {
-            t: t.clone(),
-            dim: final_state.len(),
-            final_state,
-            states,
-        })
-        .collect())
 }
