@@ -2,7 +2,9 @@
 //! retracts, saves, takes shortened steps to output times and end times, and guards every chunk.
 
 use super::events::Events;
-use super::method::{Clock, Integrator, Properties, Stepper, System};
+use std::sync::Arc;
+
+use super::method::{Clock, Integrator, Properties, Resolved, Stepper, System};
 use super::problem::Problem;
 use super::{hooks, space};
 use crate::check;
@@ -43,7 +45,7 @@ pub(super) struct Outputs {
 /// shortened step of the same method from the grid state before it (a step of another size,
 /// not an interpolation; the run itself goes on on its grid, so its states do not depend on the
 /// output times). Shortened steps need a stepper of another size, which
-/// [`Run::advance_to`] builds from the system and the method's name ([`Run::advance_to_with`]
+/// [`Run::advance_to`] builds from the run's resolved method ([`Run::advance_to_with`]
 /// from a method value); [`Run::advance`] takes none. Events ([`Events`]) are located the same
 /// way.
 pub struct Run {
@@ -57,8 +59,8 @@ pub struct Run {
     pub(super) next: Vec<f64>,
     /// Scratch: a state in the user frame.
     pub(super) user: Vec<f64>,
-    /// The method's name (a run of a catalogued system), for shortened steps and errors.
-    pub(super) method: Option<String>,
+    /// The method, resolved once (a run of a catalogued system): shortened steps and errors.
+    pub(super) method: Option<Arc<Resolved>>,
     /// The problem calls functions from outside lieflow ([`Problem::calls_out`]): one step per
     /// call of the stepper, a failure ends the run at its step, no step is taken twice.
     pub(super) single: bool,
@@ -82,8 +84,23 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        Run::start(system, Some(method), z0, dt, save_every, t0, || {
-            system.stepper(method, dt)
+        Run::start(system, z0, dt, save_every, t0, || {
+            let m = system.resolve(method)?;
+            Ok((m.stepper(dt)?, m.properties, Some(m)))
+        })
+    }
+
+    /// [`Run::new`] with a method already resolved ([`System::resolve`]) for `problem`.
+    pub fn resolved<P: Problem + ?Sized>(
+        problem: &P,
+        method: &Arc<Resolved>,
+        z0: &[f64],
+        dt: f64,
+        save_every: usize,
+        t0: f64,
+    ) -> Result<Run> {
+        Run::start(problem, z0, dt, save_every, t0, || {
+            Ok((method.stepper(dt)?, method.properties, Some(method.clone())))
         })
     }
 
@@ -96,26 +113,24 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        Run::start(problem, None, z0, dt, save_every, t0, || {
-            Ok((method.stepper(problem, dt)?, method.properties()))
+        Run::start(problem, z0, dt, save_every, t0, || {
+            Ok((method.stepper(problem, dt)?, method.properties(), None))
         })
     }
 
     /// Validates the arguments and the state once, then builds the stepper and sets its state.
     pub(super) fn start<P: Problem + ?Sized>(
         problem: &P,
-        method: Option<&str>,
         z0: &[f64],
         dt: f64,
         save_every: usize,
         t0: f64,
-        stepper: impl FnOnce() -> Result<(Box<dyn Stepper>, Properties)>,
+        stepper: impl FnOnce() -> Result<(Box<dyn Stepper>, Properties, Option<Arc<Resolved>>)>,
     ) -> Result<Run> {
-        check_run(dt, save_every, t0)?;
-        check_state(problem, z0)?;
+        check_start(problem, z0, dt, save_every, t0)?;
         // A failure recorded on this thread that no caller took belongs to no run.
         let _ = hooks::take_failure();
-        let (stepper, properties) = stepper()?;
+        let (stepper, properties, method) = stepper()?;
         let space = problem.space();
         let mut buf = z0.to_vec();
         problem.to_internal(&mut buf);
@@ -126,7 +141,7 @@ impl Run {
             clock: Clock { t0, dt, done: 0 },
             next: buf.clone(),
             user: buf.clone(),
-            method: method.map(str::to_string),
+            method,
             single: problem.calls_out(),
             at: None,
             ended: None,
@@ -158,7 +173,7 @@ impl Run {
         }
         let f = hooks::Failure {
             error: e,
-            method: self.method.clone().unwrap_or_else(|| "the method".into()),
+            method: self.method.as_ref().map_or("the method", |m| m.name).into(),
             step,
             t,
             dt: self.clock.dt,
@@ -280,8 +295,8 @@ impl Run {
     }
 
     /// [`Run::advance`] to `until`, with the shortened steps that output times between grid
-    /// times, [`Until::Time`] and `events` take (built by `system` with the run's method; the
-    /// run must come from [`Run::new`]). Events found are appended to `events.hits`; a terminal
+    /// times, [`Until::Time`] and `events` take (built by the run's resolved method; the run
+    /// must come from [`Run::new`] or [`Run::resolved`]). Events found are appended to `events.hits`; a terminal
     /// one ends the run at the event ([`Run::ended`], [`Run::state`] the event's state; in a
     /// run that saves every `save_every`-th state the event's state is saved last).
     ///
@@ -294,9 +309,9 @@ impl Run {
         out: &mut Vec<f64>,
         events: Option<&mut Events<'_>>,
     ) -> Result<usize> {
-        let name = self.method.clone();
-        let make = |h: f64| match &name {
-            Some(m) => system.stepper(m, h).map(|(s, _)| s),
+        let method = self.method.clone();
+        let make = |h: f64| match &method {
+            Some(m) => m.stepper(h),
             None => Err(Error::invalid(
                 "method",
                 "the run was made with a method value (Run::with): take its shortened steps \
@@ -786,6 +801,18 @@ pub(super) fn too_many() -> Error {
         "save_every",
         "the saved states do not fit in memory; save less often",
     )
+}
+
+/// The checks of [`Run::new`] before its method: the arguments, then the state.
+pub(super) fn check_start<P: Problem + ?Sized>(
+    problem: &P,
+    z0: &[f64],
+    dt: f64,
+    save_every: usize,
+    t0: f64,
+) -> Result<()> {
+    check_run(dt, save_every, t0)?;
+    check_state(problem, z0)
 }
 
 fn check_run(dt: f64, save_every: usize, t0: f64) -> Result<()> {
