@@ -250,13 +250,14 @@ impl Run {
         let now = self.time();
         if let Some(&first) = times.first() {
             if first < now - self.clock.grid_tol(first) {
+                // A run at its start names t0 (the argument the times are checked against).
+                let since = match (self.clock.done, self.ended) {
+                    (0, None) => format!("t0 = {}", fmt_num(now)),
+                    _ => format!("the run's current time {}", fmt_num(now)),
+                };
                 return Err(Error::invalid(
                     "t_eval",
-                    format!(
-                        "the times must not precede the run's current time {}, got {}",
-                        fmt_num(now),
-                        fmt_num(first)
-                    ),
+                    format!("the times must not precede {since}, got {}", fmt_num(first)),
                 ));
             }
         }
