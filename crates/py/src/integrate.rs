@@ -367,10 +367,11 @@ impl Integration {
                 format!("at most {MAX_THREADS} worker threads, got {n}"),
             )));
         }
-        let method = match method {
-            Some(m) => m,
-            None => sys.methods().first().map_or("", |(name, _)| name),
+        let resolved = match method {
+            Some(m) => sys.resolve(m),
+            None => sys.resolve_default(),
         };
+        let method = resolved.as_ref().map_or(method.unwrap_or(""), |m| m.name);
         let full = sys.space().dim();
         let d = if attitude { full - 9 } else { full };
         let b = states.len();
@@ -397,7 +398,6 @@ impl Integration {
         }
         // Set up on the run's threads (members in blocks validated in parallel, the first error
         // kept); a system that calls Python is set up on this thread, which holds the GIL.
-        let resolved = sys.resolve(method);
         let start = || match &resolved {
             Ok(m) => Batch::resolved(&*sys, m, &states, dt, save, t0),
             Err(_) => Batch::start(&*sys, method, &states, dt, save, t0),

@@ -121,7 +121,11 @@ impl Batch {
         let group = |(g, chunk): (usize, &[Vec<f64>])| {
             start_group(problem, method, chunk, g * GROUP, dt, save_every, t0)
         };
-        let in_lanes = dt.is_finite() && dt > 0.0 && method.batch_stepper(dt, 0).is_some();
+        // One member has no block to share: it steps alone (bit for bit the same).
+        let in_lanes = states0.len() > 1
+            && dt.is_finite()
+            && dt > 0.0
+            && method.batch_stepper(dt, 0).is_some();
         let groups: Vec<_> = if in_lanes {
             states0.par_chunks(GROUP).enumerate().map(group).collect()
         } else {
@@ -322,7 +326,7 @@ fn start_group<P: Problem + ?Sized>(
     t0: f64,
 ) -> std::result::Result<(Vec<Run>, Option<Lanes>), (usize, Error)> {
     let mut runs = Vec::with_capacity(chunk.len());
-    let block = match dt.is_finite() && dt > 0.0 {
+    let block = match chunk.len() > 1 && dt.is_finite() && dt > 0.0 {
         true => method
             .batch_stepper(dt, chunk.len())
             .transpose()

@@ -207,6 +207,9 @@ pub trait System: Problem {
     /// system's methods (with a suggestion when the name is close to one of them).
     fn resolve(&self, method: &str) -> Result<Arc<Resolved>>;
 
+    /// The system's default method (the first of its catalog), resolved once.
+    fn resolve_default(&self) -> Result<Arc<Resolved>>;
+
     /// A stepper for the method called `method` ([`System::resolve`], then
     /// [`Resolved::stepper`]).
     fn stepper(&self, method: &str, dt: f64) -> Result<(Box<dyn Stepper>, Properties)> {
@@ -245,21 +248,22 @@ impl<P: Catalog> System for P {
     }
 
     fn resolve(&self, method: &str) -> Result<Arc<Resolved>> {
-        let mut catalog = self.catalog();
-        let Some(i) = catalog.iter().position(|e| e.name == method) else {
-            let names: Vec<_> = catalog.iter().map(|e| e.name).collect();
-            return Err(unsupported(self.name(), method, &names));
-        };
-        let entry = catalog.swap_remove(i);
-        let integrator: Arc<dyn Integrator<P>> = entry.method.into();
-        let problem = Arc::new(self.clone());
-        let (i2, p2) = (integrator.clone(), problem.clone());
-        Ok(Arc::new(Resolved {
-            name: entry.name,
-            properties: integrator.properties(),
-            stepper: Box::new(move |dt| integrator.stepper(&problem, dt)),
-            batch: Box::new(move |dt, n| i2.batch_stepper(&p2, dt, n)),
-        }))
+        let catalog = self.catalog();
+        match catalog.iter().position(|e| e.name == method) {
+            Some(i) => Ok(resolved(self, catalog, i)),
+            None => {
+                let names: Vec<_> = catalog.iter().map(|e| e.name).collect();
+                Err(unsupported(self.name(), method, &names))
+            }
+        }
+    }
+
+    fn resolve_default(&self) -> Result<Arc<Resolved>> {
+        let catalog = self.catalog();
+        match catalog.is_empty() {
+            false => Ok(resolved(self, catalog, 0)),
+            true => Err(unsupported(self.name(), "", &[])),
+        }
     }
 
     fn lift(&self) -> Option<Arc<dyn System>> {
@@ -272,6 +276,20 @@ impl<P: Catalog> System for P {
     ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>> {
         Catalog::dissipation(self, d)
     }
+}
+
+/// Entry `i` of `problem`'s catalog as a [`Resolved`] method (holding a copy of the problem).
+fn resolved<P: Catalog>(problem: &P, mut catalog: Vec<Entry<P>>, i: usize) -> Arc<Resolved> {
+    let entry = catalog.swap_remove(i);
+    let integrator: Arc<dyn Integrator<P>> = entry.method.into();
+    let problem = Arc::new(problem.clone());
+    let (i2, p2) = (integrator.clone(), problem.clone());
+    Arc::new(Resolved {
+        name: entry.name,
+        properties: integrator.properties(),
+        stepper: Box::new(move |dt| integrator.stepper(&problem, dt)),
+        batch: Box::new(move |dt, n| i2.batch_stepper(&p2, dt, n)),
+    })
 }
 
 /// The error for an unknown method: the system's own methods, and the closest one when the name
