@@ -304,8 +304,8 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
                                        f"{event_tol!r}")
     # Every other argument is read and checked once, natively (`steps`: a trajectory that
     # cannot be kept is refused before any step).
-    run = system._start(state0, attitude, dt, method, save_every, t0=t0, threads=threads,
-                        steps=steps, t_eval=times, single=ev is not None)
+    run = system._start(state0, attitude, dt, method, save_every, t0, threads, steps, None, times,
+                        ev is not None)
     if not hasattr(run, "_chunk"):
         run = _Plain(run, system, state0, attitude, dt, t0, save_every)
     if chunk_steps is None:

@@ -5,7 +5,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use lieflow::integrate::{with_threads, Batch, Clock, Event, Events, Run, System, Until};
+use lieflow::integrate::{with_threads, Batch, Clock, Event, Events, Resolved, Run, System, Until};
 use lieflow::{check, Error};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
@@ -341,7 +341,8 @@ pub(crate) mod args {
 
 impl Integration {
     /// Starts one run per member of `states` (b members of the system's states, with their
-    /// attitudes appended where given), every argument checked once, and the states saved at
+    /// attitudes appended where given) with the method `resolved` (the name `method`, None for
+    /// the default), every argument checked once, and the states saved at
     /// `t_eval` when given (then checked against the run: not before t₀, not after the end
     /// t₀ + steps·dt).
     #[allow(clippy::too_many_arguments)]
@@ -351,6 +352,7 @@ impl Integration {
         batched: bool,
         attitude: bool,
         dt: f64,
+        resolved: lieflow::Result<Arc<Resolved>>,
         method: Option<&str>,
         save_every: u64,
         t0: f64,
@@ -367,10 +369,6 @@ impl Integration {
                 format!("at most {MAX_THREADS} worker threads, got {n}"),
             )));
         }
-        let resolved = match method {
-            Some(m) => sys.resolve(m),
-            None => sys.resolve_default(),
-        };
         let method = resolved.as_ref().map_or(method.unwrap_or(""), |m| m.name);
         let full = sys.space().dim();
         let d = if attitude { full - 9 } else { full };

@@ -4,9 +4,9 @@
 //! the GIL released, a batch in parallel), `__reduce__` (pickling) and `__repr__`. A system
 //! class is a thin subclass: its constructor and its own observables.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
-use lieflow::integrate::{Block, Space, System};
+use lieflow::integrate::{Block, Resolved, Space, System};
 use lieflow::{check, Error};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
@@ -31,6 +31,9 @@ pub struct PySystem {
     lifted: Option<Arc<dyn System>>,
     pub(crate) args: Py<PyTuple>,
     names: &'static [&'static str],
+    /// The methods resolved so far, by (lifted, name; None: the default): a system object is
+    /// frozen, so a method is looked up once for all its runs.
+    resolved: Mutex<Vec<(bool, Option<String>, Arc<Resolved>)>>,
 }
 
 impl PySystem {
@@ -46,7 +49,31 @@ impl PySystem {
             sys: Arc::new(sys),
             args: args.unbind(),
             names,
+            resolved: Mutex::new(Vec::new()),
         }
+    }
+
+    /// The method `method` (None: the default) of the core system `sys` (the lifted one when
+    /// `lifted`), resolved once per system object.
+    fn resolve(
+        &self,
+        sys: &Arc<dyn System>,
+        lifted: bool,
+        method: Option<&str>,
+    ) -> lieflow::Result<Arc<Resolved>> {
+        let mut cache = self.resolved.lock().unwrap_or_else(|p| p.into_inner());
+        let hit = cache
+            .iter()
+            .find(|(l, m, _)| *l == lifted && m.as_deref() == method);
+        if let Some((_, _, r)) = hit {
+            return Ok(r.clone());
+        }
+        let r = match method {
+            Some(m) => sys.resolve(m)?,
+            None => sys.resolve_default()?,
+        };
+        cache.push((lifted, method.map(str::to_string), r.clone()));
+        Ok(r)
     }
 
     /// The core system of a run: the lifted one when an attitude is given.
@@ -255,7 +282,7 @@ impl PySystem {
     /// Raises:
     ///     TypeError, InvalidArgumentError, UnsupportedMethodError, ShapeError, NonFiniteError,
     ///     NotInGroupError (state constraints and attitude).
-    #[pyo3(signature = (state0, attitude0, dt, method, save_every, *, t0 = None, threads = None, steps = None, first_member = None, t_eval = None, single = false))]
+    #[pyo3(signature = (state0, attitude0, dt, method, save_every, t0 = None, threads = None, steps = None, first_member = None, t_eval = None, single = false))]
     #[allow(clippy::too_many_arguments)]
     fn _start<'py>(
         &self,
@@ -301,6 +328,7 @@ impl PySystem {
         };
         let threads = args::count_opt("threads", threads.as_ref())?;
         let sys = self.runner(attitude.is_some())?.clone();
+        let resolved = self.resolve(&sys, attitude.is_some(), method.as_deref());
         let states = (0..b)
             .map(|i| {
                 let mut z = rows[i * d..(i + 1) * d].to_vec();
@@ -316,6 +344,7 @@ impl PySystem {
             batched,
             attitude.is_some(),
             dt,
+            resolved,
             method.as_deref(),
             save_every,
             t0,
