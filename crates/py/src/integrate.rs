@@ -715,7 +715,7 @@ impl Integration {
                 _ => t,
             },
             Some(_) => t,
-            None if self.done % self.save_every == 0 => {
+            None if self.done.is_multiple_of(self.save_every) => {
                 self.t0 + (self.done / self.save_every) as f64 * (self.save_every as f64 * self.dt)
             }
             None => t,

@@ -33,8 +33,11 @@ pub struct PySystem {
     names: &'static [&'static str],
     /// The methods resolved so far, by (lifted, name; None: the default): a system object is
     /// frozen, so a method is looked up once for all its runs.
-    resolved: Mutex<Vec<(bool, Option<String>, Arc<Resolved>)>>,
+    resolved: Mutex<Vec<MethodOf>>,
 }
+
+/// A resolved method of a system object: (lifted, name; None: the default), the method.
+type MethodOf = (bool, Option<String>, Arc<Resolved>);
 
 impl PySystem {
     /// The base part of a system object over `sys`, built from the constructor arguments `args`
