@@ -1,13 +1,15 @@
 """Costs of the Python integration driver around the native steppers (free rigid body,
-I = diag(1, 2, 3), method "splitting"):
+I = diag(1, 2, 3)):
 
-* per-call overhead of `lf.integrate` (steps = 1),
+* per-call overhead of `lf.integrate` (steps = 1), and the exact flow with an attitude through
+  `lf.integrate` against `body.exact_solution`, before (the lieflow at BEFORE, a checkout whose
+  extension is built) and after (the lieflow imported here), each in a subprocess of this run;
 * ns per step of a long single run, in one native call versus the default chunking (Ctrl-C
-  checks between chunks),
+  checks between chunks);
 * batch throughput (10^4 bodies x 10^3 steps, GIL released, rayon) on 1 and 2 threads
   (RAYON_NUM_THREADS, set in a subprocess per measurement).
 
-    python benches/python/integrate_overhead.py
+    python benches/python/integrate_overhead.py [--before /path/to/checkout/python]
 """
 
 import os
@@ -20,6 +22,27 @@ import lieflow as lf
 from timing import best_time
 
 M0 = np.array([1.0, 0.5, -0.3])
+BEFORE = "/work/wt-base30/python"
+
+CALLS = {
+    "lf.integrate(body, M0, dt=0.1, steps=1)":
+        lambda body: lf.integrate(body, M0, dt=0.1, steps=1),
+    "body.exact_solution(M0, [100.0])":
+        lambda body: body.exact_solution(M0, [100.0]),
+    'lf.integrate(body, M0, method="exact", attitude=I, steps=1, dt=100)':
+        lambda body: lf.integrate(body, M0, method="exact", attitude=np.eye(3), steps=1, dt=100),
+    "body.exact_solution(M0, [100.0], attitude=I)":
+        lambda body: body.exact_solution(M0, [100.0], attitude=np.eye(3)),
+}
+
+
+def calls_child():
+    """Best time per call (us) of each of CALLS, one line each."""
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    for fn in CALLS.values():
+        fn(body)
+    for fn in CALLS.values():
+        print(best_time(lambda: fn(body), 20_000)[0] * 1e6)
 
 
 def batch_child():
@@ -29,10 +52,24 @@ def batch_child():
     print(sec)
 
 
+def per_call(pythonpath):
+    env = dict(os.environ, PYTHONPATH=pythonpath)
+    out = subprocess.run([sys.executable, __file__, "--calls-child"], env=env,
+                         capture_output=True, text=True, check=True).stdout
+    return [float(v) for v in out.split()]
+
+
 def main():
+    before_path = sys.argv[sys.argv.index("--before") + 1] if "--before" in sys.argv else BEFORE
+    here = os.path.dirname(os.path.dirname(lf.__file__))
+    before, after = per_call(before_path), per_call(here)
+    print("| call | before (us) | after (us) |")
+    print("|---|---:|---:|")
+    for name, b, a in zip(CALLS, before, after):
+        print(f"| `{name}` | {b:.2f} | {a:.2f} |")
+    print(f"\nexact with attitude / exact_solution with attitude: before {before[2] / before[3]:.2f}x, "
+          f"after {after[2] / after[3]:.2f}x\n")
     body = lf.RigidBody([1.0, 2.0, 3.0])
-    sec = best_time(lambda: lf.integrate(body, M0, dt=0.01, steps=1), 2000)[0]
-    print(f"lf.integrate per-call overhead (steps=1):        {sec * 1e6:8.2f} us")
     n = 2_000_000
     one = best_time(lambda: lf.integrate(body, M0, dt=1e-3, steps=n, save_every=n, chunk_steps=n), 3)[0]
     chunked = best_time(lambda: lf.integrate(body, M0, dt=1e-3, steps=n, save_every=n), 3)[0]
@@ -50,4 +87,9 @@ def main():
 
 
 if __name__ == "__main__":
-    batch_child() if "--batch-child" in sys.argv else main()
+    if "--batch-child" in sys.argv:
+        batch_child()
+    elif "--calls-child" in sys.argv:
+        calls_child()
+    else:
+        main()

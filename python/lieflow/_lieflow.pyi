@@ -55,6 +55,11 @@ class Integration:
     """A native run in progress (from `System._start`); `advance` continues it."""
 
     method: str
+    members: int
+    batched: bool
+    save_every: int
+    t0: float
+    dt: float
     @property
     def time(self) -> float: ...
     def advance(self, steps: int) -> tuple[_F64, _F64 | None]:
@@ -98,14 +103,13 @@ class System:
     def has_attitude(self) -> bool: ...
     def _normalize_state(self, state0: Any) -> tuple[_F64, bool]: ...
     def _start(
-        self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, method: str | None,
-        save_every: int, *, t0: float = 0.0, threads: int | None = None, steps: int | None = None,
-        first_member: int | None = None,
+        self, state0: Any, attitude0: Any, dt: Any, method: Any, save_every: Any,
+        t0: Any = None, threads: Any = None, steps: Any = None, first_member: int | None = None,
+        t_eval: ArrayLike | None = None, single: bool = False,
     ) -> Integration: ...
     def _run(
-        self, z0: ArrayLike, attitude0: ArrayLike | None, dt: float, steps: int,
-        save_every: int, method: str, *, t0: float = 0.0, threads: int | None = None,
-        first_member: int | None = None,
+        self, state0: Any, attitude0: Any, dt: Any, steps: Any, save_every: Any, method: Any, *,
+        t0: Any = None, threads: Any = None, first_member: int | None = None,
     ) -> tuple[_F64, _F64 | None, _F64, _F64 | None]: ...
     def energy(self, states: ArrayLike) -> _F64 | float:
         """(..., d) -> (...)."""

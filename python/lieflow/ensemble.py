@@ -30,8 +30,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from ._lieflow import InvalidArgumentError, ShapeError, __version__
-from .integrate import (_MAX_COUNT, _attitude, _check_method, _check_system, _count,
-                        _sample_times, _step, _time)
+from .integrate import _MAX_COUNT, _check_method, _check_system, _count, _step, _time
 from .integrate import integrate as _integrate
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -312,15 +311,13 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     _check_method(method)
     if chunks is not None:
         chunks = _count("chunks", chunks)
-    z, batched = system._normalize_state(state0)
-    b, d = z.shape
-    att = None if attitude is None else _attitude(attitude, b, batched)
     # Every member's state (and attitude) and the method, without stepping; the members are
     # named by their index in the ensemble. steps=1 here: the trajectory a task keeps is checked
     # below for one task, not for the whole ensemble, which is never held by one process.
-    run = system._start(z, att, dt, method, save_every, t0=t0, threads=None, steps=1)
+    run = system._start(state0, attitude, dt, method, save_every, t0=t0, threads=None, steps=1)
     method = run.method
-    del run
+    z, att = run._initial()
+    b, d = z.shape
     c = max(1, min(chunks if chunks is not None else default_chunks(b), b))
     try:    # the largest task's trajectory: refused here as lieflow.integrate would refuse it
         system._start(z[:c], None if att is None else att[:c], dt, method, save_every, t0=t0,
@@ -330,7 +327,8 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
         raise
     n_inv = np.asarray(system.invariants(z[:1])).shape[-1]
     k = steps // save_every + 1
-    t = _sample_times(t0, dt, save_every, k)      # lieflow.integrate's traj.t
+    t = run._sample_times(steps)      # lieflow.integrate's traj.t
+    del run
 
     from dask.base import tokenize
     token = tokenize("lieflow.ensemble.integrate", __version__, type(system).__name__,
@@ -487,11 +485,11 @@ def sweep(make_system: Callable[[Any], Any], params: Sequence[Any], state0: Arra
                                    f"lieflow.ensemble.integrate for a batch")
     run = system._start(z, None, dt, method, save_every, t0=t0, threads=1, steps=steps)
     method = run.method
+    t = run._sample_times(steps)
     del run
     d = z.shape[1]
     n_inv = np.asarray(system.invariants(z)).shape[-1]
     k = steps // save_every + 1
-    t = _sample_times(t0, dt, save_every, k)
     coord, extra = _param_coords(values)
 
     from dask.base import tokenize

@@ -1,24 +1,22 @@
 """Integration driver: ``integrate(system, state0, dt=..., steps=..., method=...)`` -> ``Trajectory``.
 
-Pure presentation and control around the native systems (subclasses of ``lieflow.System``, or
-any object speaking the protocol below): argument checks, chunking of long runs so that Ctrl-C is
-honoured promptly (Python handles signals between native calls; the native work runs with the GIL
-released), an optional progress bar, and the assembly of the ``Trajectory``. The chunks resume
-one native run (``Integration``): validation happens once, the clock and the steppers live for
-the whole run, and the result does not depend on the chunking.
+The loop around one native run (``lieflow.Integration``): chunks, so that Ctrl-C is honoured
+promptly (Python handles signals between native calls; the native work runs with the GIL
+released), and an optional progress bar. Everything else is the native run's: it reads and
+checks every argument once (``System._start``), owns the clock, and returns with each chunk the
+times of its samples, the current state and the time of the final state (``_chunk``); the
+result does not depend on the chunking.
 
 Protocol a system implements (``lieflow.System`` implements it once for every system):
-``methods()`` (the first is the default), ``state_dim``, ``_normalize_state(state0) -> (z0 (b, d),
-batched)``, ``_start(z0, attitude0, dt, method | None, save_every, *, t0, threads, steps) -> run``
-(``steps``: the total, so that a trajectory that cannot be kept is refused first) with
-``run.method`` (the name), ``run.advance(steps) -> (states (b, k, d), attitude (b, k, 3, 3) |
-None)`` (the states saved in those steps) and ``run.state() -> (z (b, d), attitude (b, 3, 3) |
-None)``, vectorised ``energy``
-and ``invariants``/``casimirs``; optionally ``_fields(states) -> dict`` of named views and further
-observables ``NAME(states)``. ``t_eval``, ``events`` and the exact ``err.partial`` of a failed run
-use more of the run (``lieflow.Integration`` has it all): ``save_at``, ``set_events``,
-``events_found``, ``ended``, ``stopped_by``, ``steps_done``, ``steps_to``, ``finish``,
-``take_partial``, ``checked_state``.
+``methods()`` (the first is the default), ``_start(state0, attitude, dt, method | None,
+save_every, *, t0, threads, steps, t_eval, single) -> run`` with ``run.method`` (the name),
+``run.members``, ``run._initial()``, ``run._chunk(steps, t=None)`` (module ``lieflow.integrate``
+reads its tuple), ``run._partial()``, ``run._head()``, vectorised ``energy`` and
+``invariants``/``casimirs``; optionally ``_fields(states) -> dict`` of named views and further
+observables ``NAME(states)``. A run that has only ``advance(steps) -> (states (b, k, d),
+attitude | None)`` and ``state()`` is driven through them (every ``save_every``-th state; no
+``t_eval``, no events). ``t_eval`` and ``events`` use more of the run: ``set_events``,
+``steps_to``.
 """
 
 import numbers
@@ -28,6 +26,7 @@ import sys
 import numpy as np
 
 from ._lieflow import InvalidArgumentError, NonFiniteError, ShapeError, System
+from .trajectory import Trajectory, load
 
 __all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
@@ -92,11 +91,6 @@ def _check_method(method):
                         f"{method!r}")
 
 
-def _sample_times(t0, dt, save_every, k):
-    """The times of the first k samples of a run saving every ``save_every``-th step."""
-    return t0 + np.arange(k) * (save_every * dt)
-
-
 def _check_system(system):
     """TypeError unless ``system`` speaks the protocol (a ``lieflow.System`` instance or alike)."""
     if isinstance(system, System):
@@ -107,36 +101,6 @@ def _check_system(system):
     if not all(callable(getattr(system, a, None)) for a in ("_normalize_state", "_start")):
         raise TypeError(f"expected a lieflow system (e.g. lf.RigidBody([1, 2, 3])), got "
                         f"{type(system).__name__} {system!r:.60}")
-
-
-def _attitude(attitude, b, batched):
-    """The initial attitude as a (b, 3, 3) float64 array (one (3, 3) is shared by a batch).
-
-    The one array argument read here rather than natively: its type is checked by the rule of
-    every native array argument (real numbers only, a TypeError otherwise)."""
-    expected = "invalid attitude: expected an array-like of real numbers (bool, int or float)"
-    try:
-        a = np.asarray(attitude)
-    except ValueError as e:                      # a ragged nested list
-        raise TypeError(f"{expected}, got a {type(attitude).__name__} that numpy cannot read "
-                        f"as an array: {e}") from None
-    if isinstance(attitude, (str, bytes)) or a.dtype.kind not in "biuf":
-        raise TypeError(f"{expected}, got a {type(attitude).__name__} (numpy dtype {a.dtype})")
-    a = a.astype(np.float64, copy=False)
-    if not (a.shape == (3, 3) or batched and a.shape == (b, 3, 3)):
-        expected = f"(3, 3) or ({b}, 3, 3)" if batched else "(3, 3)"
-        raise ShapeError(f"attitude has the wrong shape: expected {expected}, got {a.shape}")
-    bad = np.argwhere(~np.isfinite(a))
-    if len(bad):     # named by its member and its entry (not by its place in the state)
-        *k, i, j = bad[0]
-        member = f"batch member {k[0]}: " if k else ""
-        raise NonFiniteError(f"{member}attitude contains a non-finite value (NaN or inf) at "
-                             f"({i}, {j})")
-    if a.shape == (3, 3):
-        out = np.empty((b, 3, 3))
-        out[...] = a
-        return out
-    return np.ascontiguousarray(a)
 
 
 class _Progress:
@@ -186,8 +150,8 @@ def _time(name, value):
 
 
 def _times(t_eval):
-    """t_eval as a 1-D float64 array of finite, strictly increasing times (TypeError for
-    anything but real numbers, ShapeError unless 1-D and non-empty)."""
+    """t_eval as a 1-D float64 array of finite times (TypeError for anything but real numbers,
+    ShapeError unless 1-D and non-empty); the native run checks their order and range."""
     expected = "invalid t_eval: expected a 1-D array-like of real numbers (bool, int or float)"
     if isinstance(t_eval, (str, bytes)):
         raise TypeError(f"{expected}, got a {type(t_eval).__name__}")
@@ -209,11 +173,6 @@ def _times(t_eval):
     if not np.all(np.isfinite(a)):
         raise NonFiniteError(f"t_eval contains a non-finite value (NaN or inf) at index "
                              f"{int(np.argmin(np.isfinite(a)))}")
-    bad = np.flatnonzero(np.diff(a) <= 0)
-    if bad.size:
-        i = int(bad[0]) + 1
-        raise InvalidArgumentError(f"invalid t_eval: expected strictly increasing times, got "
-                                   f"t_eval[{i}] = {a[i]!r} after {a[i - 1]!r}")
     return a
 
 
@@ -264,11 +223,6 @@ def _native(run, name, argument):
         raise TypeError(f"invalid {argument}: the runs of this system do not support it (its "
                         f"_start returned a {type(run).__name__} without .{name})")
     return fn
-
-
-def _grid_tol(t, t0):
-    """Round-off of grid times near t (the native driver's rule)."""
-    return 8 * np.finfo(float).eps * max(abs(t), abs(t0))
 
 
 def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitude=None,
@@ -333,422 +287,153 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
         raised during the run carries the trajectory computed so far as ``err.partial`` (a
         ``Trajectory`` with ``status == -1``).
     """
-    # Every argument's type and range in one place, before any native call.
-    _check_system(system)
+    if not isinstance(system, System):
+        _check_system(system)
     if steps is None and t_eval is None:
         raise TypeError("invalid steps: expected an integer >= 1, got NoneType None (steps may be "
                         "None only with t_eval, whose last time is then the end of the run)")
-    if steps is not None:
-        steps = _count("steps", steps)
-    save_every = _count("save_every", save_every)
-    dt = _step(dt)
-    t0 = _time("t0", t0)
-    _check_method(method)
-    times = None if t_eval is None else _times(t_eval)
-    if times is not None and save_every != 1:
-        raise InvalidArgumentError("invalid save_every: t_eval gives the output times; leave "
-                                   "save_every at 1")
-    ev = None if events is None else _events(events)
-    event_tol = _time("event_tol", event_tol)
-    if event_tol < 0:
-        raise InvalidArgumentError(f"invalid event_tol: expected a time >= 0, got {event_tol!r}")
-    z, batched = system._normalize_state(state0)
-    b = z.shape[0]
-    if ev is not None and batched:
-        raise InvalidArgumentError(f"invalid events: events are located in a single run, got a "
-                                   f"batch of {b} initial states; integrate the members one by one")
-    att = None if attitude is None else _attitude(attitude, b, batched)
+    times = ev = None
+    if t_eval is not None:
+        times = _times(t_eval)
+    if events is not None:
+        ev = _events(events)
+    if event_tol.__class__ is not float or event_tol != 0.0:
+        event_tol = _time("event_tol", event_tol)
+        if event_tol < 0:
+            raise InvalidArgumentError(f"invalid event_tol: expected a time >= 0, got "
+                                       f"{event_tol!r}")
+    # Every other argument is read and checked once, natively (`steps`: a trajectory that
+    # cannot be kept is refused before any step).
+    run = system._start(state0, attitude, dt, method, save_every, t0, threads, steps, None, times,
+                        ev is not None)
+    if not hasattr(run, "_chunk"):
+        run = _Plain(run, system, state0, attitude, dt, t0, save_every)
     if chunk_steps is None:
-        cap = max(MIN_CHUNK_STEPS, CHUNK_WORK // max(b, 1))
+        cap = max(MIN_CHUNK_STEPS, CHUNK_WORK // max(run.members, 1))
     else:
         cap = _count("chunk_steps", chunk_steps)
-    if threads is not None:
-        threads = _count("threads", threads)
-    if times is not None:
-        if times[0] < t0 - _grid_tol(times[0], t0):
-            raise InvalidArgumentError(f"invalid t_eval: the times must not precede t0 = {t0!r}, "
-                                       f"got {times[0]!r}")
-        if steps is not None:
-            end = t0 + steps * dt
-            if times[-1] > end + _grid_tol(end, t0):
-                raise InvalidArgumentError(f"invalid t_eval: the times must not pass the end "
-                                           f"t0 + steps * dt = {end!r}, got {times[-1]!r}")
-
-    # `steps`: the native side refuses, before any step, a trajectory that cannot be kept (with
-    # t_eval, `save_at` checks the states it keeps).
-    run = system._start(z, att, dt, method, save_every, t0=t0, threads=threads,
-                        steps=steps if times is None else None)
-    method = run.method
-    if times is not None:
-        _native(run, "save_at", "t_eval")(times)
     if ev is not None:
-        _native(run, "set_events", "events")(*ev, event_tol)
+        _native(run, "set_events", "events")(*ev, float(event_tol))
+    chunk = run._chunk
     total = steps if steps is not None else _native(run, "steps_to", "t_eval")(float(times[-1]))
-
-    # One entry per native call, appended in one statement so that Ctrl-C between two leaves
-    # the list consistent: (states, attitudes, events, state after, attitude after, steps done,
-    # end time or None).
+    # One tuple per native call, appended in one statement so that Ctrl-C between two leaves
+    # the list consistent (`_chunk`: times, states, attitudes, state after, attitude after,
+    # steps done, end time or None, (t_final, t_final unsnapped), events or None).
     chunks = []
-    ctx = _Context(system, method, dt, save_every, t0, times, ev, z, att, batched)
-    bar = _Progress(total, progress, f"{type(system).__name__} {method}")
+    bar = _Progress(total, True, f"{type(system).__name__} {run.method}") if progress else None
     try:
-        done, ended = 0, None
+        done = 0
+        ended = None
         while done < total and ended is None:
-            n = min(cap, total - done)
-            s, a = run.advance(n)
-            hits = run.events_found() if ev is not None else ()
-            ended = run.ended if ev is not None else None
-            after = done + n if ended is None else run.steps_done
-            chunks.append((s, a, hits) + run.state() + (after, ended))
-            bar.update(after - done)
-            done = after
+            c = chunk(min(cap, total - done))
+            chunks.append(c)
+            ended = c[6]
+            if bar is not None:
+                bar.update(c[5] - done)
+            done = c[5]
         if steps is None and ended is None:
-            s, a = run.finish(float(times[-1]))
-            hits = run.events_found() if ev is not None else ()
-            ended = run.ended
-            chunks.append((s, a, hits) + run.state() + (done, ended))
+            c = chunk(None, float(times[-1]))
+            chunks.append(c)
     except BaseException as e:
-        _attach_partial(e, ctx, run, chunks)
+        _attach_partial(e, system, run, chunks, times, ev)
         raise
     finally:
-        bar.close()
-    stopped = getattr(run, "stopped_by", None) if ev is not None else None
-    return ctx.trajectory(chunks, status=1 if stopped is not None else 0)
+        if bar is not None:
+            bar.close()
+    stopped = run.stopped_by if ev is not None else None
+    return _trajectory(system, run, chunks, times, 1 if stopped is not None else 0, ev)
 
 
-class _Context:
-    """What a Trajectory is built from besides the native chunks."""
-
-    def __init__(self, system, method, dt, save_every, t0, times, ev, z0, att0, batched):
-        self.system, self.method, self.dt, self.save_every = system, method, dt, save_every
-        self.t0, self.times, self.ev, self.batched = t0, times, ev, batched
-        self.z0, self.att0 = z0, att0
-
-    def trajectory(self, chunks, status, extra=None, final=None):
-        """The Trajectory of `chunks` (plus `extra` (states, attitudes, events) saved by a failed
-        call, and `final` (z, att, steps done, end time) instead of the last chunk's)."""
-        times, every, dt, t0 = self.times, self.save_every, self.dt, self.t0
-        parts = list(chunks) + ([] if extra is None else [extra + (None,) * 4])
-        if final is None:
-            final = chunks[-1][3:7] if chunks else (self.z0, self.att0, 0, None)
-        z, att, done, ended = final
-        states = [c[0] for c in parts]
-        atts = [c[1] for c in parts]
-        if times is None:
-            states.insert(0, self.z0[:, None, :])
-            atts.insert(0, None if self.att0 is None else self.att0[:, None])
-        d = self.z0.shape[1]
-        states = np.concatenate(states, axis=1) if states else np.zeros((self.z0.shape[0], 0, d))
-        attitudes = None
-        if self.att0 is not None:
-            attitudes = (np.concatenate(atts, axis=1) if atts
-                         else np.zeros((self.z0.shape[0], 0, 3, 3)))
-        k = states.shape[1]
-        if times is not None:
-            if self.z0.shape[0] == 0:       # an empty batch saves nothing natively
-                k = len(times) if status == 0 else 0
-                states = np.zeros((0, k, d))
-                attitudes = None if self.att0 is None else np.zeros((0, k, 3, 3))
-            t = times[:k].copy()
-        else:
-            terminated = status == 1
-            grid = k - 1 if terminated else k
-            t = _sample_times(t0, dt, every, grid)
-            if terminated:
-                t = np.append(t, ended)
-        # The time of the final state: the last sample's when it is the final state (so that a
-        # run continued from it with t0=traj.t_final starts exactly at traj.t[-1]).
-        if ended is not None:
-            t_final = ended
-        else:
-            t_final = t0 + done * dt
-            if times is not None and k and status == 0 and \
-                    abs(times[k - 1] - t_final) <= _grid_tol(t_final, t0):
-                t_final = float(times[k - 1])
-            elif times is None and done % every == 0 and k:
-                t_final = float(t[-1])
-        t_events = state_events = attitude_events = None
-        if self.ev is not None:
-            n = len(self.ev[0])
-            hits = [h for c in parts for h in c[2]]
-            t_events = [np.array([h[1] for h in hits if h[0] == i], dtype=float)
+def _trajectory(system, run, parts, times, status, ev):
+    """The Trajectory of the native calls `parts` (``_chunk`` tuples), the last one ending it."""
+    if len(parts) == 1:
+        t, states, attitudes = parts[0][:3]
+    else:
+        t = np.concatenate([c[0] for c in parts])
+        states = np.concatenate([c[1] for c in parts], axis=1)
+        attitudes = (None if parts[0][2] is None
+                     else np.concatenate([c[2] for c in parts], axis=1))
+    last = parts[-1]
+    z, att = last[3], last[4]
+    t_final = last[7][0] if status >= 0 else last[7][1]
+    z0, att0 = run._initial()
+    t_events = state_events = attitude_events = None
+    if ev is not None:
+        n, d = len(ev[0]), z0.shape[1]
+        hits = [h for c in parts for h in (c[8] or ())]
+        t_events = [np.array([h[1] for h in hits if h[0] == i], dtype=float) for i in range(n)]
+        state_events = [np.array([h[2] for h in hits if h[0] == i], dtype=float).reshape(-1, d)
                         for i in range(n)]
-            state_events = [np.array([h[2] for h in hits if h[0] == i], dtype=float)
-                            .reshape(-1, d) for i in range(n)]
-            if self.att0 is not None:
-                attitude_events = [np.array([h[3] for h in hits if h[0] == i], dtype=float)
-                                   .reshape(-1, 3, 3) for i in range(n)]
-        if not self.batched:
-            states, z = states[0], z[0]
-            if att is not None:
-                attitudes, att = attitudes[0], att[0]
-        return Trajectory(self.system, self.method, t, states, attitudes, z, att, dt,
-                          every if times is None else None, t_final=t_final, status=status,
-                          t_events=t_events, state_events=state_events,
-                          attitude_events=attitude_events, t0=t0,
-                          initial_state=self.z0 if self.batched else self.z0[0],
-                          initial_attitude=(None if self.att0 is None else
-                                            self.att0 if self.batched else self.att0[0]))
+        if att0 is not None:
+            attitude_events = [np.array([h[3] for h in hits if h[0] == i], dtype=float)
+                               .reshape(-1, 3, 3) for i in range(n)]
+    if not run.batched:
+        states, z, z0 = states[0], z[0], z0[0]
+        if att0 is not None:
+            attitudes, att, att0 = attitudes[0], att[0], att0[0]
+    save_every = None if times is not None else run.save_every
+    return Trajectory(system, run.method, t, states, attitudes, z, att, run.dt, save_every,
+                      t_final=t_final, status=status, t_events=t_events,
+                      state_events=state_events, attitude_events=attitude_events, t0=run.t0,
+                      initial_state=z0, initial_attitude=att0)
 
 
-def _attach_partial(err, ctx, run, chunks):
+def _attach_partial(err, system, run, chunks, times, ev):
     """Attaches the trajectory computed before `err` as ``err.partial`` and a note naming it.
 
     A single native run whose native call failed (also by an exception of a Python callable it
     called, KeyboardInterrupt included) knows its last checked state exactly (the step before
-    the one that failed) and the states that call saved; otherwise (Ctrl-C between calls,
-    batches, duck-typed runs) the trajectory ends after the last completed call, whose samples,
-    final state and time the chunks hold together."""
+    the one that failed) and the states that call saved (``_partial``); otherwise (Ctrl-C
+    between calls, batches, plain runs) the trajectory ends after the last completed call."""
     try:
-        extra = final = None
-        native = (not ctx.batched and hasattr(run, "take_partial")
-                  and hasattr(run, "checked_state"))
-        p = run.take_partial() if native else None
-        if p is not None:
-            hits = run.events_found() if ctx.ev is not None else ()
-            extra = (p[0], p[1], hits)
-            final = run.checked_state() + (run.steps_done, None)
-        traj = ctx.trajectory(chunks, status=-1, extra=extra, final=final)
+        p = run._partial() if hasattr(run, "_partial") else None
+        parts = list(chunks) + ([p] if p is not None else [])
+        if not parts:
+            parts = [run._head()]
+        traj = _trajectory(system, run, parts, times, -1, ev)
         err.partial = traj
-        steps = final[2] if final is not None else (chunks[-1][5] if chunks else 0)
         if hasattr(err, "add_note"):
-            err.add_note(f"the trajectory computed before this (to step {steps}, "
+            err.add_note(f"the trajectory computed before this (to step {parts[-1][5]}, "
                          f"t = {traj.t_final:g}) is err.partial")
     except Exception:        # never hide the original error behind one of the partial's
         pass
 
 
-class Trajectory:
-    """A computed trajectory.
+class _Plain:
+    """A run that has only ``advance`` and ``state`` (see the module docs), with what
+    ``integrate`` reads of a native run."""
 
-    Attributes:
-        system, method, dt: as passed to ``integrate``.
-        save_every: as passed to ``integrate`` (None when ``t_eval`` gave the times).
-        t: (k,) sample times (absolute: from ``t0``; ``t_eval`` when given).
-        states: (k, d) samples, or (b, k, d) for a batch.
-        attitude: (k, 3, 3) / (b, k, 3, 3) attitudes, or None.
-        final_state, final_attitude: the state after all steps (also when ``steps`` is not a
-            multiple of ``save_every``; a terminal event's state); pass them to ``integrate``
-            with ``t0=traj.t_final`` to continue.
-        t0, t_final: the times of the initial and the final state.
-        initial_state, initial_attitude: the state the run started from.
-        status: 0 the run reached its end, 1 a terminal event ended it, -1 it failed (the
-            ``partial`` trajectory of an exception), as scipy's.
-        t_events, state_events: with ``events``, one array per event function of the times
-            (n_i,) and the states (n_i, d) of its zeros (``attitude_events`` (n_i, 3, 3) with an
-            attitude); None without events.
-        Named views from the system (e.g. ``M``, ``Gamma``, ``q``, ``L``) as attributes.
+    def __init__(self, run, system, state0, attitude, dt, t0, save_every):
+        self.run, self.method, self.done, self.first = run, run.method, 0, True
+        self.z0, self.batched = system._normalize_state(state0)
+        self.members = self.z0.shape[0]
+        self.att0 = (None if attitude is None else
+                     np.array(np.broadcast_to(np.asarray(attitude, dtype=float),
+                                              (self.members, 3, 3))))
+        self.t0, self.dt, self.save_every = float(t0), float(dt), int(save_every)
 
-    Methods ``energy()`` and ``casimirs()``, ``to_xarray()`` and ``save(path)`` (read back with
-    ``lf.load(path)``), and every observable of the system:
-    ``traj.NAME(...)`` is ``system.NAME(traj.states, ...)`` (with the attitude passed as well for
-    observables such as ``spatial_momentum`` that need it). ``Trajectory.concatenate([a, b])``
-    joins a run and its continuation.
-    """
+    def _initial(self):
+        return self.z0, self.att0
 
-    def __init__(self, system, method, t, states, attitude, final_state, final_attitude, dt,
-                 save_every, *, t_final=None, status=0, t_events=None, state_events=None,
-                 attitude_events=None, t0=None, initial_state=None, initial_attitude=None):
-        self.system = system
-        self.method = method
-        self.t = t
-        self.states = states
-        self.attitude = attitude
-        self.final_state = final_state
-        self.final_attitude = final_attitude
-        self.dt = dt
-        self.save_every = save_every
-        self.t_final = t_final if t_final is not None else (float(t[-1]) if len(t) else None)
-        self.status = status
-        self.t_events = t_events
-        self.state_events = state_events
-        self.attitude_events = attitude_events
-        self.t0 = t0 if t0 is not None else (float(t[0]) if len(t) else None)
-        self.initial_state = initial_state
-        self.initial_attitude = initial_attitude
-        self._field_cache = None
+    def _chunk(self, steps, t=None):
+        if t is not None:
+            raise TypeError(f"invalid t_eval: the runs of this system do not support it (its "
+                            f"_start returned a {type(self.run).__name__} without ._chunk)")
+        s, a = self.run.advance(steps)
+        k0 = self.done // self.save_every + 1
+        self.done += steps
+        z, za = self.run.state()
+        if self.first:
+            self.first, k0 = False, k0 - 1
+            s = np.concatenate([self.z0[:, None], s], axis=1)
+            a = None if a is None else np.concatenate([self.att0[:, None], a], axis=1)
+        t = self.t0 + np.arange(k0, k0 + s.shape[1]) * (self.save_every * self.dt)
+        t_final = self.t0 + self.done * self.dt
+        if self.done % self.save_every == 0:
+            t_final = float(t[-1])
+        return (t, s, a, z, za, self.done, None, (t_final, t_final), None)
 
-    @classmethod
-    def concatenate(cls, trajectories):
-        """One trajectory from a run and its continuations: each must start where the one
-        before ended (its ``t0`` equal to the previous ``t_final`` and its initial state equal
-        to the previous ``final_state``, as ``integrate(system, traj.final_state, ...,
-        t0=traj.t_final)`` gives) on the same system. A sample repeated at the seam (the first
-        of a continuation is the last of the one before when that was its final state) is kept
-        once; events are joined per event function (None unless every part has the same number
-        of event functions). ``method``, ``dt`` and ``save_every`` are the parts' common values
-        (a tuple of the methods, None for dt and save_every, where they differ).
-
-        Raises:
-            TypeError (not Trajectories), InvalidArgumentError (nothing to join, other systems,
-            batch or state shapes, attitudes that come and go, a part that does not start where
-            the one before ended).
-        """
-        expected = "invalid trajectories: expected a list of Trajectory objects"
-        if isinstance(trajectories, (str, bytes, dict)):
-            raise TypeError(f"{expected}, got a {type(trajectories).__name__}")
-        try:
-            parts = list(trajectories)
-        except TypeError:
-            raise TypeError(f"{expected}, got a {type(trajectories).__name__}") from None
-        bad = [type(p).__name__ for p in parts if not isinstance(p, Trajectory)]
-        if bad:
-            raise TypeError(f"{expected}, got one of type {bad[0]}")
-        if not parts:
-            raise InvalidArgumentError("invalid trajectories: nothing to concatenate")
-        first = parts[0]
-        for i, (a, b) in enumerate(zip(parts, parts[1:]), start=1):
-            where = f"invalid trajectories: part {i}"
-            same = a.system is b.system or (type(a.system) is type(b.system)
-                                            and repr(a.system) == repr(b.system))
-            if not same:
-                raise InvalidArgumentError(f"{where} integrates another system ({b.system!r:.60} "
-                                           f"after {a.system!r:.60})")
-            if a.states.shape[:-2] != b.states.shape[:-2] or a.states.shape[-1] != b.states.shape[-1]:
-                raise InvalidArgumentError(f"{where} has states of shape {b.states.shape} after "
-                                           f"{a.states.shape}")
-            if (a.attitude is None) != (b.attitude is None):
-                raise InvalidArgumentError(f"{where}: an attitude in one part only")
-            t_a, t_b = a.t_final, b.t0
-            tol = 16 * np.finfo(float).eps * max(abs(t_a), abs(t_b)) + 1e-9 * min(a.dt, b.dt)
-            if t_a is None or t_b is None or not abs(t_b - t_a) <= tol:
-                raise InvalidArgumentError(f"{where} starts at t = {t_b!r}, not where the one "
-                                           f"before ended (t = {t_a!r}); continue a run with "
-                                           f"integrate(system, traj.final_state, ..., "
-                                           f"t0=traj.t_final)")
-            if b.initial_state is not None and not np.array_equal(b.initial_state, a.final_state):
-                raise InvalidArgumentError(f"{where} does not start from the final state of the "
-                                           f"one before")
-            if (b.initial_attitude is not None and a.final_attitude is not None
-                    and not np.array_equal(b.initial_attitude, a.final_attitude)):
-                raise InvalidArgumentError(f"{where} does not start from the final attitude of "
-                                           f"the one before")
-        t, states, atts = [first.t], [first.states], [first.attitude]
-        for a, b in zip(parts, parts[1:]):
-            drop = (len(a.t) and len(b.t) and b.t[0] <= a.t[-1]
-                    + 16 * np.finfo(float).eps * max(abs(a.t[-1]), 1.0) + 1e-9 * b.dt)
-            s = 1 if drop else 0
-            t.append(b.t[s:])
-            states.append(b.states[..., s:, :])
-            if b.attitude is not None:
-                atts.append(b.attitude[..., s:, :, :])
-        axis = states[0].ndim - 2
-        last = parts[-1]
-
-        def common(name):
-            values = [getattr(p, name) for p in parts]
-            return values[0] if all(v == values[0] for v in values) else None
-
-        methods = [p.method for p in parts]
-        method = methods[0] if all(m == methods[0] for m in methods) else tuple(methods)
-        events = {}
-        counts = {None if p.t_events is None else len(p.t_events) for p in parts}
-        if len(counts) == 1 and None not in counts:
-            n = counts.pop()
-            events["t_events"] = [np.concatenate([p.t_events[i] for p in parts]) for i in range(n)]
-            events["state_events"] = [np.concatenate([p.state_events[i] for p in parts])
-                                      for i in range(n)]
-            if all(p.attitude_events is not None for p in parts):
-                events["attitude_events"] = [np.concatenate([p.attitude_events[i] for p in parts])
-                                             for i in range(n)]
-        return cls(first.system, method, np.concatenate(t), np.concatenate(states, axis=axis),
-                   None if first.attitude is None else np.concatenate(atts, axis=axis),
-                   last.final_state, last.final_attitude, common("dt"), common("save_every"),
-                   t_final=last.t_final, status=last.status, t0=first.t0,
-                   initial_state=first.initial_state, initial_attitude=first.initial_attitude,
-                   **events)
-
-    @property
-    def batched(self):
-        """Whether the states carry a leading batch axis."""
-        return self.states.ndim == 3
-
-    def __len__(self):
-        """The number of samples k."""
-        return len(self.t)
-
-    def __repr__(self):
-        span = f"t=[{self.t[0]:g}, {self.t[-1]:g}]" if len(self.t) else "t=[]"
-        return (f"<Trajectory {type(self.system).__name__} method={self.method!r} "
-                f"states{self.states.shape} {span}>")
-
-    def energy(self):
-        """The energy at every sample: (k,) or (b, k)."""
-        return np.asarray(self.system.energy(self.states))
-
-    def invariants(self):
-        """The invariants the system's geometric methods keep, at every sample: (k, c) or
-        (b, k, c)."""
-        return np.asarray(self.system.invariants(self.states))
-
-    def casimirs(self):
-        """The same as ``invariants()`` (the Casimirs of the Lie–Poisson systems)."""
-        return self.invariants()
-
-    def to_xarray(self, *, observables=True):
-        """The trajectory as an ``xarray.Dataset``: coordinates ``time`` (and ``member`` for a
-        batch), ``states``, the named fields (``M``, ``Gamma``, ``X``, ...), ``energy`` and
-        ``invariants`` (unless ``observables=False``), the attitude, the initial and final
-        states, events; attributes the system and its parameters, the method, dt, save_every,
-        times and the lieflow version (layout: :mod:`lieflow.io`). Needs xarray."""
-        from .io import to_xarray
-
-        return to_xarray(self, observables=observables)
-
-    def save(self, path, *, allow_pickle=False):
-        """Writes the trajectory to the NetCDF file `path` (read it with ``lf.load(path)``;
-        the round trip is exact). A system built from Python callables is stored only with
-        ``allow_pickle=True`` (see :func:`lieflow.io.save`). Needs xarray and a NetCDF backend
-        (``pip install lieflow[io]``)."""
-        from .io import save
-
-        save(self, path, allow_pickle=allow_pickle)
-
-    def _fields(self):
-        if self._field_cache is None:
-            fields = getattr(self.system, "_fields", None)
-            self._field_cache = dict(fields(self.states)) if fields is not None else {}
-        return self._field_cache
-
-    def __getattr__(self, name):
-        # Only called for names that are not regular attributes.
-        if name.startswith("_") or "system" not in self.__dict__:
-            raise AttributeError(name)
-        fields = self._fields()
-        if name in fields:
-            return fields[name]
-        fn = getattr(self.system, name, None)
-        if not callable(fn):
-            raise AttributeError(
-                f"'Trajectory' has no attribute {name!r} (nor has {type(self.system).__name__})")
-        if name in getattr(self.system, "_attitude_observables", ()):
-            if self.attitude is None:
-                def needs_attitude(*args, **kwargs):
-                    raise InvalidArgumentError(
-                        f"invalid state: {name} needs the attitude; integrate with attitude=R0")
-                return needs_attitude
-            return lambda *args, **kwargs: fn(self.states, self.attitude, *args, **kwargs)
-        return lambda *args, **kwargs: fn(self.states, *args, **kwargs)
-
-    def __dir__(self):
-        names = set(super().__dir__()) | set(self._fields())
-        names |= {n for n in dir(self.system) if not n.startswith("_")}
-        return sorted(names)
-
-
-def load(path, *, allow_pickle=False):
-    """Reads a trajectory written by ``Trajectory.save`` (or a Dataset of
-    ``Trajectory.to_xarray()``), its system rebuilt from the file, so that
-    ``lf.integrate(traj.system, traj.final_state, ..., t0=traj.t_final)`` continues the run.
-    The round trip is exact. ``allow_pickle=True`` allows a system stored pickled (a system
-    built from Python callables; loading runs code from the file, so only for files you
-    trust). Needs xarray and a NetCDF-4 backend (``pip install lieflow[io]``).
-
-    Raises:
-        ImportError (no xarray or NetCDF-4 backend), FileNotFoundError, FileFormatError (not a
-        lieflow trajectory file, damaged, a newer format, a pickled system without
-        ``allow_pickle``).
-    """
-    from .io import read
-
-    return Trajectory(**read(path, allow_pickle=allow_pickle))
+    def _head(self):
+        t = np.array([self.t0])
+        a = None if self.att0 is None else self.att0[:, None]
+        return (t, self.z0[:, None], a, self.z0, self.att0, 0, None, (self.t0, self.t0), None)

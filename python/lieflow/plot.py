@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from matplotlib.animation import FuncAnimation
     from matplotlib.axes import Axes
 
-    from .integrate import Trajectory
+    from .trajectory import Trajectory
 
 __all__ = ["animate", "invariants", "states", "work_precision"]
 
@@ -47,7 +47,7 @@ def _axes(ax, **subplot):
 
 def _trajectory(traj):
     """TypeError unless `traj` is a Trajectory."""
-    from .integrate import Trajectory
+    from .trajectory import Trajectory
 
     if not isinstance(traj, Trajectory):
         raise TypeError(f"invalid traj: expected a lieflow Trajectory (from lf.integrate), got "

@@ -5,14 +5,13 @@
 
 use std::sync::{Arc, Mutex};
 
-use lieflow::integrate::{Batch, Event, Events, Run, System, Until};
+use lieflow::integrate::{with_threads, Batch, Clock, Event, Events, Resolved, Run, System, Until};
 use lieflow::{check, Error};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
-use crate::convert::{int, named, real, vector, Real};
-use crate::convert::{shape_str, ArrayIn};
+use crate::convert::{named, real, real_opt, vector, ArrayIn, Real};
 use crate::errors::{raised, to_py, IntoPy};
 use crate::items::{array, Out};
 
@@ -27,6 +26,22 @@ pub(crate) type RunOut<'py> = (
 
 /// Current states (b, d) and attitudes (b, 3, 3) or None.
 type States<'py> = (Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>);
+
+/// One call of a run as `lieflow.integrate` assembles it: the times (k,), states (b, k, d) and
+/// attitudes (b, k, 3, 3) or None of its samples, the current states (b, d) and attitudes, the
+/// steps done, the end time of an ended run, the time of the current state (with output times
+/// snapped to, and without), and the events found (None without events).
+type Chunk<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Out<'py>,
+    Option<Out<'py>>,
+    Bound<'py, PyArray2<f64>>,
+    Option<Bound<'py, PyArray3<f64>>>,
+    u64,
+    Option<f64>,
+    (f64, f64),
+    Option<Vec<Found<'py>>>,
+);
 
 /// A located event as Python sees it: (index of the event function, t, state (d,), attitude
 /// (3, 3) or None, absolute step).
@@ -55,15 +70,29 @@ pub struct Integration {
     calls_out: bool,
     /// One run per member, in SIMD lanes where the method has them for the system.
     runs: Mutex<Batch>,
-    pool: Option<rayon::ThreadPool>,
+    /// The worker threads (None: rayon's global pool), for the core's `with_threads`.
+    threads: Option<usize>,
     /// Length of a state without the attitude.
     d: usize,
     attitude: bool,
+    /// Whether the initial state was a batch (b, d) (else one state (d,), b = 1).
+    #[pyo3(get)]
+    batched: bool,
+    #[pyo3(get)]
     save_every: u64,
+    #[pyo3(get)]
+    t0: f64,
+    #[pyo3(get)]
+    dt: f64,
     /// Steps done (the same for every member).
     done: u64,
-    /// Whether the run saves at given times (`save_at`).
-    at: bool,
+    /// The output times, if the run saves at given times (`save_at`).
+    at: Option<Vec<f64>>,
+    /// The samples handed out so far (the initial states included).
+    saved: usize,
+    /// The initial states (b·full values), the first samples of a run that saves every
+    /// `save_every`-th state.
+    initial: Vec<f64>,
     /// The event functions (a single run only).
     events: Option<Mutex<Events<'static>>>,
     /// The states (full, flat) saved by the call that failed, before its error (one run only).
@@ -87,75 +116,273 @@ fn of_member(e: Error, i: usize, b: usize, first: Option<usize>) -> Error {
 /// starting).
 const MAX_THREADS: usize = 1024;
 
-/// A count ≥ 1 from a Python integer.
-fn count(what: &str, v: i64) -> PyResult<usize> {
-    usize::try_from(v).ok().filter(|&u| u >= 1).ok_or_else(|| {
-        to_py(Error::invalid(
-            what,
-            format!("expected {what} ≥ 1, got {v}"),
-        ))
-    })
+/// The arguments of a run as `lieflow.integrate` passes them on, read and checked here once, in
+/// its words: a TypeError for a wrong type, an InvalidArgumentError for a wrong value.
+pub(crate) mod args {
+    use lieflow::Error;
+    use numpy::{PyArrayDescrMethods, PyUntypedArray, PyUntypedArrayMethods};
+    use pyo3::exceptions::PyTypeError;
+    use pyo3::prelude::*;
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
+
+    use crate::errors::to_py;
+
+    /// An argument as given (`from_py_with`): read in the order of `lieflow.integrate`'s checks,
+    /// not in pyo3's order of parameters, and with its words.
+    pub(crate) fn given<'py>(ob: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        Ok(Some(ob.clone()))
+    }
+
+    fn type_name(ob: &Bound<'_, PyAny>) -> String {
+        ob.get_type()
+            .name()
+            .map_or_else(|_| "object".to_string(), |n| n.to_string())
+    }
+
+    /// `repr(ob)`, cut to `max` characters (Python's `{ob!r:.60}`).
+    fn repr(ob: &Bound<'_, PyAny>, max: usize) -> String {
+        let r = ob
+            .repr()
+            .map_or_else(|_| "?".to_string(), |r| r.to_string());
+        r.chars().take(max).collect()
+    }
+
+    /// `repr(v)` of a float, as Python prints it.
+    pub(crate) fn float_repr(v: f64) -> String {
+        Python::attach(|py| repr(PyFloat::new(py, v).as_any(), usize::MAX))
+    }
+
+    /// An integer ≥ 1 (≤ 2⁶³ − 1): an int or what has `__index__`, bools refused.
+    pub(crate) fn count(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<u64> {
+        let py = ob.py();
+        let bad = || {
+            PyTypeError::new_err(format!(
+                "invalid {name}: expected an integer >= 1, got {} {}",
+                type_name(ob),
+                repr(ob, usize::MAX)
+            ))
+        };
+        if ob.is_instance_of::<PyBool>() {
+            return Err(bad());
+        }
+        let n = if ob.is_exact_instance_of::<PyInt>() {
+            ob.clone()
+        } else {
+            py.import("operator")?
+                .call_method1("index", (ob,))
+                .map_err(|e| {
+                    if e.is_instance_of::<PyTypeError>(py) {
+                        bad()
+                    } else {
+                        e
+                    }
+                })?
+        };
+        let invalid = |m: String| to_py(Error::invalid(name, m));
+        match n.extract::<i64>() {
+            Ok(v) if v >= 1 => Ok(v as u64),
+            Ok(v) => Err(invalid(format!("expected an integer >= 1, got {v}"))),
+            Err(_) if n.gt(0)? => Err(invalid(format!(
+                "expected an integer <= 2**63 - 1, got {}",
+                n.str()?
+            ))),
+            Err(_) => Err(invalid(format!(
+                "expected an integer >= 1, got {}",
+                n.str()?
+            ))),
+        }
+    }
+
+    /// [`count`] of an optional argument (None: not given).
+    pub(crate) fn count_opt(name: &str, ob: Option<&Bound<'_, PyAny>>) -> PyResult<Option<u64>> {
+        match ob.filter(|o| !o.is_none()) {
+            Some(o) => count(name, o).map(Some),
+            None => Ok(None),
+        }
+    }
+
+    /// A real number (bool excluded) or a 0-d numeric array, as a float; None for anything else.
+    fn real(ob: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+        if let Ok(f) = ob.cast::<PyFloat>() {
+            return Ok(Some(f.value()));
+        }
+        if ob.is_instance_of::<PyBool>() {
+            return Ok(None);
+        }
+        let py = ob.py();
+        let real = ob.is_instance_of::<PyInt>()
+            || ob.is_instance(&py.import("numbers")?.getattr("Real")?)?
+            || ob
+                .cast::<PyUntypedArray>()
+                .is_ok_and(|a| a.ndim() == 0 && matches!(a.dtype().kind(), b'i' | b'u' | b'f'));
+        if !real {
+            return Ok(None);
+        }
+        Ok(Some(py.get_type::<PyFloat>().call1((ob,))?.extract()?))
+    }
+
+    /// The time step: a real number, finite and > 0.
+    pub(crate) fn step(ob: &Bound<'_, PyAny>) -> PyResult<f64> {
+        let Some(dt) = real(ob)? else {
+            return Err(PyTypeError::new_err(format!(
+                "invalid dt: expected a real number > 0, got {} {}",
+                type_name(ob),
+                repr(ob, usize::MAX)
+            )));
+        };
+        if !(0.0 < dt && dt < f64::INFINITY) {
+            let got = float_repr(dt);
+            return Err(to_py(Error::invalid(
+                "dt",
+                format!("expected a finite number > 0, got {got}"),
+            )));
+        }
+        Ok(dt)
+    }
+
+    /// A time: a real number, finite.
+    pub(crate) fn time(name: &str, ob: &Bound<'_, PyAny>) -> PyResult<f64> {
+        let Some(t) = real(ob)? else {
+            return Err(PyTypeError::new_err(format!(
+                "invalid {name}: expected a real number, got {} {}",
+                type_name(ob),
+                repr(ob, 60)
+            )));
+        };
+        if !t.is_finite() {
+            let got = float_repr(t);
+            return Err(to_py(Error::invalid(
+                name,
+                format!("expected a finite number, got {got}"),
+            )));
+        }
+        Ok(t)
+    }
+
+    /// A method's name, or None for the system's default.
+    pub(crate) fn method(ob: &Bound<'_, PyAny>) -> PyResult<Option<String>> {
+        if ob.is_none() {
+            return Ok(None);
+        }
+        match ob.cast::<PyString>() {
+            Ok(s) => Ok(Some(s.to_cow()?.into_owned())),
+            Err(_) => Err(PyTypeError::new_err(format!(
+                "invalid method: expected a name (str), got {} {}",
+                type_name(ob),
+                repr(ob, usize::MAX)
+            ))),
+        }
+    }
+
+    /// The initial attitudes of `b` members, (b·9) values: one (3, 3) shared by a batch, or one
+    /// per member (b, 3, 3) of a batch; real numbers only (the rule of every array argument),
+    /// finite (a NaN named by its member and its entry).
+    pub(crate) fn attitude(ob: &Bound<'_, PyAny>, b: usize, batched: bool) -> PyResult<Vec<f64>> {
+        let py = ob.py();
+        let expected =
+            "invalid attitude: expected an array-like of real numbers (bool, int or float)";
+        let np = py.import("numpy")?;
+        let a = np.call_method1("asarray", (ob,)).map_err(|e| {
+            if e.is_instance_of::<pyo3::exceptions::PyValueError>(py) {
+                PyTypeError::new_err(format!(
+                    "{expected}, got a {} that numpy cannot read as an array: {}",
+                    type_name(ob),
+                    e.value(py)
+                ))
+            } else {
+                e
+            }
+        })?;
+        let arr = a.cast::<PyUntypedArray>()?;
+        let text = ob.is_instance_of::<PyString>() || ob.is_instance_of::<pyo3::types::PyBytes>();
+        if text || !matches!(arr.dtype().kind(), b'b' | b'i' | b'u' | b'f') {
+            return Err(PyTypeError::new_err(format!(
+                "{expected}, got a {} (numpy dtype {})",
+                type_name(ob),
+                arr.dtype().str()?
+            )));
+        }
+        let shape = arr.shape().to_vec();
+        if !(shape == [3, 3] || batched && shape == [b, 3, 3]) {
+            let want = if batched {
+                format!("(3, 3) or ({b}, 3, 3)")
+            } else {
+                "(3, 3)".to_string()
+            };
+            return Err(to_py(Error::shape(
+                "attitude",
+                want,
+                crate::convert::shape_str(&shape),
+            )));
+        }
+        let flat = np
+            .call_method1("ascontiguousarray", (a, "float64"))?
+            .call_method0("ravel")?
+            .extract::<Vec<f64>>()?;
+        if let Some(k) = flat.iter().position(|v| !v.is_finite()) {
+            let (m, e) = (k / 9, k % 9);
+            let what = if shape.len() == 3 {
+                format!("batch member {m}: attitude")
+            } else {
+                "attitude".to_string()
+            };
+            return Err(to_py(Error::NonFinite {
+                what,
+                location: format!("({}, {})", e / 3, e % 3),
+            }));
+        }
+        Ok(if shape.len() == 2 {
+            flat.repeat(b)
+        } else {
+            flat
+        })
+    }
 }
 
 impl Integration {
-    /// Validates everything once and starts one run per row of `z0`.
+    /// Starts one run per member of `states` (b members of the system's states, with their
+    /// attitudes appended where given) with the method `resolved` (the name `method`, None for
+    /// the default), every argument checked once, and the states saved at
+    /// `t_eval` when given (then checked against the run: not before t₀, not after the end
+    /// t₀ + steps·dt).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn start(
         sys: Arc<dyn System>,
-        z0: &ArrayIn<'_>,
-        attitude0: Option<&ArrayIn<'_>>,
+        mut states: Vec<Vec<f64>>,
+        batched: bool,
+        attitude: bool,
         dt: f64,
+        resolved: lieflow::Result<Arc<Resolved>>,
         method: Option<&str>,
-        save_every: i64,
+        save_every: u64,
         t0: f64,
-        threads: Option<i64>,
-        steps: Option<i64>,
+        threads: Option<usize>,
+        steps: Option<u64>,
         first_member: Option<usize>,
+        t_eval: Option<Vec<f64>>,
     ) -> PyResult<Self> {
-        let save_every = count("save_every", save_every)?;
         let calls_out = sys.calls_out();
         let threads = if calls_out { Some(1) } else { threads };
-        let method = match method {
-            Some(m) => m,
-            None => sys.methods().first().map_or("", |(name, _)| name),
-        };
-        let pool = match threads {
-            None => None,
-            Some(n) => {
-                let n = count("threads", n)?;
-                if n > MAX_THREADS {
-                    return Err(to_py(Error::invalid(
-                        "threads",
-                        format!("at most {MAX_THREADS} worker threads, got {n}"),
-                    )));
-                }
-                Some(
-                    rayon::ThreadPoolBuilder::new()
-                        .num_threads(n)
-                        .build()
-                        .map_err(|e| to_py(Error::invalid("threads", e.to_string())))?,
-                )
-            }
-        };
-        let full = sys.space().dim();
-        let d = if attitude0.is_some() { full - 9 } else { full };
-        let z = z0.as_array();
-        if z.ndim() != 2 || z.shape()[1] != d {
-            return Err(to_py(Error::shape(
-                "z0",
-                format!("(b, {d})"),
-                shape_str(z.shape()),
+        if let Some(n) = threads.filter(|&n| n > MAX_THREADS) {
+            return Err(to_py(Error::invalid(
+                "threads",
+                format!("at most {MAX_THREADS} worker threads, got {n}"),
             )));
         }
-        let b = z.shape()[0];
+        let method = resolved.as_ref().map_or(method.unwrap_or(""), |m| m.name);
+        let full = sys.space().dim();
+        let d = if attitude { full - 9 } else { full };
+        let b = states.len();
+        let save = usize::try_from(save_every).unwrap_or(usize::MAX);
         // Each member's run keeps its state several times (buffer, stepper state, scratch) and a
         // few hundred bytes more: about 64 + 8·d floats measured; check twice that against the
         // memory available before building any (a huge batch is refused, not killed).
         check::array_size("state0", &[b, 2 * (64 + 8 * full)]).py()?;
         // The whole trajectory the caller will keep: (b, steps / save_every + 1, full) floats,
-        // refused before the first step when it cannot be held.
-        if let Some(steps) = steps {
-            let saved = count("steps", steps)? / save_every + 1;
+        // refused before the first step when it cannot be held (with t_eval, `save_at` checks
+        // the states it keeps).
+        if let (Some(steps), None) = (steps, &t_eval) {
+            let saved = usize::try_from(steps / save_every + 1).unwrap_or(usize::MAX);
             check::array_size("steps", &[b, saved, full]).map_err(|e| match e {
                 Error::InvalidArgument { what, message } => to_py(Error::invalid(
                     what,
@@ -167,50 +394,62 @@ impl Integration {
                 other => to_py(other),
             })?;
         }
-        let mut states: Vec<Vec<f64>> = z
-            .outer_iter()
-            .map(|r| r.iter().copied().collect())
-            .collect();
-        if let Some(a) = attitude0 {
-            let a = a.as_array();
-            if a.shape() != [b, 3, 3] {
-                return Err(to_py(Error::shape(
-                    "attitude",
-                    format!("({b}, 3, 3)"),
-                    shape_str(a.shape()),
-                )));
-            }
-            for (s, r) in states.iter_mut().zip(a.outer_iter()) {
-                s.extend(r.iter());
-            }
-        }
         // Set up on the run's threads (members in blocks validated in parallel, the first error
         // kept); a system that calls Python is set up on this thread, which holds the GIL.
-        let start = || Batch::start(&*sys, method, &states, dt, save_every, t0);
-        let runs = match &pool {
-            Some(p) if !calls_out => p.install(start),
-            _ => start(),
+        let start = || match &resolved {
+            Ok(m) => Batch::resolved(&*sys, m, &states, dt, save, t0),
+            Err(_) => Batch::start(&*sys, method, &states, dt, save, t0),
+        };
+        let runs = if calls_out {
+            start()
+        } else {
+            with_threads(threads, || Ok(start())).py()?
         }
         .map_err(|(i, e)| match i {
             Some(i) => of_member(e, i, b, first_member),
             None => e,
         })
         .py()?;
-        Ok(Integration {
+        let initial = states.drain(..).flatten().collect();
+        let mut run = Integration {
             method: method.to_string(),
             sys,
             calls_out,
             runs: Mutex::new(runs),
-            pool,
+            threads,
             d,
-            attitude: attitude0.is_some(),
-            save_every: save_every as u64,
+            attitude,
+            batched,
+            save_every,
+            t0,
+            dt,
             done: 0,
-            at: false,
+            at: None,
+            saved: 0,
+            initial,
             events: None,
             partial: None,
             first_member,
-        })
+        };
+        if let Some(times) = t_eval {
+            let last = times.last().copied();
+            run.save_times(times)?;
+            if let (Some(steps), Some(last)) = (steps, last) {
+                let end = t0 + steps as f64 * dt;
+                let c = Clock { t0, dt, done: 0 };
+                if last > end + c.grid_tol(end) {
+                    return Err(to_py(Error::invalid(
+                        "t_eval",
+                        format!(
+                            "the times must not pass the end t0 + steps * dt = {}, got {}",
+                            args::float_repr(end),
+                            args::float_repr(last)
+                        ),
+                    )));
+                }
+            }
+        }
+        Ok(run)
     }
 
     /// Splits (b, k, full) data into states (b, k, d) and attitudes (b, k, 3, 3).
@@ -251,11 +490,7 @@ impl Integration {
     /// Advances every member `until` (in parallel with the GIL released; a run with events, or
     /// of a system that calls Python, in this thread) and returns the states saved, (b, k, d) and (b, k, 3, 3) or None. After an
     /// error of a single run, what it saved before the error is kept for `take_partial`.
-    fn drive<'py>(
-        &mut self,
-        py: Python<'py>,
-        until: Until,
-    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+    fn drive(&mut self, py: Python<'_>, until: Until) -> PyResult<(Vec<f64>, usize)> {
         let full = self.d + if self.attitude { 9 } else { 0 };
         let sys = &*self.sys;
         let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
@@ -273,7 +508,7 @@ impl Integration {
                 None => None,
             },
         };
-        if let (false, Some(steps)) = (self.at, steps) {
+        if let (None, Some(steps)) = (&self.at, steps) {
             let k = (self.done + steps) / self.save_every - self.done / self.save_every;
             expected = k as usize;
             let k = k + u64::from(self.events.is_some() || matches!(until, Until::Time(_)));
@@ -292,12 +527,12 @@ impl Integration {
                 other => to_py(other),
             })? / b.max(1);
         }
-        let plain = !self.at && self.events.is_none();
+        let plain = self.at.is_none() && self.events.is_none();
         let events = self
             .events
             .as_mut()
             .map(|m| m.get_mut().unwrap_or_else(|p| p.into_inner()));
-        let pool = &self.pool;
+        let threads = self.threads;
         let first = self.first_member;
         let one = |i: usize, run: &mut Run, events: Option<&mut Events<'static>>| {
             let mut out = Vec::new();
@@ -324,10 +559,7 @@ impl Integration {
                     .map(|(i, run)| one(i, run, None))
                     .collect::<Vec<_>>()
             };
-            match pool {
-                Some(p) => p.install(work),
-                None => work(),
-            }
+            with_threads(threads, || Ok(work()))
         };
         // Plain steps of a batch in SIMD lanes: the core's batch driver (groups of members in
         // parallel, the same results bit for bit as one run per member).
@@ -348,10 +580,9 @@ impl Integration {
                     }
                     outs.push(out);
                 }
-                let results = py.detach(|| match pool {
-                    Some(p) => p.install(|| batch.advance(sys, n, &mut outs)),
-                    None => batch.advance(sys, n, &mut outs),
-                });
+                let results = py
+                    .detach(|| with_threads(threads, || Ok(batch.advance(sys, n, &mut outs))))
+                    .py()?;
                 outs.into_iter()
                     .zip(results)
                     .enumerate()
@@ -380,7 +611,7 @@ impl Integration {
                         }
                         outs
                     }
-                    _ => py.detach(|| parallel(runs)),
+                    _ => py.detach(|| parallel(runs)).py()?,
                 }
             }
         };
@@ -417,28 +648,133 @@ impl Integration {
         for (d, o) in flat.chunks_exact_mut((k * full).max(1)).zip(&data) {
             d.copy_from_slice(o);
         }
-        self.split(py, &flat, b, k)
+        Ok((flat, k))
     }
 
-    /// `_run`: the initial states and the states saved in `steps` more steps, and the final
-    /// states.
-    pub(crate) fn run_all<'py>(&mut self, py: Python<'py>, steps: i64) -> PyResult<RunOut<'py>> {
-        let (z0, r0) = self.state(py)?;
-        let (rest, r_rest) = self.advance(py, steps)?;
+    /// The length of a state with its attitude.
+    fn full(&self) -> usize {
+        self.d + if self.attitude { 9 } else { 0 }
+    }
+
+    /// The samples of one call, `flat` (b members × k states), with the initial states before
+    /// them while they are due (the first call of a run that saves every `save_every`-th
+    /// state), and their times: t₀ + n·(save_every·dt) for the run's n-th sample (a terminal
+    /// event's state, saved last, at its time `ended`), or the output times of `save_at`.
+    fn samples(
+        &mut self,
+        flat: Vec<f64>,
+        k: usize,
+        last: Option<f64>,
+    ) -> (Vec<f64>, usize, Vec<f64>) {
+        let full = self.full();
+        let b = self.members();
+        let (flat, k) = if self.at.is_none() && self.saved == 0 {
+            let mut out = Vec::with_capacity(flat.len() + self.initial.len());
+            for i in 0..b {
+                out.extend_from_slice(&self.initial[i * full..(i + 1) * full]);
+                out.extend_from_slice(&flat[i * k * full..(i + 1) * k * full]);
+            }
+            (out, k + 1)
+        } else {
+            (flat, k)
+        };
+        let n0 = self.saved;
+        let times = match &self.at {
+            Some(times) => times[n0.min(times.len())..(n0 + k).min(times.len())].to_vec(),
+            None => {
+                let every = self.save_every as f64 * self.dt;
+                (n0..n0 + k)
+                    .map(|n| match last {
+                        Some(t) if n + 1 == n0 + k => t,
+                        _ => self.t0 + n as f64 * every,
+                    })
+                    .collect()
+            }
+        };
+        self.saved += k;
+        (flat, k, times)
+    }
+
+    /// The time of the current state: the end time of an ended run, else t₀ + steps·dt, or the
+    /// time of the last sample when that sample is the current state (a grid sample, or with
+    /// `snap` an output time within round-off of it), so that a run continued from it with
+    /// t0 = t_final starts exactly at its last sample.
+    fn t_final(&self, ended: Option<f64>, snap: bool) -> f64 {
+        if let Some(t) = ended {
+            return t;
+        }
+        let t = self.t0 + self.done as f64 * self.dt;
+        let clock = Clock {
+            t0: self.t0,
+            dt: self.dt,
+            done: 0,
+        };
+        match &self.at {
+            Some(times) if snap && self.saved > 0 => match times.get(self.saved - 1) {
+                Some(&last) if (last - t).abs() <= clock.grid_tol(t) => last,
+                _ => t,
+            },
+            Some(_) => t,
+            None if self.done.is_multiple_of(self.save_every) => {
+                self.t0 + (self.done / self.save_every) as f64 * (self.save_every as f64 * self.dt)
+            }
+            None => t,
+        }
+    }
+
+    /// One call's samples (`flat`, k per member; `last`: the time of a terminal event's state
+    /// saved last) as `_chunk` returns them, with the current states and the end time.
+    #[allow(clippy::too_many_arguments)]
+    fn chunk_of<'py>(
+        &mut self,
+        py: Python<'py>,
+        flat: Vec<f64>,
+        k: usize,
+        last: Option<f64>,
+        ended: Option<f64>,
+        current: States<'py>,
+        snap: bool,
+    ) -> PyResult<Chunk<'py>> {
+        let b = self.members();
+        let (flat, k, times) = self.samples(flat, k, last);
+        let (states, att) = self.split(py, &flat, b, k)?;
+        let hits = match self.events.is_some() {
+            true => Some(self.events_found(py)?),
+            false => None,
+        };
+        let t = PyArray1::from_vec(py, times);
+        let t_final = (self.t_final(ended, snap), self.t_final(ended, false));
+        Ok((
+            t, states, att, current.0, current.1, self.done, ended, t_final, hits,
+        ))
+    }
+
+    /// The states saved at `times` instead of every `save_every`-th state (see `save_at`).
+    fn save_times(&mut self, times: Vec<f64>) -> PyResult<()> {
+        let full = self.full();
+        let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
+        check::array_size("t_eval", &[batch.len(), times.len(), full]).py()?;
+        // Output times need the members' own steppers (shortened steps).
+        for run in batch.runs_mut().py()?.iter_mut() {
+            run.save_at(&times).py()?;
+        }
+        self.at = Some(times);
+        Ok(())
+    }
+
+    /// `_run`: the initial states and the states saved in `steps` steps, and the final states.
+    pub(crate) fn run_all<'py>(&mut self, py: Python<'py>, steps: u64) -> PyResult<RunOut<'py>> {
+        let (flat, k) = self.drive(py, Until::Steps(steps))?;
+        let b = self.members();
+        let (flat, k, _) = self.samples(flat, k, None);
+        let (states, att) = self.split(py, &flat, b, k)?;
         let (zf, rf) = self.state(py)?;
-        let np = py.import("numpy")?;
-        let join = |first: Bound<'py, PyAny>, rest: Out<'py>| -> PyResult<Out<'py>> {
-            let first = np.call_method1("expand_dims", (first, 1))?;
-            Ok(np
-                .call_method1("concatenate", ((first, rest), 1))?
-                .cast_into()?)
-        };
-        let states = join(z0.into_any(), rest)?;
-        let att = match (r0, r_rest) {
-            (Some(r0), Some(r)) => Some(join(r0.into_any(), r)?),
-            _ => None,
-        };
         Ok((states, att, zf, rf))
+    }
+
+    /// The initial states (b, d) and attitudes (b, 3, 3) or None.
+    fn initial_states<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
+        self.states_of(py, &self.initial, self.members())
     }
 }
 
@@ -457,10 +793,101 @@ impl Integration {
     fn advance<'py>(
         &mut self,
         py: Python<'py>,
-        #[pyo3(from_py_with = int)] steps: i64,
+        steps: &Bound<'py, PyAny>,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
-        let steps = count("steps", steps)? as u64;
-        self.drive(py, Until::Steps(steps))
+        let steps = args::count("steps", steps)?;
+        let b = self.initial.len() / self.full().max(1);
+        let (flat, k) = self.drive(py, Until::Steps(steps))?;
+        self.split(py, &flat, b, k)
+    }
+
+    /// One call of `lieflow.integrate`'s loop: `steps` more steps, or with `t` to the time t
+    /// (as `finish`). Returns the samples of the call with their times (the initial states
+    /// first in the first call of a run that saves every `save_every`-th state), the current
+    /// states, the steps done, the end time of an ended run, the time of the current state
+    /// (snapped to the last output time within round-off, and not), and the events found.
+    ///
+    /// Raises as `advance`.
+    #[pyo3(signature = (steps, t = None))]
+    fn _chunk<'py>(
+        &mut self,
+        py: Python<'py>,
+        steps: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = real_opt)] t: Option<f64>,
+    ) -> PyResult<Chunk<'py>> {
+        let until = match t {
+            Some(t) => Until::Time(t),
+            None => Until::Steps(args::count("steps", steps)?),
+        };
+        let before = self.ended();
+        let (flat, mut k) = self.drive(py, until)?;
+        let ended = self.ended();
+        // A terminal event's state, saved last (not with output times).
+        let last = ended.filter(|_| before.is_none() && self.at.is_none());
+        if let (0, Some(times)) = (self.members(), &self.at) {
+            // An empty batch saves nothing natively: its samples are the output times passed.
+            let now = self.t0 + self.done as f64 * self.dt;
+            let tol = 8.0 * f64::EPSILON * now.abs().max(self.t0.abs());
+            let passed = match until {
+                Until::Time(_) => times.len(),
+                Until::Steps(_) => times.iter().take_while(|&&t| t <= now + tol).count(),
+            };
+            k = passed.saturating_sub(self.saved);
+        }
+        let current = self.state(py)?;
+        self.chunk_of(py, flat, k, last, ended, current, true)
+    }
+
+    /// After a failed call of a single run: `_chunk`'s tuple of the states that call saved
+    /// before its error (with the initial states when they are still due), ending at the last
+    /// checked state (`checked_state`, `steps_done`); None otherwise (then forgotten).
+    fn _partial<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Chunk<'py>>> {
+        if self.batched {
+            return Ok(None);
+        }
+        let Some(data) = self.partial.take() else {
+            return Ok(None);
+        };
+        let k = data.len() / self.full().max(1);
+        let current = self.checked_state(py)?;
+        self.chunk_of(py, data, k, None, None, current, false)
+            .map(Some)
+    }
+
+    /// `_chunk`'s tuple of a run before its first call completed: its initial samples and
+    /// states, at step 0 and time t₀.
+    fn _head<'py>(&mut self, py: Python<'py>) -> PyResult<Chunk<'py>> {
+        let current = self.initial_states(py)?;
+        let mut c = self.chunk_of(py, Vec::new(), 0, None, None, current, false)?;
+        (c.5, c.7) = (0, (self.t0, self.t0));
+        Ok(c)
+    }
+
+    /// The initial states (b, d) and attitudes (b, 3, 3) or None.
+    fn _initial<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
+        self.initial_states(py)
+    }
+
+    /// The number of members b.
+    #[getter]
+    fn members(&self) -> usize {
+        self.initial.len() / self.full().max(1)
+    }
+
+    /// The sample times t₀ + j·save_every·dt, j = 0 … steps // save_every, of a run of `steps`
+    /// steps that saves every `save_every`-th state.
+    fn _sample_times<'py>(
+        &self,
+        py: Python<'py>,
+        steps: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let k = args::count("steps", steps)? / self.save_every + 1;
+        let mut t = check::zeros("steps", &[usize::try_from(k).unwrap_or(usize::MAX)]).py()?;
+        let every = self.save_every as f64 * self.dt;
+        for (j, t) in t.iter_mut().enumerate() {
+            *t = self.t0 + j as f64 * every;
+        }
+        Ok(PyArray1::from_vec(py, t))
     }
 
     /// Advances every member to the time `t`: steps of size dt to the last grid time ≤ t, then,
@@ -472,7 +899,9 @@ impl Integration {
         py: Python<'py>,
         #[pyo3(from_py_with = real)] t: f64,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
-        self.drive(py, Until::Time(t))
+        let b = self.initial.len() / self.full().max(1);
+        let (flat, k) = self.drive(py, Until::Time(t))?;
+        self.split(py, &flat, b, k)
     }
 
     /// Saves the states at the times `t_eval` (1-D, strictly increasing, none before the
@@ -484,15 +913,7 @@ impl Integration {
     ///     the current time, too many to keep).
     fn save_at(&mut self, t_eval: ArrayIn<'_>) -> PyResult<()> {
         let times = vector("t_eval", &t_eval)?;
-        let full = self.d + if self.attitude { 9 } else { 0 };
-        let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
-        check::array_size("t_eval", &[batch.len(), times.len(), full]).py()?;
-        // Output times need the members' own steppers (shortened steps).
-        for run in batch.runs_mut().py()?.iter_mut() {
-            run.save_at(&times).py()?;
-        }
-        self.at = true;
-        Ok(())
+        self.save_times(times)
     }
 
     /// Locates the zeros of the event functions `functions[i](t, state)` (state (d,) as in the
@@ -657,10 +1078,9 @@ impl Integration {
         let data: Vec<f64> = if !self.calls_out && batch.in_lanes() {
             // Batches in lanes: read in parallel on the run's threads, GIL released.
             let batch = &mut *batch;
-            let states = py.detach(|| match &self.pool {
-                Some(p) => p.install(|| batch.states(sys)),
-                None => batch.states(sys),
-            });
+            let states = py
+                .detach(|| with_threads(self.threads, || Ok(batch.states(sys))))
+                .py()?;
             states.into_iter().flatten().collect()
         } else {
             (0..b).flat_map(|i| batch.state(sys, i)).collect()

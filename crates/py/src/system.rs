@@ -4,19 +4,19 @@
 //! the GIL released, a batch in parallel), `__reduce__` (pickling) and `__repr__`. A system
 //! class is a thin subclass: its constructor and its own observables.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
-use lieflow::integrate::{Block, Space, System};
+use lieflow::integrate::{Block, Resolved, Space, System};
 use lieflow::{check, Error};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyCFunction, PyDict, PyList, PyTuple, PyType};
 
-use crate::convert::{int, int_opt, real, size_opt};
 use crate::convert::{read_all, shape_str, ArrayIn};
+use crate::convert::{size_opt, vector};
 use crate::errors::{checked, to_py, IntoPy};
-use crate::integrate::{Integration, RunOut};
+use crate::integrate::{args, Integration, RunOut};
 use crate::items::{map_items, Input};
 
 /// Base class of every lieflow system (RigidBody, HeavyTop, PseudoRigidBody, …): the
@@ -31,7 +31,13 @@ pub struct PySystem {
     lifted: Option<Arc<dyn System>>,
     pub(crate) args: Py<PyTuple>,
     names: &'static [&'static str],
+    /// The methods resolved so far, by (lifted, name; None: the default): a system object is
+    /// frozen, so a method is looked up once for all its runs.
+    resolved: Mutex<Vec<MethodOf>>,
 }
+
+/// A resolved method of a system object: (lifted, name; None: the default), the method.
+type MethodOf = (bool, Option<String>, Arc<Resolved>);
 
 impl PySystem {
     /// The base part of a system object over `sys`, built from the constructor arguments `args`
@@ -46,7 +52,31 @@ impl PySystem {
             sys: Arc::new(sys),
             args: args.unbind(),
             names,
+            resolved: Mutex::new(Vec::new()),
         }
+    }
+
+    /// The method `method` (None: the default) of the core system `sys` (the lifted one when
+    /// `lifted`), resolved once per system object.
+    fn resolve(
+        &self,
+        sys: &Arc<dyn System>,
+        lifted: bool,
+        method: Option<&str>,
+    ) -> lieflow::Result<Arc<Resolved>> {
+        let mut cache = self.resolved.lock().unwrap_or_else(|p| p.into_inner());
+        let hit = cache
+            .iter()
+            .find(|(l, m, _)| *l == lifted && m.as_deref() == method);
+        if let Some((_, _, r)) = hit {
+            return Ok(r.clone());
+        }
+        let r = match method {
+            Some(m) => sys.resolve(m)?,
+            None => sys.resolve_default()?,
+        };
+        cache.push((lifted, method.map(str::to_string), r.clone()));
+        Ok(r)
     }
 
     /// The core system of a run: the lifted one when an attitude is given.
@@ -60,6 +90,35 @@ impl PySystem {
                 format!("{} carries no attitude", self.sys.name()),
             ))
         })
+    }
+
+    /// Reads an initial state (see `_normalize_state`): the rows (b·d values) and whether it is
+    /// a batch.
+    pub(crate) fn normalize(&self, state0: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, bool)> {
+        let space = self.sys.space();
+        let d = space.dim();
+        let blocks = space.blocks().len();
+        let sequence = state0.is_instance_of::<PyTuple>() || state0.is_instance_of::<PyList>();
+        if sequence && blocks > 1 && state0.len()? == blocks {
+            // One array per block, unless these are flat states (a batch of length `blocks`).
+            let first = ArrayIn::named("state0", &state0.get_item(0)?)?;
+            let shape = space.blocks()[0].1.shape();
+            if first.as_array().shape().ends_with(&shape) {
+                return from_blocks(&space, state0);
+            }
+        }
+        let a = ArrayIn::named("state0", state0)?;
+        let v = a.as_array();
+        if !(v.ndim() == 1 || v.ndim() == 2) || v.shape()[v.ndim() - 1] != d {
+            return Err(to_py(Error::shape(
+                "state0",
+                format!("({d},) or a batch (b, {d})"),
+                shape_str(v.shape()),
+            )));
+        }
+        let data = read_all("state0", &v)?;
+        finite_members("state0", &data, &[d], v.ndim() == 2)?;
+        Ok((data, v.ndim() == 2))
     }
 
     /// Applies `f(state) -> values` to every state (..., d), checking finiteness; output
@@ -133,11 +192,7 @@ fn rows_array<'py>(
 }
 
 /// Parses a state in tuple form: one array per block (a batch along a leading axis).
-fn from_blocks<'py>(
-    py: Python<'py>,
-    space: &Space,
-    parts: &Bound<'py, PyAny>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, bool)> {
+fn from_blocks(space: &Space, parts: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, bool)> {
     let mut columns = Vec::new();
     let mut lead: Option<Vec<usize>> = None;
     for (k, (name, block, _)) in space.ranges().enumerate() {
@@ -166,7 +221,7 @@ fn from_blocks<'py>(
             at += len;
         }
     }
-    Ok((rows_array(py, z, d)?, !lead.is_empty()))
+    Ok((z, !lead.is_empty()))
 }
 
 #[pymethods]
@@ -209,112 +264,137 @@ impl PySystem {
         py: Python<'py>,
         state0: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, bool)> {
-        let space = self.sys.space();
-        let d = space.dim();
-        let blocks = space.blocks().len();
-        let sequence = state0.is_instance_of::<PyTuple>() || state0.is_instance_of::<PyList>();
-        if sequence && blocks > 1 && state0.len()? == blocks {
-            // One array per block, unless these are flat states (a batch of length `blocks`).
-            let first = ArrayIn::named("state0", &state0.get_item(0)?)?;
-            let shape = space.blocks()[0].1.shape();
-            if first.as_array().shape().ends_with(&shape) {
-                return from_blocks(py, &space, state0);
-            }
-        }
-        let a = ArrayIn::named("state0", state0)?;
-        let v = a.as_array();
-        let bad = || {
-            to_py(Error::shape(
-                "state0",
-                format!("({d},) or a batch (b, {d})"),
-                shape_str(v.shape()),
-            ))
-        };
-        if !(v.ndim() == 1 || v.ndim() == 2) || v.shape()[v.ndim() - 1] != d {
-            return Err(bad());
-        }
-        let data = read_all("state0", &v)?;
-        finite_members("state0", &data, &[d], v.ndim() == 2)?;
-        Ok((rows_array(py, data, d)?, v.ndim() == 2))
+        let (rows, batched) = self.normalize(state0)?;
+        Ok((rows_array(py, rows, self.sys.space().dim())?, batched))
     }
 
-    /// Starts a native run of every row of `z0` (the chunked driver of `lieflow.integrate`
-    /// resumes it with `advance`).
+    /// Starts a native run of the initial state(s) `state0` (the chunked driver of
+    /// `lieflow.integrate` resumes it with `_chunk`). Every argument is read and checked here,
+    /// once, in the order and the words of `lieflow.integrate`.
     ///
     /// Args:
-    ///     z0: (b, d) initial states; attitude0: (b, 3, 3) rotations or None; dt > 0; method: a
-    ///     name from `methods()`, or None for the first (the system's default); save_every >= 1;
-    ///     t0 (keyword): the time of z0; threads
-    ///     (keyword): None for all cores, or the number of threads; steps (keyword): the steps
-    ///     the caller will take in all, to refuse a trajectory that cannot be kept before any;
-    ///     first_member (keyword): the ensemble index of z0's first row when z0 is a part of an
-    ///     ensemble (`lieflow.ensemble`): errors then name members by it ("batch member 7").
+    ///     state0: as `_normalize_state` reads it; attitude0: None, one (3, 3) rotation (shared
+    ///     by a batch) or one per member (b, 3, 3); dt > 0; method: a name from `methods()`, or
+    ///     None for the first (the system's default); save_every >= 1; t0 (keyword): the time
+    ///     of state0; threads (keyword): None for all cores, or the number of threads; steps
+    ///     (keyword): the steps the caller will take in all, to refuse a trajectory that cannot
+    ///     be kept before any; first_member (keyword): the ensemble index of the first member
+    ///     when state0 is a part of an ensemble (`lieflow.ensemble`): errors then name members
+    ///     by it ("batch member 7"); t_eval (keyword): the output times (1-D, float64, finite),
+    ///     within [t0, t0 + steps·dt]; single (keyword): refuse a batch (a run with events).
     /// Raises:
-    ///     InvalidArgumentError, UnsupportedMethodError, ShapeError, NonFiniteError,
+    ///     TypeError, InvalidArgumentError, UnsupportedMethodError, ShapeError, NonFiniteError,
     ///     NotInGroupError (state constraints and attitude).
-    #[pyo3(signature = (z0, attitude0, dt, method, save_every, *, t0 = 0.0, threads = None, steps = None, first_member = None))]
+    #[pyo3(signature = (state0, attitude0, dt, method, save_every, t0 = None, threads = None, steps = None, first_member = None, t_eval = None, single = false))]
     #[allow(clippy::too_many_arguments)]
-    fn _start(
+    fn _start<'py>(
         &self,
-        z0: ArrayIn<'_>,
-        attitude0: Option<ArrayIn<'_>>,
-        #[pyo3(from_py_with = real)] dt: f64,
-        method: Option<&str>,
-        #[pyo3(from_py_with = int)] save_every: i64,
-        #[pyo3(from_py_with = real)] t0: f64,
-        #[pyo3(from_py_with = int_opt)] threads: Option<i64>,
-        #[pyo3(from_py_with = int_opt)] steps: Option<i64>,
+        state0: &Bound<'py, PyAny>,
+        attitude0: &Bound<'py, PyAny>,
+        dt: &Bound<'py, PyAny>,
+        method: &Bound<'py, PyAny>,
+        save_every: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = args::given)] t0: Option<Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = args::given)] threads: Option<Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = args::given)] steps: Option<Bound<'py, PyAny>>,
         #[pyo3(from_py_with = size_opt)] first_member: Option<usize>,
+        t_eval: Option<ArrayIn<'py>>,
+        single: bool,
     ) -> PyResult<Integration> {
-        let sys = self.runner(attitude0.is_some())?.clone();
+        let steps = args::count_opt("steps", steps.as_ref())?;
+        let save_every = args::count("save_every", save_every)?;
+        let dt = args::step(dt)?;
+        let t0 = t0.as_ref().map_or(Ok(0.0), |t| args::time("t0", t))?;
+        let method = args::method(method)?;
+        let times = t_eval.map(|t| vector("t_eval", &t)).transpose()?;
+        if times.is_some() && save_every != 1 {
+            return Err(to_py(Error::invalid(
+                "save_every",
+                "t_eval gives the output times; leave save_every at 1",
+            )));
+        }
+        let (rows, batched) = self.normalize(state0)?;
+        let d = self.sys.space().dim();
+        let b = rows.len().checked_div(d).unwrap_or(0);
+        if single && batched {
+            return Err(to_py(Error::invalid(
+                "events",
+                format!(
+                    "events are located in a single run, got a batch of {b} initial states; \
+                     integrate the members one by one"
+                ),
+            )));
+        }
+        let attitude = match attitude0.is_none() {
+            true => None,
+            false => Some(args::attitude(attitude0, b, batched)?),
+        };
+        let threads = args::count_opt("threads", threads.as_ref())?;
+        let sys = self.runner(attitude.is_some())?.clone();
+        let resolved = self.resolve(&sys, attitude.is_some(), method.as_deref());
+        let states = (0..b)
+            .map(|i| {
+                let mut z = rows[i * d..(i + 1) * d].to_vec();
+                if let Some(a) = &attitude {
+                    z.extend_from_slice(&a[i * 9..(i + 1) * 9]);
+                }
+                z
+            })
+            .collect();
         Integration::start(
             sys,
-            &z0,
-            attitude0.as_ref(),
+            states,
+            batched,
+            attitude.is_some(),
             dt,
-            method,
+            resolved,
+            method.as_deref(),
             save_every,
             t0,
-            threads,
+            threads.map(|n| usize::try_from(n).unwrap_or(usize::MAX)),
             steps,
             first_member,
+            times,
         )
     }
 
-    /// Integrates every row of `z0` by `steps` steps in one native run (see `_start`).
+    /// Integrates `state0` by `steps` steps in one native run (arguments as `_start`).
     ///
     /// Returns:
     ///     (states (b, k, d), attitude (b, k, 3, 3) or None, z_final (b, d), attitude_final
     ///     (b, 3, 3) or None), k = steps // save_every + 1.
     /// Raises:
     ///     as `_start`, and ConvergenceError, LeftDomainError (naming the time) during the run.
-    #[pyo3(signature = (z0, attitude0, dt, steps, save_every, method, *, t0 = 0.0, threads = None, first_member = None))]
+    #[pyo3(signature = (state0, attitude0, dt, steps, save_every, method, *, t0 = None, threads = None, first_member = None))]
     #[allow(clippy::too_many_arguments)]
     fn _run<'py>(
         &self,
         py: Python<'py>,
-        z0: ArrayIn<'py>,
-        attitude0: Option<ArrayIn<'py>>,
-        #[pyo3(from_py_with = real)] dt: f64,
-        #[pyo3(from_py_with = int)] steps: i64,
-        #[pyo3(from_py_with = int)] save_every: i64,
-        method: Option<&str>,
-        #[pyo3(from_py_with = real)] t0: f64,
-        #[pyo3(from_py_with = int_opt)] threads: Option<i64>,
+        state0: &Bound<'py, PyAny>,
+        attitude0: &Bound<'py, PyAny>,
+        dt: &Bound<'py, PyAny>,
+        steps: &Bound<'py, PyAny>,
+        save_every: &Bound<'py, PyAny>,
+        method: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = args::given)] t0: Option<Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = args::given)] threads: Option<Bound<'py, PyAny>>,
         #[pyo3(from_py_with = size_opt)] first_member: Option<usize>,
     ) -> PyResult<RunOut<'py>> {
         let mut run = self._start(
-            z0,
+            state0,
             attitude0,
             dt,
             method,
             save_every,
             t0,
             threads,
-            Some(steps),
+            Some(steps.clone()),
             first_member,
+            None,
+            false,
         )?;
-        run.run_all(py, steps)
+        let n = args::count("steps", steps)?;
+        run.run_all(py, n)
     }
 
     /// The energy (Hamiltonian) of states, vectorised: (..., d) -> (...).

@@ -18,9 +18,11 @@
 
 use rayon::prelude::*;
 
-use super::method::{BatchStepper, Clock, Integrator, Properties, Stepper, System};
+use std::sync::Arc;
+
+use super::method::{BatchStepper, Clock, Integrator, Resolved, Stepper, System};
 use super::problem::Problem;
-use super::Run;
+use super::run::{check_start, Run};
 use crate::check;
 use crate::error::{Error, Result};
 
@@ -81,40 +83,62 @@ impl Batch {
         save_every: usize,
         t0: f64,
     ) -> std::result::Result<Batch, (Option<usize>, Error)> {
-        let properties = system
-            .methods()
-            .into_iter()
-            .find(|(m, _)| *m == method)
-            .map(|(_, p)| p);
+        // An unknown method is reported after the first member's own errors, as by Run::new
+        // (and an empty batch has none).
+        let method = match system.resolve(method) {
+            Ok(m) => m,
+            Err(e) => {
+                return match states0.first() {
+                    Some(z) => Err((
+                        Some(0),
+                        check_start(system, z, dt, save_every, t0)
+                            .err()
+                            .unwrap_or(e),
+                    )),
+                    None => Ok(Batch {
+                        runs: Vec::new(),
+                        lanes: Vec::new(),
+                    }),
+                }
+            }
+        };
+        Batch::resolved(system, &method, states0, dt, save_every, t0)
+    }
+
+    /// [`Batch::start`] with a method already resolved ([`System::resolve`]) for `problem`.
+    pub fn resolved<P: Problem + ?Sized>(
+        problem: &P,
+        method: &Arc<Resolved>,
+        states0: &[Vec<f64>],
+        dt: f64,
+        save_every: usize,
+        t0: f64,
+    ) -> std::result::Result<Batch, (Option<usize>, Error)> {
         // With blocks the groups are set up in parallel (on the current rayon pool); without,
         // member after member on the calling thread, as before (a system may call back into
         // a host language that this thread holds locked, such as Python's GIL). The error is
         // the one of the first member that has one.
         let group = |(g, chunk): (usize, &[Vec<f64>])| {
-            start_group(
-                system,
-                method,
-                properties,
-                chunk,
-                g * GROUP,
-                dt,
-                save_every,
-                t0,
-            )
+            start_group(problem, method, chunk, g * GROUP, dt, save_every, t0)
         };
-        let in_lanes = properties.is_some()
+        // One member has no block to share: it steps alone (bit for bit the same).
+        let in_lanes = states0.len() > 1
             && dt.is_finite()
             && dt > 0.0
-            && system.batch_stepper(method, dt, 0).is_some();
+            && method.batch_stepper(dt, 0).is_some();
         let groups: Vec<_> = if in_lanes {
             states0.par_chunks(GROUP).enumerate().map(group).collect()
         } else {
             // Each member's run holds a stepper of its own, of a size no formula gives: the
-            // memory taken is watched as they are built.
-            let budget = check::BuildBudget::new("state0", states0.len());
+            // memory taken is watched as they are built (from the second group on: one group
+            // is small, and reading the memory available costs more than a short run).
+            let budget =
+                (states0.len() > GROUP).then(|| check::BuildBudget::new("state0", states0.len()));
             let mut groups = Vec::with_capacity(states0.len().div_ceil(GROUP));
             for (g, chunk) in states0.chunks(GROUP).enumerate() {
-                budget.check(g * GROUP).map_err(|e| (None, e))?;
+                if let Some(budget) = &budget {
+                    budget.check(g * GROUP).map_err(|e| (None, e))?;
+                }
                 groups.push(group((g, chunk)));
             }
             groups
@@ -135,7 +159,11 @@ impl Batch {
     ///
     /// Errors: those of the batch stepper's `set` (the runs' states were checked already).
     pub fn new<S: System + ?Sized>(system: &S, method: &str, runs: Vec<Run>) -> Result<Batch> {
-        Batch::build(runs, |n, dt| system.batch_stepper(method, dt, n))
+        let method = match runs.first().and_then(|r| r.method.clone()) {
+            Some(m) if m.name == method => m,
+            _ => system.resolve(method)?,
+        };
+        Batch::build(runs, |n, dt| method.batch_stepper(dt, n))
     }
 
     /// [`Batch::new`] for runs made with a method value ([`Run::with`]).
@@ -288,11 +316,9 @@ impl Batch {
 }
 
 /// The runs of one group of [`Batch::start`] (members `first`…) and its block, if any.
-#[allow(clippy::too_many_arguments)]
-fn start_group<S: System + ?Sized>(
-    system: &S,
-    method: &str,
-    properties: Option<Properties>,
+fn start_group<P: Problem + ?Sized>(
+    problem: &P,
+    method: &Arc<Resolved>,
     chunk: &[Vec<f64>],
     first: usize,
     dt: f64,
@@ -300,24 +326,27 @@ fn start_group<S: System + ?Sized>(
     t0: f64,
 ) -> std::result::Result<(Vec<Run>, Option<Lanes>), (usize, Error)> {
     let mut runs = Vec::with_capacity(chunk.len());
-    let block = match properties {
-        Some(p) if dt.is_finite() && dt > 0.0 => system
-            .batch_stepper(method, dt, chunk.len())
-            .map(|b| b.map(|b| (p, b)).map_err(|e| (first, e)))
-            .transpose()?,
-        _ => None,
+    let block = match chunk.len() > 1 && dt.is_finite() && dt > 0.0 {
+        true => method
+            .batch_stepper(dt, chunk.len())
+            .transpose()
+            .map_err(|e| (first, e))?,
+        false => None,
     };
-    let Some((p, mut stepper)) = block else {
+    let Some(mut stepper) = block else {
         for (j, z) in chunk.iter().enumerate() {
-            let run = Run::new(system, method, z, dt, save_every, t0);
+            let run = Run::resolved(problem, method, z, dt, save_every, t0);
             runs.push(run.map_err(|e| (first + j, e))?);
         }
         return Ok((runs, None));
     };
     for (j, z) in chunk.iter().enumerate() {
-        let placeholder = || Ok((Box::new(InBlock) as Box<dyn Stepper>, p));
-        let run = Run::start(system, Some(method), z, dt, save_every, t0, placeholder)
-            .map_err(|e| (first + j, e))?;
+        let placeholder = || {
+            let stepper = Box::new(InBlock) as Box<dyn Stepper>;
+            Ok((stepper, method.properties, Some(method.clone())))
+        };
+        let run =
+            Run::start(problem, z, dt, save_every, t0, placeholder).map_err(|e| (first + j, e))?;
         stepper.set(j, &run.buf).map_err(|e| (first + j, e))?;
         runs.push(run);
     }

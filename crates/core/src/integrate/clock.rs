@@ -23,6 +23,37 @@ impl Clock {
         self.t0 + (self.done + k as u64) as f64 * self.dt
     }
 
+    /// Round-off of grid times near `t`: 8ε·max(|t|, |t₀|).
+    pub fn grid_tol(&self, t: f64) -> f64 {
+        8.0 * f64::EPSILON * t.abs().max(self.t0.abs())
+    }
+
+    /// The grid step k with t₀ + k·dt = t within round-off (true) or t₀ + k·dt < t < t₀ +
+    /// (k+1)·dt (false); k = 0 for t ≤ t₀.
+    pub fn grid_of(&self, t: f64) -> (u64, bool) {
+        let time = |k: u64| self.t0 + k as f64 * self.dt;
+        let tol = self.grid_tol(t);
+        let x = ((t - self.t0) / self.dt).floor();
+        let mut k = if x.is_nan() || x <= 0.0 {
+            0
+        } else if x >= 9.2e18 {
+            u64::MAX / 2
+        } else {
+            x as u64
+        };
+        for _ in 0..4 {
+            if k > 0 && time(k) > t + tol {
+                k -= 1;
+            }
+        }
+        for _ in 0..4 {
+            if time(k + 1) <= t + tol {
+                k += 1;
+            }
+        }
+        (k, (time(k) - t).abs() <= tol)
+    }
+
     /// The error for a domain violation found during step `k + 1` of this call (k steps done).
     pub fn left_domain(&self, k: usize, v: Violation) -> Error {
         let step = self.done + k as u64 + 1;

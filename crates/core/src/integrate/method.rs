@@ -8,7 +8,8 @@
 //! A system publishes a [`Catalog`]: the (name, method) pairs the Python API knows it by
 //! ("splitting4", "verlet", …); the first entry is the system's default. Through the blanket
 //! [`System`] implementation every catalogued problem is usable as a `dyn System` by name, which
-//! is what the driver and the Python bindings hold.
+//! is what the driver and the Python bindings hold; [`System::resolve`] looks a name up once and
+//! gives a [`Resolved`] method, which runs and batches hold.
 
 use std::sync::Arc;
 
@@ -169,24 +170,64 @@ pub trait Catalog: Problem + Clone + 'static {
     }
 }
 
+/// A method of a system's catalog, looked up once by name ([`System::resolve`]): its name, what
+/// it claims, and its steppers of any step size. A run and a batch hold it for their whole life
+/// (shortened steps, blocks of lanes, detached members); nothing looks the name up again.
+pub struct Resolved {
+    /// The name in the system's catalog.
+    pub name: &'static str,
+    /// What the method claims for the system.
+    pub properties: Properties,
+    stepper: Box<dyn Fn(f64) -> Result<Box<dyn Stepper>> + Send + Sync>,
+    batch: BatchMaker,
+}
+
+/// The batch steppers of a [`Resolved`] method: (dt, members) → a block, where it has one.
+type BatchMaker = Box<dyn Fn(f64, usize) -> Option<Result<Box<dyn BatchStepper>>> + Send + Sync>;
+
+impl Resolved {
+    /// A stepper of step size `dt` ([`Integrator::stepper`]).
+    pub fn stepper(&self, dt: f64) -> Result<Box<dyn Stepper>> {
+        (self.stepper)(dt)
+    }
+
+    /// A [`BatchStepper`] of `members` members, where the method has one for the system
+    /// ([`Integrator::batch_stepper`]).
+    pub fn batch_stepper(&self, dt: f64, members: usize) -> Option<Result<Box<dyn BatchStepper>>> {
+        (self.batch)(dt, members)
+    }
+}
+
 /// A system the driver integrates by method name: every [`Catalog`] problem, as a trait object.
 pub trait System: Problem {
     /// The names and properties of the catalogued methods; the first is the default.
     fn methods(&self) -> Vec<(&'static str, Properties)>;
 
-    /// A stepper for the method called `method`, or [`Error::UnsupportedMethod`] listing this
+    /// The method called `method`, looked up once, or [`Error::UnsupportedMethod`] listing this
     /// system's methods (with a suggestion when the name is close to one of them).
-    fn stepper(&self, method: &str, dt: f64) -> Result<(Box<dyn Stepper>, Properties)>;
+    fn resolve(&self, method: &str) -> Result<Arc<Resolved>>;
+
+    /// The system's default method (the first of its catalog), resolved once.
+    fn resolve_default(&self) -> Result<Arc<Resolved>>;
+
+    /// A stepper for the method called `method` ([`System::resolve`], then
+    /// [`Resolved::stepper`]).
+    fn stepper(&self, method: &str, dt: f64) -> Result<(Box<dyn Stepper>, Properties)> {
+        let m = self.resolve(method)?;
+        Ok((m.stepper(dt)?, m.properties))
+    }
 
     /// A [`BatchStepper`] of `members` members for the method called `method`, where the method
-    /// has one for this system ([`Integrator::batch_stepper`]); None otherwise (also for an
-    /// unknown name: [`System::stepper`] reports it).
+    /// has one for this system; None otherwise (also for an unknown name: [`System::resolve`]
+    /// reports it).
     fn batch_stepper(
         &self,
         method: &str,
         dt: f64,
         members: usize,
-    ) -> Option<Result<Box<dyn BatchStepper>>>;
+    ) -> Option<Result<Box<dyn BatchStepper>>> {
+        self.resolve(method).ok()?.batch_stepper(dt, members)
+    }
 
     /// The system carrying its attitude along ([`Catalog::lifted`]).
     fn lift(&self) -> Option<Arc<dyn System>>;
@@ -206,27 +247,23 @@ impl<P: Catalog> System for P {
             .collect()
     }
 
-    fn stepper(&self, method: &str, dt: f64) -> Result<(Box<dyn Stepper>, Properties)> {
+    fn resolve(&self, method: &str) -> Result<Arc<Resolved>> {
         let catalog = self.catalog();
-        match catalog.iter().find(|e| e.name == method) {
-            Some(e) => Ok((e.method.stepper(self, dt)?, e.method.properties())),
-            None => Err(unsupported(
-                self.name(),
-                method,
-                &catalog.iter().map(|e| e.name).collect::<Vec<_>>(),
-            )),
+        match catalog.iter().position(|e| e.name == method) {
+            Some(i) => Ok(resolved(self, catalog, i)),
+            None => {
+                let names: Vec<_> = catalog.iter().map(|e| e.name).collect();
+                Err(unsupported(self.name(), method, &names))
+            }
         }
     }
 
-    fn batch_stepper(
-        &self,
-        method: &str,
-        dt: f64,
-        members: usize,
-    ) -> Option<Result<Box<dyn BatchStepper>>> {
+    fn resolve_default(&self) -> Result<Arc<Resolved>> {
         let catalog = self.catalog();
-        let e = catalog.iter().find(|e| e.name == method)?;
-        e.method.batch_stepper(self, dt, members)
+        match catalog.is_empty() {
+            false => Ok(resolved(self, catalog, 0)),
+            true => Err(unsupported(self.name(), "", &[])),
+        }
     }
 
     fn lift(&self) -> Option<Arc<dyn System>> {
@@ -239,6 +276,20 @@ impl<P: Catalog> System for P {
     ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>> {
         Catalog::dissipation(self, d)
     }
+}
+
+/// Entry `i` of `problem`'s catalog as a [`Resolved`] method (holding a copy of the problem).
+fn resolved<P: Catalog>(problem: &P, mut catalog: Vec<Entry<P>>, i: usize) -> Arc<Resolved> {
+    let entry = catalog.swap_remove(i);
+    let integrator: Arc<dyn Integrator<P>> = entry.method.into();
+    let problem = Arc::new(problem.clone());
+    let (i2, p2) = (integrator.clone(), problem.clone());
+    Arc::new(Resolved {
+        name: entry.name,
+        properties: integrator.properties(),
+        stepper: Box::new(move |dt| integrator.stepper(&problem, dt)),
+        batch: Box::new(move |dt, n| i2.batch_stepper(&p2, dt, n)),
+    })
 }
 
 /// The error for an unknown method: the system's own methods, and the closest one when the name

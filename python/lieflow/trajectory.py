@@ -1,0 +1,244 @@
+"""The result of ``lieflow.integrate``: the ``Trajectory`` (samples, final state, events, named
+views and observables of the system) and ``load``, which reads one back from a file."""
+
+import numpy as np
+
+from ._lieflow import InvalidArgumentError
+
+__all__ = ["Trajectory", "load"]
+
+
+class Trajectory:
+    """A computed trajectory.
+
+    Attributes:
+        system, method, dt: as passed to ``integrate``.
+        save_every: as passed to ``integrate`` (None when ``t_eval`` gave the times).
+        t: (k,) sample times (absolute: from ``t0``; ``t_eval`` when given).
+        states: (k, d) samples, or (b, k, d) for a batch.
+        attitude: (k, 3, 3) / (b, k, 3, 3) attitudes, or None.
+        final_state, final_attitude: the state after all steps (also when ``steps`` is not a
+            multiple of ``save_every``; a terminal event's state); pass them to ``integrate``
+            with ``t0=traj.t_final`` to continue.
+        t0, t_final: the times of the initial and the final state.
+        initial_state, initial_attitude: the state the run started from.
+        status: 0 the run reached its end, 1 a terminal event ended it, -1 it failed (the
+            ``partial`` trajectory of an exception), as scipy's.
+        t_events, state_events: with ``events``, one array per event function of the times
+            (n_i,) and the states (n_i, d) of its zeros (``attitude_events`` (n_i, 3, 3) with an
+            attitude); None without events.
+        Named views from the system (e.g. ``M``, ``Gamma``, ``q``, ``L``) as attributes.
+
+    Methods ``energy()`` and ``casimirs()``, ``to_xarray()`` and ``save(path)`` (read back with
+    ``lf.load(path)``), and every observable of the system:
+    ``traj.NAME(...)`` is ``system.NAME(traj.states, ...)`` (with the attitude passed as well for
+    observables such as ``spatial_momentum`` that need it). ``Trajectory.concatenate([a, b])``
+    joins a run and its continuation.
+    """
+
+    def __init__(self, system, method, t, states, attitude, final_state, final_attitude, dt,
+                 save_every, *, t_final=None, status=0, t_events=None, state_events=None,
+                 attitude_events=None, t0=None, initial_state=None, initial_attitude=None):
+        self.system = system
+        self.method = method
+        self.t = t
+        self.states = states
+        self.attitude = attitude
+        self.final_state = final_state
+        self.final_attitude = final_attitude
+        self.dt = dt
+        self.save_every = save_every
+        self.t_final = t_final if t_final is not None else (float(t[-1]) if len(t) else None)
+        self.status = status
+        self.t_events = t_events
+        self.state_events = state_events
+        self.attitude_events = attitude_events
+        self.t0 = t0 if t0 is not None else (float(t[0]) if len(t) else None)
+        self.initial_state = initial_state
+        self.initial_attitude = initial_attitude
+        self._field_cache = None
+
+    @classmethod
+    def concatenate(cls, trajectories):
+        """One trajectory from a run and its continuations: each must start where the one
+        before ended (its ``t0`` equal to the previous ``t_final`` and its initial state equal
+        to the previous ``final_state``, as ``integrate(system, traj.final_state, ...,
+        t0=traj.t_final)`` gives) on the same system. A sample repeated at the seam (the first
+        of a continuation is the last of the one before when that was its final state) is kept
+        once; events are joined per event function (None unless every part has the same number
+        of event functions). ``method``, ``dt`` and ``save_every`` are the parts' common values
+        (a tuple of the methods, None for dt and save_every, where they differ).
+
+        Raises:
+            TypeError (not Trajectories), InvalidArgumentError (nothing to join, other systems,
+            batch or state shapes, attitudes that come and go, a part that does not start where
+            the one before ended).
+        """
+        expected = "invalid trajectories: expected a list of Trajectory objects"
+        if isinstance(trajectories, (str, bytes, dict)):
+            raise TypeError(f"{expected}, got a {type(trajectories).__name__}")
+        try:
+            parts = list(trajectories)
+        except TypeError:
+            raise TypeError(f"{expected}, got a {type(trajectories).__name__}") from None
+        bad = [type(p).__name__ for p in parts if not isinstance(p, Trajectory)]
+        if bad:
+            raise TypeError(f"{expected}, got one of type {bad[0]}")
+        if not parts:
+            raise InvalidArgumentError("invalid trajectories: nothing to concatenate")
+        first = parts[0]
+        for i, (a, b) in enumerate(zip(parts, parts[1:]), start=1):
+            where = f"invalid trajectories: part {i}"
+            same = a.system is b.system or (type(a.system) is type(b.system)
+                                            and repr(a.system) == repr(b.system))
+            if not same:
+                raise InvalidArgumentError(f"{where} integrates another system ({b.system!r:.60} "
+                                           f"after {a.system!r:.60})")
+            if a.states.shape[:-2] != b.states.shape[:-2] or a.states.shape[-1] != b.states.shape[-1]:
+                raise InvalidArgumentError(f"{where} has states of shape {b.states.shape} after "
+                                           f"{a.states.shape}")
+            if (a.attitude is None) != (b.attitude is None):
+                raise InvalidArgumentError(f"{where}: an attitude in one part only")
+            t_a, t_b = a.t_final, b.t0
+            tol = 16 * np.finfo(float).eps * max(abs(t_a), abs(t_b)) + 1e-9 * min(a.dt, b.dt)
+            if t_a is None or t_b is None or not abs(t_b - t_a) <= tol:
+                raise InvalidArgumentError(f"{where} starts at t = {t_b!r}, not where the one "
+                                           f"before ended (t = {t_a!r}); continue a run with "
+                                           f"integrate(system, traj.final_state, ..., "
+                                           f"t0=traj.t_final)")
+            if b.initial_state is not None and not np.array_equal(b.initial_state, a.final_state):
+                raise InvalidArgumentError(f"{where} does not start from the final state of the "
+                                           f"one before")
+            if (b.initial_attitude is not None and a.final_attitude is not None
+                    and not np.array_equal(b.initial_attitude, a.final_attitude)):
+                raise InvalidArgumentError(f"{where} does not start from the final attitude of "
+                                           f"the one before")
+        t, states, atts = [first.t], [first.states], [first.attitude]
+        for a, b in zip(parts, parts[1:]):
+            drop = (len(a.t) and len(b.t) and b.t[0] <= a.t[-1]
+                    + 16 * np.finfo(float).eps * max(abs(a.t[-1]), 1.0) + 1e-9 * b.dt)
+            s = 1 if drop else 0
+            t.append(b.t[s:])
+            states.append(b.states[..., s:, :])
+            if b.attitude is not None:
+                atts.append(b.attitude[..., s:, :, :])
+        axis = states[0].ndim - 2
+        last = parts[-1]
+
+        def common(name):
+            values = [getattr(p, name) for p in parts]
+            return values[0] if all(v == values[0] for v in values) else None
+
+        methods = [p.method for p in parts]
+        method = methods[0] if all(m == methods[0] for m in methods) else tuple(methods)
+        events = {}
+        counts = {None if p.t_events is None else len(p.t_events) for p in parts}
+        if len(counts) == 1 and None not in counts:
+            n = counts.pop()
+            events["t_events"] = [np.concatenate([p.t_events[i] for p in parts]) for i in range(n)]
+            events["state_events"] = [np.concatenate([p.state_events[i] for p in parts])
+                                      for i in range(n)]
+            if all(p.attitude_events is not None for p in parts):
+                events["attitude_events"] = [np.concatenate([p.attitude_events[i] for p in parts])
+                                             for i in range(n)]
+        return cls(first.system, method, np.concatenate(t), np.concatenate(states, axis=axis),
+                   None if first.attitude is None else np.concatenate(atts, axis=axis),
+                   last.final_state, last.final_attitude, common("dt"), common("save_every"),
+                   t_final=last.t_final, status=last.status, t0=first.t0,
+                   initial_state=first.initial_state, initial_attitude=first.initial_attitude,
+                   **events)
+
+    @property
+    def batched(self):
+        """Whether the states carry a leading batch axis."""
+        return self.states.ndim == 3
+
+    def __len__(self):
+        """The number of samples k."""
+        return len(self.t)
+
+    def __repr__(self):
+        span = f"t=[{self.t[0]:g}, {self.t[-1]:g}]" if len(self.t) else "t=[]"
+        return (f"<Trajectory {type(self.system).__name__} method={self.method!r} "
+                f"states{self.states.shape} {span}>")
+
+    def energy(self):
+        """The energy at every sample: (k,) or (b, k)."""
+        return np.asarray(self.system.energy(self.states))
+
+    def invariants(self):
+        """The invariants the system's geometric methods keep, at every sample: (k, c) or
+        (b, k, c)."""
+        return np.asarray(self.system.invariants(self.states))
+
+    def casimirs(self):
+        """The same as ``invariants()`` (the Casimirs of the Lie–Poisson systems)."""
+        return self.invariants()
+
+    def to_xarray(self, *, observables=True):
+        """The trajectory as an ``xarray.Dataset``: coordinates ``time`` (and ``member`` for a
+        batch), ``states``, the named fields (``M``, ``Gamma``, ``X``, ...), ``energy`` and
+        ``invariants`` (unless ``observables=False``), the attitude, the initial and final
+        states, events; attributes the system and its parameters, the method, dt, save_every,
+        times and the lieflow version (layout: :mod:`lieflow.io`). Needs xarray."""
+        from .io import to_xarray
+
+        return to_xarray(self, observables=observables)
+
+    def save(self, path, *, allow_pickle=False):
+        """Writes the trajectory to the NetCDF file `path` (read it with ``lf.load(path)``;
+        the round trip is exact). A system built from Python callables is stored only with
+        ``allow_pickle=True`` (see :func:`lieflow.io.save`). Needs xarray and a NetCDF backend
+        (``pip install lieflow[io]``)."""
+        from .io import save
+
+        save(self, path, allow_pickle=allow_pickle)
+
+    def _fields(self):
+        if self._field_cache is None:
+            fields = getattr(self.system, "_fields", None)
+            self._field_cache = dict(fields(self.states)) if fields is not None else {}
+        return self._field_cache
+
+    def __getattr__(self, name):
+        # Only called for names that are not regular attributes.
+        if name.startswith("_") or "system" not in self.__dict__:
+            raise AttributeError(name)
+        fields = self._fields()
+        if name in fields:
+            return fields[name]
+        fn = getattr(self.system, name, None)
+        if not callable(fn):
+            raise AttributeError(
+                f"'Trajectory' has no attribute {name!r} (nor has {type(self.system).__name__})")
+        if name in getattr(self.system, "_attitude_observables", ()):
+            if self.attitude is None:
+                def needs_attitude(*args, **kwargs):
+                    raise InvalidArgumentError(
+                        f"invalid state: {name} needs the attitude; integrate with attitude=R0")
+                return needs_attitude
+            return lambda *args, **kwargs: fn(self.states, self.attitude, *args, **kwargs)
+        return lambda *args, **kwargs: fn(self.states, *args, **kwargs)
+
+    def __dir__(self):
+        names = set(super().__dir__()) | set(self._fields())
+        names |= {n for n in dir(self.system) if not n.startswith("_")}
+        return sorted(names)
+
+
+def load(path, *, allow_pickle=False):
+    """Reads a trajectory written by ``Trajectory.save`` (or a Dataset of
+    ``Trajectory.to_xarray()``), its system rebuilt from the file, so that
+    ``lf.integrate(traj.system, traj.final_state, ..., t0=traj.t_final)`` continues the run.
+    The round trip is exact. ``allow_pickle=True`` allows a system stored pickled (a system
+    built from Python callables; loading runs code from the file, so only for files you
+    trust). Needs xarray and a NetCDF-4 backend (``pip install lieflow[io]``).
+
+    Raises:
+        ImportError (no xarray or NetCDF-4 backend), FileNotFoundError, FileFormatError (not a
+        lieflow trajectory file, damaged, a newer format, a pickled system without
+        ``allow_pickle``).
+    """
+    from .io import read
+
+    return Trajectory(**read(path, allow_pickle=allow_pickle))
