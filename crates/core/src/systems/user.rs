@@ -1037,9 +1037,7 @@ impl LiePoisson {
                 mu[3..].iter().map(|x| x * x).sum(),
                 (0..3).map(|i| mu[i] * mu[3 + i]).sum(),
             ],
-            Kind::So(n) => {
-                crate::pseudo_rigid::reduced::spectral_invariants(&so::hat_n_unchecked(n, mu))
-            }
+            Kind::So(n) => so::spectral_invariants(&so::hat_n_unchecked(n, mu)),
             Kind::Generic => Vec::new(),
         }
     }
