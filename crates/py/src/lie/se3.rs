@@ -19,9 +19,7 @@ use crate::errors::to_py;
 /// InvalidArgumentError (‖ω‖ > 2.25e14, the rule of so3_exp; a translation beyond the f64 range).
 #[pyfunction]
 fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "xi", &xi, |x: &Vector6<f64>| {
-        Ok(se3::try_exp(x)?.matrix4())
-    })
+    map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::exp(x)?.matrix4()))
 }
 
 /// `se3_log(g, strict=False)`: the logarithm ξ = (ω, v) of g = [[R, t], [0, 1]]: ω = so3_log(R)
@@ -39,7 +37,7 @@ fn se3_log<'py>(py: Python<'py>, g: ArrayIn<'py>, strict: bool) -> PyResult<Out<
         if strict {
             g.log()
         } else {
-            Ok(se3::log(&g))
+            Ok(se3::log_unchecked(&g))
         }
     })
 }

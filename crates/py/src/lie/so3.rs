@@ -26,7 +26,7 @@ fn hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// ‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F) > 1e-10).
 #[pyfunction]
 fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "xi", &xi, so3::try_vee)
+    map_batch(py, "xi", &xi, so3::vee)
 }
 
 /// `so3_exp(w)`: the rotation exp(ŵ) by Rodrigues' formula
@@ -37,7 +37,7 @@ fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
 fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "w", &w, so3::try_exp)
+    map_batch(py, "w", &w, so3::exp)
 }
 
 /// `so3_log(R, strict=False)`: the principal logarithm w (‖w‖ = θ ∈ [0, π], exp(ŵ) = R),
@@ -59,7 +59,7 @@ fn so3_log<'py>(py: Python<'py>, R: ArrayIn<'py>, strict: bool) -> PyResult<Out<
         if strict {
             g.log()
         } else {
-            Ok(so3::log(m))
+            Ok(so3::log_unchecked(m))
         }
     })
 }
@@ -113,7 +113,7 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
         py,
         &w,
         inverse,
-        so3::try_jacobian_right,
+        so3::jacobian_right,
         so3::jacobian_right_inv,
     )
 }
@@ -129,13 +129,7 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
 #[pyfunction]
 #[pyo3(signature = (w, inverse = false))]
 fn so3_jacobian_left<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
-    jacobian(
-        py,
-        &w,
-        inverse,
-        so3::try_jacobian_left,
-        so3::jacobian_left_inv,
-    )
+    jacobian(py, &w, inverse, so3::jacobian_left, so3::jacobian_left_inv)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

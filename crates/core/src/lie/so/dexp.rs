@@ -1,7 +1,10 @@
 //! The derivative of exp on so(n) and its inverse (000 §3).
 
 use super::exp::{check_exp_norm, exp_unchecked};
-use super::{bracket, check_algebra, check_algebra_of, from_matrix3, norm, to_matrix3};
+use super::{
+    bracket, check_algebra, check_algebra_of, dim, from_matrix3, hat_n_unchecked, norm, to_matrix3,
+    vee_n_unchecked,
+};
 use crate::check;
 use crate::error::{Error, Result};
 use crate::lie::so3;
@@ -72,8 +75,8 @@ fn dexp_raw(xi: &Mat, eta: &Mat) -> Result<Mat> {
 ///
 /// (from X³ = −θ² X), with Taylor coefficients for θ < 10⁻³.
 fn dexp3(xi: &Mat, eta: &Mat, inverse: bool) -> Mat {
-    let w = so3::vee(&to_matrix3(xi));
-    let v = so3::vee(&to_matrix3(eta));
+    let w = so3::vee_unchecked(&to_matrix3(xi));
+    let v = so3::vee_unchecked(&to_matrix3(eta));
     let t2 = w.norm_squared();
     let (a, b) = if inverse {
         let c = if t2 < 1e-6 {
@@ -180,4 +183,46 @@ fn dexp_inv_raw(xi: &Mat, eta: &Mat) -> Result<Mat> {
         residual: pn,
         tol: 1e-17,
     })
+}
+
+/// The dim × dim matrix, in e_ij coordinates, of the linear map η ↦ `map`(`xi`, η), column k from
+/// the k-th basis element.
+fn coordinate_matrix(xi: &Mat, map: fn(&Mat, &Mat) -> Result<Mat>) -> Result<Mat> {
+    let n = check_algebra("xi", xi)?;
+    let d = dim(n);
+    let mut m = Mat::zeros(d, d);
+    let mut e = vec![0.0; d];
+    for k in 0..d {
+        e[k] = 1.0;
+        let col = vee_n_unchecked(&map(xi, &hat_n_unchecked(n, &e))?);
+        e[k] = 0.0;
+        for (i, c) in col.into_iter().enumerate() {
+            m[(i, k)] = c;
+        }
+    }
+    Ok(m)
+}
+
+/// Left Jacobian J_l(ξ) of exp on so(n): the matrix of [`dexp`]_ξ in e_ij coordinates, so that
+/// exp(ξ + δ) = exp(J_l(ξ) δ) exp(ξ) to first order (dim(n) evaluations of [`dexp`]).
+pub fn jacobian_left(xi: &Mat) -> Result<Mat> {
+    coordinate_matrix(xi, dexp)
+}
+
+/// Right Jacobian J_r(ξ) = J_l(−ξ) (the matrix of dexp_{−ξ}): exp(ξ + δ) = exp(ξ) exp(J_r(ξ) δ)
+/// to first order.
+pub fn jacobian_right(xi: &Mat) -> Result<Mat> {
+    check_algebra("xi", xi)?;
+    coordinate_matrix(&-xi, dexp)
+}
+
+/// J_l(ξ)⁻¹, the matrix of [`dexp_inv`]_ξ (its domain |ξ| < π).
+pub fn jacobian_left_inv(xi: &Mat) -> Result<Mat> {
+    coordinate_matrix(xi, dexp_inv)
+}
+
+/// J_r(ξ)⁻¹ = J_l(−ξ)⁻¹, the matrix of dexp⁻¹_{−ξ} (domain |ξ| < π).
+pub fn jacobian_right_inv(xi: &Mat) -> Result<Mat> {
+    check_algebra("xi", xi)?;
+    coordinate_matrix(&-xi, dexp_inv)
 }

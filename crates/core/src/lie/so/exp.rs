@@ -61,7 +61,7 @@ pub fn exp_unchecked(xi: &Mat) -> Mat {
                 _ => c,
             })
         }
-        3 => from_matrix3(&so3::exp(&so3::vee(&to_matrix3(xi)))),
+        3 => from_matrix3(&so3::exp_unchecked(&so3::vee_unchecked(&to_matrix3(xi)))),
         _ => exp_pade(xi),
     }
 }

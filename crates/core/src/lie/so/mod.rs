@@ -17,7 +17,9 @@ mod log;
 
 pub use cayley::{cayley, cayley_inv, CAYLEY_TOL};
 pub(crate) use dexp::bernoulli_coefficients;
-pub use dexp::{dexp, dexp_inv};
+pub use dexp::{
+    dexp, dexp_inv, jacobian_left, jacobian_left_inv, jacobian_right, jacobian_right_inv,
+};
 pub use exp::{exp, exp_into, exp_unchecked, ExpWork, EXP_MAX_NORM};
 use log::log_rotation;
 pub use log::{log, LOG_PI_TOL};
@@ -348,11 +350,6 @@ impl SOn {
         Ok(Self(Mat::identity(n, n)))
     }
 
-    /// exp ξ as a group element (validates ξ, see [`exp`]).
-    pub fn exp_checked(xi: &Mat) -> Result<Self> {
-        exp(xi).map(Self)
-    }
-
     /// The size n.
     pub fn n(&self) -> usize {
         self.0.nrows()
@@ -371,6 +368,7 @@ impl SOn {
 
 impl MatrixLieGroup for SOn {
     type Algebra = Mat;
+    type Point = Vec<f64>;
 
     fn dim(&self) -> usize {
         dim(self.n())
@@ -384,8 +382,22 @@ impl MatrixLieGroup for SOn {
     fn inverse(&self) -> Self {
         Self(self.0.transpose().to_owned())
     }
-    /// [`exp_unchecked`] (NaN for invalid input; use [`SOn::exp_checked`] to validate).
-    fn exp(xi: &Mat) -> Self {
+    /// R x (a vector of NaN if x is not of length n).
+    fn act(&self, x: &Vec<f64>) -> Vec<f64> {
+        let n = self.n();
+        if x.len() != n {
+            return vec![f64::NAN; n];
+        }
+        (0..n)
+            .map(|i| (0..n).map(|j| self.0[(i, j)] * x[j]).sum())
+            .collect()
+    }
+    /// [`exp`].
+    fn exp(xi: &Mat) -> Result<Self> {
+        exp(xi).map(Self)
+    }
+    /// [`exp_unchecked`] (NaN for invalid input).
+    fn exp_unchecked(xi: &Mat) -> Self {
         Self(exp_unchecked(xi))
     }
     fn log(&self) -> Result<Mat> {
@@ -406,14 +418,35 @@ impl MatrixLieGroup for SOn {
     fn matrix(&self) -> Mat {
         self.0.clone()
     }
-    fn algebra_matrix(xi: &Mat) -> Mat {
+    fn hat(xi: &Mat) -> Mat {
         xi.clone()
+    }
+    /// The skew matrix itself, after [`check_algebra`].
+    fn vee(m: &Mat) -> Result<Mat> {
+        check_algebra("xi", m)?;
+        Ok(m.clone())
     }
     fn coords(xi: &Mat) -> Vec<f64> {
         vee_n_unchecked(xi)
     }
     fn algebra_from_coords(&self, c: &[f64]) -> Mat {
         hat_n_unchecked(self.n(), c)
+    }
+    /// [`jacobian_right`].
+    fn jacobian_right(xi: &Mat) -> Result<Mat> {
+        jacobian_right(xi)
+    }
+    /// [`jacobian_left`].
+    fn jacobian_left(xi: &Mat) -> Result<Mat> {
+        jacobian_left(xi)
+    }
+    /// [`jacobian_right_inv`].
+    fn jacobian_right_inv(xi: &Mat) -> Result<Mat> {
+        jacobian_right_inv(xi)
+    }
+    /// [`jacobian_left_inv`].
+    fn jacobian_left_inv(xi: &Mat) -> Result<Mat> {
+        jacobian_left_inv(xi)
     }
 }
 
