@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::group_laws::{adjoint_laws, exp_log, group_axioms};
+use common::group_laws::{adjoint_laws, exp_log, group_axioms, verb_laws};
 use common::{dist, expm_reference};
 use lieflow::lie::se3::{self, SE3};
 use lieflow::lie::so3::{self, SO3};
@@ -92,6 +92,16 @@ proptest! {
         group_axioms(&g, &h, &k);
         exp_log(&g, &xi);
         adjoint_laws(&g, &h, &a, &b, &c);
+    }
+
+    /// Every verb of the trait for SO(3) and SE(3) (act, checked exp, hat/vee, Ad, ad, ad*, the
+    /// Jacobians and their inverses) against its definition.
+    #[test]
+    fn so3_se3_verbs(g in rot(), h in rot(), xi in ball3(3.0), eta in vec3(3.0), x in vec3(3.0),
+                     p in rigid(), q in rigid(), zeta in se3_small(), nu in vec6(3.0)) {
+        let pt = |v: &Vector3<f64>| v.as_slice().to_vec();
+        verb_laws(&g, &h, &xi, &eta, &x, pt);
+        verb_laws(&p, &q, &zeta, &nu, &x, pt);
     }
 
     /// hat is a Lie algebra isomorphism (R³, ×) → so(3): hat(u × v) = [hat u, hat v].

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::group_laws::{adjoint_laws, exp_log, group_axioms};
+use common::group_laws::{adjoint_laws, exp_log, group_axioms, verb_laws};
 use common::{dist, expm_reference};
 use lieflow::lie::product::{self, SOnProduct};
 use lieflow::lie::so::{self, SOn};
@@ -110,6 +110,30 @@ proptest! {
         let c = SOnProduct::coords(&u);
         prop_assert_eq!(&c[..d], &so::vee_n(&u.0).unwrap()[..]);
         prop_assert_eq!(&c[d..], &so::vee_n(&u.1).unwrap()[..]);
+    }
+
+    /// Every verb of the trait for SO(n) and SO(n) × SO(n) (act, checked exp, hat/vee, Ad, ad,
+    /// ad*, the Jacobians from dexp and their inverses from dexp⁻¹) against its definition.
+    #[test]
+    fn son_product_verbs(
+        (n, a) in algebra(2.0),
+        b in prop::collection::vec(-2.0..2.0f64, 28),
+        y in prop::collection::vec(-1.0..1.0f64, 28),
+        v in prop::collection::vec(-1.0..1.0f64, 16),
+    ) {
+        let d = so::dim(n);
+        let (ga, gb) = (rot(n, &a), rot(n, &b[..d]));
+        let (g, h) = (SOn::new(ga.clone()).unwrap(), SOn::new(gb.clone()).unwrap());
+        let xi = hat(&clamp_norm(&a, 3.0));
+        let eta = hat(&y[..d]);
+        let x = v[..n].to_vec();
+        verb_laws(&g, &h, &xi, &eta, &x, |p: &Vec<f64>| p.clone());
+        let p = SOnProduct::new(ga.clone(), gb.clone()).unwrap();
+        let q = SOnProduct::new(gb, ga).unwrap();
+        let zeta = (xi.clone(), hat(&clamp_norm(&b[..d], 3.0)));
+        let nu = (eta.clone(), hat(&y[28 - d..]));
+        let pt = |p: &(Vec<f64>, Vec<f64>)| [p.0.clone(), p.1.clone()].concat();
+        verb_laws(&p, &q, &zeta, &nu, &(x.clone(), v[16 - n..].to_vec()), pt);
     }
 
     /// exp ξ ∈ SO(n) to 1e-13 for |ξ| up to 10³ and agrees with an independent expm.

@@ -115,7 +115,7 @@ pub fn log(g: &SE3) -> Result<Vector6<f64>> {
 }
 
 /// The coefficients (θ − sin θ)/θ³, (θ²/2 + cos θ − 1)/θ⁴ and
-/// ½ [(θ²/2 + cos θ − 1)/θ⁴ − 3 (θ − sin θ − θ³/6)/θ⁵] of Barfoot's Q at θ² = `t2`: by their
+/// ½ [(θ²/2 + cos θ − 1)/θ⁴ + 3 (θ − sin θ − θ³/6)/θ⁵] of Barfoot's Q at θ² = `t2`: by their
 /// Taylor series Σ (−1)ᵏ θ²ᵏ/(2k + j)! below θ = 1 (the closed forms cancel like ε/θ⁵ there;
 /// twelve terms leave a truncation error below 1e-30), closed forms above.
 fn q_coefficients(t2: f64) -> (f64, f64, f64) {
@@ -132,7 +132,7 @@ fn q_coefficients(t2: f64) -> (f64, f64, f64) {
             sum
         };
         let (c1, c2) = (series(3), series(4));
-        return (c1, c2, 0.5 * (c2 + 3.0 * series(5)));
+        return (c1, c2, 0.5 * (c2 - 3.0 * series(5)));
     }
     let t = t2.sqrt();
     let (s, c) = t.sin_cos();
@@ -140,12 +140,14 @@ fn q_coefficients(t2: f64) -> (f64, f64, f64) {
     (
         (t - s) / (t2 * t),
         c2,
-        0.5 * (c2 - 3.0 * (t - s - t2 * t / 6.0) / (t2 * t2 * t)),
+        0.5 * (c2 + 3.0 * (t - s - t2 * t / 6.0) / (t2 * t2 * t)),
     )
 }
 
-/// Barfoot's Q(ω, v) (Barfoot, "State Estimation for Robotics", 2017, (7.86); ρ = v, φ = ω):
-/// the lower-left block of the SE(3) left Jacobian.
+/// Barfoot's Q(ω, v) (Barfoot, "State Estimation for Robotics", 2017, §7.1.5; ρ = v, φ = ω):
+/// the lower-left block of the SE(3) left Jacobian,
+/// Q = ½ v̂ + c₁ (ω̂v̂ + v̂ω̂ + ω̂v̂ω̂) + c₂ (ω̂²v̂ + v̂ω̂² − 3 ω̂v̂ω̂) + c₃ (ω̂v̂ω̂² + ω̂²v̂ω̂) with the
+/// coefficients of `q_coefficients` (checked against central differences of exp in the tests).
 fn q_block(w: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
     let (c1, c2, c3) = q_coefficients(w.norm_squared());
     let (wh, vh) = (so3::hat(w), so3::hat(v));
@@ -399,5 +401,25 @@ impl MatrixLieGroup for SE3 {
     /// [`jacobian_left_inv`].
     fn jacobian_left_inv(xi: &Vector6<f64>) -> Result<Mat> {
         jacobian_left_inv(xi).map(|j| super::to_mat(&j))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The series and the closed forms of Q's coefficients agree at the switch θ = 1.
+    #[test]
+    fn q_coefficients_continuous_at_the_switch() {
+        let (below, above) = (q_coefficients(1.0 - f64::EPSILON), q_coefficients(1.0));
+        for (a, b) in [(below.0, above.0), (below.1, above.1), (below.2, above.2)] {
+            assert!((a - b).abs() < 1e-14 * b.abs(), "{a} vs {b}");
+        }
+        // θ → 0: 1/6, 1/24, 1/120.
+        let zero = q_coefficients(0.0);
+        assert_eq!(
+            zero,
+            (1.0 / 6.0, 1.0 / 24.0, 0.5 * (1.0 / 24.0 - 3.0 / 120.0))
+        );
     }
 }
