@@ -159,7 +159,7 @@ fn cases(seeds: usize) -> Vec<Case> {
         system: Arc::new(sym_l.clone()),
         dt: 1e-2,
         states: seeds_of(&|k| {
-            let r = so3::exp(&Vector3::new(0.4, -0.2, 0.1 + 0.01 * k as f64));
+            let r = so3::exp_unchecked(&Vector3::new(0.4, -0.2, 0.1 + 0.01 * k as f64));
             sym_l.state_with_attitude(nudge(msym, k, 0.01), rows(&r))
         }),
         labels: vec!["‖M‖²", "(RM)₁", "(RM)₂", "(RM)₃"],
@@ -185,7 +185,7 @@ fn cases(seeds: usize) -> Vec<Case> {
         system: Arc::new(body_l.clone()),
         dt: 1e-2,
         states: seeds_of(&|k| {
-            let r = so3::exp(&Vector3::new(0.4, -0.2, 0.1 + 0.01 * k as f64));
+            let r = so3::exp_unchecked(&Vector3::new(0.4, -0.2, 0.1 + 0.01 * k as f64));
             body_l.state_with_attitude([0.0, 0.0, 1.0 + 0.01 * k as f64], rows(&r))
         }),
         labels: vec!["‖M‖²", "(RM)₁", "(RM)₂", "(RM)₃"],
@@ -310,8 +310,8 @@ fn cases(seeds: usize) -> Vec<Case> {
         system: Arc::new(spheres.clone()),
         dt: 1e-2,
         states: seeds_of(&|k| {
-            let r1 = so3::exp(&Vector3::new(0.3, -0.2, 0.5 + 0.01 * k as f64));
-            let r2 = so3::exp(&Vector3::new(-0.4, 0.1, 0.2));
+            let r1 = so3::exp_unchecked(&Vector3::new(0.3, -0.2, 0.5 + 0.01 * k as f64));
+            let r2 = so3::exp_unchecked(&Vector3::new(-0.4, 0.1, 0.2));
             let m = |r: Matrix3<f64>| std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]));
             spheres
                 .state(

@@ -16,7 +16,7 @@
 //! use lieflow::lie::so3;
 //! use nalgebra::Vector3;
 //! // A rotation by 90° about z maps x to y.
-//! let r = so3::exp(&Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
+//! let r = so3::exp(&Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2)).unwrap();
 //! let y = r * Vector3::x();
 //! assert!((y - Vector3::y()).norm() < 1e-15);
 //! ```

@@ -68,7 +68,7 @@ fn damped_torque() -> ForceFn {
 /// (name, system, initial state) of every system with an implicit method.
 fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
     let m0 = vec![1.0, 0.5, -0.3];
-    let r = rows(so3::exp(&Vector3::new(0.4, -0.2, 0.1)));
+    let r = rows(so3::exp_unchecked(&Vector3::new(0.4, -0.2, 0.1)));
     let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
     let top = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
     let sleeping = HeavyTop::new([1.0, 1.0, 0.5], 1.0, [0.0, 0.0, 1.0]).unwrap();
@@ -121,8 +121,8 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
         .unwrap();
     let z_spheres = spheres
         .state(
-            rows3(so3::exp(&Vector3::new(0.3, -0.2, 0.5))),
-            rows3(so3::exp(&Vector3::new(-0.4, 0.1, 0.2))),
+            rows3(so3::exp_unchecked(&Vector3::new(0.3, -0.2, 0.5))),
+            rows3(so3::exp_unchecked(&Vector3::new(-0.4, 0.1, 0.2))),
             [0.6, 0.0, 0.8],
             [0.5, -0.3, 0.8],
             [-0.2, 0.4, 0.1],

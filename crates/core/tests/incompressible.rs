@@ -314,7 +314,7 @@ fn rattle_is_equivariant_under_the_two_sided_rotations() {
     let body = PseudoRigidBody::incompressible(3, svk()).unwrap();
     let z0 = state(&body, 9, 0.7);
     let rot = |w: [f64; 3]| {
-        let r = lieflow::lie::so3::exp(&nalgebra::Vector3::from(w));
+        let r = lieflow::lie::so3::exp_unchecked(&nalgebra::Vector3::from(w));
         Mat::from_fn(3, 3, |i, j| r[(i, j)])
     };
     let (g, h) = (rot([0.3, -0.5, 0.9]), rot([-1.1, 0.2, 0.4]));

@@ -6,13 +6,14 @@ use common::order;
 use lieflow::integrate::methods::composition::{run_sequence, Composition};
 use lieflow::integrate::methods::Verlet;
 use lieflow::integrate::{integrate, integrate_batch, integrate_with, Problem, Run};
+use lieflow::lie::so::spectral_invariants;
 use lieflow::pseudo_rigid::dynamics::FullBody;
 use lieflow::pseudo_rigid::momentum;
 use lieflow::pseudo_rigid::potential::{
     self, Harmonic, Potential, SaintVenantKirchhoff, Sum, Volumetric, Workspace, Zero,
 };
 use lieflow::pseudo_rigid::reduced::{
-    momenta_of_velocities, reconstruct, reduce, spectral_invariants, ReducedState, ReducedWork,
+    momenta_of_velocities, reconstruct, reduce, ReducedState, ReducedWork,
 };
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::{Error, Mat};

@@ -34,7 +34,7 @@ impl Rng {
         Vector3::new(self.next(), self.next(), self.next())
     }
     fn rotation(&mut self) -> Matrix3<f64> {
-        so3::exp(&(self.vec3() * 3.0))
+        so3::exp_unchecked(&(self.vec3() * 3.0))
     }
     fn unit(&mut self) -> Vector3<f64> {
         self.vec3().normalize()
@@ -168,10 +168,10 @@ fn along(sys: &RollingSpheres, z: &[f64], t: f64) -> Vec<f64> {
     let q = parts(z);
     let [a1, a2] = sys.alphas();
     let b = q.z[0] * q.o[0] * a1 + q.z[1] * q.o[1] * a2;
-    let u = so3::exp(&(b * t)) * q.u;
+    let u = so3::exp_unchecked(&(b * t)) * q.u;
     sys.state(
-        rows(&(q.z[0] * so3::exp(&(q.o[0] * t)))),
-        rows(&(q.z[1] * so3::exp(&(q.o[1] * t)))),
+        rows(&(q.z[0] * so3::exp_unchecked(&(q.o[0] * t)))),
+        rows(&(q.z[1] * so3::exp_unchecked(&(q.o[1] * t)))),
         arr(&u),
         arr(&q.o[0]),
         arr(&q.o[1]),
@@ -239,7 +239,7 @@ fn inputs_are_validated() {
     assert!(e.contains("positive definite"), "{e}");
     // States: rotations and unit u are checked.
     let sys = spheres();
-    let z = rows(&so3::exp(&Vector3::new(0.3, 0.2, -0.1)));
+    let z = rows(&so3::exp_unchecked(&Vector3::new(0.3, 0.2, -0.1)));
     assert!(sys.state(z, z, [0.0, 0.0, 1.0], [1.0; 3], [0.0; 3]).is_ok());
     let mut bad = z;
     bad[0][0] += 1e-3;
@@ -607,8 +607,8 @@ fn curvature_vanishes_on_the_planar_subbundle() {
 
 fn z0(sys: &RollingSpheres) -> Vec<f64> {
     sys.state(
-        rows(&so3::exp(&Vector3::new(0.3, -0.5, 0.9))),
-        rows(&so3::exp(&Vector3::new(-1.2, 0.4, 0.2))),
+        rows(&so3::exp_unchecked(&Vector3::new(0.3, -0.5, 0.9))),
+        rows(&so3::exp_unchecked(&Vector3::new(-1.2, 0.4, 0.2))),
         arr(&Vector3::new(0.2, 0.9, -0.3).normalize()),
         [1.1, -0.6, 0.8],
         [-0.4, 0.9, 0.5],
@@ -817,7 +817,7 @@ fn planar_subbundle_is_invariant() {
 #[test]
 fn lie_midpoint_on_the_lifted_rigid_body() {
     let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap().with_attitude();
-    let r = so3::exp(&Vector3::new(0.4, -0.2, 0.1));
+    let r = so3::exp_unchecked(&Vector3::new(0.4, -0.2, 0.1));
     let z: Vec<f64> = [1.0, 0.5, -0.3]
         .into_iter()
         .chain((0..9).map(|k| r[(k / 3, k % 3)]))

@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::group_laws::{adjoint_laws, exp_log, group_axioms};
+use common::group_laws::{adjoint_laws, exp_log, group_axioms, verb_laws};
 use common::{dist, expm_reference};
 use lieflow::lie::se3::{self, SE3};
 use lieflow::lie::so3::{self, SO3};
@@ -41,7 +41,7 @@ fn ball3(max: f64) -> impl Strategy<Value = Vector3<f64>> {
 }
 
 fn rot() -> impl Strategy<Value = SO3> {
-    vec3(4.0).prop_map(|w| SO3::exp(&w))
+    vec3(4.0).prop_map(|w| SO3::exp_unchecked(&w))
 }
 
 fn vec6(r: f64) -> impl Strategy<Value = Vector6<f64>> {
@@ -54,7 +54,7 @@ fn se3_small() -> impl Strategy<Value = Vector6<f64>> {
 }
 
 fn rigid() -> impl Strategy<Value = SE3> {
-    vec6(4.0).prop_map(|xi| se3::exp(&xi))
+    vec6(4.0).prop_map(|xi| se3::exp_unchecked(&xi))
 }
 
 fn orthogonality(r: &Matrix3<f64>) -> f64 {
@@ -65,14 +65,14 @@ fn orthogonality(r: &Matrix3<f64>) -> f64 {
 /// (J_l): vee(Rᵀ (exp(w + h e_i) − exp(w − h e_i)) / 2h) and vee((…) Rᵀ / 2h).
 fn fd_jacobians(w: &Vector3<f64>) -> (Matrix3<f64>, Matrix3<f64>) {
     let h = 1e-5;
-    let r = so3::exp(w);
+    let r = so3::exp_unchecked(w);
     let (mut jr, mut jl) = (Matrix3::zeros(), Matrix3::zeros());
     for i in 0..3 {
         let mut e = Vector3::zeros();
         e[i] = h;
-        let d = (so3::exp(&(w + e)) - so3::exp(&(w - e))) / (2.0 * h);
-        jr.set_column(i, &so3::vee(&(r.transpose() * d)));
-        jl.set_column(i, &so3::vee(&(d * r.transpose())));
+        let d = (so3::exp_unchecked(&(w + e)) - so3::exp_unchecked(&(w - e))) / (2.0 * h);
+        jr.set_column(i, &so3::vee_unchecked(&(r.transpose() * d)));
+        jl.set_column(i, &so3::vee_unchecked(&(d * r.transpose())));
     }
     (jr, jl)
 }
@@ -94,20 +94,30 @@ proptest! {
         adjoint_laws(&g, &h, &a, &b, &c);
     }
 
+    /// Every verb of the trait for SO(3) and SE(3) (act, checked exp, hat/vee, Ad, ad, ad*, the
+    /// Jacobians and their inverses) against its definition.
+    #[test]
+    fn so3_se3_verbs(g in rot(), h in rot(), xi in ball3(3.0), eta in vec3(3.0), x in vec3(3.0),
+                     p in rigid(), q in rigid(), zeta in se3_small(), nu in vec6(3.0)) {
+        let pt = |v: &Vector3<f64>| v.as_slice().to_vec();
+        verb_laws(&g, &h, &xi, &eta, &x, pt);
+        verb_laws(&p, &q, &zeta, &nu, &x, pt);
+    }
+
     /// hat is a Lie algebra isomorphism (R³, ×) → so(3): hat(u × v) = [hat u, hat v].
     #[test]
     fn hat_of_cross_is_commutator(u in vec3(5.0), v in vec3(5.0)) {
         let (hu, hv) = (so3::hat(&u), so3::hat(&v));
         prop_assert!((so3::hat(&u.cross(&v)) - (hu * hv - hv * hu)).norm() < 1e-12);
         prop_assert!((hu * v - u.cross(&v)).norm() < 1e-13);
-        prop_assert_eq!(so3::vee(&hu), u);
+        prop_assert_eq!(so3::vee_unchecked(&hu), u);
     }
 
     /// Rodrigues against an independent expm for |w| from 1e-9 to 1e3; R orthogonal to 1e-14.
     #[test]
     fn rodrigues_matches_expm_all_scales(a in unit3(), e in -9.0..3.0f64) {
         let w = a * 10f64.powf(e);
-        let r = so3::exp(&w);
+        let r = so3::exp_unchecked(&w);
         let reference = expm_reference(&to_mat(&so3::hat(&w)));
         let scale = 1.0 + w.norm();
         prop_assert!(dist(&to_mat(&r), &reference) < 1e-13 * scale,
@@ -123,12 +133,12 @@ proptest! {
     fn log_exp_round_trip(a in unit3(), t in 0.0..PI, e in -9.0..0.0f64) {
         for theta in [t, 10f64.powf(e), PI - 10f64.powf(e).max(1e-10)] {
             let w = a * theta;
-            let back = so3::log(&so3::exp(&w));
+            let back = so3::log_unchecked(&so3::exp_unchecked(&w));
             prop_assert!((back - w).norm() < 2e-14 * (1.0 + theta),
                 "θ = {theta:e}: {:e}", (back - w).norm());
         }
-        let r = so3::exp(&(a * t));
-        prop_assert!((so3::exp(&so3::log(&r)) - r).norm() < 1e-14);
+        let r = so3::exp_unchecked(&(a * t));
+        prop_assert!((so3::exp_unchecked(&so3::log_unchecked(&r)) - r).norm() < 1e-14);
     }
 
     /// Angles within 1e-6 and 1e-10 of π: log recovers the vector (not its antipode) and the
@@ -137,15 +147,15 @@ proptest! {
     fn log_near_and_at_pi(a in unit3()) {
         for delta in [1e-6, 1e-10] {
             let w = a * (PI - delta);
-            let r = so3::exp(&w);
-            prop_assert!((so3::log(&r) - w).norm() < 1e-13);
+            let r = so3::exp_unchecked(&w);
+            prop_assert!((so3::log_unchecked(&r) - w).norm() < 1e-13);
             let g = SO3::new(r).unwrap();
             prop_assert!((g.log().unwrap() - w).norm() < 1e-13);
         }
         let r = 2.0 * a * a.transpose() - Matrix3::identity();
-        let l = so3::log(&r);
+        let l = so3::log_unchecked(&r);
         prop_assert!((l - a * PI).norm() < 1e-14 || (l + a * PI).norm() < 1e-14);
-        prop_assert!((so3::exp(&l) - r).norm() < 1e-14);
+        prop_assert!((so3::exp_unchecked(&l) - r).norm() < 1e-14);
         let err = SO3::new(r).unwrap().log().unwrap_err();
         prop_assert!(matches!(err, Error::NoUniqueLog { .. }), "{err:?}");
     }
@@ -156,11 +166,11 @@ proptest! {
     fn jacobians(w in vec3(4.0), e in -6.0..0.0f64, a in unit3()) {
         for w in [w, a * 10f64.powf(e)] {
             let (jr_fd, jl_fd) = fd_jacobians(&w);
-            let (jr, jl) = (so3::jacobian_right(&w), so3::jacobian_left(&w));
+            let (jr, jl) = (so3::jacobian_right_unchecked(&w), so3::jacobian_left_unchecked(&w));
             prop_assert!((jr - jr_fd).norm() < 1e-8, "J_r: {:e}", (jr - jr_fd).norm());
             prop_assert!((jl - jl_fd).norm() < 1e-8, "J_l: {:e}", (jl - jl_fd).norm());
             prop_assert!((jl - jr.transpose()).norm() < 1e-14);
-            prop_assert!((jl - so3::exp(&w) * jr).norm() < 1e-13);
+            prop_assert!((jl - so3::exp_unchecked(&w) * jr).norm() < 1e-13);
             let jri = so3::jacobian_right_inv(&w).unwrap();
             let jli = so3::jacobian_left_inv(&w).unwrap();
             // J⁻¹J = I to round-off times the condition number (J is singular at |w| = 2π)
@@ -182,13 +192,13 @@ proptest! {
         prop_assert!((r - reference).norm() < 1e-13);
         prop_assert!(orthogonality(&r) < 1e-14);
         let angle = 2.0 * (0.5 * w.norm()).atan();
-        prop_assert!((so3::log(&r) - w.normalize() * angle).norm() < 1e-12);
+        prop_assert!((so3::log_unchecked(&r) - w.normalize() * angle).norm() < 1e-12);
         let back = so3::cayley_inv(&r).unwrap();
         prop_assert!((back - w).norm() < 1e-13 * (1.0 + w.norm_squared()));
     }
 
     /// so3 and so(n) at n = 3: c = (−w₃, w₂, −w₁) maps hat to hat_n, brackets to brackets and
-    /// pairings to pairings, and so3::exp(w) = expm(hat_n(c)).
+    /// pairings to pairings, and so3::exp_unchecked(w) = expm(hat_n(c)).
     #[test]
     fn relation_to_so_n(w in vec3(5.0), u in vec3(5.0)) {
         let c = so3::to_eij(&w);
@@ -200,7 +210,7 @@ proptest! {
         let br = so::bracket(&m, &mu);
         prop_assert!(dist(&br, &so::hat_n(&so3::to_eij(&w.cross(&u))).unwrap()) < 1e-12);
         let e = expm_reference(&m);
-        prop_assert!((from_mat3(&e) - so3::exp(&w)).norm() < 1e-12 * (1.0 + w.norm()));
+        prop_assert!((from_mat3(&e) - so3::exp_unchecked(&w)).norm() < 1e-12 * (1.0 + w.norm()));
     }
 
     /// The polar factor: project(R P) = R for P symmetric positive definite; project(R) = R.
@@ -226,7 +236,7 @@ proptest! {
         prop_assert!((se3::ad_matrix(&xi) * eta - SE3::ad(&xi, &eta)).norm() < 1e-13 * (1.0 + xi.norm() * eta.norm()));
         prop_assert!((se3::ad_matrix(&xi).transpose() * eta - SE3::ad_star(&xi, &eta)).norm() < 1e-13 * (1.0 + xi.norm() * eta.norm()));
         let e = expm_reference(&to_mat(&se3::ad_matrix(&xi)));
-        let a = se3::exp(&xi).adjoint_matrix();
+        let a = se3::exp_unchecked(&xi).adjoint_matrix();
         prop_assert!(dist(&to_mat(&a), &e) < 1e-10 * (1.0 + a.norm()));
     }
 
@@ -237,8 +247,8 @@ proptest! {
         for theta in [0.0, 10f64.powf(e), PI - 1e-6, PI - 1e-10] {
             let w = a * theta;
             let xi = Vector6::new(w.x, w.y, w.z, v.x, v.y, v.z);
-            let g = se3::exp(&xi);
-            prop_assert!((se3::log(&g) - xi).norm() < 1e-12, "θ = {theta:e}: {:e}", (se3::log(&g) - xi).norm());
+            let g = se3::exp_unchecked(&xi);
+            prop_assert!((se3::log_unchecked(&g) - xi).norm() < 1e-12, "θ = {theta:e}: {:e}", (se3::log_unchecked(&g) - xi).norm());
             let m = g.matrix4();
             let back = SE3::from_matrix4(&m).unwrap();
             prop_assert_eq!(back, g);
@@ -246,7 +256,7 @@ proptest! {
             prop_assert!((g.act(&x) - hx.xyz()).norm() < 1e-13);
         }
         // Pure translation: exp(0, v) = (I, v).
-        let g = se3::exp(&Vector6::new(0.0, 0.0, 0.0, v.x, v.y, v.z));
+        let g = se3::exp_unchecked(&Vector6::new(0.0, 0.0, 0.0, v.x, v.y, v.z));
         prop_assert_eq!(*g.rot(), Matrix3::identity());
         prop_assert_eq!(*g.trans(), v);
     }
@@ -261,7 +271,7 @@ fn jacobian_inverse_singular_at_two_pi() {
     // Just away from 2π and at π the inverse exists and inverts.
     for t in [PI, 2.0 * PI - 1e-3] {
         let w = Vector3::new(0.0, t, 0.0);
-        let j = so3::jacobian_right_inv(&w).unwrap() * so3::jacobian_right(&w);
+        let j = so3::jacobian_right_inv(&w).unwrap() * so3::jacobian_right_unchecked(&w);
         assert!((j - Matrix3::identity()).norm() < 1e-11);
     }
 }
@@ -277,7 +287,7 @@ fn cayley_inv_rejects_half_turn() {
 
 #[test]
 fn rotation_validation_errors() {
-    let mut r = so3::exp(&Vector3::new(0.3, -0.2, 1.0));
+    let mut r = so3::exp_unchecked(&Vector3::new(0.3, -0.2, 1.0));
     assert!(SO3::new(r).is_ok());
     assert!(so3::is_rotation(&r, 1e-14));
     r[(0, 1)] += 1e-6;
@@ -302,17 +312,17 @@ fn rotation_validation_errors() {
 #[test]
 fn try_vee_errors() {
     let w = Vector3::new(1.0, -2.0, 3.0);
-    assert_eq!(so3::try_vee(&so3::hat(&w)).unwrap(), w);
+    assert_eq!(so3::vee(&so3::hat(&w)).unwrap(), w);
     let mut m = so3::hat(&w);
     m[(0, 0)] = 1e-3;
-    assert!(matches!(so3::try_vee(&m), Err(Error::NotInGroup { .. })));
+    assert!(matches!(so3::vee(&m), Err(Error::NotInGroup { .. })));
     m[(0, 0)] = f64::NAN;
-    assert!(matches!(so3::try_vee(&m), Err(Error::NonFinite { .. })));
+    assert!(matches!(so3::vee(&m), Err(Error::NonFinite { .. })));
 }
 
 #[test]
 fn se3_validation_errors() {
-    let g = se3::exp(&Vector6::new(0.1, 0.2, -0.3, 1.0, 2.0, 3.0));
+    let g = se3::exp_unchecked(&Vector6::new(0.1, 0.2, -0.3, 1.0, 2.0, 3.0));
     let mut m = g.matrix4();
     m[(3, 0)] = 1e-6;
     let err = SE3::from_matrix4(&m).unwrap_err();
@@ -341,8 +351,8 @@ fn se3_validation_errors() {
     )
     .unwrap();
     assert!(matches!(half.log(), Err(Error::NoUniqueLog { .. })));
-    let l = se3::log(&half);
-    let again = se3::exp(&l);
+    let l = se3::log_unchecked(&half);
+    let again = se3::exp_unchecked(&l);
     assert!((again.matrix4() - half.matrix4()).norm() < 1e-14);
     assert!((Vector3::new(l[0], l[1], l[2]).norm() - PI).abs() < 1e-15);
 }

@@ -55,13 +55,19 @@ use crate::numerics::angle::{ANGLE_ROUNDING_TOL, EXP_MAX_NORM};
 use crate::{Mat, Result};
 
 /// A matrix Lie group G with Lie algebra 𝔤, the dual 𝔤* identified with 𝔤 through
-/// [`MatrixLieGroup::pairing`].
+/// [`MatrixLieGroup::pairing`]: the one place where the verbs of every group are declared
+/// (DESIGN.md, "Group verbs").
 ///
 /// Elements carry their own size where it is a runtime value (SO(n)), so constructors of the
-/// algebra that need it take `&self` as a size witness.
+/// algebra that need it take `&self` as a size witness. Checked verbs return a `Result`; the
+/// `_unchecked` twin of [`MatrixLieGroup::exp`] is for inner loops on known-good input. The
+/// Jacobians are dim × dim matrices acting on algebra coordinates ([`MatrixLieGroup::coords`]):
+/// exp(ξ + δ) = exp(ξ) exp(J_r(ξ) δ) = exp(J_l(ξ) δ) exp(ξ) to first order in δ.
 pub trait MatrixLieGroup: Clone + std::fmt::Debug {
     /// An element of the Lie algebra.
     type Algebra: Clone + std::fmt::Debug;
+    /// A vector of the defining representation, on which [`MatrixLieGroup::act`] acts.
+    type Point: Clone + std::fmt::Debug;
 
     /// Dimension of the group (the number of algebra coordinates).
     fn dim(&self) -> usize;
@@ -71,8 +77,13 @@ pub trait MatrixLieGroup: Clone + std::fmt::Debug {
     fn compose(&self, other: &Self) -> Self;
     /// Group inverse.
     fn inverse(&self) -> Self;
-    /// Exponential map 𝔤 → G.
-    fn exp(xi: &Self::Algebra) -> Self;
+    /// The action g · x on a vector of the defining representation.
+    fn act(&self, x: &Self::Point) -> Self::Point;
+    /// Exponential map 𝔤 → G, with the checks of the group's free `exp` (finite ξ, the rule of
+    /// [`ANGLE_ROUNDING_TOL`]).
+    fn exp(xi: &Self::Algebra) -> Result<Self>;
+    /// [`MatrixLieGroup::exp`] without checks (NaN for invalid input), for inner loops.
+    fn exp_unchecked(xi: &Self::Algebra) -> Self;
     /// Principal logarithm G → 𝔤 (an error where it is not unique).
     fn log(&self) -> Result<Self::Algebra>;
     /// Adjoint action Ad_g ξ = d/dt g exp(tξ) g⁻¹ at t = 0.
@@ -86,10 +97,29 @@ pub trait MatrixLieGroup: Clone + std::fmt::Debug {
     /// The group element as a matrix (its defining representation).
     fn matrix(&self) -> Mat;
     /// The algebra element as a matrix in the same representation, so that
-    /// `exp(xi).matrix() = expm(algebra_matrix(xi))`.
-    fn algebra_matrix(xi: &Self::Algebra) -> Mat;
+    /// `exp(xi).matrix() = expm(hat(xi))`.
+    fn hat(xi: &Self::Algebra) -> Mat;
+    /// Inverse of [`MatrixLieGroup::hat`]: errors if `m` is not (to the group's tolerance) the
+    /// matrix of an algebra element.
+    fn vee(m: &Mat) -> Result<Self::Algebra>;
     /// Coordinates of an algebra element.
     fn coords(xi: &Self::Algebra) -> Vec<f64>;
     /// The algebra element with coordinates `c` (of length `self.dim()`).
     fn algebra_from_coords(&self, c: &[f64]) -> Self::Algebra;
+    /// Right Jacobian J_r(ξ) of exp: exp(ξ + δ) = exp(ξ) exp(J_r(ξ) δ) + O(δ²).
+    fn jacobian_right(xi: &Self::Algebra) -> Result<Mat>;
+    /// Left Jacobian J_l(ξ) of exp: exp(ξ + δ) = exp(J_l(ξ) δ) exp(ξ) + O(δ²); J_l(ξ) = J_r(−ξ)
+    /// = Ad_exp(ξ) J_r(ξ).
+    fn jacobian_left(xi: &Self::Algebra) -> Result<Mat>;
+    /// J_r(ξ)⁻¹ (an error where J_r is singular or its series diverges).
+    fn jacobian_right_inv(xi: &Self::Algebra) -> Result<Mat>;
+    /// J_l(ξ)⁻¹ (an error where J_l is singular or its series diverges).
+    fn jacobian_left_inv(xi: &Self::Algebra) -> Result<Mat>;
+}
+
+/// A nalgebra matrix as a [`Mat`] (the Jacobians of the fixed-size groups).
+pub(crate) fn to_mat<R: nalgebra::Dim, C: nalgebra::Dim, S: nalgebra::RawStorage<f64, R, C>>(
+    m: &nalgebra::Matrix<f64, R, C, S>,
+) -> Mat {
+    Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)])
 }

@@ -122,6 +122,7 @@ fn block_diag(a: &Mat, b: &Mat) -> Mat {
 
 impl MatrixLieGroup for SOnProduct {
     type Algebra = PairAlgebra;
+    type Point = (Vec<f64>, Vec<f64>);
 
     fn dim(&self) -> usize {
         2 * so::dim(self.n())
@@ -144,10 +145,22 @@ impl MatrixLieGroup for SOnProduct {
             h: self.h.inverse(),
         }
     }
-    fn exp(x: &PairAlgebra) -> Self {
+    /// (g x, h y).
+    fn act(&self, p: &(Vec<f64>, Vec<f64>)) -> (Vec<f64>, Vec<f64>) {
+        (self.g.act(&p.0), self.h.act(&p.1))
+    }
+    /// (exp ξ, exp η), after checking that ξ, η have one size ([`check_pair`]).
+    fn exp(x: &PairAlgebra) -> Result<Self> {
+        check_pair(["xi", "eta"], x)?;
+        Ok(Self {
+            g: SOn::exp(&x.0)?,
+            h: SOn::exp(&x.1)?,
+        })
+    }
+    fn exp_unchecked(x: &PairAlgebra) -> Self {
         Self {
-            g: SOn::exp(&x.0),
-            h: SOn::exp(&x.1),
+            g: SOn::exp_unchecked(&x.0),
+            h: SOn::exp_unchecked(&x.1),
         }
     }
     fn log(&self) -> Result<PairAlgebra> {
@@ -168,13 +181,71 @@ impl MatrixLieGroup for SOnProduct {
     fn matrix(&self) -> Mat {
         block_diag(self.g.as_mat(), self.h.as_mat())
     }
-    fn algebra_matrix(x: &PairAlgebra) -> Mat {
+    fn hat(x: &PairAlgebra) -> Mat {
         block_diag(&x.0, &x.1)
+    }
+    /// The diagonal blocks of a block-diagonal 2n × 2n matrix (off-diagonal blocks zero to
+    /// [`so::SKEW_TOL`] relative, as the skew test of so(n)).
+    fn vee(m: &Mat) -> Result<PairAlgebra> {
+        let size = crate::check::square("xi", m, 4)?;
+        if size % 2 == 1 {
+            return Err(Error::shape(
+                "xi",
+                "a (2n, 2n) block-diagonal matrix",
+                format!("({size}, {size})"),
+            ));
+        }
+        let n = size / 2;
+        let off = m.subrows(0, n).subcols(n, n).norm_l2() + m.subrows(n, n).subcols(0, n).norm_l2();
+        let defect = off / m.norm_l2().max(1.0);
+        if defect > so::SKEW_TOL {
+            return Err(Error::NotInGroup {
+                what: "xi".into(),
+                group: format!("so({n}) ⊕ so({n})"),
+                defect_name: "off-diagonal blocks ‖·‖_F / max(1, ‖ξ‖_F)".into(),
+                defect,
+                tol: so::SKEW_TOL,
+            });
+        }
+        let x = (
+            m.subrows(0, n).subcols(0, n).to_owned(),
+            m.subrows(n, n).subcols(n, n).to_owned(),
+        );
+        check_pair(["xi", "eta"], &x)?;
+        Ok(x)
     }
     fn coords(x: &PairAlgebra) -> Vec<f64> {
         let mut c = so::vee_n_unchecked(&x.0);
         c.extend(so::vee_n_unchecked(&x.1));
         c
+    }
+    fn jacobian_right(x: &PairAlgebra) -> Result<Mat> {
+        check_pair(["xi", "eta"], x)?;
+        Ok(block_diag(
+            &so::jacobian_right(&x.0)?,
+            &so::jacobian_right(&x.1)?,
+        ))
+    }
+    fn jacobian_left(x: &PairAlgebra) -> Result<Mat> {
+        check_pair(["xi", "eta"], x)?;
+        Ok(block_diag(
+            &so::jacobian_left(&x.0)?,
+            &so::jacobian_left(&x.1)?,
+        ))
+    }
+    fn jacobian_right_inv(x: &PairAlgebra) -> Result<Mat> {
+        check_pair(["xi", "eta"], x)?;
+        Ok(block_diag(
+            &so::jacobian_right_inv(&x.0)?,
+            &so::jacobian_right_inv(&x.1)?,
+        ))
+    }
+    fn jacobian_left_inv(x: &PairAlgebra) -> Result<Mat> {
+        check_pair(["xi", "eta"], x)?;
+        Ok(block_diag(
+            &so::jacobian_left_inv(&x.0)?,
+            &so::jacobian_left_inv(&x.1)?,
+        ))
     }
     fn algebra_from_coords(&self, c: &[f64]) -> PairAlgebra {
         let d = so::dim(self.n());

@@ -9,6 +9,9 @@
 //! physics hat map of [`so3::hat`]). The pairing is the dot product on R⁶, so a dual element is
 //! (μ, p) = (angular, linear) in the same order. 6×6 matrices ([`ad_matrix`], [`SE3::adjoint_matrix`])
 //! act on these coordinates.
+//!
+//! As everywhere in [`crate::lie`], the plain name is checked ([`exp`], [`log`], [`vee`], the
+//! Jacobians) and [`exp_unchecked`], [`log_unchecked`] skip the checks for inner loops.
 
 use nalgebra::{Matrix3, Matrix4, Matrix6, Vector3, Vector6};
 
@@ -48,23 +51,41 @@ pub fn hat(xi: &Vector6<f64>) -> Matrix4<f64> {
     m
 }
 
+/// Inverse of [`hat`]: `m` finite, its last row zero ([`HOMOGENEOUS_TOL`]) and its rotation
+/// block skew ([`so3::vee`]), else [`Error::NonFinite`] / [`Error::NotInGroup`].
+pub fn vee(m: &Matrix4<f64>) -> Result<Vector6<f64>> {
+    check::finite_slice("xi", m.as_slice())?;
+    let defect = (0..4).map(|j| m[(3, j)].abs()).fold(0.0, f64::max);
+    if defect > HOMOGENEOUS_TOL {
+        return Err(Error::NotInGroup {
+            what: "xi".into(),
+            group: "se(3)".into(),
+            defect_name: "max |last row|".into(),
+            defect,
+            tol: HOMOGENEOUS_TOL,
+        });
+    }
+    let w = so3::vee(&m.fixed_view::<3, 3>(0, 0).into())?;
+    Ok(join(&w, &m.fixed_view::<3, 1>(0, 3).into()))
+}
+
 /// Exponential exp(ξ̂) = [[exp(ω̂), V(ω) v], [0, 1]] with V(ω) = I + ((1 − cos θ)/θ²) ω̂ +
 /// ((θ − sin θ)/θ³) ω̂² = J_l(ω) ([`so3::jacobian_left`]), stable near θ = 0 by series.
-/// No checks (NaN beyond the rule of [`crate::lie::ANGLE_ROUNDING_TOL`]; see [`try_exp`]).
-pub fn exp(xi: &Vector6<f64>) -> SE3 {
+/// No checks (NaN beyond the rule of [`crate::lie::ANGLE_ROUNDING_TOL`]; see [`exp`]).
+pub fn exp_unchecked(xi: &Vector6<f64>) -> SE3 {
     let (w, v) = split(xi);
     let (rot, jl) = so3::exp_and_jacobian_left(&w);
     SE3 { rot, trans: jl * v }
 }
 
-/// [`exp`] with checks: ξ finite, |ω| within the rule of all exponentials
-/// ([`so3::check_exp_arg`], [`crate::lie::ANGLE_ROUNDING_TOL`]) and the translation V(ω) v
-/// representable (an overflow error naming v otherwise).
-pub fn try_exp(xi: &Vector6<f64>) -> Result<SE3> {
+/// Exponential se(3) → SE(3) ([`exp_unchecked`]) with checks: ξ finite, |ω| within the rule of
+/// all exponentials ([`so3::check_exp_arg`], [`crate::lie::ANGLE_ROUNDING_TOL`]) and the
+/// translation V(ω) v representable (an overflow error naming v otherwise).
+pub fn exp(xi: &Vector6<f64>) -> Result<SE3> {
     check::finite_slice("xi", xi.as_slice())?;
     let (w, _) = split(xi);
     so3::check_exp_arg("ω", "the SE(3) exponential", &w)?;
-    let g = exp(xi);
+    let g = exp_unchecked(xi);
     if g.trans.iter().any(|x| !x.is_finite()) {
         return Err(Error::overflow(
             "xi",
@@ -77,12 +98,108 @@ pub fn try_exp(xi: &Vector6<f64>) -> Result<SE3> {
     Ok(g)
 }
 
-/// Logarithm: ω = [`so3::log`] of R (θ ∈ [0, π]; at θ = π one of the two, as documented there) and
-/// v = V(ω)⁻¹ t = J_l⁻¹(ω) t, which is regular for θ ≤ π. No checks (see [`SE3::log`]).
-pub fn log(g: &SE3) -> Vector6<f64> {
-    let w = so3::log(&g.rot);
+/// Logarithm: ω = [`so3::log_unchecked`] of R (θ ∈ [0, π]; at θ = π one of the two, as
+/// documented there) and v = V(ω)⁻¹ t = J_l⁻¹(ω) t, which is regular for θ ≤ π. No checks (see
+/// [`log`]).
+pub fn log_unchecked(g: &SE3) -> Vector6<f64> {
+    let w = so3::log_unchecked(&g.rot);
     let v = so3::jacobian_left_inv_principal(&w) * g.trans;
     join(&w, &v)
+}
+
+/// Principal logarithm SE(3) → se(3) ([`log_unchecked`]), with [`Error::NoUniqueLog`] when the
+/// rotation angle is within [`so3::LOG_PI_TOL`] of π (as [`so3::log`]).
+pub fn log(g: &SE3) -> Result<Vector6<f64>> {
+    so3::log(&g.rot)?;
+    Ok(log_unchecked(g))
+}
+
+/// The coefficients (θ − sin θ)/θ³, (θ²/2 + cos θ − 1)/θ⁴ and
+/// ½ [(θ²/2 + cos θ − 1)/θ⁴ + 3 (θ − sin θ − θ³/6)/θ⁵] of Barfoot's Q at θ² = `t2`: by their
+/// Taylor series Σ (−1)ᵏ θ²ᵏ/(2k + j)! below θ = 1 (the closed forms cancel like ε/θ⁵ there;
+/// twelve terms leave a truncation error below 1e-30), closed forms above.
+fn q_coefficients(t2: f64) -> (f64, f64, f64) {
+    if t2 < 1.0 {
+        // s[j] = Σ_k (−1)ᵏ θ²ᵏ/(2k + j)! for j = 3, 4, 5.
+        let series = |j: u32| {
+            let mut fact: f64 = (1..=j).map(f64::from).product();
+            let (mut sum, mut pow) = (0.0, 1.0);
+            for k in 0..12u32 {
+                sum += pow / fact;
+                pow *= -t2;
+                fact *= f64::from((2 * k + j + 1) * (2 * k + j + 2));
+            }
+            sum
+        };
+        let (c1, c2) = (series(3), series(4));
+        return (c1, c2, 0.5 * (c2 - 3.0 * series(5)));
+    }
+    let t = t2.sqrt();
+    let (s, c) = t.sin_cos();
+    let c2 = (0.5 * t2 + c - 1.0) / (t2 * t2);
+    (
+        (t - s) / (t2 * t),
+        c2,
+        0.5 * (c2 + 3.0 * (t - s - t2 * t / 6.0) / (t2 * t2 * t)),
+    )
+}
+
+/// Barfoot's Q(ω, v) (Barfoot, "State Estimation for Robotics", 2017, §7.1.5; ρ = v, φ = ω):
+/// the lower-left block of the SE(3) left Jacobian,
+/// Q = ½ v̂ + c₁ (ω̂v̂ + v̂ω̂ + ω̂v̂ω̂) + c₂ (ω̂²v̂ + v̂ω̂² − 3 ω̂v̂ω̂) + c₃ (ω̂v̂ω̂² + ω̂²v̂ω̂) with the
+/// coefficients of `q_coefficients` (checked against central differences of exp in the tests).
+fn q_block(w: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
+    let (c1, c2, c3) = q_coefficients(w.norm_squared());
+    let (wh, vh) = (so3::hat(w), so3::hat(v));
+    let (wv, vw, wvw) = (wh * vh, vh * wh, wh * vh * wh);
+    vh * 0.5
+        + (wv + vw + wvw) * c1
+        + (wh * wv + vw * wh - wvw * 3.0) * c2
+        + (wvw * wh + wh * wvw) * c3
+}
+
+/// The 6×6 left Jacobian [[J_l(ω), 0], [Q(ω, v), J_l(ω)]] of exp on (ω, v) coordinates
+/// (Barfoot's 𝒥 with the blocks reordered), or its inverse [[J_l⁻¹, 0], [−J_l⁻¹ Q J_l⁻¹, J_l⁻¹]]:
+/// exp(ξ + δ) = exp(J_l(ξ) δ) exp(ξ) to first order. Checked as [`so3::jacobian_left`] (and
+/// [`so3::jacobian_left_inv`]); an overflow error when Q exceeds the f64 range (huge v).
+fn jacobian_left_block(xi: &Vector6<f64>, inverse: bool) -> Result<Matrix6<f64>> {
+    check::finite_slice("xi", xi.as_slice())?;
+    let (w, v) = split(xi);
+    let j = if inverse {
+        so3::jacobian_left_inv(&w)?
+    } else {
+        so3::jacobian_left(&w)?
+    };
+    let q = q_block(&w, &v);
+    let q = if inverse { -(j * q * j) } else { q };
+    if q.iter().any(|x| !x.is_finite()) {
+        return Err(check::overflow_error("xi", "the SE(3) Jacobian"));
+    }
+    let mut m = Matrix6::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&j);
+    m.fixed_view_mut::<3, 3>(3, 3).copy_from(&j);
+    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&q);
+    Ok(m)
+}
+
+/// Left Jacobian J_l(ξ) of the SE(3) exponential (see `jacobian_left_block`).
+pub fn jacobian_left(xi: &Vector6<f64>) -> Result<Matrix6<f64>> {
+    jacobian_left_block(xi, false)
+}
+
+/// Right Jacobian J_r(ξ) = J_l(−ξ): exp(ξ + δ) = exp(ξ) exp(J_r(ξ) δ) to first order.
+pub fn jacobian_right(xi: &Vector6<f64>) -> Result<Matrix6<f64>> {
+    jacobian_left_block(&-xi, false)
+}
+
+/// J_l(ξ)⁻¹ (errors where J_l(ω) is singular, |ω| = 2πk, as [`so3::jacobian_left_inv`]).
+pub fn jacobian_left_inv(xi: &Vector6<f64>) -> Result<Matrix6<f64>> {
+    jacobian_left_block(xi, true)
+}
+
+/// J_r(ξ)⁻¹ = J_l(−ξ)⁻¹.
+pub fn jacobian_right_inv(xi: &Vector6<f64>) -> Result<Matrix6<f64>> {
+    jacobian_left_block(&-xi, true)
 }
 
 /// The 6×6 matrix of ad_ξ on (ω, v) coordinates: [[ω̂, 0], [v̂, ω̂]], i.e.
@@ -153,12 +270,6 @@ impl SE3 {
         m
     }
 
-    /// Acts on a point: g · x = R x + t.
-    #[inline]
-    pub fn act(&self, x: &Vector3<f64>) -> Vector3<f64> {
-        self.rot * x + self.trans
-    }
-
     /// The 6×6 matrix of Ad_g on (ω, v) coordinates: [[R, 0], [t̂ R, R]], i.e.
     /// Ad_g (ω, v) = (R ω, t × R ω + R v) (from g ξ̂ g⁻¹).
     pub fn adjoint_matrix(&self) -> Matrix6<f64> {
@@ -173,6 +284,7 @@ impl SE3 {
 
 impl MatrixLieGroup for SE3 {
     type Algebra = Vector6<f64>;
+    type Point = Vector3<f64>;
 
     fn dim(&self) -> usize {
         6
@@ -202,16 +314,25 @@ impl MatrixLieGroup for SE3 {
         }
     }
 
+    /// A point: g · x = R x + t.
+    #[inline]
+    fn act(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        self.rot * x + self.trans
+    }
+
     /// [`exp`].
-    fn exp(xi: &Vector6<f64>) -> Self {
+    fn exp(xi: &Vector6<f64>) -> Result<Self> {
         exp(xi)
     }
 
-    /// [`log`], with [`Error::NoUniqueLog`] when the rotation angle is within
-    /// [`so3::LOG_PI_TOL`] of π (as [`so3::SO3::log`]).
+    /// [`exp_unchecked`].
+    fn exp_unchecked(xi: &Vector6<f64>) -> Self {
+        exp_unchecked(xi)
+    }
+
+    /// [`log`].
     fn log(&self) -> Result<Vector6<f64>> {
-        so3::SO3::new_unchecked(self.rot).log()?;
-        Ok(log(self))
+        log(self)
     }
 
     /// Ad_g (ω, v) = (R ω, t × R ω + R v).
@@ -240,13 +361,18 @@ impl MatrixLieGroup for SE3 {
     }
 
     fn matrix(&self) -> Mat {
-        let m = self.matrix4();
-        Mat::from_fn(4, 4, |i, j| m[(i, j)])
+        super::to_mat(&self.matrix4())
     }
 
-    fn algebra_matrix(xi: &Vector6<f64>) -> Mat {
-        let m = hat(xi);
-        Mat::from_fn(4, 4, |i, j| m[(i, j)])
+    /// [`hat`].
+    fn hat(xi: &Vector6<f64>) -> Mat {
+        super::to_mat(&hat(xi))
+    }
+
+    /// [`vee`] of a 4×4 matrix.
+    fn vee(m: &Mat) -> Result<Vector6<f64>> {
+        check::square_of("xi", m, 4)?;
+        vee(&Matrix4::from_fn(|i, j| m[(i, j)]))
     }
 
     fn coords(xi: &Vector6<f64>) -> Vec<f64> {
@@ -255,5 +381,45 @@ impl MatrixLieGroup for SE3 {
 
     fn algebra_from_coords(&self, c: &[f64]) -> Vector6<f64> {
         Vector6::from_column_slice(c)
+    }
+
+    /// [`jacobian_right`].
+    fn jacobian_right(xi: &Vector6<f64>) -> Result<Mat> {
+        jacobian_right(xi).map(|j| super::to_mat(&j))
+    }
+
+    /// [`jacobian_left`].
+    fn jacobian_left(xi: &Vector6<f64>) -> Result<Mat> {
+        jacobian_left(xi).map(|j| super::to_mat(&j))
+    }
+
+    /// [`jacobian_right_inv`].
+    fn jacobian_right_inv(xi: &Vector6<f64>) -> Result<Mat> {
+        jacobian_right_inv(xi).map(|j| super::to_mat(&j))
+    }
+
+    /// [`jacobian_left_inv`].
+    fn jacobian_left_inv(xi: &Vector6<f64>) -> Result<Mat> {
+        jacobian_left_inv(xi).map(|j| super::to_mat(&j))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The series and the closed forms of Q's coefficients agree at the switch θ = 1.
+    #[test]
+    fn q_coefficients_continuous_at_the_switch() {
+        let (below, above) = (q_coefficients(1.0 - f64::EPSILON), q_coefficients(1.0));
+        for (a, b) in [(below.0, above.0), (below.1, above.1), (below.2, above.2)] {
+            assert!((a - b).abs() < 1e-14 * b.abs(), "{a} vs {b}");
+        }
+        // θ → 0: 1/6, 1/24, 1/120.
+        let zero = q_coefficients(0.0);
+        assert_eq!(
+            zero,
+            (1.0 / 6.0, 1.0 / 24.0, 0.5 * (1.0 / 24.0 - 3.0 / 120.0))
+        );
     }
 }

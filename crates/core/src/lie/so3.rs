@@ -4,9 +4,12 @@
 //! (The seed prints the first row of ŵ as (0, −ω₁, ω₂); the isomorphism property it proves needs
 //! (0, −ω₃, ω₂), which is what [`hat`] uses and what the tests check.)
 //!
-//! The free functions ([`exp`], [`log`], [`cayley`], the Jacobians, …) work on `Vector3`/`Matrix3`
-//! without checks or allocation, for inner loops. [`SO3`] is the validated rotation type that
-//! implements [`MatrixLieGroup`] (algebra R³, pairing the dot product, ad_u v = u × v).
+//! The free functions work on `Vector3`/`Matrix3` without allocation. As everywhere in
+//! [`crate::lie`], the plain name is checked and returns a `Result` ([`exp`], [`log`], [`vee`], the
+//! Jacobians); its `_unchecked` twin ([`exp_unchecked`], [`log_unchecked`], [`vee_unchecked`],
+//! [`jacobian_right_unchecked`], [`jacobian_left_unchecked`]) skips the checks for inner loops.
+//! [`SO3`] is the validated rotation type that implements [`MatrixLieGroup`] (algebra R³,
+//! pairing the dot product, ad_u v = u × v).
 //!
 //! Relation to the general so(n) coordinates of [`crate::lie::so`] (basis e_ij, i < j, in the
 //! order (1,2), (1,3), (2,3)): hat(w) has e_ij coordinates c = (−w₃, w₂, −w₁) ([`to_eij`],
@@ -25,9 +28,10 @@ pub fn hat(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
 }
 
-/// Inverse of [`hat`] on skew matrices (reads the skew part, so it is exact on so(3)).
+/// Inverse of [`hat`] on skew matrices (reads the skew part, so it is exact on so(3)); no
+/// checks (see [`vee`]).
 #[inline]
-pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
+pub fn vee_unchecked(m: &Matrix3<f64>) -> Vector3<f64> {
     Vector3::new(
         0.5 * (m[(2, 1)] - m[(1, 2)]),
         0.5 * (m[(0, 2)] - m[(2, 0)]),
@@ -35,9 +39,9 @@ pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
     )
 }
 
-/// [`vee`] with checks: `m` finite and skew to [`super::SKEW_TOL`] (relative defect
+/// Inverse of [`hat`]: `m` finite and skew to [`super::SKEW_TOL`] (relative defect
 /// ‖m + mᵀ‖_F / max(1, ‖m‖_F)), else [`Error::NonFinite`] / [`Error::NotInGroup`].
-pub fn try_vee(m: &Matrix3<f64>) -> Result<Vector3<f64>> {
+pub fn vee(m: &Matrix3<f64>) -> Result<Vector3<f64>> {
     check::finite_slice("xi", m.as_slice())?;
     let defect = (m + m.transpose()).norm() / m.norm().max(1.0);
     if defect > super::SKEW_TOL {
@@ -49,7 +53,7 @@ pub fn try_vee(m: &Matrix3<f64>) -> Result<Vector3<f64>> {
             tol: super::SKEW_TOL,
         });
     }
-    Ok(vee(m))
+    Ok(vee_unchecked(m))
 }
 
 /// The e_ij coordinates (DESIGN.md, order (1,2), (1,3), (2,3)) of hat(w): c = (−w₃, w₂, −w₁),
@@ -152,9 +156,9 @@ fn hat_sq(w: &Vector3<f64>, t2: f64) -> Matrix3<f64> {
 /// Rodrigues' formula exp(ŵ) = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = |w| (from
 /// ŵ³ = −θ² ŵ; checked against an independent matrix exponential in the tests), with Taylor
 /// coefficients for θ < 1e-2. One `sin_cos`, no allocation; orthogonal to ~1e-15 for θ up to
-/// 1e3 and beyond. No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`try_exp`]).
+/// 1e3 and beyond. No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`exp`]).
 #[inline]
-pub fn exp(w: &Vector3<f64>) -> Matrix3<f64> {
+pub fn exp_unchecked(w: &Vector3<f64>) -> Matrix3<f64> {
     let k = Coeffs::new(w);
     Matrix3::identity() + hat(w) * k.a + hat_sq(w, k.t2) * k.b
 }
@@ -167,10 +171,11 @@ pub fn check_exp_arg(what: &str, map: &str, w: &Vector3<f64>) -> Result<()> {
     super::check_exp_norm(what, map, super::scaled_norm(w.iter()))
 }
 
-/// [`exp`] with the checks of [`check_exp_arg`].
-pub fn try_exp(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+/// Exponential so(3) → SO(3): [`exp_unchecked`] (Rodrigues) with the checks of
+/// [`check_exp_arg`].
+pub fn exp(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
     check_exp_arg("w", "exp", w)?;
-    Ok(exp(w))
+    Ok(exp_unchecked(w))
 }
 
 /// exp(ŵ) and J_l(w) together from one `sin_cos` (the SE(3) exponential needs both).
@@ -189,7 +194,7 @@ pub(crate) fn exp_and_jacobian_left(w: &Vector3<f64>) -> (Matrix3<f64>, Matrix3<
 /// asin elsewhere (as accurate as atan2, and about twice as fast).
 #[inline]
 fn angle_cos_sin(r: &Matrix3<f64>) -> (f64, f64, Vector3<f64>) {
-    let s = vee(r);
+    let s = vee_unchecked(r);
     let c = 0.5 * (r.trace() - 1.0);
     let n = s.norm().min(1.0);
     let theta = if c.abs() <= 0.5 {
@@ -210,9 +215,9 @@ fn angle_cos_sin(r: &Matrix3<f64>) -> (f64, f64, Vector3<f64>) {
 /// its column with the largest diagonal entry, normalized, with the sign of s.
 ///
 /// Exactly at θ = π (s = 0) both ±π a are logarithms; this function returns the one whose
-/// component at the largest diagonal entry of R is positive. [`SO3::log`] refuses angles within
-/// [`LOG_PI_TOL`] of π instead. No checks: `r` is assumed to be a rotation (use [`SO3::new`]).
-pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
+/// component at the largest diagonal entry of R is positive. [`log`] refuses angles within
+/// [`LOG_PI_TOL`] of π instead. No checks: `r` is assumed to be a rotation (see [`log`]).
+pub fn log_unchecked(r: &Matrix3<f64>) -> Vector3<f64> {
     let (theta, c, s) = angle_cos_sin(r);
     if c > 0.0 {
         let t2 = theta * theta;
@@ -246,10 +251,26 @@ pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
     axis * theta
 }
 
-/// [`SO3::log`] refuses rotations whose angle θ has π − θ ≤ `LOG_PI_TOL`: there the two
+/// [`log`] refuses rotations whose angle θ has π − θ ≤ `LOG_PI_TOL`: there the two
 /// candidate logarithms ±θ a are 2θ apart while a rounding-level change of R (~1e-16 per entry,
-/// which moves θ by about as much) decides between them. The free [`log`] always returns one.
+/// which moves θ by about as much) decides between them. [`log_unchecked`] always returns one.
 pub const LOG_PI_TOL: f64 = 1e-12;
+
+/// Principal logarithm SO(3) → so(3) ([`log_unchecked`]) with checks: `r` a finite rotation
+/// ([`check_rotation`]), and [`Error::NoUniqueLog`] when π − θ ≤ [`LOG_PI_TOL`].
+pub fn log(r: &Matrix3<f64>) -> Result<Vector3<f64>> {
+    check_rotation("R", r)?;
+    let theta = angle_cos_sin(r).0;
+    let distance = std::f64::consts::PI - theta;
+    if distance <= LOG_PI_TOL {
+        return Err(Error::NoUniqueLog {
+            what: "R".into(),
+            angle: theta,
+            distance,
+        });
+    }
+    Ok(log_unchecked(r))
+}
 
 /// Tolerance on ‖RᵀR − I‖_F and |det R − 1| for accepting a matrix as a rotation.
 pub const ROTATION_TOL: f64 = 1e-10;
@@ -432,7 +453,7 @@ pub fn cayley_inv(r: &Matrix3<f64>) -> Result<Vector3<f64>> {
             ),
         ));
     }
-    Ok(vee(r) * (4.0 / d))
+    Ok(vee_unchecked(r) * (4.0 / d))
 }
 
 /// Right Jacobian of exp (the right-trivialized differential):
@@ -441,9 +462,9 @@ pub fn cayley_inv(r: &Matrix3<f64>) -> Result<Vector3<f64>> {
 /// Solà, Deray, Atchuthan, "A micro Lie theory for state estimation in robotics", 2018, SO(3)
 /// appendix); checked against central differences of [`exp`] in the tests.
 ///
-/// No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`try_jacobian_right`]).
+/// No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`jacobian_right`]).
 #[inline]
-pub fn jacobian_right(w: &Vector3<f64>) -> Matrix3<f64> {
+pub fn jacobian_right_unchecked(w: &Vector3<f64>) -> Matrix3<f64> {
     let k = Coeffs::new(w);
     Matrix3::identity() - hat(w) * k.b + hat_sq(w, k.t2) * k.c
 }
@@ -453,23 +474,25 @@ pub fn jacobian_right(w: &Vector3<f64>) -> Matrix3<f64> {
 /// so that exp(w + δ) = exp(J_l(w) δ) exp(w) + O(|δ|²). It is also the V matrix of the SE(3)
 /// exponential ([`crate::lie::se3::exp`]).
 ///
-/// No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`try_jacobian_left`]).
+/// No checks: NaN for |w| > [`super::EXP_MAX_NORM`] (see [`jacobian_left`]).
 #[inline]
-pub fn jacobian_left(w: &Vector3<f64>) -> Matrix3<f64> {
+pub fn jacobian_left_unchecked(w: &Vector3<f64>) -> Matrix3<f64> {
     let k = Coeffs::new(w);
     Matrix3::identity() + hat(w) * k.b + hat_sq(w, k.t2) * k.c
 }
 
-/// [`jacobian_right`] with the checks of [`check_exp_arg`].
-pub fn try_jacobian_right(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+/// The right Jacobian J_r(w) ([`jacobian_right_unchecked`]) with the checks of
+/// [`check_exp_arg`].
+pub fn jacobian_right(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
     check_exp_arg("w", "the so(3) Jacobian", w)?;
-    Ok(jacobian_right(w))
+    Ok(jacobian_right_unchecked(w))
 }
 
-/// [`jacobian_left`] with the checks of [`check_exp_arg`].
-pub fn try_jacobian_left(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
+/// The left Jacobian J_l(w) ([`jacobian_left_unchecked`]) with the checks of
+/// [`check_exp_arg`].
+pub fn jacobian_left(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
     check_exp_arg("w", "the so(3) Jacobian", w)?;
-    Ok(jacobian_left(w))
+    Ok(jacobian_left_unchecked(w))
 }
 
 /// J_r⁻¹ and J_l⁻¹ are singular where sin(θ/2) = 0, θ = 2πk (k ≥ 1); they error when
@@ -572,6 +595,7 @@ impl SO3 {
 
 impl MatrixLieGroup for SO3 {
     type Algebra = Vector3<f64>;
+    type Point = Vector3<f64>;
 
     fn dim(&self) -> usize {
         3
@@ -590,23 +614,24 @@ impl MatrixLieGroup for SO3 {
         SO3(self.0.transpose())
     }
 
-    /// Rodrigues' formula, [`exp`].
-    fn exp(xi: &Vector3<f64>) -> Self {
-        SO3(exp(xi))
+    /// R x.
+    fn act(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        self.0 * x
     }
 
-    /// [`log`], with [`Error::NoUniqueLog`] when π − θ ≤ [`LOG_PI_TOL`].
+    /// Rodrigues' formula, [`exp`].
+    fn exp(xi: &Vector3<f64>) -> Result<Self> {
+        exp(xi).map(SO3)
+    }
+
+    /// [`exp_unchecked`].
+    fn exp_unchecked(xi: &Vector3<f64>) -> Self {
+        SO3(exp_unchecked(xi))
+    }
+
+    /// [`log`] (R is already a rotation: only the refusal within [`LOG_PI_TOL`] of π can fail).
     fn log(&self) -> Result<Vector3<f64>> {
-        let theta = self.angle();
-        let distance = std::f64::consts::PI - theta;
-        if distance <= LOG_PI_TOL {
-            return Err(Error::NoUniqueLog {
-                what: "R".into(),
-                angle: theta,
-                distance,
-            });
-        }
-        Ok(log(&self.0))
+        log(&self.0)
     }
 
     /// Ad_R w = R w (R ŵ Rᵀ = (R w)^).
@@ -630,12 +655,18 @@ impl MatrixLieGroup for SO3 {
     }
 
     fn matrix(&self) -> Mat {
-        Mat::from_fn(3, 3, |i, j| self.0[(i, j)])
+        super::to_mat(&self.0)
     }
 
-    fn algebra_matrix(xi: &Vector3<f64>) -> Mat {
-        let h = hat(xi);
-        Mat::from_fn(3, 3, |i, j| h[(i, j)])
+    /// [`hat`].
+    fn hat(xi: &Vector3<f64>) -> Mat {
+        super::to_mat(&hat(xi))
+    }
+
+    /// [`vee`] of a 3×3 matrix.
+    fn vee(m: &Mat) -> Result<Vector3<f64>> {
+        check::square_of("xi", m, 3)?;
+        vee(&Matrix3::from_fn(|i, j| m[(i, j)]))
     }
 
     fn coords(xi: &Vector3<f64>) -> Vec<f64> {
@@ -644,6 +675,26 @@ impl MatrixLieGroup for SO3 {
 
     fn algebra_from_coords(&self, c: &[f64]) -> Vector3<f64> {
         Vector3::new(c[0], c[1], c[2])
+    }
+
+    /// [`jacobian_right`].
+    fn jacobian_right(xi: &Vector3<f64>) -> Result<Mat> {
+        jacobian_right(xi).map(|j| super::to_mat(&j))
+    }
+
+    /// [`jacobian_left`].
+    fn jacobian_left(xi: &Vector3<f64>) -> Result<Mat> {
+        jacobian_left(xi).map(|j| super::to_mat(&j))
+    }
+
+    /// [`jacobian_right_inv`].
+    fn jacobian_right_inv(xi: &Vector3<f64>) -> Result<Mat> {
+        jacobian_right_inv(xi).map(|j| super::to_mat(&j))
+    }
+
+    /// [`jacobian_left_inv`].
+    fn jacobian_left_inv(xi: &Vector3<f64>) -> Result<Mat> {
+        jacobian_left_inv(xi).map(|j| super::to_mat(&j))
     }
 }
 
@@ -656,15 +707,15 @@ mod tests {
         let u = Vector3::new(0.3, -1.2, 2.0);
         let v = Vector3::new(-0.7, 0.4, 1.1);
         assert!((hat(&u) * v - u.cross(&v)).norm() < 1e-15);
-        assert_eq!(vee(&hat(&u)), u);
+        assert_eq!(vee(&hat(&u)).unwrap(), u);
     }
 
     #[test]
     fn exp_rotates_about_axis() {
-        let r = exp(&Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
+        let r = exp_unchecked(&Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
         assert!((r * Vector3::x() - Vector3::y()).norm() < 1e-15);
         let w = Vector3::new(1e-6, -2e-6, 3e-7);
-        let r = exp(&w);
+        let r = exp_unchecked(&w);
         assert!((r.transpose() * r - Matrix3::identity()).norm() < 1e-15);
     }
 
@@ -687,7 +738,7 @@ mod tests {
     #[test]
     fn rodrigues_acts_as_the_matrices() {
         let v = Vector3::new(0.3, -1.2, 0.7);
-        let r = exp(&Vector3::new(0.4, -0.2, 0.1));
+        let r = exp_unchecked(&Vector3::new(0.4, -0.2, 0.1));
         for w in [
             Vector3::new(1e-5, -2e-5, 3e-6),
             Vector3::new(0.01, 0.02, -0.03),
@@ -695,7 +746,7 @@ mod tests {
             Vector3::new(1e101, -2e101, 3e100),
         ] {
             for (rot, m) in [
-                (Rodrigues::exp(&w), exp(&w)),
+                (Rodrigues::exp(&w), exp_unchecked(&w)),
                 (Rodrigues::cayley(&w), cayley(&w)),
             ] {
                 if !m[(0, 0)].is_finite() {

@@ -507,22 +507,6 @@ fn givens_cols(m: &mut Mat, i: usize, j: usize, c: f64, s: f64) {
     }
 }
 
-/// Spectral invariants ½tr((ξᵀξ)^k), k = 1…⌊n/2⌋, of a skew matrix: they determine its
-/// coadjoint orbit (the Casimirs of so(n)*).
-pub fn spectral_invariants(xi: &Mat) -> Vec<f64> {
-    let n = xi.nrows();
-    let sym = xi.transpose() * xi;
-    let mut pow = sym.clone();
-    let mut out = Vec::with_capacity(n / 2);
-    for k in 0..n / 2 {
-        if k > 0 {
-            pow = &pow * &sym;
-        }
-        out.push(0.5 * (0..n).map(|i| pow[(i, i)]).sum::<f64>());
-    }
-    out
-}
-
 fn diag(a: &[f64]) -> Mat {
     Mat::from_fn(a.len(), a.len(), |i, j| if i == j { a[i] } else { 0.0 })
 }

@@ -60,14 +60,14 @@ pub fn group_axioms<G: MatrixLieGroup>(g: &G, h: &G, k: &G) {
 /// `xi` must lie inside the injectivity radius of exp (for rotations: angles < π).
 pub fn exp_log<G: MatrixLieGroup>(g: &G, xi: &G::Algebra) {
     let scale = 1.0 + alg_norm::<G>(xi);
-    let x = G::exp(xi);
+    let x = G::exp(xi).unwrap();
     assert_small(
         "exp = expm(matrix)",
-        dist(&x.matrix(), &expm_reference(&G::algebra_matrix(xi))),
+        dist(&x.matrix(), &expm_reference(&G::hat(xi))),
         1e-12 * scale,
     );
     let half = lin::<G>(g, 0.5, xi, 0.0, xi);
-    let hh = G::exp(&half).compose(&G::exp(&half));
+    let hh = G::exp(&half).unwrap().compose(&G::exp(&half).unwrap());
     assert_small(
         "exp(ξ/2)² = exp ξ",
         dist(&hh.matrix(), &x.matrix()),
@@ -76,7 +76,7 @@ pub fn exp_log<G: MatrixLieGroup>(g: &G, xi: &G::Algebra) {
     let back = x.log().expect("log of exp inside the injectivity radius");
     assert_small("log(exp ξ) = ξ", alg_dist::<G>(&back, xi), 1e-10 * scale);
     if let Ok(l) = g.log() {
-        let again = G::exp(&l);
+        let again = G::exp(&l).unwrap();
         assert_small("exp(log g) = g", dist(&again.matrix(), &g.matrix()), 1e-10);
     }
     let c = G::coords(xi);
@@ -100,10 +100,10 @@ pub fn adjoint_laws<G: MatrixLieGroup>(
     let gm = g.matrix();
     let gi = g.inverse().matrix();
     // Ad_g ξ = g ξ g⁻¹ in the matrix representation.
-    let ad_g = G::algebra_matrix(&g.adjoint(xi));
+    let ad_g = G::hat(&g.adjoint(xi));
     assert_small(
         "Ad_g ξ = g ξ g⁻¹",
-        dist(&ad_g, &(&gm * G::algebra_matrix(xi) * &gi)),
+        dist(&ad_g, &(&gm * G::hat(xi) * &gi)),
         1e-11 * scale,
     );
     // Ad_{gh} = Ad_g Ad_h.
@@ -111,8 +111,8 @@ pub fn adjoint_laws<G: MatrixLieGroup>(
     let rhs = g.adjoint(&h.adjoint(xi));
     assert_small("Ad homomorphism", alg_dist::<G>(&lhs, &rhs), 1e-11 * scale);
     // [ξ, η] is the matrix commutator.
-    let (xm, ym): (Mat, Mat) = (G::algebra_matrix(xi), G::algebra_matrix(eta));
-    let br = G::algebra_matrix(&G::ad(xi, eta));
+    let (xm, ym): (Mat, Mat) = (G::hat(xi), G::hat(eta));
+    let br = G::hat(&G::ad(xi, eta));
     assert_small(
         "ad = commutator",
         dist(&br, &(&xm * &ym - &ym * &xm)),
@@ -139,11 +139,141 @@ pub fn adjoint_laws<G: MatrixLieGroup>(
     let rhs = G::pairing(zeta, &G::ad(xi, eta));
     assert_small("ad* duality", (lhs - rhs).abs(), 1e-11 * scale);
     // exp(Ad_g ξ) = g exp(ξ) g⁻¹.
-    let lhs = G::exp(&g.adjoint(xi)).matrix();
-    let rhs = &gm * G::exp(xi).matrix() * &gi;
+    let lhs = G::exp(&g.adjoint(xi)).unwrap().matrix();
+    let rhs = &gm * G::exp(xi).unwrap().matrix() * &gi;
     assert_small("exp(Ad_g ξ) = g exp ξ g⁻¹", dist(&lhs, &rhs), 1e-10 * scale);
     // Ad is linear.
     let lhs = g.adjoint(&lin::<G>(g, 2.0, xi, -3.0, eta));
     let rhs = lin::<G>(g, 2.0, &g.adjoint(xi), -3.0, &g.adjoint(eta));
     assert_small("Ad linear", alg_dist::<G>(&lhs, &rhs), 1e-10 * scale);
+}
+
+/// The column k of a dim × dim coordinate matrix as an algebra element.
+fn column<G: MatrixLieGroup>(g: &G, m: &Mat, k: usize) -> G::Algebra {
+    let c: Vec<f64> = (0..m.nrows()).map(|i| m[(i, k)]).collect();
+    g.algebra_from_coords(&c)
+}
+
+/// Every verb of [`MatrixLieGroup`] against its definition: act (a left action), checked and
+/// unchecked exp, hat/vee inverse to each other, Ad_g = d/dt g exp(tξ) g⁻¹ and
+/// ad_ξ = d/dt Ad_exp(tξ) (central differences), ad* dual to ad, the Jacobians against central
+/// differences of exp, J_l(ξ) = Ad_exp(ξ) J_r(ξ), J_r(−ξ) = J_l(ξ) and the inverses. `xi` must lie
+/// where the inverse Jacobians are defined (|ξ| < π for so(n)); `x` is a point of the defining
+/// representation, `point` its coordinates.
+pub fn verb_laws<G: MatrixLieGroup>(
+    g: &G,
+    h: &G,
+    xi: &G::Algebra,
+    eta: &G::Algebra,
+    x: &G::Point,
+    point: fn(&G::Point) -> Vec<f64>,
+) {
+    let scale = (1.0 + alg_norm::<G>(xi)) * (1.0 + alg_norm::<G>(eta));
+    let pdist = |a: &G::Point, b: &G::Point| {
+        let (a, b) = (point(a), point(b));
+        assert_eq!(a.len(), b.len());
+        a.iter()
+            .zip(&b)
+            .map(|(p, q)| (p - q).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let px = 1.0 + point(x).iter().map(|v| v * v).sum::<f64>().sqrt();
+    // act: a left action with e · x = x and g⁻¹ · (g · x) = x.
+    let lhs = g.act(&h.act(x));
+    let rhs = g.compose(h).act(x);
+    assert_small("g·(h·x) = (gh)·x", pdist(&lhs, &rhs), 1e-12 * px);
+    assert_small("e·x = x", pdist(&g.identity_like().act(x), x), 0.0);
+    let back = g.inverse().act(&g.act(x));
+    assert_small("g⁻¹·(g·x) = x", pdist(&back, x), 1e-12 * px);
+    // exp: checked = unchecked on valid input.
+    let e = G::exp(xi).expect("exp of a valid ξ");
+    assert_small(
+        "exp = exp_unchecked",
+        dist(&e.matrix(), &G::exp_unchecked(xi).matrix()),
+        0.0,
+    );
+    // hat and vee.
+    let m = G::hat(xi);
+    let v = G::vee(&m).expect("vee of hat ξ");
+    assert_small("vee(hat ξ) = ξ", alg_dist::<G>(&v, xi), 0.0);
+    let size = m.nrows();
+    let not_algebra = &m + Mat::identity(size, size);
+    assert!(G::vee(&not_algebra).is_err(), "vee(hat ξ + I) must fail");
+    // Ad_g ξ = d/dt g exp(tξ) g⁻¹ at t = 0.
+    let step = 1e-5;
+    let scaled = |t: f64, a: &G::Algebra| lin::<G>(g, t, a, 0.0, a);
+    let (gm, gi) = (g.matrix(), g.inverse().matrix());
+    let conj = |t: f64| &gm * G::exp(&scaled(t, xi)).unwrap().matrix() * &gi;
+    let fd = (conj(step) - conj(-step)) * faer::Scale(0.5 / step);
+    assert_small(
+        "Ad_g ξ = d/dt g exp(tξ) g⁻¹",
+        dist(&G::hat(&g.adjoint(xi)), &fd),
+        1e-8 * scale * (1.0 + gm.norm_l2() * gi.norm_l2()),
+    );
+    // ad_ξ η = d/dt Ad_exp(tξ) η at t = 0.
+    let ad_t = |t: f64| G::exp(&scaled(t, xi)).unwrap().adjoint(eta);
+    let fd = lin::<G>(g, 0.5 / step, &ad_t(step), -0.5 / step, &ad_t(-step));
+    assert_small(
+        "ad_ξ η = d/dt Ad_exp(tξ) η",
+        alg_dist::<G>(&G::ad(xi, eta), &fd),
+        1e-8 * scale * scale,
+    );
+    // ⟨ad*_ξ μ, η⟩ = ⟨μ, ad_ξ η⟩ with μ = Ad_g η (any element).
+    let mu = g.adjoint(eta);
+    let lhs = G::pairing(&G::ad_star(xi, &mu), eta);
+    let rhs = G::pairing(&mu, &G::ad(xi, eta));
+    assert_small(
+        "⟨ad*_ξ μ, η⟩ = ⟨μ, ad_ξ η⟩",
+        (lhs - rhs).abs(),
+        1e-11 * scale * scale,
+    );
+    // Jacobians against central differences of exp along the coordinate axes:
+    // exp(ξ)⁻¹ d exp = hat(J_r e_k), d exp exp(ξ)⁻¹ = hat(J_l e_k).
+    let jr = G::jacobian_right(xi).expect("J_r");
+    let jl = G::jacobian_left(xi).expect("J_l");
+    let d = g.dim();
+    assert_eq!(
+        (jr.nrows(), jr.ncols(), jl.nrows(), jl.ncols()),
+        (d, d, d, d)
+    );
+    let em = e.matrix();
+    let ei = e.inverse().matrix();
+    let c = G::coords(xi);
+    for k in 0..d {
+        let shifted = |t: f64| {
+            let mut c = c.clone();
+            c[k] += t;
+            G::exp(&g.algebra_from_coords(&c)).unwrap().matrix()
+        };
+        let de = (shifted(step) - shifted(-step)) * faer::Scale(0.5 / step);
+        let tol = 1e-8 * scale * scale;
+        assert_small(
+            "J_r by differences",
+            dist(&(&ei * &de), &G::hat(&column(g, &jr, k))),
+            tol,
+        );
+        assert_small(
+            "J_l by differences",
+            dist(&(&de * &ei), &G::hat(&column(g, &jl, k))),
+            tol,
+        );
+        // J_l(ξ) = Ad_exp(ξ) J_r(ξ).
+        let ad_col = e.adjoint(&column(g, &jr, k));
+        assert_small(
+            "J_l = Ad_exp(ξ) J_r",
+            alg_dist::<G>(&ad_col, &column(g, &jl, k)),
+            1e-12 * scale * (1.0 + em.norm_l2() * ei.norm_l2()),
+        );
+    }
+    // J_r(−ξ) = J_l(ξ).
+    let minus = lin::<G>(g, -1.0, xi, 0.0, xi);
+    let jr_minus = G::jacobian_right(&minus).unwrap();
+    assert_small("J_r(−ξ) = J_l(ξ)", dist(&jr_minus, &jl), 1e-13 * scale);
+    // The inverses.
+    let id = Mat::identity(d, d);
+    let jri = G::jacobian_right_inv(xi).expect("J_r⁻¹");
+    let jli = G::jacobian_left_inv(xi).expect("J_l⁻¹");
+    assert_small("J_r⁻¹ J_r = I", dist(&(&jri * &jr), &id), 1e-11 * scale);
+    assert_small("J_l⁻¹ J_l = I", dist(&(&jli * &jl), &id), 1e-11 * scale);
 }

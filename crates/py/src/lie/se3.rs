@@ -3,13 +3,30 @@
 
 use lieflow::lie::se3::{self, SE3};
 use lieflow::lie::MatrixLieGroup;
-use lieflow::Error;
-use nalgebra::{Matrix4, Vector6};
+use nalgebra::{Matrix4, Matrix6, Vector3, Vector6};
 use pyo3::prelude::*;
 
-use crate::batch::{map_batch, par_fill, read_items, Out};
+use super::map_pairs;
+use crate::batch::{map_batch, Out};
 use crate::convert::ArrayIn;
-use crate::errors::to_py;
+
+/// `se3_hat(xi)`: the 4×4 matrix [[ω̂, v], [0, 0]] of ξ = (ω, v) (so3_hat for ω̂).
+///
+/// Args: xi — (6,) or (b, 6). Returns (4, 4) or (b, 4, 4). Raises ShapeError, NonFiniteError.
+#[pyfunction]
+fn se3_hat<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::hat(x)))
+}
+
+/// `se3_vee(X)`: the inverse of `se3_hat`, ξ = (ω, v) of X = [[ω̂, v], [0, 0]].
+///
+/// Args: X — (4, 4) or (b, 4, 4). Returns (6,) or (b, 6). Raises ShapeError, NonFiniteError,
+/// NotInGroupError (last row not zero to 1e-12, or the rotation block not skew to 1e-10).
+#[pyfunction]
+#[allow(non_snake_case)]
+fn se3_vee<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "X", &X, se3::vee)
+}
 
 /// `se3_exp(xi)`: exp of ξ = (ω, v) (rotation first) as the 4×4 matrix [[exp(ω̂), V(ω) v], [0, 1]],
 /// V(ω) = I + ((1 − cos θ)/θ²) ω̂ + ((θ − sin θ)/θ³) ω̂² (the left Jacobian of SO(3)), θ = ‖ω‖;
@@ -19,9 +36,7 @@ use crate::errors::to_py;
 /// InvalidArgumentError (‖ω‖ > 2.25e14, the rule of so3_exp; a translation beyond the f64 range).
 #[pyfunction]
 fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "xi", &xi, |x: &Vector6<f64>| {
-        Ok(se3::try_exp(x)?.matrix4())
-    })
+    map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::exp(x)?.matrix4()))
 }
 
 /// `se3_log(g, strict=False)`: the logarithm ξ = (ω, v) of g = [[R, t], [0, 1]]: ω = so3_log(R)
@@ -39,23 +54,117 @@ fn se3_log<'py>(py: Python<'py>, g: ArrayIn<'py>, strict: bool) -> PyResult<Out<
         if strict {
             g.log()
         } else {
-            Ok(se3::log(&g))
+            Ok(se3::log_unchecked(&g))
         }
     })
 }
 
-/// `se3_Ad(g)`: the 6×6 matrix of the adjoint action on (ω, v) coordinates,
-/// Ad_g = [[R, 0], [t̂ R, R]], i.e. Ad_g (ω, v) = (R ω, t × R ω + R v), so that
-/// exp(Ad_g ξ) = g exp(ξ) g⁻¹.
+/// `se3_Ad(g, xi=None)`: the adjoint action Ad_g (ω, v) = (R ω, t × R ω + R v) on (ω, v)
+/// coordinates, so that exp(Ad_g ξ) = g exp(ξ) g⁻¹; without `xi`, its 6×6 matrix
+/// Ad_g = [[R, 0], [t̂ R, R]].
 ///
-/// Args: g — (4, 4) or (b, 4, 4). Returns (6, 6) or (b, 6, 6).
+/// Args: g — (4, 4) or (b, 4, 4); xi — (6,) or (b, 6) (a single one broadcasts over the other's
+/// batch). Returns (6,) or (b, 6); without xi (6, 6) or (b, 6, 6).
 /// Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
-#[pyo3(name = "se3_Ad")]
-fn se3_ad<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "g", &g, |m: &Matrix4<f64>| {
-        Ok(SE3::from_matrix4(m)?.adjoint_matrix())
-    })
+#[pyo3(name = "se3_Ad", signature = (g, xi = None))]
+fn se3_adjoint<'py>(
+    py: Python<'py>,
+    g: ArrayIn<'py>,
+    xi: Option<ArrayIn<'py>>,
+) -> PyResult<Out<'py>> {
+    match xi {
+        None => map_batch(py, "g", &g, |m: &Matrix4<f64>| {
+            Ok(SE3::from_matrix4(m)?.adjoint_matrix())
+        }),
+        Some(xi) => map_pairs(
+            py,
+            ["g", "xi"],
+            &g,
+            &xi,
+            |m: &Matrix4<f64>, x: &Vector6<f64>| Ok(SE3::from_matrix4(m)?.adjoint(x)),
+        ),
+    }
+}
+
+/// `se3_ad(xi, eta)`: the bracket ad_(ω₁, v₁) (ω₂, v₂) = (ω₁ × ω₂, ω₁ × v₂ − ω₂ × v₁) (the
+/// commutator of the 4×4 matrices).
+///
+/// Args: xi, eta — (6,) or (b, 6) (a single one broadcasts). Returns (6,) or (b, 6).
+/// Raises ShapeError, NonFiniteError.
+#[pyfunction]
+fn se3_ad<'py>(py: Python<'py>, xi: ArrayIn<'py>, eta: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
+        py,
+        ["xi", "eta"],
+        &xi,
+        &eta,
+        |x: &Vector6<f64>, y: &Vector6<f64>| Ok(SE3::ad(x, y)),
+    )
+}
+
+/// `se3_ad_star(xi, mu)`: the coadjoint action ad*_(ω, v) (μ, p) = (μ × ω + p × v, p × ω), the
+/// transpose of ad_ξ under the dot-product pairing.
+///
+/// Args: xi, mu — (6,) or (b, 6) (a single one broadcasts). Returns (6,) or (b, 6).
+/// Raises ShapeError, NonFiniteError.
+#[pyfunction]
+fn se3_ad_star<'py>(py: Python<'py>, xi: ArrayIn<'py>, mu: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
+        py,
+        ["xi", "mu"],
+        &xi,
+        &mu,
+        |x: &Vector6<f64>, m: &Vector6<f64>| Ok(SE3::ad_star(x, m)),
+    )
+}
+
+/// `se3_act(g, x)`: the rigid motion of a point, g · x = R x + t.
+///
+/// Args: g — (4, 4) or (b, 4, 4); x — (3,) or (b, 3) (a single one broadcasts). Returns (3,) or
+/// (b, 3). Raises ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+fn se3_act<'py>(py: Python<'py>, g: ArrayIn<'py>, x: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
+        py,
+        ["g", "x"],
+        &g,
+        &x,
+        |m: &Matrix4<f64>, x: &Vector3<f64>| Ok(SE3::from_matrix4(m)?.act(x)),
+    )
+}
+
+/// `se3_jacobian_left(xi, inverse=False)`: the 6×6 left Jacobian of exp on (ω, v) coordinates,
+/// [[J_l(ω), 0], [Q(ω, v), J_l(ω)]] (Barfoot's Q block), so that
+/// exp(ξ + δ) ≈ exp(J_l(ξ) δ) exp(ξ); with `inverse=True` its inverse.
+///
+/// Args: xi — (6,) or (b, 6). Returns (6, 6) or (b, 6, 6).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at ‖ω‖ = 2πk, k ≥ 1;
+/// ‖ω‖ > 2.25e14, the rule of so3_exp; a Jacobian beyond the f64 range).
+#[pyfunction]
+#[pyo3(signature = (xi, inverse = false))]
+fn se3_jacobian_left<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
+    let f: fn(&Vector6<f64>) -> lieflow::Result<Matrix6<f64>> = if inverse {
+        se3::jacobian_left_inv
+    } else {
+        se3::jacobian_left
+    };
+    map_batch(py, "xi", &xi, f)
+}
+
+/// `se3_jacobian_right(xi, inverse=False)`: the 6×6 right Jacobian J_r(ξ) = J_l(−ξ), so that
+/// exp(ξ + δ) ≈ exp(ξ) exp(J_r(ξ) δ); with `inverse=True` its inverse.
+///
+/// Args: xi — (6,) or (b, 6). Returns (6, 6) or (b, 6, 6). Raises as se3_jacobian_left.
+#[pyfunction]
+#[pyo3(signature = (xi, inverse = false))]
+fn se3_jacobian_right<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
+    let f: fn(&Vector6<f64>) -> lieflow::Result<Matrix6<f64>> = if inverse {
+        se3::jacobian_right_inv
+    } else {
+        se3::jacobian_right
+    };
+    map_batch(py, "xi", &xi, f)
 }
 
 /// `se3_inverse(g)`: (R, t)⁻¹ = (Rᵀ, −Rᵀ t) as a 4×4 matrix.
@@ -76,33 +185,29 @@ fn se3_inverse<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// Raises ShapeError (incl. batch lengths that differ), NonFiniteError, NotInGroupError.
 #[pyfunction]
 fn se3_compose<'py>(py: Python<'py>, g: ArrayIn<'py>, h: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    let (gs, bg) = read_items::<Matrix4<f64>>("g", &g)?;
-    let (hs, bh) = read_items::<Matrix4<f64>>("h", &h)?;
-    // A single element broadcasts over the other batch; an empty batch gives an empty result.
-    let n = if gs.is_empty() || hs.is_empty() {
-        0
-    } else {
-        gs.len().max(hs.len())
-    };
-    if bg && bh && gs.len() != hs.len() {
-        return Err(to_py(Error::shape(
-            "h",
-            format!("a batch of the same length as g ({}, 4, 4)", gs.len()),
-            format!("({}, 4, 4)", hs.len()),
-        )));
-    }
-    par_fill(py, "g, h", n, bg || bh, |k| {
-        let g = SE3::from_matrix4(&gs[k.min(gs.len() - 1)])?;
-        let h = SE3::from_matrix4(&hs[k.min(hs.len() - 1)])
-            .map_err(|e| e.map_what(|w| format!("h ({w})")))?;
-        Ok(g.compose(&h).matrix4())
-    })
+    map_pairs(
+        py,
+        ["g", "h"],
+        &g,
+        &h,
+        |a: &Matrix4<f64>, b: &Matrix4<f64>| {
+            let h = SE3::from_matrix4(b).map_err(|e| e.map_what(|w| format!("h ({w})")))?;
+            Ok(SE3::from_matrix4(a)?.compose(&h).matrix4())
+        },
+    )
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(se3_exp, m)?)?;
     m.add_function(wrap_pyfunction!(se3_log, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_hat, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_vee, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_adjoint, m)?)?;
     m.add_function(wrap_pyfunction!(se3_ad, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_ad_star, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_act, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_jacobian_left, m)?)?;
+    m.add_function(wrap_pyfunction!(se3_jacobian_right, m)?)?;
     m.add_function(wrap_pyfunction!(se3_inverse, m)?)?;
     m.add_function(wrap_pyfunction!(se3_compose, m)?)?;
     Ok(())

@@ -1,15 +1,18 @@
 //! `lieflow.lie`: SO(n) and so(n) for any n ≥ 2, and SO(n) × SO(n) (bindings of
 //! `lieflow::lie::so` and `lieflow::lie::product`).
 
-use lieflow::lie::{product, so};
+use lieflow::lie::so::{self, SOn};
+use lieflow::lie::{product, MatrixLieGroup};
 use lieflow::{check, Mat, Result};
 use numpy::ndarray::Array3;
-use numpy::{IntoPyArray, PyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
 use crate::convert::real;
-use crate::convert::{mat, mats, py_mat, py_mats, py_vec, py_vecs, read_all, vectors, ArrayIn};
+use crate::convert::{
+    mat, mats, py_mat, py_mats, py_vec, py_vecs, read_all, vector, vectors, ArrayIn,
+};
 use crate::errors::IntoPy;
 
 /// Applies `f` to one matrix or to a batch (b, n, n). A batch is copied once into a contiguous
@@ -65,7 +68,7 @@ fn map_mats<'py>(
     Ok(arr.into_pyarray(py).into_any())
 }
 
-/// Skew-symmetric matrix with coordinates `c` in the e_ij basis (i < j, +1 at (i, j), −1 at
+/// `so_hat(c)` (alias `hat_n`): the skew-symmetric matrix with coordinates `c` in the e_ij basis (i < j, +1 at (i, j), −1 at
 /// (j, i)), ordered (1,2), (1,3), …, (1,n), (2,3), …, (n−1,n).
 ///
 /// Args:
@@ -75,7 +78,7 @@ fn map_mats<'py>(
 /// Raises:
 ///     ShapeError: d is not of the form n(n−1)/2. NonFiniteError: NaN or inf in c.
 #[pyfunction]
-fn hat_n<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+fn so_hat<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
     let (cs, batched) = vectors("c", &c)?;
     // The (b, n, n) output is larger than the (b, d) input: check its size first.
     let first = cs.first().map(|v| so::hat_n(v)).transpose().py()?;
@@ -93,7 +96,8 @@ fn hat_n<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
     }
 }
 
-/// Coordinates of a skew-symmetric matrix in the e_ij basis (the inverse of `hat_n`).
+/// `so_vee(xi)` (alias `vee_n`): the coordinates of a skew-symmetric matrix in the e_ij basis
+/// (the inverse of `so_hat`).
 ///
 /// Args:
 ///     xi: shape (n, n), skew-symmetric (relative defect ‖ξ + ξᵀ‖ ≤ 1e-10), or a batch (b, n, n).
@@ -102,7 +106,7 @@ fn hat_n<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (not skew).
 #[pyfunction]
-fn vee_n<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+fn so_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
     let (ms, batched) = mats("xi", &xi)?;
     let out = ms
         .iter()
@@ -155,7 +159,8 @@ fn so_log<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
     map_mats(py, "R", &R, so::log)
 }
 
-/// Cayley map cay(ξ) = (I − ξ/2)⁻¹ (I + ξ/2), so(n) → SO(n).
+/// `so_cayley(xi)` (alias `cayley`): the Cayley map cay(ξ) = (I − ξ/2)⁻¹ (I + ξ/2),
+/// so(n) → SO(n).
 ///
 /// Args:
 ///     xi: skew matrix (n, n).
@@ -164,11 +169,12 @@ fn so_log<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (not skew).
 #[pyfunction]
-fn cayley<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn so_cayley<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     Ok(py_mat(py, &so::cayley(&mat("xi", &xi)?).py()?))
 }
 
-/// Inverse Cayley map ξ = 2 (I + R)⁻¹ (R − I), the exact inverse of `cayley`.
+/// `so_cayley_inv(R)` (alias `cayley_inv`): the inverse Cayley map ξ = 2 (I + R)⁻¹ (R − I), the
+/// exact inverse of `so_cayley`.
 ///
 /// Args:
 ///     R: rotation (n, n).
@@ -179,13 +185,13 @@ fn cayley<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray
 ///     NotInGroupError, ShapeError, NonFiniteError.
 #[pyfunction]
 #[allow(non_snake_case)]
-fn cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn so_cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     Ok(py_mat(py, &so::cayley_inv(&mat("R", &R)?).py()?))
 }
 
-/// Right-trivialized derivative of exp: dexp_ξ η = Σ_k ad_ξᵏ η / (k+1)!, so that
-/// d/dt so_exp(ξ + tη) at t = 0 equals dexp(ξ, η) @ so_exp(ξ)
-/// (and so_exp(ξ) @ dexp(−ξ, η), the left-trivialized form). Any ξ.
+/// `so_dexp(xi, eta)` (alias `dexp`): the right-trivialized derivative of exp, dexp_ξ η = Σ_k ad_ξᵏ η / (k+1)!, so that
+/// d/dt so_exp(ξ + tη) at t = 0 equals so_dexp(ξ, η) @ so_exp(ξ)
+/// (and so_exp(ξ) @ so_dexp(−ξ, η), the left-trivialized form). Any ξ.
 ///
 /// Args:
 ///     xi, eta: skew matrices (n, n).
@@ -194,7 +200,7 @@ fn cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAr
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (‖ξ‖ > 2.25e14).
 #[pyfunction]
-fn dexp<'py>(
+fn so_dexp<'py>(
     py: Python<'py>,
     xi: ArrayIn<'py>,
     eta: ArrayIn<'py>,
@@ -203,16 +209,16 @@ fn dexp<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// Inverse of `dexp` (Bernoulli series Σ_k B_k/k! ad_ξᵏ η), for ‖ξ‖ < π where ‖ξ‖² = ½ tr(ξᵀξ).
+/// `so_dexp_inv(xi, eta)` (alias `dexp_inv`): the inverse of `so_dexp` (Bernoulli series Σ_k B_k/k! ad_ξᵏ η), for ‖ξ‖ < π where ‖ξ‖² = ½ tr(ξᵀξ).
 ///
 /// Args:
 ///     xi, eta: skew matrices (n, n).
 /// Returns:
-///     skew matrix (n, n) with dexp(xi, result) = eta.
+///     skew matrix (n, n) with so_dexp(xi, result) = eta.
 /// Raises:
 ///     InvalidArgumentError: ‖ξ‖ ≥ π. ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
-fn dexp_inv<'py>(
+fn so_dexp_inv<'py>(
     py: Python<'py>,
     xi: ArrayIn<'py>,
     eta: ArrayIn<'py>,
@@ -221,7 +227,7 @@ fn dexp_inv<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// Adjoint action Ad_g ξ = g ξ gᵀ of SO(n) on so(n).
+/// `so_Ad(g, xi)` (alias `Ad`): the adjoint action Ad_g ξ = g ξ gᵀ of SO(n) on so(n).
 ///
 /// Args:
 ///     g: rotation (n, n). xi: skew matrix (n, n).
@@ -230,8 +236,8 @@ fn dexp_inv<'py>(
 /// Raises:
 ///     NotInGroupError (g not a rotation or xi not skew), ShapeError, NonFiniteError.
 #[pyfunction]
-#[pyo3(name = "Ad")]
-fn adjoint<'py>(
+#[pyo3(name = "so_Ad")]
+fn so_adjoint<'py>(
     py: Python<'py>,
     g: ArrayIn<'py>,
     xi: ArrayIn<'py>,
@@ -240,7 +246,7 @@ fn adjoint<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// ad_ξ η = [ξ, η] = ξη − ηξ on so(n).
+/// `so_ad(xi, eta)` (alias `ad`): ad_ξ η = [ξ, η] = ξη − ηξ on so(n).
 ///
 /// Args:
 ///     xi, eta: skew matrices (n, n).
@@ -249,7 +255,7 @@ fn adjoint<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (not skew).
 #[pyfunction]
-fn ad<'py>(
+fn so_ad<'py>(
     py: Python<'py>,
     xi: ArrayIn<'py>,
     eta: ArrayIn<'py>,
@@ -258,7 +264,7 @@ fn ad<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// Coadjoint action ad*_ξ μ = [μ, ξ], with so(n)* identified with so(n) by the pairing
+/// `so_ad_star(xi, mu)` (alias `ad_star`): the coadjoint action ad*_ξ μ = [μ, ξ], with so(n)* identified with so(n) by the pairing
 /// ⟨ξ, η⟩ = ½ tr(ξᵀη), so that ⟨ad*_ξ μ, η⟩ = ⟨μ, [ξ, η]⟩ (000 §3.3).
 ///
 /// Args:
@@ -268,7 +274,7 @@ fn ad<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (not skew).
 #[pyfunction]
-fn ad_star<'py>(
+fn so_ad_star<'py>(
     py: Python<'py>,
     xi: ArrayIn<'py>,
     mu: ArrayIn<'py>,
@@ -307,6 +313,117 @@ const _: () = assert!(so::ROTATION_TOL == 1e-10);
 #[allow(non_snake_case)]
 fn project_to_so<'py>(py: Python<'py>, M: ArrayIn<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     Ok(py_mat(py, &so::project_to_so(&mat("M", &M)?).py()?))
+}
+
+/// `so_compose(g, h)`: the product g @ h of two rotations of one size.
+///
+/// Args:
+///     g, h: rotations (n, n).
+/// Returns:
+///     rotation (n, n).
+/// Raises:
+///     NotInGroupError, ShapeError (sizes differ), NonFiniteError.
+#[pyfunction]
+fn so_compose<'py>(
+    py: Python<'py>,
+    g: ArrayIn<'py>,
+    h: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let g = SOn::new(mat("g", &g)?).py()?;
+    let h = mat("h", &h)?;
+    so::check_rotation_of("h", &h, g.n()).py()?;
+    Ok(py_mat(py, g.compose(&SOn::new(h).py()?).as_mat()))
+}
+
+/// `so_inverse(R)`: R⁻¹ = Rᵀ.
+///
+/// Args:
+///     R: rotation (n, n), or a batch (b, n, n).
+/// Returns:
+///     rotation (n, n) or (b, n, n).
+/// Raises:
+///     NotInGroupError, ShapeError, NonFiniteError.
+#[pyfunction]
+#[allow(non_snake_case)]
+fn so_inverse<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
+    map_mats(py, "R", &R, |r| {
+        Ok(SOn::new(r.clone())?.inverse().into_mat())
+    })
+}
+
+/// `so_act(R, x)`: the rotated vector R x.
+///
+/// Args:
+///     R: rotation (n, n). x: vector (n,).
+/// Returns:
+///     vector (n,).
+/// Raises:
+///     NotInGroupError, ShapeError, NonFiniteError.
+#[pyfunction]
+#[allow(non_snake_case)]
+fn so_act<'py>(
+    py: Python<'py>,
+    R: ArrayIn<'py>,
+    x: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let g = SOn::new(mat("R", &R)?).py()?;
+    let x = vector("x", &x)?;
+    check::len_of("x", &x, g.n()).py()?;
+    Ok(py_vec(py, &g.act(&x)))
+}
+
+/// The Jacobian bindings: J(ξ), or J⁻¹(ξ) when `inverse`.
+fn jacobian<'py>(
+    py: Python<'py>,
+    xi: &ArrayIn<'py>,
+    inverse: bool,
+    forward: fn(&Mat) -> Result<Mat>,
+    backward: fn(&Mat) -> Result<Mat>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let xi = mat("xi", xi)?;
+    let j = if inverse { backward(&xi) } else { forward(&xi) };
+    Ok(py_mat(py, &j.py()?))
+}
+
+/// `so_jacobian_left(xi, inverse=False)`: the left Jacobian of exp on so(n), the d × d matrix
+/// (d = n(n−1)/2) of η ↦ so_dexp(ξ, η) in e_ij coordinates, so that
+/// so_exp(ξ + δ) ≈ so_exp(J_l(ξ) δ) so_exp(ξ); with `inverse=True` its inverse (the matrix of
+/// so_dexp_inv, for ‖ξ‖ < π).
+///
+/// Args:
+///     xi: skew matrix (n, n).
+/// Returns:
+///     (d, d) matrix.
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError
+///     (‖ξ‖ > 2.25e14; inverse: ‖ξ‖ ≥ π).
+#[pyfunction]
+#[pyo3(signature = (xi, inverse = false))]
+fn so_jacobian_left<'py>(
+    py: Python<'py>,
+    xi: ArrayIn<'py>,
+    inverse: bool,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    jacobian(py, &xi, inverse, so::jacobian_left, so::jacobian_left_inv)
+}
+
+/// `so_jacobian_right(xi, inverse=False)`: the right Jacobian J_r(ξ) = J_l(−ξ), so that
+/// so_exp(ξ + δ) ≈ so_exp(ξ) so_exp(J_r(ξ) δ); with `inverse=True` its inverse.
+///
+/// Args:
+///     xi: skew matrix (n, n).
+/// Returns:
+///     (d, d) matrix, d = n(n−1)/2.
+/// Raises:
+///     as so_jacobian_left.
+#[pyfunction]
+#[pyo3(signature = (xi, inverse = false))]
+fn so_jacobian_right<'py>(
+    py: Python<'py>,
+    xi: ArrayIn<'py>,
+    inverse: bool,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    jacobian(py, &xi, inverse, so::jacobian_right, so::jacobian_right_inv)
 }
 
 type Pair<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
@@ -357,17 +474,22 @@ fn product_bracket<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(hat_n, m)?)?;
-    m.add_function(wrap_pyfunction!(vee_n, m)?)?;
+    m.add_function(wrap_pyfunction!(so_hat, m)?)?;
+    m.add_function(wrap_pyfunction!(so_vee, m)?)?;
     m.add_function(wrap_pyfunction!(so_exp, m)?)?;
     m.add_function(wrap_pyfunction!(so_log, m)?)?;
-    m.add_function(wrap_pyfunction!(cayley, m)?)?;
-    m.add_function(wrap_pyfunction!(cayley_inv, m)?)?;
-    m.add_function(wrap_pyfunction!(dexp, m)?)?;
-    m.add_function(wrap_pyfunction!(dexp_inv, m)?)?;
-    m.add_function(wrap_pyfunction!(adjoint, m)?)?;
-    m.add_function(wrap_pyfunction!(ad, m)?)?;
-    m.add_function(wrap_pyfunction!(ad_star, m)?)?;
+    m.add_function(wrap_pyfunction!(so_compose, m)?)?;
+    m.add_function(wrap_pyfunction!(so_inverse, m)?)?;
+    m.add_function(wrap_pyfunction!(so_act, m)?)?;
+    m.add_function(wrap_pyfunction!(so_cayley, m)?)?;
+    m.add_function(wrap_pyfunction!(so_cayley_inv, m)?)?;
+    m.add_function(wrap_pyfunction!(so_dexp, m)?)?;
+    m.add_function(wrap_pyfunction!(so_dexp_inv, m)?)?;
+    m.add_function(wrap_pyfunction!(so_adjoint, m)?)?;
+    m.add_function(wrap_pyfunction!(so_ad, m)?)?;
+    m.add_function(wrap_pyfunction!(so_ad_star, m)?)?;
+    m.add_function(wrap_pyfunction!(so_jacobian_left, m)?)?;
+    m.add_function(wrap_pyfunction!(so_jacobian_right, m)?)?;
     m.add_function(wrap_pyfunction!(is_rotation, m)?)?;
     m.add_function(wrap_pyfunction!(project_to_so, m)?)?;
     m.add_function(wrap_pyfunction!(product_adjoint, m)?)?;

@@ -6,27 +6,28 @@ use lieflow::lie::MatrixLieGroup;
 use nalgebra::{Matrix3, Vector3};
 use pyo3::prelude::*;
 
+use super::map_pairs;
 use crate::batch::{map_batch, Out};
 use crate::convert::ArrayIn;
 
-/// `hat(w)`: the skew matrix ŵ with ŵ x = w × x (physics convention, 000 §3.3 corrected):
+/// `so3_hat(w)` (alias `hat`): the skew matrix ŵ with ŵ x = w × x (physics convention, 000 §3.3 corrected):
 /// ŵ = [[0, −w3, w2], [w3, 0, −w1], [−w2, w1, 0]].
 ///
 /// Args: w — shape (3,) or a batch (b, 3). Returns (3, 3) or (b, 3, 3).
 /// Raises ShapeError, NonFiniteError.
 #[pyfunction]
-fn hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
+fn so3_hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::hat(w)))
 }
 
-/// `vee(xi)`: the inverse of `hat`, w with ŵ = xi.
+/// `so3_vee(xi)` (alias `vee`): the inverse of `so3_hat`, w with ŵ = xi.
 ///
 /// Args: xi — a skew-symmetric (3, 3) matrix or a batch (b, 3, 3). Returns (3,) or (b, 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (xi not skew: relative defect
 /// ‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F) > 1e-10).
 #[pyfunction]
-fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "xi", &xi, so3::try_vee)
+fn so3_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "xi", &xi, so3::vee)
 }
 
 /// `so3_exp(w)`: the rotation exp(ŵ) by Rodrigues' formula
@@ -37,7 +38,7 @@ fn vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
 fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
-    map_batch(py, "w", &w, so3::try_exp)
+    map_batch(py, "w", &w, so3::exp)
 }
 
 /// `so3_log(R, strict=False)`: the principal logarithm w (‖w‖ = θ ∈ [0, π], exp(ŵ) = R),
@@ -59,7 +60,7 @@ fn so3_log<'py>(py: Python<'py>, R: ArrayIn<'py>, strict: bool) -> PyResult<Out<
         if strict {
             g.log()
         } else {
-            Ok(so3::log(m))
+            Ok(so3::log_unchecked(m))
         }
     })
 }
@@ -113,7 +114,7 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
         py,
         &w,
         inverse,
-        so3::try_jacobian_right,
+        so3::jacobian_right,
         so3::jacobian_right_inv,
     )
 }
@@ -129,18 +130,114 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
 #[pyfunction]
 #[pyo3(signature = (w, inverse = false))]
 fn so3_jacobian_left<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
-    jacobian(
+    jacobian(py, &w, inverse, so3::jacobian_left, so3::jacobian_left_inv)
+}
+
+/// `so3_compose(R1, R2)`: the product R1 @ R2 of two rotations.
+///
+/// Args: R1, R2 — (3, 3) or (b, 3, 3); a single rotation is combined with every element of a
+/// batch, two batches must have the same length. Returns (3, 3) or (b, 3, 3).
+/// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or abs(det R − 1) > 1e-10).
+#[pyfunction]
+#[allow(non_snake_case)]
+fn so3_compose<'py>(py: Python<'py>, R1: ArrayIn<'py>, R2: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
         py,
+        ["R1", "R2"],
+        &R1,
+        &R2,
+        |a: &Matrix3<f64>, b: &Matrix3<f64>| {
+            let b = SO3::new(*b).map_err(|e| e.map_what(|w| format!("R2 ({w})")))?;
+            Ok(*SO3::new(*a)?.compose(&b).matrix3())
+        },
+    )
+}
+
+/// `so3_inverse(R)`: R⁻¹ = Rᵀ.
+///
+/// Args: R — (3, 3) or (b, 3, 3). Returns the same shape.
+/// Raises ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+#[allow(non_snake_case)]
+fn so3_inverse<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_batch(py, "R", &R, |m: &Matrix3<f64>| {
+        Ok(*SO3::new(*m)?.inverse().matrix3())
+    })
+}
+
+/// `so3_act(R, x)`: the rotated vector R x.
+///
+/// Args: R — (3, 3) or (b, 3, 3); x — (3,) or (b, 3) (a single one broadcasts over the other's
+/// batch). Returns (3,) or (b, 3). Raises ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+#[allow(non_snake_case)]
+fn so3_act<'py>(py: Python<'py>, R: ArrayIn<'py>, x: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
+        py,
+        ["R", "x"],
+        &R,
+        &x,
+        |m: &Matrix3<f64>, x: &Vector3<f64>| Ok(SO3::new(*m)?.act(x)),
+    )
+}
+
+/// `so3_Ad(R, w)`: the adjoint action Ad_R w = R w (R ŵ Rᵀ = (R w)^).
+///
+/// Args: R — (3, 3) or (b, 3, 3); w — (3,) or (b, 3) (broadcast as in so3_act). Returns (3,) or
+/// (b, 3). Raises ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+#[pyo3(name = "so3_Ad")]
+#[allow(non_snake_case)]
+fn so3_adjoint<'py>(py: Python<'py>, R: ArrayIn<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
+        py,
+        ["R", "w"],
+        &R,
         &w,
-        inverse,
-        so3::try_jacobian_left,
-        so3::jacobian_left_inv,
+        |m: &Matrix3<f64>, w: &Vector3<f64>| Ok(SO3::new(*m)?.adjoint(w)),
+    )
+}
+
+/// `so3_ad(u, v)`: the bracket ad_u v = u × v ([û, v̂] = (u × v)^).
+///
+/// Args: u, v — (3,) or (b, 3) (a single one broadcasts). Returns (3,) or (b, 3).
+/// Raises ShapeError, NonFiniteError.
+#[pyfunction]
+fn so3_ad<'py>(py: Python<'py>, u: ArrayIn<'py>, v: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
+        py,
+        ["u", "v"],
+        &u,
+        &v,
+        |u: &Vector3<f64>, v: &Vector3<f64>| Ok(SO3::ad(u, v)),
+    )
+}
+
+/// `so3_ad_star(xi, mu)`: the coadjoint action ad*_ξ μ = μ × ξ, so that
+/// ⟨ad*_ξ μ, η⟩ = ⟨μ, ξ × η⟩ (dot-product pairing; 000 §3.3).
+///
+/// Args: xi, mu — (3,) or (b, 3) (a single one broadcasts). Returns (3,) or (b, 3).
+/// Raises ShapeError, NonFiniteError.
+#[pyfunction]
+fn so3_ad_star<'py>(py: Python<'py>, xi: ArrayIn<'py>, mu: ArrayIn<'py>) -> PyResult<Out<'py>> {
+    map_pairs(
+        py,
+        ["xi", "mu"],
+        &xi,
+        &mu,
+        |x: &Vector3<f64>, m: &Vector3<f64>| Ok(SO3::ad_star(x, m)),
     )
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(hat, m)?)?;
-    m.add_function(wrap_pyfunction!(vee, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_hat, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_vee, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_compose, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_inverse, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_act, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_adjoint, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_ad, m)?)?;
+    m.add_function(wrap_pyfunction!(so3_ad_star, m)?)?;
     m.add_function(wrap_pyfunction!(so3_exp, m)?)?;
     m.add_function(wrap_pyfunction!(so3_log, m)?)?;
     m.add_function(wrap_pyfunction!(so3_cayley, m)?)?;

@@ -745,9 +745,9 @@ impl RollingSpheres {
         let ot = omega_tilde.map(Vector3::from);
         let flow = |q: &mut ([Matrix3<f64>; 2], Vector3<f64>), om: &[Vector3<f64>; 2], t: f64| {
             let b = (q.0[0] * om[0]) * self.alpha[0] + (q.0[1] * om[1]) * self.alpha[1];
-            q.1 = so3::exp(&(b * t)) * q.1;
+            q.1 = so3::exp_unchecked(&(b * t)) * q.1;
             for (zi, oi) in q.0.iter_mut().zip(om) {
-                *zi *= so3::exp(&(oi * t));
+                *zi *= so3::exp_unchecked(&(oi * t));
             }
         };
         // The bracket estimate (components in the chart of q: Ω₁, Ω₂, u̇).
@@ -759,8 +759,8 @@ impl RollingSpheres {
             flow(&mut q, &ot, -h);
             let h2 = h * h;
             [
-                so3::log(&(l.z[0].transpose() * q.0[0])) / h2,
-                so3::log(&(l.z[1].transpose() * q.0[1])) / h2,
+                so3::log_unchecked(&(l.z[0].transpose() * q.0[0])) / h2,
+                so3::log_unchecked(&(l.z[1].transpose() * q.0[1])) / h2,
                 (q.1 - l.u) / h2,
             ]
         };

@@ -181,7 +181,7 @@ impl Problem for GeneralizedRigidBody {
     /// C_k = ½ tr((MᵀM)^k), k = 1…⌊n/2⌋ (C₁ = |M|² on so(3)).
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         let m = so::hat_n_unchecked(self.n, z);
-        Ok(crate::pseudo_rigid::reduced::spectral_invariants(&m))
+        Ok(crate::lie::so::spectral_invariants(&m))
     }
     fn invariant_count(&self) -> usize {
         self.n / 2

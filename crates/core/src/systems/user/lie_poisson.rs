@@ -170,9 +170,7 @@ impl LiePoisson {
                 mu[3..].iter().map(|x| x * x).sum(),
                 (0..3).map(|i| mu[i] * mu[3 + i]).sum(),
             ],
-            Kind::So(n) => {
-                crate::pseudo_rigid::reduced::spectral_invariants(&so::hat_n_unchecked(n, mu))
-            }
+            Kind::So(n) => so::spectral_invariants(&so::hat_n_unchecked(n, mu)),
             Kind::Generic => Vec::new(),
         }
     }
@@ -342,13 +340,13 @@ impl GroupField for LiePoisson {
     fn act(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
         match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
             (Kind::So3, _, _) => {
-                let g = so3::exp(&Vector3::from_column_slice(xi));
+                let g = so3::exp_unchecked(&Vector3::from_column_slice(xi));
                 let m = g * Vector3::from_column_slice(z);
                 z.copy_from_slice(m.as_slice());
             }
             (Kind::Se3, _, _) => {
                 let x = Vector6::from_column_slice(xi);
-                let ad = se3::exp(&(-x)).adjoint_matrix();
+                let ad = se3::exp_unchecked(&(-x)).adjoint_matrix();
                 let m = ad.transpose() * Vector6::from_column_slice(z);
                 z.copy_from_slice(m.as_slice());
             }

@@ -184,13 +184,16 @@ impl FreeFlow {
     /// NaN where an angle exceeds [`crate::numerics::angle::EXP_MAX_NORM`] (lost to rounding).
     pub(crate) fn motion(&self, t: f64) -> (Vector3<f64>, Matrix3<f64>) {
         match &self.kind {
-            Kind::Uniform(w) => (self.m0, so3::exp(&(w * t))),
+            Kind::Uniform(w) => (self.m0, so3::exp_unchecked(&(w * t))),
             Kind::Symmetric { s, w, inv_io } => {
                 let mut m = self.m0;
                 top::rotate_axis(&mut m, *s, t * w);
                 let mut spin = Vector3::zeros();
                 spin[*s] = t * w;
-                (m, so3::exp(&(self.m0 * (t * inv_io))) * so3::exp(&spin))
+                (
+                    m,
+                    so3::exp_unchecked(&(self.m0 * (t * inv_io))) * so3::exp_unchecked(&spin),
+                )
             }
             Kind::Elliptic(e) => {
                 let (y, jac) = e.scaled(t);
