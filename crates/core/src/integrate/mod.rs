@@ -33,6 +33,7 @@ pub mod clock;
 pub mod events;
 pub mod forcing;
 pub mod hooks;
+mod locate;
 pub mod method;
 pub mod methods;
 pub mod problem;
