@@ -55,7 +55,7 @@ pub struct Hit {
 }
 
 /// The event functions of a run and what they found (passed to every
-/// [`crate::integrate::Run::advance_to`] of the run; located by [`super::locate`]).
+/// [`crate::integrate::Run::advance_to`] of the run; located by the run, see `integrate/locate.rs`).
 ///
 /// After every step the functions are evaluated on the new state; where one changes sign (in
 /// its direction) between two steps, its zero is located on the method's own trajectory: the
