@@ -12,8 +12,8 @@ use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::systems::{
-    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, RollingDisks, RollingSpheres,
-    Sphere, SphereParticle, SphericalPendulum, TangentTop,
+    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, RollingDisks, Sphere,
+    SphereParticle, SphericalPendulum, TangentTop,
 };
 use nalgebra::Vector3;
 
@@ -100,26 +100,8 @@ fn cases() -> Vec<Case> {
     .unwrap()
     .embedded()
     .unwrap();
-    let disks = RollingDisks::new(
-        [1.0, 0.7],
-        [[0.3, 0.1], [-0.2, 0.25]],
-        [1.0, 1.5],
-        [0.8, 0.6],
-    )
-    .unwrap()
-    .with_rolling_constant(0.4)
-    .unwrap();
-    let spheres = RollingSpheres::new(
-        0.7,
-        1.3,
-        [0.1, -0.2, 0.15],
-        [-0.3, 0.2, 0.4],
-        2.0,
-        3.5,
-        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
-        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
-    )
-    .unwrap();
+    let disks = common::rolling_disks();
+    let spheres = common::rolling_spheres();
     let particle = SphereParticle::new(2.0, 1.5, 9.81).unwrap();
     let z_particle = particle
         .from_spherical(&pend.state_from_spherical(0.8, 0.1, 0.3, 1.2).unwrap())

@@ -2,6 +2,7 @@
 //! sizes, never reports a non-converged solve whose last update is below its tolerance
 //! (`lieflow::convergence`, the one stopping rule); and the reproducers of the issue run.
 
+mod common;
 use std::sync::Arc;
 
 use lieflow::integrate::forcing::{Dissipation, ForceFn, Forced};
@@ -11,8 +12,8 @@ use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff};
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::systems::{
     Algebra, GeneralizedRigidBody, HeavyTop, HyperbolicPlane, LieHamiltonian, LiePoisson, Pendulum,
-    Potential, RelativisticTangentTop, RigidBody, RollingDisk, RollingDisks, RollingSpheres,
-    Sphere, SphereParticle, SphericalPendulum, TangentTop, WeakFieldTop,
+    Potential, RelativisticTangentTop, RigidBody, RollingDisk, Sphere, SphereParticle,
+    SphericalPendulum, TangentTop, WeakFieldTop,
 };
 use lieflow::Error;
 use nalgebra::Vector3;
@@ -94,26 +95,8 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
     .unwrap();
     let hyperbolic = TangentTop::new(Arc::new(HyperbolicPlane), 1.0, 0.5).unwrap();
     let charged = on_sphere.magnetic_analogue(0.7).unwrap();
-    let disks = RollingDisks::new(
-        [1.0, 0.7],
-        [[0.3, 0.1], [-0.2, 0.25]],
-        [1.0, 1.5],
-        [0.8, 0.6],
-    )
-    .unwrap()
-    .with_rolling_constant(0.4)
-    .unwrap();
-    let spheres = RollingSpheres::new(
-        0.7,
-        1.3,
-        [0.1, -0.2, 0.15],
-        [-0.3, 0.2, 0.4],
-        2.0,
-        3.5,
-        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
-        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
-    )
-    .unwrap();
+    let disks = common::rolling_disks();
+    let spheres = common::rolling_spheres();
     let z_disks_equilibrium = disks
         .relative_equilibria((0.0, std::f64::consts::TAU))
         .unwrap()[0]
@@ -434,15 +417,7 @@ fn gauss6_pendulum_at_a_large_step() {
 /// 1.3e-23), Gauss4 with dt = 1.4 in step 2 (residual 1.2e-31).
 #[test]
 fn rolling_disks_at_their_stable_relative_equilibria() {
-    let disks = RollingDisks::new(
-        [1.0, 0.7],
-        [[0.3, 0.1], [-0.2, 0.25]],
-        [1.0, 1.5],
-        [0.8, 0.6],
-    )
-    .unwrap()
-    .with_rolling_constant(0.4)
-    .unwrap();
+    let disks = common::rolling_disks();
     let eqs = disks
         .relative_equilibria((0.0, std::f64::consts::TAU))
         .unwrap();

@@ -5,6 +5,7 @@ pub mod group_laws;
 
 use lieflow::integrate::System;
 use lieflow::lie::gl;
+use lieflow::systems::{RollingDisks, RollingSpheres};
 use lieflow::Mat;
 
 /// Euclidean distance between two flat states of the same length.
@@ -89,4 +90,34 @@ impl Rng {
     pub fn mat(&mut self, n: usize, scale: f64) -> Mat {
         Mat::from_fn(n, n, |_, _| scale * self.uniform())
     }
+}
+
+/// The two rolling disks of the catalog and convergence tests (distinct radii, offset centres of
+/// mass, rolling constant 0.4).
+pub fn rolling_disks() -> RollingDisks {
+    RollingDisks::new(
+        [1.0, 0.7],
+        [[0.3, 0.1], [-0.2, 0.25]],
+        [1.0, 1.5],
+        [0.8, 0.6],
+    )
+    .unwrap()
+    .with_rolling_constant(0.4)
+    .unwrap()
+}
+
+/// The two rolling spheres of the catalog and convergence tests (full inertia tensors, offset
+/// centres of mass).
+pub fn rolling_spheres() -> RollingSpheres {
+    RollingSpheres::new(
+        0.7,
+        1.3,
+        [0.1, -0.2, 0.15],
+        [-0.3, 0.2, 0.4],
+        2.0,
+        3.5,
+        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
+        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
+    )
+    .unwrap()
 }
