@@ -67,3 +67,56 @@ where
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// f(x) = (x₀² x₁, sin x₀ + x₁³) and its Jacobian in closed form.
+    fn f(x: &[f64]) -> Result<Vec<f64>, ()> {
+        Ok(vec![x[0] * x[0] * x[1], x[0].sin() + x[1].powi(3)])
+    }
+    fn exact(x: &[f64]) -> [[f64; 2]; 2] {
+        [
+            [2.0 * x[0] * x[1], x[0] * x[0]],
+            [x[0].cos(), 3.0 * x[1] * x[1]],
+        ]
+    }
+    fn error(h: f64, scheme: Scheme) -> f64 {
+        let x = [0.7, -1.3];
+        let j = jacobian(&f, &x, &[h, h], scheme).unwrap();
+        let e = exact(&x);
+        (0..2)
+            .flat_map(|r| (0..2).map(move |c| (r, c)))
+            .map(|(r, c)| (j[(r, c)] - e[r][c]).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// The observed orders: halving h divides the error by 4 (central) and 16 (Richardson).
+    #[test]
+    fn the_schemes_have_their_orders() {
+        let central = error(1e-2, Scheme::Central) / error(5e-3, Scheme::Central);
+        assert!((central - 4.0).abs() < 0.05, "central ratio {central}");
+        let rich = error(8e-2, Scheme::Richardson) / error(4e-2, Scheme::Richardson);
+        assert!((rich - 16.0).abs() < 0.5, "Richardson ratio {rich}");
+        assert!(error(1e-5, Scheme::Central) < 1e-9);
+    }
+
+    /// The gradient is the one row of the Jacobian; the first error of f is returned.
+    #[test]
+    fn gradient_and_errors() {
+        let g = |x: &[f64]| -> Result<f64, ()> { Ok(x[0] * x[0] * x[1]) };
+        let mut out = [0.0; 2];
+        gradient(&g, &[0.7, -1.3], &[1e-5, 1e-5], Scheme::Central, &mut out).unwrap();
+        assert!((out[0] - 2.0 * 0.7 * -1.3).abs() < 1e-9 && (out[1] - 0.49).abs() < 1e-9);
+        let failing = |x: &[f64]| -> Result<Vec<f64>, &'static str> {
+            if x[1] > 0.0 {
+                Err("refused")
+            } else {
+                Ok(vec![x[0]])
+            }
+        };
+        let r = jacobian(&failing, &[0.0, 0.0], &[1e-3, 1e-3], Scheme::Central);
+        assert_eq!(r.err(), Some("refused"));
+    }
+}
