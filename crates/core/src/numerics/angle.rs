@@ -28,3 +28,26 @@ pub fn angle_sin_cos(theta: f64) -> (f64, f64) {
         (f64::NAN, f64::NAN)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// libm's (sin θ, cos θ) up to and at the bound, NaN beyond it and for non-finite θ.
+    #[test]
+    fn the_rule_of_the_angle() {
+        for theta in [0.0, -0.0, 1e-300, 0.3, -2.5, 1e6, -1e14, EXP_MAX_NORM] {
+            assert_eq!(angle_sin_cos(theta), theta.sin_cos(), "θ = {theta}");
+        }
+        for theta in [
+            EXP_MAX_NORM * (1.0 + f64::EPSILON),
+            -1e15,
+            f64::INFINITY,
+            f64::NAN,
+        ] {
+            let (s, c) = angle_sin_cos(theta);
+            assert!(s.is_nan() && c.is_nan(), "θ = {theta}");
+        }
+        assert!((EXP_MAX_NORM * f64::EPSILON - ANGLE_ROUNDING_TOL).abs() < 1e-17);
+    }
+}
