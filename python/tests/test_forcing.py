@@ -200,6 +200,12 @@ def test_a_batch_runs_member_after_member():
     assert np.array_equal(traj.states[1], one.states)
 
 
+def _spheres():
+    """Two rolling spheres (any will do for the argument checks)."""
+    return lf.RollingSpheres(1.0, 1.0, [0.0] * 3, [0.0] * 3, 1.0, 1.0, 0.1 * np.eye(3),
+                             0.1 * np.eye(3))
+
+
 def test_errors():
     body = lf.RigidBody(inertia=I)
     with pytest.raises(lf.InvalidArgumentError, match="none was given"):
@@ -211,7 +217,7 @@ def test_errors():
     with pytest.raises(lf.InvalidArgumentError, match="no block"):
         lf.Forced(body, body_torque, block="P")
     with pytest.raises(lf.InvalidArgumentError, match="curved block"):
-        spheres = lf.RollingSpheres(*lf.RollingSpheres._example_args)
+        spheres = _spheres()
         lf.Forced(spheres, lambda t, z: np.zeros(3), block="u")
     with pytest.raises(lf.ArgumentTypeError, match="callable"):
         lf.Forced(body, 3.0)
@@ -222,7 +228,7 @@ def test_errors():
     with pytest.raises(lf.ArgumentTypeError, match="dissipation"):
         lf.Forced(body, dissipation="strong")
     with pytest.raises(lf.InvalidArgumentError, match="none of the momentum blocks"):
-        lf.Forced(lf.RollingSpheres(*lf.RollingSpheres._example_args), body_torque)
+        lf.Forced(_spheres(), body_torque)
     with pytest.raises(lf.ArgumentTypeError, match="lieflow system"):
         lf.Forced("RigidBody", body_torque)
     with pytest.raises(lf.InvalidArgumentError, match="positive semi-definite"):

@@ -177,3 +177,40 @@ def test_the_methods_of_the_mechanics_core_from_python():
     tr = lf.integrate(disk, disk.state([0, 0, 0, 0.7], 2.0, 0.5), dt=0.01, steps=10_000,
                       save_every=100)
     assert disk.constraint_residual(tr.states).max() < 1e-13
+
+
+def _system_classes():
+    return sorted((c for c in vars(lf).values()
+                   if isinstance(c, type) and issubclass(c, lf.System) and c is not lf.System),
+                  key=lambda c: c.__name__)
+
+
+def _documented_methods(doc):
+    """The method names of a class docstring's "Methods:" sentence, in order (parenthesised
+    remarks dropped; the sentence ends at the first period outside parentheses)."""
+    import re
+    start = re.search(r"\bMethods?:", doc)
+    assert start, "no 'Methods:' in the docstring"
+    text, depth, out = doc[start.end():], 0, []
+    for i, ch in enumerate(text):
+        depth += (ch == "(") - (ch == ")")
+        if depth == 0 and ch == "." and (i + 1 == len(text) or text[i + 1].isspace()):
+            break
+        if depth == 0 and ch != ")":
+            out.append(ch)
+    return re.findall(r"[a-z][a-z0-9_]*", "".join(out))
+
+
+@pytest.mark.parametrize("cls", [c for c in _system_classes() if c is not lf.Forced],
+                         ids=lambda c: c.__name__)
+def test_the_docstring_lists_the_catalog_of_its_class(cls):
+    # The "Methods:" sentence names every method of the class's catalog, the default first,
+    # in the catalog's order (Forced's follow the system it wraps: its docstring gives the rule).
+    assert _documented_methods(cls.__doc__) == cls.methods()
+
+
+def test_the_method_list_of_a_forced_system_is_the_rule_of_its_docstring():
+    forced = lf.Forced(lf.HeavyTop([1, 2, 3], 0.5, [0, 0, 1]), lambda t, z: np.zeros(3))
+    free = [m for m in lf.HeavyTop.methods() if m in ("splitting", "lgvi")]
+    assert forced.methods()[:3] == [free[0], free[0] + "4", free[0] + "6"]
+    assert lf.Forced.methods() == lf.Forced(lf.Pendulum(), damping=0.1).methods()

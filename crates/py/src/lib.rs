@@ -47,7 +47,10 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;
     systems::register(m)?;
-    m.add_class::<pseudo_rigid::system::PyPseudoRigidBody>()?;
+    system::add_system::<
+        pseudo_rigid::system::PyPseudoRigidBody,
+        lieflow::pseudo_rigid::PseudoRigidBody,
+    >(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

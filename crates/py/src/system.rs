@@ -6,12 +6,14 @@
 
 use std::sync::{Arc, Mutex};
 
-use lieflow::integrate::{Block, Resolved, Space, System};
+use lieflow::integrate::{Block, Catalog, Resolved, Space, System};
 use lieflow::{check, Error};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyCFunction, PyDict, PyList, PyTuple, PyType};
+use pyo3::{PyClass, PyTypeInfo};
 
 use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::convert::{size_opt, vector};
@@ -226,12 +228,11 @@ fn from_blocks(space: &Space, parts: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, b
 
 #[pymethods]
 impl PySystem {
-    /// The names of the integration methods of this kind of system; the first is the default.
-    #[classmethod]
-    fn methods(cls: &Bound<'_, PyType>) -> PyResult<Vec<&'static str>> {
-        let example = cls.call1(cls.getattr("_example_args")?.cast_into::<PyTuple>()?)?;
-        let sys = &example.cast::<PySystem>()?.get().sys;
-        Ok(sys.methods().into_iter().map(|(name, _)| name).collect())
+    /// The names of the integration methods (of the system object, or on a class those of its
+    /// kind); the first is the default.
+    #[classattr]
+    fn methods() -> Methods {
+        Methods
     }
 
     /// Length d of the flat state vector.
@@ -465,56 +466,66 @@ impl PySystem {
     }
 }
 
-/// The descriptor `methods` of a system class whose instances may have other methods than its
-/// example (`PseudoRigidBody`: an incompressible body; `Forced`: those of the wrapped system):
-/// the classmethod of `lieflow.System` on the class, the instance's own catalog on an instance.
-#[pyclass(module = "lieflow", name = "_MethodsOf", frozen)]
-pub(crate) struct MethodsOf;
+/// The descriptor `methods` of every system class: on a system object its own catalog
+/// (`PseudoRigidBody(3, incompressible=True)` has other methods than the free body, `Forced` those
+/// of the system it wraps), on a class the catalog of its kind, known without an instance
+/// (`_kind_methods`, set by [`add_system`]).
+#[pyclass(module = "lieflow", name = "_Methods", frozen)]
+pub(crate) struct Methods;
 
 #[pymethods]
-impl MethodsOf {
+impl Methods {
     fn __get__<'py>(
         &self,
         obj: Option<Bound<'py, PyAny>>,
         owner: Option<Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        match obj.filter(|o| !o.is_none()) {
-            Some(obj) => {
-                let py = obj.py();
-                let names: Vec<&'static str> = obj
-                    .cast::<PySystem>()?
-                    .get()
-                    .sys
-                    .methods()
-                    .into_iter()
-                    .map(|(name, _)| name)
-                    .collect();
-                let f = PyCFunction::new_closure(
-                    py,
-                    Some(c"methods"),
-                    Some(
-                        c"The names of this system's integration methods; the first is the default.",
-                    ),
-                    move |args: &Bound<'_, PyTuple>, kwargs: Option<&Bound<'_, PyDict>>| {
-                        if !args.is_empty() || kwargs.is_some_and(|k| !k.is_empty()) {
-                            return Err(pyo3::exceptions::PyTypeError::new_err(
-                                "methods() takes no arguments",
-                            ));
-                        }
-                        Ok(names.clone())
-                    },
-                )?;
-                Ok(f.into_any())
+    ) -> PyResult<Bound<'py, PyCFunction>> {
+        // On the base class the list is unknown: the function raises when called (so that
+        // `getattr(lieflow.System, "methods")` and autodoc still work).
+        let (py, names): (_, Option<Vec<String>>) = match (obj.filter(|o| !o.is_none()), owner) {
+            (Some(obj), _) => {
+                let sys = &obj.cast::<PySystem>()?.get().sys;
+                let names = sys.methods().iter().map(|(n, _)| n.to_string()).collect();
+                (obj.py(), Some(names))
             }
-            None => {
-                let py = owner
-                    .as_ref()
-                    .map(|o| o.py())
-                    .ok_or_else(|| pyo3::exceptions::PyTypeError::new_err("no owner"))?;
-                let base = py.get_type::<PySystem>();
-                let class_method = base.getattr("__dict__")?.get_item("methods")?;
-                class_method.call_method1("__get__", (py.None(), owner))
+            (None, Some(cls)) => {
+                let names = cls.getattr("_kind_methods").ok();
+                (cls.py(), names.map(|n| n.extract()).transpose()?)
             }
-        }
+            (None, None) => return Err(PyTypeError::new_err("methods: no class given")),
+        };
+        PyCFunction::new_closure(
+            py,
+            Some(c"methods"),
+            Some(c"The names of the integration methods; the first is the default."),
+            move |args: &Bound<'_, PyTuple>, kwargs: Option<&Bound<'_, PyDict>>| {
+                if !args.is_empty() || kwargs.is_some_and(|k| !k.is_empty()) {
+                    return Err(PyTypeError::new_err("methods() takes no arguments"));
+                }
+                names.clone().ok_or_else(|| {
+                    PyTypeError::new_err(
+                        "lieflow.System is the base class: call methods() on a system class or \
+                         object",
+                    )
+                })
+            },
+        )
     }
+}
+
+/// Adds the system class `C`, the binding of the core system `S`, to the module `m`, with the
+/// names of the methods of `S`'s kind for `C.methods()` on the class.
+pub(crate) fn add_system<C: PyClass + PyTypeInfo, S: Catalog>(
+    m: &Bound<'_, PyModule>,
+) -> PyResult<()> {
+    add_with_methods::<C>(m, lieflow::integrate::kind_methods::<S>())
+}
+
+/// Adds the system class `C` to `m` with `names` as the methods of its kind.
+pub(crate) fn add_with_methods<C: PyClass + PyTypeInfo>(
+    m: &Bound<'_, PyModule>,
+    names: Vec<&'static str>,
+) -> PyResult<()> {
+    m.add_class::<C>()?;
+    m.py().get_type::<C>().setattr("_kind_methods", names)
 }

@@ -610,6 +610,11 @@ fn interned(name: &str, suffix: &str) -> &'static str {
 }
 
 impl Catalog for Forced {
+    /// None: the methods are those of the free system, known with an instance only.
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        Vec::new()
+    }
+
     /// For every symmetric second-order method `m` of the free system: `m`, `m4`, `m6`.
     fn catalog(&self) -> Vec<Entry<Self>> {
         let mut out = Vec::new();

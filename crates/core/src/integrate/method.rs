@@ -151,8 +151,15 @@ impl<P: ?Sized> Entry<P> {
 
 /// A system's named methods; the first is its default.
 pub trait Catalog: Problem + Clone + 'static {
-    /// The (name, method) pairs.
-    fn catalog(&self) -> Vec<Entry<Self>>;
+    /// The (name, method) pairs of this kind of system, known without an instance (so that a
+    /// binding lists a class's methods without building one); where they depend on the
+    /// instance, those of a typical one.
+    fn kind_catalog() -> Vec<Entry<Self>>;
+
+    /// The (name, method) pairs of this system: by default those of its kind.
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        Self::kind_catalog()
+    }
 
     /// The same system carrying its attitude R ∈ SO(3) along as a last block `R`, if it can.
     fn lifted(&self) -> Option<Self> {
@@ -237,6 +244,12 @@ pub trait System: Problem {
         &self,
         d: &crate::integrate::problem::Dissipation,
     ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>>;
+}
+
+/// The method names of a kind of system, without an instance ([`Catalog::kind_catalog`]); the
+/// first is its default.
+pub fn kind_methods<P: Catalog>() -> Vec<&'static str> {
+    P::kind_catalog().iter().map(|e| e.name).collect()
 }
 
 impl<P: Catalog> System for P {

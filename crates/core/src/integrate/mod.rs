@@ -44,7 +44,8 @@ pub mod trajectory;
 pub use batch::Batch;
 pub use events::{Event, Events, Hit};
 pub use method::{
-    BatchStepper, Catalog, Clock, Entry, Integrator, Properties, Resolved, Stepper, System,
+    kind_methods, BatchStepper, Catalog, Clock, Entry, Integrator, Properties, Resolved, Stepper,
+    System,
 };
 pub use problem::Problem;
 pub use run::{check_state, energy_checked, invariants_checked, Run, Until, RETRACT_EVERY};

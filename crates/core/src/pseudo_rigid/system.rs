@@ -558,19 +558,24 @@ impl Symmetric for PseudoRigidBody {
 /// (default, as `verlet` is for the free one), `rattle4`, `rattle6` only (Verlet and the reduced
 /// flows would ignore the constraint).
 impl Catalog for PseudoRigidBody {
-    fn catalog(&self) -> Vec<Entry<Self>> {
-        if self.incompressible {
-            return vec![
-                Entry::new("rattle", Rattle::new()),
-                Entry::new("rattle4", Rattle(Composition::suzuki4())),
-                Entry::new("rattle6", Rattle(Composition::yoshida6())),
-            ];
-        }
+    /// The free body's.
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("verlet", Verlet::strang()),
             Entry::new("verlet4", Verlet(Composition::suzuki4())),
             Entry::new("verlet6", Verlet(Composition::yoshida6())),
             Entry::new("reduced", Splitting::strang()),
         ]
+    }
+
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        match self.incompressible {
+            true => vec![
+                Entry::new("rattle", Rattle::new()),
+                Entry::new("rattle4", Rattle(Composition::suzuki4())),
+                Entry::new("rattle6", Rattle(Composition::yoshida6())),
+            ],
+            false => Self::kind_catalog(),
+        }
     }
 }

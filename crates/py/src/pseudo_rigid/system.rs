@@ -12,7 +12,7 @@ use super::potential::{PyPotential, Zero};
 use crate::convert::ArrayIn;
 use crate::convert::{int, mat, py_mat};
 use crate::errors::{to_py, IntoPy};
-use crate::system::{MethodsOf, PySystem};
+use crate::system::PySystem;
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -27,10 +27,10 @@ type Any<'py> = Bound<'py, PyAny>;
 ///     incompressible: hold the volume, det X = det X0 (a fluid or incompressible elastic
 ///         ellipsoid; the pressure is the multiplier of the constraint).
 ///
-/// Integrate with `lf.integrate(body, (X0, P0), dt=..., steps=..., method=...)`, methods
-/// "verlet" (the default), "verlet4", "verlet6" (Störmer–Verlet and its order-4/6
-/// compositions) and "reduced" (reduced-space splitting on the principal stratum, 001 §7,
-/// order 2, exact coadjoint orbits). The incompressible body has its own methods instead:
+/// Integrate with `lf.integrate(body, (X0, P0), dt=..., steps=..., method=...)`.
+/// Methods: verlet (default), verlet4, verlet6 (Störmer–Verlet and its order-4/6
+/// compositions), reduced (reduced-space splitting on the principal stratum, 001 §7, order 2,
+/// exact coadjoint orbits). The incompressible body has its own methods instead:
 /// "rattle" (the default, order 2), "rattle4" and "rattle6" (RATTLE and its Suzuki / Yoshida
 /// compositions, orders 4 and 6): symplectic on T*{det X = det X0}, they keep det X, L and
 /// Gamma to round-off (`body.methods()` on the instance lists them). Its states must move
@@ -94,12 +94,6 @@ impl PyPseudoRigidBody {
         )
     }
 
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (i64,) {
-        (2,)
-    }
-
     /// The dimension n.
     #[getter(n)]
     fn get_n(&self) -> usize {
@@ -116,14 +110,6 @@ impl PyPseudoRigidBody {
     #[getter]
     fn incompressible(&self) -> bool {
         self.body.is_incompressible()
-    }
-
-    /// The names of the integration methods, the first the default: on the class those of a
-    /// body that is not incompressible ("verlet", "verlet4", "verlet6", "reduced"), on an
-    /// instance its own ("rattle", "rattle4", "rattle6" for an incompressible body).
-    #[classattr]
-    fn methods() -> MethodsOf {
-        MethodsOf
     }
 
     /// The projection of a momentum P onto the states of the incompressible body at X:

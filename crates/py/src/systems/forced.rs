@@ -16,18 +16,7 @@ use pyo3::PyClassInitializer;
 use super::user::Callee;
 use crate::convert::{read_all, real, ArrayIn};
 use crate::errors::{to_py, IntoPy};
-use crate::system::{MethodsOf, PySystem};
-
-/// The constructor arguments of the example instance (system, force, block, depends_on_block,
-/// damping, dissipation).
-type ExampleArgs<'py> = (
-    Bound<'py, PyAny>,
-    Option<f64>,
-    Option<f64>,
-    Option<bool>,
-    f64,
-    Option<f64>,
-);
+use crate::system::PySystem;
 
 /// An optional argument that is given and not None.
 fn given<'py>(a: &Option<Bound<'py, PyAny>>) -> Option<Bound<'py, PyAny>> {
@@ -196,21 +185,6 @@ impl PyForced {
         ];
         let cls = PySystem::new(sys.clone(), args.cast_into::<PyTuple>()?, names);
         Ok(PyClassInitializer::from(cls).add_subclass(PyForced { sys, block: chosen }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args(py: Python<'_>) -> PyResult<ExampleArgs<'_>> {
-        let pendulum =
-            Bound::new(py, super::pendulum::PyPendulum::new(py, 1.0, 1.0, 9.81)?)?.into_any();
-        Ok((pendulum, None, None, None, 0.1, None))
-    }
-
-    /// The names of the integration methods (on an instance, those of the wrapped system's
-    /// symmetric second-order methods and their compositions); the first is the default.
-    #[classattr]
-    fn methods() -> MethodsOf {
-        MethodsOf
     }
 
     /// The block the force acts on (None without a force).

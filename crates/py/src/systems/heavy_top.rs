@@ -25,9 +25,10 @@ type Any<'py> = Bound<'py, PyAny>;
 /// Omega = I^{-1} M; energy H = M . I^{-1} M / 2 + mgl Gamma . chi; Casimirs [‖Gamma‖^2,
 /// M . Gamma]; for the Lagrange top (I1 = I2, chi = e3) also M3 is conserved. With an attitude
 /// R, Gamma must equal R^T e3 (use `state(M, attitude=R)`).
-/// Methods: splitting, splitting4, splitting6, lgvi, rk4, exact_splitting, exact_splitting4,
-/// exact_splitting6 (the exact free rigid body flow and the gravity kick: Strang, Suzuki 4,
-/// Yoshida 6; best for fast tops).
+/// Methods: splitting (default), splitting4, splitting6, splitting8 (the Lie–Poisson splitting:
+/// Strang, Suzuki 4, Yoshida 6, Kahan–Li 8), processed6, processed8, processed10
+/// (Blanes–Casas–Murua processed splittings, effective orders 6, 8, 10), lgvi, rk4, exact_splitting, exact_splitting4, exact_splitting6 (the exact free
+/// rigid body flow and the gravity kick: Strang, Suzuki 4, Yoshida 6; best for fast tops).
 ///
 /// Args:
 ///     inertia: principal moments (3,) or a (3, 3) symmetric positive-definite matrix;
@@ -71,12 +72,6 @@ impl PyHeavyTop {
     #[classattr]
     fn _attitude_observables() -> (&'static str,) {
         ("spatial_momentum",)
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> ([f64; 3], f64) {
-        ([1.0, 2.0, 3.0], 1.0)
     }
 
     /// The principal moments of inertia (3,).

@@ -22,8 +22,10 @@ use lieflow::Error;
 use pyo3::prelude::*;
 
 use crate::convert::{shape_str, ArrayIn};
-use crate::errors::to_py;
+use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, Input};
+use crate::system::{add_system, add_with_methods};
+use lieflow::integrate::System;
 
 /// Principal moments (3,) or a symmetric positive-definite matrix (3, 3).
 enum Inertia {
@@ -76,23 +78,28 @@ fn spatial_momentum<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<rigid_body::PyRigidBody>()?;
-    m.add_class::<rigid_body::PyGeneralizedRigidBody>()?;
-    m.add_class::<heavy_top::PyHeavyTop>()?;
-    m.add_class::<spherical_pendulum::PySphericalPendulum>()?;
-    m.add_class::<pendulum::PyPendulum>()?;
-    m.add_class::<pendulum::PySphereParticle>()?;
-    m.add_class::<rolling_disk::PyRollingDisk>()?;
-    m.add_class::<rolling_spheres::PyRollingSpheres>()?;
-    m.add_class::<rolling_disks::PyRollingDisks>()?;
+    use lieflow::systems as core;
+    add_system::<rigid_body::PyRigidBody, core::RigidBody>(m)?;
+    add_system::<rigid_body::PyGeneralizedRigidBody, core::GeneralizedRigidBody>(m)?;
+    add_system::<heavy_top::PyHeavyTop, core::HeavyTop>(m)?;
+    add_system::<spherical_pendulum::PySphericalPendulum, core::SphericalPendulum>(m)?;
+    add_system::<pendulum::PyPendulum, core::Pendulum>(m)?;
+    add_system::<pendulum::PySphereParticle, core::SphereParticle>(m)?;
+    add_system::<rolling_disk::PyRollingDisk, core::RollingDisk>(m)?;
+    add_system::<rolling_spheres::PyRollingSpheres, core::RollingSpheres>(m)?;
+    add_system::<rolling_disks::PyRollingDisks, core::RollingDisks>(m)?;
     m.add_class::<rolling_disks::PyDisksEquilibrium>()?;
-    m.add_class::<relativistic_top::PyRelativisticTangentTop>()?;
-    m.add_class::<relativistic_top::PyWeakFieldTop>()?;
-    m.add_class::<tangent_top::PyTangentTop>()?;
-    m.add_class::<tangent_top::PyChargedParticle>()?;
-    m.add_class::<user::PyCanonical>()?;
-    m.add_class::<user::PySeparable>()?;
-    m.add_class::<user::PyLiePoisson>()?;
-    m.add_class::<forced::PyForced>()?;
-    Ok(())
+    add_system::<relativistic_top::PyRelativisticTangentTop, core::RelativisticTangentTop>(m)?;
+    add_system::<relativistic_top::PyWeakFieldTop, core::WeakFieldTop>(m)?;
+    add_system::<tangent_top::PyTangentTop, core::TangentTop>(m)?;
+    add_system::<tangent_top::PyChargedParticle, core::ChargedParticle>(m)?;
+    add_system::<user::PyCanonical, core::UserCanonical>(m)?;
+    add_system::<user::PySeparable, core::UserSeparable>(m)?;
+    add_system::<user::PyLiePoisson, core::LiePoisson>(m)?;
+    // A forced system has the methods of the system it wraps; on the class, a forced
+    // canonical system's (those of a forced `Pendulum`).
+    let pendulum = core::Pendulum::new(1.0, 1.0, 9.81).py()?;
+    let forced = lieflow::integrate::forcing::Forced::new(std::sync::Arc::new(pendulum));
+    let names = forced.methods().into_iter().map(|(n, _)| n).collect();
+    add_with_methods::<forced::PyForced>(m, names)
 }

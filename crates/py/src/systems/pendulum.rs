@@ -42,12 +42,6 @@ impl PyPendulum {
         Ok(PyClassInitializer::from(base).add_subclass(PyPendulum { pendulum }))
     }
 
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (f64,) {
-        (1.0,)
-    }
-
     /// The exact state (q, p) at times t of the pendulum released at rest from the angle
     /// `amplitude` (abs(amplitude) < pi), by Jacobi elliptic functions; broadcast: (...) -> (..., 2).
     ///
@@ -98,12 +92,6 @@ impl PySphereParticle {
         let args = (mass, length, g).into_pyobject(py)?;
         let base = PySystem::new(particle.clone(), args, &["mass", "length", "g"]);
         Ok(PyClassInitializer::from(base).add_subclass(PySphereParticle { particle }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (f64,) {
-        (1.0,)
     }
 
     /// States (q, p) of `SphericalPendulum` states (u, L) with the same m, l, g:

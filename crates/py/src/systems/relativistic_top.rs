@@ -62,12 +62,6 @@ impl PyRelativisticTangentTop {
         Ok(PyClassInitializer::from(base).add_subclass(PyRelativisticTangentTop { top }))
     }
 
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (f64, f64) {
-        (1.0, 0.1)
-    }
-
     /// The canonical state from the position x (2,), the angle theta and the velocities.
     ///
     /// Raises:
@@ -177,12 +171,6 @@ impl PyWeakFieldTop {
         let args = (mass, inertia, gm, g).into_pyobject(py)?;
         let base = PySystem::new(top.clone(), args, &["mass", "inertia", "gm", "g"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyWeakFieldTop { top }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (f64, f64, Option<f64>) {
-        (1.0, 0.1, Some(1.0))
     }
 
     /// The canonical state from the position x (2,), the angle theta and the velocities.

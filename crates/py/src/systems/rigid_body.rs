@@ -22,9 +22,11 @@ type Any<'py> = Bound<'py, PyAny>;
 /// State z = M, the body angular momentum (3,). Euler's equation dM/dt = M x Omega with
 /// Omega = I^{-1} M; energy H = M . I^{-1} M / 2; Casimir [‖M‖^2]. Carries an attitude R
 /// (dR/dt = R hat(Omega)) when `integrate(..., attitude=R0)` is given; R M is conserved.
-/// Methods: splitting, splitting4, splitting6, isospectral, lgvi, dmv (discrete Moser-Veselov),
-/// dmv4, dmv6, dmv8, dmv10 (preprocessed DMV, Hairer & Vilmart 2006), rk4, rkmk4, exact (the
-/// exact flow, to round-off at any dt).
+/// Methods: splitting (default), splitting4, splitting6, splitting8 (the symmetric splitting
+/// into three axis rotations: Strang, Suzuki 4, Yoshida 6, Kahan–Li 8), processed6, processed8,
+/// processed10 (Blanes–Casas–Murua processed splittings, effective orders 6, 8, 10), isospectral, lgvi, dmv (discrete
+/// Moser-Veselov), dmv4, dmv6, dmv8, dmv10 (preprocessed DMV, Hairer & Vilmart 2006), rk4,
+/// rkmk4, exact (the exact flow, to round-off at any dt).
 ///
 /// Args:
 ///     inertia: principal moments (3,) > 0, or a (3, 3) symmetric positive-definite matrix
@@ -58,12 +60,6 @@ impl PyRigidBody {
     #[classattr]
     fn _attitude_observables() -> (&'static str,) {
         ("spatial_momentum",)
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> ([f64; 3],) {
-        ([1.0, 2.0, 3.0],)
     }
 
     /// The principal moments of inertia (3,).
@@ -192,7 +188,7 @@ impl PyRigidBody {
 /// H = sum_{i<j} M_ij^2 / (J_i + J_j) / 2 (principal frame); Casimirs C_k = tr((M^T M)^k) / 2,
 /// k = 1 .. n // 2 (they fix the spectrum of M). State z = the e_ij coordinates of the skew
 /// matrix M (i < j, row by row), length n(n-1)/2; `state(M)` and `matrix(z)` convert.
-/// Methods: isospectral, rk4.
+/// Methods: isospectral (default), rk4, rkmk4.
 ///
 /// Args:
 ///     J: principal entries (n,) (n >= 2, J_i >= 0, J_i + J_j > 0), or a symmetric
@@ -227,12 +223,6 @@ impl PyGeneralizedRigidBody {
         .py()?;
         let base = PySystem::new(body.clone(), (J,).into_pyobject(J.py())?, &["J"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyGeneralizedRigidBody { body }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> ([f64; 2],) {
-        ([1.0, 1.0],)
     }
 
     /// The dimension n (M is n x n).

@@ -56,12 +56,6 @@ impl PyRollingDisk {
         Ok(PyClassInitializer::from(base).add_subclass(PyRollingDisk { disk }))
     }
 
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (f64, f64, f64, f64) {
-        (1.0, 1.0, 1.0, 1.0)
-    }
-
     /// The state (q, p) rolling with the rates dtheta/dt, dphi/dt from q = (x, y, theta, phi).
     ///
     /// Raises:

@@ -87,12 +87,6 @@ impl PyRollingDisks {
         Ok(PyClassInitializer::from(base).add_subclass(PyRollingDisks { disks }))
     }
 
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (f64, f64, [f64; 2], [f64; 2], f64, f64, f64, f64) {
-        (1.0, 0.7, [0.3, 0.1], [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6)
-    }
-
     /// The rolling constant c.
     #[getter]
     fn rolling_constant(&self) -> f64 {

@@ -72,23 +72,6 @@ impl PyRollingSpheres {
         Ok(PyClassInitializer::from(base).add_subclass(PyRollingSpheres { sys }))
     }
 
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    #[allow(clippy::type_complexity)]
-    fn _example_args() -> (
-        f64,
-        f64,
-        [f64; 3],
-        [f64; 3],
-        f64,
-        f64,
-        [[f64; 3]; 3],
-        [[f64; 3]; 3],
-    ) {
-        let i = [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]];
-        (1.0, 1.0, [0.0; 3], [0.0; 3], 1.0, 1.0, i, i)
-    }
-
     /// e = m1 m2 / (m1 + m2) times R^2 = (r1 + r2)^2: the kinetic energy is this times L of 003 (8).
     #[getter]
     fn scale(&self) -> f64 {

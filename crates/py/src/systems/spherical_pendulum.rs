@@ -3,7 +3,6 @@
 
 use lieflow::systems as core;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
 use pyo3::PyClassInitializer;
 
 use crate::convert::real;
@@ -55,12 +54,6 @@ impl PySphericalPendulum {
                 g,
             }),
         )
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args<'py>(py: Python<'py>) -> Bound<'py, PyTuple> {
-        PyTuple::empty(py)
     }
 
     /// The mass of the bob.

@@ -12,7 +12,6 @@ use crate::convert::{mat, ArrayIn};
 use crate::convert::{real, reals, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::system::PySystem;
-use crate::systems::surfaces::Plane;
 pub(crate) use crate::systems::surfaces::PySurface;
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -48,7 +47,7 @@ fn tensor(inertia: &Any<'_>) -> PyResult<[f64; 4]> {
 /// term of 002 (37) (for a symmetric body, (39)), which for an anisotropic body depends on theta.
 /// State (x1, x2, theta, p1, p2, p_theta); fields x (2), theta, p (3), xdot (2), thetadot.
 /// Invariants: p_theta (unless embedded and anisotropic) and the Killing momenta of the affine
-/// isometries. Methods: midpoint, gauss4, gauss6 (symplectic Gauss–Legendre), rk4.
+/// isometries. Methods: gauss4 (default), gauss6, midpoint (symplectic Gauss–Legendre), rk4.
 ///
 /// Args:
 ///     surface: a `lieflow.surfaces` surface.
@@ -85,12 +84,6 @@ impl PyTangentTop {
             &["surface", "mass", "inertia", "embedded"],
         );
         Ok(PyClassInitializer::from(base).add_subclass(PyTangentTop { top }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args(py: Python<'_>) -> PyResult<(PySurface, f64, f64)> {
-        Ok((Plane(py)?, 1.0, 1.0))
     }
 
     /// The Euler tensor (2, 2).
@@ -208,6 +201,7 @@ impl PyTangentTop {
 /// Routhian of the top gives it; 002 (58) prints a different metric, potential and charge (a
 /// slip: it is p_theta, not thetadot, that is conserved). State (x1, x2, p1, p2); fields x, p,
 /// xdot. H = ‖p - p_theta A‖^2_G / 2 (the top's energy minus p_theta^2 / (2 I)).
+/// Methods: gauss4 (default), gauss6, midpoint (symplectic Gauss–Legendre), rk4.
 ///
 /// Args:
 ///     top: a `TangentTop` (not an anisotropic embedded one).
@@ -230,17 +224,6 @@ impl PyChargedParticle {
         let args = (top.clone(), charge).into_pyobject(top.py())?;
         let base = PySystem::new(particle.clone(), args, &["top", "charge"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyChargedParticle { particle }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args(py: Python<'_>) -> PyResult<(Py<PyTangentTop>, f64)> {
-        let plane = Bound::new(py, Plane(py)?)?;
-        let one = 1.0f64.into_pyobject(py)?.into_any();
-        Ok((
-            Py::new(py, PyTangentTop::new(plane, 1.0, one, false)?)?,
-            1.0,
-        ))
     }
 
     /// The charge p_theta.

@@ -192,10 +192,6 @@ fn count(name: &str, v: i64) -> PyResult<usize> {
     })
 }
 
-fn example_callable(py: Python<'_>) -> PyResult<Any<'_>> {
-    py.import("operator")?.getattr("add")
-}
-
 // ---------------------------------------------------------------------------------------------
 
 /// A canonical Hamiltonian system H(q, p) on T*R^d given by Python callables.
@@ -264,12 +260,6 @@ impl PyCanonical {
         let args = (hamiltonian, gradient, dof).into_pyobject(py)?;
         let base = PySystem::new(sys.clone(), args, &["hamiltonian", "gradient", "dof"]);
         Ok(PyClassInitializer::from(base).add_subclass(PyCanonical { sys }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args(py: Python<'_>) -> PyResult<(Any<'_>, Option<f64>, i64)> {
-        Ok((example_callable(py)?, None, 1))
     }
 
     /// The number d of degrees of freedom.
@@ -367,12 +357,6 @@ impl PySeparable {
         Ok(PyClassInitializer::from(base).add_subclass(PySeparable { sys }))
     }
 
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args(py: Python<'_>) -> PyResult<(f64, Any<'_>, Option<f64>, i64)> {
-        Ok((1.0, py.import("operator")?.getattr("neg")?, None, 1))
-    }
-
     /// The number d of degrees of freedom.
     #[getter]
     fn dof(&self) -> usize {
@@ -439,8 +423,9 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
 /// Casimirs (`invariants`): ‖M‖^2 (so3); ‖Gamma‖^2, M . Gamma (se3); tr((M^T M)^k)/2,
 /// k = 1..n//2 (so(n)); none for structure constants; or the `casimirs` given.
 /// Methods: rkmk4 (default; Runge–Kutta–Munthe-Kaas, order 4, explicit), midpoint (the Lie
-/// midpoint, symmetric, order 2), midpoint4 (its Suzuki composition, order 4): all advance by
-/// the coadjoint action, so every Casimir is kept to round-off; rk4 (baseline, keeps none).
+/// midpoint, symmetric, order 2), midpoint4 (its Suzuki composition, order 4), rk4 (baseline,
+/// keeps no Casimir). All but rk4 advance by the coadjoint action, so every Casimir is kept to
+/// round-off.
 ///
 /// Args:
 ///     algebra: "so3", "se3", ("so", n) with n >= 2, or structure constants C (d, d, d),
@@ -541,12 +526,6 @@ impl PyLiePoisson {
             &["algebra", "hamiltonian", "gradient", "casimirs"],
         );
         Ok(PyClassInitializer::from(base).add_subclass(PyLiePoisson { sys }))
-    }
-
-    /// Constructor arguments of an example instance (for `methods()` on the class).
-    #[classattr]
-    fn _example_args() -> (&'static str, [[f64; 3]; 3]) {
-        ("so3", [[1.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.25]])
     }
 
     /// dim g (the length d of a state).

@@ -475,7 +475,7 @@ impl Symmetric for RollingDisks {
 }
 
 impl Catalog for RollingDisks {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         canonical_catalog()
     }
 

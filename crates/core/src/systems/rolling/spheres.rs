@@ -932,7 +932,7 @@ impl GroupField for RollingSpheres {
 }
 
 impl Catalog for RollingSpheres {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("midpoint", LieMidpoint::new()),
             Entry::new("midpoint4", LieMidpoint(Composition::suzuki4())),

@@ -423,7 +423,7 @@ impl VectorField for TangentTop {
 }
 
 impl Catalog for TangentTop {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         canonical_catalog()
     }
 
@@ -619,7 +619,7 @@ impl VectorField for ChargedParticle {
 }
 
 impl Catalog for ChargedParticle {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         canonical_catalog()
     }
 

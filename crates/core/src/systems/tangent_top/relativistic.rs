@@ -328,7 +328,7 @@ macro_rules! legendre_kinds {
         }
 
         impl Catalog for $t {
-            fn catalog(&self) -> Vec<Entry<Self>> {
+            fn kind_catalog() -> Vec<Entry<Self>> {
                 canonical_catalog()
             }
 

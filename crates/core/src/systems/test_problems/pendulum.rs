@@ -155,7 +155,7 @@ impl VectorField for Pendulum {
 }
 
 impl Catalog for Pendulum {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("midpoint", IMPLICIT_MIDPOINT),
             Entry::new("gauss4", Gauss(2)),

@@ -217,7 +217,7 @@ impl Nonholonomic for RollingDisk {
 }
 
 impl Catalog for RollingDisk {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![Entry::new("nonholonomic", NonholonomicRattle)]
     }
 }

@@ -147,7 +147,7 @@ impl Constrained for SphereParticle {
 }
 
 impl Catalog for SphereParticle {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![Entry::new("rattle", Rattle::new())]
     }
 }

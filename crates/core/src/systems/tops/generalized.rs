@@ -220,7 +220,7 @@ impl VectorField for GeneralizedRigidBody {
 }
 
 impl Catalog for GeneralizedRigidBody {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("isospectral", Isospectral),
             Entry::new("rk4", Rk4),

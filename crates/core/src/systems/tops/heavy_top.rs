@@ -173,7 +173,7 @@ impl Problem for HeavyTop {
 top_kinds!(HeavyTop);
 
 impl Catalog for HeavyTop {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         let mut catalog = top::splittings();
         catalog.extend([
             Entry::new("lgvi", Lgvi),

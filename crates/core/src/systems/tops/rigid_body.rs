@@ -250,7 +250,7 @@ impl Integrator<RigidBody> for Dmv {
 }
 
 impl Catalog for RigidBody {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         let mut catalog = top::splittings();
         catalog.extend([
             Entry::new("isospectral", Isospectral),

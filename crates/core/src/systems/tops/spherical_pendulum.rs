@@ -179,7 +179,7 @@ impl VectorField for SphericalPendulum {
 }
 
 impl Catalog for SphericalPendulum {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("splitting", Splitting::strang()),
             Entry::new("splitting4", Splitting(Composition::suzuki4())),

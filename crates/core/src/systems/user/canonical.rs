@@ -116,7 +116,7 @@ impl VectorField for UserCanonical {
 }
 
 impl Catalog for UserCanonical {
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         canonical_catalog()
     }
 

@@ -369,7 +369,7 @@ impl GroupField for LiePoisson {
 impl Catalog for LiePoisson {
     /// rkmk4 (default), midpoint, midpoint4 (the Lie midpoint and its Suzuki composition),
     /// rk4.
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("rkmk4", Rkmk4),
             Entry::new("midpoint", LieMidpoint::new()),

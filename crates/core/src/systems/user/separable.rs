@@ -306,7 +306,7 @@ impl VectorField for UserSeparable {
 
 impl Catalog for UserSeparable {
     /// verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
-    fn catalog(&self) -> Vec<Entry<Self>> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
         let mut entries = vec![
             Entry::new("verlet", Verlet::strang()),
             Entry::new("verlet4", Verlet(Composition::suzuki4())),
