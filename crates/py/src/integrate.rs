@@ -553,6 +553,11 @@ impl Integration {
             (out, r.map_err(|e| of_member(e, i, b, first)))
         };
         let parallel = |runs: &mut [Run]| {
+            // One member runs on this thread: handing it to the pool costs a thread's wake-up
+            // (microseconds), more than a short run.
+            if let [run] = runs {
+                return Ok(vec![one(0, run, None)]);
+            }
             let mut work = || {
                 runs.par_iter_mut()
                     .enumerate()
