@@ -312,6 +312,15 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
         cap = max(MIN_CHUNK_STEPS, CHUNK_WORK // max(run.members, 1))
     else:
         cap = _count("chunk_steps", chunk_steps)
+    if ev is None and times is None and not progress and steps <= cap and hasattr(run, "_whole"):
+        # A plain run that fits in one native call: its trajectory's arrays in that call.
+        try:
+            t, states, att, z, za, t_final, z0, za0 = run._whole(steps)
+        except BaseException as e:
+            _attach_partial(e, system, run, [], None, None)
+            raise
+        return Trajectory(system, run.method, t, states, att, z, za, run.dt, run.save_every,
+                          t_final=t_final, t0=run.t0, initial_state=z0, initial_attitude=za0)
     if ev is not None:
         _native(run, "set_events", "events")(*ev, float(event_tol))
     chunk = run._chunk

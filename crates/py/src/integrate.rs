@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 
 use lieflow::integrate::{with_threads, Batch, Clock, Event, Events, Resolved, Run, System, Until};
 use lieflow::{check, Error};
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
@@ -17,15 +17,10 @@ use crate::items::{array, Out};
 
 /// The result of `System._run`: states (b, k, d), attitude (b, k, 3, 3) or None, final states
 /// (b, d), final attitude (b, 3, 3) or None.
-pub(crate) type RunOut<'py> = (
-    Out<'py>,
-    Option<Out<'py>>,
-    Bound<'py, PyArray2<f64>>,
-    Option<Bound<'py, PyArray3<f64>>>,
-);
+pub(crate) type RunOut<'py> = (Out<'py>, Option<Out<'py>>, Out<'py>, Option<Out<'py>>);
 
 /// Current states (b, d) and attitudes (b, 3, 3) or None.
-type States<'py> = (Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray3<f64>>>);
+type States<'py> = (Out<'py>, Option<Out<'py>>);
 
 /// One call of a run as `lieflow.integrate` assembles it: the times (k,), states (b, k, d) and
 /// attitudes (b, k, 3, 3) or None of its samples, the current states (b, d) and attitudes, the
@@ -35,12 +30,25 @@ type Chunk<'py> = (
     Bound<'py, PyArray1<f64>>,
     Out<'py>,
     Option<Out<'py>>,
-    Bound<'py, PyArray2<f64>>,
-    Option<Bound<'py, PyArray3<f64>>>,
+    Out<'py>,
+    Option<Out<'py>>,
     u64,
     Option<f64>,
     (f64, f64),
     Option<Vec<Found<'py>>>,
+);
+
+/// `_whole`'s arrays of a trajectory: times, states, attitudes, final states and attitudes, the
+/// time of the final state, initial states and attitudes.
+type Whole<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Out<'py>,
+    Option<Out<'py>>,
+    Out<'py>,
+    Option<Out<'py>>,
+    f64,
+    Out<'py>,
+    Option<Out<'py>>,
 );
 
 /// A located event as Python sees it: (index of the event function, t, state (d,), attitude
@@ -452,39 +460,64 @@ impl Integration {
         Ok(run)
     }
 
-    /// Splits (b, k, full) data into states (b, k, d) and attitudes (b, k, 3, 3).
+    /// The states (b, k, d) and attitudes (b, k, 3, 3) or None of `data` (b·k full states).
     fn split<'py>(
         &self,
         py: Python<'py>,
-        data: &[f64],
+        data: Vec<f64>,
         b: usize,
         k: usize,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
-        let full = self.d + if self.attitude { 9 } else { 0 };
-        let mut z = check::zeros("steps", &[b, k, self.d]).py()?;
-        let mut r = check::zeros("steps", &[b, k, if self.attitude { 9 } else { 0 }]).py()?;
-        for (i, s) in data.chunks_exact(full).enumerate() {
-            z[i * self.d..(i + 1) * self.d].copy_from_slice(&s[..self.d]);
-            r[i * (full - self.d)..(i + 1) * (full - self.d)].copy_from_slice(&s[self.d..]);
+        self.arrays(py, data, &[b, k])
+    }
+
+    /// The states (*lead, d) and attitudes (*lead, 3, 3) or None of `data` (full states).
+    fn arrays<'py>(
+        &self,
+        py: Python<'py>,
+        data: Vec<f64>,
+        lead: &[usize],
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+        let shape = |item: &[usize]| [lead, item].concat();
+        if !self.attitude {
+            return Ok((array(py, &shape(&[self.d]), data)?, None));
         }
-        let states = array(py, &[b, k, self.d], z)?;
-        let att = if self.attitude {
-            Some(array(py, &[b, k, 3, 3], r)?)
-        } else {
-            None
-        };
-        Ok((states, att))
+        let full = self.full();
+        let n = data.len() / full;
+        let mut z = check::zeros("steps", &[n, self.d]).py()?;
+        let mut r = check::zeros("steps", &[n, 9]).py()?;
+        for ((s, z), r) in data
+            .chunks_exact(full)
+            .zip(z.chunks_exact_mut(self.d))
+            .zip(r.chunks_exact_mut(9))
+        {
+            z.copy_from_slice(&s[..self.d]);
+            r.copy_from_slice(&s[self.d..]);
+        }
+        let states = array(py, &shape(&[self.d]), z)?;
+        Ok((states, Some(array(py, &shape(&[3, 3]), r)?)))
     }
 
     /// (b, d) states and (b, 3, 3) attitudes or None from b full flat states.
-    fn states_of<'py>(&self, py: Python<'py>, data: &[f64], b: usize) -> PyResult<States<'py>> {
-        let (z, r) = self.split(py, data, b, 1)?;
-        let z = z.reshape([b, self.d])?.cast_into::<PyArray2<f64>>()?;
-        let r = match r {
-            Some(r) => Some(r.reshape([b, 3, 3])?.cast_into::<PyArray3<f64>>()?),
-            None => None,
-        };
-        Ok((z, r))
+    fn states_of<'py>(&self, py: Python<'py>, data: Vec<f64>, b: usize) -> PyResult<States<'py>> {
+        self.arrays(py, data, &[b])
+    }
+
+    /// The current full states of the members, one after the other.
+    fn current(&self, py: Python<'_>) -> PyResult<Vec<f64>> {
+        let mut batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
+        let b = batch.len();
+        let sys = &*self.sys;
+        Ok(if !self.calls_out && batch.in_lanes() {
+            // Batches in lanes: read in parallel on the run's threads, GIL released.
+            let batch = &mut *batch;
+            let states = py
+                .detach(|| with_threads(self.threads, || Ok(batch.states(sys))))
+                .py()?;
+            states.into_iter().flatten().collect()
+        } else {
+            (0..b).flat_map(|i| batch.state(sys, i)).collect()
+        })
     }
 
     /// Advances every member `until` (in parallel with the GIL released; a run with events, or
@@ -742,7 +775,7 @@ impl Integration {
     ) -> PyResult<Chunk<'py>> {
         let b = self.members();
         let (flat, k, times) = self.samples(flat, k, last);
-        let (states, att) = self.split(py, &flat, b, k)?;
+        let (states, att) = self.split(py, flat, b, k)?;
         let hits = match self.events.is_some() {
             true => Some(self.events_found(py)?),
             false => None,
@@ -772,14 +805,14 @@ impl Integration {
         let (flat, k) = self.drive(py, Until::Steps(steps))?;
         let b = self.members();
         let (flat, k, _) = self.samples(flat, k, None);
-        let (states, att) = self.split(py, &flat, b, k)?;
+        let (states, att) = self.split(py, flat, b, k)?;
         let (zf, rf) = self.state(py)?;
         Ok((states, att, zf, rf))
     }
 
     /// The initial states (b, d) and attitudes (b, 3, 3) or None.
     fn initial_states<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
-        self.states_of(py, &self.initial, self.members())
+        self.states_of(py, self.initial.clone(), self.members())
     }
 }
 
@@ -803,7 +836,7 @@ impl Integration {
         let steps = args::count("steps", steps)?;
         let b = self.initial.len() / self.full().max(1);
         let (flat, k) = self.drive(py, Until::Steps(steps))?;
-        self.split(py, &flat, b, k)
+        self.split(py, flat, b, k)
     }
 
     /// One call of `lieflow.integrate`'s loop: `steps` more steps, or with `t` to the time t
@@ -841,6 +874,33 @@ impl Integration {
         }
         let current = self.state(py)?;
         self.chunk_of(py, flat, k, last, ended, current, true)
+    }
+
+    /// A plain run (no output times, no events, nothing done yet) in one call, as
+    /// `lieflow.integrate` takes a run that fits in one: `steps` steps, returned as the
+    /// trajectory's arrays (t (k,), states (b, k, d), attitudes (b, k, 3, 3) or None, final
+    /// states (b, d), final attitudes or None, t_final, initial states (b, d), initial attitudes
+    /// or None), without the axis b for a single initial state.
+    ///
+    /// Raises as `advance`; InvalidArgumentError for a run with output times or events or
+    /// already advanced.
+    fn _whole<'py>(&mut self, py: Python<'py>, steps: &Bound<'py, PyAny>) -> PyResult<Whole<'py>> {
+        let steps = args::count("steps", steps)?;
+        if self.at.is_some() || self.events.is_some() || self.done > 0 {
+            return Err(to_py(Error::invalid(
+                "steps",
+                "_whole takes a plain run from its start",
+            )));
+        }
+        let (flat, k) = self.drive(py, Until::Steps(steps))?;
+        let (flat, k, times) = self.samples(flat, k, None);
+        let b = self.members();
+        let lead: &[usize] = if self.batched { &[b] } else { &[] };
+        let (states, att) = self.arrays(py, flat, &[lead, &[k]].concat())?;
+        let (z, za) = self.arrays(py, self.current(py)?, lead)?;
+        let (z0, za0) = self.arrays(py, self.initial.clone(), lead)?;
+        let t = PyArray1::from_vec(py, times);
+        Ok((t, states, att, z, za, self.t_final(None, true), z0, za0))
     }
 
     /// After a failed call of a single run: `_chunk`'s tuple of the states that call saved
@@ -906,7 +966,7 @@ impl Integration {
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let b = self.initial.len() / self.full().max(1);
         let (flat, k) = self.drive(py, Until::Time(t))?;
-        self.split(py, &flat, b, k)
+        self.split(py, flat, b, k)
     }
 
     /// Saves the states at the times `t_eval` (1-D, strictly increasing, none before the
@@ -1059,7 +1119,7 @@ impl Integration {
         };
         let full = self.d + if self.attitude { 9 } else { 0 };
         let k = data.len() / full.max(1);
-        self.split(py, &data, 1, k).map(Some)
+        self.split(py, data, 1, k).map(Some)
     }
 
     /// The last states that passed the checks (b, d) and attitudes (b, 3, 3) or None: the
@@ -1072,25 +1132,13 @@ impl Integration {
             .iter()
             .flat_map(|r| r.checked_state(&*self.sys))
             .collect();
-        self.states_of(py, &data, runs.len())
+        self.states_of(py, data, runs.len())
     }
 
     /// The current states (b, d) and attitudes (b, 3, 3) or None.
     fn state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
-        let mut batch = self.runs.lock().unwrap_or_else(|p| p.into_inner());
-        let b = batch.len();
-        let sys = &*self.sys;
-        let data: Vec<f64> = if !self.calls_out && batch.in_lanes() {
-            // Batches in lanes: read in parallel on the run's threads, GIL released.
-            let batch = &mut *batch;
-            let states = py
-                .detach(|| with_threads(self.threads, || Ok(batch.states(sys))))
-                .py()?;
-            states.into_iter().flatten().collect()
-        } else {
-            (0..b).flat_map(|i| batch.state(sys, i)).collect()
-        };
-        self.states_of(py, &data, b)
+        let data = self.current(py)?;
+        self.states_of(py, data, self.members())
     }
 
     /// The time of the current states (absolute; the end time of an ended run).

@@ -7,7 +7,7 @@
 
 use lieflow::{check, Error};
 use numpy::ndarray::{ArrayD, IxDyn};
-use numpy::{IntoPyArray, PyArrayDyn};
+use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyFloat;
 
@@ -186,9 +186,19 @@ where
     Ok(array(py, &shape, out)?.into_any())
 }
 
-/// A numpy array of the given shape from row-major data.
+/// A numpy array of the given shape from row-major data: a small one copied into an array
+/// numpy allocates (cheaper than handing numpy a Rust buffer to own), a large one moved.
 pub fn array<'py>(py: Python<'py>, shape: &[usize], data: Vec<f64>) -> PyResult<Out<'py>> {
     let got = data.len();
+    if got <= SMALL && shape.iter().product::<usize>() == got {
+        // SAFETY: the array is new, C-contiguous, of `got` elements, all written before it is
+        // returned.
+        let a = unsafe { PyArrayDyn::<f64>::new(py, IxDyn(shape), false) };
+        unsafe { a.as_slice_mut() }
+            .map_err(|e| to_py(Error::invalid("output", e.to_string())))?
+            .copy_from_slice(&data);
+        return Ok(a);
+    }
     ArrayD::from_shape_vec(IxDyn(shape), data)
         .map(|a| a.into_pyarray(py))
         .map_err(|_| {
@@ -199,3 +209,6 @@ pub fn array<'py>(py: Python<'py>, shape: &[usize], data: Vec<f64>) -> PyResult<
             ))
         })
 }
+
+/// The size up to which [`array`] copies.
+const SMALL: usize = 1 << 12;
