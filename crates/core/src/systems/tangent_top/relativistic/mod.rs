@@ -1,0 +1,377 @@
+//! 002 §IV: the relativistic tangent Euler top in Minkowski space-time and on a curved static
+//! space-time −dt² + γ_ij dxⁱdxʲ over a surface ([`RelativisticTangentTop`], 002 (87)–(111)), and
+//! in the weak-field limit of a static gravitational potential φ(x, y) ([`WeakFieldTop`],
+//! 002 (115)–(120)).
+//!
+//! # Set-up (002 (81)–(82))
+//! A planar body with mass distribution dm(ξ), centre of mass at ξ = 0, second-moment tensor
+//! I = ∫ ξ ξᵀ dm (2×2; 𝕀 = tr I as in 002 (42); a symmetric top has I = (𝕀/2)·Id). Its frame is
+//! E_i = S_ji Ê_j with S = R(θ) the rotation by θ (E₁ = cos θ Ê₁ + sin θ Ê₂, as in 002 (41)), and
+//! time is that of a distant static observer (E₀ = ∂_t normalised). Definition IV.1 (002 (82)):
+//! the Lagrangian is the integral over the body of √|⟨ċ + ξⁱ∇_ċE_i, ċ + ξʲ∇_ċE_j⟩|, expanded to
+//! second order in ξ (odd orders integrate to zero).
+//!
+//! **Sign convention.** 002 (82)–(118) write L with the sign +m√(1 − v²); here L is the physical
+//! action density −∫dτ dm, the negative of the seed's. The Euler–Lagrange equations are the same;
+//! momenta and energies change sign: our p_θ and energy are −(seed's), so 002 (96) reads
+//! E = +mγ + … here.
+//!
+//! # Minkowski (002 (87)–(96))
+//! With ∇_ċE_i = Ṡ_ji Ê_j and |ċ|² = −1 + |ẋ|², the integrand is
+//! √(1 − v² − 2ẋ·Ṡξ − |Ṡξ|²) = √(1−v²) − ẋ·Ṡξ/√(1−v²) − |Ṡξ|²/(2√(1−v²))
+//! − (ẋ·Ṡξ)²/(2(1−v²)^{3/2}) + O(ξ³), and with Ṡ = θ̇ J S (J the rotation by π/2),
+//! K(θ) = S J I Jᵀ Sᵀ, γ = (1 − v²)^{−1/2}:
+//!
+//! L(ẋ, θ, θ̇) = −m/γ + ½ θ̇² (𝕀 γ + γ³ ẋᵀK(θ)ẋ),        (002 (90), physical sign)
+//!
+//! which agrees with 002 (90) (tr(ṠIṠᵀ) = θ̇² 𝕀). **Which variables it depends on:** although
+//! (81)–(82) look second order, with E₀ = ∂_t the frame is rotated by S(θ) only, so L depends on
+//! (ẋ, θ, θ̇) and not on ẍ: it is a first-order Lagrangian on T(ℝ² × S¹), x is cyclic (p = ∂L/∂ẋ
+//! is conserved), and for the symmetric top (K = (𝕀/2) Id) θ is cyclic too. No Ostrogradsky
+//! construction is needed; the system is integrated in canonical form with the Hamiltonian
+//! H(q, p) = p·q̇ − L, q = (x, y, θ), the velocities q̇(q, p) found by inverting the Legendre map
+//! p = ∂L/∂q̇ with Newton's method (the Hessian ∂²L/∂q̇² must be positive definite: it is for
+//! slow, slowly spinning tops, and the state check says where it is not).
+//!
+//! **Symmetric top (002 (93)–(96)).** With I₀ = 𝕀/2 (the seed's I), L = −m/γ + I₀θ̇²γ(1 + ½v²γ²)
+//! (002 (93)). The momenta p = (mγ + I₀θ̇²(2γ³ + (3/2)v²γ⁵)) ẋ and
+//! J = p_θ = 2I₀θ̇γ(1 + ½v²γ²) are conserved; so (the Legendre map being invertible) ẋ and θ̇ are
+//! constant. Eliminating θ̇, with 1 + ½v²γ² = ½(2 − v²)γ² and 2γ² + (3/2)v²γ⁴ = ½(4 − v²)γ⁴,
+//!
+//! |p| = mγv (1 + J²(1 − v²)(4 − v²) / (2 I₀ m (2 − v²)²)),          (002 (94))
+//! θ̇ = J / (2 I₀ γ (1 + ½v²γ²)),                                    (002 (95))
+//! E = mγ + I₀θ̇² (γ + (5/2) v²γ³ + (3/2) v⁴γ⁵).                     (002 (96))
+//!
+//! These agree with the seed once its "J" is read as half the canonical momentum p_θ (its (95)
+//! has I where 2I₀ = 𝕀 would stand with J = p_θ; (94) then has 4J² for J²) and the overall sign
+//! of (96) is that of its Lagrangian. **Slip:** the seed concludes from (94) that v is fixed by
+//! |p| because the left side "is never constant on an interval"; that does not make it
+//! injective, and it is not: with κ = J²/(2I₀m) > 7.34 the function v ↦ |p| decreases on an
+//! interval below v = 1 (at κ = 10 on about 0.908 < v < 0.976), so one |p| belongs to up to
+//! three speeds, and the Legendre map is singular where the slope vanishes. (κ ~ rotational
+//! energy over rest energy, far outside the small-body expansion; below the threshold the claim
+//! holds.)
+//! What makes v constant is the invertibility of the Legendre map along the motion, which
+//! [`RelativisticTangentTop`] checks.
+//!
+//! # Curved static space-time (002 (97)–(111))
+//! The metric ds² = −dt² + γ_ij dxⁱdxʲ with γ = g the metric of a [`Surface`] (orthonormal frame
+//! Ê_a, connection 1-form w(v) = ⟨∇_vÊ₁, Ê₂⟩ = α·v, see [`crate::systems::tangent_top::surface`]). The lapse is
+//! 1, so ∂_t is parallel and no Christoffel symbol carries a t (002 (86)): with ċ = ∂_t + ẋ and
+//! E₁ = cos θ Ê₁ + sin θ Ê₂, E₂ = −sin θ Ê₁ + cos θ Ê₂,
+//!
+//! ∇_ċE₁ = s E₂,  ∇_ċE₂ = −s E₁,   s = θ̇ + α·ẋ   (the covariant spin rate),
+//!
+//! i.e. in the reference frame ∇_ċE_i = (Ṡ + ΩS)_ji Ê_j with Ω = w(ẋ) J, Ṡ + ΩS = s J S. With the
+//! frame components u_a = g(ẋ, Ê_a) of ẋ (|u|² = g(ẋ, ẋ) = v²), the integrand of (82) is
+//! √(1 − |u + s J S ξ|²), the Minkowski one with ẋ → u and θ̇ → s. So, to second order in ξ,
+//!
+//! L = −m/γ + ½ s² (𝕀γ + γ³ uᵀK(θ)u),   γ = (1 − g(ẋ, ẋ))^{−1/2},      (002 (102), physical sign)
+//!
+//! and for the symmetric top (K = (𝕀/2) Id, uᵀKu = 𝕀v²/2)
+//!
+//! L = −m/γ + ½ 𝕀 s² (γ + ½ γ³ v²)    (002 (103), physical sign; the L of [`TangentTop`] − m as v → 0).
+//!
+//! Only the symmetric top is implemented on a surface ([`RelativisticTangentTop::on_surface`]):
+//! for an anisotropic body L depends on u = e♭ẋ itself, whose x-derivatives need the derivatives
+//! of the frame, which [`Surface`] does not provide (it gives g, ∂g, α, ∂α); the anisotropic top
+//! stays in the Minkowski plane ([`RelativisticTangentTop::new`]).
+//!
+//! **Derivatives** (the kernel of the symmetric top on a surface). With Q = g(ẋ, ẋ),
+//! f(Q) = γ + ½Qγ³, f′ = γ³ + ¾Qγ⁵, f″ = (9/4)γ⁵ + (15/8)Qγ⁷, L = −m√(1 − Q) + ½𝕀s²f(Q),
+//! λ = ∂L/∂Q = ½mγ + ½𝕀s²f′, σ = ∂L/∂s = 𝕀sf, n = gẋ:
+//! p_x = 2λ n + σ α,  p_θ = σ,  ∂L/∂x^k = λ ẋᵀ(∂_k g)ẋ + σ (∂_kα)·ẋ,  ∂L/∂θ = 0,
+//! and the Hessian in (ẋ, θ̇) from L_QQ = ¼mγ³ + ½𝕀s²f″, L_Qs = 𝕀sf′, L_ss = 𝕀f.
+//!
+//! **Conserved.** E = p·q̇ − L = mγ + ½𝕀s²(γ + (5/2)v²γ³ + (3/2)v⁴γ⁵) (002 (96) with θ̇ → s);
+//! p_θ = 𝕀 s f(v²) (θ is cyclic); and for every Killing field X of the surface, lifted to
+//! (x, θ) as in [`crate::systems::tangent_top::surface`], J = p_A X^A (v², s and so L are invariant under the
+//! lifted isometries; [`RelativisticTangentTop::killing_momenta`], computed by
+//! [`crate::systems::TangentTop::killing_momenta`]). Since E and p_θ are functions of (v, s) only,
+//! v and s are constant along a motion (where (v, s) ↦ (E, p_θ) is locally invertible, as for
+//! slow tops; the sphere test checks it), and the x-equation is
+//! 2λ g∇_tẋ = σ dw(ẋ, ·): a charge σ = p_θ of mass 2λ = mγ + 𝕀s²f′ in the "magnetic field" −K dA,
+//! moving on a curve of geodesic curvature κ = |p_θ K|/(2λ v) (on the sphere: a circle). 002 (94)
+//! holds with |p| read as |p_x − p_θ α|_{g⁻¹} = 2λv, and (95), (96) with θ̇ → s.
+//!
+//! **The seed's (97)–(103)** (checked by the test `curved_lagrangian_is_the_expansion_of_82`
+//! against the exact (82) over a ring of mass points on the sphere and on the hyperbolic plane,
+//! with ∇_ċE_i computed from the Christoffel symbols of g and the frame, not from α): the
+//! structure of (102)–(103) is right (in the seed's sign, L_seed = −L) once the following are read
+//! as intended. (97) writes γ_ij dxⁱdxⁱ for γ_ij dxⁱdxʲ; (99)/(101) write ξʲS_jiω_jᵏ for
+//! ξⁱS_jiω_jᵏ; the first term of (102) and (103) is m(1 − γ_ij ẋⁱẋʲ), without the square root
+//! ((108) restores it: m√(1 − v²)); the matrix ω of (102)–(103) must be read as Ω_kj = ω_jᵏ(ċ)
+//! (column j the components of ∇_ċÊ_j, so Ω = w(ẋ) J): with the other index order the cross term
+//! 2tr(ṠSᵀωᵀ) flips sign and (103) would give (θ̇ − α·ẋ)², which the ring test rejects; and (103)
+//! writes ⟨ċ, E_j⟩ (body frame) where (102) has ⟨ċ, Ê_j⟩ (the same here, the bracket being s² Id
+//! for the symmetric top, but not for an anisotropic one). In (103) "I" is the seed's I₀ = 𝕀/2,
+//! as in (93). (104)–(114), the frame independence: s = θ̇ + α·ẋ is invariant under Ê → R(χ)Ê
+//! (θ → θ − χ, α → α + dχ), and so are v² and L.
+//!
+//! # Weak field (002 (115)–(120))
+//! The static metric is ds² = −e^{2φ(x)} dt² + δ_ij dxⁱdxʲ (**slip corrected:** 002 (115) lacks
+//! the dt² of the time-time term and writes ẋ for dx). With E₀ = e^{−φ}∂_t, Γ^t_{ti} = ∂_iφ, so
+//! ∇_ċE_i = Ṡ_ji ∂_j + (S_ji G_j) ∂_t, G = ∇φ, and the integrand of (82) is
+//! e^{2φ}(1 + G·Sξ)² − |ẋ + Ṡξ|². To second order in ξ, with b = e^{2φ} − v², for a symmetric
+//! top (I = I₀ Id) this gives (the physical-sign form of 002 (117))
+//!
+//! L = −m√b + I₀θ̇²/√b − I₀e^{2φ}|G|²/(2√b)
+//!   + I₀(θ̇²v² + 2e^{2φ}θ̇ (G_y ẋ − G_x ẏ) + e^{4φ}|G|²)/(2 b^{3/2}).
+//!
+//! (The point of the body is moved along ξⁱ∇_ċE_i as (82) prescribes; evaluating φ at x + Sξ
+//! instead would add a tidal term ∝ I₀ Δφ.) The weak-field limit, φ, |G| = O(ε²), v = O(ε),
+//! θ̇ = O(1), keeping terms to O(ε³) and dropping the constant −m:
+//!
+//! L = ½ m v² − m φ + I₀ θ̇² (1 − φ + v²) + I₀ θ̇ (G_y ẋ − G_x ẏ).      (002 (118))
+//!
+//! **Slip:** 002 (118), in the seed's sign (L_seed = −L), carries the coupling term with the
+//! opposite sign, +Iθ̇(G_yẋ − G_xẏ); the expansion of 002 (117) itself gives the sign above
+//! (its ṠSᵀ should read SṠᵀ = −θ̇J). The test `weak_field_lagrangian_is_the_expansion` checks
+//! the sign against the exact integral over a ring of mass points. The Euler–Lagrange equations
+//! (002 (119), here with every term, G = ∇φ, Δφ = ∂_xG_x + ∂_yG_y):
+//!
+//! J = p_θ = 2I₀θ̇(1 − φ + v²) + I₀(G_y ẋ − G_x ẏ) = const,
+//! (m + 2I₀θ̇²)ẍ + 4I₀θ̇θ̈ ẋ + I₀θ̈ G_y = −(m + I₀θ̇²) G_x − I₀θ̇ Δφ ẏ,
+//! (m + 2I₀θ̇²)ÿ + 4I₀θ̇θ̈ ẏ − I₀θ̈ G_x = −(m + I₀θ̇²) G_y + I₀θ̇ Δφ ẋ.
+//!
+//! 002 (120) drops the θ̈G terms and prints the Δφ terms with the opposite signs (the same
+//! coupling-sign slip). Here the full equations of (118) are integrated, in canonical form as
+//! above. The Hessian of (118) in the velocities is positive definite only for slow motion (its
+//! θ̇–ẋ entry 4I₀θ̇ẋ + I₀JᵀG grows with v): the weak-field ordering v = O(ε) is a domain
+//! condition, which the state check enforces. Conserved: the energy
+//! E = ½mv² + mφ + I₀θ̇²(1 − φ + 3v²) + I₀θ̇(G_yẋ − G_xẏ), p_θ, and for a central potential
+//! the angular momentum x p_y − y p_x (a uniform field conserves the momentum across the field).
+//! The spin–field force I₀θ̇Δφ(−ẏ, ẋ) is "magnetic" (it does no work); φ = −GM/r restricted to
+//! the plane has Δφ = −GM/r³ ≠ 0, so it acts in the point-mass field.
+//!
+//! # State
+//! Both systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)
+//! are its chart's coordinates and p₁, p₂ their momenta); build one from velocities with `state`,
+//! read the velocities back with `velocities`.
+//!
+//! [`Surface`]: super::surface::Surface
+//! [`TangentTop`]: super::TangentTop
+
+mod spacetime;
+mod weak_field;
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::check;
+use crate::convergence::{self, Monitor, Rule, Verdict};
+use crate::error::{Error, Result};
+use crate::integrate::methods::canonical_catalog;
+use crate::integrate::problem::{Canonical, VectorField};
+use crate::integrate::space::{Block, Space};
+use crate::integrate::{Catalog, Entry, Problem};
+
+pub use spacetime::RelativisticTangentTop;
+pub use weak_field::{Potential, PotentialValue, WeakFieldTop};
+
+/// The derivatives of a Lagrangian L(q, q̇) on ℝ³ at one point: value, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇².
+struct Derivs {
+    l: f64,
+    lv: Vector3<f64>,
+    lq: Vector3<f64>,
+    hess: Matrix3<f64>,
+}
+
+/// The stopping rule of the Legendre inversion ([`crate::convergence`]; the Newton step relative
+/// to 1 + |q̇|_∞; ended at once at 10⁻¹³, after which one more step brings q̇ to round-off).
+const LEGENDRE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 1e-13,
+    max_iter: 60,
+};
+
+/// Solves ∂L/∂q̇(q, q̇) = p for q̇ by Newton's method with a Cholesky-factored Hessian (so that the
+/// Hessian is positive definite at the answer), halving steps that leave the domain (`derivs`
+/// returns None there), from `guess`, under the rule [`LEGENDRE`], then takes one more step. None
+/// when it fails (singular or indefinite Hessian, no convergence).
+fn legendre_inverse(
+    p: &[f64],
+    guess: Vector3<f64>,
+    derivs: impl Fn(&Vector3<f64>) -> Option<Derivs>,
+) -> Option<(Vector3<f64>, Derivs)> {
+    let p = Vector3::new(p[0], p[1], p[2]);
+    let mut v = guess;
+    let mut d = derivs(&v)?;
+    let mut monitor = Monitor::new(LEGENDRE);
+    let mut polish = false;
+    loop {
+        let chol = d.hess.cholesky()?;
+        let step = chol.solve(&(p - d.lv));
+        let mut t = 1.0;
+        let (nv, nd) = loop {
+            let nv = v + step * t;
+            if let Some(nd) = derivs(&nv) {
+                break (nv, nd);
+            }
+            t *= 0.5;
+            if t < 1e-12 {
+                return None;
+            }
+        };
+        v = nv;
+        d = nd;
+        if polish {
+            return d.hess.cholesky().is_some().then_some((v, d));
+        }
+        match monitor.check(step.amax() * t, 1.0 + v.amax()) {
+            Verdict::Continue => {}
+            Verdict::Converged => polish = true,
+            Verdict::Failed(_) => return None,
+        }
+    }
+}
+
+/// The state layout shared by both systems.
+fn space() -> Space {
+    Space::new([
+        ("x", Block::Real(2)),
+        ("theta", Block::Real(1)),
+        ("p", Block::Real(2)),
+        ("p_theta", Block::Real(1)),
+    ])
+}
+
+/// What both tops share: a Lagrangian L(q, q̇) in q = (x, y, θ) with its derivatives, and the
+/// inverse of its Legendre map, from which H, Hamilton's equations, the state helpers and the
+/// catalog follow once ([`legendre_kinds`]).
+trait Legendre: Problem {
+    /// L, ∂L/∂q̇, ∂L/∂q and ∂²L/∂q̇² at (q, q̇); None where L is not defined.
+    fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs>;
+
+    /// q̇ with ∂L/∂q̇(q, q̇) = p, and the derivatives there; None where the map is not inverted.
+    fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)>;
+
+    /// The error for a (q, q̇) where L is not defined.
+    fn undefined(&self, q: [f64; 3], v: [f64; 3]) -> Error;
+
+    /// Checks that q lies in the configuration space's chart (before a Legendre inversion).
+    fn check_point(&self, _q: &[f64]) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// L(q, q̇), checked.
+fn lagrangian<T: Legendre>(t: &T, q: [f64; 3], v: [f64; 3]) -> Result<f64> {
+    check::finite_slice("q and qdot", &[q[0], q[1], q[2], v[0], v[1], v[2]])?;
+    t.derivs(&q, &Vector3::from(v))
+        .map(|d| d.l)
+        .ok_or_else(|| t.undefined(q, v))
+}
+
+/// The canonical state (q, ∂L/∂q̇) at (q, q̇); the Legendre map must be invertible there.
+fn state<T: Legendre>(t: &T, q: [f64; 3], v: [f64; 3]) -> Result<Vec<f64>> {
+    check::finite_slice(
+        "x, theta, xdot, thetadot",
+        &[q[0], q[1], q[2], v[0], v[1], v[2]],
+    )?;
+    let d = t
+        .derivs(&q, &Vector3::from(v))
+        .ok_or_else(|| t.undefined(q, v))?;
+    if d.hess.cholesky().is_none() {
+        return Err(not_invertible(t.name()));
+    }
+    Ok(vec![q[0], q[1], q[2], d.lv[0], d.lv[1], d.lv[2]])
+}
+
+/// The velocities of a state (the inverse Legendre map).
+fn velocities<T: Legendre>(t: &T, z: &[f64]) -> Result<[f64; 3]> {
+    check::len_of("state", z, 6)?;
+    check::finite_slice("state", z)?;
+    t.check_point(&z[..3])?;
+    t.solve(&z[..3], &z[3..])
+        .map(|(v, _)| [v[0], v[1], v[2]])
+        .ok_or_else(|| not_invertible(t.name()))
+}
+
+/// E = H = p·q̇ − L of a state.
+fn energy<T: Legendre>(t: &T, z: &[f64]) -> Result<f64> {
+    check::len_of("state", z, 6)?;
+    check::finite_slice("state", z)?;
+    t.check_point(&z[..3])?;
+    let sol = t.solve(&z[..3], &z[3..]);
+    if sol.is_none() {
+        return Err(not_invertible(t.name()));
+    }
+    Ok(hamiltonian_of(&z[3..], sol))
+}
+
+/// `Canonical` (H and its gradient through the inverse Legendre map), `VectorField` (Hamilton's
+/// equations, for rk4) and the catalog of a [`Legendre`] top.
+macro_rules! legendre_kinds {
+    ($t:ty) => {
+        impl Canonical for $t {
+            fn dof(&self) -> usize {
+                3
+            }
+            fn hamiltonian(&self, q: &[f64], p: &[f64]) -> f64 {
+                hamiltonian_of(p, self.solve(q, p))
+            }
+            fn gradient(&self, q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]) {
+                gradient_of(self.solve(q, p), hq, hp);
+            }
+        }
+
+        impl VectorField for $t {
+            /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
+            fn field(&self, z: &[f64], dz: &mut [f64]) {
+                self.hamilton_field(z, dz);
+            }
+        }
+
+        impl Catalog for $t {
+            fn kind_catalog() -> Vec<Entry<Self>> {
+                canonical_catalog()
+            }
+
+            fn dissipation(
+                &self,
+                d: &$crate::integrate::forcing::Dissipation,
+            ) -> $crate::Result<std::sync::Arc<dyn $crate::integrate::forcing::Perturbation>> {
+                $crate::integrate::forcing::rayleigh(self, d)
+            }
+        }
+    };
+}
+
+fn not_invertible(name: &str) -> Error {
+    Error::invalid(
+        "state",
+        format!(
+            "{name}: the Legendre map is not invertible at these momenta (∂²L/∂q̇² not positive \
+             definite, or no velocity with these momenta); the expansion of 002 §IV needs slow, \
+             moderately spinning tops"
+        ),
+    )
+}
+
+/// H(q, p) = p·q̇ − L and its gradient ∂H/∂p = q̇, ∂H/∂q = −∂L/∂q (at the q̇ of p); NaN where the
+/// Legendre map cannot be inverted (the Gauss solver then reports the step).
+fn hamiltonian_of(p: &[f64], sol: Option<(Vector3<f64>, Derivs)>) -> f64 {
+    match sol {
+        Some((v, d)) => p[0] * v[0] + p[1] * v[1] + p[2] * v[2] - d.l,
+        None => f64::NAN,
+    }
+}
+
+fn gradient_of(sol: Option<(Vector3<f64>, Derivs)>, hq: &mut [f64], hp: &mut [f64]) {
+    match sol {
+        Some((v, d)) => {
+            for i in 0..3 {
+                hp[i] = v[i];
+                hq[i] = -d.lq[i];
+            }
+        }
+        None => {
+            hq.fill(f64::NAN);
+            hp.fill(f64::NAN);
+        }
+    }
+}
+
+legendre_kinds!(RelativisticTangentTop);
+
+legendre_kinds!(WeakFieldTop);

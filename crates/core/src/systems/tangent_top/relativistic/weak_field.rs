@@ -1,0 +1,270 @@
+//! The symmetric relativistic tangent top in the weak-field limit of a static potential φ(x, y),
+//! the Lagrangian 002 (118) with its coupling sign corrected (002 (115)–(120)).
+
+use std::fmt;
+use std::sync::Arc;
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::{energy, lagrangian, legendre_inverse, space, state, velocities, Derivs, Legendre};
+use crate::check;
+use crate::error::{Error, Result};
+use crate::integrate::space::Space;
+use crate::integrate::Problem;
+
+/// The rotation by π/2 applied to a 2-vector: J(a, b) = (−b, a).
+fn rot90(a: [f64; 2]) -> [f64; 2] {
+    [-a[1], a[0]]
+}
+
+/// φ, ∇φ = (G_x, G_y) and the Hessian (φ_xx, φ_xy, φ_yy) of a potential at one point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PotentialValue {
+    /// φ.
+    pub phi: f64,
+    /// G = ∇φ.
+    pub grad: [f64; 2],
+    /// (φ_xx, φ_xy, φ_yy).
+    pub hess: [f64; 3],
+}
+
+type PotentialFn = dyn Fn([f64; 2]) -> PotentialValue + Send + Sync;
+
+#[derive(Clone)]
+enum PotentialKind {
+    PointMass { gm: f64 },
+    Uniform { g: [f64; 2] },
+    Custom(Arc<PotentialFn>),
+}
+
+/// A static gravitational potential φ(x, y) (the g_tt = −e^{2φ} of 002 (115), corrected), with
+/// its gradient and Hessian.
+#[derive(Clone)]
+pub struct Potential {
+    kind: PotentialKind,
+}
+
+impl fmt::Debug for Potential {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.kind {
+            PotentialKind::PointMass { gm } => write!(f, "Potential::point_mass({gm})"),
+            PotentialKind::Uniform { g } => write!(f, "Potential::uniform({g:?})"),
+            PotentialKind::Custom(_) => write!(f, "Potential::custom(..)"),
+        }
+    }
+}
+
+impl Potential {
+    /// φ = −GM/r (r = |x| > 0), a point mass at the origin (the plane through it).
+    pub fn point_mass(gm: f64) -> Result<Self> {
+        check::positive("GM", gm)?;
+        Ok(Potential {
+            kind: PotentialKind::PointMass { gm },
+        })
+    }
+
+    /// φ = g·x, a uniform field of strength −g (the force on the centre is −m g).
+    pub fn uniform(g: [f64; 2]) -> Result<Self> {
+        check::finite_slice("g", &g)?;
+        Ok(Potential {
+            kind: PotentialKind::Uniform { g },
+        })
+    }
+
+    /// A potential given as a closure returning φ, ∇φ and the Hessian at a point (non-finite
+    /// values mark points outside its domain).
+    pub fn custom(f: impl Fn([f64; 2]) -> PotentialValue + Send + Sync + 'static) -> Self {
+        Potential {
+            kind: PotentialKind::Custom(Arc::new(f)),
+        }
+    }
+
+    /// φ, ∇φ and the Hessian at x (non-finite at r = 0 for the point mass).
+    pub fn eval(&self, x: [f64; 2]) -> PotentialValue {
+        match &self.kind {
+            PotentialKind::PointMass { gm } => {
+                let r2 = x[0] * x[0] + x[1] * x[1];
+                let r = r2.sqrt();
+                let r3 = r2 * r;
+                let r5 = r3 * r2;
+                PotentialValue {
+                    phi: -gm / r,
+                    grad: [gm * x[0] / r3, gm * x[1] / r3],
+                    hess: [
+                        gm * (1.0 / r3 - 3.0 * x[0] * x[0] / r5),
+                        -3.0 * gm * x[0] * x[1] / r5,
+                        gm * (1.0 / r3 - 3.0 * x[1] * x[1] / r5),
+                    ],
+                }
+            }
+            PotentialKind::Uniform { g } => PotentialValue {
+                phi: g[0] * x[0] + g[1] * x[1],
+                grad: *g,
+                hess: [0.0; 3],
+            },
+            PotentialKind::Custom(f) => f(x),
+        }
+    }
+}
+
+/// The symmetric relativistic tangent top in a weak static gravitational field, the Lagrangian
+/// 002 (118) with its coupling sign corrected (module docs):
+/// L = ½mv² − mφ + I₀θ̇²(1 − φ + v²) + I₀θ̇(G_yẋ − G_xẏ), I₀ = 𝕀/2, G = ∇φ.
+/// State z = (x, y, θ, p_x, p_y, p_θ).
+#[derive(Clone, Debug)]
+pub struct WeakFieldTop {
+    mass: f64,
+    i0: f64,
+    potential: Potential,
+}
+
+impl WeakFieldTop {
+    /// Mass m > 0, 𝕀 = `inertia` > 0 (I₀ = 𝕀/2), and the potential φ.
+    pub fn new(mass: f64, inertia: f64, potential: Potential) -> Result<Self> {
+        check::positive("mass", mass)?;
+        check::positive("inertia", inertia)?;
+        Ok(WeakFieldTop {
+            mass,
+            i0: 0.5 * inertia,
+            potential,
+        })
+    }
+
+    /// The potential.
+    pub fn potential(&self) -> &Potential {
+        &self.potential
+    }
+
+    /// L(q, q̇) of 002 (118) (corrected, physical sign), q = (x, y, θ), q̇ = (ẋ, ẏ, θ̇).
+    /// Errors: non-finite input or potential.
+    pub fn lagrangian(&self, q: [f64; 3], qdot: [f64; 3]) -> Result<f64> {
+        lagrangian(self, q, qdot)
+    }
+
+    /// The canonical state with p = ∂L/∂q̇ (see
+    /// [`RelativisticTangentTop::state`](super::RelativisticTangentTop::state)).
+    pub fn state(
+        &self,
+        x: [f64; 2],
+        theta: f64,
+        xdot: [f64; 2],
+        thetadot: f64,
+    ) -> Result<Vec<f64>> {
+        state(self, [x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
+    }
+
+    /// The velocities (ẋ, ẏ, θ̇) of a state. Errors: wrong length, non-finite, outside the
+    /// potential's domain or the range of the Legendre map.
+    pub fn velocities(&self, z: &[f64]) -> Result<[f64; 3]> {
+        velocities(self, z)
+    }
+
+    /// The angular momentum x p_y − y p_x about the origin (conserved for a central potential).
+    pub fn angular_momentum(&self, z: &[f64]) -> Result<f64> {
+        check::len_of("state", z, 6)?;
+        let q = "the angular momentum x p_y − y p_x";
+        check::cross2("state", q, [z[0], z[1]], [z[3], z[4]])
+    }
+}
+
+fn outside_potential(q: [f64; 3]) -> Error {
+    Error::invalid(
+        "x",
+        format!(
+            "the potential or its derivatives are not finite at ({}, {})",
+            q[0], q[1]
+        ),
+    )
+}
+
+impl Problem for WeakFieldTop {
+    fn calls_out(&self) -> bool {
+        matches!(self.potential.kind, PotentialKind::Custom(_))
+    }
+    fn name(&self) -> &'static str {
+        "WeakFieldTop"
+    }
+    fn space(&self) -> Space {
+        space()
+    }
+    /// E = p·q̇ − L = ½mv² + mφ + I₀θ̇²(1 − φ + 3v²) + I₀θ̇(G_yẋ − G_xẏ) (module docs).
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        energy(self, z)
+    }
+    /// p_θ (θ is cyclic); for the point mass also x p_y − y p_x (quadratic); for a uniform field
+    /// also the momentum across the field, p·Ĵĝ (linear). The Gauss methods keep all of them.
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        check::len_of("state", z, 6)?;
+        let mut out = vec![z[5]];
+        match &self.potential.kind {
+            PotentialKind::PointMass { .. } => out.push(self.angular_momentum(z)?),
+            PotentialKind::Uniform { g } => {
+                let n = g[0].hypot(g[1]);
+                if n > 0.0 {
+                    let t = rot90([g[0] / n, g[1] / n]);
+                    out.push(t[0] * z[3] + t[1] * z[4]);
+                }
+            }
+            PotentialKind::Custom(_) => {}
+        }
+        Ok(out)
+    }
+    fn invariant_count(&self) -> usize {
+        match &self.potential.kind {
+            PotentialKind::PointMass { .. } => 2,
+            PotentialKind::Uniform { g } => 1 + usize::from(g[0].hypot(g[1]) > 0.0),
+            PotentialKind::Custom(_) => 1,
+        }
+    }
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        self.velocities(z).map(|_| ())
+    }
+}
+
+impl Legendre for WeakFieldTop {
+    /// Derivatives of L at (q, q̇); None where φ or q̇ is not finite.
+    fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
+        let pv = self.potential.eval([q[0], q[1]]);
+        let (m, i0) = (self.mass, self.i0);
+        let (u, w) = ([v[0], v[1]], v[2]);
+        let s = u[0] * u[0] + u[1] * u[1];
+        let [gx, gy] = pv.grad;
+        let [hxx, hxy, hyy] = pv.hess;
+        let c = gy * u[0] - gx * u[1];
+        let l = 0.5 * m * s - m * pv.phi + i0 * w * w * (1.0 - pv.phi + s) + i0 * w * c;
+        if !(l.is_finite() && hxx.is_finite() && hxy.is_finite() && hyy.is_finite()) {
+            return None;
+        }
+        let a = m + 2.0 * i0 * w * w;
+        let lv = Vector3::new(
+            a * u[0] + i0 * w * gy,
+            a * u[1] - i0 * w * gx,
+            2.0 * i0 * w * (1.0 - pv.phi + s) + i0 * c,
+        );
+        let f = m + i0 * w * w;
+        // ∂c/∂x_k = H_yk u_x − H_xk u_y.
+        let lq = Vector3::new(
+            -f * gx + i0 * w * (hxy * u[0] - hxx * u[1]),
+            -f * gy + i0 * w * (hyy * u[0] - hxy * u[1]),
+            0.0,
+        );
+        let mut hess = Matrix3::zeros();
+        hess[(0, 0)] = a;
+        hess[(1, 1)] = a;
+        hess[(0, 2)] = 4.0 * i0 * w * u[0] + i0 * gy;
+        hess[(1, 2)] = 4.0 * i0 * w * u[1] - i0 * gx;
+        hess[(2, 0)] = hess[(0, 2)];
+        hess[(2, 1)] = hess[(1, 2)];
+        hess[(2, 2)] = 2.0 * i0 * (1.0 - pv.phi + s);
+        Some(Derivs { l, lv, lq, hess })
+    }
+
+    fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
+        let guess = Vector3::new(p[0] / self.mass, p[1] / self.mass, p[2] / (2.0 * self.i0));
+        legendre_inverse(p, guess, |v| self.derivs(q, v))
+    }
+
+    fn undefined(&self, q: [f64; 3], _v: [f64; 3]) -> Error {
+        outside_potential(q)
+    }
+}
