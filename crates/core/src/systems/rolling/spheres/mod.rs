@@ -121,16 +121,20 @@
 //! levelling off near t ≈ 10⁴: the method is reversible, not symplectic, and the system is
 //! nonholonomic, so no bound is guaranteed; 7.5e-9 then 1.5e-8 for rkmk4 and 2.7e-7 then 8.3e-7
 //! for rk4 — growing; |ΔJ|/|J| ≤ 2e-14 for the Lie-group methods.
+//!
+//! [`LieMidpoint`]: crate::integrate::methods::LieMidpoint
+//! [`GroupField`]: crate::integrate::problem::GroupField
 
-use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+mod curvature;
+mod dynamics;
+mod methods;
+mod planar;
+
+use nalgebra::{Matrix3, Vector3};
 
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Composition, LieMidpoint, Rk4, Rkmk4};
-use crate::integrate::problem::{GroupField, VectorField};
-use crate::integrate::space::{Block, Space};
-use crate::integrate::{Catalog, Entry, Problem};
-use crate::lie::so3::{self, hat};
+use crate::integrate::Problem;
 
 /// The state layout: z₁ (9, row-major), z₂ (9), u (3), Ω₁ (3), Ω₂ (3).
 pub const STATE_DIM: usize = 27;
@@ -405,79 +409,11 @@ impl RollingSpheres {
         Ok(s)
     }
 
-    /// The state of the planar motion (003 §2.4 ↔ §1): z_k the rotation by θ_k about e₃,
-    /// u = (cos φ, sin φ, 0), Ω_k = θ̇_k e₃. Then (10) gives u̇ = φ̇ e₃ × u with
-    /// φ̇ = α₁θ̇₁ + α₂θ̇₂, i.e. 003 §1's R φ̇ = r₁θ̇₁ + r₂θ̇₂ (u = e^{iφ}, z_k = e^{iθ_k}).
-    ///
-    /// The correspondence with the disks of 003 §1: the plane ⊥ e₃ is ℂ (x + iy); disk k has
-    /// radius r_k, mass m_k, centre of mass γ_k,x + iγ_k,y, and 003 §1's moment of inertia
-    /// ∫|p|²dρ_k about the disk's centre equals e₃ᵀJ_k⁰e₃ + m_k|γ_k|² = (I_k)₁₁ + (I_k)₂₂ +
-    /// m_k|γ_k|². For this state to stay planar the bodies must be planar-symmetric
-    /// ([`RollingSpheres::is_planar`]). Errors: non-finite input.
-    pub fn planar_state(&self, theta: [f64; 2], phi: f64, theta_dot: [f64; 2]) -> Result<Vec<f64>> {
-        check::finite_slice(
-            "planar state",
-            &[theta[0], theta[1], phi, theta_dot[0], theta_dot[1]],
-        )?;
-        let rot = |t: f64| {
-            let (s, c) = t.sin_cos();
-            [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-        };
-        let (s, c) = phi.sin_cos();
-        self.state(
-            rot(theta[0]),
-            rot(theta[1]),
-            [c, s, 0.0],
-            [0.0, 0.0, theta_dot[0]],
-            [0.0, 0.0, theta_dot[1]],
-        )
-    }
-
-    /// The planar coordinates (θ₁, θ₂, φ, θ̇₁, θ̇₂) of a state in T𝒬₀ (the inverse of
-    /// [`RollingSpheres::planar_state`], angles in (−π, π]). Errors: a state off T𝒬₀ by more
-    /// than `tol` (in z_ke₃ − e₃, u₃ and the in-plane parts of Ω_k), a state of the wrong
-    /// length.
-    pub fn to_planar(&self, z: &[f64], tol: f64) -> Result<[f64; 5]> {
-        check::len_of("state", z, STATE_DIM)?;
-        check::finite_slice("state", z)?;
-        let l = local(z);
-        let e3 = Vector3::z();
-        let off = (l.z[0] * e3 - e3)
-            .norm()
-            .max((l.z[1] * e3 - e3).norm())
-            .max(l.u[2].abs())
-            .max(l.omega[0].xy().norm())
-            .max(l.omega[1].xy().norm());
-        if off > tol {
-            return Err(Error::invalid(
-                "state",
-                format!("not in T𝒬₀ (planar motion about e₃): defect {off:.3e} > {tol:.1e}"),
-            ));
-        }
-        Ok([
-            l.z[0][(1, 0)].atan2(l.z[0][(0, 0)]),
-            l.z[1][(1, 0)].atan2(l.z[1][(0, 0)]),
-            l.u[1].atan2(l.u[0]),
-            l.omega[0][2],
-            l.omega[1][2],
-        ])
-    }
-
-    /// Whether T𝒬₀ is invariant for these bodies (003 §2.4): γ_k·e₃ = 0 and e₃ an eigenvector of
-    /// I_k (both to `tol`, relative to r_k and ‖I_k‖).
-    pub fn is_planar(&self, tol: f64) -> bool {
-        (0..2).all(|i| {
-            let a = self.inertias[i];
-            let col = Vector3::new(a[(0, 2)], a[(1, 2)], 0.0);
-            self.gammas[i][2].abs() <= tol * self.radii[i]
-                && col.norm() <= tol * a.norm().max(f64::MIN_POSITIVE)
-        })
-    }
-
     /// The configuration and velocity of an observed state, checked as [`RollingSpheres::state`]
-    /// and the integrators check it ([`Space::check`]: length, finite, z_k ∈ SO(3), |u| = 1):
-    /// the observables are defined on the state space only (a zero or scaled z_k is not a
-    /// configuration, and gives NaN or inf).
+    /// and the integrators check it
+    /// ([`Space::check`](crate::integrate::space::Space::check): length, finite, z_k ∈ SO(3),
+    /// |u| = 1): the observables are defined on the state space only (a zero or scaled z_k is not
+    /// a configuration, and gives NaN or inf).
     fn observed(&self, z: &[f64]) -> Result<Local> {
         self.space().check("state", z)?;
         Ok(local(z))
@@ -502,67 +438,6 @@ impl RollingSpheres {
         ]
     }
 
-    /// The constrained mass matrix M = diag(K₁^s, K₂^s) + SᵀS, S = [ŝ₁ ŝ₂] (spatial; module docs).
-    fn mass_matrix(&self, z: &[Matrix3<f64>; 2], k: &Kin) -> Matrix6<f64> {
-        let sh = [hat(&k.s[0]), hat(&k.s[1])];
-        let mut m = Matrix6::zeros();
-        for i in 0..2 {
-            for j in 0..2 {
-                let mut b = -sh[i] * sh[j];
-                if i == j {
-                    b += z[i] * self.k[i] * z[i].transpose();
-                }
-                m.fixed_view_mut::<3, 3>(3 * i, 3 * j).copy_from(&b);
-            }
-        }
-        m
-    }
-
-    /// The spatial angular velocities ω from the momenta P = Mω of an internal state (NaN if M
-    /// is not positive definite, which valid bodies exclude).
-    fn omegas_from_momenta(
-        &self,
-        z: &[Matrix3<f64>; 2],
-        u: &Vector3<f64>,
-        p: &[f64],
-    ) -> [Vector3<f64>; 2] {
-        // M depends on the configuration only (s_k), not on ω.
-        let k = self.kin_spatial(z, u, [Vector3::zeros(); 2]);
-        match self.mass_matrix(z, &k).cholesky() {
-            Some(c) => {
-                let x = c.solve(&Vector6::from_column_slice(p));
-                [x.fixed_rows::<3>(0).into(), x.fixed_rows::<3>(3).into()]
-            }
-            None => [Vector3::repeat(f64::NAN); 2],
-        }
-    }
-
-    /// The spatial momenta eR²·(P₁, P₂), P_k = ∂L_c/∂ω_k = K_k^sω_k + s_k × w of the constrained
-    /// Lagrangian L_c(ω) = L with u̇ from (10) (physical units). P₁ + P₂ is the total angular
-    /// momentum, and Ṗ_k = ṡ_k × w (module docs).
-    pub fn spatial_momenta(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        let l = self.observed(z)?;
-        let k = self.kin(&l);
-        let w = self.w(&k);
-        let sc = self.scale();
-        finite2(
-            "the spatial momenta",
-            [0, 1].map(|i| arr(&((l.z[i] * self.k[i] * l.omega[i] + k.s[i].cross(&w)) * sc))),
-        )
-    }
-
-    /// The rates eR²·(Ṗ₁, Ṗ₂) = eR²·(ṡ₁ × w, ṡ₂ × w) of [`RollingSpheres::spatial_momenta`]
-    /// (physical units; they sum to zero).
-    pub fn momentum_rates(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        let k = self.kin(&self.observed(z)?);
-        let w = self.w(&k);
-        let sd = self.sdot(&k);
-        finite2(
-            "the momentum rates",
-            [0, 1].map(|i| arr(&(sd[i].cross(&w) * self.scale()))),
-        )
-    }
-
     /// u̇ of the rolling constraint (10), u̇ = (α₁z₁Ω₁ + α₂z₂Ω₂) × u.
     pub fn udot(&self, z: &[f64]) -> Result<[f64; 3]> {
         finite1("u̇", arr(&self.kin(&self.observed(z)?).udot))
@@ -579,70 +454,10 @@ impl RollingSpheres {
         Ok(finite1("the residual", [v.norm()])?[0])
     }
 
-    /// L of (8), evaluated literally (with u̇ from (10)).
-    pub fn lagrangian(&self, z: &[f64]) -> Result<f64> {
-        let l = self.observed(z)?;
-        let ud = self.kin(&l).udot;
-        let [a1, a2] = self.alpha;
-        let b1 = l.z[0] * l.omega[0].cross(&self.e[0]);
-        let b2 = l.z[1] * l.omega[1].cross(&self.e[1]);
-        let v = 0.5 * l.omega[0].dot(&(self.j[0] * l.omega[0]))
-            + 0.5 * l.omega[1].dot(&(self.j[1] * l.omega[1]))
-            + 0.5 * ud.norm_squared()
-            - ud.dot(&(b1 * a1 - b2 * a2))
-            - a1 * a2 * b1.dot(&b2);
-        Ok(finite1("the Lagrangian", [v])?[0])
-    }
-
     /// w = ∂L/∂u̇ = u̇ − α₁b₁ + α₂b₂ = ω₁ × s₁ + ω₂ × s₂ (the relative velocity of the centres of
     /// mass over R).
     fn w(&self, k: &Kin) -> Vector3<f64> {
         k.w[0].cross(&k.s[0]) + k.w[1].cross(&k.s[1])
-    }
-
-    /// The body momenta p_k = ∂L/∂Ω_k of (8) (003 §2.3): p₁ = J₁Ω₁ − α₁e₁ × z₁ᵀ(u̇ + α₂b₂),
-    /// p₂ = J₂Ω₂ + α₂e₂ × z₂ᵀ(u̇ − α₁b₁), rescaled.
-    fn momenta(&self, l: &Local, k: &Kin) -> [Vector3<f64>; 2] {
-        let [a1, a2] = self.alpha;
-        let b1 = k.w[0].cross(&k.eps[0]);
-        let b2 = k.w[1].cross(&k.eps[1]);
-        [
-            self.j[0] * l.omega[0]
-                - self.e[0].cross(&(l.z[0].transpose() * (k.udot + b2 * a2))) * a1,
-            self.j[1] * l.omega[1]
-                + self.e[1].cross(&(l.z[1].transpose() * (k.udot - b1 * a1))) * a2,
-        ]
-    }
-
-    /// The Noether momentum of the diagonal SO(3) symmetry of L (003 §2.1),
-    /// J = z₁p₁ + z₂p₂ + u × ∂L/∂u̇ (rescaled units; conserved).
-    pub fn noether_momentum(&self, z: &[f64]) -> Result<[f64; 3]> {
-        let l = self.observed(z)?;
-        finite1("the Noether momentum", arr(&self.noether(&l)))
-    }
-
-    fn noether(&self, l: &Local) -> Vector3<f64> {
-        let k = self.kin(l);
-        let p = self.momenta(l, &k);
-        l.z[0] * p[0] + l.z[1] * p[1] + l.u.cross(&self.w(&k))
-    }
-
-    /// The total angular momentum about the centre of mass (physical units), eR²·J
-    /// ([`RollingSpheres::noether_momentum`]).
-    pub fn angular_momentum(&self, z: &[f64]) -> Result<[f64; 3]> {
-        let j = self.noether(&self.observed(z)?) * self.scale();
-        finite1("the angular momentum", arr(&j))
-    }
-
-    /// The body momenta eR²·p_k = eR²·∂L/∂Ω_k (physical units); p_k·e_k/|e_k| is the Noether
-    /// quantity of the material rotation of body k about e_k (not conserved, 003 §2.1).
-    pub fn body_momenta(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        let l = self.observed(z)?;
-        let p = self.momenta(&l, &self.kin(&l));
-        finite2(
-            "the body momenta",
-            [arr(&(p[0] * self.scale())), arr(&(p[1] * self.scale()))],
-        )
     }
 
     /// The geometric centres a₁, a₂ of (4) (centre-of-mass frame).
@@ -670,110 +485,6 @@ impl RollingSpheres {
             &(Vector3::from(a[0]) + Vector3::from_column_slice(&z[18..21]) * self.radii[0])
         ))
     }
-
-    /// Ω̇_k from the 6 × 6 system of the module docs (spatial ω̇_k, then Ω̇_k = z_kᵀω̇_k); NaN if
-    /// the system is not positive definite (it always is for valid bodies).
-    fn accel(&self, l: &Local) -> [Vector3<f64>; 2] {
-        let k = self.kin(l);
-        let sd = self.sdot(&k);
-        let acc = k.w[0].cross(&sd[0]) + k.w[1].cross(&sd[1]);
-        let m = self.mass_matrix(&l.z, &k);
-        let mut f = Vector6::zeros();
-        for i in 0..2 {
-            let ks = l.z[i] * self.k[i] * l.z[i].transpose();
-            let fi = (ks * k.w[i]).cross(&k.w[i]) - k.s[i].cross(&acc);
-            f.fixed_rows_mut::<3>(3 * i).copy_from(&fi);
-        }
-        match m.cholesky() {
-            Some(c) => {
-                let x = c.solve(&f);
-                [
-                    l.z[0].transpose() * x.fixed_rows::<3>(0),
-                    l.z[1].transpose() * x.fixed_rows::<3>(3),
-                ]
-            }
-            None => [Vector3::repeat(f64::NAN); 2],
-        }
-    }
-
-    /// The body angular accelerations (Ω̇₁, Ω̇₂) of the Lagrange–d'Alembert equations (module
-    /// docs).
-    pub fn accelerations(&self, z: &[f64]) -> Result<[[f64; 3]; 2]> {
-        let a = self.accel(&self.observed(z)?);
-        finite2("the accelerations", [arr(&a[0]), arr(&a[1])])
-    }
-
-    /// 003 §2.2's closed form of the curvature, Δ(X, X̃) = α₁α₂ u × ((z₁Ω₁ − z₂Ω₂) × (z₁Ω̃₁ −
-    /// z₂Ω̃₂)), at the configuration of `z` (its velocities are ignored).
-    pub fn curvature(
-        &self,
-        z: &[f64],
-        omega: [[f64; 3]; 2],
-        omega_tilde: [[f64; 3]; 2],
-    ) -> Result<[f64; 3]> {
-        let l = self.observed(z)?;
-        check::finite_slice("omega", omega.as_flattened())?;
-        check::finite_slice("omega_tilde", omega_tilde.as_flattened())?;
-        let v = |o: [[f64; 3]; 2]| l.z[0] * Vector3::from(o[0]) - l.z[1] * Vector3::from(o[1]);
-        let d = l.u.cross(&v(omega).cross(&v(omega_tilde))) * (self.alpha[0] * self.alpha[1]);
-        finite1("the curvature", arr(&d))
-    }
-
-    /// The curvature Δ(X, X̃) = −ν[X, X̃] (003 §2.2) computed numerically from the Lie bracket of
-    /// the constrained fields X = (Ω₁, Ω₂, (α₁z₁Ω₁ + α₂z₂Ω₂) × u), X̃ likewise (Ω_k constant in
-    /// the left trivialization), with ν(Ω₁, Ω₂, v) = v − (α₁z₁Ω₁ + α₂z₂Ω₂) × u.
-    ///
-    /// How: the flow of X is exact, φ_t(z₁, z₂, u) = (z₁exp(tΩ̂₁), z₂exp(tΩ̂₂), exp(t b̂)u) with
-    /// b = α₁z₁Ω₁ + α₂z₂Ω₂ (constant along the flow, as z_k exp(tΩ̂_k)Ω_k = z_kΩ_k). The flow
-    /// commutator C(s) = φ̃_{−s} ∘ φ_{−s} ∘ φ̃_s ∘ φ_s(q) = q + s²[X, X̃] + O(s³) (for
-    /// [X, Y] = XY − YX as derivations) is read in the chart of q — vee(log(z_k⁻¹ z_k(s))) on
-    /// SO(3) (left trivialization), u(s) − u on S² — divided by s², symmetrized in ±s (odd
-    /// orders cancel) and Richardson-extrapolated from s and 2s: error O(s⁴) + O(ε/s²).
-    /// s ≈ 5e-3 gives ~1e-10 relative.
-    pub fn curvature_by_brackets(
-        &self,
-        z: &[f64],
-        omega: [[f64; 3]; 2],
-        omega_tilde: [[f64; 3]; 2],
-        s: f64,
-    ) -> Result<[f64; 3]> {
-        let l = self.observed(z)?;
-        check::finite_slice("omega", omega.as_flattened())?;
-        check::finite_slice("omega_tilde", omega_tilde.as_flattened())?;
-        check::positive("s", s)?;
-        let o = omega.map(Vector3::from);
-        let ot = omega_tilde.map(Vector3::from);
-        let flow = |q: &mut ([Matrix3<f64>; 2], Vector3<f64>), om: &[Vector3<f64>; 2], t: f64| {
-            let b = (q.0[0] * om[0]) * self.alpha[0] + (q.0[1] * om[1]) * self.alpha[1];
-            q.1 = so3::exp_unchecked(&(b * t)) * q.1;
-            for (zi, oi) in q.0.iter_mut().zip(om) {
-                *zi *= so3::exp_unchecked(&(oi * t));
-            }
-        };
-        // The bracket estimate (components in the chart of q: Ω₁, Ω₂, u̇).
-        let d = |h: f64| -> [Vector3<f64>; 3] {
-            let mut q = (l.z, l.u);
-            flow(&mut q, &o, h);
-            flow(&mut q, &ot, h);
-            flow(&mut q, &o, -h);
-            flow(&mut q, &ot, -h);
-            let h2 = h * h;
-            [
-                so3::log_unchecked(&(l.z[0].transpose() * q.0[0])) / h2,
-                so3::log_unchecked(&(l.z[1].transpose() * q.0[1])) / h2,
-                (q.1 - l.u) / h2,
-            ]
-        };
-        let sym = |h: f64| {
-            let (p, m) = (d(h), d(-h));
-            [0, 1, 2].map(|i| (p[i] + m[i]) * 0.5)
-        };
-        let (d1, d2) = (sym(s), sym(2.0 * s));
-        let br = [0, 1, 2].map(|i| (d1[i] * 4.0 - d2[i]) / 3.0);
-        let nu =
-            br[2] - (l.z[0] * br[0] * self.alpha[0] + l.z[1] * br[1] * self.alpha[1]).cross(&l.u);
-        finite1("the curvature", arr(&(-nu)))
-    }
 }
 
 /// The values, or an overflow error naming the state where one exceeds the f64 range (a
@@ -791,153 +502,4 @@ fn finite2(quantity: &str, v: [[f64; 3]; 2]) -> Result<[[f64; 3]; 2]> {
     finite1(quantity, v[0])?;
     finite1(quantity, v[1])?;
     Ok(v)
-}
-
-impl Problem for RollingSpheres {
-    fn name(&self) -> &'static str {
-        "RollingSpheres"
-    }
-    fn space(&self) -> Space {
-        Space::new([
-            ("z1", Block::SO3),
-            ("z2", Block::SO3),
-            ("u", Block::Sphere),
-            ("Omega1", Block::Real(3)),
-            ("Omega2", Block::Real(3)),
-        ])
-    }
-    /// The kinetic energy of the two bodies, eR²·L (L of (8)) = eR²(½Ω₁ᵀK₁Ω₁ + ½Ω₂ᵀK₂Ω₂ +
-    /// ½|w|²).
-    fn energy(&self, z: &[f64]) -> Result<f64> {
-        let l = local(z);
-        let k = self.kin(&l);
-        let w = self.w(&k);
-        Ok(self.scale()
-            * 0.5
-            * (l.omega[0].dot(&(self.k[0] * l.omega[0]))
-                + l.omega[1].dot(&(self.k[1] * l.omega[1]))
-                + w.norm_squared()))
-    }
-    /// The total angular momentum eR²·J ([`RollingSpheres::angular_momentum`]): in the internal
-    /// frame it is the sum P₁ + P₂ of two state blocks whose rates ṡ₁ × w and ṡ₂ × w cancel
-    /// identically (ṡ₁ + ṡ₂ = w), so every method that updates the blocks by linear combinations
-    /// of field values keeps P₁ + P₂ to round-off; the methods that also keep SO(3) and S² (all
-    /// but RK4) keep J to round-off (measured ~1e-14 relative over 10⁵ steps).
-    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        // Not [`RollingSpheres::angular_momentum`]: a run's states are read as they are (RK4
-        // leaves SO(3) and S² slowly; the driver's finiteness guard covers the rest).
-        check::len_of("state", z, STATE_DIM)?;
-        Ok(arr(&(self.noether(&local(z)) * self.scale())).to_vec())
-    }
-    fn invariant_count(&self) -> usize {
-        3
-    }
-    /// (z₁, z₂, u, Ω₁, Ω₂) ↦ (z₁, z₂, u, P₁, P₂), the spatial momenta P = Mω (rescaled units).
-    fn to_internal(&self, z: &mut [f64]) {
-        let l = local(z);
-        let k = self.kin(&l);
-        let p = self.mass_matrix(&l.z, &k)
-            * Vector6::from_iterator(k.w[0].iter().chain(k.w[1].iter()).copied());
-        z[21..27].copy_from_slice(p.as_slice());
-    }
-    /// (z₁, z₂, u, P₁, P₂) ↦ (z₁, z₂, u, Ω₁, Ω₂), Ω_k = z_kᵀ(M⁻¹P)_k.
-    fn to_user(&self, z: &mut [f64]) {
-        let l = local(z);
-        let w = self.omegas_from_momenta(&l.z, &l.u, &z[21..27]);
-        for i in 0..2 {
-            let o = l.z[i].transpose() * w[i];
-            z[21 + 3 * i..24 + 3 * i].copy_from_slice(o.as_slice());
-        }
-    }
-}
-
-impl RollingSpheres {
-    /// The field of an internal state (z₁, z₂, u, P₁, P₂): the spatial ω = M⁻¹P, the kinematics
-    /// and the momentum rates ṡ_k × w.
-    fn internal_field(&self, z: &[f64]) -> (Kin, [Vector3<f64>; 2]) {
-        let l = local(z);
-        let w = self.omegas_from_momenta(&l.z, &l.u, &z[21..27]);
-        let k = self.kin_spatial(&l.z, &l.u, w);
-        let ww = self.w(&k);
-        let sd = self.sdot(&k);
-        let rates = [sd[0].cross(&ww), sd[1].cross(&ww)];
-        (k, rates)
-    }
-}
-
-/// ż = (ω̂₁z₁, ω̂₂z₂, u̇, Ṗ₁, Ṗ₂) on the flat 27 values of the internal frame (for the RK4
-/// baseline).
-impl VectorField for RollingSpheres {
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let (k, rates) = self.internal_field(z);
-        for i in 0..2 {
-            let zi = Matrix3::from_row_slice(&z[9 * i..9 * i + 9]);
-            put_rows(&(hat(&k.w[i]) * zi), &mut dz[9 * i..9 * i + 9]);
-        }
-        dz[18..21].copy_from_slice(k.udot.as_slice());
-        dz[21..24].copy_from_slice(rates[0].as_slice());
-        dz[24..27].copy_from_slice(rates[1].as_slice());
-    }
-}
-
-/// g = so(3) × so(3) × so(3) × ℝ³ × ℝ³ acting on the left on the internal state:
-/// z_k ↦ exp(ξ̂_k)z_k, u ↦ exp(ξ̂_u)u, P_k ↦ P_k + ξ_{P_k}; ξ(z) = (ω₁, ω₂, α₁ω₁ + α₂ω₂,
-/// ṡ₁ × w, ṡ₂ × w) with ω = M⁻¹P (ż_k = z_kΩ̂_k = ω̂_kz_k and (10)). dexp⁻¹ is J_l⁻¹ on each
-/// so(3) factor (as for [`crate::systems::RigidBody`]) and the identity on ℝ⁶.
-impl GroupField for RollingSpheres {
-    type Scratch = ();
-    fn scratch(&self) {}
-    fn algebra_dim(&self) -> usize {
-        15
-    }
-    fn generator(&self, z: &[f64], xi: &mut [f64], _s: &mut ()) {
-        let (k, rates) = self.internal_field(z);
-        let b = k.w[0] * self.alpha[0] + k.w[1] * self.alpha[1];
-        xi[0..3].copy_from_slice(k.w[0].as_slice());
-        xi[3..6].copy_from_slice(k.w[1].as_slice());
-        xi[6..9].copy_from_slice(b.as_slice());
-        xi[9..12].copy_from_slice(rates[0].as_slice());
-        xi[12..15].copy_from_slice(rates[1].as_slice());
-    }
-    fn act(&self, xi: &[f64], z: &mut [f64], s: &mut ()) {
-        let mut dz = [0.0; STATE_DIM];
-        self.act_increment(xi, z, &mut dz, s);
-        z.iter_mut().zip(dz).for_each(|(zi, d)| *zi += d);
-    }
-    /// The increments (exp(ξ̂_k) − I)z_k, (exp(ξ̂_u) − I)u and ξ_P (`so3::Rodrigues`: no bias per
-    /// step from a rotation matrix rounded to an ulp of 1).
-    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], _s: &mut ()) -> bool {
-        for i in 0..2 {
-            let g = so3::Rodrigues::exp(&Vector3::from_column_slice(&xi[3 * i..3 * i + 3]));
-            let d = g.left_increment(&Matrix3::from_row_slice(&z[9 * i..9 * i + 9]));
-            put_rows(&d, &mut dz[9 * i..9 * i + 9]);
-        }
-        let g = so3::Rodrigues::exp(&Vector3::from_column_slice(&xi[6..9]));
-        let d = g.increment(&Vector3::from_column_slice(&z[18..21]));
-        dz[18..21].copy_from_slice(d.as_slice());
-        dz[21..27].copy_from_slice(&xi[9..15]);
-        true
-    }
-    fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], _s: &mut ()) {
-        for i in 0..3 {
-            let r = 3 * i..3 * i + 3;
-            match so3::jacobian_left_inv(&Vector3::from_column_slice(&u[r.clone()])) {
-                Ok(j) => out[r.clone()]
-                    .copy_from_slice((j * Vector3::from_column_slice(&v[r])).as_slice()),
-                Err(_) => out[r].fill(f64::NAN),
-            }
-        }
-        out[9..15].copy_from_slice(&v[9..15]);
-    }
-}
-
-impl Catalog for RollingSpheres {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("midpoint", LieMidpoint::new()),
-            Entry::new("midpoint4", LieMidpoint(Composition::suzuki4())),
-            Entry::new("rkmk4", Rkmk4),
-            Entry::new("rk4", Rk4),
-        ]
-    }
 }
