@@ -30,6 +30,7 @@
 
 pub mod batch;
 pub mod clock;
+mod drive;
 pub mod events;
 pub mod forcing;
 pub mod hooks;
