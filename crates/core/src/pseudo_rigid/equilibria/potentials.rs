@@ -61,14 +61,14 @@ pub fn amended_gradient(pot: &dyn Potential, x: &Mat, lam: &Mat, gam: &Mat) -> R
 // ---------------------------------------------------------------------------------------------
 // Hessians of the augmented and amended potentials
 //
-// Notation: L_X(ξ ⊕ η) = ξX − Xη (the vertical vector, [`super::connection::vertical_vector`]).
+// Notation: L_X(ξ ⊕ η) = ξX − Xη (the vertical vector, [`crate::pseudo_rigid::connection::vertical_vector`]).
 // Its adjoint for ⟨ξ ⊕ η, ζ ⊕ θ⟩ = ½tr(ξᵀζ) + ½tr(ηᵀθ) against tr(AᵀY): since tr(ξᵀM) =
 // ⟨ξ, M − Mᵀ⟩ for skew ξ, tr((ξX − Xη)ᵀY) = ⟨ξ, YXᵀ − XYᵀ⟩ + ⟨η, YᵀX − XᵀY⟩, so
 //
 //   L_X*(Y) = (YXᵀ − XYᵀ) ⊕ (YᵀX − XᵀY) = J(X, Y)   (the momentum map, 001 (7.3)),
 //
 // in e_ij coordinates (L_X*Y)_ξ,ij = (YXᵀ − XYᵀ)_ij, (L_X*Y)_η,ij = (YᵀX − XᵀY)_ij, and
-// B_X = L_X* L_X (001 (6.9); [`super::connection::bi_connection`] is B_X⁻¹ L_X*).
+// B_X = L_X* L_X (001 (6.9); [`crate::pseudo_rigid::connection::bi_connection`] is B_X⁻¹ L_X*).
 // With κ = ξ ⊕ η, W = L_X κ and G(X, κ) = ∂/∂X ½‖L_X κ‖² = ξᵀW − Wηᵀ = −(ξW − Wη) (linear in X):
 //
 // - augmented (001 (8.12)): G is linear in X, so D²U_κ(X)[V] = D²U(X)[V] − G(V, κ)
