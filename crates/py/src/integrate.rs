@@ -128,7 +128,7 @@ const MAX_THREADS: usize = 1024;
 /// its words: a TypeError for a wrong type, an InvalidArgumentError for a wrong value.
 pub(crate) mod args {
     use lieflow::Error;
-    use numpy::{PyArrayDescrMethods, PyUntypedArray, PyUntypedArrayMethods};
+    use numpy::{PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
     use pyo3::exceptions::PyTypeError;
     use pyo3::prelude::*;
     use pyo3::types::{PyBool, PyFloat, PyInt, PyString};
@@ -286,6 +286,59 @@ pub(crate) mod args {
     /// per member (b, 3, 3) of a batch; real numbers only (the rule of every array argument),
     /// finite (a NaN named by its member and its entry).
     pub(crate) fn attitude(ob: &Bound<'_, PyAny>, b: usize, batched: bool) -> PyResult<Vec<f64>> {
+        let check_shape = |shape: &[usize]| {
+            if shape == [3, 3] || batched && shape == [b, 3, 3] {
+                return Ok(());
+            }
+            let want = if batched {
+                format!("(3, 3) or ({b}, 3, 3)")
+            } else {
+                "(3, 3)".to_string()
+            };
+            Err(to_py(Error::shape(
+                "attitude",
+                want,
+                crate::convert::shape_str(shape),
+            )))
+        };
+        // A float64 array is read in place; anything else through numpy.asarray.
+        let read = ob
+            .cast::<numpy::PyArrayDyn<f64>>()
+            .ok()
+            .and_then(|a| a.try_readonly().ok());
+        let (shape, flat) = match read {
+            Some(v) => {
+                let v = v.as_array();
+                check_shape(v.shape())?;
+                (v.shape().to_vec(), v.iter().copied().collect::<Vec<f64>>())
+            }
+            None => as_float_array(ob, check_shape)?,
+        };
+        if let Some(k) = flat.iter().position(|v| !v.is_finite()) {
+            let (m, e) = (k / 9, k % 9);
+            let what = if shape.len() == 3 {
+                format!("batch member {m}: attitude")
+            } else {
+                "attitude".to_string()
+            };
+            return Err(to_py(Error::NonFinite {
+                what,
+                location: format!("({}, {})", e / 3, e % 3),
+            }));
+        }
+        Ok(if shape.len() == 2 {
+            flat.repeat(b)
+        } else {
+            flat
+        })
+    }
+
+    /// `ob` through numpy.asarray as (shape, row-major float64 entries): a TypeError unless
+    /// real numbers (bool, int or float); the shape checked by `check_shape` before reading.
+    fn as_float_array(
+        ob: &Bound<'_, PyAny>,
+        check_shape: impl Fn(&[usize]) -> PyResult<()>,
+    ) -> PyResult<(Vec<usize>, Vec<f64>)> {
         let py = ob.py();
         let expected =
             "invalid attitude: expected an array-like of real numbers (bool, int or float)";
@@ -311,39 +364,12 @@ pub(crate) mod args {
             )));
         }
         let shape = arr.shape().to_vec();
-        if !(shape == [3, 3] || batched && shape == [b, 3, 3]) {
-            let want = if batched {
-                format!("(3, 3) or ({b}, 3, 3)")
-            } else {
-                "(3, 3)".to_string()
-            };
-            return Err(to_py(Error::shape(
-                "attitude",
-                want,
-                crate::convert::shape_str(&shape),
-            )));
-        }
+        check_shape(&shape)?;
         let flat = np
             .call_method1("ascontiguousarray", (a, "float64"))?
             .call_method0("ravel")?
             .extract::<Vec<f64>>()?;
-        if let Some(k) = flat.iter().position(|v| !v.is_finite()) {
-            let (m, e) = (k / 9, k % 9);
-            let what = if shape.len() == 3 {
-                format!("batch member {m}: attitude")
-            } else {
-                "attitude".to_string()
-            };
-            return Err(to_py(Error::NonFinite {
-                what,
-                location: format!("({}, {})", e / 3, e % 3),
-            }));
-        }
-        Ok(if shape.len() == 2 {
-            flat.repeat(b)
-        } else {
-            flat
-        })
+        Ok((shape, flat))
     }
 }
 
