@@ -35,3 +35,38 @@ pub fn canonical_catalog<P: Canonical + VectorField + Clone + 'static>() -> Vec<
         Entry::new("rk4", Rk4),
     ]
 }
+
+/// The kind boilerplate of a canonical system `$t` (a [`Canonical`] problem), written once:
+/// Hamilton's equations ([`Canonical::hamilton_field`]) as its vector field, its catalog
+/// (`$catalog`, by default [`canonical_catalog`]) and Rayleigh damping as its own dissipation
+/// ([`crate::integrate::forcing::rayleigh`]).
+macro_rules! canonical_system {
+    ($t:ty) => {
+        $crate::integrate::methods::canonical_system!(
+            $t,
+            $crate::integrate::methods::canonical_catalog()
+        );
+    };
+    ($t:ty, $catalog:expr) => {
+        impl $crate::integrate::problem::VectorField for $t {
+            /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
+            fn field(&self, z: &[f64], dz: &mut [f64]) {
+                $crate::integrate::problem::Canonical::hamilton_field(self, z, dz);
+            }
+        }
+
+        impl $crate::integrate::method::Catalog for $t {
+            fn kind_catalog() -> Vec<$crate::integrate::method::Entry<Self>> {
+                $catalog
+            }
+
+            fn dissipation(
+                &self,
+                d: &$crate::integrate::forcing::Dissipation,
+            ) -> $crate::Result<std::sync::Arc<dyn $crate::integrate::forcing::Perturbation>> {
+                $crate::integrate::forcing::rayleigh(self, d)
+            }
+        }
+    };
+}
+pub(crate) use canonical_system;

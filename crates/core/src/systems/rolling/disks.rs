@@ -50,10 +50,9 @@ use nalgebra::Complex;
 
 use crate::check;
 use crate::error::{fmt_num, Error, Result};
-use crate::integrate::methods::canonical_catalog;
-use crate::integrate::problem::{Canonical, Symmetric, VectorField};
+use crate::integrate::problem::{Canonical, Symmetric};
 use crate::integrate::space::{Block, Space};
-use crate::integrate::{Catalog, Entry, Problem};
+use crate::integrate::Problem;
 
 type C = Complex<f64>;
 
@@ -451,13 +450,6 @@ impl Canonical for RollingDisks {
     }
 }
 
-impl VectorField for RollingDisks {
-    /// ż = (∂H/∂p, −∂H/∂θ).
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        self.hamilton_field(z, dz);
-    }
-}
-
 impl Symmetric for RollingDisks {
     fn symmetry_dim(&self) -> usize {
         1
@@ -474,15 +466,4 @@ impl Symmetric for RollingDisks {
     }
 }
 
-impl Catalog for RollingDisks {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        canonical_catalog()
-    }
-
-    fn dissipation(
-        &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
-        crate::integrate::forcing::rayleigh(self, d)
-    }
-}
+crate::integrate::methods::canonical_system!(RollingDisks);

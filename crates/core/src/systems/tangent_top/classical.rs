@@ -56,10 +56,9 @@ use std::sync::Arc;
 use super::surface::{self, add, inner, inverse, mul, Mat2, Shape, Surface, Vec2};
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::canonical_catalog;
-use crate::integrate::problem::{Canonical, VectorField};
+use crate::integrate::problem::Canonical;
 use crate::integrate::space::{Block, Space};
-use crate::integrate::{Catalog, Entry, Problem};
+use crate::integrate::Problem;
 
 /// The tangent Euler top of mass m and Euler tensor I (002 (42)) on a surface, intrinsic or
 /// embedded (module docs); state z = (x¹, x², θ, p₁, p₂, p_θ).
@@ -415,25 +414,7 @@ fn charged_particle(l: &Local, p: Vec2, e: f64) -> (Vec2, Vec2) {
     (v, force)
 }
 
-impl VectorField for TangentTop {
-    /// ż = (∂H/∂p, −∂H/∂q).
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        self.hamilton_field(z, dz);
-    }
-}
-
-impl Catalog for TangentTop {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        canonical_catalog()
-    }
-
-    fn dissipation(
-        &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
-        crate::integrate::forcing::rayleigh(self, d)
-    }
-}
+crate::integrate::methods::canonical_system!(TangentTop);
 
 /// The charged particle equivalent to a tangent top (002 §III.B): with p_θ fixed, the centre of
 /// the top moves as a particle of mass m on the surface in the magnetic potential A = α (the
@@ -611,22 +592,4 @@ impl Canonical for ChargedParticle {
     }
 }
 
-impl VectorField for ChargedParticle {
-    /// ż = (∂H/∂p, −∂H/∂q).
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        self.hamilton_field(z, dz);
-    }
-}
-
-impl Catalog for ChargedParticle {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        canonical_catalog()
-    }
-
-    fn dissipation(
-        &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
-        crate::integrate::forcing::rayleigh(self, d)
-    }
-}
+crate::integrate::methods::canonical_system!(ChargedParticle);

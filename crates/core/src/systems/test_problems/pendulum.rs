@@ -17,9 +17,9 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Gauss, Rk4, Verlet, IMPLICIT_MIDPOINT};
-use crate::integrate::problem::{Canonical, Separable, VectorField, Violation};
+use crate::integrate::problem::{Canonical, Separable, Violation};
 use crate::integrate::space::{Block, Space};
-use crate::integrate::{Catalog, Entry, Problem};
+use crate::integrate::{Entry, Problem};
 use crate::numerics::elliptic::{ellipj, ellipk};
 
 /// The parameters every pendulum shares: a bob of mass m > 0 on a massless rod of length l > 0 in
@@ -147,28 +147,12 @@ impl Separable for Pendulum {
     }
 }
 
-impl VectorField for Pendulum {
-    /// q̇ = p/(ml²), ṗ = −mgl sin q.
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        self.hamilton_field(z, dz);
-    }
-}
-
-impl Catalog for Pendulum {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("midpoint", IMPLICIT_MIDPOINT),
-            Entry::new("gauss4", Gauss(2)),
-            Entry::new("gauss6", Gauss(3)),
-            Entry::new("verlet", Verlet::strang()),
-            Entry::new("rk4", Rk4),
-        ]
-    }
-
-    fn dissipation(
-        &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
-        crate::integrate::forcing::rayleigh(self, d)
-    }
-}
+crate::integrate::methods::canonical_system!(Pendulum, {
+    vec![
+        Entry::new("midpoint", IMPLICIT_MIDPOINT),
+        Entry::new("gauss4", Gauss(2)),
+        Entry::new("gauss6", Gauss(3)),
+        Entry::new("verlet", Verlet::strang()),
+        Entry::new("rk4", Rk4),
+    ]
+});

@@ -3,10 +3,9 @@ use std::fmt;
 use super::*;
 use crate::error::Result;
 use crate::integrate::hooks;
-use crate::integrate::methods::canonical_catalog;
-use crate::integrate::problem::{Canonical, VectorField};
+use crate::integrate::problem::Canonical;
 use crate::integrate::space::Space;
-use crate::integrate::{Catalog, Entry, Problem};
+use crate::integrate::Problem;
 
 /// A canonical Hamiltonian system H(q, p) on T*ℝᵈ given by functions (module docs); state
 /// z = (q, p).
@@ -108,22 +107,4 @@ impl Canonical for UserCanonical {
     }
 }
 
-impl VectorField for UserCanonical {
-    /// q̇ = ∂H/∂p, ṗ = −∂H/∂q.
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        self.hamilton_field(z, dz);
-    }
-}
-
-impl Catalog for UserCanonical {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        canonical_catalog()
-    }
-
-    fn dissipation(
-        &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
-        crate::integrate::forcing::rayleigh(self, d)
-    }
-}
+crate::integrate::methods::canonical_system!(UserCanonical);

@@ -6,9 +6,9 @@ use crate::check;
 use crate::error::{fmt_num, Error, Result};
 use crate::integrate::hooks;
 use crate::integrate::methods::{canonical_catalog, Composition, Verlet};
-use crate::integrate::problem::{Canonical, Separable, VectorField, Violation};
+use crate::integrate::problem::{Canonical, Separable, Violation};
 use crate::integrate::space::Space;
-use crate::integrate::{Catalog, Entry, Problem};
+use crate::integrate::{Entry, Problem};
 use crate::Mat;
 
 /// The constant kinetic mass M of a [`UserSeparable`] (T = ½ pᵀM⁻¹p).
@@ -297,29 +297,13 @@ impl Canonical for UserSeparable {
     }
 }
 
-impl VectorField for UserSeparable {
-    /// q̇ = M⁻¹p, ṗ = −∇U(q).
-    fn field(&self, z: &[f64], dz: &mut [f64]) {
-        self.hamilton_field(z, dz);
-    }
-}
-
-impl Catalog for UserSeparable {
-    /// verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        let mut entries = vec![
-            Entry::new("verlet", Verlet::strang()),
-            Entry::new("verlet4", Verlet(Composition::suzuki4())),
-            Entry::new("verlet6", Verlet(Composition::yoshida6())),
-        ];
-        entries.extend(canonical_catalog());
-        entries
-    }
-
-    fn dissipation(
-        &self,
-        d: &crate::integrate::forcing::Dissipation,
-    ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
-        crate::integrate::forcing::rayleigh(self, d)
-    }
-}
+// verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
+crate::integrate::methods::canonical_system!(UserSeparable, {
+    let mut entries = vec![
+        Entry::new("verlet", Verlet::strang()),
+        Entry::new("verlet4", Verlet(Composition::suzuki4())),
+        Entry::new("verlet6", Verlet(Composition::yoshida6())),
+    ];
+    entries.extend(canonical_catalog());
+    entries
+});

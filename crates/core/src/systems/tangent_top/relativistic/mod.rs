@@ -160,10 +160,9 @@ use nalgebra::{Matrix3, Vector3};
 use crate::check;
 use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
-use crate::integrate::methods::canonical_catalog;
-use crate::integrate::problem::{Canonical, VectorField};
+use crate::integrate::problem::Canonical;
 use crate::integrate::space::{Block, Space};
-use crate::integrate::{Catalog, Entry, Problem};
+use crate::integrate::Problem;
 
 pub use spacetime::RelativisticTangentTop;
 pub use weak_field::{Potential, PotentialValue, WeakFieldTop};
@@ -315,25 +314,7 @@ macro_rules! legendre_kinds {
             }
         }
 
-        impl VectorField for $t {
-            /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
-            fn field(&self, z: &[f64], dz: &mut [f64]) {
-                self.hamilton_field(z, dz);
-            }
-        }
-
-        impl Catalog for $t {
-            fn kind_catalog() -> Vec<Entry<Self>> {
-                canonical_catalog()
-            }
-
-            fn dissipation(
-                &self,
-                d: &$crate::integrate::forcing::Dissipation,
-            ) -> $crate::Result<std::sync::Arc<dyn $crate::integrate::forcing::Perturbation>> {
-                $crate::integrate::forcing::rayleigh(self, d)
-            }
-        }
+        $crate::integrate::methods::canonical_system!($t);
     };
 }
 
