@@ -694,9 +694,11 @@ impl Integrator<Forced> for Kicked {
                 });
             stages.push(i);
         }
+        // The free method, looked up once for all its stage sizes.
+        let method = problem.base.resolve(self.base)?;
         let free = sizes
             .iter()
-            .map(|g| Ok(problem.base.stepper(self.base, g * dt)?.0))
+            .map(|g| method.stepper(g * dt))
             .collect::<Result<Vec<_>>>()?;
         // The kicks see the free system as a problem (its space and frames).
         let free_problem: Arc<dyn Problem> = problem.base.clone();
