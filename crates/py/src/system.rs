@@ -2,7 +2,10 @@
 //! `lieflow.integrate` drives, once, from the core system's state space and catalog: `methods()`,
 //! named fields, `energy`, `invariants`, `_normalize_state`, `_start`/`_run` (native runs with
 //! the GIL released, a batch in parallel), `__reduce__` (pickling) and `__repr__`. A system
-//! class is a thin subclass: its constructor and its own observables.
+//! class is a thin subclass: its constructor and its own observables. It keeps nothing of its
+//! own (a unit struct) unless it must keep data that is not the core system; its methods reach
+//! the typed core system through the base ([`Thin::core`], a downcast of the one
+//! `Arc<dyn System>`), and its constructor is [`PySystem::subclass`] (or [`PySystem::init`]).
 
 use std::sync::{Arc, Mutex};
 
@@ -10,10 +13,10 @@ use lieflow::integrate::{Block, Catalog, Resolved, Space, System};
 use lieflow::{check, Error};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyCFunction, PyDict, PyList, PyTuple, PyType};
-use pyo3::{PyClass, PyTypeInfo};
+use pyo3::{PyClass, PyClassInitializer, PyTypeInfo};
 
 use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::convert::{size_opt, vector};
@@ -56,6 +59,47 @@ impl PySystem {
             names,
             resolved: Mutex::new(Vec::new()),
         }
+    }
+
+    /// The initializer of a system object of the subclass `C` over the core system `sys` (base
+    /// part as [`PySystem::new`]), for a class that keeps nothing of its own.
+    pub(crate) fn subclass<C, S>(
+        sys: S,
+        args: Bound<'_, PyTuple>,
+        names: &'static [&'static str],
+    ) -> PyClassInitializer<C>
+    where
+        C: PyClass<BaseType = PySystem> + Default,
+        S: Catalog,
+    {
+        Self::init(C::default(), sys, args, names)
+    }
+
+    /// The initializer of a system object of the subclass `C` over `sys` whose subclass part
+    /// `this` keeps data that is not the core system (the Python object it was built from).
+    pub(crate) fn init<C, S>(
+        this: C,
+        sys: S,
+        args: Bound<'_, PyTuple>,
+        names: &'static [&'static str],
+    ) -> PyClassInitializer<C>
+    where
+        C: PyClass<BaseType = PySystem>,
+        S: Catalog,
+    {
+        PyClassInitializer::from(PySystem::new(sys, args, names)).add_subclass(this)
+    }
+
+    /// The core system as its concrete type `S`; an internal-error `RuntimeError` naming both
+    /// types if it is another (a subclass asking for the wrong type: a bug of the bindings).
+    pub(crate) fn core<S: 'static>(&self) -> PyResult<&S> {
+        self.sys.as_any().downcast_ref::<S>().ok_or_else(|| {
+            PyRuntimeError::new_err(format!(
+                "lieflow internal error: the core system {} is not a {}",
+                self.sys.name(),
+                std::any::type_name::<S>()
+            ))
+        })
     }
 
     /// The method `method` (None: the default) of the core system `sys` (the lifted one when
@@ -141,6 +185,24 @@ impl PySystem {
                 f(z[0], out)
             }))
         })?
+    }
+}
+
+/// A system object seen from its subclass `C`: the base part and the typed core system, e.g.
+/// `slf.core::<core::Pendulum>()?` in a method taking `slf: &Bound<'_, Self>`.
+pub(crate) trait Thin {
+    /// The base part (`lieflow.System`) of the object.
+    fn base(&self) -> &PySystem;
+
+    /// The core system as its concrete type `S` ([`PySystem::core`]).
+    fn core<S: 'static>(&self) -> PyResult<&S> {
+        self.base().core()
+    }
+}
+
+impl<C: PyClass<BaseType = PySystem>> Thin for Bound<'_, C> {
+    fn base(&self) -> &PySystem {
+        self.as_super().get()
     }
 }
 

@@ -244,6 +244,10 @@ pub trait System: Problem {
         &self,
         d: &crate::integrate::problem::Dissipation,
     ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>>;
+
+    /// The concrete system, for bindings that downcast to their own type (a binding keeps one
+    /// `Arc<dyn System>` and reaches the typed system through it).
+    fn as_any(&self) -> &dyn std::any::Any;
 }
 
 /// The method names of a kind of system, without an instance ([`Catalog::kind_catalog`]); the
@@ -288,6 +292,10 @@ impl<P: Catalog> System for P {
         d: &crate::integrate::problem::Dissipation,
     ) -> Result<Arc<dyn crate::integrate::problem::Perturbation>> {
         Catalog::dissipation(self, d)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }
 

@@ -12,7 +12,7 @@ use super::potential::{PyPotential, Zero};
 use crate::convert::ArrayIn;
 use crate::convert::{int, mat, py_mat};
 use crate::errors::{to_py, IntoPy};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -40,14 +40,12 @@ type Any<'py> = Bound<'py, PyAny>;
 /// tr((Γ^T Γ)^k)/2, k = 1..n//2, then det X for the incompressible body.
 #[pyclass(module = "lieflow", name = "PseudoRigidBody", extends = PySystem, frozen)]
 pub struct PyPseudoRigidBody {
-    body: CoreBody,
     potential: Py<PyPotential>,
 }
 
-impl PyPseudoRigidBody {
-    fn n(&self) -> usize {
-        self.body.n()
-    }
+/// The core body of a `PseudoRigidBody`.
+fn body<'a>(slf: &'a Bound<'_, PyPseudoRigidBody>) -> PyResult<&'a CoreBody> {
+    slf.core()
 }
 
 /// Row-major values of an n×n matrix.
@@ -85,31 +83,28 @@ impl PyPseudoRigidBody {
         .py()?;
         let args = (n, potential.clone(), check_det, incompressible).into_pyobject(py)?;
         let names = &["n", "potential", "check_det", "incompressible"];
-        let base = PySystem::new(body.clone(), args, names);
-        Ok(
-            PyClassInitializer::from(base).add_subclass(PyPseudoRigidBody {
-                body,
-                potential: potential.unbind(),
-            }),
-        )
+        let this = PyPseudoRigidBody {
+            potential: potential.unbind(),
+        };
+        Ok(PySystem::init(this, body, args, names))
     }
 
     /// The dimension n.
     #[getter(n)]
-    fn get_n(&self) -> usize {
-        self.n()
+    fn get_n(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(body(slf)?.n())
     }
 
     /// Whether det X > 0 is enforced during integrations.
     #[getter]
-    fn check_det(&self) -> bool {
-        self.body.check_det()
+    fn check_det(slf: &Bound<'_, Self>) -> PyResult<bool> {
+        Ok(body(slf)?.check_det())
     }
 
     /// Whether the volume is held (det X = det X0; methods rattle, rattle4, rattle6).
     #[getter]
-    fn incompressible(&self) -> bool {
-        self.body.is_incompressible()
+    fn incompressible(slf: &Bound<'_, Self>) -> PyResult<bool> {
+        Ok(body(slf)?.is_incompressible())
     }
 
     /// The projection of a momentum P onto the states of the incompressible body at X:
@@ -123,13 +118,12 @@ impl PyPseudoRigidBody {
     /// Raises:
     ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
     fn project_momentum<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         X: ArrayIn<'py>,
         P: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
         let (x, p) = (mat("X", &X)?, mat("P", &P)?);
-        Ok(py_mat(py, &self.body.project_momentum(&x, &p).py()?))
+        Ok(py_mat(slf.py(), &body(slf)?.project_momentum(&x, &p).py()?))
     }
 
     /// The potential.
@@ -140,7 +134,7 @@ impl PyPseudoRigidBody {
 
     /// Angular momentum L = P X^T - X P^T (001 (7.3)) of states (..., d) -> (..., n, n).
     fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let n = slf.get().n();
+        let n = body(slf)?.n();
         observe(slf, states, &[n, n], |b, z, out| {
             flat(&b.momenta(z)?.0, out)
         })
@@ -148,7 +142,7 @@ impl PyPseudoRigidBody {
 
     /// Circulation Γ = P^T X - X^T P (001 (7.3)) of states (..., d) -> (..., n, n).
     fn circulation<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let n = slf.get().n();
+        let n = body(slf)?.n();
         observe(slf, states, &[n, n], |b, z, out| {
             flat(&b.momenta(z)?.1, out)
         })
@@ -156,7 +150,7 @@ impl PyPseudoRigidBody {
 
     /// Singular values a_1 >= ... >= a_n of X (the semi-axes), states (..., d) -> (..., n).
     fn singular_values<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let n = slf.get().n();
+        let n = body(slf)?.n();
         observe(slf, states, &[n], |b, z, out| {
             out.copy_from_slice(&b.singular_values(z)?);
             Ok(())
@@ -171,7 +165,7 @@ fn observe<'py>(
     shape: &[usize],
     f: impl Fn(&CoreBody, &[f64], &mut [f64]) -> lieflow::Result<()>,
 ) -> PyResult<Any<'py>> {
-    let body = &slf.get().body;
-    let base = slf.as_super().get();
-    base.map_states(slf.py(), &states, shape, |z, out| f(body, z, out))
+    let body = body(slf)?;
+    slf.base()
+        .map_states(slf.py(), &states, shape, |z, out| f(body, z, out))
 }

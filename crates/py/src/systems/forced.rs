@@ -16,7 +16,7 @@ use pyo3::PyClassInitializer;
 use super::user::Callee;
 use crate::convert::{read_all, real, ArrayIn};
 use crate::errors::{to_py, IntoPy};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 /// An optional argument that is given and not None.
 fn given<'py>(a: &Option<Bound<'py, PyAny>>) -> Option<Bound<'py, PyAny>> {
@@ -74,7 +74,6 @@ fn damping_values(d: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
 /// value of the wrong shape is a ShapeError, NaN or inf a NonFiniteError.
 #[pyclass(name = "Forced", module = "lieflow", extends = PySystem, frozen)]
 pub struct PyForced {
-    sys: Forced,
     block: Option<String>,
 }
 
@@ -183,8 +182,13 @@ impl PyForced {
             "damping",
             "dissipation",
         ];
-        let cls = PySystem::new(sys.clone(), args.cast_into::<PyTuple>()?, names);
-        Ok(PyClassInitializer::from(cls).add_subclass(PyForced { sys, block: chosen }))
+        let this = PyForced { block: chosen };
+        Ok(PySystem::init(
+            this,
+            sys,
+            args.cast_into::<PyTuple>()?,
+            names,
+        ))
     }
 
     /// The block the force acts on (None without a force).
@@ -195,14 +199,13 @@ impl PyForced {
 
     /// The terms acting on the free system, in order ("force on M", "Rayleigh damping", ...).
     #[getter]
-    fn terms(&self) -> Vec<String> {
-        self.sys.terms()
+    fn terms(slf: &Bound<'_, Self>) -> PyResult<Vec<String>> {
+        Ok(slf.core::<Forced>()?.terms())
     }
 
     /// The free system.
     #[getter]
     fn system<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
-        let base = slf.as_super().get();
-        base.args.bind(slf.py()).get_item(0)
+        slf.base().args.bind(slf.py()).get_item(0)
     }
 }

@@ -14,7 +14,7 @@ use crate::convert::real;
 use crate::convert::{self, py_vec, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, Input};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -37,9 +37,8 @@ type Any<'py> = Bound<'py, PyAny>;
 /// Raises:
 ///     ShapeError, NonFiniteError, InvalidArgumentError.
 #[pyclass(name = "HeavyTop", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyHeavyTop {
-    top: core::HeavyTop,
-}
+#[derive(Default)]
+pub struct PyHeavyTop;
 
 #[pymethods]
 impl PyHeavyTop {
@@ -64,8 +63,7 @@ impl PyHeavyTop {
         .py()?;
         let py = inertia.py();
         let args = (inertia, mgl, py_vec(py, &chi)).into_pyobject(py)?;
-        let base = PySystem::new(top.clone(), args, &["inertia", "mgl", "chi"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PyHeavyTop { top }))
+        Ok(PySystem::subclass(top, args, &["inertia", "mgl", "chi"]))
     }
 
     /// Names of the observables that take (states, attitude); `Trajectory` passes its attitude.
@@ -76,20 +74,20 @@ impl PyHeavyTop {
 
     /// The principal moments of inertia (3,).
     #[getter]
-    fn moments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        py_vec(py, &self.top.moments())
+    fn moments<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(py_vec(slf.py(), &top(slf)?.moments()))
     }
 
     /// mgl (weight times the distance of the centre of mass from the fixed point).
     #[getter]
-    fn mgl(&self) -> f64 {
-        self.top.mgl()
+    fn mgl(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(top(slf)?.mgl())
     }
 
     /// The unit direction chi of the centre of mass (body frame).
     #[getter]
-    fn chi<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        py_vec(py, &self.top.chi())
+    fn chi<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(py_vec(slf.py(), &top(slf)?.chi()))
     }
 
     /// A flat state z = (M, Gamma) from M (..., 3) and either Gamma (..., 3) or the attitude R
@@ -100,12 +98,12 @@ impl PyHeavyTop {
     ///     NonFiniteError, NotInGroupError (the attitude is not a rotation).
     #[pyo3(signature = (M, Gamma = None, attitude = None))]
     fn state<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         M: ArrayIn<'py>,
         Gamma: Option<ArrayIn<'py>>,
         attitude: Option<ArrayIn<'py>>,
     ) -> PyResult<Any<'py>> {
+        let (py, top) = (slf.py(), top(slf)?);
         let m = Input::new("M", &M, &[3]);
         match (&Gamma, &attitude) {
             (Some(g), None) => {
@@ -114,7 +112,7 @@ impl PyHeavyTop {
                     out[..3].copy_from_slice(x[0]);
                     out[3..].copy_from_slice(x[1]);
                     // The checks of an initial state: finite, Γ ≠ 0.
-                    lieflow::integrate::check_state(&self.top, out)
+                    lieflow::integrate::check_state(top, out)
                 })
             }
             (None, Some(r)) => {
@@ -124,7 +122,7 @@ impl PyHeavyTop {
                     Block::SO3.check("attitude", x[1])?;
                     out[..3].copy_from_slice(x[0]);
                     out[3..].copy_from_slice(&x[1][6..9]); // Γ = Rᵀe₃, the third row of R
-                    lieflow::integrate::check_state(&self.top, out)
+                    lieflow::integrate::check_state(top, out)
                 })
             }
             _ => Err(to_py(Error::invalid(
@@ -140,11 +138,15 @@ impl PyHeavyTop {
     /// Raises:
     ///     ShapeError, NonFiniteError.
     fn spatial_momentum<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
         attitude: ArrayIn<'py>,
     ) -> PyResult<Any<'py>> {
-        super::spatial_momentum(py, &states, &attitude, 6)
+        super::spatial_momentum(slf.py(), &states, &attitude, 6)
     }
+}
+
+/// The core heavy top of a `HeavyTop`.
+fn top<'a>(slf: &'a Bound<'_, PyHeavyTop>) -> PyResult<&'a core::HeavyTop> {
+    slf.core()
 }

@@ -10,7 +10,7 @@ use crate::convert::real;
 use crate::convert::ArrayIn;
 use crate::errors::IntoPy;
 use crate::items::{map_items, Input};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 /// A planar pendulum in canonical coordinates: q the angle from the downward vertical,
 /// p = m l^2 dq/dt, H = p^2 / (2 m l^2) - m g l cos q. State (q, p); fields q, p.
@@ -22,9 +22,8 @@ use crate::system::PySystem;
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "Pendulum", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyPendulum {
-    pendulum: core::Pendulum,
-}
+#[derive(Default)]
+pub struct PyPendulum;
 
 #[pymethods]
 impl PyPendulum {
@@ -38,8 +37,7 @@ impl PyPendulum {
     ) -> PyResult<PyClassInitializer<Self>> {
         let pendulum = core::Pendulum::new(mass, length, g).py()?;
         let args = (mass, length, g).into_pyobject(py)?;
-        let base = PySystem::new(pendulum.clone(), args, &["mass", "length", "g"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PyPendulum { pendulum }))
+        Ok(PySystem::subclass(pendulum, args, &["mass", "length", "g"]))
     }
 
     /// The exact state (q, p) at times t of the pendulum released at rest from the angle
@@ -48,8 +46,7 @@ impl PyPendulum {
     /// Raises:
     ///     InvalidArgumentError, NonFiniteError, ShapeError.
     fn exact_solution<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         amplitude: ArrayIn<'py>,
         t: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
@@ -57,8 +54,9 @@ impl PyPendulum {
             Input::new("amplitude", &amplitude, &[]),
             Input::new("t", &t, &[]),
         ];
-        map_items(py, &inputs, &[2], |x, out| {
-            out.copy_from_slice(&self.pendulum.exact(x[0][0], x[1][0])?);
+        let pendulum = slf.core::<core::Pendulum>()?;
+        map_items(slf.py(), &inputs, &[2], |x, out| {
+            out.copy_from_slice(&pendulum.exact(x[0][0], x[1][0])?);
             Ok(())
         })
     }
@@ -74,9 +72,8 @@ impl PyPendulum {
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "SphereParticle", module = "lieflow", extends = PySystem, frozen)]
-pub struct PySphereParticle {
-    particle: core::SphereParticle,
-}
+#[derive(Default)]
+pub struct PySphereParticle;
 
 #[pymethods]
 impl PySphereParticle {
@@ -90,8 +87,7 @@ impl PySphereParticle {
     ) -> PyResult<PyClassInitializer<Self>> {
         let particle = core::SphereParticle::new(mass, length, g).py()?;
         let args = (mass, length, g).into_pyobject(py)?;
-        let base = PySystem::new(particle.clone(), args, &["mass", "length", "g"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PySphereParticle { particle }))
+        Ok(PySystem::subclass(particle, args, &["mass", "length", "g"]))
     }
 
     /// States (q, p) of `SphericalPendulum` states (u, L) with the same m, l, g:
@@ -101,16 +97,16 @@ impl PySphereParticle {
     ///     ShapeError, NonFiniteError.
     #[pyo3(name = "from_spherical")]
     fn spherical_to_cartesian<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let particle = slf.core::<core::SphereParticle>()?;
         map_items(
-            py,
+            slf.py(),
             &[Input::new("states", &states, &[6])],
             &[6],
             |z, out| {
-                out.copy_from_slice(&self.particle.from_spherical(z[0])?);
+                out.copy_from_slice(&particle.from_spherical(z[0])?);
                 Ok(())
             },
         )

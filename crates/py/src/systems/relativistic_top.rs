@@ -10,7 +10,7 @@ use crate::convert::ArrayIn;
 use crate::convert::{named, real, real_opt, reals, reals_opt, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, Input};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 use crate::systems::surfaces::PySurface;
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical
@@ -29,9 +29,8 @@ use crate::systems::surfaces::PySurface;
 /// Raises:
 ///     InvalidArgumentError, ShapeError, TypeError (surface not a lieflow surface).
 #[pyclass(name = "RelativisticTangentTop", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyRelativisticTangentTop {
-    top: core::RelativisticTangentTop,
-}
+#[derive(Default)]
+pub struct PyRelativisticTangentTop;
 
 #[pymethods]
 impl PyRelativisticTangentTop {
@@ -58,8 +57,11 @@ impl PyRelativisticTangentTop {
         }
         .py()?;
         let args = (mass, inertia, surface).into_pyobject(inertia.py())?;
-        let base = PySystem::new(top.clone(), args, &["mass", "inertia", "surface"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PyRelativisticTangentTop { top }))
+        Ok(PySystem::subclass(
+            top,
+            args,
+            &["mass", "inertia", "surface"],
+        ))
     }
 
     /// The canonical state from the position x (2,), the angle theta and the velocities.
@@ -74,7 +76,8 @@ impl PyRelativisticTangentTop {
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
-        crate::errors::checked(|| slf.get().top.state(x, theta, xdot, thetadot))
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        crate::errors::checked(|| top.state(x, theta, xdot, thetadot))
     }
 
     /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
@@ -85,13 +88,11 @@ impl PyRelativisticTangentTop {
         slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let top = &slf.get().top;
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[3], |z, out| {
-                out.copy_from_slice(&top.velocities(z)?);
-                Ok(())
-            })
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        slf.base().map_states(slf.py(), &states, &[3], |z, out| {
+            out.copy_from_slice(&top.velocities(z)?);
+            Ok(())
+        })
     }
 
     /// The speed v = sqrt(g(xdot, xdot)) and the covariant spin rate s = thetadot + w(xdot) of
@@ -104,14 +105,12 @@ impl PyRelativisticTangentTop {
         slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let top = &slf.get().top;
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[2], |z, out| {
-                let (v, s) = top.speed_and_spin(z)?;
-                out.copy_from_slice(&[v, s]);
-                Ok(())
-            })
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        slf.base().map_states(slf.py(), &states, &[2], |z, out| {
+            let (v, s) = top.speed_and_spin(z)?;
+            out.copy_from_slice(&[v, s]);
+            Ok(())
+        })
     }
 
     /// All Killing momenta J = p_A X^A of the surface's isometry group (the Minkowski plane and
@@ -124,14 +123,12 @@ impl PyRelativisticTangentTop {
         slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let top = &slf.get().top;
+        let top = slf.core::<core::RelativisticTangentTop>()?;
         let k = top.surface().killing_count();
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[k], |z, out| {
-                out.copy_from_slice(&top.killing_momenta(z)?);
-                Ok(())
-            })
+        slf.base().map_states(slf.py(), &states, &[k], |z, out| {
+            out.copy_from_slice(&top.killing_momenta(z)?);
+            Ok(())
+        })
     }
 }
 
@@ -146,9 +143,8 @@ impl PyRelativisticTangentTop {
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "WeakFieldTop", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyWeakFieldTop {
-    top: core::WeakFieldTop,
-}
+#[derive(Default)]
+pub struct PyWeakFieldTop;
 
 #[pymethods]
 impl PyWeakFieldTop {
@@ -169,8 +165,11 @@ impl PyWeakFieldTop {
         .map_err(to_py)?;
         let top = core::WeakFieldTop::new(mass, inertia, potential).py()?;
         let args = (mass, inertia, gm, g).into_pyobject(py)?;
-        let base = PySystem::new(top.clone(), args, &["mass", "inertia", "gm", "g"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PyWeakFieldTop { top }))
+        Ok(PySystem::subclass(
+            top,
+            args,
+            &["mass", "inertia", "gm", "g"],
+        ))
     }
 
     /// The canonical state from the position x (2,), the angle theta and the velocities.
@@ -178,13 +177,14 @@ impl PyWeakFieldTop {
     /// Raises:
     ///     InvalidArgumentError (outside the weak-field domain), NonFiniteError.
     fn state(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
         #[pyo3(from_py_with = real)] theta: f64,
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
-        self.top.state(x, theta, xdot, thetadot).py()
+        let top = slf.core::<core::WeakFieldTop>()?;
+        top.state(x, theta, xdot, thetadot).py()
     }
 
     /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
@@ -193,13 +193,18 @@ impl PyWeakFieldTop {
     /// Raises:
     ///     ShapeError, NonFiniteError.
     fn angular_momentum<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        map_items(py, &[Input::new("states", &states, &[6])], &[], |z, out| {
-            out[0] = self.top.angular_momentum(z[0])?;
-            Ok(())
-        })
+        let top = slf.core::<core::WeakFieldTop>()?;
+        map_items(
+            slf.py(),
+            &[Input::new("states", &states, &[6])],
+            &[],
+            |z, out| {
+                out[0] = top.angular_momentum(z[0])?;
+                Ok(())
+            },
+        )
     }
 }

@@ -13,7 +13,7 @@ use super::Inertia;
 use crate::convert::{py_mat3, py_vec, shape_str, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{array, map_items, Input};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -34,9 +34,8 @@ type Any<'py> = Bound<'py, PyAny>;
 /// Raises:
 ///     ShapeError, NonFiniteError, InvalidArgumentError (non-positive or non-symmetric inertia).
 #[pyclass(name = "RigidBody", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyRigidBody {
-    body: core::RigidBody,
-}
+#[derive(Default)]
+pub struct PyRigidBody;
 
 #[pymethods]
 impl PyRigidBody {
@@ -48,12 +47,8 @@ impl PyRigidBody {
             Inertia::Matrix(m) => core::RigidBody::from_matrix(&m),
         }
         .py()?;
-        let base = PySystem::new(
-            body.clone(),
-            (inertia,).into_pyobject(inertia.py())?,
-            &["inertia"],
-        );
-        Ok(PyClassInitializer::from(base).add_subclass(PyRigidBody { body }))
+        let args = (inertia,).into_pyobject(inertia.py())?;
+        Ok(PySystem::subclass(body, args, &["inertia"]))
     }
 
     /// Names of the observables that take (states, attitude); `Trajectory` passes its attitude.
@@ -64,28 +59,30 @@ impl PyRigidBody {
 
     /// The principal moments of inertia (3,).
     #[getter]
-    fn moments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        py_vec(py, &self.body.moments())
+    fn moments<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(py_vec(slf.py(), &slf.core::<core::RigidBody>()?.moments()))
     }
 
     /// The principal frame Q in SO(3) (columns = principal axes, I = Q diag(moments) Q^T) when
     /// the inertia was given as a matrix, else None.
     #[getter]
-    fn frame<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
-        self.body.frame().map(|q| py_mat3(py, &q))
+    fn frame<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        let frame = slf.core::<core::RigidBody>()?.frame();
+        Ok(frame.map(|q| py_mat3(slf.py(), &q)))
     }
 
     /// Body angular velocity Omega = I^{-1} M, vectorised: (..., 3) -> (..., 3).
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.
-    fn angular_velocity<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+    fn angular_velocity<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let body = slf.core::<core::RigidBody>()?;
         map_items(
-            py,
+            slf.py(),
             &[Input::new("states", &states, &[3])],
             &[3],
             |m, out| {
-                out.copy_from_slice(&self.body.angular_velocity(m[0])?);
+                out.copy_from_slice(&body.angular_velocity(m[0])?);
                 Ok(())
             },
         )
@@ -97,12 +94,11 @@ impl PyRigidBody {
     /// Raises:
     ///     ShapeError, NonFiniteError.
     fn spatial_momentum<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
         attitude: ArrayIn<'py>,
     ) -> PyResult<Any<'py>> {
-        super::spatial_momentum(py, &states, &attitude, 3)
+        super::spatial_momentum(slf.py(), &states, &attitude, 3)
     }
 
     /// The exact body momentum M(t) from M(0) = M0 by Jacobi elliptic functions (000 §4; the
@@ -124,12 +120,12 @@ impl PyRigidBody {
     ///     InvalidArgumentError (t so large that a phase of the motion is lost to rounding).
     #[pyo3(signature = (M0, t, attitude=None))]
     fn exact_solution<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         M0: ArrayIn<'py>,
         t: ArrayIn<'py>,
         attitude: Option<ArrayIn<'py>>,
     ) -> PyResult<Any<'py>> {
+        let (py, body) = (slf.py(), slf.core::<core::RigidBody>()?);
         let tv = t.as_array();
         if tv.ndim() > 1 {
             return Err(to_py(Error::shape(
@@ -143,7 +139,7 @@ impl PyRigidBody {
             let out_item: Vec<usize> = tv.shape().iter().copied().chain([3]).collect();
             return map_items(py, &[Input::new("M0", &M0, &[3])], &out_item, |m, out| {
                 for (o, &ti) in out.chunks_exact_mut(3).zip(&times) {
-                    o.copy_from_slice(&self.body.exact_momentum(m[0], ti)?);
+                    o.copy_from_slice(&body.exact_momentum(m[0], ti)?);
                 }
                 Ok(())
             });
@@ -159,7 +155,7 @@ impl PyRigidBody {
             &out_item,
             |x, out| {
                 for (o, &ti) in out.chunks_exact_mut(12).zip(&times) {
-                    let (m, r) = self.body.exact_motion(x[0], x[1], ti)?;
+                    let (m, r) = body.exact_motion(x[0], x[1], ti)?;
                     o[..3].copy_from_slice(&m);
                     o[3..].copy_from_slice(&r);
                 }
@@ -196,9 +192,8 @@ impl PyRigidBody {
 /// Raises:
 ///     ShapeError, NonFiniteError, InvalidArgumentError.
 #[pyclass(name = "GeneralizedRigidBody", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyGeneralizedRigidBody {
-    body: core::GeneralizedRigidBody,
-}
+#[derive(Default)]
+pub struct PyGeneralizedRigidBody;
 
 #[pymethods]
 impl PyGeneralizedRigidBody {
@@ -221,20 +216,23 @@ impl PyGeneralizedRigidBody {
             )),
         }
         .py()?;
-        let base = PySystem::new(body.clone(), (J,).into_pyobject(J.py())?, &["J"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PyGeneralizedRigidBody { body }))
+        Ok(PySystem::subclass(
+            body,
+            (J,).into_pyobject(J.py())?,
+            &["J"],
+        ))
     }
 
     /// The dimension n (M is n x n).
     #[getter]
-    fn n(&self) -> usize {
-        self.body.n()
+    fn n(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(body(slf)?.n())
     }
 
     /// The principal entries J_i (n,).
     #[getter]
-    fn moments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        py_vec(py, self.body.principal())
+    fn moments<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(py_vec(slf.py(), body(slf)?.principal()))
     }
 
     /// Flat state z (e_ij coordinates, `lieflow.lie.vee_n`) of skew matrices: (..., n, n) ->
@@ -242,10 +240,10 @@ impl PyGeneralizedRigidBody {
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError, NotInGroupError (M not skew-symmetric).
-    fn state<'py>(&self, py: Python<'py>, M: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let n = self.body.n();
+    fn state<'py>(slf: &Bound<'py, Self>, M: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let n = body(slf)?.n();
         map_items(
-            py,
+            slf.py(),
             &[Input::new("M", &M, &[n, n])],
             &[so::dim(n)],
             |m, out| {
@@ -260,10 +258,10 @@ impl PyGeneralizedRigidBody {
     ///
     /// Raises:
     ///     ShapeError.
-    fn matrix<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let n = self.body.n();
+    fn matrix<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let n = body(slf)?.n();
         map_items(
-            py,
+            slf.py(),
             &[Input::new("states", &states, &[so::dim(n)])],
             &[n, n],
             |z, out| {
@@ -275,4 +273,11 @@ impl PyGeneralizedRigidBody {
             },
         )
     }
+}
+
+/// The core body of a `GeneralizedRigidBody`.
+fn body<'a>(
+    slf: &'a Bound<'_, PyGeneralizedRigidBody>,
+) -> PyResult<&'a core::GeneralizedRigidBody> {
+    slf.core()
 }

@@ -9,7 +9,7 @@ use crate::convert::ArrayIn;
 use crate::convert::{real, reals};
 use crate::errors::IntoPy;
 use crate::items::{map_items, Input};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 /// The vertical rolling disk (Bloch, Nonholonomic Mechanics and Control, §1.4): q = (x, y,
 /// theta, phi) (contact point, rolling angle, heading), p = M dq/dt with
@@ -23,9 +23,8 @@ use crate::system::PySystem;
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "RollingDisk", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyRollingDisk {
-    disk: core::RollingDisk,
-}
+#[derive(Default)]
+pub struct PyRollingDisk;
 
 #[pymethods]
 impl PyRollingDisk {
@@ -52,8 +51,7 @@ impl PyRollingDisk {
             "spring",
             "tilt",
         ];
-        let base = PySystem::new(disk.clone(), args, names);
-        Ok(PyClassInitializer::from(base).add_subclass(PyRollingDisk { disk }))
+        Ok(PySystem::subclass(disk, args, names))
     }
 
     /// The state (q, p) rolling with the rates dtheta/dt, dphi/dt from q = (x, y, theta, phi).
@@ -61,12 +59,14 @@ impl PyRollingDisk {
     /// Raises:
     ///     ShapeError, NonFiniteError.
     fn state(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<4>)] q: [f64; 4],
         #[pyo3(from_py_with = real)] thetadot: f64,
         #[pyo3(from_py_with = real)] phidot: f64,
     ) -> PyResult<Vec<f64>> {
-        self.disk.state(q, thetadot, phidot).py()
+        slf.core::<core::RollingDisk>()?
+            .state(q, thetadot, phidot)
+            .py()
     }
 
     /// The relative residual ‖A(q) M^-1 p‖ / ‖M^-1 p‖ of the rolling constraints, vectorised:
@@ -75,13 +75,18 @@ impl PyRollingDisk {
     /// Raises:
     ///     ShapeError, NonFiniteError.
     fn constraint_residual<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        map_items(py, &[Input::new("states", &states, &[8])], &[], |z, out| {
-            out[0] = self.disk.constraint_residual(z[0])?;
-            Ok(())
-        })
+        let disk = slf.core::<core::RollingDisk>()?;
+        map_items(
+            slf.py(),
+            &[Input::new("states", &states, &[8])],
+            &[],
+            |z, out| {
+                out[0] = disk.constraint_residual(z[0])?;
+                Ok(())
+            },
+        )
     }
 }

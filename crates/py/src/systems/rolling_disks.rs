@@ -10,7 +10,7 @@ use pyo3::PyClassInitializer;
 use crate::convert::ArrayIn;
 use crate::convert::{named, real, real_opt, real_pair, reals, Real};
 use crate::errors::IntoPy;
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 use numpy::{PyArrayDescrMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::types::PyComplex;
 
@@ -45,9 +45,8 @@ fn point(what: &str, v: &Any<'_>) -> PyResult<[f64; 2]> {
 /// Raises:
 ///     InvalidArgumentError (r, m <= 0, ‖gamma‖ >= r, I <= m ‖gamma‖^2), TypeError.
 #[pyclass(name = "RollingDisks", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyRollingDisks {
-    disks: RollingDisks,
-}
+#[derive(Default)]
+pub struct PyRollingDisks;
 
 #[pymethods]
 impl PyRollingDisks {
@@ -83,14 +82,13 @@ impl PyRollingDisks {
             "inertia2",
             "rolling_constant",
         ];
-        let base = PySystem::new(disks.clone(), args, names);
-        Ok(PyClassInitializer::from(base).add_subclass(PyRollingDisks { disks }))
+        Ok(PySystem::subclass(disks, args, names))
     }
 
     /// The rolling constant c.
     #[getter]
-    fn rolling_constant(&self) -> f64 {
-        self.disks.rolling_constant()
+    fn rolling_constant(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(slf.core::<RollingDisks>()?.rolling_constant())
     }
 
     /// The state (theta, M(theta) thetadot) from the angles and their rates.
@@ -98,33 +96,35 @@ impl PyRollingDisks {
     /// Raises:
     ///     NonFiniteError.
     fn state(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
         #[pyo3(from_py_with = reals::<2>)] thetadot: [f64; 2],
     ) -> PyResult<Vec<f64>> {
-        self.disks.state(theta, thetadot).py()
+        slf.core::<RollingDisks>()?.state(theta, thetadot).py()
     }
 
     /// The mass matrix M(theta) of T = thetadot^T M thetadot / 2 (2, 2).
     fn mass_matrix(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
     ) -> PyResult<[[f64; 2]; 2]> {
-        self.disks.mass_matrix(theta).py()
+        slf.core::<RollingDisks>()?.mass_matrix(theta).py()
     }
 
     /// The locked inertia (1, 1) M(theta) (1, 1)^T: the moment of inertia of the pair rotating
     /// rigidly about its centre of mass.
-    fn locked_inertia(&self, #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2]) -> PyResult<f64> {
-        self.disks.locked_inertia(theta).py()
+    fn locked_inertia(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
+    ) -> PyResult<f64> {
+        slf.core::<RollingDisks>()?.locked_inertia(theta).py()
     }
 
     /// Named views for `Trajectory`: theta (..., 2), p (..., 2), thetadot (..., 2), phi (...).
     fn _fields<'py>(slf: &Bound<'py, Self>, states: &Any<'py>) -> PyResult<Bound<'py, PyDict>> {
         let py = slf.py();
-        let base = slf.as_super().get();
+        let (base, disks) = (slf.base(), slf.core::<RollingDisks>()?);
         let fields = base._fields(py, states.extract()?)?;
-        let disks = &slf.get().disks;
         let states = ArrayIn::named("states", states)?;
         let v = base.map_states(py, &states, &[2], |z, out| {
             out.copy_from_slice(&disks.velocities(z)?);
@@ -141,13 +141,11 @@ impl PyRollingDisks {
 
     /// The total angular momentum about the centre of mass, J = p1 + p2, (..., 4) -> (...).
     fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let disks = &slf.get().disks;
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[], |z, out| {
-                out[0] = disks.angular_momentum(z)?;
-                Ok(())
-            })
+        let disks = slf.core::<RollingDisks>()?;
+        slf.base().map_states(slf.py(), &states, &[], |z, out| {
+            out[0] = disks.angular_momentum(z)?;
+            Ok(())
+        })
     }
 
     /// Where the pieces are, in the centre-of-mass frame (003 (4)): a dict of arrays
@@ -157,8 +155,7 @@ impl PyRollingDisks {
         slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (py, disks) = (slf.py(), &slf.get().disks);
-        let base = slf.as_super().get();
+        let (py, base, disks) = (slf.py(), slf.base(), slf.core::<RollingDisks>()?);
         let out = PyDict::new(py);
         let centres = base.map_states(py, &states, &[2, 2], |z, o| {
             o.copy_from_slice(disks.positions(z)?.centres.as_flattened());
@@ -191,13 +188,14 @@ impl PyRollingDisks {
     #[pyo3(signature = (rolling_constant = None, theta1_range = (0.0, std::f64::consts::TAU)),
            text_signature = "($self, rolling_constant=None, theta1_range=(0.0, 6.283185307179586))")]
     fn relative_equilibria(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = real_opt)] rolling_constant: Option<f64>,
         #[pyo3(from_py_with = real_pair)] theta1_range: (f64, f64),
     ) -> PyResult<Vec<PyDisksEquilibrium>> {
+        let disks = slf.core::<RollingDisks>()?.clone();
         let disks = match rolling_constant {
-            Some(c) => self.disks.clone().with_rolling_constant(c).py()?,
-            None => self.disks.clone(),
+            Some(c) => disks.with_rolling_constant(c).py()?,
+            None => disks,
         };
         let eqs = disks.relative_equilibria(theta1_range).py()?;
         Ok(eqs

@@ -9,7 +9,7 @@ use pyo3::PyClassInitializer;
 use crate::convert::ArrayIn;
 use crate::convert::{real, real_matrix, real_vec, reals};
 use crate::errors::{to_py, IntoPy};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 use lieflow::Error;
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -31,9 +31,8 @@ type Any<'py> = Bound<'py, PyAny>;
 /// Raises:
 ///     InvalidArgumentError, NonFiniteError.
 #[pyclass(name = "RollingSpheres", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyRollingSpheres {
-    sys: RollingSpheres,
-}
+#[derive(Default)]
+pub struct PyRollingSpheres;
 
 /// Maps `f(system, state) -> values` over states (..., 27) -> (..., *shape).
 fn observe<'py>(
@@ -42,9 +41,8 @@ fn observe<'py>(
     shape: &[usize],
     f: impl Fn(&RollingSpheres, &[f64], &mut [f64]) -> lieflow::Result<()>,
 ) -> PyResult<Any<'py>> {
-    let sys = &slf.get().sys;
-    slf.as_super()
-        .get()
+    let sys = slf.core::<RollingSpheres>()?;
+    slf.base()
         .map_states(slf.py(), &states, shape, |z, out| f(sys, z, out))
 }
 
@@ -68,20 +66,19 @@ impl PyRollingSpheres {
         let names = &[
             "r1", "r2", "gamma1", "gamma2", "m1", "m2", "inertia1", "inertia2",
         ];
-        let base = PySystem::new(sys.clone(), args, names);
-        Ok(PyClassInitializer::from(base).add_subclass(PyRollingSpheres { sys }))
+        Ok(PySystem::subclass(sys, args, names))
     }
 
     /// e = m1 m2 / (m1 + m2) times R^2 = (r1 + r2)^2: the kinetic energy is this times L of 003 (8).
     #[getter]
-    fn scale(&self) -> f64 {
-        self.sys.scale()
+    fn scale(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(slf.core::<RollingSpheres>()?.scale())
     }
 
     /// (alpha1, alpha2) = (r1, r2) / (r1 + r2).
     #[getter]
-    fn alphas(&self) -> [f64; 2] {
-        self.sys.alphas()
+    fn alphas(slf: &Bound<'_, Self>) -> PyResult<[f64; 2]> {
+        Ok(slf.core::<RollingSpheres>()?.alphas())
     }
 
     /// The state (27,) from z1, z2 (3, 3) rotations, u (3,) unit, Omega1, Omega2 (3,).
@@ -89,14 +86,15 @@ impl PyRollingSpheres {
     /// Raises:
     ///     NotInGroupError, NonFiniteError.
     fn state(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = real_matrix::<3, 3>)] z1: [[f64; 3]; 3],
         #[pyo3(from_py_with = real_matrix::<3, 3>)] z2: [[f64; 3]; 3],
         #[pyo3(from_py_with = reals::<3>)] u: [f64; 3],
         #[pyo3(from_py_with = reals::<3>)] Omega1: [f64; 3],
         #[pyo3(from_py_with = reals::<3>)] Omega2: [f64; 3],
     ) -> PyResult<Vec<f64>> {
-        self.sys.state(z1, z2, u, Omega1, Omega2).py()
+        let sys = slf.core::<RollingSpheres>()?;
+        sys.state(z1, z2, u, Omega1, Omega2).py()
     }
 
     /// The planar state (003 §2.4 <-> §1): z_k the rotation by theta_k about e3,
@@ -105,12 +103,13 @@ impl PyRollingSpheres {
     /// perpendicular to e3 and e3 is an eigenvector of I_k. 003 §1's disk moment of inertia
     /// (about the disk's centre) is I_k[0,0] + I_k[1,1] + m_k ‖gamma_k‖^2.
     fn planar_state(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
         #[pyo3(from_py_with = real)] phi: f64,
         #[pyo3(from_py_with = reals::<2>)] thetadot: [f64; 2],
     ) -> PyResult<Vec<f64>> {
-        self.sys.planar_state(theta, phi, thetadot).py()
+        let sys = slf.core::<RollingSpheres>()?;
+        sys.planar_state(theta, phi, thetadot).py()
     }
 
     /// The planar coordinates (theta1, theta2, phi, thetadot_1, thetadot_2) of one state on
@@ -120,7 +119,7 @@ impl PyRollingSpheres {
     ///     InvalidArgumentError (off the planar subbundle), ShapeError.
     #[pyo3(signature = (state, tol = 1e-9))]
     fn to_planar(
-        &self,
+        slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = real_vec)] state: Vec<f64>,
         #[pyo3(from_py_with = real)] tol: f64,
     ) -> PyResult<[f64; 5]> {
@@ -130,7 +129,7 @@ impl PyRollingSpheres {
                 format!("expected a finite tolerance ≥ 0, got {tol}"),
             )));
         }
-        self.sys.to_planar(&state, tol).py()
+        slf.core::<RollingSpheres>()?.to_planar(&state, tol).py()
     }
 
     /// Total angular momentum about the centre of mass (conserved), (..., 27) -> (..., 3).

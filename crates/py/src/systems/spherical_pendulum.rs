@@ -9,7 +9,7 @@ use crate::convert::real;
 use crate::convert::ArrayIn;
 use crate::errors::IntoPy;
 use crate::items::{map_items, Input};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -26,12 +26,8 @@ type Any<'py> = Bound<'py, PyAny>;
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "SphericalPendulum", module = "lieflow", extends = PySystem, frozen)]
-pub struct PySphericalPendulum {
-    pendulum: core::SphericalPendulum,
-    mass: f64,
-    length: f64,
-    g: f64,
-}
+#[derive(Default)]
+pub struct PySphericalPendulum;
 
 #[pymethods]
 impl PySphericalPendulum {
@@ -45,33 +41,25 @@ impl PySphericalPendulum {
     ) -> PyResult<PyClassInitializer<Self>> {
         let pendulum = core::SphericalPendulum::new(mass, length, g).py()?;
         let args = (mass, length, g).into_pyobject(py)?;
-        let base = PySystem::new(pendulum.clone(), args, &["mass", "length", "g"]);
-        Ok(
-            PyClassInitializer::from(base).add_subclass(PySphericalPendulum {
-                pendulum,
-                mass,
-                length,
-                g,
-            }),
-        )
+        Ok(PySystem::subclass(pendulum, args, &["mass", "length", "g"]))
     }
 
     /// The mass of the bob.
     #[getter]
-    fn mass(&self) -> f64 {
-        self.mass
+    fn mass(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(slf.core::<core::SphericalPendulum>()?.mass())
     }
 
     /// The length of the rod.
     #[getter]
-    fn length(&self) -> f64 {
-        self.length
+    fn length(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(slf.core::<core::SphericalPendulum>()?.length())
     }
 
     /// The gravitational acceleration.
     #[getter]
-    fn g(&self) -> f64 {
-        self.g
+    fn g(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(slf.core::<core::SphericalPendulum>()?.gravity())
     }
 
     /// The state (q, L) from the spherical coordinates of 000 §5.1.1 (theta from the downward
@@ -82,13 +70,13 @@ impl PySphericalPendulum {
     ///     ShapeError (shapes that do not broadcast), NonFiniteError.
     #[pyo3(signature = (theta, phi, thetadot = None, phidot = None))]
     fn state_from_spherical<'py>(
-        &self,
-        py: Python<'py>,
+        slf: &Bound<'py, Self>,
         theta: ArrayIn<'py>,
         phi: ArrayIn<'py>,
         thetadot: Option<ArrayIn<'py>>,
         phidot: Option<ArrayIn<'py>>,
     ) -> PyResult<Any<'py>> {
+        let (py, pendulum) = (slf.py(), slf.core::<core::SphericalPendulum>()?);
         let zero = || -> PyResult<ArrayIn<'py>> { 0.0f64.into_pyobject(py)?.extract() };
         let thetadot = thetadot.map_or_else(zero, Ok)?;
         let phidot = phidot.map_or_else(zero, Ok)?;
@@ -102,9 +90,7 @@ impl PySphericalPendulum {
             ],
             &[6],
             |x, out| {
-                let s = self
-                    .pendulum
-                    .state_from_spherical(x[0][0], x[1][0], x[2][0], x[3][0])?;
+                let s = pendulum.state_from_spherical(x[0][0], x[1][0], x[2][0], x[3][0])?;
                 out.copy_from_slice(&s);
                 Ok(())
             },
@@ -115,10 +101,16 @@ impl PySphericalPendulum {
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.
-    fn vertical_momentum<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        map_items(py, &[Input::new("states", &states, &[6])], &[], |z, out| {
-            out[0] = self.pendulum.vertical_momentum(z[0])?;
-            Ok(())
-        })
+    fn vertical_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let pendulum = slf.core::<core::SphericalPendulum>()?;
+        map_items(
+            slf.py(),
+            &[Input::new("states", &states, &[6])],
+            &[],
+            |z, out| {
+                out[0] = pendulum.vertical_momentum(z[0])?;
+                Ok(())
+            },
+        )
     }
 }

@@ -11,7 +11,7 @@ use pyo3::PyClassInitializer;
 use crate::convert::{mat, ArrayIn};
 use crate::convert::{real, reals, Real};
 use crate::errors::{to_py, IntoPy};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 pub(crate) use crate::systems::surfaces::PySurface;
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -58,9 +58,8 @@ fn tensor(inertia: &Any<'_>) -> PyResult<[f64; 4]> {
 /// Raises:
 ///     InvalidArgumentError, ShapeError.
 #[pyclass(name = "TangentTop", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyTangentTop {
-    top: TangentTop,
-}
+#[derive(Default)]
+pub struct PyTangentTop;
 
 #[pymethods]
 impl PyTangentTop {
@@ -78,19 +77,15 @@ impl PyTangentTop {
             top = top.embedded().py()?;
         }
         let args = (surface.clone(), mass, inertia, embedded).into_pyobject(surface.py())?;
-        let base = PySystem::new(
-            top.clone(),
-            args,
-            &["surface", "mass", "inertia", "embedded"],
-        );
-        Ok(PyClassInitializer::from(base).add_subclass(PyTangentTop { top }))
+        let names = &["surface", "mass", "inertia", "embedded"];
+        Ok(PySystem::subclass(top, args, names))
     }
 
     /// The Euler tensor (2, 2).
     #[getter]
-    fn tensor(&self) -> [[f64; 2]; 2] {
-        let t = self.top.tensor();
-        [[t[0], t[1]], [t[2], t[3]]]
+    fn tensor(slf: &Bound<'_, Self>) -> PyResult<[[f64; 2]; 2]> {
+        let t = slf.core::<TangentTop>()?.tensor();
+        Ok([[t[0], t[1]], [t[2], t[3]]])
     }
 
     /// The canonical state from x (2,), theta and the velocities (Legendre transform of (47)).
@@ -104,14 +99,15 @@ impl PyTangentTop {
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
-        crate::errors::checked(|| slf.get().top.state(x, theta, xdot, thetadot))
+        let top = slf.core::<TangentTop>()?;
+        crate::errors::checked(|| top.state(x, theta, xdot, thetadot))
     }
 
     /// Named views for `Trajectory`: x (..., 2), theta (...), p (..., 3), and the velocities
     /// xdot (..., 2) and thetadot (...).
     fn _fields<'py>(slf: &Bound<'py, Self>, states: &Any<'py>) -> PyResult<Bound<'py, PyDict>> {
         let py = slf.py();
-        let fields = slf.as_super().get()._fields(py, states.extract()?)?;
+        let fields = slf.base()._fields(py, states.extract()?)?;
         if let Some(theta) = fields.get_item("theta")? {
             fields.set_item("theta", pick(&theta, 0i64.into_pyobject(py)?.into_any())?)?;
         }
@@ -123,39 +119,33 @@ impl PyTangentTop {
 
     /// The velocities (x1dot, x2dot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
     fn velocities<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let top = &slf.get().top;
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[3], |z, out| {
-                out.copy_from_slice(&top.velocities(z)?);
-                Ok(())
-            })
+        let top = slf.core::<TangentTop>()?;
+        slf.base().map_states(slf.py(), &states, &[3], |z, out| {
+            out.copy_from_slice(&top.velocities(z)?);
+            Ok(())
+        })
     }
 
     /// The body's angular momentum p_theta (kept exactly by the Gauss methods when conserved),
     /// (..., 6) -> (...).
     fn p_theta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let top = &slf.get().top;
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[], |z, out| {
-                out[0] = top.p_theta(z)?;
-                Ok(())
-            })
+        let top = slf.core::<TangentTop>()?;
+        slf.base().map_states(slf.py(), &states, &[], |z, out| {
+            out[0] = top.p_theta(z)?;
+            Ok(())
+        })
     }
 
     /// All Killing momenta J = p_A X^A of the surface's isometry group (Plane: translations x, y
     /// and the rotation; Sphere: the ambient angular momentum x, y, z; HyperbolicPlane: the
     /// Möbius generators E, H, F; Revolution and Torus: p_phi), (..., 6) -> (..., k).
     fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let top = &slf.get().top;
+        let top = slf.core::<TangentTop>()?;
         let k = top.surface().killing_count();
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[k], |z, out| {
-                out.copy_from_slice(&top.killing_momenta(z)?);
-                Ok(())
-            })
+        slf.base().map_states(slf.py(), &states, &[k], |z, out| {
+            out.copy_from_slice(&top.killing_momenta(z)?);
+            Ok(())
+        })
     }
 
     /// The body in R^3 for a surface with an embedding: rows (position c, E1, E2),
@@ -164,20 +154,18 @@ impl PyTangentTop {
     /// Raises:
     ///     InvalidArgumentError (the surface has no embedding).
     fn ambient_frame<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let top = &slf.get().top;
+        let top = slf.core::<TangentTop>()?;
         if top.surface().embedding().is_none() {
             return Err(to_py(Error::invalid(
                 "ambient_frame",
                 format!("the {} chart has no embedding in R^3", top.surface().name()),
             )));
         }
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[3, 3], |z, out| {
-                let f = top.ambient_frame(z)?.expect("checked above");
-                out.copy_from_slice(f.as_flattened());
-                Ok(())
-            })
+        slf.base().map_states(slf.py(), &states, &[3, 3], |z, out| {
+            let f = top.ambient_frame(z)?.expect("checked above");
+            out.copy_from_slice(f.as_flattened());
+            Ok(())
+        })
     }
 
     /// The charged particle equivalent to tops with this p_theta (002 §III.B, Routh form): its
@@ -209,9 +197,8 @@ impl PyTangentTop {
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "ChargedParticle", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyChargedParticle {
-    particle: ChargedParticle,
-}
+#[derive(Default)]
+pub struct PyChargedParticle;
 
 #[pymethods]
 impl PyChargedParticle {
@@ -220,16 +207,15 @@ impl PyChargedParticle {
         top: Bound<'_, PyTangentTop>,
         #[pyo3(from_py_with = real)] charge: f64,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let particle = top.get().top.magnetic_analogue(charge).py()?;
+        let particle = top.core::<TangentTop>()?.magnetic_analogue(charge).py()?;
         let args = (top.clone(), charge).into_pyobject(top.py())?;
-        let base = PySystem::new(particle.clone(), args, &["top", "charge"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PyChargedParticle { particle }))
+        Ok(PySystem::subclass(particle, args, &["top", "charge"]))
     }
 
     /// The charge p_theta.
     #[getter]
-    fn charge(&self) -> f64 {
-        self.particle.charge()
+    fn charge(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(slf.core::<ChargedParticle>()?.charge())
     }
 
     /// The metric of the particle at x (2, 2): g, plus (I/2m) h g^-1 h for a symmetric embedded
@@ -237,16 +223,24 @@ impl PyChargedParticle {
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn metric(&self, #[pyo3(from_py_with = reals::<2>)] x: [f64; 2]) -> PyResult<[[f64; 2]; 2]> {
-        crate::errors::checked(|| self.particle.metric(x))
+    fn metric(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+    ) -> PyResult<[[f64; 2]; 2]> {
+        let particle = slf.core::<ChargedParticle>()?;
+        crate::errors::checked(|| particle.metric(x))
     }
 
     /// The magnetic potential A = alpha at x.
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
-    fn potential(&self, #[pyo3(from_py_with = reals::<2>)] x: [f64; 2]) -> PyResult<[f64; 2]> {
-        crate::errors::checked(|| self.particle.potential(x))
+    fn potential(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+    ) -> PyResult<[f64; 2]> {
+        let particle = slf.core::<ChargedParticle>()?;
+        crate::errors::checked(|| particle.potential(x))
     }
 
     /// The canonical state (x, p = m G xdot + charge A) from x and xdot.
@@ -258,37 +252,34 @@ impl PyChargedParticle {
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
         #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
     ) -> PyResult<Vec<f64>> {
-        crate::errors::checked(|| slf.get().particle.state(x, xdot))
+        let particle = slf.core::<ChargedParticle>()?;
+        crate::errors::checked(|| particle.state(x, xdot))
     }
 
     /// Named views for `Trajectory`: x (..., 2), p (..., 2), xdot (..., 2).
     fn _fields<'py>(slf: &Bound<'py, Self>, states: &Any<'py>) -> PyResult<Bound<'py, PyDict>> {
         let py = slf.py();
-        let fields = slf.as_super().get()._fields(py, states.extract()?)?;
+        let fields = slf.base()._fields(py, states.extract()?)?;
         fields.set_item("xdot", Self::velocities(slf, states.extract()?)?)?;
         Ok(fields)
     }
 
     /// The velocities xdot of states, (..., 4) -> (..., 2).
     fn velocities<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let p = &slf.get().particle;
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[2], |z, out| {
-                out.copy_from_slice(&p.velocities(z)?);
-                Ok(())
-            })
+        let p = slf.core::<ChargedParticle>()?;
+        slf.base().map_states(slf.py(), &states, &[2], |z, out| {
+            out.copy_from_slice(&p.velocities(z)?);
+            Ok(())
+        })
     }
 
     /// The Killing momenta, those of the top at p_theta = charge, (..., 4) -> (..., k).
     fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let p = &slf.get().particle;
+        let p = slf.core::<ChargedParticle>()?;
         let k = p.top().surface().killing_count();
-        slf.as_super()
-            .get()
-            .map_states(slf.py(), &states, &[k], |z, out| {
-                out.copy_from_slice(&p.killing_momenta(z)?);
-                Ok(())
-            })
+        slf.base().map_states(slf.py(), &states, &[k], |z, out| {
+            out.copy_from_slice(&p.killing_momenta(z)?);
+            Ok(())
+        })
     }
 }

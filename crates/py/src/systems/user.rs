@@ -31,7 +31,7 @@ use pyo3::PyClassInitializer;
 
 use crate::convert::{int_opt, mat, named, read_all, shape_str, ArrayIn, Real};
 use crate::errors::{argument_type_error, raised, to_py, IntoPy};
-use crate::system::PySystem;
+use crate::system::{PySystem, Thin};
 
 type Any<'py> = Bound<'py, PyAny>;
 
@@ -214,9 +214,8 @@ fn count(name: &str, v: i64) -> PyResult<usize> {
 /// with a note naming the step; a value of the wrong shape is a ShapeError, NaN or inf a
 /// NonFiniteError, both naming the callable and the step.
 #[pyclass(name = "Canonical", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyCanonical {
-    sys: UserCanonical,
-}
+#[derive(Default)]
+pub struct PyCanonical;
 
 #[pymethods]
 impl PyCanonical {
@@ -258,20 +257,23 @@ impl PyCanonical {
         });
         let sys = UserCanonical::new(d, value, grad_fn).py()?;
         let args = (hamiltonian, gradient, dof).into_pyobject(py)?;
-        let base = PySystem::new(sys.clone(), args, &["hamiltonian", "gradient", "dof"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PyCanonical { sys }))
+        Ok(PySystem::subclass(
+            sys,
+            args,
+            &["hamiltonian", "gradient", "dof"],
+        ))
     }
 
     /// The number d of degrees of freedom.
     #[getter]
-    fn dof(&self) -> usize {
-        Canonical::dof(&self.sys)
+    fn dof(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(Canonical::dof(slf.core::<UserCanonical>()?))
     }
 
     /// Whether the gradient is computed by finite differences (no `gradient` was given).
     #[getter]
-    fn finite_differences(&self) -> bool {
-        self.sys.finite_differences()
+    fn finite_differences(slf: &Bound<'_, Self>) -> PyResult<bool> {
+        Ok(slf.core::<UserCanonical>()?.finite_differences())
     }
 }
 
@@ -315,9 +317,8 @@ fn kinetic_mass(m: &Any<'_>) -> PyResult<KineticMass> {
 /// The callables are called as those of `Canonical` (exceptions re-raised naming the step, also
 /// at the initial state: Verlet evaluates the force when it starts).
 #[pyclass(name = "Separable", module = "lieflow", extends = PySystem, frozen)]
-pub struct PySeparable {
-    sys: UserSeparable,
-}
+#[derive(Default)]
+pub struct PySeparable;
 
 #[pymethods]
 impl PySeparable {
@@ -353,20 +354,21 @@ impl PySeparable {
         });
         let sys = UserSeparable::new(kinetic, d, value, grad_fn).py()?;
         let args = (mass, potential, gradient, dof).into_pyobject(py)?;
-        let base = PySystem::new(sys.clone(), args, &["mass", "potential", "gradient", "dof"]);
-        Ok(PyClassInitializer::from(base).add_subclass(PySeparable { sys }))
+        let names = &["mass", "potential", "gradient", "dof"];
+        Ok(PySystem::subclass(sys, args, names))
     }
 
     /// The number d of degrees of freedom.
     #[getter]
-    fn dof(&self) -> usize {
-        lieflow::integrate::problem::Separable::dof(&self.sys)
+    fn dof(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        let sys = slf.core::<UserSeparable>()?;
+        Ok(lieflow::integrate::problem::Separable::dof(sys))
     }
 
     /// Whether grad U is computed by finite differences (no `gradient` was given).
     #[getter]
-    fn finite_differences(&self) -> bool {
-        self.sys.finite_differences()
+    fn finite_differences(slf: &Bound<'_, Self>) -> PyResult<bool> {
+        Ok(slf.core::<UserSeparable>()?.finite_differences())
     }
 }
 
@@ -440,9 +442,8 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError, ShapeError, NonFiniteError.
 #[pyclass(name = "LiePoisson", module = "lieflow", extends = PySystem, frozen)]
-pub struct PyLiePoisson {
-    sys: CoreLiePoisson,
-}
+#[derive(Default)]
+pub struct PyLiePoisson;
 
 #[pymethods]
 impl PyLiePoisson {
@@ -520,33 +521,29 @@ impl PyLiePoisson {
         };
         let sys = CoreLiePoisson::new(alg, ham, cas).py()?;
         let args = (algebra, hamiltonian, gradient, casimirs).into_pyobject(py)?;
-        let base = PySystem::new(
-            sys.clone(),
-            args,
-            &["algebra", "hamiltonian", "gradient", "casimirs"],
-        );
-        Ok(PyClassInitializer::from(base).add_subclass(PyLiePoisson { sys }))
+        let names = &["algebra", "hamiltonian", "gradient", "casimirs"];
+        Ok(PySystem::subclass(sys, args, names))
     }
 
     /// dim g (the length d of a state).
     #[getter]
-    fn dim(&self) -> usize {
-        self.sys.dim()
+    fn dim(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(slf.core::<CoreLiePoisson>()?.dim())
     }
 
     /// Whether H is the native quadratic form (given as a matrix).
     #[getter]
-    fn is_quadratic(&self) -> bool {
-        self.sys.is_quadratic()
+    fn is_quadratic(slf: &Bound<'_, Self>) -> PyResult<bool> {
+        Ok(slf.core::<CoreLiePoisson>()?.is_quadratic())
     }
 
     /// The structure constants C (d, d, d), C[i, j, k] = C_ij^k, [e_i, e_j] = C_ij^k e_k.
     ///
     /// Raises:
     ///     InvalidArgumentError (an array too large to hold: so(n) for n of some hundreds).
-    fn structure_constants<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f64>>> {
-        let d = self.sys.dim();
-        let c = self.sys.structure_constants().py()?;
+    fn structure_constants<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        let sys = slf.core::<CoreLiePoisson>()?;
+        let (d, c) = (sys.dim(), sys.structure_constants().py()?);
         let a = Array3::from_shape_vec((d, d, d), c).map_err(|e| {
             to_py(Error::shape(
                 "structure_constants",
@@ -554,6 +551,6 @@ impl PyLiePoisson {
                 e.to_string(),
             ))
         })?;
-        Ok(a.into_pyarray(py))
+        Ok(a.into_pyarray(slf.py()))
     }
 }

@@ -45,6 +45,21 @@ impl SphericalPendulum {
         })
     }
 
+    /// The mass m of the bob.
+    pub fn mass(&self) -> f64 {
+        self.bob.mass
+    }
+
+    /// The length l of the rod.
+    pub fn length(&self) -> f64 {
+        self.bob.length
+    }
+
+    /// The gravitational acceleration g.
+    pub fn gravity(&self) -> f64 {
+        self.bob.gravity
+    }
+
     /// The state (q, L) from spherical coordinates of 000 §5.1.1 (θ from the downward vertical):
     /// q = (sinθ cosφ, sinθ sinφ, −cosθ), L = ml² q × q̇.
     pub fn state_from_spherical(
