@@ -267,10 +267,11 @@ pub fn array_size(what: &str, shape: &[usize]) -> Result<usize> {
             return Err(Error::invalid(
                 what,
                 format!(
-                    "an array of shape {} needs {:.1} GiB, more than the {:.1} GiB of memory \
-                     available",
+                    "an array of shape {} needs {:.1} GiB, more than the {:.1} GiB one array \
+                     may take (7/8 of the {:.1} GiB of memory available)",
                     shape_text(shape),
                     gib(bytes as f64),
+                    gib((free / 8 * 7) as f64),
                     gib(free as f64)
                 ),
             ));
@@ -413,6 +414,31 @@ pub fn cross2(what: &str, quantity: &str, x: [f64; 2], y: [f64; 2]) -> Result<f6
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refused_array_names_the_share_of_memory_it_may_take() {
+        // Between 7/8 of the memory available and all of it: refused, and the message names
+        // the 7/8 it may take beside the whole (the memory available may move meanwhile: the
+        // two numbers are read back from the message).
+        let Some(free) = available_memory() else {
+            return;
+        };
+        let n = (free / 8 * 7 / 8 + free / 512) as usize;
+        let Err(Error::InvalidArgument { message, .. }) = array_size("steps", &[n]) else {
+            return;
+        };
+        let number = |after: &str| -> f64 {
+            let rest = &message[message.find(after).expect(after) + after.len()..];
+            rest.split(' ').next().unwrap().parse().unwrap()
+        };
+        let (may, whole) = (number("more than the "), number("(7/8 of the "));
+        assert!(
+            message.contains("GiB one array may take (7/8 of the"),
+            "{message}"
+        );
+        assert!((may - whole * 7.0 / 8.0).abs() <= 0.1, "{message}");
+        assert!(number("needs ") > may, "{message}");
+    }
 
     #[test]
     fn rejects_nan_and_shape() {
