@@ -117,19 +117,7 @@ fn point_bodies(seed: u64) -> (RollingSpheres, [Points; 2], [f64; 2]) {
 }
 
 /// Spheres with full (non-diagonal) inertia and off-centre centres of mass.
-fn spheres() -> RollingSpheres {
-    RollingSpheres::new(
-        0.7,
-        1.3,
-        [0.1, -0.2, 0.15],
-        [-0.3, 0.2, 0.4],
-        2.0,
-        3.5,
-        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
-        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
-    )
-    .unwrap()
-}
+use common::rolling_spheres as spheres;
 
 fn random_state(sys: &RollingSpheres, rng: &mut Rng, speed: f64) -> Vec<f64> {
     sys.state(
