@@ -214,3 +214,22 @@ def test_the_method_list_of_a_forced_system_is_the_rule_of_its_docstring():
     free = [m for m in lf.HeavyTop.methods() if m in ("splitting", "lgvi")]
     assert forced.methods()[:3] == [free[0], free[0] + "4", free[0] + "6"]
     assert lf.Forced.methods() == lf.Forced(lf.Pendulum(), damping=0.1).methods()
+
+
+def test_the_base_class_has_no_method_list_of_its_own():
+    assert callable(lf.System.methods)       # autodoc and getattr still see it
+    with pytest.raises(TypeError, match="base class"):
+        lf.System.methods()
+    with pytest.raises(TypeError, match="no arguments"):
+        lf.RigidBody.methods(1)
+
+
+def test_a_whole_run_is_refused_once_the_run_has_moved():
+    body = lf.RigidBody([1, 2, 3])
+    run = body._start(np.array([1.0, 0.5, -0.3]), None, 0.1, None, 1)
+    run._chunk(2)
+    with pytest.raises(lf.InvalidArgumentError, match="from its start"):
+        run._whole(1)
+    whole = body._start(np.array([1.0, 0.5, -0.3]), None, 0.1, None, 1)._whole(2)
+    traj = lf.integrate(body, np.array([1.0, 0.5, -0.3]), dt=0.1, steps=2, chunk_steps=1)
+    assert np.array_equal(whole[1], traj.states) and np.array_equal(whole[0], traj.t)
