@@ -39,7 +39,7 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     pseudo_rigid::potential::register(&potentials)?;
     m.add("potentials", potentials)?;
     let surfaces = PyModule::new(m.py(), "lieflow.surfaces")?;
-    systems::surfaces::register(&surfaces)?;
+    systems::tangent_top::surface::register(&surfaces)?;
     m.add("surfaces", surfaces)?;
     add_submodule(m, "elliptic", elliptic::register)?;
     add_submodule(m, "ellipsoids", pseudo_rigid::ellipsoids::register)?;

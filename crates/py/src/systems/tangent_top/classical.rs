@@ -8,11 +8,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PySlice};
 use pyo3::PyClassInitializer;
 
+pub(crate) use super::surface::PySurface;
 use crate::convert::{mat, ArrayIn};
 use crate::convert::{real, reals, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::system::{PySystem, Thin};
-pub(crate) use crate::systems::surfaces::PySurface;
 
 type Any<'py> = Bound<'py, PyAny>;
 

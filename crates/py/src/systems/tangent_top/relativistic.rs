@@ -6,12 +6,12 @@ use lieflow::Error;
 use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
+use super::surface::PySurface;
 use crate::convert::ArrayIn;
 use crate::convert::{named, real, real_opt, reals, reals_opt, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, Input};
 use crate::system::{PySystem, Thin};
-use crate::systems::surfaces::PySurface;
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical
 /// sign of the Lagrangian, L = -m/gamma + thetadot^2 (I gamma + gamma^3 xdot^T K(theta) xdot)/2),

@@ -1,10 +1,9 @@
-//! `RigidBody` and `GeneralizedRigidBody`: bindings of `lieflow::systems::tops` (000 §3–§4,
-//! the so(n) body). Thin subclasses of `lieflow.System`: constructors and observables.
+//! `RigidBody`: the binding of `lieflow::systems::tops::rigid_body` (000 §3–§4). A thin
+//! subclass of `lieflow.System`: constructor and observables.
 #![allow(non_snake_case)]
 
-use lieflow::lie::so;
 use lieflow::systems as core;
-use lieflow::{Error, Mat};
+use lieflow::Error;
 use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
@@ -175,109 +174,4 @@ impl PyRigidBody {
         let r = array(py, &shape(&[3, 3]), r)?;
         Ok((m, r).into_pyobject(py)?.into_any())
     }
-}
-
-/// The generalized rigid body on so(n)* (Euler–Arnold / Manakov equations; the form of the
-/// pseudo-rigid body's reduced equation 001 (7.25)).
-///
-/// M = J Omega + Omega J with J the mass matrix; dM/dt = [M, Omega]; energy
-/// H = sum_{i<j} M_ij^2 / (J_i + J_j) / 2 (principal frame); Casimirs C_k = tr((M^T M)^k) / 2,
-/// k = 1 .. n // 2 (they fix the spectrum of M). State z = the e_ij coordinates of the skew
-/// matrix M (i < j, row by row), length n(n-1)/2; `state(M)` and `matrix(z)` convert.
-/// Methods: isospectral (default), rk4, rkmk4.
-///
-/// Args:
-///     J: principal entries (n,) (n >= 2, J_i >= 0, J_i + J_j > 0), or a symmetric
-///         positive-semidefinite (n, n) matrix (diagonalised once).
-/// Raises:
-///     ShapeError, NonFiniteError, InvalidArgumentError.
-#[pyclass(name = "GeneralizedRigidBody", module = "lieflow", extends = PySystem, frozen)]
-#[derive(Default)]
-pub struct PyGeneralizedRigidBody;
-
-#[pymethods]
-impl PyGeneralizedRigidBody {
-    #[new]
-    #[pyo3(signature = (J))]
-    fn new(J: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
-        let a = ArrayIn::named("J", J)?;
-        let v = a.as_array();
-        let body = match v.ndim() {
-            1 => core::GeneralizedRigidBody::new(&v.iter().copied().collect::<Vec<_>>()),
-            2 => core::GeneralizedRigidBody::from_matrix(&Mat::from_fn(
-                v.shape()[0],
-                v.shape()[1],
-                |i, j| v[[i, j]],
-            )),
-            _ => Err(Error::shape(
-                "J",
-                "(n,) principal entries or an (n, n) symmetric matrix",
-                shape_str(v.shape()),
-            )),
-        }
-        .py()?;
-        Ok(PySystem::subclass(
-            body,
-            (J,).into_pyobject(J.py())?,
-            &["J"],
-        ))
-    }
-
-    /// The dimension n (M is n x n).
-    #[getter]
-    fn n(slf: &Bound<'_, Self>) -> PyResult<usize> {
-        Ok(body(slf)?.n())
-    }
-
-    /// The principal entries J_i (n,).
-    #[getter]
-    fn moments<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(py_vec(slf.py(), body(slf)?.principal()))
-    }
-
-    /// Flat state z (e_ij coordinates, `lieflow.lie.vee_n`) of skew matrices: (..., n, n) ->
-    /// (..., n(n-1)/2).
-    ///
-    /// Raises:
-    ///     ShapeError, NonFiniteError, NotInGroupError (M not skew-symmetric).
-    fn state<'py>(slf: &Bound<'py, Self>, M: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let n = body(slf)?.n();
-        map_items(
-            slf.py(),
-            &[Input::new("M", &M, &[n, n])],
-            &[so::dim(n)],
-            |m, out| {
-                let m = Mat::from_fn(n, n, |i, j| m[0][i * n + j]);
-                out.copy_from_slice(&so::vee_n(&m)?);
-                Ok(())
-            },
-        )
-    }
-
-    /// The skew matrices M of flat states: (..., n(n-1)/2) -> (..., n, n).
-    ///
-    /// Raises:
-    ///     ShapeError.
-    fn matrix<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let n = body(slf)?.n();
-        map_items(
-            slf.py(),
-            &[Input::new("states", &states, &[so::dim(n)])],
-            &[n, n],
-            |z, out| {
-                let m = so::hat_n(z[0])?;
-                for (k, o) in out.iter_mut().enumerate() {
-                    *o = m[(k / n, k % n)];
-                }
-                Ok(())
-            },
-        )
-    }
-}
-
-/// The core body of a `GeneralizedRigidBody`.
-fn body<'a>(
-    slf: &'a Bound<'_, PyGeneralizedRigidBody>,
-) -> PyResult<&'a core::GeneralizedRigidBody> {
-    slf.core()
 }

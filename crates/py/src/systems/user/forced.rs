@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use pyo3::PyClassInitializer;
 
-use super::user::Callee;
+use super::Callee;
 use crate::convert::{read_all, real, ArrayIn};
 use crate::errors::{to_py, IntoPy};
 use crate::system::{PySystem, Thin};
