@@ -146,7 +146,8 @@ def test_error_paths():
     inf = R.copy()
     inf[2, 2] = np.inf
     not_skew = xi + np.eye(3)
-    shapes = [np.zeros((2, 3)), np.zeros(3), np.zeros((1, 1)), np.zeros((2, 2, 2, 2))]
+    # (2, 2, 2, 2) is a (2, 2) batch of so(2) items under the one vectorisation rule (below).
+    shapes = [np.zeros((2, 3)), np.zeros(3), np.zeros((1, 1)), np.zeros((2, 2, 3))]
     one_arg = [lie.so_exp, lie.so_log, lie.cayley, lie.cayley_inv, lie.project_to_so,
                lie.is_rotation, lie.vee_n]
     for f in one_arg:
@@ -206,6 +207,35 @@ def test_error_paths():
         lie.product_Ad(R, refl, xi, xi)
     with pytest.raises(lf.ShapeError):
         lie.product_bracket(xi, xi, rand_skew(4), rand_skew(4))
+
+
+def test_functions_map_any_leading_axes_item_by_item():
+    """The one vectorisation rule: (..., item) in, (..., out item) out, each item as alone."""
+    rng = np.random.default_rng(5)
+    c = rng.normal(size=(2, 3, 6))
+    xi = lie.so_hat(c)
+    assert xi.shape == (2, 3, 4, 4)
+    R = lie.so_exp(xi)
+    for i in range(2):
+        for j in range(3):
+            assert np.array_equal(xi[i, j], lie.so_hat(c[i, j]))
+            assert np.array_equal(R[i, j], lie.so_exp(xi[i, j]))
+    np.testing.assert_allclose(lie.so_vee(lie.so_log(R)), c, atol=1e-12)
+    assert lie.so_exp(np.zeros((2, 2, 2, 2))).shape == (2, 2, 2, 2)
+    w = rng.normal(size=(4, 1, 3))
+    assert np.array_equal(lie.so3_exp(w)[2, 0], lie.so3_exp(w[2, 0]))
+    # Two inputs broadcast as numpy's: (4, 1) against (5,) gives (4, 5).
+    g = lie.se3_exp(rng.normal(size=(4, 1, 6)))
+    h = lie.se3_exp(rng.normal(size=(5, 6)))
+    gh = lie.se3_compose(g, h)
+    assert gh.shape == (4, 5, 4, 4)
+    np.testing.assert_allclose(gh, g @ h, atol=1e-13)
+    with pytest.raises(lf.ShapeError, match="broadcast"):
+        lie.se3_compose(g, h[:3, None])
+    bad = w.copy()
+    bad[3, 0, 1] = np.nan
+    with pytest.raises(lf.NonFiniteError, match=r"w\[3, 0\] contains .* at index 1$"):
+        lie.so3_exp(bad)
 
 
 skew_coords = st.integers(2, 8).flatmap(

@@ -7,10 +7,10 @@ use std::ops::Deref;
 
 use lieflow::{check, Error, Mat};
 use nalgebra::{Matrix3, Vector3};
-use numpy::ndarray::{Array1, Array2, Array3, ArrayViewD};
+use numpy::ndarray::{Array1, Array2, ArrayViewD};
 use numpy::npyffi::PY_ARRAY_API;
 use numpy::{
-    AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayDescrMethods, PyArrayDyn,
+    AllowTypeChange, IntoPyArray, PyArray1, PyArray2, PyArrayDescrMethods, PyArrayDyn,
     PyArrayLikeDyn, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
@@ -178,14 +178,6 @@ pub fn read_all(what: &str, v: &ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
     Ok(data)
 }
 
-/// An empty vector with room for `n` items, allocated fallibly.
-fn try_vec<T>(what: &str, n: usize) -> PyResult<Vec<T>> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(n)
-        .map_err(|_| to_py(Error::invalid(what, format!("cannot allocate {n} items"))))?;
-    Ok(v)
-}
-
 /// An r×c matrix from row-major data.
 fn to_mat(r: usize, c: usize, x: &[f64]) -> Mat {
     Mat::from_fn(r, c, |i, j| x[i * c + j])
@@ -202,29 +194,6 @@ pub fn mat(what: &str, a: &ArrayIn<'_>) -> PyResult<Mat> {
     Ok(to_mat(r, c, &read_all(what, &v)?))
 }
 
-/// A 2-D array (one matrix) or a 3-D array (a batch along the leading axis).
-/// Returns the matrices and whether the input was batched.
-pub fn mats(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<Mat>, bool)> {
-    let v = a.as_array();
-    match v.ndim() {
-        2 => Ok((vec![mat(what, a)?], false)),
-        3 => {
-            let (b, r, c) = (v.shape()[0], v.shape()[1], v.shape()[2]);
-            check::dense_size(what, r, c).map_err(to_py)?;
-            let data = read_all(what, &v)?;
-            let mut out = try_vec(what, b)?;
-            out.extend(
-                data.chunks_exact((r * c).max(1))
-                    .take(b)
-                    .map(|x| to_mat(r, c, x)),
-            );
-            out.resize_with(b, || Mat::zeros(r, c));
-            Ok((out, true))
-        }
-        _ => Err(shape_err(what, "(n, n) or a batch (b, n, n)", &v)),
-    }
-}
-
 /// A 1-D array.
 pub fn vector(what: &str, a: &ArrayIn<'_>) -> PyResult<Vec<f64>> {
     let v = a.as_array();
@@ -232,23 +201,6 @@ pub fn vector(what: &str, a: &ArrayIn<'_>) -> PyResult<Vec<f64>> {
         return Err(shape_err(what, "a 1-D array", &v));
     }
     read_all(what, &v)
-}
-
-/// A 1-D array (one vector) or a 2-D array (a batch along the leading axis).
-pub fn vectors(what: &str, a: &ArrayIn<'_>) -> PyResult<(Vec<Vec<f64>>, bool)> {
-    let v = a.as_array();
-    match v.ndim() {
-        1 => Ok((vec![read_all(what, &v)?], false)),
-        2 => {
-            let (b, d) = (v.shape()[0], v.shape()[1]);
-            let data = read_all(what, &v)?;
-            let mut out = try_vec(what, b)?;
-            out.extend(data.chunks_exact(d.max(1)).take(b).map(|x| x.to_vec()));
-            out.resize_with(b, Vec::new);
-            Ok((out, true))
-        }
-        _ => Err(shape_err(what, "(d,) or a batch (b, d)", &v)),
-    }
 }
 
 /// A 3-vector.
@@ -265,54 +217,9 @@ pub fn py_mat<'py>(py: Python<'py>, m: &Mat) -> Bound<'py, PyArray2<f64>> {
     Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)]).into_pyarray(py)
 }
 
-/// Matrices of one shape → 3-D numpy array (batch axis first); the buffer is size-checked and
-/// allocated fallibly (`what` names the argument the batch comes from).
-pub fn py_mats<'py>(
-    py: Python<'py>,
-    what: &str,
-    ms: &[Mat],
-) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let (r, c) = ms.first().map_or((0, 0), |m| (m.nrows(), m.ncols()));
-    let mut data = check::zeros(what, &[ms.len(), r, c]).map_err(to_py)?;
-    for (o, m) in data.chunks_exact_mut((r * c).max(1)).zip(ms) {
-        for i in 0..r {
-            for j in 0..c {
-                o[i * c + j] = m[(i, j)];
-            }
-        }
-    }
-    let a = Array3::from_shape_vec((ms.len(), r, c), data)
-        .map_err(|e| to_py(Error::shape(what, "matrices of one shape", e.to_string())))?;
-    Ok(a.into_pyarray(py))
-}
-
 /// Slice → 1-D numpy array.
 pub fn py_vec<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
     Array1::from(v.to_vec()).into_pyarray(py)
-}
-
-/// Equal-length vectors → 2-D numpy array (batch axis first); the buffer is size-checked and
-/// allocated fallibly (`what` names the argument the batch comes from).
-pub fn py_vecs<'py>(
-    py: Python<'py>,
-    what: &str,
-    vs: &[Vec<f64>],
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let d = vs.first().map_or(0, |v| v.len());
-    let mut data = check::zeros(what, &[vs.len(), d]).map_err(to_py)?;
-    for (o, v) in data.chunks_exact_mut(d.max(1)).zip(vs) {
-        if v.len() != d {
-            return Err(to_py(Error::shape(
-                what,
-                format!("vectors of one length {d}"),
-                format!("one of length {}", v.len()),
-            )));
-        }
-        o.copy_from_slice(v);
-    }
-    let a = Array2::from_shape_vec((vs.len(), d), data)
-        .map_err(|e| to_py(Error::shape(what, "vectors of one length", e.to_string())))?;
-    Ok(a.into_pyarray(py))
 }
 
 /// 3×3 matrix → numpy.

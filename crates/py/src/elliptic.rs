@@ -11,11 +11,7 @@ use crate::items::{map_items, Input};
 type Any<'py> = Bound<'py, PyAny>;
 
 fn scalar<'a, 'py>(what: &'a str, a: &'a ArrayIn<'py>) -> Input<'a, 'py> {
-    Input {
-        what,
-        array: a,
-        item: &[],
-    }
+    Input::new(what, a, &[])
 }
 
 /// Jacobi elliptic functions (sn, cn, dn)(u | m) by the descending Landen transformation

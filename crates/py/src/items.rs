@@ -10,8 +10,9 @@ use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyFloat;
+use rayon::prelude::*;
 
-use crate::convert::{shape_str, ArrayIn};
+use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::to_py;
 
 /// A float64 numpy array of any shape.
@@ -22,12 +23,29 @@ pub struct Input<'a, 'py> {
     pub what: &'a str,
     pub array: &'a ArrayIn<'py>,
     pub item: &'a [usize],
+    /// Whether the rule checks its items finite before the function sees them (otherwise the
+    /// function does, with its own message: a domain error may say more).
+    pub finite: bool,
 }
 
 impl<'a, 'py> Input<'a, 'py> {
-    /// The input `what` with items of shape `item`.
+    /// The input `what` with items of shape `item`, checked by the mapped function.
     pub fn new(what: &'a str, array: &'a ArrayIn<'py>, item: &'a [usize]) -> Self {
-        Input { what, array, item }
+        Input {
+            what,
+            array,
+            item,
+            finite: false,
+        }
+    }
+
+    /// The input `what` with items of shape `item`, each checked finite by the rule
+    /// (`NonFiniteError` naming the item and its entry).
+    pub fn finite(what: &'a str, array: &'a ArrayIn<'py>, item: &'a [usize]) -> Self {
+        Input {
+            finite: true,
+            ..Input::new(what, array, item)
+        }
     }
 }
 
@@ -35,8 +53,9 @@ fn expected_str(item: &[usize]) -> String {
     if item.is_empty() {
         "a scalar or an array".into()
     } else {
+        let one = shape_str(item);
         let inner: Vec<String> = item.iter().map(|d| d.to_string()).collect();
-        format!("(..., {})", inner.join(", "))
+        format!("{one} or (..., {})", inner.join(", "))
     }
 }
 
@@ -83,12 +102,174 @@ fn broadcast(shapes: &[&[usize]]) -> Option<Vec<usize>> {
     Some(out)
 }
 
-/// Applies `f(items, out)` to every combination of items along the (broadcast) leading axes of
-/// the inputs; `out` has `out_item` shape. Returns an array of shape (...lead, ...out_item), or a
-/// Python float when that shape is () (one scalar-valued item, like numpy's scalar results).
-/// Shape mismatches become `ShapeError`; an error of `f` in a batch names the item by its index
-/// along the leading axes (`states[7, 12]`, or `states[7, 12]: state` where it names another
-/// thing than an input).
+/// The most inputs one mapped function takes.
+const MAX_INPUTS: usize = 4;
+
+/// The number of items from which [`par_map_items`] runs on the thread pool.
+const PAR_MIN: usize = 256;
+
+/// A mapping of the inputs' items, read and checked once: the broadcast leading axes, the data of
+/// every input (row-major, as read), and each input's stride in items along each leading axis
+/// (0 where it is broadcast).
+struct Plan<'a> {
+    names: Vec<&'a str>,
+    lead: Vec<usize>,
+    shape: Vec<usize>,
+    count: usize,
+    out_len: usize,
+    data: Vec<Vec<f64>>,
+    items: Vec<&'a [usize]>,
+    finite: Vec<bool>,
+    strides: Vec<Vec<usize>>,
+}
+
+impl<'a> Plan<'a> {
+    fn new(inputs: &[Input<'a, '_>], out_item: &[usize]) -> PyResult<Self> {
+        assert!(
+            inputs.len() <= MAX_INPUTS,
+            "at most {MAX_INPUTS} mapped inputs"
+        );
+        let views: Vec<_> = inputs.iter().map(|i| i.array.as_array()).collect();
+        let mut leads = Vec::with_capacity(inputs.len());
+        for (inp, v) in inputs.iter().zip(&views) {
+            let s = v.shape();
+            let k = inp.item.len();
+            if s.len() < k || s[s.len() - k..] != *inp.item {
+                return Err(to_py(Error::shape(
+                    inp.what,
+                    expected_str(inp.item),
+                    shape_str(s),
+                )));
+            }
+            leads.push(&s[..s.len() - k]);
+        }
+        let lead = broadcast(&leads).ok_or_else(|| {
+            let got: Vec<String> = inputs
+                .iter()
+                .zip(&views)
+                .map(|(i, v)| format!("{} {}", i.what, shape_str(v.shape())))
+                .collect();
+            to_py(Error::shape(
+                "inputs",
+                "leading axes that broadcast together (the same length, or 1)",
+                got.join(", "),
+            ))
+        })?;
+        let names: Vec<&str> = inputs.iter().map(|i| i.what).collect();
+        // The one guard of every mapped output: its size is checked before it is allocated
+        // (a broadcast input of 10¹⁰ items is refused, not an abort of the process).
+        let shape: Vec<usize> = lead.iter().chain(out_item).copied().collect();
+        check::array_size(&names.join(", "), &shape).map_err(to_py)?;
+        let mut data = Vec::with_capacity(inputs.len());
+        let mut strides = Vec::with_capacity(inputs.len());
+        for ((inp, v), l) in inputs.iter().zip(&views).zip(&leads) {
+            // Each input is read once as it is (its own size, checked), never broadcast in memory.
+            data.push(read_all(inp.what, v)?);
+            let mut st = vec![0; lead.len()];
+            let mut step = 1;
+            for (j, &n) in l.iter().enumerate().rev() {
+                if n != 1 {
+                    st[lead.len() - l.len() + j] = step;
+                }
+                step *= n;
+            }
+            strides.push(st);
+        }
+        Ok(Plan {
+            names,
+            count: lead.iter().product(),
+            out_len: out_item.iter().product(),
+            lead,
+            shape,
+            data,
+            items: inputs.iter().map(|i| i.item).collect(),
+            finite: inputs.iter().map(|i| i.finite).collect(),
+            strides,
+        })
+    }
+
+    /// The index of item k along the leading axes, as errors write it ("7, 12").
+    fn index(&self, k: usize) -> String {
+        let mut r = k;
+        let mut idx = vec![0; self.lead.len()];
+        for (i, &n) in idx.iter_mut().zip(&self.lead).rev() {
+            (*i, r) = (r % n, r / n);
+        }
+        let idx: Vec<String> = idx.iter().map(|i| i.to_string()).collect();
+        idx.join(", ")
+    }
+
+    /// Item k of every input checked finite, `f` applied, its output checked representable;
+    /// an error names the item by its index along the leading axes (`states[7, 12]`, or
+    /// `states[7, 12]: state` where it names another thing than an input).
+    fn call<F>(&self, k: usize, f: &F, out: &mut [f64]) -> lieflow::Result<()>
+    where
+        F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
+    {
+        let mut items: [&[f64]; MAX_INPUTS] = [&[]; MAX_INPUTS];
+        for (i, item) in items.iter_mut().take(self.data.len()).enumerate() {
+            let len: usize = self.items[i].iter().product();
+            let (mut r, mut at) = (k, 0);
+            for (&n, &st) in self.lead.iter().zip(&self.strides[i]).rev() {
+                at += (r % n) * st;
+                r /= n;
+            }
+            *item = &self.data[i][at * len..(at + 1) * len];
+        }
+        let items = &items[..self.data.len()];
+        let name = |e: Error| match self.lead.is_empty() {
+            true => e,
+            false => e.map_what(|w| match self.names.contains(&w) {
+                true => format!("{w}[{}]", self.index(k)),
+                false => format!("{}[{}]: {w}", self.names.join(", "), self.index(k)),
+            }),
+        };
+        let mut finite = true;
+        for (i, item) in items.iter().enumerate() {
+            if self.finite[i] {
+                check::finite_items(self.names[i], item, self.items[i])
+                    .map_err(|(_, e)| name(e))?;
+            } else {
+                finite &= item.iter().all(|x| x.is_finite());
+            }
+        }
+        f(items, out).map_err(name)?;
+        let at = (!self.lead.is_empty()).then(|| self.index(k));
+        representable(&self.names.join(", "), finite, out, at.as_deref())
+    }
+
+    /// Every item mapped on this thread.
+    fn run<'py, F>(self, py: Python<'py>, f: &F) -> PyResult<Bound<'py, PyAny>>
+    where
+        F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
+    {
+        let mut out = check::zeros(&self.names.join(", "), &self.shape).map_err(to_py)?;
+        for k in 0..self.count {
+            let o = &mut out[k * self.out_len..(k + 1) * self.out_len];
+            self.call(k, f, o).map_err(to_py)?;
+        }
+        self.finish(py, out)
+    }
+
+    /// The output as numpy returns it: an array (...lead, ...out_item), or a Python float when
+    /// that shape is () (one scalar-valued item, like numpy's scalar results).
+    fn finish<'py>(self, py: Python<'py>, out: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
+        if self.shape.is_empty() {
+            return Ok(PyFloat::new(py, out[0]).into_any());
+        }
+        Ok(array(py, &self.shape, out)?.into_any())
+    }
+}
+
+/// The one vectorisation rule of the bindings: applies `f(items, out)` to every combination of
+/// items along the leading axes of the inputs, which broadcast as numpy's do; an item is the
+/// trailing block of shape `Input::item` (a state (d,), an attitude (3, 3), a scalar ()), `out`
+/// one of shape `out_item`. Returns an array (...lead, ...out_item), or a Python float when that
+/// shape is (). Inputs made with [`Input::finite`] are checked finite item by item
+/// (`NonFiniteError` naming the item and its entry); an output item from finite inputs must be
+/// finite ([`representable`]); shape mismatches are `ShapeError`s. Runs on this
+/// thread with the GIL held: for functions that may call Python (user systems' callables); pure
+/// Rust functions use [`par_map_items`].
 pub fn map_items<'py, F>(
     py: Python<'py>,
     inputs: &[Input<'_, 'py>],
@@ -98,92 +279,33 @@ pub fn map_items<'py, F>(
 where
     F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
 {
-    let views: Vec<_> = inputs.iter().map(|i| i.array.as_array()).collect();
-    let mut leads = Vec::with_capacity(inputs.len());
-    for (inp, v) in inputs.iter().zip(&views) {
-        let s = v.shape();
-        let k = inp.item.len();
-        if s.len() < k || s[s.len() - k..] != *inp.item {
-            return Err(to_py(Error::shape(
-                inp.what,
-                expected_str(inp.item),
-                shape_str(s),
-            )));
-        }
-        leads.push(&s[..s.len() - k]);
+    Plan::new(inputs, out_item)?.run(py, &f)
+}
+
+/// [`map_items`] for functions of pure Rust: from [`PAR_MIN`] items on, the items are mapped on
+/// the thread pool with the GIL released (the first error found is raised).
+pub fn par_map_items<'py, F>(
+    py: Python<'py>,
+    inputs: &[Input<'_, 'py>],
+    out_item: &[usize],
+    f: F,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()> + Sync + Send,
+{
+    let plan = Plan::new(inputs, out_item)?;
+    if plan.count < PAR_MIN || plan.out_len == 0 {
+        return plan.run(py, &f);
     }
-    let lead = broadcast(&leads).ok_or_else(|| {
-        let got: Vec<String> = inputs
-            .iter()
-            .zip(&views)
-            .map(|(i, v)| format!("{} {}", i.what, shape_str(v.shape())))
-            .collect();
-        to_py(Error::shape(
-            "inputs",
-            "leading axes that broadcast together",
-            got.join(", "),
-        ))
-    })?;
-    // The one guard of every mapped output: its size is checked and it is allocated fallibly
-    // (a broadcast input of 10¹⁰ items is refused, not an abort of the process).
-    let shape: Vec<usize> = lead.iter().chain(out_item).copied().collect();
-    let names: Vec<&str> = inputs.iter().map(|i| i.what).collect();
-    let mut out = check::zeros(&names.join(", "), &shape).map_err(to_py)?;
-    let count: usize = lead.iter().product();
-    // Every input is read item by item from its broadcast view (no broadcast copy in memory).
-    let mut streams = Vec::with_capacity(inputs.len());
-    for (inp, v) in inputs.iter().zip(&views) {
-        let full: Vec<usize> = lead.iter().chain(inp.item).copied().collect();
-        // Broadcasting to a shape computed from this very input cannot fail.
-        let b = v
-            .broadcast(IxDyn(&full))
-            .ok_or_else(|| to_py(Error::shape(inp.what, shape_str(&full), "")))?;
-        streams.push(b.into_iter());
-    }
-    let mut scratch: Vec<Vec<f64>> = inputs
-        .iter()
-        .map(|i| vec![0.0; i.item.iter().product()])
-        .collect();
-    let out_len: usize = out_item.iter().product();
-    for k in 0..count {
-        for (s, it) in scratch.iter_mut().zip(&mut streams) {
-            // `zip` asks the slice first, so the stream is read by exactly one item.
-            for (x, y) in s.iter_mut().zip(it.by_ref()) {
-                *x = *y;
-            }
-        }
-        let items: Vec<&[f64]> = scratch.iter().map(|s| s.as_slice()).collect();
-        let o = &mut out[k * out_len..(k + 1) * out_len];
-        // The item's index along the leading axes, for errors in a batch.
-        let at = || {
-            let mut r = k;
-            let mut idx = vec![0; lead.len()];
-            for (i, &n) in idx.iter_mut().zip(&lead).rev() {
-                (*i, r) = (r % n, r / n);
-            }
-            idx.iter()
-                .map(|i| i.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        f(&items, o).map_err(|e| {
-            to_py(if count > 1 {
-                e.map_what(|w| match names.contains(&w) {
-                    true => format!("{w}[{}]", at()),
-                    false => format!("{}[{}]: {w}", names.join(", "), at()),
-                })
-            } else {
-                e
-            })
-        })?;
-        let finite = items.iter().all(|s| s.iter().all(|x| x.is_finite()));
-        let at = (count > 1).then(at);
-        representable(&names.join(", "), finite, o, at.as_deref()).map_err(to_py)?;
-    }
-    if shape.is_empty() {
-        return Ok(PyFloat::new(py, out[0]).into_any());
-    }
-    Ok(array(py, &shape, out)?.into_any())
+    let mut out = check::zeros(&plan.names.join(", "), &plan.shape).map_err(to_py)?;
+    py.detach(|| {
+        out.par_chunks_mut(plan.out_len)
+            .with_min_len(PAR_MIN)
+            .enumerate()
+            .try_for_each(|(k, o)| plan.call(k, &f, o))
+    })
+    .map_err(to_py)?;
+    plan.finish(py, out)
 }
 
 /// A numpy array of the given shape from row-major data: a small one copied into an array

@@ -6,13 +6,12 @@ use lieflow::lie::MatrixLieGroup;
 use nalgebra::{Matrix4, Matrix6, Vector3, Vector6};
 use pyo3::prelude::*;
 
-use super::map_pairs;
-use crate::batch::{map_batch, Out};
+use crate::batch::{map_batch, map_pairs, Out};
 use crate::convert::ArrayIn;
 
 /// `se3_hat(xi)`: the 4×4 matrix [[ω̂, v], [0, 0]] of ξ = (ω, v) (so3_hat for ω̂).
 ///
-/// Args: xi — (6,) or (b, 6). Returns (4, 4) or (b, 4, 4). Raises ShapeError, NonFiniteError.
+/// Args: xi — (6,) or (..., 6). Returns (4, 4) or (..., 4, 4). Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn se3_hat<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::hat(x)))
@@ -20,7 +19,7 @@ fn se3_hat<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 
 /// `se3_vee(X)`: the inverse of `se3_hat`, ξ = (ω, v) of X = [[ω̂, v], [0, 0]].
 ///
-/// Args: X — (4, 4) or (b, 4, 4). Returns (6,) or (b, 6). Raises ShapeError, NonFiniteError,
+/// Args: X — (4, 4) or (..., 4, 4). Returns (6,) or (..., 6). Raises ShapeError, NonFiniteError,
 /// NotInGroupError (last row not zero to 1e-12, or the rotation block not skew to 1e-10).
 #[pyfunction]
 #[allow(non_snake_case)]
@@ -32,7 +31,7 @@ fn se3_vee<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// V(ω) = I + ((1 − cos θ)/θ²) ω̂ + ((θ − sin θ)/θ³) ω̂² (the left Jacobian of SO(3)), θ = ‖ω‖;
 /// equal to scipy.linalg.expm([[ω̂, v], [0, 0]]).
 ///
-/// Args: xi — (6,) or (b, 6). Returns (4, 4) or (b, 4, 4). Raises ShapeError, NonFiniteError,
+/// Args: xi — (6,) or (..., 6). Returns (4, 4) or (..., 4, 4). Raises ShapeError, NonFiniteError,
 /// InvalidArgumentError (‖ω‖ > 2.25e14, the rule of so3_exp; a translation beyond the f64 range).
 #[pyfunction]
 fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
@@ -43,7 +42,7 @@ fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// (‖ω‖ ≤ π) and v = V(ω)⁻¹ t. At a rotation angle of π exactly, `strict=False` returns one of the
 /// two logarithms and `strict=True` raises NoUniqueLogError (when π − θ ≤ 1e-12).
 ///
-/// Args: g — (4, 4) or (b, 4, 4). Returns (6,) or (b, 6).
+/// Args: g — (4, 4) or (..., 4, 4). Returns (6,) or (..., 6).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (last row not (0, 0, 0, 1) to 1e-12, or R
 /// not a rotation to 1e-10), NoUniqueLogError (strict only).
 #[pyfunction]
@@ -63,8 +62,8 @@ fn se3_log<'py>(py: Python<'py>, g: ArrayIn<'py>, strict: bool) -> PyResult<Out<
 /// coordinates, so that exp(Ad_g ξ) = g exp(ξ) g⁻¹; without `xi`, its 6×6 matrix
 /// Ad_g = [[R, 0], [t̂ R, R]].
 ///
-/// Args: g — (4, 4) or (b, 4, 4); xi — (6,) or (b, 6) (a single one broadcasts over the other's
-/// batch). Returns (6,) or (b, 6); without xi (6, 6) or (b, 6, 6).
+/// Args: g — (4, 4) or (..., 4, 4); xi — (6,) or (..., 6) (leading axes
+/// broadcast). Returns (6,) or (..., 6); without xi (6, 6) or (..., 6, 6).
 /// Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 #[pyo3(name = "se3_Ad", signature = (g, xi = None))]
@@ -90,7 +89,7 @@ fn se3_adjoint<'py>(
 /// `se3_ad(xi, eta)`: the bracket ad_(ω₁, v₁) (ω₂, v₂) = (ω₁ × ω₂, ω₁ × v₂ − ω₂ × v₁) (the
 /// commutator of the 4×4 matrices).
 ///
-/// Args: xi, eta — (6,) or (b, 6) (a single one broadcasts). Returns (6,) or (b, 6).
+/// Args: xi, eta — (6,) or (..., 6) (leading axes broadcast). Returns (6,) or (..., 6).
 /// Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn se3_ad<'py>(py: Python<'py>, xi: ArrayIn<'py>, eta: ArrayIn<'py>) -> PyResult<Out<'py>> {
@@ -106,7 +105,7 @@ fn se3_ad<'py>(py: Python<'py>, xi: ArrayIn<'py>, eta: ArrayIn<'py>) -> PyResult
 /// `se3_ad_star(xi, mu)`: the coadjoint action ad*_(ω, v) (μ, p) = (μ × ω + p × v, p × ω), the
 /// transpose of ad_ξ under the dot-product pairing.
 ///
-/// Args: xi, mu — (6,) or (b, 6) (a single one broadcasts). Returns (6,) or (b, 6).
+/// Args: xi, mu — (6,) or (..., 6) (leading axes broadcast). Returns (6,) or (..., 6).
 /// Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn se3_ad_star<'py>(py: Python<'py>, xi: ArrayIn<'py>, mu: ArrayIn<'py>) -> PyResult<Out<'py>> {
@@ -121,8 +120,8 @@ fn se3_ad_star<'py>(py: Python<'py>, xi: ArrayIn<'py>, mu: ArrayIn<'py>) -> PyRe
 
 /// `se3_act(g, x)`: the rigid motion of a point, g · x = R x + t.
 ///
-/// Args: g — (4, 4) or (b, 4, 4); x — (3,) or (b, 3) (a single one broadcasts). Returns (3,) or
-/// (b, 3). Raises ShapeError, NonFiniteError, NotInGroupError.
+/// Args: g — (4, 4) or (..., 4, 4); x — (3,) or (..., 3) (leading axes broadcast). Returns
+/// (3,) or (..., 3). Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 fn se3_act<'py>(py: Python<'py>, g: ArrayIn<'py>, x: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_pairs(
@@ -138,7 +137,7 @@ fn se3_act<'py>(py: Python<'py>, g: ArrayIn<'py>, x: ArrayIn<'py>) -> PyResult<O
 /// [[J_l(ω), 0], [Q(ω, v), J_l(ω)]] (Barfoot's Q block), so that
 /// exp(ξ + δ) ≈ exp(J_l(ξ) δ) exp(ξ); with `inverse=True` its inverse.
 ///
-/// Args: xi — (6,) or (b, 6). Returns (6, 6) or (b, 6, 6).
+/// Args: xi — (6,) or (..., 6). Returns (6, 6) or (..., 6, 6).
 /// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at ‖ω‖ = 2πk, k ≥ 1;
 /// ‖ω‖ > 2.25e14, the rule of so3_exp; a Jacobian beyond the f64 range).
 #[pyfunction]
@@ -155,7 +154,7 @@ fn se3_jacobian_left<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> P
 /// `se3_jacobian_right(xi, inverse=False)`: the 6×6 right Jacobian J_r(ξ) = J_l(−ξ), so that
 /// exp(ξ + δ) ≈ exp(ξ) exp(J_r(ξ) δ); with `inverse=True` its inverse.
 ///
-/// Args: xi — (6,) or (b, 6). Returns (6, 6) or (b, 6, 6). Raises as se3_jacobian_left.
+/// Args: xi — (6,) or (..., 6). Returns (6, 6) or (..., 6, 6). Raises as se3_jacobian_left.
 #[pyfunction]
 #[pyo3(signature = (xi, inverse = false))]
 fn se3_jacobian_right<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
@@ -169,7 +168,7 @@ fn se3_jacobian_right<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> 
 
 /// `se3_inverse(g)`: (R, t)⁻¹ = (Rᵀ, −Rᵀ t) as a 4×4 matrix.
 ///
-/// Args: g — (4, 4) or (b, 4, 4). Returns the same shape.
+/// Args: g — (4, 4) or (..., 4, 4). Returns the same shape.
 /// Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 fn se3_inverse<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
@@ -180,9 +179,9 @@ fn se3_inverse<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
 
 /// `se3_compose(g, h)`: the product g·h = (R_g R_h, R_g t_h + t_g) as a 4×4 matrix.
 ///
-/// Args: g, h — (4, 4) or (b, 4, 4); a single matrix is combined with every element of a batch,
-/// two batches must have the same length. Returns (4, 4) or (b, 4, 4).
-/// Raises ShapeError (incl. batch lengths that differ), NonFiniteError, NotInGroupError.
+/// Args: g, h — (4, 4) or (..., 4, 4); leading axes broadcast as numpy's. Returns (4, 4) or
+/// (..., 4, 4). Raises ShapeError (incl. leading axes that do not broadcast), NonFiniteError,
+/// NotInGroupError.
 #[pyfunction]
 fn se3_compose<'py>(py: Python<'py>, g: ArrayIn<'py>, h: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_pairs(

@@ -3,121 +3,97 @@
 
 use lieflow::lie::so::{self, SOn};
 use lieflow::lie::{product, MatrixLieGroup};
-use lieflow::{check, Mat, Result};
-use numpy::ndarray::Array3;
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use lieflow::{check, Error, Mat, Result};
+use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use rayon::prelude::*;
 
 use crate::convert::real;
-use crate::convert::{
-    mat, mats, py_mat, py_mats, py_vec, py_vecs, read_all, vector, vectors, ArrayIn,
-};
+use crate::convert::{mat, py_mat, py_vec, shape_str, vector, ArrayIn};
 use crate::errors::IntoPy;
+use crate::items::{par_map_items, Input};
 
-/// Applies `f` to one matrix or to a batch (b, n, n). A batch is copied once into a contiguous
-/// buffer, then converted, mapped and written to the output in parallel (rayon) with the GIL
-/// released. Returns an (n, n) or (b, n, n) array.
+/// The item shape (r, c) of an array of matrices (..., r, c).
+fn matrix_item(what: &str, a: &ArrayIn<'_>) -> PyResult<[usize; 2]> {
+    let s = a.as_array().shape().to_vec();
+    let [.., r, c] = s[..] else {
+        return Err(Error::shape(what, "(n, n) or (..., n, n)", shape_str(&s))).py();
+    };
+    check::dense_size(what, r, c).py()?;
+    Ok([r, c])
+}
+
+/// Applies `f` to every matrix of an array (..., n, n) (`items::par_map_items`).
 fn map_mats<'py>(
     py: Python<'py>,
     what: &str,
     a: &ArrayIn<'py>,
     f: fn(&Mat) -> Result<Mat>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let v = a.as_array();
-    if v.ndim() != 3 {
-        let x = mat(what, a)?;
-        let y = f(&x).py()?;
-        let entries = |m: &Mat| -> Vec<f64> {
-            (0..m.nrows())
-                .flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)]))
-                .collect()
-        };
-        let finite = entries(&x).iter().all(|v| v.is_finite());
-        crate::items::representable(what, finite, &entries(&y), None).py()?;
-        return Ok(py_mat(py, &y).into_any());
+    let [r, c] = matrix_item(what, a)?;
+    par_map_items(py, &[Input::new(what, a, &[r, c])], &[r, c], |x, out| {
+        store(&f(&Mat::from_fn(r, c, |i, j| x[0][i * c + j]))?, out);
+        Ok(())
+    })
+}
+
+/// A matrix into row-major `out`.
+fn store(m: &Mat, out: &mut [f64]) {
+    let c = m.ncols();
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = m[(k / c, k % c)];
     }
-    let (b, r, c) = (v.shape()[0], v.shape()[1], v.shape()[2]);
-    if r * c == 0 {
-        // Let the core report the shape error of an empty matrix.
-        f(&Mat::zeros(r, c)).py()?;
-    }
-    let data = read_all(what, &v)?;
-    let mut out = check::zeros(what, v.shape()).py()?;
-    let out = py
-        .detach(|| -> Result<Vec<f64>> {
-            if b > 0 {
-                out.par_chunks_mut(r * c)
-                    .zip(data.par_chunks(r * c))
-                    .try_for_each(|(o, x)| {
-                        let y = f(&Mat::from_fn(r, c, |i, j| x[i * c + j]))?;
-                        for i in 0..r {
-                            for j in 0..c {
-                                o[i * c + j] = y[(i, j)];
-                            }
-                        }
-                        let finite = x.iter().all(|v| v.is_finite());
-                        crate::items::representable(what, finite, o, None)
-                    })?;
-            }
-            Ok(out)
-        })
-        .py()?;
-    let arr = Array3::from_shape_vec((b, r, c), out)
-        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
-    Ok(arr.into_pyarray(py).into_any())
 }
 
 /// `so_hat(c)` (alias `hat_n`): the skew-symmetric matrix with coordinates `c` in the e_ij basis (i < j, +1 at (i, j), −1 at
 /// (j, i)), ordered (1,2), (1,3), …, (1,n), (2,3), …, (n−1,n).
 ///
 /// Args:
-///     c: shape (d,) with d = n(n−1)/2 for some n ≥ 2, or a batch (b, d).
+///     c: shape (d,) with d = n(n−1)/2 for some n ≥ 2, or (..., d).
 /// Returns:
-///     xi: shape (n, n), or (b, n, n) for a batch.
+///     xi: shape (n, n), or (..., n, n).
 /// Raises:
 ///     ShapeError: d is not of the form n(n−1)/2. NonFiniteError: NaN or inf in c.
 #[pyfunction]
 fn so_hat<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
-    let (cs, batched) = vectors("c", &c)?;
-    // The (b, n, n) output is larger than the (b, d) input: check its size first.
-    let first = cs.first().map(|v| so::hat_n(v)).transpose().py()?;
-    let (rows, cols) = first.as_ref().map_or((0, 0), |m| (m.nrows(), m.ncols()));
-    check::array_size("c", &[cs.len(), rows, cols]).py()?;
-    let out = cs
-        .iter()
-        .map(|v| so::hat_n(v))
-        .collect::<Result<Vec<Mat>>>()
-        .py()?;
-    if batched {
-        Ok(py_mats(py, "c", &out)?.into_any())
-    } else {
-        Ok(py_mat(py, &out[0]).into_any())
+    let shape = c.as_array().shape().to_vec();
+    let d = *shape.last().unwrap_or(&0);
+    // n from d first: the output item (n, n) is part of the rule's size check.
+    let n = so::n_from_dim(d).unwrap_or(0);
+    if n == 0 || shape.is_empty() {
+        return Err(Error::shape(
+            "c",
+            "(..., d) with d = n(n−1)/2 for some n ≥ 2 (1, 3, 6, 10, …)",
+            shape_str(&shape),
+        ))
+        .py();
     }
+    par_map_items(py, &[Input::finite("c", &c, &[d])], &[n, n], |x, out| {
+        store(&so::hat_n_unchecked(n, x[0]), out);
+        Ok(())
+    })
 }
 
 /// `so_vee(xi)` (alias `vee_n`): the coordinates of a skew-symmetric matrix in the e_ij basis
 /// (the inverse of `so_hat`).
 ///
 /// Args:
-///     xi: shape (n, n), skew-symmetric (relative defect ‖ξ + ξᵀ‖ ≤ 1e-10), or a batch (b, n, n).
+///     xi: shape (n, n), skew-symmetric (relative defect ‖ξ + ξᵀ‖ ≤ 1e-10), or (..., n, n).
 /// Returns:
-///     c: shape (n(n−1)/2,), or (b, n(n−1)/2).
+///     c: shape (n(n−1)/2,), or (..., n(n−1)/2).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (not skew).
 #[pyfunction]
 fn so_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
-    let (ms, batched) = mats("xi", &xi)?;
-    let out = ms
-        .iter()
-        .map(so::vee_n)
-        .collect::<Result<Vec<Vec<f64>>>>()
-        .py()?;
-    if batched {
-        Ok(py_vecs(py, "xi", &out)?.into_any())
-    } else {
-        Ok(py_vec(py, &out[0]).into_any())
-    }
+    let [r, c] = matrix_item("xi", &xi)?;
+    par_map_items(
+        py,
+        &[Input::new("xi", &xi, &[r, c])],
+        &[so::dim(r)],
+        |x, out| {
+            out.copy_from_slice(&so::vee_n(&Mat::from_fn(r, c, |i, j| x[0][i * c + j]))?);
+            Ok(())
+        },
+    )
 }
 
 /// Exponential map so(n) → SO(n).
@@ -128,9 +104,9 @@ fn so_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>>
 /// thread and size, so repeated calls cost the same.
 ///
 /// Args:
-///     xi: skew matrix (n, n), or a batch (b, n, n) computed in parallel without the GIL.
+///     xi: skew matrix (n, n), or (..., n, n) (many computed in parallel without the GIL).
 /// Returns:
-///     R: shape (n, n) or (b, n, n), in SO(n).
+///     R: shape (n, n) or (..., n, n), in SO(n).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (xi not skew),
 ///     InvalidArgumentError (‖ξ‖ > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of
@@ -143,10 +119,10 @@ fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>>
 /// Principal logarithm SO(n) → so(n) (all rotation angles in [0, π)).
 ///
 /// Args:
-///     R: rotation (n, n) (‖RᵀR − I‖_F ≤ 1e-10, det R > 0), or a batch (b, n, n) computed in
-///         parallel without the GIL.
+///     R: rotation (n, n) (‖RᵀR − I‖_F ≤ 1e-10, det R > 0), or (..., n, n) (many
+///         computed in parallel without the GIL).
 /// Returns:
-///     xi: skew matrix (n, n) or (b, n, n) with so_exp(xi) = R.
+///     xi: skew matrix (n, n) or (..., n, n) with so_exp(xi) = R.
 /// Raises:
 ///     NotInGroupError: R not a rotation (the message gives ‖RᵀR − I‖_F and det R).
 ///     NoUniqueLogError: a rotation angle within 1e-12 of π, for every n (π within round-off;
@@ -338,9 +314,9 @@ fn so_compose<'py>(
 /// `so_inverse(R)`: R⁻¹ = Rᵀ.
 ///
 /// Args:
-///     R: rotation (n, n), or a batch (b, n, n).
+///     R: rotation (n, n), or (..., n, n).
 /// Returns:
-///     rotation (n, n) or (b, n, n).
+///     rotation (n, n) or (..., n, n).
 /// Raises:
 ///     NotInGroupError, ShapeError, NonFiniteError.
 #[pyfunction]

@@ -6,14 +6,13 @@ use lieflow::lie::MatrixLieGroup;
 use nalgebra::{Matrix3, Vector3};
 use pyo3::prelude::*;
 
-use super::map_pairs;
-use crate::batch::{map_batch, Out};
+use crate::batch::{map_batch, map_pairs, Out};
 use crate::convert::ArrayIn;
 
 /// `so3_hat(w)` (alias `hat`): the skew matrix ŵ with ŵ x = w × x (physics convention, 000 §3.3 corrected):
 /// ŵ = [[0, −w3, w2], [w3, 0, −w1], [−w2, w1, 0]].
 ///
-/// Args: w — shape (3,) or a batch (b, 3). Returns (3, 3) or (b, 3, 3).
+/// Args: w — shape (3,) or (..., 3). Returns (3, 3) or (..., 3, 3).
 /// Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn so3_hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
@@ -22,7 +21,7 @@ fn so3_hat<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 
 /// `so3_vee(xi)` (alias `vee`): the inverse of `so3_hat`, w with ŵ = xi.
 ///
-/// Args: xi — a skew-symmetric (3, 3) matrix or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Args: xi — a skew-symmetric (3, 3) matrix or (..., 3, 3). Returns (3,) or (..., 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (xi not skew: relative defect
 /// ‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F) > 1e-10).
 #[pyfunction]
@@ -33,7 +32,7 @@ fn so3_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// `so3_exp(w)`: the rotation exp(ŵ) by Rodrigues' formula
 /// R = I + (sin θ/θ) ŵ + ((1 − cos θ)/θ²) ŵ², θ = ‖w‖ (rotation by θ about w/θ).
 ///
-/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError,
+/// Args: w — (3,) or (..., 3). Returns (3, 3) or (..., 3, 3). Raises ShapeError, NonFiniteError,
 /// InvalidArgumentError (‖w‖ > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of the angle is
 /// lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
@@ -48,7 +47,7 @@ fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// (the one whose component at the largest diagonal entry of R is positive); with `strict=True`
 /// NoUniqueLogError is raised when π − θ ≤ 1e-12.
 ///
-/// Args: R — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Args: R — a rotation (3, 3) or (..., 3, 3). Returns (3,) or (..., 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or abs(det R − 1) > 1e-10),
 /// NoUniqueLogError (strict only).
 #[pyfunction]
@@ -69,7 +68,7 @@ fn so3_log<'py>(py: Python<'py>, R: ArrayIn<'py>, strict: bool) -> PyResult<Out<
 /// a rotation about w by the angle 2·atan(‖w‖/2) (agrees with exp to second order); defined and
 /// computed scale-safely for every finite w (the angle tends to π as ‖w‖ → ∞).
 ///
-/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3). Raises ShapeError, NonFiniteError.
+/// Args: w — (3,) or (..., 3). Returns (3, 3) or (..., 3, 3). Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn so3_cayley<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "w", &w, |w: &Vector3<f64>| Ok(so3::cayley(w)))
@@ -77,7 +76,7 @@ fn so3_cayley<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 
 /// `so3_cayley_inv(R)`: the inverse Cayley map, w = 2·vee(R − Rᵀ)/(1 + tr R).
 ///
-/// Args: R — a rotation (3, 3) or a batch (b, 3, 3). Returns (3,) or (b, 3).
+/// Args: R — a rotation (3, 3) or (..., 3, 3). Returns (3,) or (..., 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (rotation by π:
 /// 1 + tr R ≤ 1e-12, where R + I is singular).
 #[pyfunction]
@@ -104,7 +103,7 @@ fn jacobian<'py>(
 /// exp(w + δ) ≈ exp(w) exp(J_r(w) δ); with `inverse=True` its inverse
 /// J_r⁻¹ = I + ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
 ///
-/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
+/// Args: w — (3,) or (..., 3). Returns (3, 3) or (..., 3, 3).
 /// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at ‖w‖ = 2πk, k ≥ 1;
 /// ‖w‖ > 2.25e14, the rule of so3_exp).
 #[pyfunction]
@@ -124,7 +123,7 @@ fn so3_jacobian_right<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> P
 /// exp(w + δ) ≈ exp(J_l(w) δ) exp(w); with `inverse=True` its inverse
 /// J_l⁻¹ = I − ŵ/2 + (1/θ² − (1 + cos θ)/(2θ sin θ)) ŵ².
 ///
-/// Args: w — (3,) or (b, 3). Returns (3, 3) or (b, 3, 3).
+/// Args: w — (3,) or (..., 3). Returns (3, 3) or (..., 3, 3).
 /// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at ‖w‖ = 2πk, k ≥ 1;
 /// ‖w‖ > 2.25e14, the rule of so3_exp).
 #[pyfunction]
@@ -135,8 +134,7 @@ fn so3_jacobian_left<'py>(py: Python<'py>, w: ArrayIn<'py>, inverse: bool) -> Py
 
 /// `so3_compose(R1, R2)`: the product R1 @ R2 of two rotations.
 ///
-/// Args: R1, R2 — (3, 3) or (b, 3, 3); a single rotation is combined with every element of a
-/// batch, two batches must have the same length. Returns (3, 3) or (b, 3, 3).
+/// Args: R1, R2 — (3, 3) or (..., 3, 3); leading axes broadcast as numpy's. Returns (3, 3) or (..., 3, 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or abs(det R − 1) > 1e-10).
 #[pyfunction]
 #[allow(non_snake_case)]
@@ -155,7 +153,7 @@ fn so3_compose<'py>(py: Python<'py>, R1: ArrayIn<'py>, R2: ArrayIn<'py>) -> PyRe
 
 /// `so3_inverse(R)`: R⁻¹ = Rᵀ.
 ///
-/// Args: R — (3, 3) or (b, 3, 3). Returns the same shape.
+/// Args: R — (3, 3) or (..., 3, 3). Returns the same shape.
 /// Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 #[allow(non_snake_case)]
@@ -167,8 +165,8 @@ fn so3_inverse<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Out<'py>> {
 
 /// `so3_act(R, x)`: the rotated vector R x.
 ///
-/// Args: R — (3, 3) or (b, 3, 3); x — (3,) or (b, 3) (a single one broadcasts over the other's
-/// batch). Returns (3,) or (b, 3). Raises ShapeError, NonFiniteError, NotInGroupError.
+/// Args: R — (3, 3) or (..., 3, 3); x — (3,) or (..., 3) (leading axes
+/// broadcast). Returns (3,) or (..., 3). Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 #[allow(non_snake_case)]
 fn so3_act<'py>(py: Python<'py>, R: ArrayIn<'py>, x: ArrayIn<'py>) -> PyResult<Out<'py>> {
@@ -183,8 +181,8 @@ fn so3_act<'py>(py: Python<'py>, R: ArrayIn<'py>, x: ArrayIn<'py>) -> PyResult<O
 
 /// `so3_Ad(R, w)`: the adjoint action Ad_R w = R w (R ŵ Rᵀ = (R w)^).
 ///
-/// Args: R — (3, 3) or (b, 3, 3); w — (3,) or (b, 3) (broadcast as in so3_act). Returns (3,) or
-/// (b, 3). Raises ShapeError, NonFiniteError, NotInGroupError.
+/// Args: R — (3, 3) or (..., 3, 3); w — (3,) or (..., 3) (broadcast as in so3_act). Returns (3,) or
+/// (..., 3). Raises ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 #[pyo3(name = "so3_Ad")]
 #[allow(non_snake_case)]
@@ -200,7 +198,7 @@ fn so3_adjoint<'py>(py: Python<'py>, R: ArrayIn<'py>, w: ArrayIn<'py>) -> PyResu
 
 /// `so3_ad(u, v)`: the bracket ad_u v = u × v ([û, v̂] = (u × v)^).
 ///
-/// Args: u, v — (3,) or (b, 3) (a single one broadcasts). Returns (3,) or (b, 3).
+/// Args: u, v — (3,) or (..., 3) (leading axes broadcast). Returns (3,) or (..., 3).
 /// Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn so3_ad<'py>(py: Python<'py>, u: ArrayIn<'py>, v: ArrayIn<'py>) -> PyResult<Out<'py>> {
@@ -216,7 +214,7 @@ fn so3_ad<'py>(py: Python<'py>, u: ArrayIn<'py>, v: ArrayIn<'py>) -> PyResult<Ou
 /// `so3_ad_star(xi, mu)`: the coadjoint action ad*_ξ μ = μ × ξ, so that
 /// ⟨ad*_ξ μ, η⟩ = ⟨μ, ξ × η⟩ (dot-product pairing; 000 §3.3).
 ///
-/// Args: xi, mu — (3,) or (b, 3) (a single one broadcasts). Returns (3,) or (b, 3).
+/// Args: xi, mu — (3,) or (..., 3) (leading axes broadcast). Returns (3,) or (..., 3).
 /// Raises ShapeError, NonFiniteError.
 #[pyfunction]
 fn so3_ad_star<'py>(py: Python<'py>, xi: ArrayIn<'py>, mu: ArrayIn<'py>) -> PyResult<Out<'py>> {
