@@ -1,6 +1,8 @@
 # Type stubs for lieflow.pseudo_rigid (bindings of lieflow::pseudo_rigid, 001).
 # so(n) elements are skew (n, n) arrays; matrices on so(n) + so(n) use the e_ij basis with the
-# xi block first.
+# xi block first. Every function of arrays except stratum, reduce and adjoint_motion maps over
+# leading axes that broadcast as numpy's: a scalar result is a float for one item, an array
+# for many.
 from typing import Any, Literal, TypedDict
 
 from typing_extensions import final
@@ -50,7 +52,7 @@ def bi_inertia_solve(X: ArrayLike, lam: ArrayLike, gam: ArrayLike) -> tuple[_F64
 def bi_inertia_eigen(X: ArrayLike) -> tuple[_F64, _F64]:
     """Eigenvalues (non-decreasing) and eigenvectors (columns) of B_X (001 (8.14)-(8.15))."""
 
-def bi_inertia_quadratic_form(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> float:
+def bi_inertia_quadratic_form(X: ArrayLike, xi: ArrayLike, eta: ArrayLike) -> float | _F64:
     """<xi + eta, B_X(xi + eta)> in SVD coordinates (001 (6.14))."""
 
 def left_connection(X: ArrayLike, Y: ArrayLike) -> _F64:
@@ -85,7 +87,7 @@ def from_body(
 ) -> tuple[_F64, _F64]:
     """(X, V) from body coordinates (001 §4.1)."""
 
-def kinetic_energy(X: ArrayLike, V: ArrayLike) -> float:
+def kinetic_energy(X: ArrayLike, V: ArrayLike) -> float | _F64:
     """tr(V^T V) / 2 (001 (3.2), (4.5), (6.28))."""
 
 def stratum(X: ArrayLike, tol: float = 1e-8) -> _StratumInfo:
@@ -96,7 +98,7 @@ def riemann_variables(X: ArrayLike, V: ArrayLike) -> tuple[_F64, _F64]:
 
 def riemann_bracket(
     Q: ArrayLike, N: ArrayLike, dfdQ: ArrayLike, dfdN: ArrayLike, dgdQ: ArrayLike, dgdN: ArrayLike
-) -> float:
+) -> float | _F64:
     """Poisson bracket of functions of (Q, N) (001 (9.1))."""
 
 class _Reduced(TypedDict):

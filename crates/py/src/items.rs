@@ -103,7 +103,7 @@ fn broadcast(shapes: &[&[usize]]) -> Option<Vec<usize>> {
 }
 
 /// The most inputs one mapped function takes.
-const MAX_INPUTS: usize = 4;
+const MAX_INPUTS: usize = 6;
 
 /// The number of items from which [`par_map_items`] runs on the thread pool.
 const PAR_MIN: usize = 256;
@@ -114,7 +114,8 @@ const PAR_MIN: usize = 256;
 struct Plan<'a> {
     names: Vec<&'a str>,
     lead: Vec<usize>,
-    shape: Vec<usize>,
+    /// The item shapes of the outputs; an item's outputs are written one after another.
+    outs: Vec<&'a [usize]>,
     count: usize,
     out_len: usize,
     data: Vec<Vec<f64>>,
@@ -124,7 +125,7 @@ struct Plan<'a> {
 }
 
 impl<'a> Plan<'a> {
-    fn new(inputs: &[Input<'a, '_>], out_item: &[usize]) -> PyResult<Self> {
+    fn new(inputs: &[Input<'a, '_>], outs: &[&'a [usize]]) -> PyResult<Self> {
         assert!(
             inputs.len() <= MAX_INPUTS,
             "at most {MAX_INPUTS} mapped inputs"
@@ -158,8 +159,15 @@ impl<'a> Plan<'a> {
         let names: Vec<&str> = inputs.iter().map(|i| i.what).collect();
         // The one guard of every mapped output: its size is checked before it is allocated
         // (a broadcast input of 10¹⁰ items is refused, not an abort of the process).
-        let shape: Vec<usize> = lead.iter().chain(out_item).copied().collect();
-        check::array_size(&names.join(", "), &shape).map_err(to_py)?;
+        let out_len: usize = outs.iter().map(|o| o.iter().product::<usize>()).sum();
+        let count: usize = lead.iter().product();
+        for shape in outs
+            .iter()
+            .map(|o| lead.iter().chain(*o).copied().collect::<Vec<_>>())
+            .chain([vec![count, out_len]])
+        {
+            check::array_size(&names.join(", "), &shape).map_err(to_py)?;
+        }
         let mut data = Vec::with_capacity(inputs.len());
         let mut strides = Vec::with_capacity(inputs.len());
         for ((inp, v), l) in inputs.iter().zip(&views).zip(&leads) {
@@ -177,10 +185,10 @@ impl<'a> Plan<'a> {
         }
         Ok(Plan {
             names,
-            count: lead.iter().product(),
-            out_len: out_item.iter().product(),
+            count,
+            out_len,
             lead,
-            shape,
+            outs: outs.to_vec(),
             data,
             items: inputs.iter().map(|i| i.item).collect(),
             finite: inputs.iter().map(|i| i.finite).collect(),
@@ -243,7 +251,7 @@ impl<'a> Plan<'a> {
     where
         F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
     {
-        let mut out = check::zeros(&self.names.join(", "), &self.shape).map_err(to_py)?;
+        let mut out = self.buffer()?;
         for k in 0..self.count {
             let o = &mut out[k * self.out_len..(k + 1) * self.out_len];
             self.call(k, f, o).map_err(to_py)?;
@@ -251,13 +259,42 @@ impl<'a> Plan<'a> {
         self.finish(py, out)
     }
 
-    /// The output as numpy returns it: an array (...lead, ...out_item), or a Python float when
-    /// that shape is () (one scalar-valued item, like numpy's scalar results).
+    /// The buffer of every item's outputs (sizes checked in [`Plan::new`]).
+    fn buffer(&self) -> PyResult<Vec<f64>> {
+        check::zeros(&self.names.join(", "), &[self.count, self.out_len]).map_err(to_py)
+    }
+
+    /// The outputs as numpy returns them: an array (...lead, ...out item) each, or a Python float
+    /// where that shape is () (one scalar-valued item, like numpy's scalar results); one output
+    /// alone, several as a tuple.
     fn finish<'py>(self, py: Python<'py>, out: Vec<f64>) -> PyResult<Bound<'py, PyAny>> {
-        if self.shape.is_empty() {
-            return Ok(PyFloat::new(py, out[0]).into_any());
+        let one = |shape: Vec<usize>, data: Vec<f64>| -> PyResult<Bound<'py, PyAny>> {
+            match shape.is_empty() {
+                true => Ok(PyFloat::new(py, data[0]).into_any()),
+                false => Ok(array(py, &shape, data)?.into_any()),
+            }
+        };
+        let shape = |o: &[usize]| self.lead.iter().chain(o).copied().collect::<Vec<_>>();
+        if let [o] = self.outs[..] {
+            return one(shape(o), out);
         }
-        Ok(array(py, &self.shape, out)?.into_any())
+        let mut parts = Vec::with_capacity(self.outs.len());
+        let mut at = 0;
+        for o in &self.outs {
+            let len: usize = o.iter().product();
+            let mut data =
+                check::zeros(&self.names.join(", "), &[self.count, len]).map_err(to_py)?;
+            for (k, d) in data
+                .chunks_exact_mut(len.max(1))
+                .enumerate()
+                .take(self.count)
+            {
+                d.copy_from_slice(&out[k * self.out_len + at..k * self.out_len + at + len]);
+            }
+            parts.push(one(shape(o), data)?);
+            at += len;
+        }
+        Ok(pyo3::types::PyTuple::new(py, parts)?.into_any())
     }
 }
 
@@ -279,7 +316,7 @@ pub fn map_items<'py, F>(
 where
     F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
 {
-    Plan::new(inputs, out_item)?.run(py, &f)
+    Plan::new(inputs, &[out_item])?.run(py, &f)
 }
 
 /// [`map_items`] for functions of pure Rust: from [`PAR_MIN`] items on, the items are mapped on
@@ -293,11 +330,25 @@ pub fn par_map_items<'py, F>(
 where
     F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()> + Sync + Send,
 {
-    let plan = Plan::new(inputs, out_item)?;
+    par_map_items_n(py, inputs, &[out_item], f)
+}
+
+/// [`par_map_items`] for functions of several outputs, of item shapes `outs`: `f` writes an
+/// item's outputs one after another into `out`; returns the tuple of the arrays.
+pub fn par_map_items_n<'py, F>(
+    py: Python<'py>,
+    inputs: &[Input<'_, 'py>],
+    outs: &[&[usize]],
+    f: F,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()> + Sync + Send,
+{
+    let plan = Plan::new(inputs, outs)?;
     if plan.count < PAR_MIN || plan.out_len == 0 {
         return plan.run(py, &f);
     }
-    let mut out = check::zeros(&plan.names.join(", "), &plan.shape).map_err(to_py)?;
+    let mut out = plan.buffer()?;
     py.detach(|| {
         out.par_chunks_mut(plan.out_len)
             .with_min_len(PAR_MIN)
@@ -306,6 +357,20 @@ where
     })
     .map_err(to_py)?;
     plan.finish(py, out)
+}
+
+/// The item shape (r, c) of an array of matrices (..., r, c).
+pub fn matrix_item(what: &str, a: &ArrayIn<'_>) -> PyResult<[usize; 2]> {
+    let s = a.as_array().shape().to_vec();
+    let [.., r, c] = s[..] else {
+        return Err(to_py(Error::shape(
+            what,
+            "(n, n) or (..., n, n)",
+            shape_str(&s),
+        )));
+    };
+    check::dense_size(what, r, c).map_err(to_py)?;
+    Ok([r, c])
 }
 
 /// A numpy array of the given shape from row-major data: a small one copied into an array

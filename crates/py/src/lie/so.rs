@@ -10,17 +10,7 @@ use pyo3::prelude::*;
 use crate::convert::real;
 use crate::convert::{mat, py_mat, py_vec, shape_str, vector, ArrayIn};
 use crate::errors::IntoPy;
-use crate::items::{par_map_items, Input};
-
-/// The item shape (r, c) of an array of matrices (..., r, c).
-fn matrix_item(what: &str, a: &ArrayIn<'_>) -> PyResult<[usize; 2]> {
-    let s = a.as_array().shape().to_vec();
-    let [.., r, c] = s[..] else {
-        return Err(Error::shape(what, "(n, n) or (..., n, n)", shape_str(&s))).py();
-    };
-    check::dense_size(what, r, c).py()?;
-    Ok([r, c])
-}
+use crate::items::{matrix_item, par_map_items, Input};
 
 /// Applies `f` to every matrix of an array (..., n, n) (`items::par_map_items`).
 fn map_mats<'py>(

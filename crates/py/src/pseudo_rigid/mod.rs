@@ -1,6 +1,12 @@
 //! `lieflow.pseudo_rigid`: bindings of `lieflow::pseudo_rigid` (001: generalized pseudo-rigid
 //! bodies on GL+(n)). Conversions only; every formula lives in the core crate.
 //!
+//! Every function of arrays follows the one vectorisation rule of the bindings (`crate::items`):
+//! its arguments may carry leading axes, which broadcast as numpy's ((..., n, n) for a matrix,
+//! (..., n) for a vector), and its results carry the broadcast leading axes; n is read from the
+//! first argument. `stratum` and `reduce` (dictionaries) and `adjoint_motion` (a trajectory) take
+//! one item.
+//!
 //! Conventions: so(n) elements are skew (n, n) arrays; matrices on so(n) + so(n) are in the e_ij
 //! basis (i < j, row by row) with the xi block first; pairing <xi, eta> = tr(xi.T @ eta) / 2.
 #![allow(non_snake_case)]
@@ -15,33 +21,115 @@ use lieflow::lie::gl::STRATUM_TOL;
 use lieflow::pseudo_rigid::{
     connection as cn, momentum as mo, riemann, strata, Action, BiInertia, Body,
 };
-use lieflow::Mat;
-use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::real;
-use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
+use crate::convert::{mat, py_mat, py_vec, ArrayIn};
 use crate::errors::IntoPy;
+use crate::items::{matrix_item, par_map_items_n, Input};
 
-type Arr2<'py> = Bound<'py, PyArray2<f64>>;
-type Arr1<'py> = Bound<'py, PyArray1<f64>>;
+type Any<'py> = Bound<'py, PyAny>;
 
-fn at(X: &ArrayIn<'_>) -> PyResult<BiInertia> {
-    BiInertia::new(&mat("X", X)?).py()
+/// The kinds of item of the functions of this module, with n read from the first argument
+/// (..., n, n).
+#[derive(Clone, Copy)]
+enum Kind {
+    /// (n, n).
+    Mat,
+    /// (n,).
+    Vector,
+    /// ().
+    Scalar,
+    /// A matrix on so(n) + so(n): (n(n−1), n(n−1)).
+    Dense,
+    /// (n(n−1),).
+    DenseVector,
+    /// A matrix on one so(n): (n(n−1)/2, n(n−1)/2).
+    Half,
+}
+use Kind::*;
+
+impl Kind {
+    fn shape(self, n: usize) -> Vec<usize> {
+        let d = n * n.saturating_sub(1);
+        match self {
+            Mat => vec![n, n],
+            Vector => vec![n],
+            Scalar => vec![],
+            Dense => vec![d, d],
+            DenseVector => vec![d],
+            Half => vec![d / 2, d / 2],
+        }
+    }
 }
 
-/// [`at`] for the functions that return a dense n(n−1)×n(n−1) matrix: refuses sizes that cannot
-/// be allocated (an abort would take the Python process down) with InvalidArgumentError.
-fn at_dense(X: &ArrayIn<'_>) -> PyResult<BiInertia> {
-    let b = at(X)?;
-    let d = b.n() * (b.n() - 1);
-    lieflow::check::dense_size("X", d, d).py()?;
-    Ok(b)
+/// The functions of this module under the one vectorisation rule (`crate::items`): `f(n, items,
+/// out)` on every item of the arguments (name, array, kind), whose leading axes broadcast, n from
+/// the first argument (..., n, n); the outputs of kinds `outs` are written one after another into
+/// `out` (one array, or a tuple of them).
+fn map<'py, F>(
+    py: Python<'py>,
+    args: &[(&str, &ArrayIn<'py>, Kind)],
+    outs: &[Kind],
+    f: F,
+) -> PyResult<Any<'py>>
+where
+    F: Fn(usize, &[&[f64]], &mut [f64]) -> lieflow::Result<()> + Sync + Send,
+{
+    let [n, _] = matrix_item(args[0].0, args[0].1)?;
+    if outs.iter().any(|o| matches!(o, Dense)) {
+        dense_fits(args[0].1)?;
+    }
+    let items: Vec<Vec<usize>> = args.iter().map(|a| a.2.shape(n)).collect();
+    let outs: Vec<Vec<usize>> = outs.iter().map(|o| o.shape(n)).collect();
+    let inputs: Vec<Input> = args
+        .iter()
+        .zip(&items)
+        .map(|(a, item)| Input::new(a.0, a.1, item))
+        .collect();
+    let outs: Vec<&[usize]> = outs.iter().map(Vec::as_slice).collect();
+    par_map_items_n(py, &inputs, &outs, |x, out| f(n, x, out))
 }
 
-fn pair<'py>(py: Python<'py>, (a, b): (Mat, Mat)) -> (Arr2<'py>, Arr2<'py>) {
-    (py_mat(py, &a), py_mat(py, &b))
+/// For the functions that form a dense n(n−1)×n(n−1) matrix: refuses sizes that cannot be
+/// allocated (an abort would take the Python process down) with InvalidArgumentError.
+fn dense_fits(X: &ArrayIn<'_>) -> PyResult<()> {
+    let [n, _] = matrix_item("X", X)?;
+    let d = n * n.saturating_sub(1);
+    lieflow::check::dense_size("X", d, d).py()
+}
+
+/// An (n, n) item as a matrix.
+fn m(n: usize, x: &[f64]) -> lieflow::Mat {
+    lieflow::Mat::from_fn(n, n, |i, j| x[i * n + j])
+}
+
+/// The bi-inertia tensor at the item X.
+fn bi(n: usize, x: &[f64]) -> lieflow::Result<BiInertia> {
+    BiInertia::new(&m(n, x))
+}
+
+/// Matrices written row-major one after another; a result of another size than the output
+/// item is an error (never a panic).
+fn put(out: &mut [f64], mats: &[&lieflow::Mat]) -> lieflow::Result<()> {
+    let len: usize = mats.iter().map(|a| a.nrows() * a.ncols()).sum();
+    if len != out.len() {
+        return Err(lieflow::Error::invalid(
+            "result",
+            format!("{len} entries where the output item has {}", out.len()),
+        ));
+    }
+    let mut k = 0;
+    for a in mats {
+        for i in 0..a.nrows() {
+            for j in 0..a.ncols() {
+                out[k] = a[(i, j)];
+                k += 1;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Left inertia tensor A^L_X(xi) = X X^T xi + xi X X^T (001 (2.11)).
@@ -53,12 +141,13 @@ fn pair<'py>(py: Python<'py>, (a, b): (Mat, Mat)) -> (Arr2<'py>, Arr2<'py>) {
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0 or xi not skew).
 #[pyfunction]
-pub fn left_inertia<'py>(
-    py: Python<'py>,
-    X: ArrayIn<'py>,
-    xi: ArrayIn<'py>,
-) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(py, &at(&X)?.left(&mat("xi", &xi)?).py()?))
+pub fn left_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, xi: ArrayIn<'py>) -> PyResult<Any<'py>> {
+    map(
+        py,
+        &[("X", &X, Mat), ("xi", &xi, Mat)],
+        &[Mat],
+        |n, x, out| put(out, &[&bi(n, x[0])?.left(&m(n, x[1]))?]),
+    )
 }
 
 /// Right inertia tensor A^R_X(xi) = X^T X xi + xi X^T X (001 (2.11)).
@@ -69,8 +158,13 @@ pub fn right_inertia<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
     xi: ArrayIn<'py>,
-) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(py, &at(&X)?.right(&mat("xi", &xi)?).py()?))
+) -> PyResult<Any<'py>> {
+    map(
+        py,
+        &[("X", &X, Mat), ("xi", &xi, Mat)],
+        &[Mat],
+        |n, x, out| put(out, &[&bi(n, x[0])?.right(&m(n, x[1]))?]),
+    )
 }
 
 /// The bi-inertia tensor B_X (001 (6.9)) as an (n(n-1), n(n-1)) matrix in the e_ij basis, xi
@@ -80,8 +174,10 @@ pub fn right_inertia<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
 #[pyfunction]
-pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(py, &at_dense(&X)?.try_matrix().py()?))
+pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Any<'py>> {
+    map(py, &[("X", &X, Mat)], &[Dense], |n, x, out| {
+        put(out, &[&bi(n, x[0])?.try_matrix()?])
+    })
 }
 
 /// B_X(xi + eta) = (A^L_X xi - 2 X eta X^T, -2 X^T xi X + A^R_X eta) (001 (6.9), (6.10)).
@@ -96,9 +192,12 @@ pub fn bi_inertia_apply<'py>(
     X: ArrayIn<'py>,
     xi: ArrayIn<'py>,
     eta: ArrayIn<'py>,
-) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
-    let r = at(&X)?.apply(&mat("xi", &xi)?, &mat("eta", &eta)?).py()?;
-    Ok(pair(py, r))
+) -> PyResult<Any<'py>> {
+    let args = [("X", &X, Mat), ("xi", &xi, Mat), ("eta", &eta, Mat)];
+    map(py, &args, &[Mat, Mat], |n, x, out| {
+        let (a, b) = bi(n, x[0])?.apply(&m(n, x[1]), &m(n, x[2]))?;
+        put(out, &[&a, &b])
+    })
 }
 
 /// Solves B_X(xi + eta) = lam + gam by the closed form in the SVD frame (001 (7.6)-(7.9)), in
@@ -117,9 +216,12 @@ pub fn bi_inertia_solve<'py>(
     X: ArrayIn<'py>,
     lam: ArrayIn<'py>,
     gam: ArrayIn<'py>,
-) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
-    let r = at(&X)?.solve(&mat("lam", &lam)?, &mat("gam", &gam)?).py()?;
-    Ok(pair(py, r))
+) -> PyResult<Any<'py>> {
+    let args = [("X", &X, Mat), ("lam", &lam, Mat), ("gam", &gam, Mat)];
+    map(py, &args, &[Mat, Mat], |n, x, out| {
+        let (a, b) = bi(n, x[0])?.solve(&m(n, x[1]), &m(n, x[2]))?;
+        put(out, &[&a, &b])
+    })
 }
 
 /// Eigen-decomposition of B_X (001 (8.14)-(8.15)): eigenvalues (a_i - a_j)^2 and (a_i + a_j)^2
@@ -132,9 +234,12 @@ pub fn bi_inertia_solve<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
-pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr1<'py>, Arr2<'py>)> {
-    let (vals, vecs) = at_dense(&X)?.eigen().py()?;
-    Ok((py_vec(py, &vals), py_mat(py, &vecs)))
+pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Any<'py>> {
+    map(py, &[("X", &X, Mat)], &[DenseVector, Dense], |n, x, out| {
+        let (vals, vecs) = bi(n, x[0])?.eigen()?;
+        out[..vals.len()].copy_from_slice(&vals);
+        put(&mut out[vals.len()..], &[&vecs])
+    })
 }
 
 /// The quadratic form <xi + eta, B_X(xi + eta)> in SVD coordinates (001 (6.14)); equals
@@ -143,14 +248,17 @@ pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr1
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
-pub fn bi_inertia_quadratic_form(
-    X: ArrayIn<'_>,
-    xi: ArrayIn<'_>,
-    eta: ArrayIn<'_>,
-) -> PyResult<f64> {
-    at(&X)?
-        .quadratic_form(&mat("xi", &xi)?, &mat("eta", &eta)?)
-        .py()
+pub fn bi_inertia_quadratic_form<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    xi: ArrayIn<'py>,
+    eta: ArrayIn<'py>,
+) -> PyResult<Any<'py>> {
+    let args = [("X", &X, Mat), ("xi", &xi, Mat), ("eta", &eta, Mat)];
+    map(py, &args, &[Scalar], |n, x, out| {
+        out[0] = bi(n, x[0])?.quadratic_form(&m(n, x[1]), &m(n, x[2]))?;
+        Ok(())
+    })
 }
 
 /// Left connection omega^L_X(Y) = (A^L_X)^{-1}(Y X^T - X Y^T) (001 (2.14)); defined on all of
@@ -165,11 +273,13 @@ pub fn left_connection<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
     Y: ArrayIn<'py>,
-) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(
+) -> PyResult<Any<'py>> {
+    map(
         py,
-        &cn::left_connection(&at(&X)?, &mat("Y", &Y)?).py()?,
-    ))
+        &[("X", &X, Mat), ("Y", &Y, Mat)],
+        &[Mat],
+        |n, x, out| put(out, &[&cn::left_connection(&bi(n, x[0])?, &m(n, x[1]))?]),
+    )
 }
 
 /// Right connection omega^R_X(Y) = (A^R_X)^{-1}(Y^T X - X^T Y) (001 (2.15)); defined on all of
@@ -181,11 +291,13 @@ pub fn right_connection<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
     Y: ArrayIn<'py>,
-) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(
+) -> PyResult<Any<'py>> {
+    map(
         py,
-        &cn::right_connection(&at(&X)?, &mat("Y", &Y)?).py()?,
-    ))
+        &[("X", &X, Mat), ("Y", &Y, Mat)],
+        &[Mat],
+        |n, x, out| put(out, &[&cn::right_connection(&bi(n, x[0])?, &m(n, x[1]))?]),
+    )
 }
 
 /// Bi-connection omega^B_X(Y) = B_X^{-1}((Y X^T - X Y^T) + (Y^T X - X^T Y)) (001 (6.18)), via
@@ -197,13 +309,16 @@ pub fn right_connection<'py>(
 ///     DegenerateStratumError (coincident singular values), ShapeError, NonFiniteError,
 ///     NotInGroupError.
 #[pyfunction]
-pub fn bi_connection<'py>(
-    py: Python<'py>,
-    X: ArrayIn<'py>,
-    Y: ArrayIn<'py>,
-) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
-    let r = cn::bi_connection(&at(&X)?, &mat("Y", &Y)?).py()?;
-    Ok(pair(py, r))
+pub fn bi_connection<'py>(py: Python<'py>, X: ArrayIn<'py>, Y: ArrayIn<'py>) -> PyResult<Any<'py>> {
+    map(
+        py,
+        &[("X", &X, Mat), ("Y", &Y, Mat)],
+        &[Mat, Mat],
+        |n, x, out| {
+            let (a, b) = cn::bi_connection(&bi(n, x[0])?, &m(n, x[1]))?;
+            put(out, &[&a, &b])
+        },
+    )
 }
 
 /// The vertical vector (xi + eta)_P(X) = xi X + X eta^T (001 (6.17)).
@@ -216,9 +331,18 @@ pub fn vertical_vector<'py>(
     X: ArrayIn<'py>,
     xi: ArrayIn<'py>,
     eta: ArrayIn<'py>,
-) -> PyResult<Arr2<'py>> {
-    let v = cn::vertical_vector(&at(&X)?, &mat("xi", &xi)?, &mat("eta", &eta)?).py()?;
-    Ok(py_mat(py, &v))
+) -> PyResult<Any<'py>> {
+    let args = [("X", &X, Mat), ("xi", &xi, Mat), ("eta", &eta, Mat)];
+    map(py, &args, &[Mat], |n, x, out| {
+        put(
+            out,
+            &[&cn::vertical_vector(
+                &bi(n, x[0])?,
+                &m(n, x[1]),
+                &m(n, x[2]),
+            )?],
+        )
+    })
 }
 
 /// Horizontal part of Y at X for an action (001 (2.18)-(2.22), (6.4)-(6.7), (6.23)): Y minus
@@ -237,12 +361,19 @@ pub fn horizontal_part<'py>(
     X: ArrayIn<'py>,
     Y: ArrayIn<'py>,
     action: &str,
-) -> PyResult<Arr2<'py>> {
+) -> PyResult<Any<'py>> {
     let action: Action = action.parse().py()?;
-    Ok(py_mat(
+    map(
         py,
-        &cn::horizontal_part(&at(&X)?, &mat("Y", &Y)?, action).py()?,
-    ))
+        &[("X", &X, Mat), ("Y", &Y, Mat)],
+        &[Mat],
+        |n, x, out| {
+            put(
+                out,
+                &[&cn::horizontal_part(&bi(n, x[0])?, &m(n, x[1]), action)?],
+            )
+        },
+    )
 }
 
 /// Locked inertia tensor from the metric tr(Y^T Z) (001 (2.27), (6.24)): the matrix of
@@ -253,12 +384,16 @@ pub fn horizontal_part<'py>(
 ///     InvalidArgumentError (unknown action), ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 #[pyo3(signature = (X, action = "two-sided"))]
-pub fn locked_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, action: &str) -> PyResult<Arr2<'py>> {
+pub fn locked_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, action: &str) -> PyResult<Any<'py>> {
     let action: Action = action.parse().py()?;
-    Ok(py_mat(
-        py,
-        &cn::locked_inertia(&at_dense(&X)?, action).py()?,
-    ))
+    dense_fits(&X)?;
+    let out = match action {
+        Action::TwoSided => Dense,
+        _ => Half,
+    };
+    map(py, &[("X", &X, Mat)], &[out], |n, x, out| {
+        put(out, &[&cn::locked_inertia(&bi(n, x[0])?, action)?])
+    })
 }
 
 /// Angular momentum L = V X^T - X V^T (001 (2.29), (7.3)) of a velocity or momentum V at X.
@@ -270,11 +405,13 @@ pub fn angular_momentum<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
     V: ArrayIn<'py>,
-) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(
+) -> PyResult<Any<'py>> {
+    map(
         py,
-        &mo::angular_momentum(&mat("X", &X)?, &mat("V", &V)?).py()?,
-    ))
+        &[("X", &X, Mat), ("V", &V, Mat)],
+        &[Mat],
+        |n, x, out| put(out, &[&mo::angular_momentum(&m(n, x[0]), &m(n, x[1]))?]),
+    )
 }
 
 /// Circulation Gamma = V^T X - X^T V (001 (2.29), (7.3)) of a velocity or momentum V at X.
@@ -282,21 +419,14 @@ pub fn angular_momentum<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
 #[pyfunction]
-pub fn circulation<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResult<Arr2<'py>> {
-    Ok(py_mat(
+pub fn circulation<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResult<Any<'py>> {
+    map(
         py,
-        &mo::circulation(&mat("X", &X)?, &mat("V", &V)?).py()?,
-    ))
+        &[("X", &X, Mat), ("V", &V, Mat)],
+        &[Mat],
+        |n, x, out| put(out, &[&mo::circulation(&m(n, x[0]), &m(n, x[1]))?]),
+    )
 }
-
-type BodyTuple<'py> = (
-    Arr2<'py>,
-    Arr1<'py>,
-    Arr2<'py>,
-    Arr2<'py>,
-    Arr1<'py>,
-    Arr2<'py>,
-);
 
 /// Body coordinates (R, a, S, Omega, adot, Lambda) of (X, V) (001 (2.4), (2.33), §4.1):
 /// X = R diag(a) S^T,
@@ -308,16 +438,19 @@ type BodyTuple<'py> = (
 ///     DegenerateStratumError (coincident singular values: Omega, Lambda undetermined),
 ///     ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
-pub fn to_body<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResult<BodyTuple<'py>> {
-    let b = mo::to_body(&mat("X", &X)?, &mat("V", &V)?).py()?;
-    Ok((
-        py_mat(py, &b.r),
-        py_vec(py, &b.a),
-        py_mat(py, &b.s),
-        py_mat(py, &b.omega),
-        py_vec(py, &b.adot),
-        py_mat(py, &b.lambda),
-    ))
+pub fn to_body<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResult<Any<'py>> {
+    let outs = [Mat, Vector, Mat, Mat, Vector, Mat];
+    map(py, &[("X", &X, Mat), ("V", &V, Mat)], &outs, |n, x, out| {
+        let b = mo::to_body(&m(n, x[0]), &m(n, x[1]))?;
+        let (r, a, s) = (&b.r, &b.a, &b.s);
+        let (o, ad, l) = (&b.omega, &b.adot, &b.lambda);
+        let nn = n * n;
+        put(&mut out[..nn], &[r])?;
+        out[nn..nn + n].copy_from_slice(a);
+        put(&mut out[nn + n..3 * nn + n], &[s, o])?;
+        out[3 * nn + n..3 * nn + 2 * n].copy_from_slice(ad);
+        put(&mut out[3 * nn + 2 * n..], &[l])
+    })
 }
 
 /// (X, V) from body coordinates: X = R A S^T, V = R (Omega A + Adot - A Lambda) S^T
@@ -339,16 +472,27 @@ pub fn from_body<'py>(
     Omega: ArrayIn<'py>,
     adot: ArrayIn<'py>,
     Lambda: ArrayIn<'py>,
-) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
-    let body = Body {
-        r: mat("R", &R)?,
-        a: vector("a", &a)?,
-        s: mat("S", &S)?,
-        omega: mat("Omega", &Omega)?,
-        adot: vector("adot", &adot)?,
-        lambda: mat("Lambda", &Lambda)?,
-    };
-    Ok(pair(py, body.to_state().py()?))
+) -> PyResult<Any<'py>> {
+    let args = [
+        ("R", &R, Mat),
+        ("a", &a, Vector),
+        ("S", &S, Mat),
+        ("Omega", &Omega, Mat),
+        ("adot", &adot, Vector),
+        ("Lambda", &Lambda, Mat),
+    ];
+    map(py, &args, &[Mat, Mat], |n, x, out| {
+        let body = Body {
+            r: m(n, x[0]),
+            a: x[1].to_vec(),
+            s: m(n, x[2]),
+            omega: m(n, x[3]),
+            adot: x[4].to_vec(),
+            lambda: m(n, x[5]),
+        };
+        let (X, V) = body.to_state()?;
+        put(out, &[&X, &V])
+    })
 }
 
 /// Kinetic energy K = tr(V^T V) / 2 (001 (3.2); equal to (4.5), (4.12), (6.28)).
@@ -356,8 +500,20 @@ pub fn from_body<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
-pub fn kinetic_energy(X: ArrayIn<'_>, V: ArrayIn<'_>) -> PyResult<f64> {
-    mo::kinetic_energy(&mat("X", &X)?, &mat("V", &V)?).py()
+pub fn kinetic_energy<'py>(
+    py: Python<'py>,
+    X: ArrayIn<'py>,
+    V: ArrayIn<'py>,
+) -> PyResult<Any<'py>> {
+    map(
+        py,
+        &[("X", &X, Mat), ("V", &V, Mat)],
+        &[Scalar],
+        |n, x, out| {
+            out[0] = mo::kinetic_energy(&m(n, x[0]), &m(n, x[1]))?;
+            Ok(())
+        },
+    )
 }
 
 /// Stratum and isotropy of X under the two-sided SO(n) x SO(n) action (001 (6.2), (9.2), (9.3)).
@@ -405,11 +561,16 @@ pub fn riemann_variables<'py>(
     py: Python<'py>,
     X: ArrayIn<'py>,
     V: ArrayIn<'py>,
-) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
-    Ok(pair(
+) -> PyResult<Any<'py>> {
+    map(
         py,
-        riemann::riemann_variables(&mat("X", &X)?, &mat("V", &V)?).py()?,
-    ))
+        &[("X", &X, Mat), ("V", &V, Mat)],
+        &[Mat, Mat],
+        |n, x, out| {
+            let (q, nn) = riemann::riemann_variables(&m(n, x[0]), &m(n, x[1]))?;
+            put(out, &[&q, &nn])
+        },
+    )
 }
 
 /// Poisson bracket {f, g} of functions of (Q, N) from the structure functions (001 (9.1)):
@@ -420,17 +581,29 @@ pub fn riemann_variables<'py>(
 /// Raises:
 ///     ShapeError, NonFiniteError.
 #[pyfunction]
-pub fn riemann_bracket(
-    Q: ArrayIn<'_>,
-    N: ArrayIn<'_>,
-    dfdQ: ArrayIn<'_>,
-    dfdN: ArrayIn<'_>,
-    dgdQ: ArrayIn<'_>,
-    dgdN: ArrayIn<'_>,
-) -> PyResult<f64> {
-    let (fq, fnn) = (mat("dfdQ", &dfdQ)?, mat("dfdN", &dfdN)?);
-    let (gq, gn) = (mat("dgdQ", &dgdQ)?, mat("dgdN", &dgdN)?);
-    riemann::poisson_bracket(&mat("Q", &Q)?, &mat("N", &N)?, (&fq, &fnn), (&gq, &gn)).py()
+pub fn riemann_bracket<'py>(
+    py: Python<'py>,
+    Q: ArrayIn<'py>,
+    N: ArrayIn<'py>,
+    dfdQ: ArrayIn<'py>,
+    dfdN: ArrayIn<'py>,
+    dgdQ: ArrayIn<'py>,
+    dgdN: ArrayIn<'py>,
+) -> PyResult<Any<'py>> {
+    let args = [
+        ("Q", &Q, Mat),
+        ("N", &N, Mat),
+        ("dfdQ", &dfdQ, Mat),
+        ("dfdN", &dfdN, Mat),
+        ("dgdQ", &dgdQ, Mat),
+        ("dgdN", &dgdN, Mat),
+    ];
+    map(py, &args, &[Scalar], |n, x, out| {
+        let f = (&m(n, x[2]), &m(n, x[3]));
+        let g = (&m(n, x[4]), &m(n, x[5]));
+        out[0] = riemann::poisson_bracket(&m(n, x[0]), &m(n, x[1]), f, g)?;
+        Ok(())
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -505,17 +678,25 @@ pub fn reconstruct<'py>(
     p_a: ArrayIn<'py>,
     p_Omega: ArrayIn<'py>,
     p_Lambda: ArrayIn<'py>,
-) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
-    let st = lieflow::pseudo_rigid::reduced::ReducedState {
-        a: vector("a", &a)?,
-        p_a: vector("p_a", &p_a)?,
-        p_omega: mat("p_Omega", &p_Omega)?,
-        p_lambda: mat("p_Lambda", &p_Lambda)?,
-    };
-    Ok(pair(
-        py,
-        lieflow::pseudo_rigid::reduced::reconstruct(&mat("R", &R)?, &mat("S", &S)?, &st).py()?,
-    ))
+) -> PyResult<Any<'py>> {
+    let args = [
+        ("R", &R, Mat),
+        ("S", &S, Mat),
+        ("a", &a, Vector),
+        ("p_a", &p_a, Vector),
+        ("p_Omega", &p_Omega, Mat),
+        ("p_Lambda", &p_Lambda, Mat),
+    ];
+    map(py, &args, &[Mat, Mat], |n, x, out| {
+        let st = lieflow::pseudo_rigid::reduced::ReducedState {
+            a: x[2].to_vec(),
+            p_a: x[3].to_vec(),
+            p_omega: m(n, x[4]),
+            p_lambda: m(n, x[5]),
+        };
+        let (X, P) = lieflow::pseudo_rigid::reduced::reconstruct(&m(n, x[0]), &m(n, x[1]), &st)?;
+        put(out, &[&X, &P])
+    })
 }
 
 type ArrD<'py> = Bound<'py, numpy::PyArrayDyn<f64>>;
