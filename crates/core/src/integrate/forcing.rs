@@ -629,15 +629,13 @@ impl Catalog for Forced {
                 ("6", Composition::yoshida6()),
             ] {
                 let name = interned(name, suffix);
-                out.push(Entry::new(
-                    name,
-                    Kicked {
-                        base: name_of(name, suffix),
-                        manifold: p.manifold,
-                        invariants,
-                        composition: comp,
-                    },
-                ));
+                let kicked = Kicked {
+                    base: name_of(name, suffix),
+                    manifold: p.manifold,
+                    invariants,
+                    composition: comp,
+                };
+                out.push(Entry::new(name, move || kicked.clone()));
             }
         }
         out
@@ -655,6 +653,7 @@ impl Catalog for Forced {
 }
 
 /// The method of [`Forced`]: the composition of the kicked step of the free method `base`.
+#[derive(Clone)]
 struct Kicked {
     base: &'static str,
     manifold: bool,

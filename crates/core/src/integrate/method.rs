@@ -131,21 +131,30 @@ pub trait Integrator<P: ?Sized>: Send + Sync {
     }
 }
 
-/// A named method of a system's catalog.
+/// A named method of a system's catalog, built only when it is resolved or its properties are
+/// asked for (a catalog costs its names, not the construction of every method: resolving one
+/// method builds one).
 pub struct Entry<P: ?Sized> {
     /// The name the Python API knows it by.
     pub name: &'static str,
-    /// The method.
-    pub method: Box<dyn Integrator<P>>,
+    make: Box<dyn Fn() -> Box<dyn Integrator<P>>>,
 }
 
-impl<P: ?Sized> Entry<P> {
-    /// The entry `name` → `method`.
-    pub fn new(name: &'static str, method: impl Integrator<P> + 'static) -> Self {
+impl<P: ?Sized + 'static> Entry<P> {
+    /// The entry `name` → the method `make()` builds.
+    pub fn new<M: Integrator<P> + 'static>(
+        name: &'static str,
+        make: impl Fn() -> M + 'static,
+    ) -> Self {
         Entry {
             name,
-            method: Box::new(method),
+            make: Box::new(move || Box::new(make()) as Box<dyn Integrator<P>>),
         }
+    }
+
+    /// The method.
+    pub fn method(&self) -> Box<dyn Integrator<P>> {
+        (self.make)()
     }
 }
 
@@ -260,7 +269,7 @@ impl<P: Catalog> System for P {
     fn methods(&self) -> Vec<(&'static str, Properties)> {
         self.catalog()
             .iter()
-            .map(|e| (e.name, e.method.properties()))
+            .map(|e| (e.name, e.method().properties()))
             .collect()
     }
 
@@ -300,9 +309,9 @@ impl<P: Catalog> System for P {
 }
 
 /// Entry `i` of `problem`'s catalog as a [`Resolved`] method (holding a copy of the problem).
-fn resolved<P: Catalog>(problem: &P, mut catalog: Vec<Entry<P>>, i: usize) -> Arc<Resolved> {
-    let entry = catalog.swap_remove(i);
-    let integrator: Arc<dyn Integrator<P>> = entry.method.into();
+fn resolved<P: Catalog>(problem: &P, catalog: Vec<Entry<P>>, i: usize) -> Arc<Resolved> {
+    let entry = &catalog[i];
+    let integrator: Arc<dyn Integrator<P>> = entry.method().into();
     let problem = Arc::new(problem.clone());
     let (i2, p2) = (integrator.clone(), problem.clone());
     Arc::new(Resolved {

@@ -561,19 +561,19 @@ impl Catalog for PseudoRigidBody {
     /// The free body's.
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
-            Entry::new("verlet", Verlet::strang()),
-            Entry::new("verlet4", Verlet(Composition::suzuki4())),
-            Entry::new("verlet6", Verlet(Composition::yoshida6())),
-            Entry::new("reduced", Splitting::strang()),
+            Entry::new("verlet", Verlet::strang),
+            Entry::new("verlet4", || Verlet(Composition::suzuki4())),
+            Entry::new("verlet6", || Verlet(Composition::yoshida6())),
+            Entry::new("reduced", Splitting::strang),
         ]
     }
 
     fn catalog(&self) -> Vec<Entry<Self>> {
         match self.incompressible {
             true => vec![
-                Entry::new("rattle", Rattle::new()),
-                Entry::new("rattle4", Rattle(Composition::suzuki4())),
-                Entry::new("rattle6", Rattle(Composition::yoshida6())),
+                Entry::new("rattle", Rattle::new),
+                Entry::new("rattle4", || Rattle(Composition::suzuki4())),
+                Entry::new("rattle6", || Rattle(Composition::yoshida6())),
             ],
             false => Self::kind_catalog(),
         }

@@ -29,10 +29,10 @@ use crate::integrate::problem::{Canonical, VectorField};
 /// baseline.
 pub fn canonical_catalog<P: Canonical + VectorField + Clone + 'static>() -> Vec<Entry<P>> {
     vec![
-        Entry::new("gauss4", Gauss(2)),
-        Entry::new("gauss6", Gauss(3)),
-        Entry::new("midpoint", IMPLICIT_MIDPOINT),
-        Entry::new("rk4", Rk4),
+        Entry::new("gauss4", || Gauss(2)),
+        Entry::new("gauss6", || Gauss(3)),
+        Entry::new("midpoint", || IMPLICIT_MIDPOINT),
+        Entry::new("rk4", || Rk4),
     ]
 }
 

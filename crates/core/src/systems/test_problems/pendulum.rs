@@ -149,10 +149,10 @@ impl Separable for Pendulum {
 
 crate::integrate::methods::canonical_system!(Pendulum, {
     vec![
-        Entry::new("midpoint", IMPLICIT_MIDPOINT),
-        Entry::new("gauss4", Gauss(2)),
-        Entry::new("gauss6", Gauss(3)),
-        Entry::new("verlet", Verlet::strang()),
-        Entry::new("rk4", Rk4),
+        Entry::new("midpoint", || IMPLICIT_MIDPOINT),
+        Entry::new("gauss4", || Gauss(2)),
+        Entry::new("gauss6", || Gauss(3)),
+        Entry::new("verlet", Verlet::strang),
+        Entry::new("rk4", || Rk4),
     ]
 });

@@ -218,6 +218,6 @@ impl Nonholonomic for RollingDisk {
 
 impl Catalog for RollingDisk {
     fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![Entry::new("nonholonomic", NonholonomicRattle)]
+        vec![Entry::new("nonholonomic", || NonholonomicRattle)]
     }
 }

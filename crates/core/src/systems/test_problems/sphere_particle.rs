@@ -148,6 +148,6 @@ impl Constrained for SphereParticle {
 
 impl Catalog for SphereParticle {
     fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![Entry::new("rattle", Rattle::new())]
+        vec![Entry::new("rattle", Rattle::new)]
     }
 }

@@ -222,9 +222,9 @@ impl VectorField for GeneralizedRigidBody {
 impl Catalog for GeneralizedRigidBody {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
-            Entry::new("isospectral", Isospectral),
-            Entry::new("rk4", Rk4),
-            Entry::new("rkmk4", Rkmk4),
+            Entry::new("isospectral", || Isospectral),
+            Entry::new("rk4", || Rk4),
+            Entry::new("rkmk4", || Rkmk4),
         ]
     }
 

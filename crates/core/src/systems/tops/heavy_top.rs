@@ -176,11 +176,16 @@ impl Catalog for HeavyTop {
     fn kind_catalog() -> Vec<Entry<Self>> {
         let mut catalog = top::splittings();
         catalog.extend([
-            Entry::new("lgvi", Lgvi),
-            Entry::new("rk4", Rk4),
-            Entry::new("exact_splitting", ExactSplitting(Composition::strang())),
-            Entry::new("exact_splitting4", ExactSplitting(Composition::suzuki4())),
-            Entry::new("exact_splitting6", ExactSplitting(Composition::yoshida6())),
+            Entry::new("lgvi", || Lgvi),
+            Entry::new("rk4", || Rk4),
+            Entry::new("exact_splitting", || ExactSplitting(Composition::strang())),
+            Entry::new(
+                "exact_splitting4",
+                || ExactSplitting(Composition::suzuki4()),
+            ),
+            Entry::new("exact_splitting6", || {
+                ExactSplitting(Composition::yoshida6())
+            }),
         ]);
         catalog
     }

@@ -253,16 +253,16 @@ impl Catalog for RigidBody {
     fn kind_catalog() -> Vec<Entry<Self>> {
         let mut catalog = top::splittings();
         catalog.extend([
-            Entry::new("isospectral", Isospectral),
-            Entry::new("lgvi", Lgvi),
-            Entry::new("dmv", Dmv(2)),
-            Entry::new("dmv4", Dmv(4)),
-            Entry::new("dmv6", Dmv(6)),
-            Entry::new("dmv8", Dmv(8)),
-            Entry::new("dmv10", Dmv(10)),
-            Entry::new("rk4", Rk4),
-            Entry::new("rkmk4", Rkmk4),
-            Entry::new("exact", Exact),
+            Entry::new("isospectral", || Isospectral),
+            Entry::new("lgvi", || Lgvi),
+            Entry::new("dmv", || Dmv(2)),
+            Entry::new("dmv4", || Dmv(4)),
+            Entry::new("dmv6", || Dmv(6)),
+            Entry::new("dmv8", || Dmv(8)),
+            Entry::new("dmv10", || Dmv(10)),
+            Entry::new("rk4", || Rk4),
+            Entry::new("rkmk4", || Rkmk4),
+            Entry::new("exact", || Exact),
         ]);
         catalog
     }

@@ -196,10 +196,10 @@ impl VectorField for SphericalPendulum {
 impl Catalog for SphericalPendulum {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
-            Entry::new("splitting", Splitting::strang()),
-            Entry::new("splitting4", Splitting(Composition::suzuki4())),
-            Entry::new("splitting6", Splitting(Composition::yoshida6())),
-            Entry::new("rk4", Rk4),
+            Entry::new("splitting", Splitting::strang),
+            Entry::new("splitting4", || Splitting(Composition::suzuki4())),
+            Entry::new("splitting6", || Splitting(Composition::yoshida6())),
+            Entry::new("rk4", || Rk4),
         ]
     }
 }

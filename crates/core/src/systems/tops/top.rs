@@ -706,13 +706,13 @@ fn rotate_about<S: pulp::Simd, const D: usize, const K: usize, const I: usize, c
 /// Kahan–Li 8) and the processed ones (Blanes–Casas–Murua, effective orders 6, 8, 10).
 pub(super) fn splittings<P: Split + Clone + 'static>() -> Vec<Entry<P>> {
     vec![
-        Entry::new("splitting", Splitting::strang()),
-        Entry::new("splitting4", Splitting(Composition::suzuki4())),
-        Entry::new("splitting6", Splitting(Composition::yoshida6())),
-        Entry::new("splitting8", Splitting(Composition::kahan_li8())),
-        Entry::new("processed6", ProcessedSplitting(Processed::bcm6())),
-        Entry::new("processed8", ProcessedSplitting(Processed::bcm8())),
-        Entry::new("processed10", ProcessedSplitting(Processed::bcm10())),
+        Entry::new("splitting", Splitting::strang),
+        Entry::new("splitting4", || Splitting(Composition::suzuki4())),
+        Entry::new("splitting6", || Splitting(Composition::yoshida6())),
+        Entry::new("splitting8", || Splitting(Composition::kahan_li8())),
+        Entry::new("processed6", || ProcessedSplitting(Processed::bcm6())),
+        Entry::new("processed8", || ProcessedSplitting(Processed::bcm8())),
+        Entry::new("processed10", || ProcessedSplitting(Processed::bcm10())),
     ]
 }
 

@@ -371,10 +371,10 @@ impl Catalog for LiePoisson {
     /// rk4.
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
-            Entry::new("rkmk4", Rkmk4),
-            Entry::new("midpoint", LieMidpoint::new()),
-            Entry::new("midpoint4", LieMidpoint(Composition::suzuki4())),
-            Entry::new("rk4", Rk4),
+            Entry::new("rkmk4", || Rkmk4),
+            Entry::new("midpoint", LieMidpoint::new),
+            Entry::new("midpoint4", || LieMidpoint(Composition::suzuki4())),
+            Entry::new("rk4", || Rk4),
         ]
     }
 

@@ -300,9 +300,9 @@ impl Canonical for UserSeparable {
 // verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
 crate::integrate::methods::canonical_system!(UserSeparable, {
     let mut entries = vec![
-        Entry::new("verlet", Verlet::strang()),
-        Entry::new("verlet4", Verlet(Composition::suzuki4())),
-        Entry::new("verlet6", Verlet(Composition::yoshida6())),
+        Entry::new("verlet", Verlet::strang),
+        Entry::new("verlet4", || Verlet(Composition::suzuki4())),
+        Entry::new("verlet6", || Verlet(Composition::yoshida6())),
     ];
     entries.extend(canonical_catalog());
     entries

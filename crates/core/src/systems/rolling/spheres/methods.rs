@@ -172,10 +172,10 @@ impl GroupField for RollingSpheres {
 impl Catalog for RollingSpheres {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
-            Entry::new("midpoint", LieMidpoint::new()),
-            Entry::new("midpoint4", LieMidpoint(Composition::suzuki4())),
-            Entry::new("rkmk4", Rkmk4),
-            Entry::new("rk4", Rk4),
+            Entry::new("midpoint", LieMidpoint::new),
+            Entry::new("midpoint4", || LieMidpoint(Composition::suzuki4())),
+            Entry::new("rkmk4", || Rkmk4),
+            Entry::new("rk4", || Rk4),
         ]
     }
 }

@@ -92,10 +92,11 @@ impl LgviStepper {
             let jg = j * g;
             let phi = (jg + g.cross(&jg)) * 2.0 - p * (1.0 + g.norm_squared());
             let jac = (j + so3::hat(&g) * j - so3::hat(&jg)) * 2.0 - p * g.transpose() * 2.0;
-            let dg = jac
-                .lu()
-                .solve(&phi)
-                .ok_or_else(|| monitor.failed(f64::INFINITY))?;
+            // In place (`solve` copies and calls `solve_mut`: the same operations).
+            let mut dg = phi;
+            if !jac.lu().solve_mut(&mut dg) {
+                return Err(monitor.failed(f64::INFINITY));
+            }
             g -= dg;
             match monitor.check(dg.norm(), 1.0 + g.norm()) {
                 Verdict::Continue => {}

@@ -1,0 +1,143 @@
+"""lieflow's Strang splitting against the C loop a programmer would write (issue 28).
+
+The free rigid body I = (1, 2, 3) and the heavy top (mgl = 0.7, chi = (0.2, -0.3, 1)), dt = 0.01,
+`method="splitting"`: one body over 2·10⁶ steps, and 10⁴ bodies over 10³ steps with 1 and 2
+threads, each with and without the attitude. The C twin (`benches/c/strang_loop.c`: the same
+flows, the first and last half flows of consecutive steps fused, the same sin/cos polynomial, the
+attitude as a unit quaternion) is built with the system's C compiler (`cc -O3 -march=native`,
+with OpenMP when the compiler has it); without a compiler the C column is skipped with a
+message. Times are the best of ROUNDS rounds, C and lieflow alternating; lieflow is one
+`lf.integrate` call that saves the last state only. Body 0's final state is compared with the C
+loop's (the two round differently: quaternion against matrix), as a check that both compute the
+same thing.
+
+    python benches/python/c_loop.py [--rounds 5]
+"""
+
+import argparse
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+
+import numpy as np
+
+import lieflow as lf
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE = os.path.join(HERE, "..", "c", "strang_loop.c")
+DT = 0.01
+ONE_STEPS = 2_000_000
+BATCH, BATCH_STEPS = 10_000, 1_000
+
+
+def build(tmp):
+    """The C loop's executable, or None (with the reason printed) without a C compiler."""
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        print("no C compiler found (set CC): the C column is skipped")
+        return None
+    exe = os.path.join(tmp, "strang_loop")
+    for flags in (["-fopenmp"], []):
+        cmd = [cc, "-O3", "-march=native", *flags, SOURCE, "-o", exe, "-lm"]
+        if subprocess.run(cmd, capture_output=True).returncode == 0:
+            print("built:", " ".join(cmd[:-3] + [os.path.basename(SOURCE)]))
+            return exe
+    print(f"{cc} could not build {SOURCE}: the C column is skipped")
+    return None
+
+
+def run_c(exe, system, attitude, bodies, steps, threads):
+    out = subprocess.run([exe, system, str(int(attitude)), str(bodies), str(steps), str(threads)],
+                         capture_output=True, text=True, check=True).stdout.split("\n")
+    sec = float(out[0])
+    z = np.array(out[1].split(), dtype=float)
+    r = np.array(out[2].split(), dtype=float).reshape(3, 3)
+    return sec, z, r
+
+
+def states(system, bodies):
+    """The initial states of strang_loop.c: M_k = (1, 0.5, -0.3) + 0.1 sin(...), Gamma = e3."""
+    k = np.arange(bodies, dtype=float)
+    m = np.stack([1.0 + 0.1 * np.sin(1.3 * k), 0.5 + 0.1 * np.sin(2.1 * k + 0.4),
+                  -0.3 + 0.1 * np.sin(0.7 * k + 1.1)], axis=1)
+    if system == "heavy":
+        m = np.concatenate([m, np.tile([0.0, 0.0, 1.0], (bodies, 1))], axis=1)
+    return m[0] if bodies == 1 else m
+
+
+def run_lieflow(system, attitude, bodies, steps, threads):
+    body = (lf.RigidBody([1, 2, 3]) if system == "rigid"
+            else lf.HeavyTop([1, 2, 3], 0.7, chi=[0.2, -0.3, 1.0]))
+    z0 = states(system, bodies)
+    r0 = np.eye(3) if attitude else None
+    t0 = time.perf_counter()
+    tr = lf.integrate(body, z0, dt=DT, steps=steps, save_every=steps, attitude=r0,
+                      threads=threads)
+    sec = time.perf_counter() - t0
+    z = np.asarray(tr.states)
+    r = None if tr.attitudes is None else np.asarray(tr.attitudes)
+    if bodies > 1:
+        z, r = z[0], (None if r is None else r[0])
+    return sec, z[-1], (None if r is None else r[-1])
+
+
+ROWS = [  # (system, attitude, bodies, steps, threads)
+    ("rigid", False, 1, ONE_STEPS, 1),
+    ("rigid", True, 1, ONE_STEPS, 1),
+    ("rigid", False, BATCH, BATCH_STEPS, 1),
+    ("rigid", True, BATCH, BATCH_STEPS, 1),
+    ("rigid", False, BATCH, BATCH_STEPS, 2),
+    ("rigid", True, BATCH, BATCH_STEPS, 2),
+    ("heavy", False, 1, ONE_STEPS, 1),
+    ("heavy", True, 1, ONE_STEPS, 1),
+    ("heavy", False, BATCH, BATCH_STEPS, 1),
+    ("heavy", True, BATCH, BATCH_STEPS, 1),
+    ("heavy", False, BATCH, BATCH_STEPS, 2),
+    ("heavy", True, BATCH, BATCH_STEPS, 2),
+]
+
+
+def label(system, attitude, bodies, steps, threads):
+    name = "rigid body" if system == "rigid" else "heavy top"
+    what = "with attitude" if attitude else ("M only" if system == "rigid" else "M, Γ only")
+    if bodies == 1:
+        return f"{name}, one body, {what}, {steps:.0e} steps"
+    return f"{name}, {bodies:.0e} bodies × {steps:.0e} steps, {what}, {threads} thread(s)"
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rounds", type=int, default=5)
+    args = ap.parse_args()
+    lf.integrate(lf.RigidBody([1, 2, 3]), [1.0, 0.5, -0.3], dt=DT, steps=10)  # warm-up
+    with tempfile.TemporaryDirectory() as tmp:
+        exe = build(tmp)
+        print(f"\nbest of {args.rounds} rounds, C and lieflow alternating; per step and body.\n")
+        print("| loop | C | lieflow | lieflow / C | body 0: max difference |")
+        print("|---|---:|---:|---:|---:|")
+        for row in ROWS:
+            work = row[2] * row[3]
+            best_c, best_l = np.inf, np.inf
+            for _ in range(args.rounds):
+                if exe is not None:
+                    sec, zc, rc = run_c(exe, *row)
+                    best_c = min(best_c, sec)
+                sec, zl, rl = run_lieflow(*row)
+                best_l = min(best_l, sec)
+            ns_l = best_l / work * 1e9
+            if exe is None:
+                print(f"| {label(*row)} | – | {ns_l:.1f} ns | – | – |")
+                continue
+            d = len(zl)
+            diff = np.abs(zc[:d] - zl).max()
+            if rl is not None:
+                diff = max(diff, np.abs(rc - rl).max())
+            ns_c = best_c / work * 1e9
+            print(f"| {label(*row)} | {ns_c:.1f} ns | {ns_l:.1f} ns | {ns_l / ns_c:.2f} "
+                  f"| {diff:.1e} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
