@@ -106,9 +106,10 @@ static inline void casimir(Body *b, double tau, int heavy, int att) {
     }
 }
 
-/* Kick over tau: M <- M + tau Gamma x c, c = mgl chi. */
+/* Kick over tau: M <- M + tau Gamma x c. */
+static double CVEC[3]; /* c = mgl chi / |chi|, as lieflow's HeavyTop */
 static inline void kick(Body *b, double tau) {
-    double c[3] = {MGL * CHI[0], MGL * CHI[1], MGL * CHI[2]}, *g = b->g;
+    const double *c = CVEC, *g = b->g;
     b->m[0] += tau * (g[1] * c[2] - g[2] * c[1]);
     b->m[1] += tau * (g[2] * c[0] - g[0] * c[2]);
     b->m[2] += tau * (g[0] * c[1] - g[1] * c[0]);
@@ -160,6 +161,8 @@ int main(int argc, char **argv) {
     long bodies = atol(argv[3]), steps = atol(argv[4]);
     int threads = atoi(argv[5]);
     for (int a = 0; a < 2; a++) COEF[a] = 1.0 / I[AX[a]] - 1.0 / I[1];
+    double nchi = sqrt(CHI[0] * CHI[0] + CHI[1] * CHI[1] + CHI[2] * CHI[2]);
+    for (int i = 0; i < 3; i++) CVEC[i] = MGL * CHI[i] / nchi;
     Body *b = malloc(sizeof(Body) * bodies);
     for (long k = 0; k < bodies; k++) {
         /* The same initial states as c_loop.py: body k from the seeded formula below. */

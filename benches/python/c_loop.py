@@ -42,7 +42,7 @@ def build(tmp):
     for flags in (["-fopenmp"], []):
         cmd = [cc, "-O3", "-march=native", *flags, SOURCE, "-o", exe, "-lm"]
         if subprocess.run(cmd, capture_output=True).returncode == 0:
-            print("built:", " ".join(cmd[:-3] + [os.path.basename(SOURCE)]))
+            print("built:", " ".join([os.path.basename(cc), *cmd[1:-4], "strang_loop.c"]))
             return exe
     print(f"{cc} could not build {SOURCE}: the C column is skipped")
     return None
@@ -77,7 +77,7 @@ def run_lieflow(system, attitude, bodies, steps, threads):
                       threads=threads)
     sec = time.perf_counter() - t0
     z = np.asarray(tr.states)
-    r = None if tr.attitudes is None else np.asarray(tr.attitudes)
+    r = None if tr.attitude is None else np.asarray(tr.attitude)
     if bodies > 1:
         z, r = z[0], (None if r is None else r[0])
     return sec, z[-1], (None if r is None else r[-1])
