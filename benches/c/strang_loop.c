@@ -3,7 +3,8 @@
  * two non-reference principal axes, the Casimir turn about M for the attitude, the kick of the
  * potential), the first and last half flows of consecutive steps fused, the same short sin/cos
  * polynomial (Taylor to r^17 / r^16), the attitude as a unit quaternion renormalised every 256
- * steps. Built and run by benches/python/c_loop.py:
+ * steps; one body alone, or a batch laid out component by component in blocks of 64 bodies that
+ * the compiler vectorises (SoA). Built and run by benches/python/c_loop.py:
  *
  *     cc -O3 -march=native [-fopenmp] strang_loop.c -o strang_loop -lm
  *     strang_loop SYSTEM ATTITUDE BODIES STEPS THREADS
@@ -152,6 +153,131 @@ static void run(Body *b, long steps, double h, int heavy, int att) {
     }
 }
 
+/* The batch laid out component by component (SoA) in blocks of BLOCK bodies stepped together
+ * through all the steps, each flow a loop over the block that the compiler vectorises: the same
+ * operations per body as `run`. */
+#define BLOCK 64
+typedef struct {
+    double m[3][BLOCK], g[3][BLOCK], q[4][BLOCK];
+} Block;
+
+/* The axis flow about e_K ((I, J, K) cyclic) on a block, K a constant of each instance. */
+#define AXIS_SOA(NAME, K, I, J)                                                                 \
+    static inline void NAME(Block *restrict b, double tc, int heavy, int att, int n) {          \
+        _Pragma("omp simd") for (int l = 0; l < n; l++) {                                       \
+            double th = tc * b->m[K][l], s, cm1;                                                \
+            sin_cosm1(th, &s, &cm1);                                                            \
+            double mi = b->m[I][l], mj = b->m[J][l];                                            \
+            b->m[I][l] = mi + (cm1 * mi + s * mj);                                              \
+            b->m[J][l] = mj + (cm1 * mj - s * mi);                                              \
+            if (heavy) {                                                                        \
+                double gi = b->g[I][l], gj = b->g[J][l];                                        \
+                b->g[I][l] = gi + (cm1 * gi + s * gj);                                          \
+                b->g[J][l] = gj + (cm1 * gj - s * gi);                                          \
+            }                                                                                   \
+            if (att) {                                                                          \
+                double hs, hcm1;                                                                \
+                sin_cosm1(0.5 * th, &hs, &hcm1);                                                \
+                double w = 1.0 + hcm1, q0 = b->q[0][l], qi = b->q[1 + I][l],                    \
+                       qj = b->q[1 + J][l], qk = b->q[1 + K][l];                                \
+                /* q (x) (w, hs e_K): (q0 w - qK hs, qI w + qJ hs, qJ w - qI hs, qK w + q0 hs) */ \
+                b->q[0][l] = q0 * w - qk * hs;                                                  \
+                b->q[1 + I][l] = qi * w + qj * hs;                                              \
+                b->q[1 + J][l] = qj * w - qi * hs;                                              \
+                b->q[1 + K][l] = qk * w + q0 * hs;                                              \
+            }                                                                                   \
+        }                                                                                       \
+    }
+AXIS_SOA(axis_soa_2, 2, 0, 1)
+AXIS_SOA(axis_soa_0, 0, 1, 2)
+
+/* Axis flow a over tau on a block (AX = {2, 0}). */
+static inline void axis_soa(Block *b, int a, double tau, int heavy, int att, int n) {
+    if (a == 0)
+        axis_soa_2(b, tau * COEF[0], heavy, att, n);
+    else
+        axis_soa_0(b, tau * COEF[1], heavy, att, n);
+}
+
+static inline void casimir_soa(Block *b, double tau, int heavy, int att, int n) {
+    double t = tau / I[1];
+#pragma omp simd
+    for (int l = 0; l < n; l++) {
+        double v[3] = {t * b->m[0][l], t * b->m[1][l], t * b->m[2][l]};
+        double th2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2], p, q;
+        if (heavy) {
+            pq(th2, &p, &q);
+            double A = 1.0 + th2 * p, B = 0.5 - th2 * q;
+            double x[3] = {b->g[0][l], b->g[1][l], b->g[2][l]};
+            double w[3] = {v[1] * x[2] - v[2] * x[1], v[2] * x[0] - v[0] * x[2], v[0] * x[1] - v[1] * x[0]};
+            double u[3] = {v[1] * w[2] - v[2] * w[1], v[2] * w[0] - v[0] * w[2], v[0] * w[1] - v[1] * w[0]};
+            for (int c = 0; c < 3; c++) b->g[c][l] = x[c] + (B * u[c] - A * w[c]);
+        }
+        if (att) {
+            double z = 0.25 * th2;
+            pq(z, &p, &q);
+            double sinc = 1.0 + z * p, c = 1.0 - 0.5 * z + z * z * q;
+            double h[3] = {0.5 * sinc * v[0], 0.5 * sinc * v[1], 0.5 * sinc * v[2]};
+            double a0 = b->q[0][l], a1 = b->q[1][l], a2 = b->q[2][l], a3 = b->q[3][l];
+            b->q[0][l] = a0 * c - a1 * h[0] - a2 * h[1] - a3 * h[2];
+            b->q[1][l] = a0 * h[0] + a1 * c + a2 * h[2] - a3 * h[1];
+            b->q[2][l] = a0 * h[1] - a1 * h[2] + a2 * c + a3 * h[0];
+            b->q[3][l] = a0 * h[2] + a1 * h[1] - a2 * h[0] + a3 * c;
+        }
+    }
+}
+
+static inline void kick_soa(Block *b, double tau, int n) {
+    const double *c = CVEC;
+#pragma omp simd
+    for (int l = 0; l < n; l++) {
+        double g0 = b->g[0][l], g1 = b->g[1][l], g2 = b->g[2][l];
+        b->m[0][l] += tau * (g1 * c[2] - g2 * c[1]);
+        b->m[1][l] += tau * (g2 * c[0] - g0 * c[2]);
+        b->m[2][l] += tau * (g0 * c[1] - g1 * c[0]);
+    }
+}
+
+static void renormalise_soa(Block *b, int n) {
+    for (int l = 0; l < n; l++) {
+        double q[4] = {b->q[0][l], b->q[1][l], b->q[2][l], b->q[3][l]};
+        renormalise(q);
+        for (int c = 0; c < 4; c++) b->q[c][l] = q[c];
+    }
+}
+
+/* `steps` Strang steps of a block of n bodies (the sequence of `run`). */
+static void run_soa(Block *b, int n, long steps, double h, int heavy, int att) {
+    double h2 = 0.5 * h;
+    if (heavy) {
+        kick_soa(b, h2, n);
+        for (long s = 0; s < steps; s++) {
+            axis_soa(b, 0, h2, 1, att, n);
+            axis_soa(b, 1, h2, 1, att, n);
+            casimir_soa(b, h, 1, att, n);
+            axis_soa(b, 1, h2, 1, att, n);
+            axis_soa(b, 0, h2, 1, att, n);
+            kick_soa(b, s + 1 < steps ? h : h2, n);
+            if (att && (s & 255) == 255) renormalise_soa(b, n);
+        }
+    } else if (att) {
+        axis_soa(b, 0, h2, 0, 1, n);
+        for (long s = 0; s < steps; s++) {
+            axis_soa(b, 1, h2, 0, 1, n);
+            casimir_soa(b, h, 0, 1, n);
+            axis_soa(b, 1, h2, 0, 1, n);
+            axis_soa(b, 0, s + 1 < steps ? h : h2, 0, 1, n);
+            if ((s & 255) == 255) renormalise_soa(b, n);
+        }
+    } else {
+        axis_soa(b, 0, h2, 0, 0, n);
+        for (long s = 0; s < steps; s++) {
+            axis_soa(b, 1, h, 0, 0, n);
+            axis_soa(b, 0, s + 1 < steps ? h : h2, 0, 0, n);
+        }
+    }
+}
+
 int main(int argc, char **argv) {
     if (argc != 6) {
         fprintf(stderr, "usage: %s rigid|heavy ATTITUDE BODIES STEPS THREADS\n", argv[0]);
@@ -176,14 +302,34 @@ int main(int argc, char **argv) {
         b[k].q[0] = 1.0;
         b[k].q[1] = b[k].q[2] = b[k].q[3] = 0.0;
     }
+    long blocks = (bodies + BLOCK - 1) / BLOCK;
+    Block *soa = malloc(sizeof(Block) * blocks);
+    for (long k = 0; k < bodies; k++) {
+        Block *bl = &soa[k / BLOCK];
+        int l = (int)(k % BLOCK);
+        for (int c = 0; c < 3; c++) bl->m[c][l] = b[k].m[c], bl->g[c][l] = b[k].g[c];
+        for (int c = 0; c < 4; c++) bl->q[c][l] = b[k].q[c];
+    }
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
+    if (bodies == 1) {
+        run(&b[0], steps, 0.01, heavy, att);
+    } else {
 #ifdef _OPENMP
-    omp_set_num_threads(threads);
+        omp_set_num_threads(threads);
 #pragma omp parallel for schedule(static)
 #endif
-    for (long k = 0; k < bodies; k++) run(&b[k], steps, 0.01, heavy, att);
+        for (long k = 0; k < blocks; k++) {
+            long n = bodies - k * BLOCK < BLOCK ? bodies - k * BLOCK : BLOCK;
+            run_soa(&soa[k], (int)n, steps, 0.01, heavy, att);
+        }
+    }
     clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (bodies > 1) {
+        for (int c = 0; c < 3; c++) b[0].m[c] = soa[0].m[c][0], b[0].g[c] = soa[0].g[c][0];
+        for (int c = 0; c < 4; c++) b[0].q[c] = soa[0].q[c][0];
+    }
+    free(soa);
     double sec = (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec);
     double *q = b[0].q;
     double r[9] = {1 - 2 * (q[2] * q[2] + q[3] * q[3]), 2 * (q[1] * q[2] - q[0] * q[3]), 2 * (q[1] * q[3] + q[0] * q[2]),

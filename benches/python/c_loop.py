@@ -4,9 +4,10 @@ The free rigid body I = (1, 2, 3) and the heavy top (mgl = 0.7, chi = (0.2, -0.3
 `method="splitting"`: one body over 2·10⁶ steps, and 10⁴ bodies over 10³ steps with 1 and 2
 threads, each with and without the attitude. The C twin (`benches/c/strang_loop.c`: the same
 flows, the first and last half flows of consecutive steps fused, the same sin/cos polynomial, the
-attitude as a unit quaternion) is built with the system's C compiler (`cc -O3 -march=native`,
-with OpenMP when the compiler has it); without a compiler the C column is skipped with a
-message. Times are the best of ROUNDS rounds, C and lieflow alternating; lieflow is one
+attitude as a unit quaternion; one body alone, a batch component by component in blocks the
+compiler vectorises) is built with the system's C compiler (`cc -O3 -march=native`, with OpenMP
+when the compiler has it), and again with `-ffp-contract=off` (no fused multiply-adds, as
+lieflow's kernels); without a compiler the C columns are skipped with a message. Times are the best of ROUNDS rounds, C and lieflow alternating; lieflow is one
 `lf.integrate` call that saves the last state only. Body 0's final state is compared with the C
 loop's (the two round differently: quaternion against matrix), as a check that both compute the
 same thing.
@@ -32,14 +33,14 @@ ONE_STEPS = 2_000_000
 BATCH, BATCH_STEPS = 10_000, 1_000
 
 
-def build(tmp):
+def build(tmp, extra=(), name="strang_loop"):
     """The C loop's executable, or None (with the reason printed) without a C compiler."""
     cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
     if cc is None:
         print("no C compiler found (set CC): the C column is skipped")
         return None
-    exe = os.path.join(tmp, "strang_loop")
-    for flags in (["-fopenmp"], []):
+    exe = os.path.join(tmp, name)
+    for flags in (["-fopenmp", *extra], list(extra)):
         cmd = [cc, "-O3", "-march=native", *flags, SOURCE, "-o", exe, "-lm"]
         if subprocess.run(cmd, capture_output=True).returncode == 0:
             print("built:", " ".join([os.path.basename(cc), *cmd[1:-4], "strang_loop.c"]))
@@ -114,29 +115,33 @@ def main():
     lf.integrate(lf.RigidBody([1, 2, 3]), [1.0, 0.5, -0.3], dt=DT, steps=10)  # warm-up
     with tempfile.TemporaryDirectory() as tmp:
         exe = build(tmp)
+        # The same source without contracting a*b + c into fused multiply-adds (gcc's default
+        # for C with -march=native contracts them; lieflow's kernels round every operation).
+        plain = build(tmp, ["-ffp-contract=off"], "strang_loop_plain") if exe else None
         print(f"\nbest of {args.rounds} rounds, C and lieflow alternating; per step and body.\n")
-        print("| loop | C | lieflow | lieflow / C | body 0: max difference |")
-        print("|---|---:|---:|---:|---:|")
+        print("| loop | C | C, no FMA | lieflow | lieflow / C | body 0: max difference |")
+        print("|---|---:|---:|---:|---:|---:|")
         for row in ROWS:
             work = row[2] * row[3]
-            best_c, best_l = np.inf, np.inf
+            best_c, best_p, best_l = np.inf, np.inf, np.inf
             for _ in range(args.rounds):
                 if exe is not None:
                     sec, zc, rc = run_c(exe, *row)
                     best_c = min(best_c, sec)
+                    best_p = min(best_p, run_c(plain, *row)[0])
                 sec, zl, rl = run_lieflow(*row)
                 best_l = min(best_l, sec)
             ns_l = best_l / work * 1e9
             if exe is None:
-                print(f"| {label(*row)} | – | {ns_l:.1f} ns | – | – |")
+                print(f"| {label(*row)} | – | – | {ns_l:.1f} ns | – | – |")
                 continue
             d = len(zl)
             diff = np.abs(zc[:d] - zl).max()
             if rl is not None:
                 diff = max(diff, np.abs(rc - rl).max())
-            ns_c = best_c / work * 1e9
-            print(f"| {label(*row)} | {ns_c:.1f} ns | {ns_l:.1f} ns | {ns_l / ns_c:.2f} "
-                  f"| {diff:.1e} |", flush=True)
+            ns_c, ns_p = best_c / work * 1e9, best_p / work * 1e9
+            print(f"| {label(*row)} | {ns_c:.1f} ns | {ns_p:.1f} ns | {ns_l:.1f} ns "
+                  f"| {ns_l / ns_c:.2f} | {diff:.1e} |", flush=True)
 
 
 if __name__ == "__main__":
