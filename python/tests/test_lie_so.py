@@ -232,6 +232,13 @@ def test_functions_map_any_leading_axes_item_by_item():
     np.testing.assert_allclose(gh, g @ h, atol=1e-13)
     with pytest.raises(lf.ShapeError, match="broadcast"):
         lie.se3_compose(g, h[:3, None])
+    # Inputs in any memory order map the same (a Fortran-ordered or strided array is not read
+    # as if it were in C order).
+    body = lf.RigidBody([1, 2, 3])
+    z = rng.normal(size=(7, 3))
+    for other in (np.asfortranarray(z), np.repeat(z, 2, axis=0)[::2], z.T.copy().T):
+        assert np.array_equal(body.energy(other), body.energy(z))
+        assert np.array_equal(lie.so3_exp(other), lie.so3_exp(z))
     bad = w.copy()
     bad[3, 0, 1] = np.nan
     with pytest.raises(lf.NonFiniteError, match=r"w\[3, 0\] contains .* at index 1$"):

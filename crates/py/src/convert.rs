@@ -178,9 +178,31 @@ pub fn read_all(what: &str, v: &ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
     Ok(data)
 }
 
-/// An r×c matrix from row-major data.
-fn to_mat(r: usize, c: usize, x: &[f64]) -> Mat {
+/// An r×c matrix from row-major data (an item of `crate::items`).
+pub fn to_mat(r: usize, c: usize, x: &[f64]) -> Mat {
     Mat::from_fn(r, c, |i, j| x[i * c + j])
+}
+
+/// Matrices written row-major one after another into `out` (an item's outputs in
+/// `crate::items`); a result of another size than `out` is an error, never a panic.
+pub fn put_mats(out: &mut [f64], mats: &[&Mat]) -> lieflow::Result<()> {
+    let len: usize = mats.iter().map(|a| a.nrows() * a.ncols()).sum();
+    if len != out.len() {
+        return Err(Error::invalid(
+            "result",
+            format!("{len} entries where the output item has {}", out.len()),
+        ));
+    }
+    let mut k = 0;
+    for a in mats {
+        for i in 0..a.nrows() {
+            for j in 0..a.ncols() {
+                out[k] = a[(i, j)];
+                k += 1;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A 2-D array as a matrix (at most [`check::MAX_DENSE_ENTRIES`] entries).

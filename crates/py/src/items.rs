@@ -11,6 +11,7 @@ use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyFloat;
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::to_py;
@@ -118,14 +119,16 @@ struct Plan<'a> {
     outs: Vec<&'a [usize]>,
     count: usize,
     out_len: usize,
-    data: Vec<Vec<f64>>,
+    /// The inputs' data: borrowed from numpy where contiguous and the GIL stays held, a copy
+    /// for the mapping that releases it (another Python thread may then write the array).
+    data: Vec<Cow<'a, [f64]>>,
     items: Vec<&'a [usize]>,
     finite: Vec<bool>,
     strides: Vec<Vec<usize>>,
 }
 
 impl<'a> Plan<'a> {
-    fn new(inputs: &[Input<'a, '_>], outs: &[&'a [usize]]) -> PyResult<Self> {
+    fn new(inputs: &[Input<'a, '_>], outs: &[&'a [usize]], copy: bool) -> PyResult<Self> {
         assert!(
             inputs.len() <= MAX_INPUTS,
             "at most {MAX_INPUTS} mapped inputs"
@@ -172,7 +175,12 @@ impl<'a> Plan<'a> {
         let mut strides = Vec::with_capacity(inputs.len());
         for ((inp, v), l) in inputs.iter().zip(&views).zip(&leads) {
             // Each input is read once as it is (its own size, checked), never broadcast in memory.
-            data.push(read_all(inp.what, v)?);
+            // Borrowed only in C order (numpy's `as_slice` also accepts Fortran order, whose
+            // flat order is not the items').
+            data.push(match v.to_slice() {
+                Some(s) if !copy => Cow::Borrowed(s),
+                _ => Cow::Owned(read_all(inp.what, v)?),
+            });
             let mut st = vec![0; lead.len()];
             let mut step = 1;
             for (j, &n) in l.iter().enumerate().rev() {
@@ -316,7 +324,7 @@ pub fn map_items<'py, F>(
 where
     F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
 {
-    Plan::new(inputs, &[out_item])?.run(py, &f)
+    Plan::new(inputs, &[out_item], false)?.run(py, &f)
 }
 
 /// [`map_items`] for functions of pure Rust: from [`PAR_MIN`] items on, the items are mapped on
@@ -344,7 +352,7 @@ pub fn par_map_items_n<'py, F>(
 where
     F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()> + Sync + Send,
 {
-    let plan = Plan::new(inputs, outs)?;
+    let plan = Plan::new(inputs, outs, true)?;
     if plan.count < PAR_MIN || plan.out_len == 0 {
         return plan.run(py, &f);
     }

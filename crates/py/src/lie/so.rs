@@ -8,7 +8,7 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::real;
-use crate::convert::{mat, py_mat, py_vec, shape_str, vector, ArrayIn};
+use crate::convert::{mat, put_mats, py_mat, py_vec, shape_str, to_mat, vector, ArrayIn};
 use crate::errors::IntoPy;
 use crate::items::{matrix_item, par_map_items, Input};
 
@@ -21,17 +21,8 @@ fn map_mats<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let [r, c] = matrix_item(what, a)?;
     par_map_items(py, &[Input::new(what, a, &[r, c])], &[r, c], |x, out| {
-        store(&f(&Mat::from_fn(r, c, |i, j| x[0][i * c + j]))?, out);
-        Ok(())
+        put_mats(out, &[&f(&to_mat(r, c, x[0]))?])
     })
-}
-
-/// A matrix into row-major `out`.
-fn store(m: &Mat, out: &mut [f64]) {
-    let c = m.ncols();
-    for (k, o) in out.iter_mut().enumerate() {
-        *o = m[(k / c, k % c)];
-    }
 }
 
 /// `so_hat(c)` (alias `hat_n`): the skew-symmetric matrix with coordinates `c` in the e_ij basis (i < j, +1 at (i, j), −1 at
@@ -58,8 +49,7 @@ fn so_hat<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
         .py();
     }
     par_map_items(py, &[Input::finite("c", &c, &[d])], &[n, n], |x, out| {
-        store(&so::hat_n_unchecked(n, x[0]), out);
-        Ok(())
+        put_mats(out, &[&so::hat_n_unchecked(n, x[0])])
     })
 }
 
@@ -80,7 +70,7 @@ fn so_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>>
         &[Input::new("xi", &xi, &[r, c])],
         &[so::dim(r)],
         |x, out| {
-            out.copy_from_slice(&so::vee_n(&Mat::from_fn(r, c, |i, j| x[0][i * c + j]))?);
+            out.copy_from_slice(&so::vee_n(&to_mat(r, c, x[0]))?);
             Ok(())
         },
     )

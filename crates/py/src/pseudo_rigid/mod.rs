@@ -25,7 +25,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::real;
-use crate::convert::{mat, py_mat, py_vec, ArrayIn};
+use crate::convert::{mat, put_mats, py_mat, py_vec, to_mat, ArrayIn};
 use crate::errors::IntoPy;
 use crate::items::{matrix_item, par_map_items_n, Input};
 
@@ -102,34 +102,12 @@ fn dense_fits(X: &ArrayIn<'_>) -> PyResult<()> {
 
 /// An (n, n) item as a matrix.
 fn m(n: usize, x: &[f64]) -> lieflow::Mat {
-    lieflow::Mat::from_fn(n, n, |i, j| x[i * n + j])
+    to_mat(n, n, x)
 }
 
 /// The bi-inertia tensor at the item X.
 fn bi(n: usize, x: &[f64]) -> lieflow::Result<BiInertia> {
     BiInertia::new(&m(n, x))
-}
-
-/// Matrices written row-major one after another; a result of another size than the output
-/// item is an error (never a panic).
-fn put(out: &mut [f64], mats: &[&lieflow::Mat]) -> lieflow::Result<()> {
-    let len: usize = mats.iter().map(|a| a.nrows() * a.ncols()).sum();
-    if len != out.len() {
-        return Err(lieflow::Error::invalid(
-            "result",
-            format!("{len} entries where the output item has {}", out.len()),
-        ));
-    }
-    let mut k = 0;
-    for a in mats {
-        for i in 0..a.nrows() {
-            for j in 0..a.ncols() {
-                out[k] = a[(i, j)];
-                k += 1;
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Left inertia tensor A^L_X(xi) = X X^T xi + xi X X^T (001 (2.11)).
@@ -146,7 +124,7 @@ pub fn left_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, xi: ArrayIn<'py>) -> 
         py,
         &[("X", &X, Mat), ("xi", &xi, Mat)],
         &[Mat],
-        |n, x, out| put(out, &[&bi(n, x[0])?.left(&m(n, x[1]))?]),
+        |n, x, out| put_mats(out, &[&bi(n, x[0])?.left(&m(n, x[1]))?]),
     )
 }
 
@@ -163,7 +141,7 @@ pub fn right_inertia<'py>(
         py,
         &[("X", &X, Mat), ("xi", &xi, Mat)],
         &[Mat],
-        |n, x, out| put(out, &[&bi(n, x[0])?.right(&m(n, x[1]))?]),
+        |n, x, out| put_mats(out, &[&bi(n, x[0])?.right(&m(n, x[1]))?]),
     )
 }
 
@@ -176,7 +154,7 @@ pub fn right_inertia<'py>(
 #[pyfunction]
 pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Any<'py>> {
     map(py, &[("X", &X, Mat)], &[Dense], |n, x, out| {
-        put(out, &[&bi(n, x[0])?.try_matrix()?])
+        put_mats(out, &[&bi(n, x[0])?.try_matrix()?])
     })
 }
 
@@ -196,7 +174,7 @@ pub fn bi_inertia_apply<'py>(
     let args = [("X", &X, Mat), ("xi", &xi, Mat), ("eta", &eta, Mat)];
     map(py, &args, &[Mat, Mat], |n, x, out| {
         let (a, b) = bi(n, x[0])?.apply(&m(n, x[1]), &m(n, x[2]))?;
-        put(out, &[&a, &b])
+        put_mats(out, &[&a, &b])
     })
 }
 
@@ -220,7 +198,7 @@ pub fn bi_inertia_solve<'py>(
     let args = [("X", &X, Mat), ("lam", &lam, Mat), ("gam", &gam, Mat)];
     map(py, &args, &[Mat, Mat], |n, x, out| {
         let (a, b) = bi(n, x[0])?.solve(&m(n, x[1]), &m(n, x[2]))?;
-        put(out, &[&a, &b])
+        put_mats(out, &[&a, &b])
     })
 }
 
@@ -238,7 +216,7 @@ pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Any<'
     map(py, &[("X", &X, Mat)], &[DenseVector, Dense], |n, x, out| {
         let (vals, vecs) = bi(n, x[0])?.eigen()?;
         out[..vals.len()].copy_from_slice(&vals);
-        put(&mut out[vals.len()..], &[&vecs])
+        put_mats(&mut out[vals.len()..], &[&vecs])
     })
 }
 
@@ -278,7 +256,7 @@ pub fn left_connection<'py>(
         py,
         &[("X", &X, Mat), ("Y", &Y, Mat)],
         &[Mat],
-        |n, x, out| put(out, &[&cn::left_connection(&bi(n, x[0])?, &m(n, x[1]))?]),
+        |n, x, out| put_mats(out, &[&cn::left_connection(&bi(n, x[0])?, &m(n, x[1]))?]),
     )
 }
 
@@ -296,7 +274,7 @@ pub fn right_connection<'py>(
         py,
         &[("X", &X, Mat), ("Y", &Y, Mat)],
         &[Mat],
-        |n, x, out| put(out, &[&cn::right_connection(&bi(n, x[0])?, &m(n, x[1]))?]),
+        |n, x, out| put_mats(out, &[&cn::right_connection(&bi(n, x[0])?, &m(n, x[1]))?]),
     )
 }
 
@@ -316,7 +294,7 @@ pub fn bi_connection<'py>(py: Python<'py>, X: ArrayIn<'py>, Y: ArrayIn<'py>) -> 
         &[Mat, Mat],
         |n, x, out| {
             let (a, b) = cn::bi_connection(&bi(n, x[0])?, &m(n, x[1]))?;
-            put(out, &[&a, &b])
+            put_mats(out, &[&a, &b])
         },
     )
 }
@@ -334,7 +312,7 @@ pub fn vertical_vector<'py>(
 ) -> PyResult<Any<'py>> {
     let args = [("X", &X, Mat), ("xi", &xi, Mat), ("eta", &eta, Mat)];
     map(py, &args, &[Mat], |n, x, out| {
-        put(
+        put_mats(
             out,
             &[&cn::vertical_vector(
                 &bi(n, x[0])?,
@@ -368,7 +346,7 @@ pub fn horizontal_part<'py>(
         &[("X", &X, Mat), ("Y", &Y, Mat)],
         &[Mat],
         |n, x, out| {
-            put(
+            put_mats(
                 out,
                 &[&cn::horizontal_part(&bi(n, x[0])?, &m(n, x[1]), action)?],
             )
@@ -392,7 +370,7 @@ pub fn locked_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, action: &str) -> Py
         _ => Half,
     };
     map(py, &[("X", &X, Mat)], &[out], |n, x, out| {
-        put(out, &[&cn::locked_inertia(&bi(n, x[0])?, action)?])
+        put_mats(out, &[&cn::locked_inertia(&bi(n, x[0])?, action)?])
     })
 }
 
@@ -410,7 +388,7 @@ pub fn angular_momentum<'py>(
         py,
         &[("X", &X, Mat), ("V", &V, Mat)],
         &[Mat],
-        |n, x, out| put(out, &[&mo::angular_momentum(&m(n, x[0]), &m(n, x[1]))?]),
+        |n, x, out| put_mats(out, &[&mo::angular_momentum(&m(n, x[0]), &m(n, x[1]))?]),
     )
 }
 
@@ -424,7 +402,7 @@ pub fn circulation<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> Py
         py,
         &[("X", &X, Mat), ("V", &V, Mat)],
         &[Mat],
-        |n, x, out| put(out, &[&mo::circulation(&m(n, x[0]), &m(n, x[1]))?]),
+        |n, x, out| put_mats(out, &[&mo::circulation(&m(n, x[0]), &m(n, x[1]))?]),
     )
 }
 
@@ -445,11 +423,11 @@ pub fn to_body<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResu
         let (r, a, s) = (&b.r, &b.a, &b.s);
         let (o, ad, l) = (&b.omega, &b.adot, &b.lambda);
         let nn = n * n;
-        put(&mut out[..nn], &[r])?;
+        put_mats(&mut out[..nn], &[r])?;
         out[nn..nn + n].copy_from_slice(a);
-        put(&mut out[nn + n..3 * nn + n], &[s, o])?;
+        put_mats(&mut out[nn + n..3 * nn + n], &[s, o])?;
         out[3 * nn + n..3 * nn + 2 * n].copy_from_slice(ad);
-        put(&mut out[3 * nn + 2 * n..], &[l])
+        put_mats(&mut out[3 * nn + 2 * n..], &[l])
     })
 }
 
@@ -491,7 +469,7 @@ pub fn from_body<'py>(
             lambda: m(n, x[5]),
         };
         let (X, V) = body.to_state()?;
-        put(out, &[&X, &V])
+        put_mats(out, &[&X, &V])
     })
 }
 
@@ -568,7 +546,7 @@ pub fn riemann_variables<'py>(
         &[Mat, Mat],
         |n, x, out| {
             let (q, nn) = riemann::riemann_variables(&m(n, x[0]), &m(n, x[1]))?;
-            put(out, &[&q, &nn])
+            put_mats(out, &[&q, &nn])
         },
     )
 }
@@ -695,7 +673,7 @@ pub fn reconstruct<'py>(
             p_lambda: m(n, x[5]),
         };
         let (X, P) = lieflow::pseudo_rigid::reduced::reconstruct(&m(n, x[0]), &m(n, x[1]), &st)?;
-        put(out, &[&X, &P])
+        put_mats(out, &[&X, &P])
     })
 }
 
