@@ -6,8 +6,8 @@ threads, each with and without the attitude. The C twin (`benches/c/strang_loop.
 flows, the first and last half flows of consecutive steps fused, the same sin/cos polynomial, the
 attitude as a unit quaternion; one body alone, a batch component by component in blocks the
 compiler vectorises) is built with the system's C compiler (`cc -O3 -march=native`, with OpenMP
-when the compiler has it), and again with `-ffp-contract=off` (no fused multiply-adds, as
-lieflow's kernels); without a compiler the C columns are skipped with a message. Times are the best of ROUNDS rounds, C and lieflow alternating; lieflow is one
+when the compiler has it), and again with `-ffp-contract=off` (no fused multiply-adds: what
+they are worth here); without a compiler the C columns are skipped with a message. Times are the best of ROUNDS rounds, C and lieflow alternating; lieflow is one
 `lf.integrate` call that saves the last state only. Body 0's final state is compared with the C
 loop's (the two round differently: quaternion against matrix), as a check that both compute the
 same thing.
@@ -116,7 +116,8 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         exe = build(tmp)
         # The same source without contracting a*b + c into fused multiply-adds (gcc's default
-        # for C with -march=native contracts them; lieflow's kernels round every operation).
+        # for C with -march=native contracts them, as lieflow's kernels fuse them): what FMA is
+        # worth on this machine.
         plain = build(tmp, ["-ffp-contract=off"], "strang_loop_plain") if exe else None
         print(f"\nbest of {args.rounds} rounds, C and lieflow alternating; per step and body.\n")
         print("| loop | C | C, no FMA | lieflow | lieflow / C | body 0: max difference |")

@@ -123,41 +123,62 @@ impl Block {
     }
 }
 
-/// A state space: named blocks laid out one after the other in a flat vector.
-#[derive(Clone, Debug, PartialEq, Eq, Default)]
+/// The most blocks a [`Space`] holds (the systems have at most five).
+pub const MAX_BLOCKS: usize = 8;
+
+/// A state space: named blocks laid out one after the other in a flat vector. Held inline (no
+/// allocation: a batch checks and lays out every member's state with it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Space {
-    blocks: Vec<(&'static str, Block)>,
+    items: [(&'static str, Block); MAX_BLOCKS],
+    len: usize,
+}
+
+impl Default for Space {
+    fn default() -> Self {
+        Space {
+            items: [("", Block::Real(0)); MAX_BLOCKS],
+            len: 0,
+        }
+    }
 }
 
 impl Space {
-    /// The space of the given (name, block) pairs, in order.
+    /// The space of the given (name, block) pairs, in order (at most [`MAX_BLOCKS`]).
     pub fn new(blocks: impl IntoIterator<Item = (&'static str, Block)>) -> Self {
-        Space {
-            blocks: blocks.into_iter().collect(),
-        }
+        blocks
+            .into_iter()
+            .fold(Space::default(), |s, (name, b)| s.with(name, b))
     }
 
     /// The same space with one more block at the end (e.g. the attitude `R: SO(3)`).
+    ///
+    /// Panics beyond [`MAX_BLOCKS`] blocks (a system's layout, fixed in the code).
     pub fn with(mut self, name: &'static str, block: Block) -> Self {
-        self.blocks.push((name, block));
+        assert!(
+            self.len < MAX_BLOCKS,
+            "a Space holds at most {MAX_BLOCKS} blocks"
+        );
+        self.items[self.len] = (name, block);
+        self.len += 1;
         self
     }
 
     /// The blocks with their names.
     pub fn blocks(&self) -> &[(&'static str, Block)] {
-        &self.blocks
+        &self.items[..self.len]
     }
 
     /// The length of a state vector.
     pub fn dim(&self) -> usize {
-        self.blocks.iter().map(|(_, b)| b.len()).sum()
+        self.blocks().iter().map(|(_, b)| b.len()).sum()
     }
 
     /// The blocks with their names and value ranges.
     pub fn ranges(
         &self,
     ) -> impl Iterator<Item = (&'static str, Block, std::ops::Range<usize>)> + '_ {
-        self.blocks.iter().scan(0, |start, &(name, b)| {
+        self.blocks().iter().scan(0, |start, &(name, b)| {
             let r = *start..*start + b.len();
             *start = r.end;
             Some((name, b, r))
@@ -173,14 +194,17 @@ impl Space {
 
     /// Whether some block is curved (the driver then retracts the state now and then).
     pub fn is_curved(&self) -> bool {
-        self.blocks.iter().any(|(_, b)| b.is_curved())
+        self.blocks().iter().any(|(_, b)| b.is_curved())
     }
 
     /// Checks the length of `z` and every block ([`Block::check`]).
     pub fn check(&self, what: &str, z: &[f64]) -> Result<()> {
         check::len_of(what, z, self.dim())?;
         for (name, b, r) in self.ranges() {
-            b.check(&format!("{what} ({name})"), &z[r])?;
+            // The block's name is formatted only for an error (a batch checks every member).
+            if b.check(what, &z[r.clone()]).is_err() {
+                b.check(&format!("{what} ({name})"), &z[r])?;
+            }
         }
         Ok(())
     }
@@ -195,7 +219,7 @@ impl Space {
     /// A short description such as `M: R^3 × R: SO(3)`.
     pub fn describe(&self) -> String {
         let parts: Vec<String> = self
-            .blocks
+            .blocks()
             .iter()
             .map(|(name, b)| {
                 let s = match b {

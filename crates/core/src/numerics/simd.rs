@@ -10,10 +10,14 @@
 //! **Reproducibility.** The same generic kernel runs with `S = pulp::Scalar` (one lane) for the
 //! single-member steppers and with the dispatched vector type for batches, and it uses only
 //! operations that IEEE 754 rounds correctly and identically in every lane and instruction set:
-//! `+`, `−`, `×`, comparisons, selects and bit operations — **no FMA** (a fused multiply-add
-//! rounds once where `a·b + c` rounds twice, so an FMA path and a non-FMA path differ in the last
-//! bit). A member's result is therefore the same bits whatever lane, block, batch size,
-//! instruction set or thread computes it. Lanes that need the slow path (below) are taken one by
+//! `+`, `−`, `×`, the fused multiply-add a·b + c rounded once ([`fma`]), comparisons, selects
+//! and bit operations. The fused multiply-add is never replaced by a multiply and an add (which
+//! round twice, a different last bit): under the dispatched instruction sets (x86-64 v3 and v4,
+//! NEON) it is the hardware instruction, and the one-lane kernels run inside the same dispatch
+//! (`pulp::Arch::dispatch`), so that `pulp::Scalar`'s `f64::mul_add` compiles to it too; on a
+//! machine without FMA it is the platform's correctly rounded `fma` (slower, the same bits). A
+//! member's result is therefore the same bits whatever lane, block, batch size, instruction set,
+//! machine or thread computes it. Lanes that need the slow path (below) are taken one by
 //! one by the same scalar function, again independent of their neighbours.
 //!
 //! **sin/cos** ([`sin_cos_lanes`], scalar [`lane_sin_cos`]): the angle x is reduced to
@@ -154,28 +158,34 @@ fn fast<S: Simd>(simd: S, x: S::f64s) -> ([S::f64s; 3], S::m64s) {
     ([s, c, cm1], slow)
 }
 
+/// a·b + c rounded once (a fused multiply-add: the hardware's under the dispatched instruction
+/// sets, the correctly rounded `fma` of the platform's libm on a scalar path without them; the
+/// same bits either way).
+#[inline(always)]
+pub fn fma<S: Simd>(simd: S, a: S::f64s, b: S::f64s, c: S::f64s) -> S::f64s {
+    simd.mul_add_f64s(a, b, c)
+}
+
 /// P(z) and Q(z) of the Taylor polynomials (sin r = r + r³P(r²), cos r = 1 − r²/2 + r⁴Q(r²)),
-/// by Estrin's scheme (pairs, then z², z⁴: a chain of 4 multiply-adds instead of Horner's 7, for
-/// the one-body path, which waits on it), and z².
+/// by Estrin's scheme in fused multiply-adds (pairs, then z², z⁴: a chain of 3 instead of
+/// Horner's 7, for the one-body path, which waits on it), and z².
 #[inline(always)]
 fn taylor_pq<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s, S::f64s) {
     let splat = |v: f64| simd.splat_f64s(v);
     let z2 = simd.mul_f64s(z, z);
     let z4 = simd.mul_f64s(z2, z2);
-    let pair = |a: f64, b: f64| simd.add_f64s(splat(a), simd.mul_f64s(splat(b), z));
-    let p = simd.add_f64s(
-        simd.add_f64s(pair(S[0], S[1]), simd.mul_f64s(pair(S[2], S[3]), z2)),
-        simd.mul_f64s(
-            simd.add_f64s(pair(S[4], S[5]), simd.mul_f64s(pair(S[6], S[7]), z2)),
-            z4,
-        ),
+    let pair = |a: f64, b: f64| fma(simd, splat(b), z, splat(a));
+    let p = fma(
+        simd,
+        fma(simd, pair(S[6], S[7]), z2, pair(S[4], S[5])),
+        z4,
+        fma(simd, pair(S[2], S[3]), z2, pair(S[0], S[1])),
     );
-    let q = simd.add_f64s(
-        simd.add_f64s(pair(C[0], C[1]), simd.mul_f64s(pair(C[2], C[3]), z2)),
-        simd.mul_f64s(
-            simd.add_f64s(pair(C[4], C[5]), simd.mul_f64s(splat(C[6]), z2)),
-            z4,
-        ),
+    let q = fma(
+        simd,
+        fma(simd, splat(C[6]), z2, pair(C[4], C[5])),
+        z4,
+        fma(simd, pair(C[2], C[3]), z2, pair(C[0], C[1])),
     );
     (p, q, z2)
 }
@@ -185,9 +195,10 @@ fn taylor_pq<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s, S::f64s) {
 #[inline(always)]
 pub fn sinc_versinc_small<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s) {
     let (p, q, _) = taylor_pq(simd, z);
+    let minus_z = simd.xor_f64s(z, simd.splat_f64s(-0.0));
     (
-        simd.add_f64s(simd.splat_f64s(1.0), simd.mul_f64s(z, p)),
-        simd.sub_f64s(simd.splat_f64s(0.5), simd.mul_f64s(z, q)),
+        fma(simd, z, p, simd.splat_f64s(1.0)),
+        fma(simd, minus_z, q, simd.splat_f64s(0.5)),
     )
 }
 
@@ -196,22 +207,24 @@ pub fn sinc_versinc_small<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s) {
 #[inline(always)]
 fn sin_cos_reduced<S: Simd>(simd: S, r: S::f64s, r_lo: S::f64s) -> (S::f64s, S::f64s, S::f64s) {
     let splat = |v: f64| simd.splat_f64s(v);
+    let neg = |v| simd.xor_f64s(v, splat(-0.0));
     let z = simd.mul_f64s(r, r);
     let (p, q, z2) = taylor_pq(simd, z);
     let hz = simd.mul_f64s(splat(0.5), z);
-    // sin(r + r_lo) ≈ r + (r³P + r_lo·(1 − z/2)).
-    let sin_corr = simd.add_f64s(
-        simd.mul_f64s(simd.mul_f64s(r, z), p),
-        simd.sub_f64s(r_lo, simd.mul_f64s(hz, r_lo)),
-    );
-    let sin_r = simd.add_f64s(r, sin_corr);
-    // cos(r + r_lo) ≈ w + (((1 − w) − z/2) + (z²Q − r·r_lo)), w = 1 − z/2.
+    // sin(r + r_lo) ≈ (r + r³P) + r_lo·(1 − z/2): r + r³P in one rounding (as the small path
+    // without r_lo), then the correction of r_lo (≤ 1 ulp of sin in all).
+    let lo = fma(simd, neg(hz), r_lo, r_lo);
+    let sin_r = simd.add_f64s(fma(simd, simd.mul_f64s(r, z), p, r), lo);
+    // cos(r + r_lo) ≈ w + (((1 − w) − z/2) + (z²Q − r·r_lo)), w = 1 − z/2; cos − 1 as
+    // z²Q − (r·r_lo + z/2), one rounding after the product (for r_lo = 0: z²Q − z/2).
     let one = splat(1.0);
     let w = simd.sub_f64s(one, hz);
-    let tail = simd.sub_f64s(simd.mul_f64s(z2, q), simd.mul_f64s(r, r_lo));
+    let r_rlo = simd.mul_f64s(r, r_lo);
+    let tail = fma(simd, z2, q, neg(r_rlo));
     let cos_corr = simd.add_f64s(simd.sub_f64s(simd.sub_f64s(one, w), hz), tail);
     let cos_r = simd.add_f64s(w, cos_corr);
-    (sin_r, cos_r, simd.sub_f64s(tail, hz))
+    let cosm1 = fma(simd, z2, q, neg(simd.add_f64s(r_rlo, hz)));
+    (sin_r, cos_r, cosm1)
 }
 
 /// The largest |x| for which k = round(2x/π) is 0 whatever the rounding of 2x/π
@@ -230,18 +243,17 @@ pub fn sin_cos_small<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s) {
 }
 
 /// [`sin_cosm1_fast`] for lanes that all have |x| ≤ [`SMALL_MAX`]: the same bits (as
-/// [`sin_cos_small`]), without the terms of r_lo = +0: r = x + (+0) as in the reduction, then
-/// z²Q − r·r_lo = z²Q (z²Q ≥ +0 and r·r_lo = ±0), and r + (rzP + (r_lo − (z/2)r_lo)) =
-/// r + (rzP + (+0)) = r + rzP (the two differ only where rzP = −0, and r + (±0) = r there, r = +0
-/// included). Two operations fewer on the chain of the one-body steppers, which wait on it.
+/// [`sin_cos_small`]), without the reduction and the terms of r_lo = +0. The reduction gives
+/// r = x + (+0) (x but for the sign of a zero, which z = r² and r + r³P then do not show) and
+/// r_lo = +0, whose correction adds +0 to sin and turns −(r·r_lo + z/2) into −z/2. Three
+/// operations fewer on the chain of the one-body steppers, which wait on it.
 #[inline(always)]
 pub fn sin_cosm1_small<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s) {
-    let r = simd.add_f64s(x, simd.splat_f64s(0.0));
-    let z = simd.mul_f64s(r, r);
+    let z = simd.mul_f64s(x, x);
     let (p, q, z2) = taylor_pq(simd, z);
-    let hz = simd.mul_f64s(simd.splat_f64s(0.5), z);
-    let sin = simd.add_f64s(r, simd.mul_f64s(simd.mul_f64s(r, z), p));
-    (sin, simd.sub_f64s(simd.mul_f64s(z2, q), hz))
+    let minus_hz = simd.mul_f64s(simd.splat_f64s(-0.5), z);
+    let sin = fma(simd, simd.mul_f64s(x, z), p, x);
+    (sin, fma(simd, z2, q, minus_hz))
 }
 
 /// Whether every lane of `x` has |x| ≤ [`SMALL_MAX`] (so [`sin_cos_small`] applies; false for
@@ -325,27 +337,32 @@ fn fix_slow<S: Simd>(
 /// (sin θ, cos θ) of a rotation angle: one lane of [`sin_cos_lanes`], bit for bit what every
 /// lane of a batch computes for the same θ (for |θ| ≤ [`SMALL_MAX`], the usual angle of a
 /// step, by [`sin_cos_small`]: the same bits without the reduction). NaN beyond
-/// [`crate::numerics::angle::EXP_MAX_NORM`] and for a non-finite θ.
+/// [`crate::numerics::angle::EXP_MAX_NORM`] and for a non-finite θ. Dispatched, so that its fused
+/// multiply-adds are the hardware's where the machine has them.
 #[inline]
 pub fn lane_sin_cos(theta: f64) -> (f64, f64) {
-    let s = pulp::Scalar::new();
-    if all_small(s, theta) {
-        sin_cos_small(s, theta)
-    } else {
-        sin_cos_lanes(s, theta)
-    }
+    pulp::Arch::new().dispatch(|| {
+        let s = pulp::Scalar::new();
+        if all_small(s, theta) {
+            sin_cos_small(s, theta)
+        } else {
+            sin_cos_lanes(s, theta)
+        }
+    })
 }
 
 /// (sin θ, cos θ − 1) of a rotation angle: one lane of [`sin_cosm1_lanes`], bit for bit (as
 /// [`lane_sin_cos`]).
 #[inline]
 pub fn angle_sin_cosm1(theta: f64) -> (f64, f64) {
-    let s = pulp::Scalar::new();
-    if all_small(s, theta) {
-        sin_cosm1_small(s, theta)
-    } else {
-        sin_cosm1_lanes(s, theta)
-    }
+    pulp::Arch::new().dispatch(|| {
+        let s = pulp::Scalar::new();
+        if all_small(s, theta) {
+            sin_cosm1_small(s, theta)
+        } else {
+            sin_cosm1_lanes(s, theta)
+        }
+    })
 }
 
 #[cfg(test)]
@@ -628,6 +645,9 @@ mod tests {
         let bits = |(a, b): (f64, f64)| (a.to_bits(), b.to_bits());
         for (x, sc) in xs.iter().zip(got) {
             assert_eq!(bits(sc), bits(angle_sin_cosm1(*x)), "x = {x:e}");
+            // Outside a dispatch the fused multiply-adds are libm's `fma`: the same bits.
+            let outside = sin_cosm1_lanes(pulp::Scalar::new(), *x);
+            assert_eq!(bits(sc), bits(outside), "x = {x:e}");
         }
         let simd = pulp::Scalar::new();
         let mut xs: Vec<f64> = sample(20_000)

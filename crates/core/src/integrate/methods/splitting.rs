@@ -14,8 +14,9 @@
 //!
 //! A problem whose flows also run on many members at once ([`Split::lanes`]) gets a
 //! [`BatchStepper`] for batches: the members' states side by side in one block, the same fused
-//! sequence, each member's lazy outer flow kept apart, so that a member ends bit for bit where
-//! its one-member stepper would.
+//! sequence, each member's lazy outer flow kept apart. Its one-member stepper is that batch
+//! stepper of one member, so that a member ends bit for bit where it would alone by
+//! construction (and one body runs the same kernel, without a dispatch per flow).
 
 use std::sync::Arc;
 
@@ -90,7 +91,13 @@ impl Scheme {
         problem.store(&w, z);
     }
 
+    /// The one-member stepper: the problem's kernel of many members ([`Split::lanes`]) on one,
+    /// where it has one (so a member gives the same bits alone and in a batch by construction),
+    /// else its flows one by one.
     fn stepper<P: Split + Clone + 'static>(self, problem: &P, dt: f64) -> Box<dyn Stepper> {
+        if let Some(one) = self.members(problem, dt, 1) {
+            return Box::new(Alone(one));
+        }
         Box::new(SplittingStepper {
             scheme: self,
             problem: problem.clone(),
@@ -106,6 +113,18 @@ impl Scheme {
         dt: f64,
         members: usize,
     ) -> Option<Result<Box<dyn BatchStepper>>> {
+        let batch = self.members(problem, dt, members)?;
+        Some(Ok(Box::new(batch)))
+    }
+
+    /// The batch stepper of `members` members, if the problem has [`Split::lanes`] (and does
+    /// not check every step).
+    fn members<P: Split + Clone + 'static>(
+        &self,
+        problem: &P,
+        dt: f64,
+        members: usize,
+    ) -> Option<SplittingBatch<P>> {
         if P::CHECKED {
             return None;
         }
@@ -121,7 +140,7 @@ impl Scheme {
             .iter()
             .map(|&(i, c)| (i, c * dt))
             .collect();
-        Some(Ok(Box::new(SplittingBatch {
+        Some(SplittingBatch {
             problem: problem.clone(),
             lanes,
             d,
@@ -130,10 +149,10 @@ impl Scheme {
             pending: vec![0.0; members],
             first: vec![0.0; members],
             inner,
-            scheme: self,
+            scheme: self.clone(),
             h: dt,
             c_last,
-        })))
+        })
     }
 }
 
@@ -266,14 +285,32 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
     }
 
     fn detach(&self, member: usize) -> Result<Box<dyn Stepper>> {
-        let z: Vec<f64> = self.column(member).collect();
-        Ok(Box::new(SplittingStepper {
-            problem: self.problem.clone(),
-            scheme: self.scheme.clone(),
-            h: self.h,
-            work: Some(self.problem.load(&z)?),
-            pending: self.pending[member],
-        }))
+        let mut one = self
+            .scheme
+            .members(&self.problem, self.h, 1)
+            .expect("a batch stepper has lanes");
+        for (c, v) in self.column(member).enumerate() {
+            one.block[c] = v;
+        }
+        one.pending[0] = self.pending[member];
+        Ok(Box::new(Alone(one)))
+    }
+}
+
+/// The one-member stepper of a problem with [`Split::lanes`]: its batch stepper of one member.
+struct Alone<P: Split>(SplittingBatch<P>);
+
+impl<P: Split + Clone + 'static> Stepper for Alone<P> {
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        self.0.set(0, z)
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        self.0.get(0, z)
+    }
+
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        self.0.advance(steps, clock)
     }
 }
 

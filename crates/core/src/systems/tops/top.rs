@@ -28,6 +28,7 @@ use crate::integrate::methods::{Composition, Processed, ProcessedSplitting, Spli
 use crate::integrate::problem::Split;
 use crate::integrate::space::{Block, Space};
 use crate::integrate::Entry;
+use crate::numerics::simd::fma;
 use nalgebra::{Matrix3, Vector3};
 
 /// Checks principal moments: finite and > 0.
@@ -302,64 +303,44 @@ impl Top {
         self.flows
     }
 
-    /// The exact flow i over time τ (module docs).
-    #[inline]
+    /// The exact flow i over time τ (module docs): one body through the batch kernel
+    /// ([`TopLanes`]), so that a body gives the same bits alone and in a batch. NaN where an
+    /// angle is lost to rounding (see `rotate_axis`).
     pub(crate) fn flow(&self, i: usize, tau: f64, b: &mut TopWork) {
-        match self.kinds[i] {
-            Flow::Axis(a) => {
-                let k = self.axes[a];
-                // One lane of the batch kernel (`TopLanes`): the same sin/cos and operations, so
-                // a body gives the same bits alone and in a batch. NaN where the angle is lost
-                // to rounding (see `rotate_axis`).
-                let (s, cm1) = crate::numerics::simd::angle_sin_cosm1(tau * self.coef[a] * b.m[k]);
-                rotate_axis_sc(&mut b.m, k, s, cm1);
-                if let Some(g) = b.g.as_mut() {
-                    rotate_axis_sc(g, k, s, cm1);
-                }
-                if let Some(r) = b.r.as_mut() {
-                    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                    let (ci, cj) = (r.column(i).into_owned(), r.column(j).into_owned());
-                    r.set_column(i, &(ci + (ci * cm1 + cj * s)));
-                    r.set_column(j, &(cj + (cj * cm1 - ci * s)));
-                }
-            }
-            Flow::Casimir => {
-                // One lane of `TopLanes` (as the axis flows): Γ and the rows of R turned.
-                let m = [b.m[0], b.m[1], b.m[2]];
-                let turn = Turn::new(pulp::Scalar::new(), tau * self.inv_ir, m);
-                if let Some(g) = b.g.as_mut() {
-                    let mut x = [g[0], g[1], g[2]];
-                    turn.apply(&mut x);
-                    *g = Vector3::from(x);
-                }
-                if let Some(r) = b.r.as_mut() {
-                    for i in 0..3 {
-                        let mut x = [r[(i, 0)], r[(i, 1)], r[(i, 2)]];
-                        turn.apply(&mut x);
-                        for (j, xj) in x.into_iter().enumerate() {
-                            r[(i, j)] = xj;
-                        }
-                    }
-                }
-            }
-            Flow::Kick => self.kick(tau, b),
+        let kernel = self.kernel();
+        let d = crate::integrate::problem::SplitLanes::dim(&kernel);
+        let mut z = [0.0; 15];
+        self.store(b, &mut z);
+        let program = crate::integrate::problem::Program {
+            outer: i,
+            fused: 0.0,
+            inner: &[],
+            steps: 1,
+        };
+        crate::integrate::problem::SplitLanes::run(&kernel, &mut z[..d], &[tau], &program);
+        *b = self.load(&z[..d]);
+    }
+
+    /// The exact flow of the heavy-top potential V = Γ·c over time τ: M ↦ M + τ Γ × c (the
+    /// identity for a free body).
+    pub(crate) fn kick(&self, tau: f64, b: &mut TopWork) {
+        if let Some(i) = self.kinds[..self.flows]
+            .iter()
+            .position(|&k| k == Flow::Kick)
+        {
+            self.flow(i, tau, b);
         }
     }
 
-    /// The exact flow of the heavy-top potential V = Γ·c over time τ: M ↦ M + τ Γ × c (one lane
-    /// of `TopLanes`).
-    #[inline]
-    pub(crate) fn kick(&self, tau: f64, b: &mut TopWork) {
-        if let (Some(g), Some(c)) = (b.g, self.c) {
-            let mut m = [b.m[0], b.m[1], b.m[2]];
-            kick_lanes(
-                pulp::Scalar::new(),
-                tau,
-                &mut m,
-                [g[0], g[1], g[2]],
-                c.into(),
-            );
-            b.m = Vector3::from(m);
+    /// The kernel of the flows ([`TopLanes`]) for this body.
+    fn kernel(&self) -> TopLanes {
+        TopLanes {
+            kinds: self.kinds,
+            axes: self.axes,
+            coef: self.coef,
+            inv_ir: self.inv_ir,
+            c: self.c.map(Into::into),
+            lifted: self.lifted,
         }
     }
 
@@ -367,14 +348,7 @@ impl Top {
     pub(crate) fn lanes(
         &self,
     ) -> Option<std::sync::Arc<dyn crate::integrate::problem::SplitLanes>> {
-        Some(std::sync::Arc::new(TopLanes {
-            kinds: self.kinds,
-            axes: self.axes,
-            coef: self.coef,
-            inv_ir: self.inv_ir,
-            c: self.c.map(Into::into),
-            lifted: self.lifted,
-        }))
+        Some(std::sync::Arc::new(self.kernel()))
     }
 
     /// The Euler–Poisson field on (M, [Γ], [R]): Ṁ = M × Ω + Γ × c, Γ̇ = Γ × Ω, Ṙ = R hat(Ω),
@@ -397,15 +371,15 @@ impl Top {
 }
 
 /// The flows of the free rigid body (M) and of the heavy top (M, Γ), with or without the attitude
-/// R, on a block of bodies, in SIMD lanes ([`crate::numerics::simd`]), with exactly the operations of [`Top::flow`]
-/// (which is one lane of this kernel): flow `Axis(a)` rotates M (and Γ) about e_k,
-/// k = `axes[a]`, by the angle −τ·`coef[a]`·M_k (and the columns i, j of R by the same angle);
-/// `Casimir` turns Γ and the rows of R by exp(−τ M̂/I_r) ([`Turn`]); `Kick` adds τ Γ × c to M
-/// ([`kick_lanes`]).
+/// R, on a block of bodies, in SIMD lanes ([`crate::numerics::simd`]); [`Top::flow`] is this
+/// kernel on one body. Flow `Axis(a)` rotates M (and Γ) about e_k, k = `axes[a]`, by the angle
+/// −τ·`coef[a]`·M_k (and the columns i, j of R by the same angle); `Casimir` turns Γ and the rows
+/// of R by exp(−τ M̂/I_r) ([`Turn`]); `Kick` adds τ Γ × c to M ([`kick_lanes`]).
 ///
 /// Each group of [`GROUP`] vectors of bodies is loaded into registers once and stepped through
 /// the whole program there (the vectors interleaved, so that the latency of one sin/cos is hidden
-/// behind the others), then stored.
+/// behind the others), then stored. One body runs in one scalar lane, inside the same dispatch.
+#[derive(Clone, Copy, Debug)]
 struct TopLanes {
     kinds: [Flow; 4],
     axes: [usize; 2],
@@ -417,8 +391,8 @@ struct TopLanes {
     lifted: bool,
 }
 
-/// Vectors of bodies stepped together by [`TopLanes`].
-const GROUP: usize = 4;
+/// Vectors of bodies stepped together by [`TopLanes`] in a batch.
+const GROUP: usize = 8;
 
 impl crate::integrate::problem::SplitLanes for TopLanes {
     fn dim(&self) -> usize {
@@ -467,64 +441,70 @@ impl<const D: usize> pulp::WithSimd for LanesRun<'_, D> {
     type Output = ();
 
     #[inline(always)]
-    #[allow(clippy::needless_range_loop)] // the group's vectors index several arrays
     fn with_simd<S: pulp::Simd>(self, simd: S) {
-        let n = self.first.len();
-        if n == 0 {
-            return;
+        match self.first.len() {
+            0 => {}
+            // One body (a single run, a flow of `Top::flow`): one lane, compiled inside this
+            // dispatch (its fused multiply-adds are the machine's).
+            1 => self.steps::<pulp::Scalar, 1>(pulp::Scalar::new()),
+            _ => self.steps::<S, GROUP>(simd),
         }
+    }
+}
+
+impl<const D: usize> LanesRun<'_, D> {
+    #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // the group's vectors index several arrays
+    fn steps<S: pulp::Simd, const G: usize>(self, simd: S) {
+        let n = self.first.len();
         let lanes = S::F64_LANES;
         let mut chunks = self.block.chunks_exact_mut(n);
         let mut rows: [&mut [f64]; D] = std::array::from_fn(|_| chunks.next().unwrap_or_default());
         let (p, top) = (self.program, self.lanes);
-        // The inner flows' times, scaled as each flow uses them (once per call, not per step).
-        let inner: Vec<(usize, f64)> = p
-            .inner
-            .iter()
-            .map(|&(i, t)| (i, t * top.factor(i)))
-            .collect();
+        let splat = |t: f64| [simd.splat_f64s(t); G];
         let mut start = 0;
         while start < n {
-            // Loads GROUP vectors of bodies (zeros past the end: lanes of no body).
+            // Loads G vectors of bodies (zeros past the end: lanes of no body).
             let part = |j: usize| {
                 let lo = (start + j * lanes).min(n);
                 lo..(lo + lanes).min(n)
             };
-            let mut z = [[simd.splat_f64s(0.0); GROUP]; D];
-            let mut tau = [simd.splat_f64s(0.0); GROUP];
-            for j in 0..GROUP {
+            let mut z = [[simd.splat_f64s(0.0); G]; D];
+            let mut tau = [simd.splat_f64s(0.0); G];
+            for j in 0..G {
                 for (c, row) in rows.iter().enumerate() {
                     z[c][j] = simd.partial_load_f64s(&row[part(j)]);
                 }
                 tau[j] = simd.partial_load_f64s(&self.first[part(j)]);
             }
-            // The first outer flow, with each body's own time.
+            // The first outer flow, with each body's own time; every time scaled as its flow
+            // uses it (τ·factor).
             let outer = simd.splat_f64s(top.factor(p.outer));
             top.apply(simd, p.outer, tau.map(|t| simd.mul_f64s(t, outer)), &mut z);
-            for &(i, t) in &inner {
-                top.apply(simd, i, [simd.splat_f64s(t); GROUP], &mut z);
+            for &(i, t) in p.inner {
+                top.apply(simd, i, splat(t * top.factor(i)), &mut z);
             }
-            let fused = [simd.splat_f64s(p.fused * top.factor(p.outer)); GROUP];
+            let fused = splat(p.fused * top.factor(p.outer));
             for _ in 1..p.steps {
                 top.apply(simd, p.outer, fused, &mut z);
-                for &(i, t) in &inner {
-                    top.apply(simd, i, [simd.splat_f64s(t); GROUP], &mut z);
+                for &(i, t) in p.inner {
+                    top.apply(simd, i, splat(t * top.factor(i)), &mut z);
                 }
             }
-            for j in 0..GROUP {
+            for j in 0..G {
                 let range = part(j);
                 for (c, row) in rows.iter_mut().enumerate() {
                     simd.partial_store_f64s(&mut row[range.clone()], z[c][j]);
                 }
             }
-            start += GROUP * lanes;
+            start += G * lanes;
         }
     }
 }
 
 impl TopLanes {
-    /// The factor by which flow i scales its time, as [`Top::flow`] does: a_k for an axis flow
-    /// (the angle is τ a_k M_k), 1/I_r for the Casimir flow, 1 for the kick.
+    /// The factor by which flow i scales its time: a_k for an axis flow (the angle is
+    /// τ a_k M_k), 1/I_r for the Casimir flow, 1 for the kick.
     fn factor(&self, i: usize) -> f64 {
         match self.kinds[i] {
             Flow::Axis(a) => self.coef[a],
@@ -536,18 +516,18 @@ impl TopLanes {
     /// Flow i over the scaled times `tau` (τ·[`TopLanes::factor`]) on a group (the block's rows
     /// as in [`LanesRun`]).
     #[inline(always)]
-    fn apply<S: pulp::Simd, const D: usize>(
+    fn apply<S: pulp::Simd, const D: usize, const G: usize>(
         &self,
         simd: S,
         i: usize,
-        tau: [S::f64s; GROUP],
-        z: &mut [[S::f64s; GROUP]; D],
+        tau: [S::f64s; G],
+        z: &mut [[S::f64s; G]; D],
     ) {
         match self.kinds[i] {
             Flow::Axis(a) => rotate(simd, z, self.axes[a], tau),
             Flow::Casimir => {
                 // Every block after M (Γ, the rows of R) turns with the same exp(−v̂).
-                for g in 0..GROUP {
+                for g in 0..G {
                     let turn = Turn::new(simd, tau[g], [z[0][g], z[1][g], z[2][g]]);
                     for base in (3..D).step_by(3) {
                         let mut x = [z[base][g], z[base + 1][g], z[base + 2][g]];
@@ -560,7 +540,7 @@ impl TopLanes {
             }
             Flow::Kick => {
                 if let Some(c) = self.c {
-                    for g in 0..GROUP {
+                    for g in 0..G {
                         let mut m = [z[0][g], z[1][g], z[2][g]];
                         let v = [z[3 % D][g], z[4 % D][g], z[5 % D][g]];
                         kick_lanes(simd, tau[g], &mut m, v, c);
@@ -590,9 +570,13 @@ struct Turn<S: pulp::Simd> {
 impl<S: pulp::Simd> Turn<S> {
     #[inline(always)]
     fn new(simd: S, t: S::f64s, m: [S::f64s; 3]) -> Self {
-        let (add, mul) = (|a, b| simd.add_f64s(a, b), |a, b| simd.mul_f64s(a, b));
-        let v = m.map(|x| mul(x, t));
-        let th2 = add(add(mul(v[0], v[0]), mul(v[1], v[1])), mul(v[2], v[2]));
+        let v = m.map(|x| simd.mul_f64s(x, t));
+        let th2 = fma(
+            simd,
+            v[2],
+            v[2],
+            fma(simd, v[1], v[1], simd.mul_f64s(v[0], v[0])),
+        );
         let small_max = crate::numerics::simd::SMALL_MAX * crate::numerics::simd::SMALL_MAX;
         let small = simd.less_than_or_equal_f64s(th2, simd.splat_f64s(small_max));
         let (mut a, mut b) = crate::numerics::simd::sinc_versinc_small(simd, th2);
@@ -620,7 +604,7 @@ impl<S: pulp::Simd> Turn<S> {
         let w = cross(simd, self.v, *x);
         let u = cross(simd, self.v, w);
         for k in 0..3 {
-            let d = simd.sub_f64s(simd.mul_f64s(self.b, u[k]), simd.mul_f64s(self.a, w[k]));
+            let d = fma(simd, self.b, u[k], neg(simd, simd.mul_f64s(self.a, w[k])));
             x[k] = simd.add_f64s(x[k], d);
         }
     }
@@ -637,64 +621,70 @@ fn kick_lanes<S: pulp::Simd>(
 ) {
     let gc = cross(simd, g, c.map(|x| simd.splat_f64s(x)));
     for k in 0..3 {
-        m[k] = simd.add_f64s(m[k], simd.mul_f64s(gc[k], tau));
+        m[k] = fma(simd, gc[k], tau, m[k]);
     }
 }
 
-/// a × b.
+/// a × b, each component a_i b_j − a_j b_i with one fused multiply-add.
 #[inline(always)]
 fn cross<S: pulp::Simd>(simd: S, a: [S::f64s; 3], b: [S::f64s; 3]) -> [S::f64s; 3] {
-    let d =
-        |i: usize, j: usize| simd.sub_f64s(simd.mul_f64s(a[i], b[j]), simd.mul_f64s(a[j], b[i]));
+    let d = |i: usize, j: usize| fma(simd, a[i], b[j], neg(simd, simd.mul_f64s(a[j], b[i])));
     [d(1, 2), d(2, 0), d(0, 1)]
+}
+
+/// −x (exact: the sign bit).
+#[inline(always)]
+fn neg<S: pulp::Simd>(simd: S, x: S::f64s) -> S::f64s {
+    simd.xor_f64s(x, simd.splat_f64s(-0.0))
 }
 
 /// The rotation of every body of a group about e_k by the angle −tc·M_k (tc = τ·a per lane):
 /// V_i ← V_i + ((c − 1)V_i + s V_j), V_j ← V_j + ((c − 1)V_j − s V_i) with (i, j, k) cyclic for
-/// V = M, Γ and the rows of R, as `rotate_axis_sc` (c − 1 carried to its own precision: no bias
-/// per step).
+/// V = M, Γ and the rows of R (c − 1 carried to its own precision: no bias per step), each
+/// increment (c − 1)V_i + s V_j with one fused multiply-add.
 #[inline(always)]
-fn rotate<S: pulp::Simd, const D: usize>(
+fn rotate<S: pulp::Simd, const D: usize, const G: usize>(
     simd: S,
-    z: &mut [[S::f64s; GROUP]; D],
+    z: &mut [[S::f64s; G]; D],
     k: usize,
-    tc: [S::f64s; GROUP],
+    tc: [S::f64s; G],
 ) {
     match k {
-        0 => rotate_about::<S, D, 0, 1, 2>(simd, z, tc),
-        1 => rotate_about::<S, D, 1, 2, 0>(simd, z, tc),
-        _ => rotate_about::<S, D, 2, 0, 1>(simd, z, tc),
+        0 => rotate_about::<S, D, G, 0, 1, 2>(simd, z, tc),
+        1 => rotate_about::<S, D, G, 1, 2, 0>(simd, z, tc),
+        _ => rotate_about::<S, D, G, 2, 0, 1>(simd, z, tc),
     }
 }
 
 #[inline(always)]
-fn rotate_about<S: pulp::Simd, const D: usize, const K: usize, const I: usize, const J: usize>(
+fn rotate_about<
+    S: pulp::Simd,
+    const D: usize,
+    const G: usize,
+    const K: usize,
+    const I: usize,
+    const J: usize,
+>(
     simd: S,
-    z: &mut [[S::f64s; GROUP]; D],
-    tc: [S::f64s; GROUP],
+    z: &mut [[S::f64s; G]; D],
+    tc: [S::f64s; G],
 ) {
-    let mut s = [simd.splat_f64s(0.0); GROUP];
-    let mut cm1 = [simd.splat_f64s(0.0); GROUP];
-    let angle: [S::f64s; GROUP] = std::array::from_fn(|g| simd.mul_f64s(tc[g], z[K][g]));
+    let angle: [S::f64s; G] = std::array::from_fn(|g| simd.mul_f64s(tc[g], z[K][g]));
     // Small angles (the usual case) skip the argument reduction: the same bits
     // (`simd::sin_cosm1_small`), so the choice, made per group, changes no result.
-    if angle
+    let small = angle
         .iter()
-        .all(|&a| crate::numerics::simd::all_small(simd, a))
-    {
-        for g in 0..GROUP {
-            (s[g], cm1[g]) = crate::numerics::simd::sin_cosm1_small(simd, angle[g]);
-        }
-    } else {
-        for g in 0..GROUP {
-            (s[g], cm1[g]) = crate::numerics::simd::sin_cosm1_lanes(simd, angle[g]);
-        }
-    }
-    for base in (0..D).step_by(3) {
-        for g in 0..GROUP {
+        .all(|&a| crate::numerics::simd::all_small(simd, a));
+    for g in 0..G {
+        let (s, cm1) = if small {
+            crate::numerics::simd::sin_cosm1_small(simd, angle[g])
+        } else {
+            crate::numerics::simd::sin_cosm1_lanes(simd, angle[g])
+        };
+        for base in (0..D).step_by(3) {
             let (vi, vj) = (z[base + I][g], z[base + J][g]);
-            let di = simd.add_f64s(simd.mul_f64s(cm1[g], vi), simd.mul_f64s(s[g], vj));
-            let dj = simd.sub_f64s(simd.mul_f64s(cm1[g], vj), simd.mul_f64s(s[g], vi));
+            let di = fma(simd, cm1, vi, simd.mul_f64s(s, vj));
+            let dj = fma(simd, cm1, vj, neg(simd, simd.mul_f64s(s, vi)));
             z[base + I][g] = simd.add_f64s(vi, di);
             z[base + J][g] = simd.add_f64s(vj, dj);
         }
