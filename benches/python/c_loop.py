@@ -13,6 +13,9 @@ loop's (the two round differently: quaternion against matrix), as a check that b
 same thing.
 
     python benches/python/c_loop.py [--rounds 5]
+
+Then the cost of `splitting4` and `processed8` per step, and per stage against the Strang step
+(which should be 1: they run the same kernel).
 """
 
 import argparse
@@ -68,14 +71,14 @@ def states(system, bodies):
     return m[0] if bodies == 1 else m
 
 
-def run_lieflow(system, attitude, bodies, steps, threads):
+def run_lieflow(system, attitude, bodies, steps, threads, method="splitting"):
     body = (lf.RigidBody([1, 2, 3]) if system == "rigid"
             else lf.HeavyTop([1, 2, 3], 0.7, chi=[0.2, -0.3, 1.0]))
     z0 = states(system, bodies)
     r0 = np.eye(3) if attitude else None
     t0 = time.perf_counter()
     tr = lf.integrate(body, z0, dt=DT, steps=steps, save_every=steps, attitude=r0,
-                      threads=threads)
+                      threads=threads, method=method)
     sec = time.perf_counter() - t0
     z = np.asarray(tr.states)
     r = None if tr.attitude is None else np.asarray(tr.attitude)
@@ -143,6 +146,28 @@ def main():
             ns_c, ns_p = best_c / work * 1e9, best_p / work * 1e9
             print(f"| {label(*row)} | {ns_c:.1f} ns | {ns_p:.1f} ns | {ns_l:.1f} ns "
                   f"| {ns_l / ns_c:.2f} | {diff:.1e} |", flush=True)
+    stages(args.rounds)
+
+
+# The higher-order splittings and their stages (a Strang step each): their cost per stage should
+# be the Strang step's.
+STAGED = [("splitting", 1), ("splitting4", 5), ("processed8", 13)]
+
+
+def stages(rounds):
+    """Cost per step of the higher-order splittings against the Strang step, per stage."""
+    print("\nhigher order, per step and body (and per stage against splitting):\n")
+    print("| system | " + " | ".join(f"{m} ({k} stage{'s' * (k > 1)})" for m, k in STAGED) + " |")
+    print("|---|" + "---:|" * len(STAGED))
+    for system in ("rigid", "heavy"):
+        for attitude in (False, True):
+            for bodies, steps in ((1, 200_000), (BATCH, 200)):
+                ns = [min(run_lieflow(system, attitude, bodies, steps, 1, method=m)[0]
+                          for _ in range(rounds)) / (bodies * steps) * 1e9 for m, _ in STAGED]
+                cells = [f"{t:.1f} ns" + ("" if k == 1 else f" ({t / ns[0] / k:.2f})")
+                         for t, (_, k) in zip(ns, STAGED)]
+                name = label(system, attitude, bodies, steps, 1)
+                print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
 
 
 if __name__ == "__main__":

@@ -116,15 +116,17 @@ pub fn sin_cosm1_fast<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s, S::m64
 /// sin x, cos x and cos x − 1 by the fast path, and the slow lanes.
 #[inline(always)]
 fn fast<S: Simd>(simd: S, x: S::f64s) -> ([S::f64s; 3], S::m64s) {
-    let splat = |v: f64| simd.splat_f64s(v);
     let ax = simd.abs_f64s(x);
     // k = round(2x/π) and its low bits.
-    let t = simd.add_f64s(simd.mul_f64s(x, splat(TWO_OVER_PI)), splat(MAGIC));
-    let k = simd.sub_f64s(t, splat(MAGIC));
+    let t = simd.add_f64s(
+        simd.mul_f64s(x, splat(simd, TWO_OVER_PI)),
+        splat(simd, MAGIC),
+    );
+    let k = simd.sub_f64s(t, splat(simd, MAGIC));
     let bits = simd.transmute_u64s_f64s(t);
     // r = x − k·C₁ (exact) − k·C₂ (exact product, exact two-sum) − k·C₃.
-    let a = simd.sub_f64s(x, simd.mul_f64s(k, splat(C1)));
-    let b = simd.mul_f64s(k, splat(C2));
+    let a = simd.sub_f64s(x, simd.mul_f64s(k, splat(simd, C1)));
+    let b = simd.mul_f64s(k, splat(simd, C2));
     let r1 = simd.sub_f64s(a, b);
     // Two-sum of a and −b: r1 + e1 = a − b exactly.
     let bb = simd.sub_f64s(r1, a);
@@ -132,27 +134,29 @@ fn fast<S: Simd>(simd: S, x: S::f64s) -> ([S::f64s; 3], S::m64s) {
         simd.sub_f64s(a, simd.sub_f64s(r1, bb)),
         simd.add_f64s(b, bb),
     );
-    let tail = simd.sub_f64s(e1, simd.mul_f64s(k, splat(C3)));
+    let tail = simd.sub_f64s(e1, simd.mul_f64s(k, splat(simd, C3)));
     let r = simd.add_f64s(r1, tail);
     let r_lo = simd.add_f64s(simd.sub_f64s(r1, r), tail);
     let (sin_r, cos_r, cosm1_r) = sin_cos_reduced(simd, r, r_lo);
     // Quadrant k mod 4: odd k swaps, k ∈ {2, 3} negates sin, k ∈ {1, 2} negates cos.
-    let u = |v: u64| simd.splat_u64s(v);
-    let odd = simd.equal_u64s(simd.and_u64s(bits, u(1)), u(1));
-    let neg_s = simd.equal_u64s(simd.and_u64s(bits, u(2)), u(2));
-    let neg_c = simd.equal_u64s(simd.and_u64s(simd.add_u64s(bits, u(1)), u(2)), u(2));
+    let odd = simd.equal_u64s(simd.and_u64s(bits, simd.splat_u64s(1)), simd.splat_u64s(1));
+    let neg_s = simd.equal_u64s(simd.and_u64s(bits, simd.splat_u64s(2)), simd.splat_u64s(2));
+    let neg_c = simd.equal_u64s(
+        simd.and_u64s(simd.add_u64s(bits, simd.splat_u64s(1)), simd.splat_u64s(2)),
+        simd.splat_u64s(2),
+    );
     let s = simd.select_f64s(odd, cos_r, sin_r);
     let c = simd.select_f64s(odd, sin_r, cos_r);
-    let sign = splat(-0.0);
+    let sign = splat(simd, -0.0);
     let s = simd.select_f64s(neg_s, simd.xor_f64s(s, sign), s);
     let c = simd.select_f64s(neg_c, simd.xor_f64s(c, sign), c);
-    let quad0 = simd.equal_u64s(simd.and_u64s(bits, u(3)), u(0));
-    let cm1 = simd.select_f64s(quad0, cosm1_r, simd.sub_f64s(c, splat(1.0)));
+    let quad0 = simd.equal_u64s(simd.and_u64s(bits, simd.splat_u64s(3)), simd.splat_u64s(0));
+    let cm1 = simd.select_f64s(quad0, cosm1_r, simd.sub_f64s(c, splat(simd, 1.0)));
     // Lanes for the slow path: |x| beyond the fast range (or NaN), or deep cancellation.
-    let in_range = simd.less_than_or_equal_f64s(ax, splat(FAST_MAX));
+    let in_range = simd.less_than_or_equal_f64s(ax, splat(simd, FAST_MAX));
     let cancel = simd.and_m64s(
-        simd.less_than_f64s(simd.abs_f64s(r), splat(TINY)),
-        simd.greater_than_f64s(ax, splat(0.5)),
+        simd.less_than_f64s(simd.abs_f64s(r), splat(simd, TINY)),
+        simd.greater_than_f64s(ax, splat(simd, 0.5)),
     );
     let slow = simd.or_m64s(simd.not_m64s(in_range), cancel);
     ([s, c, cm1], slow)
@@ -166,26 +170,60 @@ pub fn fma<S: Simd>(simd: S, a: S::f64s, b: S::f64s, c: S::f64s) -> S::f64s {
     simd.mul_add_f64s(a, b, c)
 }
 
+// The kernels' small helpers are functions, not closures: a closure that LLVM does not inline
+// is compiled outside the dispatched instruction set, and its intrinsics become calls.
+
+/// v in every lane.
+#[inline(always)]
+pub fn splat<S: Simd>(simd: S, v: f64) -> S::f64s {
+    simd.splat_f64s(v)
+}
+
+/// −x (exact: the sign bit).
+#[inline(always)]
+pub fn neg<S: Simd>(simd: S, x: S::f64s) -> S::f64s {
+    simd.xor_f64s(x, simd.splat_f64s(-0.0))
+}
+
+/// a + b z.
+#[inline(always)]
+fn pair<S: Simd>(simd: S, z: S::f64s, a: f64, b: f64) -> S::f64s {
+    fma(simd, splat(simd, b), z, splat(simd, a))
+}
+
 /// P(z) and Q(z) of the Taylor polynomials (sin r = r + r³P(r²), cos r = 1 − r²/2 + r⁴Q(r²)),
 /// by Estrin's scheme in fused multiply-adds (pairs, then z², z⁴: a chain of 3 instead of
 /// Horner's 7, for the one-body path, which waits on it), and z².
 #[inline(always)]
 fn taylor_pq<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s, S::f64s) {
-    let splat = |v: f64| simd.splat_f64s(v);
     let z2 = simd.mul_f64s(z, z);
     let z4 = simd.mul_f64s(z2, z2);
-    let pair = |a: f64, b: f64| fma(simd, splat(b), z, splat(a));
     let p = fma(
         simd,
-        fma(simd, pair(S[6], S[7]), z2, pair(S[4], S[5])),
+        fma(
+            simd,
+            pair(simd, z, S[6], S[7]),
+            z2,
+            pair(simd, z, S[4], S[5]),
+        ),
         z4,
-        fma(simd, pair(S[2], S[3]), z2, pair(S[0], S[1])),
+        fma(
+            simd,
+            pair(simd, z, S[2], S[3]),
+            z2,
+            pair(simd, z, S[0], S[1]),
+        ),
     );
     let q = fma(
         simd,
-        fma(simd, splat(C[6]), z2, pair(C[4], C[5])),
+        fma(simd, splat(simd, C[6]), z2, pair(simd, z, C[4], C[5])),
         z4,
-        fma(simd, pair(C[2], C[3]), z2, pair(C[0], C[1])),
+        fma(
+            simd,
+            pair(simd, z, C[2], C[3]),
+            z2,
+            pair(simd, z, C[0], C[1]),
+        ),
     );
     (p, q, z2)
 }
@@ -206,24 +244,22 @@ pub fn sinc_versinc_small<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s) {
 /// docs); cos − 1 = (z²Q − r·r_lo) − z/2 without the 1 (no cancellation).
 #[inline(always)]
 fn sin_cos_reduced<S: Simd>(simd: S, r: S::f64s, r_lo: S::f64s) -> (S::f64s, S::f64s, S::f64s) {
-    let splat = |v: f64| simd.splat_f64s(v);
-    let neg = |v| simd.xor_f64s(v, splat(-0.0));
     let z = simd.mul_f64s(r, r);
     let (p, q, z2) = taylor_pq(simd, z);
-    let hz = simd.mul_f64s(splat(0.5), z);
+    let hz = simd.mul_f64s(splat(simd, 0.5), z);
     // sin(r + r_lo) ≈ (r + r³P) + r_lo·(1 − z/2): r + r³P in one rounding (as the small path
     // without r_lo), then the correction of r_lo (≤ 1 ulp of sin in all).
-    let lo = fma(simd, neg(hz), r_lo, r_lo);
+    let lo = fma(simd, neg(simd, hz), r_lo, r_lo);
     let sin_r = simd.add_f64s(fma(simd, simd.mul_f64s(r, z), p, r), lo);
     // cos(r + r_lo) ≈ w + (((1 − w) − z/2) + (z²Q − r·r_lo)), w = 1 − z/2; cos − 1 as
     // z²Q − (r·r_lo + z/2), one rounding after the product (for r_lo = 0: z²Q − z/2).
-    let one = splat(1.0);
+    let one = splat(simd, 1.0);
     let w = simd.sub_f64s(one, hz);
     let r_rlo = simd.mul_f64s(r, r_lo);
-    let tail = fma(simd, z2, q, neg(r_rlo));
+    let tail = fma(simd, z2, q, neg(simd, r_rlo));
     let cos_corr = simd.add_f64s(simd.sub_f64s(simd.sub_f64s(one, w), hz), tail);
     let cos_r = simd.add_f64s(w, cos_corr);
-    let cosm1 = fma(simd, z2, q, neg(simd.add_f64s(r_rlo, hz)));
+    let cosm1 = fma(simd, z2, q, neg(simd, simd.add_f64s(r_rlo, hz)));
     (sin_r, cos_r, cosm1)
 }
 

@@ -28,7 +28,7 @@ use crate::integrate::methods::{Composition, Processed, ProcessedSplitting, Spli
 use crate::integrate::problem::Split;
 use crate::integrate::space::{Block, Space};
 use crate::integrate::Entry;
-use crate::numerics::simd::fma;
+use crate::numerics::simd::{fma, neg};
 use nalgebra::{Matrix3, Vector3};
 
 /// Checks principal moments: finite and > 0.
@@ -376,7 +376,7 @@ impl Top {
 /// −τ·`coef[a]`·M_k (and the columns i, j of R by the same angle); `Casimir` turns Γ and the rows
 /// of R by exp(−τ M̂/I_r) ([`Turn`]); `Kick` adds τ Γ × c to M ([`kick_lanes`]).
 ///
-/// Each group of [`GROUP`] vectors of bodies is loaded into registers once and stepped through
+/// Each group of [`group`] vectors of bodies is loaded into registers once and stepped through
 /// the whole program there (the vectors interleaved, so that the latency of one sin/cos is hidden
 /// behind the others), then stored. One body runs in one scalar lane, inside the same dispatch.
 #[derive(Clone, Copy, Debug)]
@@ -391,8 +391,15 @@ struct TopLanes {
     lifted: bool,
 }
 
-/// Vectors of bodies stepped together by [`TopLanes`] in a batch.
-const GROUP: usize = 8;
+/// Vectors of bodies stepped together by [`TopLanes`] in a batch: 8 with AVX-512's 32
+/// registers, 4 with AVX2's 16 (measured best of 1, 2, 4, 8, 16 on AVX-512).
+const fn group(lanes: usize) -> usize {
+    if lanes >= 8 {
+        8
+    } else {
+        4
+    }
+}
 
 impl crate::integrate::problem::SplitLanes for TopLanes {
     fn dim(&self) -> usize {
@@ -447,7 +454,8 @@ impl<const D: usize> pulp::WithSimd for LanesRun<'_, D> {
             // One body (a single run, a flow of `Top::flow`): one lane, compiled inside this
             // dispatch (its fused multiply-adds are the machine's).
             1 => self.steps::<pulp::Scalar, 1>(pulp::Scalar::new()),
-            _ => self.steps::<S, GROUP>(simd),
+            _ if group(S::F64_LANES) == 8 => self.steps::<S, 8>(simd),
+            _ => self.steps::<S, 4>(simd),
         }
     }
 }
@@ -461,7 +469,6 @@ impl<const D: usize> LanesRun<'_, D> {
         let mut chunks = self.block.chunks_exact_mut(n);
         let mut rows: [&mut [f64]; D] = std::array::from_fn(|_| chunks.next().unwrap_or_default());
         let (p, top) = (self.program, self.lanes);
-        let splat = |t: f64| [simd.splat_f64s(t); G];
         let mut start = 0;
         while start < n {
             // Loads G vectors of bodies (zeros past the end: lanes of no body).
@@ -480,15 +487,18 @@ impl<const D: usize> LanesRun<'_, D> {
             // The first outer flow, with each body's own time; every time scaled as its flow
             // uses it (τ·factor).
             let outer = simd.splat_f64s(top.factor(p.outer));
-            top.apply(simd, p.outer, tau.map(|t| simd.mul_f64s(t, outer)), &mut z);
-            for &(i, t) in p.inner {
-                top.apply(simd, i, splat(t * top.factor(i)), &mut z);
+            for t in &mut tau {
+                *t = simd.mul_f64s(*t, outer);
             }
-            let fused = splat(p.fused * top.factor(p.outer));
+            top.apply(simd, p.outer, tau, &mut z);
+            for &(i, t) in p.inner {
+                top.apply(simd, i, [simd.splat_f64s(t * top.factor(i)); G], &mut z);
+            }
+            let fused = [simd.splat_f64s(p.fused * top.factor(p.outer)); G];
             for _ in 1..p.steps {
                 top.apply(simd, p.outer, fused, &mut z);
                 for &(i, t) in p.inner {
-                    top.apply(simd, i, splat(t * top.factor(i)), &mut z);
+                    top.apply(simd, i, [simd.splat_f64s(t * top.factor(i)); G], &mut z);
                 }
             }
             for j in 0..G {
@@ -570,7 +580,11 @@ struct Turn<S: pulp::Simd> {
 impl<S: pulp::Simd> Turn<S> {
     #[inline(always)]
     fn new(simd: S, t: S::f64s, m: [S::f64s; 3]) -> Self {
-        let v = m.map(|x| simd.mul_f64s(x, t));
+        let v = [
+            simd.mul_f64s(m[0], t),
+            simd.mul_f64s(m[1], t),
+            simd.mul_f64s(m[2], t),
+        ];
         let th2 = fma(
             simd,
             v[2],
@@ -619,7 +633,12 @@ fn kick_lanes<S: pulp::Simd>(
     g: [S::f64s; 3],
     c: [f64; 3],
 ) {
-    let gc = cross(simd, g, c.map(|x| simd.splat_f64s(x)));
+    let c = [
+        simd.splat_f64s(c[0]),
+        simd.splat_f64s(c[1]),
+        simd.splat_f64s(c[2]),
+    ];
+    let gc = cross(simd, g, c);
     for k in 0..3 {
         m[k] = fma(simd, gc[k], tau, m[k]);
     }
@@ -628,14 +647,11 @@ fn kick_lanes<S: pulp::Simd>(
 /// a × b, each component a_i b_j − a_j b_i with one fused multiply-add.
 #[inline(always)]
 fn cross<S: pulp::Simd>(simd: S, a: [S::f64s; 3], b: [S::f64s; 3]) -> [S::f64s; 3] {
-    let d = |i: usize, j: usize| fma(simd, a[i], b[j], neg(simd, simd.mul_f64s(a[j], b[i])));
-    [d(1, 2), d(2, 0), d(0, 1)]
-}
-
-/// −x (exact: the sign bit).
-#[inline(always)]
-fn neg<S: pulp::Simd>(simd: S, x: S::f64s) -> S::f64s {
-    simd.xor_f64s(x, simd.splat_f64s(-0.0))
+    [
+        fma(simd, a[1], b[2], neg(simd, simd.mul_f64s(a[2], b[1]))),
+        fma(simd, a[2], b[0], neg(simd, simd.mul_f64s(a[0], b[2]))),
+        fma(simd, a[0], b[1], neg(simd, simd.mul_f64s(a[1], b[0]))),
+    ]
 }
 
 /// The rotation of every body of a group about e_k by the angle −tc·M_k (tc = τ·a per lane):
@@ -669,12 +685,14 @@ fn rotate_about<
     z: &mut [[S::f64s; G]; D],
     tc: [S::f64s; G],
 ) {
-    let angle: [S::f64s; G] = std::array::from_fn(|g| simd.mul_f64s(tc[g], z[K][g]));
+    let mut angle = tc;
     // Small angles (the usual case) skip the argument reduction: the same bits
     // (`simd::sin_cosm1_small`), so the choice, made per group, changes no result.
-    let small = angle
-        .iter()
-        .all(|&a| crate::numerics::simd::all_small(simd, a));
+    let mut small = true;
+    for g in 0..G {
+        angle[g] = simd.mul_f64s(tc[g], z[K][g]);
+        small &= crate::numerics::simd::all_small(simd, angle[g]);
+    }
     for g in 0..G {
         let (s, cm1) = if small {
             crate::numerics::simd::sin_cosm1_small(simd, angle[g])
