@@ -217,6 +217,20 @@ impl<P: Split> SplittingBatch<P> {
     fn column(&self, member: usize) -> impl Iterator<Item = f64> + '_ {
         (0..self.d).map(move |c| self.block[c * self.n + member])
     }
+
+    /// The flows (index, time) in order on one member's flat state `y`: one run of the kernel
+    /// (the first flow, then the others, one step), as the flows one by one would do it.
+    fn run_flows(&self, y: &mut [f64], flows: &[(usize, f64)]) {
+        if let Some((&(outer, t), inner)) = flows.split_first() {
+            let program = Program {
+                outer,
+                fused: 0.0,
+                inner,
+                steps: 1,
+            };
+            self.lanes.run(y, &[t], &program);
+        }
+    }
 }
 
 impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
@@ -225,14 +239,14 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
     }
 
     fn set(&mut self, member: usize, z: &[f64]) -> Result<()> {
-        let mut w = self.problem.load(z)?;
+        self.problem.load(z)?;
         let processed;
         let y = if self.scheme.pre.is_empty() {
             z
         } else {
-            self.scheme.enter(&self.problem, &mut w);
+            // The processor P, as the one-member stepper's `set` applies it.
             let mut y = z.to_vec();
-            self.problem.store(&w, &mut y);
+            self.run_flows(&mut y, &self.scheme.pre);
             processed = y;
             &processed[..]
         };
@@ -247,13 +261,12 @@ impl<P: Split + Clone + 'static> BatchStepper for SplittingBatch<P> {
         for (zc, v) in z.iter_mut().zip(self.column(member)) {
             *zc = v;
         }
+        // On the copy: the pending outer flow, then the inverse processor.
         let pending = self.pending[member];
-        if pending != 0.0 || !self.scheme.post.is_empty() {
-            // What the one-member stepper's `get` does, on a copy.
-            if let Ok(w) = self.problem.load(z) {
-                self.scheme.leave(&self.problem, &w, pending, z);
-            }
+        if pending != 0.0 {
+            self.run_flows(z, &[(self.scheme.seq[0].0, pending)]);
         }
+        self.run_flows(z, &self.scheme.post);
     }
 
     fn advance(&mut self, steps: usize, _clock: Clock) -> Result<()> {
