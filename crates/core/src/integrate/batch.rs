@@ -465,7 +465,7 @@ fn step_block<P: Problem + ?Sized>(
             let r = match check::finite_slice("state", &run.next) {
                 Ok(()) => {
                     std::mem::swap(&mut run.buf, &mut run.next);
-                    let retracted = run.retract_at(stop);
+                    let retracted = run.retract_at(problem, stop);
                     let set = if retracted {
                         lanes.stepper.set(j, &run.buf)
                     } else {

@@ -97,7 +97,7 @@ impl Run {
                 }
             }
         }
-        if self.retract.is_some() {
+        if self.retract {
             stop = stop.min((done / RETRACT_EVERY + 1) * RETRACT_EVERY);
         }
         stop - done
@@ -207,7 +207,7 @@ impl Run {
         end: u64,
         out: &mut Vec<f64>,
     ) -> Result<()> {
-        if self.retract_at(stop) {
+        if self.retract_at(problem, stop) {
             let r = self.stepper.set(&self.buf);
             self.failed(r, stop)?;
         }
@@ -216,15 +216,13 @@ impl Run {
 
     /// Moves the clock to `stop` and retracts the checked state when a retraction is due there;
     /// returns whether it did (the stepper must then be set to it).
-    pub(super) fn retract_at(&mut self, stop: u64) -> bool {
+    pub(super) fn retract_at<P: Problem + ?Sized>(&mut self, problem: &P, stop: u64) -> bool {
         self.clock.done = stop;
-        match &self.retract {
-            Some(space) if stop % RETRACT_EVERY == 0 => {
-                space.retract(&mut self.buf);
-                true
-            }
-            _ => false,
+        let due = self.retract && stop % RETRACT_EVERY == 0;
+        if due {
+            problem.space().retract(&mut self.buf);
         }
+        due
     }
 
     /// Saves the checked state at step `stop` (reached from `from`) when it is a saved step,

@@ -4,9 +4,9 @@
 use super::events::Events;
 use std::sync::Arc;
 
+use super::hooks;
 use super::method::{Clock, Integrator, Properties, Resolved, Stepper, System};
 use super::problem::Problem;
-use super::{hooks, space};
 use crate::check;
 use crate::error::{Error, Result};
 
@@ -50,7 +50,9 @@ pub(super) struct Outputs {
 /// way.
 pub struct Run {
     pub(super) stepper: Box<dyn Stepper>,
-    pub(super) retract: Option<space::Space>,
+    /// Whether the driver retracts the state onto its space every [`RETRACT_EVERY`] steps (a
+    /// method that keeps the manifold, on a curved space).
+    pub(super) retract: bool,
     pub(super) save_every: u64,
     pub(super) clock: Clock,
     /// The state (internal frame) at `clock.done`, the last that passed the checks.
@@ -136,7 +138,7 @@ impl Run {
         problem.to_internal(&mut buf);
         let mut run = Run {
             stepper,
-            retract: (properties.manifold && space.is_curved()).then_some(space),
+            retract: properties.manifold && space.is_curved(),
             save_every: save_every as u64,
             clock: Clock { t0, dt, done: 0 },
             next: buf.clone(),
