@@ -87,20 +87,12 @@ def run_lieflow(system, attitude, bodies, steps, threads, method="splitting"):
     return sec, z[-1], (None if r is None else r[-1])
 
 
-ROWS = [  # (system, attitude, bodies, steps, threads)
-    ("rigid", False, 1, ONE_STEPS, 1),
-    ("rigid", True, 1, ONE_STEPS, 1),
-    ("rigid", False, BATCH, BATCH_STEPS, 1),
-    ("rigid", True, BATCH, BATCH_STEPS, 1),
-    ("rigid", False, BATCH, BATCH_STEPS, 2),
-    ("rigid", True, BATCH, BATCH_STEPS, 2),
-    ("heavy", False, 1, ONE_STEPS, 1),
-    ("heavy", True, 1, ONE_STEPS, 1),
-    ("heavy", False, BATCH, BATCH_STEPS, 1),
-    ("heavy", True, BATCH, BATCH_STEPS, 1),
-    ("heavy", False, BATCH, BATCH_STEPS, 2),
-    ("heavy", True, BATCH, BATCH_STEPS, 2),
-]
+# (system, attitude, bodies, steps, threads): one body, then batches on 1 and 2 threads.
+ROWS = [(system, attitude, bodies, steps, threads)
+        for system in ("rigid", "heavy")
+        for bodies, steps, threads in ((1, ONE_STEPS, 1), (BATCH, BATCH_STEPS, 1),
+                                       (BATCH, BATCH_STEPS, 2))
+        for attitude in (False, True)]
 
 
 def label(system, attitude, bodies, steps, threads):

@@ -200,32 +200,28 @@ fn taylor_pq<S: Simd>(simd: S, z: S::f64s) -> (S::f64s, S::f64s, S::f64s) {
     let z4 = simd.mul_f64s(z2, z2);
     let p = fma(
         simd,
-        fma(
-            simd,
-            pair(simd, z, S[6], S[7]),
-            z2,
-            pair(simd, z, S[4], S[5]),
-        ),
+        cubic(simd, z, z2, [S[4], S[5], S[6], S[7]]),
         z4,
-        fma(
-            simd,
-            pair(simd, z, S[2], S[3]),
-            z2,
-            pair(simd, z, S[0], S[1]),
-        ),
+        cubic(simd, z, z2, [S[0], S[1], S[2], S[3]]),
     );
     let q = fma(
         simd,
         fma(simd, splat(simd, C[6]), z2, pair(simd, z, C[4], C[5])),
         z4,
-        fma(
-            simd,
-            pair(simd, z, C[2], C[3]),
-            z2,
-            pair(simd, z, C[0], C[1]),
-        ),
+        cubic(simd, z, z2, [C[0], C[1], C[2], C[3]]),
     );
     (p, q, z2)
+}
+
+/// c₀ + c₁z + (c₂ + c₃z)z² (Estrin's pairs).
+#[inline(always)]
+fn cubic<S: Simd>(simd: S, z: S::f64s, z2: S::f64s, c: [f64; 4]) -> S::f64s {
+    fma(
+        simd,
+        pair(simd, z, c[2], c[3]),
+        z2,
+        pair(simd, z, c[0], c[1]),
+    )
 }
 
 /// (sin θ/θ, (1 − cos θ)/θ²) from z = θ² for θ ≤ [`SMALL_MAX`]: 1 + z P(z) and ½ − z Q(z), the

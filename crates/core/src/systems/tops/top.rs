@@ -775,6 +775,100 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// The kernel gives the same bits whatever runs it: the best instruction set of the machine,
+    /// AVX2 where the machine has it, the portable scalar lanes outside any dispatch (libm's
+    /// `fma`), and each member alone; with angles on both sides of the small-angle path in one
+    /// vector. The free body (3 components) and the heavy top with attitude (15).
+    /// The kernel's run on D components with the lanes `simd` (outside any dispatch).
+    fn with<const D: usize>(
+        k: &TopLanes,
+        block: &mut [f64],
+        first: &[f64],
+        program: &crate::integrate::problem::Program<'_>,
+        simd: impl pulp::Simd,
+    ) {
+        pulp::WithSimd::with_simd(Run::<D>(k, block, first, program), simd)
+    }
+
+    /// [`LanesRun`] from its parts, for a chosen instruction set.
+    struct Run<'a, const D: usize>(
+        &'a TopLanes,
+        &'a mut [f64],
+        &'a [f64],
+        &'a crate::integrate::problem::Program<'a>,
+    );
+
+    impl<const D: usize> pulp::WithSimd for Run<'_, D> {
+        type Output = ();
+        #[inline(always)]
+        fn with_simd<S: pulp::Simd>(self, simd: S) {
+            let run = LanesRun::<D> {
+                lanes: self.0,
+                block: self.1,
+                first: self.2,
+                program: self.3,
+            };
+            run.with_simd(simd)
+        }
+    }
+
+    #[test]
+    fn the_kernel_gives_the_same_bits_on_every_instruction_set() {
+        use crate::integrate::problem::{Program, SplitLanes};
+        for heavy in [false, true] {
+            let mut top = Top::new([1.0, 2.0, 3.0], None, heavy.then_some([0.14, -0.21, 0.7]));
+            top.set_lifted(heavy);
+            let kernel = top.kernel();
+            let (d, n) = (kernel.dim(), 37);
+            let block: Vec<f64> = (0..d * n)
+                .map(|i| (0.37 * (7 * (i / n) + 13 * (i % n)) as f64).sin())
+                .collect();
+            // Member 5 turns by about 1.5 rad in its first flow: the reduction path.
+            let mut first: Vec<f64> = (0..n).map(|j| 0.005 + 1e-4 * j as f64).collect();
+            first[5] = 3.0;
+            let inner: Vec<(usize, f64)> = (1..top.flows())
+                .chain((1..top.flows() - 1).rev())
+                .map(|i| (i, 0.005))
+                .collect();
+            let program = Program {
+                outer: 0,
+                fused: 0.01,
+                inner: &inner,
+                steps: 50,
+            };
+            let go = |run: &dyn Fn(&mut [f64], &[f64])| {
+                let mut b = block.clone();
+                run(&mut b, &first);
+                b.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+            };
+            let best = go(&|b, f| kernel.run(b, f, &program));
+            let alone = go(&|b, f| {
+                for j in 0..n {
+                    let mut z: Vec<f64> = (0..d).map(|c| b[c * n + j]).collect();
+                    kernel.run(&mut z, &f[j..j + 1], &program);
+                    for (c, v) in z.into_iter().enumerate() {
+                        b[c * n + j] = v;
+                    }
+                }
+            });
+            assert_eq!(best, alone, "heavy = {heavy}: a member alone");
+            let scalar = go(&|b, f| match d {
+                3 => with::<3>(&kernel, b, f, &program, pulp::Scalar::new()),
+                _ => with::<15>(&kernel, b, f, &program, pulp::Scalar::new()),
+            });
+            assert_eq!(best, scalar, "heavy = {heavy}: portable scalar lanes");
+            #[cfg(target_arch = "x86_64")]
+            if let Some(v3) = pulp::x86::V3::try_new() {
+                let avx2 = go(&|b, f| match d {
+                    3 => pulp::Simd::vectorize(v3, Run::<3>(&kernel, b, f, &program)),
+                    _ => pulp::Simd::vectorize(v3, Run::<15>(&kernel, b, f, &program)),
+                });
+                assert_eq!(best, avx2, "heavy = {heavy}: AVX2");
+            }
+            assert!(best.iter().all(|&x| f64::from_bits(x).is_finite()));
+        }
+    }
+
     proptest! {
         /// The Rodrigues turn of the lanes is exp(−t M̂) Γ (so3::exp), at angles up to 5 rad
         /// (the polynomials below 0.78, sin θ/θ beyond).
