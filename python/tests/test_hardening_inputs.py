@@ -515,12 +515,12 @@ def test_relative_equilibria_plane_must_be_a_pair():
 
 def test_a_batch_whose_runs_do_not_fit_is_refused_not_aborted():
     # Each member of a relativistic top's batch holds a stepper of about 5 KiB, more than the
-    # up-front estimate per member: under an address-space limit of 6 GiB a batch of 10⁶ used to
-    # abort the process in an allocation. The memory its runs take is now watched as they are
+    # up-front estimate per member: under an address-space limit a batch of 10⁶ (≈ 5 GiB) used
+    # to abort the process in an allocation. The memory its runs take is now watched as they are
     # built (check::BuildBudget, which also reads `ulimit -v`).
     code = (
         "import resource, numpy as np, lieflow as lf\n"
-        "resource.setrlimit(resource.RLIMIT_AS, (6 << 30, 6 << 30))\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))\n"
         "top = lf.RelativisticTangentTop(1.0, 0.5)\n"
         "z = np.tile(top.state([0.1, 0.2], 0.0, [0.1, 0.0], 1.0), (10**6, 1))\n"
         "try:\n"

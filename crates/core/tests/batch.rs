@@ -4,7 +4,7 @@
 //! in which the run is advanced; errors still name the member and the step.
 
 use lieflow::integrate::methods::{Composition, Splitting};
-use lieflow::integrate::{integrate, integrate_batch, integrate_with, Batch, Run, System};
+use lieflow::integrate::{integrate, integrate_batch, integrate_with, Batch, Run, System, Until};
 use lieflow::systems::{HeavyTop, RigidBody};
 use lieflow::Error;
 
@@ -212,16 +212,33 @@ fn leaving_the_lanes_mid_run_continues_exactly() {
         .iter()
         .map(|z| Run::new(&b, "splitting4", z, 0.01, 400, 0.0).unwrap())
         .collect();
-    let mut batch = Batch::new(&b, "splitting4", runs).unwrap();
-    let mut outs = vec![Vec::new(); all.len()];
-    for r in batch.advance(&b, 123, &mut outs) {
-        r.unwrap();
+    // Runs made alone and put in blocks, and members started in blocks (which get their
+    // stepper and scratch only when they leave: Batch::start).
+    let built = Batch::new(&b, "splitting4", runs).unwrap();
+    let started = Batch::start(&b, "splitting4", &all, 0.01, 400, 0.0).unwrap();
+    for mut batch in [built, started] {
+        assert!(batch.in_lanes());
+        let mut outs = vec![Vec::new(); all.len()];
+        for r in batch.advance(&b, 123, &mut outs) {
+            r.unwrap();
+        }
+        for (i, run) in batch.runs_mut().unwrap().iter_mut().enumerate() {
+            // Output times between grid times: shortened steps, the user-frame scratch.
+            run.save_at(&[2.005, 3.995]).unwrap();
+            let mut at = Vec::new();
+            run.advance_to(&b, Until::Steps(277), &mut at, None)
+                .unwrap();
+            assert_eq!(bits(&run.state(&b)), bits(&whole[i].final_state));
+            let alone = &mut Run::new(&b, "splitting4", &all[i], 0.01, 400, 0.0).unwrap();
+            alone.save_at(&[2.005, 3.995]).unwrap();
+            let mut want = Vec::new();
+            alone
+                .advance_to(&b, Until::Steps(400), &mut want, None)
+                .unwrap();
+            assert_eq!(bits(&at), bits(&want));
+        }
+        assert!(!batch.in_lanes());
     }
-    for (i, run) in batch.runs_mut().unwrap().iter_mut().enumerate() {
-        run.advance(&b, 277, &mut outs[i]).unwrap();
-        assert_eq!(bits(&run.state(&b)), bits(&whole[i].final_state));
-    }
-    assert!(!batch.in_lanes());
 }
 
 #[test]

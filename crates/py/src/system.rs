@@ -395,15 +395,18 @@ impl PySystem {
         let threads = args::count_opt("threads", threads.as_ref())?;
         let sys = self.runner(attitude.is_some())?.clone();
         let resolved = self.resolve(&sys, attitude.is_some(), method.as_deref());
-        let states = (0..b)
-            .map(|i| {
-                let mut z = rows[i * d..(i + 1) * d].to_vec();
-                if let Some(a) = &attitude {
-                    z.extend_from_slice(&a[i * 9..(i + 1) * 9]);
+        // The members' full states one after the other (each with its attitude).
+        let states = match &attitude {
+            None => rows,
+            Some(a) => {
+                let mut states = Vec::with_capacity(b * (d + 9));
+                for (z, r) in rows.chunks_exact(d.max(1)).zip(a.chunks_exact(9)) {
+                    states.extend_from_slice(z);
+                    states.extend_from_slice(r);
                 }
-                z
-            })
-            .collect();
+                states
+            }
+        };
         Integration::start(
             sys,
             states,

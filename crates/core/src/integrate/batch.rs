@@ -75,10 +75,10 @@ impl Batch {
     /// Errors: those of [`Run::new`] and of the batch stepper's `set`, with the index of the
     /// first member that has one; a batch whose runs would not fit in the memory available
     /// ([`check::BuildBudget`], no member named).
-    pub fn start<S: System + ?Sized>(
+    pub fn start<S: System + ?Sized, Z: AsRef<[f64]> + Sync>(
         system: &S,
         method: &str,
-        states0: &[Vec<f64>],
+        states0: &[Z],
         dt: f64,
         save_every: usize,
         t0: f64,
@@ -91,7 +91,7 @@ impl Batch {
                 return match states0.first() {
                     Some(z) => Err((
                         Some(0),
-                        check_start(system, z, dt, save_every, t0)
+                        check_start(system, z.as_ref(), dt, save_every, t0)
                             .err()
                             .unwrap_or(e),
                     )),
@@ -106,10 +106,10 @@ impl Batch {
     }
 
     /// [`Batch::start`] with a method already resolved ([`System::resolve`]) for `problem`.
-    pub fn resolved<P: Problem + ?Sized>(
+    pub fn resolved<P: Problem + ?Sized, Z: AsRef<[f64]> + Sync>(
         problem: &P,
         method: &Arc<Resolved>,
-        states0: &[Vec<f64>],
+        states0: &[Z],
         dt: f64,
         save_every: usize,
         t0: f64,
@@ -118,7 +118,7 @@ impl Batch {
         // member after member on the calling thread, as before (a system may call back into
         // a host language that this thread holds locked, such as Python's GIL). The error is
         // the one of the first member that has one.
-        let group = |(g, chunk): (usize, &[Vec<f64>])| {
+        let group = |(g, chunk): (usize, &[Z])| {
             start_group(problem, method, chunk, g * GROUP, dt, save_every, t0)
         };
         // One member has no block to share: it steps alone (bit for bit the same).
@@ -253,29 +253,30 @@ impl Batch {
         }
     }
 
-    /// The current states of all members (user frame), as [`Batch::state`], computed in
-    /// parallel by groups on the current rayon pool.
-    pub fn states<P: Problem + ?Sized>(&mut self, problem: &P) -> Vec<Vec<f64>> {
-        let groups: Vec<Vec<Vec<f64>>> = self
-            .runs
-            .par_chunks_mut(GROUP)
+    /// The current states of all members (user frame), as [`Batch::state`], one after the
+    /// other, computed in parallel by groups on the current rayon pool.
+    pub fn states<P: Problem + ?Sized>(&mut self, problem: &P) -> Vec<f64> {
+        let dim = problem.space().dim();
+        let mut all = vec![0.0; self.runs.len() * dim];
+        all.par_chunks_mut((GROUP * dim).max(1))
+            .zip(self.runs.par_chunks_mut(GROUP))
             .zip(self.lanes.par_iter_mut())
-            .map(|(runs, lanes)| {
-                runs.iter()
-                    .enumerate()
-                    .map(|(j, run)| match lanes {
+            .for_each(|((all, runs), lanes)| {
+                for (j, (z, run)) in all.chunks_exact_mut(dim).zip(&*runs).enumerate() {
+                    match lanes {
                         Some(l) if l.live[j] => {
-                            let mut z = run.buf.clone();
-                            l.stepper.get(j, &mut z);
-                            problem.to_user(&mut z);
-                            z
+                            z.copy_from_slice(&run.buf);
+                            l.stepper.get(j, z);
                         }
-                        _ => run.state(problem),
-                    })
-                    .collect()
-            })
-            .collect();
-        groups.into_iter().flatten().collect()
+                        _ => {
+                            z.copy_from_slice(&run.buf);
+                            run.stepper.get(z);
+                        }
+                    }
+                    problem.to_user(z);
+                }
+            });
+        all
     }
 
     /// Advances every member by `steps` steps as [`Run::advance`] does, appending member i's
@@ -316,10 +317,10 @@ impl Batch {
 }
 
 /// The runs of one group of [`Batch::start`] (members `first`…) and its block, if any.
-fn start_group<P: Problem + ?Sized>(
+fn start_group<P: Problem + ?Sized, Z: AsRef<[f64]>>(
     problem: &P,
     method: &Arc<Resolved>,
-    chunk: &[Vec<f64>],
+    chunk: &[Z],
     first: usize,
     dt: f64,
     save_every: usize,
@@ -335,7 +336,7 @@ fn start_group<P: Problem + ?Sized>(
     };
     let Some(mut stepper) = block else {
         for (j, z) in chunk.iter().enumerate() {
-            let run = Run::resolved(problem, method, z, dt, save_every, t0);
+            let run = Run::resolved(problem, method, z.as_ref(), dt, save_every, t0);
             runs.push(run.map_err(|e| (first + j, e))?);
         }
         return Ok((runs, None));
@@ -345,8 +346,8 @@ fn start_group<P: Problem + ?Sized>(
             let stepper = Box::new(InBlock) as Box<dyn Stepper>;
             Ok((stepper, method.properties, Some(method.clone())))
         };
-        let run =
-            Run::start(problem, z, dt, save_every, t0, placeholder).map_err(|e| (first + j, e))?;
+        let run = Run::start(problem, z.as_ref(), dt, save_every, t0, true, placeholder)
+            .map_err(|e| (first + j, e))?;
         stepper.set(j, &run.buf).map_err(|e| (first + j, e))?;
         runs.push(run);
     }
@@ -360,7 +361,7 @@ fn leave_lanes(slot: &mut Option<Lanes>, runs: &mut [Run]) -> Result<()> {
     if let Some(lanes) = slot.take() {
         for (j, run) in runs.iter_mut().enumerate() {
             if lanes.live[j] {
-                run.stepper = lanes.stepper.detach(j)?;
+                run.go_alone(lanes.stepper.detach(j)?);
             }
         }
     }
@@ -432,6 +433,7 @@ fn step_block<P: Problem + ?Sized>(
     outs: &mut [Vec<f64>],
     results: &mut [Result<()>],
 ) {
+    let mut next = Vec::new();
     let mut done = start;
     while done < end {
         let Some(lead) = lanes.live.iter().position(|&l| l) else {
@@ -447,7 +449,7 @@ fn step_block<P: Problem + ?Sized>(
                     lanes.live[j] = false;
                     let set = lanes.stepper.detach(j).and_then(|mut s| {
                         s.set(&run.buf)?;
-                        run.stepper = s;
+                        run.go_alone(s);
                         Ok(())
                     });
                     if let Err(e) = set {
@@ -461,10 +463,11 @@ fn step_block<P: Problem + ?Sized>(
             if !lanes.live[j] {
                 continue;
             }
-            lanes.stepper.get(j, &mut run.next);
-            let r = match check::finite_slice("state", &run.next) {
+            next.clone_from(&run.buf);
+            lanes.stepper.get(j, &mut next);
+            let r = match check::finite_slice("state", &next) {
                 Ok(()) => {
-                    std::mem::swap(&mut run.buf, &mut run.next);
+                    run.buf.copy_from_slice(&next);
                     let retracted = run.retract_at(problem, stop);
                     let set = if retracted {
                         lanes.stepper.set(j, &run.buf)
@@ -482,7 +485,7 @@ fn step_block<P: Problem + ?Sized>(
                     match lanes.stepper.detach(j) {
                         Err(d) => Err(d),
                         Ok(s) => {
-                            run.stepper = s;
+                            run.go_alone(s);
                             if n > 1 {
                                 run.replay(problem, n, e).and_then(|()| {
                                     run.commit(problem, done, stop, end, &mut outs[j])
@@ -499,7 +502,7 @@ fn step_block<P: Problem + ?Sized>(
                     // A save or a retraction failed: the member leaves the block where it is.
                     lanes.live[j] = false;
                     if let Ok(s) = lanes.stepper.detach(j) {
-                        run.stepper = s;
+                        run.go_alone(s);
                     }
                 }
                 results[j] = Err(e);

@@ -236,16 +236,27 @@ impl Run {
         out: &mut Vec<f64>,
     ) -> Result<()> {
         let save = self.at.is_none() && stop % self.save_every == 0;
-        if save || stop == end {
-            self.user.copy_from_slice(&self.buf);
-            problem.to_user(&mut self.user);
-            if let Err(e) = check::finite_slice("state", &self.user) {
-                return Err(self.non_finite(problem.name(), from, stop, e));
+        // The state is checked in the user frame: where it is saved, or in the scratch (the
+        // last state of a call, which a member of a block sizes only now).
+        let (z, at) = match save {
+            true => {
+                out.try_reserve(self.buf.len()).map_err(|_| too_many())?;
+                let at = out.len();
+                (&mut *out, at)
             }
+            false if stop == end => {
+                self.user.clear();
+                (&mut self.user, 0)
+            }
+            false => return Ok(()),
+        };
+        z.extend_from_slice(&self.buf);
+        problem.to_user(&mut z[at..]);
+        if let Err(e) = check::finite_slice("state", &z[at..]) {
             if save {
-                out.try_reserve(self.user.len()).map_err(|_| too_many())?;
-                out.extend_from_slice(&self.user);
+                z.truncate(at);
             }
+            return Err(self.non_finite(problem.name(), from, stop, e));
         }
         Ok(())
     }

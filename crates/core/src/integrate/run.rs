@@ -57,9 +57,10 @@ pub struct Run {
     pub(super) clock: Clock,
     /// The state (internal frame) at `clock.done`, the last that passed the checks.
     pub(super) buf: Vec<f64>,
-    /// Scratch: the state after the steps in progress (internal frame).
+    /// Scratch: the state after the steps in progress (internal frame). Empty while the run is
+    /// a member of a block of lanes (the block has its own; [`Run::go_alone`] sizes it).
     pub(super) next: Vec<f64>,
-    /// Scratch: a state in the user frame.
+    /// Scratch: a state in the user frame (events, located steps; empty as `next`).
     pub(super) user: Vec<f64>,
     /// The method, resolved once (a run of a catalogued system): shortened steps and errors.
     pub(super) method: Option<Arc<Resolved>>,
@@ -86,7 +87,7 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        Run::start(system, z0, dt, save_every, t0, || {
+        Run::start(system, z0, dt, save_every, t0, false, || {
             let m = system.resolve(method)?;
             Ok((m.stepper(dt)?, m.properties, Some(m)))
         })
@@ -101,7 +102,7 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        Run::start(problem, z0, dt, save_every, t0, || {
+        Run::start(problem, z0, dt, save_every, t0, false, || {
             Ok((method.stepper(dt)?, method.properties, Some(method.clone())))
         })
     }
@@ -115,18 +116,20 @@ impl Run {
         save_every: usize,
         t0: f64,
     ) -> Result<Run> {
-        Run::start(problem, z0, dt, save_every, t0, || {
+        Run::start(problem, z0, dt, save_every, t0, false, || {
             Ok((method.stepper(problem, dt)?, method.properties(), None))
         })
     }
 
-    /// Validates the arguments and the state once, then builds the stepper and sets its state.
+    /// Validates the arguments and the state once, then builds the stepper and sets its state
+    /// (`in_block`: the run of a member of a block of lanes, without scratch of its own).
     pub(super) fn start<P: Problem + ?Sized>(
         problem: &P,
         z0: &[f64],
         dt: f64,
         save_every: usize,
         t0: f64,
+        in_block: bool,
         stepper: impl FnOnce() -> Result<(Box<dyn Stepper>, Properties, Option<Arc<Resolved>>)>,
     ) -> Result<Run> {
         check_start(problem, z0, dt, save_every, t0)?;
@@ -136,13 +139,17 @@ impl Run {
         let space = problem.space();
         let mut buf = z0.to_vec();
         problem.to_internal(&mut buf);
+        let scratch = || match in_block {
+            true => Vec::new(),
+            false => vec![0.0; buf.len()],
+        };
         let mut run = Run {
             stepper,
             retract: properties.manifold && space.is_curved(),
             save_every: save_every as u64,
             clock: Clock { t0, dt, done: 0 },
-            next: buf.clone(),
-            user: buf.clone(),
+            next: scratch(),
+            user: scratch(),
             method,
             single: problem.calls_out(),
             at: None,
@@ -181,6 +188,14 @@ impl Run {
             dt: self.clock.dt,
         };
         Err(f.located())
+    }
+
+    /// A member leaving its block of lanes goes on with `stepper` (the block's exact copy of it)
+    /// and scratch of its own.
+    pub(super) fn go_alone(&mut self, stepper: Box<dyn Stepper>) {
+        self.stepper = stepper;
+        self.next.resize(self.buf.len(), 0.0);
+        self.user.resize(self.buf.len(), 0.0);
     }
 
     /// Sets the stepper back to the checked state after an error (whatever that costs: the run

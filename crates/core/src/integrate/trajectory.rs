@@ -162,11 +162,11 @@ pub fn integrate_batch<S: System + ?Sized>(
     let t: Vec<f64> = (0..n_saved).map(|k| k as f64 * every).collect();
     Ok(outs
         .into_iter()
-        .zip(finals)
+        .zip(finals.chunks_exact(system.space().dim()))
         .map(|(states, final_state)| Trajectory {
             t: t.clone(),
             dim: final_state.len(),
-            final_state,
+            final_state: final_state.to_vec(),
             states,
         })
         .collect())

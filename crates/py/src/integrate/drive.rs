@@ -21,9 +21,14 @@ pub(super) fn of_member(e: Error, i: usize, b: usize, first: Option<usize>) -> E
 
 impl Integration {
     /// Advances every member `until` (in parallel with the GIL released; a run with events, or
-    /// of a system that calls Python, in this thread) and returns the states saved, (b, k, d) and (b, k, 3, 3) or None. After an
-    /// error of a single run, what it saved before the error is kept for `take_partial`.
-    pub(super) fn drive(&mut self, py: Python<'_>, until: Until) -> PyResult<(Vec<f64>, usize)> {
+    /// of a system that calls Python, in this thread) and returns the states saved, k full
+    /// states per member (member i's in the i-th vector). After an error of a single run, what
+    /// it saved before the error is kept for `take_partial`.
+    pub(super) fn drive(
+        &mut self,
+        py: Python<'_>,
+        until: Until,
+    ) -> PyResult<(Vec<Vec<f64>>, usize)> {
         let full = self.d + if self.attitude { 9 } else { 0 };
         let sys = &*self.sys;
         let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
@@ -182,10 +187,6 @@ impl Integration {
                 "the members of the batch saved different numbers of states",
             )));
         }
-        let mut flat = check::zeros("steps", &[b, k * full]).py()?;
-        for (d, o) in flat.chunks_exact_mut((k * full).max(1)).zip(&data) {
-            d.copy_from_slice(o);
-        }
-        Ok((flat, k))
+        Ok((data, k))
     }
 }

@@ -132,9 +132,8 @@ impl Integration {
         steps: &Bound<'py, PyAny>,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let steps = args::count("steps", steps)?;
-        let b = self.initial.len() / self.full().max(1);
-        let (flat, k) = self.drive(py, Until::Steps(steps))?;
-        self.split(py, flat, b, k)
+        let (outs, k) = self.drive(py, Until::Steps(steps))?;
+        self.saved_arrays(py, &outs, k)
     }
 
     /// One call of `lieflow.integrate`'s loop: `steps` more steps, or with `t` to the time t
@@ -156,7 +155,7 @@ impl Integration {
             None => Until::Steps(args::count("steps", steps)?),
         };
         let before = self.ended();
-        let (flat, mut k) = self.drive(py, until)?;
+        let (outs, mut k) = self.drive(py, until)?;
         let ended = self.ended();
         // A terminal event's state, saved last (not with output times).
         let last = ended.filter(|_| before.is_none() && self.at.is_none());
@@ -171,7 +170,7 @@ impl Integration {
             k = passed.saturating_sub(self.saved);
         }
         let current = self.state(py)?;
-        self.chunk_of(py, flat, k, last, ended, current, true)
+        self.chunk_of(py, &outs, k, last, ended, current, true)
     }
 
     /// A plain run (no output times, no events, nothing done yet) in one call, as
@@ -190,11 +189,10 @@ impl Integration {
                 "_whole takes a plain run from its start",
             )));
         }
-        let (flat, k) = self.drive(py, Until::Steps(steps))?;
-        let (flat, k, times) = self.samples(flat, k, None);
+        let (outs, k) = self.drive(py, Until::Steps(steps))?;
         let b = self.members();
         let lead: &[usize] = if self.batched { &[b] } else { &[] };
-        let (states, att) = self.arrays(py, flat, &[lead, &[k]].concat())?;
+        let (states, att, times) = self.samples(py, &outs, k, None, lead)?;
         let (z, za) = self.arrays(py, self.current(py)?, lead)?;
         let (z0, za0) = self.arrays(py, self.initial.clone(), lead)?;
         let t = PyArray1::from_vec(py, times);
@@ -213,7 +211,7 @@ impl Integration {
         };
         let k = data.len() / self.full().max(1);
         let current = self.checked_state(py)?;
-        self.chunk_of(py, data, k, None, None, current, false)
+        self.chunk_of(py, &[data], k, None, None, current, false)
             .map(Some)
     }
 
@@ -221,7 +219,7 @@ impl Integration {
     /// states, at step 0 and time t₀.
     fn _head<'py>(&mut self, py: Python<'py>) -> PyResult<Chunk<'py>> {
         let current = self.initial_states(py)?;
-        let mut c = self.chunk_of(py, Vec::new(), 0, None, None, current, false)?;
+        let mut c = self.chunk_of(py, &[], 0, None, None, current, false)?;
         (c.5, c.7) = (0, (self.t0, self.t0));
         Ok(c)
     }
@@ -262,9 +260,8 @@ impl Integration {
         py: Python<'py>,
         #[pyo3(from_py_with = real)] t: f64,
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
-        let b = self.initial.len() / self.full().max(1);
-        let (flat, k) = self.drive(py, Until::Time(t))?;
-        self.split(py, flat, b, k)
+        let (outs, k) = self.drive(py, Until::Time(t))?;
+        self.saved_arrays(py, &outs, k)
     }
 
     /// Saves the states at the times `t_eval` (1-D, strictly increasing, none before the
@@ -415,9 +412,8 @@ impl Integration {
         let Some(data) = self.partial.take() else {
             return Ok(None);
         };
-        let full = self.d + if self.attitude { 9 } else { 0 };
-        let k = data.len() / full.max(1);
-        self.split(py, data, 1, k).map(Some)
+        let k = data.len() / self.full().max(1);
+        self.arrays(py, data, &[1, k]).map(Some)
     }
 
     /// The last states that passed the checks (b, d) and attitudes (b, 3, 3) or None: the

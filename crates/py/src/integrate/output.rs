@@ -11,17 +11,6 @@ use crate::errors::IntoPy;
 use crate::items::{array, Out};
 
 impl Integration {
-    /// The states (b, k, d) and attitudes (b, k, 3, 3) or None of `data` (b·k full states).
-    pub(super) fn split<'py>(
-        &self,
-        py: Python<'py>,
-        data: Vec<f64>,
-        b: usize,
-        k: usize,
-    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
-        self.arrays(py, data, &[b, k])
-    }
-
     /// The states (*lead, d) and attitudes (*lead, 3, 3) or None of `data` (full states).
     pub(super) fn arrays<'py>(
         &self,
@@ -29,24 +18,53 @@ impl Integration {
         data: Vec<f64>,
         lead: &[usize],
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+        match self.attitude {
+            false => Ok((array(py, &[lead, &[self.d]].concat(), data)?, None)),
+            true => self.arrays_of(py, data.chunks_exact(self.full()), lead),
+        }
+    }
+
+    /// The states (*lead, d) and attitudes (*lead, 3, 3) or None of the full states `states`
+    /// (as many as `lead` says), copied once.
+    fn arrays_of<'a, 'py>(
+        &self,
+        py: Python<'py>,
+        states: impl Iterator<Item = &'a [f64]>,
+        lead: &[usize],
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         let shape = |item: &[usize]| [lead, item].concat();
-        if !self.attitude {
-            return Ok((array(py, &shape(&[self.d]), data)?, None));
+        let n = lead.iter().product();
+        let d = self.d;
+        let mut z = check::zeros("steps", &[n, d]).py()?;
+        let mut r = match self.attitude {
+            true => check::zeros("steps", &[n, 9]).py()?,
+            false => Vec::new(),
+        };
+        let mut rows = r.chunks_exact_mut(9);
+        for (s, z) in states.zip(z.chunks_exact_mut(d.max(1))) {
+            z.copy_from_slice(&s[..d]);
+            if let Some(r) = rows.next() {
+                r.copy_from_slice(&s[d..]);
+            }
         }
-        let full = self.full();
-        let n = data.len() / full;
-        let mut z = check::zeros("steps", &[n, self.d]).py()?;
-        let mut r = check::zeros("steps", &[n, 9]).py()?;
-        for ((s, z), r) in data
-            .chunks_exact(full)
-            .zip(z.chunks_exact_mut(self.d))
-            .zip(r.chunks_exact_mut(9))
-        {
-            z.copy_from_slice(&s[..self.d]);
-            r.copy_from_slice(&s[self.d..]);
-        }
-        let states = array(py, &shape(&[self.d]), z)?;
-        Ok((states, Some(array(py, &shape(&[3, 3]), r)?)))
+        let states = array(py, &shape(&[d]), z)?;
+        let att = match self.attitude {
+            true => Some(array(py, &shape(&[3, 3]), r)?),
+            false => None,
+        };
+        Ok((states, att))
+    }
+
+    /// The states (b, k, d) and attitudes (b, k, 3, 3) or None that the members saved in one
+    /// call (member i's k full states in `outs[i]`).
+    pub(super) fn saved_arrays<'py>(
+        &self,
+        py: Python<'py>,
+        outs: &[Vec<f64>],
+        k: usize,
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
+        let states = outs.iter().flat_map(|o| o.chunks_exact(self.full()));
+        self.arrays_of(py, states, &[self.members(), k])
     }
 
     /// (b, d) states and (b, 3, 3) attitudes or None from b full flat states.
@@ -67,10 +85,8 @@ impl Integration {
         Ok(if !self.calls_out && batch.in_lanes() {
             // Batches in lanes: read in parallel on the run's threads, GIL released.
             let batch = &mut *batch;
-            let states = py
-                .detach(|| with_threads(self.threads, || Ok(batch.states(sys))))
-                .py()?;
-            states.into_iter().flatten().collect()
+            py.detach(|| with_threads(self.threads, || Ok(batch.states(sys))))
+                .py()?
         } else {
             (0..b).flat_map(|i| batch.state(sys, i)).collect()
         })
@@ -81,28 +97,33 @@ impl Integration {
         self.d + if self.attitude { 9 } else { 0 }
     }
 
-    /// The samples of one call, `flat` (b members × k states), with the initial states before
-    /// them while they are due (the first call of a run that saves every `save_every`-th
-    /// state), and their times: t₀ + n·(save_every·dt) for the run's n-th sample (a terminal
-    /// event's state, saved last, at its time `ended`), or the output times of `save_at`.
-    pub(super) fn samples(
+    /// The samples of one call, `outs` (member i's k full states in `outs[i]`; a member
+    /// absent saved none), with the initial states before them while they are due (the first
+    /// call of a run that saves every `save_every`-th state), as arrays (*lead, k', d) and
+    /// (*lead, k', 3, 3) or None (`lead`: [b], or [] for a single run), k' samples per member,
+    /// and their times: t₀ + n·(save_every·dt) for the run's n-th sample (a terminal event's
+    /// state, saved last, at its time `last`), or the output times of `save_at`.
+    pub(super) fn samples<'py>(
         &mut self,
-        flat: Vec<f64>,
+        py: Python<'py>,
+        outs: &[Vec<f64>],
         k: usize,
         last: Option<f64>,
-    ) -> (Vec<f64>, usize, Vec<f64>) {
+        lead: &[usize],
+    ) -> PyResult<(Out<'py>, Option<Out<'py>>, Vec<f64>)> {
         let full = self.full();
         let b = self.members();
-        let (flat, k) = if self.at.is_none() && self.saved == 0 {
-            let mut out = Vec::with_capacity(flat.len() + self.initial.len());
-            for i in 0..b {
-                out.extend_from_slice(&self.initial[i * full..(i + 1) * full]);
-                out.extend_from_slice(&flat[i * k * full..(i + 1) * k * full]);
-            }
-            (out, k + 1)
-        } else {
-            (flat, k)
-        };
+        let initial = self.at.is_none() && self.saved == 0;
+        let k = k + usize::from(initial);
+        let states = (0..b).flat_map(|i| {
+            let first = match initial {
+                true => &self.initial[i * full..(i + 1) * full],
+                false => &[],
+            };
+            let saved = outs.get(i).map_or(&[][..], Vec::as_slice);
+            first.chunks_exact(full).chain(saved.chunks_exact(full))
+        });
+        let (z, att) = self.arrays_of(py, states, &[lead, &[k]].concat())?;
         let n0 = self.saved;
         let times = match &self.at {
             Some(times) => times[n0.min(times.len())..(n0 + k).min(times.len())].to_vec(),
@@ -117,7 +138,7 @@ impl Integration {
             }
         };
         self.saved += k;
-        (flat, k, times)
+        Ok((z, att, times))
     }
 
     /// The time of the current state: the end time of an ended run, else t₀ + steps·dt, or the
@@ -147,13 +168,13 @@ impl Integration {
         }
     }
 
-    /// One call's samples (`flat`, k per member; `last`: the time of a terminal event's state
+    /// One call's samples (`outs`, k per member; `last`: the time of a terminal event's state
     /// saved last) as `_chunk` returns them, with the current states and the end time.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn chunk_of<'py>(
         &mut self,
         py: Python<'py>,
-        flat: Vec<f64>,
+        outs: &[Vec<f64>],
         k: usize,
         last: Option<f64>,
         ended: Option<f64>,
@@ -161,8 +182,7 @@ impl Integration {
         snap: bool,
     ) -> PyResult<Chunk<'py>> {
         let b = self.members();
-        let (flat, k, times) = self.samples(flat, k, last);
-        let (states, att) = self.split(py, flat, b, k)?;
+        let (states, att, times) = self.samples(py, outs, k, last, &[b])?;
         let hits = match self.events.is_some() {
             true => Some(self.events_found(py)?),
             false => None,
@@ -176,10 +196,9 @@ impl Integration {
 
     /// `_run`: the initial states and the states saved in `steps` steps, and the final states.
     pub(crate) fn run_all<'py>(&mut self, py: Python<'py>, steps: u64) -> PyResult<RunOut<'py>> {
-        let (flat, k) = self.drive(py, Until::Steps(steps))?;
+        let (outs, k) = self.drive(py, Until::Steps(steps))?;
         let b = self.members();
-        let (flat, k, _) = self.samples(flat, k, None);
-        let (states, att) = self.split(py, flat, b, k)?;
+        let (states, att, _) = self.samples(py, &outs, k, None, &[b])?;
         let (zf, rf) = self.state(py)?;
         Ok((states, att, zf, rf))
     }

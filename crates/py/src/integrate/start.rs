@@ -16,15 +16,15 @@ use crate::errors::{to_py, IntoPy};
 const MAX_THREADS: usize = 1024;
 
 impl Integration {
-    /// Starts one run per member of `states` (b members of the system's states, with their
-    /// attitudes appended where given) with the method `resolved` (the name `method`, None for
+    /// Starts one run per member of `states` (b members' full states one after the other: the
+    /// system's state, with its attitude appended where given) with the method `resolved` (the name `method`, None for
     /// the default), every argument checked once, and the states saved at
     /// `t_eval` when given (then checked against the run: not before t₀, not after the end
     /// t₀ + steps·dt).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn start(
         sys: Arc<dyn System>,
-        mut states: Vec<Vec<f64>>,
+        states: Vec<f64>,
         batched: bool,
         attitude: bool,
         dt: f64,
@@ -48,7 +48,8 @@ impl Integration {
         let method = resolved.as_ref().map_or(method.unwrap_or(""), |m| m.name);
         let full = sys.space().dim();
         let d = if attitude { full - 9 } else { full };
-        let b = states.len();
+        let members: Vec<&[f64]> = states.chunks_exact(full.max(1)).collect();
+        let b = members.len();
         let save = usize::try_from(save_every).unwrap_or(usize::MAX);
         // Each member's run keeps its state several times (buffer, stepper state, scratch) and a
         // few hundred bytes more: about 64 + 8·d floats measured; check twice that against the
@@ -73,8 +74,8 @@ impl Integration {
         // Set up on the run's threads (members in blocks validated in parallel, the first error
         // kept); a system that calls Python is set up on this thread, which holds the GIL.
         let start = || match &resolved {
-            Ok(m) => Batch::resolved(&*sys, m, &states, dt, save, t0),
-            Err(_) => Batch::start(&*sys, method, &states, dt, save, t0),
+            Ok(m) => Batch::resolved(&*sys, m, &members, dt, save, t0),
+            Err(_) => Batch::start(&*sys, method, &members, dt, save, t0),
         };
         let runs = if calls_out {
             start()
@@ -86,7 +87,7 @@ impl Integration {
             None => e,
         })
         .py()?;
-        let initial = states.drain(..).flatten().collect();
+        drop(members);
         let mut run = Integration {
             method: method.to_string(),
             sys,
@@ -102,7 +103,7 @@ impl Integration {
             done: 0,
             at: None,
             saved: 0,
-            initial,
+            initial: states,
             events: None,
             partial: None,
             first_member,
