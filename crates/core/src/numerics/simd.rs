@@ -281,11 +281,31 @@ pub fn sin_cos_small<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s) {
 /// operations fewer on the chain of the one-body steppers, which wait on it.
 #[inline(always)]
 pub fn sin_cosm1_small<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s) {
-    let z = simd.mul_f64s(x, x);
+    sin_cosm1_poly(simd, x, simd.mul_f64s(x, x))
+}
+
+/// [`sin_cosm1_small`] of x given z = x².
+#[inline(always)]
+fn sin_cosm1_poly<S: Simd>(simd: S, x: S::f64s, z: S::f64s) -> (S::f64s, S::f64s) {
     let (p, q, z2) = taylor_pq(simd, z);
     let minus_hz = simd.mul_f64s(simd.splat_f64s(-0.5), z);
     let sin = fma(simd, simd.mul_f64s(x, z), p, x);
     (sin, fma(simd, z2, q, minus_hz))
+}
+
+/// (sin x, cos x − 1) of the rotation angles of a step: [`sin_cosm1_small`] when every lane
+/// has x² ≤ [`SMALL_MAX`]² (the usual step: the test reuses the square the polynomials take,
+/// one comparison; x² ≤ fl(0.78²) bounds |x| by 0.78 + 1e-16, far inside the range where the
+/// reduction is the identity), else [`sin_cosm1_lanes`]: the same bits either way.
+#[inline(always)]
+pub fn sin_cosm1_step<S: Simd>(simd: S, x: S::f64s) -> (S::f64s, S::f64s) {
+    let z = simd.mul_f64s(x, x);
+    let small = simd.less_than_or_equal_f64s(z, simd.splat_f64s(SMALL_MAX * SMALL_MAX));
+    if simd.first_true_m64s(simd.not_m64s(small)) >= S::F64_LANES {
+        sin_cosm1_poly(simd, x, z)
+    } else {
+        sin_cosm1_lanes(simd, x)
+    }
 }
 
 /// Whether every lane of `x` has |x| ≤ [`SMALL_MAX`] (so [`sin_cos_small`] applies; false for

@@ -685,20 +685,9 @@ fn rotate_about<
     z: &mut [[S::f64s; G]; D],
     tc: [S::f64s; G],
 ) {
-    let mut angle = tc;
-    // Small angles (the usual case) skip the argument reduction: the same bits
-    // (`simd::sin_cosm1_small`), so the choice, made per group, changes no result.
-    let mut small = true;
     for g in 0..G {
-        angle[g] = simd.mul_f64s(tc[g], z[K][g]);
-        small &= crate::numerics::simd::all_small(simd, angle[g]);
-    }
-    for g in 0..G {
-        let (s, cm1) = if small {
-            crate::numerics::simd::sin_cosm1_small(simd, angle[g])
-        } else {
-            crate::numerics::simd::sin_cosm1_lanes(simd, angle[g])
-        };
+        let angle = simd.mul_f64s(tc[g], z[K][g]);
+        let (s, cm1) = crate::numerics::simd::sin_cosm1_step(simd, angle);
         for base in (0..D).step_by(3) {
             let (vi, vj) = (z[base + I][g], z[base + J][g]);
             let di = fma(simd, cm1, vi, simd.mul_f64s(s, vj));
