@@ -6,7 +6,7 @@ observables are vectorised over leading axes (..., d) and return a float for a s
 
 from collections.abc import Callable, Sequence
 from types import ModuleType
-from typing import Any, overload
+from typing import Any, Literal, overload
 
 from typing_extensions import Self, disjoint_base, final
 
@@ -448,18 +448,22 @@ class Forced(System):
 @final
 class LiePoisson(System):
     """A Lie–Poisson system d mu/dt = ad*_{dH/dmu} mu on g* (so3, se3, ("so", n) or structure
-    constants (d, d, d)); rkmk4 (default), midpoint, midpoint4 (keep the coadjoint orbit), rk4.
-    Casimirs: |M|^2 (so3); |Gamma|^2, M.Gamma (se3); tr((M^T M)^k)/2 (so(n)); or `casimirs`."""
+    constants (d, d, d)), or -ad* with side="right"; rkmk4 (default), midpoint, midpoint4 (keep
+    the coadjoint orbit), rk4. Casimirs: |M|^2 (so3); |Gamma|^2, M.Gamma (se3);
+    tr((M^T M)^k)/2 (so(n)); or `casimirs`."""
 
     def __new__(
         cls, algebra: str | tuple[str, int] | ArrayLike,
         hamiltonian: Callable[[_F64], float] | ArrayLike,
         gradient: Callable[[_F64], ArrayLike] | None = None,
         casimirs: Sequence[Callable[[_F64], float]] | None = None,
+        side: Literal["left", "right"] | None = None,
     ) -> Self:
         """hamiltonian: a callable mu -> float, or a symmetric (d, d) matrix A for H = mu.A mu/2
         (the native path); gradient: mu -> (d,) or None (finite differences; None for a
-        matrix)."""
+        matrix); side: the invariance reduced from, "left" (default) or "right"."""
+    @property
+    def side(self) -> Literal["left", "right"]: ...
     @property
     def dim(self) -> int: ...
     @property

@@ -294,6 +294,7 @@ def _stored_objects(lf_module):
     out += [("forced-damped", lf.Forced(lf.Pendulum(1.0, 1.0, 9.81), damping=0.3)),
             ("forced-dissipation", lf.Forced(lf.RigidBody([1.0, 2.0, 3.0]), dissipation=0.5)),
             ("lie-poisson-so4", lf.LiePoisson(("so", 4), np.eye(6))),
+            ("lie-poisson-right", lf.LiePoisson("se3", np.eye(6), side="right")),
             ("charged", lf.TangentTop(lf.surfaces.Torus(2.0, 0.7), 1.0, 0.5)
              .magnetic_analogue(0.3)),
             ("int32-array", lf.RigidBody(np.array([1, 2, 3], dtype=np.int32)))]

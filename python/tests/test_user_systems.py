@@ -299,13 +299,58 @@ def test_pickling_and_repr():
     for sys, z0 in [(lf.Canonical(osc_h, osc_grad, dof=1), [1.0, 0.0]),
                     (lf.Separable([[2.0]], pend_u, pend_du), [0.3, 0.0]),
                     (lf.LiePoisson("so3", rb_h, rb_grad, casimirs=[casimir]), M0),
-                    (lf.LiePoisson(("so", 4), np.eye(6)), np.arange(6.0) / 6)]:
+                    (lf.LiePoisson(("so", 4), np.eye(6)), np.arange(6.0) / 6),
+                    (lf.LiePoisson("se3", np.eye(6), side="right"), np.arange(6.0) / 6)]:
         copy = pickle.loads(pickle.dumps(sys))
         assert repr(copy) == repr(sys)
         a = lf.integrate(sys, z0, dt=0.01, steps=50).states
         b = lf.integrate(copy, z0, dt=0.01, steps=50).states
         np.testing.assert_array_equal(a, b)
     assert repr(lf.Canonical(osc_h, dof=1)).startswith("Canonical(hamiltonian=<function osc_h")
+
+
+def cubic_h(mu):
+    return float(0.5 * mu @ mu + 0.2 * np.sum(mu**3) / 3)
+
+
+def cubic_grad(mu):
+    return mu + 0.2 * mu**2
+
+
+def cubic_h_mirror(mu):
+    return cubic_h(-mu)
+
+
+def cubic_grad_mirror(mu):
+    return -cubic_grad(-mu)
+
+
+@pytest.mark.parametrize("method", ["rkmk4", "midpoint", "rk4"])
+def test_a_right_invariant_system_is_the_left_one_of_the_inverse_motion(method):
+    # 000 Theorems 4.3-4.4 by the mirror g -> g^{-1}: the right system of H from mu0 is the
+    # negated left system of H(-mu) from -mu0, bit for bit; not the left system of H.
+    right = lf.LiePoisson("so3", cubic_h, cubic_grad, side="right")
+    mirror = lf.LiePoisson("so3", cubic_h_mirror, cubic_grad_mirror)
+    left = lf.LiePoisson("so3", cubic_h, cubic_grad)
+    assert (right.side, left.side) == ("right", "left")
+    r = lf.integrate(right, M0, dt=0.01, steps=200, method=method).states
+    m = lf.integrate(mirror, -M0, dt=0.01, steps=200, method=method).states
+    np.testing.assert_array_equal(r, -m)
+    l_ = lf.integrate(left, M0, dt=0.01, steps=200, method=method).states
+    assert np.abs(r[-1] - l_[-1]).max() > 1e-3
+    # The rigid body reduced from the right: d M/dt = Omega x M, the spatial frame's sign.
+    body = lf.LiePoisson("so3", np.diag(1 / INERTIA), side="right")
+    z = lf.integrate(body, M0, dt=1e-3, steps=1).states
+    np.testing.assert_allclose((z[1] - z[0]) / 1e-3, np.cross(M0 / INERTIA, M0), atol=1e-2)
+
+
+def test_side_is_checked():
+    with pytest.raises(lf.InvalidArgumentError, match="expected \"left\" or \"right\""):
+        lf.LiePoisson("so3", np.eye(3), side="up")
+    with pytest.raises(lf.ArgumentTypeError, match="side"):
+        lf.LiePoisson("so3", np.eye(3), side=1)
+    with pytest.raises(lf.InvalidArgumentError, match="left-invariant"):
+        lf.Forced(lf.LiePoisson("so3", np.eye(3), side="right"), dissipation=0.1)
 
 
 def grad_raising(q, p):

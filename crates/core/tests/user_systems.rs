@@ -16,7 +16,7 @@ use lieflow::lie::{se3, so};
 use lieflow::systems::user::{CanonicalFn, CanonicalGradientFn, GradientFn, ScalarFn};
 use lieflow::systems::{
     Algebra, GeneralizedRigidBody, KineticMass, LieHamiltonian, LiePoisson, Pendulum, RigidBody,
-    UserCanonical, UserSeparable,
+    Side, UserCanonical, UserSeparable,
 };
 use lieflow::{Error, Mat};
 use nalgebra::Vector6;
@@ -740,4 +740,88 @@ fn catalogs_and_names() {
     assert_eq!(rigid_quadratic().name(), "LiePoisson");
     assert_eq!(oscillator(true).name(), "Canonical");
     assert!(UserCanonical::new(0, Arc::new(|_: &[f64], _: &[f64]| Ok(0.0)), None).is_err());
+}
+
+/// H(μ) = Σ ½ a_i μ_i² + ⅓ b_i μ_i³ (odd: H(−μ) ≠ H(μ)), with its gradient; `mirror`: H(−μ).
+fn cubic_hamiltonian(d: usize, mirror: bool) -> LieHamiltonian {
+    let s = if mirror { -1.0 } else { 1.0 };
+    let a = move |i: usize| 1.0 + 0.5 * i as f64;
+    let b = move |i: usize| s * (0.2 - 0.07 * i as f64);
+    let value: ScalarFn = Arc::new(move |m: &[f64]| {
+        Ok((0..d)
+            .map(|i| 0.5 * a(i) * m[i] * m[i] + b(i) * m[i] * m[i] * m[i] / 3.0)
+            .sum())
+    });
+    let gradient: GradientFn = Arc::new(move |m: &[f64], out: &mut [f64]| {
+        for i in 0..d {
+            out[i] = a(i) * m[i] + b(i) * m[i] * m[i];
+        }
+        Ok(())
+    });
+    LieHamiltonian::Function {
+        value,
+        gradient: Some(gradient),
+    }
+}
+
+#[test]
+fn a_right_invariant_system_is_the_left_one_of_the_inverse_motion() {
+    // The right system of H from μ₀ is, bit for bit, the negated left system of H̃(μ) = H(−μ)
+    // from −μ₀ (the mirror g ↦ g⁻¹: module docs of systems::user, "Left and right"), on every
+    // kind of algebra and with every method; and it is not the left system of H itself.
+    let so3_constants = LiePoisson::new(Algebra::So3, rigid_quadratic_h(), None)
+        .unwrap()
+        .structure_constants()
+        .unwrap();
+    let algebras = [
+        (Algebra::So3, vec![1.0, 0.5, -0.3]),
+        (Algebra::Se3, vec![1.0, 0.5, -0.3, 0.2, -0.1, 0.4]),
+        (Algebra::So(4), vec![0.3, -0.2, 0.5, 0.1, 0.4, -0.6]),
+        (Algebra::Constants(so3_constants), vec![1.0, 0.5, -0.3]),
+    ];
+    for (algebra, mu0) in algebras {
+        let d = mu0.len();
+        let right = LiePoisson::new(algebra.clone(), cubic_hamiltonian(d, false), None)
+            .unwrap()
+            .with_side(Side::Right);
+        let mirror = LiePoisson::new(algebra.clone(), cubic_hamiltonian(d, true), None).unwrap();
+        let left = LiePoisson::new(algebra.clone(), cubic_hamiltonian(d, false), None).unwrap();
+        let minus: Vec<f64> = mu0.iter().map(|x| -x).collect();
+        for method in ["rkmk4", "midpoint", "rk4"] {
+            let r = integrate(&right, method, &mu0, 0.01, 300, 30).unwrap();
+            let m = integrate(&mirror, method, &minus, 0.01, 300, 30).unwrap();
+            let l = integrate(&left, method, &mu0, 0.01, 300, 30).unwrap();
+            for k in 0..r.len() {
+                let negated: Vec<u64> = m.state(k).iter().map(|x| (-x).to_bits()).collect();
+                let bits: Vec<u64> = r.state(k).iter().map(|x| x.to_bits()).collect();
+                assert_eq!(bits, negated, "{algebra:?} {method} sample {k}");
+            }
+            assert!(
+                dist(r.state(10), l.state(10)) > 1e-3,
+                "{algebra:?} {method}"
+            );
+        }
+        // The orbit-preserving methods keep the Casimirs of the right system too.
+        let r = integrate(&right, "rkmk4", &mu0, 0.01, 2000, 100).unwrap();
+        assert!(max_invariant_drift(&right, &r) < 1e-13, "{algebra:?}");
+        assert_eq!(right.side(), Side::Right);
+    }
+}
+
+#[test]
+fn double_bracket_dissipation_is_refused_for_a_right_invariant_system() {
+    use lieflow::integrate::problem::Dissipation;
+    let right = rigid_quadratic().with_side(Side::Right);
+    let e = right
+        .dissipation(&Dissipation::DoubleBracket(0.1))
+        .err()
+        .unwrap();
+    assert!(e.to_string().contains("left-invariant"), "{e}");
+    assert!(rigid_quadratic()
+        .dissipation(&Dissipation::DoubleBracket(0.1))
+        .is_ok());
+}
+
+fn rigid_quadratic_h() -> LieHamiltonian {
+    LieHamiltonian::Quadratic(diag(&INERTIA.map(|i| 1.0 / i)))
 }

@@ -37,4 +37,6 @@ pub use tangent_top::{
 pub use test_problems::{Pendulum, RollingDisk, SphereParticle};
 pub use tops::methods::{Dmv, Exact, ExactSplitting, Isospectral, Lgvi};
 pub use tops::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
-pub use user::{Algebra, KineticMass, LieHamiltonian, LiePoisson, UserCanonical, UserSeparable};
+pub use user::{
+    Algebra, KineticMass, LieHamiltonian, LiePoisson, Side, UserCanonical, UserSeparable,
+};

@@ -29,10 +29,34 @@ pub enum LieHamiltonian {
     },
 }
 
-/// A Lie–Poisson system μ̇ = ad*_{∇H} μ on g* (module docs).
+/// The invariance a Lie–Poisson system comes from, which fixes the sign of its bracket (module
+/// docs, "Left and right"): reduction of a left-invariant system gives μ̇ = ad*_{∇H} μ (000
+/// §4.1, Theorem 4.3: the body frame), of a right-invariant one μ̇ = −ad*_{∇H} μ (Theorem 4.4:
+/// the spatial frame).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Side {
+    /// Left-invariant (the rigid body in the body frame): μ̇ = ad*_{∇H} μ.
+    #[default]
+    Left,
+    /// Right-invariant (spatial form): μ̇ = −ad*_{∇H} μ.
+    Right,
+}
+
+impl Side {
+    /// +1 for [`Side::Left`], −1 for [`Side::Right`]: the sign of the bracket.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Left => 1.0,
+            Side::Right => -1.0,
+        }
+    }
+}
+
+/// A Lie–Poisson system μ̇ = ±ad*_{∇H} μ on g* (module docs).
 #[derive(Clone)]
 pub struct LiePoisson {
     algebra: Arc<Structure>,
+    side: Side,
     hamiltonian: LieHamiltonian,
     casimirs: Option<Vec<ScalarFn>>,
     /// The so(n) kernels (of a generalized rigid body; only its group action is used).
@@ -97,10 +121,23 @@ impl LiePoisson {
         };
         Ok(LiePoisson {
             algebra: Arc::new(algebra),
+            side: Side::Left,
             hamiltonian,
             casimirs,
             so_kernels,
         })
+    }
+
+    /// The same system reduced from the other invariance: `side` fixes the sign of the
+    /// bracket ([`Side`]; a new system is [`Side::Left`]).
+    pub fn with_side(mut self, side: Side) -> Self {
+        self.side = side;
+        self
+    }
+
+    /// The invariance the system comes from ([`Side`]).
+    pub fn side(&self) -> Side {
+        self.side
     }
 
     /// dim g.
@@ -299,7 +336,7 @@ impl Problem for LiePoisson {
 }
 
 impl VectorField for LiePoisson {
-    /// μ̇ = ad*_{∇H} μ.
+    /// μ̇ = ±ad*_{∇H} μ ([`Side`]).
     fn field(&self, z: &[f64], dz: &mut [f64]) {
         let d = self.algebra.dim;
         let mut stack = [0.0; 32];
@@ -311,11 +348,15 @@ impl VectorField for LiePoisson {
             &mut heap[..]
         };
         self.kernel_gradient(z, g);
+        if self.side == Side::Right {
+            g.iter_mut().for_each(|x| *x = -*x);
+        }
         self.algebra.ad_star(g, z, dz);
     }
 }
 
-/// The coadjoint action (module docs): ξ(μ) = −∇H(μ), exp(ξ)·μ = Ad*_{exp(−ξ)} μ.
+/// The coadjoint action (module docs): ξ(μ) = ∓∇H(μ) ([`Side`]: − for left), exp(ξ)·μ =
+/// Ad*_{exp(−ξ)} μ.
 impl GroupField for LiePoisson {
     type Scratch = LieScratch;
     fn scratch(&self) -> LieScratch {
@@ -335,7 +376,9 @@ impl GroupField for LiePoisson {
     }
     fn generator(&self, z: &[f64], xi: &mut [f64], _s: &mut LieScratch) {
         self.kernel_gradient(z, xi);
-        xi.iter_mut().for_each(|x| *x = -*x);
+        if self.side == Side::Left {
+            xi.iter_mut().for_each(|x| *x = -*x);
+        }
     }
     fn act(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
         match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
@@ -378,10 +421,19 @@ impl Catalog for LiePoisson {
         ]
     }
 
+    /// Double-bracket dissipation of a left-invariant system (the generic construction takes
+    /// the field as ad*_{∇H} μ; for a right-invariant one it would pump energy in).
     fn dissipation(
         &self,
         d: &crate::integrate::forcing::Dissipation,
     ) -> crate::Result<std::sync::Arc<dyn crate::integrate::forcing::Perturbation>> {
+        if self.side == Side::Right {
+            return Err(Error::invalid(
+                "dissipation",
+                "double-bracket dissipation is built for left-invariant Lie–Poisson systems \
+                 (side=\"left\"); this one is right-invariant",
+            ));
+        }
         crate::integrate::forcing::double_bracket(self, d)
     }
 }

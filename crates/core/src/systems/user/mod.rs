@@ -27,6 +27,15 @@
 //! [`crate::lie::so::vee_n`] (pairing ½ tr(ξᵀη), 001 (2.8)): Ṁ = [M, Ω], the sign of
 //! [`crate::systems::GeneralizedRigidBody`]; Casimirs ½ tr((MᵀM)^k), k = 1…⌊n/2⌋.
 //!
+//! **Left and right.** A left-invariant Lagrangian reduces to μ̇ = ad*_ξ μ with ξ = ∇H(μ) (000
+//! §4.1, the body frame); a right-invariant one to μ̇ = −ad*_ξ μ (the spatial frame). Derived
+//! by the mirror g ↦ g⁻¹: if g(t) has right velocity ξ = ġg⁻¹, then h = g⁻¹ has left velocity
+//! h⁻¹ḣ = −ξ, so the right system of ℓ is the left system of ℓ̃(η) = ℓ(−η), whose momentum is
+//! μ̃ = −μ; its equation d/dt μ̃ = ad*_η μ̃ reads μ̇ = −ad*_ξ μ. [`Side`] chooses the sign
+//! ([`LiePoisson::with_side`]); the coadjoint action then takes ξ(μ) = +∇H(μ). The test: a
+//! right-invariant run from μ₀ is, bit for bit, the negated left-invariant run of H̃(μ) = H(−μ)
+//! from −μ₀ (negation commutes exactly with every operation of the methods).
+//!
 //! **The coadjoint action as a [`GroupField`](crate::integrate::problem::GroupField).** G acts on g* by g·μ = Ad*_{g⁻¹} μ =
 //! Ad_{g⁻¹}ᵀ μ, whose infinitesimal generator is ξ·μ = −ad*_ξ μ; so ξ(μ) = −∇H(μ) gives
 //! ξ(μ)·μ = ad*_{∇H} μ. exp(ξ)·μ is computed by the group maps of [`crate::lie`] where the group
@@ -79,7 +88,7 @@ use crate::numerics::fd::{self, Scheme};
 
 pub use crate::lie::structure::Algebra;
 pub use canonical::UserCanonical;
-pub use lie_poisson::{LieHamiltonian, LiePoisson, LieScratch};
+pub use lie_poisson::{LieHamiltonian, LiePoisson, LieScratch, Side};
 pub use separable::{KineticMass, UserSeparable};
 
 /// H(q, p) of a [`UserCanonical`].

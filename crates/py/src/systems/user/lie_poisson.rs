@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use lieflow::systems::user::{GradientFn, ScalarFn};
-use lieflow::systems::{Algebra, LieHamiltonian, LiePoisson as CoreLiePoisson};
+use lieflow::systems::{Algebra, LieHamiltonian, LiePoisson as CoreLiePoisson, Side};
 use lieflow::Error;
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray3};
@@ -59,7 +59,29 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
     Ok(Algebra::Constants(read_all("algebra", &v)?))
 }
 
-/// A Lie–Poisson system on g*: d mu/dt = ad*_{dH/dmu} mu.
+/// The `side` argument: None or "left" (left-invariant), "right".
+fn side(s: Option<&Any<'_>>) -> PyResult<Side> {
+    let Some(s) = optional(s) else {
+        return Ok(Side::Left);
+    };
+    let name = s.cast::<PyString>().map_err(|_| {
+        argument_type_error(
+            s.py(),
+            "argument 'side': expected \"left\" or \"right\"".into(),
+        )
+    })?;
+    match name.extract::<String>()?.as_str() {
+        "left" => Ok(Side::Left),
+        "right" => Ok(Side::Right),
+        other => Err(to_py(Error::invalid(
+            "side",
+            format!("expected \"left\" or \"right\", got {other:?}"),
+        ))),
+    }
+}
+
+/// A Lie–Poisson system on g*: d mu/dt = ad*_{dH/dmu} mu (left-invariant), or
+/// d mu/dt = -ad*_{dH/dmu} mu (`side="right"`).
 ///
 /// With [e_i, e_j] = C_ij^k e_k and mu the coordinates dual to e_k (the pairing is the dot
 /// product), (ad*_xi mu)_j = sum_{i,k} C_ij^k xi_i mu_k; on so(3) this is dM/dt = M x Omega for
@@ -69,6 +91,9 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
 /// `GeneralizedRigidBody`; fields show the skew matrix), mu (structure constants).
 /// Casimirs (`invariants`): ‖M‖^2 (so3); ‖Gamma‖^2, M . Gamma (se3); tr((M^T M)^k)/2,
 /// k = 1..n//2 (so(n)); none for structure constants; or the `casimirs` given.
+/// `side` is the invariance the system is reduced from (000 §4.1, Theorems 4.3-4.4): "left"
+/// (body frame, as above) or "right" (spatial frame: the sign of the bracket flips; a right
+/// run from mu0 is the negated left run of H(-mu) from -mu0, the mirror g -> g^{-1}).
 /// Methods: rkmk4 (default; Runge–Kutta–Munthe-Kaas, order 4, explicit), midpoint (the Lie
 /// midpoint, symmetric, order 2), midpoint4 (its Suzuki composition, order 4), rk4 (baseline,
 /// keeps no Casimir). All but rk4 advance by the coadjoint action, so every Casimir is kept to
@@ -84,6 +109,7 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
 ///         `Canonical`); must be None for a matrix hamiltonian.
 ///     casimirs: None (the algebra's), or a sequence of callables mu -> float to monitor as
 ///         `invariants` in their place.
+///     side: "left" (default) or "right".
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError, ShapeError, NonFiniteError.
 #[pyclass(name = "LiePoisson", module = "lieflow", extends = PySystem, frozen)]
@@ -93,15 +119,17 @@ pub struct PyLiePoisson;
 #[pymethods]
 impl PyLiePoisson {
     #[new]
-    #[pyo3(signature = (algebra, hamiltonian, gradient=None, casimirs=None))]
+    #[pyo3(signature = (algebra, hamiltonian, gradient=None, casimirs=None, side=None))]
     fn new(
         algebra: Any<'_>,
         hamiltonian: Any<'_>,
         gradient: Option<Any<'_>>,
         casimirs: Option<Any<'_>>,
+        side: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = hamiltonian.py();
         let alg = self::algebra(&algebra)?;
+        let side_of = self::side(side.as_ref())?;
         let ham = if hamiltonian.is_callable() {
             let h = Callee::new("hamiltonian", &hamiltonian)?;
             let g = optional(gradient.as_ref())
@@ -164,10 +192,23 @@ impl PyLiePoisson {
                 Some(fs)
             }
         };
-        let sys = CoreLiePoisson::new(alg, ham, cas).py()?;
-        let args = (algebra, hamiltonian, gradient, casimirs).into_pyobject(py)?;
-        let names = &["algebra", "hamiltonian", "gradient", "casimirs"];
+        let sys = CoreLiePoisson::new(alg, ham, cas).py()?.with_side(side_of);
+        let side = match side_of {
+            Side::Left => "left",
+            Side::Right => "right",
+        };
+        let args = (algebra, hamiltonian, gradient, casimirs, side).into_pyobject(py)?;
+        let names = &["algebra", "hamiltonian", "gradient", "casimirs", "side"];
         Ok(PySystem::subclass(sys, args, names))
+    }
+
+    /// The invariance the system is reduced from: "left" or "right".
+    #[getter]
+    fn side(slf: &Bound<'_, Self>) -> PyResult<&'static str> {
+        Ok(match slf.core::<CoreLiePoisson>()?.side() {
+            Side::Left => "left",
+            Side::Right => "right",
+        })
     }
 
     /// dim g (the length d of a state).
