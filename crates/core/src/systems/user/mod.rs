@@ -76,6 +76,7 @@
 //! where long runs or non-smooth scales matter.
 
 mod canonical;
+mod euler_poincare;
 mod lie_poisson;
 mod separable;
 
@@ -88,6 +89,9 @@ use crate::numerics::fd::{self, Scheme};
 
 pub use crate::lie::structure::Algebra;
 pub use canonical::UserCanonical;
+pub use euler_poincare::{
+    Action, EulerPoincare, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn, Legendre,
+};
 pub use lie_poisson::{LieHamiltonian, LiePoisson, LieScratch, Side};
 pub use separable::{KineticMass, UserSeparable};
 

@@ -1,0 +1,585 @@
+//! Mechanics from a reduced Lagrangian (000 §4): the Euler–Poincaré equations of ℓ(ξ) on a Lie
+//! algebra g, or of ℓ(ξ, a) with an advected parameter a ∈ V* (a symmetry-breaking parameter such
+//! as the heavy top's vertical Γ), left- or right-invariant, solved in their Hamiltonian form.
+//!
+//! **From ℓ to a Lie–Poisson system.** The Legendre transform μ = ∂ℓ/∂ξ (inverted by Newton's
+//! method where ℓ is not quadratic) gives the reduced energy H(μ, a) = ⟨μ, ξ⟩ − ℓ(ξ, a), with
+//! ∂H/∂μ = ξ and ∂H/∂a = −∂ℓ/∂a. Without a parameter, the left Euler–Poincaré equation
+//! d/dt ∂ℓ/∂ξ = ad*_ξ ∂ℓ/∂ξ is the Lie–Poisson equation μ̇ = ad*_{∂H/∂μ} μ on g*, and the right one
+//! (ξ = ġg⁻¹) has the opposite sign ([`Side`], derived by the mirror g ↦ g⁻¹ in the module docs of
+//! [`super`]). With a parameter a ∈ V* under a representation ρ of g on V, the equations are the
+//! Lie–Poisson equations on the dual of the semidirect product g ⋉ V, whose bracket is
+//! [(ξ, v), (η, w)] = ([ξ, η], ρ(ξ)w − ρ(η)v): for the state (μ, a) they read
+//!
+//! μ̇ = ad*_ξ μ + ∂ℓ/∂a ⋄ a,    ȧ = −ξ·a    (left, 000 (4.4)–(4.5)),
+//!
+//! with ξ·a = −ρ(ξ)ᵀa the action on V* and the diamond ⟨b ⋄ a, η⟩ = −⟨b, η·a⟩, i.e.
+//! (b ⋄ a)_i = ⟨ρ(e_i)b, a⟩ ([`EulerPoincare::diamond`]). The seed
+//! writes the parameter term as −a ⋄ ∂ℓ/∂a with the pairing the other way round; it is the same
+//! term. For the right side the mirror gives μ̇ = −ad*_ξ μ − ∂ℓ/∂a ⋄ a, ȧ = +ξ·a (a = g·a₀); the
+//! seed's right-hand version (000, after Theorem 4.11) keeps the parameter term's sign, which the
+//! mirror test contradicts: trust the test. The heavy top is the check: so(3) ⋉ ℝ³ with
+//! ρ(ξ) = ξ̂ is se(3), and ℓ(Ω, Γ) = ½⟨Ω, 𝕀Ω⟩ − mgl⟨Γ, χ⟩ gives Ṁ = M × Ω + mgl Γ × χ,
+//! Γ̇ = Γ × Ω (tested against [`crate::systems::HeavyTop`]).
+//!
+//! So an [`EulerPoincare`] system is a [`LiePoisson`] system (its methods, Casimirs, batches and
+//! errors) on g or g ⋉ V with the Hamiltonian of its Lagrangian, plus the Legendre transform both
+//! ways and the diamond map. A quadratic ℓ(ξ) = ½⟨ξ, 𝕀ξ⟩ is the native path H = ½⟨μ, 𝕀⁻¹μ⟩.
+
+use std::sync::Arc;
+
+use nalgebra::DMatrix;
+
+use super::lie_poisson::{LieHamiltonian, LiePoisson, Side};
+use super::{fd_gradient, finite_entries, finite_value, GradientFn, ScalarFn, FD_STEP};
+use crate::check;
+use crate::convergence::{self, Monitor, Rule, Verdict};
+use crate::error::{fmt_num, Error, Result};
+use crate::lie::so;
+use crate::lie::structure::{Algebra, Structure};
+
+/// ℓ(ξ, a) (a empty without a parameter).
+pub type LagrangianFn = Arc<dyn Fn(&[f64], &[f64]) -> Result<f64> + Send + Sync>;
+/// (∂ℓ/∂ξ, ∂ℓ/∂a) at (ξ, a) into the two outputs.
+pub type LagrangianGradientFn =
+    Arc<dyn Fn(&[f64], &[f64], &mut [f64], &mut [f64]) -> Result<()> + Send + Sync>;
+/// ∂²ℓ/∂ξ² at (ξ, a) into a d×d row-major output.
+pub type HessianFn = Arc<dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<()> + Send + Sync>;
+
+/// The reduced Lagrangian of an [`EulerPoincare`] system.
+#[derive(Clone)]
+pub enum Lagrangian {
+    /// ℓ(ξ) = ½⟨ξ, 𝕀ξ⟩ with 𝕀 symmetric positive definite (d×d, row-major): the native path.
+    Quadratic(Vec<f64>),
+    /// ℓ and its derivatives as functions; a derivative not given is taken by central
+    /// differences (of ℓ for the gradient, of the gradient for the Hessian).
+    Function {
+        /// ℓ(ξ, a).
+        value: LagrangianFn,
+        /// (∂ℓ/∂ξ, ∂ℓ/∂a), or `None`.
+        gradient: Option<LagrangianGradientFn>,
+        /// ∂²ℓ/∂ξ², or `None`.
+        hessian: Option<HessianFn>,
+    },
+}
+
+/// How g acts on the parameter space V (of dimension m).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    /// The defining representation of so(3) or so(n) on ℝⁿ: ρ(ξ)v = ξ̂v.
+    Vector,
+    /// The action on V* as d matrices A_i (m×m, row-major, one after the other): e_i·a = A_i a.
+    /// Then ρ(e_i) = −A_iᵀ (checked to be a representation: the Jacobi identity of g ⋉ V).
+    Matrices(Vec<f64>),
+}
+
+/// The stopping rule of the Legendre inversion: the Newton step relative to 1 + ‖ξ‖_∞, ended at
+/// once at 10⁻¹⁴ (round-off), then one more step.
+const LEGENDRE: Rule = Rule {
+    tol: convergence::TOL,
+    floor: 1e-14,
+    max_iter: 50,
+};
+
+/// The Legendre transform of ℓ both ways and the reduced energy (module docs).
+pub struct Legendre {
+    d: usize,
+    m: usize,
+    lagrangian: Lagrangian,
+}
+
+impl Legendre {
+    /// ℓ(ξ, a), checked finite.
+    pub fn lagrangian(&self, xi: &[f64], a: &[f64]) -> Result<f64> {
+        match &self.lagrangian {
+            Lagrangian::Quadratic(i) => Ok(0.5 * dot(xi, &mat_vec(i, xi))),
+            Lagrangian::Function { value, .. } => {
+                finite_value("the Lagrangian l(xi, a)", value(xi, a)?)
+            }
+        }
+    }
+
+    /// (∂ℓ/∂ξ, ∂ℓ/∂a) at (ξ, a), checked finite.
+    pub fn gradients(&self, xi: &[f64], a: &[f64], dxi: &mut [f64], da: &mut [f64]) -> Result<()> {
+        match &self.lagrangian {
+            Lagrangian::Quadratic(i) => {
+                dxi.copy_from_slice(&mat_vec(i, xi));
+                da.fill(0.0);
+            }
+            Lagrangian::Function {
+                gradient: Some(g), ..
+            } => g(xi, a, dxi, da)?,
+            Lagrangian::Function { gradient: None, .. } => {
+                let (d, m) = (self.d, self.m);
+                let x = [xi, a].concat();
+                let f = |y: &[f64]| self.lagrangian(&y[..d], &y[d..]);
+                let mut g = vec![0.0; d + m];
+                fd_gradient(&f, &x, &mut g)?;
+                dxi.copy_from_slice(&g[..d]);
+                da.copy_from_slice(&g[d..]);
+            }
+        }
+        finite_entries("the gradient of the Lagrangian", "dl/dxi", dxi)?;
+        finite_entries("the gradient of the Lagrangian", "dl/da", da)
+    }
+
+    /// ∂²ℓ/∂ξ² at (ξ, a) (d×d), checked finite.
+    fn hessian(&self, xi: &[f64], a: &[f64]) -> Result<DMatrix<f64>> {
+        let d = self.d;
+        let h = match &self.lagrangian {
+            Lagrangian::Quadratic(i) => DMatrix::from_row_slice(d, d, i),
+            Lagrangian::Function {
+                hessian: Some(h), ..
+            } => {
+                let mut out = vec![0.0; d * d];
+                h(xi, a, &mut out)?;
+                DMatrix::from_row_slice(d, d, &out)
+            }
+            Lagrangian::Function { hessian: None, .. } => {
+                // Central differences of ∂ℓ/∂ξ with one Richardson extrapolation, symmetrised.
+                let scale = xi.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+                let mut cols = DMatrix::zeros(d, d);
+                let mut da = vec![0.0; self.m];
+                let mut grad_at = |y: &[f64]| -> Result<Vec<f64>> {
+                    let mut g = vec![0.0; d];
+                    self.gradients(y, a, &mut g, &mut da)?;
+                    Ok(g)
+                };
+                for j in 0..d {
+                    let h = FD_STEP * xi[j].abs().max(scale).max(1.0);
+                    let mut diff = |h: f64| -> Result<Vec<f64>> {
+                        let mut y = xi.to_vec();
+                        y[j] = xi[j] + h;
+                        let up = grad_at(&y)?;
+                        y[j] = xi[j] - h;
+                        let down = grad_at(&y)?;
+                        Ok(up
+                            .iter()
+                            .zip(&down)
+                            .map(|(u, v)| (u - v) / (2.0 * h))
+                            .collect())
+                    };
+                    let (d1, d2) = (diff(h)?, diff(0.5 * h)?);
+                    for i in 0..d {
+                        cols[(i, j)] = (4.0 * d2[i] - d1[i]) / 3.0;
+                    }
+                }
+                (&cols + cols.transpose()) * 0.5
+            }
+        };
+        finite_entries(
+            "the Hessian of the Lagrangian",
+            "d2l/dxi2",
+            h.transpose().as_slice(),
+        )?;
+        Ok(h)
+    }
+
+    /// μ = ∂ℓ/∂ξ(ξ, a).
+    pub fn momentum(&self, xi: &[f64], a: &[f64], mu: &mut [f64]) -> Result<()> {
+        let mut da = vec![0.0; self.m];
+        self.gradients(xi, a, mu, &mut da)
+    }
+
+    /// The velocity ξ with ∂ℓ/∂ξ(ξ, a) = μ: 𝕀⁻¹μ for a quadratic ℓ, else Newton's method on the
+    /// Hessian from the linear guess ∂²ℓ/∂ξ²(0, a)⁻¹ μ, to round-off (one step after the rule
+    /// [`LEGENDRE`] is met).
+    ///
+    /// Errors: a singular ∂²ℓ/∂ξ² on the way ([`Error::InvalidArgument`] naming ξ and μ), no
+    /// convergence ([`Error::NotConverged`]), the functions' errors.
+    pub fn velocity(&self, mu: &[f64], a: &[f64], xi: &mut [f64]) -> Result<()> {
+        let d = self.d;
+        let singular = |at: &[f64]| {
+            Error::invalid(
+                "state",
+                format!(
+                    "the Legendre map dl/dxi is singular at xi = {} (the Hessian d2l/dxi2 has no \
+                     inverse there), so no velocity has the momentum mu = {}",
+                    fmt_vec(at),
+                    fmt_vec(mu)
+                ),
+            )
+        };
+        let solve = |h: DMatrix<f64>, r: &[f64], at: &[f64]| -> Result<Vec<f64>> {
+            let scale = h.amax();
+            let lu = h.lu();
+            let x = lu
+                .solve(&nalgebra::DVector::from_column_slice(r))
+                .filter(|x| x.iter().all(|v| v.is_finite()))
+                .ok_or_else(|| singular(at))?;
+            // A pivot at round-off of the scale: numerically singular.
+            let min_pivot = (0..d)
+                .map(|k| lu.u()[(k, k)].abs())
+                .fold(f64::INFINITY, f64::min);
+            if min_pivot <= 1e-14 * scale || scale == 0.0 {
+                return Err(singular(at));
+            }
+            Ok(x.as_slice().to_vec())
+        };
+        if let Lagrangian::Quadratic(_) = self.lagrangian {
+            let h = self.hessian(xi, a)?;
+            xi.copy_from_slice(&solve(h, mu, &vec![0.0; d])?);
+            return Ok(());
+        }
+        let zero = vec![0.0; d];
+        xi.copy_from_slice(&solve(self.hessian(&zero, a)?, mu, &zero)?);
+        let mut monitor = Monitor::new(LEGENDRE);
+        let mut polish = false;
+        let mut g = vec![0.0; d];
+        let mut da = vec![0.0; self.m];
+        loop {
+            self.gradients(xi, a, &mut g, &mut da)?;
+            let r: Vec<f64> = mu.iter().zip(&g).map(|(m, g)| m - g).collect();
+            let step = solve(self.hessian(xi, a)?, &r, xi)?;
+            for (x, s) in xi.iter_mut().zip(&step) {
+                *x += s;
+            }
+            if polish {
+                return Ok(());
+            }
+            let size = step.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+            let scale = 1.0 + xi.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            match monitor.check(size, scale) {
+                Verdict::Continue => {}
+                Verdict::Converged => polish = true,
+                Verdict::Failed(f) => {
+                    return Err(Error::NotConverged {
+                        what: format!(
+                            "the Legendre inversion dl/dxi(xi) = mu at mu = {}",
+                            fmt_vec(mu)
+                        ),
+                        iterations: f.iterations,
+                        residual: f.residual,
+                        tol: LEGENDRE.tol,
+                    })
+                }
+            }
+        }
+    }
+
+    /// H(μ, a) = ⟨μ, ξ⟩ − ℓ(ξ, a) at the velocity of μ.
+    pub fn hamiltonian(&self, mu: &[f64], a: &[f64]) -> Result<f64> {
+        let mut xi = vec![0.0; self.d];
+        self.velocity(mu, a, &mut xi)?;
+        Ok(dot(mu, &xi) - self.lagrangian(&xi, a)?)
+    }
+
+    /// (∂H/∂μ, ∂H/∂a) = (ξ, −∂ℓ/∂a) into `out` (d + m).
+    pub fn hamiltonian_gradient(&self, mu: &[f64], a: &[f64], out: &mut [f64]) -> Result<()> {
+        let (d, m) = (self.d, self.m);
+        let (xi, rest) = out.split_at_mut(d);
+        self.velocity(mu, a, xi)?;
+        let mut g = vec![0.0; d];
+        self.gradients(xi, a, &mut g, &mut rest[..m])?;
+        rest.iter_mut().for_each(|v| *v = -*v);
+        Ok(())
+    }
+}
+
+/// A system of a reduced Lagrangian (module docs): its Lie–Poisson form and its Legendre map.
+#[derive(Clone)]
+pub struct EulerPoincare {
+    system: LiePoisson,
+    legendre: Arc<Legendre>,
+    /// The representation ρ(e_i) of g on V (m×m each, row-major), for the diamond map.
+    rho: Arc<Vec<f64>>,
+}
+
+impl EulerPoincare {
+    /// The system of `lagrangian` on `algebra` reduced from the side `side`, with a parameter
+    /// of dimension m acted on by `action` (None: no parameter). The state is μ (d), then a (m).
+    ///
+    /// Errors: those of the algebra ([`LiePoisson::new`]); an inertia of the wrong size,
+    /// non-finite, not symmetric or not positive definite; an action of the wrong size, or
+    /// `Action::Vector` on an algebra that is not so(3) or so(n); matrices that are not a
+    /// representation (the Jacobi identity of g ⋉ V fails).
+    pub fn new(
+        algebra: Algebra,
+        lagrangian: Lagrangian,
+        side: Side,
+        action: Option<(Action, usize)>,
+    ) -> Result<Self> {
+        let g = Structure::new(algebra.clone())?;
+        let d = g.dim;
+        if let Lagrangian::Quadratic(i) = &lagrangian {
+            check_inertia(i, d)?;
+            if action.is_some() {
+                return Err(Error::invalid(
+                    "inertia",
+                    "a quadratic Lagrangian l = <xi, I xi>/2 has no parameter; pass the \
+                     Lagrangian l(xi, a) as a function to use an action",
+                ));
+            }
+        }
+        let (semidirect, rho, m) = match &action {
+            None => (algebra, Vec::new(), 0),
+            Some((action, m)) => {
+                let rho = representation(&algebra, d, action, *m)?;
+                let total = if matches!((&algebra, action), (Algebra::So3, Action::Vector)) {
+                    // so(3) ⋉ ℝ³ with ρ(ξ) = ξ̂ is se(3) (module docs): the built-in group.
+                    Algebra::Se3
+                } else {
+                    Algebra::Constants(semidirect_constants(&g.dense(), d, &rho, *m))
+                };
+                (total, rho, *m)
+            }
+        };
+        let legendre = Arc::new(Legendre {
+            d,
+            m,
+            lagrangian: lagrangian.clone(),
+        });
+        let hamiltonian = match &lagrangian {
+            Lagrangian::Quadratic(i) => LieHamiltonian::Quadratic(inverse(i, d)?),
+            Lagrangian::Function { .. } => {
+                let (lv, lg) = (legendre.clone(), legendre.clone());
+                let value: ScalarFn = Arc::new(move |z: &[f64]| lv.hamiltonian(&z[..d], &z[d..]));
+                let gradient: GradientFn = Arc::new(move |z: &[f64], out: &mut [f64]| {
+                    lg.hamiltonian_gradient(&z[..d], &z[d..], out)
+                });
+                LieHamiltonian::Function {
+                    value,
+                    gradient: Some(gradient),
+                }
+            }
+        };
+        let system = LiePoisson::new(semidirect, hamiltonian, None)
+            .map_err(|e| match e {
+                Error::InvalidArgument { message, .. } if action.is_some() => Error::invalid(
+                    "action",
+                    format!("the action is not a representation of the algebra: {message}"),
+                ),
+                other => other,
+            })?
+            .with_side(side);
+        Ok(EulerPoincare {
+            system,
+            legendre,
+            rho: Arc::new(rho),
+        })
+    }
+
+    /// The Lie–Poisson form (the system to integrate).
+    pub fn system(&self) -> &LiePoisson {
+        &self.system
+    }
+
+    /// The Legendre transform of the Lagrangian.
+    pub fn legendre(&self) -> &Legendre {
+        &self.legendre
+    }
+
+    /// (dim g, dim V).
+    pub fn dims(&self) -> (usize, usize) {
+        (self.legendre.d, self.legendre.m)
+    }
+
+    /// The diamond b ⋄ a ∈ g* of b ∈ V (the derivative ∂ℓ/∂a) and a ∈ V*, defined by
+    /// ⟨b ⋄ a, η⟩ = −⟨b, η·a⟩ with η·a = −ρ(η)ᵀa: (b ⋄ a)_i = ⟨b, ρ(e_i)ᵀ a⟩ = ⟨ρ(e_i) b, a⟩.
+    pub fn diamond(&self, b: &[f64], a: &[f64], out: &mut [f64]) {
+        let m = self.legendre.m;
+        for (i, o) in out.iter_mut().enumerate() {
+            let r = &self.rho[i * m * m..(i + 1) * m * m];
+            *o = (0..m)
+                .map(|p| a[p] * (0..m).map(|q| r[p * m + q] * b[q]).sum::<f64>())
+                .sum();
+        }
+    }
+}
+
+/// ρ(e_i) (m×m each) of `action` on the algebra.
+fn representation(algebra: &Algebra, d: usize, action: &Action, m: usize) -> Result<Vec<f64>> {
+    match action {
+        Action::Vector => {
+            let n = match algebra {
+                Algebra::So3 => 3,
+                Algebra::So(n) => *n,
+                _ => {
+                    return Err(Error::invalid(
+                        "action",
+                        "the \"vector\" action is the defining representation of so(3) and \
+                         so(n) on R^n; give the action of another algebra as a callable",
+                    ))
+                }
+            };
+            if m != n {
+                return Err(Error::shape(
+                    "parameter",
+                    format!("({n},) (the vector action of so({n}))"),
+                    format!("({m},)"),
+                ));
+            }
+            let mut rho = Vec::with_capacity(d * n * n);
+            for i in 0..d {
+                let mut e = vec![0.0; d];
+                e[i] = 1.0;
+                // ρ(e_i) = ê_i, row-major.
+                match algebra {
+                    Algebra::So3 => {
+                        let x = crate::lie::so3::hat(&nalgebra::Vector3::new(e[0], e[1], e[2]));
+                        rho.extend((0..9).map(|k| x[(k / 3, k % 3)]));
+                    }
+                    _ => {
+                        let x = so::hat_n_unchecked(n, &e);
+                        rho.extend((0..n * n).map(|k| x[(k / n, k % n)]));
+                    }
+                }
+            }
+            Ok(rho)
+        }
+        Action::Matrices(a) => {
+            check::finite_slice("action", a)?;
+            if a.len() != d * m * m {
+                return Err(Error::shape(
+                    "action",
+                    format!("({d}, {m}, {m}) (one matrix per basis element)"),
+                    format!("{} values", a.len()),
+                ));
+            }
+            // ρ(e_i) = −A_iᵀ.
+            let mut rho = vec![0.0; d * m * m];
+            for i in 0..d {
+                for p in 0..m {
+                    for q in 0..m {
+                        rho[i * m * m + p * m + q] = -a[i * m * m + q * m + p];
+                    }
+                }
+            }
+            Ok(rho)
+        }
+    }
+}
+
+/// The structure constants of g ⋉ V (dimension d + m) from those of g (`c`, d³) and ρ:
+/// [e_i, e_j] = C_ij^k e_k, [e_i, f_q] = Σ_p ρ(e_i)_{pq} f_p = −[f_q, e_i], [f, f] = 0.
+fn semidirect_constants(c: &[f64], d: usize, rho: &[f64], m: usize) -> Vec<f64> {
+    let n = d + m;
+    let mut out = vec![0.0; n * n * n];
+    for i in 0..d {
+        for j in 0..d {
+            for k in 0..d {
+                out[(i * n + j) * n + k] = c[(i * d + j) * d + k];
+            }
+        }
+        for q in 0..m {
+            for p in 0..m {
+                let v = rho[i * m * m + p * m + q];
+                out[(i * n + d + q) * n + d + p] = v;
+                out[((d + q) * n + i) * n + d + p] = -v;
+            }
+        }
+    }
+    out
+}
+
+/// Checks an inertia operator 𝕀 (d×d): finite, symmetric, positive definite.
+fn check_inertia(i: &[f64], d: usize) -> Result<()> {
+    if i.len() != d * d {
+        return Err(Error::shape(
+            "inertia",
+            format!("a symmetric positive definite ({d}, {d}) matrix"),
+            format!("{} values", i.len()),
+        ));
+    }
+    check::finite_slice("inertia", i)?;
+    let m = DMatrix::from_row_slice(d, d, i);
+    let asym = (&m - m.transpose()).amax();
+    if asym > 1e-12 * m.amax() {
+        return Err(Error::invalid(
+            "inertia",
+            format!("the inertia must be symmetric: max |I - I^T| = {asym:.3e}"),
+        ));
+    }
+    if m.cholesky().is_none() {
+        return Err(Error::invalid(
+            "inertia",
+            "the inertia must be positive definite (the kinetic energy <xi, I xi>/2 > 0)",
+        ));
+    }
+    Ok(())
+}
+
+/// 𝕀⁻¹ (row-major) of a checked inertia.
+fn inverse(i: &[f64], d: usize) -> Result<Vec<f64>> {
+    let m = DMatrix::from_row_slice(d, d, i);
+    let inv = m
+        .cholesky()
+        .map(|c| c.inverse())
+        .ok_or_else(|| Error::invalid("inertia", "the inertia must be positive definite"))?;
+    let inv = (&inv + inv.transpose()) * 0.5;
+    Ok(inv.transpose().as_slice().to_vec())
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn mat_vec(a: &[f64], x: &[f64]) -> Vec<f64> {
+    let d = x.len();
+    (0..d)
+        .map(|i| (0..d).map(|j| a[i * d + j] * x[j]).sum())
+        .collect()
+}
+
+fn fmt_vec(v: &[f64]) -> String {
+    let items: Vec<String> = v.iter().map(|x| fmt_num(*x)).collect();
+    format!("[{}]", items.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn so3_with_the_vector_action_is_se3() {
+        let so3 = Structure::new(Algebra::So3).unwrap();
+        let rho = representation(&Algebra::So3, 3, &Action::Vector, 3).unwrap();
+        let c = semidirect_constants(&so3.dense(), 3, &rho, 3);
+        assert_eq!(c, Structure::new(Algebra::Se3).unwrap().dense());
+        // The same from the action on V* as matrices: e_i·a = ê_i a (ρ = −Aᵀ = ê_i).
+        let a: Vec<f64> = (0..3)
+            .flat_map(|i| rho[i * 9..(i + 1) * 9].to_vec())
+            .collect();
+        assert_eq!(
+            representation(&Algebra::So3, 3, &Action::Matrices(a), 3).unwrap(),
+            {
+                let mut r = rho.clone();
+                for i in 0..3 {
+                    for p in 0..3 {
+                        for q in 0..3 {
+                            r[i * 9 + p * 3 + q] = -rho[i * 9 + q * 3 + p];
+                        }
+                    }
+                }
+                r
+            }
+        );
+    }
+
+    #[test]
+    fn the_vector_action_of_so_n_is_a_representation() {
+        // The Jacobi identity of so(n) ⋉ ℝⁿ (checked by Structure::new) holds only if ρ is one.
+        for n in [2, 3, 4, 5] {
+            let d = n * (n - 1) / 2;
+            let g = Structure::new(Algebra::So(n)).unwrap();
+            let rho = representation(&Algebra::So(n), d, &Action::Vector, n).unwrap();
+            let c = semidirect_constants(&g.dense(), d, &rho, n);
+            Structure::new(Algebra::Constants(c)).unwrap();
+        }
+        // A non-representation is refused: ρ(e_i) = identity for every i.
+        let mut a = vec![0.0; 3 * 4];
+        for i in 0..3 {
+            a[i * 4] = 1.0;
+            a[i * 4 + 3] = 1.0;
+        }
+        let l = Lagrangian::Function {
+            value: Arc::new(|x: &[f64], _: &[f64]| Ok(0.5 * dot(x, x))),
+            gradient: None,
+            hessian: None,
+        };
+        let e = EulerPoincare::new(Algebra::So3, l, Side::Left, Some((Action::Matrices(a), 2)))
+            .err()
+            .unwrap();
+        assert!(e.to_string().contains("not a representation"), "{e}");
+    }
+}
