@@ -53,6 +53,7 @@ from ._lieflow import (
 from ._lieflow import (
     Canonical,
     ChargedParticle,
+    EulerPoincare,
     Forced,
     GeneralizedRigidBody,
     HeavyTop,
@@ -87,6 +88,7 @@ __all__ = [
     "ChargedParticle",
     "ConvergenceError",
     "DegenerateStratumError",
+    "EulerPoincare",
     "FileFormatError",
     "Forced",
     "GeneralizedRigidBody",

@@ -446,6 +446,39 @@ class Forced(System):
     def system(self) -> System: ...
 
 @final
+class EulerPoincare(System):
+    """Mechanics from a reduced Lagrangian l(xi) or l(xi, a) (000 §4) in its Lie–Poisson form:
+    state mu = dl/dxi (d,), then a (m,) with an action; left (body) or right (spatial); the
+    methods of LiePoisson."""
+
+    def __new__(
+        cls, algebra: str | tuple[str, int] | ArrayLike,
+        lagrangian: Callable[..., float] | None = None,
+        inertia: ArrayLike | None = None,
+        gradient: Callable[..., Any] | None = None,
+        hessian: Callable[..., ArrayLike] | None = None,
+        side: Literal["left", "right"] | None = None,
+        action: Literal["vector"] | Callable[[_F64, _F64], ArrayLike] | None = None,
+        parameter_dim: int | None = None,
+    ) -> Self:
+        """lagrangian: l(xi) or l(xi, a); inertia: I for l = <xi, I xi>/2 (native); gradient:
+        xi -> dl/dxi, or (xi, a) -> (dl/dxi, dl/da); hessian: (xi[, a]) -> (d, d); action:
+        "vector" or (xi, a) -> xi.a with parameter_dim."""
+    @property
+    def dim(self) -> int: ...
+    @property
+    def parameter_dim(self) -> int: ...
+    @property
+    def side(self) -> Literal["left", "right"]: ...
+    @property
+    def is_quadratic(self) -> bool: ...
+    def state(self, xi: ArrayLike, a: ArrayLike | None = None) -> _F64:
+        """(mu[, a]) with mu = dl/dxi(xi, a)."""
+    def velocity(self, state: ArrayLike) -> _F64:
+        """xi of a state (the inverse Legendre transform)."""
+    def diamond(self, b: ArrayLike, a: ArrayLike) -> _F64:
+        """b <> a (d,): <b <> a, eta> = -<b, eta.a>."""
+
 class LiePoisson(System):
     """A Lie–Poisson system d mu/dt = ad*_{dH/dmu} mu on g* (so3, se3, ("so", n) or structure
     constants (d, d, d)), or -ad* with side="right"; rkmk4 (default), midpoint, midpoint4 (keep

@@ -98,6 +98,7 @@ FORMAT = 2
 #: ``Forced`` force function) are never data and are not listed.
 ALLOWED_CALLS = frozenset({
     "lieflow:ChargedParticle",
+    "lieflow:EulerPoincare",
     "lieflow:Forced",
     "lieflow:GeneralizedRigidBody",
     "lieflow:HeavyTop",

@@ -295,6 +295,8 @@ def _stored_objects(lf_module):
             ("forced-dissipation", lf.Forced(lf.RigidBody([1.0, 2.0, 3.0]), dissipation=0.5)),
             ("lie-poisson-so4", lf.LiePoisson(("so", 4), np.eye(6))),
             ("lie-poisson-right", lf.LiePoisson("se3", np.eye(6), side="right")),
+            ("euler-poincare", lf.EulerPoincare(("so", 4), inertia=np.diag(np.arange(1.0, 7.0)),
+                                                side="right")),
             ("charged", lf.TangentTop(lf.surfaces.Torus(2.0, 0.7), 1.0, 0.5)
              .magnetic_analogue(0.3)),
             ("int32-array", lf.RigidBody(np.array([1, 2, 3], dtype=np.int32)))]

@@ -331,15 +331,26 @@ def user_casimir(mu):
 KIRCHHOFF = np.diag([1.0, 0.7, 0.4, 2.0, 1.5, 1.2])
 KIRCHHOFF[0, 4] = KIRCHHOFF[4, 0] = 0.1
 
+def user_ep_l(w, g):
+    return 0.5 * float(w @ (A3 * w)) - 0.7 * float(g[2])
+
+
+def user_ep_dl(w, g):
+    return A3 * w, np.array([0.0, 0.0, -0.7])
+
+
 RECEIVERS.update({
+    "uep": lambda lf: lf.EulerPoincare("so3", user_ep_l, gradient=user_ep_dl, action="vector"),
     "ucan": lambda lf: lf.Canonical(user_h, user_grad, 2),
     "usep": lambda lf: lf.Separable([1.0, 2.0], user_u, user_du),
     "ulp": lambda lf: lf.LiePoisson("so3", user_lp_h, user_lp_grad, [user_casimir]),
     "ulpq": lambda lf: lf.LiePoisson("se3", KIRCHHOFF),
 })
-CONSTRUCTORS.update({"Canonical": "ucan", "Separable": "usep", "LiePoisson": "ulp"})
+CONSTRUCTORS.update({"Canonical": "ucan", "Separable": "usep", "LiePoisson": "ulp",
+                     "EulerPoincare": "uep"})
 USER_STATES = {"ucan": np.array([0.3, -0.2, 0.1, 0.4]), "usep": np.array([0.3, -0.2, 0.1, 0.4]),
-               "ulp": M3, "ulpq": np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8])}
+               "ulp": M3, "ulpq": np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8]),
+               "uep": np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8])}
 
 
 def user_specs(add):
@@ -368,6 +379,15 @@ def user_specs(add):
         add(f"integrate[{key}]", "integrate", A("system", lazy_recv(key), "obj"),
             A("state0", st, "vec"), A("dt", 0.01, "float", kw=True),
             A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True))
+    add("EulerPoincare", "EulerPoincare", A("algebra", "so3", "str"),
+        A("lagrangian", user_ep_l, "obj", opt=True),
+        A("gradient", user_ep_dl, "obj", kw=True, opt=True),
+        A("action", "vector", "str", kw=True, opt=True))
+    add("EulerPoincare[inertia]", "EulerPoincare", A("algebra", "so3", "str"),
+        A("inertia", np.diag(A3), "mat", kw=True))
+    add("uep.state", "@uep.state", A("xi", M3, "vec"), A("a", np.array([0.0, 0.6, 0.8]), "vec"))
+    add("uep.velocity", "@uep.velocity", A("state", USER_STATES["uep"], "vec"))
+    add("uep.diamond", "@uep.diamond", A("b", M3, "vec"), A("a", np.array([0.0, 0.6, 0.8]), "vec"))
     add("ulpq.structure_constants", "@ulpq.structure_constants")
     add("ulp.structure_constants", "@ulp.structure_constants")
 

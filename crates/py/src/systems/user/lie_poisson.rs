@@ -20,7 +20,7 @@ use crate::system::{PySystem, Thin};
 use super::{optional, Any, Callee};
 
 /// The `algebra` argument: "so3", "se3", ("so", n) or structure constants (d, d, d).
-fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
+pub(super) fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
     let names = "\"so3\", \"se3\", (\"so\", n) or structure constants (d, d, d)";
     if let Ok(s) = a.cast::<PyString>() {
         return match s.extract::<String>()?.as_str() {
@@ -60,7 +60,7 @@ fn algebra(a: &Any<'_>) -> PyResult<Algebra> {
 }
 
 /// The `side` argument: None or "left" (left-invariant), "right".
-fn side(s: Option<&Any<'_>>) -> PyResult<Side> {
+pub(super) fn side(s: Option<&Any<'_>>) -> PyResult<Side> {
     let Some(s) = optional(s) else {
         return Ok(Side::Left);
     };

@@ -17,6 +17,7 @@
 #![allow(non_snake_case)]
 
 pub(crate) mod canonical;
+pub(crate) mod euler_poincare;
 pub(crate) mod forced;
 pub(crate) mod lie_poisson;
 pub(crate) mod separable;
@@ -159,6 +160,42 @@ impl Callee {
             *o = *x;
         }
         Ok(())
+    }
+
+    /// Calls f with the arrays `args` and reads the pair (first, second) it returns (a tuple or
+    /// list of two arrays of the outputs' lengths), checked finite.
+    fn call_pair(
+        &self,
+        args: &[&[f64]],
+        first: &mut [f64],
+        second: &mut [f64],
+    ) -> lieflow::Result<()> {
+        Python::attach(|py| {
+            let called = PyTuple::new(py, args.iter().map(|x| PyArray1::from_slice(py, x)))
+                .and_then(|a| self.f.bind(py).call1(a))
+                .map_err(|e| self.raised(e))?;
+            let items: Vec<Any<'_>> = match called.len() {
+                Ok(2) if !called.is_instance_of::<numpy::PyUntypedArray>() => {
+                    vec![called.get_item(0), called.get_item(1)]
+                        .into_iter()
+                        .collect::<PyResult<_>>()
+                        .map_err(|e| self.raised(e))?
+                }
+                _ => {
+                    return Err(Error::shape(
+                        &*self.what,
+                        format!("a pair (({},), ({},))", first.len(), second.len()),
+                        called
+                            .get_type()
+                            .name()
+                            .map_or_else(|_| "?".to_string(), |n| n.to_string()),
+                    ))
+                }
+            };
+            let [a, b] = [&items[0], &items[1]];
+            self.read(Ok(a.clone()), &[first.len()], first)?;
+            self.read(Ok(b.clone()), &[second.len()], second)
+        })
     }
 
     fn scalar(&self, args: &[&[f64]]) -> lieflow::Result<f64> {

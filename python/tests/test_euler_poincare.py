@@ -1,0 +1,208 @@
+"""lf.EulerPoincare (issue 24, 000 §4): the built-in bodies from their Lagrangians (the free rigid
+body and the generalized rigid body from their inertia, the heavy top from l(Omega, Gamma) with
+the vector action), a quartic Lagrangian against scipy's DOP853 on its Euler–Poincaré equation,
+the Legendre transform inverted to round-off, the right system as the mirror of the left, a
+callable action against the built-in one, the diamond against its definition, and the errors."""
+
+import pickle
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import lieflow as lf
+
+I = np.array([1.0, 2.0, 3.0])
+M0 = np.array([1.0, 0.5, -0.3])
+MGL, CHI = 0.7, np.array([0.0, 0.6, 0.8])
+C = 0.4
+K = np.array([0.3, -0.2, 0.5])
+
+
+# --- module-level callables (they pickle by reference) ---
+
+def top_l(w, g):
+    return 0.5 * float(w @ (I * w)) - MGL * float(g @ CHI)
+
+
+def top_dl(w, g):
+    return I * w, -MGL * CHI
+
+
+def quartic(w, odd=0.0):
+    n2 = float(w @ w)
+    return 0.5 * float(w @ (I * w)) + 0.25 * C * n2 * n2 + odd * n2 * float(K @ w) / 3
+
+
+def quartic_grad(w, odd=0.0):
+    n2 = float(w @ w)
+    return I * w + C * n2 * w + odd * (2 * w * float(K @ w) + n2 * K) / 3
+
+
+def quartic_hess(w):
+    return np.diag(I) + C * (float(w @ w) * np.eye(3) + 2 * np.outer(w, w))
+
+
+def odd_l(w):
+    return quartic(w, 0.5)
+
+
+def odd_grad(w):
+    return quartic_grad(w, 0.5)
+
+
+def odd_l_mirror(w):
+    return quartic(w, -0.5)
+
+
+def odd_grad_mirror(w):
+    return quartic_grad(w, -0.5)
+
+
+def cross_action(xi, a):
+    return np.cross(xi, a)
+
+
+def test_the_free_rigid_body_comes_out_of_its_inertia():
+    ep = lf.EulerPoincare("so3", inertia=np.diag(I))
+    assert (ep.dim, ep.parameter_dim, ep.side) == (3, 0, "left")
+    assert ep.is_quadratic
+    exact = lf.integrate(lf.RigidBody(I), M0, dt=0.01, steps=1000, method="exact").states
+    run = lf.integrate(ep, M0, dt=0.01, steps=1000).states        # rkmk4
+    np.testing.assert_allclose(run, exact, atol=1e-8)
+    # Legendre both ways: mu = I xi.
+    np.testing.assert_array_equal(ep.state(M0 / I), M0)
+    np.testing.assert_allclose(ep.velocity(M0), M0 / I, rtol=1e-15)
+    assert ep.energy(M0) == pytest.approx(0.5 * M0 @ (M0 / I), rel=1e-15)
+
+
+def test_the_generalized_rigid_body_comes_out_of_its_mass_matrix():
+    # l = <Omega, J Omega + Omega J>/2 with the pairing tr(A^T B)/2 of so(n): in the e_ij
+    # coordinates the inertia is diagonal with entries J_i + J_j (i < j).
+    j = np.array([1.0, 1.5, 2.5, 4.0])
+    n = len(j)
+    inertia = np.diag([j[a] + j[b] for a in range(n) for b in range(a + 1, n)])
+    ep = lf.EulerPoincare(("so", n), inertia=inertia)
+    body = lf.GeneralizedRigidBody(j)
+    m0 = np.array([0.3, -0.2, 0.5, 0.1, 0.4, -0.6])
+    a = lf.integrate(ep, m0, dt=0.01, steps=1000, method="rk4").states
+    b = lf.integrate(body, m0, dt=0.01, steps=1000, method="rk4").states
+    np.testing.assert_allclose(a, b, atol=1e-12)
+
+
+def test_the_heavy_top_comes_out_of_its_lagrangian():
+    top = lf.EulerPoincare("so3", top_l, gradient=top_dl, action="vector")
+    assert (top.dim, top.parameter_dim) == (3, 3)
+    g0 = np.array([0.3, -0.2, np.sqrt(0.87)])
+    z0 = top.state(M0 / I, g0)
+    np.testing.assert_allclose(z0, np.concatenate([M0, g0]), rtol=1e-15)
+    ht = lf.HeavyTop(I, MGL, chi=CHI)
+    a = lf.integrate(top, z0, dt=0.01, steps=1000, method="rk4").states
+    b = lf.integrate(ht, z0, dt=0.01, steps=1000, method="rk4").states
+    np.testing.assert_allclose(a, b, atol=1e-11)
+    assert top.energy(z0) == pytest.approx(ht.energy(z0), abs=1e-14)
+    # The diamond of dl/dGamma = -mgl chi with Gamma is the gravity torque mgl Gamma x chi,
+    # and <b <> a, eta> = -<b, eta.a> with eta.a = eta x a.
+    np.testing.assert_allclose(top.diamond(-MGL * CHI, g0), MGL * np.cross(g0, CHI), atol=1e-15)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        b, a, eta = rng.normal(size=(3, 3))
+        assert top.diamond(b, a) @ eta == pytest.approx(-b @ np.cross(eta, a), abs=1e-14)
+    # The Casimirs |Gamma|^2 and M.Gamma kept to round-off by the coadjoint methods.
+    tr = lf.integrate(top, z0, dt=0.01, steps=2000)
+    assert np.abs(tr.invariants() - tr.invariants()[0]).max() < 1e-13
+
+
+def test_a_callable_action_is_the_built_in_one():
+    builtin = lf.EulerPoincare("so3", top_l, gradient=top_dl, action="vector")
+    given = lf.EulerPoincare("so3", top_l, gradient=top_dl, action=cross_action, parameter_dim=3)
+    z0 = builtin.state(M0 / I, [0.3, -0.2, np.sqrt(0.87)])
+    a = lf.integrate(builtin, z0, dt=0.01, steps=300, method="rk4").states
+    b = lf.integrate(given, z0, dt=0.01, steps=300, method="rk4").states
+    np.testing.assert_allclose(a, b, atol=1e-13)
+
+
+def test_a_quartic_lagrangian_against_dop853():
+    ep = lf.EulerPoincare("so3", quartic, gradient=quartic_grad, hessian=quartic_hess)
+    w0 = np.array([0.8, -0.4, 0.3])
+    mu0 = ep.state(w0)
+    np.testing.assert_allclose(mu0, quartic_grad(w0), rtol=1e-15)
+    np.testing.assert_allclose(ep.velocity(mu0), w0, atol=4 * np.finfo(float).eps)
+
+    def rhs(_, w):
+        # (I + C(|w|^2 1 + 2 w w^T)) dw/dt = mu x w, mu = dl/dw: the EP equation in w.
+        return np.linalg.solve(quartic_hess(w), np.cross(quartic_grad(w), w))
+
+    ref = solve_ivp(rhs, (0, 10), w0, method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]
+    end = lf.integrate(ep, mu0, dt=5e-3, steps=2000, save_every=2000).states[-1]
+    np.testing.assert_allclose(end, quartic_grad(ref), atol=1e-9)
+    # Without the Hessian (central differences of the gradient) and without the gradient
+    # (central differences of l): the same run to the differences' accuracy.
+    exact = lf.integrate(ep, mu0, dt=0.01, steps=50).states
+    for fd in (lf.EulerPoincare("so3", quartic, gradient=quartic_grad),
+               lf.EulerPoincare("so3", quartic)):
+        np.testing.assert_allclose(ep.velocity(mu0), fd.velocity(mu0), atol=1e-9)
+        np.testing.assert_allclose(lf.integrate(fd, mu0, dt=0.01, steps=50).states, exact,
+                                   atol=1e-9)
+
+
+@pytest.mark.parametrize("method", ["rkmk4", "midpoint", "rk4"])
+def test_a_right_invariant_lagrangian_is_the_left_one_of_the_inverse_motion(method):
+    right = lf.EulerPoincare("so3", odd_l, gradient=odd_grad, side="right")
+    mirror = lf.EulerPoincare("so3", odd_l_mirror, gradient=odd_grad_mirror)
+    left = lf.EulerPoincare("so3", odd_l, gradient=odd_grad)
+    r = lf.integrate(right, M0, dt=0.01, steps=60, method=method).states
+    m = lf.integrate(mirror, -M0, dt=0.01, steps=60, method=method).states
+    np.testing.assert_allclose(r, -m, atol=1e-14)
+    assert np.abs(r[-1] - lf.integrate(left, M0, dt=0.01, steps=60, method=method)
+                  .states[-1]).max() > 1e-3
+    assert right.side == "right"
+
+
+def test_pickling_and_storing():
+    for ep, z0 in [(lf.EulerPoincare("so3", inertia=np.diag(I), side="right"), M0),
+                   (lf.EulerPoincare("so3", top_l, gradient=top_dl, action="vector"),
+                    np.concatenate([M0, [0.0, 0.0, 1.0]]))]:
+        copy = pickle.loads(pickle.dumps(ep))
+        assert repr(copy) == repr(ep)
+        np.testing.assert_array_equal(lf.integrate(copy, z0, dt=0.01, steps=20).states,
+                                      lf.integrate(ep, z0, dt=0.01, steps=20).states)
+
+
+def test_errors():
+    with pytest.raises(lf.ArgumentTypeError, match="needs the Lagrangian"):
+        lf.EulerPoincare("so3")
+    with pytest.raises(lf.InvalidArgumentError, match="not both"):
+        lf.EulerPoincare("so3", quartic, inertia=np.eye(3))
+    with pytest.raises(lf.InvalidArgumentError, match="positive definite"):
+        lf.EulerPoincare("so3", inertia=np.diag([1.0, -1.0, 1.0]))
+    with pytest.raises(lf.InvalidArgumentError, match="symmetric"):
+        lf.EulerPoincare("so3", inertia=[[1.0, 0.5, 0], [0, 1, 0], [0, 0, 1]])
+    with pytest.raises(lf.InvalidArgumentError, match="own derivatives"):
+        lf.EulerPoincare("so3", inertia=np.eye(3), gradient=quartic_grad)
+    with pytest.raises(lf.InvalidArgumentError, match="unknown action"):
+        lf.EulerPoincare("so3", top_l, action="matrix")
+    with pytest.raises(lf.InvalidArgumentError, match="parameter_dim"):
+        lf.EulerPoincare("so3", top_l, action=cross_action)
+    with pytest.raises(lf.InvalidArgumentError, match="vector"):
+        lf.EulerPoincare("se3", top_l, action="vector")
+    with pytest.raises(lf.InvalidArgumentError, match="left"):
+        lf.EulerPoincare("so3", inertia=np.eye(3), side="up")
+    ep = lf.EulerPoincare("so3", inertia=np.diag(I))
+    with pytest.raises(lf.InvalidArgumentError, match="no parameter"):
+        ep.state(M0, [1.0, 0.0, 0.0])
+    with pytest.raises(lf.InvalidArgumentError, match="no parameter"):
+        ep.diamond([1.0, 0, 0], [0, 1.0, 0])
+    with pytest.raises(lf.ShapeError):
+        ep.velocity([1.0, 2.0])
+    top = lf.EulerPoincare("so3", top_l, gradient=top_dl, action="vector")
+    with pytest.raises(lf.InvalidArgumentError, match="has a parameter"):
+        top.state(M0)
+    # A Legendre map singular where Newton starts (l = |xi|^4/4 at xi = 0): typed, named.
+    flat = lf.EulerPoincare("so3", lambda w: 0.25 * float(w @ w) ** 2)
+    with pytest.raises(lf.InvalidArgumentError, match=r"singular at xi = \[0, 0, 0\]"):
+        flat.velocity(M0)
+    # A gradient returning the wrong thing for a system with a parameter.
+    bad = lf.EulerPoincare("so3", top_l, gradient=lambda w, g: I * w, action="vector")
+    with pytest.raises(lf.ShapeError, match="pair"):
+        lf.integrate(bad, np.concatenate([M0, [0, 0, 1.0]]), dt=0.01, steps=2)
