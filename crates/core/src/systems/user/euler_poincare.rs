@@ -183,7 +183,7 @@ impl Legendre {
 
     /// The velocity ξ with ∂ℓ/∂ξ(ξ, a) = μ: 𝕀⁻¹μ for a quadratic ℓ, else Newton's method on the
     /// Hessian from the linear guess ∂²ℓ/∂ξ²(0, a)⁻¹ μ, to round-off (one step after the rule
-    /// [`LEGENDRE`] is met).
+    /// of the Legendre inversion is met: the step below 10⁻¹² of 1 + the largest velocity).
     ///
     /// Errors: a singular ∂²ℓ/∂ξ² on the way ([`Error::InvalidArgument`] naming ξ and μ), no
     /// convergence ([`Error::NotConverged`]), the functions' errors.
