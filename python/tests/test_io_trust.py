@@ -274,7 +274,8 @@ def _receivers():
 
 
 #: Receivers of the fuzz table built from Python callables: never data (saved pickled only).
-HOLD_CALLABLES = {"ucan", "usep", "ulp", "frc", "callable", "revolution", "graph", "metric"}
+HOLD_CALLABLES = {"ucan", "usep", "ulp", "uep", "frc", "callable", "revolution", "graph",
+                  "metric"}
 
 
 def _stored_objects(lf_module):
