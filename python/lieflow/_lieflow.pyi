@@ -25,7 +25,7 @@ __all__ = [
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
     "RelativisticTangentTop", "WeakFieldTop", "TangentTop", "ChargedParticle", "Canonical",
-    "Separable", "LiePoisson", "Forced", "PseudoRigidBody", "__version__",
+    "Separable", "LiePoisson", "EulerPoincare", "Forced", "PseudoRigidBody", "__version__",
 ]
 
 class LieflowError(ValueError): ...
@@ -479,6 +479,7 @@ class EulerPoincare(System):
     def diamond(self, b: ArrayLike, a: ArrayLike) -> _F64:
         """b <> a (d,): <b <> a, eta> = -<b, eta.a>."""
 
+@final
 class LiePoisson(System):
     """A Lie–Poisson system d mu/dt = ad*_{dH/dmu} mu on g* (so3, se3, ("so", n) or structure
     constants (d, d, d)), or -ad* with side="right"; rkmk4 (default), midpoint, midpoint4 (keep
