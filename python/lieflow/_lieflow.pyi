@@ -476,6 +476,8 @@ class EulerPoincare(System):
         """(mu[, a]) with mu = dl/dxi(xi, a)."""
     def velocity(self, state: ArrayLike) -> _F64:
         """xi of a state (the inverse Legendre transform)."""
+    def noether(self, states: ArrayLike, g: ArrayLike) -> _F64:
+        """Ad*_{g^-1} mu (left) or Ad*_g mu (right), (..., d), at group elements (..., n, n)."""
     def diamond(self, b: ArrayLike, a: ArrayLike) -> _F64:
         """b <> a (d,): <b <> a, eta> = -<b, eta.a>."""
 

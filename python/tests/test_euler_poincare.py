@@ -159,6 +159,35 @@ def test_a_right_invariant_lagrangian_is_the_left_one_of_the_inverse_motion(meth
     assert right.side == "right"
 
 
+def test_the_noether_momentum_is_conserved_along_the_motion():
+    # 000 Theorems 4.2-4.4: R M is constant along the free body's motion (left); the right
+    # Lagrangian's motion of the same body is (-M, R^T), with Ad*_{R^T}(-M) = -R M; the heavy
+    # top keeps only the vertical component (Theorem 4.11).
+    r0 = lf.lie.so3_exp([0.2, -0.35, 0.56])
+    tr = lf.integrate(lf.RigidBody(I), M0, dt=0.01, steps=2000, save_every=100, attitude=r0)
+    left = lf.EulerPoincare("so3", inertia=np.diag(I))
+    p = left.noether(tr.states, tr.attitude)
+    assert p.shape == (21, 3)
+    np.testing.assert_allclose(p, np.broadcast_to(r0 @ M0, p.shape), atol=1e-13)
+    right = lf.EulerPoincare("so3", inertia=np.diag(I), side="right")
+    q = right.noether(-tr.states, np.swapaxes(tr.attitude, -1, -2))
+    np.testing.assert_allclose(q, -p, atol=1e-15)
+    top = lf.EulerPoincare("so3", top_l, gradient=top_dl, action="vector")
+    z0 = np.concatenate([M0, r0[2]])          # Gamma = R^T e3
+    ht = lf.integrate(lf.HeavyTop(I, MGL, chi=CHI), z0, dt=0.01, steps=2000, save_every=100,
+                      attitude=r0)
+    p = top.noether(ht.states, ht.attitude)
+    np.testing.assert_allclose(p[:, 2], p[0, 2], atol=1e-13)
+    assert np.abs(p[:, 0] - p[0, 0]).max() > 1e-2
+    with pytest.raises(lf.NotInGroupError):
+        left.noether(M0, 2 * np.eye(3))
+    with pytest.raises(lf.ShapeError):
+        left.noether(M0, np.eye(4))
+    constants = lf.LiePoisson("so3", np.eye(3)).structure_constants()
+    with pytest.raises(lf.InvalidArgumentError, match="no matrix group"):
+        lf.EulerPoincare(constants, inertia=np.eye(3)).noether(M0, np.eye(3))
+
+
 def test_pickling_and_storing():
     for ep, z0 in [(lf.EulerPoincare("so3", inertia=np.diag(I), side="right"), M0),
                    (lf.EulerPoincare("so3", top_l, gradient=top_dl, action="vector"),

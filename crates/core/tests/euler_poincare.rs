@@ -272,3 +272,167 @@ fn a_singular_legendre_map_is_a_typed_error_naming_the_point() {
         assert!(e.to_string().contains(what), "{e}");
     }
 }
+
+/// A rotation about a unit axis by an angle (row-major).
+fn rotation(axis: [f64; 3], angle: f64) -> [f64; 9] {
+    let r = nalgebra::Rotation3::from_axis_angle(
+        &nalgebra::Unit::new_normalize(nalgebra::Vector3::from(axis)),
+        angle,
+    );
+    let m = r.matrix();
+    std::array::from_fn(|k| m[(k / 3, k % 3)])
+}
+
+#[test]
+fn the_noether_momentum_is_conserved_along_the_motion() {
+    // 000 Theorem 4.3 (4.2 for the rigid body): along a left-invariant motion (M(t), R(t)) the
+    // spatial momentum Ad*_{R⁻¹} M = R M is constant; with the right-invariant Lagrangian the
+    // same motion is (−M, Rᵀ) (the mirror) and Ad*_{Rᵀ}(−M) = −R M (Theorem 4.4).
+    let left = EulerPoincare::new(
+        Algebra::So3,
+        Lagrangian::Quadratic(diag(&I)),
+        Side::Left,
+        None,
+    )
+    .unwrap();
+    let right = EulerPoincare::new(
+        Algebra::So3,
+        Lagrangian::Quadratic(diag(&I)),
+        Side::Right,
+        None,
+    )
+    .unwrap();
+    let body = RigidBody::new(I).unwrap().with_attitude();
+    let r0 = rotation([0.3, -0.5, 0.8], 0.7);
+    let z0 = body.state_with_attitude(M0, r0);
+    let tr = integrate(&body, "splitting", &z0, 0.01, 2000, 100).unwrap();
+    let mut p0 = [0.0; 3];
+    left.noether(&M0, &r0, &mut p0).unwrap();
+    for k in 0..tr.len() {
+        let z = tr.state(k);
+        let (m, r) = (&z[..3], &z[3..12]);
+        let mut p = [0.0; 3];
+        left.noether(m, r, &mut p).unwrap();
+        assert!(dist(&p, &p0) < 1e-13, "sample {k}: {p:?} {p0:?}");
+        let rt: Vec<f64> = (0..9).map(|i| r[(i % 3) * 3 + i / 3]).collect();
+        let minus: Vec<f64> = m.iter().map(|x| -x).collect();
+        right.noether(&minus, &rt, &mut p).unwrap();
+        assert!(dist(&p, &p0.map(|x| -x)) < 1e-13, "sample {k}");
+    }
+    // The heavy top (Theorem 4.11): only the vertical component e₃·(R M) is conserved.
+    let (mgl, chi) = (0.7, [0.0, 0.6, 0.8]);
+    let ep = EulerPoincare::new(
+        Algebra::So3,
+        heavy_top_lagrangian(mgl, chi),
+        Side::Left,
+        Some((Action::Vector, 3)),
+    )
+    .unwrap();
+    let top = HeavyTop::new(I, mgl, chi).unwrap().with_attitude();
+    let tr = integrate(
+        &top,
+        "splitting",
+        &top.state_with_attitude(M0, r0),
+        0.01,
+        2000,
+        100,
+    )
+    .unwrap();
+    let (mut first, mut moved) = (None, 0.0f64);
+    for k in 0..tr.len() {
+        let z = tr.state(k);
+        let mut p = [0.0; 3];
+        ep.noether(&z[..6], &z[6..15], &mut p).unwrap();
+        let p0 = *first.get_or_insert(p);
+        assert!((p[2] - p0[2]).abs() < 1e-13, "sample {k}: {p:?} {p0:?}");
+        moved = moved.max((p[0] - p0[0]).abs());
+    }
+    assert!(
+        moved > 1e-2,
+        "the horizontal components are not conserved: {moved}"
+    );
+    // Bad group elements are refused.
+    let mut p = [0.0; 3];
+    assert!(left
+        .noether(&M0, &[1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 1.0], &mut p)
+        .is_err());
+    assert!(left.noether(&M0, &[1.0, 0.0, 0.0, 1.0], &mut p).is_err());
+}
+
+#[test]
+fn the_noether_momentum_of_so_n_and_se3_composes_as_the_coadjoint_action() {
+    // π(μ, g₁g₂) = Ad*_{g₁⁻¹} π(μ, g₂) (left): g₁ π g₁ᵀ on so(n); on se(3) the spatial
+    // momentum of a body at (R, t): (R M + t × R Γ, R Γ).
+    let n = 4;
+    let ep = EulerPoincare::new(
+        Algebra::So(n),
+        Lagrangian::Quadratic(diag(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0])),
+        Side::Left,
+        None,
+    )
+    .unwrap();
+    let q = |a: f64, b: f64| {
+        // A rotation of ℝ⁴ in the planes (0, 1) and (2, 3).
+        let mut g = [0.0; 16];
+        g[0] = a.cos();
+        g[1] = -a.sin();
+        g[4] = a.sin();
+        g[5] = a.cos();
+        g[10] = b.cos();
+        g[11] = -b.sin();
+        g[14] = b.sin();
+        g[15] = b.cos();
+        g
+    };
+    let (g1, g2) = (q(0.4, -0.9), q(1.1, 0.3));
+    let mut g12 = [0.0; 16];
+    for i in 0..4 {
+        for j in 0..4 {
+            g12[i * 4 + j] = (0..4).map(|k| g1[i * 4 + k] * g2[k * 4 + j]).sum();
+        }
+    }
+    let mu = [0.3, -0.2, 0.5, 0.1, 0.4, -0.6];
+    let (mut p12, mut p2, mut p1_of_p2) = ([0.0; 6], [0.0; 6], [0.0; 6]);
+    ep.noether(&mu, &g12, &mut p12).unwrap();
+    ep.noether(&mu, &g2, &mut p2).unwrap();
+    ep.noether(&p2, &g1, &mut p1_of_p2).unwrap();
+    assert!(dist(&p12, &p1_of_p2) < 1e-15, "{p12:?} {p1_of_p2:?}");
+    // The norm of the momentum (a Casimir of so(n)*: ½ tr(MᵀM)) is kept by the action.
+    let n2 = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>();
+    assert!((n2(&p12) - n2(&mu)).abs() < 1e-15);
+    // se(3): for g = (R, t), Ad*_{g⁻¹}(M, Γ) = (R M + t × R Γ, R Γ).
+    let ep = EulerPoincare::new(
+        Algebra::Se3,
+        Lagrangian::Quadratic(diag(&[1.0; 6])),
+        Side::Left,
+        None,
+    )
+    .unwrap();
+    let r = rotation([0.3, -0.5, 0.8], 0.7);
+    let t = [0.4, -1.2, 0.9];
+    let mut g = [0.0; 16];
+    for i in 0..3 {
+        for j in 0..3 {
+            g[i * 4 + j] = r[i * 3 + j];
+        }
+        g[i * 4 + 3] = t[i];
+    }
+    g[15] = 1.0;
+    let mu = [1.0, 0.5, -0.3, 0.2, -0.1, 0.4];
+    let mut p = [0.0; 6];
+    ep.noether(&mu, &g, &mut p).unwrap();
+    let rv = |v: &[f64]| -> [f64; 3] {
+        std::array::from_fn(|i| (0..3).map(|j| r[i * 3 + j] * v[j]).sum())
+    };
+    let (rm, rg) = (rv(&mu[..3]), rv(&mu[3..]));
+    let tg = cross(&t, &rg);
+    let want = [
+        rm[0] + tg[0],
+        rm[1] + tg[1],
+        rm[2] + tg[2],
+        rg[0],
+        rg[1],
+        rg[2],
+    ];
+    assert!(dist(&p, &want) < 1e-14, "{p:?} {want:?}");
+}

@@ -387,6 +387,8 @@ def user_specs(add):
         A("inertia", np.diag(A3), "mat", kw=True))
     add("uep.state", "@uep.state", A("xi", M3, "vec"), A("a", np.array([0.0, 0.6, 0.8]), "vec"))
     add("uep.velocity", "@uep.velocity", A("state", USER_STATES["uep"], "vec"))
+    add("uep.noether", "@uep.noether", A("states", USER_STATES["uep"], "vec"),
+        A("g", np.eye(3), "mat"))
     add("uep.diamond", "@uep.diamond", A("b", M3, "vec"), A("a", np.array([0.0, 0.6, 0.8]), "vec"))
     add("ulpq.structure_constants", "@ulpq.structure_constants")
     add("ulp.structure_constants", "@ulp.structure_constants")

@@ -16,6 +16,7 @@ use pyo3::types::PyString;
 
 use crate::convert::{read_all, shape_str, ArrayIn};
 use crate::errors::{argument_type_error, to_py, IntoPy};
+use crate::items::{map_items, Input};
 use crate::system::PySystem;
 
 use super::lie_poisson::{algebra, side};
@@ -261,6 +262,45 @@ impl PyEulerPoincare {
             .velocity(&z[..d], &z[d..], &mut xi)
             .py()?;
         Ok(PyArray1::from_vec(py, xi))
+    }
+
+    /// The Noether momentum of states (..., d[+m]) at group elements g (..., n, n) (the motion's
+    /// configuration, body to space; n = 3 for so3, n for ("so", n), 4 for se3 as homogeneous
+    /// matrices): Ad*_{g^-1} mu for a left-invariant Lagrangian (000 Theorem 4.3: the spatial
+    /// momentum R M of the rigid body), Ad*_g mu for a right-invariant one (Theorem 4.4);
+    /// conserved along a motion. With a parameter only the components that fix the reference
+    /// parameter are (Theorem 4.11: for the heavy top the vertical one, (R M)[2]); the whole
+    /// vector (..., d) is returned. Leading axes broadcast.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (structure constants: no group), NotInGroupError, ShapeError,
+    ///     NonFiniteError.
+    fn noether<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+        g: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let ep = &slf.get().ep;
+        let (d, m) = ep.dims();
+        let n = ep.group_size().ok_or_else(|| {
+            to_py(Error::invalid(
+                "g",
+                "an algebra given by structure constants has no matrix group here: no Noether \
+                 momentum",
+            ))
+        })?;
+        map_items(
+            slf.py(),
+            &[
+                Input::new("states", &states, &[d + m]),
+                Input::new("g", &g, &[n, n]),
+            ],
+            &[d],
+            |x, out| {
+                lieflow::check::finite_slice("states", x[0])?;
+                ep.noether(&x[0][..d], x[1], out)
+            },
+        )
     }
 
     /// The diamond b <> a in g* (d,) of b in V (m,: a derivative dl/da) and a in V* (m,):
