@@ -269,6 +269,9 @@ impl Legendre {
         let (d, m) = (self.d, self.m);
         let (xi, rest) = out.split_at_mut(d);
         self.velocity(mu, a, xi)?;
+        if m == 0 {
+            return Ok(());
+        }
         let mut g = vec![0.0; d];
         self.gradients(xi, a, &mut g, &mut rest[..m])?;
         rest.iter_mut().for_each(|v| *v = -*v);
