@@ -215,6 +215,12 @@ def test_errors():
         lf.EulerPoincare("so3", top_l, action=cross_action)
     with pytest.raises(lf.InvalidArgumentError, match="vector"):
         lf.EulerPoincare("se3", top_l, action="vector")
+    with pytest.raises(lf.InvalidArgumentError, match="m >= 1"):
+        lf.EulerPoincare("so3", top_l, action=cross_action, parameter_dim=0)
+    with pytest.raises(lf.InvalidArgumentError, match="not a representation"):
+        lf.EulerPoincare("so3", top_l, action=lambda xi, a: a, parameter_dim=2)
+    with pytest.raises(lf.NonFiniteError):
+        lf.EulerPoincare("so3", inertia=np.diag(I)).velocity([1.0, np.nan, 0.0])
     with pytest.raises(lf.InvalidArgumentError, match="left"):
         lf.EulerPoincare("so3", inertia=np.eye(3), side="up")
     ep = lf.EulerPoincare("so3", inertia=np.diag(I))

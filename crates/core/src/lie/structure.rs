@@ -22,6 +22,15 @@ pub enum Algebra {
     Constants(Vec<f64>),
 }
 
+impl Algebra {
+    /// dim g.
+    ///
+    /// Errors: those of invalid structure constants or n < 2 (as [`crate::systems::LiePoisson::new`]).
+    pub fn dim(&self) -> Result<usize> {
+        Ok(Structure::new(self.clone())?.dim)
+    }
+}
+
 /// One non-zero structure constant: [e_i, e_j] has c along e_k.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Term {

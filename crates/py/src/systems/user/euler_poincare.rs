@@ -8,7 +8,7 @@ use std::sync::Arc;
 use lieflow::systems::user::{
     Action, EulerPoincare as CoreEp, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn,
 };
-use lieflow::systems::{LiePoisson as CoreLiePoisson, Side};
+use lieflow::systems::Side;
 use lieflow::Error;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -82,7 +82,7 @@ impl PyEulerPoincare {
         let py = algebra.py();
         let alg = self::algebra(&algebra)?;
         let side_of = self::side(side.as_ref())?;
-        let dim = dim_of(&alg).py()?;
+        let dim = alg.dim().py()?;
         let parameter = match optional(action.as_ref()) {
             None => None,
             Some(a) => Some(self::action(
@@ -344,31 +344,16 @@ impl PyEulerPoincare {
 
 /// A float vector of length n named `what`, finite.
 fn vector(what: &str, v: &Any<'_>, n: usize) -> PyResult<Vec<f64>> {
-    let a = ArrayIn::named(what, v)?;
-    let view = a.as_array();
-    if view.shape() != [n] {
+    let x = crate::convert::vector(what, &ArrayIn::named(what, v)?)?;
+    if x.len() != n {
         return Err(to_py(Error::shape(
             what,
             format!("({n},)"),
-            shape_str(view.shape()),
+            format!("({},)", x.len()),
         )));
     }
-    let x = read_all(what, &view)?;
     lieflow::check::finite_slice(what, &x).py()?;
     Ok(x)
-}
-
-/// dim g of an algebra argument.
-fn dim_of(alg: &lieflow::systems::Algebra) -> lieflow::Result<usize> {
-    Ok(CoreLiePoisson::new(
-        alg.clone(),
-        lieflow::systems::LieHamiltonian::Function {
-            value: Arc::new(|_: &[f64]| Ok(0.0)),
-            gradient: None,
-        },
-        None,
-    )?
-    .dim())
 }
 
 /// The `action` argument with its parameter dimension.
