@@ -436,3 +436,215 @@ fn the_noether_momentum_of_so_n_and_se3_composes_as_the_coadjoint_action() {
     ];
     assert!(dist(&p, &want) < 1e-14, "{p:?} {want:?}");
 }
+
+/// g₁ g₂ for n×n row-major matrices.
+fn matmul(n: usize, a: &[f64], b: &[f64]) -> Vec<f64> {
+    let mut c = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            c[i * n + j] = (0..n).map(|k| a[i * n + k] * b[k * n + j]).sum();
+        }
+    }
+    c
+}
+
+/// max |gᵀg − I| of an n×n row-major matrix's n×n block of rows and columns `k`.
+fn orthogonality_defect(n: usize, k: usize, g: &[f64]) -> f64 {
+    let mut worst = 0.0f64;
+    for i in 0..k {
+        for j in 0..k {
+            let s: f64 = (0..k).map(|l| g[l * n + i] * g[l * n + j]).sum();
+            worst = worst.max((s - if i == j { 1.0 } else { 0.0 }).abs());
+        }
+    }
+    worst
+}
+
+#[test]
+fn the_attitude_of_a_lie_poisson_system_is_the_rigid_body_attitude_on_so3() {
+    // ℓ = ½⟨Ω, 𝕀Ω⟩ lifted: (M, R) against the built-in body with attitude, same method (the
+    // same reconstruction R ← R exp(−θ)), and against the exact solution.
+    let ep = EulerPoincare::new(
+        Algebra::So3,
+        Lagrangian::Quadratic(diag(&I)),
+        Side::Left,
+        None,
+    )
+    .unwrap();
+    let sys = ep.system().with_attitude().unwrap();
+    assert_eq!(sys.space().dim(), 12);
+    let body = RigidBody::new(I).unwrap().with_attitude();
+    let r0 = rotation([0.3, -0.5, 0.8], 0.7);
+    let z0 = body.state_with_attitude(M0, r0);
+    let exact = integrate(&body, "exact", &z0, 0.01, 1000, 100).unwrap();
+    let builtin = integrate(&body, "rkmk4", &z0, 0.01, 1000, 100).unwrap();
+    for method in ["rkmk4", "midpoint"] {
+        let run = integrate(&sys, method, &z0, 0.01, 1000, 100).unwrap();
+        for k in 0..run.len() {
+            if method == "rkmk4" {
+                assert!(dist(run.state(k), builtin.state(k)) < 1e-12, "sample {k}");
+            }
+            let tol = if method == "rkmk4" { 1e-8 } else { 1e-3 };
+            assert!(dist(run.state(k), exact.state(k)) < tol, "{method} {k}");
+        }
+    }
+    // A non-rotation is refused at the start.
+    let mut bad = z0.clone();
+    bad[3] = 2.0;
+    assert!(integrate(&sys, "rkmk4", &bad, 0.01, 10, 1).is_err());
+    // Structure constants have no matrix group, hence no attitude.
+    let so3: Vec<f64> = (0..27)
+        .map(|c| {
+            let (i, j, k) = (c / 9, (c / 3) % 3, c % 3);
+            match (i, j, k) {
+                (0, 1, 2) | (1, 2, 0) | (2, 0, 1) => 1.0,
+                (1, 0, 2) | (2, 1, 0) | (0, 2, 1) => -1.0,
+                _ => 0.0,
+            }
+        })
+        .collect();
+    let generic = EulerPoincare::new(
+        Algebra::Constants(so3),
+        Lagrangian::Quadratic(diag(&I)),
+        Side::Left,
+        None,
+    )
+    .unwrap();
+    assert!(generic.system().with_attitude().is_none());
+}
+
+/// A rotation of ℝ⁴ in the planes (0, 1) and (2, 3), row-major.
+fn rotation4(a: f64, b: f64) -> Vec<f64> {
+    let mut g = vec![0.0; 16];
+    g[0] = a.cos();
+    g[1] = -a.sin();
+    g[4] = a.sin();
+    g[5] = a.cos();
+    g[10] = b.cos();
+    g[11] = -b.sin();
+    g[14] = b.sin();
+    g[15] = b.cos();
+    g
+}
+
+#[test]
+fn the_configuration_keeps_the_noether_momentum_on_so4_and_se3_and_converges_at_the_order() {
+    // so(4), ℓ = ½⟨Ω, JΩ + ΩJ⟩ = ½ Σ_{i<j} (J_i + J_j) Ω_ij² (the generalized rigid body), and a
+    // Kirchhoff body on se(3) with a coupled inertia: the Noether momentum (in the invariants
+    // after the Casimirs) is kept to round-off by the orbit methods, g stays in the group, and
+    // rkmk4's configuration converges at order 4.
+    let j = [1.0, 1.5, 2.2, 3.1];
+    let mut inertia = Vec::new();
+    for a in 0..4 {
+        for b in a + 1..4 {
+            inertia.push(j[a] + j[b]);
+        }
+    }
+    let mut kirchhoff = diag(&[2.0, 3.0, 4.0, 1.0, 1.5, 2.5]);
+    kirchhoff[2] = 0.3;
+    kirchhoff[12] = 0.3;
+    kirchhoff[4] = -0.2;
+    kirchhoff[24] = -0.2;
+    let se3_g0 = {
+        let r = rotation([0.3, -0.5, 0.8], 0.7);
+        let mut g = vec![0.0; 16];
+        for i in 0..3 {
+            g[i * 4..i * 4 + 3].copy_from_slice(&r[i * 3..i * 3 + 3]);
+            g[i * 4 + 3] = [0.4, -1.2, 0.9][i];
+        }
+        g[15] = 1.0;
+        g
+    };
+    // (algebra, inertia, μ₀, g₀, the size of g's orthogonal block)
+    type Case = (Algebra, Vec<f64>, Vec<f64>, Vec<f64>, usize);
+    let cases: [Case; 2] = [
+        (
+            Algebra::So(4),
+            diag(&inertia),
+            vec![0.3, -0.2, 0.5, 0.1, 0.4, -0.6],
+            rotation4(0.4, -0.9),
+            4,
+        ),
+        (
+            Algebra::Se3,
+            kirchhoff,
+            vec![1.0, 0.5, -0.3, 0.2, -0.1, 0.4],
+            se3_g0,
+            3,
+        ),
+    ];
+    for (algebra, inertia, mu0, g0, rot) in cases {
+        let name = format!("{algebra:?}");
+        let ep =
+            EulerPoincare::new(algebra, Lagrangian::Quadratic(inertia), Side::Left, None).unwrap();
+        let sys = ep.system().with_attitude().unwrap();
+        let z0 = [mu0.clone(), g0.clone()].concat();
+        let casimirs = ep.system().invariant_count();
+        let inv0 = sys.invariants(&z0).unwrap();
+        assert_eq!(inv0.len(), casimirs + 6, "{name}");
+        for method in ["rkmk4", "midpoint"] {
+            let run = integrate(&sys, method, &z0, 0.01, 2000, 200).unwrap();
+            for k in 0..run.len() {
+                let z = run.state(k);
+                let inv = sys.invariants(z).unwrap();
+                let drift = dist(&inv[casimirs..], &inv0[casimirs..]);
+                assert!(
+                    drift < 2e-14,
+                    "{name} {method} sample {k}: Noether drift {drift:e}"
+                );
+                let defect = orthogonality_defect(4, rot, &z[6..]);
+                assert!(defect < 1e-14, "{name} {method}: {defect:e}");
+            }
+            // The motion moves g (the test is not vacuous).
+            assert!(dist(&run.state(run.len() - 1)[6..], &g0) > 0.1, "{name}");
+        }
+        // Order 4 of the configuration: errors at dt and dt/2 against dt/8.
+        let reference = integrate(&sys, "rkmk4", &z0, 0.0125, 800, 800).unwrap();
+        let err = |dt: f64, steps: usize| {
+            let r = integrate(&sys, "rkmk4", &z0, dt, steps, steps).unwrap();
+            dist(&r.state(1)[6..], &reference.state(1)[6..])
+        };
+        let ratio = err(0.1, 100) / err(0.05, 200);
+        assert!((13.0..19.0).contains(&ratio), "{name}: ratio {ratio}");
+    }
+}
+
+#[test]
+fn the_right_configuration_is_the_inverse_of_the_left_one() {
+    // The mirror g ↦ g⁻¹ with the configuration: the right run of H from (μ₀, g₀) is the left run
+    // of H(−μ) = H (quadratic) from (−μ₀, g₀⁻¹), negated and inverted; its Noether momentum
+    // Ad*_g μ is kept.
+    let make = |side| {
+        EulerPoincare::new(
+            Algebra::So(4),
+            Lagrangian::Quadratic(diag(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0])),
+            side,
+            None,
+        )
+        .unwrap()
+        .system()
+        .with_attitude()
+        .unwrap()
+    };
+    let (left, right) = (make(Side::Left), make(Side::Right));
+    let mu0 = [0.3, -0.2, 0.5, 0.1, 0.4, -0.6];
+    let g0 = rotation4(0.4, -0.9);
+    let g0t: Vec<f64> = (0..16).map(|k| g0[(k % 4) * 4 + k / 4]).collect();
+    let zr = [mu0.to_vec(), g0.clone()].concat();
+    let zl = [mu0.iter().map(|x| -x).collect(), g0t].concat();
+    let rr = integrate(&right, "rkmk4", &zr, 0.01, 1000, 100).unwrap();
+    let rl = integrate(&left, "rkmk4", &zl, 0.01, 1000, 100).unwrap();
+    let inv0 = right.invariants(&zr).unwrap();
+    for k in 0..rr.len() {
+        let (a, b) = (rr.state(k), rl.state(k));
+        let neg: Vec<f64> = b[..6].iter().map(|x| -x).collect();
+        assert!(dist(&a[..6], &neg) < 1e-14, "sample {k}");
+        let gl_t: Vec<f64> = (0..16).map(|q| b[6 + (q % 4) * 4 + q / 4]).collect();
+        assert!(dist(&a[6..], &gl_t) < 1e-13, "sample {k}");
+        let inv = right.invariants(a).unwrap();
+        assert!(dist(&inv, &inv0) < 1e-13, "sample {k}");
+        // g g⁻¹ = 1 as a check of the helper.
+        let id = matmul(4, &a[6..], &b[6..]);
+        assert!((id[0] - 1.0).abs() < 1e-13);
+    }
+}

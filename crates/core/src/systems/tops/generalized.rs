@@ -343,7 +343,7 @@ pub struct SoScratch {
 }
 
 impl SoScratch {
-    fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         SoScratch {
             n,
             a: vec![0.0; n * n],
@@ -353,6 +353,14 @@ impl SoScratch {
             t: vec![0.0; n * n],
             dz: vec![0.0; n * (n - 1) / 2],
         }
+    }
+
+    /// exp(A) − I of a dense n×n matrix A (row-major; any matrix: the series below does not use
+    /// skewness), held in the scratch until its next use.
+    pub(crate) fn expm1_of(&mut self, a: &[f64]) -> &[f64] {
+        self.a.copy_from_slice(a);
+        self.expm1();
+        &self.g
     }
 
     /// g ← exp(a) − I for the skew matrix in `a` (overwritten): the Taylor series of exp − I at

@@ -30,6 +30,7 @@ use std::sync::Arc;
 
 use nalgebra::DMatrix;
 
+use super::attitude::Group;
 use super::lie_poisson::{LieHamiltonian, LiePoisson, Side};
 use super::{fd_gradient, finite_entries, finite_value, GradientFn, ScalarFn, FD_STEP};
 use crate::check;
@@ -356,7 +357,8 @@ impl EulerPoincare {
                 ),
                 other => other,
             })?
-            .with_side(side);
+            .with_side(side)
+            .with_group(Group::of(&algebra));
         Ok(EulerPoincare {
             algebra,
             system,
@@ -383,77 +385,26 @@ impl EulerPoincare {
     /// The size n of the group elements g (n×n matrices) of the algebra: 3 for so(3), n for
     /// so(n), 4 for se(3) (homogeneous matrices); None for structure constants (no group).
     pub fn group_size(&self) -> Option<usize> {
-        match self.algebra {
-            Algebra::So3 => Some(3),
-            Algebra::So(n) => Some(n),
-            Algebra::Se3 => Some(4),
-            Algebra::Constants(_) => None,
-        }
+        Group::of(&self.algebra).map(Group::size)
     }
 
-    /// The Noether momentum of the momentum μ (d) at the group element g (n×n, row-major; the
-    /// configuration g(t) of the motion, body to space): Ad*_{g⁻¹}μ for a left-invariant
-    /// Lagrangian, constant along motions with ġ = gξ (000 Theorem 4.3; the spatial angular
-    /// momentum R M of the rigid body, Theorem 4.2), Ad*_g μ for a right-invariant one (ġ = ξg,
-    /// Theorem 4.4). With ⟨Ad*_h μ, ξ⟩ = ⟨μ, Ad_h ξ⟩: so(3) R M (left), Rᵀ M (right); so(n)
-    /// g M gᵀ, gᵀ M g (as skew matrices, pairing ½ tr(AᵀB)); se(3) (Ad_{g∓1})ᵀ μ. With an
-    /// advected parameter only the components that fix a₀ are conserved (Theorem 4.11: for the
-    /// heavy top the vertical one, e₃·(R M)); the whole vector is returned.
+    /// The Noether momentum of the momentum μ (the first dim g entries of a state) at the group
+    /// element g (n×n, row-major; the configuration g(t) of the motion, body to space):
+    /// Ad*_{g⁻¹}μ (left) or Ad*_g μ (right), [`Group::noether`]. With an advected parameter only
+    /// the components that fix a₀ are conserved (Theorem 4.11: for the heavy top the vertical
+    /// one, e₃·(R M)); the whole vector is returned.
     ///
     /// Errors: structure constants (no group), g of the wrong size or not in the group
     /// ([`Error::NotInGroup`] from the group's check).
     pub fn noether(&self, mu: &[f64], g: &[f64], out: &mut [f64]) -> Result<()> {
-        use nalgebra::{Matrix3, Matrix4, Vector3, Vector6};
-        let n = self.group_size().ok_or_else(|| {
+        let group = Group::of(&self.algebra).ok_or_else(|| {
             Error::invalid(
                 "g",
                 "an algebra given by structure constants has no matrix group here: no Noether \
                  momentum",
             )
         })?;
-        if g.len() != n * n {
-            return Err(Error::shape(
-                "g",
-                format!("({n}, {n})"),
-                format!("{} values", g.len()),
-            ));
-        }
-        check::finite_slice("g", g)?;
-        let left = self.system.side() == Side::Left;
-        match self.algebra {
-            Algebra::So3 => {
-                let r = Matrix3::from_row_slice(g);
-                crate::lie::so3::check_rotation("g", &r)?;
-                let m = Vector3::from_column_slice(&mu[..3]);
-                let p = if left { r * m } else { r.transpose() * m };
-                out.copy_from_slice(p.as_slice());
-            }
-            Algebra::So(n) => {
-                let q = DMatrix::from_row_slice(n, n, g);
-                so::check_rotation_of("g", &crate::Mat::from_fn(n, n, |i, j| q[(i, j)]), n)?;
-                let m = so::hat_n_unchecked(n, &mu[..self.legendre.d]);
-                let m = DMatrix::from_fn(n, n, |i, j| m[(i, j)]);
-                let p = if left {
-                    &q * m * q.transpose()
-                } else {
-                    q.transpose() * m * &q
-                };
-                let p = crate::Mat::from_fn(n, n, |i, j| p[(i, j)]);
-                out.copy_from_slice(&so::vee_n_unchecked(&p));
-            }
-            Algebra::Se3 => {
-                let h = crate::lie::se3::SE3::from_matrix4(&Matrix4::from_row_slice(g))?;
-                let h = if left {
-                    crate::lie::MatrixLieGroup::inverse(&h)
-                } else {
-                    h
-                };
-                let p = h.adjoint_matrix().transpose() * Vector6::from_column_slice(&mu[..6]);
-                out.copy_from_slice(p.as_slice());
-            }
-            Algebra::Constants(_) => unreachable!("no group size"),
-        }
-        Ok(())
+        group.noether(self.system.side(), mu, g, out)
     }
 
     /// The diamond b ⋄ a ∈ g* of b ∈ V (the derivative ∂ℓ/∂a) and a ∈ V*, defined by

@@ -15,6 +15,8 @@ use crate::lie::structure::{Algebra, Kind, Structure};
 use crate::lie::{se3, so, so3};
 use crate::systems::tops::generalized::{GeneralizedRigidBody, SoScratch};
 
+use super::attitude::{Group, GroupScratch};
+
 /// The Hamiltonian of a [`LiePoisson`] system.
 #[derive(Clone)]
 pub enum LieHamiltonian {
@@ -59,6 +61,10 @@ pub struct LiePoisson {
     side: Side,
     hamiltonian: LieHamiltonian,
     casimirs: Option<Vec<ScalarFn>>,
+    /// The group G of the configuration g (None: structure constants, no matrices) and whether
+    /// the state carries g after μ ([`LiePoisson::with_attitude`]).
+    group: Option<Group>,
+    lifted: bool,
     /// The so(n) kernels (of a generalized rigid body; only its group action is used).
     so_kernels: Option<GeneralizedRigidBody>,
 }
@@ -88,6 +94,7 @@ impl LiePoisson {
         hamiltonian: LieHamiltonian,
         casimirs: Option<Vec<ScalarFn>>,
     ) -> Result<Self> {
+        let group = Group::of(&algebra);
         let algebra = Structure::new(algebra)?;
         let d = algebra.dim;
         if let LieHamiltonian::Quadratic(a) = &hamiltonian {
@@ -124,6 +131,8 @@ impl LiePoisson {
             side: Side::Left,
             hamiltonian,
             casimirs,
+            group,
+            lifted: false,
             so_kernels,
         })
     }
@@ -138,6 +147,41 @@ impl LiePoisson {
     /// The invariance the system comes from ([`Side`]).
     pub fn side(&self) -> Side {
         self.side
+    }
+
+    /// The system whose configuration group is `group`, acted on by the first `group.dim()`
+    /// components of the algebra (an Euler–Poincaré system with a parameter lives on g ⋉ V
+    /// while g stays in G; [`super::attitude`]).
+    pub(crate) fn with_group(mut self, group: Option<Group>) -> Self {
+        self.group = group;
+        self
+    }
+
+    /// The group G of the configuration (None for structure constants).
+    pub fn group(&self) -> Option<Group> {
+        self.group
+    }
+
+    /// The same system carrying its configuration g ∈ G along as a last block (`R` for SO(3),
+    /// `g` otherwise, n×n row-major): ġ = gξ (left) or ξg (right) with ξ = ∂H/∂μ, moved by every
+    /// method with the momentum ([`super::attitude`]); its Noether momentum joins the
+    /// invariants. None for structure constants (no matrix group).
+    pub fn with_attitude(&self) -> Option<Self> {
+        self.group?;
+        let mut lifted = self.clone();
+        lifted.lifted = true;
+        Some(lifted)
+    }
+
+    /// Whether the state carries the configuration g.
+    pub fn has_attitude(&self) -> bool {
+        self.lifted
+    }
+
+    /// Whether the Noether momentum is conserved as a whole: the algebra is the group's own
+    /// (without an advected parameter, which breaks the symmetry to the isotropy of a₀).
+    fn noether_conserved(&self) -> bool {
+        self.group.is_some_and(|g| g.dim() == self.algebra.dim)
     }
 
     /// dim g.
@@ -291,6 +335,7 @@ pub struct LieScratch {
     sum: Vec<f64>,
     term: Vec<f64>,
     next: Vec<f64>,
+    group: Option<GroupScratch>,
 }
 
 impl Problem for LiePoisson {
@@ -302,61 +347,88 @@ impl Problem for LiePoisson {
         "LiePoisson"
     }
     fn space(&self) -> Space {
-        match self.algebra.kind {
+        let space = match self.algebra.kind {
             Kind::So3 => Space::new([("M", Block::Real(3))]),
             Kind::Se3 => Space::new([("M", Block::Real(3)), ("Gamma", Block::Real(3))]),
             Kind::So(n) => Space::new([("M", Block::SoDual(n))]),
             Kind::Generic => Space::new([("mu", Block::Real(self.algebra.dim))]),
+        };
+        match (self.lifted, self.group) {
+            (true, Some(g)) => space.with(g.block_name(), g.block()),
+            _ => space,
         }
     }
     /// H(μ).
     fn energy(&self, z: &[f64]) -> Result<f64> {
-        self.value(z)
+        self.value(&z[..self.algebra.dim])
     }
-    /// The Casimirs: the functions given, or the built-in ones of the algebra.
+    /// The Casimirs: the functions given, or the built-in ones of the algebra; with the
+    /// attitude and no parameter also the Noether momentum ([`super::attitude::Group::noether`]).
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        match &self.casimirs {
+        let d = self.algebra.dim;
+        let mut out = match &self.casimirs {
             Some(fs) => fs
                 .iter()
                 .enumerate()
-                .map(|(k, f)| finite_value(&format!("casimir {k}"), f(z)?))
-                .collect(),
-            None => Ok(self.builtin_casimirs(z)),
+                .map(|(k, f)| finite_value(&format!("casimir {k}"), f(&z[..d])?))
+                .collect::<Result<Vec<f64>>>()?,
+            None => self.builtin_casimirs(&z[..d]),
+        };
+        if let (true, Some(g)) = (self.lifted && self.noether_conserved(), self.group) {
+            let mut p = vec![0.0; d];
+            g.noether(self.side, &z[..d], &z[d..], &mut p)?;
+            out.extend(p);
         }
+        Ok(out)
     }
     fn invariant_count(&self) -> usize {
-        match (&self.casimirs, &self.algebra.kind) {
+        let casimirs = match (&self.casimirs, &self.algebra.kind) {
             (Some(fs), _) => fs.len(),
             (None, Kind::So3) => 1,
             (None, Kind::Se3) => 2,
             (None, Kind::So(n)) => n / 2,
             (None, Kind::Generic) => 0,
+        };
+        let noether = self.lifted && self.noether_conserved();
+        casimirs + if noether { self.algebra.dim } else { 0 }
+    }
+    /// The attitude, if carried, is in the group.
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        match (self.lifted, self.group) {
+            (true, Some(g)) => g.check(g.block_name(), &z[self.algebra.dim..]),
+            _ => Ok(()),
         }
     }
 }
 
 impl VectorField for LiePoisson {
-    /// μ̇ = ±ad*_{∇H} μ ([`Side`]).
+    /// μ̇ = ±ad*_{∇H} μ ([`Side`]); with the attitude ġ = gξ (left) or ξg (right), ξ = ∇H.
     fn field(&self, z: &[f64], dz: &mut [f64]) {
         let d = self.algebra.dim;
+        let (z, g) = z.split_at(d);
+        let (dz, dg) = dz.split_at_mut(d);
         let mut stack = [0.0; 32];
         let mut heap = Vec::new();
-        let g = if d <= stack.len() {
+        let grad = if d <= stack.len() {
             &mut stack[..d]
         } else {
             heap.resize(d, 0.0);
             &mut heap[..]
         };
-        self.kernel_gradient(z, g);
-        if self.side == Side::Right {
-            g.iter_mut().for_each(|x| *x = -*x);
+        self.kernel_gradient(z, grad);
+        if let (true, Some(group)) = (self.lifted, self.group) {
+            let mut s = group.scratch();
+            group.velocity(self.side, &grad[..group.dim()], g, dg, &mut s);
         }
-        self.algebra.ad_star(g, z, dz);
+        if self.side == Side::Right {
+            grad.iter_mut().for_each(|x| *x = -*x);
+        }
+        self.algebra.ad_star(grad, z, dz);
     }
 }
 
 /// The coadjoint action (module docs): ξ(μ) = ∓∇H(μ) ([`Side`]: − for left), exp(ξ)·μ =
-/// Ad*_{exp(−ξ)} μ.
+/// Ad*_{exp(−ξ)} μ; with the attitude, g follows ([`super::attitude::Group::follow`]).
 impl GroupField for LiePoisson {
     type Scratch = LieScratch;
     fn scratch(&self) -> LieScratch {
@@ -369,18 +441,26 @@ impl GroupField for LiePoisson {
             sum: vec![0.0; d],
             term: vec![0.0; d],
             next: vec![0.0; d],
+            group: match (self.lifted, self.group) {
+                (true, Some(g)) => Some(g.scratch()),
+                _ => None,
+            },
         }
     }
     fn algebra_dim(&self) -> usize {
         self.algebra.dim
     }
     fn generator(&self, z: &[f64], xi: &mut [f64], _s: &mut LieScratch) {
-        self.kernel_gradient(z, xi);
+        self.kernel_gradient(&z[..self.algebra.dim], xi);
         if self.side == Side::Left {
             xi.iter_mut().for_each(|x| *x = -*x);
         }
     }
     fn act(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
+        let (z, g) = z.split_at_mut(self.algebra.dim);
+        if let (Some(group), Some(gs)) = (self.group, &mut s.group) {
+            group.follow(self.side, &xi[..group.dim()], g, gs);
+        }
         match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
             (Kind::So3, _, _) => {
                 let g = so3::exp_unchecked(&Vector3::from_column_slice(xi));
@@ -423,6 +503,11 @@ impl Catalog for LiePoisson {
 
     /// Double-bracket dissipation of a left-invariant system (the generic construction takes
     /// the field as ad*_{∇H} μ; for a right-invariant one it would pump energy in).
+    /// The system with its configuration g ([`LiePoisson::with_attitude`]).
+    fn lifted(&self) -> Option<Self> {
+        self.with_attitude()
+    }
+
     fn dissipation(
         &self,
         d: &crate::integrate::forcing::Dissipation,

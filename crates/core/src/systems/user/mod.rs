@@ -75,6 +75,7 @@
 //! energy error of a long run may drift by about that much per unit time. Pass the gradient
 //! where long runs or non-smooth scales matter.
 
+pub mod attitude;
 mod canonical;
 mod euler_poincare;
 mod lie_poisson;

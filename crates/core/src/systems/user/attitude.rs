@@ -1,0 +1,256 @@
+//! The configuration g ∈ G that a Lie–Poisson system carries along (its attitude): the
+//! reconstruction ġ = gξ (left, 000 Theorem 4.3) or ġ = ξg (right, Theorem 4.4) with
+//! ξ = ∂H/∂μ, and the Noether momentum that g and μ conserve together.
+//!
+//! **The step that goes with a coadjoint step.** The methods of a [`LiePoisson`] system move μ
+//! by the coadjoint action, μ ← exp(θ)·μ = Ad*_{exp(−θ)} μ ([`GroupField`]). For a steady
+//! velocity ξ, the left motion g(t) = g₀ exp(tξ) has μ(t) = Ad*_{exp(tξ)} μ₀, i.e. θ = −tξ;
+//! the right motion g(t) = exp(tξ) g₀ has μ(t) = Ad*_{exp(−tξ)} μ₀, i.e. θ = tξ. So a step
+//! μ ← exp(θ)·μ moves g by g ← g exp(−θ) (left) or g ← exp(θ) g (right) ([`Group::follow`]).
+//! This is the same method applied to the lifted system on G × g*, on which G acts by
+//! h·(g, μ) = (g h⁻¹, Ad*_{h⁻¹} μ) (left; (h g, …) right) with the same generator: the order
+//! of the method is kept, and the Noether momentum Ad*_{g⁻¹}μ (left) or Ad*_g μ (right) is
+//! kept exactly up to round-off: Ad*_{(g exp(−θ))⁻¹} Ad*_{exp(−θ)} μ = Ad*_{g⁻¹} μ.
+//!
+//! With an advected parameter the system lives on g ⋉ V while g stays in G: the G-part of a
+//! semidirect element exp(θ, w) is exp(θ) (the projection G ⋉ V → G is a homomorphism), so only
+//! the first dim g components of θ move the attitude.
+//!
+//! [`GroupField`]: crate::integrate::problem::GroupField
+//! [`LiePoisson`]: super::LiePoisson
+
+use nalgebra::{Matrix3, Matrix4, Vector3, Vector6};
+
+use super::lie_poisson::Side;
+use crate::check;
+use crate::error::{Error, Result};
+use crate::integrate::space::Block;
+use crate::lie::structure::Algebra;
+use crate::lie::{se3, so, so3, MatrixLieGroup};
+use crate::systems::tops::generalized::SoScratch;
+
+/// A matrix group of the built-in algebras, as the configuration space of a system.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Group {
+    /// SO(3), rotations R (3×3), so(3) in the physics basis.
+    So3,
+    /// SO(n) (n×n), so(n) in the e_ij coordinates of [`so::vee_n`].
+    So(usize),
+    /// SE(3) as homogeneous matrices [[R, t], [0, 1]] (4×4), se(3) as ξ = (ω, v).
+    Se3,
+}
+
+/// Scratch of [`Group::follow`]: exp(θ) − I and one product.
+pub struct GroupScratch {
+    exp: SoScratch,
+    a: Vec<f64>,
+    t: Vec<f64>,
+}
+
+impl Group {
+    /// The group of a built-in algebra; None for structure constants (no matrices).
+    pub fn of(algebra: &Algebra) -> Option<Group> {
+        match algebra {
+            Algebra::So3 => Some(Group::So3),
+            Algebra::So(n) => Some(Group::So(*n)),
+            Algebra::Se3 => Some(Group::Se3),
+            Algebra::Constants(_) => None,
+        }
+    }
+
+    /// n of the n×n matrices.
+    pub fn size(self) -> usize {
+        match self {
+            Group::So3 => 3,
+            Group::So(n) => n,
+            Group::Se3 => 4,
+        }
+    }
+
+    /// dim g.
+    pub fn dim(self) -> usize {
+        match self {
+            Group::So3 => 3,
+            Group::So(n) => so::dim(n),
+            Group::Se3 => 6,
+        }
+    }
+
+    /// The block of a state that holds an element: `SO(3)` for rotations (checked and retracted
+    /// by the driver), n×n matrices otherwise (checked by [`Group::check`]).
+    pub(crate) fn block(self) -> Block {
+        match self {
+            Group::So3 => Block::SO3,
+            _ => Block::Matrix(self.size()),
+        }
+    }
+
+    /// The name of that block: `R` for a rotation, `g` otherwise.
+    pub(crate) fn block_name(self) -> &'static str {
+        match self {
+            Group::So3 => "R",
+            _ => "g",
+        }
+    }
+
+    /// Errors unless `g` (n×n, row-major) is finite and in the group (the group's own check:
+    /// [`Error::NotInGroup`] with its defect).
+    pub fn check(self, what: &str, g: &[f64]) -> Result<()> {
+        let n = self.size();
+        if g.len() != n * n {
+            return Err(Error::shape(
+                what,
+                format!("({n}, {n})"),
+                format!("{} values", g.len()),
+            ));
+        }
+        check::finite_slice(what, g)?;
+        match self {
+            Group::So3 => so3::check_rotation(what, &Matrix3::from_row_slice(g)),
+            Group::So(n) => {
+                so::check_rotation_of(what, &crate::Mat::from_fn(n, n, |i, j| g[i * n + j]), n)
+            }
+            Group::Se3 => se3::SE3::from_matrix4(&Matrix4::from_row_slice(g))
+                .map(|_| ())
+                .map_err(|e| match e {
+                    Error::NotInGroup {
+                        group,
+                        defect_name,
+                        defect,
+                        tol,
+                        ..
+                    } => Error::NotInGroup {
+                        what: what.into(),
+                        group,
+                        defect_name,
+                        defect,
+                        tol,
+                    },
+                    other => other,
+                }),
+        }
+    }
+
+    /// The matrix ξ̂ (n×n, row-major) of ξ ∈ g.
+    fn hat(self, xi: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        match self {
+            Group::So3 | Group::Se3 => {
+                let w = [
+                    [0.0, -xi[2], xi[1]],
+                    [xi[2], 0.0, -xi[0]],
+                    [-xi[1], xi[0], 0.0],
+                ];
+                let n = self.size();
+                for i in 0..3 {
+                    out[i * n..i * n + 3].copy_from_slice(&w[i]);
+                }
+                if self == Group::Se3 {
+                    for i in 0..3 {
+                        out[i * 4 + 3] = xi[3 + i];
+                    }
+                }
+            }
+            Group::So(n) => {
+                let mut k = 0;
+                for i in 0..n {
+                    for j in i + 1..n {
+                        out[i * n + j] = xi[k];
+                        out[j * n + i] = -xi[k];
+                        k += 1;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The scratch of [`Group::follow`] and [`Group::velocity`].
+    pub(crate) fn scratch(self) -> GroupScratch {
+        let n = self.size();
+        GroupScratch {
+            exp: SoScratch::new(n),
+            a: vec![0.0; n * n],
+            t: vec![0.0; n * n],
+        }
+    }
+
+    /// g ← g exp(−θ) (left) or exp(θ) g (right): the configuration's step that goes with the
+    /// momentum's μ ← exp(θ)·μ (module docs). The product is formed as g + g(exp(∓θ) − I), so
+    /// that its rounding errors are relative to |θ||g| rather than |g|.
+    pub(crate) fn follow(self, side: Side, theta: &[f64], g: &mut [f64], s: &mut GroupScratch) {
+        let n = self.size();
+        self.hat(theta, &mut s.a);
+        if side == Side::Left {
+            s.a.iter_mut().for_each(|x| *x = -*x);
+        }
+        let e = s.exp.expm1_of(&s.a);
+        for i in 0..n {
+            for j in 0..n {
+                s.t[i * n + j] = match side {
+                    Side::Left => (0..n).map(|k| g[i * n + k] * e[k * n + j]).sum(),
+                    Side::Right => (0..n).map(|k| e[i * n + k] * g[k * n + j]).sum(),
+                };
+            }
+        }
+        g.iter_mut().zip(&s.t).for_each(|(x, t)| *x += t);
+    }
+
+    /// ġ = gξ̂ (left) or ξ̂g (right) into `dg`.
+    pub(crate) fn velocity(
+        self,
+        side: Side,
+        xi: &[f64],
+        g: &[f64],
+        dg: &mut [f64],
+        s: &mut GroupScratch,
+    ) {
+        let n = self.size();
+        self.hat(xi, &mut s.a);
+        for i in 0..n {
+            for j in 0..n {
+                dg[i * n + j] = match side {
+                    Side::Left => (0..n).map(|k| g[i * n + k] * s.a[k * n + j]).sum(),
+                    Side::Right => (0..n).map(|k| s.a[i * n + k] * g[k * n + j]).sum(),
+                };
+            }
+        }
+    }
+
+    /// The Noether momentum of the momentum μ (dim g) at g (n×n, row-major; body to space):
+    /// Ad*_{g⁻¹}μ for a left-invariant system, constant along ġ = gξ (000 Theorem 4.3; the
+    /// spatial angular momentum R M of the rigid body, Theorem 4.2), Ad*_g μ for a
+    /// right-invariant one (ġ = ξg, Theorem 4.4). With ⟨Ad*_h μ, ξ⟩ = ⟨μ, Ad_h ξ⟩: so(3)
+    /// R M (left), Rᵀ M (right); so(n) g M gᵀ, gᵀ M g (as skew matrices, pairing ½ tr(AᵀB));
+    /// se(3) (Ad_{g∓1})ᵀ μ.
+    ///
+    /// Errors: those of [`Group::check`].
+    pub fn noether(self, side: Side, mu: &[f64], g: &[f64], out: &mut [f64]) -> Result<()> {
+        self.check("g", g)?;
+        let left = side == Side::Left;
+        match self {
+            Group::So3 => {
+                let r = Matrix3::from_row_slice(g);
+                let m = Vector3::from_column_slice(&mu[..3]);
+                let p = if left { r * m } else { r.transpose() * m };
+                out.copy_from_slice(p.as_slice());
+            }
+            Group::So(n) => {
+                let q = crate::Mat::from_fn(n, n, |i, j| g[i * n + j]);
+                let m = so::hat_n_unchecked(n, &mu[..so::dim(n)]);
+                let p = if left {
+                    &q * m * q.transpose()
+                } else {
+                    q.transpose() * m * &q
+                };
+                out.copy_from_slice(&so::vee_n_unchecked(&p));
+            }
+            Group::Se3 => {
+                let h = se3::SE3::from_matrix4(&Matrix4::from_row_slice(g))?;
+                let h = if left { h.inverse() } else { h };
+                let p = h.adjoint_matrix().transpose() * Vector6::from_column_slice(&mu[..6]);
+                out.copy_from_slice(p.as_slice());
+            }
+        }
+        Ok(())
+    }
+}
