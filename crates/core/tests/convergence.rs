@@ -10,9 +10,10 @@ use lieflow::integrate::{integrate, Problem, System};
 use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff};
 use lieflow::pseudo_rigid::PseudoRigidBody;
+use lieflow::systems::user::{EulerPoincare, Lagrangian, LagrangianFn, LagrangianGradientFn};
 use lieflow::systems::{
     Algebra, GeneralizedRigidBody, HeavyTop, HyperbolicPlane, LieHamiltonian, LiePoisson, Pendulum,
-    Potential, RelativisticTangentTop, RigidBody, RollingDisk, Sphere, SphereParticle,
+    Potential, RelativisticTangentTop, RigidBody, RollingDisk, Side, Sphere, SphereParticle,
     SphericalPendulum, TangentTop, WeakFieldTop,
 };
 use lieflow::Error;
@@ -30,6 +31,7 @@ fn implicit(case: &str, method: &str) -> bool {
             "lgvi",
             "isospectral",
             "dmv",
+            "variational",
         ]
         .iter()
         .any(|m| method.starts_with(m))
@@ -140,6 +142,43 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
     let so3_user = lie_poisson(Algebra::So3, &[1.0, 0.5, 1.0 / 3.0]);
     let se3_user = lie_poisson(Algebra::Se3, &[1.0, 0.5, 0.25, 1.0, 0.8, 0.6]);
     let lifted = [m0.clone(), r.clone()].concat();
+    let ep_quadratic = EulerPoincare::new(
+        Algebra::So3,
+        Lagrangian::Quadratic(diagonal(&[1.0, 2.0, 3.0])),
+        Side::Left,
+        None,
+    )
+    .unwrap()
+    .with_attitude()
+    .unwrap();
+    // ℓ = ½⟨Ω, 𝕀Ω⟩ + |Ω|⁴/8 on se(3) (right-invariant): Newton's Legendre inversion every step.
+    let quartic: LagrangianFn = Arc::new(|w: &[f64], _: &[f64]| {
+        let n2: f64 = w.iter().map(|x| x * x).sum();
+        Ok(w.iter()
+            .enumerate()
+            .map(|(i, x)| 0.5 * (1.0 + i as f64) * x * x)
+            .sum::<f64>()
+            + n2 * n2 / 8.0)
+    });
+    let quartic_gradient: LagrangianGradientFn =
+        Arc::new(|w: &[f64], _: &[f64], dw: &mut [f64], _: &mut [f64]| {
+            let n2: f64 = w.iter().map(|x| x * x).sum();
+            for (i, (d, x)) in dw.iter_mut().zip(w).enumerate() {
+                *d = (1.0 + i as f64) * x + 0.5 * n2 * x;
+            }
+            Ok(())
+        });
+    let ep_quartic = EulerPoincare::new(
+        Algebra::Se3,
+        Lagrangian::Function {
+            value: quartic,
+            gradient: Some(quartic_gradient),
+            hessian: None,
+        },
+        Side::Right,
+        None,
+    )
+    .unwrap();
     let forced_body = Forced::new(Arc::new(body.with_attitude()))
         .with_force("M", damped_torque(), true)
         .unwrap();
@@ -240,6 +279,16 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
             weak.state([1.0, 0.0], 0.0, [0.0, 0.9], 1.0).unwrap(),
         ),
         ("LiePoisson so(3)".into(), Arc::new(so3_user), m0.clone()),
+        (
+            "EulerPoincare so(3) with attitude".into(),
+            Arc::new(ep_quadratic),
+            lifted.clone(),
+        ),
+        (
+            "EulerPoincare quartic se(3)".into(),
+            Arc::new(ep_quartic),
+            vec![0.3, -0.5, 0.8, 1.0, 0.4, -0.6],
+        ),
         (
             "LiePoisson se(3)".into(),
             Arc::new(se3_user),

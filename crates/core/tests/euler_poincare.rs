@@ -648,3 +648,212 @@ fn the_right_configuration_is_the_inverse_of_the_left_one() {
         assert!((id[0] - 1.0).abs() < 1e-13);
     }
 }
+
+/// The error at the end of `method` on `sys` from z0 over t = `t` in `steps` steps against `want`.
+fn end_error(
+    sys: &EulerPoincare,
+    method: &str,
+    z0: &[f64],
+    t: f64,
+    steps: usize,
+    want: &[f64],
+) -> f64 {
+    let r = integrate(sys, method, z0, t / steps as f64, steps, steps).unwrap();
+    dist(r.state(1), want)
+}
+
+#[test]
+fn the_variational_method_converges_at_orders_2_4_6_and_keeps_the_coadjoint_orbit() {
+    // The free rigid body from ℓ = ½⟨Ω, 𝕀Ω⟩ against its exact solution (M and R): the discrete
+    // Euler–Poincaré method is of order 2 and its Suzuki/Yoshida compositions of orders 4 and 6
+    // (which also shows that the method is symmetric); |M|² and R M are kept to round-off.
+    let ep = EulerPoincare::new(
+        Algebra::So3,
+        Lagrangian::Quadratic(diag(&I)),
+        Side::Left,
+        None,
+    )
+    .unwrap()
+    .with_attitude()
+    .unwrap();
+    let body = RigidBody::new(I).unwrap().with_attitude();
+    let z0 = body.state_with_attitude(M0, rotation([0.3, -0.5, 0.8], 0.7));
+    let t = 4.0;
+    let exact = integrate(&body, "exact", &z0, t, 1, 1).unwrap();
+    let want = exact.state(1);
+    for (method, order, steps) in [
+        ("variational", 2, 100),
+        ("variational4", 4, 40),
+        ("variational6", 6, 20),
+    ] {
+        let ratio = end_error(&ep, method, &z0, t, steps, want)
+            / end_error(&ep, method, &z0, t, 2 * steps, want);
+        let expect = 2f64.powi(order);
+        assert!(
+            (0.75 * expect..1.3 * expect).contains(&ratio),
+            "{method}: ratio {ratio}, expected {expect}"
+        );
+    }
+    // The method and the built-in LGVI are different second-order discretisations of the same
+    // motion: their difference shrinks like h².
+    let diff = |steps: usize| {
+        let dt = t / steps as f64;
+        let a = integrate(&ep, "variational", &z0, dt, steps, steps).unwrap();
+        let b = integrate(&body, "lgvi", &z0, dt, steps, steps).unwrap();
+        dist(&a.state(1)[..3], &b.state(1)[..3])
+    };
+    let ratio = diff(200) / diff(400);
+    assert!(
+        (3.5..4.5).contains(&ratio),
+        "variational − lgvi: ratio {ratio}"
+    );
+    // 10⁵ steps: the Casimir and the Noether momentum R M to round-off.
+    let run = integrate(&ep, "variational", &z0, 0.01, 100_000, 10_000).unwrap();
+    let inv0 = ep.invariants(&z0).unwrap();
+    let (e0, mut de) = (ep.energy(&z0).unwrap(), 0.0f64);
+    for k in 0..run.len() {
+        let inv = ep.invariants(run.state(k)).unwrap();
+        assert!((inv[0] - inv0[0]).abs() < 1e-13, "sample {k}: |M|² {inv:?}");
+        let drift = dist(&inv[1..], &inv0[1..]);
+        assert!(drift <= 1e-13, "sample {k}: Noether drift {drift:e}");
+        de = de.max((ep.energy(run.state(k)).unwrap() - e0).abs());
+    }
+    // Bounded energy error (a symplectic method): O(h²), no drift.
+    assert!(de < 1e-4 * e0, "energy error {de:e}");
+}
+
+#[test]
+fn the_variational_method_on_the_heavy_top_so4_and_se3() {
+    // The heavy top from ℓ(Ω, Γ) with its attitude: against the built-in top (a fine splitting8 run),
+    // the Casimirs |Γ|², M·Γ and the vertical Noether component e₃·(R M) to round-off.
+    let (mgl, chi) = (0.7, [0.0, 0.6, 0.8]);
+    let ep = EulerPoincare::new(
+        Algebra::So3,
+        heavy_top_lagrangian(mgl, chi),
+        Side::Left,
+        Some((Action::Vector, 3)),
+    )
+    .unwrap()
+    .with_attitude()
+    .unwrap();
+    let top = HeavyTop::new(I, mgl, chi).unwrap().with_attitude();
+    let r0 = rotation([0.3, -0.5, 0.8], 0.7);
+    let z0 = top.state_with_attitude(M0, r0);
+    let reference = integrate(&top, "splitting8", &z0, 1e-3, 10_000, 10_000).unwrap();
+    let run = integrate(&ep, "variational6", &z0, 0.02, 500, 500).unwrap();
+    let err = dist(run.state(1), reference.state(1));
+    assert!(err < 1e-8, "variational6 against the heavy top: {err:e}");
+    let ratio = end_error(
+        &ep,
+        "variational",
+        &z0,
+        2.0,
+        100,
+        reference_at(&top, &z0, 2.0).as_slice(),
+    ) / end_error(
+        &ep,
+        "variational",
+        &z0,
+        2.0,
+        200,
+        reference_at(&top, &z0, 2.0).as_slice(),
+    );
+    assert!(
+        (3.3..4.8).contains(&ratio),
+        "order 2 with a parameter: ratio {ratio}"
+    );
+    let long = integrate(&ep, "variational", &z0, 0.01, 20_000, 1000).unwrap();
+    let vertical = |z: &[f64]| {
+        let mut p = [0.0; 3];
+        ep.noether(&z[..6], &z[6..], &mut p).unwrap();
+        p[2]
+    };
+    let (c0, v0) = (top.invariants(&z0).unwrap(), vertical(&z0));
+    for k in 0..long.len() {
+        let z = long.state(k);
+        let c = ep.invariants(z).unwrap();
+        assert!(
+            (c[0] - c0[0]).abs() < 1e-13 && (c[1] - c0[1]).abs() < 1e-13,
+            "{k}: {c:?}"
+        );
+        assert!((vertical(z) - v0).abs() < 1e-13, "sample {k}: e3·RM");
+    }
+    // so(4) and a Kirchhoff body on se(3): Casimirs and the Noether momentum.
+    let mut kirchhoff = diag(&[2.0, 3.0, 4.0, 1.0, 1.5, 2.5]);
+    kirchhoff[2] = 0.3;
+    kirchhoff[12] = 0.3;
+    let mut g_se3 = vec![0.0; 16];
+    for i in 0..3 {
+        g_se3[i * 4..i * 4 + 3].copy_from_slice(&r0[i * 3..i * 3 + 3]);
+        g_se3[i * 4 + 3] = [0.4, -1.2, 0.9][i];
+    }
+    g_se3[15] = 1.0;
+    for (algebra, inertia, g0) in [
+        (
+            Algebra::So(4),
+            diag(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]),
+            rotation4(0.4, -0.9),
+        ),
+        (Algebra::Se3, kirchhoff, g_se3),
+    ] {
+        let name = format!("{algebra:?}");
+        let ep = EulerPoincare::new(algebra, Lagrangian::Quadratic(inertia), Side::Left, None)
+            .unwrap()
+            .with_attitude()
+            .unwrap();
+        let z0 = [vec![0.3, -0.2, 0.5, 0.1, 0.4, -0.6], g0].concat();
+        let inv0 = ep.invariants(&z0).unwrap();
+        let run = integrate(&ep, "variational", &z0, 0.01, 10_000, 1000).unwrap();
+        for k in 0..run.len() {
+            // Relative to the state's size: on se(3) the spatial momentum R M + t × RΓ adds terms
+            // of size |t| (the body drifts away, |t| ≈ 30 here) that cancel to a constant.
+            let z = run.state(k);
+            let inv = ep.invariants(z).unwrap();
+            let scale = z.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+            let drift = dist(&inv, &inv0) / scale;
+            assert!(drift < 2e-14, "{name} sample {k}: {drift:e}");
+        }
+        // The same motion as the Lie–Poisson methods (variational6 against rkmk4, t = 1).
+        let a = integrate(&ep, "variational6", &z0, 0.05, 20, 20).unwrap();
+        let b = integrate(&ep, "rkmk4", &z0, 0.005, 200, 200).unwrap();
+        assert!(dist(a.state(1), b.state(1)) < 1e-8, "{name}");
+    }
+}
+
+/// The heavy top's state at t by a fine run of its order-8 splitting.
+fn reference_at(top: &HeavyTop, z0: &[f64], t: f64) -> Vec<f64> {
+    let steps = (t / 1e-3).round() as usize;
+    integrate(top, "splitting8", z0, t / steps as f64, steps, steps)
+        .unwrap()
+        .state(1)
+        .to_vec()
+}
+
+#[test]
+fn the_variational_method_for_a_quartic_and_a_right_invariant_lagrangian() {
+    // ℓ = ½⟨Ω, 𝕀Ω⟩ + (c/4)|Ω|⁴: variational6 against rkmk4 at a tenth of the step (the rkmk4
+    // run is itself checked against the independent solution above), and the right system as the
+    // mirror of the left one.
+    let ep = EulerPoincare::new(Algebra::So3, quartic(0.4, 0.0), Side::Left, None).unwrap();
+    let mut mu0 = [0.0; 3];
+    ep.legendre()
+        .momentum(&[0.8, -0.4, 0.3], &[], &mut mu0)
+        .unwrap();
+    let a = integrate(&ep, "variational6", &mu0, 1e-2, 1000, 1000).unwrap();
+    let b = integrate(&ep, "rkmk4", &mu0, 1e-3, 10_000, 10_000).unwrap();
+    assert!(
+        dist(a.state(1), b.state(1)) < 1e-9,
+        "{:?} {:?}",
+        a.state(1),
+        b.state(1)
+    );
+    let right = EulerPoincare::new(Algebra::So3, quartic(0.4, 0.5), Side::Right, None).unwrap();
+    let mirror = EulerPoincare::new(Algebra::So3, quartic(0.4, -0.5), Side::Left, None).unwrap();
+    let minus: Vec<f64> = M0.iter().map(|x| -x).collect();
+    let r = integrate(&right, "variational", &M0, 0.01, 300, 30).unwrap();
+    let m = integrate(&mirror, "variational", &minus, 0.01, 300, 30).unwrap();
+    for k in 0..r.len() {
+        let negated: Vec<f64> = m.state(k).iter().map(|x| -x).collect();
+        assert!(dist(r.state(k), &negated) < 1e-14, "sample {k}");
+    }
+}

@@ -238,6 +238,50 @@ impl Structure {
             .fold(0.0f64, |m, x| m.max(*x))
     }
 
+    /// dexp⁻¹_u v = Σ_k B_k/k! ad_uᵏ v (right-trivialised: d/dε exp(u + εw) exp(−u) = dexp_u w),
+    /// or with `dual` its transpose (dexp⁻¹_u)ᵀ v = Σ_k B_k/k! (ad*_u)ᵏ v, by the Bernoulli series
+    /// (B₁ = −½); NaN when the bound of ‖ad_u‖ reaches π (the series converges for ‖ad_u‖ < 2π,
+    /// slowly near it). Summed until a bound of the tail is below 10⁻¹⁷ of the sum; `work`: four
+    /// vectors of length d.
+    pub(crate) fn dexp_inv_series(
+        &self,
+        u: &[f64],
+        v: &[f64],
+        out: &mut [f64],
+        dual: bool,
+        work: [&mut Vec<f64>; 4],
+    ) {
+        let [rows, cols, term, next] = work;
+        let beta = self.ad_bound(u, rows, cols);
+        if beta.is_nan() || beta >= std::f64::consts::PI || v.iter().any(|x| !x.is_finite()) {
+            out.fill(f64::NAN);
+            return;
+        }
+        out.copy_from_slice(v);
+        term.copy_from_slice(v);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let mut bound = 1.0;
+        for &b in &so::bernoulli_coefficients()[1..] {
+            if dual {
+                self.ad_star(u, term, next);
+            } else {
+                self.bracket(u, term, next);
+            }
+            std::mem::swap(term, next);
+            let mut pn = 0.0f64;
+            for (o, t) in out.iter_mut().zip(term.iter()) {
+                *o += b * t;
+                pn = pn.max(t.abs());
+            }
+            // |b_j| ≤ 4/(2π)^j (j ≥ 2) and ‖ad_u‖ ≤ β < π: the rest is below 4‖p_k‖/(2π)^k.
+            bound /= two_pi;
+            let sum = out.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if pn == 0.0 || 4.0 * pn * bound <= 1e-17 * sum {
+                return;
+            }
+        }
+    }
+
     /// The dense (d, d, d) array C[i][j][k].
     pub(crate) fn dense(&self) -> Vec<f64> {
         let d = self.dim;

@@ -173,6 +173,39 @@ impl LiePoisson {
         Some(lifted)
     }
 
+    /// The same system without the configuration.
+    pub(crate) fn without_attitude(&self) -> Self {
+        let mut base = self.clone();
+        base.lifted = false;
+        base
+    }
+
+    /// ad*_ξ μ = ad_ξᵀ μ on the algebra (module docs).
+    pub(crate) fn ad_star(&self, xi: &[f64], mu: &[f64], out: &mut [f64]) {
+        self.algebra.ad_star(xi, mu, out);
+    }
+
+    /// (dexp⁻¹_u)ᵀ p: on so(3) and so(n), whose ad_u is skew in their orthonormal coordinates,
+    /// dexp⁻¹_{−u} p ([`GroupField::dexp_inv`]); otherwise the Bernoulli series of ad*_u
+    /// ([`Structure::dexp_inv_series`]).
+    pub(crate) fn dexp_inv_dual(&self, u: &[f64], p: &[f64], out: &mut [f64], s: &mut LieScratch) {
+        match self.algebra.kind {
+            Kind::So3 | Kind::So(_) => {
+                let mut minus = std::mem::take(&mut s.sum);
+                minus.iter_mut().zip(u).for_each(|(m, x)| *m = -x);
+                self.dexp_inv(&minus, p, out, s);
+                s.sum = minus;
+            }
+            _ => {
+                let LieScratch {
+                    a, b, term, next, ..
+                } = s;
+                self.algebra
+                    .dexp_inv_series(u, p, out, true, [a, b, term, next]);
+            }
+        }
+    }
+
     /// Whether the state carries the configuration g.
     pub fn has_attitude(&self) -> bool {
         self.lifted
@@ -297,32 +330,13 @@ impl LiePoisson {
         }
     }
 
-    /// dexp⁻¹_u v = Σ_k B_k/k! ad_uᵏ v (module docs); NaN when the bound of ‖ad_u‖ reaches π.
+    /// dexp⁻¹_u v by its Bernoulli series ([`Structure::dexp_inv_series`]).
     fn dexp_inv_generic(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut LieScratch) {
-        let beta = self.algebra.ad_bound(u, &mut s.a, &mut s.b);
-        if beta.is_nan() || beta >= std::f64::consts::PI || v.iter().any(|x| !x.is_finite()) {
-            out.fill(f64::NAN);
-            return;
-        }
-        out.copy_from_slice(v);
-        s.term.copy_from_slice(v);
-        let two_pi = 2.0 * std::f64::consts::PI;
-        let mut bound = 1.0;
-        for &b in &so::bernoulli_coefficients()[1..] {
-            self.algebra.bracket(u, &s.term, &mut s.next);
-            std::mem::swap(&mut s.term, &mut s.next);
-            let mut pn = 0.0f64;
-            for (o, t) in out.iter_mut().zip(&s.term) {
-                *o += b * t;
-                pn = pn.max(t.abs());
-            }
-            // |b_j| ≤ 4/(2π)^j (j ≥ 2) and ‖ad_u‖ ≤ β < π: the rest is below 4‖p_k‖/(2π)^k.
-            bound /= two_pi;
-            let sum = out.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            if pn == 0.0 || 4.0 * pn * bound <= 1e-17 * sum {
-                return;
-            }
-        }
+        let LieScratch {
+            a, b, term, next, ..
+        } = s;
+        self.algebra
+            .dexp_inv_series(u, v, out, false, [a, b, term, next]);
     }
 }
 

@@ -26,16 +26,25 @@
 //! errors) on g or g ⋉ V with the Hamiltonian of its Lagrangian, plus the Legendre transform both
 //! ways and the diamond map. A quadratic ℓ(ξ) = ½⟨ξ, 𝕀ξ⟩ is the native path H = ½⟨μ, 𝕀⁻¹μ⟩.
 
+mod variational;
+
 use std::sync::Arc;
 
 use nalgebra::DMatrix;
 
+pub use variational::Variational;
+
 use super::attitude::Group;
+use super::lie_poisson::LieScratch;
 use super::lie_poisson::{LieHamiltonian, LiePoisson, Side};
 use super::{fd_gradient, finite_entries, finite_value, GradientFn, ScalarFn, FD_STEP};
 use crate::check;
 use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::{fmt_num, Error, Result};
+use crate::integrate::methods::{Composition, LieMidpoint, Rk4, Rkmk4};
+use crate::integrate::problem::{GroupField, VectorField};
+use crate::integrate::space::Space;
+use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::so;
 use crate::lie::structure::{Algebra, Structure};
 
@@ -367,9 +376,19 @@ impl EulerPoincare {
         })
     }
 
-    /// The Lie–Poisson form (the system to integrate).
+    /// The Lie–Poisson form (with the configuration where the system carries it).
     pub fn system(&self) -> &LiePoisson {
         &self.system
+    }
+
+    /// The same system carrying its configuration g ∈ G along as a last block
+    /// ([`LiePoisson::with_attitude`]; G the group of g, also with a parameter); None for
+    /// structure constants.
+    pub fn with_attitude(&self) -> Option<Self> {
+        Some(EulerPoincare {
+            system: self.system.with_attitude()?,
+            ..self.clone()
+        })
     }
 
     /// The Legendre transform of the Lagrangian.
@@ -557,6 +576,87 @@ fn mat_vec(a: &[f64], x: &[f64]) -> Vec<f64> {
 fn fmt_vec(v: &[f64]) -> String {
     let items: Vec<String> = v.iter().map(|x| fmt_num(*x)).collect();
     format!("[{}]", items.join(", "))
+}
+
+/// The Lie–Poisson form's: state, energy H, Casimirs (and the Noether momentum with the
+/// configuration).
+impl Problem for EulerPoincare {
+    fn calls_out(&self) -> bool {
+        self.system.calls_out()
+    }
+    fn name(&self) -> &'static str {
+        "EulerPoincare"
+    }
+    fn space(&self) -> Space {
+        self.system.space()
+    }
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        self.system.energy(z)
+    }
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        self.system.invariants(z)
+    }
+    fn invariant_count(&self) -> usize {
+        self.system.invariant_count()
+    }
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        self.system.check_state(z)
+    }
+}
+
+impl VectorField for EulerPoincare {
+    fn field(&self, z: &[f64], dz: &mut [f64]) {
+        self.system.field(z, dz)
+    }
+}
+
+impl GroupField for EulerPoincare {
+    type Scratch = LieScratch;
+    fn scratch(&self) -> LieScratch {
+        self.system.scratch()
+    }
+    fn algebra_dim(&self) -> usize {
+        self.system.algebra_dim()
+    }
+    fn generator(&self, z: &[f64], xi: &mut [f64], s: &mut LieScratch) {
+        self.system.generator(z, xi, s)
+    }
+    fn act(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
+        self.system.act(xi, z, s)
+    }
+    fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut LieScratch) {
+        self.system.dexp_inv(u, v, out, s)
+    }
+}
+
+impl Catalog for EulerPoincare {
+    /// variational (default; the discrete Euler–Poincaré method, order 2), variational4 and
+    /// variational6 (its Suzuki and Yoshida compositions), then the Lie–Poisson methods of the
+    /// Hamiltonian form: midpoint, midpoint4, rkmk4, rk4.
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("variational", || Variational(Composition::strang())),
+            Entry::new("variational4", || Variational(Composition::suzuki4())),
+            Entry::new("variational6", || Variational(Composition::yoshida6())),
+            Entry::new("midpoint", LieMidpoint::new),
+            Entry::new("midpoint4", || LieMidpoint(Composition::suzuki4())),
+            Entry::new("rkmk4", || Rkmk4),
+            Entry::new("rk4", || Rk4),
+        ]
+    }
+
+    /// The system with its configuration ([`EulerPoincare::with_attitude`]).
+    fn lifted(&self) -> Option<Self> {
+        self.with_attitude()
+    }
+
+    /// The Lie–Poisson form's double-bracket dissipation (left-invariant systems).
+    fn dissipation(
+        &self,
+        d: &crate::integrate::forcing::Dissipation,
+    ) -> Result<Arc<dyn crate::integrate::forcing::Perturbation>> {
+        self.system.dissipation(d)
+    }
 }
 
 #[cfg(test)]
