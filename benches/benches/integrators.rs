@@ -5,7 +5,10 @@
 
 use criterion::{BatchSize, Criterion};
 use lieflow::integrate::{integrate, integrate_batch, Properties, System};
-use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
+use lieflow::systems::user::{EulerPoincare, Lagrangian};
+use lieflow::systems::{
+    Algebra, GeneralizedRigidBody, HeavyTop, RigidBody, Side, SphericalPendulum,
+};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -53,6 +56,24 @@ fn steps(c: &mut Criterion) {
         &top,
         &top.state(M0, [0.0, 0.0, 1.0]),
         top.methods(),
+    );
+    // The same body from its Lagrangian ℓ = ½⟨Ω, 𝕀Ω⟩ (issue 24: the native quadratic path of
+    // the discrete Euler–Poincaré method against the built-in lgvi above).
+    let ep = EulerPoincare::new(
+        Algebra::So3,
+        Lagrangian::Quadratic(vec![1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.0]),
+        Side::Left,
+        None,
+    )
+    .unwrap()
+    .with_attitude()
+    .unwrap();
+    per_step(
+        c,
+        "euler_poincare_attitude",
+        &ep,
+        &lifted.state_with_attitude(M0, I3),
+        ep.methods(),
     );
     let pend = SphericalPendulum::new(1.0, 1.0, 9.81).unwrap();
     let s = pend.state_from_spherical(1.0, 0.0, 0.3, 1.2).unwrap();

@@ -207,8 +207,16 @@ impl Structure {
         })
     }
 
-    /// out ← ad*_g μ, (ad*_g μ)_j = Σ C_ij^k g_i μ_k.
+    /// out ← ad*_g μ, (ad*_g μ)_j = Σ C_ij^k g_i μ_k (on so(3) the cross product μ × g).
     pub(crate) fn ad_star(&self, g: &[f64], mu: &[f64], out: &mut [f64]) {
+        if let (Kind::So3, [g0, g1, g2, ..], [m0, m1, m2, ..], [o0, o1, o2, ..]) =
+            (&self.kind, g, mu, &mut *out)
+        {
+            *o0 = m1 * g2 - m2 * g1;
+            *o1 = m2 * g0 - m0 * g2;
+            *o2 = m0 * g1 - m1 * g0;
+            return;
+        }
         out.fill(0.0);
         for t in &self.terms {
             out[t.j as usize] += t.c * g[t.i as usize] * mu[t.k as usize];

@@ -29,6 +29,24 @@ use crate::lie::structure::Algebra;
 use crate::lie::{se3, so, so3, MatrixLieGroup};
 use crate::systems::tops::generalized::SoScratch;
 
+/// g ← g + gE (left) or g + Eg (right) for N×N row-major matrices (sizes known to the compiler).
+fn product_add<const N: usize>(side: Side, g: &mut [f64], e: &[f64]) {
+    let mut t = [[0.0; N]; N];
+    for (i, row) in t.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = match side {
+                Side::Left => (0..N).map(|k| g[i * N + k] * e[k * N + j]).sum(),
+                Side::Right => (0..N).map(|k| e[i * N + k] * g[k * N + j]).sum(),
+            };
+        }
+    }
+    for (i, row) in t.iter().enumerate() {
+        for (j, x) in row.iter().enumerate() {
+            g[i * N + j] += x;
+        }
+    }
+}
+
 /// A matrix group of the built-in algebras, as the configuration space of a system.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Group {
@@ -40,9 +58,11 @@ pub enum Group {
     Se3,
 }
 
-/// Scratch of [`Group::follow`]: exp(θ) − I and one product.
+/// Scratch of [`Group::follow`]: the Taylor series of SO(n), exp(θ) − I,
+/// a matrix and the negated increment.
 pub struct GroupScratch {
     exp: SoScratch,
+    e: Vec<f64>,
     a: Vec<f64>,
     t: Vec<f64>,
 }
@@ -164,13 +184,72 @@ impl Group {
         }
     }
 
-    /// The scratch of [`Group::follow`] and [`Group::velocity`].
+    /// The scratch of [`Group::follow`].
     pub(crate) fn scratch(self) -> GroupScratch {
         let n = self.size();
         GroupScratch {
             exp: SoScratch::new(n),
+            e: vec![0.0; n * n],
             a: vec![0.0; n * n],
-            t: vec![0.0; n * n],
+            t: vec![0.0; self.dim()],
+        }
+    }
+
+    /// E = exp(ξ̂) − I into `s.exp_m1` (n×n): Rodrigues' closed form on SO(3) and SE(3)
+    /// (E_R = a ξ̂ + b ξ̂², a = sin θ/θ, b = ½ (sin(θ/2)/(θ/2))², no cancellation at small θ;
+    /// SE(3)'s translation V v = v + b ω×v + c ω×(ω×v), c = (θ − sin θ)/θ³), the scaled Taylor
+    /// series of [`SoScratch`] on SO(n).
+    fn expm1(self, xi: &[f64], s: &mut GroupScratch) {
+        let n = self.size();
+        self.hat(xi, &mut s.a);
+        match self {
+            Group::So(_) => {
+                let e = s.exp.expm1_of(&s.a);
+                s.e.copy_from_slice(e);
+            }
+            Group::So3 | Group::Se3 => {
+                let theta = (xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]).sqrt();
+                // sin θ/θ = (sin(θ/2)/(θ/2)) cos(θ/2): one sin_cos.
+                let (sh, ch) = (0.5 * theta).sin_cos();
+                let half = if theta == 0.0 {
+                    1.0
+                } else {
+                    sh / (0.5 * theta)
+                };
+                let a = half * ch;
+                let b = 0.5 * half * half;
+                // w² = w wᵀ − θ² I (3×3 block of ξ̂²).
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let w2 = xi[i] * xi[j] - if i == j { theta * theta } else { 0.0 };
+                        s.e[i * n + j] = a * s.a[i * n + j] + b * w2;
+                    }
+                }
+                if self == Group::Se3 {
+                    let c = if theta < 1e-2 {
+                        let t2 = theta * theta;
+                        1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0
+                    } else {
+                        (theta - theta.sin()) / (theta * theta * theta)
+                    };
+                    let (w, v) = (&xi[..3], &xi[3..6]);
+                    let wv = [
+                        w[1] * v[2] - w[2] * v[1],
+                        w[2] * v[0] - w[0] * v[2],
+                        w[0] * v[1] - w[1] * v[0],
+                    ];
+                    let wwv = [
+                        w[1] * wv[2] - w[2] * wv[1],
+                        w[2] * wv[0] - w[0] * wv[2],
+                        w[0] * wv[1] - w[1] * wv[0],
+                    ];
+                    for i in 0..3 {
+                        s.e[i * 4 + 3] = v[i] + b * wv[i] + c * wwv[i];
+                        s.e[12 + i] = 0.0;
+                    }
+                    s.e[15] = 0.0;
+                }
+            }
         }
     }
 
@@ -179,38 +258,67 @@ impl Group {
     /// that its rounding errors are relative to |θ||g| rather than |g|.
     pub(crate) fn follow(self, side: Side, theta: &[f64], g: &mut [f64], s: &mut GroupScratch) {
         let n = self.size();
-        self.hat(theta, &mut s.a);
-        if side == Side::Left {
-            s.a.iter_mut().for_each(|x| *x = -*x);
+        let sign = side.sign();
+        for (t, x) in s.t.iter_mut().zip(theta) {
+            *t = -sign * x;
         }
-        let e = s.exp.expm1_of(&s.a);
-        for i in 0..n {
-            for j in 0..n {
-                s.t[i * n + j] = match side {
-                    Side::Left => (0..n).map(|k| g[i * n + k] * e[k * n + j]).sum(),
-                    Side::Right => (0..n).map(|k| e[i * n + k] * g[k * n + j]).sum(),
-                };
+        let minus = std::mem::take(&mut s.t);
+        self.expm1(&minus[..self.dim()], s);
+        s.t = minus;
+        match self {
+            Group::So3 => product_add::<3>(side, g, &s.e),
+            Group::Se3 => product_add::<4>(side, g, &s.e),
+            Group::So(_) => {
+                for i in 0..n {
+                    for j in 0..n {
+                        s.a[i * n + j] = match side {
+                            Side::Left => (0..n).map(|k| g[i * n + k] * s.e[k * n + j]).sum(),
+                            Side::Right => (0..n).map(|k| s.e[i * n + k] * g[k * n + j]).sum(),
+                        };
+                    }
+                }
+                g.iter_mut().zip(&s.a).for_each(|(x, t)| *x += t);
             }
         }
-        g.iter_mut().zip(&s.t).for_each(|(x, t)| *x += t);
+    }
+
+    /// The entry (i, j) of ξ̂ (n×n).
+    fn hat_entry(self, xi: &[f64], i: usize, j: usize) -> f64 {
+        match self {
+            Group::So3 | Group::Se3 => match (i, j) {
+                (0, 1) => -xi[2],
+                (0, 2) => xi[1],
+                (1, 0) => xi[2],
+                (1, 2) => -xi[0],
+                (2, 0) => -xi[1],
+                (2, 1) => xi[0],
+                (r, 3) if r < 3 => xi[3 + r],
+                _ => 0.0,
+            },
+            Group::So(n) => {
+                let (lo, hi, sign) = match i.cmp(&j) {
+                    std::cmp::Ordering::Less => (i, j, 1.0),
+                    std::cmp::Ordering::Greater => (j, i, -1.0),
+                    std::cmp::Ordering::Equal => return 0.0,
+                };
+                // e_ij coordinates: the upper triangle row by row.
+                sign * xi[lo * n - lo * (lo + 1) / 2 + (hi - lo - 1)]
+            }
+        }
     }
 
     /// ġ = gξ̂ (left) or ξ̂g (right) into `dg`.
-    pub(crate) fn velocity(
-        self,
-        side: Side,
-        xi: &[f64],
-        g: &[f64],
-        dg: &mut [f64],
-        s: &mut GroupScratch,
-    ) {
+    pub(crate) fn velocity(self, side: Side, xi: &[f64], g: &[f64], dg: &mut [f64]) {
         let n = self.size();
-        self.hat(xi, &mut s.a);
         for i in 0..n {
             for j in 0..n {
                 dg[i * n + j] = match side {
-                    Side::Left => (0..n).map(|k| g[i * n + k] * s.a[k * n + j]).sum(),
-                    Side::Right => (0..n).map(|k| s.a[i * n + k] * g[k * n + j]).sum(),
+                    Side::Left => (0..n)
+                        .map(|k| g[i * n + k] * self.hat_entry(xi, k, j))
+                        .sum(),
+                    Side::Right => (0..n)
+                        .map(|k| self.hat_entry(xi, i, k) * g[k * n + j])
+                        .sum(),
                 };
             }
         }

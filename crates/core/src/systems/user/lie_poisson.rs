@@ -185,12 +185,43 @@ impl LiePoisson {
         self.algebra.ad_star(xi, mu, out);
     }
 
-    /// (dexp⁻¹_u)ᵀ p: on so(3) and so(n), whose ad_u is skew in their orthonormal coordinates,
-    /// dexp⁻¹_{−u} p ([`GroupField::dexp_inv`]); otherwise the Bernoulli series of ad*_u
+    /// (dexp⁻¹_u)ᵀ p: on so(3) in closed form; on so(n), whose ad_u is skew in its orthonormal
+    /// coordinates, dexp⁻¹_{−u} p ([`GroupField::dexp_inv`]); otherwise the Bernoulli series of ad*_u
     /// ([`Structure::dexp_inv_series`]).
     pub(crate) fn dexp_inv_dual(&self, u: &[f64], p: &[f64], out: &mut [f64], s: &mut LieScratch) {
         match self.algebra.kind {
-            Kind::So3 | Kind::So(_) => {
+            Kind::So3 => {
+                // J_l⁻¹(u)ᵀ p = p + ½ u × p + c u × (u × p), c = (1 − (θ/2) cot(θ/2))/θ² (its
+                // series below θ = 0.1, to θ⁸: the rest is below 10⁻¹⁹); NaN from θ = π on, as
+                // dexp_inv.
+                let t2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+                let theta = t2.sqrt();
+                if theta.is_nan() || theta >= std::f64::consts::PI {
+                    out.fill(f64::NAN);
+                    return;
+                }
+                let c = if theta < 0.1 {
+                    1.0 / 12.0
+                        + t2 * (1.0 / 720.0
+                            + t2 * (1.0 / 30240.0 + t2 * (1.0 / 1209600.0 + t2 / 47900160.0)))
+                } else {
+                    let half = 0.5 * theta;
+                    (1.0 - half / half.tan()) / t2
+                };
+                let cross = |a: &[f64], b: &[f64]| {
+                    [
+                        a[1] * b[2] - a[2] * b[1],
+                        a[2] * b[0] - a[0] * b[2],
+                        a[0] * b[1] - a[1] * b[0],
+                    ]
+                };
+                let up = cross(u, p);
+                let uup = cross(u, &up);
+                for i in 0..3 {
+                    out[i] = p[i] + 0.5 * up[i] + c * uup[i];
+                }
+            }
+            Kind::So(_) => {
                 let mut minus = std::mem::take(&mut s.sum);
                 minus.iter_mut().zip(u).for_each(|(m, x)| *m = -x);
                 self.dexp_inv(&minus, p, out, s);
@@ -431,8 +462,7 @@ impl VectorField for LiePoisson {
         };
         self.kernel_gradient(z, grad);
         if let (true, Some(group)) = (self.lifted, self.group) {
-            let mut s = group.scratch();
-            group.velocity(self.side, &grad[..group.dim()], g, dg, &mut s);
+            group.velocity(self.side, &grad[..group.dim()], g, dg);
         }
         if self.side == Side::Right {
             grad.iter_mut().for_each(|x| *x = -*x);

@@ -102,7 +102,11 @@ impl Legendre {
     /// ℓ(ξ, a), checked finite.
     pub fn lagrangian(&self, xi: &[f64], a: &[f64]) -> Result<f64> {
         match &self.lagrangian {
-            Lagrangian::Quadratic(i) => Ok(0.5 * dot(xi, &mat_vec(i, xi))),
+            Lagrangian::Quadratic(i) => {
+                let mut ixi = vec![0.0; xi.len()];
+                mat_vec(i, xi, &mut ixi);
+                Ok(0.5 * dot(xi, &ixi))
+            }
             Lagrangian::Function { value, .. } => {
                 finite_value("the Lagrangian l(xi, a)", value(xi, a)?)
             }
@@ -113,7 +117,7 @@ impl Legendre {
     pub fn gradients(&self, xi: &[f64], a: &[f64], dxi: &mut [f64], da: &mut [f64]) -> Result<()> {
         match &self.lagrangian {
             Lagrangian::Quadratic(i) => {
-                dxi.copy_from_slice(&mat_vec(i, xi));
+                mat_vec(i, xi, dxi);
                 da.fill(0.0);
             }
             Lagrangian::Function {
@@ -566,11 +570,11 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-fn mat_vec(a: &[f64], x: &[f64]) -> Vec<f64> {
-    let d = x.len();
-    (0..d)
-        .map(|i| (0..d).map(|j| a[i * d + j] * x[j]).sum())
-        .collect()
+/// out ← A x for a d×d row-major A (d = x.len()).
+fn mat_vec(a: &[f64], x: &[f64], out: &mut [f64]) {
+    for (o, row) in out.iter_mut().zip(a.chunks_exact(x.len())) {
+        *o = row.iter().zip(x).map(|(r, v)| r * v).sum();
+    }
 }
 
 fn fmt_vec(v: &[f64]) -> String {

@@ -41,15 +41,18 @@
 //! through the representation of the group, not of its Lie algebra; the exponential serves every
 //! algebra and action lieflow knows (the coadjoint maps of [`LiePoisson`]).
 //!
-//! **The solve** is Newton's method with one matrix per step: K = (1 − ½ad*_u) ℓ''/h − ½C(λ)
-//! (C(λ)_{·i} = ad*_{e_i} λ; dexp_u⁻¹ = 1 − ½ad_u + O(u²)), the derivative of the residual to
-//! first order in u, factored at the
-//! start guess u = hξ(μ_k) (ξ the Legendre inverse); for a quadratic ℓ, ℓ'' = 𝕀 is constant.
+//! **The solve** is Newton's method with the residual's derivative to first order in u,
+//! K = (1 − ½ad*_u) ℓ''/h − ½C(λ) (C(λ)_{·i} = ad*_{e_i} λ; dexp_u⁻¹ = 1 − ½ad_u + O(u²)),
+//! inverted to that order by two applications of ℓ''⁻¹: a contraction by O(|u|²) per
+//! iteration, three iterations at |u| = 0.01. ℓ'' is 𝕀 for a quadratic ℓ (its inverse kept),
+//! else the Hessian at the start guess u = hξ(μ_k) (ξ the Legendre inverse), factored once per
+//! step; for a quadratic ℓ the start guess is of second order (ξ = 𝕀⁻¹ of the momentum at the
+//! step's middle, μ_k + ½ad*_u μ_k).
 //! The rule is [`crate::convergence`]'s ([`RULE`]: the update relative to ‖u‖_∞); a step whose
 //! update is still above the tolerance after [`RULE`]`.max_iter` iterations is
 //! [`crate::Error::NotConverged`].
 
-use super::{inverse, EulerPoincare, Lagrangian};
+use super::{inverse, mat_vec, EulerPoincare, Lagrangian};
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::hooks;
@@ -167,6 +170,18 @@ enum Failure {
     NotConverged(Failed),
 }
 
+/// ℓ''⁻¹v in place: the kept 𝕀⁻¹ of a quadratic ℓ (`tmp`: d values), or the factored Hessian.
+fn apply_inverse(inertia_inv: &Option<Vec<f64>>, lu: &mut DenseLu, v: &mut [f64], tmp: &mut [f64]) {
+    let d = v.len();
+    match inertia_inv {
+        Some(ai) => {
+            mat_vec(ai, v, &mut tmp[..d]);
+            v.copy_from_slice(&tmp[..d]);
+        }
+        None => lu.solve(v),
+    }
+}
+
 fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
@@ -180,12 +195,8 @@ impl VariationalStepper {
         let big = d + m;
         if self.inertia_inv.is_some() {
             // ℓ̃ = ℓ = ½⟨ξ, 𝕀ξ⟩: λ = 𝕀u/h, no parameter.
-            for i in 0..d {
-                self.lam[i] = (0..d)
-                    .map(|j| self.hessian[i * d + j] * self.u[j])
-                    .sum::<f64>()
-                    / h;
-            }
+            mat_vec(&self.hessian, &self.u[..d], &mut self.lam[..d]);
+            self.lam[..d].iter_mut().for_each(|l| *l /= h);
             return true;
         }
         for (x, u) in self.xi.iter_mut().zip(&self.u[..d]) {
@@ -230,6 +241,36 @@ impl VariationalStepper {
         true
     }
 
+    /// The Newton update Δu = K⁻¹w into `r`, w = −(residual) in `r` on entry. K =
+    /// (ℓ'' − ½ad*_u ℓ'')/h − ½C(λ) = (ℓ''/h)(1 − P), P = ℓ''⁻¹(½ad*_u ℓ'' + ½hC(λ)) = O(u), is
+    /// the residual's derivative to first order in u (dexp_u⁻¹ = 1 − ½ad_u + O(u²)), inverted to
+    /// the same order: K⁻¹ = h(1 + P)ℓ''⁻¹ + O(u²). With v = ℓ''⁻¹w, Pv = ℓ''⁻¹(½ad*_u w +
+    /// ½h ad*_v λ) (C(λ)v = ad*_v λ): two applications of ℓ''⁻¹ and no matrix to form.
+    fn newton_step(&mut self, h: f64) {
+        let (d, big) = (self.d, self.u.len());
+        self.r[d..big].fill(0.0);
+        self.base.ad_star(&self.u, &self.r, &mut self.out);
+        apply_inverse(
+            &self.inertia_inv,
+            &mut self.lu,
+            &mut self.r[..d],
+            &mut self.theta,
+        );
+        self.base.ad_star(&self.r, &self.lam, &mut self.col);
+        for i in 0..d {
+            self.out[i] = 0.5 * self.out[i] + 0.5 * h * self.col[i];
+        }
+        apply_inverse(
+            &self.inertia_inv,
+            &mut self.lu,
+            &mut self.out[..d],
+            &mut self.theta,
+        );
+        for i in 0..d {
+            self.r[i] = h * (self.r[i] + self.out[i]);
+        }
+    }
+
     /// One step of size h on y (module docs).
     fn substep(&mut self, h: f64) -> std::result::Result<(), Failure> {
         let (d, m, s) = (self.d, self.m, self.sign);
@@ -241,19 +282,27 @@ impl VariationalStepper {
         // The start guess u = hξ̃ and ℓ'' there.
         match &self.inertia_inv {
             Some(ai) => {
-                // ξ̃ = 𝕀⁻¹λ with λ = μ̃ + ½ ad*_u μ̃ + O(h²) (the momentum at the step's middle),
-                // u = h𝕀⁻¹μ̃ in the bracket.
-                for i in 0..d {
-                    self.col[i] = h * (0..d).map(|j| ai[i * d + j] * self.mu[j]).sum::<f64>();
+                // ξ̃ = 𝕀⁻¹λ with λ = dexp_uᵀ μ̃ = μ̃ + ½ad*_u μ̃ + ⅙(ad*_u)²μ̃ + O(u³) (the
+                // momentum at the step's middle), u = h𝕀⁻¹(μ̃ + ½ad*_u μ̃) in the bracket, itself
+                // from u = h𝕀⁻¹μ̃: an error of O(h⁴), so that two Newton iterations reach
+                // round-off at |u| = 0.01.
+                self.r[..big].copy_from_slice(&self.mu[..big]);
+                for pass in 0..2 {
+                    mat_vec(ai, &self.r[..d], &mut self.col[..d]);
+                    self.col[..d].iter_mut().for_each(|c| *c *= h);
+                    self.col[d..big].fill(0.0);
+                    self.base.ad_star(&self.col, &self.mu, &mut self.out);
+                    for i in 0..d {
+                        self.r[i] = self.mu[i] + 0.5 * self.out[i];
+                    }
+                    if pass == 1 {
+                        self.base.ad_star(&self.col, &self.out, &mut self.lam);
+                        for i in 0..d {
+                            self.r[i] += self.lam[i] / 6.0;
+                        }
+                    }
                 }
-                self.col[d..big].fill(0.0);
-                self.base.ad_star(&self.col, &self.mu, &mut self.out);
-                for i in 0..d {
-                    self.r[i] = self.mu[i] + 0.5 * self.out[i];
-                }
-                for i in 0..d {
-                    self.xi[i] = (0..d).map(|j| ai[i * d + j] * self.r[j]).sum();
-                }
+                mat_vec(ai, &self.r[..d], &mut self.xi);
             }
             None => {
                 let Self { ep, y, xi, .. } = self;
@@ -282,36 +331,15 @@ impl VariationalStepper {
         if !self.evaluate(h) {
             return Err(Failure::NotFinite);
         }
-        // K = (1 − ½ad*_u) ℓ''/h − ½C(λ), the derivative of the residual to first order in u.
-        {
-            let Self {
-                base,
-                hessian,
-                lu,
-                col,
-                out,
-                u,
-                lam,
-                ..
-            } = self;
-            let k = lu.matrix();
+        // ℓ'' factored once per step where it is not the constant 𝕀 (whose inverse is kept).
+        if self.inertia_inv.is_none() {
+            let k = self.lu.matrix();
             for i in 0..d {
-                col.fill(0.0);
-                for r in 0..d {
-                    col[r] = hessian[r * d + i];
-                }
-                base.ad_star(u, col, out);
-                for r in 0..d {
-                    k[(r, i)] = (hessian[r * d + i] - 0.5 * out[r]) / h;
-                }
-                col.fill(0.0);
-                col[i] = 1.0;
-                base.ad_star(col, lam, out);
-                for r in 0..d {
-                    k[(r, i)] -= 0.5 * out[r];
+                for j in 0..d {
+                    k[(i, j)] = self.hessian[i * d + j];
                 }
             }
-            if !lu.factor() {
+            if !self.lu.factor() {
                 return Err(Failure::NotFinite);
             }
         }
@@ -342,7 +370,7 @@ impl VariationalStepper {
                     r[i] = -(r[i] - 0.5 * h * diamond[i] - mu[i]);
                 }
             }
-            self.lu.solve(&mut self.r[..d]);
+            self.newton_step(h);
             let mut step = 0.0f64;
             for (x, dx) in self.u[..d].iter_mut().zip(&self.r[..d]) {
                 *x += dx;
