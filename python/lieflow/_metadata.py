@@ -82,13 +82,17 @@ def _arguments(ds):
     lead = ("member",) if batched else ()
     b, (k, d) = states.shape[:-2], states.shape[-2:]
     square = ("attitude_row", "attitude_col")
+    # The attitude's size n (an n×n group element: 3 for the rotations of the SO(3) bodies, n for
+    # SO(n), 4 for SE(3)), read from the file and then held to every attitude variable.
+    n = next((ds.variables[v].shape[-1] for v in ("initial_attitude", "attitude")
+              if v in ds.variables and ds.variables[v].ndim >= 2), 3)
     expected = {"time": (("time",), (k,)),
                 "states": (lead + ("time", "component"), b + (k, d)),
                 "initial_state": (lead + ("component",), b + (d,)),
                 "final_state": (lead + ("component",), b + (d,)),
-                "attitude": (lead + ("time",) + square, b + (k, 3, 3)),
-                "initial_attitude": (lead + square, b + (3, 3)),
-                "final_attitude": (lead + square, b + (3, 3)),
+                "attitude": (lead + ("time",) + square, b + (k, n, n)),
+                "initial_attitude": (lead + square, b + (n, n)),
+                "final_attitude": (lead + square, b + (n, n)),
                 "energy": (lead + ("time",), b + (k,))}
     if batched:
         expected["member"] = (("member",), b)
@@ -186,7 +190,8 @@ def _events(ds, var, dims, batched, d, status):
         e = f"event_{i}"
         layout = {f"t_events_{i}": ((e,), 0), f"state_events_{i}": ((e, "component"), d)}
         if with_attitude:
-            layout[f"attitude_events_{i}"] = ((e, "attitude_row", "attitude_col"), 3)
+            size = ds.variables["initial_attitude"].shape[-1]
+            layout[f"attitude_events_{i}"] = ((e, "attitude_row", "attitude_col"), size)
         for name, (want, last) in layout.items():
             if name not in ds.variables:
                 raise FileFormatError(f"event_functions is {n} but there is no variable {name}")

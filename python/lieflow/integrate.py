@@ -241,8 +241,10 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
         method: one of ``system.methods()`` (default: the first, the system's own default).
         save_every: keep every ``save_every``-th state (and the initial one): the trajectory has
             ``steps // save_every + 1`` samples at t = t0 + j * save_every * dt.
-        attitude: for systems on SO(3): the initial attitude R (3, 3) (shared by a batch) or one
-            per batch member (b, 3, 3); it is then integrated along.
+        attitude: the initial configuration g of a system on a matrix group, integrated along:
+            a rotation R (3, 3) for the SO(3) bodies, an (n, n) element of SO(n) or a homogeneous
+            (4, 4) element of SE(3) for ``LiePoisson``/``EulerPoincare`` on those algebras;
+            shared by a batch, or one per batch member (b, n, n).
         progress: show a progress bar (tqdm if installed, else a line on stderr).
         chunk_steps: steps per native call (default: ``CHUNK_WORK // batch size``, at least
             ``MIN_CHUNK_STEPS``). Ctrl-C is noticed between calls. Results do not depend on it.
@@ -418,7 +420,7 @@ class _Plain:
         self.members = self.z0.shape[0]
         self.att0 = (None if attitude is None else
                      np.array(np.broadcast_to(np.asarray(attitude, dtype=float),
-                                              (self.members, 3, 3))))
+                                              (self.members,) + np.shape(attitude)[-2:])))
         self.t0, self.dt, self.save_every = float(t0), float(dt), int(save_every)
 
     def _initial(self):

@@ -16,7 +16,8 @@ class Trajectory:
         save_every: as passed to ``integrate`` (None when ``t_eval`` gave the times).
         t: (k,) sample times (absolute: from ``t0``; ``t_eval`` when given).
         states: (k, d) samples, or (b, k, d) for a batch.
-        attitude: (k, 3, 3) / (b, k, 3, 3) attitudes, or None.
+        attitude: (k, n, n) / (b, k, n, n) attitudes (group elements: n = 3 for rotations), or
+            None.
         final_state, final_attitude: the state after all steps (also when ``steps`` is not a
             multiple of ``save_every``; a terminal event's state); pass them to ``integrate``
             with ``t0=traj.t_final`` to continue.
@@ -25,7 +26,7 @@ class Trajectory:
         status: 0 the run reached its end, 1 a terminal event ended it, -1 it failed (the
             ``partial`` trajectory of an exception), as scipy's.
         t_events, state_events: with ``events``, one array per event function of the times
-            (n_i,) and the states (n_i, d) of its zeros (``attitude_events`` (n_i, 3, 3) with an
+            (n_i,) and the states (n_i, d) of its zeros (``attitude_events`` (n_i, n, n) with an
             attitude); None without events.
         Named views from the system (e.g. ``M``, ``Gamma``, ``q``, ``L``) as attributes.
 

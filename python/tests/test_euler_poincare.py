@@ -68,8 +68,14 @@ def test_the_free_rigid_body_comes_out_of_its_inertia():
     assert (ep.dim, ep.parameter_dim, ep.side) == (3, 0, "left")
     assert ep.is_quadratic
     exact = lf.integrate(lf.RigidBody(I), M0, dt=0.01, steps=1000, method="exact").states
-    run = lf.integrate(ep, M0, dt=0.01, steps=1000).states        # rkmk4
+    run = lf.integrate(ep, M0, dt=0.01, steps=1000, method="rkmk4").states
     np.testing.assert_allclose(run, exact, atol=1e-8)
+    # The default, the discrete Euler–Poincaré method (order 2), and its order-6 composition.
+    assert ep.methods()[0] == "variational"
+    run = lf.integrate(ep, M0, dt=0.01, steps=1000).states
+    np.testing.assert_allclose(run, exact, atol=1e-4)
+    run = lf.integrate(ep, M0, dt=0.01, steps=1000, method="variational6").states
+    np.testing.assert_allclose(run, exact, atol=1e-11)
     # Legendre both ways: mu = I xi.
     np.testing.assert_array_equal(ep.state(M0 / I), M0)
     np.testing.assert_allclose(ep.velocity(M0), M0 / I, rtol=1e-15)
@@ -134,8 +140,10 @@ def test_a_quartic_lagrangian_against_dop853():
         return np.linalg.solve(quartic_hess(w), np.cross(quartic_grad(w), w))
 
     ref = solve_ivp(rhs, (0, 10), w0, method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]
-    end = lf.integrate(ep, mu0, dt=5e-3, steps=2000, save_every=2000).states[-1]
-    np.testing.assert_allclose(end, quartic_grad(ref), atol=1e-9)
+    for method in ("variational6", "rkmk4"):
+        end = lf.integrate(ep, mu0, dt=5e-3, steps=2000, save_every=2000,
+                           method=method).states[-1]
+        np.testing.assert_allclose(end, quartic_grad(ref), atol=1e-9, err_msg=method)
     # Without the Hessian (central differences of the gradient) and without the gradient
     # (central differences of l): the same run to the differences' accuracy.
     exact = lf.integrate(ep, mu0, dt=0.01, steps=50).states
@@ -146,7 +154,7 @@ def test_a_quartic_lagrangian_against_dop853():
                                    atol=1e-9)
 
 
-@pytest.mark.parametrize("method", ["rkmk4", "midpoint", "rk4"])
+@pytest.mark.parametrize("method", ["variational", "rkmk4", "midpoint", "rk4"])
 def test_a_right_invariant_lagrangian_is_the_left_one_of_the_inverse_motion(method):
     right = lf.EulerPoincare("so3", odd_l, gradient=odd_grad, side="right")
     mirror = lf.EulerPoincare("so3", odd_l_mirror, gradient=odd_grad_mirror)
@@ -241,3 +249,79 @@ def test_errors():
     bad = lf.EulerPoincare("so3", top_l, gradient=lambda w, g: I * w, action="vector")
     with pytest.raises(lf.ShapeError, match="pair"):
         lf.integrate(bad, np.concatenate([M0, [0, 0, 1.0]]), dt=0.01, steps=2)
+
+
+def _se3_element(r, t):
+    g = np.eye(4)
+    g[:3, :3], g[:3, 3] = r, t
+    return g
+
+
+@pytest.mark.parametrize("algebra, inertia, g0", [
+    ("so3", np.diag(I), lf.lie.so3_exp([0.2, -0.35, 0.56])),
+    (("so", 4), np.diag([1.0, 2.0, 3.0, 4.0, 5.0, 6.0]),
+     np.linalg.qr(np.arange(16.0).reshape(4, 4) ** 0.5 + np.eye(4))[0]),
+    ("se3", np.diag([2.0, 3.0, 4.0, 1.0, 1.5, 2.5]),
+     _se3_element(lf.lie.so3_exp([0.2, -0.35, 0.56]), [0.4, -1.2, 0.9])),
+])
+def test_the_configuration_is_carried_and_keeps_the_noether_momentum(algebra, inertia, g0):
+    # With attitude=g0 the configuration g (3, 3), (4, 4) in SO(4) or (4, 4) homogeneous in
+    # SE(3) is integrated along; the variational method keeps the Noether momentum
+    # (`Trajectory.noether` passes the attitude) and the Casimirs to round-off, and g in its
+    # group.
+    if np.linalg.det(g0) < 0:
+        g0 = g0 @ np.diag([-1.0, 1.0, 1.0, 1.0])
+    ep = lf.EulerPoincare(algebra, inertia=inertia)
+    mu0 = np.linspace(0.3, -0.6, ep.dim)
+    tr = lf.integrate(ep, mu0, dt=0.01, steps=10_000, save_every=1000, attitude=g0)
+    n = g0.shape[0]
+    assert tr.attitude.shape == (11, n, n)
+    p = tr.noether()
+    scale = max(1.0, np.abs(tr.attitude).max())
+    assert np.abs(p - ep.noether(mu0, g0)).max() < 2e-14 * scale
+    assert np.abs(tr.invariants() - tr.invariants()[0]).max() < 1e-13    # the Casimirs
+    rot = tr.attitude[..., :3, :3] if n == 4 and algebra == "se3" else tr.attitude
+    k = rot.shape[-1]
+    assert np.abs(np.swapaxes(rot, -1, -2) @ rot - np.eye(k)).max() < 1e-13
+    assert np.abs(tr.attitude[-1] - g0).max() > 0.1         # g moved
+    # A wrong size or an element off the group is refused.
+    with pytest.raises(lf.ShapeError):
+        lf.integrate(ep, mu0, dt=0.01, steps=1, attitude=np.eye(n + 1))
+    bad = g0.copy()
+    bad[0, 0] += 0.1
+    with pytest.raises(lf.NotInGroupError):
+        lf.integrate(ep, mu0, dt=0.01, steps=1, attitude=bad)
+
+
+def test_the_heavy_top_from_its_lagrangian_with_its_attitude():
+    # The variational method with the vector action: the heavy top with attitude against the
+    # built-in one (a fine splitting8 run), Theorem 4.11's vertical component e3.(R M) kept.
+    top = lf.EulerPoincare("so3", top_l, gradient=top_dl, action="vector")
+    ht = lf.HeavyTop(I, MGL, chi=CHI)
+    r0 = lf.lie.so3_exp([0.2, -0.35, 0.56])
+    z0 = top.state(M0 / I, r0[2])              # Gamma = R^T e3, the body's vertical
+    ref = lf.integrate(ht, z0, dt=1e-3, steps=5000, save_every=5000, attitude=r0,
+                       method="splitting8")
+    run = lf.integrate(top, z0, dt=0.02, steps=250, save_every=250, attitude=r0,
+                       method="variational6")
+    np.testing.assert_allclose(run.states[-1], ref.states[-1], atol=1e-8)
+    np.testing.assert_allclose(run.attitude[-1], ref.attitude[-1], atol=1e-8)
+    long = lf.integrate(top, z0, dt=0.01, steps=5000, save_every=500, attitude=r0)
+    vertical = long.noether()[:, 2]
+    assert np.abs(vertical - vertical[0]).max() < 1e-13
+    assert np.abs(long.invariants() - long.invariants()[0]).max() < 1e-13
+
+
+def test_a_trajectory_with_an_se3_configuration_saves_and_loads(tmp_path):
+    pytest.importorskip("xarray")
+    pytest.importorskip("netCDF4")
+    ep = lf.EulerPoincare("se3", inertia=np.diag([2.0, 3.0, 4.0, 1.0, 1.5, 2.5]))
+    g0 = _se3_element(np.eye(3), [1.0, 2.0, 3.0])
+    tr = lf.integrate(ep, np.linspace(0.3, -0.6, 6), dt=0.01, steps=100, save_every=10,
+                      attitude=g0)
+    path = tmp_path / "se3.nc"
+    tr.save(path)
+    back = lf.load(path)
+    np.testing.assert_array_equal(back.attitude, tr.attitude)
+    assert back.attitude.shape == (11, 4, 4)
+    np.testing.assert_array_equal(back.noether(), tr.noether())

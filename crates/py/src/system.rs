@@ -336,8 +336,9 @@ impl PySystem {
     /// once, in the order and the words of `lieflow.integrate`.
     ///
     /// Args:
-    ///     state0: as `_normalize_state` reads it; attitude0: None, one (3, 3) rotation (shared
-    ///     by a batch) or one per member (b, 3, 3); dt > 0; method: a name from `methods()`, or
+    ///     state0: as `_normalize_state` reads it; attitude0: None, one (n, n) group element
+    ///     (a rotation (3, 3) for the SO(3) bodies; shared by a batch) or one per member
+    ///     (b, n, n); dt > 0; method: a name from `methods()`, or
     ///     None for the first (the system's default); save_every >= 1; t0 (keyword): the time
     ///     of state0; threads (keyword): None for all cores, or the number of threads; steps
     ///     (keyword): the steps the caller will take in all, to refuse a trajectory that cannot
@@ -388,19 +389,29 @@ impl PySystem {
                 ),
             )));
         }
-        let attitude = match attitude0.is_none() {
-            true => None,
-            false => Some(args::attitude(attitude0, b, batched)?),
+        let with_attitude = !attitude0.is_none();
+        let sys = self.runner(with_attitude)?.clone();
+        // The size n of the attitude: the lifted system's last block (n, n).
+        let n = match with_attitude {
+            true => sys
+                .space()
+                .blocks()
+                .last()
+                .map_or(0, |(_, blk)| blk.shape()[0]),
+            false => 0,
+        };
+        let attitude = match with_attitude {
+            true => Some(args::attitude(attitude0, b, batched, n)?),
+            false => None,
         };
         let threads = args::count_opt("threads", threads.as_ref())?;
-        let sys = self.runner(attitude.is_some())?.clone();
-        let resolved = self.resolve(&sys, attitude.is_some(), method.as_deref());
+        let resolved = self.resolve(&sys, with_attitude, method.as_deref());
         // The members' full states one after the other (each with its attitude).
         let states = match &attitude {
             None => rows,
             Some(a) => {
-                let mut states = Vec::with_capacity(b * (d + 9));
-                for (z, r) in rows.chunks_exact(d.max(1)).zip(a.chunks_exact(9)) {
+                let mut states = Vec::with_capacity(b * (d + n * n));
+                for (z, r) in rows.chunks_exact(d.max(1)).zip(a.chunks_exact(n * n)) {
                     states.extend_from_slice(z);
                     states.extend_from_slice(r);
                 }
@@ -411,7 +422,7 @@ impl PySystem {
             sys,
             states,
             batched,
-            attitude.is_some(),
+            n,
             dt,
             resolved,
             method.as_deref(),

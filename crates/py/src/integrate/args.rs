@@ -156,18 +156,23 @@ pub(crate) fn method(ob: &Bound<'_, PyAny>) -> PyResult<Option<String>> {
     }
 }
 
-/// The initial attitudes of `b` members, (b·9) values: one (3, 3) shared by a batch, or one
-/// per member (b, 3, 3) of a batch; real numbers only (the rule of every array argument),
-/// finite (a NaN named by its member and its entry).
-pub(crate) fn attitude(ob: &Bound<'_, PyAny>, b: usize, batched: bool) -> PyResult<Vec<f64>> {
+/// The initial attitudes (n×n group elements) of `b` members, (b·n²) values: one (n, n)
+/// shared by a batch, or one per member (b, n, n) of a batch; real numbers only (the rule of
+/// every array argument), finite (a NaN named by its member and its entry).
+pub(crate) fn attitude(
+    ob: &Bound<'_, PyAny>,
+    b: usize,
+    batched: bool,
+    n: usize,
+) -> PyResult<Vec<f64>> {
     let check_shape = |shape: &[usize]| {
-        if shape == [3, 3] || batched && shape == [b, 3, 3] {
+        if shape == [n, n] || batched && shape == [b, n, n] {
             return Ok(());
         }
         let want = if batched {
-            format!("(3, 3) or ({b}, 3, 3)")
+            format!("({n}, {n}) or ({b}, {n}, {n})")
         } else {
-            "(3, 3)".to_string()
+            format!("({n}, {n})")
         };
         Err(to_py(Error::shape(
             "attitude",
@@ -189,7 +194,7 @@ pub(crate) fn attitude(ob: &Bound<'_, PyAny>, b: usize, batched: bool) -> PyResu
         None => as_float_array(ob, check_shape)?,
     };
     if let Some(k) = flat.iter().position(|v| !v.is_finite()) {
-        let (m, e) = (k / 9, k % 9);
+        let (m, e) = (k / (n * n), k % (n * n));
         let what = if shape.len() == 3 {
             format!("batch member {m}: attitude")
         } else {
@@ -197,7 +202,7 @@ pub(crate) fn attitude(ob: &Bound<'_, PyAny>, b: usize, batched: bool) -> PyResu
         };
         return Err(to_py(Error::NonFinite {
             what,
-            location: format!("({}, {})", e / 3, e % 3),
+            location: format!("({}, {})", e / n, e % n),
         }));
     }
     Ok(if shape.len() == 2 {

@@ -29,7 +29,7 @@ impl Integration {
         py: Python<'_>,
         until: Until,
     ) -> PyResult<(Vec<Vec<f64>>, usize)> {
-        let full = self.d + if self.attitude { 9 } else { 0 };
+        let full = self.full();
         let sys = &*self.sys;
         let batch = self.runs.get_mut().unwrap_or_else(|p| p.into_inner());
         let b = batch.len();

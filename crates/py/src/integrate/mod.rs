@@ -19,15 +19,15 @@ use crate::convert::{named, real, real_opt, vector, ArrayIn, Real};
 use crate::errors::{raised, to_py, IntoPy};
 use crate::items::Out;
 
-/// The result of `System._run`: states (b, k, d), attitude (b, k, 3, 3) or None, final states
-/// (b, d), final attitude (b, 3, 3) or None.
+/// The result of `System._run`: states (b, k, d), attitude (b, k, n, n) or None, final states
+/// (b, d), final attitude (b, n, n) or None.
 pub(crate) type RunOut<'py> = (Out<'py>, Option<Out<'py>>, Out<'py>, Option<Out<'py>>);
 
-/// Current states (b, d) and attitudes (b, 3, 3) or None.
+/// Current states (b, d) and attitudes (b, n, n) or None.
 type States<'py> = (Out<'py>, Option<Out<'py>>);
 
 /// One call of a run as `lieflow.integrate` assembles it: the times (k,), states (b, k, d) and
-/// attitudes (b, k, 3, 3) or None of its samples, the current states (b, d) and attitudes, the
+/// attitudes (b, k, n, n) or None of its samples, the current states (b, d) and attitudes, the
 /// steps done, the end time of an ended run, the time of the current state (with output times
 /// snapped to, and without), and the events found (None without events).
 type Chunk<'py> = (
@@ -56,7 +56,7 @@ type Whole<'py> = (
 );
 
 /// A located event as Python sees it: (index of the event function, t, state (d,), attitude
-/// (3, 3) or None, absolute step).
+/// (n, n) or None, absolute step).
 type Found<'py> = (
     usize,
     f64,
@@ -86,7 +86,8 @@ pub struct Integration {
     threads: Option<usize>,
     /// Length of a state without the attitude.
     d: usize,
-    attitude: bool,
+    /// The size n of the attitude (an n×n matrix after the state), 0 without one.
+    attitude: usize,
     /// Whether the initial state was a batch (b, d) (else one state (d,), b = 1).
     #[pyo3(get)]
     batched: bool,
@@ -119,7 +120,7 @@ impl Integration {
     /// Advances every member by `steps` steps (in parallel, GIL released).
     ///
     /// Returns:
-    ///     (states (b, k, d), attitude (b, k, 3, 3) or None): the states saved in these steps
+    ///     (states (b, k, d), attitude (b, k, n, n) or None): the states saved in these steps
     ///     (every `save_every`-th step counted from the start of the run, or those at the
     ///     output times of `save_at`; with events, the terminal event's state last).
     /// Raises:
@@ -175,7 +176,7 @@ impl Integration {
 
     /// A plain run (no output times, no events, nothing done yet) in one call, as
     /// `lieflow.integrate` takes a run that fits in one: `steps` steps, returned as the
-    /// trajectory's arrays (t (k,), states (b, k, d), attitudes (b, k, 3, 3) or None, final
+    /// trajectory's arrays (t (k,), states (b, k, d), attitudes (b, k, n, n) or None, final
     /// states (b, d), final attitudes or None, t_final, initial states (b, d), initial attitudes
     /// or None), without the axis b for a single initial state.
     ///
@@ -224,7 +225,7 @@ impl Integration {
         Ok(c)
     }
 
-    /// The initial states (b, d) and attitudes (b, 3, 3) or None.
+    /// The initial states (b, d) and attitudes (b, n, n) or None.
     fn _initial<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
         self.initial_states(py)
     }
@@ -344,7 +345,7 @@ impl Integration {
     }
 
     /// The events located since the last call (and forgets them), in time order: a list of
-    /// (index of the event function, t, state (d,), attitude (3, 3) or None, absolute step).
+    /// (index of the event function, t, state (d,), attitude (n, n) or None, absolute step).
     fn events_found<'py>(&mut self, py: Python<'py>) -> PyResult<Vec<Found<'py>>> {
         let Some(events) = &mut self.events else {
             return Ok(Vec::new());
@@ -356,8 +357,8 @@ impl Integration {
             .into_iter()
             .map(|h| {
                 let state = PyArray1::from_slice(py, &h.state[..d]);
-                let att = if attitude {
-                    Some(PyArray1::from_slice(py, &h.state[d..]).reshape([3, 3])?)
+                let att = if attitude > 0 {
+                    Some(PyArray1::from_slice(py, &h.state[d..]).reshape([attitude, attitude])?)
                 } else {
                     None
                 };
@@ -404,7 +405,7 @@ impl Integration {
     }
 
     /// After a failed `advance`/`finish` of a single run: the states (1, k, d) and attitudes
-    /// (1, k, 3, 3) or None saved by that call before its error (then forgotten); None otherwise.
+    /// (1, k, n, n) or None saved by that call before its error (then forgotten); None otherwise.
     fn take_partial<'py>(
         &mut self,
         py: Python<'py>,
@@ -416,7 +417,7 @@ impl Integration {
         self.arrays(py, data, &[1, k]).map(Some)
     }
 
-    /// The last states that passed the checks (b, d) and attitudes (b, 3, 3) or None: the
+    /// The last states that passed the checks (b, d) and attitudes (b, n, n) or None: the
     /// current states, and after an error the states before the failing step (at
     /// `steps_done`), where the stepper's own `state()` may already be outside the domain.
     fn checked_state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
@@ -429,7 +430,7 @@ impl Integration {
         self.states_of(py, data, runs.len())
     }
 
-    /// The current states (b, d) and attitudes (b, 3, 3) or None.
+    /// The current states (b, d) and attitudes (b, n, n) or None.
     fn state<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
         let data = self.current(py)?;
         self.states_of(py, data, self.members())

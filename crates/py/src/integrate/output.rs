@@ -11,7 +11,7 @@ use crate::errors::IntoPy;
 use crate::items::{array, Out};
 
 impl Integration {
-    /// The states (*lead, d) and attitudes (*lead, 3, 3) or None of `data` (full states).
+    /// The states (*lead, d) and attitudes (*lead, n, n) or None of `data` (full states).
     pub(super) fn arrays<'py>(
         &self,
         py: Python<'py>,
@@ -19,12 +19,12 @@ impl Integration {
         lead: &[usize],
     ) -> PyResult<(Out<'py>, Option<Out<'py>>)> {
         match self.attitude {
-            false => Ok((array(py, &[lead, &[self.d]].concat(), data)?, None)),
-            true => self.arrays_of(py, data.chunks_exact(self.full()), lead),
+            0 => Ok((array(py, &[lead, &[self.d]].concat(), data)?, None)),
+            _ => self.arrays_of(py, data.chunks_exact(self.full()), lead),
         }
     }
 
-    /// The states (*lead, d) and attitudes (*lead, 3, 3) or None of the full states `states`
+    /// The states (*lead, d) and attitudes (*lead, n, n) or None of the full states `states`
     /// (as many as `lead` says), copied once.
     fn arrays_of<'a, 'py>(
         &self,
@@ -36,11 +36,12 @@ impl Integration {
         let n = lead.iter().product();
         let d = self.d;
         let mut z = check::zeros("steps", &[n, d]).py()?;
-        let mut r = match self.attitude {
-            true => check::zeros("steps", &[n, 9]).py()?,
-            false => Vec::new(),
+        let a = self.attitude;
+        let mut r = match a {
+            0 => Vec::new(),
+            _ => check::zeros("steps", &[n, a * a]).py()?,
         };
-        let mut rows = r.chunks_exact_mut(9);
+        let mut rows = r.chunks_exact_mut((a * a).max(1));
         for (s, z) in states.zip(z.chunks_exact_mut(d.max(1))) {
             z.copy_from_slice(&s[..d]);
             if let Some(r) = rows.next() {
@@ -48,14 +49,14 @@ impl Integration {
             }
         }
         let states = array(py, &shape(&[d]), z)?;
-        let att = match self.attitude {
-            true => Some(array(py, &shape(&[3, 3]), r)?),
-            false => None,
+        let att = match a {
+            0 => None,
+            _ => Some(array(py, &shape(&[a, a]), r)?),
         };
         Ok((states, att))
     }
 
-    /// The states (b, k, d) and attitudes (b, k, 3, 3) or None that the members saved in one
+    /// The states (b, k, d) and attitudes (b, k, n, n) or None that the members saved in one
     /// call (member i's k full states in `outs[i]`).
     pub(super) fn saved_arrays<'py>(
         &self,
@@ -67,7 +68,7 @@ impl Integration {
         self.arrays_of(py, states, &[self.members(), k])
     }
 
-    /// (b, d) states and (b, 3, 3) attitudes or None from b full flat states.
+    /// (b, d) states and (b, n, n) attitudes or None from b full flat states.
     pub(super) fn states_of<'py>(
         &self,
         py: Python<'py>,
@@ -94,13 +95,13 @@ impl Integration {
 
     /// The length of a state with its attitude.
     pub(super) fn full(&self) -> usize {
-        self.d + if self.attitude { 9 } else { 0 }
+        self.d + self.attitude * self.attitude
     }
 
     /// The samples of one call, `outs` (member i's k full states in `outs[i]`; a member
     /// absent saved none), with the initial states before them while they are due (the first
     /// call of a run that saves every `save_every`-th state), as arrays (*lead, k', d) and
-    /// (*lead, k', 3, 3) or None (`lead`: [b], or [] for a single run), k' samples per member,
+    /// (*lead, k', n, n) or None (`lead`: [b], or [] for a single run), k' samples per member,
     /// and their times: t₀ + n·(save_every·dt) for the run's n-th sample (a terminal event's
     /// state, saved last, at its time `last`), or the output times of `save_at`.
     pub(super) fn samples<'py>(
@@ -203,7 +204,7 @@ impl Integration {
         Ok((states, att, zf, rf))
     }
 
-    /// The initial states (b, d) and attitudes (b, 3, 3) or None.
+    /// The initial states (b, d) and attitudes (b, n, n) or None.
     pub(super) fn initial_states<'py>(&self, py: Python<'py>) -> PyResult<States<'py>> {
         self.states_of(py, self.initial.clone(), self.members())
     }

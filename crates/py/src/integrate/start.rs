@@ -26,7 +26,7 @@ impl Integration {
         sys: Arc<dyn System>,
         states: Vec<f64>,
         batched: bool,
-        attitude: bool,
+        attitude: usize,
         dt: f64,
         resolved: lieflow::Result<Arc<Resolved>>,
         method: Option<&str>,
@@ -47,7 +47,7 @@ impl Integration {
         }
         let method = resolved.as_ref().map_or(method.unwrap_or(""), |m| m.name);
         let full = sys.space().dim();
-        let d = if attitude { full - 9 } else { full };
+        let d = full - attitude * attitude;
         let members: Vec<&[f64]> = states.chunks_exact(full.max(1)).collect();
         let b = members.len();
         let save = usize::try_from(save_every).unwrap_or(usize::MAX);

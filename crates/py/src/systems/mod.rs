@@ -40,7 +40,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     add_system::<user::canonical::PyCanonical, core::UserCanonical>(m)?;
     add_system::<user::separable::PySeparable, core::UserSeparable>(m)?;
     add_system::<user::lie_poisson::PyLiePoisson, core::LiePoisson>(m)?;
-    add_system::<user::euler_poincare::PyEulerPoincare, core::LiePoisson>(m)?;
+    add_system::<user::euler_poincare::PyEulerPoincare, core::user::EulerPoincare>(m)?;
     // A forced system has the methods of the system it wraps; on the class, a forced
     // canonical system's (those of a forced `Pendulum`).
     let pendulum = core::Pendulum::new(1.0, 1.0, 9.81).py()?;

@@ -33,9 +33,16 @@ use super::{optional, Any, Callee};
 /// version keeps the sign of the parameter term, which the mirror test contradicts). xi is found
 /// from mu by inverting the Legendre transform (Newton's method to round-off for a
 /// non-quadratic l; a singular d2l/dxi2 is an InvalidArgumentError naming the point), and the
-/// energy is E = <mu, xi> - l. Everything else is `LiePoisson`'s: the same algebras and
-/// conventions, and the Casimirs (`invariants`).
-/// Methods: rkmk4 (default), midpoint, midpoint4, rk4 (those of `LiePoisson`).
+/// energy is E = <mu, xi> - l. The algebras, conventions and Casimirs (`invariants`) are
+/// `LiePoisson`'s. With `integrate(..., attitude=g0)` the configuration g (a rotation (3, 3),
+/// an (n, n) element of SO(n), or a homogeneous (4, 4) element of SE(3)) is carried along,
+/// dg/dt = g xi (left) or xi g (right), and, without a parameter, the Noether momentum joins
+/// the invariants (`noether`, 000 Theorems 4.3-4.4).
+/// Methods: variational (default; the discrete Euler–Poincaré method: the Lie group
+/// variational integrator of l, symplectic and symmetric, order 2, keeping the coadjoint orbit
+/// and the Noether momentum to round-off), variational4, variational6 (its compositions of
+/// orders 4 and 6), midpoint, midpoint4 (the Lie midpoint rule and its composition), rkmk4,
+/// rk4.
 ///
 /// Args:
 ///     algebra: "so3", "se3", ("so", n) or structure constants (d, d, d), as `LiePoisson`.
@@ -168,7 +175,7 @@ impl PyEulerPoincare {
             }
         };
         let ep = CoreEp::new(alg, lag, side_of, parameter).py()?;
-        let sys = ep.system().clone();
+        let sys = ep.clone();
         let side = match side_of {
             Side::Left => "left",
             Side::Right => "right",
@@ -195,6 +202,12 @@ impl PyEulerPoincare {
             "parameter_dim",
         ];
         Ok(PySystem::init(PyEulerPoincare { ep }, sys, args, names))
+    }
+
+    /// Names of the observables that take (states, attitude); `Trajectory` passes its attitude.
+    #[classattr]
+    fn _attitude_observables() -> (&'static str,) {
+        ("noether",)
     }
 
     /// dim g (the length of mu).
