@@ -73,6 +73,9 @@ from ._lieflow import (
     System,
     TangentTop,
     WeakFieldTop,
+    inertia_tensor,
+    mass_matrix,
+    spatial_inertia,
 )
 from . import continuation, ellipsoids, elliptic, io, lie, plot, potentials, pseudo_rigid, surfaces
 from . import ensemble  # imports dask and xarray only when its functions are called
@@ -122,12 +125,15 @@ __all__ = [
     "__version__",
     "elliptic",
     "ensemble",
+    "inertia_tensor",
     "integrate",
     "io",
     "lie",
     "load",
+    "mass_matrix",
     "plot",
     "potentials",
     "pseudo_rigid",
+    "spatial_inertia",
     "surfaces",
 ]

@@ -26,6 +26,7 @@ __all__ = [
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
     "RelativisticTangentTop", "WeakFieldTop", "TangentTop", "ChargedParticle", "Canonical",
     "Separable", "LiePoisson", "EulerPoincare", "Forced", "PseudoRigidBody", "__version__",
+    "inertia_tensor", "mass_matrix", "spatial_inertia",
 ]
 
 class LieflowError(ValueError): ...
@@ -444,6 +445,21 @@ class Forced(System):
     def terms(self) -> list[str]: ...
     @property
     def system(self) -> System: ...
+
+def inertia_tensor(
+    masses: ArrayLike | None = None, positions: ArrayLike | None = None, *,
+    shape: Literal["ellipsoid", "box"] | None = None, mass: float | None = None,
+    semi_axes: ArrayLike | None = None,
+) -> _F64:
+    """I = sum m (|x|^2 1 - x x^T) (3, 3) of point masses or of a homogeneous solid (000 §3.1)."""
+def mass_matrix(
+    masses: ArrayLike | None = None, positions: ArrayLike | None = None, *,
+    shape: Literal["ellipsoid", "box"] | None = None, mass: float | None = None,
+    semi_axes: ArrayLike | None = None,
+) -> _F64:
+    """J = sum m x x^T (n, n) of point masses or of a homogeneous solid in R^n."""
+def spatial_inertia(R: ArrayLike, inertia: ArrayLike) -> _F64:
+    """R I R^T (..., 3, 3) (000 (4.1))."""
 
 @final
 class EulerPoincare(System):

@@ -325,3 +325,49 @@ def test_a_trajectory_with_an_se3_configuration_saves_and_loads(tmp_path):
     np.testing.assert_array_equal(back.attitude, tr.attitude)
     assert back.attitude.shape == (11, 4, 4)
     np.testing.assert_array_equal(back.noether(), tr.noether())
+
+
+def test_inertia_from_a_body():
+    # 000 §3.1: 1/2 sum m |w x x|^2 = <w, I w>/2 for point masses; J = sum m x x^T with
+    # I = tr(J) 1 - J; the solids' closed forms; (4.1) J_s = R I R^T with R I W = J_s (R W).
+    rng = np.random.default_rng(5)
+    m, x = rng.uniform(0.2, 2.0, 6), rng.normal(size=(6, 3))
+    inertia = lf.inertia_tensor(m, x)
+    for w in rng.normal(size=(4, 3)):
+        energy = 0.5 * np.sum(m * np.sum(np.cross(w, x) ** 2, axis=1))
+        assert energy == pytest.approx(0.5 * w @ inertia @ w, rel=1e-14)
+    j = lf.mass_matrix(m, x)
+    np.testing.assert_allclose(inertia, np.trace(j) * np.eye(3) - j, atol=1e-14)
+    a = np.array([1.0, 0.7, 0.4])
+    np.testing.assert_allclose(lf.inertia_tensor(shape="ellipsoid", mass=5.0, semi_axes=a),
+                               np.diag([a[1] ** 2 + a[2] ** 2, a[0] ** 2 + a[2] ** 2,
+                                        a[0] ** 2 + a[1] ** 2]), rtol=1e-15)
+    np.testing.assert_allclose(lf.mass_matrix(shape="box", mass=3.0, semi_axes=[1, 2, 1, 1]),
+                               np.diag([1.0, 4.0, 1.0, 1.0]), rtol=1e-15)
+    # The 4-ball's second moment m/(n + 2): J of the ellipsoid in R^4.
+    np.testing.assert_allclose(lf.mass_matrix(shape="ellipsoid", mass=6.0, semi_axes=np.ones(4)),
+                               np.eye(4), rtol=1e-15)
+    r = lf.lie.so3_exp(rng.normal(size=(5, 3)))
+    js = lf.spatial_inertia(r, inertia)
+    assert js.shape == (5, 3, 3)
+    w = np.array([0.3, -0.7, 0.2])
+    np.testing.assert_allclose(js @ (r @ w)[..., None], (r @ (inertia @ w))[..., None],
+                               atol=1e-14)
+    np.testing.assert_allclose(lf.spatial_inertia(np.eye(3), [1.0, 2.0, 3.0]), np.diag([1, 2, 3.0]))
+    # A body built from its inertia: the same motion as RigidBody with that matrix.
+    ep = lf.EulerPoincare("so3", inertia=inertia)
+    a1 = lf.integrate(ep, M0, dt=0.01, steps=100, method="rkmk4").states
+    a2 = lf.integrate(lf.RigidBody(inertia), M0, dt=0.01, steps=100, method="rkmk4").states
+    np.testing.assert_allclose(a1, a2, atol=1e-12)
+    with pytest.raises(lf.InvalidArgumentError, match="masses and positions"):
+        lf.inertia_tensor()
+    with pytest.raises(lf.InvalidArgumentError, match="non-negative"):
+        lf.inertia_tensor([1.0, -1.0], np.ones((2, 3)))
+    with pytest.raises(lf.ShapeError):
+        lf.inertia_tensor([1.0, 1.0], np.ones((2, 2)))
+    with pytest.raises(lf.InvalidArgumentError, match="ellipsoid"):
+        lf.inertia_tensor(shape="cone", mass=1.0, semi_axes=a)
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.inertia_tensor(shape="box", mass=-1.0, semi_axes=a)
+    with pytest.raises(lf.NotInGroupError):
+        lf.spatial_inertia(2 * np.eye(3), inertia)

@@ -27,6 +27,8 @@ ALLOWED = [
      "a real number is a point of the plane on the real axis (gamma as a complex number)"),
     ("GeneralizedRigidBody", "J", "wrong-last-axis", "accepted-bad",
      "J of another length n is the body of another so(n): valid"),
+    ("mass_matrix", "positions", "wrong-last-axis", "accepted-bad",
+     "positions of another dimension n are a body in R^n, whose mass matrix is (n, n): valid"),
     ("pseudo_rigid.equilibrium_directions", "a", "wrong-last-axis", "accepted-bad",
      "semi-axes of another length n are another dimension: valid"),
     ("run.save_at", "t_eval", "wrong-last-axis", "accepted-bad",

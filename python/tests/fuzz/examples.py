@@ -391,6 +391,14 @@ def user_specs(add):
         A("g", np.eye(3), "mat"))
     add("uep.diamond", "@uep.diamond", A("b", M3, "vec"), A("a", np.array([0.0, 0.6, 0.8]), "vec"))
     add("ulpq.structure_constants", "@ulpq.structure_constants")
+    # The inertia of a body (000 §3.1, (4.1)).
+    for f in ("inertia_tensor", "mass_matrix"):
+        add(f, f, A("masses", np.array([1.0, 0.5, 2.0]), "vec"),
+            A("positions", np.array([[0.3, -0.2, 0.5], [1.0, 0.4, -0.7], [-0.6, 0.8, 0.1]]),
+              "mat"))
+        add(f"{f}[solid]", f, A("shape", "ellipsoid", "str", kw=True),
+            A("mass", 2.0, "float", kw=True), A("semi_axes", A3, "vec", kw=True))
+    add("spatial_inertia", "spatial_inertia", A("R", R3, "rot"), A("inertia", A3, "vec"))
     add("ulp.structure_constants", "@ulp.structure_constants")
 
 

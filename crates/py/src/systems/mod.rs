@@ -21,6 +21,7 @@ use lieflow::integrate::System;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     use lieflow::systems as core;
+    tops::inertia::register(m)?;
     add_system::<tops::rigid_body::PyRigidBody, core::RigidBody>(m)?;
     add_system::<tops::generalized::PyGeneralizedRigidBody, core::GeneralizedRigidBody>(m)?;
     add_system::<tops::heavy_top::PyHeavyTop, core::HeavyTop>(m)?;

@@ -185,7 +185,7 @@ impl Group {
     }
 
     /// The scratch of [`Group::follow`].
-    pub(crate) fn scratch(self) -> GroupScratch {
+    pub fn scratch(self) -> GroupScratch {
         let n = self.size();
         GroupScratch {
             exp: SoScratch::new(n),
@@ -256,7 +256,7 @@ impl Group {
     /// g ← g exp(−θ) (left) or exp(θ) g (right): the configuration's step that goes with the
     /// momentum's μ ← exp(θ)·μ (module docs). The product is formed as g + g(exp(∓θ) − I), so
     /// that its rounding errors are relative to |θ||g| rather than |g|.
-    pub(crate) fn follow(self, side: Side, theta: &[f64], g: &mut [f64], s: &mut GroupScratch) {
+    pub fn follow(self, side: Side, theta: &[f64], g: &mut [f64], s: &mut GroupScratch) {
         let n = self.size();
         let sign = side.sign();
         for (t, x) in s.t.iter_mut().zip(theta) {

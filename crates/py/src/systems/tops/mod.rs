@@ -1,9 +1,10 @@
 //! The bodies on SO(3) and so(n) of 000 (`lieflow::systems::tops`): `RigidBody`,
 //! `GeneralizedRigidBody`, `HeavyTop`, `SphericalPendulum`, and what their bindings share (the
-//! inertia argument, the spatial momentum R M).
+//! inertia argument, the spatial momentum R M); `inertia`: the inertia of a body from its masses.
 
 pub(crate) mod generalized;
 pub(crate) mod heavy_top;
+pub(crate) mod inertia;
 pub(crate) mod rigid_body;
 pub(crate) mod spherical_pendulum;
 
