@@ -258,6 +258,23 @@ impl Group {
     /// that its rounding errors are relative to |θ||g| rather than |g|.
     pub fn follow(self, side: Side, theta: &[f64], g: &mut [f64], s: &mut GroupScratch) {
         let n = self.size();
+        if self == Group::So3 {
+            // Rodrigues by increments (so3::Rodrigues): left R ← R exp(θ)ᵀ, every row r ↦
+            // exp(θ) r; right R ← exp(θ) R, every column c ↦ exp(θ) c.
+            let rot = so3::Rodrigues::exp(&Vector3::new(theta[0], theta[1], theta[2]));
+            for k in 0..3 {
+                let at = |i: usize| match side {
+                    Side::Left => k * 3 + i,
+                    Side::Right => i * 3 + k,
+                };
+                let mut v = Vector3::new(g[at(0)], g[at(1)], g[at(2)]);
+                rot.apply(&mut v);
+                for i in 0..3 {
+                    g[at(i)] = v[i];
+                }
+            }
+            return;
+        }
         let sign = side.sign();
         for (t, x) in s.t.iter_mut().zip(theta) {
             *t = -sign * x;
@@ -266,7 +283,7 @@ impl Group {
         self.expm1(&minus[..self.dim()], s);
         s.t = minus;
         match self {
-            Group::So3 => product_add::<3>(side, g, &s.e),
+            Group::So3 => unreachable!("by Rodrigues above"),
             Group::Se3 => product_add::<4>(side, g, &s.e),
             Group::So(_) => {
                 for i in 0..n {

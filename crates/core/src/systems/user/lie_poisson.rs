@@ -507,8 +507,9 @@ impl GroupField for LiePoisson {
         }
         match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
             (Kind::So3, _, _) => {
-                let g = so3::exp_unchecked(&Vector3::from_column_slice(xi));
-                let m = g * Vector3::from_column_slice(z);
+                // By the increment (so3::Rodrigues: no per-step bias of |M|²).
+                let mut m = Vector3::from_column_slice(z);
+                so3::Rodrigues::exp(&Vector3::from_column_slice(xi)).apply(&mut m);
                 z.copy_from_slice(m.as_slice());
             }
             (Kind::Se3, _, _) => {
@@ -520,6 +521,31 @@ impl GroupField for LiePoisson {
             (Kind::So(_), Some(body), Some(so)) => body.act(xi, z, so),
             _ => self.act_generic(xi, z, s),
         }
+    }
+    /// exp(ξ)·z − z formed as an increment on so(3) (Rodrigues) and so(n) (the generalized
+    /// body's kernels), so that the methods add it with compensated summation; with the
+    /// attitude, g's change by [`super::attitude::Group::follow`]. Not for se(3) and structure
+    /// constants (the methods then act directly).
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], s: &mut LieScratch) -> bool {
+        let d = self.algebra.dim;
+        match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
+            (Kind::So3, _, _) => {
+                let inc = so3::Rodrigues::exp(&Vector3::from_column_slice(xi))
+                    .increment(&Vector3::from_column_slice(&z[..3]));
+                dz[..3].copy_from_slice(inc.as_slice());
+            }
+            (Kind::So(_), Some(body), Some(so)) => {
+                body.act_increment(xi, &z[..d], &mut dz[..d], so);
+            }
+            _ => return false,
+        }
+        if let (Some(group), Some(gs)) = (self.group, &mut s.group) {
+            let (g, dg) = (&z[d..], &mut dz[d..]);
+            dg.copy_from_slice(g);
+            group.follow(self.side, &xi[..group.dim()], dg, gs);
+            dg.iter_mut().zip(g).for_each(|(x, y)| *x -= y);
+        }
+        true
     }
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut LieScratch) {
         match (&self.algebra.kind, &self.so_kernels, &mut s.so) {

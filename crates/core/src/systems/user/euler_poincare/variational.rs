@@ -125,6 +125,7 @@ impl Integrator<EulerPoincare> for Variational {
             col: vec![0.0; big],
             out: vec![0.0; big],
             theta: vec![0.0; d],
+            carry: vec![0.0; big],
         }))
     }
 }
@@ -162,6 +163,8 @@ struct VariationalStepper {
     col: Vec<f64>,
     out: Vec<f64>,
     theta: Vec<f64>,
+    /// The low-order parts of y's compensated sum (μ and a).
+    carry: Vec<f64>,
 }
 
 /// Why a substep failed.
@@ -401,34 +404,57 @@ impl VariationalStepper {
             b_next,
             diamond,
             col,
+            r,
+            out,
+            carry,
             y,
             group,
             theta,
             ..
         } = self;
+        // The step's increment Δ = μ̃_{k+1} − μ̃_k (and a_{k+1} − a_k) in `out`, added to y once
+        // with compensated summation (an increment that repeats itself below an ulp of y at a
+        // steady motion would otherwise round the same way every step).
+        out[..big].fill(0.0);
         if m > 0 {
             ep.diamond(b_now, &mu[d..big], diamond);
             for i in 0..d {
                 mu[i] += 0.5 * h * diamond[i];
+                out[i] = 0.5 * h * diamond[i];
             }
         }
         for (c, x) in col.iter_mut().zip(u.iter()) {
             *c = -x;
         }
-        base.act(col, mu, scratch);
+        if base.act_increment(col, mu, r, scratch) {
+            for i in 0..big {
+                out[i] += r[i];
+                mu[i] += r[i];
+            }
+        } else {
+            r[..big].copy_from_slice(&mu[..big]);
+            base.act(col, mu, scratch);
+            for i in 0..big {
+                out[i] += mu[i] - r[i];
+            }
+        }
         if m > 0 {
             ep.diamond(b_next, &mu[d..big], diamond);
             for i in 0..d {
-                mu[i] += 0.5 * h * diamond[i];
+                out[i] += 0.5 * h * diamond[i];
             }
         }
-        if mu[..big].iter().any(|x| !x.is_finite()) {
+        if out[..big].iter().any(|x| !x.is_finite()) {
             return Err(Failure::NotFinite);
         }
-        for i in 0..d {
-            y[i] = s * mu[i];
+        for i in 0..big {
+            let inc = if i < d { s * out[i] } else { out[i] };
+            // Kahan: y += inc, the lost low-order part kept in carry.
+            let t = inc - carry[i];
+            let sum = y[i] + t;
+            carry[i] = (sum - y[i]) - t;
+            y[i] = sum;
         }
-        y[d..big].copy_from_slice(&mu[d..big]);
         if let Some((g, gs)) = group {
             // g ← g exp(ũ) (left) or exp(−ũ) g (right): θ = −ũ in Group::follow.
             for (t, x) in theta.iter_mut().zip(u.iter()) {
@@ -444,6 +470,7 @@ impl VariationalStepper {
 impl Stepper for VariationalStepper {
     fn set(&mut self, z: &[f64]) -> Result<()> {
         self.y.copy_from_slice(z);
+        self.carry.fill(0.0);
         Ok(())
     }
 
