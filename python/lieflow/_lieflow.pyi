@@ -451,7 +451,7 @@ def inertia_tensor(
     shape: Literal["ellipsoid", "box"] | None = None, mass: float | None = None,
     semi_axes: ArrayLike | None = None,
 ) -> _F64:
-    """I = sum m (|x|^2 1 - x x^T) (3, 3) of point masses or of a homogeneous solid (000 §3.1)."""
+    """``I = sum m (x.x 1 - x x^T)`` (3, 3) of point masses or a homogeneous solid (000 §3.1)."""
 def mass_matrix(
     masses: ArrayLike | None = None, positions: ArrayLike | None = None, *,
     shape: Literal["ellipsoid", "box"] | None = None, mass: float | None = None,

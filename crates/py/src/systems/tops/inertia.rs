@@ -53,7 +53,7 @@ fn mass_matrix_of_args(
     }
 }
 
-/// The inertia tensor I = sum_k m_k (|x_k|^2 1 - x_k x_k^T) (3, 3) of a body (000 §3.1): of
+/// The inertia tensor ``I = sum_k m_k (x_k.x_k 1 - x_k x_k^T)`` (3, 3) of a body (000 §3.1): of
 /// point masses (`masses` (k,), `positions` (k, 3) in the body frame), or of a homogeneous
 /// solid in its principal frame (`shape` "ellipsoid" (I = m/5 diag(b^2 + c^2, a^2 + c^2,
 /// a^2 + b^2)) or "box" (m/3 diag(...), semi-axes the half-sides), with `mass` and `semi_axes`
