@@ -371,3 +371,51 @@ def test_inertia_from_a_body():
         lf.inertia_tensor(shape="box", mass=-1.0, semi_axes=a)
     with pytest.raises(lf.NotInGroupError):
         lf.spatial_inertia(2 * np.eye(3), inertia)
+
+
+@pytest.mark.parametrize("method", ["variational", "variational4", "midpoint"])
+def test_an_exception_in_the_lagrangian_ends_the_run_at_its_step(method):
+    # A gradient that raises once, at its 400th call: the run stops at that step with the
+    # exception itself (a note naming the step), the calls of the failing run are those of a
+    # clean run up to that step (nothing called twice), and the partial restarts the motion.
+    log = []
+
+    def grad(w):
+        log.append(float(w[0]))
+        if len(log) == 400:
+            raise KeyError("once")
+        return quartic_grad(w)
+
+    ep = lf.EulerPoincare("so3", quartic, gradient=grad, hessian=quartic_hess)
+    with pytest.raises(KeyError, match="once") as info:
+        lf.integrate(ep, M0, dt=0.01, steps=2000, save_every=5, method=method)
+    notes = " ".join(info.value.__notes__)
+    assert f"of {method}" in notes, notes
+    part, failed = info.value.partial, list(log)
+    assert part.status == -1 and 0 < part.t_final < 20
+    steps = round(part.t_final / 0.01)
+    log.clear()
+    clean = lf.integrate(ep, M0, dt=0.01, steps=steps, save_every=5, method=method)
+    assert failed[:len(log)] == log
+    np.testing.assert_array_equal(part.final_state, clean.final_state)
+    np.testing.assert_array_equal(part.states, clean.states)
+
+
+def atan_l(w):
+    return float(np.sum(w * np.arctan(w) - 0.5 * np.log1p(w * w)))
+
+
+def atan_grad(w):
+    return np.arctan(w)
+
+
+def test_a_momentum_with_no_velocity_is_a_typed_error():
+    # dl/dxi = arctan(xi) is onto (-pi/2, pi/2) only: mu = 1.6 has no velocity; Newton's
+    # iterates run off (xi ~ 1e3 after a few steps) and the inversion stops with an error naming
+    # the momentum, never a NaN or an endless loop. Inside the range it converges (xi = tan mu).
+    ep = lf.EulerPoincare("so3", atan_l, gradient=atan_grad)
+    np.testing.assert_allclose(ep.velocity([1.5, 0.2, -0.1]), np.tan([1.5, 0.2, -0.1]),
+                               rtol=1e-13)
+    with pytest.raises((lf.ConvergenceError, lf.InvalidArgumentError), match="mu") as info:
+        ep.velocity([1.6, 0.0, 0.0])
+    assert "nan" not in str(info.value).lower()
