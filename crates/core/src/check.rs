@@ -105,6 +105,32 @@ pub fn len_of(what: &str, v: &[f64], len: usize) -> Result<()> {
     finite_slice(what, v)
 }
 
+/// Checks a d×d matrix (row-major) `a` described as `expected` in errors: d² values, finite,
+/// symmetric to 10⁻¹² of its largest entry (the error names the worst pair).
+pub fn symmetric(what: &str, expected: &str, a: &[f64], d: usize) -> Result<()> {
+    if a.len() != d * d {
+        return Err(Error::shape(
+            what,
+            format!("{expected} ({d}, {d})"),
+            format!("{} values", a.len()),
+        ));
+    }
+    finite_slice(what, a)?;
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for i in 0..d {
+        for j in i + 1..d {
+            let s = (a[i * d + j] - a[j * d + i]).abs();
+            if s > 1e-12 * scale {
+                return Err(Error::invalid(
+                    what,
+                    format!("must be symmetric: |A[{i}, {j}] − A[{j}, {i}]| = {s:.3e}"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Checks that a scalar is finite and strictly positive.
 pub fn positive(what: &str, x: f64) -> Result<()> {
     if x.is_finite() && x > 0.0 {

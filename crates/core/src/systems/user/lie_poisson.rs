@@ -45,6 +45,14 @@ pub enum Side {
 }
 
 impl Side {
+    /// "left" or "right".
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+
     /// +1 for [`Side::Left`], −1 for [`Side::Right`]: the sign of the bracket.
     pub fn sign(self) -> f64 {
         match self {
@@ -98,29 +106,8 @@ impl LiePoisson {
         let algebra = Structure::new(algebra)?;
         let d = algebra.dim;
         if let LieHamiltonian::Quadratic(a) = &hamiltonian {
-            if a.len() != d * d {
-                return Err(Error::shape(
-                    "hamiltonian",
-                    format!("a symmetric ({d}, {d}) matrix (H = ½ μᵀAμ on a {d}-dimensional g*)"),
-                    format!("{} values", a.len()),
-                ));
-            }
-            check::finite_slice("hamiltonian", a)?;
-            let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            for i in 0..d {
-                for j in i + 1..d {
-                    let s = (a[i * d + j] - a[j * d + i]).abs();
-                    if s > 1e-12 * scale {
-                        return Err(Error::invalid(
-                            "hamiltonian",
-                            format!(
-                                "the quadratic form must be symmetric: |A[{i}, {j}] − A[{j}, {i}]| \
-                                 = {s:.3e}"
-                            ),
-                        ));
-                    }
-                }
-            }
+            let expected = format!("a symmetric matrix (H = ½ μᵀAμ on a {d}-dimensional g*)");
+            check::symmetric("hamiltonian", &expected, a, d)?;
         }
         let so_kernels = match algebra.kind {
             Kind::So(n) => Some(GeneralizedRigidBody::new(&vec![1.0; n])?),

@@ -8,7 +8,6 @@ use std::sync::Arc;
 use lieflow::systems::user::{
     Action, EulerPoincare as CoreEp, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn,
 };
-use lieflow::systems::Side;
 use lieflow::Error;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -176,10 +175,7 @@ impl PyEulerPoincare {
         };
         let ep = CoreEp::new(alg, lag, side_of, parameter).py()?;
         let sys = ep.clone();
-        let side = match side_of {
-            Side::Left => "left",
-            Side::Right => "right",
-        };
+        let side = side_of.name();
         let args = (
             algebra,
             lagrangian,
@@ -231,10 +227,7 @@ impl PyEulerPoincare {
     /// The invariance the Lagrangian has: "left" or "right".
     #[getter]
     fn side(&self) -> &'static str {
-        match self.ep.system().side() {
-            Side::Left => "left",
-            Side::Right => "right",
-        }
+        self.ep.system().side().name()
     }
 
     /// The state (mu[, a]) of the velocity xi (d,) and parameter a (m,): mu = dl/dxi(xi, a).

@@ -193,10 +193,7 @@ impl PyLiePoisson {
             }
         };
         let sys = CoreLiePoisson::new(alg, ham, cas).py()?.with_side(side_of);
-        let side = match side_of {
-            Side::Left => "left",
-            Side::Right => "right",
-        };
+        let side = side_of.name();
         let args = (algebra, hamiltonian, gradient, casimirs, side).into_pyobject(py)?;
         let names = &["algebra", "hamiltonian", "gradient", "casimirs", "side"];
         Ok(PySystem::subclass(sys, args, names))
@@ -205,10 +202,7 @@ impl PyLiePoisson {
     /// The invariance the system is reduced from: "left" or "right".
     #[getter]
     fn side(slf: &Bound<'_, Self>) -> PyResult<&'static str> {
-        Ok(match slf.core::<CoreLiePoisson>()?.side() {
-            Side::Left => "left",
-            Side::Right => "right",
-        })
+        Ok(slf.core::<CoreLiePoisson>()?.side().name())
     }
 
     /// dim g (the length d of a state).

@@ -530,23 +530,8 @@ fn semidirect_constants(c: &[f64], d: usize, rho: &[f64], m: usize) -> Vec<f64> 
 
 /// Checks an inertia operator 𝕀 (d×d): finite, symmetric, positive definite.
 fn check_inertia(i: &[f64], d: usize) -> Result<()> {
-    if i.len() != d * d {
-        return Err(Error::shape(
-            "inertia",
-            format!("a symmetric positive definite ({d}, {d}) matrix"),
-            format!("{} values", i.len()),
-        ));
-    }
-    check::finite_slice("inertia", i)?;
-    let m = DMatrix::from_row_slice(d, d, i);
-    let asym = (&m - m.transpose()).amax();
-    if asym > 1e-12 * m.amax() {
-        return Err(Error::invalid(
-            "inertia",
-            format!("the inertia must be symmetric: max |I - I^T| = {asym:.3e}"),
-        ));
-    }
-    if m.cholesky().is_none() {
+    check::symmetric("inertia", "a symmetric positive definite matrix", i, d)?;
+    if DMatrix::from_row_slice(d, d, i).cholesky().is_none() {
         return Err(Error::invalid(
             "inertia",
             "the inertia must be positive definite (the kinetic energy <xi, I xi>/2 > 0)",
