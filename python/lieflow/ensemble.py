@@ -250,8 +250,9 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     t0 : float, default 0.0
         The time of the initial states; every time is absolute.
     attitude : array_like, optional
-        For systems on SO(3): the initial attitude, one (3, 3) rotation shared by all members
-        or one per member (b, 3, 3); it is then integrated along.
+        The initial configuration of a system on a matrix group (a rotation (3, 3) for the SO(3)
+        bodies, (n, n) in SO(n) or (4, 4) in SE(3) for ``LiePoisson``/``EulerPoincare``), one
+        shared by all members or one per member (b, n, n); it is then integrated along.
 
     Returns
     -------
@@ -340,7 +341,7 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     variables = {"states": (k, d), "energy": (k,), "invariants": (k, n_inv),
                  "final_state": (d,)}
     if att is not None:
-        variables.update(attitude=(k, 3, 3), final_attitude=(3, 3))
+        variables.update(attitude=(k,) + att.shape[-2:], final_attitude=att.shape[-2:])
     arrays = _lazy(dask, da, (_integrate_chunk, f"lieflow-ensemble-{token}"), parts,
                    [hi - lo for lo, hi in bounds], variables)
     dims = {"states": ("member", "time", "component"), "energy": ("member", "time"),

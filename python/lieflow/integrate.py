@@ -377,7 +377,7 @@ def _trajectory(system, run, parts, times, status, ev):
                         for i in range(n)]
         if att0 is not None:
             attitude_events = [np.array([h[3] for h in hits if h[0] == i], dtype=float)
-                               .reshape(-1, 3, 3) for i in range(n)]
+                               .reshape((-1,) + att0.shape[-2:]) for i in range(n)]
     if not run.batched:
         states, z, z0 = states[0], z[0], z0[0]
         if att0 is not None:

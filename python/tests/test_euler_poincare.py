@@ -222,7 +222,8 @@ def test_errors():
     with pytest.raises(lf.InvalidArgumentError, match="parameter_dim"):
         lf.EulerPoincare("so3", top_l, action=cross_action)
     with pytest.raises(lf.InvalidArgumentError, match="vector"):
-        lf.EulerPoincare("se3", top_l, action="vector")
+        lf.EulerPoincare(lf.LiePoisson("so3", np.eye(3)).structure_constants(), top_l,
+                         action="vector")
     with pytest.raises(lf.InvalidArgumentError, match="m >= 1"):
         lf.EulerPoincare("so3", top_l, action=cross_action, parameter_dim=0)
     with pytest.raises(lf.InvalidArgumentError, match="not a representation"):
@@ -419,3 +420,19 @@ def test_a_momentum_with_no_velocity_is_a_typed_error():
     with pytest.raises((lf.ConvergenceError, lf.InvalidArgumentError), match="mu") as info:
         ep.velocity([1.6, 0.0, 0.0])
     assert "nan" not in str(info.value).lower()
+
+
+def test_events_and_ensembles_carry_an_se3_configuration():
+    # The attitude's size follows the group everywhere: events (n_i, 4, 4), the Dask ensemble's
+    # lazy arrays (b, k, 4, 4) (the review of issue 24: both assumed 3 x 3).
+    pytest.importorskip("dask")
+    ep = lf.EulerPoincare("se3", inertia=np.diag([2.0, 3.0, 4.0, 1.0, 1.5, 2.5]))
+    g0 = _se3_element(np.eye(3), [1.0, 2.0, 3.0])
+    mu0 = np.linspace(0.3, -0.6, 6)
+    tr = lf.integrate(ep, mu0, dt=0.01, steps=500, attitude=g0,
+                      events=[lambda t, z: z[0] - 0.25])
+    assert len(tr.t_events[0]) >= 1 and tr.attitude_events[0].shape == (len(tr.t_events[0]), 4, 4)
+    ds = lf.ensemble.integrate(ep, np.tile(mu0, (4, 1)), dt=0.01, steps=50, attitude=g0)
+    assert ds["attitude"].shape == (4, 51, 4, 4) and ds["final_attitude"].shape == (4, 4, 4)
+    direct = lf.integrate(ep, mu0, dt=0.01, steps=50, attitude=g0)
+    np.testing.assert_array_equal(ds["attitude"][2].values, direct.attitude)

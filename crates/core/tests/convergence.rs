@@ -151,6 +151,15 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
     .unwrap()
     .with_attitude()
     .unwrap();
+    // A needle, 𝕀 = diag(1, 1, 10⁻⁶) (cond 10⁶: the Newton matrix is formed, and u's stiff
+    // component is known only to ε·h·cond; the residual in momentum units stops the solve).
+    let ep_needle = EulerPoincare::new(
+        Algebra::So3,
+        Lagrangian::Quadratic(diagonal(&[1.0, 1.0, 1e-6])),
+        Side::Left,
+        None,
+    )
+    .unwrap();
     // ℓ = ½⟨Ω, 𝕀Ω⟩ + |Ω|⁴/8 on se(3) (right-invariant): Newton's Legendre inversion every step.
     let quartic: LagrangianFn = Arc::new(|w: &[f64], _: &[f64]| {
         let n2: f64 = w.iter().map(|x| x * x).sum();
@@ -283,6 +292,11 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
             "EulerPoincare so(3) with attitude".into(),
             Arc::new(ep_quadratic),
             lifted.clone(),
+        ),
+        (
+            "EulerPoincare needle".into(),
+            Arc::new(ep_needle),
+            vec![1.0, 1.0, 1e-6],
         ),
         (
             "EulerPoincare quartic se(3)".into(),

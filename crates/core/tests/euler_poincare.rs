@@ -895,3 +895,72 @@ fn kirchhoffs_body_comes_out_of_its_lagrangian_on_se3() {
         assert!(dist(v.state(k), a.state(k)) < 1e-3, "sample {k}");
     }
 }
+
+#[test]
+fn a_vehicle_on_se3_with_gravity_at_rest_in_translation_is_the_heavy_top() {
+    // ℓ(Ω, V, Γ) = ½⟨(Ω, V), 𝕀(Ω, V)⟩ − mgl⟨Γ, χ⟩ on se(3) with the vector action of its
+    // rotations on Γ (a body in a fluid under gravity): Ṁ = M × Ω + P × V + mgl Γ × χ,
+    // Ṗ = P × Ω, Γ̇ = Γ × Ω. With 𝕀 block-diagonal and P₀ = 0, P stays 0 and (M, Γ) is the heavy
+    // top's motion (an independent route: the built-in HeavyTop).
+    let (mgl, chi) = (0.7, [0.0, 0.6, 0.8]);
+    let masses = [1.0, 1.5, 2.5];
+    let value: LagrangianFn = Arc::new(move |x: &[f64], g: &[f64]| {
+        let t: f64 = (0..3)
+            .map(|i| 0.5 * (I[i] * x[i] * x[i] + masses[i] * x[3 + i] * x[3 + i]))
+            .sum();
+        Ok(t - mgl * (0..3).map(|i| g[i] * chi[i]).sum::<f64>())
+    });
+    let gradient: LagrangianGradientFn = Arc::new(
+        move |x: &[f64], _g: &[f64], dx: &mut [f64], dg: &mut [f64]| {
+            for i in 0..3 {
+                dx[i] = I[i] * x[i];
+                dx[3 + i] = masses[i] * x[3 + i];
+                dg[i] = -mgl * chi[i];
+            }
+            Ok(())
+        },
+    );
+    let vehicle = EulerPoincare::new(
+        Algebra::Se3,
+        Lagrangian::Function {
+            value,
+            gradient: Some(gradient),
+            hessian: None,
+        },
+        Side::Left,
+        Some((Action::Vector, 3)),
+    )
+    .unwrap();
+    assert_eq!(vehicle.dims(), (6, 3));
+    let top = HeavyTop::new(I, mgl, chi).unwrap();
+    let gamma = [0.3, -0.2, 0.87f64.sqrt()];
+    let z_top = top.state(M0, gamma);
+    let z_vehicle = [M0.to_vec(), vec![0.0; 3], gamma.to_vec()].concat();
+    let a = integrate(&vehicle, "variational6", &z_vehicle, 0.02, 500, 50).unwrap();
+    let b = integrate(&top, "splitting8", &z_top, 0.002, 5000, 500).unwrap();
+    for k in 0..a.len() {
+        let (za, zb) = (a.state(k), b.state(k));
+        assert!(
+            za[3..6].iter().all(|p| p.abs() < 1e-15),
+            "sample {k}: P = {:?}",
+            &za[3..6]
+        );
+        let mg = [&za[..3], &za[6..]].concat();
+        assert!(dist(&mg, zb) < 1e-8, "sample {k}");
+    }
+    // A vector action on structure constants is refused.
+    let so3: Vec<f64> = (0..27)
+        .map(|c| match (c / 9, (c / 3) % 3, c % 3) {
+            (0, 1, 2) | (1, 2, 0) | (2, 0, 1) => 1.0,
+            (1, 0, 2) | (2, 1, 0) | (0, 2, 1) => -1.0,
+            _ => 0.0,
+        })
+        .collect();
+    assert!(EulerPoincare::new(
+        Algebra::Constants(so3),
+        heavy_top_lagrangian(mgl, chi),
+        Side::Left,
+        Some((Action::Vector, 3))
+    )
+    .is_err());
+}

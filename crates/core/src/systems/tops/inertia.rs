@@ -51,6 +51,7 @@ pub fn mass_matrix(masses: &[f64], positions: &[f64]) -> Result<(usize, Vec<f64>
         return Err(Error::invalid("masses", "all masses are zero"));
     }
     let n = positions.len() / k;
+    check::array_size("the mass matrix", &[n, n])?;
     let mut j = vec![0.0; n * n];
     for (m, x) in masses.iter().zip(positions.chunks_exact(n)) {
         for a in 0..n {
@@ -79,6 +80,7 @@ pub fn mass_matrix_of(solid: Solid, mass: f64, semi_axes: &[f64]) -> Result<Vec<
     for &a in semi_axes {
         check::positive("semi_axes", a)?;
     }
+    check::array_size("the mass matrix", &[n, n])?;
     let factor = match solid {
         Solid::Ellipsoid => mass / (n + 2) as f64,
         Solid::Box => mass / 3.0,

@@ -54,8 +54,9 @@ use super::{optional, Any, Callee};
 ///         gradient.
 ///     side: "left" (default) or "right".
 ///     action: None (no parameter), "vector" (the defining representation of so3 or ("so", n)
-///         on R^n: xi.a = hat(xi) a, m = n), or a callable (xi, a) -> xi.a, linear in both,
-///         with `parameter_dim` m.
+///         on R^n: xi.a = hat(xi) a, m = n; on se3 its rotation part on R^3: a direction
+///         fixed in space, such as gravity for a vehicle in a fluid), or a callable
+///         (xi, a) -> xi.a, linear in both, with `parameter_dim` m.
 ///     parameter_dim: m for a callable action.
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError (a bad inertia; an action that is not a
@@ -380,9 +381,9 @@ fn action(
             )));
         }
         let n = match alg {
-            lieflow::systems::Algebra::So3 => 3,
+            lieflow::systems::Algebra::So3 | lieflow::systems::Algebra::Se3 => 3,
             lieflow::systems::Algebra::So(n) => *n,
-            _ => 0,
+            lieflow::systems::Algebra::Constants(_) => 0,
         };
         return Ok((Action::Vector, n));
     }

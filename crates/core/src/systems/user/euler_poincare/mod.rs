@@ -76,7 +76,8 @@ pub enum Lagrangian {
 /// How g acts on the parameter space V (of dimension m).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Action {
-    /// The defining representation of so(3) or so(n) on ℝⁿ: ρ(ξ)v = ξ̂v.
+    /// The defining representation of so(3) or so(n) on ℝⁿ: ρ(ξ)v = ξ̂v; on se(3) that of its
+    /// rotation part on ℝ³, ρ(ω, v) = ω̂ (through so(3) = se(3)/ℝ³).
     Vector,
     /// The action on V* as d matrices A_i (m×m, row-major, one after the other): e_i·a = A_i a.
     /// Then ρ(e_i) = −A_iᵀ (checked to be a representation: the Jacobi identity of g ⋉ V).
@@ -310,7 +311,7 @@ impl EulerPoincare {
     ///
     /// Errors: those of the algebra ([`LiePoisson::new`]); an inertia of the wrong size,
     /// non-finite, not symmetric or not positive definite; an action of the wrong size, or
-    /// `Action::Vector` on an algebra that is not so(3) or so(n); matrices that are not a
+    /// `Action::Vector` on structure constants; matrices that are not a
     /// representation (the Jacobi identity of g ⋉ V fails).
     pub fn new(
         algebra: Algebra,
@@ -448,37 +449,48 @@ fn representation(algebra: &Algebra, d: usize, action: &Action, m: usize) -> Res
     match action {
         Action::Vector => {
             let n = match algebra {
-                Algebra::So3 => 3,
+                Algebra::So3 | Algebra::Se3 => 3,
                 Algebra::So(n) => *n,
-                _ => {
+                Algebra::Constants(_) => {
                     return Err(Error::invalid(
                         "action",
                         "the \"vector\" action is the defining representation of so(3) and \
-                         so(n) on R^n; give the action of another algebra as a callable",
+                         so(n) on R^n (and of se(3) through its rotations); give the action of \
+                         another algebra as a callable",
                     ))
                 }
             };
             if m != n {
                 return Err(Error::shape(
                     "parameter",
-                    format!("({n},) (the vector action of so({n}))"),
+                    format!("({n},) (the vector action on R^{n})"),
                     format!("({m},)"),
                 ));
             }
-            let mut rho = Vec::with_capacity(d * n * n);
-            for i in 0..d {
-                let mut e = vec![0.0; d];
-                e[i] = 1.0;
-                // ρ(e_i) = ê_i, row-major.
+            // ρ(e_i) = ê_i (row-major); on se(3) the rotations ê_i (i < 3) and 0 for the
+            // translations: the representation of se(3) through so(3) = se(3)/ℝ³ (a direction
+            // fixed in space seen from a body that also translates, e.g. gravity for a vehicle
+            // in a fluid).
+            let mut rho = vec![0.0; d * n * n];
+            for (i, r) in rho.chunks_exact_mut(n * n).enumerate() {
                 match algebra {
-                    Algebra::So3 => {
-                        let x = crate::lie::so3::hat(&nalgebra::Vector3::new(e[0], e[1], e[2]));
-                        rho.extend((0..9).map(|k| x[(k / 3, k % 3)]));
+                    Algebra::So3 | Algebra::Se3 if i < 3 => {
+                        let mut e = nalgebra::Vector3::zeros();
+                        e[i] = 1.0;
+                        let x = crate::lie::so3::hat(&e);
+                        r.iter_mut()
+                            .enumerate()
+                            .for_each(|(k, v)| *v = x[(k / 3, k % 3)]);
                     }
-                    _ => {
+                    Algebra::So(_) => {
+                        let mut e = vec![0.0; d];
+                        e[i] = 1.0;
                         let x = so::hat_n_unchecked(n, &e);
-                        rho.extend((0..n * n).map(|k| x[(k / n, k % n)]));
+                        r.iter_mut()
+                            .enumerate()
+                            .for_each(|(k, v)| *v = x[(k / n, k % n)]);
                     }
+                    _ => {}
                 }
             }
             Ok(rho)
@@ -612,6 +624,9 @@ impl GroupField for EulerPoincare {
     }
     fn act(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
         self.system.act(xi, z, s)
+    }
+    fn act_increment(&self, xi: &[f64], z: &[f64], dz: &mut [f64], s: &mut LieScratch) -> bool {
+        self.system.act_increment(xi, z, dz, s)
     }
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut LieScratch) {
         self.system.dexp_inv(u, v, out, s)

@@ -48,8 +48,8 @@
 //! else the Hessian at the start guess u = hξ(μ_k) (ξ the Legendre inverse), factored once per
 //! step; for a quadratic ℓ the start guess is of second order (ξ = 𝕀⁻¹ of the momentum at the
 //! step's middle, μ_k + ½ad*_u μ_k).
-//! The rule is [`crate::convergence`]'s ([`RULE`]: the update relative to ‖u‖_∞); a step whose
-//! update is still above the tolerance after [`RULE`]`.max_iter` iterations is
+//! The rule is [`crate::convergence`]'s ([`RULE`]: the residual relative to the momenta); a step
+//! whose residual is still above the tolerance after [`RULE`]`.max_iter` iterations is
 //! [`crate::Error::NotConverged`].
 
 use super::{inverse, mat_vec, EulerPoincare, Lagrangian};
@@ -64,8 +64,11 @@ use crate::numerics::linalg::DenseLu;
 use crate::systems::user::attitude::{Group, GroupScratch};
 use crate::systems::user::lie_poisson::{LiePoisson, LieScratch, Side};
 
-/// The stopping rule of the step's Newton iteration: ‖Δu‖_∞ relative to ‖u‖_∞, accepted below
-/// 10⁻¹², then on while it decreases; ended at once by an update at the rounding of u (2ε).
+/// The stopping rule of the step's Newton iteration: the residual of the momentum equation
+/// relative to the step's momenta (max(‖μ_k‖_∞, ‖λ‖_∞)), accepted below 10⁻¹², then on while
+/// it decreases; ended at once by a residual at the rounding of the momenta (2ε). (In u the
+/// precision of a stiff direction of ℓ'' is only ε·h·cond(ℓ'') of ‖u‖, so the residual, not
+/// the update, says when the step is solved.)
 pub const RULE: Rule = Rule {
     tol: convergence::TOL,
     floor: 2.0 * f64::EPSILON,
@@ -92,6 +95,9 @@ impl Integrator<EulerPoincare> for Variational {
             Lagrangian::Quadratic(i) => (i.clone(), Some(inverse(i, d)?)),
             Lagrangian::Function { .. } => (vec![0.0; d * d], None),
         };
+        let norms = inertia_inv
+            .as_ref()
+            .map(|inv| (row_norm(&hessian, d), row_norm(inv, d)));
         let group = problem
             .system
             .has_attitude()
@@ -111,6 +117,8 @@ impl Integrator<EulerPoincare> for Variational {
             hessian,
             inertia_inv,
             lu: DenseLu::new(d),
+            norms,
+            dense: true,
             y: vec![0.0; n],
             mu: vec![0.0; big],
             u: vec![0.0; big],
@@ -146,6 +154,9 @@ struct VariationalStepper {
     hessian: Vec<f64>,
     inertia_inv: Option<Vec<f64>>,
     lu: DenseLu,
+    /// (‖𝕀‖_∞, ‖𝕀⁻¹‖_∞) of a quadratic ℓ, and whether this step's Newton matrix is formed.
+    norms: Option<(f64, f64)>,
+    dense: bool,
     y: Vec<f64>,
     /// The mirrored momentum (and a), padded to dim g ⋉ V.
     mu: Vec<f64>,
@@ -173,16 +184,18 @@ enum Failure {
     NotConverged(Failed),
 }
 
-/// ℓ''⁻¹v in place: the kept 𝕀⁻¹ of a quadratic ℓ (`tmp`: d values), or the factored Hessian.
-fn apply_inverse(inertia_inv: &Option<Vec<f64>>, lu: &mut DenseLu, v: &mut [f64], tmp: &mut [f64]) {
+/// ‖A‖_∞ (the largest row sum) of a d×d row-major A.
+fn row_norm(a: &[f64], d: usize) -> f64 {
+    a.chunks_exact(d)
+        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// 𝕀⁻¹v in place (`tmp`: d values).
+fn apply_inverse(inertia_inv: &[f64], v: &mut [f64], tmp: &mut [f64]) {
     let d = v.len();
-    match inertia_inv {
-        Some(ai) => {
-            mat_vec(ai, v, &mut tmp[..d]);
-            v.copy_from_slice(&tmp[..d]);
-        }
-        None => lu.solve(v),
-    }
+    mat_vec(inertia_inv, v, &mut tmp[..d]);
+    v.copy_from_slice(&tmp[..d]);
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
@@ -244,31 +257,66 @@ impl VariationalStepper {
         true
     }
 
-    /// The Newton update Δu = K⁻¹w into `r`, w = −(residual) in `r` on entry. K =
+    /// K = (ℓ'' − ½ad*_u ℓ'')/h − ½C(λ) (C(λ)_{·i} = ad*_{e_i} λ) formed at the start guess and
+    /// factored; false if it is singular or not finite.
+    fn factor_newton_matrix(&mut self, h: f64) -> bool {
+        let d = self.d;
+        let Self {
+            base,
+            hessian,
+            lu,
+            col,
+            out,
+            u,
+            lam,
+            ..
+        } = self;
+        let k = lu.matrix();
+        for i in 0..d {
+            col.fill(0.0);
+            for r in 0..d {
+                col[r] = hessian[r * d + i];
+            }
+            base.ad_star(u, col, out);
+            for r in 0..d {
+                k[(r, i)] = (hessian[r * d + i] - 0.5 * out[r]) / h;
+            }
+            col.fill(0.0);
+            col[i] = 1.0;
+            base.ad_star(col, lam, out);
+            for r in 0..d {
+                k[(r, i)] -= 0.5 * out[r];
+            }
+        }
+        lu.factor()
+    }
+
+    /// The Newton update Δu = K⁻¹w into `r`, w = −(residual) in `r` on entry: by the factored
+    /// K where it is formed, else matrix-free (below). K =
     /// (ℓ'' − ½ad*_u ℓ'')/h − ½C(λ) = (ℓ''/h)(1 − P), P = ℓ''⁻¹(½ad*_u ℓ'' + ½hC(λ)) = O(u), is
     /// the residual's derivative to first order in u (dexp_u⁻¹ = 1 − ½ad_u + O(u²)), inverted to
     /// the same order: K⁻¹ = h(1 + P)ℓ''⁻¹ + O(u²). With v = ℓ''⁻¹w, Pv = ℓ''⁻¹(½ad*_u w +
     /// ½h ad*_v λ) (C(λ)v = ad*_v λ): two applications of ℓ''⁻¹ and no matrix to form.
     fn newton_step(&mut self, h: f64) {
         let (d, big) = (self.d, self.u.len());
+        if self.dense {
+            self.lu.solve(&mut self.r[..d]);
+            return;
+        }
         self.r[d..big].fill(0.0);
         self.base.ad_star(&self.u, &self.r, &mut self.out);
-        apply_inverse(
-            &self.inertia_inv,
-            &mut self.lu,
-            &mut self.r[..d],
-            &mut self.theta,
-        );
+        let Some(inv) = &self.inertia_inv else {
+            unreachable!("the matrix-free step is for a quadratic ℓ only")
+        };
+        apply_inverse(inv, &mut self.r[..d], &mut self.theta);
         self.base.ad_star(&self.r, &self.lam, &mut self.col);
         for i in 0..d {
             self.out[i] = 0.5 * self.out[i] + 0.5 * h * self.col[i];
         }
-        apply_inverse(
-            &self.inertia_inv,
-            &mut self.lu,
-            &mut self.out[..d],
-            &mut self.theta,
-        );
+        let Some(inv) = &self.inertia_inv else {
+            unreachable!("the matrix-free step is for a quadratic ℓ only")
+        };
+        apply_inverse(inv, &mut self.out[..d], &mut self.theta);
         for i in 0..d {
             self.r[i] = h * (self.r[i] + self.out[i]);
         }
@@ -334,17 +382,17 @@ impl VariationalStepper {
         if !self.evaluate(h) {
             return Err(Failure::NotFinite);
         }
-        // ℓ'' factored once per step where it is not the constant 𝕀 (whose inverse is kept).
-        if self.inertia_inv.is_none() {
-            let k = self.lu.matrix();
-            for i in 0..d {
-                for j in 0..d {
-                    k[(i, j)] = self.hessian[i * d + j];
-                }
+        // The Newton matrix: matrix-free where its first-order inverse converges fast (a
+        // quadratic ℓ with cond(𝕀)·|u| and h|λ|‖𝕀⁻¹‖ small), else K formed and factored once.
+        self.dense = match self.norms {
+            Some((i, inv)) => {
+                let (u, lam) = (inf_norm(&self.u[..d]), inf_norm(&self.lam[..d]));
+                i * inv * u > 0.1 || h.abs() * lam * inv > 0.1
             }
-            if !self.lu.factor() {
-                return Err(Failure::NotFinite);
-            }
+            None => true,
+        };
+        if self.dense && !self.factor_newton_matrix(h) {
+            return Err(Failure::NotFinite);
         }
         let mut monitor = Monitor::new(RULE);
         loop {
@@ -373,16 +421,22 @@ impl VariationalStepper {
                     r[i] = -(r[i] - 0.5 * h * diamond[i] - mu[i]);
                 }
             }
+            // The residual, in momentum units, relative to the momenta of the step (the
+            // unknown u of a stiff direction of ℓ'' is known only to ε·h·cond(ℓ'')).
+            let residual = inf_norm(&self.r[..d]);
+            let scale = inf_norm(&self.mu[..d])
+                .max(inf_norm(&self.lam[..d]))
+                .max(f64::MIN_POSITIVE);
             self.newton_step(h);
             let mut step = 0.0f64;
             for (x, dx) in self.u[..d].iter_mut().zip(&self.r[..d]) {
                 *x += dx;
                 step = step.max(dx.abs());
             }
-            if !step.is_finite() {
+            if !step.is_finite() || !residual.is_finite() {
                 return Err(Failure::NotFinite);
             }
-            let verdict = monitor.check(step, inf_norm(&self.u[..d]).max(f64::MIN_POSITIVE));
+            let verdict = monitor.check(residual, scale);
             if let Verdict::Failed(failed) = verdict {
                 return Err(Failure::NotConverged(failed));
             }
