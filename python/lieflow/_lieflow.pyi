@@ -466,7 +466,7 @@ class EulerPoincare(System):
     """Mechanics from a reduced Lagrangian l(xi) or l(xi, a) (000 §4): state mu = dl/dxi (d,),
     then a (m,) with an action; left (body) or right (spatial); with attitude=g0 the
     configuration g (3, 3), (n, n) or (4, 4) is carried along. Methods: variational (default,
-    the discrete Euler–Poincaré method), variational4, variational6, midpoint, midpoint4, rkmk4,
+    the discrete Euler–Poincaré method), variational4, variational6, rkmk4, midpoint, midpoint4,
     rk4."""
 
     def __new__(

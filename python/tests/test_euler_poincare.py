@@ -436,3 +436,15 @@ def test_events_and_ensembles_carry_an_se3_configuration():
     assert ds["attitude"].shape == (4, 51, 4, 4) and ds["final_attitude"].shape == (4, 4, 4)
     direct = lf.integrate(ep, mu0, dt=0.01, steps=50, attitude=g0)
     np.testing.assert_array_equal(ds["attitude"][2].values, direct.attitude)
+
+
+def test_attitude_refusals_and_a_step_too_large_are_typed_errors():
+    # Structure constants have no matrix group: no attitude. A step so large that u leaves the
+    # domain of dexp^-1 ends the run with a LeftDomainError naming the step, never NaN.
+    c = lf.LiePoisson("so3", np.eye(3)).structure_constants()
+    for system in (lf.LiePoisson(c, np.eye(3)), lf.EulerPoincare(c, inertia=np.diag(I))):
+        with pytest.raises(lf.InvalidArgumentError, match="no attitude"):
+            lf.integrate(system, M0, dt=0.01, steps=1, attitude=np.eye(3))
+    ep = lf.EulerPoincare("so3", inertia=np.diag(I))
+    with pytest.raises(lf.LeftDomainError, match="step 1"):
+        lf.integrate(ep, 100 * M0, dt=1.0, steps=5)

@@ -964,3 +964,53 @@ fn a_vehicle_on_se3_with_gravity_at_rest_in_translation_is_the_heavy_top() {
     )
     .is_err());
 }
+
+#[test]
+fn the_attitude_field_is_the_one_the_group_methods_integrate() {
+    // ġ = gξ̂ (left) / ξ̂g (right) in the vector field (rk4) against rkmk4's g ← g exp(−θ) /
+    // exp(θ) g: two routes to g(t = 1) that agree to their O(h⁴) error only if the hat of every
+    // group (so(3), so(4) e_ij, se(3)) and the side are right.
+    let mut se3_g0 = vec![0.0; 16];
+    let r = rotation([0.3, -0.5, 0.8], 0.7);
+    for i in 0..3 {
+        se3_g0[i * 4..i * 4 + 3].copy_from_slice(&r[i * 3..i * 3 + 3]);
+        se3_g0[i * 4 + 3] = [0.4, -1.2, 0.9][i];
+    }
+    se3_g0[15] = 1.0;
+    let cases = [
+        (Algebra::So3, diag(&I), vec![1.0, 0.5, -0.3], r.to_vec()),
+        (
+            Algebra::So(4),
+            diag(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]),
+            vec![0.3, -0.2, 0.5, 0.1, 0.4, -0.6],
+            rotation4(0.4, -0.9),
+        ),
+        (
+            Algebra::Se3,
+            diag(&[2.0, 3.0, 4.0, 1.0, 1.5, 2.5]),
+            vec![1.0, 0.5, -0.3, 0.2, -0.1, 0.4],
+            se3_g0,
+        ),
+    ];
+    for (algebra, inertia, mu0, g0) in cases {
+        for side in [Side::Left, Side::Right] {
+            let name = format!("{algebra:?} {side:?}");
+            let ep = EulerPoincare::new(
+                algebra.clone(),
+                Lagrangian::Quadratic(inertia.clone()),
+                side,
+                None,
+            )
+            .unwrap()
+            .with_attitude()
+            .unwrap();
+            let z0 = [mu0.clone(), g0.clone()].concat();
+            let a = integrate(&ep, "rk4", &z0, 0.01, 100, 100).unwrap();
+            let b = integrate(&ep, "rkmk4", &z0, 0.01, 100, 100).unwrap();
+            let n = mu0.len();
+            let err = dist(&a.state(1)[n..], &b.state(1)[n..]);
+            assert!(err < 1e-9, "{name}: {err:e}");
+            assert!(dist(&a.state(1)[n..], &g0) > 0.1, "{name}: g moved");
+        }
+    }
+}

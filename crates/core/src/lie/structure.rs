@@ -347,3 +347,31 @@ fn so_terms(n: usize) -> Vec<Term> {
     }
     terms
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_dual_bernoulli_series_is_the_transpose_of_the_plain_one() {
+        // ⟨(dexp⁻¹_u)ᵀ p, v⟩ = ⟨p, dexp⁻¹_u v⟩ on se(3) (not skew in its coordinates) and so(4).
+        for algebra in [Algebra::Se3, Algebra::So(4)] {
+            let g = Structure::new(algebra).unwrap();
+            let d = g.dim;
+            let u: Vec<f64> = (0..d)
+                .map(|k| 0.3 * ((k as f64 + 1.0) * 1.3).sin())
+                .collect();
+            let p: Vec<f64> = (0..d).map(|k| ((k as f64 + 2.0) * 0.7).cos()).collect();
+            let v: Vec<f64> = (0..d).map(|k| ((k as f64 + 1.0) * 2.1).sin()).collect();
+            let [mut a, mut b, mut c, mut e] = std::array::from_fn(|_| vec![0.0; d]);
+            let (mut dual, mut plain) = (vec![0.0; d], vec![0.0; d]);
+            g.dexp_inv_series(&u, &p, &mut dual, true, [&mut a, &mut b, &mut c, &mut e]);
+            g.dexp_inv_series(&u, &v, &mut plain, false, [&mut a, &mut b, &mut c, &mut e]);
+            let lhs: f64 = dual.iter().zip(&v).map(|(x, y)| x * y).sum();
+            let rhs: f64 = p.iter().zip(&plain).map(|(x, y)| x * y).sum();
+            assert!((lhs - rhs).abs() < 1e-15, "{lhs} {rhs}");
+            // Not the identity: the series has terms.
+            assert!(dual.iter().zip(&p).any(|(x, y)| (x - y).abs() > 1e-3));
+        }
+    }
+}

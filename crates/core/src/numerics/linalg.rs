@@ -77,6 +77,18 @@ pub(crate) fn mul(
     }
 }
 
+/// Kahan's compensated y += inc, entry by entry: the low-order part each addition loses is kept
+/// in `carry` and added back with the next increment, so that an increment which repeats itself
+/// below an ulp of y (a steady motion) does not round the same way every step.
+pub(crate) fn compensated_add(y: &mut [f64], carry: &mut [f64], inc: &[f64]) {
+    for ((yi, ci), &di) in y.iter_mut().zip(carry.iter_mut()).zip(inc) {
+        let d = di - *ci;
+        let t = *yi + d;
+        *ci = (t - *yi) - d;
+        *yi = t;
+    }
+}
+
 /// A dense n×n LU factorization with partial pivoting (faer) whose storage is allocated once:
 /// fill [`DenseLu::matrix`], [`DenseLu::factor`], then [`DenseLu::solve`] any number of times.
 /// Shared by the implicit methods (Gauss, RATTLE, the nonholonomic RATTLE) and the Padé

@@ -164,12 +164,7 @@ impl<P: GroupField> MidpointStepper<P> {
         if problem.act_increment(k, y, dz, scratch) {
             // Kahan's compensated y += dz (as in Rkmk4: at a steady motion the increment of a
             // component kept by the symmetry repeats itself below that component's ulp).
-            for ((yi, ci), &di) in y.iter_mut().zip(carry.iter_mut()).zip(dz.iter()) {
-                let d = di - *ci;
-                let t = *yi + d;
-                *ci = (t - *yi) - d;
-                *yi = t;
-            }
+            crate::numerics::linalg::compensated_add(y, carry, dz);
         } else {
             problem.act(k, y, scratch);
         }

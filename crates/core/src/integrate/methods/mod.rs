@@ -22,7 +22,7 @@ pub use splitting::{ProcessedSplitting, Splitting};
 pub use verlet::Verlet;
 
 use crate::integrate::method::Entry;
-use crate::integrate::problem::{Canonical, VectorField};
+use crate::integrate::problem::{Canonical, GroupField, VectorField};
 
 /// The catalog of a general (non-separable) canonical system: the symplectic Gauss–Legendre
 /// methods "gauss4" (the default), "gauss6", "midpoint", and "rk4" as the non-geometric
@@ -32,6 +32,18 @@ pub fn canonical_catalog<P: Canonical + VectorField + Clone + 'static>() -> Vec<
         Entry::new("gauss4", || Gauss(2)),
         Entry::new("gauss6", || Gauss(3)),
         Entry::new("midpoint", || IMPLICIT_MIDPOINT),
+        Entry::new("rk4", || Rk4),
+    ]
+}
+
+/// The catalog of a [`GroupField`] system with a vector field (the Lie–Poisson systems): RKMK4
+/// "rkmk4", the Lie midpoint "midpoint" and its Suzuki composition "midpoint4" (all on the group
+/// orbit), and "rk4" as the baseline, in that order.
+pub fn group_field_catalog<P: GroupField + VectorField + Clone + 'static>() -> Vec<Entry<P>> {
+    vec![
+        Entry::new("rkmk4", || Rkmk4),
+        Entry::new("midpoint", LieMidpoint::new),
+        Entry::new("midpoint4", || LieMidpoint(Composition::suzuki4())),
         Entry::new("rk4", || Rk4),
     ]
 }

@@ -114,12 +114,7 @@ impl<P: GroupField> RkmkStepper<P> {
             if problem.act_increment(u, y, dz, scratch) {
                 // Kahan's compensated y += dz: a step's rounding is carried into the next
                 // instead of repeating itself at a steady motion (GroupField::act_increment).
-                for ((yi, ci), &di) in y.iter_mut().zip(carry.iter_mut()).zip(dz.iter()) {
-                    let d = di - *ci;
-                    let t = *yi + d;
-                    *ci = (t - *yi) - d;
-                    *yi = t;
-                }
+                crate::numerics::linalg::compensated_add(y, carry, dz);
             } else {
                 problem.act(u, y, scratch);
             }

@@ -21,13 +21,43 @@
 
 use nalgebra::{Matrix3, Matrix4, Vector3, Vector6};
 
-use super::lie_poisson::Side;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::space::Block;
 use crate::lie::structure::Algebra;
 use crate::lie::{se3, so, so3, MatrixLieGroup};
 use crate::systems::tops::generalized::SoScratch;
+
+/// The invariance a Lie–Poisson system comes from, which fixes the sign of its bracket (the
+/// module docs of [`super`], "Left and right"): reduction of a left-invariant system gives
+/// μ̇ = ad*_{∇H} μ (000 §4.1, Theorem 4.3: the body frame), of a right-invariant one
+/// μ̇ = −ad*_{∇H} μ (Theorem 4.4: the spatial frame).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Side {
+    /// Left-invariant (the rigid body in the body frame): μ̇ = ad*_{∇H} μ.
+    #[default]
+    Left,
+    /// Right-invariant (spatial form): μ̇ = −ad*_{∇H} μ.
+    Right,
+}
+
+impl Side {
+    /// "left" or "right".
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+
+    /// +1 for [`Side::Left`], −1 for [`Side::Right`]: the sign of the bracket.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Left => 1.0,
+            Side::Right => -1.0,
+        }
+    }
+}
 
 /// g ← g + gE (left) or g + Eg (right) for N×N row-major matrices (sizes known to the compiler).
 fn product_add<const N: usize>(side: Side, g: &mut [f64], e: &[f64]) {

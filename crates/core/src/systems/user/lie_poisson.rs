@@ -7,7 +7,7 @@ use super::*;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::hooks;
-use crate::integrate::methods::{Composition, LieMidpoint, Rk4, Rkmk4};
+use crate::integrate::methods::group_field_catalog;
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Entry, Problem};
@@ -15,7 +15,7 @@ use crate::lie::structure::{Algebra, Kind, Structure};
 use crate::lie::{se3, so, so3};
 use crate::systems::tops::generalized::{GeneralizedRigidBody, SoScratch};
 
-use super::attitude::{Group, GroupScratch};
+use super::attitude::{Group, GroupScratch, Side};
 
 /// The Hamiltonian of a [`LiePoisson`] system.
 #[derive(Clone)]
@@ -29,37 +29,6 @@ pub enum LieHamiltonian {
         /// ∇H(μ), or `None`.
         gradient: Option<GradientFn>,
     },
-}
-
-/// The invariance a Lie–Poisson system comes from, which fixes the sign of its bracket (module
-/// docs, "Left and right"): reduction of a left-invariant system gives μ̇ = ad*_{∇H} μ (000
-/// §4.1, Theorem 4.3: the body frame), of a right-invariant one μ̇ = −ad*_{∇H} μ (Theorem 4.4:
-/// the spatial frame).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Side {
-    /// Left-invariant (the rigid body in the body frame): μ̇ = ad*_{∇H} μ.
-    #[default]
-    Left,
-    /// Right-invariant (spatial form): μ̇ = −ad*_{∇H} μ.
-    Right,
-}
-
-impl Side {
-    /// "left" or "right".
-    pub fn name(self) -> &'static str {
-        match self {
-            Side::Left => "left",
-            Side::Right => "right",
-        }
-    }
-
-    /// +1 for [`Side::Left`], −1 for [`Side::Right`]: the sign of the bracket.
-    pub fn sign(self) -> f64 {
-        match self {
-            Side::Left => 1.0,
-            Side::Right => -1.0,
-        }
-    }
 }
 
 /// A Lie–Poisson system μ̇ = ±ad*_{∇H} μ on g* (module docs).
@@ -550,12 +519,7 @@ impl Catalog for LiePoisson {
     /// rkmk4 (default), midpoint, midpoint4 (the Lie midpoint and its Suzuki composition),
     /// rk4.
     fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("rkmk4", || Rkmk4),
-            Entry::new("midpoint", LieMidpoint::new),
-            Entry::new("midpoint4", || LieMidpoint(Composition::suzuki4())),
-            Entry::new("rk4", || Rk4),
-        ]
+        group_field_catalog()
     }
 
     /// Double-bracket dissipation of a left-invariant system (the generic construction takes

@@ -89,11 +89,12 @@ use crate::integrate::space::{Block, Space};
 use crate::numerics::fd::{self, Scheme};
 
 pub use crate::lie::structure::Algebra;
+pub use attitude::Side;
 pub use canonical::UserCanonical;
 pub use euler_poincare::{
     Action, EulerPoincare, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn, Legendre,
 };
-pub use lie_poisson::{LieHamiltonian, LiePoisson, LieScratch, Side};
+pub use lie_poisson::{LieHamiltonian, LiePoisson, LieScratch};
 pub use separable::{KineticMass, UserSeparable};
 
 /// H(q, p) of a [`UserCanonical`].

@@ -40,7 +40,7 @@ use super::{optional, Any, Callee};
 /// Methods: variational (default; the discrete Euler–Poincaré method: the Lie group
 /// variational integrator of l, symplectic and symmetric, order 2, keeping the coadjoint orbit
 /// and the Noether momentum to round-off), variational4, variational6 (its compositions of
-/// orders 4 and 6), midpoint, midpoint4 (the Lie midpoint rule and its composition), rkmk4,
+/// orders 4 and 6), rkmk4, midpoint, midpoint4 (the Lie midpoint rule and its composition),
 /// rk4.
 ///
 /// Args:
@@ -380,12 +380,8 @@ fn action(
                 ),
             )));
         }
-        let n = match alg {
-            lieflow::systems::Algebra::So3 | lieflow::systems::Algebra::Se3 => 3,
-            lieflow::systems::Algebra::So(n) => *n,
-            lieflow::systems::Algebra::Constants(_) => 0,
-        };
-        return Ok((Action::Vector, n));
+        // The core refuses the vector action where it has no dimension.
+        return Ok((Action::Vector, Action::vector_dim(alg).unwrap_or(0)));
     }
     let f = Callee::new("action", a)?;
     let m = match parameter_dim {

@@ -35,13 +35,14 @@ use nalgebra::DMatrix;
 pub use variational::Variational;
 
 use super::attitude::Group;
+use super::attitude::Side;
 use super::lie_poisson::LieScratch;
-use super::lie_poisson::{LieHamiltonian, LiePoisson, Side};
+use super::lie_poisson::{LieHamiltonian, LiePoisson};
 use super::{fd_gradient, finite_entries, finite_value, GradientFn, ScalarFn, FD_STEP};
 use crate::check;
 use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::{fmt_num, Error, Result};
-use crate::integrate::methods::{Composition, LieMidpoint, Rk4, Rkmk4};
+use crate::integrate::methods::{group_field_catalog, Composition};
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::Space;
 use crate::integrate::{Catalog, Entry, Problem};
@@ -82,6 +83,18 @@ pub enum Action {
     /// The action on V* as d matrices A_i (m×m, row-major, one after the other): e_i·a = A_i a.
     /// Then ρ(e_i) = −A_iᵀ (checked to be a representation: the Jacobi identity of g ⋉ V).
     Matrices(Vec<f64>),
+}
+
+impl Action {
+    /// m of the vector action on `algebra`: n for so(3) and so(n) (ℝⁿ), 3 for se(3) (its
+    /// rotations on ℝ³); None for structure constants.
+    pub fn vector_dim(algebra: &Algebra) -> Option<usize> {
+        match algebra {
+            Algebra::So3 | Algebra::Se3 => Some(3),
+            Algebra::So(n) => Some(*n),
+            Algebra::Constants(_) => None,
+        }
+    }
 }
 
 /// The stopping rule of the Legendre inversion: the Newton step relative to 1 + ‖ξ‖_∞, ended at
@@ -448,17 +461,13 @@ impl EulerPoincare {
 fn representation(algebra: &Algebra, d: usize, action: &Action, m: usize) -> Result<Vec<f64>> {
     match action {
         Action::Vector => {
-            let n = match algebra {
-                Algebra::So3 | Algebra::Se3 => 3,
-                Algebra::So(n) => *n,
-                Algebra::Constants(_) => {
-                    return Err(Error::invalid(
-                        "action",
-                        "the \"vector\" action is the defining representation of so(3) and \
+            let Some(n) = Action::vector_dim(algebra) else {
+                return Err(Error::invalid(
+                    "action",
+                    "the \"vector\" action is the defining representation of so(3) and \
                          so(n) on R^n (and of se(3) through its rotations); give the action of \
                          another algebra as a callable",
-                    ))
-                }
+                ));
             };
             if m != n {
                 return Err(Error::shape(
@@ -636,17 +645,15 @@ impl GroupField for EulerPoincare {
 impl Catalog for EulerPoincare {
     /// variational (default; the discrete Euler–Poincaré method, order 2), variational4 and
     /// variational6 (its Suzuki and Yoshida compositions), then the Lie–Poisson methods of the
-    /// Hamiltonian form: midpoint, midpoint4, rkmk4, rk4.
+    /// Hamiltonian form (`group_field_catalog`: rkmk4, midpoint, midpoint4, rk4).
     fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![
+        let mut catalog = vec![
             Entry::new("variational", || Variational(Composition::strang())),
             Entry::new("variational4", || Variational(Composition::suzuki4())),
             Entry::new("variational6", || Variational(Composition::yoshida6())),
-            Entry::new("midpoint", LieMidpoint::new),
-            Entry::new("midpoint4", || LieMidpoint(Composition::suzuki4())),
-            Entry::new("rkmk4", || Rkmk4),
-            Entry::new("rk4", || Rk4),
-        ]
+        ];
+        catalog.extend(group_field_catalog());
+        catalog
     }
 
     /// The system with its configuration ([`EulerPoincare::with_attitude`]).

@@ -60,9 +60,9 @@ use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::methods::Composition;
 use crate::integrate::problem::{GroupField, Violation};
 use crate::integrate::Problem;
-use crate::numerics::linalg::DenseLu;
-use crate::systems::user::attitude::{Group, GroupScratch};
-use crate::systems::user::lie_poisson::{LiePoisson, LieScratch, Side};
+use crate::numerics::linalg::{compensated_add, DenseLu};
+use crate::systems::user::attitude::{Group, GroupScratch, Side};
+use crate::systems::user::lie_poisson::{LiePoisson, LieScratch};
 
 /// The stopping rule of the step's Newton iteration: the residual of the momentum equation
 /// relative to the step's momenta (max(‖μ_k‖_∞, ‖λ‖_∞)), accepted below 10⁻¹², then on while
@@ -501,14 +501,8 @@ impl VariationalStepper {
         if out[..big].iter().any(|x| !x.is_finite()) {
             return Err(Failure::NotFinite);
         }
-        for i in 0..big {
-            let inc = if i < d { s * out[i] } else { out[i] };
-            // Kahan: y += inc, the lost low-order part kept in carry.
-            let t = inc - carry[i];
-            let sum = y[i] + t;
-            carry[i] = (sum - y[i]) - t;
-            y[i] = sum;
-        }
+        out[..d].iter_mut().for_each(|x| *x *= s);
+        compensated_add(&mut y[..big], carry, &out[..big]);
         if let Some((g, gs)) = group {
             // g ← g exp(ũ) (left) or exp(−ũ) g (right): θ = −ũ in Group::follow.
             for (t, x) in theta.iter_mut().zip(u.iter()) {
