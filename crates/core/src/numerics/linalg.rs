@@ -89,6 +89,48 @@ pub(crate) fn compensated_add(y: &mut [f64], carry: &mut [f64], inc: &[f64]) {
     }
 }
 
+/// The Cholesky factor of a symmetric positive definite matrix, in place: `a` ← C, lower
+/// triangular with a positive diagonal and CCᵀ = a (the upper triangle is read as the lower's
+/// mirror and zeroed). False when `a` is not positive definite (a pivot ≤ 0 or not finite).
+pub(crate) fn cholesky(mut a: MatMut<'_, f64>) -> bool {
+    let n = a.nrows();
+    for j in 0..n {
+        let mut d = a[(j, j)];
+        for k in 0..j {
+            d -= a[(j, k)] * a[(j, k)];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        let d = d.sqrt();
+        a[(j, j)] = d;
+        for i in j + 1..n {
+            let mut s = a[(i, j)];
+            for k in 0..j {
+                s -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = s / d;
+            a[(j, i)] = 0.0;
+        }
+    }
+    true
+}
+
+/// b ← C⁻¹b for a lower triangular C with a nonzero diagonal (forward substitution on every
+/// column of b).
+pub(crate) fn solve_lower(c: MatRef<'_, f64>, mut b: MatMut<'_, f64>) {
+    let n = c.nrows();
+    for col in 0..b.ncols() {
+        for i in 0..n {
+            let mut s = b[(i, col)];
+            for k in 0..i {
+                s -= c[(i, k)] * b[(k, col)];
+            }
+            b[(i, col)] = s / c[(i, i)];
+        }
+    }
+}
+
 /// A dense n×n LU factorization with partial pivoting (faer) whose storage is allocated once:
 /// fill [`DenseLu::matrix`], [`DenseLu::factor`], then [`DenseLu::solve`] any number of times.
 /// Shared by the implicit methods (Gauss, RATTLE, the nonholonomic RATTLE) and the Padé
