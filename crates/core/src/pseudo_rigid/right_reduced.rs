@@ -263,6 +263,10 @@ impl RightReduced {
     }
 }
 
+/// (Q, N) ↦ (∂𝓛/∂Q, ∂𝓛/∂N) of a Lagrangian 𝓛(Q, N), or the caller's error.
+pub type LagrangianGradient<'a, E> =
+    dyn FnMut(&Mat, &Mat) -> std::result::Result<(Mat, Mat), E> + 'a;
+
 /// The reduced field of a right-invariant Lagrangian 𝓛(Q, N) (001 (3.17), module docs): returns
 /// (Q̇, Ṅ). `gradient(Q, N)` gives (∂𝓛/∂Q over symmetric matrices, ∂𝓛/∂N); D_N(∂𝓛/∂N) and
 /// D_Q(∂𝓛/∂N)[Q̇] are its central differences with steps ε^{1/3}·max(1, max|entry|) (relative
@@ -270,7 +274,7 @@ impl RightReduced {
 /// D_N(∂𝓛/∂N)[Ṅ] = ((∂𝓛/∂N − (∂𝓛/∂N)ᵀ)NᵀQ⁻¹ + 2∂𝓛/∂Q)ᵀ − D_Q(∂𝓛/∂N)[Q̇] (an error when the
 /// Hessian of 𝓛 in N is singular: 𝓛 is then not regular). Errors of `gradient` are returned.
 pub fn euler_lagrange<E: From<Error>>(
-    gradient: &mut dyn FnMut(&Mat, &Mat) -> std::result::Result<(Mat, Mat), E>,
+    gradient: &mut LagrangianGradient<'_, E>,
     q: &Mat,
     nn: &Mat,
 ) -> std::result::Result<(Mat, Mat), E> {
@@ -768,7 +772,7 @@ mod tests {
                         (red.energy(&zp).unwrap() - red.energy(&zm).unwrap()) / (2.0 * h);
                 }
             }
-            for k in 0..2 * n * n {
+            for (k, &dzk) in dz.iter().enumerate() {
                 let mut df = (Mat::zeros(n, n), Mat::zeros(n, n));
                 if k < n * n {
                     df.0[(k / n, k % n)] = 1.0;
@@ -783,9 +787,8 @@ mod tests {
                 )
                 .unwrap();
                 assert!(
-                    (b - dz[k]).abs() < 1e-8 * (1.0 + dz[k].abs()),
-                    "n={n} k={k}: {b} vs {}",
-                    dz[k]
+                    (b - dzk).abs() < 1e-8 * (1.0 + dzk.abs()),
+                    "n={n} k={k}: {b} vs {dzk}"
                 );
             }
         }
