@@ -10,7 +10,7 @@ use lieflow::integrate::problem::Symmetric;
 use lieflow::integrate::{check_state, integrate, System};
 use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
-use lieflow::pseudo_rigid::PseudoRigidBody;
+use lieflow::pseudo_rigid::{PseudoRigidBody, RightReduced};
 use lieflow::systems::{
     GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, RollingDisks, Sphere,
     SphereParticle, SphericalPendulum, TangentTop,
@@ -115,6 +115,9 @@ fn cases() -> Vec<Case> {
         Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()),
         Arc::new(Volumetric::polytropic(0.5, 1.4).unwrap()),
     ]));
+    let right_reduced = RightReduced::new(3, elastic.clone())
+        .unwrap()
+        .reconstructing();
     let incompressible =
         PseudoRigidBody::incompressible(3, Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()))
             .unwrap();
@@ -261,6 +264,20 @@ fn cases() -> Vec<Case> {
             z0: pseudo_rigid_state(3),
             t_end: 1.0,
             dt: 0.01,
+            reverse: |z| negate(9..18)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "RightReduced n = 3 (reconstructing)",
+            system: Arc::new(right_reduced.clone()),
+            z0: {
+                let full = pseudo_rigid_state(3);
+                let m = |o: usize| lieflow::Mat::from_fn(3, 3, |i, j| full[o + 3 * i + j]);
+                right_reduced.reduce(&m(0), &m(9)).unwrap()
+            },
+            t_end: 1.0,
+            dt: 0.01,
+            // (X, P) ↦ (X, −P): Q and X kept, N = XPᵀ negated.
             reverse: |z| negate(9..18)(z),
             long_skip: &[],
         },

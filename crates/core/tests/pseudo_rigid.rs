@@ -522,3 +522,118 @@ fn bad_inputs_are_typed_errors() {
         Err(Error::InvalidArgument { .. })
     ));
 }
+
+/// Kelvin's circulation as a loop integral (001 (2.34)–(2.36)): the space integral ∮ v·dx of a
+/// material loop equals ⟨Γ, ζ⟩ with ζ the loop's oriented areas; the unit square's ζ is its area.
+#[test]
+fn loop_circulation_is_the_pairing_of_gamma_with_the_loop_areas() {
+    let square = Mat::from_fn(4, 2, |k, i| {
+        [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]][k][i]
+    });
+    let z = mo::loop_area(&square).unwrap();
+    assert_eq!((z[(0, 1)], z[(1, 0)]), (1.0, -1.0));
+    for n in [2, 3, 4] {
+        let x = gl_plus(
+            n,
+            &(0..n * n)
+                .map(|k| {
+                    if k % (n + 1) == 0 {
+                        1.5
+                    } else {
+                        0.3 * (k as f64 * 1.7).sin()
+                    }
+                })
+                .collect::<Vec<_>>(),
+        );
+        let v = Mat::from_fn(n, n, |i, j| ((i * 5 + j * 3) as f64).sin());
+        // A closed curve in label space sampled at 64 points (a tilted, off-centre ellipse).
+        let labels = Mat::from_fn(64, n, |k, i| {
+            let s = std::f64::consts::TAU * k as f64 / 64.0;
+            0.2 * i as f64 + (1.0 + 0.3 * i as f64) * (s + i as f64).cos()
+        });
+        let lhs = mo::loop_circulation(&x, &v, &labels).unwrap();
+        let rhs = so::pairing(
+            &mo::circulation(&x, &v).unwrap(),
+            &mo::loop_area(&labels).unwrap(),
+        );
+        assert!(
+            (lhs - rhs).abs() < 1e-12 * (1.0 + rhs.abs()),
+            "n={n}: {lhs} vs {rhs}"
+        );
+        // An irrotational motion (horizontal for the right connection, V = X⁻ᵀS with S
+        // symmetric, 001 (2.21)) has no circulation around any loop.
+        let s = Mat::from_fn(n, n, |i, j| ((i + j) as f64).cos());
+        let v0 = x.transpose().partial_piv_lu().solve(&s);
+        let c = mo::loop_circulation(&x, &v0, &labels).unwrap();
+        assert!(c.abs() < 1e-12 * (1.0 + lhs.abs()), "{c}");
+    }
+    assert!(mo::loop_area(&Mat::zeros(2, 3)).is_err());
+}
+
+/// Guichardet's connection of N particles (001 (2.23)–(2.28)): for particles x = Xu whose labels
+/// have Σ m u uᵀ = 1 it is the left connection ω^L_X(Ẋ), and their locked inertia is A^L_X; in
+/// three dimensions hat⁻¹ω = A⁻¹ Σ m x × ẋ with the inertia tensor A = tr(Q)1 − Q.
+#[test]
+fn guichardet_connection_is_the_left_connection_of_a_homogeneous_body() {
+    for n in [2, 3, 4] {
+        let x = gl_plus(
+            n,
+            &(0..n * n)
+                .map(|k| {
+                    if k % (n + 1) == 0 {
+                        1.2 + 0.1 * k as f64
+                    } else {
+                        0.4 * (k as f64 * 2.3).cos()
+                    }
+                })
+                .collect::<Vec<_>>(),
+        );
+        let y = Mat::from_fn(n, n, |i, j| ((i * 3 + j * 7) as f64).cos());
+        // 2n particles at ±e_i of mass ½: Σ m u uᵀ = 1.
+        let labels = Mat::from_fn(2 * n, n, |a, i| {
+            if a % n == i {
+                if a < n {
+                    1.0
+                } else {
+                    -1.0
+                }
+            } else {
+                0.0
+            }
+        });
+        let masses = vec![0.5; 2 * n];
+        let pos = &labels * x.transpose();
+        let vel = &labels * y.transpose();
+        let w = cn::guichardet_connection(&masses, &pos, &vel).unwrap();
+        let b = BiInertia::new(&x).unwrap();
+        let wl = cn::left_connection(&b, &y).unwrap();
+        assert!(
+            dist(&w, &wl) < 1e-12 * (1.0 + wl.norm_l2()),
+            "n={n}: {}",
+            dist(&w, &wl)
+        );
+        let i_p = cn::particle_locked_inertia(&masses, &pos).unwrap();
+        let i_l = cn::locked_inertia(&b, Action::Left).unwrap();
+        assert!(dist(&i_p, &i_l) < 1e-12 * i_l.norm_l2(), "n={n}");
+    }
+    // Three dimensions, arbitrary particles: the vector form (2.23)–(2.24) with A⁻¹.
+    let masses = [1.0, 2.0, 0.5, 1.5];
+    let pos = Mat::from_fn(4, 3, |a, i| ((a * 3 + i) as f64 * 1.3).sin());
+    let vel = Mat::from_fn(4, 3, |a, i| ((a * 5 + 2 * i) as f64 * 0.7).cos());
+    let (mut q, mut l) = (nalgebra::Matrix3::<f64>::zeros(), Vector3::zeros());
+    for a in 0..4 {
+        let xa = Vector3::new(pos[(a, 0)], pos[(a, 1)], pos[(a, 2)]);
+        let va = Vector3::new(vel[(a, 0)], vel[(a, 1)], vel[(a, 2)]);
+        q += masses[a] * xa * xa.transpose();
+        l += masses[a] * xa.cross(&va);
+    }
+    let inertia = nalgebra::Matrix3::identity() * q.trace() - q;
+    let omega = inertia.try_inverse().unwrap() * l;
+    let w = cn::guichardet_connection(&masses, &pos, &vel).unwrap();
+    let w3 = so3::hat(&omega);
+    let w3 = Mat::from_fn(3, 3, |i, j| w3[(i, j)]);
+    assert!(dist(&w, &w3) < 1e-12 * omega.norm(), "{}", dist(&w, &w3));
+    // Collinear particles: A_Q is singular.
+    let line = Mat::from_fn(4, 3, |a, i| a as f64 * [1.0, 2.0, 3.0][i]);
+    assert!(cn::guichardet_connection(&masses, &line, &vel).is_err());
+}

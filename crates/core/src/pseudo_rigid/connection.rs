@@ -155,3 +155,105 @@ pub fn locked_inertia(b: &BiInertia, action: Action) -> Result<Mat> {
     });
     super::inertia::rescale("the locked inertia tensor", gram, scale, -2)
 }
+
+/// Guichardet's connection of N particles in n dimensions (001 §2.3, (2.23)–(2.26)):
+/// ω = A_Q⁻¹(Σ_α m_α (ẋ_α x_αᵀ − x_α ẋ_αᵀ)) ∈ so(n), A_Q ξ = Qξ + ξQ, Q = Σ_α m_α x_α x_αᵀ — the
+/// rigid rotation that carries the particles' angular momentum (in three dimensions
+/// hat⁻¹ω = A⁻¹ Σ m x × ẋ with A = tr(Q)1 − Q the inertia tensor (2.23), (2.25); the seed's (2.24)
+/// drops the A⁻¹ that (2.26) has). `positions` and `velocities` are N × n (rows x_α, ẋ_α),
+/// masses > 0. For particles x_α = Xu_α whose labels have Σ m u uᵀ = 1, Q = XXᵀ and
+/// Σ m ẋxᵀ = ẊXᵀ: ω is the left connection ω^L_X(Ẋ) (2.14), of which it is thus the discrete
+/// original. A_Q is diagonal in Q's eigenbasis (ξ_ij/(q_i + q_j)); an error where the particles
+/// span fewer than n − 1 dimensions (A_Q singular).
+pub fn guichardet_connection(masses: &[f64], positions: &Mat, velocities: &Mat) -> Result<Mat> {
+    let (q, _) = particle_moments(masses, positions)?;
+    if velocities.nrows() != positions.nrows() || velocities.ncols() != positions.ncols() {
+        return Err(Error::shape(
+            "velocities",
+            format!("({}, {})", positions.nrows(), positions.ncols()),
+            format!("({}, {})", velocities.nrows(), velocities.ncols()),
+        ));
+    }
+    check::finite_mat("velocities", velocities)?;
+    let n = positions.ncols();
+    let mut l = Mat::zeros(n, n);
+    for (a, &m) in masses.iter().enumerate() {
+        for i in 0..n {
+            for j in 0..n {
+                l[(i, j)] += m
+                    * (velocities[(a, i)] * positions[(a, j)]
+                        - positions[(a, i)] * velocities[(a, j)]);
+            }
+        }
+    }
+    let eig = q
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|e| Error::invalid("positions", format!("eigen-decomposition failed: {e:?}")))?;
+    let (v, s) = (eig.U(), eig.S());
+    let lt = v.transpose() * &l * v;
+    let scale = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
+    let mut w = Mat::zeros(n, n);
+    for i in 0..n {
+        for j in 0..n {
+            if i != j {
+                let d = s[i] + s[j];
+                if d.is_nan() || d <= 1e-14 * scale {
+                    return Err(Error::invalid(
+                        "positions",
+                        "the particles lie on a line (or at one point): the locked inertia \
+                         A_Q ξ = Qξ + ξQ is singular and the connection is not defined",
+                    ));
+                }
+                w[(i, j)] = lt[(i, j)] / d;
+            }
+        }
+    }
+    Ok(v * w * v.transpose())
+}
+
+/// The locked inertia of N particles (001 (2.27)): the Gram matrix
+/// 𝕀_ab = Σ_α m_α (e_a x_α)·(e_b x_α) of the rotation generators e_a (so(n)'s e_ij basis, as
+/// [`locked_inertia`]), i.e. the matrix of A_Q; for x_α = Xu_α with Σ m u uᵀ = 1 it is the
+/// pseudo-rigid body's locked inertia of the left action (A^L_X).
+pub fn particle_locked_inertia(masses: &[f64], positions: &Mat) -> Result<Mat> {
+    let (q, n) = particle_moments(masses, positions)?;
+    let d = so::dim(n);
+    let basis: Vec<Mat> = (0..d)
+        .map(|k| {
+            let mut c = vec![0.0; d];
+            c[k] = 1.0;
+            so::hat_n_unchecked(n, &c)
+        })
+        .collect();
+    // Σ m (e_a x)·(e_b x) = tr(e_aᵀ e_b Q).
+    Ok(Mat::from_fn(d, d, |a, b| {
+        let p = basis[a].transpose() * &basis[b] * &q;
+        (0..n).map(|i| p[(i, i)]).sum()
+    }))
+}
+
+/// Q = Σ m x xᵀ of N particles (checked: masses > 0 and finite, N × n positions finite, n ≥ 2).
+fn particle_moments(masses: &[f64], positions: &Mat) -> Result<(Mat, usize)> {
+    let n = positions.ncols();
+    if positions.nrows() != masses.len() || n < 2 {
+        return Err(Error::shape(
+            "positions",
+            format!("({}, n) with n ≥ 2, one row per mass", masses.len()),
+            format!("({}, {})", positions.nrows(), n),
+        ));
+    }
+    for &m in masses {
+        check::positive("masses", m)?;
+    }
+    check::finite_mat("positions", positions)?;
+    let mut q = Mat::zeros(n, n);
+    for (a, &m) in masses.iter().enumerate() {
+        for i in 0..n {
+            for j in 0..n {
+                q[(i, j)] += m * positions[(a, i)] * positions[(a, j)];
+            }
+        }
+    }
+    check::finite_mat("Q", &q).map_err(|_| check::overflow_error("positions", "Σ m x xᵀ"))?;
+    Ok((q, n))
+}

@@ -53,6 +53,67 @@ pub fn circulation(x: &Mat, v: &Mat) -> Result<Mat> {
     momentum_map_scaled(x, v).1
 }
 
+/// Kelvin's circulation ∮_C v·dx of the material loop C = X(C₀) (001 §2.5, (2.34)): C₀ is the
+/// closed polygon through the label points u_0, …, u_{m−1} (rows of `labels`, m × n; closed back
+/// to u_0), its particles sit at x = Xu and move with v = Vu. Computed in space, segment by
+/// segment: v is linear and dx constant along a segment, so ∫ v·dx = ½(v_k + v_{k+1})·(x_{k+1} −
+/// x_k) exactly. Equals ⟨Γ, ζ⟩ = ½ tr(Γᵀζ) with Γ = VᵀX − XᵀV and ζ = [`loop_area`] (2.35) —
+/// the circulation Γ is the loop integral of every loop at once, so Kelvin's theorem (the loop
+/// integral is constant along the motion) is the conservation of Γ.
+pub fn loop_circulation(x: &Mat, v: &Mat, labels: &Mat) -> Result<f64> {
+    let n = check_state(x, v)?;
+    check_loop(labels, n)?;
+    let (xs, vs) = (labels * x.transpose(), labels * v.transpose());
+    let m = labels.nrows();
+    let mut s = 0.0;
+    for k in 0..m {
+        let l = (k + 1) % m;
+        for i in 0..n {
+            s += 0.5 * (vs[(k, i)] + vs[(l, i)]) * (xs[(l, i)] - xs[(k, i)]);
+        }
+    }
+    if !s.is_finite() {
+        return Err(check::overflow_error("labels", "∮ v·dx"));
+    }
+    Ok(s)
+}
+
+/// The oriented areas ζ_ij = ∫_{S₀} du_i ∧ du_j = ∮_{C₀} u_i du_j (001 (2.36)) of the closed
+/// polygon C₀ through the rows of `labels` (m × n, m ≥ 3): a skew n×n matrix (ζ_ij is the area of
+/// the loop's projection onto the (i, j) plane, counterclockwise positive). Exact for the polygon
+/// (u_i is linear and du_j constant along a segment); the skew part is taken, which removes the
+/// round-off of the exact zero ∮ d(u_i u_j)/2.
+pub fn loop_area(labels: &Mat) -> Result<Mat> {
+    let n = labels.ncols();
+    check_loop(labels, n)?;
+    let m = labels.nrows();
+    let mut z = Mat::zeros(n, n);
+    for k in 0..m {
+        let l = (k + 1) % m;
+        for i in 0..n {
+            for j in 0..n {
+                z[(i, j)] +=
+                    0.5 * (labels[(k, i)] + labels[(l, i)]) * (labels[(l, j)] - labels[(k, j)]);
+            }
+        }
+    }
+    let z = (&z - z.transpose()) * faer::Scale(0.5);
+    check::finite_mat("loop area", &z).map_err(|_| check::overflow_error("labels", "ζ"))?;
+    Ok(z)
+}
+
+/// A loop's label points: m ≥ 3 rows of n finite values.
+fn check_loop(labels: &Mat, n: usize) -> Result<()> {
+    if labels.ncols() != n || labels.nrows() < 3 {
+        return Err(Error::shape(
+            "labels",
+            format!("(m, {n}) with m ≥ 3 points of a closed loop"),
+            format!("({}, {})", labels.nrows(), labels.ncols()),
+        ));
+    }
+    check::finite_mat("labels", labels)
+}
+
 /// Momentum map J(X, P) = L ⊕ Γ of the two-sided SO(n)×SO(n) action (001 (7.2)).
 /// Scale-aware; an overflow error where L or Γ exceeds the f64 range.
 pub fn momentum_map(x: &Mat, p: &Mat) -> Result<(Mat, Mat)> {
