@@ -583,3 +583,52 @@ fn bad_input_gets_typed_errors() {
         .exact_momentum(&[1.0, 0.0, 1.0 / 3f64.sqrt() * 0.0 + 1.0], f64::NAN)
         .is_err());
 }
+
+/// 000 Theorem 4.11 (Noether with a broken symmetry) for the built-in heavy top with attitude:
+/// gravity breaks SO(3) down to the rotations about the vertical, so the spatial angular momentum
+/// s = R M obeys ṡ = mgl e₃ × Rχ (checked by central differences along the run) and only its
+/// vertical component e₃·s is conserved (to round-off by lgvi, which is equivariant under that
+/// subgroup), while the horizontal ones move.
+#[test]
+fn heavy_top_noether_with_symmetry_breaking_theorem_4_11() {
+    let (mgl, chi) = (0.8, [0.1, 0.2, 1.0]);
+    let top = lieflow::systems::HeavyTop::new([1.0, 1.4, 2.1], mgl, chi)
+        .unwrap()
+        .with_attitude();
+    let r0 = lieflow::lie::so3::exp_unchecked(&Vector3::new(0.5, -0.3, 0.2));
+    let r0: [f64; 9] = std::array::from_fn(|k| r0[(k / 3, k % 3)]);
+    let z0 = top.state_with_attitude([0.4, -0.9, 1.3], r0);
+    let chi = Vector3::from(chi).normalize();
+    let spatial = |z: &[f64]| {
+        let r = nalgebra::Matrix3::from_row_slice(&z[6..15]);
+        (r * Vector3::new(z[0], z[1], z[2]), r * chi)
+    };
+    let dt = 1e-3;
+    let t = lieflow::integrate::integrate(&top, "splitting6", &z0, dt, 4000, 1).unwrap();
+    let mut worst = 0.0f64;
+    for k in 1..t.len() - 1 {
+        let (sp, _) = spatial(t.state(k + 1));
+        let (sm, _) = spatial(t.state(k - 1));
+        let (_, rchi) = spatial(t.state(k));
+        let rate = (sp - sm) / (2.0 * dt);
+        let expected = mgl * Vector3::z().cross(&rchi);
+        worst = worst.max((rate - expected).norm());
+    }
+    assert!(worst < 1e-5, "ṡ − mgl e₃ × Rχ: {worst}");
+    let long = lieflow::integrate::integrate(&top, "lgvi", &z0, 0.01, 100_000, 1000).unwrap();
+    let (s0, _) = spatial(&z0);
+    let mut horizontal = 0.0f64;
+    for k in 0..long.len() {
+        let (s, _) = spatial(long.state(k));
+        assert!(
+            (s.z - s0.z).abs() < 1e-12,
+            "e₃·RM drifted by {}",
+            s.z - s0.z
+        );
+        horizontal = horizontal.max((s.xy() - s0.xy()).norm());
+    }
+    assert!(
+        horizontal > 0.1,
+        "the horizontal components should move: {horizontal}"
+    );
+}
