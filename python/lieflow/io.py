@@ -105,6 +105,7 @@ ALLOWED_CALLS = frozenset({
     "lieflow:LiePoisson",
     "lieflow:Pendulum",
     "lieflow:PseudoRigidBody",
+    "lieflow.pseudo_rigid:RightReduced",
     "lieflow:RelativisticTangentTop",
     "lieflow:RigidBody",
     "lieflow:RollingDisk",

@@ -3,23 +3,27 @@
 # xi block first. Every function of arrays except stratum, reduce and adjoint_motion maps over
 # leading axes that broadcast as numpy's: a scalar result is a float for one item, an array
 # for many.
-from typing import Any, Literal, TypedDict
+from typing import Any, Callable, Literal, TypedDict
 
 from typing_extensions import final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._lieflow import System
+from .potentials import Potential
+
 _F64 = NDArray[np.float64]
 __all__ = [
-    "RelativeEquilibrium", "Stability", "Verdict", "adjoint_motion", "amended_hessian",
+    "RelativeEquilibrium", "RightReduced", "Stability", "Verdict", "adjoint_motion", "amended_hessian",
     "amended_potential", "angular_momentum", "augmented_gradient", "augmented_hessian",
     "augmented_potential", "bi_connection", "bi_inertia", "bi_inertia_apply", "bi_inertia_eigen",
     "bi_inertia_quadratic_form", "bi_inertia_solve", "circulation", "equilibrium_directions",
-    "from_body", "horizontal_part", "index_symbols", "kinetic_energy", "left_connection",
-    "left_inertia", "locked_inertia", "reconstruct", "reduce", "relative_equilibria",
-    "riemann_bracket", "riemann_variables", "right_connection", "right_inertia", "stratum",
-    "to_body", "vertical_vector",
+    "from_body", "guichardet_connection", "horizontal_part", "index_symbols", "kinetic_energy",
+    "left_connection", "left_inertia", "locked_inertia", "loop_area", "loop_circulation",
+    "particle_locked_inertia", "reconstruct", "reduce", "reduced_euler_lagrange",
+    "relative_equilibria", "riemann_bracket", "riemann_variables", "right_connection",
+    "right_inertia", "stratum", "to_body", "vertical_vector",
 ]
 
 _Action = Literal["two-sided", "left", "right"]
@@ -190,3 +194,37 @@ class RelativeEquilibrium:
     def motion(self, t: ArrayLike) -> tuple[_F64, _F64]:
         """(X(t), P(t)), each (k, n, n)."""
     def stability(self) -> Stability: ...
+
+def loop_circulation(X: ArrayLike, V: ArrayLike, labels: ArrayLike) -> float:
+    """Kelvin's circulation of the material loop X(C0), C0 the closed polygon through the rows
+    of ``labels`` (001 (2.34)); equals ``<Gamma, loop_area(labels)>``."""
+def loop_area(labels: ArrayLike) -> _F64:
+    """The oriented areas zeta_ij of the closed polygon through the rows of ``labels``
+    (001 (2.36)), a skew (n, n) array."""
+def guichardet_connection(masses: ArrayLike, positions: ArrayLike, velocities: ArrayLike) -> _F64:
+    """Guichardet's connection of N particles (001 (2.23)-(2.26)), a skew (n, n) array."""
+def particle_locked_inertia(masses: ArrayLike, positions: ArrayLike) -> _F64:
+    """The locked inertia of N particles (001 (2.27)) in so(n)'s e_ij basis."""
+def reduced_euler_lagrange(
+    lagrangian: Callable[[_F64, _F64], float], Q: ArrayLike, N: ArrayLike,
+    gradient: Callable[[_F64, _F64], tuple[ArrayLike, ArrayLike]] | None = None,
+) -> tuple[_F64, _F64]:
+    """(dQ/dt, dN/dt) of the reduced Euler-Lagrange equation (001 (3.17)) of L(Q, N)."""
+
+@final
+class RightReduced(System):
+    """The pseudo-rigid body reduced by its right SO(n) symmetry (001 §3) on T*GL+(n)/SO(n),
+    state (Q, N[, X]) row-major."""
+    def __new__(cls, n: int, potential: Potential | None = None,
+                reconstruct: bool = False) -> RightReduced: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def reconstruct_configuration(self) -> bool: ...
+    @property
+    def potential(self) -> Potential: ...
+    def reduce(self, X: ArrayLike, P: ArrayLike) -> _F64: ...
+    def reconstruct(self, states: ArrayLike) -> tuple[_F64, _F64]: ...
+    def hamiltonian_parts(self, states: ArrayLike) -> _F64: ...
+    def angular_momentum(self, states: ArrayLike) -> _F64: ...
+    def circulation(self, states: ArrayLike) -> _F64: ...

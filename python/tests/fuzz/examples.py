@@ -199,6 +199,11 @@ def event_m2(t, state):
     return state[1]
 
 
+def riemann_lagrangian(Q, N):
+    """The free body's L(Q, N) = tr(N^T Q^-1 N)/2 (001 (3.18))."""
+    return 0.5 * float(np.trace(N.T @ np.linalg.solve(Q, N)))
+
+
 def _svk(lf):
     return lf.potentials.SaintVenantKirchhoff(1.0, 2.0)
 
@@ -215,6 +220,7 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "disk": lambda lf: lf.RollingDisk(1.0, 0.5, 0.125, 0.0625, spring=0.4),
     "prb": lambda lf: lf.PseudoRigidBody(3, _svk(lf)),
     "iprb": lambda lf: lf.PseudoRigidBody(3, _svk(lf), incompressible=True),
+    "rrb": lambda lf: lf.pseudo_rigid.RightReduced(3, _svk(lf), reconstruct=True),
     "rtt": lambda lf: lf.RelativisticTangentTop(1.0, 0.2, lf.surfaces.Sphere(1.0)),
     "wft": lambda lf: lf.WeakFieldTop(1.0, 1e-3, gm=1e-4),
     "tt": lambda lf: lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
@@ -276,6 +282,7 @@ def state_of(key):
         "prb": lambda lf, s: np.concatenate([X3.ravel(), V3.ravel()]),
         "iprb": lambda lf, s: np.concatenate([X3.ravel(),
                                               s.project_momentum(X3, V3).ravel()]),
+        "rrb": lambda lf, s: s.reduce(X3, V3),
         "rtt": lambda lf, s: np.asarray(s.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)),
         "wft": lambda lf, s: np.asarray(s.state([1.0, 0.5], 0.1, [0.1, 0.2], 0.3)),
         "tt": lambda lf, s: np.asarray(s.state([1.0, 0.3], 0.2, [0.1, 0.3], 1.5)),
@@ -286,13 +293,14 @@ def state_of(key):
     return Lazy(lambda lf: makers[key](lf, RECEIVERS[key](lf)))
 
 
-SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "iprb", "rtt", "wft", "tt", "cp",
+SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "iprb", "rrb", "rtt", "wft", "tt", "cp",
            "rds", "rsph"]
 CONSTRUCTORS = {  # class name -> receiver key built by it
     "RigidBody": "rb", "GeneralizedRigidBody": "grb", "HeavyTop": "ht", "SphericalPendulum": "sp",
     "Pendulum": "pend", "SphereParticle": "spart", "RollingDisk": "disk", "PseudoRigidBody": "prb",
     "RelativisticTangentTop": "rtt", "WeakFieldTop": "wft", "TangentTop": "tt",
     "ChargedParticle": "cp", "RollingDisks": "rds", "RollingSpheres": "rsph",
+    "RightReduced": "rrb",
 }
 
 
@@ -600,6 +608,20 @@ def build_specs() -> list[Spec]:
         A("p_a", np.array([0.1, -0.2, 0.05]), "vec"), A("p_Omega", XI, "skew"),
         A("p_Lambda", ETA, "skew"))
     add(P + "adjoint_motion", P + "adjoint_motion", A("X", X3, "gl"), A("P", V3, "mat"))
+    LOOP = np.array([[1.0, 0.0, 0.2], [0.0, 1.0, -0.1], [-1.0, 0.0, 0.3], [0.0, -1.0, 0.0]])
+    add(P + "loop_circulation", P + "loop_circulation", A("X", X3, "gl"), A("V", V3, "mat"),
+        A("labels", LOOP, "mat"))
+    add(P + "loop_area", P + "loop_area", A("labels", LOOP, "mat"))
+    add(P + "guichardet_connection", P + "guichardet_connection",
+        A("masses", np.array([1.0, 2.0, 0.5, 1.5]), "vec"), A("positions", LOOP, "mat"),
+        A("velocities", V3 @ LOOP.T @ np.ones((4, 3)) * 0.1 + LOOP, "mat"))
+    add(P + "particle_locked_inertia", P + "particle_locked_inertia",
+        A("masses", np.array([1.0, 2.0, 0.5, 1.5]), "vec"), A("positions", LOOP, "mat"))
+    add(P + "reduced_euler_lagrange", P + "reduced_euler_lagrange",
+        A("lagrangian", riemann_lagrangian, "fn"), A("Q", X3 @ X3.T, "mat"),
+        A("N", X3 @ V3.T, "mat"), A("gradient", None, "obj", opt=True))
+    add(P + "RightReduced", P + "RightReduced", A("n", 3, "int", positive=True),
+        A("potential", Lazy(_svk), "obj", opt=True), A("reconstruct", True, "bool", kw=True))
     svk = Lazy(_svk)
     for f in ("amended_potential", "amended_hessian"):
         add(P + f, P + f, A("X", X3, "gl"), A("lam", XI, "skew"), A("gam", ETA, "skew"),
@@ -761,6 +783,9 @@ def build_specs() -> list[Spec]:
         "prb": [(f, [A("states", state_of("prb"), "vec")])
                 for f in ("angular_momentum", "circulation", "singular_values")]
         + [("project_momentum", [A("X", X3, "gl"), A("P", V3, "mat")])],
+        "rrb": [(f, [A("states", state_of("rrb"), "vec")])
+                for f in ("angular_momentum", "circulation", "hamiltonian_parts", "reconstruct")]
+        + [("reduce", [A("X", X3, "gl"), A("P", V3, "mat")])],
         "iprb": [(f, [A("states", state_of("iprb"), "vec")])
                  for f in ("angular_momentum", "circulation", "singular_values")]
         + [("project_momentum", [A("X", X3, "gl"), A("P", V3, "mat")])],
@@ -831,7 +856,7 @@ def build_specs() -> list[Spec]:
         add(f"integrate[{key}]", "integrate", A("system", lazy_recv(key), "obj"),
             A("state0", state_of(key), "vec"), A("dt", 0.01, "float", kw=True),
             A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True),
-            slow=key in ("prb", "iprb", "rtt", "tt", "cp", "rds", "rsph"))
+            slow=key in ("prb", "iprb", "rrb", "rtt", "tt", "cp", "rds", "rsph"))
     ht_att = Lazy(lambda lf: RECEIVERS["ht"](lf).state(M3, attitude=R3))
     for key, st in (("rb", state_of("rb")), ("ht", ht_att)):
         add(f"integrate[{key},attitude]", "integrate", A("system", lazy_recv(key), "obj"),

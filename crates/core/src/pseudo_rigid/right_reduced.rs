@@ -159,29 +159,12 @@ impl RightReduced {
         Ok((x, pt.transpose().to_owned()))
     }
 
-    /// The Cholesky factor C of Q (CCᵀ = Q), or an error naming Q when it is not positive
-    /// definite.
-    fn representative(&self, q: &Mat) -> Result<Mat> {
-        let n = self.n();
-        let mut c = q.clone();
-        if !linalg::cholesky(c.as_mut()) {
-            return Err(Error::NotInGroup {
-                what: "Q".into(),
-                group: format!("Sym+({n})"),
-                defect_name: "positive definiteness (Cholesky pivot)".into(),
-                defect: f64::NAN,
-                tol: 0.0,
-            });
-        }
-        Ok(c)
-    }
-
     /// (C, P_C) with CCᵀ = Q and P_C = NᵀC⁻ᵀ: the representative of the state's orbit the
     /// reduced quantities are evaluated at.
     fn representative_state(&self, z: &[f64]) -> Result<(Mat, Mat)> {
         let (q, nn) = self.split(z)?;
         check::finite_slice("state", z)?;
-        let c = self.representative(&q)?;
+        let c = cholesky_of(&q)?;
         let mut w = nn;
         linalg::solve_lower(c.as_ref(), w.as_mut());
         Ok((c, w.transpose().to_owned()))
@@ -269,27 +252,27 @@ pub type LagrangianGradient<'a, E> =
 
 /// The reduced field of a right-invariant Lagrangian 𝓛(Q, N) (001 (3.17), module docs): returns
 /// (Q̇, Ṅ). `gradient(Q, N)` gives (∂𝓛/∂Q over symmetric matrices, ∂𝓛/∂N); D_N(∂𝓛/∂N) and
-/// D_Q(∂𝓛/∂N)[Q̇] are its central differences with steps ε^{1/3}·max(1, max|entry|) (relative
-/// error ≈ 1e-10 for a smooth 𝓛), and Ṅ solves
+/// D_Q(∂𝓛/∂N)[Q̇] are its central differences with steps h·max(1, max|entry|): h = ε^{1/3} for
+/// a gradient exact to round-off (relative error ≈ 1e-10 for a smooth 𝓛), h = ε^{2/9} when
+/// `gradient_is_difference` (a gradient that is itself [`lagrangian_gradient`], whose error
+/// ε^{2/3} the outer difference divides by h: ≈ 1e-7), and Ṅ solves
 /// D_N(∂𝓛/∂N)[Ṅ] = ((∂𝓛/∂N − (∂𝓛/∂N)ᵀ)NᵀQ⁻¹ + 2∂𝓛/∂Q)ᵀ − D_Q(∂𝓛/∂N)[Q̇] (an error when the
 /// Hessian of 𝓛 in N is singular: 𝓛 is then not regular). Errors of `gradient` are returned.
 pub fn euler_lagrange<E: From<Error>>(
     gradient: &mut LagrangianGradient<'_, E>,
     q: &Mat,
     nn: &Mat,
+    gradient_is_difference: bool,
 ) -> std::result::Result<(Mat, Mat), E> {
-    let step = f64::EPSILON.cbrt();
+    let step = match gradient_is_difference {
+        false => f64::EPSILON.cbrt(),
+        true => f64::EPSILON.powf(2.0 / 9.0),
+    };
     let n = check::square("Q", q, 1)?;
     check::square_of("N", nn, n)?;
     check::finite_mat("Q", q)?;
     check::finite_mat("N", nn)?;
-    let c = {
-        let mut c = q.clone();
-        if !linalg::cholesky(c.as_mut()) {
-            return Err(Error::invalid("Q", "Q = XXᵀ must be symmetric positive definite").into());
-        }
-        c
-    };
+    let c = cholesky_of(q)?;
     let q_dot = nn + nn.transpose();
     let (gq, gn) = gradient(q, nn)?;
     check::square_of("∂L/∂Q", &gq, n)?;
@@ -332,6 +315,61 @@ pub fn euler_lagrange<E: From<Error>>(
     }
     let n_dot = Mat::from_fn(n, n, |i, j| sol[(i * n + j, 0)]);
     Ok((q_dot, n_dot))
+}
+
+/// (∂𝓛/∂Q over symmetric matrices, ∂𝓛/∂N) of a Lagrangian given by its values, by central
+/// differences with steps ε^{1/3}·max(1, max|entry|) (relative error ≈ 1e-10 for a smooth 𝓛; the
+/// gradient [`euler_lagrange`] needs when the caller has none). Q_ij and Q_ji move together, so
+/// the difference quotient is G_ij + G_ji = 2G_ij off the diagonal.
+pub fn lagrangian_gradient(
+    value: &dyn Fn(&Mat, &Mat) -> Result<f64>,
+    q: &Mat,
+    nn: &Mat,
+) -> Result<(Mat, Mat)> {
+    let n = check::square("Q", q, 1)?;
+    check::square_of("N", nn, n)?;
+    let step = f64::EPSILON.cbrt();
+    let (hq, hn) = (
+        step * check::max_abs(q).max(1.0),
+        step * check::max_abs(nn).max(1.0),
+    );
+    let mut gq = Mat::zeros(n, n);
+    let mut gn = Mat::zeros(n, n);
+    for i in 0..n {
+        for j in 0..n {
+            if j >= i {
+                let e = Mat::from_fn(n, n, |a, b| {
+                    f64::from(u8::from((a, b) == (i, j) || (a, b) == (j, i)))
+                });
+                let d = (value(&(q + &e * faer::Scale(hq)), nn)?
+                    - value(&(q - &e * faer::Scale(hq)), nn)?)
+                    / (2.0 * hq);
+                let g = if i == j { d } else { 0.5 * d };
+                gq[(i, j)] = g;
+                gq[(j, i)] = g;
+            }
+            let e = Mat::from_fn(n, n, |a, b| f64::from(u8::from((a, b) == (i, j))));
+            gn[(i, j)] = (value(q, &(nn + &e * faer::Scale(hn)))?
+                - value(q, &(nn - &e * faer::Scale(hn)))?)
+                / (2.0 * hn);
+        }
+    }
+    Ok((gq, gn))
+}
+
+/// The Cholesky factor C of Q (CCᵀ = Q), or an error naming Q when it is not positive definite.
+fn cholesky_of(q: &Mat) -> Result<Mat> {
+    let mut c = q.clone();
+    if !linalg::cholesky(c.as_mut()) {
+        return Err(Error::NotInGroup {
+            what: "Q".into(),
+            group: format!("Sym+({})", q.nrows()),
+            defect_name: "positive definiteness (Cholesky pivot)".into(),
+            defect: f64::NAN,
+            tol: 0.0,
+        });
+    }
+    Ok(c)
 }
 
 fn read(n: usize, z: &[f64]) -> Mat {
@@ -400,7 +438,7 @@ impl Problem for RightReduced {
                 tol: STATE_TOL,
             });
         }
-        let c = self.representative(&q)?;
+        let c = cholesky_of(&q)?;
         self.check_invariance(&c)?;
         if self.reconstruct {
             let x = read(n, &z[2 * n * n..]);
@@ -856,7 +894,7 @@ mod tests {
             let dk_dq = &qi * nn * nn.transpose() * &qi * faer::Scale(-0.5);
             Ok((dk_dq - dv, &qi * nn))
         };
-        let (qd, nd) = euler_lagrange(&mut grad, &q, &nn).unwrap();
+        let (qd, nd) = euler_lagrange(&mut grad, &q, &nn, false).unwrap();
         let (qr, nr) = red.full().riemann_vector_field(&q, &nn).unwrap();
         assert!(rel(&qd, &qr) < 1e-14);
         assert!(rel(&nd, &nr) < 1e-8, "{}", rel(&nd, &nr));
@@ -883,7 +921,7 @@ mod tests {
         let e0 = energy(&q, &nn);
         let h = 2e-3;
         for _ in 0..500 {
-            let mut f = |q: &Mat, nn: &Mat| euler_lagrange(&mut grad2, q, nn).unwrap();
+            let mut f = |q: &Mat, nn: &Mat| euler_lagrange(&mut grad2, q, nn, false).unwrap();
             let (k1q, k1n) = f(&q, &nn);
             let (k2q, k2n) = f(
                 &(&q + &k1q * faer::Scale(h / 2.0)),
@@ -907,12 +945,12 @@ mod tests {
         let e1 = energy(&q, &nn);
         assert!((e1 - e0).abs() < 1e-8 * e0.abs(), "{e0} → {e1}");
         // A sign error in (3.17)'s first term would not keep it: flip it and see.
-        let (_, good) = euler_lagrange(&mut grad2, &q, &nn).unwrap();
+        let (_, good) = euler_lagrange(&mut grad2, &q, &nn, false).unwrap();
         let mut flipped = |q: &Mat, nn: &Mat| -> Result<(Mat, Mat)> {
             let (dq, dn) = grad2(q, nn)?;
             Ok((dq, dn.transpose().to_owned()))
         };
-        let (_, bad) = euler_lagrange(&mut flipped, &q, &nn).unwrap();
+        let (_, bad) = euler_lagrange(&mut flipped, &q, &nn, false).unwrap();
         assert!(rel(&bad, &good) > 1e-3);
     }
 

@@ -15,6 +15,7 @@ pub mod ellipsoids;
 pub mod equilibria;
 pub mod gravity;
 pub mod potential;
+pub mod right_reduced;
 pub mod system;
 
 use lieflow::lie::gl::STRATUM_TOL;
@@ -609,6 +610,14 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reduce, m)?)?;
     m.add_function(wrap_pyfunction!(reconstruct, m)?)?;
     m.add_function(wrap_pyfunction!(adjoint_motion, m)?)?;
+    m.add_function(wrap_pyfunction!(loop_circulation, m)?)?;
+    m.add_function(wrap_pyfunction!(loop_area, m)?)?;
+    m.add_function(wrap_pyfunction!(guichardet_connection, m)?)?;
+    m.add_function(wrap_pyfunction!(particle_locked_inertia, m)?)?;
+    m.add_function(wrap_pyfunction!(right_reduced::reduced_euler_lagrange, m)?)?;
+    crate::system::add_system::<right_reduced::PyRightReduced, lieflow::pseudo_rigid::RightReduced>(
+        m,
+    )?;
     equilibria::register(m)?;
     gravity::register(m)?;
     Ok(())
@@ -713,4 +722,92 @@ pub fn adjoint_motion<'py>(
             .map_err(|e| crate::errors::to_py(lieflow::Error::invalid("X", e.to_string())))
     };
     Ok((arr(xt)?, arr(pt)?))
+}
+
+/// Kelvin's circulation of a material loop (001 §2.5, (2.34)): the integral of v.dx around the
+/// loop C = X(C0) in space, where C0 is the closed polygon through the label points (rows of
+/// `labels`; closed back to the first), its particles at x = X u moving with v = V u.
+///
+/// Equals <Gamma, zeta> = tr(Gamma^T zeta)/2 with Gamma = V^T X - X^T V the circulation and
+/// zeta = `loop_area(labels)` (2.35): Kelvin's theorem (the integral is constant along a motion
+/// for every loop) is the conservation of Gamma. Exact for the polygon (computed in space,
+/// segment by segment).
+///
+/// Args:
+///     X: (n, n) with det X > 0; V: (n, n) velocity; labels: (m, n), m >= 3.
+/// Raises:
+///     ShapeError, NonFiniteError, NotInGroupError.
+#[pyfunction]
+pub fn loop_circulation(X: ArrayIn<'_>, V: ArrayIn<'_>, labels: ArrayIn<'_>) -> PyResult<f64> {
+    let labels = mat("labels", &labels)?;
+    mo::loop_circulation(&mat("X", &X)?, &mat("V", &V)?, &labels).py()
+}
+
+/// The oriented areas zeta_ij = integral over S0 of du_i ^ du_j = loop integral of u_i du_j
+/// (001 (2.36)) of the closed polygon through the rows of `labels` ((m, n), m >= 3): a skew
+/// (n, n) array whose (i, j) entry is the area of the loop's projection on the (u_i, u_j) plane
+/// (counterclockwise positive).
+///
+/// Raises:
+///     ShapeError, NonFiniteError.
+#[pyfunction]
+pub fn loop_area<'py>(
+    py: Python<'py>,
+    labels: ArrayIn<'py>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    Ok(py_mat(py, &mo::loop_area(&mat("labels", &labels)?).py()?))
+}
+
+/// Guichardet's connection of N particles (001 §2.3, (2.23)–(2.26)):
+/// omega = A_Q^-1 (sum_a m_a (v_a x_a^T - x_a v_a^T)) in so(n), A_Q xi = Q xi + xi Q,
+/// Q = sum_a m_a x_a x_a^T: the rigid rotation that carries the particles' angular momentum (in
+/// three dimensions hat^-1(omega) = A^-1 sum m x cross v with the inertia tensor
+/// A = tr(Q) 1 - Q). For particles x = X u whose labels have sum m u u^T = 1 it is the left
+/// connection `left_connection(X, V)` (2.14): the pseudo-rigid body's connection is its
+/// continuum case.
+///
+/// Args:
+///     masses: (N,) > 0; positions, velocities: (N, n).
+/// Returns:
+///     (n, n) skew array.
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError (masses <= 0; particles on a line).
+#[pyfunction]
+pub fn guichardet_connection<'py>(
+    py: Python<'py>,
+    masses: Bound<'py, PyAny>,
+    positions: ArrayIn<'py>,
+    velocities: ArrayIn<'py>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let masses = crate::convert::real_vec(&masses)?;
+    let (x, v) = (
+        mat("positions", &positions)?,
+        mat("velocities", &velocities)?,
+    );
+    Ok(py_mat(
+        py,
+        &cn::guichardet_connection(&masses, &x, &v).py()?,
+    ))
+}
+
+/// The locked inertia of N particles (001 (2.27)): the Gram matrix
+/// I_ab = sum_a m_a (e_a x_a).(e_b x_a) of so(n)'s basis e_ij (i < j, the order of
+/// `locked_inertia`), the matrix of A_Q; for x = X u with sum m u u^T = 1 it equals
+/// `locked_inertia(X, "left")`.
+///
+/// Args:
+///     masses: (N,) > 0; positions: (N, n).
+/// Returns:
+///     (d, d) array, d = n(n-1)/2.
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError.
+#[pyfunction]
+pub fn particle_locked_inertia<'py>(
+    py: Python<'py>,
+    masses: Bound<'py, PyAny>,
+    positions: ArrayIn<'py>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let masses = crate::convert::real_vec(&masses)?;
+    let x = mat("positions", &positions)?;
+    Ok(py_mat(py, &cn::particle_locked_inertia(&masses, &x).py()?))
 }

@@ -1,0 +1,245 @@
+//! `lieflow.pseudo_rigid.RightReduced` and `reduced_euler_lagrange`: bindings of
+//! `lieflow::pseudo_rigid::right_reduced` (001 §3, reduction by the right SO(n) action). A thin
+//! subclass of `lieflow.System`: constructor, reduce/reconstruct and observables.
+#![allow(non_snake_case)]
+
+use lieflow::pseudo_rigid::right_reduced::{self as rr, RightReduced as Core};
+use lieflow::{Error, Mat};
+use pyo3::prelude::*;
+use pyo3::PyClassInitializer;
+
+use super::potential::{PyPotential, Zero};
+use crate::convert::{int, mat, py_mat, ArrayIn};
+use crate::errors::{raised, to_py, IntoPy};
+use crate::system::{PySystem, Thin};
+
+type Any<'py> = Bound<'py, PyAny>;
+
+/// A pseudo-rigid body reduced by its right SO(n) symmetry, the relabelling of its particles
+/// (001 §3): a system on T*GL+(n)/SO(n) in the Riemann variables Q = X X^T, N = X P^T.
+///
+/// H = tr(N^T Q^-1 N)/2 + U, the motion is the Riemann system (001 (3.20)) and the Poisson
+/// structure (9.1). The circulation Gamma = P^T X - X^T P is the momentum map of the symmetry:
+/// its spectral invariants are the Casimirs (the reduced spaces Gamma^-1(gamma)/G_gamma of
+/// 001 (3.27)), and with `reconstruct=True` the system carries X along, so the full motion and
+/// its circulation come back with `reconstruct(states)`.
+///
+/// Args:
+///     n: dimension (>= 2).
+///     potential: a `lieflow.potentials` potential, right SO(n)-invariant (every built-in one
+///         is; a Callable potential is checked at the initial state: InvalidArgumentError if
+///         U(Xh) != U(X)). Default Zero().
+///     reconstruct: carry X (state (Q, N, X), 3n² values) instead of (Q, N) (2n² values).
+///
+/// Methods: verlet (default), verlet4, verlet6, rk4. The Verlet methods are the full body's
+/// Störmer–Verlet step reduced: a kick N <- N - tau C (dU/dX(C))^T (C C^T = Q) and the exact
+/// drift Q <- Q + tau (N + N^T) + tau^2 K, N <- N + tau K, K = N^T Q^-1 N, and their Suzuki /
+/// Yoshida compositions: Poisson maps that keep the Casimirs to round-off and reconstruct
+/// exactly the full Verlet motion of the same steps. rk4 integrates the Riemann field, as a
+/// baseline. Q cannot see the sign of det X: integrate motions that collapse through
+/// det X = 0 with the full `PseudoRigidBody`.
+///
+/// States are flat: (Q row-major, N row-major[, X row-major]); make them with
+/// `body.reduce(X, P)`. Invariants: tr((L^T L)^k)/2 then tr((Gamma^T Gamma)^k)/2,
+/// k = 1..n//2 (the full body's values).
+#[pyclass(module = "lieflow.pseudo_rigid", name = "RightReduced", extends = PySystem, frozen)]
+pub struct PyRightReduced {
+    potential: Py<PyPotential>,
+}
+
+fn body<'a>(slf: &'a Bound<'_, PyRightReduced>) -> PyResult<&'a Core> {
+    slf.core()
+}
+
+fn flat(m: &Mat, out: &mut [f64]) {
+    let n = m.nrows();
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = m[(k / n, k % n)];
+    }
+}
+
+#[pymethods]
+impl PyRightReduced {
+    #[new]
+    #[pyo3(signature = (n, potential=None, reconstruct=false))]
+    fn new(
+        py: Python<'_>,
+        #[pyo3(from_py_with = int)] n: i64,
+        potential: Option<Bound<'_, PyPotential>>,
+        reconstruct: bool,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let size = usize::try_from(n)
+            .map_err(|_| to_py(Error::invalid("n", format!("expected n ≥ 2, got {n}"))))?;
+        let potential = match potential {
+            Some(p) => p,
+            None => Bound::new(py, Zero(py)?)?,
+        };
+        let mut core = Core::new(size, potential.get().inner.clone()).py()?;
+        if reconstruct {
+            core = core.reconstructing();
+        }
+        let args = (n, potential.clone(), reconstruct).into_pyobject(py)?;
+        let this = PyRightReduced {
+            potential: potential.unbind(),
+        };
+        Ok(PySystem::init(
+            this,
+            core,
+            args,
+            &["n", "potential", "reconstruct"],
+        ))
+    }
+
+    /// The dimension n.
+    #[getter(n)]
+    fn get_n(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(body(slf)?.n())
+    }
+
+    /// Whether X is carried along (state (Q, N, X)).
+    #[getter]
+    fn reconstruct_configuration(slf: &Bound<'_, Self>) -> PyResult<bool> {
+        Ok(body(slf)?.is_reconstructing())
+    }
+
+    /// The potential.
+    #[getter]
+    fn potential(&self, py: Python<'_>) -> Py<PyPotential> {
+        self.potential.clone_ref(py)
+    }
+
+    /// The reduced state of a full one: (Q, N) = (X X^T, X P^T) (001 (3.4)), then X when the
+    /// system reconstructs.
+    ///
+    /// Args:
+    ///     X: (n, n) with det X > 0; P: (n, n).
+    /// Returns:
+    ///     (d,) flat state.
+    /// Raises:
+    ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+    fn reduce<'py>(
+        slf: &Bound<'py, Self>,
+        X: ArrayIn<'py>,
+        P: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+        let z = body(slf)?.reduce(&mat("X", &X)?, &mat("P", &P)?).py()?;
+        Ok(numpy::PyArray1::from_vec(slf.py(), z))
+    }
+
+    /// The full states (X, P = N^T X^-T) of states (..., d) of a reconstructing system ->
+    /// ((..., n, n), (..., n, n)).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (the system does not carry X), ShapeError, NonFiniteError.
+    fn reconstruct<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let b = body(slf)?;
+        let n = b.n();
+        let both = slf
+            .base()
+            .map_states(slf.py(), &states, &[2, n, n], |z, out| {
+                let (x, p) = b.reconstruct(z)?;
+                flat(&x, &mut out[..n * n]);
+                flat(&p, &mut out[n * n..]);
+                Ok(())
+            })?;
+        // (..., 2, n, n) -> the two (..., n, n) halves.
+        let py = slf.py();
+        let all = pyo3::types::PySlice::full(py);
+        let half = |k: usize| both.get_item((pyo3::types::PyEllipsis::get(py), k, &all, &all));
+        Ok((half(0)?, half(1)?).into_pyobject(py)?.into_any())
+    }
+
+    /// The three terms of the reduced Hamiltonian 001 (3.31) at the state's circulation gamma:
+    /// [<Y, Y>/2 (the horizontal kinetic energy, on T*(GL+(n)/SO(n))),
+    /// <gamma, (A^R_X)^-1 gamma>/2 (the locked energy of the relabelling), U]; they add up to H.
+    /// States (..., d) -> (..., 3).
+    fn hamiltonian_parts<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let b = body(slf)?;
+        slf.base().map_states(slf.py(), &states, &[3], |z, out| {
+            out.copy_from_slice(&b.hamiltonian_parts(z)?);
+            Ok(())
+        })
+    }
+
+    /// Angular momentum L = N^T - N (001 (2.29), (3.10)) of states (..., d) -> (..., n, n).
+    fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let b = body(slf)?;
+        let n = b.n();
+        slf.base().map_states(slf.py(), &states, &[n, n], |z, out| {
+            flat(&b.angular_momentum(z)?, out);
+            Ok(())
+        })
+    }
+
+    /// The circulation at the representative C (the Cholesky factor of Q):
+    /// Gamma_C = C^-1 N C - C^T N^T C^-T, conjugate to the circulation of every X over (Q, N)
+    /// (equal to it up to a rotation of the labels). States (..., d) -> (..., n, n).
+    fn circulation<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let b = body(slf)?;
+        let n = b.n();
+        slf.base().map_states(slf.py(), &states, &[n, n], |z, out| {
+            flat(&b.circulation(z)?, out);
+            Ok(())
+        })
+    }
+}
+
+/// The reduced Euler–Lagrange equation (001 (3.17)) of a right SO(n)-invariant Lagrangian
+/// L(Q, N) in the Riemann variables Q = X X^T, N = X dX/dt^T:
+///
+///     d/dt (dL/dN)^T = (dL/dN - (dL/dN)^T) N^T Q^-1 + 2 dL/dQ,   dQ/dt = N + N^T.
+///
+/// For L = tr(N^T Q^-1 N)/2 - U(Q) it is the Riemann field (001 (3.20)). dL/dQ is the gradient
+/// over symmetric matrices (Q's variations are symmetric). The Hessian of L in N and the mixed
+/// derivative along dQ/dt are central differences of the gradient (steps eps^(1/3) relative).
+///
+/// Args:
+///     lagrangian: L(Q, N) -> float, Q and N (n, n) arrays.
+///     Q: (n, n) symmetric positive definite; N: (n, n).
+///     gradient: optional (Q, N) -> (dL/dQ, dL/dN), two (n, n) arrays; without it the gradient is
+///         a central difference of `lagrangian` (steps eps^(1/3) relative) and the Hessian a
+///         difference of that (steps eps^(2/9)), so dN/dt has about 7 digits instead of 10.
+/// Returns:
+///     (dQ/dt, dN/dt), two (n, n) arrays.
+/// Raises:
+///     ShapeError, NonFiniteError, InvalidArgumentError (Q not positive definite, or the Hessian
+///     of L in N singular: L not regular); an exception of `lagrangian` or `gradient` propagates.
+#[pyfunction]
+#[pyo3(signature = (lagrangian, Q, N, gradient=None))]
+pub fn reduced_euler_lagrange<'py>(
+    py: Python<'py>,
+    lagrangian: Bound<'py, PyAny>,
+    Q: ArrayIn<'py>,
+    N: ArrayIn<'py>,
+    gradient: Option<Bound<'py, PyAny>>,
+) -> PyResult<(Any<'py>, Any<'py>)> {
+    let (q, nn) = (mat("Q", &Q)?, mat("N", &N)?);
+    let n = q.nrows();
+    let value = |q: &Mat, nn: &Mat| -> lieflow::Result<f64> {
+        let v = lagrangian
+            .call1((py_mat(py, q), py_mat(py, nn)))
+            .map_err(|e| raised("the lagrangian", e))?;
+        v.extract::<f64>()
+            .map_err(|e| raised("the lagrangian's value", e))
+    };
+    let mut grad = |q: &Mat, nn: &Mat| -> lieflow::Result<(Mat, Mat)> {
+        if let Some(g) = &gradient {
+            let r = g
+                .call1((py_mat(py, q), py_mat(py, nn)))
+                .map_err(|e| raised("the gradient", e))?;
+            let (a, b): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
+                r.extract().map_err(|e| raised("the gradient's value", e))?;
+            let conv = |what: &str, x: &Bound<'_, PyAny>| -> lieflow::Result<Mat> {
+                let arr = ArrayIn::named(what, x).map_err(|e| raised(what, e))?;
+                let m = mat(what, &arr).map_err(|e| raised(what, e))?;
+                lieflow::check::square_of(what, &m, n)?;
+                lieflow::check::finite_mat(what, &m)?;
+                Ok(m)
+            };
+            return Ok((conv("dL/dQ", &a)?, conv("dL/dN", &b)?));
+        }
+        rr::lagrangian_gradient(&value, q, nn)
+    };
+    let (qd, nd) = rr::euler_lagrange(&mut grad, &q, &nn, gradient.is_none()).py()?;
+    Ok((py_mat(py, &qd).into_any(), py_mat(py, &nd).into_any()))
+}
