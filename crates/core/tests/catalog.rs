@@ -12,8 +12,8 @@ use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::{PseudoRigidBody, RightReduced};
 use lieflow::systems::{
-    GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, RollingDisks, Sphere,
-    SphereParticle, SphericalPendulum, TangentTop,
+    FrameTop, GeneralizedRigidBody, HeavyTop, Pendulum, RigidBody, RollingDisk, RollingDisks,
+    SpaceForm, Sphere, SphereParticle, SphericalPendulum, TangentTop,
 };
 use nalgebra::Vector3;
 
@@ -118,6 +118,12 @@ fn cases() -> Vec<Case> {
     let right_reduced = RightReduced::new(3, elastic.clone())
         .unwrap()
         .reconstructing();
+    let frame_top = FrameTop::new(
+        SpaceForm::sphere(1.0).unwrap(),
+        1.3,
+        &[2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2],
+    )
+    .unwrap();
     let incompressible =
         PseudoRigidBody::incompressible(3, Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()))
             .unwrap();
@@ -265,6 +271,23 @@ fn cases() -> Vec<Case> {
             t_end: 1.0,
             dt: 0.01,
             reverse: |z| negate(9..18)(z),
+            long_skip: &[],
+        },
+        Case {
+            name: "FrameTop on S³",
+            system: Arc::new(frame_top.clone()),
+            z0: {
+                let x = [0.8, 0.0, 0.6, 0.0];
+                let v = [0.0, 0.5, 0.0, -0.4];
+                let r = so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
+                frame_top
+                    .state(&x, &r, &v, &Vector3::new(0.7, -0.4, 1.1))
+                    .unwrap()
+            },
+            t_end: 1.0,
+            dt: 0.01,
+            // (g, Π, P) ↦ (g, −Π, −P).
+            reverse: |z| negate(16..22)(z),
             long_skip: &[],
         },
         Case {

@@ -31,8 +31,9 @@ pub mod user;
 
 pub use rolling::{RollingDisks, RollingSpheres};
 pub use tangent_top::{
-    ChargedParticle, Graph, HyperbolicPlane, MetricSurface, Plane, Potential, PotentialValue,
-    RelativisticTangentTop, Revolution, Sphere, Surface, TangentTop, WeakFieldTop,
+    ChargedParticle, FrameTop, Graph, HyperbolicPlane, MetricSurface, Plane, Potential,
+    PotentialValue, RelativisticTangentTop, Revolution, SpaceForm, Sphere, Surface, TangentTop,
+    WeakFieldTop,
 };
 pub use test_problems::{Pendulum, RollingDisk, SphereParticle};
 pub use tops::methods::{Dmv, Exact, ExactSplitting, Isospectral, Lgvi};

@@ -11,7 +11,7 @@ pub mod inertia;
 pub mod methods;
 pub mod rigid_body;
 pub mod spherical_pendulum;
-mod top;
+pub(crate) mod top;
 
 pub use generalized::GeneralizedRigidBody;
 pub use heavy_top::HeavyTop;
