@@ -181,8 +181,9 @@ pub fn e_term<'py>(
 /// The Euler–Lagrange equations of 001 Prop. 4.2 in body coordinates ``X = R A S^T``,
 /// ``Omega = R^T dR/dt``, ``Lambda = S^T dS/dt``: (4.11a) ``d^2A/dt^2 = E - dU/dA``,
 /// (4.11b) ``d/dt p_Omega = [p_Omega, Omega]``, (4.11c) ``d/dt p_Lambda = [p_Lambda, Lambda]``,
-/// with E of (4.8) and the body momenta (4.15) ``p_Omega = A^2 Omega + Omega A^2 - 2 A Lambda A
-/// = R^T L R``, ``p_Lambda = A^2 Lambda + Lambda A^2 - 2 A Omega A = S^T Gamma S``. At n = 3
+/// with E of (4.8) and the body momenta (4.15)
+/// ``p_Omega = A^2 Omega + Omega A^2 - 2 A Lambda A = R^T L R``,
+/// ``p_Lambda = A^2 Lambda + Lambda A^2 - 2 A Omega A = S^T Gamma S``. At n = 3
 /// through the vector form (5.5): ``d^2a/dt^2 = E - grad U(a)``, ``dm/dt = m x w``,
 /// ``dc/dt = c x l`` (``hat(w) = Omega``, ``hat(l) = Lambda``, ``hat(m) = p_Omega``,
 /// ``hat(c) = p_Lambda``).

@@ -156,8 +156,10 @@ impl PyRollingSpheres {
     }
 
     /// The Lagrangian L of 003 (8), evaluated as printed with du/dt from the rolling constraint
-    /// (10): ``L = Omega1^T J1 Omega1 / 2 + Omega2^T J2 Omega2 / 2 + |udot|^2 / 2
-    /// - udot . (alpha1 b1 - alpha2 b2) - alpha1 alpha2 b1 . b2`` with ``b_k = z_k (Omega_k x e_k)``,
+    /// (10):
+    /// ``L = Omega1^T J1 Omega1 / 2 + Omega2^T J2 Omega2 / 2 + |udot|^2 / 2 - B``,
+    /// ``B = udot . (alpha1 b1 - alpha2 b2) + alpha1 alpha2 b1 . b2``, with
+    /// ``b_k = z_k (Omega_k x e_k)``,
     /// ``e_k = gamma_k / r_k`` and the rescaled tensors J_k of 003 §2; ``scale * L`` is the kinetic
     /// energy of both bodies (`energy`, computed in the completed-square form). (..., 27) -> (...).
     ///
@@ -200,8 +202,9 @@ impl PyRollingSpheres {
     /// constrained fields, ``Delta(X, X~) = -nu([X, X~])`` with
     /// ``nu(Omega1, Omega2, v) = v - (alpha1 z1 Omega1 + alpha2 z2 Omega2) x u``: the bracket
     /// from the commutator of the exact flows of X and X~ over the time s (second differences,
-    /// symmetrised in +-s and Richardson-extrapolated from s and 2s; error O(s^4) + O(eps / s^2),
-    /// about 1e-10 relative at the default s). Equal to `curvature` (the closed form).
+    /// symmetrised in +-s and Richardson-extrapolated from s and 2s; error
+    /// O((s ‖Omega‖)^4) + O(eps / s^2): about 1e-9 relative at the default s for angular
+    /// velocities of order one). Equal to `curvature` (the closed form).
     ///
     /// Args:
     ///     states: (..., 27); Omega, Omega_tilde: (..., 2, 3); s: the flow time, > 0.
@@ -209,7 +212,7 @@ impl PyRollingSpheres {
     ///     (..., 3) array.
     /// Raises:
     ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (s <= 0).
-    #[pyo3(signature = (states, Omega, Omega_tilde, s = 5e-3))]
+    #[pyo3(signature = (states, Omega, Omega_tilde, s = 2e-3))]
     fn curvature_by_brackets<'py>(
         slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,

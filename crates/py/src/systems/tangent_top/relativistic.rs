@@ -161,8 +161,9 @@ impl PyRelativisticTangentTop {
     }
 
     /// The energy of the symmetric top from its speed v and spin rate thetadot, 002 (96)
-    /// (physical sign): ``E = m gamma + I0 thetadot^2 (gamma + 5 v^2 gamma^3 / 2
-    /// + 3 v^4 gamma^5 / 2)``, ``I0 = tr I / 2``; on a surface with thetadot the covariant spin
+    /// (physical sign):
+    /// ``E = m gamma + I0 thetadot^2 (gamma + 5 v^2 gamma^3 / 2 + 3 v^4 gamma^5 / 2)``,
+    /// ``I0 = tr I / 2``; on a surface with thetadot the covariant spin
     /// rate ``s = thetadot + alpha . xdot``. Maps over the broadcast leading axes of v and
     /// thetadot.
     ///
