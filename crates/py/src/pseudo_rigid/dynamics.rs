@@ -289,14 +289,11 @@ pub fn reduced_hamiltonian<'py>(
 /// ``da/dt = p_a``, ``dp_a/dt = -dH/da`` (7.28), and the Lie–Poisson equations (7.25)–(7.27)
 /// ``d/dt p_Omega = [p_Omega, Omega]``, ``d/dt p_Lambda = [p_Lambda, Lambda]`` with
 /// ``Omega + Lambda = B_A^{-1}(p_Omega + p_Lambda)`` (7.9), H of `reduced_hamiltonian`.
+/// Arguments and errors as `reduced_hamiltonian`.
 ///
-/// Args:
-///     as `reduced_hamiltonian`.
 /// Returns:
 ///     dict with the rate of each variable under its name: "a", "p_a" ((n,)), "p_Omega",
 ///     "p_Lambda" ((n, n)), so that ``state[k] + dt * field[k]`` is an Euler step.
-/// Raises:
-///     as `reduced_hamiltonian`.
 #[pyfunction]
 #[pyo3(signature = (a, p_a, p_Omega, p_Lambda, potential=None))]
 pub fn reduced_vector_field<'py>(

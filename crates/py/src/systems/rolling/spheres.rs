@@ -158,7 +158,7 @@ impl PyRollingSpheres {
     /// The Lagrangian L of 003 (8), evaluated as printed with du/dt from the rolling constraint
     /// (10):
     /// ``L = Omega1^T J1 Omega1 / 2 + Omega2^T J2 Omega2 / 2 + |udot|^2 / 2 - B``,
-    /// ``B = udot . (alpha1 b1 - alpha2 b2) + alpha1 alpha2 b1 . b2``, with
+    /// ``B = dot(udot, alpha1 b1 - alpha2 b2) + alpha1 alpha2 dot(b1, b2)``, with
     /// ``b_k = z_k (Omega_k x e_k)``,
     /// ``e_k = gamma_k / r_k`` and the rescaled tensors J_k of 003 §2; ``scale * L`` is the kinetic
     /// energy of both bodies (`energy`, computed in the completed-square form). (..., 27) -> (...).

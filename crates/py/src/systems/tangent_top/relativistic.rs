@@ -140,7 +140,7 @@ impl PyRelativisticTangentTop {
 
     /// The spin rate of the symmetric top from its speed v and spin momentum J = p_theta,
     /// 002 (95): ``thetadot = J / (2 I0 gamma (1 + v^2 gamma^2 / 2))``, ``I0 = tr I / 2``; on a
-    /// surface the covariant spin rate ``s = thetadot + alpha . xdot``. Maps over the broadcast
+    /// surface the covariant spin rate ``s = thetadot + w(xdot)``. Maps over the broadcast
     /// leading axes of v and p_theta.
     ///
     /// Args:
@@ -164,7 +164,7 @@ impl PyRelativisticTangentTop {
     /// (physical sign):
     /// ``E = m gamma + I0 thetadot^2 (gamma + 5 v^2 gamma^3 / 2 + 3 v^4 gamma^5 / 2)``,
     /// ``I0 = tr I / 2``; on a surface with thetadot the covariant spin
-    /// rate ``s = thetadot + alpha . xdot``. Maps over the broadcast leading axes of v and
+    /// rate ``s = thetadot + w(xdot)``. Maps over the broadcast leading axes of v and
     /// thetadot.
     ///
     /// Args:
