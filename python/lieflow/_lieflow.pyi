@@ -242,6 +242,15 @@ class RollingSpheres(System):
     ) -> list[float]: ...
     def planar_state(self, theta: ArrayLike, phi: float, thetadot: ArrayLike) -> list[float]: ...
     def to_planar(self, state: ArrayLike, tol: float = 1e-9) -> tuple[float, float, float, float, float]: ...
+    def lagrangian(self, states: ArrayLike) -> _F64 | float:
+        """(..., 27) -> (...): L of 003 (8) (scale * L = energy)."""
+    def curvature(self, states: ArrayLike, Omega: ArrayLike, Omega_tilde: ArrayLike) -> _F64:
+        """(..., 27), (..., 2, 3), (..., 2, 3) -> (..., 3): 003 §2.2's closed form
+        alpha1 alpha2 u x ((z1 W1 - z2 W2) x (z1 W1~ - z2 W2~))."""
+    def curvature_by_brackets(
+        self, states: ArrayLike, Omega: ArrayLike, Omega_tilde: ArrayLike, s: float = 2e-3,
+    ) -> _F64:
+        """The curvature -nu([X, X~]) of 003 §2.2 from the commutator of the exact flows."""
     def angular_momentum(self, states: ArrayLike) -> _F64:
         """(..., 27) -> (..., 3): total angular momentum about the centre of mass (conserved)."""
     def body_momenta(self, states: ArrayLike) -> _F64:
@@ -299,6 +308,12 @@ class RelativisticTangentTop(System):
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
     def velocities(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
+    def momentum_94(self, v: ArrayLike, p_theta: ArrayLike) -> _F64 | float:
+        """|p| of the symmetric top from v and J = p_theta, 002 (94)."""
+    def spin_rate_95(self, v: ArrayLike, p_theta: ArrayLike) -> _F64 | float:
+        """thetadot of the symmetric top from v and J = p_theta, 002 (95)."""
+    def energy_96(self, v: ArrayLike, thetadot: ArrayLike) -> _F64 | float:
+        """The energy of the symmetric top from v and thetadot, 002 (96)."""
     def speed_and_spin(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 2): v = sqrt(g(xdot, xdot)), s = thetadot + w(xdot)."""
     def killing_momenta(self, states: ArrayLike) -> _F64:
@@ -326,6 +341,10 @@ class TangentTop(System):
     @property
     def tensor(self) -> list[list[float]]: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
+    def metric(self, x: ArrayLike, theta: float) -> _F64:
+        """(3, 3): the configuration metric g_AB of 002 (47) (corrected cross terms)."""
+    def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
+        """L = m g(xdot, xdot)/2 + I (thetadot + w(xdot))^2 / 2 (002 (43)-(47))."""
     def velocities(self, states: ArrayLike) -> _F64: ...
     def p_theta(self, states: ArrayLike) -> _F64 | float: ...
     def killing_momenta(self, states: ArrayLike) -> _F64: ...

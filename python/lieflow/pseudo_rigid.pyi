@@ -18,11 +18,13 @@ __all__ = [
     "RelativeEquilibrium", "RightReduced", "Stability", "Verdict", "adjoint_motion", "amended_hessian",
     "amended_potential", "angular_momentum", "augmented_gradient", "augmented_hessian",
     "augmented_potential", "bi_connection", "bi_inertia", "bi_inertia_apply", "bi_inertia_eigen",
-    "bi_inertia_quadratic_form", "bi_inertia_solve", "circulation", "equilibrium_directions",
-    "from_body", "guichardet_connection", "horizontal_part", "index_symbols", "kinetic_energy",
-    "left_connection", "left_inertia", "locked_inertia", "loop_area", "loop_circulation",
-    "particle_locked_inertia", "reconstruct", "reduce", "reduced_euler_lagrange",
-    "relative_equilibria", "riemann_bracket", "riemann_variables", "right_connection",
+    "bi_inertia_quadratic_form", "bi_inertia_solve", "circulation", "e_term",
+    "equilibrium_directions", "from_body", "guichardet_connection", "horizontal_part",
+    "index_symbols", "kinetic_energy", "lagrange_vector_field", "left_connection", "left_inertia",
+    "locked_inertia", "loop_area", "loop_circulation", "particle_locked_inertia", "reconstruct",
+    "reduce", "reduced_euler_lagrange", "reduced_hamiltonian", "reduced_vector_field",
+    "relative_equilibria", "riemann_bracket", "riemann_variables", "riemann_vector_field",
+    "right_connection",
     "right_inertia", "stratum", "to_body", "vertical_vector",
 ]
 
@@ -123,6 +125,45 @@ def reconstruct(
 
 def adjoint_motion(X: ArrayLike, P: ArrayLike) -> tuple[_F64, _F64]:
     """Dedekind's adjoint motion (X^T, P^T) of stacked frames (..., n, n)."""
+
+# --- the equations of motion (001 (3.20), Prop. 4.2, (4.8), (5.5), (7.24)-(7.28)) ---
+
+class _LagrangeRates(TypedDict):
+    p_Omega: _F64
+    p_Lambda: _F64
+    E: _F64
+    addot: _F64
+    p_Omegadot: _F64
+    p_Lambdadot: _F64
+
+class _ReducedRates(TypedDict):
+    a: _F64
+    p_a: _F64
+    p_Omega: _F64
+    p_Lambda: _F64
+
+def riemann_vector_field(Q: ArrayLike, N: ArrayLike, potential: Any | None = None) -> tuple[_F64, _F64]:
+    """(dQ/dt, dN/dt) = (N + N^T, N^T Q^-1 N - 2 Q dU/dQ) (001 (3.20))."""
+
+def e_term(a: ArrayLike, Omega: ArrayLike, Lambda: ArrayLike) -> _F64:
+    """E = D(-(Omega^2 + Lambda^2) A + Omega A Lambda + Lambda A Omega) (001 (4.8); n = 3: (5.4))."""
+
+def lagrange_vector_field(
+    a: ArrayLike, Omega: ArrayLike, Lambda: ArrayLike, potential: Any | None = None
+) -> _LagrangeRates:
+    """The Euler-Lagrange equations (4.11a)-(4.11c) of 001 Prop. 4.2 (n = 3: (5.5))."""
+
+def reduced_hamiltonian(
+    a: ArrayLike, p_a: ArrayLike, p_Omega: ArrayLike, p_Lambda: ArrayLike,
+    potential: Any | None = None,
+) -> float | _F64:
+    """H = |p_a|^2/2 + <p, B_A^-1 p>/2 + U(A) on the principal stratum (001 (7.24), (6.30))."""
+
+def reduced_vector_field(
+    a: ArrayLike, p_a: ArrayLike, p_Omega: ArrayLike, p_Lambda: ArrayLike,
+    potential: Any | None = None,
+) -> _ReducedRates:
+    """The reduced Hamilton equations (001 (7.25)-(7.28)): the rate of each variable by name."""
 
 # --- relative equilibria and their stability (001 §8) ---
 

@@ -122,3 +122,73 @@ def test_weak_field_top_methods_and_pickling():
     top = lf.WeakFieldTop(1.0, 1e-3, gm=1e-4)
     copy = pickle.loads(pickle.dumps(top))
     assert repr(copy) == repr(top) and copy.methods() == top.methods()
+
+
+# --- the relations (94)-(96) of the symmetric top (issue 25) ---
+
+@pytest.mark.parametrize("surface, x", [(None, [0.3, -0.2]), (lf.surfaces.Sphere(1.3), [1.1, 0.4]),
+                                        (lf.surfaces.HyperbolicPlane(), [0.2, 1.1])])
+def test_relations_94_to_96_are_the_legendre_map_and_the_energy(surface, x):
+    # The states come from the Legendre map of the Lagrangian (002 (93) / (103)) and the energy
+    # from the Hamiltonian; (94)-(96) are the closed forms in (v, J = p_theta) and (v, s).
+    top = lf.RelativisticTangentTop(1.0, 0.2, surface)
+    for xdot, thetadot in ([0.3, -0.2], 2.5), ([0.05, 0.1], -1.2), ([-0.35, 0.3], 0.4):
+        z = np.asarray(top.state(x, 0.4, xdot, thetadot))
+        (v, s), j = top.speed_and_spin(z), z[5]
+        if surface is None:
+            p = np.hypot(z[3], z[4])
+            assert s == pytest.approx(thetadot, abs=1e-14)
+        else:   # |p_x - p_theta alpha| in the inverse metric
+            pi = z[3:5] - j * np.asarray(surface.connection(x))
+            p = np.sqrt(pi @ np.linalg.solve(surface.metric(x), pi))
+        assert top.momentum_94(v, j) == pytest.approx(p, rel=1e-12)
+        assert top.spin_rate_95(v, j) == pytest.approx(s, rel=1e-12)
+        assert top.energy_96(v, s) == pytest.approx(top.energy(z), rel=1e-13)
+    # They map over broadcast leading axes.
+    vs = np.array([[0.1], [0.5]])
+    assert top.momentum_94(vs, [0.2, 0.3, 0.4]).shape == (2, 3)
+    np.testing.assert_allclose(top.energy_96(vs, 2.0)[:, 0],
+                               [top.energy_96(0.1, 2.0), top.energy_96(0.5, 2.0)], rtol=0)
+    assert isinstance(top.spin_rate_95(0.5, 0.3), float)
+
+
+def test_relations_94_to_96_refuse_what_they_do_not_cover():
+    top = lf.RelativisticTangentTop(1.0, 0.2)
+    for f in (top.momentum_94, top.spin_rate_95, top.energy_96):
+        with pytest.raises(lf.InvalidArgumentError, match="v"):
+            f(1.0, 0.3)                                        # v = c
+        with pytest.raises(lf.InvalidArgumentError, match="v"):
+            f([0.2, -0.1], 0.3)
+        with pytest.raises(lf.NonFiniteError):
+            f(0.5, np.nan)
+        with pytest.raises(lf.ShapeError):
+            f([0.1, 0.2], [0.1, 0.2, 0.3])
+    with pytest.raises(lf.InvalidArgumentError, match="p_theta"):
+        top.momentum_94(0.5, 1e300)                            # |p| beyond the float range
+    aniso = lf.RelativisticTangentTop(1.0, (0.1, 0.02, 0.2))
+    with pytest.raises(lf.InvalidArgumentError, match="symmetric"):
+        aniso.momentum_94(0.5, 0.3)
+
+
+def test_relation_94_does_not_fix_the_speed_for_fast_spin():
+    # 002 concludes from (94) that |p| determines v. v -> |p| is monotone only for
+    # kappa = J^2 / (2 I0 m) below 7.34: found here by bisection on the monotonicity of (94)
+    # sampled finely on [0, 1), then three speeds with one |p| at kappa = 10.
+    top = lf.RelativisticTangentTop(1.0, 2.0)          # m = 1, I0 = tr I / 2 = 1
+    v = np.linspace(0.0, 1.0 - 1e-9, 200_001)
+
+    def monotone(kappa):
+        return bool(np.all(np.diff(top.momentum_94(v, np.sqrt(2 * kappa))) > 0))
+
+    lo, hi = 1.0, 10.0
+    assert monotone(lo) and not monotone(hi)
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if monotone(mid) else (lo, mid)
+    assert abs(lo - 7.34) < 5e-3, lo
+    p = top.momentum_94(v, np.sqrt(20.0))
+    falling = v[1:][np.diff(p) < 0]
+    assert 0.90 < falling[0] < 0.92 and 0.97 < falling[-1] < 0.98
+    p0 = 0.5 * (p.max(where=v < falling[0], initial=0) + p.min(where=v > falling[-1], initial=np.inf))
+    speeds = v[1:][np.diff(np.sign(p - p0)) != 0]
+    assert len(speeds) == 3 and speeds[0] < falling[0] < speeds[1] < falling[-1] < speeds[2]

@@ -186,3 +186,148 @@ def test_points_next_to_a_coordinate_singularity_are_refused():
     with pytest.raises(lf.InvalidArgumentError):
         S.HyperbolicPlane().metric([0.0, 1e-200])
     assert np.isfinite(S.Sphere(1.0).frame([1e-150, 0.0])).all()
+
+
+# --- the metric (47) and the Lagrangian of the top, and MetricSurface.check_frame (issue 25) ---
+
+TOPS = [
+    ("plane", lambda: lf.TangentTop(S.Plane(), 1.3, 0.5), [0.2, -0.1]),
+    ("sphere", lambda: lf.TangentTop(S.Sphere(1.2), 0.9, 0.4), [1.0, 0.3]),
+    ("hyperbolic", lambda: lf.TangentTop(S.HyperbolicPlane(), 1.0, 0.7), [0.1, 1.3]),
+    ("torus", lambda: lf.TangentTop(S.Torus(2.0, 0.7), 1.1, 0.6), [0.9, 0.4]),
+    ("embedded anisotropic sphere",
+     lambda: lf.TangentTop(S.Sphere(1.2), 0.9, [[0.3, 0.05], [0.05, 0.2]], embedded=True),
+     [1.0, 0.3]),
+]
+
+
+@pytest.mark.parametrize("name, make, x", TOPS, ids=[t[0] for t in TOPS])
+def test_lagrangian_is_the_metric_form_and_its_legendre_map_is_the_hamiltonians(name, make, x):
+    top = make()
+    theta, xdot, thetadot = 0.7, np.array([0.3, -0.4]), 1.1
+    etadot = np.array([*xdot, thetadot])
+    g = top.metric(x, theta)
+    assert g.shape == (3, 3) and np.all(np.linalg.eigvalsh(g) > 0)
+    np.testing.assert_allclose(g, g.T, atol=0)
+    lag = top.lagrangian(x, theta, xdot, thetadot)
+    assert lag == pytest.approx(0.5 * etadot @ g @ etadot, rel=1e-14)
+    # p = dL/d(etadot) by central differences (exact for a quadratic up to round-off) is the
+    # momentum of `state`, and the Hamiltonian's velocities of that state are etadot again.
+    eps = 1e-4
+    p = []
+    for k in range(3):
+        e = eps * np.eye(3)[k]
+        up, dn = etadot + e, etadot - e
+        p.append((top.lagrangian(x, theta, up[:2], up[2]) - top.lagrangian(x, theta, dn[:2], dn[2]))
+                 / (2 * eps))
+    z = np.asarray(top.state(x, theta, xdot, thetadot))
+    np.testing.assert_allclose(z[3:], p, atol=1e-11)
+    np.testing.assert_allclose(top.velocities(z), etadot, atol=1e-13)
+    assert top.energy(z) == pytest.approx(lag, rel=1e-13)      # a purely kinetic Lagrangian
+
+
+@pytest.mark.parametrize("name, make, x", TOPS, ids=[t[0] for t in TOPS])
+def test_euler_lagrange_equations_of_the_lagrangian_hold_along_a_motion(name, make, x):
+    # d/dt p = dL/d(eta): the position derivatives of L (the metric's, the connection's and, for
+    # the embedded anisotropic top, theta's) against the rate of p along a gauss6 motion.
+    top = make()
+    h = 2.5e-3
+    z0 = top.state(x, 0.7, [0.3, -0.4], 1.1)
+    tr = lf.integrate(top, z0, dt=h / 10, steps=40, method="gauss6", save_every=10)
+    pdot = (tr.p[0] - 8 * tr.p[1] + 8 * tr.p[3] - tr.p[4]) / (12 * h)
+    eta, etadot = tr.states[2, :3], top.velocities(tr.states[2])
+    eps = 1e-5
+    dL = []
+    for k in range(3):
+        up, dn = eta + eps * np.eye(3)[k], eta - eps * np.eye(3)[k]
+        dL.append((top.lagrangian(up[:2], up[2], etadot[:2], etadot[2])
+                   - top.lagrangian(dn[:2], dn[2], etadot[:2], etadot[2])) / (2 * eps))
+    np.testing.assert_allclose(pdot, dL, atol=1e-8)
+
+
+@pytest.mark.parametrize("surface, x", [(S.Sphere(1.2), [1.0, 0.3]), (S.HyperbolicPlane(), [0.1, 1.3]),
+                                        (S.Quadric(0.8, -0.5), [0.3, -0.4])])
+def test_metric_47_in_the_surfaces_terms(surface, x):
+    # g_AB = [[m g + I a a^T, I a], [I a^T, I]], a the connection 1-form: the cross terms carry
+    # +I a (002 (47) prints -I a; its (45) has the slip).
+    m, inertia, theta = 0.9, 0.4, 0.7
+    g = lf.TangentTop(surface, m, inertia).metric(x, theta)
+    alpha = np.array(surface.connection(x))
+    assert np.abs(alpha).max() > 0.05
+    np.testing.assert_allclose(g[:2, 2], inertia * alpha, atol=1e-15)
+    np.testing.assert_allclose(g[2, 2], inertia, atol=0)
+    np.testing.assert_allclose(g[:2, :2], m * surface.metric(x) + inertia * np.outer(alpha, alpha),
+                               atol=1e-15)
+    np.testing.assert_allclose(lf.TangentTop(S.Plane(), m, inertia).metric([0.3, 0.2], theta),
+                               np.diag([m, m, inertia]), atol=0)
+
+
+def test_metric_and_lagrangian_refuse_points_outside_the_chart_and_raise_callable_errors():
+    top = lf.TangentTop(S.Sphere(1.0), 1.0, 0.5)
+    with pytest.raises(lf.InvalidArgumentError):
+        top.metric([0.0, 0.3], 0.0)
+    with pytest.raises(lf.InvalidArgumentError):
+        top.lagrangian([4.0, 0.3], 0.0, [0.1, 0.2], 0.3)
+    with pytest.raises(lf.InvalidArgumentError):
+        top.lagrangian([1.0, 0.3], 0.0, [1e200, 0.2], 0.3)       # L beyond the float range
+    with pytest.raises(lf.NonFiniteError):
+        top.metric([1.0, 0.3], np.nan)
+
+    def failing_metric(t, p):
+        raise RuntimeError("metric failed")
+
+    bad = lf.TangentTop(S.MetricSurface(failing_metric, sphere_frame, inside), 1.0, 0.5)
+    with pytest.raises(RuntimeError, match="metric failed"):
+        bad.metric([1.0, 0.3], 0.0)
+    with pytest.raises(RuntimeError, match="metric failed"):
+        bad.lagrangian([1.0, 0.3], 0.0, [0.1, 0.2], 0.3)
+
+
+def frame_defect(metric, frame, x):
+    """max over a, b of abs(g(E_a, E_b) - delta_ab), from the callables in numpy."""
+    g, e = np.asarray(metric(*x), float), np.asarray(frame(*x), float)
+    return np.abs(e @ g @ e.T - np.eye(2)).max()
+
+
+def euclidean_frame(t, p):
+    return [[1.0, 0.0], [0.0, 1.0]]
+
+
+def flipped_frame(t, p):
+    return [[0.0, 1.0 / np.sin(t)], [1.0, 0.0]]
+
+
+def test_check_frame_of_a_metric_surface():
+    good = S.MetricSurface(sphere_metric, sphere_frame, inside)
+    for x in ([1.2, 0.4], [0.3, -2.0], [2.9, 5.0]):
+        assert good.check_frame(x) is None and good.check_frame(x, tol=1e-15) is None
+    # Orthonormal for the Euclidean metric, not for the sphere's (except on the equator).
+    euclid = S.MetricSurface(sphere_metric, euclidean_frame, inside)
+    assert euclid.check_frame([np.pi / 2, 0.3]) is None
+    with pytest.raises(lf.InvalidArgumentError, match="frame"):
+        euclid.check_frame([1.0, 0.3])
+    with pytest.raises(lf.InvalidArgumentError, match="oriented"):
+        S.MetricSurface(sphere_metric, flipped_frame, inside).check_frame([1.0, 0.3])
+    # The tolerance against the defect computed in numpy, on frames scaled by 1 + s.
+    for s in (1e-9, 1e-7, 1e-5):
+        def scaled(t, p, s=s):
+            return (1 + s) * np.asarray(sphere_frame(t, p))
+
+        surface = S.MetricSurface(sphere_metric, scaled, inside)
+        defect = frame_defect(sphere_metric, scaled, (1.0, 0.3))
+        assert defect == pytest.approx(2 * s, rel=1e-3)
+        surface.check_frame([1.0, 0.3], tol=1.01 * defect)
+        with pytest.raises(lf.InvalidArgumentError):
+            surface.check_frame([1.0, 0.3], tol=0.99 * defect)
+    with pytest.raises(lf.InvalidArgumentError, match="domain"):
+        good.check_frame([-1.0, 0.3])
+    with pytest.raises(lf.InvalidArgumentError, match="tol"):
+        good.check_frame([1.0, 0.3], tol=np.nan)
+    with pytest.raises(lf.InvalidArgumentError, match="MetricSurface"):
+        S.Sphere(1.0).check_frame([1.0, 0.3])
+
+    def failing_frame(t, p):
+        raise RuntimeError("frame failed")
+
+    with pytest.raises(RuntimeError, match="frame failed"):
+        S.MetricSurface(sphere_metric, failing_frame, inside).check_frame([1.0, 0.3])

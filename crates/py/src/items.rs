@@ -327,6 +327,20 @@ where
     Plan::new(inputs, &[out_item], false)?.run(py, &f)
 }
 
+/// [`map_items`] for functions of several outputs, of item shapes `outs` (on this thread, with the
+/// GIL held: for functions that may call Python); returns the tuple of the arrays.
+pub fn map_items_n<'py, F>(
+    py: Python<'py>,
+    inputs: &[Input<'_, 'py>],
+    outs: &[&[usize]],
+    f: F,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: Fn(&[&[f64]], &mut [f64]) -> lieflow::Result<()>,
+{
+    Plan::new(inputs, outs, false)?.run(py, &f)
+}
+
 /// [`map_items`] for functions of pure Rust: from [`PAR_MIN`] items on, the items are mapped on
 /// the thread pool with the GIL released (the first error found is raised).
 pub fn par_map_items<'py, F>(

@@ -104,6 +104,7 @@ G4 = np.block([[R3, np.array([[0.3], [-0.1], [0.2]])], [np.zeros((1, 3)), np.one
 H4 = np.block([[R3B, np.array([[-0.2], [0.4], [0.1]])], [np.zeros((1, 3)), np.ones((1, 1))]])
 SE3XI = np.array([0.3, -0.2, 0.5, 0.1, 0.2, -0.3])
 A3 = np.array([1.3, 1.0, 0.7])
+SKEW4 = np.triu(np.arange(16.0).reshape(4, 4) / 20, 1) - np.triu(np.arange(16.0).reshape(4, 4) / 20, 1).T
 M3 = np.array([1.0, 0.5, -0.3])
 I_SPH1 = np.array([[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]])
 I_SPH2 = np.array([[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]])
@@ -623,6 +624,24 @@ def build_specs() -> list[Spec]:
     add(P + "RightReduced", P + "RightReduced", A("n", 3, "int", positive=True),
         A("potential", Lazy(_svk), "obj", opt=True), A("reconstruct", True, "bool", kw=True))
     svk = Lazy(_svk)
+    # the equations of motion (001 (3.20), (4.8), Prop. 4.2, (7.24)-(7.28)); issue 25
+    add(P + "riemann_vector_field", P + "riemann_vector_field", A("Q", Q, "mat"),
+        A("N", X3 @ V3.T, "mat"), A("potential", svk, "obj", opt=True))
+    add(P + "e_term", P + "e_term", A("a", A3, "vec"), A("Omega", XI, "skew"),
+        A("Lambda", ETA, "skew"))
+    a4 = np.array([1.4, 1.1, 0.9, 0.6])      # n = 4: the general path (n = 3 is the fast path)
+    add(P + "e_term[n=4]", P + "e_term", A("a", a4, "vec"), A("Omega", SKEW4, "skew"),
+        A("Lambda", -0.5 * SKEW4.T @ SKEW4 @ SKEW4, "skew"))
+    add(P + "lagrange_vector_field", P + "lagrange_vector_field", A("a", A3, "vec"),
+        A("Omega", XI, "skew"), A("Lambda", ETA, "skew"), A("potential", svk, "obj", opt=True))
+    add(P + "lagrange_vector_field[n=4,callable]", P + "lagrange_vector_field", A("a", a4, "vec"),
+        A("Omega", SKEW4, "skew"), A("Lambda", np.zeros((4, 4)), "skew"),
+        A("potential", Lazy(lambda lf: lf.potentials.Callable(u_value, u_gradient)), "obj",
+          opt=True))
+    for f in ("reduced_hamiltonian", "reduced_vector_field"):
+        add(P + f, P + f, A("a", A3, "vec"), A("p_a", np.array([0.1, -0.2, 0.05]), "vec"),
+            A("p_Omega", XI, "skew"), A("p_Lambda", ETA, "skew"),
+            A("potential", svk, "obj", opt=True))
     for f in ("amended_potential", "amended_hessian"):
         add(P + f, P + f, A("X", X3, "gl"), A("lam", XI, "skew"), A("gam", ETA, "skew"),
             A("potential", svk, "obj"))
@@ -702,6 +721,8 @@ def build_specs() -> list[Spec]:
     for s, x in SURFACE_POINT.items():
         for f in ("curvature", "metric", "frame", "connection"):
             add(f"Surface[{s}].{f}", f"@{s}.{f}", A("x", np.array(x), "vec"))
+    add("Surface[metric].check_frame", "@metric.check_frame", A("x", np.array([1.2, 0.4]), "vec"),
+        A("tol", 1e-10, "float", kw=True))
 
     # ---- lieflow.elliptic ----
     add("elliptic.ellipj", "elliptic.ellipj", A("u", np.array([0.3, 1.2]), "bcast"),
@@ -790,7 +811,12 @@ def build_specs() -> list[Spec]:
                  for f in ("angular_momentum", "circulation", "singular_values")]
         + [("project_momentum", [A("X", X3, "gl"), A("P", V3, "mat")])],
         "rtt": [("state", [A("x", np.array([1.2, 0.3]), "vec"), A("theta", 0.5, "float"),
-                           A("xdot", np.array([0.3, 0.4]), "vec"), A("thetadot", 2.0, "float")])]
+                           A("xdot", np.array([0.3, 0.4]), "vec"), A("thetadot", 2.0, "float")]),
+                ("momentum_94", [A("v", np.array([0.1, 0.5, 0.9]), "bcast"),
+                                 A("p_theta", 0.7, "bcast")]),
+                ("spin_rate_95", [A("v", np.array([0.1, 0.5, 0.9]), "bcast"),
+                                  A("p_theta", 0.7, "bcast")]),
+                ("energy_96", [A("v", 0.5, "bcast"), A("thetadot", np.array([0.0, 2.0]), "bcast")])]
         + [(f, [A("states", state_of("rtt"), "vec")])
            for f in ("velocities", "speed_and_spin", "killing_momenta")],
         "wft": [("state", [A("x", np.array([1.0, 0.5]), "vec"), A("theta", 0.1, "float"),
@@ -798,6 +824,10 @@ def build_specs() -> list[Spec]:
                 ("angular_momentum", [A("states", state_of("wft"), "vec")])],
         "tt": [("state", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float"),
                           A("xdot", np.array([0.1, 0.3]), "vec"), A("thetadot", 1.5, "float")]),
+               ("metric", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float")]),
+               ("lagrangian", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float"),
+                               A("xdot", np.array([0.1, 0.3]), "vec"),
+                               A("thetadot", 1.5, "float")]),
                ("magnetic_analogue", [A("p_theta", 0.7, "float")])]
         + [(f, [A("states", state_of("tt"), "vec")])
            for f in ("velocities", "p_theta", "killing_momenta", "ambient_frame")],
@@ -822,7 +852,16 @@ def build_specs() -> list[Spec]:
                      [0.3, -0.4], 0.2, [0.5, 0.7])), "vec"), A("tol", 1e-9, "float", kw=True)])]
         + [(f, [A("states", state_of("rsph"), "vec")])
            for f in ("accelerations", "angular_momentum", "body_momenta", "centres",
-                     "centres_of_mass", "contact_point", "spatial_momenta", "udot")],
+                     "centres_of_mass", "contact_point", "spatial_momenta", "udot",
+                     "lagrangian")]
+        + [("curvature", [A("states", state_of("rsph"), "vec"),
+                          A("Omega", np.array([[1.1, -0.6, 0.8], [-0.4, 0.9, 0.5]]), "vec"),
+                          A("Omega_tilde", np.array([[0.2, 0.7, -0.3], [0.5, -0.1, 0.6]]), "vec")]),
+           ("curvature_by_brackets", [
+               A("states", state_of("rsph"), "vec"),
+               A("Omega", np.array([[1.1, -0.6, 0.8], [-0.4, 0.9, 0.5]]), "vec"),
+               A("Omega_tilde", np.array([[0.2, 0.7, -0.3], [0.5, -0.1, 0.6]]), "vec"),
+               A("s", 5e-3, "float", kw=True, positive=True)])],
         "rdeq": [("state", [A("omega", 1.0, "float")])],
         "run": [("advance", [A("steps", 5, "int")]), ("state", [])]
         # Output control (issue 15).

@@ -193,27 +193,9 @@ impl FullBody {
     ) -> Result<LagrangeRates> {
         let n = self.n;
         check::len_of("a", a, n)?;
-        if let Some(i) = a.iter().position(|&ai| ai <= 0.0) {
-            return Err(Error::invalid(
-                "a",
-                format!("singular values must be > 0, got a[{i}] = {}", a[i]),
-            ));
-        }
-        for (what, m) in [("omega", omega), ("lambda", lambda)] {
-            check::square_of(what, m, n)?;
-            let defect = so::skew_defect(m);
-            if defect > so::SKEW_TOL {
-                return Err(Error::NotInGroup {
-                    what: what.into(),
-                    group: format!("so({n})"),
-                    defect_name: "‖ξ + ξᵀ‖_F / max(1, ‖ξ‖_F)".into(),
-                    defect,
-                    tol: so::SKEW_TOL,
-                });
-            }
-        }
+        momentum::check_velocities(a, omega, lambda)?;
         let (p_omega, p_lambda) = momentum::body_momenta(a, omega, lambda)?;
-        let e = momentum::e_term(a, omega, lambda);
+        let e = momentum::e_term_unchecked(a, omega, lambda);
         let am = Mat::from_fn(n, n, |i, j| if i == j { a[i] } else { 0.0 });
         let mut ws = self.workspace();
         let mut g = Mat::zeros(n, n);

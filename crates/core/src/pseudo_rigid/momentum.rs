@@ -228,7 +228,7 @@ impl Body {
     /// (the diagonal, as a vector). Checked against finite differences of (4.5).
     pub fn e_term(&self) -> Result<Vec<f64>> {
         self.validate()?;
-        Ok(e_term(&self.a, &self.omega, &self.lambda))
+        Ok(e_term_unchecked(&self.a, &self.omega, &self.lambda))
     }
 
     /// Kinetic energy in body coordinates (001 (4.5)):
@@ -264,9 +264,39 @@ impl Body {
     }
 }
 
-/// The E term of 001 (4.8) at (A, Ω, Λ), unchecked (callers validate): the diagonal of
-/// −(Ω² + Λ²)A + ΩAΛ + ΛAΩ, as a vector. [`Body::e_term`] is the checked form.
-pub(crate) fn e_term(a: &[f64], omega: &Mat, lambda: &Mat) -> Vec<f64> {
+/// Checks the arguments (A = diag(a), Ω, Λ) of the formulas in body coordinates that need no
+/// frames (E of (4.8), the Euler–Lagrange equations of 001 Prop. 4.2): a of length n ≥ 2, finite,
+/// every a_i > 0; Ω, Λ finite, n×n and skew (to [`so::SKEW_TOL`]). Returns n.
+pub fn check_velocities(a: &[f64], omega: &Mat, lambda: &Mat) -> Result<usize> {
+    let n = a.len();
+    if n < 2 {
+        return Err(Error::shape("a", "(n,) with n ≥ 2", format!("({n},)")));
+    }
+    check::finite_slice("a", a)?;
+    if let Some(i) = a.iter().position(|&ai| ai <= 0.0) {
+        return Err(Error::invalid(
+            "a",
+            format!("singular values must be > 0, got a[{i}] = {}", a[i]),
+        ));
+    }
+    for (what, m) in [("Omega", omega), ("Lambda", lambda)] {
+        check::square_of(what, m, n)?;
+        check::finite_mat(what, m)?;
+        so::check_algebra_of(what, m, n)?;
+    }
+    Ok(n)
+}
+
+/// The E term of 001 (4.8) at (A, Ω, Λ) with A = diag(a):
+/// E = 𝔇(−(Ω² + Λ²)A + ΩAΛ + ΛAΩ) = ∂K/∂A at fixed Ω, Λ, Ȧ (the diagonal, as a vector).
+/// Checked ([`check_velocities`]); [`e_term_3`] is the n = 3 vector form (5.4).
+pub fn e_term(a: &[f64], omega: &Mat, lambda: &Mat) -> Result<Vec<f64>> {
+    check_velocities(a, omega, lambda)?;
+    Ok(e_term_unchecked(a, omega, lambda))
+}
+
+/// [`e_term`] without checks (callers validate): the diagonal of −(Ω² + Λ²)A + ΩAΛ + ΛAΩ.
+pub(crate) fn e_term_unchecked(a: &[f64], omega: &Mat, lambda: &Mat) -> Vec<f64> {
     let a = diag(a);
     let (o, l) = (omega, lambda);
     let e = -(o * o + l * l) * &a + o * &a * l + l * &a * o;

@@ -4,13 +4,14 @@
 //! Every function of arrays follows the one vectorisation rule of the bindings (`crate::items`):
 //! its arguments may carry leading axes, which broadcast as numpy's ((..., n, n) for a matrix,
 //! (..., n) for a vector), and its results carry the broadcast leading axes; n is read from the
-//! first argument. `stratum` and `reduce` (dictionaries) and `adjoint_motion` (a trajectory) take
-//! one item.
+//! first argument (the first matrix argument in `dynamics`). `stratum` and `reduce` (dictionaries)
+//! and `adjoint_motion` (a trajectory) take one item.
 //!
 //! Conventions: so(n) elements are skew (n, n) arrays; matrices on so(n) + so(n) are in the e_ij
 //! basis (i < j, row by row) with the xi block first; pairing <xi, eta> = tr(xi.T @ eta) / 2.
 #![allow(non_snake_case)]
 
+pub mod dynamics;
 pub mod ellipsoids;
 pub mod equilibria;
 pub mod gravity;
@@ -618,6 +619,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     crate::system::add_system::<right_reduced::PyRightReduced, lieflow::pseudo_rigid::RightReduced>(
         m,
     )?;
+    dynamics::register(m)?;
     equilibria::register(m)?;
     gravity::register(m)?;
     Ok(())

@@ -219,14 +219,15 @@ impl TangentTop {
     }
 
     /// The metric g_AB of 002 (47) (corrected signs, module docs) at η = (x¹, x², θ), with
-    /// m g → G(x, θ) for the embedded top. Errors: x outside the surface's domain, non-finite η.
+    /// m g → G(x, θ) for the embedded top. Errors: x outside the surface's domain, non-finite η,
+    /// an overflow error where an entry exceeds the f64 range.
     pub fn metric(&self, eta: [f64; 3]) -> Result<[[f64; 3]; 3]> {
         check::finite_slice("eta", &eta)?;
         let x = [eta[0], eta[1]];
         self.surface.check(x).map_err(|v| v.at_start())?;
         let l = self.local(x, eta[2]);
         let (g, a, i) = (l.g, l.alpha, self.inertia());
-        Ok([
+        let out = [
             [
                 g[0][0] + i * a[0] * a[0],
                 g[0][1] + i * a[0] * a[1],
@@ -238,11 +239,16 @@ impl TangentTop {
                 i * a[1],
             ],
             [i * a[0], i * a[1], i],
-        ])
+        ];
+        if !out.as_flattened().iter().all(|v| v.is_finite()) {
+            return Err(check::overflow_error("eta", "the metric g_AB of 002 (47)"));
+        }
+        Ok(out)
     }
 
     /// The Lagrangian L = ½ ẋᵀ G ẋ + ½ 𝕀 (θ̇ + α_i ẋ^i)² at (η, η̇), G = m g (+ WᵀQW embedded).
-    /// Errors: x outside the domain, non-finite input.
+    /// Errors: x outside the domain, non-finite input, an overflow error where L exceeds the
+    /// f64 range.
     pub fn lagrangian(&self, eta: [f64; 3], etadot: [f64; 3]) -> Result<f64> {
         check::finite_slice("eta and etadot", &[eta, etadot].concat())?;
         let x = [eta[0], eta[1]];
@@ -250,7 +256,11 @@ impl TangentTop {
         let l = self.local(x, eta[2]);
         let v = [etadot[0], etadot[1]];
         let s = etadot[2] + l.alpha[0] * v[0] + l.alpha[1] * v[1];
-        Ok(0.5 * quad(&l.g, v) + 0.5 * self.inertia() * s * s)
+        let lag = 0.5 * quad(&l.g, v) + 0.5 * self.inertia() * s * s;
+        if !lag.is_finite() {
+            return Err(check::overflow_error("eta and etadot", "the Lagrangian"));
+        }
+        Ok(lag)
     }
 
     /// The canonical state z = (x, θ, p) with p_A = g_AB η̇^B (Legendre transform) of the top at x

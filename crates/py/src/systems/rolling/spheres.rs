@@ -2,6 +2,7 @@
 //! `lieflow.System`: constructor, states and observables.
 #![allow(non_snake_case)]
 
+use lieflow::systems::rolling::spheres::STATE_DIM;
 use lieflow::systems::RollingSpheres;
 use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
@@ -9,6 +10,7 @@ use pyo3::PyClassInitializer;
 use crate::convert::ArrayIn;
 use crate::convert::{real, real_matrix, real_vec, reals};
 use crate::errors::{to_py, IntoPy};
+use crate::items::{par_map_items, Input};
 use crate::system::{PySystem, Thin};
 use lieflow::Error;
 
@@ -44,6 +46,27 @@ fn observe<'py>(
     let sys = slf.core::<RollingSpheres>()?;
     slf.base()
         .map_states(slf.py(), &states, shape, |z, out| f(sys, z, out))
+}
+
+/// `f(state, Omega, Omega_tilde) -> (3,)` over the broadcast leading axes of states (..., 27)
+/// and two pairs of angular velocities (..., 2, 3).
+fn pairs<'py>(
+    py: Python<'py>,
+    states: &ArrayIn<'py>,
+    omega: &ArrayIn<'py>,
+    omega_tilde: &ArrayIn<'py>,
+    f: impl Fn(&[f64], [[f64; 3]; 2], [[f64; 3]; 2]) -> lieflow::Result<[f64; 3]> + Sync + Send,
+) -> PyResult<Any<'py>> {
+    let inputs = [
+        Input::finite("states", states, &[STATE_DIM]),
+        Input::finite("Omega", omega, &[2, 3]),
+        Input::finite("Omega_tilde", omega_tilde, &[2, 3]),
+    ];
+    let pair = |x: &[f64]| [[x[0], x[1], x[2]], [x[3], x[4], x[5]]];
+    par_map_items(py, &inputs, &[3], |x, out| {
+        out.copy_from_slice(&f(x[0], pair(x[1]), pair(x[2]))?);
+        Ok(())
+    })
 }
 
 #[pymethods]
@@ -130,6 +153,77 @@ impl PyRollingSpheres {
             )));
         }
         slf.core::<RollingSpheres>()?.to_planar(&state, tol).py()
+    }
+
+    /// The Lagrangian L of 003 (8), evaluated as printed with du/dt from the rolling constraint
+    /// (10):
+    /// ``L = Omega1^T J1 Omega1 / 2 + Omega2^T J2 Omega2 / 2 + |udot|^2 / 2 - B``,
+    /// ``B = dot(udot, alpha1 b1 - alpha2 b2) + alpha1 alpha2 dot(b1, b2)``, with
+    /// ``b_k = z_k (Omega_k x e_k)``,
+    /// ``e_k = gamma_k / r_k`` and the rescaled tensors J_k of 003 §2; ``scale * L`` is the kinetic
+    /// energy of both bodies (`energy`, computed in the completed-square form). (..., 27) -> (...).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError, NotInGroupError (z_k not rotations, u not a unit vector).
+    fn lagrangian<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        observe(slf, states, &[], |s, z, out| {
+            out[0] = s.lagrangian(z)?;
+            Ok(())
+        })
+    }
+
+    /// The curvature of the rolling distribution (003 §2.2) in closed form:
+    /// ``Delta(X, X~) = alpha1 alpha2 u x ((z1 Omega1 - z2 Omega2) x (z1 Omega1~ - z2 Omega2~))``
+    /// for the constrained fields X, X~ with body angular velocities ``Omega = (Omega1, Omega2)``
+    /// and ``Omega_tilde = (Omega1~, Omega2~)``, at the configuration (z1, z2, u) of the states
+    /// (their velocities are ignored); ``Delta = -nu([X, X~])``, see `curvature_by_brackets`.
+    /// Maps over the broadcast leading axes of the three arguments.
+    ///
+    /// Args:
+    ///     states: (..., 27); Omega, Omega_tilde: (..., 2, 3), rows the angular velocities of the
+    ///     two bodies.
+    /// Returns:
+    ///     (..., 3) array.
+    /// Raises:
+    ///     ShapeError, NonFiniteError, NotInGroupError (z_k not rotations, u not a unit vector).
+    fn curvature<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+        Omega: ArrayIn<'py>,
+        Omega_tilde: ArrayIn<'py>,
+    ) -> PyResult<Any<'py>> {
+        let sys = slf.core::<RollingSpheres>()?;
+        pairs(slf.py(), &states, &Omega, &Omega_tilde, |z, o, ot| {
+            sys.curvature(z, o, ot)
+        })
+    }
+
+    /// The curvature of the rolling distribution (003 §2.2) from the Lie bracket of the
+    /// constrained fields, ``Delta(X, X~) = -nu([X, X~])`` with
+    /// ``nu(Omega1, Omega2, v) = v - (alpha1 z1 Omega1 + alpha2 z2 Omega2) x u``: the bracket
+    /// from the commutator of the exact flows of X and X~ over the time s (second differences,
+    /// symmetrised in +-s and Richardson-extrapolated from s and 2s; error
+    /// O((s ‖Omega‖)^4) + O(eps / s^2): about 1e-9 relative at the default s for angular
+    /// velocities of order one). Equal to `curvature` (the closed form).
+    ///
+    /// Args:
+    ///     states: (..., 27); Omega, Omega_tilde: (..., 2, 3); s: the flow time, > 0.
+    /// Returns:
+    ///     (..., 3) array.
+    /// Raises:
+    ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (s <= 0).
+    #[pyo3(signature = (states, Omega, Omega_tilde, s = 2e-3))]
+    fn curvature_by_brackets<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+        Omega: ArrayIn<'py>,
+        Omega_tilde: ArrayIn<'py>,
+        #[pyo3(from_py_with = real)] s: f64,
+    ) -> PyResult<Any<'py>> {
+        let sys = slf.core::<RollingSpheres>()?;
+        pairs(slf.py(), &states, &Omega, &Omega_tilde, |z, o, ot| {
+            sys.curvature_by_brackets(z, o, ot, s)
+        })
     }
 
     /// Total angular momentum about the centre of mass (conserved), (..., 27) -> (..., 3).

@@ -4,6 +4,8 @@
 
 use lieflow::systems::{ChargedParticle, TangentTop};
 use lieflow::Error;
+use numpy::ndarray::arr2;
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PySlice};
 use pyo3::PyClassInitializer;
@@ -101,6 +103,52 @@ impl PyTangentTop {
     ) -> PyResult<Vec<f64>> {
         let top = slf.core::<TangentTop>()?;
         crate::errors::checked(|| top.state(x, theta, xdot, thetadot))
+    }
+
+    /// The metric of the configuration space at eta = (x1, x2, theta), 002 (47) with the sign of
+    /// its cross terms corrected: ``g_AB = [[m g + I a a^T, I a], [I a^T, I]]`` with g the surface's
+    /// metric, a = (alpha_1, alpha_2) its connection 1-form and I = tr of the Euler tensor; for the
+    /// embedded top ``m g`` becomes ``G(x, theta) = m g + W^T Q(theta) W`` (002 (37), (39)). The
+    /// Lagrangian is ``L = etadot^T g_AB etadot / 2`` and the canonical momenta of `state` are
+    /// ``p = g_AB etadot``.
+    ///
+    /// Args:
+    ///     x: (2,) in the surface's chart; theta: the body's angle.
+    /// Returns:
+    ///     (3, 3) symmetric positive definite array.
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart), NonFiniteError.
+    fn metric<'py>(
+        slf: &Bound<'py, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let top = slf.core::<TangentTop>()?;
+        let g = crate::errors::checked(|| top.metric([x[0], x[1], theta]))?;
+        Ok(arr2(&g).into_pyarray(slf.py()))
+    }
+
+    /// The Lagrangian of the top, 002 (43)–(47) (cross term with the corrected sign):
+    /// ``L = m g(xdot, xdot) / 2 + I (thetadot + alpha_i xdot^i)^2 / 2`` with I = tr of the Euler
+    /// tensor and alpha the connection 1-form of the surface's frame; for the embedded top
+    /// ``m g`` becomes ``G(x, theta) = m g + W^T Q(theta) W`` (002 (37), (39)).
+    ///
+    /// Args:
+    ///     x: (2,) in the surface's chart; theta; xdot: (2,); thetadot.
+    /// Returns:
+    ///     float.
+    /// Raises:
+    ///     InvalidArgumentError (x outside the chart, L beyond the float range), NonFiniteError.
+    fn lagrangian(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<f64> {
+        let top = slf.core::<TangentTop>()?;
+        let (eta, etadot) = ([x[0], x[1], theta], [xdot[0], xdot[1], thetadot]);
+        crate::errors::checked(|| top.lagrangian(eta, etadot))
     }
 
     /// Named views for `Trajectory`: x (..., 2), theta (...), p (..., 3), and the velocities

@@ -10,7 +10,7 @@ use super::surface::PySurface;
 use crate::convert::ArrayIn;
 use crate::convert::{named, real, real_opt, reals, reals_opt, Real};
 use crate::errors::{to_py, IntoPy};
-use crate::items::{map_items, Input};
+use crate::items::{map_items, par_map_items, Input};
 use crate::system::{PySystem, Thin};
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical
@@ -113,6 +113,77 @@ impl PyRelativisticTangentTop {
         })
     }
 
+    /// The momentum of the symmetric top as a function of its speed v and spin momentum
+    /// J = p_theta, 002 (94) (physical sign, J = p_theta; the text's J is half of it):
+    /// ``|p| = m gamma v (1 + J^2 (1 - v^2)(4 - v^2) / (2 I0 m (2 - v^2)^2))`` with
+    /// ``gamma = (1 - v^2)^(-1/2)``, ``I0 = tr I / 2``; on a surface ``|p|`` is the norm of
+    /// ``p_x - p_theta alpha`` in the inverse metric. The text concludes that ``|p|`` fixes v; it
+    /// does not for ``J^2 / (2 I0 m) > 7.34``, where v -> ``|p|`` decreases on an interval.
+    /// Maps over the broadcast leading axes of v and p_theta.
+    ///
+    /// Args:
+    ///     v: speed(s), 0 <= v < 1; p_theta: the spin momentum J.
+    /// Returns:
+    ///     float, or an array of the broadcast shape.
+    /// Raises:
+    ///     InvalidArgumentError (v outside [0, 1), an anisotropic top), NonFiniteError, ShapeError.
+    fn momentum_94<'py>(
+        slf: &Bound<'py, Self>,
+        v: ArrayIn<'py>,
+        p_theta: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        relation(slf.py(), ("v", &v), ("p_theta", &p_theta), |v, j| {
+            top.momentum_94(v, j)
+        })
+    }
+
+    /// The spin rate of the symmetric top from its speed v and spin momentum J = p_theta,
+    /// 002 (95): ``thetadot = J / (2 I0 gamma (1 + v^2 gamma^2 / 2))``, ``I0 = tr I / 2``; on a
+    /// surface the covariant spin rate ``s = thetadot + w(xdot)``. Maps over the broadcast
+    /// leading axes of v and p_theta.
+    ///
+    /// Args:
+    ///     v: speed(s), 0 <= v < 1; p_theta: the spin momentum J.
+    /// Returns:
+    ///     float, or an array of the broadcast shape.
+    /// Raises:
+    ///     InvalidArgumentError (v outside [0, 1), an anisotropic top), NonFiniteError, ShapeError.
+    fn spin_rate_95<'py>(
+        slf: &Bound<'py, Self>,
+        v: ArrayIn<'py>,
+        p_theta: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        relation(slf.py(), ("v", &v), ("p_theta", &p_theta), |v, j| {
+            top.spin_rate_95(v, j)
+        })
+    }
+
+    /// The energy of the symmetric top from its speed v and spin rate thetadot, 002 (96)
+    /// (physical sign):
+    /// ``E = m gamma + I0 thetadot^2 (gamma + 5 v^2 gamma^3 / 2 + 3 v^4 gamma^5 / 2)``,
+    /// ``I0 = tr I / 2``; on a surface with thetadot the covariant spin
+    /// rate ``s = thetadot + w(xdot)``. Maps over the broadcast leading axes of v and
+    /// thetadot.
+    ///
+    /// Args:
+    ///     v: speed(s), 0 <= v < 1; thetadot: spin rate(s).
+    /// Returns:
+    ///     float, or an array of the broadcast shape.
+    /// Raises:
+    ///     InvalidArgumentError (v outside [0, 1), an anisotropic top), NonFiniteError, ShapeError.
+    fn energy_96<'py>(
+        slf: &Bound<'py, Self>,
+        v: ArrayIn<'py>,
+        thetadot: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        relation(slf.py(), ("v", &v), ("thetadot", &thetadot), |v, w| {
+            top.energy_96(v, w)
+        })
+    }
+
     /// All Killing momenta J = p_A X^A of the surface's isometry group (the Minkowski plane and
     /// Plane: translations x, y and the rotation; Sphere: the ambient angular momentum x, y, z;
     /// HyperbolicPlane: the Möbius generators E, H, F; Revolution: p_phi), (..., 6) -> (..., k).
@@ -130,6 +201,22 @@ impl PyRelativisticTangentTop {
             Ok(())
         })
     }
+}
+
+/// `f(v, y)` over the broadcast leading axes of two arrays of scalars (the relations (94)–(96));
+/// the core's name of J is the argument's, `p_theta`.
+fn relation<'py>(
+    py: Python<'py>,
+    v: (&str, &ArrayIn<'py>),
+    y: (&str, &ArrayIn<'py>),
+    f: impl Fn(f64, f64) -> lieflow::Result<f64> + Sync + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let inputs = [Input::finite(v.0, v.1, &[]), Input::finite(y.0, y.1, &[])];
+    par_map_items(py, &inputs, &[], |x, out| {
+        out[0] = f(x[0][0], x[1][0])
+            .map_err(|e| e.map_what(|w| if w == "J" { y.0.into() } else { w.into() }))?;
+        Ok(())
+    })
 }
 
 /// The tangent top in the weak-field limit of a static space-time with potential phi (002

@@ -25,6 +25,8 @@ type Any<'py> = Bound<'py, PyAny>;
 #[pyclass(module = "lieflow.surfaces", name = "Surface", frozen)]
 pub struct PySurface {
     pub(crate) inner: Arc<dyn Surface>,
+    /// The same surface as its type for `MetricSurface` (its `check_frame`), else None.
+    metric_surface: Option<Arc<surface::MetricSurface>>,
     /// (function of `lieflow.surfaces`, its arguments), for pickling.
     recipe: (&'static str, Py<PyTuple>),
     desc: String,
@@ -39,6 +41,7 @@ impl PySurface {
         let desc = format!("{name}{}", args.repr()?);
         Ok(PySurface {
             inner,
+            metric_surface: None,
             recipe: (name, args.unbind()),
             desc: desc.replace(",)", ")"),
         })
@@ -95,6 +98,34 @@ impl PySurface {
     ///     InvalidArgumentError (x outside the chart).
     fn connection(&self, #[pyo3(from_py_with = reals::<2>)] x: Vec2) -> PyResult<Vec2> {
         self.at(x, |x| self.inner.connection(x))
+    }
+
+    /// Checks at x that the frame of a `MetricSurface` is orthonormal and positively oriented
+    /// for its metric: ``g(E_a, E_b) = delta_ab`` within `tol` (``g(E_a, E_b) = e_a^T g e_b``
+    /// with the rows e_a of `frame(x1, x2)`) and ``det e > 0``; the connection 1-form and the
+    /// dynamics on the surface assume it (002 (43)). Returns None.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (the frame fails the check, names the pair (a, b); x outside the
+    ///     chart; tol not a finite number >= 0; a surface other than a MetricSurface, whose frame
+    ///     is orthonormal by construction), the exception of a callable.
+    #[pyo3(signature = (x, tol = 1e-10))]
+    fn check_frame(
+        &self,
+        #[pyo3(from_py_with = reals::<2>)] x: Vec2,
+        #[pyo3(from_py_with = real)] tol: f64,
+    ) -> PyResult<()> {
+        let Some(ms) = &self.metric_surface else {
+            return Err(crate::errors::to_py(Error::invalid(
+                "check_frame",
+                format!(
+                    "only a MetricSurface has a frame given by callables to check; the frame of \
+                     {} is orthonormal by construction",
+                    self.desc
+                ),
+            )));
+        };
+        checked(|| ms.check_frame(x, tol))
     }
 
     /// The names of the Killing generators, in the order of `TangentTop.killing_momenta`.
@@ -307,7 +338,8 @@ fn Quadric(
 
 /// A surface given by its metric and an orthonormal frame, as callables x1, x2 -> (2, 2) arrays:
 /// `metric` g_ij, `frame` with row a the components of E_a (orthonormal for g, positively
-/// oriented); `domain(x1, x2) -> bool` optionally restricts the chart. The connection 1-form and
+/// oriented: `Surface.check_frame` checks it at a point); `domain(x1, x2) -> bool` optionally
+/// restricts the chart. The connection 1-form and
 /// the derivatives are computed numerically (errors about 1e-12 in alpha, 1e-9 in its
 /// derivatives). No Killing generators, no embedding. The slowest path: the differences call
 /// the two callables about 180 times per evaluation of a top's vector field, so a gauss4 step
@@ -356,7 +388,11 @@ fn MetricSurface<'py>(
         dom,
     );
     let args = (metric, frame, domain).into_pyobject(py)?;
-    PySurface::new(Arc::new(inner), "MetricSurface", args)
+    let inner = Arc::new(inner);
+    Ok(PySurface {
+        metric_surface: Some(inner.clone()),
+        ..PySurface::new(inner, "MetricSurface", args)?
+    })
 }
 
 /// Fills the `surfaces` submodule.

@@ -73,8 +73,15 @@ impl MetricSurface {
     }
 
     /// Checks at x that the frame is orthonormal and positively oriented for the metric
-    /// (g(Ê_a, Ê_b) = δ_ab within `tol`, det e > 0). Errors: [`Error::InvalidArgument`].
+    /// (g(Ê_a, Ê_b) = δ_ab within `tol`, det e > 0). Errors: [`Error::InvalidArgument`] (also
+    /// for a tolerance that is not a finite number ≥ 0).
     pub fn check_frame(&self, x: Vec2, tol: f64) -> Result<()> {
+        if !(tol.is_finite() && tol >= 0.0) {
+            return Err(Error::invalid(
+                "tol",
+                format!("expected a finite tolerance ≥ 0, got {tol}"),
+            ));
+        }
         if !self.contains(x) {
             return Err(Error::invalid(
                 "x",
