@@ -4,6 +4,7 @@ Submodules
 ----------
 lie           matrix Lie groups and algebras: SO(n), SO(3), SE(3), GL+(n), SO(n)×SO(n)
 pseudo_rigid  generalized pseudo-rigid bodies on GL+(n) (inertia tensors, connections, momenta)
+spaces        the 3-dimensional space forms of the FrameTop (Euclidean, Sphere, Hyperbolic)
 elliptic      Jacobi elliptic functions sn, cn, dn and the integrals K(m), F(phi | m)
 ellipsoids    self-gravitating fluid ellipsoids (Maclaurin, Jacobi, Dedekind, Riemann S-type)
 continuation  continuation of families of relative equilibria, branch points, stability
@@ -20,6 +21,7 @@ Pendulum, SphereParticle, RollingDisk                           canonical, const
                                                                 nonholonomic test problems
 TangentTop, ChargedParticle, surfaces                           the tangent Euler top of 002 §II–III
 RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
+FrameTop, spaces                                                the top on R^3, S^3, H^3 (002 §V)
 RollingSpheres                                                  two rolling spheres of 003 §2
 RollingDisks                                                    two rolling disks of 003 §1
 Canonical, Separable, LiePoisson                                user-defined systems from Python
@@ -55,6 +57,7 @@ from ._lieflow import (
     ChargedParticle,
     EulerPoincare,
     Forced,
+    FrameTop,
     GeneralizedRigidBody,
     HeavyTop,
     Integration,
@@ -77,7 +80,8 @@ from ._lieflow import (
     mass_matrix,
     spatial_inertia,
 )
-from . import continuation, ellipsoids, elliptic, io, lie, plot, potentials, pseudo_rigid, surfaces
+from . import (continuation, ellipsoids, elliptic, io, lie, plot, potentials, pseudo_rigid, spaces,
+               surfaces)
 from . import ensemble  # imports dask and xarray only when its functions are called
 from .integrate import Trajectory, integrate, load
 from .io import FileFormatError
@@ -94,6 +98,7 @@ __all__ = [
     "EulerPoincare",
     "FileFormatError",
     "Forced",
+    "FrameTop",
     "GeneralizedRigidBody",
     "HeavyTop",
     "Integration",
@@ -134,6 +139,7 @@ __all__ = [
     "plot",
     "potentials",
     "pseudo_rigid",
+    "spaces",
     "spatial_inertia",
     "surfaces",
 ]

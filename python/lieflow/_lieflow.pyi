@@ -20,11 +20,11 @@ _F64 = NDArray[np.float64]
 __all__ = [
     "LieflowError", "NotInGroupError", "ShapeError", "NonFiniteError", "DegenerateStratumError",
     "NoUniqueLogError", "InvalidArgumentError", "UnsupportedMethodError", "ConvergenceError",
-    "LeftDomainError", "ArgumentTypeError", "lie", "pseudo_rigid", "potentials", "surfaces",
+    "LeftDomainError", "ArgumentTypeError", "lie", "pseudo_rigid", "potentials", "spaces", "surfaces",
     "elliptic", "ellipsoids", "continuation", "System", "Integration", "RigidBody",
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
-    "RelativisticTangentTop", "WeakFieldTop", "TangentTop", "ChargedParticle", "Canonical",
+    "RelativisticTangentTop", "WeakFieldTop", "TangentTop", "ChargedParticle", "FrameTop", "Canonical",
     "Separable", "LiePoisson", "EulerPoincare", "Forced", "PseudoRigidBody", "__version__",
     "inertia_tensor", "mass_matrix", "spatial_inertia",
 ]
@@ -48,6 +48,7 @@ potentials: ModuleType
 elliptic: ModuleType
 ellipsoids: ModuleType
 continuation: ModuleType
+spaces: ModuleType
 surfaces: ModuleType
 
 
@@ -351,6 +352,31 @@ class TangentTop(System):
     def ambient_frame(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 3, 3): rows c, E1, E2 in R^3."""
     def magnetic_analogue(self, p_theta: float) -> ChargedParticle: ...
+
+@final
+class FrameTop(System):
+    """The tangent Euler top on a three-dimensional space form (002 §V); exact, splitting,
+    splitting4, splitting6, rk4."""
+
+    def __new__(cls, space: Any, mass: float, inertia: ArrayLike) -> Self: ...
+    @property
+    def space(self) -> Any: ...
+    @property
+    def mass(self) -> float: ...
+    @property
+    def inertia(self) -> _F64: ...
+    def state(self, x: ArrayLike, R: ArrayLike, xdot: ArrayLike, omega: ArrayLike) -> _F64: ...
+    def position(self, states: ArrayLike) -> _F64: ...
+    def frame(self, states: ArrayLike) -> _F64: ...
+    def velocity(self, states: ArrayLike) -> _F64: ...
+    def angular_velocity(self, states: ArrayLike) -> _F64: ...
+    def killing_momenta(self, states: ArrayLike) -> _F64: ...
+    def group_momentum(self, states: ArrayLike) -> _F64:
+        """On S^3: (..., 4, 4) so(4) body momentum M, dM/dt = [M, xi]."""
+    def group_inertia(self) -> _F64:
+        """On S^3: (6, 6) inertia of the SO(4) top in e_ij coordinates."""
+    def translational_energy(self, states: ArrayLike) -> _F64 | float: ...
+    def rotational_energy(self, states: ArrayLike) -> _F64 | float: ...
 
 @final
 class ChargedParticle(System):

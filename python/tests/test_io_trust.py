@@ -300,7 +300,10 @@ def _stored_objects(lf_module):
                                                 side="right")),
             ("charged", lf.TangentTop(lf.surfaces.Torus(2.0, 0.7), 1.0, 0.5)
              .magnetic_analogue(0.3)),
-            ("int32-array", lf.RigidBody(np.array([1, 2, 3], dtype=np.int32)))]
+            ("int32-array", lf.RigidBody(np.array([1, 2, 3], dtype=np.int32))),
+            ("frame-top-flat", lf.FrameTop(lf.spaces.Euclidean(3), 1.0, [1.0, 2.0, 3.0])),
+            ("frame-top-hyperbolic", lf.FrameTop(lf.spaces.Hyperbolic(3, radius=2.0), 1.0,
+                                                 np.diag([1.0, 2.0, 3.0])))]
     return out
 
 
@@ -343,7 +346,10 @@ def test_every_allowed_entry_is_a_constructor():
         if module == "lieflow":
             assert isinstance(obj, type) and issubclass(obj, lf.System), name
             assert getattr(lf, attr) is obj and attr in lf.__all__, name
-        elif module in ("lieflow.potentials", "lieflow.surfaces"):
+        elif module == "lieflow.pseudo_rigid":
+            assert isinstance(obj, type) and issubclass(obj, lf.System), name
+            assert getattr(lf.pseudo_rigid, attr) is obj and attr in lf.pseudo_rigid.__all__, name
+        elif module in ("lieflow.potentials", "lieflow.surfaces", "lieflow.spaces"):
             mod = getattr(lf, module.split(".")[1])
             assert attr in mod.__all__ and getattr(mod, attr) is obj, name
             assert attr[0].isupper() and obj.__doc__, name     # a documented factory

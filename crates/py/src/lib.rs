@@ -41,6 +41,9 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let surfaces = PyModule::new(m.py(), "lieflow.surfaces")?;
     systems::tangent_top::surface::register(&surfaces)?;
     m.add("surfaces", surfaces)?;
+    let spaces = PyModule::new(m.py(), "lieflow.spaces")?;
+    systems::tangent_top::space_form::register(&spaces)?;
+    m.add("spaces", spaces)?;
     add_submodule(m, "elliptic", elliptic::register)?;
     add_submodule(m, "ellipsoids", pseudo_rigid::ellipsoids::register)?;
     add_submodule(m, "continuation", analysis::register)?;

@@ -29,6 +29,9 @@ ALLOWED = [
      "J of another length n is the body of another so(n): valid"),
     ("mass_matrix", "positions", "wrong-last-axis", "accepted-bad",
      "positions of another dimension n are a body in R^n, whose mass matrix is (n, n): valid"),
+    ("pseudo_rigid.particle_locked_inertia", "positions", "wrong-last-axis", "accepted-bad",
+     "positions of another dimension n are particles in R^n, whose locked inertia is "
+     "(n(n-1)/2, n(n-1)/2): valid"),
     ("pseudo_rigid.equilibrium_directions", "a", "wrong-last-axis", "accepted-bad",
      "semi-axes of another length n are another dimension: valid"),
     ("run.save_at", "t_eval", "wrong-last-axis", "accepted-bad",

@@ -59,7 +59,7 @@ class Spec:
         if not self.module:
             head = self.target.lstrip("@").split(".")[0]
             self.module = {"lie": "lie", "pseudo_rigid": "pseudo_rigid", "potentials": "potentials",
-                           "surfaces": "surfaces", "elliptic": "elliptic",
+                           "surfaces": "surfaces", "spaces": "spaces", "elliptic": "elliptic",
                            "ellipsoids": "pseudo_rigid", "continuation": "pseudo_rigid",
                            "integrate": "integrate"}.get(head, "systems")
             if head in RECEIVER_MODULE:
@@ -109,6 +109,8 @@ M3 = np.array([1.0, 0.5, -0.3])
 I_SPH1 = np.array([[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]])
 I_SPH2 = np.array([[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]])
 U_SPH = np.array([0.2, 0.9, -0.3]) / np.linalg.norm([0.2, 0.9, -0.3])
+FT_X = np.array([0.9, 0.0, 1.2, 0.0])                 # on Sphere(3, radius=1.5)
+FT_V = np.array([0.0, 0.5, 0.0, -0.4])                # tangent there
 
 
 # --- user callables (module level: native code calls them; they also pickle) ---
@@ -222,6 +224,8 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "prb": lambda lf: lf.PseudoRigidBody(3, _svk(lf)),
     "iprb": lambda lf: lf.PseudoRigidBody(3, _svk(lf), incompressible=True),
     "rrb": lambda lf: lf.pseudo_rigid.RightReduced(3, _svk(lf), reconstruct=True),
+    "ft": lambda lf: lf.FrameTop(lf.spaces.Sphere(3, radius=1.5), 1.3, A3),
+    "s3": lambda lf: lf.spaces.Sphere(3, radius=1.5),
     "rtt": lambda lf: lf.RelativisticTangentTop(1.0, 0.2, lf.surfaces.Sphere(1.0)),
     "wft": lambda lf: lf.WeakFieldTop(1.0, 1e-3, gm=1e-4),
     "tt": lambda lf: lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
@@ -262,7 +266,7 @@ RECEIVER_MODULE = {**{k: "potentials" for k in ("harmonic", "svk", "volumetric",
                                                   "sum", "callable", "selfgrav")},
                    **{k: "surfaces" for k in ("plane", "sphere", "hyp", "torus", "quadric",
                                               "revolution", "graph", "metric")},
-                   "releq": "pseudo_rigid", "branch": "pseudo_rigid"}
+                   "releq": "pseudo_rigid", "branch": "pseudo_rigid", "s3": "spaces"}
 # The point of each surface's chart used for its methods.
 SURFACE_POINT = {"plane": [0.2, -0.1], "sphere": [1.0, 0.3], "hyp": [0.1, 1.0],
                  "torus": [0.9, 0.4], "quadric": [0.3, -0.4], "revolution": [0.9, 0.4],
@@ -284,6 +288,7 @@ def state_of(key):
         "iprb": lambda lf, s: np.concatenate([X3.ravel(),
                                               s.project_momentum(X3, V3).ravel()]),
         "rrb": lambda lf, s: s.reduce(X3, V3),
+        "ft": lambda lf, s: s.state(FT_X, R3, FT_V, W3),
         "rtt": lambda lf, s: np.asarray(s.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)),
         "wft": lambda lf, s: np.asarray(s.state([1.0, 0.5], 0.1, [0.1, 0.2], 0.3)),
         "tt": lambda lf, s: np.asarray(s.state([1.0, 0.3], 0.2, [0.1, 0.3], 1.5)),
@@ -294,14 +299,14 @@ def state_of(key):
     return Lazy(lambda lf: makers[key](lf, RECEIVERS[key](lf)))
 
 
-SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "iprb", "rrb", "rtt", "wft", "tt", "cp",
+SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "iprb", "rrb", "ft", "rtt", "wft", "tt", "cp",
            "rds", "rsph"]
 CONSTRUCTORS = {  # class name -> receiver key built by it
     "RigidBody": "rb", "GeneralizedRigidBody": "grb", "HeavyTop": "ht", "SphericalPendulum": "sp",
     "Pendulum": "pend", "SphereParticle": "spart", "RollingDisk": "disk", "PseudoRigidBody": "prb",
     "RelativisticTangentTop": "rtt", "WeakFieldTop": "wft", "TangentTop": "tt",
     "ChargedParticle": "cp", "RollingDisks": "rds", "RollingSpheres": "rsph",
-    "RightReduced": "rrb",
+    "RightReduced": "rrb", "FrameTop": "ft",
 }
 
 
@@ -615,7 +620,7 @@ def build_specs() -> list[Spec]:
     add(P + "loop_area", P + "loop_area", A("labels", LOOP, "mat"))
     add(P + "guichardet_connection", P + "guichardet_connection",
         A("masses", np.array([1.0, 2.0, 0.5, 1.5]), "vec"), A("positions", LOOP, "mat"),
-        A("velocities", V3 @ LOOP.T @ np.ones((4, 3)) * 0.1 + LOOP, "mat"))
+        A("velocities", LOOP @ V3.T, "mat"))
     add(P + "particle_locked_inertia", P + "particle_locked_inertia",
         A("masses", np.array([1.0, 2.0, 0.5, 1.5]), "vec"), A("positions", LOOP, "mat"))
     add(P + "reduced_euler_lagrange", P + "reduced_euler_lagrange",
@@ -739,6 +744,12 @@ def build_specs() -> list[Spec]:
     for c in ("SphericalPendulum", "Pendulum", "SphereParticle"):
         add(c, c, A("mass", 2.0, "float", positive=True), A("length", 1.5, "float", positive=True),
             A("g", 9.81, "float"))
+    add("FrameTop", "FrameTop", A("space", Lazy(lambda lf: lf.spaces.Sphere(3, radius=1.5)), "obj"),
+        A("mass", 1.3, "float", positive=True), A("inertia", A3, "vec"))
+    add("spaces.Euclidean", "spaces.Euclidean", A("n", 3, "int", opt=True))
+    for f in ("Sphere", "Hyperbolic"):
+        add("spaces." + f, "spaces." + f, A("n", 3, "int", opt=True),
+            A("radius", 1.5, "float", opt=True, positive=True))
     add("RollingDisk", "RollingDisk", A("mass", 1.0, "float", positive=True),
         A("radius", 0.5, "float", positive=True), A("roll_inertia", 0.125, "float", positive=True),
         A("turn_inertia", 0.0625, "float", positive=True), A("spring", 0.4, "float", kw=True),
@@ -807,6 +818,13 @@ def build_specs() -> list[Spec]:
         "rrb": [(f, [A("states", state_of("rrb"), "vec")])
                 for f in ("angular_momentum", "circulation", "hamiltonian_parts", "reconstruct")]
         + [("reduce", [A("X", X3, "gl"), A("P", V3, "mat")])],
+        "ft": [(f, [A("states", state_of("ft"), "vec")])
+               for f in ("position", "frame", "velocity", "angular_velocity", "killing_momenta",
+                         "group_momentum", "translational_energy", "rotational_energy")]
+        + [("group_inertia", []),
+           ("state", [A("x", FT_X, "vec"), A("R", R3, "rot"), A("xdot", FT_V, "vec"),
+                      A("omega", W3, "vec")])],
+        "s3": [("reference_frame", [A("x", FT_X, "vec")])],
         "iprb": [(f, [A("states", state_of("iprb"), "vec")])
                  for f in ("angular_momentum", "circulation", "singular_values")]
         + [("project_momentum", [A("X", X3, "gl"), A("P", V3, "mat")])],
@@ -895,7 +913,7 @@ def build_specs() -> list[Spec]:
         add(f"integrate[{key}]", "integrate", A("system", lazy_recv(key), "obj"),
             A("state0", state_of(key), "vec"), A("dt", 0.01, "float", kw=True),
             A("steps", 10, "int", kw=True), A("method", None, "str", kw=True, opt=True),
-            slow=key in ("prb", "iprb", "rrb", "rtt", "tt", "cp", "rds", "rsph"))
+            slow=key in ("prb", "iprb", "rrb", "ft", "rtt", "tt", "cp", "rds", "rsph"))
     ht_att = Lazy(lambda lf: RECEIVERS["ht"](lf).state(M3, attitude=R3))
     for key, st in (("rb", state_of("rb")), ("ht", ht_att)):
         add(f"integrate[{key},attitude]", "integrate", A("system", lazy_recv(key), "obj"),

@@ -82,17 +82,18 @@ SKIP = {  # public names that are not callables to fuzz, with the reason
     "lieflow.pseudo_rigid.Verdict": "a record (no methods)",
     "lieflow.potentials.Potential": "made by the potential constructors; methods fuzzed on each",
     "lieflow.surfaces.Surface": "made by the surface constructors; methods fuzzed on each",
+    "lieflow.spaces.Space": "made by Euclidean, Sphere, Hyperbolic; methods fuzzed on a sphere",
     "lieflow.continuation.Branch": "made by follow; its methods are fuzzed on a branch",
     "lieflow.continuation.SpecialPoint": "made by follow; a record (attributes only)",
 }
 CLASS_RECEIVER = {**CONSTRUCTORS, "Integration": "run", "Trajectory": "traj",
                   "RollingDisksEquilibrium": "rdeq", "RelativeEquilibrium": "releq",
-                  "Potential": "harmonic", "Surface": "sphere", "Branch": "branch"}
+                  "Potential": "harmonic", "Surface": "sphere", "Branch": "branch", "Space": "s3"}
 
 
 def public_callables():
     out = []
-    for modname in ("", ".lie", ".pseudo_rigid", ".potentials", ".surfaces", ".elliptic",
+    for modname in ("", ".lie", ".pseudo_rigid", ".potentials", ".spaces", ".surfaces", ".elliptic",
                     ".ellipsoids", ".continuation", ".plot",
                     *((".ensemble",) if _has_dask() else ())):
         mod = eval("lf" + modname)

@@ -208,7 +208,10 @@ pub fn guichardet_connection(masses: &[f64], positions: &Mat, velocities: &Mat) 
             }
         }
     }
-    Ok(v * w * v.transpose())
+    let omega = v * w * v.transpose();
+    check::finite_mat("connection", &omega)
+        .map_err(|_| check::overflow_error("masses, positions, velocities", "the connection"))?;
+    Ok(omega)
 }
 
 /// The locked inertia of N particles (001 (2.27)): the Gram matrix
@@ -226,10 +229,13 @@ pub fn particle_locked_inertia(masses: &[f64], positions: &Mat) -> Result<Mat> {
         })
         .collect();
     // Σ m (e_a x)·(e_b x) = tr(e_aᵀ e_b Q).
-    Ok(Mat::from_fn(d, d, |a, b| {
+    let gram = Mat::from_fn(d, d, |a, b| {
         let p = basis[a].transpose() * &basis[b] * &q;
         (0..n).map(|i| p[(i, i)]).sum()
-    }))
+    });
+    check::finite_mat("locked inertia", &gram)
+        .map_err(|_| check::overflow_error("masses, positions", "the locked inertia"))?;
+    Ok(gram)
 }
 
 /// Q = Σ m x xᵀ of N particles (checked: masses > 0 and finite, N × n positions finite, n ≥ 2).

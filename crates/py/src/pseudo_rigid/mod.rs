@@ -777,11 +777,11 @@ pub fn loop_area<'py>(
 #[pyfunction]
 pub fn guichardet_connection<'py>(
     py: Python<'py>,
-    masses: Bound<'py, PyAny>,
+    masses: ArrayIn<'py>,
     positions: ArrayIn<'py>,
     velocities: ArrayIn<'py>,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
-    let masses = crate::convert::real_vec(&masses)?;
+    let masses = crate::convert::vector("masses", &masses)?;
     let (x, v) = (
         mat("positions", &positions)?,
         mat("velocities", &velocities)?,
@@ -806,10 +806,10 @@ pub fn guichardet_connection<'py>(
 #[pyfunction]
 pub fn particle_locked_inertia<'py>(
     py: Python<'py>,
-    masses: Bound<'py, PyAny>,
+    masses: ArrayIn<'py>,
     positions: ArrayIn<'py>,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
-    let masses = crate::convert::real_vec(&masses)?;
+    let masses = crate::convert::vector("masses", &masses)?;
     let x = mat("positions", &positions)?;
     Ok(py_mat(py, &cn::particle_locked_inertia(&masses, &x).py()?))
 }

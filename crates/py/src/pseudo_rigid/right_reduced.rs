@@ -213,22 +213,51 @@ pub fn reduced_euler_lagrange<'py>(
     N: ArrayIn<'py>,
     gradient: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(Any<'py>, Any<'py>)> {
+    for (what, f) in [
+        ("lagrangian", Some(&lagrangian)),
+        ("gradient", gradient.as_ref()),
+    ] {
+        if let Some(f) = f {
+            if !f.is_callable() {
+                return Err(crate::errors::argument_type_error(
+                    py,
+                    format!(
+                        "{what} must be a callable (Q, N) -> ..., got {}",
+                        f.get_type().name()?
+                    ),
+                ));
+            }
+        }
+    }
     let (q, nn) = (mat("Q", &Q)?, mat("N", &N)?);
     let n = q.nrows();
     let value = |q: &Mat, nn: &Mat| -> lieflow::Result<f64> {
         let v = lagrangian
             .call1((py_mat(py, q), py_mat(py, nn)))
             .map_err(|e| raised("the lagrangian", e))?;
-        v.extract::<f64>()
-            .map_err(|e| raised("the lagrangian's value", e))
+        v.extract::<f64>().map_err(|_| {
+            let got = v
+                .get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default();
+            Error::invalid(
+                "lagrangian",
+                format!("the lagrangian must return a real number, got a {got}"),
+            )
+        })
     };
     let mut grad = |q: &Mat, nn: &Mat| -> lieflow::Result<(Mat, Mat)> {
         if let Some(g) = &gradient {
             let r = g
                 .call1((py_mat(py, q), py_mat(py, nn)))
                 .map_err(|e| raised("the gradient", e))?;
-            let (a, b): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
-                r.extract().map_err(|e| raised("the gradient's value", e))?;
+            let (a, b): (Bound<'_, PyAny>, Bound<'_, PyAny>) = r.extract().map_err(|_| {
+                Error::invalid(
+                    "gradient",
+                    "the gradient must return a pair (dL/dQ, dL/dN) of (n, n) arrays",
+                )
+            })?;
             let conv = |what: &str, x: &Bound<'_, PyAny>| -> lieflow::Result<Mat> {
                 let arr = ArrayIn::named(what, x).map_err(|e| raised(what, e))?;
                 let m = mat(what, &arr).map_err(|e| raised(what, e))?;

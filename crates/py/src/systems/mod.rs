@@ -38,6 +38,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     add_system::<tangent_top::relativistic::PyWeakFieldTop, core::WeakFieldTop>(m)?;
     add_system::<tangent_top::classical::PyTangentTop, core::TangentTop>(m)?;
     add_system::<tangent_top::classical::PyChargedParticle, core::ChargedParticle>(m)?;
+    add_system::<tangent_top::frame_top::PyFrameTop, core::FrameTop>(m)?;
     add_system::<user::canonical::PyCanonical, core::UserCanonical>(m)?;
     add_system::<user::separable::PySeparable, core::UserSeparable>(m)?;
     add_system::<user::lie_poisson::PyLiePoisson, core::LiePoisson>(m)?;

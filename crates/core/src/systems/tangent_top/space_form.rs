@@ -52,13 +52,13 @@ pub enum SpaceForm {
 impl SpaceForm {
     /// S³ of radius r > 0.
     pub fn sphere(radius: f64) -> Result<Self> {
-        check::positive("radius", radius)?;
+        check_radius(radius)?;
         Ok(SpaceForm::Sphere { radius })
     }
 
     /// H³ of radius r > 0 (sectional curvature −1/r²).
     pub fn hyperbolic(radius: f64) -> Result<Self> {
-        check::positive("radius", radius)?;
+        check_radius(radius)?;
         Ok(SpaceForm::Hyperbolic { radius })
     }
 
@@ -363,6 +363,18 @@ pub fn expm1(x: &Matrix4<f64>) -> Matrix4<f64> {
         d = d * (d + Matrix4::identity() * 2.0);
     }
     d
+}
+
+/// r > 0, finite, with a finite curvature 1/r² (r ≥ 1e-150).
+fn check_radius(radius: f64) -> Result<()> {
+    check::positive("radius", radius)?;
+    if !(1.0 / (radius * radius)).is_finite() {
+        return Err(Error::invalid(
+            "radius",
+            format!("the curvature 1/r² of a radius {radius:e} exceeds the f64 range (r ≥ 1e-150)"),
+        ));
+    }
+    Ok(())
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

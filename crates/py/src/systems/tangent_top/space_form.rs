@@ -59,17 +59,18 @@ impl PySpace {
         self.inner.check_point(&x).py()?;
         let f = self.inner.reference(&x);
         let k = 4 - self.inner.ambient_dim();
-        let rows: Vec<Vec<f64>> = (k..4).map(|i| (1..4).map(|j| f[(i, j)]).collect()).collect();
-        PyArray2::from_vec2(py, &rows).map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
+        let rows: Vec<Vec<f64>> = (k..4)
+            .map(|i| (1..4).map(|j| f[(i, j)]).collect())
+            .collect();
+        PyArray2::from_vec2(py, &rows)
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
     }
 
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Any<'py>, Bound<'py, PyTuple>)> {
         let m = py.import("lieflow.spaces")?;
         Ok(match self.inner {
             SpaceForm::Euclidean => (m.getattr("Euclidean")?, PyTuple::new(py, [3])?),
-            SpaceForm::Sphere { radius } => {
-                (m.getattr("Sphere")?, (3, radius).into_pyobject(py)?)
-            }
+            SpaceForm::Sphere { radius } => (m.getattr("Sphere")?, (3, radius).into_pyobject(py)?),
             SpaceForm::Hyperbolic { radius } => {
                 (m.getattr("Hyperbolic")?, (3, radius).into_pyobject(py)?)
             }

@@ -1,0 +1,269 @@
+//! `FrameTop`: binding of `lieflow::systems::tangent_top::frame_top` (002 §V), a thin subclass of
+//! `lieflow.System`.
+#![allow(non_snake_case)]
+
+use lieflow::systems::FrameTop;
+use lieflow::Error;
+use nalgebra::{Matrix3, Vector3};
+use pyo3::prelude::*;
+use pyo3::PyClassInitializer;
+
+use super::space_form::PySpace;
+use crate::convert::{mat, real, vector, ArrayIn};
+use crate::errors::{to_py, IntoPy};
+use crate::system::{PySystem, Thin};
+
+type Any<'py> = Bound<'py, PyAny>;
+
+/// The inertia tensor from (3,) principal moments or a (3, 3) symmetric matrix, row-major.
+fn inertia_tensor(ob: &Any<'_>) -> PyResult<[f64; 9]> {
+    let a = ArrayIn::named("inertia", ob)?;
+    let v = a.as_array();
+    match v.shape() {
+        [3] => {
+            let d = vector("inertia", &a)?;
+            Ok([d[0], 0.0, 0.0, 0.0, d[1], 0.0, 0.0, 0.0, d[2]])
+        }
+        [3, 3] => {
+            let m = mat("inertia", &a)?;
+            Ok(std::array::from_fn(|k| m[(k / 3, k % 3)]))
+        }
+        s => Err(to_py(Error::shape(
+            "inertia",
+            "(3,) principal moments or a (3, 3) inertia tensor",
+            format!("{s:?}"),
+        ))),
+    }
+}
+
+/// The tangent Euler top on a three-dimensional space form (002 §V): a rigid body whose centre x
+/// moves on `space` (`lieflow.spaces.Euclidean(3)`, `Sphere(3, radius)`, `Hyperbolic(3, radius)`)
+/// and whose axes are an orthonormal frame tangent there; L = m g(xdot, xdot)/2 + omega.I omega/2
+/// with omega the angular velocity relative to parallel transport.
+///
+/// The configuration space is the frame bundle, which is the isometry group G (SE(3), SO(4),
+/// SO+(1,3)): g = [x/r | e1 e2 e3] (g = [[1, 0], [x, R]] on R^3), and the top is a left-invariant
+/// Lie–Poisson system on G with body momenta Pi = I omega, P = m v (v the body velocity):
+/// dPi/dt = Pi x Omega (the free Euler top), dP/dt = P x Omega + (kappa/m) Pi x P (kappa the
+/// curvature), dg/dt = g xi. Integrals: H, T = |P|^2/2m and H - T, the Casimirs Pi.P and
+/// |P|^2 + kappa |Pi|^2, the six Killing momenta (`killing_momenta`).
+///
+/// Args:
+///     space: a `lieflow.spaces` space.
+///     mass: m > 0.
+///     inertia: the body's inertia tensor, (3,) principal moments or (3, 3) symmetric positive
+///         definite (for a mass distribution with Euler tensor E, I = tr(E) 1 - E).
+///
+/// Methods: exact (default), splitting, splitting4, splitting6, rk4. `exact` is the exact flow:
+/// T commutes with the rotational energy, whose flow is the free rigid body's (elliptic
+/// functions), and T's flow is a one-parameter subgroup followed by a turn of the frame. The
+/// splittings split the rotational energy into the three axis rotations (orders 2, 4, 6); all of
+/// these keep the Casimirs, T and the Killing momenta to round-off. rk4 integrates the field,
+/// as a baseline. States are flat: (g row-major (16), Pi (3), P (3)); make them with
+/// `top.state(x, R, xdot, omega)`. Invariants: Pi.P, |P|^2 + kappa |Pi|^2, T, then the six Killing
+/// momenta.
+#[pyclass(name = "FrameTop", module = "lieflow", extends = PySystem, frozen)]
+pub struct PyFrameTop {
+    space: Py<PySpace>,
+}
+
+fn top<'a>(slf: &'a Bound<'_, PyFrameTop>) -> PyResult<&'a FrameTop> {
+    slf.core()
+}
+
+#[pymethods]
+impl PyFrameTop {
+    #[new]
+    fn new(
+        py: Python<'_>,
+        space: Bound<'_, PySpace>,
+        #[pyo3(from_py_with = real)] mass: f64,
+        inertia: Bound<'_, PyAny>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let core = FrameTop::new(space.get().inner, mass, &inertia_tensor(&inertia)?).py()?;
+        let args = (space.clone(), mass, inertia).into_pyobject(py)?;
+        Ok(PySystem::init(
+            PyFrameTop {
+                space: space.unbind(),
+            },
+            core,
+            args,
+            &["space", "mass", "inertia"],
+        ))
+    }
+
+    /// The space form.
+    #[getter]
+    fn space(&self, py: Python<'_>) -> Py<PySpace> {
+        self.space.clone_ref(py)
+    }
+
+    /// The mass m.
+    #[getter]
+    fn mass(slf: &Bound<'_, Self>) -> PyResult<f64> {
+        Ok(top(slf)?.mass())
+    }
+
+    /// The inertia tensor, (3, 3).
+    #[getter]
+    fn inertia<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+        let i = top(slf)?.inertia();
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|r| (0..3).map(|c| i[(r, c)]).collect())
+            .collect();
+        numpy::PyArray2::from_vec2(slf.py(), &rows)
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
+    }
+
+    /// The flat state of the body at the point x with frame Ê(x) R (Ê = `space.reference_frame`),
+    /// velocity xdot (ambient components, tangent at x) and angular velocity omega relative to
+    /// parallel transport (body frame).
+    ///
+    /// Args:
+    ///     x: (3,) on R^3, (4,) on the sphere and the hyperboloid; R: (3, 3) rotation;
+    ///     xdot: like x; omega: (3,).
+    /// Returns:
+    ///     (22,) state (g row-major, Pi, P).
+    /// Raises:
+    ///     ShapeError, NonFiniteError, InvalidArgumentError (x not on the space, xdot not tangent),
+    ///     NotInGroupError (R not a rotation).
+    fn state<'py>(
+        slf: &Bound<'py, Self>,
+        x: ArrayIn<'_>,
+        R: ArrayIn<'_>,
+        xdot: ArrayIn<'_>,
+        omega: ArrayIn<'_>,
+    ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+        let r = mat("R", &R)?;
+        if r.nrows() != 3 || r.ncols() != 3 {
+            return Err(to_py(Error::shape(
+                "R",
+                "(3, 3)",
+                format!("({}, {})", r.nrows(), r.ncols()),
+            )));
+        }
+        let r = Matrix3::from_fn(|i, j| r[(i, j)]);
+        let w = vector("omega", &omega)?;
+        if w.len() != 3 {
+            return Err(to_py(Error::shape(
+                "omega",
+                "(3,)",
+                format!("({},)", w.len()),
+            )));
+        }
+        let (x, xd) = (vector("x", &x)?, vector("xdot", &xdot)?);
+        let z = top(slf)?
+            .state(&x, &r, &xd, &Vector3::from_column_slice(&w))
+            .py()?;
+        Ok(numpy::PyArray1::from_vec(slf.py(), z))
+    }
+
+    /// The centre's point x of states (..., 22) -> (..., d).
+    fn position<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        let d = t.space().ambient_dim();
+        slf.base().map_states(slf.py(), &states, &[d], |z, out| {
+            out.copy_from_slice(&t.position(z)?);
+            Ok(())
+        })
+    }
+
+    /// The body frame R relative to the reference frame Ê(x): (..., 22) -> (..., 3, 3).
+    fn frame<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        slf.base().map_states(slf.py(), &states, &[3, 3], |z, out| {
+            let r = t.frame(z)?;
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = r[(k / 3, k % 3)];
+            }
+            Ok(())
+        })
+    }
+
+    /// The velocity xdot (ambient components): (..., 22) -> (..., d).
+    fn velocity<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        let d = t.space().ambient_dim();
+        slf.base().map_states(slf.py(), &states, &[d], |z, out| {
+            out.copy_from_slice(&t.velocity(z)?);
+            Ok(())
+        })
+    }
+
+    /// The angular velocity omega = I^-1 Pi relative to parallel transport (body frame):
+    /// (..., 22) -> (..., 3).
+    fn angular_velocity<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        slf.base().map_states(slf.py(), &states, &[3], |z, out| {
+            out.copy_from_slice(t.angular_velocity(z)?.as_slice());
+            Ok(())
+        })
+    }
+
+    /// The six Killing momenta (J_Pi, J_P), the spatial momentum Ad*_{g^-1}(Pi, P): on the sphere
+    /// and the hyperboloid the momenta of the rotations about, and the translations (boosts)
+    /// along, the axes at the base point, K = [[0, -r J_P^T], [r J_P, hat(J_Pi)]] =
+    /// m (xdot x^T - x xdot^T) + e hat(Pi) e^T; on R^3 the angular momentum about the origin
+    /// x cross m xdot + R Pi, then the momentum m xdot. (..., 22) -> (..., 6).
+    fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        slf.base().map_states(slf.py(), &states, &[6], |z, out| {
+            out.copy_from_slice(&t.killing_momenta(z)?);
+            Ok(())
+        })
+    }
+
+    /// On the 3-sphere: the so(4) body momentum M = [[0, -r P^T], [r P, hat(Pi)]] of the frame
+    /// g in SO(4) whose first column is x/r, with dM/dt = [M, xi] for xi = g^-1 dg/dt and the
+    /// pairing <M, xi> = tr(M^T xi)/2; the top is `lf.LiePoisson(("so", 4), H)` with
+    /// H(M) = <M, J^-1 M>/2, J = `group_inertia()`. (..., 22) -> (..., 4, 4).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (not on the sphere).
+    fn group_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        t.group_inertia().py()?;
+        slf.base().map_states(slf.py(), &states, &[4, 4], |z, out| {
+            let m = t.group_momentum(z)?;
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = m[(k / 4, k % 4)];
+            }
+            Ok(())
+        })
+    }
+
+    /// On the 3-sphere: the (6, 6) inertia J of the SO(4) top in so(4)'s e_ij coordinates
+    /// (01, 02, 03, 12, 13, 23): diag(m r^2, m r^2, m r^2) and the inertia tensor read through
+    /// (xi12, xi13, xi23) = (-Omega3, Omega2, -Omega1); l(xi) = <xi, J xi>/2, M = J xi.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (not on the sphere).
+    fn group_inertia<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+        let j = top(slf)?.group_inertia().py()?;
+        let rows: Vec<Vec<f64>> = (0..6).map(|r| j[6 * r..6 * r + 6].to_vec()).collect();
+        numpy::PyArray2::from_vec2(slf.py(), &rows)
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
+    }
+
+    /// T = |P|^2 / 2m, the translational energy (conserved): (..., 22) -> (...).
+    fn translational_energy<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        slf.base().map_states(slf.py(), &states, &[], |z, out| {
+            out[0] = t.translational_energy(z)?;
+            Ok(())
+        })
+    }
+
+    /// H - T = Pi.I^-1 Pi / 2, the rotational energy (conserved; 002 §V's "H - T"):
+    /// (..., 22) -> (...).
+    fn rotational_energy<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
+        let t = top(slf)?;
+        slf.base().map_states(slf.py(), &states, &[], |z, out| {
+            out[0] = t.rotational_energy(z)?;
+            Ok(())
+        })
+    }
+}

@@ -1,0 +1,211 @@
+"""002 §V: the tangent Euler top on R^3, S^3 and H^3 (lf.FrameTop). Each claim by a second route:
+the SO(4) rigid body of lf.LiePoisson, the Killing momenta from positions, velocities and frames,
+Poisson brackets by differentiating along the isometries' flows, the rank of the integrals."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import lieflow as lf
+
+INERTIA = np.array([[2.0, 0.3, -0.1], [0.3, 3.1, 0.2], [-0.1, 0.2, 4.2]])
+M = 1.3
+
+
+def rot(w):
+    return lf.lie.so3_exp(np.asarray(w, float))
+
+
+def start(space):
+    """A point, a tangent velocity (ambient) on `space`."""
+    r = space.radius
+    if space.ambient_dim == 3:
+        return np.array([0.3, -0.2, 1.0]), np.array([0.4, 0.1, -0.3])
+    if space.curvature > 0:
+        x = np.array([0.5, -0.3, 0.6, 0.2])
+        x *= r / np.linalg.norm(x)
+        a = np.array([0.2, 0.5, -0.1, 0.4])
+        return x, a - (a @ x) / r**2 * x
+    xs = np.array([0.6, -0.4, 0.9])
+    x = np.concatenate([[np.sqrt(r**2 + xs @ xs)], xs])
+    vs = np.array([0.3, 0.2, -0.5])
+    return x, np.concatenate([[xs @ vs / x[0]], vs])
+
+
+SPACES = [lf.spaces.Euclidean(3), lf.spaces.Sphere(3, radius=1.7),
+          lf.spaces.Hyperbolic(3, radius=1.4)]
+
+
+def state(top):
+    x, v = start(top.space)
+    return top.state(x, rot([0.4, -0.7, 0.3]), v, [0.7, -0.4, 1.1])
+
+
+@pytest.mark.parametrize("space", SPACES, ids=repr)
+def test_state_views_killing_momenta_and_integrals(space):
+    top = lf.FrameTop(space, M, INERTIA)
+    x, v = start(space)
+    R = rot([0.4, -0.7, 0.3])
+    z = top.state(x, R, v, [0.7, -0.4, 1.1])
+    np.testing.assert_allclose(top.position(z), x, atol=1e-14)
+    np.testing.assert_allclose(top.velocity(z), v, atol=1e-14)
+    np.testing.assert_allclose(top.frame(z), R, atol=1e-14)
+    np.testing.assert_allclose(top.angular_velocity(z), [0.7, -0.4, 1.1], atol=1e-14)
+    # The frame e = Ê(x) R.
+    g = z[:16].reshape(4, 4)
+    e = g[1:, 1:] if space.ambient_dim == 3 else g[:, 1:]
+    np.testing.assert_allclose(e, space.reference_frame(x) @ R, atol=1e-14)
+    # The Killing momenta from x, ẋ, e and Π = 𝕀ω (a second route).
+    pi = INERTIA @ [0.7, -0.4, 1.1]
+    J = top.killing_momenta(z)
+    if space.ambient_dim == 3:
+        p = M * v
+        np.testing.assert_allclose(J, np.concatenate([np.cross(x, p) + R @ pi, p]), atol=1e-13)
+    else:
+        hat = lambda w: np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+        K = M * (np.outer(v, x) - np.outer(x, v)) + e @ hat(pi) @ e.T
+        np.testing.assert_allclose(J[:3], [K[3, 2], K[1, 3], K[2, 1]], atol=1e-13)
+        np.testing.assert_allclose(J[3:], K[1:, 0] / space.radius, atol=1e-13)
+    # Along the exact flow: H, T, H − T, the Casimirs and J kept (H³: a short run, g grows like
+    # e^{d/r}).
+    dt, steps = (5e-3, 1000) if space.curvature < 0 else (0.05, 2000)
+    traj = lf.integrate(top, z, dt=dt, steps=steps, save_every=100)
+    for f in (traj.energy(), top.translational_energy(traj.states),
+              top.rotational_energy(traj.states)):
+        np.testing.assert_allclose(f, f[0], rtol=1e-12)
+    inv = traj.invariants()
+    np.testing.assert_allclose(inv, np.broadcast_to(inv[0], inv.shape), rtol=1e-11, atol=1e-11)
+    assert pickle.loads(pickle.dumps(top)).space == space
+
+
+def test_on_the_three_sphere_it_is_the_so4_rigid_body_of_lie_poisson():
+    top = lf.FrameTop(lf.spaces.Sphere(3, radius=1.7), M, INERTIA)
+    z = state(top)
+    J = top.group_inertia()
+    coords = lambda m: m[..., [0, 0, 0, 1, 1, 2], [1, 2, 3, 2, 3, 3]]
+    lp = lf.LiePoisson(("so", 4), np.linalg.inv(J))
+    g0 = z[:16].reshape(4, 4)
+    a = lf.integrate(top, z, dt=0.01, steps=1000, save_every=100)
+    b = lf.integrate(lp, coords(top.group_momentum(z)), dt=0.01, steps=1000, save_every=100,
+                     method="rkmk4", attitude=g0)
+    np.testing.assert_allclose(coords(top.group_momentum(a.states)), b.states, atol=1e-9)
+    np.testing.assert_allclose(a.states[:, :16].reshape(-1, 4, 4), b.attitude, atol=1e-9)
+    # The frame top's Killing momenta are the Noether momentum g M gᵀ of LiePoisson's run:
+    # K = [[0, −r J_Pᵀ], [r J_P, hat(J_Π)]].
+    i, j = [0, 0, 0, 1, 1, 2], [1, 2, 3, 2, 3, 3]
+    Mb = np.zeros((len(b.states), 4, 4))
+    Mb[:, i, j], Mb[:, j, i] = b.states, -b.states
+    K = b.attitude @ Mb @ np.swapaxes(b.attitude, -1, -2)
+    J = top.killing_momenta(a.states)
+    r = top.space.radius
+    want = np.stack([-r * J[:, 3], -r * J[:, 4], -r * J[:, 5], -J[:, 2], J[:, 1], -J[:, 0]], axis=1)
+    np.testing.assert_allclose(K[:, i, j], want, atol=1e-9)
+    with pytest.raises(lf.InvalidArgumentError, match="3-sphere"):
+        lf.FrameTop(lf.spaces.Euclidean(3), M, INERTIA).group_inertia()
+
+
+def _brackets_and_rank(top, z):
+    """On S³: the Poisson brackets of the Cartan pair of Killing momenta and the rank of the six
+    integrals (H, T, C₁, C₂, J_P1, J_Π1) along the 12 tangent directions of T*SO(4), by central
+    differences. {F, ⟨J, a⟩} is dF along the isometry flow g ↦ exp(τâ) g (μ fixed)."""
+    r = top.space.radius
+
+    def hat4(w, u):
+        a = np.zeros((4, 4))
+        a[1:, 1:] = [[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]
+        a[1:, 0], a[0, 1:] = u / r, -u / r
+        return a
+
+    def expm(a):
+        w, v = np.linalg.eig(a)
+        return (v @ np.diag(np.exp(w)) @ np.linalg.inv(v)).real
+
+    def with_g(z, g):
+        y = z.copy()
+        y[:16] = g.ravel()
+        return y
+
+    def funcs(y):
+        inv = top.invariants(y)
+        J = top.killing_momenta(y)
+        return np.array([top.energy(y), top.translational_energy(y), inv[0], inv[1], J[3], J[0]])
+
+    g = z[:16].reshape(4, 4)
+    e = np.eye(3)
+    h = 1e-5
+
+    def bracket(f, a):   # {f, ⟨J, a⟩}: d/dτ f(exp(τâ) g)
+        return (f(with_g(z, expm(h * a) @ g)) - f(with_g(z, expm(-h * a) @ g))) / (2 * h)
+
+    J = lambda k: (lambda y: top.killing_momenta(y)[k])
+    # ⟨J, a⟩ for a = (Ω-part, v-part): J_P1 ↔ a = (0, e1) up to a positive factor, J_Π1 ↔ (e1, 0).
+    commuting = bracket(J(0), hat4(0 * e[0], e[0]))        # {J_Π1, J_P1}
+    not_commuting = bracket(J(4), hat4(0 * e[0], e[0]))    # {J_P2, J_P1}
+    cols = []
+    for k in range(12):
+        zp, zm = z.copy(), z.copy()
+        if k < 6:
+            a = hat4(e[k] if k < 3 else 0 * e[0], e[k - 3] if k >= 3 else 0 * e[0])
+            zp, zm = with_g(z, g @ expm(h * a)), with_g(z, g @ expm(-h * a))
+        else:
+            zp[16 + k - 6] += h
+            zm[16 + k - 6] -= h
+        cols.append((funcs(zp) - funcs(zm)) / (2 * h))
+    return commuting, not_commuting, np.linalg.svd(np.array(cols).T, compute_uv=False)
+
+
+def test_integrability_on_the_three_sphere_six_integrals_in_involution_of_rank_six():
+    top = lf.FrameTop(lf.spaces.Sphere(3, radius=1.7), M, INERTIA)
+    z = state(top)
+    commuting, not_commuting, sv = _brackets_and_rank(top, z)
+    assert abs(commuting) < 1e-8
+    assert abs(not_commuting) > 1e-2
+    assert sv[-1] > 1e-3 * sv[0], sv
+    # 002 §V lists "the total angular momentum and one of its components" among the integrals:
+    # on S³ no component of the spin (parallel transported, in space e Π) is conserved, while
+    # Π·P is.
+    traj = lf.integrate(top, z, dt=0.05, steps=2000, save_every=100)
+    g = traj.states[:, :16].reshape(-1, 4, 4)
+    spin = np.einsum("kij,kj->ki", g[:, :, 1:], traj.states[:, 16:19])
+    assert np.ptp(spin, axis=0).max() > 0.1
+    c1 = np.einsum("ki,ki->k", traj.states[:, 16:19], traj.states[:, 19:22])
+    np.testing.assert_allclose(c1, c1[0], rtol=1e-12)
+
+
+def test_euclidean_space_a_free_particle_and_a_free_rigid_body():
+    top = lf.FrameTop(lf.spaces.Euclidean(3), M, INERTIA)
+    x, v = start(top.space)
+    R = rot([0.4, -0.7, 0.3])
+    z = top.state(x, R, v, [0.7, -0.4, 1.1])
+    traj = lf.integrate(top, z, dt=0.3, steps=10, save_every=10)
+    np.testing.assert_allclose(top.position(traj.final_state), x + 3.0 * v, atol=1e-13)
+    body = lf.RigidBody(INERTIA)
+    rb = lf.integrate(body, INERTIA @ [0.7, -0.4, 1.1], dt=0.3, steps=10, save_every=10,
+                      method="exact", attitude=R)
+    np.testing.assert_allclose(top.frame(traj.final_state), rb.attitude[-1], atol=1e-12)
+
+
+def test_bad_input_is_refused_with_typed_errors():
+    top = lf.FrameTop(lf.spaces.Sphere(3), M, [1.0, 2.0, 3.0])
+    with pytest.raises(lf.InvalidArgumentError, match="not a point"):
+        top.state([1.0, 0.1, 0, 0], np.eye(3), [0, 1.0, 0, 0], [0, 0, 1.0])
+    with pytest.raises(lf.InvalidArgumentError, match="tangent"):
+        top.state([1.0, 0, 0, 0], np.eye(3), [0.5, 1.0, 0, 0], [0, 0, 1.0])
+    with pytest.raises(lf.NotInGroupError):
+        top.state([1.0, 0, 0, 0], 2 * np.eye(3), [0, 1.0, 0, 0], [0, 0, 1.0])
+    with pytest.raises(lf.ShapeError):
+        top.state([1.0, 0, 0], np.eye(3), [0, 1.0, 0], [0, 0, 1.0])
+    with pytest.raises(lf.InvalidArgumentError, match="n = 4"):
+        lf.spaces.Sphere(4)
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.spaces.Hyperbolic(3, radius=-1.0)
+    with pytest.raises(lf.InvalidArgumentError, match="x₀ > 0"):
+        lf.FrameTop(lf.spaces.Hyperbolic(3), M, [1.0, 2.0, 3.0]).state(
+            [-1.0, 0, 0, 0], np.eye(3), [0, 1.0, 0, 0], [0, 0, 1.0])
+    with pytest.raises(lf.ShapeError):
+        lf.FrameTop(lf.spaces.Sphere(3), M, np.eye(4))
+    z = top.state([1.0, 0, 0, 0], np.eye(3), [0, 1.0, 0, 0], [0, 0, 1.0])
+    z[0] = 2.0     # g no longer in SO(4)
+    with pytest.raises(lf.NotInGroupError):
+        lf.integrate(top, z, dt=0.1, steps=1)
