@@ -116,8 +116,9 @@ fn reduced_state(n: usize, x: &[&[f64]]) -> ReducedState {
 /// ``V V^T - X (dU/dX)^T``, the Riemann form of ``d^2X/dt^2 = -dU/dX``.
 ///
 /// Args:
-///     Q: (n, n) symmetric positive definite; N: (n, n); potential: a `lieflow.potentials`
-///     potential (default: the free body).
+///     Q: (n, n), symmetric positive definite.
+///     N: (n, n).
+///     potential: a `lieflow.potentials` potential (default: the free body).
 /// Returns:
 ///     (Qdot, Ndot): two (n, n) arrays.
 /// Raises:

@@ -42,11 +42,11 @@ fn inertia_tensor(ob: &Any<'_>) -> PyResult<[f64; 9]> {
 /// with omega the angular velocity relative to parallel transport.
 ///
 /// The configuration space is the frame bundle, which is the isometry group G (SE(3), SO(4),
-/// SO+(1,3)): g = [x/r | e1 e2 e3] (g = [[1, 0], [x, R]] on R^3), and the top is a left-invariant
+/// SO+(1,3)): the columns of g are x/r, e1, e2, e3 (g = [[1, 0], [x, R]] on R^3), and the top is a left-invariant
 /// Lie–Poisson system on G with body momenta Pi = I omega, P = m v (v the body velocity):
 /// dPi/dt = Pi x Omega (the free Euler top), dP/dt = P x Omega + (kappa/m) Pi x P (kappa the
-/// curvature), dg/dt = g xi. Integrals: H, T = |P|^2/2m and H - T, the Casimirs Pi.P and
-/// |P|^2 + kappa |Pi|^2, the six Killing momenta (`killing_momenta`).
+/// curvature), dg/dt = g xi. Integrals: H, T = P.P/2m and H - T, the Casimirs Pi.P and
+/// P.P + kappa Pi.Pi, the six Killing momenta (`killing_momenta`).
 ///
 /// Args:
 ///     space: a `lieflow.spaces` space.
@@ -60,7 +60,7 @@ fn inertia_tensor(ob: &Any<'_>) -> PyResult<[f64; 9]> {
 /// splittings split the rotational energy into the three axis rotations (orders 2, 4, 6); all of
 /// these keep the Casimirs, T and the Killing momenta to round-off. rk4 integrates the field,
 /// as a baseline. States are flat: (g row-major (16), Pi (3), P (3)); make them with
-/// `top.state(x, R, xdot, omega)`. Invariants: Pi.P, |P|^2 + kappa |Pi|^2, T, then the six Killing
+/// `top.state(x, R, xdot, omega)`. Invariants: Pi.P, P.P + kappa Pi.Pi, T, then the six Killing
 /// momenta.
 #[pyclass(name = "FrameTop", module = "lieflow", extends = PySystem, frozen)]
 pub struct PyFrameTop {
@@ -245,7 +245,7 @@ impl PyFrameTop {
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
     }
 
-    /// T = |P|^2 / 2m, the translational energy (conserved): (..., 22) -> (...).
+    /// T = P.P / 2m, the translational energy (conserved): (..., 22) -> (...).
     fn translational_energy<'py>(
         slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,

@@ -16,7 +16,7 @@ type Any<'py> = Bound<'py, PyAny>;
 
 /// A three-dimensional space form with a global orthonormal reference frame field Ê(x): made by
 /// `Euclidean`, `Sphere` and `Hyperbolic` of this module. Points: x in R^3 (Euclidean), unit
-/// vectors of R^4 times the radius (Sphere), the upper sheet x0^2 - |x|^2 = r^2, x0 > 0, of the
+/// vectors of R^4 times the radius (Sphere), the upper sheet x0^2 - x1^2 - x2^2 - x3^2 = r^2, x0 > 0, of the
 /// hyperboloid in Minkowski space (Hyperbolic; metric -a0 b0 + a.b on tangent vectors).
 #[pyclass(module = "lieflow.spaces", name = "Space", frozen)]
 pub struct PySpace {
@@ -131,7 +131,7 @@ fn Sphere(
     })
 }
 
-/// Hyperbolic 3-space of radius r, the hyperboloid x0^2 - |x|^2 = r^2, x0 > 0 in Minkowski R^(1,3)
+/// Hyperbolic 3-space of radius r, the hyperboloid x0^2 - x1^2 - x2^2 - x3^2 = r^2, x0 > 0 in Minkowski R^(1,3)
 /// (curvature -1/r^2; frame bundle SO+(1,3)).
 ///
 /// Raises:
