@@ -458,8 +458,9 @@ impl Problem for RightReduced {
     }
 }
 
-/// The working state of the reduced flows: (Q, N[, X]), the representative C, W = C⁻¹N or the
-/// force, the potential's workspace; whether Q stopped being positive definite.
+/// The working state of the reduced flows: (Q, N[, X]), the representative C (the Cholesky
+/// factor of the current Q when `fresh`), W = C⁻¹N or the force, the potential's workspace;
+/// whether Q stopped being positive definite.
 #[derive(Debug)]
 pub struct Work {
     q: Mat,
@@ -470,6 +471,7 @@ pub struct Work {
     t: Mat,
     ws: Workspace,
     lost: bool,
+    fresh: bool,
 }
 
 impl Clone for Work {
@@ -484,16 +486,21 @@ impl Clone for Work {
             t: Mat::zeros(n, n),
             ws: Workspace::new(n),
             lost: self.lost,
+            fresh: false,
         }
     }
 }
 
 impl Work {
-    /// C ← the Cholesky factor of Q; false (and `lost` set) when Q is not positive definite.
+    /// C ← the Cholesky factor of Q (once per value of Q); false (and `lost` set) when Q is not
+    /// positive definite.
     fn factor(&mut self) -> bool {
-        self.c.copy_from(&self.q);
-        if !linalg::cholesky(self.c.as_mut()) {
-            self.lost = true;
+        if !self.fresh && !self.lost {
+            self.c.copy_from(&self.q);
+            if !linalg::cholesky(self.c.as_mut()) {
+                self.lost = true;
+            }
+            self.fresh = true;
         }
         !self.lost
     }
@@ -514,6 +521,7 @@ impl Split for RightReduced {
             t: Mat::zeros(n, n),
             ws: Workspace::new(n),
             lost: false,
+            fresh: false,
         })
     }
 
@@ -536,11 +544,25 @@ impl Split for RightReduced {
             return;
         }
         if i == 0 {
-            // N ← N − τ C (∂U/∂X(C))ᵀ.
-            w.w.fill(0.0);
-            self.body
-                .potential()
-                .add_gradient(w.c.as_ref(), w.w.as_mut(), &mut w.ws);
+            // N ← N − τ C (∂U/∂X(C))ᵀ (∂U/∂X on stack matrices at n = 3 where the potential
+            // has them).
+            let pot = self.body.potential();
+            let g3 = (w.c.nrows() == 3)
+                .then(|| pot.gradient3(&nalgebra::Matrix3::from_fn(|i, j| w.c[(i, j)])))
+                .flatten();
+            match g3 {
+                Some(g) => {
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            w.w[(i, j)] = g[(i, j)];
+                        }
+                    }
+                }
+                None => {
+                    w.w.fill(0.0);
+                    pot.add_gradient(w.c.as_ref(), w.w.as_mut(), &mut w.ws);
+                }
+            }
             linalg::mul(
                 w.nn.as_mut(),
                 Accum::Add,
@@ -573,6 +595,7 @@ impl Split for RightReduced {
             }
         }
         linalg::axpy(w.nn.as_mut(), tau, w.t.as_ref());
+        w.fresh = false;
     }
 
     const CHECKED: bool = true;

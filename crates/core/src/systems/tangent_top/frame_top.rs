@@ -296,12 +296,13 @@ impl FrameTop {
 
     /// ½Π_k²/I_k over τ: the rotation about e_k by θ = τΠ_k/I_k (Π, P by Sᵀ, the frame by S).
     fn flow_axis(&self, k: usize, tau: f64, w: &mut FrameWork) {
-        let theta = tau * w.pi[k] / self.moments[k];
-        top::rotate_axis(&mut w.pi, k, theta);
-        top::rotate_axis(&mut w.p, k, theta);
+        // One (sin θ, cos θ − 1) for the six vectors the rotation turns.
+        let (s, cm1) = crate::numerics::simd::angle_sin_cosm1(tau * w.pi[k] / self.moments[k]);
+        top::rotate_axis_sc(&mut w.pi, k, s, cm1);
+        top::rotate_axis_sc(&mut w.p, k, s, cm1);
         for row in 0..4 {
             let mut v = Vector3::new(w.g[(row, 1)], w.g[(row, 2)], w.g[(row, 3)]);
-            top::rotate_axis(&mut v, k, theta);
+            top::rotate_axis_sc(&mut v, k, s, cm1);
             for c in 0..3 {
                 w.g[(row, c + 1)] = v[c];
             }
@@ -406,7 +407,8 @@ impl Problem for FrameTop {
     }
 }
 
-/// Flows: 0 the translational energy T (outer), 1–3 the axis rotations ½Π_k²/I_k.
+/// Flows: 0–2 the axis rotations ½Π_k²/I_k, 3 the translational energy T (the middle flow: T
+/// commutes with the others, so it is applied once per Strang step, over the whole step).
 impl Split for FrameTop {
     type Work = FrameWork;
 
@@ -425,8 +427,8 @@ impl Split for FrameTop {
 
     fn flow(&self, i: usize, tau: f64, w: &mut FrameWork) {
         match i {
-            0 => self.flow_t(tau, w),
-            k => self.flow_axis(k - 1, tau, w),
+            3 => self.flow_t(tau, w),
+            k => self.flow_axis(k, tau, w),
         }
     }
 }

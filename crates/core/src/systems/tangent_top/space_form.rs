@@ -339,10 +339,11 @@ impl SpaceForm {
 }
 
 /// exp(X) − 1 of a 4×4 matrix to the precision of its own size (not of 1): the Taylor series of
-/// X/2ˢ (17 terms, ‖X/2ˢ‖∞ ≤ ½: truncation below 1e-19 relative), then s doublings
-/// D ← D(D + 2) (exp(2Y) − 1 = (e^Y − 1)(e^Y + 1)). A step's increment g(exp X − 1) so formed
-/// rounds once onto g, without the bias of exp(X) rounded to an ulp of 1 at the same X every
-/// step (which made the frame's orthogonality drift linearly, as `so3::Rodrigues` explains).
+/// Y = X/2ˢ (‖Y‖∞ ≤ ½) to the first term below 2⁻⁵⁶ of the first (at most 17 terms; 6 at
+/// ‖Y‖ = 10⁻³), then s doublings D ← D(D + 2) (exp(2Y) − 1 = (e^Y − 1)(e^Y + 1)). A step's increment
+/// g(exp X − 1) so formed rounds once onto g, without the bias of exp(X) rounded to an ulp of 1 at
+/// the same X every step (which made the frame's orthogonality drift linearly, as
+/// `so3::Rodrigues` explains).
 pub fn expm1(x: &Matrix4<f64>) -> Matrix4<f64> {
     let norm = (0..4)
         .map(|i| (0..4).map(|j| x[(i, j)].abs()).sum::<f64>())
@@ -353,9 +354,17 @@ pub fn expm1(x: &Matrix4<f64>) -> Matrix4<f64> {
     // The smallest s ≥ 0 with ‖X‖∞/2ˢ ≤ ½.
     let s = (2.0 * norm).log2().ceil().max(0.0) as i32;
     let y = x * 0.5f64.powi(s);
-    // Horner: Y(1 + Y/2(1 + Y/3(… (1 + Y/17)))).
+    let ny = norm * 0.5f64.powi(s);
+    // Terms: the first k with ‖Y‖^(k−1)/k! ≤ 2⁻⁵⁶ (relative to the first term ‖Y‖).
+    let mut terms = 1;
+    let mut t = 1.0;
+    while terms < 17 && t > f64::EPSILON / 4.0 {
+        terms += 1;
+        t *= ny / f64::from(terms);
+    }
+    // Horner: Y(1 + Y/2(1 + Y/3(… (1 + Y/terms)))).
     let mut d = Matrix4::identity();
-    for k in (2..=17).rev() {
+    for k in (2..=terms).rev() {
         d = Matrix4::identity() + y * d / f64::from(k);
     }
     let mut d = y * d;
