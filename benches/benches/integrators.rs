@@ -7,7 +7,8 @@ use criterion::{BatchSize, Criterion};
 use lieflow::integrate::{integrate, integrate_batch, Properties, System};
 use lieflow::systems::user::{EulerPoincare, Lagrangian};
 use lieflow::systems::{
-    Algebra, GeneralizedRigidBody, HeavyTop, RigidBody, Side, SphericalPendulum,
+    Algebra, FrameTop, GeneralizedRigidBody, HeavyTop, RigidBody, Side, SpaceForm,
+    SphericalPendulum,
 };
 use std::hint::black_box;
 use std::time::Instant;
@@ -75,6 +76,23 @@ fn steps(c: &mut Criterion) {
         &lifted.state_with_attitude(M0, I3),
         ep.methods(),
     );
+    // The tangent top on S³ (issue 25): exact flow, axis splittings, rk4.
+    let ft = FrameTop::new(
+        SpaceForm::sphere(1.7).unwrap(),
+        1.3,
+        &[1.0, 0.1, 0.0, 0.1, 2.0, 0.0, 0.0, 0.0, 3.0],
+    )
+    .unwrap();
+    let r = nalgebra::Matrix3::identity();
+    let zf = ft
+        .state(
+            &[1.7, 0.0, 0.0, 0.0],
+            &r,
+            &[0.0, 0.5, 0.0, -0.4],
+            &nalgebra::Vector3::new(0.8, -0.6, 1.1),
+        )
+        .unwrap();
+    per_step(c, "frame_top_s3", &ft, &zf, ft.methods());
     let pend = SphericalPendulum::new(1.0, 1.0, 9.81).unwrap();
     let s = pend.state_from_spherical(1.0, 0.0, 0.3, 1.2).unwrap();
     per_step(c, "spherical_pendulum", &pend, &s, pend.methods());

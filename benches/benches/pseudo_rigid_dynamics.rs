@@ -1,5 +1,6 @@
 //! Pseudo-rigid body dynamics (001 §3, §7): Störmer–Verlet steps per second on T*GL⁺(n) with a
-//! Saint Venant–Kirchhoff potential, n = 3 and n = 10, and the reduced-space splitting at n = 3.
+//! Saint Venant–Kirchhoff potential, n = 3 and n = 10, the reduced-space splitting, and the body
+//! reduced by its right SO(n) action (`RightReduced`, 001 §3.2: its Verlet, plain and carrying X).
 //!
 //! Run: `CARGO_TARGET_DIR=… cargo bench -p lieflow-benches --bench pseudo_rigid_dynamics`;
 //! results in docs/bench-pr5.md. Each measured iteration advances one driver run
@@ -11,9 +12,9 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use lieflow::integrate::Run;
+use lieflow::integrate::{Run, System};
 use lieflow::pseudo_rigid::potential::{Potential, SaintVenantKirchhoff};
-use lieflow::pseudo_rigid::PseudoRigidBody;
+use lieflow::pseudo_rigid::{PseudoRigidBody, RightReduced};
 use lieflow::Mat;
 
 const STEPS: usize = 1000;
@@ -31,18 +32,17 @@ fn initial(n: usize) -> (Mat, Mat) {
     (x, p)
 }
 
-/// A run of `method` on the body, started once at (X₀, P₀) and advanced in place by every
-/// measured iteration (one state saved per `STEPS` steps, into a reserved buffer).
-fn bench_run(
+/// A run of `method` on the body, started once at z₀ and advanced in place by every measured
+/// iteration (one state saved per `STEPS` steps, into a reserved buffer).
+fn bench_run<S: System>(
     g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
     id: BenchmarkId,
-    body: &PseudoRigidBody,
+    body: &S,
+    z0: &[f64],
     method: &str,
     dt: f64,
 ) {
-    let (x0, p0) = initial(body.n());
-    let z0 = body.state(&x0, &p0).unwrap();
-    let mut run = Run::new(body, method, &z0, dt, STEPS, 0.0).unwrap();
+    let mut run = Run::new(body, method, z0, dt, STEPS, 0.0).unwrap();
     let mut out = Vec::with_capacity(z0.len());
     g.bench_function(id, |b| {
         b.iter(|| {
@@ -59,36 +59,58 @@ fn verlet(c: &mut Criterion) {
     g.measurement_time(Duration::from_secs(3));
     g.throughput(Throughput::Elements(STEPS as u64));
     for n in [3, 10] {
+        let (x0, p0) = initial(n);
         let free = PseudoRigidBody::new(n, svk.clone(), false).unwrap();
+        let z0 = free.state(&x0, &p0).unwrap();
         bench_run(
             &mut g,
             BenchmarkId::from_parameter(n),
             &free,
+            &z0,
             "verlet",
             1e-4,
         );
         let checked = PseudoRigidBody::new(n, svk.clone(), true).unwrap();
-        bench_run(
-            &mut g,
-            BenchmarkId::new("check_det", n),
-            &checked,
-            "verlet",
-            1e-4,
-        );
+        let id = BenchmarkId::new("check_det", n);
+        bench_run(&mut g, id, &checked, &z0, "verlet", 1e-4);
     }
     g.finish();
     let mut g = c.benchmark_group("pseudo_rigid_reduced_svk");
     g.measurement_time(Duration::from_secs(3));
     g.throughput(Throughput::Elements(STEPS as u64));
     for n in [3, 10] {
+        let (x0, p0) = initial(n);
         let body = PseudoRigidBody::new(n, svk.clone(), false).unwrap();
+        let z0 = body.state(&x0, &p0).unwrap();
         bench_run(
             &mut g,
             BenchmarkId::from_parameter(n),
             &body,
+            &z0,
             "reduced",
             1e-5,
         );
+    }
+    g.finish();
+    let mut g = c.benchmark_group("pseudo_rigid_right_reduced_svk");
+    g.measurement_time(Duration::from_secs(3));
+    g.throughput(Throughput::Elements(STEPS as u64));
+    for n in [3, 10] {
+        let (x0, p0) = initial(n);
+        let body = RightReduced::new(n, svk.clone()).unwrap();
+        let z0 = body.reduce(&x0, &p0).unwrap();
+        bench_run(
+            &mut g,
+            BenchmarkId::from_parameter(n),
+            &body,
+            &z0,
+            "verlet",
+            1e-4,
+        );
+        let lifted = body.reconstructing();
+        let z0 = lifted.reduce(&x0, &p0).unwrap();
+        let id = BenchmarkId::new("reconstructing", n);
+        bench_run(&mut g, id, &lifted, &z0, "verlet", 1e-4);
     }
     g.finish();
 }
