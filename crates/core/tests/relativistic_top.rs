@@ -12,8 +12,8 @@ use std::sync::Arc;
 
 use lieflow::integrate::{integrate, Problem, System};
 use lieflow::systems::{
-    HyperbolicPlane, Plane, Potential, PotentialValue, RelativisticTangentTop, Sphere, Surface,
-    WeakFieldTop,
+    HyperbolicPlane, MetricSurface, Plane, Potential, PotentialValue, RelativisticTangentTop,
+    Sphere, Surface, TangentTop, WeakFieldTop,
 };
 use lieflow::Error;
 
@@ -1154,4 +1154,200 @@ fn prescribed_centre_motion_91_92() {
     assert!(top.prescribed_inertia(0.0, [1.0, 0.0]).is_err());
     assert!(top.prescribed_spin_rate(0.0, -1.0, u).is_err());
     assert!(top.prescribed_potential(f64::NAN, 1.0, u).is_err());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Frame independence (002 (104)–(114)): the same motion from two reference frame fields
+// ---------------------------------------------------------------------------------------------
+
+/// A change of reference frame by a position-dependent angle: β(x) and its gradient.
+type Beta = fn([f64; 2]) -> (f64, [f64; 2]);
+
+fn beta_plane(x: [f64; 2]) -> (f64, [f64; 2]) {
+    (
+        0.7 * x[0].sin() + 0.4 * x[1] + 0.3 * x[0] * x[1],
+        [0.7 * x[0].cos() + 0.3 * x[1], 0.4 + 0.3 * x[0]],
+    )
+}
+
+fn beta_sphere(x: [f64; 2]) -> (f64, [f64; 2]) {
+    (
+        0.6 * (2.0 * x[0]).sin() + 0.5 * x[1].cos(),
+        [1.2 * (2.0 * x[0]).cos(), -0.5 * x[1].sin()],
+    )
+}
+
+/// The surface with its frame turned by β(x), Ê'₁ = cos β Ê₁ + sin β Ê₂,
+/// Ê'₂ = −sin β Ê₁ + cos β Ê₂, as a [`MetricSurface`] (α' = α + dβ by finite differences).
+fn rotated(surface: Arc<dyn Surface>, beta: Beta) -> Arc<dyn Surface> {
+    let (s1, s2, s3) = (surface.clone(), surface.clone(), surface);
+    Arc::new(MetricSurface::new(
+        move |x| s1.metric(x),
+        move |x| {
+            let e = s2.frame(x);
+            let (sn, c) = beta(x).0.sin_cos();
+            [
+                [c * e[0][0] + sn * e[1][0], c * e[0][1] + sn * e[1][1]],
+                [-sn * e[0][0] + c * e[1][0], -sn * e[0][1] + c * e[1][1]],
+            ]
+        },
+        Some(Arc::new(move |x| s3.contains(x))),
+    ))
+}
+
+/// What the frame test needs of a top: its Lagrangian and the canonical state from velocities.
+trait FrameTest: System {
+    fn lag(&self, q: [f64; 3], v: [f64; 3]) -> f64;
+    fn start(&self, q: [f64; 3], v: [f64; 3]) -> Vec<f64>;
+}
+
+impl FrameTest for TangentTop {
+    fn lag(&self, q: [f64; 3], v: [f64; 3]) -> f64 {
+        self.lagrangian(q, v).unwrap()
+    }
+    fn start(&self, q: [f64; 3], v: [f64; 3]) -> Vec<f64> {
+        self.state([q[0], q[1]], q[2], [v[0], v[1]], v[2]).unwrap()
+    }
+}
+
+impl FrameTest for RelativisticTangentTop {
+    fn lag(&self, q: [f64; 3], v: [f64; 3]) -> f64 {
+        self.lagrangian(q, v).unwrap()
+    }
+    fn start(&self, q: [f64; 3], v: [f64; 3]) -> Vec<f64> {
+        self.state([q[0], q[1]], q[2], [v[0], v[1]], v[2]).unwrap()
+    }
+}
+
+/// The body's E₁ = cos θ Ê₁ + sin θ Ê₂ in the chart's coordinates.
+fn body_e1(surface: &dyn Surface, z: &[f64]) -> [f64; 2] {
+    let e = surface.frame([z[0], z[1]]);
+    let (sn, c) = z[2].sin_cos();
+    [c * e[0][0] + sn * e[1][0], c * e[0][1] + sn * e[1][1]]
+}
+
+/// The worst differences between a top `a` in the frame of `sa` and the same top `b` in the
+/// frame of `sb`, turned by β: |L_a(x, θ, ẋ, θ̇) − L_b(x, θ − β, ẋ, θ̇ − dβ(ẋ))| at `cases`, and
+/// along gauss6 runs from the first case, of the positions x, the body frame E₁ and the energy.
+fn frame_change<T: FrameTest>(
+    (a, sa): (&T, &dyn Surface),
+    (b, sb): (&T, &dyn Surface),
+    beta: Beta,
+    cases: &[([f64; 3], [f64; 3])],
+) -> (f64, f64) {
+    let moved = |q: [f64; 3], v: [f64; 3]| {
+        let (bv, db) = beta([q[0], q[1]]);
+        (
+            [q[0], q[1], q[2] - bv],
+            [v[0], v[1], v[2] - db[0] * v[0] - db[1] * v[1]],
+        )
+    };
+    let mut dl = 0.0f64;
+    for &(q, v) in cases {
+        let (qb, vb) = moved(q, v);
+        dl = dl.max((a.lag(q, v) - b.lag(qb, vb)).abs());
+    }
+    let (q, v) = cases[0];
+    let (qb, vb) = moved(q, v);
+    let (za, zb) = (a.start(q, v), b.start(qb, vb));
+    let ta = integrate(a, "gauss6", &za, 0.02, 300, 10).unwrap();
+    let tb = integrate(b, "gauss6", &zb, 0.02, 300, 10).unwrap();
+    let mut drun = 0.0f64;
+    for k in 0..ta.len() {
+        let (x, y) = (ta.state(k), tb.state(k));
+        drun = drun.max(dist(&x[..2], &y[..2]));
+        drun = drun.max(dist(&body_e1(sa, x), &body_e1(sb, y)));
+        drun = drun.max((a.energy(x).unwrap() - b.energy(y).unwrap()).abs());
+    }
+    // The motion is not trivial: it turns the frame and moves the centre.
+    let end = ta.state(ta.len() - 1);
+    assert!(dist(&end[..2], &za[..2]) > 0.1);
+    (dl, drun)
+}
+
+/// 002 (104)–(114) claim that the relativistic top's Lagrangian does not depend on the choice of
+/// the reference frame field Ê: turning it by β(x) changes S → R S (θ → θ − β) and the
+/// connection ω → ω + dβ J (α → α + dβ), and (114) finds L̃ = L + vᵀ[A + ω, B]v, whose bracket of
+/// skew matrices is skew, so the extra term vanishes. It holds: the same physical motion (the
+/// centre x(t) and the body frame E₁(t)) comes out of two frames that differ by a
+/// position-dependent β(x), in flat space (Minkowski: the closed form of 002 (90) on the
+/// Cartesian frame against a MetricSurface with the turned frame) and on the unit sphere (the
+/// built-in frame against the turned one), for the symmetric and the anisotropic top,
+/// relativistic and classical (002 §II.C, the same statement for TangentTop); L agrees at
+/// arbitrary points and the runs agree to the accuracy of the MetricSurface's differences.
+#[test]
+fn frame_change_leaves_the_motion_unchanged() {
+    let (m, tr, moments) = (1.0, 0.3, [0.2, 0.05, 0.08]);
+    let tensor = [moments[0], moments[1], moments[1], moments[2]];
+    let plane: Arc<dyn Surface> = Arc::new(Plane);
+    let sph: Arc<dyn Surface> = Arc::new(Sphere::new(1.0).unwrap());
+    let (plane_b, sph_b) = (
+        rotated(plane.clone(), beta_plane),
+        rotated(sph.clone(), beta_sphere),
+    );
+    let flat_cases = [
+        ([0.2, -0.3, 0.4], [0.4, 0.3, 1.8]),
+        ([1.5, 0.7, -1.0], [-0.2, 0.5, 0.7]),
+    ];
+    let sphere_cases = [
+        ([1.1, 0.4, 0.7], [0.25, 0.3, 1.6]),
+        ([0.8, -1.3, 2.0], [-0.3, 0.2, -0.9]),
+    ];
+    let mut report = Vec::new();
+    let mut check = |what: &str, (dl, drun): (f64, f64), tol_l: f64, tol_run: f64| {
+        report.push(format!("{what}: |ΔL| {dl:.1e}, run {drun:.1e}"));
+        assert!(dl < tol_l && drun < tol_run, "{what}: {dl} {drun}");
+    };
+    // Relativistic, Minkowski (closed-form kernel) and on the sphere; symmetric and anisotropic.
+    for (what, a, b) in [
+        (
+            "relativistic symmetric, flat",
+            RelativisticTangentTop::symmetric(m, tr).unwrap(),
+            RelativisticTangentTop::on_surface(plane_b.clone(), m, tr).unwrap(),
+        ),
+        (
+            "relativistic anisotropic, flat",
+            RelativisticTangentTop::new(m, moments).unwrap(),
+            RelativisticTangentTop::on_surface_with_moments(plane_b.clone(), m, moments).unwrap(),
+        ),
+    ] {
+        let r = frame_change((&a, &*plane), (&b, &*plane_b), beta_plane, &flat_cases);
+        check(what, r, 1e-10, 1e-8);
+    }
+    for (what, a, b) in [
+        (
+            "relativistic symmetric, sphere",
+            RelativisticTangentTop::on_surface(sph.clone(), m, tr).unwrap(),
+            RelativisticTangentTop::on_surface(sph_b.clone(), m, tr).unwrap(),
+        ),
+        (
+            "relativistic anisotropic, sphere",
+            RelativisticTangentTop::on_surface_with_moments(sph.clone(), m, moments).unwrap(),
+            RelativisticTangentTop::on_surface_with_moments(sph_b.clone(), m, moments).unwrap(),
+        ),
+    ] {
+        let r = frame_change((&a, &*sph), (&b, &*sph_b), beta_sphere, &sphere_cases);
+        check(what, r, 1e-10, 1e-8);
+    }
+    // Classical (intrinsic; only tr I enters, 002 (42)).
+    for (surface, turned, beta, cases, name) in [
+        (&plane, &plane_b, beta_plane as Beta, &flat_cases, "flat"),
+        (&sph, &sph_b, beta_sphere as Beta, &sphere_cases, "sphere"),
+    ] {
+        for (kind, t) in [
+            ("symmetric", [0.5 * tr, 0.0, 0.0, 0.5 * tr]),
+            ("anisotropic", tensor),
+        ] {
+            let a = TangentTop::with_tensor(surface.clone(), m, t).unwrap();
+            let b = TangentTop::with_tensor(turned.clone(), m, t).unwrap();
+            let r = frame_change((&a, &**surface), (&b, &**turned), beta, cases);
+            check(&format!("classical {kind}, {name}"), r, 1e-10, 1e-8);
+        }
+    }
+    for line in report {
+        eprintln!("frame change: {line}");
+    }
+    // And the frames do differ: the angles of one state in the two frames.
+    let (bv, _) = beta_sphere([1.1, 0.4]);
+    assert!(bv.abs() > 0.5);
 }
