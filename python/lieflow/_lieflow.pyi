@@ -301,12 +301,25 @@ class PseudoRigidBody(System):
 @final
 class RelativisticTangentTop(System):
     """The relativistic tangent top in Minkowski space (002 (87)-(96)), or with `surface` the
-    symmetric top on -dt^2 + g over that surface (002 (97)-(103)); gauss4, gauss6, midpoint, rk4."""
+    top on -dt^2 + g over that surface (002 (97)-(103)); inertia tr I, (I11, I12, I22) or (2, 2);
+    gauss4, gauss6, midpoint, rk4."""
 
     def __new__(
-        cls, mass: float, inertia: float | tuple[float, float, float], surface: Any | None = None,
+        cls, mass: float, inertia: float | ArrayLike, surface: Any | None = None,
     ) -> Self: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
+    def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
+        """L of 002 (90) / (102), physical sign."""
+    def prescribed_inertia(self, theta: ArrayLike, velocity: ArrayLike) -> _F64 | float:
+        """F(theta) = I gamma + gamma^3 u^T K(theta) u, the centre moving with velocity u (002 (91))."""
+    def prescribed_spin_rate(
+        self, theta: ArrayLike, energy: ArrayLike, velocity: ArrayLike,
+    ) -> _F64 | float:
+        """sqrt(2 E / F(theta)), 002 (92)."""
+    def prescribed_potential(
+        self, theta: ArrayLike, energy: ArrayLike, velocity: ArrayLike,
+    ) -> _F64 | float:
+        """V(theta) = -E / F(theta): thetadot^2 / 2 + V = 0."""
     def velocities(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
     def momentum_94(self, v: ArrayLike, p_theta: ArrayLike) -> _F64 | float:

@@ -761,6 +761,10 @@ def build_specs() -> list[Spec]:
     add("RelativisticTangentTop", "RelativisticTangentTop", A("mass", 1.0, "float", positive=True),
         A("inertia", 0.2, "float", positive=True),
         A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj", opt=True))
+    add("RelativisticTangentTop[tensor]", "RelativisticTangentTop",
+        A("mass", 1.0, "float", positive=True),
+        A("inertia", np.array([[0.2, 0.05], [0.05, 0.08]]), "mat"),
+        A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj", opt=True))
     add("WeakFieldTop", "WeakFieldTop", A("mass", 1.0, "float", positive=True),
         A("inertia", 1e-3, "float", positive=True), A("gm", 1e-4, "float", kw=True, opt=True))
     add("WeakFieldTop[g]", "WeakFieldTop", A("mass", 1.0, "float", positive=True),
@@ -834,7 +838,18 @@ def build_specs() -> list[Spec]:
                                  A("p_theta", 0.7, "bcast")]),
                 ("spin_rate_95", [A("v", np.array([0.1, 0.5, 0.9]), "bcast"),
                                   A("p_theta", 0.7, "bcast")]),
-                ("energy_96", [A("v", 0.5, "bcast"), A("thetadot", np.array([0.0, 2.0]), "bcast")])]
+                ("energy_96", [A("v", 0.5, "bcast"), A("thetadot", np.array([0.0, 2.0]), "bcast")]),
+                ("lagrangian", [A("x", np.array([1.2, 0.3]), "vec"), A("theta", 0.5, "float"),
+                                A("xdot", np.array([0.3, 0.4]), "vec"),
+                                A("thetadot", 2.0, "float")]),
+                ("prescribed_inertia", [A("theta", np.array([0.0, 0.7]), "bcast"),
+                                        A("velocity", np.array([0.6, 0.1]), "vec")]),
+                ("prescribed_spin_rate", [A("theta", np.array([0.0, 0.7]), "bcast"),
+                                          A("energy", 0.8, "bcast"),
+                                          A("velocity", np.array([0.6, 0.1]), "vec")]),
+                ("prescribed_potential", [A("theta", 0.3, "bcast"),
+                                          A("energy", np.array([0.0, 0.8]), "bcast"),
+                                          A("velocity", np.array([0.6, 0.1]), "vec")])]
         + [(f, [A("states", state_of("rtt"), "vec")])
            for f in ("velocities", "speed_and_spin", "killing_momenta")],
         "wft": [("state", [A("x", np.array([1.0, 0.5]), "vec"), A("theta", 0.1, "float"),
