@@ -13,7 +13,7 @@ use std::sync::Arc;
 use lieflow::integrate::{integrate, Problem, System};
 use lieflow::systems::{
     HyperbolicPlane, MetricSurface, Plane, Potential, PotentialValue, RelativisticTangentTop,
-    Sphere, Surface, TangentTop, WeakFieldTop,
+    Sphere, StaticFieldTop, Surface, TangentTop, WeakFieldTop,
 };
 use lieflow::Error;
 
@@ -1350,4 +1350,179 @@ fn frame_change_leaves_the_motion_unchanged() {
     // And the frames do differ: the angles of one state in the two frames.
     let (bv, _) = beta_sphere([1.1, 0.4]);
     assert!(bv.abs() > 0.5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The symmetric top on the static space-time −e^{2φ}dt² + dx² (002 (115)–(117))
+// ---------------------------------------------------------------------------------------------
+
+/// A uniform field φ = G·x and the point x where φ(x) = phi (on the line along G).
+fn uniform_at(phi: f64, grad: [f64; 2]) -> (Potential, [f64; 2]) {
+    let g2 = grad[0] * grad[0] + grad[1] * grad[1];
+    (
+        Potential::uniform(grad).unwrap(),
+        [phi * grad[0] / g2, phi * grad[1] / g2],
+    )
+}
+
+#[test]
+fn static_field_lagrangian_is_the_expansion_of_82() {
+    // 002 (117), derived again, against the exact integral (82) over an isotropic cross of mass
+    // points on −e^{2φ}dt² + dx² in a strong field (φ = −0.3, |G| ≈ 0.47, v ≈ 0.4): the error is
+    // O(r⁴). With the opposite sign of the spin–field coupling (the other reading of (117)'s
+    // ṠSᵀGᵀv, and the sign of (118)) it is O(r²).
+    let m = 1.2;
+    let (phi, grad) = (-0.3, [0.4, -0.25]);
+    let (potential, x) = uniform_at(phi, grad);
+    let q = [x[0], x[1], 0.6];
+    let v = [0.35, -0.2, 1.7];
+    let errs = |r: f64| {
+        let top = StaticFieldTop::new(m, m * r * r, potential.clone()).unwrap();
+        let exact = exact_82(&cross_body(m, r, r), phi, grad, q, v);
+        let l = top.lagrangian(q, v).unwrap();
+        // The coupling I₀e^{2φ}θ̇(G_yẋ − G_xẏ)/b^{3/2} with the other sign.
+        let (i0, e2) = (0.5 * m * r * r, (2.0 * phi).exp());
+        let b = e2 - v[0] * v[0] - v[1] * v[1];
+        let coupling = i0 * e2 * v[2] * (grad[1] * v[0] - grad[0] * v[1]) / b.powf(1.5);
+        ((l - exact).abs(), (l - 2.0 * coupling - exact).abs())
+    };
+    let (e1, _) = errs(0.02);
+    let (e2, w2) = errs(0.01);
+    let (e3, w3) = errs(0.005);
+    eprintln!(
+        "(117): |L − (82)| = {e1:.3e} (r = 0.02), {e2:.3e} (r = 0.01), {e3:.3e} (r = 0.005), \
+         ratios {:.2}, {:.2}; with the other coupling sign {w2:.3e}, {w3:.3e}",
+        e1 / e2,
+        e2 / e3
+    );
+    assert!(e1 / e2 > 14.0 && e1 / e2 < 18.0, "{}", e1 / e2);
+    assert!(e2 / e3 > 14.0 && e2 / e3 < 18.0, "{}", e2 / e3);
+    assert!(w3 > 50.0 * e3 && (w2 / w3 - 4.0).abs() < 0.5);
+}
+
+#[test]
+fn static_field_expands_to_118() {
+    // φ, |G| = O(ε²), v = O(ε), θ̇ = O(1): L_static = L_(118) − m + O(ε⁴) and
+    // E_static = E_(118) + m + O(ε⁴), so the differences drop 16-fold as ε halves, while the
+    // O(ε³) terms of (118) (the coupling) are far larger than them.
+    let (m, inertia) = (1.0, 0.3);
+    let q = [1.0, 0.3, 0.4];
+    let diffs = |eps: f64| {
+        let pot = Potential::point_mass(0.8 * eps * eps).unwrap();
+        let st = StaticFieldTop::new(m, inertia, pot.clone()).unwrap();
+        let wf = WeakFieldTop::new(m, inertia, pot).unwrap();
+        let v = [0.8 * eps, -0.5 * eps, 1.1];
+        let dl = (st.lagrangian(q, v).unwrap() - (wf.lagrangian(q, v).unwrap() - m)).abs();
+        let zs = st.state([q[0], q[1]], q[2], [v[0], v[1]], v[2]).unwrap();
+        let zw = wf.state([q[0], q[1]], q[2], [v[0], v[1]], v[2]).unwrap();
+        let de = (st.energy(&zs).unwrap() - (wf.energy(&zw).unwrap() + m)).abs();
+        (dl, de)
+    };
+    let (l1, e1) = diffs(0.02);
+    let (l2, e2) = diffs(0.01);
+    // The O(ε³) coupling I₀θ̇(G_yẋ − G_xẏ) of (118) at ε = 0.01.
+    let g = Potential::point_mass(0.8e-4)
+        .unwrap()
+        .eval([q[0], q[1]])
+        .grad;
+    let coupling = (0.5 * inertia * 1.1 * (g[1] * 0.8e-2 + g[0] * 0.5e-2)).abs();
+    eprintln!(
+        "(117) → (118): |ΔL| {l1:.3e} (ε = 0.02), {l2:.3e} (ε = 0.01), ratio {:.2}; |ΔE| \
+         {e1:.3e}, {e2:.3e}, ratio {:.2}; the O(ε³) coupling at ε = 0.01 ≈ {coupling:.1e}",
+        l1 / l2,
+        e1 / e2
+    );
+    assert!((l1 / l2 - 16.0).abs() < 1.0 && (e1 / e2 - 16.0).abs() < 1.0);
+    assert!(l2 < 0.2 * coupling); // and the ratio grows like 1/ε
+}
+
+#[test]
+fn static_field_with_zero_potential_is_the_flat_top() {
+    let (m, inertia) = (1.3, 0.25);
+    let st = StaticFieldTop::new(m, inertia, Potential::uniform([0.0, 0.0]).unwrap()).unwrap();
+    let flat = RelativisticTangentTop::symmetric(m, inertia).unwrap();
+    let mut worst = 0.0f64;
+    for (q, v) in [
+        ([0.1, -0.4, 0.3], [0.3, 0.5, 2.0]),
+        ([2.0, 1.0, -1.0], [-0.7, 0.1, -0.4]),
+    ] {
+        worst = worst.max((st.lagrangian(q, v).unwrap() - flat.lagrangian(q, v).unwrap()).abs());
+        let z = st.state([q[0], q[1]], q[2], [v[0], v[1]], v[2]).unwrap();
+        let zf = flat.state([q[0], q[1]], q[2], [v[0], v[1]], v[2]).unwrap();
+        worst = worst.max(dist(&z, &zf));
+        worst = worst.max(dist(&st.velocities(&zf).unwrap(), &v));
+        worst = worst.max((st.energy(&z).unwrap() - flat.energy(&zf).unwrap()).abs());
+    }
+    let z0 = flat.state([0.2, 0.1], 0.4, [0.5, -0.3], 2.5).unwrap();
+    let a = integrate(&st, "gauss4", &z0, 0.05, 400, 400).unwrap();
+    let b = integrate(&flat, "gauss4", &z0, 0.05, 400, 400).unwrap();
+    let d = dist(&a.final_state, &b.final_state);
+    eprintln!("StaticFieldTop(φ = 0) vs RelativisticTangentTop: {worst:.1e}, run {d:.1e}");
+    assert!(worst < 1e-14 && d < 1e-12, "{worst} {d}");
+}
+
+#[test]
+fn static_field_momenta_euler_lagrange_and_conservation() {
+    // A point mass strong enough that (118) would not do (φ = −0.15 at r = 1, v ≈ 0.4):
+    // p = ∂L/∂q̇ by differences of L, the Euler–Lagrange residual along the gauss6 run, and the
+    // energy (∂_t Killing), p_θ and x p_y − y p_x over a long run.
+    let top = StaticFieldTop::new(1.0, 0.2, Potential::point_mass(0.15).unwrap()).unwrap();
+    let (q, v) = ([1.0, 0.0, 0.3], [0.05, 0.38, 1.2]);
+    let z0 = top.state([q[0], q[1]], q[2], [v[0], v[1]], v[2]).unwrap();
+    for i in 0..3 {
+        let p = fd(&|w| top.lagrangian(q, *w).unwrap(), v, i, 1e-4);
+        assert!((p - z0[3 + i]).abs() < 1e-10, "p_{i}: {p} vs {}", z0[3 + i]);
+    }
+    assert!(dist(&top.velocities(&z0).unwrap(), &v) < 1e-13);
+    let traj = integrate(&top, "gauss6", &z0, 0.01, 800, 1).unwrap();
+    let res = el_residual(
+        &|q, v| top.lagrangian(q, v).unwrap(),
+        &positions(&traj),
+        0.01,
+    );
+    let e0 = top.energy(&z0).unwrap();
+    let inv0 = top.invariants(&z0).unwrap();
+    assert_eq!(inv0.len(), 2);
+    assert_eq!(inv0[1], top.angular_momentum(&z0).unwrap());
+    let long = integrate(&top, "gauss6", &z0, 0.02, 10_000, 10).unwrap();
+    let (mut de, mut dinv, mut rmin, mut rmax) = (0.0f64, 0.0f64, f64::MAX, 0.0f64);
+    for k in 0..long.len() {
+        let z = long.state(k);
+        de = de.max((top.energy(z).unwrap() - e0).abs());
+        dinv = dinv.max(dist(&top.invariants(z).unwrap(), &inv0));
+        let r = z[0].hypot(z[1]);
+        (rmin, rmax) = (rmin.min(r), rmax.max(r));
+    }
+    eprintln!(
+        "StaticFieldTop point mass: EL residual {res:.2e}; gauss6 t = 200: |ΔE| {de:.2e}, \
+         |Δ(p_θ, x×p)| {dinv:.1e}, r in [{rmin:.3}, {rmax:.3}]"
+    );
+    assert!(res < 1e-8 && de < 1e-11 && dinv < 1e-12);
+    assert!(rmax - rmin > 0.05, "a bound, non-circular orbit");
+}
+
+#[test]
+fn static_field_bad_input_gets_typed_errors() {
+    let invalid = |r: lieflow::Result<Vec<f64>>| matches!(r, Err(Error::InvalidArgument { .. }));
+    assert!(StaticFieldTop::new(0.0, 0.2, Potential::point_mass(1.0).unwrap()).is_err());
+    assert!(StaticFieldTop::new(1.0, -0.2, Potential::point_mass(1.0).unwrap()).is_err());
+    let top = StaticFieldTop::new(1.0, 0.2, Potential::point_mass(0.5).unwrap()).unwrap();
+    // Local light speed e^φ = e^{−0.5} ≈ 0.61 at r = 1: 0.7 is faster.
+    let r = top.state([1.0, 0.0], 0.0, [0.0, 0.7], 1.0);
+    assert!(
+        matches!(&r, Err(Error::InvalidArgument { message, .. }) if message.contains("light")),
+        "{r:?}"
+    );
+    assert!(invalid(top.state([0.0, 0.0], 0.0, [0.1, 0.0], 1.0))); // at the point mass
+    assert!(top.lagrangian([f64::NAN, 0.0, 0.0], [0.0; 3]).is_err());
+    assert!(top.velocities(&[1.0, 0.0, 0.0, 0.1, 0.0]).is_err());
+    assert!(top.energy(&[0.0, 0.0, 0.0, 0.1, 0.0, 0.1]).is_err());
+    assert!(matches!(
+        top.velocities(&[1.0, 0.0, 0.0, f64::NAN, 0.0, 0.1]),
+        Err(Error::NonFinite { .. })
+    ));
+    // A field so deep that e^{2φ} underflows: no speed is slower than light.
+    let deep = StaticFieldTop::new(1.0, 0.2, Potential::uniform([1000.0, 0.0]).unwrap()).unwrap();
+    assert!(deep.state([-1.0, 0.0], 0.0, [0.0, 0.0], 1.0).is_err());
+    assert_eq!(top.invariant_count(), 2);
 }

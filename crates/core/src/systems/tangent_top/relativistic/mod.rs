@@ -1,7 +1,8 @@
 //! 002 §IV: the relativistic tangent Euler top in Minkowski space-time and on a curved static
 //! space-time −dt² + γ_ij dxⁱdxʲ over a surface ([`RelativisticTangentTop`], 002 (87)–(111)), and
 //! in the weak-field limit of a static gravitational potential φ(x, y) ([`WeakFieldTop`],
-//! 002 (115)–(120)).
+//! 002 (115)–(120)), and on the static space-time of the potential itself ([`StaticFieldTop`],
+//! 002 (115)–(117)).
 //!
 //! # Set-up (002 (81)–(82))
 //! A planar body with mass distribution dm(ξ), centre of mass at ξ = 0, second-moment tensor
@@ -183,9 +184,12 @@
 //! L = ½ m v² − m φ + I₀ θ̇² (1 − φ + v²) + I₀ θ̇ (G_y ẋ − G_x ẏ).      (002 (118))
 //!
 //! **Slip:** 002 (118), in the seed's sign (L_seed = −L), carries the coupling term with the
-//! opposite sign, +Iθ̇(G_yẋ − G_xẏ); the expansion of 002 (117) itself gives the sign above
-//! (its ṠSᵀ should read SṠᵀ = −θ̇J). The test `weak_field_lagrangian_is_the_expansion` checks
-//! the sign against the exact integral over a ring of mass points. The Euler–Lagrange equations
+//! opposite sign, +Iθ̇(G_yẋ − G_xẏ); the expansion of 002 (117) gives the sign above. (117)
+//! itself is right here if its G is a row vector, as its GGᵀ = |G|² says: then
+//! −2e^{2φ}ṠSᵀGᵀv = −2e^{2φ}θ̇(JGᵀ)·v = +2e^{2φ}θ̇(G_yẋ − G_xẏ); read as Gᵀ-column
+//! contracted the other way, GᵀṠSᵀv, it has the wrong sign. The test
+//! `weak_field_lagrangian_is_the_expansion` checks the sign against the exact integral over a
+//! ring of mass points, and `static_field_lagrangian_is_the_expansion_of_82` the whole L. The Euler–Lagrange equations
 //! (002 (119), here with every term, G = ∇φ, Δφ = ∂_xG_x + ∂_yG_y):
 //!
 //! J = p_θ = 2I₀θ̇(1 − φ + v²) + I₀(G_y ẋ − G_x ẏ) = const,
@@ -202,8 +206,31 @@
 //! The spin–field force I₀θ̇Δφ(−ẏ, ẋ) is "magnetic" (it does no work); φ = −GM/r restricted to
 //! the plane has Δφ = −GM/r³ ≠ 0, so it acts in the point-mass field.
 //!
+//! # Static field (002 (115)–(117)), [`StaticFieldTop`]
+//! The L above, not expanded in the field or the speed: the symmetric top on
+//! −e^{2φ}dt² + dx² + dy² to second order in ξ only, (117) (physical sign; (115) with its dt²
+//! restored, the flat spatial metric of (118)). Its derivatives (the kernel) through
+//! Q = v², c = G_yẋ − G_xẏ = h·ẋ (h = JᵀG = (G_y, −G_x)), w = θ̇, ε = e^{2φ}, |G|²: with
+//! b = ε − Q, β = b^{−1/2}, T = w²Q + 2εwc + ε²|G|²,
+//! L = −m/β + I₀w²β − ½I₀ε|G|²β + ½I₀β³T,
+//! L_Q = ½mβ + I₀w²β³ − ¼I₀ε|G|²β³ + ¾I₀β⁵T, L_c = I₀εwβ³, L_w = 2I₀wβ + I₀β³(wQ + εc),
+//! L_QQ = ¼mβ³ + (9/4)I₀w²β⁵ − ⅜I₀ε|G|²β⁵ + (15/8)I₀β⁷T, L_Qc = (3/2)I₀εwβ⁵,
+//! L_Qw = 2I₀wβ³ + (3/2)I₀β⁵(wQ + εc), L_cc = 0, L_cw = I₀εβ³, L_ww = 2I₀β + I₀Qβ³;
+//! p_x = 2L_Q ẋ + L_c h, p_θ = L_w, ∂²L/∂ẋ² = 2L_Q Id + 4L_QQ ẋẋᵀ + 2L_Qc(ẋhᵀ + hẋᵀ),
+//! ∂²L/∂ẋ∂θ̇ = 2L_Qw ẋ + L_cw h; and through the field, with ∂_kε = 2εG_k,
+//! ∂_k|G|² = 2(HG)_k (H the Hessian of φ), ∂_k c = H_yk ẋ − H_xk ẏ,
+//! L_ε = −½mβ − ½I₀w²β³ − ½I₀|G|²β + ¼I₀ε|G|²β³ − ¾I₀β⁵T + I₀β³(wc + ε|G|²),
+//! L_|G|² = −½I₀εβ + ½I₀ε²β³, ∂L/∂x^k = 2εG_k L_ε + 2(HG)_k L_|G|² + L_c ∂_k c, ∂L/∂θ = 0.
+//! The metric is static (∂_t Killing), so E = p·q̇ − L is conserved; θ is cyclic (p_θ); a
+//! central φ keeps x p_y − y p_x and a uniform one the momentum across the field. φ = 0 gives
+//! the flat top (002 (93)); expanding in φ, |G| = O(ε²), v = O(ε), θ̇ = O(1) gives
+//! (118) − m + O(ε⁴) (`static_field_expands_to_118` measures the ε⁴). The anisotropic body would
+//! add θ through Q(θ) = SISᵀ: L = −m√b + 𝕀θ̇²/(2√b) − e^{2φ}GᵀQG/(2√b) + aᵀQa/(2b^{3/2}) with
+//! a = e^{2φ}G − θ̇Jᵀẋ (not implemented), and a curved spatial metric g would enter as on a
+//! surface above (u, s), with G the frame components of dφ (not implemented).
+//!
 //! # State
-//! Both systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)
+//! All three systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)
 //! are its chart's coordinates and p₁, p₂ their momenta); build one from velocities with `state`,
 //! read the velocities back with `velocities`.
 //!
@@ -211,6 +238,7 @@
 //! [`TangentTop`]: super::TangentTop
 
 mod spacetime;
+mod static_field;
 mod weak_field;
 
 use nalgebra::{Matrix3, Vector3};
@@ -223,6 +251,7 @@ use crate::integrate::space::{Block, Space};
 use crate::integrate::Problem;
 
 pub use spacetime::RelativisticTangentTop;
+pub use static_field::StaticFieldTop;
 pub use weak_field::{Potential, PotentialValue, WeakFieldTop};
 
 /// The derivatives of a Lagrangian L(q, q̇) on ℝ³ at one point: value, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇².
@@ -414,3 +443,5 @@ fn gradient_of(sol: Option<(Vector3<f64>, Derivs)>, hq: &mut [f64], hp: &mut [f6
 legendre_kinds!(RelativisticTangentTop);
 
 legendre_kinds!(WeakFieldTop);
+
+legendre_kinds!(StaticFieldTop);
