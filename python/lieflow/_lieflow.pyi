@@ -342,6 +342,24 @@ class WeakFieldTop(System):
         g: tuple[float, float] | None = None,
     ) -> Self: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
+    def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
+        """L of 002 (118), coupling sign corrected, physical sign."""
+    def angular_momentum(self, states: ArrayLike) -> _F64 | float: ...
+
+@final
+class StaticFieldTop(System):
+    """The symmetric relativistic top on -exp(2 phi) dt^2 + dx^2 (002 (115)-(117), derived
+    again); gauss4, gauss6, midpoint, rk4."""
+
+    def __new__(
+        cls, mass: float, inertia: float, gm: float | None = None,
+        g: tuple[float, float] | None = None,
+    ) -> Self: ...
+    def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
+    def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
+        """L of 002 (117), physical sign."""
+    def velocities(self, states: ArrayLike) -> _F64:
+        """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
     def angular_momentum(self, states: ArrayLike) -> _F64 | float: ...
 
 @final

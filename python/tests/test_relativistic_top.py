@@ -361,3 +361,58 @@ def test_frame_change_leaves_the_motion_unchanged():
     np.testing.assert_allclose(tb.states[:, 2] + turn, ta.states[:, 2], atol=1e-8)
     np.testing.assert_allclose(tb.energy(), ta.energy(), atol=1e-10)
     assert np.ptp(ta.states[:, 1]) > 0.1
+
+
+# --- issue 25, 002 (115)-(117): the top on the static space-time -exp(2 phi) dt^2 + dx^2 ---
+
+def test_static_field_top_conserves_energy_spin_and_angular_momentum():
+    # A point mass strong enough that the weak-field (118) would not do (phi = -0.15 at r = 1).
+    top = lf.StaticFieldTop(1.0, 0.2, gm=0.15)
+    z0 = top.state([1.0, 0.0], 0.3, [0.05, 0.38], 1.2)
+    tr = lf.integrate(top, z0, dt=0.02, steps=5000, method="gauss6", save_every=50)
+    assert np.ptp(tr.energy()) < 1e-12
+    inv = top.invariants(tr.states)
+    assert inv.shape == (len(tr.states), 2) and np.ptp(inv, axis=0).max() < 1e-13
+    np.testing.assert_array_equal(inv[:, 1], top.angular_momentum(tr.states))
+    r = np.hypot(tr.states[:, 0], tr.states[:, 1])
+    assert np.ptp(r) > 0.05                                # the orbit is not trivial
+    np.testing.assert_allclose(top.velocities(z0), [0.05, 0.38, 1.2], atol=1e-13)
+    copy = pickle.loads(pickle.dumps(top))
+    assert repr(copy) == repr(top) and copy.methods() == top.methods() == lf.StaticFieldTop.methods()
+    np.testing.assert_array_equal(lf.integrate(copy, z0, dt=0.02, steps=30).states,
+                                  lf.integrate(top, z0, dt=0.02, steps=30).states)
+
+
+def test_static_field_top_limits_flat_and_weak_field():
+    # phi = 0: the flat RelativisticTangentTop. Weak field and slow motion (phi, G ~ eps^2,
+    # v ~ eps): L = L(118) - m + O(eps^4), the difference 16 times smaller as eps halves.
+    flat = lf.RelativisticTangentTop(1.3, 0.25)
+    zero = lf.StaticFieldTop(1.3, 0.25, g=(0.0, 0.0))
+    z0 = flat.state([0.2, 0.1], 0.4, [0.5, -0.3], 2.5)
+    np.testing.assert_allclose(lf.integrate(zero, z0, dt=0.05, steps=100).states,
+                               lf.integrate(flat, z0, dt=0.05, steps=100).states, atol=1e-13)
+    args = ([0.2, 0.1], 0.4, [0.5, -0.3], 2.5)
+    assert zero.lagrangian(*args) == pytest.approx(flat.lagrangian(*args), abs=1e-15)
+
+    def diff(eps):
+        st = lf.StaticFieldTop(1.0, 0.3, gm=0.8 * eps**2)
+        wf = lf.WeakFieldTop(1.0, 0.3, gm=0.8 * eps**2)
+        a = ([1.0, 0.3], 0.4, [0.8 * eps, -0.5 * eps], 1.1)
+        return abs(st.lagrangian(*a) - (wf.lagrangian(*a) - 1.0))
+    ratio = diff(0.02) / diff(0.01)
+    print(f"(117) -> (118): L difference ratio on halving eps {ratio:.2f}")
+    assert abs(ratio - 16) < 1
+
+
+def test_static_field_top_rejects_bad_input():
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.StaticFieldTop(1.0, 0.2)                         # no potential
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.StaticFieldTop(1.0, 0.2, gm=1.0, g=(0.0, 1.0))   # two
+    top = lf.StaticFieldTop(1.0, 0.2, gm=0.5)
+    with pytest.raises(lf.InvalidArgumentError, match="light"):
+        top.state([1.0, 0.0], 0.0, [0.0, 0.7], 1.0)         # exp(phi) = 0.61 < 0.7
+    with pytest.raises(lf.InvalidArgumentError):
+        top.state([0.0, 0.0], 0.0, [0.1, 0.0], 1.0)         # at the point mass
+    with pytest.raises(lf.NonFiniteError):
+        top.lagrangian([np.nan, 0.0], 0.0, [0.1, 0.0], 1.0)

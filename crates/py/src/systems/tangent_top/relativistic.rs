@@ -1,4 +1,4 @@
-//! `RelativisticTangentTop` and `WeakFieldTop`: bindings of `lieflow::systems::tangent_top::relativistic`
+//! `RelativisticTangentTop`, `WeakFieldTop` and `StaticFieldTop`: bindings of `lieflow::systems::tangent_top::relativistic`
 //! (002 §IV). Thin subclasses of `lieflow.System`.
 
 use lieflow::systems::tangent_top::relativistic as core;
@@ -392,13 +392,7 @@ impl PyWeakFieldTop {
         #[pyo3(from_py_with = real_opt)] gm: Option<f64>,
         #[pyo3(from_py_with = reals_opt::<2>)] g: Option<[f64; 2]>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let potential = match (gm, g) {
-            (Some(gm), None) => core::Potential::point_mass(gm),
-            (None, Some(g)) => core::Potential::uniform(g),
-            _ => Err(Error::invalid("potential", "give exactly one of gm and g")),
-        }
-        .map_err(to_py)?;
-        let top = core::WeakFieldTop::new(mass, inertia, potential).py()?;
+        let top = core::WeakFieldTop::new(mass, inertia, potential(gm, g)?).py()?;
         let args = (mass, inertia, gm, g).into_pyobject(py)?;
         Ok(PySystem::subclass(
             top,
@@ -422,6 +416,28 @@ impl PyWeakFieldTop {
         top.state(x, theta, xdot, thetadot).py()
     }
 
+    /// The Lagrangian 002 (118) (coupling sign corrected, physical sign, rest energy dropped):
+    /// ``L = m v^2/2 - m phi + I0 thetadot^2 (1 - phi + v^2) + I0 thetadot (G_y xdot - G_x ydot)``,
+    /// ``I0 = tr I / 2``, ``G = grad phi``.
+    ///
+    /// Args:
+    ///     x: (2,); theta; xdot: (2,); thetadot.
+    /// Returns:
+    ///     float.
+    /// Raises:
+    ///     InvalidArgumentError (phi not finite at x), NonFiniteError.
+    fn lagrangian(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<f64> {
+        let top = slf.core::<core::WeakFieldTop>()?;
+        top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
+            .py()
+    }
+
     /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
     /// vectorised: (..., 6) -> (...).
     ///
@@ -432,6 +448,131 @@ impl PyWeakFieldTop {
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let top = slf.core::<core::WeakFieldTop>()?;
+        map_items(
+            slf.py(),
+            &[Input::new("states", &states, &[6])],
+            &[],
+            |z, out| {
+                out[0] = top.angular_momentum(z[0])?;
+                Ok(())
+            },
+        )
+    }
+}
+
+/// The potential of `WeakFieldTop` and `StaticFieldTop`: exactly one of gm (a point mass,
+/// phi = -gm/r) or g (a uniform field phi = g.x).
+fn potential(gm: Option<f64>, g: Option<[f64; 2]>) -> PyResult<core::Potential> {
+    match (gm, g) {
+        (Some(gm), None) => core::Potential::point_mass(gm),
+        (None, Some(g)) => core::Potential::uniform(g),
+        _ => Err(Error::invalid("potential", "give exactly one of gm and g")),
+    }
+    .map_err(to_py)
+}
+
+/// The symmetric relativistic tangent top on the static space-time
+/// ``-exp(2 phi) dt^2 + dx^2 + dy^2`` of a potential phi, to second order in the body's size
+/// (002 (115)-(117), derived again; physical sign): with ``b = exp(2 phi) - v^2``,
+/// ``I0 = tr I / 2``, ``G = grad phi``,
+/// ``L = -m sqrt(b) + I0 thetadot^2 / sqrt(b) - I0 exp(2 phi) G^2 / (2 sqrt(b))
+/// + I0 (thetadot^2 v^2 + 2 exp(2 phi) thetadot (G_y xdot - G_x ydot) + exp(4 phi) G^2)
+/// / (2 b^(3/2))``. Weak fields and slow motion give `WeakFieldTop` (002 (118)) plus -m; phi = 0
+/// the flat `RelativisticTangentTop`. State (x, y, theta, p_x, p_y, p_theta); coordinate speeds
+/// below exp(phi). Invariants: p_theta, and x p_y - y p_x (point mass) or the momentum across a
+/// uniform field; the energy is conserved. Methods: gauss4 (default), gauss6, midpoint, rk4.
+///
+/// Args:
+///     mass > 0, inertia > 0 (tr I); exactly one of gm (phi = -gm/r) or g (a uniform field
+///     phi = g.x, (2,)).
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "StaticFieldTop", module = "lieflow", extends = PySystem, frozen)]
+#[derive(Default)]
+pub struct PyStaticFieldTop;
+
+#[pymethods]
+impl PyStaticFieldTop {
+    #[new]
+    #[pyo3(signature = (mass, inertia, gm = None, g = None))]
+    fn new(
+        py: Python<'_>,
+        #[pyo3(from_py_with = real)] mass: f64,
+        #[pyo3(from_py_with = real)] inertia: f64,
+        #[pyo3(from_py_with = real_opt)] gm: Option<f64>,
+        #[pyo3(from_py_with = reals_opt::<2>)] g: Option<[f64; 2]>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let top = core::StaticFieldTop::new(mass, inertia, potential(gm, g)?).py()?;
+        let args = (mass, inertia, gm, g).into_pyobject(py)?;
+        Ok(PySystem::subclass(
+            top,
+            args,
+            &["mass", "inertia", "gm", "g"],
+        ))
+    }
+
+    /// The canonical state from the position x (2,), the angle theta and the velocities.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (a speed not below exp(phi), phi not finite at x, a Legendre map
+    ///     not invertible), NonFiniteError.
+    fn state(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<Vec<f64>> {
+        let top = slf.core::<core::StaticFieldTop>()?;
+        top.state(x, theta, xdot, thetadot).py()
+    }
+
+    /// The Lagrangian of 002 (117) (derived again, physical sign; the class docstring).
+    ///
+    /// Args:
+    ///     x: (2,); theta; xdot: (2,); thetadot.
+    /// Returns:
+    ///     float.
+    /// Raises:
+    ///     InvalidArgumentError (a speed not below exp(phi), phi not finite at x),
+    ///     NonFiniteError.
+    fn lagrangian(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<f64> {
+        let top = slf.core::<core::StaticFieldTop>()?;
+        top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
+            .py()
+    }
+
+    /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError, InvalidArgumentError.
+    fn velocities<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::StaticFieldTop>()?;
+        slf.base().map_states(slf.py(), &states, &[3], |z, out| {
+            out.copy_from_slice(&top.velocities(z)?);
+            Ok(())
+        })
+    }
+
+    /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
+    /// vectorised: (..., 6) -> (...).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn angular_momentum<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::StaticFieldTop>()?;
         map_items(
             slf.py(),
             &[Input::new("states", &states, &[6])],
