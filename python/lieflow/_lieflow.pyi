@@ -24,8 +24,8 @@ __all__ = [
     "elliptic", "ellipsoids", "continuation", "System", "Integration", "RigidBody",
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
-    "RelativisticTangentTop", "WeakFieldTop", "TangentTop", "ChargedParticle", "FrameTop", "Canonical",
-    "Separable", "LiePoisson", "EulerPoincare", "Forced", "PseudoRigidBody", "__version__",
+    "RelativisticTangentTop", "WeakFieldTop", "StaticFieldTop", "TangentTop", "ChargedParticle",
+    "FrameTop", "Canonical", "Separable", "LiePoisson", "EulerPoincare", "Forced", "PseudoRigidBody", "__version__",
     "inertia_tensor", "mass_matrix", "spatial_inertia",
 ]
 
