@@ -75,7 +75,7 @@
 //!
 //! **Anisotropic top (002 (102)).** For any I the body term is P = uᵀK(θ)u with u the
 //! components of ẋ in the orthonormal frame, u_a = g(ẋ, Ê_a), i.e. u = Fẋ with the coframe
-//! F = e g (`e[a][i]` = e_a^i, [`Surface::frame`]): L = −m/γ + ½s²(𝕀γ + γ³P) (tested against
+//! F = e g (`e[a][i]` = e_a^i, [`Surface::frame`](super::surface::Surface::frame)): L = −m/γ + ½s²(𝕀γ + γ³P) (tested against
 //! the exact (82) over an anisotropic body of mass points, `anisotropic_curved_lagrangian_is_the_
 //! expansion_of_82`). L depends on θ, so p_θ is not conserved. The x-derivatives of u need the
 //! derivatives of the frame, and these follow from the data a [`Surface`] already gives:
@@ -97,8 +97,8 @@
 //! L_ss = 𝕀γ + γ³P, L_sP = sγ³, L_PP = 0; with n = gẋ, k = Nẋ:
 //! p_x = 2L_Q n + L_s α + 2L_P k,  p_θ = L_s,
 //! ∂L/∂x^k = L_Q ẋᵀ(∂_k g)ẋ + L_s (∂_kα)·ẋ + L_P ∂_k P,  ∂L/∂θ = L_P ∂_θ P,
-//! ∂²L/∂ẋ² = 2L_Q g + 2L_P N + 4L_QQ nnᵀ + 4L_QP(nkᵀ + knᵀ) + 2L_Qs(nαᵀ + αnᵀ)
-//! + 2L_sP(kαᵀ + αkᵀ) + L_ss ααᵀ, ∂²L/∂ẋ∂θ̇ = 2L_Qs n + 2L_sP k + L_ss α, ∂²L/∂θ̇² = L_ss.
+//! ∂²L/∂ẋ² = 2L_Q g + 2L_P N + 4L_QQ nnᵀ + 4L_QP(nkᵀ + knᵀ) + 2L_Qs(nαᵀ + αnᵀ) +
+//! 2L_sP(kαᵀ + αkᵀ) + L_ss ααᵀ, ∂²L/∂ẋ∂θ̇ = 2L_Qs n + 2L_sP k + L_ss α, ∂²L/∂θ̇² = L_ss.
 //! For the symmetric top (P = ½𝕀Q) these are the derivatives of L = −m√(1 − Q) + ½𝕀s²f(Q),
 //! f(Q) = γ + ½Qγ³, written below.
 //!

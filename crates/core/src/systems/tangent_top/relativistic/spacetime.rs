@@ -265,7 +265,7 @@ impl RelativisticTangentTop {
         check::finite_slice("theta", &[theta])?;
         check::finite_slice("velocity", &velocity)?;
         let speed2 = velocity[0] * velocity[0] + velocity[1] * velocity[1];
-        if !(speed2 < 1.0) {
+        if speed2.is_nan() || speed2 >= 1.0 {
             return Err(superluminal([velocity[0], velocity[1], 0.0], speed2.sqrt()));
         }
         let g = 1.0 / (1.0 - speed2).sqrt();

@@ -16,8 +16,8 @@ use crate::integrate::Problem;
 /// The symmetric relativistic tangent top on the static space-time ds² = −e^{2φ}dt² + dx² + dy²
 /// of a potential φ, the Lagrangian 002 (117) (derived again, physical sign, module docs):
 /// with b = e^{2φ} − v², I₀ = 𝕀/2, G = ∇φ,
-/// L = −m√b + I₀θ̇²/√b − I₀e^{2φ}|G|²/(2√b)
-///   + I₀(θ̇²v² + 2e^{2φ}θ̇(G_yẋ − G_xẏ) + e^{4φ}|G|²)/(2b^{3/2}).
+/// L = −m√b + I₀θ̇²/√b − I₀e^{2φ}|G|²/(2√b) +
+/// I₀(θ̇²v² + 2e^{2φ}θ̇(G_yẋ − G_xẏ) + e^{4φ}|G|²)/(2b^{3/2}).
 /// Its weak-field, slow-motion limit is [`WeakFieldTop`](super::WeakFieldTop) (002 (118)), and
 /// φ = 0 gives the flat [`RelativisticTangentTop`](super::RelativisticTangentTop). State
 /// z = (x, y, θ, p_x, p_y, p_θ); coordinate speeds v < e^φ.
