@@ -236,6 +236,21 @@ def test_anisotropic_top_on_a_surface_takes_the_tensor_and_conserves_energy_and_
         lf.RelativisticTangentTop(1.0, [[np.nan, 0.0], [0.0, 0.1]], S.Sphere(1.0))
     with pytest.raises(lf.InvalidArgumentError):                               # not semidefinite
         lf.RelativisticTangentTop(1.0, [[0.1, 0.2], [0.2, 0.1]], S.Sphere(1.0))
+    # The frame is called for an anisotropic body: a callable's exception comes back unchanged.
+
+    def metric(t, p):
+        return [[1.0, 0.0], [0.0, np.sin(t) ** 2]]
+
+    def frame(t, p):
+        if t > 1.5:
+            raise RuntimeError("frame failed")
+        return [[1.0, 0.0], [0.0, 1.0 / np.sin(t)]]
+
+    python = lf.RelativisticTangentTop(1.0, TENSOR, S.MetricSurface(metric, frame, None))
+    with pytest.raises(RuntimeError, match="frame failed"):
+        python.state([1.6, 0.0], 0.0, [0.1, 0.0], 1.0)
+    with pytest.raises(RuntimeError, match="frame failed"):
+        lf.integrate(python, python.state([1.45, 0.0], 0.0, [0.3, 0.0], 1.0), dt=0.05, steps=100)
 
 
 def _euler_lagrange_theta(top, u):
