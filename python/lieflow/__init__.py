@@ -20,7 +20,7 @@ PseudoRigidBody, potentials                                     pseudo-rigid bod
 Pendulum, SphereParticle, RollingDisk                           canonical, constrained and
                                                                 nonholonomic test problems
 TangentTop, ChargedParticle, surfaces                           the tangent Euler top of 002 §II–III
-RelativisticTangentTop, WeakFieldTop                            the relativistic top of 002 §IV
+RelativisticTangentTop, StaticFieldTop, WeakFieldTop            the relativistic top of 002 §IV
 FrameTop, spaces                                                the top on R^3, S^3, H^3 (002 §V)
 RollingSpheres                                                  two rolling spheres of 003 §2
 RollingDisks                                                    two rolling disks of 003 §1
@@ -73,6 +73,7 @@ from ._lieflow import (
     Separable,
     SphereParticle,
     SphericalPendulum,
+    StaticFieldTop,
     System,
     TangentTop,
     WeakFieldTop,
@@ -126,6 +127,7 @@ __all__ = [
     "TangentTop",
     "Trajectory",
     "UnsupportedMethodError",
+    "StaticFieldTop",
     "WeakFieldTop",
     "__version__",
     "elliptic",

@@ -24,8 +24,8 @@ __all__ = [
     "elliptic", "ellipsoids", "continuation", "System", "Integration", "RigidBody",
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
-    "RelativisticTangentTop", "WeakFieldTop", "TangentTop", "ChargedParticle", "FrameTop", "Canonical",
-    "Separable", "LiePoisson", "EulerPoincare", "Forced", "PseudoRigidBody", "__version__",
+    "RelativisticTangentTop", "WeakFieldTop", "StaticFieldTop", "TangentTop", "ChargedParticle",
+    "FrameTop", "Canonical", "Separable", "LiePoisson", "EulerPoincare", "Forced", "PseudoRigidBody", "__version__",
     "inertia_tensor", "mass_matrix", "spatial_inertia",
 ]
 
@@ -301,12 +301,25 @@ class PseudoRigidBody(System):
 @final
 class RelativisticTangentTop(System):
     """The relativistic tangent top in Minkowski space (002 (87)-(96)), or with `surface` the
-    symmetric top on -dt^2 + g over that surface (002 (97)-(103)); gauss4, gauss6, midpoint, rk4."""
+    top on -dt^2 + g over that surface (002 (97)-(103)); inertia tr I, (I11, I12, I22) or (2, 2);
+    gauss4, gauss6, midpoint, rk4."""
 
     def __new__(
-        cls, mass: float, inertia: float | tuple[float, float, float], surface: Any | None = None,
+        cls, mass: float, inertia: float | ArrayLike, surface: Any | None = None,
     ) -> Self: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
+    def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
+        """L of 002 (90) / (102), physical sign."""
+    def prescribed_inertia(self, theta: ArrayLike, velocity: ArrayLike) -> _F64 | float:
+        """F(theta) = I gamma + gamma^3 u^T K(theta) u, the centre moving with velocity u (002 (91))."""
+    def prescribed_spin_rate(
+        self, theta: ArrayLike, energy: ArrayLike, velocity: ArrayLike,
+    ) -> _F64 | float:
+        """sqrt(2 E / F(theta)), 002 (92)."""
+    def prescribed_potential(
+        self, theta: ArrayLike, energy: ArrayLike, velocity: ArrayLike,
+    ) -> _F64 | float:
+        """V(theta) = -E / F(theta): thetadot^2 / 2 + V = 0."""
     def velocities(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
     def momentum_94(self, v: ArrayLike, p_theta: ArrayLike) -> _F64 | float:
@@ -329,6 +342,24 @@ class WeakFieldTop(System):
         g: tuple[float, float] | None = None,
     ) -> Self: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
+    def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
+        """L of 002 (118), coupling sign corrected, physical sign."""
+    def angular_momentum(self, states: ArrayLike) -> _F64 | float: ...
+
+@final
+class StaticFieldTop(System):
+    """The symmetric relativistic top on -exp(2 phi) dt^2 + dx^2 (002 (115)-(117), derived
+    again); gauss4, gauss6, midpoint, rk4."""
+
+    def __new__(
+        cls, mass: float, inertia: float, gm: float | None = None,
+        g: tuple[float, float] | None = None,
+    ) -> Self: ...
+    def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
+    def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
+        """L of 002 (117), physical sign."""
+    def velocities(self, states: ArrayLike) -> _F64:
+        """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
     def angular_momentum(self, states: ArrayLike) -> _F64 | float: ...
 
 @final

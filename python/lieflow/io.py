@@ -114,6 +114,7 @@ ALLOWED_CALLS = frozenset({
     "lieflow:RollingSpheres",
     "lieflow:SphereParticle",
     "lieflow:SphericalPendulum",
+    "lieflow:StaticFieldTop",
     "lieflow:TangentTop",
     "lieflow:WeakFieldTop",
     "lieflow.potentials:Harmonic",

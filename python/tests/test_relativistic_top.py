@@ -86,8 +86,8 @@ def test_bad_surface_arguments_are_rejected():
         lf.RelativisticTangentTop(1.0, 0.2, surface="sphere")
     with pytest.raises(TypeError):
         lf.RelativisticTangentTop(1.0, 0.2, surface=lf.TangentTop(lf.surfaces.Plane(), 1.0, 1.0))
-    with pytest.raises(lf.InvalidArgumentError):   # anisotropic body: Minkowski plane only
-        lf.RelativisticTangentTop(1.0, (0.1, 0.0, 0.2), surface=lf.surfaces.Sphere(1.0))
+    with pytest.raises(lf.ShapeError):             # neither tr I, (3,) nor (2, 2)
+        lf.RelativisticTangentTop(1.0, (0.1, 0.0), surface=lf.surfaces.Sphere(1.0))
     top = lf.RelativisticTangentTop(1.0, 0.2, surface=lf.surfaces.Sphere(2.0))
     with pytest.raises(lf.InvalidArgumentError):   # v = R |dtheta/dt| = 1.2
         top.state([1.0, 0.0], 0.0, [0.6, 0.0], 1.0)
@@ -192,3 +192,242 @@ def test_relation_94_does_not_fix_the_speed_for_fast_spin():
     p0 = 0.5 * (p.max(where=v < falling[0], initial=0) + p.min(where=v > falling[-1], initial=np.inf))
     speeds = v[1:][np.diff(np.sign(p - p0)) != 0]
     assert len(speeds) == 3 and speeds[0] < falling[0] < speeds[1] < falling[-1] < speeds[2]
+
+
+# --- issue 25, 002 §IV leftovers: (102) the anisotropic top on a surface, (91)-(92) the spin
+# with a prescribed centre motion, (104)-(114) frame independence ---
+
+MOMENTS = (0.2, 0.05, 0.08)          # (I11, I12, I22), integral xi xi^T dm
+TENSOR = [[0.2, 0.05], [0.05, 0.08]]
+
+
+def test_anisotropic_top_on_a_surface_takes_the_tensor_and_conserves_energy_and_j_z():
+    # 002 (102): a (2, 2) or (3,) second-moment tensor on a surface; theta is not cyclic (no
+    # p_theta among the invariants, and it varies); the energy and J_z are kept by gauss6.
+    S = lf.surfaces
+    top = lf.RelativisticTangentTop(1.0, TENSOR, S.Sphere(1.0))
+    same = lf.RelativisticTangentTop(1.0, MOMENTS, S.Sphere(1.0))
+    z0 = np.asarray(top.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0))
+    np.testing.assert_array_equal(z0, same.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0))
+    tr = lf.integrate(top, z0, dt=0.02, steps=2000, method="gauss6", save_every=100)
+    assert np.ptp(tr.energy()) < 1e-12
+    inv = top.invariants(tr.states)
+    assert inv.shape == (len(tr.states), 1) and np.ptp(inv) < 1e-12           # J_z
+    assert np.ptp(top.killing_momenta(tr.states), axis=0).max() < 1e-9
+    assert np.ptp(tr.states[:, 5]) > 1e-3                                      # p_theta varies
+    copy = pickle.loads(pickle.dumps(top))
+    np.testing.assert_array_equal(lf.integrate(copy, z0, dt=0.02, steps=50).states,
+                                  lf.integrate(top, z0, dt=0.02, steps=50).states)
+    # On the Plane it is the Minkowski top of 002 (90) (a second kernel).
+    plane = lf.RelativisticTangentTop(1.0, TENSOR, S.Plane())
+    flat = lf.RelativisticTangentTop(1.0, MOMENTS)
+    z0 = flat.state([0.0, 0.0], 0.3, [0.5, 0.2], 2.0)
+    np.testing.assert_allclose(lf.integrate(plane, z0, dt=0.05, steps=40).states,
+                               lf.integrate(flat, z0, dt=0.05, steps=40).states, atol=1e-13)
+    # L: the tensor's term is there (it differs from the symmetric top of the same trace).
+    sym = lf.RelativisticTangentTop(1.0, 0.28, S.Sphere(1.0))
+    args = ([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)
+    assert abs(top.lagrangian(*args) - sym.lagrangian(*args)) > 1e-3
+    with pytest.raises(lf.InvalidArgumentError, match="symmetric"):
+        lf.RelativisticTangentTop(1.0, [[0.2, 0.05], [0.0, 0.08]], S.Sphere(1.0))
+    with pytest.raises(lf.ShapeError):
+        lf.RelativisticTangentTop(1.0, [0.2, 0.05], S.Sphere(1.0))
+    with pytest.raises(lf.NonFiniteError):
+        lf.RelativisticTangentTop(1.0, [[np.nan, 0.0], [0.0, 0.1]], S.Sphere(1.0))
+    with pytest.raises(lf.InvalidArgumentError):                               # not semidefinite
+        lf.RelativisticTangentTop(1.0, [[0.1, 0.2], [0.2, 0.1]], S.Sphere(1.0))
+    # The frame is called for an anisotropic body: a callable's exception comes back unchanged.
+
+    def metric(t, p):
+        return [[1.0, 0.0], [0.0, np.sin(t) ** 2]]
+
+    def frame(t, p):
+        if t > 1.5:
+            raise RuntimeError("frame failed")
+        return [[1.0, 0.0], [0.0, 1.0 / np.sin(t)]]
+
+    python = lf.RelativisticTangentTop(1.0, TENSOR, S.MetricSurface(metric, frame, None))
+    with pytest.raises(RuntimeError, match="frame failed"):
+        python.state([1.6, 0.0], 0.0, [0.1, 0.0], 1.0)
+    with pytest.raises(RuntimeError, match="frame failed"):
+        lf.integrate(python, python.state([1.45, 0.0], 0.0, [0.3, 0.0], 1.0), dt=0.05, steps=100)
+
+
+def _euler_lagrange_theta(top, u):
+    """theta'' of L(theta, thetadot) = top.lagrangian(0, theta, u, thetadot) with xdot = u held
+    fixed, by finite differences of L only: L_ww theta'' + L_wtheta thetadot = L_theta. L is
+    quadratic in thetadot, so its thetadot-differences with a large step are exact."""
+    def L(th, w):
+        return top.lagrangian([0.0, 0.0], th, u, w)
+
+    def d_theta(f, th, h=1e-3):                     # 4th-order central difference
+        return (8 * (f(th + h) - f(th - h)) - (f(th + 2 * h) - f(th - 2 * h))) / (12 * h)
+
+    def rhs(t, y):
+        th, w = y
+        hw = 0.5
+        l_ww = (L(th, w + hw) + L(th, w - hw) - 2 * L(th, w)) / hw**2
+        l_wth = d_theta(lambda a: (L(a, w + hw) - L(a, w - hw)) / (2 * hw), th)
+        l_th = d_theta(lambda a: L(a, w), th)
+        return [w, (l_th - l_wth * w) / l_ww]
+    return rhs
+
+
+def test_prescribed_motion_91_92_against_the_euler_lagrange_equation():
+    # 002 (91)-(92): with the centre in straight uniform motion (u = (0.6, 0), ydot = 0) the spin
+    # keeps E = F(theta) thetadot^2 / 2, so thetadot = sqrt(2E/F(theta)) and thetadot'' = -V'(theta)
+    # with V = -E/F. The Euler-Lagrange equation of the top's own L (differences of
+    # RelativisticTangentTop.lagrangian), integrated by scipy, is the second route.
+    from scipy.integrate import solve_ivp
+    top = lf.RelativisticTangentTop(1.0, [[0.12, 0.0], [0.0, 0.04]])   # long axis = body E1
+    u = [0.6, 0.0]
+    th0, w0 = 0.3, 2.0
+    energy = 0.5 * top.prescribed_inertia(th0, u) * w0**2
+    sol = solve_ivp(_euler_lagrange_theta(top, u), (0.0, 8.0), [th0, w0], method="DOP853",
+                    rtol=1e-12, atol=1e-12, dense_output=True)
+    assert sol.success
+    th, w = sol.y
+    assert th[-1] - th0 > 2 * np.pi                                  # several half-turns
+    rate = top.prescribed_spin_rate(th, energy, u)
+    err = np.abs(w - rate).max()
+    print(f"(92) vs the Euler-Lagrange run: max |thetadot - sqrt(2E/F)| = {err:.1e}")
+    assert err < 1e-8
+    # theta'' = -V'(theta): the potential's derivative by differences against the EL equation.
+    thg = np.linspace(0.0, np.pi, 7)
+    h = 1e-4
+    dv = (top.prescribed_potential(thg + h, energy, u)
+          - top.prescribed_potential(thg - h, energy, u)) / (2 * h)
+    acc = np.array([_euler_lagrange_theta(top, u)(0.0, [a, r])[1]
+                    for a, r in zip(thg, top.prescribed_spin_rate(thg, energy, u))])
+    assert np.abs(acc + dv).max() < 1e-6
+    assert np.allclose(0.5 * rate**2 + top.prescribed_potential(th, energy, u), 0.0, atol=1e-15)
+    # Faster and slower: the spin is fastest with the long axis along u (theta = 0 mod pi: the
+    # smaller second moment across the motion) and slowest broadside, by
+    # sqrt(F_max / F_min) = sqrt((I + gamma^2 v^2 I11) / (I + gamma^2 v^2 I22)).
+    gam2 = 1 / (1 - 0.36)
+    th, w = sol.sol(np.linspace(0.0, 8.0, 400_001))
+    ratio = w.max() / w.min()
+    want = np.sqrt((0.16 + gam2 * 0.36 * 0.12) / (0.16 + gam2 * 0.36 * 0.04))
+    print(f"spin rate max/min along the run {ratio:.6f}, predicted {want:.6f}")
+    assert abs(ratio - want) < 1e-6
+    fast = np.mod(th[np.argmax(w)], np.pi)
+    slow = np.mod(th[np.argmin(w)], np.pi)
+    assert min(fast, np.pi - fast) < 0.05 and abs(slow - np.pi / 2) < 0.05
+    # The classical limit spins uniformly: the modulation vanishes as v -> 0.
+    f = top.prescribed_inertia(np.linspace(0, np.pi, 50), [1e-3, 0.0])
+    assert np.ptp(f) / f.mean() < 1e-6
+    # Vectorised over broadcast axes; errors.
+    assert top.prescribed_inertia(np.zeros((3, 1)), [[0.1, 0.0], [0.2, 0.0]]).shape == (3, 2)
+    with pytest.raises(lf.InvalidArgumentError, match="speed"):
+        top.prescribed_inertia(0.0, [0.8, 0.7])
+    with pytest.raises(lf.InvalidArgumentError, match="energy"):
+        top.prescribed_spin_rate(0.0, -1.0, u)
+    with pytest.raises(lf.NonFiniteError):
+        top.prescribed_potential(np.nan, 1.0, u)
+    with pytest.raises(lf.ShapeError):
+        top.prescribed_inertia(0.0, [0.1, 0.0, 0.0])
+
+
+def test_seed_91_cross_term_sign():
+    # 002 (91) prints -2 I3 sin cos; with I12 = integral xi1 xi2 dm and E1 = cos theta e_x +
+    # sin theta e_y (002 (41)) the top's L has +2 I12 sin cos.
+    top = lf.RelativisticTangentTop(1.0, (0.1, 0.03, 0.05))
+    v, th = 0.6, 0.7
+    gam = 1 / np.sqrt(1 - v**2)
+    s, c = np.sin(th), np.cos(th)
+    ours = 0.15 * gam + gam**3 * v**2 * (0.1 * s**2 + 2 * 0.03 * s * c + 0.05 * c**2)
+    seed = 0.15 * gam + gam**3 * v**2 * (0.1 * s**2 - 2 * 0.03 * s * c + 0.05 * c**2)
+    l2 = top.lagrangian([0, 0], th, [v, 0], 1.0) - top.lagrangian([0, 0], th, [v, 0], 0.0)
+    assert top.prescribed_inertia(th, [v, 0]) == pytest.approx(ours, rel=1e-14)
+    assert 2 * l2 == pytest.approx(ours, rel=1e-13) and abs(2 * l2 - seed) > 1e-2
+
+
+def test_frame_change_leaves_the_motion_unchanged():
+    # 002 (104)-(114): turning the reference frame by beta(x) (theta -> theta - beta,
+    # alpha -> alpha + d beta) changes nothing physical; (114)'s extra term v^T [A + w, B] v
+    # vanishes as the bracket is skew. The anisotropic top on the sphere from the built-in frame
+    # and from a MetricSurface (Python callables) with the frame turned by beta(x).
+    def beta(t, p):
+        return 0.6 * np.sin(2 * t) + 0.5 * np.cos(p), np.array([1.2 * np.cos(2 * t), -0.5 * np.sin(p)])
+
+    def metric(t, p):
+        return [[1.0, 0.0], [0.0, np.sin(t) ** 2]]
+
+    def frame(t, p):
+        b = beta(t, p)[0]
+        e = np.array([[1.0, 0.0], [0.0, 1.0 / np.sin(t)]])
+        return np.array([[np.cos(b), np.sin(b)], [-np.sin(b), np.cos(b)]]) @ e
+
+    S = lf.surfaces
+    native, turned = S.Sphere(1.0), S.MetricSurface(metric, frame, None)
+    turned.check_frame([1.1, 0.4])
+    a = lf.RelativisticTangentTop(1.0, TENSOR, native)
+    b = lf.RelativisticTangentTop(1.0, TENSOR, turned)
+    x, th, xd, w = [1.1, 0.4], 0.7, np.array([0.25, 0.3]), 1.6
+    bv, db = beta(*x)
+    assert abs(bv) > 0.5
+    assert b.lagrangian(x, th - bv, xd, w - db @ xd) == pytest.approx(a.lagrangian(x, th, xd, w),
+                                                                       abs=1e-12)
+    ta = lf.integrate(a, a.state(x, th, xd, w), dt=0.02, steps=200, method="gauss6", save_every=20)
+    tb = lf.integrate(b, b.state(x, th - bv, xd, w - db @ xd), dt=0.02, steps=200,
+                      method="gauss6", save_every=20)
+    np.testing.assert_allclose(ta.states[:, :2], tb.states[:, :2], atol=1e-8)
+    turn = np.array([beta(*q)[0] for q in tb.states[:, :2]])
+    np.testing.assert_allclose(tb.states[:, 2] + turn, ta.states[:, 2], atol=1e-8)
+    np.testing.assert_allclose(tb.energy(), ta.energy(), atol=1e-10)
+    assert np.ptp(ta.states[:, 1]) > 0.1
+
+
+# --- issue 25, 002 (115)-(117): the top on the static space-time -exp(2 phi) dt^2 + dx^2 ---
+
+def test_static_field_top_conserves_energy_spin_and_angular_momentum():
+    # A point mass strong enough that the weak-field (118) would not do (phi = -0.15 at r = 1).
+    top = lf.StaticFieldTop(1.0, 0.2, gm=0.15)
+    z0 = top.state([1.0, 0.0], 0.3, [0.05, 0.38], 1.2)
+    tr = lf.integrate(top, z0, dt=0.02, steps=5000, method="gauss6", save_every=50)
+    assert np.ptp(tr.energy()) < 1e-12
+    inv = top.invariants(tr.states)
+    assert inv.shape == (len(tr.states), 2) and np.ptp(inv, axis=0).max() < 1e-13
+    np.testing.assert_array_equal(inv[:, 1], top.angular_momentum(tr.states))
+    r = np.hypot(tr.states[:, 0], tr.states[:, 1])
+    assert np.ptp(r) > 0.05                                # the orbit is not trivial
+    np.testing.assert_allclose(top.velocities(z0), [0.05, 0.38, 1.2], atol=1e-13)
+    copy = pickle.loads(pickle.dumps(top))
+    assert repr(copy) == repr(top) and copy.methods() == top.methods() == lf.StaticFieldTop.methods()
+    np.testing.assert_array_equal(lf.integrate(copy, z0, dt=0.02, steps=30).states,
+                                  lf.integrate(top, z0, dt=0.02, steps=30).states)
+
+
+def test_static_field_top_limits_flat_and_weak_field():
+    # phi = 0: the flat RelativisticTangentTop. Weak field and slow motion (phi, G ~ eps^2,
+    # v ~ eps): L = L(118) - m + O(eps^4), the difference 16 times smaller as eps halves.
+    flat = lf.RelativisticTangentTop(1.3, 0.25)
+    zero = lf.StaticFieldTop(1.3, 0.25, g=(0.0, 0.0))
+    z0 = flat.state([0.2, 0.1], 0.4, [0.5, -0.3], 2.5)
+    np.testing.assert_allclose(lf.integrate(zero, z0, dt=0.05, steps=100).states,
+                               lf.integrate(flat, z0, dt=0.05, steps=100).states, atol=1e-13)
+    args = ([0.2, 0.1], 0.4, [0.5, -0.3], 2.5)
+    assert zero.lagrangian(*args) == pytest.approx(flat.lagrangian(*args), abs=1e-15)
+
+    def diff(eps):
+        st = lf.StaticFieldTop(1.0, 0.3, gm=0.8 * eps**2)
+        wf = lf.WeakFieldTop(1.0, 0.3, gm=0.8 * eps**2)
+        a = ([1.0, 0.3], 0.4, [0.8 * eps, -0.5 * eps], 1.1)
+        return abs(st.lagrangian(*a) - (wf.lagrangian(*a) - 1.0))
+    ratio = diff(0.02) / diff(0.01)
+    print(f"(117) -> (118): L difference ratio on halving eps {ratio:.2f}")
+    assert abs(ratio - 16) < 1
+
+
+def test_static_field_top_rejects_bad_input():
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.StaticFieldTop(1.0, 0.2)                         # no potential
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.StaticFieldTop(1.0, 0.2, gm=1.0, g=(0.0, 1.0))   # two
+    top = lf.StaticFieldTop(1.0, 0.2, gm=0.5)
+    with pytest.raises(lf.InvalidArgumentError, match="light"):
+        top.state([1.0, 0.0], 0.0, [0.0, 0.7], 1.0)         # exp(phi) = 0.61 < 0.7
+    with pytest.raises(lf.InvalidArgumentError):
+        top.state([0.0, 0.0], 0.0, [0.1, 0.0], 1.0)         # at the point mass
+    with pytest.raises(lf.NonFiniteError):
+        top.lagrangian([np.nan, 0.0], 0.0, [0.1, 0.0], 1.0)

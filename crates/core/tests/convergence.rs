@@ -14,7 +14,7 @@ use lieflow::systems::user::{EulerPoincare, Lagrangian, LagrangianFn, Lagrangian
 use lieflow::systems::{
     Algebra, GeneralizedRigidBody, HeavyTop, HyperbolicPlane, LieHamiltonian, LiePoisson, Pendulum,
     Potential, RelativisticTangentTop, RigidBody, RollingDisk, Side, Sphere, SphereParticle,
-    SphericalPendulum, TangentTop, WeakFieldTop,
+    SphericalPendulum, StaticFieldTop, TangentTop, WeakFieldTop,
 };
 use lieflow::Error;
 use nalgebra::Vector3;
@@ -136,6 +136,13 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
     let curved =
         RelativisticTangentTop::on_surface(Arc::new(Sphere::new(1.0).unwrap()), 1.0, 0.2).unwrap();
     let weak = WeakFieldTop::new(1.0, 0.2, Potential::point_mass(1.0).unwrap()).unwrap();
+    let static_field = StaticFieldTop::new(1.0, 0.2, Potential::point_mass(0.15).unwrap()).unwrap();
+    let curved_aniso = RelativisticTangentTop::on_surface_with_moments(
+        Arc::new(Sphere::new(1.0).unwrap()),
+        1.0,
+        [0.15, 0.04, 0.05],
+    )
+    .unwrap();
     let lie_poisson = |algebra, d: &[f64]| {
         LiePoisson::new(algebra, LieHamiltonian::Quadratic(diagonal(d)), None).unwrap()
     };
@@ -286,6 +293,20 @@ fn systems() -> Vec<(String, Arc<dyn System>, Vec<f64>)> {
             "WeakFieldTop".into(),
             Arc::new(weak.clone()),
             weak.state([1.0, 0.0], 0.0, [0.0, 0.9], 1.0).unwrap(),
+        ),
+        (
+            "StaticFieldTop".into(),
+            Arc::new(static_field.clone()),
+            static_field
+                .state([1.0, 0.0], 0.3, [0.05, 0.38], 1.2)
+                .unwrap(),
+        ),
+        (
+            "RelativisticTangentTop anisotropic on the sphere".into(),
+            Arc::new(curved_aniso.clone()),
+            curved_aniso
+                .state([1.2, 0.3], 0.3, [0.4, 0.2], 1.0)
+                .unwrap(),
         ),
         ("LiePoisson so(3)".into(), Arc::new(so3_user), m0.clone()),
         (

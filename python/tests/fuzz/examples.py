@@ -228,6 +228,7 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "s3": lambda lf: lf.spaces.Sphere(3, radius=1.5),
     "rtt": lambda lf: lf.RelativisticTangentTop(1.0, 0.2, lf.surfaces.Sphere(1.0)),
     "wft": lambda lf: lf.WeakFieldTop(1.0, 1e-3, gm=1e-4),
+    "sft": lambda lf: lf.StaticFieldTop(1.0, 0.2, gm=0.15),
     "tt": lambda lf: lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
     "cp": lambda lf: lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5).magnetic_analogue(0.7),
     "rds": lambda lf: lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6),
@@ -291,6 +292,7 @@ def state_of(key):
         "ft": lambda lf, s: s.state(FT_X, R3, FT_V, W3),
         "rtt": lambda lf, s: np.asarray(s.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)),
         "wft": lambda lf, s: np.asarray(s.state([1.0, 0.5], 0.1, [0.1, 0.2], 0.3)),
+        "sft": lambda lf, s: np.asarray(s.state([1.0, 0.0], 0.3, [0.05, 0.38], 1.2)),
         "tt": lambda lf, s: np.asarray(s.state([1.0, 0.3], 0.2, [0.1, 0.3], 1.5)),
         "cp": lambda lf, s: np.asarray(s.state([1.0, 0.3], [0.1, 0.3])),
         "rds": lambda lf, s: np.asarray(s.state([0.3, -1.1], [0.7, 0.2])),
@@ -299,12 +301,14 @@ def state_of(key):
     return Lazy(lambda lf: makers[key](lf, RECEIVERS[key](lf)))
 
 
-SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "iprb", "rrb", "ft", "rtt", "wft", "tt", "cp",
+SYSTEMS = ["rb", "grb", "ht", "sp", "pend", "spart", "disk", "prb", "iprb", "rrb", "ft", "rtt", "wft",
+           "sft", "tt", "cp",
            "rds", "rsph"]
 CONSTRUCTORS = {  # class name -> receiver key built by it
     "RigidBody": "rb", "GeneralizedRigidBody": "grb", "HeavyTop": "ht", "SphericalPendulum": "sp",
     "Pendulum": "pend", "SphereParticle": "spart", "RollingDisk": "disk", "PseudoRigidBody": "prb",
-    "RelativisticTangentTop": "rtt", "WeakFieldTop": "wft", "TangentTop": "tt",
+    "RelativisticTangentTop": "rtt", "WeakFieldTop": "wft", "StaticFieldTop": "sft",
+    "TangentTop": "tt",
     "ChargedParticle": "cp", "RollingDisks": "rds", "RollingSpheres": "rsph",
     "RightReduced": "rrb", "FrameTop": "ft",
 }
@@ -761,10 +765,18 @@ def build_specs() -> list[Spec]:
     add("RelativisticTangentTop", "RelativisticTangentTop", A("mass", 1.0, "float", positive=True),
         A("inertia", 0.2, "float", positive=True),
         A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj", opt=True))
+    add("RelativisticTangentTop[tensor]", "RelativisticTangentTop",
+        A("mass", 1.0, "float", positive=True),
+        A("inertia", np.array([[0.2, 0.05], [0.05, 0.08]]), "mat"),
+        A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj", opt=True))
     add("WeakFieldTop", "WeakFieldTop", A("mass", 1.0, "float", positive=True),
         A("inertia", 1e-3, "float", positive=True), A("gm", 1e-4, "float", kw=True, opt=True))
     add("WeakFieldTop[g]", "WeakFieldTop", A("mass", 1.0, "float", positive=True),
         A("inertia", 1e-3, "float", positive=True), A("g", (0.0, -0.1), "vec", kw=True, opt=True))
+    add("StaticFieldTop", "StaticFieldTop", A("mass", 1.0, "float", positive=True),
+        A("inertia", 0.2, "float", positive=True), A("gm", 0.15, "float", kw=True, opt=True))
+    add("StaticFieldTop[g]", "StaticFieldTop", A("mass", 1.0, "float", positive=True),
+        A("inertia", 0.2, "float", positive=True), A("g", (0.0, -0.1), "vec", kw=True, opt=True))
     add("TangentTop", "TangentTop", A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj"),
         A("mass", 1.0, "float", positive=True), A("inertia", 0.5, "float", positive=True),
         A("embedded", True, "bool", kw=True))
@@ -834,12 +846,31 @@ def build_specs() -> list[Spec]:
                                  A("p_theta", 0.7, "bcast")]),
                 ("spin_rate_95", [A("v", np.array([0.1, 0.5, 0.9]), "bcast"),
                                   A("p_theta", 0.7, "bcast")]),
-                ("energy_96", [A("v", 0.5, "bcast"), A("thetadot", np.array([0.0, 2.0]), "bcast")])]
+                ("energy_96", [A("v", 0.5, "bcast"), A("thetadot", np.array([0.0, 2.0]), "bcast")]),
+                ("lagrangian", [A("x", np.array([1.2, 0.3]), "vec"), A("theta", 0.5, "float"),
+                                A("xdot", np.array([0.3, 0.4]), "vec"),
+                                A("thetadot", 2.0, "float")]),
+                ("prescribed_inertia", [A("theta", np.array([0.0, 0.7]), "bcast"),
+                                        A("velocity", np.array([0.6, 0.1]), "vec")]),
+                ("prescribed_spin_rate", [A("theta", np.array([0.0, 0.7]), "bcast"),
+                                          A("energy", 0.8, "bcast"),
+                                          A("velocity", np.array([0.6, 0.1]), "vec")]),
+                ("prescribed_potential", [A("theta", 0.3, "bcast"),
+                                          A("energy", np.array([0.0, 0.8]), "bcast"),
+                                          A("velocity", np.array([0.6, 0.1]), "vec")])]
         + [(f, [A("states", state_of("rtt"), "vec")])
            for f in ("velocities", "speed_and_spin", "killing_momenta")],
         "wft": [("state", [A("x", np.array([1.0, 0.5]), "vec"), A("theta", 0.1, "float"),
                            A("xdot", np.array([0.1, 0.2]), "vec"), A("thetadot", 0.3, "float")]),
+                ("lagrangian", [A("x", np.array([1.0, 0.5]), "vec"), A("theta", 0.1, "float"),
+                                A("xdot", np.array([0.1, 0.2]), "vec"), A("thetadot", 0.3, "float")]),
                 ("angular_momentum", [A("states", state_of("wft"), "vec")])],
+        "sft": [("state", [A("x", np.array([1.0, 0.0]), "vec"), A("theta", 0.3, "float"),
+                           A("xdot", np.array([0.05, 0.38]), "vec"), A("thetadot", 1.2, "float")]),
+                ("lagrangian", [A("x", np.array([1.0, 0.0]), "vec"), A("theta", 0.3, "float"),
+                                A("xdot", np.array([0.05, 0.38]), "vec"),
+                                A("thetadot", 1.2, "float")])]
+        + [(f, [A("states", state_of("sft"), "vec")]) for f in ("velocities", "angular_momentum")],
         "tt": [("state", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float"),
                           A("xdot", np.array([0.1, 0.3]), "vec"), A("thetadot", 1.5, "float")]),
                ("metric", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float")]),

@@ -256,7 +256,7 @@ pub type LagrangianGradient<'a, E> =
 /// a gradient exact to round-off (relative error ≈ 1e-10 for a smooth 𝓛), h = ε^{2/9} when
 /// `gradient_is_difference` (a gradient that is itself [`lagrangian_gradient`], whose error
 /// ε^{2/3} the outer difference divides by h: ≈ 1e-7), and Ṅ solves
-/// D_N(∂𝓛/∂N)[Ṅ] = ((∂𝓛/∂N − (∂𝓛/∂N)ᵀ)NᵀQ⁻¹ + 2∂𝓛/∂Q)ᵀ − D_Q(∂𝓛/∂N)[Q̇] (an error when the
+/// D_N(∂𝓛/∂N)\[Ṅ\] = ((∂𝓛/∂N − (∂𝓛/∂N)ᵀ)NᵀQ⁻¹ + 2∂𝓛/∂Q)ᵀ − D_Q(∂𝓛/∂N)\[Q̇\] (an error when the
 /// Hessian of 𝓛 in N is singular: 𝓛 is then not regular). Errors of `gradient` are returned.
 pub fn euler_lagrange<E: From<Error>>(
     gradient: &mut LagrangianGradient<'_, E>,

@@ -10,8 +10,9 @@
 //!   [`tops::methods`] ([`Exact`], [`ExactSplitting`], [`Dmv`], [`Lgvi`], [`Isospectral`]).
 //! * [`tangent_top`] (002): [`TangentTop`] z = (x¹, x², θ, p₁, p₂, p_θ) (6), the tangent Euler
 //!   top on a [`Surface`]; [`ChargedParticle`] z = (x¹, x², p₁, p₂) (4), its magnetic analogue;
-//!   §IV [`RelativisticTangentTop`] (Minkowski) and [`WeakFieldTop`] (weak static field)
-//!   z = (x, y, θ, p_x, p_y, p_θ) (6).
+//!   §IV [`RelativisticTangentTop`] (Minkowski, or −dt² + g over a surface),
+//!   [`StaticFieldTop`] (the static field −e^{2φ}dt² + dx²) and [`WeakFieldTop`] (its weak-field
+//!   limit) z = (x, y, θ, p_x, p_y, p_θ) (6).
 //! * [`rolling`] (003): §1 [`RollingDisks`] z = (θ₁, θ₂, p₁, p₂) (4), two disks rolling against
 //!   each other; §2 [`RollingSpheres`] z = (z₁, z₂, u, Ω₁, Ω₂) (27), two spheres rolling against
 //!   each other (z_k ∈ SO(3) row-major, u ∈ S²).
@@ -32,8 +33,8 @@ pub mod user;
 pub use rolling::{RollingDisks, RollingSpheres};
 pub use tangent_top::{
     ChargedParticle, FrameTop, Graph, HyperbolicPlane, MetricSurface, Plane, Potential,
-    PotentialValue, RelativisticTangentTop, Revolution, SpaceForm, Sphere, Surface, TangentTop,
-    WeakFieldTop,
+    PotentialValue, RelativisticTangentTop, Revolution, SpaceForm, Sphere, StaticFieldTop, Surface,
+    TangentTop, WeakFieldTop,
 };
 pub use test_problems::{Pendulum, RollingDisk, SphereParticle};
 pub use tops::methods::{Dmv, Exact, ExactSplitting, Isospectral, Lgvi};

@@ -1,8 +1,8 @@
 //! The system classes of `lieflow`, one folder per source text as in `lieflow::systems`: the
 //! bodies of 000 (`tops/`: `RigidBody`, `GeneralizedRigidBody`, `HeavyTop`,
 //! `SphericalPendulum`), the tangent tops of 002 (`tangent_top/`: the surfaces, `TangentTop`,
-//! `ChargedParticle`, `RelativisticTangentTop`, `WeakFieldTop`), the rolling bodies of 003
-//! (`rolling/`: `RollingDisks`, `RollingSpheres`), the user-defined systems (`user/`:
+//! `ChargedParticle`, `RelativisticTangentTop`, `WeakFieldTop`, `StaticFieldTop`), the rolling
+//! bodies of 003 (`rolling/`: `RollingDisks`, `RollingSpheres`), the user-defined systems (`user/`:
 //! `Canonical`, `Separable`, `LiePoisson`, and `Forced`, which wraps any system) and the test
 //! problems of the mechanics core (`test_problems/`: `Pendulum`, `SphereParticle`,
 //! `RollingDisk`). Every class is a thin subclass of `lieflow.System`.
@@ -36,6 +36,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m,
     )?;
     add_system::<tangent_top::relativistic::PyWeakFieldTop, core::WeakFieldTop>(m)?;
+    add_system::<tangent_top::relativistic::PyStaticFieldTop, core::StaticFieldTop>(m)?;
     add_system::<tangent_top::classical::PyTangentTop, core::TangentTop>(m)?;
     add_system::<tangent_top::classical::PyChargedParticle, core::ChargedParticle>(m)?;
     add_system::<tangent_top::frame_top::PyFrameTop, core::FrameTop>(m)?;

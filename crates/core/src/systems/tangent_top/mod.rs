@@ -11,6 +11,8 @@ pub mod surface;
 
 pub use classical::{ChargedParticle, TangentTop};
 pub use frame_top::FrameTop;
-pub use relativistic::{Potential, PotentialValue, RelativisticTangentTop, WeakFieldTop};
+pub use relativistic::{
+    Potential, PotentialValue, RelativisticTangentTop, StaticFieldTop, WeakFieldTop,
+};
 pub use space_form::SpaceForm;
 pub use surface::{Graph, HyperbolicPlane, MetricSurface, Plane, Revolution, Sphere, Surface};

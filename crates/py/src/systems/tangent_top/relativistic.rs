@@ -1,4 +1,4 @@
-//! `RelativisticTangentTop` and `WeakFieldTop`: bindings of `lieflow::systems::tangent_top::relativistic`
+//! `RelativisticTangentTop`, `WeakFieldTop` and `StaticFieldTop`: bindings of `lieflow::systems::tangent_top::relativistic`
 //! (002 §IV). Thin subclasses of `lieflow.System`.
 
 use lieflow::systems::tangent_top::relativistic as core;
@@ -8,26 +8,29 @@ use pyo3::PyClassInitializer;
 
 use super::surface::PySurface;
 use crate::convert::ArrayIn;
-use crate::convert::{named, real, real_opt, reals, reals_opt, Real};
+use crate::convert::{real, real_opt, reals, reals_opt, shape_str, Real};
 use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, par_map_items, Input};
 use crate::system::{PySystem, Thin};
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical
 /// sign of the Lagrangian, L = -m/gamma + thetadot^2 (I gamma + gamma^3 xdot^T K(theta) xdot)/2),
-/// or, with `surface`, the symmetric top on the static space-time -dt^2 + g over that surface
-/// (002 (97)–(103)): L = -m/gamma + I s^2 (gamma + gamma^3 v^2 / 2) / 2, v^2 = g(xdot, xdot),
-/// s = thetadot + w(xdot) with w the surface's connection 1-form. State (x1, x2, theta, p1, p2,
-/// p_theta) in the chart; fields x, theta, p, p_theta; speeds v < 1. Invariants: (p_x, p_y)
-/// and, for the symmetric top, p_theta (Minkowski); p_theta and the Killing momenta of the
-/// affine isometries (surface). Methods: gauss4 (default), gauss6, midpoint, rk4.
+/// or, with `surface`, the top on the static space-time -dt^2 + g over that surface
+/// (002 (97)–(103)): L = -m/gamma + s^2 (I gamma + gamma^3 u^T K(theta) u) / 2,
+/// v^2 = g(xdot, xdot), s = thetadot + w(xdot) with w the surface's connection 1-form, u the
+/// components of xdot in the surface's orthonormal frame (for the symmetric top
+/// L = -m/gamma + I s^2 (gamma + gamma^3 v^2 / 2) / 2). State (x1, x2, theta, p1, p2, p_theta)
+/// in the chart; fields x, theta, p, p_theta; speeds v < 1. Invariants: (p_x, p_y) and, for
+/// the symmetric top, p_theta (Minkowski); p_theta (symmetric top) and the Killing momenta of
+/// the affine isometries (surface). Methods: gauss4 (default), gauss6, midpoint, rk4.
 ///
 /// Args:
-///     mass > 0; inertia: the scalar tr I (the symmetric top) or the second-moment tensor as
-///         (I11, I12, I22), positive semidefinite (Minkowski only); surface: a
-///         `lieflow.surfaces` surface, or None for the Minkowski plane.
+///     mass > 0; inertia: the scalar tr I (the symmetric top) or the second-moment tensor
+///         integral xi xi^T dm as (I11, I12, I22) or a symmetric (2, 2) array, positive
+///         semidefinite; surface: a `lieflow.surfaces` surface, or None for the Minkowski plane.
 /// Raises:
-///     InvalidArgumentError, ShapeError, TypeError (surface not a lieflow surface).
+///     InvalidArgumentError, ShapeError, NonFiniteError, TypeError (surface not a lieflow
+///     surface).
 #[pyclass(name = "RelativisticTangentTop", module = "lieflow", extends = PySystem, frozen)]
 #[derive(Default)]
 pub struct PyRelativisticTangentTop;
@@ -41,19 +44,14 @@ impl PyRelativisticTangentTop {
         inertia: &Bound<'_, PyAny>,
         surface: Option<Bound<'_, PySurface>>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let top = match (inertia.extract::<Real>().map(|r| r.0), &surface) {
-            (Ok(i), None) => core::RelativisticTangentTop::symmetric(mass, i),
-            (Ok(i), Some(s)) => {
-                core::RelativisticTangentTop::on_surface(s.get().inner.clone(), mass, i)
+        let surf = surface.as_ref().map(|s| s.get().inner.clone());
+        let top = match (moments(inertia)?, surf) {
+            (Inertia::Trace(i), None) => core::RelativisticTangentTop::symmetric(mass, i),
+            (Inertia::Trace(i), Some(s)) => core::RelativisticTangentTop::on_surface(s, mass, i),
+            (Inertia::Moments(m), None) => core::RelativisticTangentTop::new(mass, m),
+            (Inertia::Moments(m), Some(s)) => {
+                core::RelativisticTangentTop::on_surface_with_moments(s, mass, m)
             }
-            (Err(_), None) => {
-                let m = named("inertia", reals::<3>(inertia))?;
-                core::RelativisticTangentTop::new(mass, m)
-            }
-            (Err(_), Some(_)) => Err(Error::invalid(
-                "inertia",
-                "on a surface only the symmetric top is implemented: give the scalar tr I",
-            )),
         }
         .py()?;
         let args = (mass, inertia, surface).into_pyobject(inertia.py())?;
@@ -62,6 +60,103 @@ impl PyRelativisticTangentTop {
             args,
             &["mass", "inertia", "surface"],
         ))
+    }
+
+    /// The Lagrangian of 002 (90) / (102) (physical sign, the negative of the text's):
+    /// ``L = -m/gamma + s^2 (I gamma + gamma^3 u^T K(theta) u) / 2`` with ``s = thetadot +
+    /// w(xdot)``, u the components of xdot in the surface's orthonormal frame (Cartesian in the
+    /// Minkowski plane), ``gamma = (1 - g(xdot, xdot))^(-1/2)``.
+    ///
+    /// Args:
+    ///     x: (2,) in the chart; theta; xdot: (2,); thetadot.
+    /// Returns:
+    ///     float.
+    /// Raises:
+    ///     InvalidArgumentError (v >= 1, x outside the chart), NonFiniteError.
+    fn lagrangian(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<f64> {
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        crate::errors::checked(|| top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot]))
+    }
+
+    /// F(theta) of the spin about a centre in straight uniform motion with velocity u, 002 (91):
+    /// with xdot = u held fixed, ``L = -m/gamma + F(theta) thetadot^2 / 2``,
+    /// ``F = I gamma + gamma^3 u^T K(theta) u`` (period pi in theta). The text's (91) prints the
+    /// cross term as ``-2 I3 sin cos``; with ``I12 = integral xi1 xi2 dm`` it is
+    /// ``+2 I12 sin cos``. Maps over the broadcast leading axes of theta and velocity.
+    ///
+    /// Args:
+    ///     theta: angle(s) of the body from the x axis; velocity: (..., 2), speed < 1.
+    /// Returns:
+    ///     float, or an array of the broadcast shape.
+    /// Raises:
+    ///     InvalidArgumentError (speed >= 1), NonFiniteError, ShapeError.
+    fn prescribed_inertia<'py>(
+        slf: &Bound<'py, Self>,
+        theta: ArrayIn<'py>,
+        velocity: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        let inputs = [
+            Input::finite("theta", &theta, &[]),
+            Input::finite("velocity", &velocity, &[2]),
+        ];
+        par_map_items(slf.py(), &inputs, &[], |x, out| {
+            out[0] = top.prescribed_inertia(x[0][0], [x[1][0], x[1][1]])?;
+            Ok(())
+        })
+    }
+
+    /// The spin rate ``abs(thetadot) = sqrt(2 E / F(theta))`` about a centre in straight uniform
+    /// motion with velocity u, at spin energy ``E = F(theta) thetadot^2 / 2`` (conserved), 002
+    /// (92) (the text's ``thetadot^2 = E/F`` with its F half of this one). Fastest with the
+    /// body's larger second moment along u, slowest across it. Maps over the broadcast leading
+    /// axes.
+    ///
+    /// Args:
+    ///     theta: angle(s); energy: E >= 0; velocity: (..., 2), speed < 1.
+    /// Returns:
+    ///     float, or an array of the broadcast shape.
+    /// Raises:
+    ///     InvalidArgumentError (speed >= 1, E < 0), NonFiniteError, ShapeError.
+    fn prescribed_spin_rate<'py>(
+        slf: &Bound<'py, Self>,
+        theta: ArrayIn<'py>,
+        energy: ArrayIn<'py>,
+        velocity: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        prescribed(slf.py(), [&theta, &energy, &velocity], |th, e, u| {
+            top.prescribed_spin_rate(th, e, u)
+        })
+    }
+
+    /// The effective potential ``V(theta) = -E / F(theta)`` of the spin about a centre in
+    /// straight uniform motion with velocity u, at spin energy E: ``thetadot^2 / 2 + V = 0`` and
+    /// ``thetadot' = -V'(theta)`` (002 (92) calls E/F, which is thetadot^2, the effective
+    /// potential). Maps over the broadcast leading axes.
+    ///
+    /// Args:
+    ///     theta: angle(s); energy: E >= 0; velocity: (..., 2), speed < 1.
+    /// Returns:
+    ///     float, or an array of the broadcast shape.
+    /// Raises:
+    ///     InvalidArgumentError (speed >= 1, E < 0), NonFiniteError, ShapeError.
+    fn prescribed_potential<'py>(
+        slf: &Bound<'py, Self>,
+        theta: ArrayIn<'py>,
+        energy: ArrayIn<'py>,
+        velocity: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::RelativisticTangentTop>()?;
+        prescribed(slf.py(), [&theta, &energy, &velocity], |th, e, u| {
+            top.prescribed_potential(th, e, u)
+        })
     }
 
     /// The canonical state from the position x (2,), the angle theta and the velocities.
@@ -203,6 +298,59 @@ impl PyRelativisticTangentTop {
     }
 }
 
+/// The inertia argument: the scalar tr I (the symmetric top) or the second-moment tensor.
+enum Inertia {
+    Trace(f64),
+    Moments([f64; 3]),
+}
+
+/// The inertia from a number (tr I), (3,) (I11, I12, I22) or a symmetric (2, 2) tensor.
+fn moments(inertia: &Bound<'_, PyAny>) -> PyResult<Inertia> {
+    if let Ok(Real(i)) = inertia.extract::<Real>() {
+        return Ok(Inertia::Trace(i));
+    }
+    let a = ArrayIn::named("inertia", inertia)?;
+    let v = a.as_array();
+    match v.shape() {
+        [3] => Ok(Inertia::Moments([v[[0]], v[[1]], v[[2]]])),
+        [2, 2] => {
+            let m = [v[[0, 0]], v[[0, 1]], v[[1, 0]], v[[1, 1]]];
+            lieflow::check::finite_slice("inertia", &m).map_err(to_py)?;
+            let scale = m[0].abs() + m[3].abs();
+            if (m[1] - m[2]).abs() > 1e-12 * scale {
+                return Err(to_py(Error::invalid(
+                    "inertia",
+                    format!("expected a symmetric (2, 2) second-moment tensor, got {m:?}"),
+                )));
+            }
+            Ok(Inertia::Moments([m[0], 0.5 * (m[1] + m[2]), m[3]]))
+        }
+        shape => Err(to_py(Error::shape(
+            "inertia",
+            "a number (tr I), (3,) (I11, I12, I22) or (2, 2)",
+            shape_str(shape),
+        ))),
+    }
+}
+
+/// `f(theta, energy, velocity)` over the broadcast leading axes (the prescribed-motion
+/// functions of 002 (92)).
+fn prescribed<'py>(
+    py: Python<'py>,
+    [theta, energy, velocity]: [&ArrayIn<'py>; 3],
+    f: impl Fn(f64, f64, [f64; 2]) -> lieflow::Result<f64> + Sync + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let inputs = [
+        Input::finite("theta", theta, &[]),
+        Input::finite("energy", energy, &[]),
+        Input::finite("velocity", velocity, &[2]),
+    ];
+    par_map_items(py, &inputs, &[], |x, out| {
+        out[0] = f(x[0][0], x[1][0], [x[2][0], x[2][1]])?;
+        Ok(())
+    })
+}
+
 /// `f(v, y)` over the broadcast leading axes of two arrays of scalars (the relations (94)–(96));
 /// the core's name of J is the argument's, `p_theta`.
 fn relation<'py>(
@@ -244,13 +392,7 @@ impl PyWeakFieldTop {
         #[pyo3(from_py_with = real_opt)] gm: Option<f64>,
         #[pyo3(from_py_with = reals_opt::<2>)] g: Option<[f64; 2]>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let potential = match (gm, g) {
-            (Some(gm), None) => core::Potential::point_mass(gm),
-            (None, Some(g)) => core::Potential::uniform(g),
-            _ => Err(Error::invalid("potential", "give exactly one of gm and g")),
-        }
-        .map_err(to_py)?;
-        let top = core::WeakFieldTop::new(mass, inertia, potential).py()?;
+        let top = core::WeakFieldTop::new(mass, inertia, potential(gm, g)?).py()?;
         let args = (mass, inertia, gm, g).into_pyobject(py)?;
         Ok(PySystem::subclass(
             top,
@@ -274,6 +416,28 @@ impl PyWeakFieldTop {
         top.state(x, theta, xdot, thetadot).py()
     }
 
+    /// The Lagrangian 002 (118) (coupling sign corrected, physical sign, rest energy dropped):
+    /// ``L = m v^2/2 - m phi + I0 thetadot^2 (1 - phi + v^2) + I0 thetadot (G_y xdot - G_x ydot)``,
+    /// ``I0 = tr I / 2``, ``G = grad phi``.
+    ///
+    /// Args:
+    ///     x: (2,); theta; xdot: (2,); thetadot.
+    /// Returns:
+    ///     float.
+    /// Raises:
+    ///     InvalidArgumentError (phi not finite at x), NonFiniteError.
+    fn lagrangian(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<f64> {
+        let top = slf.core::<core::WeakFieldTop>()?;
+        top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
+            .py()
+    }
+
     /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
     /// vectorised: (..., 6) -> (...).
     ///
@@ -284,6 +448,131 @@ impl PyWeakFieldTop {
         states: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let top = slf.core::<core::WeakFieldTop>()?;
+        map_items(
+            slf.py(),
+            &[Input::new("states", &states, &[6])],
+            &[],
+            |z, out| {
+                out[0] = top.angular_momentum(z[0])?;
+                Ok(())
+            },
+        )
+    }
+}
+
+/// The potential of `WeakFieldTop` and `StaticFieldTop`: exactly one of gm (a point mass,
+/// phi = -gm/r) or g (a uniform field phi = g.x).
+fn potential(gm: Option<f64>, g: Option<[f64; 2]>) -> PyResult<core::Potential> {
+    match (gm, g) {
+        (Some(gm), None) => core::Potential::point_mass(gm),
+        (None, Some(g)) => core::Potential::uniform(g),
+        _ => Err(Error::invalid("potential", "give exactly one of gm and g")),
+    }
+    .map_err(to_py)
+}
+
+/// The symmetric relativistic tangent top on the static space-time
+/// ``-exp(2 phi) dt^2 + dx^2 + dy^2`` of a potential phi, to second order in the body's size
+/// (002 (115)-(117), derived again; physical sign): with ``b = exp(2 phi) - v^2``,
+/// ``I0 = tr I / 2``, ``G = grad phi``,
+/// ``L = -m sqrt(b) + I0 thetadot^2 / sqrt(b) - I0 exp(2 phi) G^2 / (2 sqrt(b))
+/// + I0 (thetadot^2 v^2 + 2 exp(2 phi) thetadot (G_y xdot - G_x ydot) + exp(4 phi) G^2)
+/// / (2 b^(3/2))``. Weak fields and slow motion give `WeakFieldTop` (002 (118)) plus -m; phi = 0
+/// the flat `RelativisticTangentTop`. State (x, y, theta, p_x, p_y, p_theta); coordinate speeds
+/// below exp(phi). Invariants: p_theta, and x p_y - y p_x (point mass) or the momentum across a
+/// uniform field; the energy is conserved. Methods: gauss4 (default), gauss6, midpoint, rk4.
+///
+/// Args:
+///     mass > 0, inertia > 0 (tr I); exactly one of gm (phi = -gm/r) or g (a uniform field
+///     phi = g.x, (2,)).
+/// Raises:
+///     InvalidArgumentError.
+#[pyclass(name = "StaticFieldTop", module = "lieflow", extends = PySystem, frozen)]
+#[derive(Default)]
+pub struct PyStaticFieldTop;
+
+#[pymethods]
+impl PyStaticFieldTop {
+    #[new]
+    #[pyo3(signature = (mass, inertia, gm = None, g = None))]
+    fn new(
+        py: Python<'_>,
+        #[pyo3(from_py_with = real)] mass: f64,
+        #[pyo3(from_py_with = real)] inertia: f64,
+        #[pyo3(from_py_with = real_opt)] gm: Option<f64>,
+        #[pyo3(from_py_with = reals_opt::<2>)] g: Option<[f64; 2]>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let top = core::StaticFieldTop::new(mass, inertia, potential(gm, g)?).py()?;
+        let args = (mass, inertia, gm, g).into_pyobject(py)?;
+        Ok(PySystem::subclass(
+            top,
+            args,
+            &["mass", "inertia", "gm", "g"],
+        ))
+    }
+
+    /// The canonical state from the position x (2,), the angle theta and the velocities.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (a speed not below exp(phi), phi not finite at x, a Legendre map
+    ///     not invertible), NonFiniteError.
+    fn state(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<Vec<f64>> {
+        let top = slf.core::<core::StaticFieldTop>()?;
+        top.state(x, theta, xdot, thetadot).py()
+    }
+
+    /// The Lagrangian of 002 (117) (derived again, physical sign; the class docstring).
+    ///
+    /// Args:
+    ///     x: (2,); theta; xdot: (2,); thetadot.
+    /// Returns:
+    ///     float.
+    /// Raises:
+    ///     InvalidArgumentError (a speed not below exp(phi), phi not finite at x),
+    ///     NonFiniteError.
+    fn lagrangian(
+        slf: &Bound<'_, Self>,
+        #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
+        #[pyo3(from_py_with = real)] theta: f64,
+        #[pyo3(from_py_with = reals::<2>)] xdot: [f64; 2],
+        #[pyo3(from_py_with = real)] thetadot: f64,
+    ) -> PyResult<f64> {
+        let top = slf.core::<core::StaticFieldTop>()?;
+        top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
+            .py()
+    }
+
+    /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError, InvalidArgumentError.
+    fn velocities<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::StaticFieldTop>()?;
+        slf.base().map_states(slf.py(), &states, &[3], |z, out| {
+            out.copy_from_slice(&top.velocities(z)?);
+            Ok(())
+        })
+    }
+
+    /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
+    /// vectorised: (..., 6) -> (...).
+    ///
+    /// Raises:
+    ///     ShapeError, NonFiniteError.
+    fn angular_momentum<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::StaticFieldTop>()?;
         map_items(
             slf.py(),
             &[Input::new("states", &states, &[6])],

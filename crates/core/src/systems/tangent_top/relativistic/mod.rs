@@ -1,7 +1,8 @@
 //! 002 §IV: the relativistic tangent Euler top in Minkowski space-time and on a curved static
 //! space-time −dt² + γ_ij dxⁱdxʲ over a surface ([`RelativisticTangentTop`], 002 (87)–(111)), and
 //! in the weak-field limit of a static gravitational potential φ(x, y) ([`WeakFieldTop`],
-//! 002 (115)–(120)).
+//! 002 (115)–(120)), and on the static space-time of the potential itself ([`StaticFieldTop`],
+//! 002 (115)–(117)).
 //!
 //! # Set-up (002 (81)–(82))
 //! A planar body with mass distribution dm(ξ), centre of mass at ξ = 0, second-moment tensor
@@ -72,18 +73,42 @@
 //!
 //! L = −m/γ + ½ 𝕀 s² (γ + ½ γ³ v²)    (002 (103), physical sign; the L of [`TangentTop`] − m as v → 0).
 //!
-//! Only the symmetric top is implemented on a surface ([`RelativisticTangentTop::on_surface`]):
-//! for an anisotropic body L depends on u = e♭ẋ itself, whose x-derivatives need the derivatives
-//! of the frame, which [`Surface`] does not provide (it gives g, ∂g, α, ∂α); the anisotropic top
-//! stays in the Minkowski plane ([`RelativisticTangentTop::new`]).
+//! **Anisotropic top (002 (102)).** For any I the body term is P = uᵀK(θ)u with u the
+//! components of ẋ in the orthonormal frame, u_a = g(ẋ, Ê_a), i.e. u = Fẋ with the coframe
+//! F = e g (`e[a][i]` = e_a^i, [`Surface::frame`](super::surface::Surface::frame)): L = −m/γ + ½s²(𝕀γ + γ³P) (tested against
+//! the exact (82) over an anisotropic body of mass points, `anisotropic_curved_lagrangian_is_the_
+//! expansion_of_82`). L depends on θ, so p_θ is not conserved. The x-derivatives of u need the
+//! derivatives of the frame, and these follow from the data a [`Surface`] already gives:
+//! ∇Ê₁ = wÊ₂, ∇Ê₂ = −wÊ₁ read in coordinates, ∂_k e_1^j = −Γ^j_kl e_1^l + α_k e_2^j and
+//! ∂_k e_2^j = −Γ^j_kl e_2^l − α_k e_1^j, so that
 //!
-//! **Derivatives** (the kernel of the symmetric top on a surface). With Q = g(ẋ, ẋ),
+//! ∂_k u_a = ½ e_a^l ẋ^i (∂_k g_il + ∂_i g_kl − ∂_l g_ik) − α_k (Ju)_a,   Ju = (−u₂, u₁),
+//!
+//! and ∂_k P = 2(∂_k u)·Ku, ∂_θ P = uᵀK′u (K′ = JK − KJ), ∂P/∂ẋ = 2Nẋ, ∂²P/∂ẋ² = 2N with
+//! N = FᵀKF. (For I = (𝕀/2)·Id, P = ½𝕀g(ẋ, ẋ), since Σ_a e_a e_aᵀ = g⁻¹; that is (103).)
+//! Under a change of reference frame Ê → R(β(x))Ê, u → R(β)ᵀu and θ → θ − β, so the body-frame
+//! components R(θ)ᵀu, hence P, do not change: with s, L is frame independent (002 (104)–(114),
+//! below). A lifted isometry carries the body frame and ẋ together, so it keeps P, s and v: the
+//! Killing momenta are conserved for any I, and so is the energy.
+//!
+//! **Derivatives** (the kernel on a surface). With Q = g(ẋ, ẋ), L = −m√(1 − Q) + ½s²(𝕀γ + γ³P),
+//! L_Q = ½mγ + ¼s²(𝕀γ³ + 3γ⁵P), L_s = s(𝕀γ + γ³P) = p_θ, L_P = ½s²γ³,
+//! L_QQ = ¼mγ³ + ⅜s²(𝕀γ⁵ + 5γ⁷P), L_Qs = s(½𝕀γ³ + (3/2)γ⁵P), L_QP = ¾s²γ⁵,
+//! L_ss = 𝕀γ + γ³P, L_sP = sγ³, L_PP = 0; with n = gẋ, k = Nẋ:
+//! p_x = 2L_Q n + L_s α + 2L_P k,  p_θ = L_s,
+//! ∂L/∂x^k = L_Q ẋᵀ(∂_k g)ẋ + L_s (∂_kα)·ẋ + L_P ∂_k P,  ∂L/∂θ = L_P ∂_θ P,
+//! ∂²L/∂ẋ² = 2L_Q g + 2L_P N + 4L_QQ nnᵀ + 4L_QP(nkᵀ + knᵀ) + 2L_Qs(nαᵀ + αnᵀ) +
+//! 2L_sP(kαᵀ + αkᵀ) + L_ss ααᵀ, ∂²L/∂ẋ∂θ̇ = 2L_Qs n + 2L_sP k + L_ss α, ∂²L/∂θ̇² = L_ss.
+//! For the symmetric top (P = ½𝕀Q) these are the derivatives of L = −m√(1 − Q) + ½𝕀s²f(Q),
+//! f(Q) = γ + ½Qγ³, written below.
+//!
+//! The symmetric top in those terms: with Q = g(ẋ, ẋ),
 //! f(Q) = γ + ½Qγ³, f′ = γ³ + ¾Qγ⁵, f″ = (9/4)γ⁵ + (15/8)Qγ⁷, L = −m√(1 − Q) + ½𝕀s²f(Q),
 //! λ = ∂L/∂Q = ½mγ + ½𝕀s²f′, σ = ∂L/∂s = 𝕀sf, n = gẋ:
 //! p_x = 2λ n + σ α,  p_θ = σ,  ∂L/∂x^k = λ ẋᵀ(∂_k g)ẋ + σ (∂_kα)·ẋ,  ∂L/∂θ = 0,
 //! and the Hessian in (ẋ, θ̇) from L_QQ = ¼mγ³ + ½𝕀s²f″, L_Qs = 𝕀sf′, L_ss = 𝕀f.
 //!
-//! **Conserved.** E = p·q̇ − L = mγ + ½𝕀s²(γ + (5/2)v²γ³ + (3/2)v⁴γ⁵) (002 (96) with θ̇ → s);
+//! **Conserved** (symmetric top). E = p·q̇ − L = mγ + ½𝕀s²(γ + (5/2)v²γ³ + (3/2)v⁴γ⁵) (002 (96) with θ̇ → s);
 //! p_θ = 𝕀 s f(v²) (θ is cyclic); and for every Killing field X of the surface, lifted to
 //! (x, θ) as in [`crate::systems::tangent_top::surface`], J = p_A X^A (v², s and so L are invariant under the
 //! lifted isometries; [`RelativisticTangentTop::killing_momenta`], computed by
@@ -105,8 +130,42 @@
 //! 2tr(ṠSᵀωᵀ) flips sign and (103) would give (θ̇ − α·ẋ)², which the ring test rejects; and (103)
 //! writes ⟨ċ, E_j⟩ (body frame) where (102) has ⟨ċ, Ê_j⟩ (the same here, the bracket being s² Id
 //! for the symmetric top, but not for an anisotropic one). In (103) "I" is the seed's I₀ = 𝕀/2,
-//! as in (93). (104)–(114), the frame independence: s = θ̇ + α·ẋ is invariant under Ê → R(χ)Ê
-//! (θ → θ − χ, α → α + dχ), and so are v² and L.
+//! as in (93). With those readings (102) is the anisotropic L above: ∇_ċE_i = ((Ṡ + ΩS))_ji Ê_j
+//! and Ṡ + ΩS = sJS, so its first bracket is tr((Ṡ + ΩS)I(Ṡ + ΩS)ᵀ) = 𝕀s² and its last
+//! ⟨ċ, Ê_j⟩⟨ċ, Ê_m⟩((Ṡ + ΩS)I(Ṡ + ΩS)ᵀ)_jm = s²uᵀK(θ)u (the test against the exact (82) over
+//! an anisotropic body checks it).
+//!
+//! # Prescribed centre motion (002 (91)–(92))
+//! With the centre moving uniformly in a straight line, ẋ = u fixed (Minkowski), L reduces to
+//! L(θ, θ̇) = −m/γ + ½F(θ)θ̇², F(θ) = 𝕀γ + γ³uᵀK(θ)u
+//! ([`RelativisticTangentTop::prescribed_inertia`]). For u = (v, 0),
+//! uᵀK(θ)u = v²(I₁₁ sin²θ + 2I₁₂ sin θ cos θ + I₂₂ cos²θ): the second moment of the body
+//! across the motion. **Slip:** 002 (91) prints the cross term as −2I₃ sin θ cos θ; with the
+//! seed's own S = R(θ) (E₁ = cos θ Ê₁ + sin θ Ê₂, 002 (41)) and I₃ = ∫ξ¹ξ² dm the sign is +
+//! (the printed one is right for the product of inertia −∫ξ¹ξ² dm, or for θ measured the other
+//! way; the test `prescribed_centre_motion_91_92` decides against L of the full top). F has
+//! period π in θ, not 2π as the text says. The θ-equation keeps the spin energy
+//! E = θ̇ ∂L/∂θ̇ − L − m/γ = ½F(θ)θ̇² (the seed's "L = θ̇²F(θ) = H", with its F half of this one
+//! and the sign of its L), so θ̇ = ±√(2E/F(θ)) (002 (92),
+//! [`RelativisticTangentTop::prescribed_spin_rate`]). The seed calls E/F an effective
+//! potential; E/F is θ̇² itself. A potential in the usual sense is V(θ) = −E/F(θ): ½θ̇² + V = 0
+//! and θ̈ = −V′(θ) = −½θ̇²F′/F (differentiate ½Fθ̇² = E)
+//! ([`RelativisticTangentTop::prescribed_potential`]). So the spin is fastest where F is least,
+//! with the body's larger second moment along the motion (the smaller across it), and slowest
+//! broadside, by the factor √(F_max/F_min) = √((𝕀 + γ²v²I_max)/(𝕀 + γ²v²I_min)) (I_max, I_min
+//! the principal second moments), which tends to 1 as v → 0: the classical top spins
+//! uniformly. (This is the seed's "rotates faster and other times slower"; the centre's motion is
+//! prescribed, not free: for the free anisotropic top ẋ varies too.)
+//!
+//! # Frame independence (002 (104)–(114))
+//! Under a change of reference frame Ê → R(β(x))Ê the body angle is θ → θ − β and the connection
+//! form α → α + dβ, so s = θ̇ + α·ẋ is invariant; u → R(β)ᵀu, so the body-frame components
+//! R(θ)ᵀu of ẋ, v² and P = uᵀK(θ)u are invariant: L is the same function of the motion, for the
+//! symmetric and the anisotropic top. The seed reaches this through (110)–(114): the extra term
+//! is vᵀ[A + ω, B]v with A = SᵀṠ, B = RᵀṘ and ω skew, so the bracket is skew and the term vanishes.
+//! (Its (111) drops the factor 2 that (110) carries on RᵀṘRᵀṘ; with it the R-terms are
+//! −B² − B² + 2B² = 0 as claimed.) The tests `frame_change_*` integrate the same physical
+//! motion from two frames that differ by a position-dependent β(x).
 //!
 //! # Weak field (002 (115)–(120))
 //! The static metric is ds² = −e^{2φ(x)} dt² + δ_ij dxⁱdxʲ (**slip corrected:** 002 (115) lacks
@@ -125,9 +184,12 @@
 //! L = ½ m v² − m φ + I₀ θ̇² (1 − φ + v²) + I₀ θ̇ (G_y ẋ − G_x ẏ).      (002 (118))
 //!
 //! **Slip:** 002 (118), in the seed's sign (L_seed = −L), carries the coupling term with the
-//! opposite sign, +Iθ̇(G_yẋ − G_xẏ); the expansion of 002 (117) itself gives the sign above
-//! (its ṠSᵀ should read SṠᵀ = −θ̇J). The test `weak_field_lagrangian_is_the_expansion` checks
-//! the sign against the exact integral over a ring of mass points. The Euler–Lagrange equations
+//! opposite sign, +Iθ̇(G_yẋ − G_xẏ); the expansion of 002 (117) gives the sign above. (117)
+//! itself is right here if its G is a row vector, as its GGᵀ = |G|² says: then
+//! −2e^{2φ}ṠSᵀGᵀv = −2e^{2φ}θ̇(JGᵀ)·v = +2e^{2φ}θ̇(G_yẋ − G_xẏ); read as Gᵀ-column
+//! contracted the other way, GᵀṠSᵀv, it has the wrong sign. The test
+//! `weak_field_lagrangian_is_the_expansion` checks the sign against the exact integral over a
+//! ring of mass points, and `static_field_lagrangian_is_the_expansion_of_82` the whole L. The Euler–Lagrange equations
 //! (002 (119), here with every term, G = ∇φ, Δφ = ∂_xG_x + ∂_yG_y):
 //!
 //! J = p_θ = 2I₀θ̇(1 − φ + v²) + I₀(G_y ẋ − G_x ẏ) = const,
@@ -144,8 +206,31 @@
 //! The spin–field force I₀θ̇Δφ(−ẏ, ẋ) is "magnetic" (it does no work); φ = −GM/r restricted to
 //! the plane has Δφ = −GM/r³ ≠ 0, so it acts in the point-mass field.
 //!
+//! # Static field (002 (115)–(117)), [`StaticFieldTop`]
+//! The L above, not expanded in the field or the speed: the symmetric top on
+//! −e^{2φ}dt² + dx² + dy² to second order in ξ only, (117) (physical sign; (115) with its dt²
+//! restored, the flat spatial metric of (118)). Its derivatives (the kernel) through
+//! Q = v², c = G_yẋ − G_xẏ = h·ẋ (h = JᵀG = (G_y, −G_x)), w = θ̇, ε = e^{2φ}, |G|²: with
+//! b = ε − Q, β = b^{−1/2}, T = w²Q + 2εwc + ε²|G|²,
+//! L = −m/β + I₀w²β − ½I₀ε|G|²β + ½I₀β³T,
+//! L_Q = ½mβ + I₀w²β³ − ¼I₀ε|G|²β³ + ¾I₀β⁵T, L_c = I₀εwβ³, L_w = 2I₀wβ + I₀β³(wQ + εc),
+//! L_QQ = ¼mβ³ + (9/4)I₀w²β⁵ − ⅜I₀ε|G|²β⁵ + (15/8)I₀β⁷T, L_Qc = (3/2)I₀εwβ⁵,
+//! L_Qw = 2I₀wβ³ + (3/2)I₀β⁵(wQ + εc), L_cc = 0, L_cw = I₀εβ³, L_ww = 2I₀β + I₀Qβ³;
+//! p_x = 2L_Q ẋ + L_c h, p_θ = L_w, ∂²L/∂ẋ² = 2L_Q Id + 4L_QQ ẋẋᵀ + 2L_Qc(ẋhᵀ + hẋᵀ),
+//! ∂²L/∂ẋ∂θ̇ = 2L_Qw ẋ + L_cw h; and through the field, with ∂_kε = 2εG_k,
+//! ∂_k|G|² = 2(HG)_k (H the Hessian of φ), ∂_k c = H_yk ẋ − H_xk ẏ,
+//! L_ε = −½mβ − ½I₀w²β³ − ½I₀|G|²β + ¼I₀ε|G|²β³ − ¾I₀β⁵T + I₀β³(wc + ε|G|²),
+//! L_|G|² = −½I₀εβ + ½I₀ε²β³, ∂L/∂x^k = 2εG_k L_ε + 2(HG)_k L_|G|² + L_c ∂_k c, ∂L/∂θ = 0.
+//! The metric is static (∂_t Killing), so E = p·q̇ − L is conserved; θ is cyclic (p_θ); a
+//! central φ keeps x p_y − y p_x and a uniform one the momentum across the field. φ = 0 gives
+//! the flat top (002 (93)); expanding in φ, |G| = O(ε²), v = O(ε), θ̇ = O(1) gives
+//! (118) − m + O(ε⁴) (`static_field_expands_to_118` measures the ε⁴). The anisotropic body would
+//! add θ through Q(θ) = SISᵀ: L = −m√b + 𝕀θ̇²/(2√b) − e^{2φ}GᵀQG/(2√b) + aᵀQa/(2b^{3/2}) with
+//! a = e^{2φ}G − θ̇Jᵀẋ (not implemented), and a curved spatial metric g would enter as on a
+//! surface above (u, s), with G the frame components of dφ (not implemented).
+//!
 //! # State
-//! Both systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)
+//! All three systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)
 //! are its chart's coordinates and p₁, p₂ their momenta); build one from velocities with `state`,
 //! read the velocities back with `velocities`.
 //!
@@ -153,6 +238,7 @@
 //! [`TangentTop`]: super::TangentTop
 
 mod spacetime;
+mod static_field;
 mod weak_field;
 
 use nalgebra::{Matrix3, Vector3};
@@ -165,6 +251,7 @@ use crate::integrate::space::{Block, Space};
 use crate::integrate::Problem;
 
 pub use spacetime::RelativisticTangentTop;
+pub use static_field::StaticFieldTop;
 pub use weak_field::{Potential, PotentialValue, WeakFieldTop};
 
 /// The derivatives of a Lagrangian L(q, q̇) on ℝ³ at one point: value, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇².
@@ -356,3 +443,5 @@ fn gradient_of(sol: Option<(Vector3<f64>, Derivs)>, hq: &mut [f64], hp: &mut [f6
 legendre_kinds!(RelativisticTangentTop);
 
 legendre_kinds!(WeakFieldTop);
+
+legendre_kinds!(StaticFieldTop);

@@ -12,21 +12,25 @@ use crate::error::{Error, Result};
 use crate::integrate::space::Space;
 use crate::integrate::Problem;
 use crate::systems::tangent_top::classical::TangentTop;
-use crate::systems::tangent_top::surface::{self, inverse, Geometry, Plane, Surface};
+use crate::systems::tangent_top::surface::{
+    self, inner, inverse, mul, Geometry, Mat2, Plane, Surface,
+};
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time, 002 (87)–(96) (module docs):
 /// L = −m/γ + ½θ̇²(𝕀γ + γ³ẋᵀK(θ)ẋ), K(θ) = R(θ) J I Jᵀ R(θ)ᵀ, physical sign (−L of 002 (90));
-/// or, built by [`RelativisticTangentTop::on_surface`], the symmetric top on the static
-/// space-time −dt² + g over a [`Surface`], 002 (97)–(103): L = −m/γ + ½𝕀s²(γ + ½γ³v²),
-/// v² = g(ẋ, ẋ), s = θ̇ + α·ẋ. State z = (x¹, x², θ, p₁, p₂, p_θ); speeds v < 1 (c = 1).
+/// or, built by [`RelativisticTangentTop::on_surface`] (the symmetric top) or
+/// [`RelativisticTangentTop::on_surface_with_moments`] (any I), the top on the static space-time
+/// −dt² + g over a [`Surface`], 002 (97)–(103): L = −m/γ + ½s²(𝕀γ + γ³uᵀK(θ)u), v² = g(ẋ, ẋ),
+/// s = θ̇ + α·ẋ, u the components of ẋ in the surface's orthonormal frame (for the symmetric top
+/// L = −m/γ + ½𝕀s²(γ + ½γ³v²)). State z = (x¹, x², θ, p₁, p₂, p_θ); speeds v < 1 (c = 1).
 #[derive(Clone, Debug)]
 pub struct RelativisticTangentTop {
     mass: f64,
     /// The second-moment tensor I = ∫ξξᵀdm as (I₁₁, I₁₂, I₂₂).
     moments: [f64; 3],
     /// The spatial slice: None for the Minkowski plane in Cartesian coordinates (the closed-form
-    /// kernel of 002 (90), any I); a surface for [`RelativisticTangentTop::on_surface`] (the
-    /// kernel of the symmetric top, 002 (103)).
+    /// kernel of 002 (90)); a surface for [`RelativisticTangentTop::on_surface`] and
+    /// [`RelativisticTangentTop::on_surface_with_moments`] (the kernel of 002 (102)).
     surface: Option<Arc<dyn Surface>>,
 }
 
@@ -74,8 +78,7 @@ impl RelativisticTangentTop {
 
     /// The symmetric top (I = (𝕀/2)·Id, `inertia` = 𝕀 > 0) of mass m > 0 on the static space-time
     /// ds² = −dt² + g over `surface` (002 (97)–(103), module docs); z = (x¹, x², θ, p₁, p₂, p_θ)
-    /// in the surface's chart. (An anisotropic body is supported in the Minkowski plane only,
-    /// [`RelativisticTangentTop::new`].) On [`Plane`] it is the same top as
+    /// in the surface's chart. On [`Plane`] it is the same top as
     /// [`RelativisticTangentTop::symmetric`], with the Killing momenta of SE(2) as invariants.
     pub fn on_surface(surface: Arc<dyn Surface>, mass: f64, inertia: f64) -> Result<Self> {
         let top = Self::symmetric(mass, inertia)?;
@@ -83,6 +86,29 @@ impl RelativisticTangentTop {
             surface: Some(surface),
             ..top
         })
+    }
+
+    /// The top of mass m > 0 with any second-moment tensor I = [[i11, i12], [i12, i22]]
+    /// (`moments` = (i11, i12, i22), as [`RelativisticTangentTop::new`]) on the static space-time
+    /// ds² = −dt² + g over `surface`: L = −m/γ + ½s²(𝕀γ + γ³uᵀK(θ)u) (002 (102), physical sign,
+    /// module docs), u the components of ẋ in the surface's orthonormal frame. An anisotropic
+    /// body's L depends on θ (p_θ is not conserved); the energy and the Killing momenta are. On
+    /// [`Plane`] it is the same top as [`RelativisticTangentTop::new`].
+    pub fn on_surface_with_moments(
+        surface: Arc<dyn Surface>,
+        mass: f64,
+        moments: [f64; 3],
+    ) -> Result<Self> {
+        let top = Self::new(mass, moments)?;
+        Ok(RelativisticTangentTop {
+            surface: Some(surface),
+            ..top
+        })
+    }
+
+    /// The second-moment tensor I = ∫ξξᵀdm as (I₁₁, I₁₂, I₂₂).
+    pub fn moments(&self) -> [f64; 3] {
+        self.moments
     }
 
     /// The spatial slice: the surface of [`RelativisticTangentTop::on_surface`], else [`Plane`].
@@ -229,6 +255,70 @@ impl RelativisticTangentTop {
     }
 }
 
+impl RelativisticTangentTop {
+    /// F(θ) = 𝕀γ + γ³uᵀK(θ)u, the spin's moment of inertia about a centre that moves uniformly
+    /// in a straight line with velocity u (002 (91), module docs "Prescribed centre motion"):
+    /// with ẋ = u held fixed, L = −m/γ + ½F(θ)θ̇². u are Cartesian components in the Minkowski
+    /// plane (the components in the orthonormal frame Ê, θ measured from Ê₁). Errors:
+    /// non-finite input, |u| ≥ 1.
+    pub fn prescribed_inertia(&self, theta: f64, velocity: [f64; 2]) -> Result<f64> {
+        check::finite_slice("theta", &[theta])?;
+        check::finite_slice("velocity", &velocity)?;
+        let speed2 = velocity[0] * velocity[0] + velocity[1] * velocity[1];
+        if speed2.is_nan() || speed2 >= 1.0 {
+            return Err(superluminal([velocity[0], velocity[1], 0.0], speed2.sqrt()));
+        }
+        let g = 1.0 / (1.0 - speed2).sqrt();
+        let (k, _) = self.k(theta);
+        let u = velocity;
+        let p = k[0] * u[0] * u[0] + 2.0 * k[1] * u[0] * u[1] + k[2] * u[1] * u[1];
+        let f = self.inertia() * g + g * g * g * p;
+        if !f.is_finite() {
+            return Err(check::overflow_error("velocity", "F(θ)"));
+        }
+        Ok(f)
+    }
+
+    /// The spin rate |θ̇| = √(2E/F(θ)) at the angle θ of the spin with the conserved spin energy
+    /// E = ½F(θ)θ̇² ≥ 0 (002 (92), physical sign: the seed's θ̇² = E/F with its F = ½ of this
+    /// one), the centre moving with the fixed velocity u ([`RelativisticTangentTop::prescribed_inertia`]).
+    /// Errors: as `prescribed_inertia`, E < 0.
+    pub fn prescribed_spin_rate(&self, theta: f64, energy: f64, velocity: [f64; 2]) -> Result<f64> {
+        let f = self.prescribed_inertia(theta, velocity)?;
+        check_spin_energy(energy)?;
+        let rate = (2.0 * energy / f).sqrt();
+        if !rate.is_finite() {
+            return Err(check::overflow_error("energy", "the spin rate"));
+        }
+        Ok(rate)
+    }
+
+    /// The effective potential V(θ) = −E/F(θ) of the spin with the fixed centre velocity u and
+    /// spin energy E = ½F(θ)θ̇² ≥ 0: ½θ̇² + V(θ) = 0 and θ̈ = −V′(θ) (module docs; the seed's
+    /// V_eff = E/F of 002 (92) is θ̇² itself). Errors: as
+    /// [`RelativisticTangentTop::prescribed_spin_rate`].
+    pub fn prescribed_potential(&self, theta: f64, energy: f64, velocity: [f64; 2]) -> Result<f64> {
+        let f = self.prescribed_inertia(theta, velocity)?;
+        check_spin_energy(energy)?;
+        let v = -energy / f;
+        if !v.is_finite() {
+            return Err(check::overflow_error("energy", "the effective potential"));
+        }
+        Ok(v)
+    }
+}
+
+fn check_spin_energy(energy: f64) -> Result<()> {
+    if energy.is_finite() && energy >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "energy",
+            format!("expected a finite spin energy E = F θ̇²/2 ≥ 0, got {energy}"),
+        ))
+    }
+}
+
 fn check_speed(v: f64) -> Result<()> {
     if v.is_finite() && (0.0..1.0).contains(&v) {
         Ok(())
@@ -265,9 +355,10 @@ impl Problem for RelativisticTangentTop {
         energy(self, z)
     }
     /// Minkowski: (p_x, p_y), and p_θ for the symmetric top: momenta of cyclic coordinates,
-    /// linear, so kept exactly by the Gauss methods. On a surface: p_θ and the Killing momenta of
-    /// the affine generators ([`Surface::killing_is_affine`]; quadratic in z, so also kept by the
-    /// Gauss methods); [`RelativisticTangentTop::killing_momenta`] gives all.
+    /// linear, so kept exactly by the Gauss methods. On a surface: p_θ (symmetric top only) and
+    /// the Killing momenta of the affine generators ([`Surface::killing_is_affine`]; quadratic in
+    /// z, so also kept by the Gauss methods); [`RelativisticTangentTop::killing_momenta`] gives
+    /// all.
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         check::len_of("state", z, 6)?;
         let Some(surface) = &self.surface else {
@@ -280,15 +371,17 @@ impl Problem for RelativisticTangentTop {
         check::finite_slice("state", z)?;
         self.check_point(&z[..3])?;
         let affine = surface::killing_momenta(&**surface, z, true);
-        Ok(std::iter::once(z[5]).chain(affine).collect())
+        let spin = self.is_symmetric().then_some(z[5]);
+        Ok(spin.into_iter().chain(affine).collect())
     }
     fn invariant_count(&self) -> usize {
         match &self.surface {
             None => 2 + usize::from(self.is_symmetric()),
             Some(surface) => {
-                1 + (0..surface.killing_count())
-                    .filter(|&k| surface.killing_is_affine(k))
-                    .count()
+                usize::from(self.is_symmetric())
+                    + (0..surface.killing_count())
+                        .filter(|&k| surface.killing_is_affine(k))
+                        .count()
             }
         }
     }
@@ -303,26 +396,14 @@ impl Legendre for RelativisticTangentTop {
     fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
         match &self.surface {
             None => self.minkowski_derivs(q, v),
-            Some(surface) => {
-                let x = [q[0], q[1]];
-                if !(surface.contains(x) && q[2].is_finite()) {
-                    return None;
-                }
-                self.curved_derivs(&surface.geometry(x), v)
-            }
+            Some(surface) => self.curved_derivs(&self.local(&**surface, q)?, q[2], v),
         }
     }
 
     fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
         match &self.surface {
             None => self.minkowski_solve(q, p),
-            Some(surface) => {
-                let x = [q[0], q[1]];
-                if !(surface.contains(x) && q[2].is_finite()) {
-                    return None;
-                }
-                self.curved_solve(&surface.geometry(x), p)
-            }
+            Some(surface) => self.curved_solve(&self.local(&**surface, q)?, q[2], p),
         }
     }
 
@@ -348,11 +429,104 @@ impl Legendre for RelativisticTangentTop {
     }
 }
 
+/// What the kernel of a top on a surface needs at one point x: the geometry (g, ∂g, α, ∂α) and,
+/// for an anisotropic body, the orthonormal frame `e[a][i]` = e_a^i (for u = e g ẋ).
+struct Local {
+    geo: Geometry,
+    frame: Option<Mat2>,
+}
+
+/// The body's part of L on a surface at (x, θ, ẋ): P = uᵀK(θ)u with u the frame components of ẋ
+/// (module docs, "Anisotropic top"), ∂P/∂ẋ = 2k, ∂²P/∂ẋ² = 2N, ∂P/∂x^k and ∂P/∂θ.
+struct BodyTerm {
+    p: f64,
+    k: [f64; 2],
+    n: Mat2,
+    px: [f64; 2],
+    ptheta: f64,
+}
+
 impl RelativisticTangentTop {
-    /// The symmetric top on a surface (module docs, "Derivatives"): L, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇² at
-    /// the geometry of x and q̇ = (ẋ, θ̇); None where g(ẋ, ẋ) ≥ 1 or q̇ is not finite.
-    fn curved_derivs(&self, geo: &Geometry, v: &Vector3<f64>) -> Option<Derivs> {
+    /// The geometry at x (and the frame, for an anisotropic body); None outside the chart.
+    fn local(&self, surface: &dyn Surface, q: &[f64]) -> Option<Local> {
+        let x = [q[0], q[1]];
+        if !(surface.contains(x) && q[2].is_finite()) {
+            return None;
+        }
+        let geo = surface.geometry(x);
+        let frame = (!self.is_symmetric()).then(|| surface.frame(x));
+        Some(Local { geo, frame })
+    }
+
+    /// P = uᵀK(θ)u and its derivatives (module docs, "Anisotropic top"). Symmetric top:
+    /// P = (𝕀/2) g(ẋ, ẋ). Otherwise with the coframe F = e g (u = Fẋ), N = FᵀKF, k = Nẋ,
+    /// ∂_k u = p_k − α_k J u, (p_k)_a = ½ e_a^l ẋ^i (∂_k g_il + ∂_i g_kl − ∂_l g_ik),
+    /// ∂P/∂x^k = 2 (∂_k u)·Ku and ∂P/∂θ = uᵀK′u.
+    fn body_term(&self, local: &Local, theta: f64, xd: [f64; 2]) -> BodyTerm {
+        let geo = &local.geo;
+        let g = &geo.g;
+        let Some(e) = &local.frame else {
+            let h = 0.5 * self.inertia();
+            let gx = [
+                g[0][0] * xd[0] + g[0][1] * xd[1],
+                g[1][0] * xd[0] + g[1][1] * xd[1],
+            ];
+            return BodyTerm {
+                p: h * (gx[0] * xd[0] + gx[1] * xd[1]),
+                k: [h * gx[0], h * gx[1]],
+                n: g.map(|r| r.map(|v| h * v)),
+                px: std::array::from_fn(|k| h * inner(&geo.dg[k], xd, xd)),
+                ptheta: 0.0,
+            };
+        };
+        let f = mul(e, g);
+        let u = [
+            f[0][0] * xd[0] + f[0][1] * xd[1],
+            f[1][0] * xd[0] + f[1][1] * xd[1],
+        ];
+        let (kk, kp) = self.k(theta);
+        let km = [[kk[0], kk[1]], [kk[1], kk[2]]];
+        let ku = [
+            km[0][0] * u[0] + km[0][1] * u[1],
+            km[1][0] * u[0] + km[1][1] * u[1],
+        ];
+        let kpm = [[kp[0], kp[1]], [kp[1], kp[2]]];
+        // N = Fᵀ K F, k = Fᵀ K u.
+        let ft = [[f[0][0], f[1][0]], [f[0][1], f[1][1]]];
+        let n = mul(&ft, &mul(&km, &f));
+        let k = [
+            ft[0][0] * ku[0] + ft[0][1] * ku[1],
+            ft[1][0] * ku[0] + ft[1][1] * ku[1],
+        ];
+        let dg = &geo.dg;
+        let px = std::array::from_fn(|kx| {
+            // ∂_k u = p_k − α_k J u, J u = (−u₂, u₁).
+            let du: [f64; 2] = std::array::from_fn(|a| {
+                let mut pa = 0.0;
+                for i in 0..2 {
+                    for l in 0..2 {
+                        pa += e[a][l] * xd[i] * (dg[kx][i][l] + dg[i][kx][l] - dg[l][i][kx]);
+                    }
+                }
+                let ju = if a == 0 { -u[1] } else { u[0] };
+                0.5 * pa - geo.alpha[kx] * ju
+            });
+            2.0 * (du[0] * ku[0] + du[1] * ku[1])
+        });
+        BodyTerm {
+            p: u[0] * ku[0] + u[1] * ku[1],
+            k,
+            n,
+            px,
+            ptheta: inner(&kpm, u, u),
+        }
+    }
+
+    /// The top on a surface (module docs, "Derivatives"): L, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇² at the local
+    /// data of x, the angle θ and q̇ = (ẋ, θ̇); None where g(ẋ, ẋ) ≥ 1 or a value is not finite.
+    fn curved_derivs(&self, local: &Local, theta: f64, v: &Vector3<f64>) -> Option<Derivs> {
         let (m, tr) = (self.mass, self.inertia());
+        let geo = &local.geo;
         let (xd, w) = ([v[0], v[1]], v[2]);
         let g = &geo.g;
         let n = [
@@ -363,57 +537,67 @@ impl RelativisticTangentTop {
         if !(qq.is_finite() && qq < 1.0 && w.is_finite()) {
             return None;
         }
+        let body = self.body_term(local, theta, xd);
+        let pp = body.p;
+        if !pp.is_finite() {
+            return None;
+        }
         let a = geo.alpha;
         let s = w + a[0] * xd[0] + a[1] * xd[1];
         let g1 = 1.0 / (1.0 - qq).sqrt();
         let g3 = g1 * g1 * g1;
         let g5 = g3 * g1 * g1;
         let g7 = g5 * g1 * g1;
-        let f = g1 + 0.5 * qq * g3;
-        let f1 = g3 + 0.75 * qq * g5;
-        let f2 = 2.25 * g5 + 1.875 * qq * g7;
         let s2 = s * s;
-        let l = -m / g1 + 0.5 * tr * s2 * f;
-        let lam = 0.5 * m * g1 + 0.5 * tr * s2 * f1; // ∂L/∂Q
-        let sig = tr * s * f; // ∂L/∂s = p_θ
-        let l_qq = 0.25 * m * g3 + 0.5 * tr * s2 * f2;
-        let l_qs = tr * s * f1;
-        let l_ss = tr * f;
+        let l = -m / g1 + 0.5 * s2 * (tr * g1 + g3 * pp);
+        let l_q = 0.5 * m * g1 + 0.25 * s2 * (tr * g3 + 3.0 * g5 * pp); // ∂L/∂Q
+        let l_s = s * (tr * g1 + g3 * pp); // ∂L/∂s = p_θ
+        let l_p = 0.5 * s2 * g3; // ∂L/∂P
+        let l_qq = 0.25 * m * g3 + 0.375 * s2 * (tr * g5 + 5.0 * g7 * pp);
+        let l_qs = s * (0.5 * tr * g3 + 1.5 * g5 * pp);
+        let l_qp = 0.75 * s2 * g5;
+        let l_ss = tr * g1 + g3 * pp;
+        let l_sp = s * g3;
+        let k = body.k;
         let lv = Vector3::new(
-            2.0 * lam * n[0] + sig * a[0],
-            2.0 * lam * n[1] + sig * a[1],
-            sig,
+            2.0 * l_q * n[0] + l_s * a[0] + 2.0 * l_p * k[0],
+            2.0 * l_q * n[1] + l_s * a[1] + 2.0 * l_p * k[1],
+            l_s,
         );
         let mut lq = Vector3::zeros();
-        for k in 0..2 {
-            let d = &geo.dg[k];
-            let vgv = d[0][0] * xd[0] * xd[0]
-                + (d[0][1] + d[1][0]) * xd[0] * xd[1]
-                + d[1][1] * xd[1] * xd[1];
-            let da = geo.dalpha[k];
-            lq[k] = lam * vgv + sig * (da[0] * xd[0] + da[1] * xd[1]);
+        for kx in 0..2 {
+            let da = geo.dalpha[kx];
+            lq[kx] = l_q * inner(&geo.dg[kx], xd, xd)
+                + l_s * (da[0] * xd[0] + da[1] * xd[1])
+                + l_p * body.px[kx];
         }
+        lq[2] = l_p * body.ptheta;
         let mut hess = Matrix3::zeros();
         for i in 0..2 {
             for j in 0..2 {
-                hess[(i, j)] = 2.0 * lam * g[i][j]
+                hess[(i, j)] = 2.0 * l_q * g[i][j]
+                    + 2.0 * l_p * body.n[i][j]
                     + 4.0 * l_qq * n[i] * n[j]
+                    + 4.0 * l_qp * (n[i] * k[j] + k[i] * n[j])
                     + 2.0 * l_qs * (n[i] * a[j] + a[i] * n[j])
+                    + 2.0 * l_sp * (k[i] * a[j] + a[i] * k[j])
                     + l_ss * a[i] * a[j];
             }
-            let h = 2.0 * l_qs * n[i] + l_ss * a[i];
+            let h = 2.0 * l_qs * n[i] + 2.0 * l_sp * k[i] + l_ss * a[i];
             hess[(i, 2)] = h;
             hess[(2, i)] = h;
         }
         hess[(2, 2)] = l_ss;
-        Some(Derivs { l, lv, lq, hess })
+        let finite = l.is_finite() && lq.iter().all(|x| x.is_finite());
+        finite.then_some(Derivs { l, lv, lq, hess })
     }
 
     /// The inverse Legendre map of the top on a surface: from a free particle of mass
-    /// m + 𝕀 s² (exact at low speed) carrying π = p_x − p_θ α at spin s = p_θ/𝕀, slower than
-    /// light; failing that, from rest.
-    fn curved_solve(&self, geo: &Geometry, p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
+    /// m + 𝕀 s² (exact at low speed for the symmetric top) carrying π = p_x − p_θ α at spin
+    /// s = p_θ/𝕀, slower than light; failing that, from rest.
+    fn curved_solve(&self, local: &Local, theta: f64, p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
         let tr = self.inertia();
+        let geo = &local.geo;
         let s = p[2] / tr;
         let a = geo.alpha;
         let pi = [p[0] - p[2] * a[0], p[1] - p[2] * a[1]];
@@ -426,9 +610,9 @@ impl RelativisticTangentTop {
         let e = (mm * mm + up[0] * pi[0] + up[1] * pi[1]).sqrt();
         let xd = [up[0] / e, up[1] / e];
         let guess = Vector3::new(xd[0], xd[1], s - a[0] * xd[0] - a[1] * xd[1]);
-        legendre_inverse(p, guess, |v| self.curved_derivs(geo, v)).or_else(|| {
-            legendre_inverse(p, Vector3::new(0.0, 0.0, s), |v| self.curved_derivs(geo, v))
-        })
+        let derivs = |v: &Vector3<f64>| self.curved_derivs(local, theta, v);
+        legendre_inverse(p, guess, derivs)
+            .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, s), derivs))
     }
 
     /// Derivatives of the Minkowski L (002 (90)) at (q, q̇); None where |ẋ| ≥ 1 or the input is

@@ -107,6 +107,48 @@ impl Potential {
     }
 }
 
+impl Potential {
+    /// Whether φ is a closure from outside lieflow.
+    pub(super) fn calls_out(&self) -> bool {
+        matches!(self.kind, PotentialKind::Custom(_))
+    }
+
+    /// The momenta of the potential's symmetries at a state z = (x, y, θ, p_x, p_y, p_θ): for
+    /// the point mass the angular momentum x p_y − y p_x (quadratic in z), for a uniform field
+    /// the momentum across the field p·Ĵĝ (linear); none for a custom potential.
+    pub(super) fn symmetry_momenta(&self, z: &[f64]) -> Result<Vec<f64>> {
+        check::len_of("state", z, 6)?;
+        Ok(match &self.kind {
+            PotentialKind::PointMass { .. } => vec![angular_momentum(z)?],
+            PotentialKind::Uniform { g } => {
+                let n = g[0].hypot(g[1]);
+                if n > 0.0 {
+                    let t = rot90([g[0] / n, g[1] / n]);
+                    vec![t[0] * z[3] + t[1] * z[4]]
+                } else {
+                    vec![]
+                }
+            }
+            PotentialKind::Custom(_) => vec![],
+        })
+    }
+
+    /// The number of [`Potential::symmetry_momenta`].
+    pub(super) fn symmetry_count(&self) -> usize {
+        match &self.kind {
+            PotentialKind::PointMass { .. } => 1,
+            PotentialKind::Uniform { g } => usize::from(g[0].hypot(g[1]) > 0.0),
+            PotentialKind::Custom(_) => 0,
+        }
+    }
+}
+
+/// x p_y − y p_x of a state (length checked by the caller).
+pub(super) fn angular_momentum(z: &[f64]) -> Result<f64> {
+    let q = "the angular momentum x p_y − y p_x";
+    check::cross2("state", q, [z[0], z[1]], [z[3], z[4]])
+}
+
 /// The symmetric relativistic tangent top in a weak static gravitational field, the Lagrangian
 /// 002 (118) with its coupling sign corrected (module docs):
 /// L = ½mv² − mφ + I₀θ̇²(1 − φ + v²) + I₀θ̇(G_yẋ − G_xẏ), I₀ = 𝕀/2, G = ∇φ.
@@ -162,12 +204,11 @@ impl WeakFieldTop {
     /// The angular momentum x p_y − y p_x about the origin (conserved for a central potential).
     pub fn angular_momentum(&self, z: &[f64]) -> Result<f64> {
         check::len_of("state", z, 6)?;
-        let q = "the angular momentum x p_y − y p_x";
-        check::cross2("state", q, [z[0], z[1]], [z[3], z[4]])
+        angular_momentum(z)
     }
 }
 
-fn outside_potential(q: [f64; 3]) -> Error {
+pub(super) fn outside_potential(q: [f64; 3]) -> Error {
     Error::invalid(
         "x",
         format!(
@@ -179,7 +220,7 @@ fn outside_potential(q: [f64; 3]) -> Error {
 
 impl Problem for WeakFieldTop {
     fn calls_out(&self) -> bool {
-        matches!(self.potential.kind, PotentialKind::Custom(_))
+        self.potential.calls_out()
     }
     fn name(&self) -> &'static str {
         "WeakFieldTop"
@@ -196,25 +237,11 @@ impl Problem for WeakFieldTop {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         check::len_of("state", z, 6)?;
         let mut out = vec![z[5]];
-        match &self.potential.kind {
-            PotentialKind::PointMass { .. } => out.push(self.angular_momentum(z)?),
-            PotentialKind::Uniform { g } => {
-                let n = g[0].hypot(g[1]);
-                if n > 0.0 {
-                    let t = rot90([g[0] / n, g[1] / n]);
-                    out.push(t[0] * z[3] + t[1] * z[4]);
-                }
-            }
-            PotentialKind::Custom(_) => {}
-        }
+        out.extend(self.potential.symmetry_momenta(z)?);
         Ok(out)
     }
     fn invariant_count(&self) -> usize {
-        match &self.potential.kind {
-            PotentialKind::PointMass { .. } => 2,
-            PotentialKind::Uniform { g } => 1 + usize::from(g[0].hypot(g[1]) > 0.0),
-            PotentialKind::Custom(_) => 1,
-        }
+        1 + self.potential.symmetry_count()
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.velocities(z).map(|_| ())
