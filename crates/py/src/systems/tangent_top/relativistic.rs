@@ -373,8 +373,10 @@ fn relation<'py>(
 /// midpoint, rk4.
 ///
 /// Args:
-///     mass > 0, inertia > 0 (tr I); exactly one of gm (phi = -gm/r) or g (a uniform field,
-///     (2,)).
+///     mass: m > 0.
+///     inertia: tr I > 0.
+///     gm: a point mass, phi = -gm/r (give exactly one of gm and g).
+///     g: a uniform field, phi = g.x, (2,).
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "WeakFieldTop", module = "lieflow", extends = PySystem, frozen)]
@@ -483,8 +485,10 @@ fn potential(gm: Option<f64>, g: Option<[f64; 2]>) -> PyResult<core::Potential> 
 /// uniform field; the energy is conserved. Methods: gauss4 (default), gauss6, midpoint, rk4.
 ///
 /// Args:
-///     mass > 0, inertia > 0 (tr I); exactly one of gm (phi = -gm/r) or g (a uniform field
-///     phi = g.x, (2,)).
+///     mass: m > 0.
+///     inertia: tr I > 0.
+///     gm: a point mass, phi = -gm/r (give exactly one of gm and g).
+///     g: a uniform field, phi = g.x, (2,).
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "StaticFieldTop", module = "lieflow", extends = PySystem, frozen)]
