@@ -77,6 +77,7 @@ def test_state_views_killing_momenta_and_integrals(space):
     inv = traj.invariants()
     np.testing.assert_allclose(inv, np.broadcast_to(inv[0], inv.shape), rtol=1e-11, atol=1e-11)
     assert pickle.loads(pickle.dumps(top)).space == space
+    assert {space: 1}[pickle.loads(pickle.dumps(space))] == 1     # hashable, equal by value
 
 
 def test_on_the_three_sphere_it_is_the_so4_rigid_body_of_lie_poisson():

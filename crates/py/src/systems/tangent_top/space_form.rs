@@ -81,6 +81,15 @@ impl PySpace {
         self.inner.name()
     }
 
+    fn __hash__(&self) -> u64 {
+        let (kind, r) = match self.inner {
+            SpaceForm::Euclidean => (0u64, 1.0f64),
+            SpaceForm::Sphere { radius } => (1, radius),
+            SpaceForm::Hyperbolic { radius } => (2, radius),
+        };
+        kind.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ r.to_bits()
+    }
+
     fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
         other
             .cast::<PySpace>()
