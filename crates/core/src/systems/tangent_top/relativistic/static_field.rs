@@ -101,16 +101,12 @@ impl Problem for StaticFieldTop {
     fn energy(&self, z: &[f64]) -> Result<f64> {
         energy(self, z)
     }
-    /// p_θ (θ is cyclic); for the point mass also x p_y − y p_x (quadratic); for a uniform field
-    /// also the momentum across the field, p·Ĵĝ (linear). The Gauss methods keep all of them.
+    /// p_θ and the momenta of the field's symmetries (`Potential::invariants`).
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        check::len_of("state", z, 6)?;
-        let mut out = vec![z[5]];
-        out.extend(self.potential.symmetry_momenta(z)?);
-        Ok(out)
+        self.potential.invariants(z)
     }
     fn invariant_count(&self) -> usize {
-        1 + self.potential.symmetry_count()
+        self.potential.invariant_count()
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.velocities(z).map(|_| ())

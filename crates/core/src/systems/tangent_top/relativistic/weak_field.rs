@@ -113,12 +113,14 @@ impl Potential {
         matches!(self.kind, PotentialKind::Custom(_))
     }
 
-    /// The momenta of the potential's symmetries at a state z = (x, y, θ, p_x, p_y, p_θ): for
-    /// the point mass the angular momentum x p_y − y p_x (quadratic in z), for a uniform field
-    /// the momentum across the field p·Ĵĝ (linear); none for a custom potential.
-    pub(super) fn symmetry_momenta(&self, z: &[f64]) -> Result<Vec<f64>> {
+    /// The invariants of a top in this field at a state z = (x, y, θ, p_x, p_y, p_θ): p_θ (θ is
+    /// cyclic), then the momenta of the potential's symmetries: for the point mass the angular
+    /// momentum x p_y − y p_x (quadratic in z), for a uniform field the momentum across the
+    /// field p·Ĵĝ (linear); none more for a custom potential. The Gauss methods keep all of them.
+    pub(super) fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         check::len_of("state", z, 6)?;
-        Ok(match &self.kind {
+        let mut out = vec![z[5]];
+        out.extend(match &self.kind {
             PotentialKind::PointMass { .. } => vec![angular_momentum(z)?],
             PotentialKind::Uniform { g } => {
                 let n = g[0].hypot(g[1]);
@@ -130,12 +132,13 @@ impl Potential {
                 }
             }
             PotentialKind::Custom(_) => vec![],
-        })
+        });
+        Ok(out)
     }
 
-    /// The number of [`Potential::symmetry_momenta`].
-    pub(super) fn symmetry_count(&self) -> usize {
-        match &self.kind {
+    /// The number of [`Potential::invariants`].
+    pub(super) fn invariant_count(&self) -> usize {
+        1 + match &self.kind {
             PotentialKind::PointMass { .. } => 1,
             PotentialKind::Uniform { g } => usize::from(g[0].hypot(g[1]) > 0.0),
             PotentialKind::Custom(_) => 0,
@@ -232,16 +235,12 @@ impl Problem for WeakFieldTop {
     fn energy(&self, z: &[f64]) -> Result<f64> {
         energy(self, z)
     }
-    /// p_θ (θ is cyclic); for the point mass also x p_y − y p_x (quadratic); for a uniform field
-    /// also the momentum across the field, p·Ĵĝ (linear). The Gauss methods keep all of them.
+    /// p_θ and the momenta of the field's symmetries (`Potential::invariants`).
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
-        check::len_of("state", z, 6)?;
-        let mut out = vec![z[5]];
-        out.extend(self.potential.symmetry_momenta(z)?);
-        Ok(out)
+        self.potential.invariants(z)
     }
     fn invariant_count(&self) -> usize {
-        1 + self.potential.symmetry_count()
+        self.potential.invariant_count()
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.velocities(z).map(|_| ())
