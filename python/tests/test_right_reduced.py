@@ -197,3 +197,26 @@ def test_guichardet_in_three_dimensions_is_the_inertia_tensor_inverse_on_the_ang
                                np.linalg.eigvalsh(A), atol=1e-12)
     with pytest.raises(lf.InvalidArgumentError, match="line"):
         PR.guichardet_connection(m, np.outer(np.arange(6.0), [1, 2, 3]), v)
+
+
+def test_an_exception_of_the_potential_in_the_start_checks_is_raised_and_does_not_leak():
+    """A Callable potential that raises while the start checks evaluate it (the invariance check)
+    ends that call with its own exception, not the NaN it left; the next run is clean."""
+    class Boom(Exception):
+        pass
+
+    calls = [0]
+
+    def u(X):
+        calls[0] += 1
+        if calls[0] == 1:
+            raise Boom("once")
+        return 0.5 * float(np.sum(X * X))
+
+    pot = lf.potentials.Callable(u, lambda X: np.asarray(X), lambda X, V: np.asarray(V))
+    red = PR.RightReduced(3, pot)
+    z = red.reduce(np.diag([1.0, 1.2, 0.9]), np.zeros((3, 3)))
+    with pytest.raises(Boom, match="once"):
+        lf.integrate(red, z, dt=0.01, steps=10)
+    traj = lf.integrate(red, z, dt=0.01, steps=10)
+    assert np.isfinite(traj.states).all()

@@ -132,9 +132,15 @@ impl Run {
         in_block: bool,
         stepper: impl FnOnce() -> Result<(Box<dyn Stepper>, Properties, Option<Arc<Resolved>>)>,
     ) -> Result<Run> {
-        check_start(problem, z0, dt, save_every, t0)?;
         // A failure recorded on this thread that no caller took belongs to no run.
         let _ = hooks::take_failure();
+        let checked = check_start(problem, z0, dt, save_every, t0);
+        // A foreign function the checks called (a state check that evaluates a user's
+        // potential) failed: its error, not the NaN it left, and not left for the next run.
+        if let Some(e) = hooks::take_failure() {
+            return Err(e);
+        }
+        checked?;
         let (stepper, properties, method) = stepper()?;
         let space = problem.space();
         let mut buf = z0.to_vec();
