@@ -1,10 +1,14 @@
 //! The tangent Euler top on the three-dimensional space forms (002 §V): each claim by a second
 //! route — geodesics and parallel transport in closed form, the Lie–Poisson field by RK4 at small
 //! steps, the Killing momenta from positions and velocities, Ṁ = [M, ξ] on SO(4) by differences.
+//! The top on a Riemannian chart ([`RiemannianFrameTop`]): its connection against a rotating
+//! frame of flat space, its field against Hamilton's equations of H by differences, its motion
+//! against the space-form top on ℝ³ (a rotating frame field) and on S³ (stereographic chart).
 
+use lieflow::integrate::problem::VectorField;
 use lieflow::integrate::{integrate, Problem};
 use lieflow::lie::so3;
-use lieflow::systems::{FrameTop, SpaceForm};
+use lieflow::systems::{FrameTop, Riemannian, RiemannianFrameTop, SpaceForm, SpaceTop};
 use nalgebra::{Matrix3, Matrix4, Vector3};
 
 const INERTIA: [f64; 9] = [2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2];
@@ -365,4 +369,256 @@ fn expm1_of_the_group_elements() {
             );
         }
     }
+}
+
+// The top on a Riemannian chart.
+
+/// A rotating orthonormal frame of flat space, Q(x) = exp(ŵ(x)).
+fn twist(x: [f64; 3]) -> Matrix3<f64> {
+    so3::exp_unchecked(&Vector3::new(
+        0.3 * x[0] + 0.1 * x[1] * x[1],
+        -0.2 * x[2] + 0.4 * x[0] * x[1],
+        0.5 * x[0] * x[2] - 0.3 * x[1],
+    ))
+}
+
+/// Rows of a matrix's transpose: the closures take `e[a][i]` = component i of Ê_a = column a.
+fn rows_of_columns(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    std::array::from_fn(|a| std::array::from_fn(|i| m[(i, a)]))
+}
+
+fn flat_twisted() -> Riemannian {
+    Riemannian::new(
+        |_| [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        |x| rows_of_columns(&twist(x)),
+        None,
+    )
+}
+
+/// The stereographic chart of S³(r) from its south pole: X(y) = r((1 − s)/(1 + s), 2y/(1 + s)),
+/// s = |y|², with g = 4r²/(1 + s)² and the frame Ê_a = (1 + s)/(2r) ∂_a.
+const R3: f64 = 1.3;
+
+fn stereo(y: [f64; 3]) -> Vec<f64> {
+    let s = y.iter().map(|v| v * v).sum::<f64>();
+    let mut x = vec![R3 * (1.0 - s) / (1.0 + s)];
+    x.extend(y.iter().map(|v| 2.0 * R3 * v / (1.0 + s)));
+    x
+}
+
+/// dX (4×3, row-major by ambient component).
+fn stereo_jacobian(y: [f64; 3]) -> [[f64; 3]; 4] {
+    let s = y.iter().map(|v| v * v).sum::<f64>();
+    let d2 = (1.0 + s) * (1.0 + s);
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            if i == 0 {
+                -4.0 * R3 * y[j] / d2
+            } else {
+                let delta = if i - 1 == j { 1.0 + s } else { 0.0 };
+                2.0 * R3 * (delta - 2.0 * y[i - 1] * y[j]) / d2
+            }
+        })
+    })
+}
+
+fn stereo_chart() -> Riemannian {
+    let conformal = |y: [f64; 3]| 1.0 + y.iter().map(|v| v * v).sum::<f64>();
+    Riemannian::new(
+        move |y| {
+            let l = 2.0 * R3 / conformal(y);
+            let l2 = l * l;
+            [[l2, 0.0, 0.0], [0.0, l2, 0.0], [0.0, 0.0, l2]]
+        },
+        move |y| {
+            let e = conformal(y) / (2.0 * R3);
+            [[e, 0.0, 0.0], [0.0, e, 0.0], [0.0, 0.0, e]]
+        },
+        Some(std::sync::Arc::new(|y: [f64; 3]| {
+            y.iter().map(|v| v * v).sum::<f64>() < 100.0
+        })),
+    )
+}
+
+/// The ambient components of dX(y) E(y) R: the body axes of the chart's top in ℝ⁴.
+fn stereo_axes(y: [f64; 3], r: &Matrix3<f64>) -> Matrix4<f64> {
+    let j = stereo_jacobian(y);
+    let e = (1.0 + y.iter().map(|v| v * v).sum::<f64>()) / (2.0 * R3);
+    let mut a = Matrix4::zeros();
+    for i in 0..4 {
+        for c in 0..3 {
+            a[(i, c)] = (0..3).map(|k| j[i][k] * e * r[(k, c)]).sum();
+        }
+    }
+    a
+}
+
+/// C's columns are the axial vectors of QᵀdQ for a rotating frame Q of flat space (by central
+/// differences of Q at a small step, a route independent of the chart's stencil), and the frame
+/// check passes or names the defect.
+#[test]
+fn connection_of_a_rotating_frame_of_flat_space() {
+    let space = flat_twisted();
+    let x = [0.4, -0.7, 0.9];
+    let c = space.connection(x);
+    let h = 1e-6;
+    for j in 0..3 {
+        let (mut xp, mut xm) = (x, x);
+        xp[j] += h;
+        xm[j] -= h;
+        let a = twist(x).transpose() * (twist(xp) - twist(xm)) / (2.0 * h);
+        let want = Vector3::new(a[(2, 1)], a[(0, 2)], a[(1, 0)]);
+        assert!((c.column(j) - want).amax() < 1e-8, "{j}: {c} vs {want}");
+    }
+    space.check_frame(x, 1e-12).unwrap();
+    let bad = Riemannian::new(
+        |_| [[2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        |x| rows_of_columns(&twist(x)),
+        None,
+    );
+    assert!(bad.check_frame(x, 1e-10).is_err());
+}
+
+/// The field is Hamilton's equations of H (by differences of the energy): ẋ = ∂H/∂p,
+/// ṗ = −∂H/∂x, Ṙ = R(∂H/∂Π)^, on the sphere's chart with a turned frame and a spin.
+#[test]
+fn the_field_is_hamiltons_equations_of_h() {
+    let top = RiemannianFrameTop::new(
+        stereo_chart(),
+        1.3,
+        &[2.0, 0.0, 0.0, 0.0, 3.1, 0.0, 0.0, 0.0, 4.2],
+    )
+    .unwrap();
+    let z = top
+        .state(
+            &[0.3, -0.2, 0.5],
+            &frame(),
+            &[0.4, 0.1, -0.3],
+            &Vector3::new(0.7, -0.4, 1.1),
+        )
+        .unwrap();
+    let mut dz = vec![0.0; 18];
+    top.field(&z, &mut dz);
+    let h = 1e-5;
+    let d = |k: usize| {
+        let (mut zp, mut zm) = (z.clone(), z.clone());
+        zp[k] += h;
+        zm[k] -= h;
+        (top.energy(&zp).unwrap() - top.energy(&zm).unwrap()) / (2.0 * h)
+    };
+    for k in 0..3 {
+        assert!((dz[k] - d(3 + k)).abs() < 1e-8, "xdot {k}");
+        assert!(
+            (dz[3 + k] + d(k)).abs() < 1e-7,
+            "pdot {k}: {} vs {}",
+            dz[3 + k],
+            -d(k)
+        );
+    }
+    let dh_dpi = Vector3::new(d(15), d(16), d(17));
+    let r = Matrix3::from_row_slice(&z[6..15]);
+    let rdot = Matrix3::from_row_slice(&dz[6..15]);
+    assert!((r.transpose() * rdot - so3::hat(&dh_dpi)).amax() < 1e-8);
+    // Π̇ = Π × 𝕀⁻¹Π: the free Euler top.
+    let pi = Vector3::from_column_slice(&z[15..18]);
+    let w = Vector3::new(pi[0] / 2.0, pi[1] / 3.1, pi[2] / 4.2);
+    assert!((Vector3::from_column_slice(&dz[15..18]) - pi.cross(&w)).amax() < 1e-15);
+}
+
+/// On flat space with a rotating frame field the top is a free particle and a free rigid body:
+/// the same motion as `FrameTop` on ℝ³ (its body axes Q(x)R in space).
+#[test]
+fn on_flat_space_with_a_rotating_frame_the_euclidean_top() {
+    let top = RiemannianFrameTop::new(flat_twisted(), 1.3, &INERTIA).unwrap();
+    let euclid = FrameTop::new(SpaceForm::Euclidean, 1.3, &INERTIA).unwrap();
+    let (x, xd) = (vec![0.3, -0.2, 1.0], vec![0.4, 0.1, -0.3]);
+    let omega = Vector3::new(0.7, -0.4, 1.1);
+    let z0 = top.state(&x, &frame(), &xd, &omega).unwrap();
+    let q0 = twist([x[0], x[1], x[2]]);
+    let e0 = euclid.state(&x, &(q0 * frame()), &xd, &omega).unwrap();
+    let (t, n) = (2.0, 200);
+    let a = integrate(&top, "midpoint6", &z0, t / n as f64, n, n).unwrap();
+    let b = integrate(&euclid, "exact", &e0, t, 1, 1).unwrap();
+    let (za, zb) = (a.state(1), b.state(1));
+    let xa = top.position(za).unwrap();
+    assert!(dist(&xa, &euclid.position(zb).unwrap()) < 1e-9);
+    let axes = twist([xa[0], xa[1], xa[2]]) * top.frame(za).unwrap();
+    assert!((axes - euclid.frame(zb).unwrap()).amax() < 1e-8);
+    assert!(dist(&top.velocity(za).unwrap(), &xd) < 1e-9);
+}
+
+/// On S³ in the stereographic chart: the same motion as `FrameTop` on the sphere (positions and
+/// body axes in ℝ⁴, the angular velocity), so the coupling to the curvature is the one the group
+/// picture derives; the orders of the methods; H − T and |Π| kept to round-off, H bounded.
+#[test]
+fn on_the_three_sphere_in_a_stereographic_chart() {
+    let chart = RiemannianFrameTop::new(stereo_chart(), 1.3, &INERTIA).unwrap();
+    let sphere = SpaceForm::sphere(R3).unwrap();
+    let group = FrameTop::new(sphere, 1.3, &INERTIA).unwrap();
+    let (y0, yd0) = ([0.3, -0.2, 0.5], [0.4, 0.1, -0.3]);
+    let omega = Vector3::new(0.7, -0.4, 1.1);
+    let z0 = chart.state(&y0, &frame(), &yd0, &omega).unwrap();
+    // The same body in ℝ⁴: x = X(y), ẋ = dX ẏ, axes dX E R = Ê(x) R'.
+    let x0 = stereo(y0);
+    let j = stereo_jacobian(y0);
+    let xd0: Vec<f64> = (0..4)
+        .map(|i| (0..3).map(|k| j[i][k] * yd0[k]).sum())
+        .collect();
+    let reference = sphere.reference(&x0);
+    let axes = stereo_axes(y0, &frame());
+    let r0 = (reference.transpose() * axes)
+        .fixed_view::<3, 3>(1, 0)
+        .into_owned();
+    let g0 = group.state(&x0, &r0, &xd0, &omega).unwrap();
+    let (t, n) = (1.5, 150);
+    let a = integrate(&chart, "midpoint6", &z0, t / n as f64, n, n).unwrap();
+    let b = integrate(&group, "exact", &g0, t, 1, 1).unwrap();
+    let (za, zb) = (a.state(1), b.state(1));
+    let y: Vec<f64> = chart.position(za).unwrap();
+    let y = [y[0], y[1], y[2]];
+    assert!(dist(&stereo(y), &group.position(zb).unwrap()) < 1e-8);
+    let g = Matrix4::from_row_slice(&zb[..16]);
+    let want = g.fixed_view::<4, 3>(0, 1).into_owned();
+    let got = stereo_axes(y, &chart.frame(za).unwrap());
+    assert!((got.fixed_view::<4, 3>(0, 0) - want).amax() < 1e-8);
+    assert!(
+        (chart.angular_velocity(za).unwrap() - group.angular_velocity(zb).unwrap()).amax() < 1e-12
+    );
+    assert!(
+        (chart.translational_energy(za).unwrap() - group.translational_energy(zb).unwrap()).abs()
+            < 1e-8
+    );
+
+    // Orders against the finest run; invariants.
+    let end = |m: &str, n: usize| integrate(&chart, m, &z0, t / n as f64, n, n).unwrap();
+    let zr = za.to_vec();
+    for (m, order, n) in [
+        ("midpoint", 2.0, 20),
+        ("midpoint4", 4.0, 10),
+        ("rkmk4", 4.0, 20),
+    ] {
+        let e1 = dist(end(m, n).state(1), &zr);
+        let e2 = dist(end(m, 2 * n).state(1), &zr);
+        let observed = (e1 / e2).log2();
+        assert!(
+            (observed - order).abs() < 0.3,
+            "{m}: {observed} ({e1:e}, {e2:e})"
+        );
+    }
+    let long = integrate(&chart, "midpoint", &z0, 0.05, 2000, 20).unwrap();
+    let (h0, i0) = (chart.energy(&z0).unwrap(), chart.invariants(&z0).unwrap());
+    let mut worst_h = 0.0f64;
+    for k in 0..long.len() {
+        let z = long.state(k);
+        worst_h = worst_h.max((chart.energy(z).unwrap() - h0).abs() / h0);
+        let i = chart.invariants(z).unwrap();
+        assert!(
+            (i[0] - i0[0]).abs() < 1e-13 * i0[0],
+            "H − T: {} vs {}",
+            i[0],
+            i0[0]
+        );
+        assert!((i[1] - i0[1]).abs() < 1e-13 * i0[1], "|Π|²");
+    }
+    assert!(worst_h < 1e-3, "H: {worst_h}");
 }

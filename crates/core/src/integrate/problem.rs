@@ -283,6 +283,15 @@ pub trait GroupField: Problem {
     /// dexp⁻¹_u(v) ∈ g (the inverse of the right-trivialized derivative of exp at u, applied to
     /// v); non-finite values where u lies outside the domain the implementation supports.
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut Self::Scratch);
+
+    /// The relative accuracy the generator is known to: the implicit Lie-group methods accept
+    /// an iterate whose update is below the larger of this and [`crate::convergence::TOL`].
+    /// [`crate::convergence::TOL`] by default; a generator computed by finite differences, whose
+    /// round-off is amplified far above ε, declares its own (else a step that has converged to
+    /// the field's own noise would be reported as a failure).
+    fn solve_tolerance(&self) -> f64 {
+        crate::convergence::TOL
+    }
 }
 
 /// A system with a symmetry: a momentum map J: state → g* and the infinitesimal generators of

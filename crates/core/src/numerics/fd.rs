@@ -68,6 +68,25 @@ where
     Ok(())
 }
 
+/// The fourth-order central difference (8(f(x + h) − f(x − h)) − (f(x + 2h) − f(x − 2h)))/12h of a
+/// fixed-size map along coordinate k, with the step h·max(1, |x_k|) (the closed-form charts'
+/// derivative checks and the numerical surfaces and 3-manifolds; no allocation).
+pub(crate) fn diff4<const D: usize, const N: usize>(
+    f: impl Fn([f64; D]) -> [f64; N],
+    x: [f64; D],
+    k: usize,
+    h: f64,
+) -> [f64; N] {
+    let h = h * x[k].abs().max(1.0);
+    let at = |t: f64| {
+        let mut y = x;
+        y[k] += t;
+        f(y)
+    };
+    let (p1, m1, p2, m2) = (at(h), at(-h), at(2.0 * h), at(-2.0 * h));
+    std::array::from_fn(|i| (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -33,8 +33,8 @@ pub mod user;
 pub use rolling::{RollingDisks, RollingSpheres};
 pub use tangent_top::{
     ChargedParticle, FrameTop, Graph, HyperbolicPlane, MetricSurface, Plane, Potential,
-    PotentialValue, RelativisticTangentTop, Revolution, SpaceForm, Sphere, StaticFieldTop, Surface,
-    TangentTop, WeakFieldTop,
+    PotentialValue, RelativisticTangentTop, Revolution, Riemannian, RiemannianFrameTop, SpaceForm,
+    SpaceTop, Sphere, StaticFieldTop, Surface, TangentTop, WeakFieldTop,
 };
 pub use test_problems::{Pendulum, RollingDisk, SphereParticle};
 pub use tops::methods::{Dmv, Exact, ExactSplitting, Isospectral, Lgvi};

@@ -22,7 +22,7 @@
 //!
 //! **The implicit solve** is a fixed-point iteration from k = h ξ(z) (a contraction for
 //! h·Lip(ξ) < 2) under the rule of [`crate::convergence`] ([`RULE`]: ‖Δk‖_∞ relative to
-//! max(‖k‖_∞, 1), accepted below 10⁻¹², then on until the update vanishes or stops decreasing,
+//! max(‖k‖_∞, 1), accepted below 10⁻¹² or the field's own [`GroupField::solve_tolerance`], then on until the update vanishes or stops decreasing,
 //! so that an early stop does not leave a systematic O(tol) energy drift);
 //! [`crate::Error::NotConverged`] names a step whose update is still above the tolerance after
 //! [`RULE`]`.max_iter` iterations. A non-finite increment stops the run with
@@ -138,7 +138,10 @@ impl<P: GroupField> MidpointStepper<P> {
         } = self;
         problem.generator(y, k, scratch);
         k.iter_mut().for_each(|x| *x *= h);
-        let mut monitor = Monitor::new(RULE);
+        let mut monitor = Monitor::new(Rule {
+            tol: problem.solve_tolerance().max(RULE.tol),
+            ..RULE
+        });
         loop {
             for (hi, ki) in half.iter_mut().zip(k.iter()) {
                 *hi = 0.5 * ki;
@@ -206,7 +209,7 @@ impl<P: GroupField> Stepper for MidpointStepper<P> {
                             s,
                             "Lie midpoint fixed-point iteration",
                             failed,
-                            RULE.tol,
+                            self.problem.solve_tolerance().max(RULE.tol),
                         ))
                     }
                 }

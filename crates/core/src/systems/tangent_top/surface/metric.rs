@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use super::{det, finite2, inner, Mat2, Surface, Vec2};
 use crate::error::{Error, Result};
+use crate::numerics::fd::diff4;
 
 /// A closure of the chart returning a 2×2 matrix.
 pub type MatrixField = Arc<dyn Fn(Vec2) -> Mat2 + Send + Sync>;
@@ -35,18 +36,6 @@ impl fmt::Debug for MetricSurface {
 const H1: f64 = 7e-4;
 /// Step of the differences of α.
 const H2: f64 = 5e-3;
-
-/// Fourth-order central difference of f along coordinate k at x with step h·max(1, |x_k|).
-fn diff4<const N: usize>(f: impl Fn(Vec2) -> [f64; N], x: Vec2, k: usize, h: f64) -> [f64; N] {
-    let h = h * x[k].abs().max(1.0);
-    let at = |t: f64| {
-        let mut y = x;
-        y[k] += t;
-        f(y)
-    };
-    let (p1, m1, p2, m2) = (at(h), at(-h), at(2.0 * h), at(-2.0 * h));
-    std::array::from_fn(|i| (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h))
-}
 
 fn flat(m: Mat2) -> [f64; 4] {
     [m[0][0], m[0][1], m[1][0], m[1][1]]

@@ -48,9 +48,13 @@
 //! ⟨A, B⟩ = ½tr(AᵀB) and 𝕁 = diag(m r², m r², m r², 𝕀) in the e_ij coordinates of (Ω, v)
 //! ([`FrameTop::group_inertia`]): M = 𝕁ξ and Ṁ = [M, ξ].
 //!
-//! State z = (g row-major, 16 values; Π; P), 22 values; [`FrameTop::state`] makes it from
+//! State z = (g row-major, 16 values; Π; P), 22 values; [`SpaceTop::state`] makes it from
 //! (x, R, ẋ, ω) with R the frame relative to the reference field Ê(x). The kernels work in the
 //! principal axes of 𝕀 (`to_internal`).
+
+mod riemannian;
+
+pub use riemannian::RiemannianFrameTop;
 
 use super::space_form::SpaceForm;
 use crate::check;
@@ -64,18 +68,114 @@ use crate::systems::tops::methods::exact::relative_attitude;
 use crate::systems::tops::top;
 use nalgebra::{Matrix3, Matrix4, Vector3};
 
-/// The tangent Euler top on a three-dimensional space form (module docs).
+/// The body a top carries: mass, inertia tensor and its principal axes (shared by [`FrameTop`]
+/// and [`RiemannianFrameTop`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct FrameTop {
-    space: SpaceForm,
+pub struct Body {
     mass: f64,
     /// Principal moments (the kernels' frame).
     moments: [f64; 3],
     /// 𝕀 = V diag(moments) Vᵀ in the user's body frame (None: diagonal already).
-    frame: Option<Matrix3<f64>>,
+    axes: Option<Matrix3<f64>>,
     /// 𝕀 and 𝕀⁻¹ in the user's body frame.
     inertia: Matrix3<f64>,
     inertia_inv: Matrix3<f64>,
+}
+
+impl Body {
+    /// Mass m > 0 and the inertia tensor 𝕀 (3×3 row-major, symmetric positive definite).
+    pub fn new(mass: f64, inertia: &[f64; 9]) -> Result<Self> {
+        check::positive("mass", mass)?;
+        let (moments, q) = top::principal_frame(inertia)?;
+        let a = Matrix3::from_row_slice(inertia);
+        let a = (a + a.transpose()) * 0.5;
+        let inv = a
+            .try_inverse()
+            .ok_or_else(|| Error::invalid("inertia", "the inertia tensor is singular"))?;
+        let diagonal = (0..3).all(|i| (0..3).all(|j| i == j || inertia[3 * i + j] == 0.0));
+        Ok(Body {
+            mass,
+            moments,
+            axes: (!diagonal).then_some(q),
+            inertia: a,
+            inertia_inv: inv,
+        })
+    }
+
+    /// The mass m.
+    pub fn mass(&self) -> f64 {
+        self.mass
+    }
+
+    /// The inertia tensor 𝕀 (user body frame).
+    pub fn inertia(&self) -> Matrix3<f64> {
+        self.inertia
+    }
+
+    /// The principal moments (the kernels' frame).
+    pub(crate) fn moments(&self) -> &[f64; 3] {
+        &self.moments
+    }
+
+    /// The principal axes V (𝕀 = V diag(moments) Vᵀ), None when 𝕀 is diagonal.
+    pub(crate) fn axes(&self) -> Option<&Matrix3<f64>> {
+        self.axes.as_ref()
+    }
+}
+
+/// What both tops give (the binding reads either through it): the state from (x, R, ẋ, ω) and
+/// back, and the two conserved energies. Points and velocities are ambient components on a space
+/// form, chart components on a Riemannian chart.
+pub trait SpaceTop: Problem {
+    /// The body.
+    fn body(&self) -> &Body;
+
+    /// The number of components of a point (and of a velocity).
+    fn point_dim(&self) -> usize;
+
+    /// The flat state of the body at x with frame Ê(x)R, velocity ẋ and angular velocity ω
+    /// relative to parallel transport (body frame). Checked: x in the space, ẋ tangent, R ∈
+    /// SO(3), all finite.
+    fn state(
+        &self,
+        x: &[f64],
+        r: &Matrix3<f64>,
+        xdot: &[f64],
+        omega: &Vector3<f64>,
+    ) -> Result<Vec<f64>>;
+
+    /// x: the centre's point.
+    fn position(&self, z: &[f64]) -> Result<Vec<f64>>;
+
+    /// R: the body frame relative to the reference frame Ê(x).
+    fn frame(&self, z: &[f64]) -> Result<Matrix3<f64>>;
+
+    /// ẋ.
+    fn velocity(&self, z: &[f64]) -> Result<Vec<f64>>;
+
+    /// Π = 𝕀ω (user body frame).
+    fn spin(&self, z: &[f64]) -> Result<Vector3<f64>>;
+
+    /// T = ½ m g(ẋ, ẋ), the translational energy (conserved).
+    fn translational_energy(&self, z: &[f64]) -> Result<f64>;
+
+    /// ω = 𝕀⁻¹Π, the angular velocity relative to parallel transport (body frame).
+    fn angular_velocity(&self, z: &[f64]) -> Result<Vector3<f64>> {
+        Ok(self.body().inertia_inv * self.spin(z)?)
+    }
+
+    /// H − T = ½ Π·𝕀⁻¹Π, the rotational energy (conserved: 002 §V's "H − T").
+    fn rotational_energy(&self, z: &[f64]) -> Result<f64> {
+        let pi = self.spin(z)?;
+        Ok(0.5 * pi.dot(&(self.body().inertia_inv * pi)))
+    }
+}
+
+/// The tangent Euler top on a three-dimensional space form (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameTop {
+    space: SpaceForm,
+    body: Body,
 }
 
 /// The working state of the kernels (principal frame): the frame g and the momenta (Π, P).
@@ -90,21 +190,9 @@ impl FrameTop {
     /// A top of mass m > 0 with the inertia tensor 𝕀 (3×3 row-major, symmetric positive
     /// definite) on `space`.
     pub fn new(space: SpaceForm, mass: f64, inertia: &[f64; 9]) -> Result<Self> {
-        check::positive("mass", mass)?;
-        let (moments, q) = top::principal_frame(inertia)?;
-        let a = Matrix3::from_row_slice(inertia);
-        let a = (a + a.transpose()) * 0.5;
-        let inv = a
-            .try_inverse()
-            .ok_or_else(|| Error::invalid("inertia", "the inertia tensor is singular"))?;
-        let diagonal = (0..3).all(|i| (0..3).all(|j| i == j || inertia[3 * i + j] == 0.0));
         Ok(FrameTop {
             space,
-            mass,
-            moments,
-            frame: (!diagonal).then_some(q),
-            inertia: a,
-            inertia_inv: inv,
+            body: Body::new(mass, inertia)?,
         })
     }
 
@@ -113,73 +201,10 @@ impl FrameTop {
         self.space
     }
 
-    /// The mass m.
-    pub fn mass(&self) -> f64 {
-        self.mass
-    }
-
-    /// The inertia tensor 𝕀 (user body frame).
-    pub fn inertia(&self) -> Matrix3<f64> {
-        self.inertia
-    }
-
-    /// The flat state (g, Π, P) of the body at x with frame Ê(x)R, velocity ẋ (ambient, tangent)
-    /// and angular velocity ω relative to parallel transport (body frame). Checked: x on the
-    /// space, ẋ tangent, R ∈ SO(3), all finite.
-    pub fn state(
-        &self,
-        x: &[f64],
-        r: &Matrix3<f64>,
-        xdot: &[f64],
-        omega: &Vector3<f64>,
-    ) -> Result<Vec<f64>> {
-        self.space.check_point(x)?;
-        self.space.check_tangent(x, xdot)?;
-        check::finite_slice("omega", omega.as_slice())?;
-        so3::check_rotation("R", r)?;
-        let mut d = Matrix4::identity();
-        d.fixed_view_mut::<3, 3>(1, 1).copy_from(r);
-        let g = self.space.reference(x) * d;
-        let v = self.space.body(&g, xdot);
-        Ok(flat(&g, &(self.inertia * omega), &(v * self.mass)))
-    }
-
     fn split(&self, z: &[f64]) -> Result<(Matrix4<f64>, Vector3<f64>, Vector3<f64>)> {
         check::len_of("state", z, 22)?;
         check::finite_slice("state", z)?;
         Ok(unflat(z))
-    }
-
-    /// x: the centre's point (ambient components).
-    pub fn position(&self, z: &[f64]) -> Result<Vec<f64>> {
-        Ok(self.space.position(&self.split(z)?.0))
-    }
-
-    /// R: the body frame relative to the reference frame Ê(x).
-    pub fn frame(&self, z: &[f64]) -> Result<Matrix3<f64>> {
-        Ok(self.space.relative_frame(&self.split(z)?.0))
-    }
-
-    /// ẋ = Σ v_i e_i (ambient components), v = P/m.
-    pub fn velocity(&self, z: &[f64]) -> Result<Vec<f64>> {
-        let (g, _, p) = self.split(z)?;
-        Ok(self.space.ambient(&g, &(p / self.mass)))
-    }
-
-    /// ω = 𝕀⁻¹Π, the angular velocity relative to parallel transport (body frame).
-    pub fn angular_velocity(&self, z: &[f64]) -> Result<Vector3<f64>> {
-        Ok(self.inertia_inv * self.split(z)?.1)
-    }
-
-    /// T = |P|²/2m, the translational energy (conserved).
-    pub fn translational_energy(&self, z: &[f64]) -> Result<f64> {
-        Ok(self.split(z)?.2.norm_squared() / (2.0 * self.mass))
-    }
-
-    /// H − T = ½ Π·𝕀⁻¹Π, the rotational energy (conserved: 002 §V's "H − T").
-    pub fn rotational_energy(&self, z: &[f64]) -> Result<f64> {
-        let pi = self.split(z)?.1;
-        Ok(0.5 * pi.dot(&(self.inertia_inv * pi)))
     }
 
     /// (C₁, C₂) = (Π·P, |P|² + κ|Π|²), the Casimirs of g_κ*.
@@ -243,11 +268,11 @@ impl FrameTop {
     /// (ξ₁₂, ξ₁₃, ξ₂₃) = (−Ω₃, Ω₂, −Ω₁) (row-major). An error on the other spaces.
     pub fn group_inertia(&self) -> Result<[f64; 36]> {
         self.sphere_only("group_inertia")?;
-        let mr2 = self.mass * self.space.length().powi(2);
+        let mr2 = self.body.mass * self.space.length().powi(2);
         // The rotation coordinates c = (ξ₁₂, ξ₁₃, ξ₂₃) = B Ω with B = [[0,0,−1],[0,1,0],[−1,0,0]]
         // (B = B⁻¹ = Bᵀ): 𝕁_rot = B 𝕀 B.
         let b = Matrix3::new(0.0, 0.0, -1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0);
-        let rot = b * self.inertia * b;
+        let rot = b * self.body.inertia * b;
         let mut j = [0.0; 36];
         for i in 0..3 {
             j[6 * i + i] = mr2;
@@ -276,10 +301,10 @@ impl FrameTop {
     /// T over τ (module docs).
     /// Both factors by increments (g + g(exp ξ̂ − 1), then rows turned by `so3::Rodrigues`).
     fn flow_t(&self, tau: f64, w: &mut FrameWork) {
-        let kp = self.space.curvature() / self.mass;
+        let kp = self.space.curvature() / self.body.mass;
         let d = self
             .space
-            .expm1(&(w.pi * (tau * kp)), &(w.p * (tau / self.mass)));
+            .expm1(&(w.pi * (tau * kp)), &(w.p * (tau / self.body.mass)));
         w.g += w.g * d;
         // g ← g diag(1, exp(−τκ′Π̂)): each row r of the frame block becomes exp(τκ′Π̂)r; and
         // P ← exp(τκ′Π̂)P.
@@ -297,7 +322,7 @@ impl FrameTop {
     /// ½Π_k²/I_k over τ: the rotation about e_k by θ = τΠ_k/I_k (Π, P by Sᵀ, the frame by S).
     fn flow_axis(&self, k: usize, tau: f64, w: &mut FrameWork) {
         // One (sin θ, cos θ − 1) for the six vectors the rotation turns.
-        let (s, cm1) = crate::numerics::simd::angle_sin_cosm1(tau * w.pi[k] / self.moments[k]);
+        let (s, cm1) = crate::numerics::simd::angle_sin_cosm1(tau * w.pi[k] / self.body.moments[k]);
         top::rotate_axis_sc(&mut w.pi, k, s, cm1);
         top::rotate_axis_sc(&mut w.p, k, s, cm1);
         for row in 0..4 {
@@ -311,7 +336,7 @@ impl FrameTop {
 
     /// The free rigid body's exact flow over τ (E = ½Π·𝕀⁻¹Π).
     fn flow_rotation(&self, tau: f64, w: &mut FrameWork) {
-        let rel = relative_attitude(&self.moments, &w.pi, tau);
+        let rel = relative_attitude(&self.body.moments, &w.pi, tau);
         rel.apply_momentum(&mut w.pi);
         rel.apply(&mut w.p);
         for row in 0..4 {
@@ -321,6 +346,64 @@ impl FrameTop {
                 w.g[(row, c + 1)] = v[c];
             }
         }
+    }
+}
+
+impl SpaceTop for FrameTop {
+    fn body(&self) -> &Body {
+        &self.body
+    }
+
+    /// 3 on ℝ³, 4 on S³ and H³ (ambient components).
+    fn point_dim(&self) -> usize {
+        self.space.ambient_dim()
+    }
+
+    /// The state (g, Π, P); x and ẋ ambient, ẋ tangent at x.
+    fn state(
+        &self,
+        x: &[f64],
+        r: &Matrix3<f64>,
+        xdot: &[f64],
+        omega: &Vector3<f64>,
+    ) -> Result<Vec<f64>> {
+        self.space.check_point(x)?;
+        self.space.check_tangent(x, xdot)?;
+        check::finite_slice("omega", omega.as_slice())?;
+        so3::check_rotation("R", r)?;
+        let mut d = Matrix4::identity();
+        d.fixed_view_mut::<3, 3>(1, 1).copy_from(r);
+        let g = self.space.reference(x) * d;
+        let v = self.space.body(&g, xdot);
+        Ok(flat(
+            &g,
+            &(self.body.inertia * omega),
+            &(v * self.body.mass),
+        ))
+    }
+
+    /// Ambient components.
+    fn position(&self, z: &[f64]) -> Result<Vec<f64>> {
+        Ok(self.space.position(&self.split(z)?.0))
+    }
+
+    fn frame(&self, z: &[f64]) -> Result<Matrix3<f64>> {
+        Ok(self.space.relative_frame(&self.split(z)?.0))
+    }
+
+    /// ẋ = Σ v_i e_i (ambient components), v = P/m.
+    fn velocity(&self, z: &[f64]) -> Result<Vec<f64>> {
+        let (g, _, p) = self.split(z)?;
+        Ok(self.space.ambient(&g, &(p / self.body.mass)))
+    }
+
+    fn spin(&self, z: &[f64]) -> Result<Vector3<f64>> {
+        Ok(self.split(z)?.1)
+    }
+
+    /// |P|²/2m.
+    fn translational_energy(&self, z: &[f64]) -> Result<f64> {
+        Ok(self.split(z)?.2.norm_squared() / (2.0 * self.body.mass))
     }
 }
 
@@ -391,7 +474,7 @@ impl Problem for FrameTop {
 
     /// The principal frame of 𝕀: g ← g diag(1, V), Π ← VᵀΠ, P ← VᵀP.
     fn to_internal(&self, z: &mut [f64]) {
-        if let Some(v) = &self.frame {
+        if let Some(v) = &self.body.axes {
             let (mut g, pi, p) = unflat(z);
             turn_frame(&mut g, v);
             write(&g, &(v.transpose() * pi), &(v.transpose() * p), z);
@@ -399,7 +482,7 @@ impl Problem for FrameTop {
     }
 
     fn to_user(&self, z: &mut [f64]) {
-        if let Some(v) = &self.frame {
+        if let Some(v) = &self.body.axes {
             let (mut g, pi, p) = unflat(z);
             turn_frame(&mut g, &v.transpose());
             write(&g, &(v * pi), &(v * p), z);
@@ -437,10 +520,10 @@ impl Split for FrameTop {
 impl VectorField for FrameTop {
     fn field(&self, z: &[f64], dz: &mut [f64]) {
         let (g, pi, p) = unflat(z);
-        let omega = Vector3::from_fn(|k, _| pi[k] / self.moments[k]);
-        let v = p / self.mass;
+        let omega = Vector3::from_fn(|k, _| pi[k] / self.body.moments[k]);
+        let v = p / self.body.mass;
         let gd = g * self.space.hat(&omega, &v);
-        let kp = self.space.curvature() / self.mass;
+        let kp = self.space.curvature() / self.body.mass;
         write(
             &gd,
             &pi.cross(&omega),
