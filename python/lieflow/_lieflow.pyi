@@ -386,8 +386,9 @@ class TangentTop(System):
 
 @final
 class FrameTop(System):
-    """The tangent Euler top on a three-dimensional space form (002 §V); exact, splitting,
-    splitting4, splitting6, rk4."""
+    """The tangent Euler top on a three-dimensional space (002 §V): on a space form exact,
+    splitting, splitting4, splitting6, rk4; on a Riemannian chart midpoint, midpoint4, midpoint6,
+    rkmk4, rk4."""
 
     def __new__(cls, space: Any, mass: float, inertia: ArrayLike) -> Self: ...
     @property

@@ -94,8 +94,8 @@ FORMAT = 2
 #: calls nothing else: a spec naming another callable, or holding anything but None, booleans,
 #: numbers, strings, numeric arrays, complex numbers, lists, tuples and calls of these, is a
 #: FileFormatError. The systems built from Python callables (``Canonical``, ``Separable``, the
-#: ``Callable`` potential, the ``Revolution``, ``Graph`` and ``MetricSurface`` surfaces, a
-#: ``Forced`` force function) are never data and are not listed.
+#: ``Callable`` potential, the ``Revolution``, ``Graph`` and ``MetricSurface`` surfaces, the
+#: ``Riemannian`` space, a ``Forced`` force function) are never data and are not listed.
 ALLOWED_CALLS = frozenset({
     "lieflow:ChargedParticle",
     "lieflow:EulerPoincare",

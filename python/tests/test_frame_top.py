@@ -234,3 +234,123 @@ def test_for_n_greater_than_three_the_spin_is_the_free_rigid_body_on_so_n():
     for i, j in pairs[4:]:
         i, j = i - 1, j - 1
         assert 1 / (J[i] + J[j]) - c == pytest.approx((bb[i] - bb[j]) / (aa[i] - aa[j]), rel=1e-13)
+
+
+# ---- the top on a Riemannian chart (lf.spaces.Riemannian) ----
+
+R3 = 1.3
+
+
+def stereo_metric(y1, y2, y3):
+    """S^3(R3) in the stereographic chart from its south pole: g = 4 R3^2 / (1 + |y|^2)^2."""
+    lam = 2 * R3 / (1 + y1 * y1 + y2 * y2 + y3 * y3)
+    return lam * lam * np.eye(3)
+
+
+def stereo_frame(y1, y2, y3):
+    return (1 + y1 * y1 + y2 * y2 + y3 * y3) / (2 * R3) * np.eye(3)
+
+
+def stereo(y):
+    s = y @ y
+    return R3 * np.concatenate([[(1 - s) / (1 + s)], 2 * y / (1 + s)])
+
+
+def stereo_jacobian(y):
+    s = y @ y
+    d = (1 + s) ** 2
+    top = -4 * R3 * y / d
+    rest = 2 * R3 * ((1 + s) * np.eye(3) - 2 * np.outer(y, y)) / d
+    return np.vstack([top, rest])
+
+
+def test_on_a_stereographic_chart_of_the_three_sphere_the_same_motion():
+    """The chart's top (metric and frame as callables) against FrameTop on Sphere(3): the centre
+    and the body axes in R^4, the angular velocity and T agree to the differences' accuracy;
+    H - T and Pi.Pi are kept to round-off, T oscillates without drift."""
+    chart = lf.FrameTop(lf.spaces.Riemannian(stereo_metric, stereo_frame), M, INERTIA)
+    assert chart.methods() == ["midpoint", "midpoint4", "midpoint6", "rkmk4", "rk4"]
+    group = lf.FrameTop(lf.spaces.Sphere(3, radius=R3), M, INERTIA)
+    y0, yd0, R0 = np.array([0.3, -0.2, 0.5]), np.array([0.4, 0.1, -0.3]), rot([0.4, -0.7, 0.3])
+    w0 = [0.7, -0.4, 1.1]
+    z0 = chart.state(y0, R0, yd0, w0)
+    assert z0.shape == (18,)
+    np.testing.assert_allclose(chart.position(z0), y0)
+    np.testing.assert_allclose(chart.velocity(z0), yd0, atol=1e-12)
+    np.testing.assert_allclose(chart.frame(z0), R0)
+    x0 = stereo(y0)
+    J = stereo_jacobian(y0)
+    axes = J @ chart.space.reference_frame(y0) @ R0
+    g0 = group.state(x0, group.space.reference_frame(x0).T @ axes, J @ yd0, w0)
+    a = lf.integrate(chart, z0, dt=0.05, steps=20, method="midpoint6")
+    b = lf.integrate(group, g0, dt=0.05, steps=20)
+    ya = chart.position(a.states)
+    np.testing.assert_allclose(np.array([stereo(y) for y in ya]), group.position(b.states),
+                               atol=1e-8)
+    got = np.array([stereo_jacobian(y) @ chart.space.reference_frame(y) @ r
+                    for y, r in zip(ya, chart.frame(a.states))])
+    want = group.space.reference_frame(group.position(b.final_state)) @ group.frame(b.final_state)
+    np.testing.assert_allclose(got[-1], want, atol=1e-8)
+    np.testing.assert_allclose(chart.angular_velocity(a.states), group.angular_velocity(b.states),
+                               atol=1e-12)
+    np.testing.assert_allclose(chart.translational_energy(a.states),
+                               group.translational_energy(b.states), rtol=1e-8)
+    inv = chart.invariants(a.states)
+    np.testing.assert_allclose(inv, np.broadcast_to(inv[0], inv.shape), rtol=1e-13)
+    np.testing.assert_allclose(chart.rotational_energy(a.states),
+                               group.rotational_energy(b.states), rtol=1e-13)
+
+
+def test_a_chart_of_flat_space_with_a_turning_frame_is_the_euclidean_top():
+    """A rotating orthonormal frame of flat space: the motion is a free particle and a free rigid
+    body whatever the frame (its connection enters the spin's coupling and cancels)."""
+    def turning(x1, x2, x3):
+        return rot([0.3 * x1, -0.2 * x3, 0.4 * x1 * x2]).T     # rows = the frame vectors
+
+    chart = lf.FrameTop(lf.spaces.Riemannian(lambda *x: np.eye(3), turning), M, INERTIA)
+    x, v, R = np.array([0.3, -0.2, 1.0]), np.array([0.4, 0.1, -0.3]), rot([0.4, -0.7, 0.3])
+    traj = lf.integrate(chart, chart.state(x, R, v, [0.7, -0.4, 1.1]), dt=0.05, steps=20,
+                        method="midpoint4")
+    flat = lf.FrameTop(lf.spaces.Euclidean(3), M, INERTIA)
+    Q0 = turning(*x).T
+    ref = lf.integrate(flat, flat.state(x, Q0 @ R, v, [0.7, -0.4, 1.1]), dt=1.0, steps=1)
+    xe = chart.position(traj.final_state)
+    np.testing.assert_allclose(xe, x + v, atol=1e-9)
+    np.testing.assert_allclose(turning(*xe).T @ chart.frame(traj.final_state),
+                               flat.frame(ref.final_state), atol=1e-8)
+
+
+def within_three(y1, y2, y3):
+    return y1 * y1 + y2 * y2 + y3 * y3 < 9.0
+
+
+def test_a_chart_pickles_refuses_what_it_lacks_and_raises_its_callables_exceptions():
+    space = lf.spaces.Riemannian(stereo_metric, stereo_frame, within_three)
+    top = lf.FrameTop(space, M, [1.0, 2.0, 3.0])
+    again = pickle.loads(pickle.dumps(top))
+    z = top.state([0.1, 0.2, 0.3], np.eye(3), [0.1, 0, 0], [0, 0, 1.0])
+    np.testing.assert_array_equal(again.state([0.1, 0.2, 0.3], np.eye(3), [0.1, 0, 0],
+                                              [0, 0, 1.0]), z)
+    assert space == space and space != lf.spaces.Riemannian(stereo_metric, stereo_frame)
+    space.check_frame([0.1, 0.2, 0.3])
+    with pytest.raises(lf.InvalidArgumentError, match="g\\(Ê_1, Ê_1\\)"):
+        lf.spaces.Riemannian(stereo_metric, lambda *y: np.eye(3)).check_frame([0.1, 0.2, 0.3])
+    with pytest.raises(lf.InvalidArgumentError, match="check_frame"):
+        lf.spaces.Sphere(3).check_frame([0.1, 0.2, 0.3])
+    for what in ("killing_momenta", "group_momentum"):
+        with pytest.raises(lf.InvalidArgumentError, match="Killing"):
+            getattr(top, what)(z)
+    with pytest.raises(lf.InvalidArgumentError, match="curvature"):
+        space.curvature
+    with pytest.raises(lf.InvalidArgumentError, match="outside the chart"):
+        top.state([3.0, 0.0, 0.5], np.eye(3), [0.1, 0, 0], [0, 0, 1.0])
+
+    def failing(y1, y2, y3):
+        if y1 > 0.15:
+            raise ZeroDivisionError("metric fails here")
+        return stereo_metric(y1, y2, y3)
+
+    bad = lf.FrameTop(lf.spaces.Riemannian(failing, stereo_frame), M, [1.0, 2.0, 3.0])
+    z0 = bad.state([0.1, 0.0, 0.0], np.eye(3), [1.0, 0, 0], [0, 0, 1.0])
+    with pytest.raises(ZeroDivisionError, match="fails here"):
+        lf.integrate(bad, z0, dt=0.02, steps=20)

@@ -126,6 +126,11 @@ def _exercise(obj, target, lf):
         return {**{k: v.values for k, v in ds.variables.items()}, "attrs": dict(ds.attrs)}
     if "potentials" in target:
         return obj.value(X3), obj.gradient(X3), obj.hessian(X3, V3)
+    if target.endswith("spaces.Riemannian"):     # through a top on it: state and two steps
+        x, v = np.array([0.3, -0.2, 0.5]), np.array([0.4, 0.1, -0.3])
+        top = lf.FrameTop(obj, 1.3, [2.0, 3.0, 4.0])
+        z = top.state(x, np.eye(3), v, [0.7, -0.4, 1.1])
+        return obj.reference_frame(x), lf.integrate(top, z, dt=0.05, steps=2).final_state
     key = {"Revolution": "revolution", "Graph": "graph", "MetricSurface": "metric"}[target.split(".")[-1]]
     x = SURFACE_POINT[key]
     return obj.curvature(x), obj.metric(x), obj.frame(x), obj.connection(x)

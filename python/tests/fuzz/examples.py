@@ -151,6 +151,20 @@ def inside(t, p):
     return 0.0 < t < math.pi
 
 
+def conformal_metric(x1, x2, x3):
+    s = 1.0 + 0.1 * (x1 * x1 + x2 * x2 + x3 * x3)
+    return [[s * s, 0.0, 0.0], [0.0, s * s, 0.0], [0.0, 0.0, s * s]]
+
+
+def conformal_frame(x1, x2, x3):
+    s = 1.0 + 0.1 * (x1 * x1 + x2 * x2 + x3 * x3)
+    return [[1.0 / s, 0.0, 0.0], [0.0, 1.0 / s, 0.0], [0.0, 0.0, 1.0 / s]]
+
+
+def ball(x1, x2, x3):
+    return x1 * x1 + x2 * x2 + x3 * x3 < 25.0
+
+
 class _Parts(list):
     """A list that the harness's mutation check compares with itself (its deepcopy is itself):
     Trajectory has no value equality (== is identity), so a copy would always differ."""
@@ -226,6 +240,8 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "rrb": lambda lf: lf.pseudo_rigid.RightReduced(3, _svk(lf), reconstruct=True),
     "ft": lambda lf: lf.FrameTop(lf.spaces.Sphere(3, radius=1.5), 1.3, A3),
     "s3": lambda lf: lf.spaces.Sphere(3, radius=1.5),
+    "chart": lambda lf: lf.spaces.Riemannian(conformal_metric, conformal_frame, ball),
+    "ftc": lambda lf: lf.FrameTop(lf.spaces.Riemannian(conformal_metric, conformal_frame), 1.3, A3),
     "rtt": lambda lf: lf.RelativisticTangentTop(1.0, 0.2, lf.surfaces.Sphere(1.0)),
     "wft": lambda lf: lf.WeakFieldTop(1.0, 1e-3, gm=1e-4),
     "sft": lambda lf: lf.StaticFieldTop(1.0, 0.2, gm=0.15),
@@ -267,7 +283,8 @@ RECEIVER_MODULE = {**{k: "potentials" for k in ("harmonic", "svk", "volumetric",
                                                   "sum", "callable", "selfgrav")},
                    **{k: "surfaces" for k in ("plane", "sphere", "hyp", "torus", "quadric",
                                               "revolution", "graph", "metric")},
-                   "releq": "pseudo_rigid", "branch": "pseudo_rigid", "s3": "spaces"}
+                   "releq": "pseudo_rigid", "branch": "pseudo_rigid", "s3": "spaces",
+                   "chart": "spaces"}
 # The point of each surface's chart used for its methods.
 SURFACE_POINT = {"plane": [0.2, -0.1], "sphere": [1.0, 0.3], "hyp": [0.1, 1.0],
                  "torus": [0.9, 0.4], "quadric": [0.3, -0.4], "revolution": [0.9, 0.4],
@@ -290,6 +307,7 @@ def state_of(key):
                                               s.project_momentum(X3, V3).ravel()]),
         "rrb": lambda lf, s: s.reduce(X3, V3),
         "ft": lambda lf, s: s.state(FT_X, R3, FT_V, W3),
+        "ftc": lambda lf, s: s.state(FT_X[:3], R3, FT_V[:3], W3),
         "rtt": lambda lf, s: np.asarray(s.state([1.2, 0.3], 0.5, [0.3, 0.4], 2.0)),
         "wft": lambda lf, s: np.asarray(s.state([1.0, 0.5], 0.1, [0.1, 0.2], 0.3)),
         "sft": lambda lf, s: np.asarray(s.state([1.0, 0.0], 0.3, [0.05, 0.38], 1.2)),
@@ -754,6 +772,8 @@ def build_specs() -> list[Spec]:
     for f in ("Sphere", "Hyperbolic"):
         add("spaces." + f, "spaces." + f, A("n", 3, "int", opt=True),
             A("radius", 1.5, "float", opt=True, positive=True))
+    add("spaces.Riemannian", "use:spaces.Riemannian", A("metric", conformal_metric, "fn"),
+        A("frame", conformal_frame, "fn"), A("domain", ball, "fn", opt=True))
     add("RollingDisk", "RollingDisk", A("mass", 1.0, "float", positive=True),
         A("radius", 0.5, "float", positive=True), A("roll_inertia", 0.125, "float", positive=True),
         A("turn_inertia", 0.0625, "float", positive=True), A("spring", 0.4, "float", kw=True),
@@ -837,6 +857,13 @@ def build_specs() -> list[Spec]:
            ("state", [A("x", FT_X, "vec"), A("R", R3, "rot"), A("xdot", FT_V, "vec"),
                       A("omega", W3, "vec")])],
         "s3": [("reference_frame", [A("x", FT_X, "vec")])],
+        "chart": [("reference_frame", [A("x", FT_X[:3], "vec")]),
+                  ("check_frame", [A("x", FT_X[:3], "vec"), A("tol", 1e-10, "float", kw=True)])],
+        "ftc": [(f, [A("states", state_of("ftc"), "vec")])
+                for f in ("position", "frame", "velocity", "angular_velocity",
+                          "translational_energy", "rotational_energy")]
+        + [("state", [A("x", FT_X[:3], "vec"), A("R", R3, "rot"), A("xdot", FT_V[:3], "vec"),
+                      A("omega", W3, "vec")])],
         "iprb": [(f, [A("states", state_of("iprb"), "vec")])
                  for f in ("angular_momentum", "circulation", "singular_values")]
         + [("project_momentum", [A("X", X3, "gl"), A("P", V3, "mat")])],

@@ -2,15 +2,15 @@
 //! `lieflow.System`.
 #![allow(non_snake_case)]
 
-use lieflow::systems::FrameTop;
+use lieflow::systems::{FrameTop, RiemannianFrameTop, SpaceTop};
 use lieflow::Error;
 use nalgebra::{Matrix3, Vector3};
 use pyo3::prelude::*;
 use pyo3::PyClassInitializer;
 
-use super::space_form::PySpace;
+use super::space_form::{Kind, PySpace};
 use crate::convert::{mat, real, vector, ArrayIn};
-use crate::errors::{to_py, IntoPy};
+use crate::errors::{checked, to_py, IntoPy};
 use crate::system::{PySystem, Thin};
 
 type Any<'py> = Bound<'py, PyAny>;
@@ -62,13 +62,39 @@ fn inertia_tensor(ob: &Any<'_>) -> PyResult<[f64; 9]> {
 /// as a baseline. States are flat: (g row-major (16), Pi (3), P (3)); make them with
 /// `top.state(x, R, xdot, omega)`. Invariants: Pi.P, P.P + kappa Pi.Pi, T, then the six Killing
 /// momenta.
+///
+/// On a chart (`lieflow.spaces.Riemannian(metric, frame)`) the top is minimally coupled to the
+/// frame's connection C: the spin still obeys the free Euler equations exactly, and the centre
+/// moves by Wong's equations of the spatial spin sigma = R Pi in C (the curvature force of
+/// 002 (122), orthogonal to xdot, so T is conserved). States (x, p, R row-major, Pi), 18 values.
+/// Methods: midpoint (default), midpoint4, midpoint6 (the Lie midpoint rule and its compositions),
+/// rkmk4, rk4; all but rk4 move the spin by its exact flow, so H - T and Pi.Pi are kept to
+/// round-off, R stays a rotation and H oscillates without drift. Invariants: H - T, Pi.Pi. No
+/// Killing momenta.
 #[pyclass(name = "FrameTop", module = "lieflow", extends = PySystem, frozen)]
 pub struct PyFrameTop {
     space: Py<PySpace>,
 }
 
-fn top<'a>(slf: &'a Bound<'_, PyFrameTop>) -> PyResult<&'a FrameTop> {
-    slf.core()
+/// The core top, on a space form or on a chart.
+fn top<'a>(slf: &'a Bound<'_, PyFrameTop>) -> PyResult<&'a dyn SpaceTop> {
+    match slf.core::<FrameTop>() {
+        Ok(t) => Ok(t),
+        Err(_) => Ok(slf.core::<RiemannianFrameTop>()?),
+    }
+}
+
+/// The top on a space form, or an InvalidArgumentError naming `what` on a chart.
+fn form_top<'a>(slf: &'a Bound<'_, PyFrameTop>, what: &str) -> PyResult<&'a FrameTop> {
+    slf.core::<FrameTop>().map_err(|_| {
+        to_py(Error::invalid(
+            what,
+            format!(
+                "{what} needs the isometries of a space form (Euclidean, Sphere, Hyperbolic); no \
+                 Killing fields are known for a Riemannian chart"
+            ),
+        ))
+    })
 }
 
 #[pymethods]
@@ -80,16 +106,23 @@ impl PyFrameTop {
         #[pyo3(from_py_with = real)] mass: f64,
         inertia: Bound<'_, PyAny>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let core = FrameTop::new(space.get().inner, mass, &inertia_tensor(&inertia)?).py()?;
+        let tensor = inertia_tensor(&inertia)?;
         let args = (space.clone(), mass, inertia).into_pyobject(py)?;
-        Ok(PySystem::init(
-            PyFrameTop {
-                space: space.unbind(),
-            },
-            core,
-            args,
-            &["space", "mass", "inertia"],
-        ))
+        let this = PyFrameTop {
+            space: space.clone().unbind(),
+        };
+        let names = &["space", "mass", "inertia"];
+        Ok(match &space.get().inner {
+            Kind::Form(form) => {
+                PySystem::init(this, FrameTop::new(*form, mass, &tensor).py()?, args, names)
+            }
+            Kind::Chart { chart, .. } => PySystem::init(
+                this,
+                RiemannianFrameTop::new(chart.clone(), mass, &tensor).py()?,
+                args,
+                names,
+            ),
+        })
     }
 
     /// The space form.
@@ -101,13 +134,13 @@ impl PyFrameTop {
     /// The mass m.
     #[getter]
     fn mass(slf: &Bound<'_, Self>) -> PyResult<f64> {
-        Ok(top(slf)?.mass())
+        Ok(top(slf)?.body().mass())
     }
 
     /// The inertia tensor, (3, 3).
     #[getter]
     fn inertia<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
-        let i = top(slf)?.inertia();
+        let i = top(slf)?.body().inertia();
         let rows: Vec<Vec<f64>> = (0..3)
             .map(|r| (0..3).map(|c| i[(r, c)]).collect())
             .collect();
@@ -123,10 +156,11 @@ impl PyFrameTop {
     ///     x: (3,) on R^3, (4,) on the sphere and the hyperboloid; R: (3, 3) rotation;
     ///     xdot: like x; omega: (3,).
     /// Returns:
-    ///     (22,) state (g row-major, Pi, P).
+    ///     (22,) state (g row-major, Pi, P) on a space form; (18,) state (x, p, R row-major,
+    ///     Pi) on a Riemannian chart, p = m g xdot + C^T R Pi the canonical momentum.
     /// Raises:
     ///     ShapeError, NonFiniteError, InvalidArgumentError (x not on the space, xdot not tangent),
-    ///     NotInGroupError (R not a rotation).
+    ///     NotInGroupError (R not a rotation), the exception of a callable.
     fn state<'py>(
         slf: &Bound<'py, Self>,
         x: ArrayIn<'_>,
@@ -152,16 +186,15 @@ impl PyFrameTop {
             )));
         }
         let (x, xd) = (vector("x", &x)?, vector("xdot", &xdot)?);
-        let z = top(slf)?
-            .state(&x, &r, &xd, &Vector3::from_column_slice(&w))
-            .py()?;
+        let t = top(slf)?;
+        let z = checked(|| t.state(&x, &r, &xd, &Vector3::from_column_slice(&w)))?;
         Ok(numpy::PyArray1::from_vec(slf.py(), z))
     }
 
     /// The centre's point x of states (..., 22) -> (..., d).
     fn position<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let t = top(slf)?;
-        let d = t.space().ambient_dim();
+        let d = t.point_dim();
         slf.base().map_states(slf.py(), &states, &[d], |z, out| {
             out.copy_from_slice(&t.position(z)?);
             Ok(())
@@ -183,7 +216,7 @@ impl PyFrameTop {
     /// The velocity xdot (ambient components): (..., 22) -> (..., d).
     fn velocity<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let t = top(slf)?;
-        let d = t.space().ambient_dim();
+        let d = t.point_dim();
         slf.base().map_states(slf.py(), &states, &[d], |z, out| {
             out.copy_from_slice(&t.velocity(z)?);
             Ok(())
@@ -206,7 +239,7 @@ impl PyFrameTop {
     /// m (xdot x^T - x xdot^T) + e hat(Pi) e^T; on R^3 the angular momentum about the origin
     /// x cross m xdot + R Pi, then the momentum m xdot. (..., 22) -> (..., 6).
     fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let t = top(slf)?;
+        let t = form_top(slf, "killing_momenta")?;
         slf.base().map_states(slf.py(), &states, &[6], |z, out| {
             out.copy_from_slice(&t.killing_momenta(z)?);
             Ok(())
@@ -221,7 +254,7 @@ impl PyFrameTop {
     /// Raises:
     ///     InvalidArgumentError (not on the sphere).
     fn group_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
-        let t = top(slf)?;
+        let t = form_top(slf, "group_momentum")?;
         t.group_inertia().py()?;
         slf.base().map_states(slf.py(), &states, &[4, 4], |z, out| {
             let m = t.group_momentum(z)?;
@@ -239,7 +272,7 @@ impl PyFrameTop {
     /// Raises:
     ///     InvalidArgumentError (not on the sphere).
     fn group_inertia<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
-        let j = top(slf)?.group_inertia().py()?;
+        let j = form_top(slf, "group_inertia")?.group_inertia().py()?;
         let rows: Vec<Vec<f64>> = (0..6).map(|r| j[6 * r..6 * r + 6].to_vec()).collect();
         numpy::PyArray2::from_vec2(slf.py(), &rows)
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))

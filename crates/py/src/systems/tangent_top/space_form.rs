@@ -1,100 +1,195 @@
-//! `lieflow.spaces`: the three-dimensional space forms of `lieflow::systems::tangent_top::space_form`
-//! (002 §V) the `FrameTop` moves on. A space pickles by the function of this module and its
-//! arguments.
+//! `lieflow.spaces`: the three-dimensional spaces the `FrameTop` moves on (002 §V): the space
+//! forms of `lieflow::systems::tangent_top::space_form` and a Riemannian chart given by callables
+//! (`lieflow::systems::tangent_top::riemannian`). A space pickles by the function of this module
+//! and its arguments.
 #![allow(non_snake_case)]
 
+use lieflow::systems::tangent_top::riemannian::Riemannian as Chart;
 use lieflow::systems::tangent_top::space_form::SpaceForm;
 use lieflow::Error;
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-use crate::convert::{int, real, vector, ArrayIn};
-use crate::errors::{to_py, IntoPy};
+use super::surface::{call_floats, callable, domain_closure};
+use crate::convert::{int, real, reals, vector, ArrayIn};
+use crate::errors::{checked, to_py, IntoPy};
 
 type Any<'py> = Bound<'py, PyAny>;
 
-/// A three-dimensional space form with a global orthonormal reference frame field Ê(x): made by
-/// `Euclidean`, `Sphere` and `Hyperbolic` of this module. Points: x in R^3 (Euclidean), unit
-/// vectors of R^4 times the radius (Sphere), the upper sheet x0^2 - x1^2 - x2^2 - x3^2 = r^2, x0 > 0, of the
-/// hyperboloid in Minkowski space (Hyperbolic; metric -a0 b0 + a.b on tangent vectors).
+/// What a `Space` is: a space form, or a chart with the callables it was made of.
+pub(crate) enum Kind {
+    Form(SpaceForm),
+    Chart {
+        chart: Chart,
+        /// (metric, frame, domain), for pickling and the repr.
+        args: Py<PyTuple>,
+    },
+}
+
+/// A three-dimensional Riemannian space with an orthonormal reference frame field Ê(x): made by
+/// `Euclidean`, `Sphere`, `Hyperbolic` and `Riemannian` of this module. Points: x in R^3
+/// (Euclidean), unit vectors of R^4 times the radius (Sphere), the upper sheet
+/// x0^2 - x1^2 - x2^2 - x3^2 = r^2, x0 > 0, of the hyperboloid in Minkowski space (Hyperbolic;
+/// metric -a0 b0 + a.b on tangent vectors), chart coordinates (Riemannian).
 #[pyclass(module = "lieflow.spaces", name = "Space", frozen)]
 pub struct PySpace {
-    pub(crate) inner: SpaceForm,
+    pub(crate) inner: Kind,
+}
+
+impl PySpace {
+    /// The space form, or an InvalidArgumentError naming `what` for a chart.
+    fn form(&self, what: &str) -> PyResult<SpaceForm> {
+        match &self.inner {
+            Kind::Form(f) => Ok(*f),
+            Kind::Chart { .. } => Err(to_py(Error::invalid(
+                what,
+                format!(
+                    "{what} is defined for the space forms (Euclidean, Sphere, Hyperbolic); a \
+                     Riemannian chart has none"
+                ),
+            ))),
+        }
+    }
 }
 
 #[pymethods]
 impl PySpace {
     /// The sectional curvature: 0, 1/r^2 or -1/r^2.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (a Riemannian chart, whose curvature varies).
     #[getter]
-    fn curvature(&self) -> f64 {
-        self.inner.curvature()
+    fn curvature(&self) -> PyResult<f64> {
+        Ok(self.form("curvature")?.curvature())
     }
 
     /// The radius r (1 for Euclidean space, which has none).
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (a Riemannian chart).
     #[getter]
-    fn radius(&self) -> f64 {
-        self.inner.length()
+    fn radius(&self) -> PyResult<f64> {
+        Ok(self.form("radius")?.length())
     }
 
-    /// The number of ambient components of a point: 3 (Euclidean) or 4.
+    /// The number of components of a point: 3 (Euclidean, a Riemannian chart) or 4.
     #[getter]
     fn ambient_dim(&self) -> usize {
-        self.inner.ambient_dim()
+        match &self.inner {
+            Kind::Form(f) => f.ambient_dim(),
+            Kind::Chart { .. } => 3,
+        }
+    }
+
+    /// Checks at x that the frame of a `Riemannian` chart is orthonormal and positively oriented
+    /// for its metric: ``E^T g E = 1`` within `tol` (E the matrix whose columns are the rows of
+    /// `frame(x1, x2, x3)`) and ``det E > 0``. Returns None.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (the frame fails the check, names the pair (a, b); x outside the
+    ///     chart; tol not a finite number >= 0; a space form, whose frame is orthonormal by
+    ///     construction), the exception of a callable.
+    #[pyo3(signature = (x, tol = 1e-10))]
+    fn check_frame(
+        &self,
+        #[pyo3(from_py_with = reals::<3>)] x: [f64; 3],
+        #[pyo3(from_py_with = real)] tol: f64,
+    ) -> PyResult<()> {
+        match &self.inner {
+            Kind::Chart { chart, .. } => checked(|| chart.check_frame(x, tol)),
+            Kind::Form(f) => Err(to_py(Error::invalid(
+                "check_frame",
+                format!(
+                    "only a Riemannian chart has a frame given by callables to check; the frame \
+                     of {} is orthonormal by construction",
+                    f.name()
+                ),
+            ))),
+        }
     }
 
     /// The reference frame Ê(x): a (d, 3) array whose columns are the ambient components of
     /// Ê1, Ê2, Ê3 at the point x (d = `ambient_dim`). Euclidean: the constant frame; Sphere:
     /// x.i/r, x.j/r, x.k/r (quaternion products, the left-invariant fields of SU(2)); Hyperbolic:
-    /// the boost taking (r, 0, 0, 0) to x applied to e1, e2, e3.
+    /// the boost taking (r, 0, 0, 0) to x applied to e1, e2, e3; Riemannian: the chart
+    /// components of the frame the callable gives (the transpose of its value).
     ///
     /// Raises:
-    ///     ShapeError, NonFiniteError, InvalidArgumentError (x not on the space).
+    ///     ShapeError, NonFiniteError, InvalidArgumentError (x not on the space), the exception
+    ///     of a callable.
     fn reference_frame<'py>(
         &self,
         py: Python<'py>,
         x: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let x = vector("x", &x)?;
-        self.inner.check_point(&x).py()?;
-        let f = self.inner.reference(&x);
-        let k = 4 - self.inner.ambient_dim();
-        let rows: Vec<Vec<f64>> = (k..4)
-            .map(|i| (1..4).map(|j| f[(i, j)]).collect())
-            .collect();
+        let rows: Vec<Vec<f64>> = match &self.inner {
+            Kind::Form(form) => {
+                form.check_point(&x).py()?;
+                let f = form.reference(&x);
+                let k = 4 - form.ambient_dim();
+                (k..4)
+                    .map(|i| (1..4).map(|j| f[(i, j)]).collect())
+                    .collect()
+            }
+            Kind::Chart { chart, .. } => {
+                let x: [f64; 3] = x
+                    .as_slice()
+                    .try_into()
+                    .map_err(|_| to_py(Error::shape("x", "(3,)", format!("({},)", x.len()))))?;
+                checked(|| chart.check_point(x))?;
+                let e = checked(|| Ok(chart.frame(x)))?;
+                (0..3)
+                    .map(|i| (0..3).map(|j| e[(i, j)]).collect())
+                    .collect()
+            }
+        };
         PyArray2::from_vec2(py, &rows)
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
     }
 
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Any<'py>, Bound<'py, PyTuple>)> {
         let m = py.import("lieflow.spaces")?;
-        Ok(match self.inner {
-            SpaceForm::Euclidean => (m.getattr("Euclidean")?, PyTuple::new(py, [3])?),
-            SpaceForm::Sphere { radius } => (m.getattr("Sphere")?, (3, radius).into_pyobject(py)?),
-            SpaceForm::Hyperbolic { radius } => {
-                (m.getattr("Hyperbolic")?, (3, radius).into_pyobject(py)?)
+        Ok(match &self.inner {
+            Kind::Form(SpaceForm::Euclidean) => (m.getattr("Euclidean")?, PyTuple::new(py, [3])?),
+            Kind::Form(SpaceForm::Sphere { radius }) => {
+                (m.getattr("Sphere")?, (3, *radius).into_pyobject(py)?)
             }
+            Kind::Form(SpaceForm::Hyperbolic { radius }) => {
+                (m.getattr("Hyperbolic")?, (3, *radius).into_pyobject(py)?)
+            }
+            Kind::Chart { args, .. } => (m.getattr("Riemannian")?, args.bind(py).clone()),
         })
     }
 
-    fn __repr__(&self) -> String {
-        self.inner.name()
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(match &self.inner {
+            Kind::Form(f) => f.name(),
+            Kind::Chart { args, .. } => format!("Riemannian{}", args.bind(py).repr()?),
+        })
     }
 
-    fn __hash__(&self) -> u64 {
-        let (kind, r) = match self.inner {
-            SpaceForm::Euclidean => (0u64, 1.0f64),
-            SpaceForm::Sphere { radius } => (1, radius),
-            SpaceForm::Hyperbolic { radius } => (2, radius),
+    /// Space forms hash by value; a chart by identity.
+    fn __hash__(slf: &Bound<'_, Self>) -> u64 {
+        let (kind, r) = match &slf.get().inner {
+            Kind::Form(SpaceForm::Euclidean) => (0u64, 1.0f64),
+            Kind::Form(SpaceForm::Sphere { radius }) => (1, *radius),
+            Kind::Form(SpaceForm::Hyperbolic { radius }) => (2, *radius),
+            Kind::Chart { .. } => return slf.as_ptr() as u64,
         };
         kind.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ r.to_bits()
     }
 
-    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
-        other
-            .cast::<PySpace>()
-            .map(|o| o.get().inner == self.inner)
-            .unwrap_or(false)
+    /// Space forms are equal by value; a chart only to itself.
+    fn __eq__(slf: &Bound<'_, Self>, other: &Bound<'_, PyAny>) -> bool {
+        let Ok(o) = other.cast::<PySpace>() else {
+            return false;
+        };
+        match (&slf.get().inner, &o.get().inner) {
+            (Kind::Form(a), Kind::Form(b)) => a == b,
+            _ => slf.as_ptr() == o.as_ptr(),
+        }
     }
 }
 
@@ -120,7 +215,7 @@ fn three(n: i64) -> PyResult<()> {
 fn Euclidean(#[pyo3(from_py_with = int)] n: i64) -> PyResult<PySpace> {
     three(n)?;
     Ok(PySpace {
-        inner: SpaceForm::Euclidean,
+        inner: Kind::Form(SpaceForm::Euclidean),
     })
 }
 
@@ -136,7 +231,7 @@ fn Sphere(
 ) -> PyResult<PySpace> {
     three(n)?;
     Ok(PySpace {
-        inner: SpaceForm::sphere(radius).py()?,
+        inner: Kind::Form(SpaceForm::sphere(radius).py()?),
     })
 }
 
@@ -153,12 +248,67 @@ fn Hyperbolic(
 ) -> PyResult<PySpace> {
     three(n)?;
     Ok(PySpace {
-        inner: SpaceForm::hyperbolic(radius).py()?,
+        inner: Kind::Form(SpaceForm::hyperbolic(radius).py()?),
+    })
+}
+
+/// A Riemannian 3-manifold in one chart (002 §V for a general metric): the metric g(x) and an
+/// orthonormal frame field given as callables of the chart coordinates.
+///
+/// Numerical, like `lieflow.surfaces.MetricSurface`: the connection of the frame (the matrix C
+/// whose column j is the axial vector of ``A_j = (g(E_a, nabla_j E_b))_ab``) by fourth-order
+/// differences of g and the frame, and its derivatives by differences of C (errors about 1e-12
+/// in C and 1e-9 in its derivatives for smooth data of order one). Each evaluation of the top's
+/// field calls the callables about 330 times. A `FrameTop` on it has no Killing momenta.
+///
+/// Args:
+///     metric: ``metric(x1, x2, x3)`` -> (3, 3) symmetric positive definite g_ij.
+///     frame: ``frame(x1, x2, x3)`` -> (3, 3) whose row a holds the components e_a^i of the
+///         orthonormal frame vector E_a (check it with `check_frame`).
+///     domain: optional ``domain(x1, x2, x3)`` -> bool; the chart is where it holds and g is
+///         finite and positive definite.
+/// Returns:
+///     Space.
+/// Raises:
+///     TypeError (not callable).
+#[pyfunction]
+#[pyo3(signature = (metric, frame, domain=None))]
+fn Riemannian<'py>(
+    metric: Any<'py>,
+    frame: Any<'py>,
+    domain: Option<Any<'py>>,
+) -> PyResult<PySpace> {
+    let py = metric.py();
+    let field = |what: &'static str, f: Py<PyAny>| {
+        move |x: [f64; 3]| {
+            let v = call_floats::<9>(&f, &x, what, &[3, 3]);
+            std::array::from_fn(|i| std::array::from_fn(|j| v[3 * i + j]))
+        }
+    };
+    let dom = match &domain {
+        Some(d) => Some(std::sync::Arc::new(domain_closure::<3>(
+            callable("domain", d)?,
+            "domain(x1, x2, x3)",
+        ))
+            as lieflow::systems::tangent_top::riemannian::Domain),
+        None => None,
+    };
+    let chart = Chart::new(
+        field("metric(x1, x2, x3)", callable("metric", &metric)?),
+        field("frame(x1, x2, x3)", callable("frame", &frame)?),
+        dom,
+    );
+    Ok(PySpace {
+        inner: Kind::Chart {
+            chart,
+            args: (metric, frame, domain).into_pyobject(py)?.unbind(),
+        },
     })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySpace>()?;
+    m.add_function(wrap_pyfunction!(Riemannian, m)?)?;
     m.add_function(wrap_pyfunction!(Euclidean, m)?)?;
     m.add_function(wrap_pyfunction!(Sphere, m)?)?;
     m.add_function(wrap_pyfunction!(Hyperbolic, m)?)?;

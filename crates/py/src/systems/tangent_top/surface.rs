@@ -154,7 +154,7 @@ impl PySurface {
 /// Calls `f(*args)` and reads the array it returns, which must have `shape` (row-major); on an
 /// exception or a wrong return records the error on this thread (`lieflow::integrate::hooks`)
 /// and gives NaN (a run ends after that step; a direct call raises the error).
-fn call_floats<const N: usize>(
+pub(crate) fn call_floats<const N: usize>(
     f: &Py<PyAny>,
     args: &[f64],
     what: &str,
@@ -186,6 +186,29 @@ fn call_floats<const N: usize>(
     })
 }
 
+/// A chart's domain from a Python callable `domain(*x)` returning a bool; an exception or another
+/// value records the error on this thread (`lieflow::integrate::hooks`) and reads as outside.
+pub(crate) fn domain_closure<const D: usize>(
+    d: Py<PyAny>,
+    what: &'static str,
+) -> impl Fn([f64; D]) -> bool + Send + Sync + 'static {
+    move |x: [f64; D]| {
+        if lieflow::integrate::hooks::pending() {
+            return false;
+        }
+        Python::attach(|py| {
+            let f = d.bind(py);
+            PyTuple::new(py, x)
+                .and_then(|a| f.call1(a))
+                .and_then(|v| domain_value(f, &v))
+                .unwrap_or_else(|e| {
+                    lieflow::integrate::hooks::fail(raised(what, e));
+                    false
+                })
+        })
+    }
+}
+
 /// The value of a `domain(x1, x2)` callable: a bool or a numpy bool; anything else (a number,
 /// NaN, a string, a list) is an `ArgumentTypeError` naming `domain`, not read by its truthiness.
 fn domain_value(f: &Any<'_>, v: &Any<'_>) -> PyResult<bool> {
@@ -215,7 +238,7 @@ fn domain_value(f: &Any<'_>, v: &Any<'_>) -> PyResult<bool> {
     ))
 }
 
-fn callable(what: &str, f: &Any<'_>) -> PyResult<Py<PyAny>> {
+pub(crate) fn callable(what: &str, f: &Any<'_>) -> PyResult<Py<PyAny>> {
     if f.is_callable() {
         Ok(f.clone().unbind())
     } else {
@@ -363,23 +386,10 @@ fn MetricSurface<'py>(
         }
     };
     let dom: Option<surface::DomainFn> = match &domain {
-        Some(d) => {
-            let d = callable("domain", d)?;
-            Some(Arc::new(move |x: Vec2| {
-                if lieflow::integrate::hooks::pending() {
-                    return false;
-                }
-                Python::attach(|py| {
-                    let f = d.bind(py);
-                    f.call1((x[0], x[1]))
-                        .and_then(|v| domain_value(f, &v))
-                        .unwrap_or_else(|e| {
-                            lieflow::integrate::hooks::fail(raised("domain(x1, x2)", e));
-                            false
-                        })
-                })
-            }))
-        }
+        Some(d) => Some(Arc::new(domain_closure::<2>(
+            callable("domain", d)?,
+            "domain(x1, x2)",
+        ))),
         None => None,
     };
     let inner = surface::MetricSurface::new(
