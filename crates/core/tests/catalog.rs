@@ -537,7 +537,7 @@ fn symmetric_methods_are_time_reversible() {
             let err = distance(&back, &c.z0) / distance(&c.z0, &vec![0.0; c.z0.len()]);
             eprintln!("{}: {name}: reversibility defect {err:.2e}", c.name);
             // The Riemannian chart's geometry comes from differences of its closures (∂C to
-            // ≈ 1e-11 relative round-off), and its midpoint solves stop at that noise (1e-10).
+            // ≈ 1e-11 relative round-off), and its midpoint solves stop at that noise (1e-9).
             let tol = if c.name.contains("Riemannian") {
                 1e-11
             } else {
