@@ -9,7 +9,6 @@ use nalgebra::{Matrix3, Vector3};
 use super::weak_field::{angular_momentum, outside_potential};
 use super::{
     energy, lagrangian, legendre_inverse, space, state, velocities, Derivs, Legendre, Potential,
-    PotentialValue,
 };
 use crate::check;
 use crate::error::{Error, Result};
@@ -220,57 +219,107 @@ impl Problem for StaticFieldTop {
     }
 }
 
+/// What the kernel needs at one point x, whatever the velocities (computed once per Legendre
+/// inversion): the slice's geometry, the field's ε = e^{2φ}, |G|² = g⁻¹(dφ, dφ),
+/// h = gφ⊥/√det g (φ⊥ = (∂₂φ, −∂₁φ); c = h·ẋ) and their x-derivatives (module docs, "Static
+/// field").
+struct Local {
+    geo: Geometry,
+    /// φ (the local light speed is e^φ).
+    phi: f64,
+    eps: f64,
+    g2: f64,
+    h: [f64; 2],
+    /// `dh[k][j]` = ∂_k h_j.
+    dh: Mat2,
+    /// ∂_k ε = 2ε∂_kφ.
+    deps: [f64; 2],
+    /// ∂_k|G|² = 2∂_k∂_iφ (g⁻¹dφ)ⁱ − (g⁻¹dφ)ᵀ∂_kg(g⁻¹dφ).
+    dg2: [f64; 2],
+}
+
 impl StaticFieldTop {
-    /// The geometry of the slice and the field at x; None outside the chart.
-    fn local(&self, q: &[f64]) -> Option<(Geometry, PotentialValue)> {
+    /// The geometry of the slice and the field at x (`Local`); None outside the chart or where
+    /// φ, its derivatives or e^{2φ} are not finite. In the plane (g = Id, ∂g = 0) the terms with
+    /// ∂g are exact zeros and the products with g, g⁻¹ and √det g = 1 exact: h = (G_y, −G_x),
+    /// |G|² = G_x² + G_y², ∂_k|G|² = 2(HG)_k, ∂_kh = ∂_kφ⊥, bit for bit the flat formulas.
+    fn local(&self, q: &[f64]) -> Option<Local> {
         let x = [q[0], q[1]];
         let slice = self.slice();
-        slice
-            .contains(x)
-            .then(|| (slice.geometry(x), self.potential.eval(x)))
-    }
-
-    /// The kernel (module docs, "Static field"): L, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇² at the geometry `geo`
-    /// of the slice and the field `pv` at x, the angle θ and q̇ = (ẋ, θ̇), through the invariants
-    /// Q = g(ẋ, ẋ), c = h·ẋ (h = gφ⊥/√det g, φ⊥ = (∂₂φ, −∂₁φ)), s = θ̇ + α·ẋ and the field's
-    /// ε = e^{2φ}, |G|² = g⁻¹(dφ, dφ). In the plane (g = Id, α = 0) every added term is an exact
-    /// zero, so the numbers are those of the flat kernel. None where φ or its derivatives are
-    /// not finite, Q ≥ e^{2φ} or a value overflows.
-    fn kernel(
-        &self,
-        geo: &Geometry,
-        pv: &PotentialValue,
-        theta: f64,
-        v: &Vector3<f64>,
-    ) -> Option<Derivs> {
-        let (m, i0) = (self.mass, self.i0);
-        let (u, w) = ([v[0], v[1]], v[2]);
-        let (g, a) = (&geo.g, geo.alpha);
+        if !slice.contains(x) {
+            return None;
+        }
+        let geo = slice.geometry(x);
+        let pv = self.potential.eval(x);
         let [gx, gy] = pv.grad;
         let [hxx, hxy, hyy] = pv.hess;
         let eps = (2.0 * pv.phi).exp();
+        if ![eps, gx, gy, hxx, hxy, hyy].iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let g = &geo.g;
+        let gi = inverse(g);
+        let sd = det(g).sqrt();
+        let perp = [gy, -gx];
+        let h = [
+            (perp[0] * g[0][0] + perp[1] * g[1][0]) / sd,
+            (perp[0] * g[0][1] + perp[1] * g[1][1]) / sd,
+        ];
+        let grad_up = [gi[0][0] * gx + gi[0][1] * gy, gi[1][0] * gx + gi[1][1] * gy]; // g⁻¹dφ
+        let g2 = gx * grad_up[0] + gy * grad_up[1];
+        let hess_rows = [[hxx, hxy], [hxy, hyy]];
+        let mut dh = [[0.0; 2]; 2];
+        let (mut deps, mut dg2) = ([0.0; 2], [0.0; 2]);
+        for k in 0..2 {
+            let dg = &geo.dg[k];
+            let hr = hess_rows[k];
+            deps[k] = 2.0 * eps * pv.grad[k];
+            dg2[k] = 2.0 * (hr[0] * grad_up[0] + hr[1] * grad_up[1]) - inner(dg, grad_up, grad_up);
+            // ∂_k h = (g ∂_kφ⊥ + ∂_kg φ⊥)/√det g − h ½tr(g⁻¹∂_kg).
+            let dperp = [hr[1], -hr[0]];
+            let dlog = 0.5 * (gi[0][0] * dg[0][0] + gi[0][1] * dg[1][0])
+                + 0.5 * (gi[1][0] * dg[0][1] + gi[1][1] * dg[1][1]);
+            dh[k] = std::array::from_fn(|j| {
+                ((dperp[0] * g[0][j] + dperp[1] * g[1][j])
+                    + (perp[0] * dg[0][j] + perp[1] * dg[1][j]))
+                    / sd
+                    - h[j] * dlog
+            });
+        }
+        Some(Local {
+            geo,
+            phi: pv.phi,
+            eps,
+            g2,
+            h,
+            dh,
+            deps,
+            dg2,
+        })
+    }
+
+    /// The kernel (module docs, "Static field"): L, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇² at the data `lo` of
+    /// x, the angle θ and q̇ = (ẋ, θ̇), through the invariants Q = g(ẋ, ẋ), c = h·ẋ,
+    /// s = θ̇ + α·ẋ and the field's ε, |G|². In the plane (g = Id, α = 0) every added term is an
+    /// exact zero, so the numbers are those of the flat kernel. None where Q ≥ e^{2φ} or a
+    /// value is not finite.
+    fn kernel(&self, lo: &Local, theta: f64, v: &Vector3<f64>) -> Option<Derivs> {
+        let (m, i0) = (self.mass, self.i0);
+        let (u, w) = ([v[0], v[1]], v[2]);
+        let geo = &lo.geo;
+        let (g, a, h) = (&geo.g, geo.alpha, lo.h);
+        let (eps, g2) = (lo.eps, lo.g2);
         let n = [
             g[0][0] * u[0] + g[0][1] * u[1],
             g[1][0] * u[0] + g[1][1] * u[1],
         ]; // gẋ
         let qq = n[0] * u[0] + n[1] * u[1];
         let b = eps - qq;
-        let field_finite = [eps, gx, gy, hxx, hxy, hyy].iter().all(|x| x.is_finite());
-        if !(field_finite && b > 0.0 && w.is_finite() && theta.is_finite()) {
+        if !(b > 0.0 && w.is_finite() && theta.is_finite()) {
             return None;
         }
         let s = w + (a[0] * u[0] + a[1] * u[1]);
-        let gi = inverse(g);
-        let sd = det(g).sqrt();
-        // h = g φ⊥ / √det g: c = h·ẋ = G₂u₁ − G₁u₂ in any positive orthonormal frame.
-        let perp = [gy, -gx];
-        let h = [
-            (perp[0] * g[0][0] + perp[1] * g[1][0]) / sd,
-            (perp[0] * g[0][1] + perp[1] * g[1][1]) / sd,
-        ];
         let c = h[0] * u[0] + h[1] * u[1];
-        let grad_up = [gi[0][0] * gx + gi[0][1] * gy, gi[1][0] * gx + gi[1][1] * gy]; // g⁻¹dφ
-        let g2 = gx * grad_up[0] + gy * grad_up[1];
         let b1 = 1.0 / b.sqrt(); // β = b^{−1/2}
         let b3 = b1 * b1 * b1;
         let b5 = b3 * b1 * b1;
@@ -298,29 +347,15 @@ impl StaticFieldTop {
             2.0 * l_q * n[1] + l_c * h[1] + l_s * a[1],
             l_s,
         );
-        // Through x: ∂_kε = 2εG_k, ∂_k|G|² = 2(Hess φ g⁻¹dφ)_k − (g⁻¹dφ)ᵀ∂_kg(g⁻¹dφ),
-        // ∂_k h = (g ∂_kφ⊥ + ∂_kg φ⊥)/√det g − h ½tr(g⁻¹∂_kg), ∂_kQ = ẋᵀ∂_kgẋ, ∂_ks = ∂_kα·ẋ.
-        let hess_rows = [[hxx, hxy], [hxy, hyy]];
+        // Through x: ∂_kQ = ẋᵀ∂_kgẋ, ∂_kc = ∂_kh·ẋ, ∂_ks = ∂_kα·ẋ, and ∂_kε, ∂_k|G|² of `lo`.
         let mut lq = Vector3::zeros();
         for k in 0..2 {
-            let dg = &geo.dg[k];
-            let hr = hess_rows[k];
-            let deps = 2.0 * eps * pv.grad[k];
-            let dg2 = 2.0 * (hr[0] * grad_up[0] + hr[1] * grad_up[1]) - inner(dg, grad_up, grad_up);
-            let dperp = [hr[1], -hr[0]];
-            let dlog = 0.5 * (gi[0][0] * dg[0][0] + gi[0][1] * dg[1][0])
-                + 0.5 * (gi[1][0] * dg[0][1] + gi[1][1] * dg[1][1]);
-            let dh: [f64; 2] = std::array::from_fn(|j| {
-                ((dperp[0] * g[0][j] + dperp[1] * g[1][j])
-                    + (perp[0] * dg[0][j] + perp[1] * dg[1][j]))
-                    / sd
-                    - h[j] * dlog
-            });
+            let dh = lo.dh[k];
             let dc = dh[0] * u[0] + dh[1] * u[1];
-            let dq = inner(dg, u, u);
+            let dq = inner(&geo.dg[k], u, u);
             let da = geo.dalpha[k];
             let ds = da[0] * u[0] + da[1] * u[1];
-            lq[k] = deps * l_eps + dg2 * l_g2 + l_c * dc + l_q * dq + l_s * ds;
+            lq[k] = lo.deps[k] * l_eps + lo.dg2[k] * l_g2 + l_c * dc + l_q * dq + l_s * ds;
         }
         let mut hess = Matrix3::zeros();
         for i in 0..2 {
@@ -349,24 +384,23 @@ impl Legendre for StaticFieldTop {
     /// The kernel at the geometry and field of x (module docs, "Static field"); None outside
     /// the chart and where [`StaticFieldTop::kernel`] is.
     fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
-        let (geo, pv) = self.local(q)?;
-        self.kernel(&geo, &pv, q[2], v)
+        self.kernel(&self.local(q)?, q[2], v)
     }
 
     /// From a free particle of mass m + 𝕀s² (the low-speed form of the momenta) carrying
     /// π = p_x − p_θα at spin s = p_θ/𝕀, slower than the local light speed e^φ; failing that,
     /// from rest. The geometry and the field are evaluated once.
     fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
-        let (geo, pv) = self.local(q)?;
-        let c = pv.phi.exp();
+        let lo = self.local(q)?;
+        let c = lo.phi.exp();
         if !(c.is_finite() && c > 0.0) {
             return None;
         }
         let tr = 2.0 * self.i0;
         let s = p[2] / tr;
-        let a = geo.alpha;
+        let a = lo.geo.alpha;
         let pi = [p[0] - p[2] * a[0], p[1] - p[2] * a[1]];
-        let gi = inverse(&geo.g);
+        let gi = inverse(&lo.geo.g);
         let up = [
             gi[0][0] * pi[0] + gi[0][1] * pi[1],
             gi[1][0] * pi[0] + gi[1][1] * pi[1],
@@ -375,7 +409,7 @@ impl Legendre for StaticFieldTop {
         let e = (mm * mm + up[0] * pi[0] + up[1] * pi[1]).sqrt();
         let xd = [c * up[0] / e, c * up[1] / e];
         let guess = Vector3::new(xd[0], xd[1], s - (a[0] * xd[0] + a[1] * xd[1]));
-        let derivs = |v: &Vector3<f64>| self.kernel(&geo, &pv, q[2], v);
+        let derivs = |v: &Vector3<f64>| self.kernel(&lo, q[2], v);
         legendre_inverse(p, guess, derivs)
             .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, s), derivs))
     }
