@@ -348,12 +348,13 @@ class WeakFieldTop(System):
 
 @final
 class StaticFieldTop(System):
-    """The symmetric relativistic top on -exp(2 phi) dt^2 + dx^2 (002 (115)-(117), derived
-    again); gauss4, gauss6, midpoint, rk4."""
+    """The symmetric relativistic top on -exp(2 phi) dt^2 + dx^2, or with `surface` on
+    -exp(2 phi) dt^2 + g over that surface (002 (115)-(117), derived again); gauss4, gauss6,
+    midpoint, rk4."""
 
     def __new__(
         cls, mass: float, inertia: float, gm: float | None = None,
-        g: tuple[float, float] | None = None,
+        g: tuple[float, float] | None = None, surface: Any | None = None,
     ) -> Self: ...
     def state(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> list[float]: ...
     def lagrangian(self, x: ArrayLike, theta: float, xdot: ArrayLike, thetadot: float) -> float:
@@ -361,6 +362,8 @@ class StaticFieldTop(System):
     def velocities(self, states: ArrayLike) -> _F64:
         """(..., 6) -> (..., 3): (xdot, ydot, thetadot)."""
     def angular_momentum(self, states: ArrayLike) -> _F64 | float: ...
+    def killing_momenta(self, states: ArrayLike) -> _F64:
+        """(..., 6) -> (..., k): the Killing momenta of the plane or the surface."""
 
 @final
 class TangentTop(System):

@@ -2,7 +2,8 @@
 its speed and spin and satisfies the re-derived relations (94)–(96); the weak-field top keeps its
 energy and angular momentum and follows the Newtonian orbit when the spin vanishes; the top on a
 curved static space-time over a surface (002 (97)-(103)) keeps its energy, p_theta and Killing
-momenta, pickles, and rejects bad surfaces."""
+momenta, pickles, and rejects bad surfaces; the static-field top (002 (115)-(117)) in the plane
+and over a surface."""
 
 import pickle
 
@@ -431,3 +432,84 @@ def test_static_field_top_rejects_bad_input():
         top.state([0.0, 0.0], 0.0, [0.1, 0.0], 1.0)         # at the point mass
     with pytest.raises(lf.NonFiniteError):
         top.lagrangian([np.nan, 0.0], 0.0, [0.1, 0.0], 1.0)
+
+
+# --- 002 (115)-(117) with a curved spatial metric: the top on -exp(2 phi) dt^2 + g ---
+
+def test_static_field_top_on_a_sphere_conserves_energy_p_theta_and_j_z():
+    # phi = 0.2 theta (a uniform field of the chart, symmetric about the z axis): the energy,
+    # p_theta and J_z are conserved, J_x and J_y are not; the top pickles with its surface.
+    top = lf.StaticFieldTop(1.0, 0.2, g=(0.2, 0.0), surface=lf.surfaces.Sphere(1.0))
+    z0 = top.state([1.2, 0.3], 0.5, [0.1, 0.8], 2.0)
+    np.testing.assert_allclose(top.velocities(z0), [0.1, 0.8, 2.0], atol=1e-13)
+    tr = lf.integrate(top, z0, dt=0.02, steps=5000, method="gauss6", save_every=50)
+    assert np.ptp(tr.energy()) < 1e-12
+    inv = top.invariants(tr.states)
+    assert inv.shape == (len(tr.states), 2) and np.ptp(inv, axis=0).max() < 1e-13   # p_theta, J_z
+    j = top.killing_momenta(tr.states)
+    assert j.shape == (len(tr.states), 3)
+    np.testing.assert_array_equal(j[:, 2], inv[:, 1])
+    assert np.ptp(j[:, 0]) > 0.05                                  # the field breaks J_x
+    assert np.ptp(tr.states[:, 0]) > 0.1                           # and moves the latitude
+    copy = pickle.loads(pickle.dumps(top))
+    assert repr(copy) == repr(top) and "Sphere" in repr(copy)
+    assert copy.methods() == top.methods() == lf.StaticFieldTop.methods()
+    np.testing.assert_array_equal(lf.integrate(copy, z0, dt=0.02, steps=30).states,
+                                  lf.integrate(top, z0, dt=0.02, steps=30).states)
+
+
+def test_static_field_top_on_a_surface_limits():
+    # On the Plane: the flat top, the same numbers. phi = 0 on the half-plane: the top of
+    # -dt^2 + g, RelativisticTangentTop on that surface.
+    flat = lf.StaticFieldTop(1.0, 0.2, gm=0.15)
+    plane = lf.StaticFieldTop(1.0, 0.2, gm=0.15, surface=lf.surfaces.Plane())
+    z0 = flat.state([1.0, 0.0], 0.3, [0.05, 0.38], 1.2)
+    np.testing.assert_array_equal(plane.state([1.0, 0.0], 0.3, [0.05, 0.38], 1.2), z0)
+    np.testing.assert_array_equal(lf.integrate(plane, z0, dt=0.02, steps=100).states,
+                                  lf.integrate(flat, z0, dt=0.02, steps=100).states)
+    # The invariants on the Plane: p_theta and the rotation's Killing momentum x p_y - y p_x + p_theta.
+    np.testing.assert_allclose(plane.invariants(z0),
+                               [z0[5], flat.angular_momentum(z0) + z0[5]], atol=1e-15)
+    H = lf.surfaces.HyperbolicPlane()
+    zero = lf.StaticFieldTop(1.0, 0.3, g=(0.0, 0.0), surface=H)
+    rtt = lf.RelativisticTangentTop(1.0, 0.3, H)
+    args = ([0.1, 1.0], 0.0, [0.4, 0.2], 1.3)
+    assert zero.lagrangian(*args) == pytest.approx(rtt.lagrangian(*args), abs=1e-15)
+    z0 = rtt.state(*args)
+    np.testing.assert_allclose(lf.integrate(zero, z0, dt=0.02, steps=100).states,
+                               lf.integrate(rtt, z0, dt=0.02, steps=100).states, atol=1e-12)
+    np.testing.assert_allclose(zero.invariants(z0), rtt.invariants(z0), atol=1e-15)
+
+
+def test_static_field_top_on_a_surface_rejects_bad_input():
+    with pytest.raises(TypeError):
+        lf.StaticFieldTop(1.0, 0.2, g=(0.1, 0.0), surface="sphere")
+    with pytest.raises(lf.InvalidArgumentError):
+        lf.StaticFieldTop(1.0, 0.2, surface=lf.surfaces.Sphere(1.0))      # no potential
+    top = lf.StaticFieldTop(1.0, 0.2, g=(0.2, 0.0), surface=lf.surfaces.Sphere(2.0))
+    with pytest.raises(lf.InvalidArgumentError, match="light"):
+        top.state([1.0, 0.0], 0.0, [0.7, 0.0], 1.0)        # v = R |dtheta/dt| = 1.4 > exp(0.2)
+    with pytest.raises(lf.InvalidArgumentError, match="chart"):
+        top.state([-0.1, 0.0], 0.0, [0.1, 0.0], 1.0)
+    with pytest.raises(lf.InvalidArgumentError):
+        top.killing_momenta([3.5, 0.0, 0.0, 0.1, 0.0, 0.1])
+
+
+def test_static_field_top_on_a_surface_from_callables_raises_their_errors():
+    def metric(t, p):
+        return [[1.0, 0.0], [0.0, np.sin(t) ** 2]]
+
+    def frame(t, p):
+        if t > 1.5:
+            raise RuntimeError("frame failed")
+        return [[1.0, 0.0], [0.0, 1.0 / np.sin(t)]]
+
+    python = lf.StaticFieldTop(1.0, 0.2, g=(0.2, 0.0),
+                               surface=lf.surfaces.MetricSurface(metric, frame, None))
+    native = lf.StaticFieldTop(1.0, 0.2, g=(0.2, 0.0), surface=lf.surfaces.Sphere(1.0))
+    z0 = native.state([1.0, 0.3], 0.5, [0.2, 0.3], 1.5)
+    np.testing.assert_allclose(lf.integrate(python, z0, dt=0.02, steps=20).states,
+                               lf.integrate(native, z0, dt=0.02, steps=20).states, atol=1e-7)
+    assert python.invariants(z0).shape == (1,)             # a surface of callables: p_theta only
+    with pytest.raises(RuntimeError, match="frame failed"):
+        python.state([1.6, 0.0], 0.0, [0.1, 0.0], 1.0)

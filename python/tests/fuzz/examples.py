@@ -797,6 +797,9 @@ def build_specs() -> list[Spec]:
         A("inertia", 0.2, "float", positive=True), A("gm", 0.15, "float", kw=True, opt=True))
     add("StaticFieldTop[g]", "StaticFieldTop", A("mass", 1.0, "float", positive=True),
         A("inertia", 0.2, "float", positive=True), A("g", (0.0, -0.1), "vec", kw=True, opt=True))
+    add("StaticFieldTop[surface]", "StaticFieldTop", A("mass", 1.0, "float", positive=True),
+        A("inertia", 0.2, "float", positive=True), A("g", (0.2, 0.0), "vec", kw=True, opt=True),
+        A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj", kw=True, opt=True))
     add("TangentTop", "TangentTop", A("surface", Lazy(lambda lf: lf.surfaces.Sphere(1.0)), "obj"),
         A("mass", 1.0, "float", positive=True), A("inertia", 0.5, "float", positive=True),
         A("embedded", True, "bool", kw=True))
@@ -897,7 +900,8 @@ def build_specs() -> list[Spec]:
                 ("lagrangian", [A("x", np.array([1.0, 0.0]), "vec"), A("theta", 0.3, "float"),
                                 A("xdot", np.array([0.05, 0.38]), "vec"),
                                 A("thetadot", 1.2, "float")])]
-        + [(f, [A("states", state_of("sft"), "vec")]) for f in ("velocities", "angular_momentum")],
+        + [(f, [A("states", state_of("sft"), "vec")])
+           for f in ("velocities", "angular_momentum", "killing_momenta")],
         "tt": [("state", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float"),
                           A("xdot", np.array([0.1, 0.3]), "vec"), A("thetadot", 1.5, "float")]),
                ("metric", [A("x", np.array([1.0, 0.3]), "vec"), A("theta", 0.2, "float")]),

@@ -11,7 +11,8 @@
 //! * [`tangent_top`] (002): [`TangentTop`] z = (x¹, x², θ, p₁, p₂, p_θ) (6), the tangent Euler
 //!   top on a [`Surface`]; [`ChargedParticle`] z = (x¹, x², p₁, p₂) (4), its magnetic analogue;
 //!   §IV [`RelativisticTangentTop`] (Minkowski, or −dt² + g over a surface),
-//!   [`StaticFieldTop`] (the static field −e^{2φ}dt² + dx²) and [`WeakFieldTop`] (its weak-field
+//!   [`StaticFieldTop`] (the static field −e^{2φ}dt² + dx², or + g over a surface) and
+//!   [`WeakFieldTop`] (its weak-field
 //!   limit) z = (x, y, θ, p_x, p_y, p_θ) (6).
 //! * [`rolling`] (003): §1 [`RollingDisks`] z = (θ₁, θ₂, p₁, p₂) (4), two disks rolling against
 //!   each other; §2 [`RollingSpheres`] z = (z₁, z₂, u, Ω₁, Ω₂) (27), two spheres rolling against

@@ -1,4 +1,4 @@
-//! `RelativisticTangentTop`, `WeakFieldTop` and `StaticFieldTop`: bindings of `lieflow::systems::tangent_top::relativistic`
+//! `RelativisticTangentTop`, `WeakFieldTop` and `StaticFieldTop` (flat or over a surface): bindings of `lieflow::systems::tangent_top::relativistic`
 //! (002 §IV). Thin subclasses of `lieflow.System`.
 
 use lieflow::systems::tangent_top::relativistic as core;
@@ -474,23 +474,30 @@ fn potential(gm: Option<f64>, g: Option<[f64; 2]>) -> PyResult<core::Potential> 
 }
 
 /// The symmetric relativistic tangent top on the static space-time
-/// ``-exp(2 phi) dt^2 + dx^2 + dy^2`` of a potential phi, to second order in the body's size
-/// (002 (115)-(117), derived again; physical sign): with ``b = exp(2 phi) - v^2``,
-/// ``I0 = tr I / 2``, ``G = grad phi``,
-/// ``L = -m sqrt(b) + I0 thetadot^2 / sqrt(b) - I0 exp(2 phi) G^2 / (2 sqrt(b))
-/// + I0 (thetadot^2 v^2 + 2 exp(2 phi) thetadot (G_y xdot - G_x ydot) + exp(4 phi) G^2)
-/// / (2 b^(3/2))``. Weak fields and slow motion give `WeakFieldTop` (002 (118)) plus -m; phi = 0
-/// the flat `RelativisticTangentTop`. State (x, y, theta, p_x, p_y, p_theta); coordinate speeds
-/// below exp(phi). Invariants: p_theta, and x p_y - y p_x (point mass) or the momentum across a
-/// uniform field; the energy is conserved. Methods: gauss4 (default), gauss6, midpoint, rk4.
+/// ``-exp(2 phi) dt^2 + dx^2 + dy^2`` of a potential phi, or, with `surface`,
+/// ``-exp(2 phi) dt^2 + g`` over that surface, to second order in the body's size
+/// (002 (115)-(117), derived again; physical sign): with ``Q = g(xdot, xdot)``,
+/// ``b = exp(2 phi) - Q``, ``I0 = tr I / 2``, ``s = thetadot + w(xdot)`` (w the surface's
+/// connection 1-form; s = thetadot in the plane), G the components of d phi and u those of xdot
+/// in an orthonormal frame, ``c = G_2 u_1 - G_1 u_2`` (``G_y xdot - G_x ydot`` in the plane),
+/// ``L = -m sqrt(b) + I0 s^2 / sqrt(b) - I0 exp(2 phi) G^2 / (2 sqrt(b))
+/// + I0 (s^2 Q + 2 exp(2 phi) s c + exp(4 phi) G^2) / (2 b^(3/2))``. In the plane, weak fields
+/// and slow motion give `WeakFieldTop` (002 (118)) plus -m; phi = 0 gives
+/// `RelativisticTangentTop` (flat or on the same surface). phi is a function of the chart
+/// coordinates (x1, x2). State (x1, x2, theta, p1, p2, p_theta); speeds sqrt(Q) below exp(phi).
+/// Invariants: p_theta, and in the plane x p_y - y p_x (point mass) or the momentum across a
+/// uniform field; on a surface the Killing momenta of its affine isometries that keep phi (e.g.
+/// J_z on the sphere in ``g=(k, 0)``, phi = k theta); the energy is conserved. Methods: gauss4
+/// (default), gauss6, midpoint, rk4.
 ///
 /// Args:
 ///     mass: m > 0.
 ///     inertia: tr I > 0.
-///     gm: a point mass, phi = -gm/r (give exactly one of gm and g).
-///     g: a uniform field, phi = g.x, (2,).
+///     gm: a point mass at the chart's origin, phi = -gm/r (give exactly one of gm and g).
+///     g: a uniform field of the chart, phi = g.x, (2,).
+///     surface: a `lieflow.surfaces` surface, or None for the plane.
 /// Raises:
-///     InvalidArgumentError.
+///     InvalidArgumentError, TypeError (surface not a lieflow surface).
 #[pyclass(name = "StaticFieldTop", module = "lieflow", extends = PySystem, frozen)]
 #[derive(Default)]
 pub struct PyStaticFieldTop;
@@ -498,28 +505,54 @@ pub struct PyStaticFieldTop;
 #[pymethods]
 impl PyStaticFieldTop {
     #[new]
-    #[pyo3(signature = (mass, inertia, gm = None, g = None))]
+    #[pyo3(signature = (mass, inertia, gm = None, g = None, surface = None))]
     fn new(
         py: Python<'_>,
         #[pyo3(from_py_with = real)] mass: f64,
         #[pyo3(from_py_with = real)] inertia: f64,
         #[pyo3(from_py_with = real_opt)] gm: Option<f64>,
         #[pyo3(from_py_with = reals_opt::<2>)] g: Option<[f64; 2]>,
+        surface: Option<Bound<'_, PySurface>>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let top = core::StaticFieldTop::new(mass, inertia, potential(gm, g)?).py()?;
-        let args = (mass, inertia, gm, g).into_pyobject(py)?;
+        let phi = potential(gm, g)?;
+        let top = match &surface {
+            None => core::StaticFieldTop::new(mass, inertia, phi),
+            Some(s) => core::StaticFieldTop::on_surface(s.get().inner.clone(), mass, inertia, phi),
+        }
+        .py()?;
+        let args = (mass, inertia, gm, g, surface).into_pyobject(py)?;
         Ok(PySystem::subclass(
             top,
             args,
-            &["mass", "inertia", "gm", "g"],
+            &["mass", "inertia", "gm", "g", "surface"],
         ))
     }
 
-    /// The canonical state from the position x (2,), the angle theta and the velocities.
+    /// All Killing momenta J = p_A X^A of the spatial slice's isometry group (the plane:
+    /// translations x, y and the rotation x p_y - y p_x + p_theta; Sphere: the ambient angular
+    /// momentum x, y, z; HyperbolicPlane: the Möbius generators E, H, F; Revolution: p_phi),
+    /// (..., 6) -> (..., k). Conserved where the isometry also keeps phi.
     ///
     /// Raises:
-    ///     InvalidArgumentError (a speed not below exp(phi), phi not finite at x, a Legendre map
-    ///     not invertible), NonFiniteError.
+    ///     ShapeError, NonFiniteError, InvalidArgumentError (x outside the chart).
+    fn killing_momenta<'py>(
+        slf: &Bound<'py, Self>,
+        states: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let top = slf.core::<core::StaticFieldTop>()?;
+        let k = top.surface().killing_count();
+        slf.base().map_states(slf.py(), &states, &[k], |z, out| {
+            out.copy_from_slice(&top.killing_momenta(z)?);
+            Ok(())
+        })
+    }
+
+    /// The canonical state from the position x (2,) in the chart, the angle theta and the
+    /// velocities.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (a speed not below exp(phi), x outside the surface's chart, phi
+    ///     not finite at x, a Legendre map not invertible), NonFiniteError.
     fn state(
         slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
@@ -528,18 +561,18 @@ impl PyStaticFieldTop {
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<Vec<f64>> {
         let top = slf.core::<core::StaticFieldTop>()?;
-        top.state(x, theta, xdot, thetadot).py()
+        crate::errors::checked(|| top.state(x, theta, xdot, thetadot))
     }
 
     /// The Lagrangian of 002 (117) (derived again, physical sign; the class docstring).
     ///
     /// Args:
-    ///     x: (2,); theta; xdot: (2,); thetadot.
+    ///     x: (2,) in the chart; theta; xdot: (2,); thetadot.
     /// Returns:
     ///     float.
     /// Raises:
-    ///     InvalidArgumentError (a speed not below exp(phi), phi not finite at x),
-    ///     NonFiniteError.
+    ///     InvalidArgumentError (a speed not below exp(phi), x outside the chart, phi not finite
+    ///     at x), NonFiniteError.
     fn lagrangian(
         slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
@@ -548,8 +581,7 @@ impl PyStaticFieldTop {
         #[pyo3(from_py_with = real)] thetadot: f64,
     ) -> PyResult<f64> {
         let top = slf.core::<core::StaticFieldTop>()?;
-        top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot])
-            .py()
+        crate::errors::checked(|| top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot]))
     }
 
     /// The velocities (xdot, ydot, thetadot) of states, vectorised: (..., 6) -> (..., 3).

@@ -1,8 +1,8 @@
 //! 002 §IV: the relativistic tangent Euler top in Minkowski space-time and on a curved static
 //! space-time −dt² + γ_ij dxⁱdxʲ over a surface ([`RelativisticTangentTop`], 002 (87)–(111)), and
 //! in the weak-field limit of a static gravitational potential φ(x, y) ([`WeakFieldTop`],
-//! 002 (115)–(120)), and on the static space-time of the potential itself ([`StaticFieldTop`],
-//! 002 (115)–(117)).
+//! 002 (115)–(120)), and on the static space-time of the potential itself, flat or over a
+//! surface ([`StaticFieldTop`], 002 (115)–(117)).
 //!
 //! # Set-up (002 (81)–(82))
 //! A planar body with mass distribution dm(ξ), centre of mass at ξ = 0, second-moment tensor
@@ -207,27 +207,69 @@
 //! the plane has Δφ = −GM/r³ ≠ 0, so it acts in the point-mass field.
 //!
 //! # Static field (002 (115)–(117)), [`StaticFieldTop`]
-//! The L above, not expanded in the field or the speed: the symmetric top on
-//! −e^{2φ}dt² + dx² + dy² to second order in ξ only, (117) (physical sign; (115) with its dt²
-//! restored, the flat spatial metric of (118)). Its derivatives (the kernel) through
-//! Q = v², c = G_yẋ − G_xẏ = h·ẋ (h = JᵀG = (G_y, −G_x)), w = θ̇, ε = e^{2φ}, |G|²: with
-//! b = ε − Q, β = b^{−1/2}, T = w²Q + 2εwc + ε²|G|²,
-//! L = −m/β + I₀w²β − ½I₀ε|G|²β + ½I₀β³T,
-//! L_Q = ½mβ + I₀w²β³ − ¼I₀ε|G|²β³ + ¾I₀β⁵T, L_c = I₀εwβ³, L_w = 2I₀wβ + I₀β³(wQ + εc),
-//! L_QQ = ¼mβ³ + (9/4)I₀w²β⁵ − ⅜I₀ε|G|²β⁵ + (15/8)I₀β⁷T, L_Qc = (3/2)I₀εwβ⁵,
-//! L_Qw = 2I₀wβ³ + (3/2)I₀β⁵(wQ + εc), L_cc = 0, L_cw = I₀εβ³, L_ww = 2I₀β + I₀Qβ³;
-//! p_x = 2L_Q ẋ + L_c h, p_θ = L_w, ∂²L/∂ẋ² = 2L_Q Id + 4L_QQ ẋẋᵀ + 2L_Qc(ẋhᵀ + hẋᵀ),
-//! ∂²L/∂ẋ∂θ̇ = 2L_Qw ẋ + L_cw h; and through the field, with ∂_kε = 2εG_k,
-//! ∂_k|G|² = 2(HG)_k (H the Hessian of φ), ∂_k c = H_yk ẋ − H_xk ẏ,
-//! L_ε = −½mβ − ½I₀w²β³ − ½I₀|G|²β + ¼I₀ε|G|²β³ − ¾I₀β⁵T + I₀β³(wc + ε|G|²),
-//! L_|G|² = −½I₀εβ + ½I₀ε²β³, ∂L/∂x^k = 2εG_k L_ε + 2(HG)_k L_|G|² + L_c ∂_k c, ∂L/∂θ = 0.
-//! The metric is static (∂_t Killing), so E = p·q̇ − L is conserved; θ is cyclic (p_θ); a
-//! central φ keeps x p_y − y p_x and a uniform one the momentum across the field. φ = 0 gives
-//! the flat top (002 (93)); expanding in φ, |G| = O(ε²), v = O(ε), θ̇ = O(1) gives
+//! The L above, not expanded in the field or the speed, and on a curved spatial metric: the
+//! symmetric top on ds² = −e^{2φ}dt² + γ_ij dxⁱdxʲ to second order in ξ only ((115) with its dt²
+//! restored; (117), physical sign), γ = dx² + dy² ([`StaticFieldTop::new`]) or the metric g of a
+//! [`Surface`] ([`StaticFieldTop::on_surface`]), φ(x¹, x²) a function of the chart.
+//!
+//! **Derivation on a surface.** With ċ = ∂_t + ẋ and the body frame E_a = S_ba Ê_b spatial, the
+//! only Christoffel symbols of the static metric that reach ∇_ċE_a are the surface's and
+//! Γ^t_{tj} = ∂_jφ (Γ^k_{tj} = Γ^t_{ij} = 0), so
+//!
+//! ∇_ċE_a = dφ(E_a) ∂_t + s (JS)_ba Ê_b = (SᵀG)_a ∂_t + s (JS)_ba Ê_b,   s = θ̇ + α·ẋ,
+//!
+//! G_b = dφ(Ê_b) = e_bⁱ∂_iφ the frame components of dφ (the ω_a⁰ ∝ G_a of (116)). With u the
+//! frame components of ẋ the integrand of (82) is e^{2φ}(1 + G·Sξ)² − |u + sJSξ|²: the flat one
+//! with ẋ → u, θ̇ → s, G in the frame. So L is the flat (117) in
+//! Q = |u|² = g(ẋ, ẋ), s, c = G₂u₁ − G₁u₂, ε = e^{2φ}, |G|² = g^{ij}∂_iφ∂_jφ:
+//!
+//! L = −m√b + I₀s²/√b − I₀ε|G|²/(2√b) + I₀(s²Q + 2εsc + ε²|G|²)/(2b^{3/2}),   b = ε − Q.
+//!
+//! G and u turn together under a change of frame and s does not change ("Frame
+//! independence"), so L is frame independent; in the chart (a positive orthonormal frame has
+//! e₁ᵏe₂ⁱ − e₂ᵏe₁ⁱ = ϵ^{ki}/√det g), with n = gẋ and φ⊥ = (∂₂φ, −∂₁φ),
+//! c = (∂₂φ n₁ − ∂₁φ n₂)/√det g = h·ẋ,   h = gφ⊥/√det g,
+//! and the kernel needs g, ∂g, α, ∂α and the chart Hessian of φ, not the frame. In the plane
+//! (g = Id, α = 0) s = θ̇, u = ẋ, h = JᵀG = (G_y, −G_x), c = G_yẋ − G_xẏ.
+//!
+//! **Slips of (115)–(117)** (besides the dt² of (115)): (117) is right with G a row vector (see
+//! "Weak field") and with every Ṡ read as the covariant Ṡ + ωS, i.e. θ̇ → s, as its brackets
+//! tr(ṠṠᵀ) + 2tr(ṠSᵀωᵀ) + tr(ωωᵀ) = 2s² do; the printed coupling −2e^{2φ}ṠSᵀGᵀv carries Ṡ
+//! alone, which would couple the field to θ̇ instead of s on a curved surface. The test
+//! `static_field_on_a_surface_is_the_expansion_of_82` (the exact (82) over a ring on the sphere,
+//! the half-plane and a graph, ∇_ċE from the chart's Christoffel symbols and differences of φ)
+//! finds the error O(r⁴) with s and c as here, O(r²) with θ̇ in the coupling or with −c.
+//!
+//! **Derivatives** (the kernel, one for the plane and the surfaces): with β = b^{−1/2},
+//! T = s²Q + 2εsc + ε²|G|²,
+//! L = −m/β + I₀s²β − ½I₀ε|G|²β + ½I₀β³T,
+//! L_Q = ½mβ + I₀s²β³ − ¼I₀ε|G|²β³ + ¾I₀β⁵T, L_c = I₀εsβ³, L_s = 2I₀sβ + I₀β³(sQ + εc),
+//! L_QQ = ¼mβ³ + (9/4)I₀s²β⁵ − ⅜I₀ε|G|²β⁵ + (15/8)I₀β⁷T, L_Qc = (3/2)I₀εsβ⁵,
+//! L_Qs = 2I₀sβ³ + (3/2)I₀β⁵(sQ + εc), L_cc = 0, L_cs = I₀εβ³, L_ss = 2I₀β + I₀Qβ³,
+//! L_ε = −½mβ − ½I₀s²β³ − ½I₀|G|²β + ¼I₀ε|G|²β³ − ¾I₀β⁵T + I₀β³(sc + ε|G|²),
+//! L_|G|² = −½I₀εβ + ½I₀ε²β³; then
+//! p_x = 2L_Q n + L_c h + L_s α,  p_θ = L_s,
+//! ∂²L/∂ẋ² = 2L_Q g + 4L_QQ nnᵀ + 2L_Qc(nhᵀ + hnᵀ) + 2L_Qs(nαᵀ + αnᵀ) + L_cs(hαᵀ + αhᵀ) + L_ss ααᵀ,
+//! ∂²L/∂ẋ∂θ̇ = 2L_Qs n + L_cs h + L_ss α,  ∂²L/∂θ̇² = L_ss,
+//! ∂L/∂x^k = L_Q ẋᵀ∂_kgẋ + L_c ∂_kh·ẋ + L_s ∂_kα·ẋ + 2ε∂_kφ L_ε + ∂_k|G|² L_|G|²,  ∂L/∂θ = 0,
+//! ∂_k|G|² = 2∂_k∂_iφ (g⁻¹dφ)ⁱ − (g⁻¹dφ)ᵀ∂_kg(g⁻¹dφ),
+//! ∂_kh = (g∂_kφ⊥ + ∂_kg φ⊥)/√det g − ½tr(g⁻¹∂_kg) h.
+//! In the plane every term with ∂g, α, ∂α is an exact zero (g = Id, √det g = 1), so the plane's
+//! numbers are those of the flat formulas, and [`StaticFieldTop::new`] runs the same kernel on
+//! [`Plane`](super::surface::Plane)'s geometry (`kernel_derivatives_are_those_of_its_lagrangian`
+//! checks the kernel against differences of its L).
+//!
+//! **Conserved.** The metric is static (∂_t Killing), so E = p·q̇ − L is; θ is cyclic (p_θ). In
+//! the plane a central φ keeps x p_y − y p_x and a uniform one the momentum across the field.
+//! On a surface Q, s, c, ε and |G|² are invariant under a lifted isometry that keeps φ, so the
+//! momentum J = p_A X^A of a Killing field X with X(φ) = 0 is conserved; the invariants list
+//! those of the affine generators X(x) = Ax + b that provably keep the potential (φ = k·x:
+//! Aᵀk = 0 and k·b = 0; the point mass: A skew and b = 0), e.g. J_z on the sphere in φ = kϑ,
+//! and [`StaticFieldTop::killing_momenta`] gives all. φ = 0 gives the top of −dt² + g
+//! (002 (93), (103)); in the plane, expanding in φ, |G| = O(ε²), v = O(ε), θ̇ = O(1) gives
 //! (118) − m + O(ε⁴) (`static_field_expands_to_118` measures the ε⁴). The anisotropic body would
 //! add θ through Q(θ) = SISᵀ: L = −m√b + 𝕀θ̇²/(2√b) − e^{2φ}GᵀQG/(2√b) + aᵀQa/(2b^{3/2}) with
-//! a = e^{2φ}G − θ̇Jᵀẋ (not implemented), and a curved spatial metric g would enter as on a
-//! surface above (u, s), with G the frame components of dφ (not implemented).
+//! a = e^{2φ}G − θ̇Jᵀẋ (not implemented).
 //!
 //! # State
 //! All three systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)

@@ -136,6 +136,26 @@ impl Potential {
         Ok(out)
     }
 
+    /// Whether the affine vector field X(x) = A x + b of the chart leaves φ invariant,
+    /// X(φ) = 0 everywhere (`a[i][j]` = A_ij): for φ = k·x when Aᵀk = 0 and k·b = 0; for the point
+    /// mass when A is skew and b = 0 (x·(Ax + b) = 0 for all x); never for a custom φ (unknown).
+    /// The symmetries of the field on a surface ([`StaticFieldTop`](super::StaticFieldTop)).
+    pub(super) fn kept_by(&self, a: [[f64; 2]; 2], b: [f64; 2]) -> bool {
+        match &self.kind {
+            PotentialKind::PointMass { .. } => {
+                a[0][0] == 0.0 && a[1][1] == 0.0 && a[0][1] + a[1][0] == 0.0 && b == [0.0, 0.0]
+            }
+            PotentialKind::Uniform { g } => {
+                let atk = [
+                    a[0][0] * g[0] + a[1][0] * g[1],
+                    a[0][1] * g[0] + a[1][1] * g[1],
+                ];
+                atk == [0.0, 0.0] && g[0] * b[0] + g[1] * b[1] == 0.0
+            }
+            PotentialKind::Custom(_) => false,
+        }
+    }
+
     /// The number of [`Potential::invariants`].
     pub(super) fn invariant_count(&self) -> usize {
         1 + match &self.kind {
