@@ -7,7 +7,7 @@ use criterion::{BatchSize, Criterion};
 use lieflow::integrate::{integrate, integrate_batch, Properties, System};
 use lieflow::systems::user::{EulerPoincare, Lagrangian};
 use lieflow::systems::{
-    Algebra, FrameTop, GeneralizedRigidBody, HeavyTop, RigidBody, Side, SpaceForm,
+    Algebra, FrameTop, GeneralizedRigidBody, HeavyTop, RigidBody, Side, SpaceForm, SpaceTop,
     SphericalPendulum,
 };
 use std::hint::black_box;

@@ -17,7 +17,7 @@
 //! flat space (C = axial vectors of QᵀdQ) and, through the motion, against the 3-sphere.
 //!
 //! **Numerical**, like `MetricSurface`: ∂g and ∂E by fourth-order central differences
-//! ([`crate::numerics::fd::diff4`], step 7e-4·max(1, |x^k|)), C from them, ∂C by fourth-order
+//! (`numerics::fd::diff4`, step 7e-4·max(1, |x^k|)), C from them, ∂C by fourth-order
 //! differences of C (step 5e-3·max(1, |x^k|)). Expect errors of about 1e-12 in C and 1e-9 in ∂C
 //! for smooth data of order one. No Killing fields are known for a general metric.
 
