@@ -175,6 +175,13 @@ pub trait Catalog: Problem + Clone + 'static {
         None
     }
 
+    /// The tangent lift of the system ([`crate::integrate::tangent`]), whose runs carry the
+    /// Jacobian of the discrete flow, where the system gives the derivatives it needs; by
+    /// default none.
+    fn tangent(&self) -> Option<Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        None
+    }
+
     /// The system's own dissipative term of kind `d` (Rayleigh damping of a canonical system,
     /// double-bracket dissipation of a Lie–Poisson system), for
     /// [`crate::integrate::forcing::Forced`]; by default none.
@@ -248,6 +255,9 @@ pub trait System: Problem {
     /// The system carrying its attitude along ([`Catalog::lifted`]).
     fn lift(&self) -> Option<Arc<dyn System>>;
 
+    /// The tangent lift ([`Catalog::tangent`]).
+    fn tangent(&self) -> Option<Arc<dyn crate::integrate::tangent::TangentSystem>>;
+
     /// The system's own dissipative term of kind `d` ([`Catalog::dissipation`]).
     fn dissipation(
         &self,
@@ -294,6 +304,10 @@ impl<P: Catalog> System for P {
 
     fn lift(&self) -> Option<Arc<dyn System>> {
         self.lifted().map(|s| Arc::new(s) as Arc<dyn System>)
+    }
+
+    fn tangent(&self) -> Option<Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        Catalog::tangent(self)
     }
 
     fn dissipation(

@@ -40,6 +40,7 @@ pub mod methods;
 pub mod problem;
 pub mod run;
 pub mod space;
+pub mod tangent;
 pub mod trajectory;
 
 pub use batch::Batch;

@@ -60,6 +60,7 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rattle, Splitting, Verlet};
 use crate::integrate::problem::{Constrained, Separable, Split, Symmetric, Violation};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{SeparableTangent, Tangent, TangentSystem};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::gl;
 use crate::lie::so::{self, spectral_invariants};
@@ -377,6 +378,32 @@ impl Separable for PseudoRigidBody {
     }
 }
 
+/// The tangent lift ([`crate::integrate::tangent`]): v′ = identity, f′(X)[V] = −D²U(X)[V] (the
+/// potential's Hessian, analytic for every built-in potential).
+impl SeparableTangent for PseudoRigidBody {
+    fn velocity_tangent(&self, _p: &[f64], dp: &[f64], dv: &mut [f64]) {
+        dv.copy_from_slice(dp);
+    }
+
+    fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], s: &mut ForceScratch) {
+        let n = s.ws.n();
+        df.fill(0.0);
+        self.body.potential().add_hessian(
+            MatRef::from_row_major_slice(q, n, n),
+            MatRef::from_row_major_slice(dq, n, n),
+            MatMut::from_row_major_slice_mut(df, n, n),
+            &mut s.ws,
+        );
+        df.iter_mut().for_each(|v| *v = -*v);
+    }
+}
+
+impl Catalog for Tangent<PseudoRigidBody> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        Verlet::family()
+    }
+}
+
 impl PseudoRigidBody {
     /// [`Separable::force`] for any n, on views of the row-major slices (no copies).
     #[inline(never)]
@@ -560,12 +587,9 @@ impl Symmetric for PseudoRigidBody {
 impl Catalog for PseudoRigidBody {
     /// The free body's.
     fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![
-            Entry::new("verlet", Verlet::strang),
-            Entry::new("verlet4", || Verlet(Composition::suzuki4())),
-            Entry::new("verlet6", || Verlet(Composition::yoshida6())),
-            Entry::new("reduced", Splitting::strang),
-        ]
+        let mut catalog = Verlet::family();
+        catalog.push(Entry::new("reduced", Splitting::strang));
+        catalog
     }
 
     fn catalog(&self) -> Vec<Entry<Self>> {
@@ -577,5 +601,10 @@ impl Catalog for PseudoRigidBody {
             ],
             false => Self::kind_catalog(),
         }
+    }
+
+    /// The Verlet methods' tangent lift (the free body; not yet the incompressible one).
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
+        (!self.incompressible).then(|| Tangent::separable(self.clone()).into_system())
     }
 }

@@ -15,7 +15,7 @@
 
 use super::composition::Composition;
 use crate::error::Result;
-use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
+use crate::integrate::method::{Clock, Entry, Integrator, Properties, Stepper};
 use crate::integrate::problem::Separable;
 
 /// Störmer–Verlet composed with the given [`Composition`] (order 2, 4 or 6 for the built-in
@@ -27,6 +27,16 @@ impl Verlet {
     /// Plain Störmer–Verlet, order 2.
     pub fn strang() -> Self {
         Verlet(Composition::strang())
+    }
+
+    /// The catalog entries `verlet`, `verlet4`, `verlet6` (Strang, Suzuki's 5-stage order 4,
+    /// Yoshida's order 6) of a separable problem: one list for a system and its tangent lift.
+    pub fn family<P: Separable + Clone + 'static>() -> Vec<Entry<P>> {
+        vec![
+            Entry::new("verlet", Verlet::strang),
+            Entry::new("verlet4", || Verlet(Composition::suzuki4())),
+            Entry::new("verlet6", || Verlet(Composition::yoshida6())),
+        ]
     }
 }
 

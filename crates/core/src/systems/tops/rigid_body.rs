@@ -277,4 +277,10 @@ impl Catalog for RigidBody {
     fn lifted(&self) -> Option<Self> {
         Some(self.with_attitude())
     }
+
+    /// `rk4`'s tangent lift, without the attitude.
+    fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        (!self.top.lifted)
+            .then(|| crate::integrate::tangent::Tangent::field(self.clone()).into_system())
+    }
 }

@@ -370,6 +370,25 @@ impl Top {
     }
 }
 
+impl Top {
+    /// The derivative of [`Top::field`] along dy (without the attitude): δṀ = δM × Ω + M × δΩ
+    /// (+ δΓ × c), δΓ̇ = δΓ × Ω + Γ × δΩ, δΩ = I⁻¹δM (principal frame).
+    pub(crate) fn field_tangent(&self, y: &[f64], dy: &[f64], out: &mut [f64]) {
+        let m = Vector3::from_column_slice(&y[..3]);
+        let dm = Vector3::from_column_slice(&dy[..3]);
+        let w = Vector3::from_fn(|i, _| m[i] / self.moments[i]);
+        let dw = Vector3::from_fn(|i, _| dm[i] / self.moments[i]);
+        let mut ddm = dm.cross(&w) + m.cross(&dw);
+        if let Some(c) = &self.c {
+            let g = Vector3::from_column_slice(&y[3..6]);
+            let dg = Vector3::from_column_slice(&dy[3..6]);
+            ddm += dg.cross(c);
+            out[3..6].copy_from_slice((dg.cross(&w) + g.cross(&dw)).as_slice());
+        }
+        out[..3].copy_from_slice(ddm.as_slice());
+    }
+}
+
 /// The flows of the free rigid body (M) and of the heavy top (M, Γ), with or without the attitude
 /// R, on a block of bodies, in SIMD lanes ([`crate::numerics::simd`]); [`Top::flow`] is this
 /// kernel on one body. Flow `Axis(a)` rotates M (and Γ) about e_k, k = `axes[a]`, by the angle
@@ -740,6 +759,21 @@ macro_rules! top_kinds {
         impl $crate::integrate::problem::VectorField for $t {
             fn field(&self, z: &[f64], dz: &mut [f64]) {
                 self.top.field(z, dz)
+            }
+        }
+
+        impl $crate::integrate::tangent::VectorFieldTangent for $t {
+            fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+                self.top.field_tangent(z, dz, out)
+            }
+        }
+
+        /// `rk4` on the tangent lift (the splittings' lift is not built yet).
+        impl $crate::integrate::Catalog for $crate::integrate::tangent::Tangent<$t> {
+            fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
+                vec![$crate::integrate::Entry::new("rk4", || {
+                    $crate::integrate::methods::Rk4
+                })]
             }
         }
 

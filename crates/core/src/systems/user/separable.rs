@@ -5,10 +5,10 @@ use super::*;
 use crate::check;
 use crate::error::{fmt_num, Error, Result};
 use crate::integrate::hooks;
-use crate::integrate::methods::{canonical_catalog, Composition, Verlet};
+use crate::integrate::methods::{canonical_catalog, Verlet};
 use crate::integrate::problem::{Canonical, Separable, Violation};
 use crate::integrate::space::Space;
-use crate::integrate::{Entry, Problem};
+use crate::integrate::Problem;
 use crate::Mat;
 
 /// The constant kinetic mass M of a [`UserSeparable`] (T = ½ pᵀM⁻¹p).
@@ -299,11 +299,7 @@ impl Canonical for UserSeparable {
 
 // verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
 crate::integrate::methods::canonical_system!(UserSeparable, {
-    let mut entries = vec![
-        Entry::new("verlet", Verlet::strang),
-        Entry::new("verlet4", || Verlet(Composition::suzuki4())),
-        Entry::new("verlet6", || Verlet(Composition::yoshida6())),
-    ];
+    let mut entries = Verlet::family();
     entries.extend(canonical_catalog());
     entries
 });

@@ -1,0 +1,290 @@
+//! Tangent maps of the discrete flow (issue 26): the tangent lift of a problem, integrated by the
+//! problem's own methods.
+//!
+//! **The mechanism.** For a problem P of a kind K and its state z ∈ ℝᵈ, the tangent lift TP is a
+//! problem of the same kind K on (z, δz₁, …, δz_k), whose pieces are the pieces of P and their
+//! directional derivatives (ż = f(z), δż_j = f′(z)δz_j). Every method of kind K then applies to TP
+//! unchanged, and what it computes for the δz_j is exactly the derivative of its own discrete map
+//! Φ_h applied to δz_j(0), to round-off — not an approximation of the variational equations:
+//! - Runge–Kutta methods (RK4, Gauss) commute with linearisation: RK on the lifted field is the
+//!   derivative of RK (internal differentiation; Hairer, Nørsett & Wanner I, §II.6);
+//! - a Verlet composition is a composition of kicks q ↦ q, p ↦ p + τf(q) and drifts
+//!   q ↦ q + τv(p): on the lifted separable problem (positions (q, δq), momenta (p, δp), force
+//!   (f(q), f′(q)δq), velocity (v(p), v′(p)δp)) each kick and drift is the tangent map of the
+//!   original one, so the composition is the tangent of the composition.
+//!
+//! So one lift per problem kind serves every method of that kind (no tangent twin of a method),
+//! and a system opts in by giving the directional derivatives of its kind's primitives
+//! ([`SeparableTangent`]: its force, from the potential's Hessian; [`VectorFieldTangent`]: its
+//! field). The implicit methods' iterations converge on the lifted unknowns as on the plain ones
+//! (the lifted Newton matrix is block-triangular with the plain one on its diagonal). With k = d
+//! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + d) plain
+//! runs.
+//!
+//! **Layouts.** A separable lift stores (q, δq₁, …, δq_k, p, δp₁, …, δp_k) (its kind needs the
+//! positions before the momenta); a field lift (z, δz₁, …, δz_k). [`TangentSystem::seed`] and
+//! [`TangentSystem::jacobian`] convert from and to the problem's flat layout, so nothing outside
+//! this module sees either. The problem's chart ([`Problem::to_internal`]) must be linear (a
+//! turn to principal axes): the lift applies it to the directions as to states.
+//!
+//! **What the lift keeps.** Its space is flat (no block is retracted during the run, which
+//! would not be differentiated), its energy and invariants are the base state's.
+
+use std::sync::Arc;
+
+use super::method::{Catalog, System};
+use super::problem::{Problem, Separable, VectorField, Violation};
+use super::run::check_state;
+use super::space::{Block, Space};
+use crate::error::{Error, Result};
+
+/// A [`Separable`] problem with the directional derivatives of its velocity and force: the data
+/// of its tangent lift.
+pub trait SeparableTangent: Separable {
+    /// dv = v′(p)·dp, the derivative of the velocity along dp.
+    fn velocity_tangent(&self, p: &[f64], dp: &[f64], dv: &mut [f64]);
+
+    /// df = f′(q)·dq, the derivative of the force along dq (for f = −∂U/∂q, −D²U(q)[dq]).
+    fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], s: &mut Self::Scratch);
+}
+
+/// A [`VectorField`] with the directional derivative of its field: the data of its tangent lift.
+pub trait VectorFieldTangent: VectorField {
+    /// out = f′(z)·dz.
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]);
+}
+
+/// Where the lift keeps its directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Layout {
+    /// (q, δq₁…δq_k, p, δp₁…δp_k), each block of length `dof`.
+    Separable { dof: usize },
+    /// (z, δz₁…δz_k).
+    Field,
+}
+
+/// The tangent lift of a problem with k = d directions (module docs).
+#[derive(Clone, Debug)]
+pub struct Tangent<P> {
+    problem: P,
+    d: usize,
+    layout: Layout,
+}
+
+/// A lifted system as the driver and the bindings see it: a [`System`] whose states carry the
+/// directions, with the conversions from and to the base problem's flat layout.
+pub trait TangentSystem: System {
+    /// The dimension d of the base state.
+    fn base_dim(&self) -> usize;
+
+    /// The lifted state of a base state (user frame) with the identity as directions.
+    fn seed(&self, z0: &[f64]) -> Result<Vec<f64>>;
+
+    /// The base state (d values) and the Jacobian ∂z/∂z₀ (d×d row-major, column j = δz_j) of a
+    /// lifted state.
+    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64]);
+}
+
+impl<P: Problem + Clone> Tangent<P> {
+    fn with(problem: P, layout: Layout) -> Self {
+        let d = problem.space().dim();
+        Tangent { problem, d, layout }
+    }
+
+    /// The base problem.
+    pub fn problem(&self) -> &P {
+        &self.problem
+    }
+
+    /// Index of component i of the base state (i < d) in direction j (0 = the state itself).
+    #[inline]
+    fn at(&self, j: usize, i: usize) -> usize {
+        match self.layout {
+            Layout::Field => j * self.d + i,
+            Layout::Separable { dof } => {
+                let (half, c) = (i / dof, i % dof);
+                half * dof * (self.d + 1) + j * dof + c
+            }
+        }
+    }
+
+    fn gather(&self, lifted: &[f64], j: usize, out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = lifted[self.at(j, i)];
+        }
+    }
+
+    fn scatter(&self, v: &[f64], j: usize, lifted: &mut [f64]) {
+        for (i, x) in v.iter().enumerate() {
+            lifted[self.at(j, i)] = *x;
+        }
+    }
+
+    /// Applies `map` to the base state and to every direction, each as a flat base state.
+    fn each(&self, z: &mut [f64], map: impl Fn(&mut [f64])) {
+        let mut v = vec![0.0; self.d];
+        for j in 0..=self.d {
+            self.gather(z, j, &mut v);
+            map(&mut v);
+            self.scatter(&v, j, z);
+        }
+    }
+}
+
+impl<P: SeparableTangent + Clone> Tangent<P> {
+    /// The lift of a separable problem (its Verlet methods).
+    pub fn separable(problem: P) -> Self {
+        let dof = problem.dof();
+        Tangent::with(problem, Layout::Separable { dof })
+    }
+}
+
+impl<P: VectorFieldTangent + Clone> Tangent<P> {
+    /// The lift of a vector field (its Runge–Kutta methods).
+    pub fn field(problem: P) -> Self {
+        Tangent::with(problem, Layout::Field)
+    }
+}
+
+impl<P: Problem + Clone> Problem for Tangent<P> {
+    fn name(&self) -> &'static str {
+        self.problem.name()
+    }
+
+    /// Flat: d(1 + d) values.
+    fn space(&self) -> Space {
+        Space::new([("z", Block::Real(self.d * (self.d + 1)))])
+    }
+
+    fn energy(&self, z: &[f64]) -> Result<f64> {
+        self.problem.energy(&self.base(z))
+    }
+
+    fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
+        self.problem.invariants(&self.base(z))
+    }
+
+    fn invariant_count(&self) -> usize {
+        self.problem.invariant_count()
+    }
+
+    /// The base state checked as the base problem checks it.
+    fn check_state(&self, z: &[f64]) -> Result<()> {
+        check_state(&self.problem, &self.base(z))
+    }
+
+    fn to_internal(&self, z: &mut [f64]) {
+        self.each(z, |v| self.problem.to_internal(v));
+    }
+
+    fn to_user(&self, z: &mut [f64]) {
+        self.each(z, |v| self.problem.to_user(v));
+    }
+
+    fn calls_out(&self) -> bool {
+        self.problem.calls_out()
+    }
+}
+
+impl<P: Problem + Clone> Tangent<P> {
+    fn base(&self, z: &[f64]) -> Vec<f64> {
+        let mut v = vec![0.0; self.d];
+        self.gather(z, 0, &mut v);
+        v
+    }
+}
+
+/// Positions (q, δq₁…δq_k), momenta (p, δp₁…δp_k), force (f(q), f′(q)δq_j), velocity
+/// (v(p), v′(p)δp_j).
+impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
+    type Scratch = P::Scratch;
+
+    fn scratch(&self) -> P::Scratch {
+        self.problem.scratch()
+    }
+
+    fn dof(&self) -> usize {
+        self.problem.dof() * (self.d + 1)
+    }
+
+    fn velocity(&self, p: &[f64], v: &mut [f64]) {
+        let n = self.problem.dof();
+        let (v0, dv) = v.split_at_mut(n);
+        self.problem.velocity(&p[..n], v0);
+        for (dpj, dvj) in p[n..].chunks_exact(n).zip(dv.chunks_exact_mut(n)) {
+            self.problem.velocity_tangent(&p[..n], dpj, dvj);
+        }
+    }
+
+    fn force(
+        &self,
+        q: &[f64],
+        f: &mut [f64],
+        s: &mut P::Scratch,
+    ) -> std::result::Result<(), Violation> {
+        let n = self.problem.dof();
+        let (f0, df) = f.split_at_mut(n);
+        self.problem.force(&q[..n], f0, s)?;
+        for (dqj, dfj) in q[n..].chunks_exact(n).zip(df.chunks_exact_mut(n)) {
+            self.problem.force_tangent(&q[..n], dqj, dfj, s);
+        }
+        Ok(())
+    }
+}
+
+/// (f(z), f′(z)δz_j).
+impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
+    fn field(&self, z: &[f64], dz: &mut [f64]) {
+        let d = self.d;
+        let (f0, df) = dz.split_at_mut(d);
+        self.problem.field(&z[..d], f0);
+        for (dzj, dfj) in z[d..].chunks_exact(d).zip(df.chunks_exact_mut(d)) {
+            self.problem.field_tangent(&z[..d], dzj, dfj);
+        }
+    }
+}
+
+impl<P: Problem + Clone> Tangent<P>
+where
+    Tangent<P>: Catalog,
+{
+    /// The lift as a [`TangentSystem`] trait object.
+    pub fn into_system(self) -> Arc<dyn TangentSystem> {
+        Arc::new(self)
+    }
+}
+
+impl<P: Problem + Clone> TangentSystem for Tangent<P>
+where
+    Tangent<P>: Catalog,
+{
+    fn base_dim(&self) -> usize {
+        self.d
+    }
+
+    fn seed(&self, z0: &[f64]) -> Result<Vec<f64>> {
+        if z0.len() != self.d {
+            return Err(Error::shape(
+                "state",
+                format!("({},)", self.d),
+                format!("({},)", z0.len()),
+            ));
+        }
+        let mut z = vec![0.0; self.d * (self.d + 1)];
+        self.scatter(z0, 0, &mut z);
+        for j in 0..self.d {
+            z[self.at(j + 1, j)] = 1.0;
+        }
+        Ok(z)
+    }
+
+    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64]) {
+        let d = self.d;
+        self.gather(lifted, 0, z);
+        for j in 0..d {
+            for i in 0..d {
+                jac[i * d + j] = lifted[self.at(j + 1, i)];
+            }
+        }
+    }
+}

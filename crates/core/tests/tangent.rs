@@ -1,0 +1,152 @@
+//! Tangent maps of the discrete flow (issue 26): the Jacobian a lifted run carries against
+//! central differences of the same method, and the symplecticity JᵀΩJ = Ω of the Verlet methods'
+//! Jacobian.
+
+use std::sync::Arc;
+
+use lieflow::integrate::tangent::TangentSystem;
+use lieflow::integrate::{integrate, System};
+use lieflow::pseudo_rigid::potential::{SaintVenantKirchhoff, Sum, Volumetric};
+use lieflow::pseudo_rigid::PseudoRigidBody;
+use lieflow::systems::{HeavyTop, RigidBody};
+
+/// (base state at the end, Jacobian d×d row-major) of `steps` steps of `method`.
+fn lifted_end(
+    t: &dyn TangentSystem,
+    method: &str,
+    z0: &[f64],
+    dt: f64,
+    steps: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let d = t.base_dim();
+    let seed = t.seed(z0).unwrap();
+    let traj = integrate(t, method, &seed, dt, steps, steps).unwrap();
+    let (mut z, mut jac) = (vec![0.0; d], vec![0.0; d * d]);
+    t.jacobian(traj.state(1), &mut z, &mut jac);
+    (z, jac)
+}
+
+/// Central differences of the end state in each initial component (step h·max(1, |z_j|)).
+fn differences(
+    sys: &dyn System,
+    method: &str,
+    z0: &[f64],
+    dt: f64,
+    steps: usize,
+    h: f64,
+) -> Vec<f64> {
+    let d = z0.len();
+    let mut jac = vec![0.0; d * d];
+    for j in 0..d {
+        let hj = h * z0[j].abs().max(1.0);
+        let end = |s: f64| {
+            let mut z = z0.to_vec();
+            z[j] += s;
+            integrate(sys, method, &z, dt, steps, steps)
+                .unwrap()
+                .state(1)
+                .to_vec()
+        };
+        let (p, m) = (end(hj), end(-hj));
+        for i in 0..d {
+            jac[i * d + j] = (p[i] - m[i]) / (2.0 * hj);
+        }
+    }
+    jac
+}
+
+fn max_rel(a: &[f64], b: &[f64]) -> f64 {
+    let scale = b.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
+}
+
+fn body() -> PseudoRigidBody {
+    let elastic = Arc::new(Sum::new(vec![
+        Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()),
+        Arc::new(Volumetric::polytropic(0.5, 1.4).unwrap()),
+    ]));
+    PseudoRigidBody::new(3, elastic, true).unwrap()
+}
+
+fn body_state() -> Vec<f64> {
+    let x = [1.3, 0.1, -0.05, 0.02, 1.1, 0.08, -0.03, 0.05, 0.9];
+    let p = [0.1, -0.5, 0.2, 0.6, 0.05, -0.3, -0.1, 0.4, 0.02];
+    x.iter().chain(p.iter()).copied().collect()
+}
+
+/// The Verlet methods on the pseudo-rigid body: the lifted run's Jacobian is the derivative of
+/// the method's own map (central differences to 1e-8), its base state is the plain run's, and
+/// JᵀΩJ = Ω to round-off.
+#[test]
+fn verlet_jacobian_of_the_pseudo_rigid_body() {
+    let b = body();
+    let t = b.tangent().expect("the free body has a tangent lift");
+    let z0 = body_state();
+    let (dt, steps) = (0.05, 40);
+    for method in ["verlet", "verlet4", "verlet6"] {
+        let (z, jac) = lifted_end(&*t, method, &z0, dt, steps);
+        let plain = integrate(&b, method, &z0, dt, steps, steps).unwrap();
+        assert_eq!(
+            z,
+            plain.state(1),
+            "{method}: the base state is the plain run's"
+        );
+        let fd = differences(&b, method, &z0, dt, steps, 1e-5);
+        let err = max_rel(&jac, &fd);
+        eprintln!("{method}: Jacobian vs differences {err:.2e}");
+        assert!(err < 1e-8, "{method}: {err:e}");
+        // JᵀΩJ = Ω with Ω = [[0, 1], [−1, 0]] (blocks of 9).
+        let d = 18;
+        let omega = |i: usize, j: usize| match (i < 9, j < 9) {
+            (true, false) if j == i + 9 => 1.0,
+            (false, true) if i == j + 9 => -1.0,
+            _ => 0.0,
+        };
+        let mut worst = 0.0f64;
+        for a in 0..d {
+            for c in 0..d {
+                let mut s = 0.0;
+                for i in 0..d {
+                    for k in 0..d {
+                        s += jac[i * d + a] * omega(i, k) * jac[k * d + c];
+                    }
+                }
+                worst = worst.max((s - omega(a, c)).abs());
+            }
+        }
+        let norm = jac.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        eprintln!("{method}: |JᵀΩJ − Ω| = {worst:.2e} (|J|∞ {norm:.1})");
+        assert!(worst < 1e-12 * norm * norm, "{method}: {worst:e}");
+    }
+    // The incompressible body has no lift yet.
+    let inc =
+        PseudoRigidBody::incompressible(3, Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()))
+            .unwrap();
+    assert!(inc.tangent().is_none());
+}
+
+/// RK4 on the free rigid body and the heavy top (principal frame turned: the lift's chart).
+#[test]
+fn rk4_jacobian_of_the_tops() {
+    let inertia = [2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2];
+    let rb = RigidBody::from_matrix(&inertia).unwrap();
+    let ht = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
+    let cases: [(&dyn System, Vec<f64>); 2] = [
+        (&rb, vec![0.3, -0.8, 1.1]),
+        (&ht, vec![1.0, 0.5, -0.3, 0.0, 0.6, 0.8]),
+    ];
+    for (sys, z0) in cases {
+        let t = sys.tangent().expect("a lift");
+        let (z, jac) = lifted_end(&*t, "rk4", &z0, 0.02, 100);
+        let plain = integrate(sys, "rk4", &z0, 0.02, 100, 100).unwrap();
+        assert!(max_rel(&z, plain.state(1)) < 1e-15);
+        let fd = differences(sys, "rk4", &z0, 0.02, 100, 1e-5);
+        let err = max_rel(&jac, &fd);
+        eprintln!("{}: rk4 Jacobian vs differences {err:.2e}", sys.name());
+        assert!(err < 1e-8, "{}: {err:e}", sys.name());
+    }
+    assert!(rb.with_attitude().tangent().is_none());
+}
