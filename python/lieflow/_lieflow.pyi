@@ -21,7 +21,7 @@ __all__ = [
     "LieflowError", "NotInGroupError", "ShapeError", "NonFiniteError", "DegenerateStratumError",
     "NoUniqueLogError", "InvalidArgumentError", "UnsupportedMethodError", "ConvergenceError",
     "LeftDomainError", "ArgumentTypeError", "lie", "pseudo_rigid", "potentials", "spaces", "surfaces",
-    "elliptic", "ellipsoids", "continuation", "System", "Integration", "RigidBody",
+    "elliptic", "ellipsoids", "continuation", "System", "Integration", "_Tangent", "RigidBody",
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
     "RelativisticTangentTop", "WeakFieldTop", "StaticFieldTop", "TangentTop", "ChargedParticle",
@@ -89,6 +89,12 @@ class Integration:
     def take_partial(self) -> tuple[_F64, _F64 | None] | None: ...
     def checked_state(self) -> tuple[_F64, _F64 | None]: ...
 
+@final
+class _Tangent:
+    """The layout of a system's tangent lift (internal to `lieflow.integrate`)."""
+    def seed(self, states: ArrayLike) -> _F64: ...
+    def split(self, lifted: ArrayLike) -> tuple[_F64, _F64]: ...
+
 @disjoint_base
 class System:
     """Base class of every system: the protocol `lieflow.integrate` drives, pickling, repr."""
@@ -96,6 +102,9 @@ class System:
     @classmethod
     def methods(cls) -> list[str]:
         """The integration methods; the first is the default."""
+    def sensitivity_methods(self) -> list[str]:
+        """The methods whose Jacobians `integrate(..., sensitivity=True)` computes."""
+    def _tangent(self) -> tuple[System, _Tangent] | None: ...
     @property
     def state_dim(self) -> int: ...
     @property

@@ -25,7 +25,8 @@ import sys
 
 import numpy as np
 
-from ._lieflow import InvalidArgumentError, NonFiniteError, ShapeError, System
+from ._lieflow import (InvalidArgumentError, NonFiniteError, ShapeError, System,
+                       UnsupportedMethodError)
 from .trajectory import Trajectory, load
 
 __all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
@@ -227,7 +228,7 @@ def _native(run, name, argument):
 
 def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitude=None,
               progress=False, chunk_steps=None, threads=None, *, t0=0.0, t_eval=None,
-              events=None, event_tol=0.0):
+              events=None, event_tol=0.0, sensitivity=False):
     """Integrates ``system`` from ``state0`` by ``steps`` fixed steps of size ``dt``.
 
     Args:
@@ -269,6 +270,12 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             of the method. A g exactly 0 at a step is an event there; a start at g = 0 is not.
             Single initial states only (a batch is an InvalidArgumentError).
         event_tol: an absolute tolerance in time (>= 0) added to round-off when locating events.
+        sensitivity: also compute the Jacobian ∂z_k/∂z_0 of the method's own discrete map at
+            every sample (``traj.jacobian``, (k, d, d); exact to round-off, not finite
+            differences): the run integrates the system's tangent lift with the same method
+            (about d + 1 times the work of the plain run). Available where the system gives the
+            derivatives its method needs (``system.sensitivity_methods()``); not yet with an
+            attitude or events.
 
     Returns:
         A ``Trajectory``. With events, ``traj.t_events`` and ``traj.state_events`` list the
@@ -291,6 +298,12 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
     """
     if not isinstance(system, System):
         _check_system(system)
+    if sensitivity is not False:
+        if sensitivity is not True:
+            raise TypeError(f"invalid sensitivity: expected True or False, got "
+                            f"{type(sensitivity).__name__} {sensitivity!r}")
+        return _with_sensitivity(system, state0, dt, steps, method, save_every, attitude,
+                                 progress, chunk_steps, threads, t0, t_eval, events)
     if steps is None and t_eval is None:
         raise TypeError("invalid steps: expected an integer >= 1, got NoneType None (steps may be "
                         "None only with t_eval, whose last time is then the end of the run)")
@@ -353,6 +366,40 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             bar.close()
     stopped = run.stopped_by if ev is not None else None
     return _trajectory(system, run, chunks, times, 1 if stopped is not None else 0, ev)
+
+
+def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, progress,
+                      chunk_steps, threads, t0, t_eval, events):
+    """``integrate(..., sensitivity=True)``: the run of the tangent lift, split into the states
+    and their Jacobians (see ``integrate``)."""
+    name = type(system).__name__
+    if attitude is not None or events is not None:
+        what = "attitude" if attitude is not None else "events"
+        raise InvalidArgumentError(f"invalid {what}: sensitivity=True is not available with "
+                                   f"{'an attitude' if what == 'attitude' else 'events'} yet")
+    lift = system._tangent()
+    if lift is None:
+        raise InvalidArgumentError(f"invalid sensitivity: {name} has no tangent maps yet "
+                                   f"({name}.sensitivity_methods() is empty)")
+    lifted, layout = lift
+    if method is None:
+        method = system.methods()[0]
+    if not isinstance(method, str):
+        raise TypeError(f"invalid method: expected a str, got {type(method).__name__} {method!r}")
+    if method not in lifted.methods():
+        raise UnsupportedMethodError(
+            f"unsupported method {method!r} with sensitivity=True: the tangent maps of {name} are "
+            f"available for {lifted.methods()} (method=...)")
+    z0, batched = system._normalize_state(state0)
+    seeds = layout.seed(z0 if batched else z0[0])
+    traj = integrate(lifted, seeds, dt, steps, method, save_every, None, progress, chunk_steps,
+                     threads, t0=t0, t_eval=t_eval)
+    states, jac = layout.split(traj.states)
+    final, final_jac = layout.split(traj.final_state)
+    return Trajectory(system, traj.method, traj.t, states, None, final, None, traj.dt,
+                      traj.save_every, t_final=traj.t_final, status=traj.status, t0=traj.t0,
+                      initial_state=z0 if batched else z0[0], jacobian=jac,
+                      final_jacobian=final_jac)
 
 
 def _trajectory(system, run, parts, times, status, ev):

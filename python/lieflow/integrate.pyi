@@ -83,11 +83,13 @@ def integrate(
     t_eval: ArrayLike | None = None,
     events: _EventFunction | list[_EventFunction] | None = None,
     event_tol: float = 0.0,
+    sensitivity: bool = False,
 ) -> Trajectory:
     """Integrate `steps` fixed steps of size `dt` from time `t0`; k = steps // save_every + 1
     samples, or the states at the times `t_eval` (shortened steps between grid times; with
     steps=None the run ends at t_eval[-1]). `events`: scipy-style event functions (attributes
     `terminal`, `direction`), located on the method's trajectory by shortened steps. An
-    exception during the run carries `err.partial`, the trajectory computed before it."""
+    exception during the run carries `err.partial`, the trajectory computed before it.
+    `sensitivity=True`: also the Jacobians of the method's discrete map (`traj.jacobian`)."""
 
 from .trajectory import Trajectory as Trajectory, load as load

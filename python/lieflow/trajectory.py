@@ -28,6 +28,9 @@ class Trajectory:
         t_events, state_events: with ``events``, one array per event function of the times
             (n_i,) and the states (n_i, d) of its zeros (``attitude_events`` (n_i, n, n) with an
             attitude); None without events.
+        jacobian: with ``sensitivity=True``, (k, d, d) (or (b, k, d, d)) the Jacobians
+            ∂z_k/∂z_0 of the method's own discrete map at the samples (``final_jacobian`` at
+            the final state); None otherwise.
         Named views from the system (e.g. ``M``, ``Gamma``, ``q``, ``L``) as attributes.
 
     Methods ``energy()`` and ``casimirs()``, ``to_xarray()`` and ``save(path)`` (read back with
@@ -39,7 +42,8 @@ class Trajectory:
 
     def __init__(self, system, method, t, states, attitude, final_state, final_attitude, dt,
                  save_every, *, t_final=None, status=0, t_events=None, state_events=None,
-                 attitude_events=None, t0=None, initial_state=None, initial_attitude=None):
+                 attitude_events=None, t0=None, initial_state=None, initial_attitude=None,
+                 jacobian=None, final_jacobian=None):
         self.system = system
         self.method = method
         self.t = t
@@ -57,6 +61,8 @@ class Trajectory:
         self.t0 = t0 if t0 is not None else (float(t[0]) if len(t) else None)
         self.initial_state = initial_state
         self.initial_attitude = initial_attitude
+        self.jacobian = jacobian
+        self.final_jacobian = final_jacobian
         self._field_cache = None
 
     @classmethod

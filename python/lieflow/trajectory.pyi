@@ -32,6 +32,9 @@ class Trajectory:
     attitude_events: list[_F64] | None
     initial_state: _F64 | None
     initial_attitude: _F64 | None
+    jacobian: _F64 | None
+    """(k, d, d) / (b, k, d, d) Jacobians dz_k/dz_0 with sensitivity=True, else None."""
+    final_jacobian: _F64 | None
     states: _F64
     """(k, d), or (b, k, d) for a batch."""
     attitude: _F64 | None
@@ -45,6 +48,7 @@ class Trajectory:
         t_events: list[_F64] | None = None, state_events: list[_F64] | None = None,
         attitude_events: list[_F64] | None = None, t0: float | None = None,
         initial_state: _F64 | None = None, initial_attitude: _F64 | None = None,
+        jacobian: _F64 | None = None, final_jacobian: _F64 | None = None,
     ) -> None: ...
     @classmethod
     def concatenate(cls, trajectories: Iterable[Trajectory]) -> Trajectory:

@@ -150,3 +150,89 @@ fn rk4_jacobian_of_the_tops() {
     }
     assert!(rb.with_attitude().tangent().is_none());
 }
+
+fn hat(v: &[f64]) -> [[f64; 3]; 3] {
+    [[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]]
+}
+
+/// The Lie–Poisson tensor of so(3)* (d = 3) or se(3)* (d = 6, (M, Γ)) at z, up to its overall
+/// sign (which a Poisson map keeps either way): [[M̂, Γ̂], [Γ̂, 0]].
+fn poisson_tensor(z: &[f64]) -> Vec<f64> {
+    let d = z.len();
+    let mut b = vec![0.0; d * d];
+    let m = hat(&z[..3]);
+    for i in 0..3 {
+        for j in 0..3 {
+            b[i * d + j] = m[i][j];
+            if d == 6 {
+                let g = hat(&z[3..6]);
+                b[i * d + j + 3] = g[i][j];
+                b[(i + 3) * d + j] = g[i][j];
+            }
+        }
+    }
+    b
+}
+
+/// The splittings of the tops (their defaults) on the tangent lift: the Jacobian against central
+/// differences of the same method, and on the symplectic leaf: J B(z₀) Jᵀ = B(z) (a Poisson map)
+/// and ∇C(z)ᵀJ = ∇C(z₀)ᵀ for the Casimirs (|M|²; |Γ|², M·Γ), to round-off.
+#[test]
+fn splitting_jacobians_of_the_tops_are_poisson() {
+    let rb = RigidBody::from_matrix(&[2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2]).unwrap();
+    let ht = HeavyTop::new([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]).unwrap();
+    let cases: [(&dyn System, Vec<f64>); 2] = [
+        (&rb, vec![0.3, -0.8, 1.1]),
+        (&ht, vec![1.0, 0.5, -0.3, 0.0, 0.6, 0.8]),
+    ];
+    for (sys, z0) in cases {
+        let t = sys.tangent().expect("a lift");
+        let d = z0.len();
+        for method in ["splitting", "splitting4", "splitting6"] {
+            let (z, jac) = lifted_end(&*t, method, &z0, 0.05, 60);
+            let plain = integrate(sys, method, &z0, 0.05, 60, 60).unwrap();
+            assert!(max_rel(&z, plain.state(1)) < 1e-14, "{method}: base state");
+            let fd = differences(sys, method, &z0, 0.05, 60, 1e-5);
+            let err = max_rel(&jac, &fd);
+            eprintln!("{} {method}: Jacobian vs differences {err:.2e}", sys.name());
+            assert!(err < 1e-8, "{} {method}: {err:e}", sys.name());
+            // J B(z₀) Jᵀ = B(z).
+            let (b0, b1) = (poisson_tensor(&z0), poisson_tensor(&z));
+            let mut worst = 0.0f64;
+            for i in 0..d {
+                for k in 0..d {
+                    let mut s = 0.0;
+                    for a in 0..d {
+                        for c in 0..d {
+                            s += jac[i * d + a] * b0[a * d + c] * jac[k * d + c];
+                        }
+                    }
+                    worst = worst.max((s - b1[i * d + k]).abs());
+                }
+            }
+            // Casimir gradients: (2M) for the body; (0, 2Γ) and (Γ, M) for the top.
+            let grads: Vec<(Vec<f64>, Vec<f64>)> = if d == 3 {
+                vec![(
+                    z0.iter().map(|x| 2.0 * x).collect(),
+                    z.iter().map(|x| 2.0 * x).collect(),
+                )]
+            } else {
+                let g =
+                    |v: &[f64]| [vec![0.0; 3], v[3..6].iter().map(|x| 2.0 * x).collect()].concat();
+                let mg = |v: &[f64]| [v[3..6].to_vec(), v[..3].to_vec()].concat();
+                vec![(g(&z0), g(&z)), (mg(&z0), mg(&z))]
+            };
+            for (g0, g1) in grads {
+                for j in 0..d {
+                    let s: f64 = (0..d).map(|i| g1[i] * jac[i * d + j]).sum();
+                    worst = worst.max((s - g0[j]).abs());
+                }
+            }
+            eprintln!(
+                "{} {method}: Poisson tensor and Casimirs {worst:.2e}",
+                sys.name()
+            );
+            assert!(worst < 1e-12, "{} {method}: {worst:e}", sys.name());
+        }
+    }
+}

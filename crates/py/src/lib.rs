@@ -12,6 +12,7 @@ mod integrate;
 mod items;
 mod lie;
 mod pseudo_rigid;
+mod sensitivity;
 mod system;
 mod systems;
 
@@ -49,6 +50,7 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     add_submodule(m, "continuation", analysis::register)?;
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;
+    m.add_class::<sensitivity::PyTangent>()?;
     systems::register(m)?;
     system::add_system::<
         pseudo_rigid::system::PyPseudoRigidBody,

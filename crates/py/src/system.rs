@@ -61,6 +61,18 @@ impl PySystem {
         }
     }
 
+    /// A bare system object over a core system made by another (the tangent lift of
+    /// `lieflow.integrate(..., sensitivity=True)`): no constructor arguments, no attitude.
+    pub(crate) fn derived(py: Python<'_>, sys: Arc<dyn System>) -> Self {
+        PySystem {
+            lifted: None,
+            sys,
+            args: PyTuple::empty(py).unbind(),
+            names: &[],
+            resolved: Mutex::new(Vec::new()),
+        }
+    }
+
     /// The initializer of a system object of the subclass `C` over the core system `sys` (base
     /// part as [`PySystem::new`]), for a class that keeps nothing of its own.
     pub(crate) fn subclass<C, S>(
@@ -313,6 +325,31 @@ impl PySystem {
     #[getter]
     fn has_attitude(&self) -> bool {
         self.lifted.is_some()
+    }
+
+    /// The methods whose Jacobians `lieflow.integrate(..., sensitivity=True)` computes for this
+    /// system (its tangent lift's catalog; empty where the system has none yet).
+    fn sensitivity_methods(&self) -> Vec<&'static str> {
+        self.sys
+            .tangent()
+            .map(|t| t.methods().into_iter().map(|(n, _)| n).collect())
+            .unwrap_or_default()
+    }
+
+    /// The tangent lift of the system for `lieflow.integrate(..., sensitivity=True)` (issue 26):
+    /// (a system object over the lift, its layout), or None where the system has none.
+    fn _tangent(
+        &self,
+        py: Python<'_>,
+    ) -> PyResult<Option<(Py<PySystem>, Py<crate::sensitivity::PyTangent>)>> {
+        let Some(t) = self.sys.tangent() else {
+            return Ok(None);
+        };
+        let sys: Arc<dyn System> = t.clone();
+        Ok(Some((
+            Py::new(py, PySystem::derived(py, sys))?,
+            Py::new(py, crate::sensitivity::PyTangent { inner: t })?,
+        )))
     }
 
     /// Parses an initial state: a flat state (d,) or a batch (b, d), or a tuple with one array

@@ -8,6 +8,9 @@
 //! Φ_h applied to δz_j(0), to round-off — not an approximation of the variational equations:
 //! - Runge–Kutta methods (RK4, Gauss) commute with linearisation: RK on the lifted field is the
 //!   derivative of RK (internal differentiation; Hairer, Nørsett & Wanner I, §II.6);
+//! - a splitting composes exact flows φ_τ; the lift's flows are their tangent maps
+//!   (φ_τ(z), Dφ_τ(z)δz), exact flows of the lifted pieces, so the composition is the tangent of
+//!   the composition (first-same-as-last fusion included: the lifted flows are flows);
 //! - a Verlet composition is a composition of kicks q ↦ q, p ↦ p + τf(q) and drifts
 //!   q ↦ q + τv(p): on the lifted separable problem (positions (q, δq), momenta (p, δp), force
 //!   (f(q), f′(q)δq), velocity (v(p), v′(p)δp)) each kick and drift is the tangent map of the
@@ -16,7 +19,7 @@
 //! So one lift per problem kind serves every method of that kind (no tangent twin of a method),
 //! and a system opts in by giving the directional derivatives of its kind's primitives
 //! ([`SeparableTangent`]: its force, from the potential's Hessian; [`VectorFieldTangent`]: its
-//! field). The implicit methods' iterations converge on the lifted unknowns as on the plain ones
+//! field; [`SplitTangent`]: its flows' tangent maps). The implicit methods' iterations converge on the lifted unknowns as on the plain ones
 //! (the lifted Newton matrix is block-triangular with the plain one on its diagonal). With k = d
 //! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + d) plain
 //! runs.
@@ -33,7 +36,7 @@
 use std::sync::Arc;
 
 use super::method::{Catalog, System};
-use super::problem::{Problem, Separable, VectorField, Violation};
+use super::problem::{Problem, Separable, Split, VectorField, Violation};
 use super::run::check_state;
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
@@ -46,6 +49,21 @@ pub trait SeparableTangent: Separable {
 
     /// df = f′(q)·dq, the derivative of the force along dq (for f = −∂U/∂q, −D²U(q)[dq]).
     fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], s: &mut Self::Scratch);
+}
+
+/// A [`Split`] problem with the tangent maps of its exact flows: the data of its tangent lift
+/// (whose flows are then the lifted flows (φ_τ(z), Dφ_τ(z)δz), exact again).
+pub trait SplitTangent: Split {
+    /// dz ← Dφ_i,τ(z)·dz for one direction dz (flat, internal frame), given the working state
+    /// `before` the flow and `after` it.
+    fn flow_tangent(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &Self::Work,
+        after: &Self::Work,
+        dz: &mut [f64],
+    );
 }
 
 /// A [`VectorField`] with the directional derivative of its field: the data of its tangent lift.
@@ -139,8 +157,9 @@ impl<P: SeparableTangent + Clone> Tangent<P> {
     }
 }
 
-impl<P: VectorFieldTangent + Clone> Tangent<P> {
-    /// The lift of a vector field (its Runge–Kutta methods).
+impl<P: Problem + Clone> Tangent<P> {
+    /// The lift of a vector field (its Runge–Kutta methods) or of a split problem (its
+    /// splittings): (z, δz₁, …, δz_d).
     pub fn field(problem: P) -> Self {
         Tangent::with(problem, Layout::Field)
     }
@@ -241,6 +260,48 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
         for (dzj, dfj) in z[d..].chunks_exact(d).zip(df.chunks_exact_mut(d)) {
             self.problem.field_tangent(&z[..d], dzj, dfj);
         }
+    }
+}
+
+/// The working form of a split lift: the base problem's, and the directions (flat).
+#[derive(Clone, Debug)]
+pub struct SplitWork<W> {
+    base: W,
+    dirs: Vec<f64>,
+}
+
+/// The flows (φ_τ(z), Dφ_τ(z)δz_j) (field layout).
+impl<P: SplitTangent + Clone> Split for Tangent<P> {
+    type Work = SplitWork<P::Work>;
+
+    fn load(&self, z: &[f64]) -> Result<Self::Work> {
+        Ok(SplitWork {
+            base: self.problem.load(&z[..self.d])?,
+            dirs: z[self.d..].to_vec(),
+        })
+    }
+
+    fn store(&self, w: &Self::Work, z: &mut [f64]) {
+        self.problem.store(&w.base, &mut z[..self.d]);
+        z[self.d..].copy_from_slice(&w.dirs);
+    }
+
+    fn flows(&self) -> usize {
+        self.problem.flows()
+    }
+
+    fn flow(&self, i: usize, tau: f64, w: &mut Self::Work) {
+        let before = w.base.clone();
+        self.problem.flow(i, tau, &mut w.base);
+        for dz in w.dirs.chunks_exact_mut(self.d) {
+            self.problem.flow_tangent(i, tau, &before, &w.base, dz);
+        }
+    }
+
+    const CHECKED: bool = P::CHECKED;
+
+    fn check_step(&self, w: &mut Self::Work) -> std::result::Result<(), Violation> {
+        self.problem.check_step(&mut w.base)
     }
 }
 

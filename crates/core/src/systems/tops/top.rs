@@ -371,6 +371,63 @@ impl Top {
 }
 
 impl Top {
+    /// The tangent map of flow i over τ on one direction dy (flat, principal frame, without the
+    /// attitude), from the states before and after it: Axis(a) turns M and Γ about e_k by
+    /// θ = τ·coef·M_k (v_i' = cos θ v_i + sin θ v_j, v_j' = cos θ v_j − sin θ v_i), so
+    /// δv' = Rot(θ)δv + δθ (v_j', −v_i') with δθ = τ·coef·δM_k; Casimir turns Γ by exp(−v̂),
+    /// v = τM/I_r, so δΓ' = exp(−v̂)δΓ − (J_l(−v)δv) × Γ'; Kick: δM' = δM + τ δΓ × c.
+    pub(crate) fn flow_tangent(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &TopWork,
+        after: &TopWork,
+        dy: &mut [f64],
+    ) {
+        let dm = Vector3::from_column_slice(&dy[..3]);
+        let dg = self.c.map(|_| Vector3::from_column_slice(&dy[3..6]));
+        let (mut ndm, mut ndg) = (dm, dg);
+        match self.kinds[i] {
+            Flow::Axis(a) => {
+                let k = self.axes[a];
+                let tc = tau * self.coef[a];
+                let theta = tc * before.m[k];
+                let dtheta = tc * dm[k];
+                let (s, c) = theta.sin_cos();
+                let (ii, jj) = ((k + 1) % 3, (k + 2) % 3);
+                let turn = |v: &Vector3<f64>, after: &Vector3<f64>| {
+                    let mut out = *v;
+                    out[ii] = c * v[ii] + s * v[jj] + dtheta * after[jj];
+                    out[jj] = c * v[jj] - s * v[ii] - dtheta * after[ii];
+                    out
+                };
+                ndm = turn(&dm, &after.m);
+                if let (Some(dg), Some(g1)) = (dg, after.g) {
+                    ndg = Some(turn(&dg, &g1));
+                }
+            }
+            Flow::Casimir => {
+                if let (Some(dg), Some(g1)) = (dg, after.g) {
+                    let v = before.m * (tau * self.inv_ir);
+                    let dv = dm * (tau * self.inv_ir);
+                    let e = crate::lie::so3::exp_unchecked(&-v);
+                    let jl = crate::lie::so3::jacobian_left(&-v)
+                        .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+                    ndg = Some(e * dg - (jl * dv).cross(&g1));
+                }
+            }
+            Flow::Kick => {
+                if let (Some(dg), Some(c)) = (dg, self.c) {
+                    ndm = dm + dg.cross(&c) * tau;
+                }
+            }
+        }
+        dy[..3].copy_from_slice(ndm.as_slice());
+        if let Some(g) = ndg {
+            dy[3..6].copy_from_slice(g.as_slice());
+        }
+    }
+
     /// The derivative of [`Top::field`] along dy (without the attitude): δṀ = δM × Ω + M × δΩ
     /// (+ δΓ × c), δΓ̇ = δΓ × Ω + Γ × δΩ, δΩ = I⁻¹δM (principal frame).
     pub(crate) fn field_tangent(&self, y: &[f64], dy: &[f64], out: &mut [f64]) {
@@ -720,7 +777,7 @@ fn rotate_about<
 /// The Lie–Poisson splittings the SO(3) bodies share (the first entries of their catalogs, in
 /// this order): symmetric compositions of the sub-flows (Strang, Suzuki 4, Yoshida 6,
 /// Kahan–Li 8) and the processed ones (Blanes–Casas–Murua, effective orders 6, 8, 10).
-pub(super) fn splittings<P: Split + Clone + 'static>() -> Vec<Entry<P>> {
+pub(crate) fn splittings<P: Split + Clone + 'static>() -> Vec<Entry<P>> {
     vec![
         Entry::new("splitting", Splitting::strang),
         Entry::new("splitting4", || Splitting(Composition::suzuki4())),
@@ -768,12 +825,27 @@ macro_rules! top_kinds {
             }
         }
 
-        /// `rk4` on the tangent lift (the splittings' lift is not built yet).
+        impl $crate::integrate::tangent::SplitTangent for $t {
+            fn flow_tangent(
+                &self,
+                i: usize,
+                tau: f64,
+                before: &Self::Work,
+                after: &Self::Work,
+                dz: &mut [f64],
+            ) {
+                self.top.flow_tangent(i, tau, before, after, dz)
+            }
+        }
+
+        /// The splittings and `rk4` on the tangent lift (without the attitude).
         impl $crate::integrate::Catalog for $crate::integrate::tangent::Tangent<$t> {
             fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
-                vec![$crate::integrate::Entry::new("rk4", || {
+                let mut c = $crate::systems::tops::top::splittings();
+                c.push($crate::integrate::Entry::new("rk4", || {
                     $crate::integrate::methods::Rk4
-                })]
+                }));
+                c
             }
         }
 

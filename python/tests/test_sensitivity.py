@@ -1,0 +1,113 @@
+"""Issue 26: ``lf.integrate(..., sensitivity=True)``, the Jacobians of the method's own discrete
+map (the tangent lift run by the same method). Each against central differences of the same
+method; the Verlet Jacobians symplectic; batches as single runs; typed refusals."""
+
+import numpy as np
+import pytest
+
+import lieflow as lf
+
+X0 = np.array([[1.3, 0.1, -0.05], [0.02, 1.1, 0.08], [-0.03, 0.05, 0.9]])
+P0 = np.array([[0.1, -0.5, 0.2], [0.6, 0.05, -0.3], [-0.1, 0.4, 0.02]])
+OMEGA = np.block([[np.zeros((9, 9)), np.eye(9)], [-np.eye(9), np.zeros((9, 9))]])
+
+
+def body():
+    return lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(1.0, 2.0)
+                              + lf.potentials.Volumetric(0.5, 1.4))
+
+
+def differences(system, z0, method, dt, steps, h=1e-5):
+    """Central differences of the final state in each initial component."""
+    d = len(z0)
+    jac = np.empty((d, d))
+    for j in range(d):
+        hj = h * max(1.0, abs(z0[j]))
+        e = np.zeros(d)
+        e[j] = hj
+        end = [lf.integrate(system, z0 + s * e, dt, steps, method=method).final_state
+               for s in (1, -1)]
+        jac[:, j] = (end[0] - end[1]) / (2 * hj)
+    return jac
+
+
+@pytest.mark.parametrize("method", ["verlet", "verlet4"])
+def test_pseudo_rigid_body_verlet_jacobians_are_the_methods_derivative_and_symplectic(method):
+    prb = body()
+    assert prb.sensitivity_methods() == ["verlet", "verlet4", "verlet6"]
+    z0 = np.concatenate([X0.ravel(), P0.ravel()])
+    traj = lf.integrate(prb, z0, 0.05, 40, method=method, save_every=10, sensitivity=True)
+    plain = lf.integrate(prb, z0, 0.05, 40, method=method, save_every=10)
+    np.testing.assert_array_equal(traj.states, plain.states)
+    assert traj.jacobian.shape == (5, 18, 18)
+    np.testing.assert_array_equal(traj.jacobian[0], np.eye(18))
+    np.testing.assert_array_equal(traj.jacobian[-1], traj.final_jacobian)
+    fd = differences(prb, z0, method, 0.05, 40)
+    np.testing.assert_allclose(traj.final_jacobian, fd, atol=1e-8 * np.abs(fd).max())
+    for J in traj.jacobian:
+        assert np.abs(J.T @ OMEGA @ J - OMEGA).max() < 1e-12 * max(1.0, np.abs(J).max()) ** 2
+
+
+TOPS = [
+    (lf.RigidBody([1.0, 2.0, 3.0]), np.array([0.3, -0.8, 1.1])),
+    (lf.HeavyTop([1.0, 2.0, 3.0], 0.7, chi=[0.2, -0.3, 1.0]),
+     np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8])),
+]
+
+
+@pytest.mark.parametrize("system,z0", TOPS, ids=["RigidBody", "HeavyTop"])
+def test_every_sensitivity_method_of_the_tops_against_differences(system, z0):
+    """The splittings (the default first, processed ones included) and rk4: the Jacobian of the
+    method's map against central differences of the same method."""
+    methods = system.sensitivity_methods()
+    assert methods[0] == system.methods()[0] and "rk4" in methods
+    for method in methods:
+        traj = lf.integrate(system, z0, 0.02, 100, method=method, save_every=100,
+                            sensitivity=True)
+        fd = differences(system, z0, method, 0.02, 100)
+        np.testing.assert_allclose(traj.final_jacobian, fd, atol=1e-8 * np.abs(fd).max(),
+                                   err_msg=method)
+
+
+@pytest.mark.parametrize("system,z0", TOPS, ids=["RigidBody", "HeavyTop"])
+def test_a_batch_of_jacobians_is_its_members_runs(system, z0):
+    traj = lf.integrate(system, z0, 0.02, 100, save_every=100, sensitivity=True)
+    batch = lf.integrate(system, np.stack([z0, 1.1 * z0]), 0.02, 100,
+                         save_every=50, sensitivity=True)
+    assert batch.jacobian.shape == (2, 3, len(z0), len(z0))
+    np.testing.assert_array_equal(batch.jacobian[0, -1], traj.final_jacobian)
+
+
+def test_t_eval_with_sensitivity_is_the_shortened_steps_derivative():
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    z0 = np.array([0.3, -0.8, 1.1])
+    traj = lf.integrate(rb, z0, 0.1, 10, method="rk4", t_eval=[0.25, 0.55], sensitivity=True)
+    assert traj.jacobian.shape == (2, 3, 3)
+    fd = np.empty((3, 3))
+    for j in range(3):
+        e = np.zeros(3)
+        e[j] = 1e-6
+        a = lf.integrate(rb, z0 + e, 0.1, 10, method="rk4", t_eval=[0.25, 0.55]).states[1]
+        b = lf.integrate(rb, z0 - e, 0.1, 10, method="rk4", t_eval=[0.25, 0.55]).states[1]
+        fd[:, j] = (a - b) / 2e-6
+    np.testing.assert_allclose(traj.jacobian[1], fd, atol=1e-8)
+
+
+def test_sensitivity_refuses_what_it_cannot_do_with_typed_errors():
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    z0 = [0.3, -0.8, 1.1]
+    with pytest.raises(lf.UnsupportedMethodError, match="available for"):
+        lf.integrate(rb, z0, 0.1, 10, method="dmv", sensitivity=True)
+    with pytest.raises(lf.InvalidArgumentError, match="attitude"):
+        lf.integrate(rb, z0, 0.1, 10, method="rk4", attitude=np.eye(3), sensitivity=True)
+    with pytest.raises(lf.InvalidArgumentError, match="events"):
+        lf.integrate(rb, z0, 0.1, 10, method="rk4", events=lambda t, z: z[0], sensitivity=True)
+    with pytest.raises(lf.InvalidArgumentError, match="no tangent maps"):
+        lf.integrate(lf.Pendulum(1.0, 1.0, 9.81), [0.3, 0.1], 0.1, 10, sensitivity=True)
+    assert lf.Pendulum(1.0, 1.0, 9.81).sensitivity_methods() == []
+    with pytest.raises(TypeError, match="sensitivity"):
+        lf.integrate(rb, z0, 0.1, 10, method="rk4", sensitivity="yes")
+    inc = lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(1.0, 2.0), incompressible=True)
+    assert inc.sensitivity_methods() == []
+    plain = lf.integrate(rb, z0, 0.1, 10, method="rk4")
+    assert plain.jacobian is None and plain.final_jacobian is None
