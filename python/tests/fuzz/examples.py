@@ -825,6 +825,7 @@ def build_specs() -> list[Spec]:
         add(f"{key}.methods", f"@{key}.methods")
     own = {
         "rb": [("angular_velocity", [A("states", M3, "vec")]),
+               ("sensitivity_methods", []),
                ("spatial_momentum", [A("states", M3, "vec"), A("attitude", R3, "rot")]),
                ("exact_solution", [A("M0", M3, "vec"), A("t", np.array([0.0, 0.7, 2.0]), "bcast")]),
                ("exact_solution[attitude]", [A("M0", M3, "vec"), A("t", np.array([0.0, 0.7, 2.0]), "bcast"),
@@ -1000,6 +1001,12 @@ def build_specs() -> list[Spec]:
         A("state0", np.array([1.0, 0.5, -0.3]), "vec"), A("dt", 0.01, "float", kw=True),
         A("steps", 200, "obj", kw=True), A("events", event_m2, "fn", kw=True, opt=True),
         A("event_tol", 0.0, "float", kw=True))
+    # ---- lf.integrate(..., sensitivity=True) (issue 26) ----
+    add("integrate[rb,sensitivity]", "integrate", A("system", lazy_recv("rb"), "obj"),
+        A("state0", np.array([[1.0, 0.5, -0.3], [0.2, -0.4, 0.9]]), "vec"),
+        A("dt", 0.01, "float", kw=True), A("steps", 20, "int", kw=True),
+        A("save_every", 5, "int", kw=True, positive=True),
+        A("sensitivity", True, "bool", kw=True))
     # ---- user-defined systems (issue 15) ----
     user_specs(add)
     forced_specs(add)
