@@ -93,7 +93,9 @@ class Integration:
 class _Tangent:
     """The layout of a system's tangent lift (internal to `lieflow.integrate`)."""
     def seed(self, states: ArrayLike) -> _F64: ...
-    def split(self, lifted: ArrayLike) -> tuple[_F64, _F64]: ...
+    @property
+    def parameters(self) -> list[str]: ...
+    def split(self, lifted: ArrayLike) -> tuple[_F64, _F64, _F64]: ...
 
 @disjoint_base
 class System:
@@ -102,6 +104,9 @@ class System:
     @classmethod
     def methods(cls) -> list[str]:
         """The integration methods; the first is the default."""
+    @property
+    def parameters(self) -> list[str]:
+        """The parameters theta, the columns of `Trajectory.parameter_jacobian`."""
     def sensitivity_methods(self) -> list[str]:
         """The methods whose Jacobians `integrate(..., sensitivity=True)` computes."""
     def _tangent(self) -> tuple[System, _Tangent] | None: ...

@@ -271,9 +271,11 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             Single initial states only (a batch is an InvalidArgumentError).
         event_tol: an absolute tolerance in time (>= 0) added to round-off when locating events.
         sensitivity: also compute the Jacobian ∂z_k/∂z_0 of the method's own discrete map at
-            every sample (``traj.jacobian``, (k, d, d); exact to round-off, not finite
-            differences): the run integrates the system's tangent lift with the same method
-            (about d + 1 times the work of the plain run). Available where the system gives the
+            every sample (``traj.jacobian``, (k, d, d)) and its derivative along the system's
+            parameters (``traj.parameter_jacobian``, (k, d, p), columns ``system.parameters``);
+            exact to round-off, not finite differences: the run integrates the system's tangent
+            lift with the same method (about d + p + 1 times the work of the plain run);
+            ``traj.vjp(cotangent)`` gives the gradient of a loss. Available where the system gives the
             derivatives its method needs (``system.sensitivity_methods()``); not yet with an
             attitude or events.
 
@@ -394,12 +396,13 @@ def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, p
     seeds = layout.seed(z0 if batched else z0[0])
     traj = integrate(lifted, seeds, dt, steps, method, save_every, None, progress, chunk_steps,
                      threads, t0=t0, t_eval=t_eval)
-    states, jac = layout.split(traj.states)
-    final, final_jac = layout.split(traj.final_state)
+    states, jac, pjac = layout.split(traj.states)
+    final, final_jac, final_pjac = layout.split(traj.final_state)
     return Trajectory(system, traj.method, traj.t, states, None, final, None, traj.dt,
                       traj.save_every, t_final=traj.t_final, status=traj.status, t0=traj.t0,
                       initial_state=z0 if batched else z0[0], jacobian=jac,
-                      final_jacobian=final_jac)
+                      final_jacobian=final_jac, parameter_jacobian=pjac,
+                      final_parameter_jacobian=final_pjac)
 
 
 def _trajectory(system, run, parts, times, status, ev):

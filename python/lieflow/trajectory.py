@@ -31,6 +31,8 @@ class Trajectory:
         jacobian: with ``sensitivity=True``, (k, d, d) (or (b, k, d, d)) the Jacobians
             ∂z_k/∂z_0 of the method's own discrete map at the samples (``final_jacobian`` at
             the final state); None otherwise.
+        parameter_jacobian: with ``sensitivity=True``, (k, d, p) the derivatives ∂z_k/∂θ along
+            ``system.parameters`` (``final_parameter_jacobian`` at the final state).
         Named views from the system (e.g. ``M``, ``Gamma``, ``q``, ``L``) as attributes.
 
     Methods ``energy()`` and ``casimirs()``, ``to_xarray()`` and ``save(path)`` (read back with
@@ -43,7 +45,8 @@ class Trajectory:
     def __init__(self, system, method, t, states, attitude, final_state, final_attitude, dt,
                  save_every, *, t_final=None, status=0, t_events=None, state_events=None,
                  attitude_events=None, t0=None, initial_state=None, initial_attitude=None,
-                 jacobian=None, final_jacobian=None):
+                 jacobian=None, final_jacobian=None, parameter_jacobian=None,
+                 final_parameter_jacobian=None):
         self.system = system
         self.method = method
         self.t = t
@@ -63,7 +66,50 @@ class Trajectory:
         self.initial_attitude = initial_attitude
         self.jacobian = jacobian
         self.final_jacobian = final_jacobian
+        self.parameter_jacobian = parameter_jacobian
+        self.final_parameter_jacobian = final_parameter_jacobian
         self._field_cache = None
+
+    def vjp(self, cotangent):
+        """The gradient of a loss L of this trajectory with respect to the initial state and the
+        system's parameters, from the cotangent ∂L/∂z: (grad_state0 (d,), grad_parameters (p,))
+        with grad = Σ_k J_kᵀ c_k over the samples (a run with ``sensitivity=True``).
+
+        Args:
+            cotangent: (d,) on the final state, or (k, d) on every sample (``states``' shape);
+                for a batch (b, d) or (b, k, d), and the gradients are (b, d), (b, p).
+        Raises:
+            TypeError (not real numbers), InvalidArgumentError (a run without
+            ``sensitivity=True``), ShapeError, NonFiniteError.
+        """
+        if self.jacobian is None:
+            raise InvalidArgumentError("invalid vjp: this trajectory carries no Jacobians; "
+                                       "integrate with sensitivity=True")
+        from ._lieflow import NonFiniteError, ShapeError
+        expected = "invalid cotangent: expected an array-like of real numbers (bool, int or float)"
+        if isinstance(cotangent, (str, bytes)):
+            raise TypeError(f"{expected}, got a {type(cotangent).__name__}")
+        try:
+            c = np.asarray(cotangent)
+        except (ValueError, TypeError) as e:
+            raise TypeError(f"{expected}, got a {type(cotangent).__name__} that numpy cannot "
+                            f"read as an array: {e}") from None
+        if c.dtype.kind not in "biuf":
+            raise TypeError(f"{expected}, got numpy dtype {c.dtype}")
+        c = c.astype(np.float64)
+        if not np.all(np.isfinite(c)):
+            raise NonFiniteError("invalid cotangent: it contains a non-finite value (NaN or inf)")
+        batched = self.states.ndim == 3
+        lead = self.states.shape[:1] if batched else ()
+        d = self.states.shape[-1]
+        if c.shape == lead + (d,):
+            j, p = self.final_jacobian, self.final_parameter_jacobian
+            return np.einsum("...ij,...i->...j", j, c), np.einsum("...ij,...i->...j", p, c)
+        if c.shape == self.states.shape:
+            return (np.einsum("...kij,...ki->...j", self.jacobian, c),
+                    np.einsum("...kij,...ki->...j", self.parameter_jacobian, c))
+        raise ShapeError(f"invalid cotangent: expected shape {lead + (d,)} (the final state) or "
+                         f"{self.states.shape} (every sample), got {c.shape}")
 
     @classmethod
     def concatenate(cls, trajectories):

@@ -3,7 +3,7 @@ import os
 from typing import Any, Iterable
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .integrate import _IntegrableSystem
 
@@ -35,6 +35,9 @@ class Trajectory:
     jacobian: _F64 | None
     """(k, d, d) / (b, k, d, d) Jacobians dz_k/dz_0 with sensitivity=True, else None."""
     final_jacobian: _F64 | None
+    parameter_jacobian: _F64 | None
+    """(k, d, p) / (b, k, d, p) derivatives dz_k/dtheta along `system.parameters`."""
+    final_parameter_jacobian: _F64 | None
     states: _F64
     """(k, d), or (b, k, d) for a batch."""
     attitude: _F64 | None
@@ -49,7 +52,11 @@ class Trajectory:
         attitude_events: list[_F64] | None = None, t0: float | None = None,
         initial_state: _F64 | None = None, initial_attitude: _F64 | None = None,
         jacobian: _F64 | None = None, final_jacobian: _F64 | None = None,
+        parameter_jacobian: _F64 | None = None, final_parameter_jacobian: _F64 | None = None,
     ) -> None: ...
+    def vjp(self, cotangent: ArrayLike) -> tuple[_F64, _F64]:
+        """(grad_state0, grad_parameters) of a loss from its cotangent on the final state (d,)
+        or on every sample (k, d)."""
     @classmethod
     def concatenate(cls, trajectories: Iterable[Trajectory]) -> Trajectory:
         """A run and its continuations (each starting at the previous `t_final` from its

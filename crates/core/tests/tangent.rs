@@ -18,12 +18,25 @@ fn lifted_end(
     dt: f64,
     steps: usize,
 ) -> (Vec<f64>, Vec<f64>) {
+    let (z, jac, _) = lifted_end_all(t, method, z0, dt, steps);
+    (z, jac)
+}
+
+/// (base state, Jacobian, parameter Jacobian d×p) at the end.
+fn lifted_end_all(
+    t: &dyn TangentSystem,
+    method: &str,
+    z0: &[f64],
+    dt: f64,
+    steps: usize,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let d = t.base_dim();
+    let np = t.parameter_names().len();
     let seed = t.seed(z0).unwrap();
     let traj = integrate(t, method, &seed, dt, steps, steps).unwrap();
-    let (mut z, mut jac) = (vec![0.0; d], vec![0.0; d * d]);
-    t.jacobian(traj.state(1), &mut z, &mut jac);
-    (z, jac)
+    let (mut z, mut jac, mut pjac) = (vec![0.0; d], vec![0.0; d * d], vec![0.0; d * np]);
+    t.jacobian(traj.state(1), &mut z, &mut jac, &mut pjac);
+    (z, jac, pjac)
 }
 
 /// Central differences of the end state in each initial component (step h·max(1, |z_j|)).
@@ -234,5 +247,81 @@ fn splitting_jacobians_of_the_tops_are_poisson() {
             );
             assert!(worst < 1e-12, "{} {method}: {worst:e}", sys.name());
         }
+    }
+}
+
+/// ∂z/∂θ for the tops' parameters (the moments; mgl and the components of χ), for a splitting
+/// and rk4, against central differences of systems built with the parameter moved (χ moved
+/// without its normalisation: mgl scaled by |χ + h e_j|).
+#[test]
+fn parameter_jacobians_of_the_tops() {
+    let moments = [1.0, 2.0, 3.0];
+    let (mgl, chi) = (0.7, {
+        let c = [0.2f64, -0.3, 1.0];
+        let n = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        [c[0] / n, c[1] / n, c[2] / n]
+    });
+    let heavy =
+        |moments: [f64; 3], mgl: f64, chi: [f64; 3]| HeavyTop::new(moments, mgl, chi).unwrap();
+    let z_rb = vec![0.3, -0.8, 1.1];
+    let z_ht = vec![1.0, 0.5, -0.3, 0.0, 0.6, 0.8];
+    let h = 1e-6;
+    for method in ["splitting4", "rk4"] {
+        // The free body.
+        let rb = RigidBody::new(moments).unwrap();
+        let t = rb.tangent().unwrap();
+        assert_eq!(t.parameter_names(), ["I1", "I2", "I3"]);
+        let (_, _, pjac) = lifted_end_all(&*t, method, &z_rb, 0.05, 40);
+        for m in 0..3 {
+            let end = |s: f64| {
+                let mut i = moments;
+                i[m] += s;
+                integrate(&RigidBody::new(i).unwrap(), method, &z_rb, 0.05, 40, 40)
+                    .unwrap()
+                    .state(1)
+                    .to_vec()
+            };
+            let (p, q) = (end(h), end(-h));
+            for i in 0..3 {
+                let fd = (p[i] - q[i]) / (2.0 * h);
+                assert!(
+                    (pjac[i * 3 + m] - fd).abs() < 1e-7,
+                    "{method} I{}: {} vs {fd}",
+                    m + 1,
+                    pjac[i * 3 + m]
+                );
+            }
+        }
+        // The heavy top.
+        let ht = heavy(moments, mgl, chi);
+        let t = ht.tangent().unwrap();
+        let np = t.parameter_names().len();
+        assert_eq!(np, 7);
+        let (_, _, pjac) = lifted_end_all(&*t, method, &z_ht, 0.05, 40);
+        let mut worst = 0.0f64;
+        for m in 0..np {
+            let end = |s: f64| {
+                let (mut i, mut g, mut c) = (moments, mgl, chi);
+                match m {
+                    0..=2 => i[m] += s,
+                    3 => g += s,
+                    _ => {
+                        c[m - 4] += s;
+                        g *= (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                    }
+                }
+                integrate(&heavy(i, g, c), method, &z_ht, 0.05, 40, 40)
+                    .unwrap()
+                    .state(1)
+                    .to_vec()
+            };
+            let (p, q) = (end(h), end(-h));
+            for i in 0..6 {
+                let fd = (p[i] - q[i]) / (2.0 * h);
+                worst = worst.max((pjac[i * np + m] - fd).abs());
+            }
+        }
+        eprintln!("HeavyTop {method}: parameter Jacobian vs differences {worst:.2e}");
+        assert!(worst < 1e-7, "HeavyTop {method}: {worst:e}");
     }
 }

@@ -22,7 +22,7 @@ pub struct PyTangent {
 
 #[pymethods]
 impl PyTangent {
-    /// The lifted states (..., d(1 + d)) of states (..., d) with the identity as directions.
+    /// The lifted states (..., d(1 + d + p)) of states (..., d) with the identity as directions.
     fn seed<'py>(
         &self,
         py: Python<'py>,
@@ -40,47 +40,62 @@ impl PyTangent {
             )));
         }
         let data = read_all("state0", &v)?;
-        let mut out = Vec::with_capacity(data.len() * (d + 1));
+        let width = d * (d + t.parameter_names().len() + 1);
+        let mut out = Vec::with_capacity(data.len() / d * width);
         for z in data.chunks_exact(d) {
             out.extend(t.seed(z).py()?);
         }
         let mut lifted = shape;
-        *lifted.last_mut().expect("checked above") = d * (d + 1);
+        *lifted.last_mut().expect("checked above") = width;
         numpy::ndarray::ArrayD::from_shape_vec(lifted, out)
             .map(|a| a.into_pyarray(py))
             .map_err(|e| to_py(Error::shape("state0", "(..., d)", e.to_string())))
     }
 
-    /// (states (..., d), Jacobians (..., d, d)) of lifted states (..., d(1 + d)).
+    /// The names of the parameters the lift differentiates along.
+    #[getter]
+    fn parameters(&self) -> Vec<&'static str> {
+        self.inner.parameter_names()
+    }
+
+    /// (states (..., d), Jacobians (..., d, d), parameter Jacobians (..., d, p)) of lifted
+    /// states (..., d(1 + d + p)).
     fn split<'py>(
         &self,
         py: Python<'py>,
         lifted: ArrayIn<'py>,
-    ) -> PyResult<(Array<'py>, Array<'py>)> {
+    ) -> PyResult<(Array<'py>, Array<'py>, Array<'py>)> {
         let t = &self.inner;
-        let d = t.base_dim();
+        let (d, np) = (t.base_dim(), t.parameter_names().len());
+        let width = d * (d + np + 1);
         let v = lifted.as_array();
         let shape = v.shape().to_vec();
-        if shape.last() != Some(&(d * (d + 1))) {
+        if shape.last() != Some(&width) {
             return Err(to_py(Error::shape(
                 "states",
-                format!("(..., {})", d * (d + 1)),
+                format!("(..., {width})"),
                 format!("{shape:?}"),
             )));
         }
         let data = read_all("states", &v)?;
-        let n = data.len() / (d * (d + 1));
-        let (mut zs, mut js) = (vec![0.0; n * d], vec![0.0; n * d * d]);
-        for ((l, z), j) in data
-            .chunks_exact(d * (d + 1))
-            .zip(zs.chunks_exact_mut(d))
-            .zip(js.chunks_exact_mut(d * d))
-        {
-            t.jacobian(l, z, j);
+        let n = data.len() / width;
+        let (mut zs, mut js, mut ps) = (
+            vec![0.0; n * d],
+            vec![0.0; n * d * d],
+            vec![0.0; n * d * np],
+        );
+        for (i, l) in data.chunks_exact(width).enumerate() {
+            t.jacobian(
+                l,
+                &mut zs[i * d..(i + 1) * d],
+                &mut js[i * d * d..(i + 1) * d * d],
+                &mut ps[i * d * np..(i + 1) * d * np],
+            );
         }
         let lead = &shape[..shape.len() - 1];
         let zshape: Vec<usize> = lead.iter().copied().chain([d]).collect();
         let jshape: Vec<usize> = lead.iter().copied().chain([d, d]).collect();
+        let pshape: Vec<usize> = lead.iter().copied().chain([d, np]).collect();
         let err = |e: numpy::ndarray::ShapeError| {
             to_py(Error::shape("states", "(..., D)", e.to_string()))
         };
@@ -89,6 +104,9 @@ impl PyTangent {
                 .map_err(err)?
                 .into_pyarray(py),
             numpy::ndarray::ArrayD::from_shape_vec(jshape, js)
+                .map_err(err)?
+                .into_pyarray(py),
+            numpy::ndarray::ArrayD::from_shape_vec(pshape, ps)
                 .map_err(err)?
                 .into_pyarray(py),
         ))

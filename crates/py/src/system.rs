@@ -327,6 +327,14 @@ impl PySystem {
         self.lifted.is_some()
     }
 
+    /// The names of the system's parameters θ, in order: the columns of
+    /// `Trajectory.parameter_jacobian` (e.g. ``("I1", "I2", "I3")`` for a `RigidBody`); empty
+    /// where the system has none it differentiates along.
+    #[getter]
+    fn parameters(&self) -> Vec<&'static str> {
+        self.sys.parameters()
+    }
+
     /// The methods whose Jacobians `lieflow.integrate(..., sensitivity=True)` computes for this
     /// system (its tangent lift's catalog; empty where the system has none yet).
     fn sensitivity_methods(&self) -> Vec<&'static str> {

@@ -257,6 +257,8 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
         np.array([[1.0, 0.5, -0.3]]), None, 0.01, None, 1),
     "traj": lambda lf: lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), [1.0, 0.5, -0.3], dt=0.01,
                                     steps=10),
+    "straj": lambda lf: lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), [1.0, 0.5, -0.3], dt=0.01,
+                                     steps=10, sensitivity=True),
     "rsph": lambda lf: lf.RollingSpheres(0.7, 1.3, [0.1, -0.2, 0.15], [-0.3, 0.2, 0.4], 2.0, 3.5,
                                          I_SPH1, I_SPH2),
     "harmonic": lambda lf: lf.potentials.Harmonic(1.3),
@@ -955,6 +957,7 @@ def build_specs() -> list[Spec]:
                  ("concatenate", [A("trajectories", Lazy(_two_runs), "obj")]),
                  ("to_xarray", [A("observables", True, "bool", kw=True)]),
                  ("save", [A("path", Lazy(lambda lf: _scratch_path("save.nc")), "path")])],
+        "straj": [("vjp", [A("cotangent", np.array([1.0, -0.5, 0.2]), "vec")])],
     }
     for key, methods in own.items():
         for name, args in methods:

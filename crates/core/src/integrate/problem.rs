@@ -57,6 +57,12 @@ pub trait Problem: Send + Sync {
     /// Inverse of [`Problem::to_internal`].
     fn to_user(&self, _z: &mut [f64]) {}
 
+    /// The names of the system's parameters θ, in order, whose sensitivities ∂z/∂θ a tangent
+    /// run carries ([`crate::integrate::tangent`]); none by default.
+    fn parameters(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
+
     /// Whether the kernels call functions from outside lieflow (user closures, a binding's
     /// callables), which may fail or have side effects: a run then steps one step at a time and
     /// ends at the first failure without taking any step again ([`super::hooks`]).

@@ -20,12 +20,16 @@
 //! and a system opts in by giving the directional derivatives of its kind's primitives
 //! ([`SeparableTangent`]: its force, from the potential's Hessian; [`VectorFieldTangent`]: its
 //! field; [`SplitTangent`]: its flows' tangent maps). The implicit methods' iterations converge on the lifted unknowns as on the plain ones
-//! (the lifted Newton matrix is block-triangular with the plain one on its diagonal). With k = d
-//! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + d) plain
+//! (the lifted Newton matrix is block-triangular with the plain one on its diagonal). With k
+//! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + k) plain
 //! runs.
 //!
+//! **Parameters.** The problem's parameters θ ([`Problem::parameters`]) get p more directions
+//! δz_{θ_m} = ∂z/∂θ_m, from 0 at the start, whose pieces carry the inhomogeneous term
+//! (f′(z)δz + ∂f/∂θ_m; for a flow Dφ δz + ∂φ/∂θ_m): so k = d + p directions in all.
+//!
 //! **Layouts.** A separable lift stores (q, δq₁, …, δq_k, p, δp₁, …, δp_k) (its kind needs the
-//! positions before the momenta); a field lift (z, δz₁, …, δz_k). [`TangentSystem::seed`] and
+//! positions before the momenta); a field or split lift (z, δz₁, …, δz_k). [`TangentSystem::seed`] and
 //! [`TangentSystem::jacobian`] convert from and to the problem's flat layout, so nothing outside
 //! this module sees either. The problem's chart ([`Problem::to_internal`]) must be linear (a
 //! turn to principal axes): the lift applies it to the directions as to states.
@@ -49,6 +53,12 @@ pub trait SeparableTangent: Separable {
 
     /// df = f′(q)·dq, the derivative of the force along dq (for f = −∂U/∂q, −D²U(q)[dq]).
     fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], s: &mut Self::Scratch);
+
+    /// df += ∂f/∂θ_m (q) for the problem's parameter m ([`Problem::parameters`]); NaN unless
+    /// a problem with parameters implements it (a run then stops at its first step).
+    fn force_parameter(&self, _q: &[f64], _m: usize, df: &mut [f64], _s: &mut Self::Scratch) {
+        df.fill(f64::NAN);
+    }
 }
 
 /// A [`Split`] problem with the tangent maps of its exact flows: the data of its tangent lift
@@ -64,12 +74,32 @@ pub trait SplitTangent: Split {
         after: &Self::Work,
         dz: &mut [f64],
     );
+
+    /// dz += ∂φ_i,τ/∂θ_m (z) for the parameter m, after [`SplitTangent::flow_tangent`] on the
+    /// same dz; NaN unless a problem with parameters implements it.
+    fn flow_parameter(
+        &self,
+        _i: usize,
+        _tau: f64,
+        _before: &Self::Work,
+        _after: &Self::Work,
+        _m: usize,
+        dz: &mut [f64],
+    ) {
+        dz.fill(f64::NAN);
+    }
 }
 
 /// A [`VectorField`] with the directional derivative of its field: the data of its tangent lift.
 pub trait VectorFieldTangent: VectorField {
     /// out = f′(z)·dz.
     fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]);
+
+    /// out += ∂f/∂θ_m (z) for the parameter m; NaN unless a problem with parameters
+    /// implements it.
+    fn field_parameter(&self, _z: &[f64], _m: usize, out: &mut [f64]) {
+        out.fill(f64::NAN);
+    }
 }
 
 /// Where the lift keeps its directions.
@@ -86,6 +116,8 @@ enum Layout {
 pub struct Tangent<P> {
     problem: P,
     d: usize,
+    /// The number of parameter directions (after the d state directions).
+    np: usize,
     layout: Layout,
 }
 
@@ -95,18 +127,34 @@ pub trait TangentSystem: System {
     /// The dimension d of the base state.
     fn base_dim(&self) -> usize;
 
-    /// The lifted state of a base state (user frame) with the identity as directions.
+    /// The names of the parameters θ whose directions the lift carries.
+    fn parameter_names(&self) -> Vec<&'static str>;
+
+    /// The lifted state of a base state (user frame) with the identity as directions (and
+    /// ∂z₀/∂θ = 0).
     fn seed(&self, z0: &[f64]) -> Result<Vec<f64>>;
 
-    /// The base state (d values) and the Jacobian ∂z/∂z₀ (d×d row-major, column j = δz_j) of a
-    /// lifted state.
-    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64]);
+    /// The base state (d values), the Jacobian ∂z/∂z₀ (d×d row-major, column j = δz_j) and the
+    /// parameter Jacobian ∂z/∂θ (d×p row-major) of a lifted state.
+    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]);
 }
 
 impl<P: Problem + Clone> Tangent<P> {
     fn with(problem: P, layout: Layout) -> Self {
         let d = problem.space().dim();
-        Tangent { problem, d, layout }
+        let np = problem.parameters().len();
+        Tangent {
+            problem,
+            d,
+            np,
+            layout,
+        }
+    }
+
+    /// The number k = d + p of directions.
+    #[inline]
+    fn k(&self) -> usize {
+        self.d + self.np
     }
 
     /// The base problem.
@@ -121,7 +169,7 @@ impl<P: Problem + Clone> Tangent<P> {
             Layout::Field => j * self.d + i,
             Layout::Separable { dof } => {
                 let (half, c) = (i / dof, i % dof);
-                half * dof * (self.d + 1) + j * dof + c
+                half * dof * (self.k() + 1) + j * dof + c
             }
         }
     }
@@ -141,7 +189,7 @@ impl<P: Problem + Clone> Tangent<P> {
     /// Applies `map` to the base state and to every direction, each as a flat base state.
     fn each(&self, z: &mut [f64], map: impl Fn(&mut [f64])) {
         let mut v = vec![0.0; self.d];
-        for j in 0..=self.d {
+        for j in 0..=self.k() {
             self.gather(z, j, &mut v);
             map(&mut v);
             self.scatter(&v, j, z);
@@ -170,9 +218,9 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.name()
     }
 
-    /// Flat: d(1 + d) values.
+    /// Flat: d(1 + k) values.
     fn space(&self) -> Space {
-        Space::new([("z", Block::Real(self.d * (self.d + 1)))])
+        Space::new([("z", Block::Real(self.d * (self.k() + 1)))])
     }
 
     fn energy(&self, z: &[f64]) -> Result<f64> {
@@ -223,9 +271,10 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
     }
 
     fn dof(&self) -> usize {
-        self.problem.dof() * (self.d + 1)
+        self.problem.dof() * (self.k() + 1)
     }
 
+    /// The velocity does not depend on the parameters (T(p) is the problem's own).
     fn velocity(&self, p: &[f64], v: &mut [f64]) {
         let n = self.problem.dof();
         let (v0, dv) = v.split_at_mut(n);
@@ -244,8 +293,16 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
         let n = self.problem.dof();
         let (f0, df) = f.split_at_mut(n);
         self.problem.force(&q[..n], f0, s)?;
-        for (dqj, dfj) in q[n..].chunks_exact(n).zip(df.chunks_exact_mut(n)) {
+        let d = self.d;
+        for (j, (dqj, dfj)) in q[n..]
+            .chunks_exact(n)
+            .zip(df.chunks_exact_mut(n))
+            .enumerate()
+        {
             self.problem.force_tangent(&q[..n], dqj, dfj, s);
+            if j >= d {
+                self.problem.force_parameter(&q[..n], j - d, dfj, s);
+            }
         }
         Ok(())
     }
@@ -257,8 +314,15 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
         let d = self.d;
         let (f0, df) = dz.split_at_mut(d);
         self.problem.field(&z[..d], f0);
-        for (dzj, dfj) in z[d..].chunks_exact(d).zip(df.chunks_exact_mut(d)) {
+        for (j, (dzj, dfj)) in z[d..]
+            .chunks_exact(d)
+            .zip(df.chunks_exact_mut(d))
+            .enumerate()
+        {
             self.problem.field_tangent(&z[..d], dzj, dfj);
+            if j >= d {
+                self.problem.field_parameter(&z[..d], j - d, dfj);
+            }
         }
     }
 }
@@ -293,8 +357,13 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
     fn flow(&self, i: usize, tau: f64, w: &mut Self::Work) {
         let before = w.base.clone();
         self.problem.flow(i, tau, &mut w.base);
-        for dz in w.dirs.chunks_exact_mut(self.d) {
+        let d = self.d;
+        for (j, dz) in w.dirs.chunks_exact_mut(d).enumerate() {
             self.problem.flow_tangent(i, tau, &before, &w.base, dz);
+            if j >= d {
+                self.problem
+                    .flow_parameter(i, tau, &before, &w.base, j - d, dz);
+            }
         }
     }
 
@@ -323,6 +392,10 @@ where
         self.d
     }
 
+    fn parameter_names(&self) -> Vec<&'static str> {
+        self.problem.parameters()
+    }
+
     fn seed(&self, z0: &[f64]) -> Result<Vec<f64>> {
         if z0.len() != self.d {
             return Err(Error::shape(
@@ -331,7 +404,7 @@ where
                 format!("({},)", z0.len()),
             ));
         }
-        let mut z = vec![0.0; self.d * (self.d + 1)];
+        let mut z = vec![0.0; self.d * (self.k() + 1)];
         self.scatter(z0, 0, &mut z);
         for j in 0..self.d {
             z[self.at(j + 1, j)] = 1.0;
@@ -339,12 +412,15 @@ where
         Ok(z)
     }
 
-    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64]) {
-        let d = self.d;
+    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]) {
+        let (d, np) = (self.d, self.np);
         self.gather(lifted, 0, z);
-        for j in 0..d {
-            for i in 0..d {
+        for i in 0..d {
+            for j in 0..d {
                 jac[i * d + j] = lifted[self.at(j + 1, i)];
+            }
+            for m in 0..np {
+                pjac[i * np + m] = lifted[self.at(d + 1 + m, i)];
             }
         }
     }

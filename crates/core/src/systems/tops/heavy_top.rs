@@ -117,9 +117,31 @@ impl HeavyTop {
     }
 }
 
+impl HeavyTop {
+    /// Parameter m (`I1`, `I2`, `I3`, `mgl`, `chi1`, `chi2`, `chi3`) as the kernels see it:
+    /// ∂c/∂mgl = χ, ∂c/∂χ_j = mgl e_j (principal frame).
+    pub(crate) fn top_parameter(&self, m: usize) -> top::TopParam {
+        match m {
+            0..=2 => top::TopParam::Moment(m),
+            3 => top::TopParam::Gravity(top::to_frame(&self.top.frame, self.chi.as_slice())),
+            _ => {
+                let mut e = Vector3::zeros();
+                e[m - 4] = self.mgl;
+                top::TopParam::Gravity(top::to_frame(&self.top.frame, e.as_slice()))
+            }
+        }
+    }
+}
+
 impl Problem for HeavyTop {
     fn name(&self) -> &'static str {
         "HeavyTop"
+    }
+
+    /// The principal moments I1, I2, I3 (as for `RigidBody`), mgl, and the components of the
+    /// unit vector χ (body frame; a derivative along them, not along an unnormalised χ).
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["I1", "I2", "I3", "mgl", "chi1", "chi2", "chi3"]
     }
     fn space(&self) -> Space {
         self.top.space()

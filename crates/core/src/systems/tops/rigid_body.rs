@@ -120,9 +120,22 @@ impl RigidBody {
     }
 }
 
+impl RigidBody {
+    /// Parameter m (`I1`, `I2`, `I3`) as the kernels see it.
+    pub(crate) fn top_parameter(&self, m: usize) -> top::TopParam {
+        top::TopParam::Moment(m)
+    }
+}
+
 impl Problem for RigidBody {
     fn name(&self) -> &'static str {
         "RigidBody"
+    }
+
+    /// The principal moments I1, I2, I3 (of an inertia given as a matrix: its eigenvalues, in
+    /// the order of its principal frame, which stays fixed).
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["I1", "I2", "I3"]
     }
     fn space(&self) -> Space {
         self.top.space()

@@ -370,7 +370,97 @@ impl Top {
     }
 }
 
+/// A parameter of a top as the kernels see it: a principal moment I_k, or the gravity vector
+/// c = mgl χ (principal frame) moving along dc (∂c/∂mgl = χ, ∂c/∂χ_j = mgl e_j).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum TopParam {
+    Moment(usize),
+    Gravity(Vector3<f64>),
+}
+
 impl Top {
+    /// The reference axis r of the splittings (the middle moment; `axes` are the other two).
+    fn reference_axis(&self) -> usize {
+        (self.axes[0] + 2) % 3
+    }
+
+    /// dy += ∂φ_i,τ/∂θ at the state `before` flow i (its result `after`; flat, principal frame,
+    /// without the attitude): Axis(a) through θ = τ·coef·M_k with coef = 1/I_k − 1/I_r;
+    /// Casimir through v = τM/I_r; Kick through c (module docs of [`Top::flow_tangent`]).
+    pub(crate) fn flow_parameter(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &TopWork,
+        after: &TopWork,
+        p: TopParam,
+        dy: &mut [f64],
+    ) {
+        let r = self.reference_axis();
+        match (self.kinds[i], p) {
+            (Flow::Axis(a), TopParam::Moment(q)) => {
+                let k = self.axes[a];
+                let dcoef = if q == k {
+                    -1.0 / (self.moments[k] * self.moments[k])
+                } else if q == r {
+                    self.inv_ir * self.inv_ir
+                } else {
+                    0.0
+                };
+                let dtheta = tau * dcoef * before.m[k];
+                let (ii, jj) = ((k + 1) % 3, (k + 2) % 3);
+                dy[ii] += dtheta * after.m[jj];
+                dy[jj] -= dtheta * after.m[ii];
+                if let Some(g1) = after.g {
+                    dy[3 + ii] += dtheta * g1[jj];
+                    dy[3 + jj] -= dtheta * g1[ii];
+                }
+            }
+            (Flow::Casimir, TopParam::Moment(q)) if q == r => {
+                if let Some(g1) = after.g {
+                    let v = before.m * (tau * self.inv_ir);
+                    let dv = before.m * (-tau * self.inv_ir * self.inv_ir);
+                    let jl = crate::lie::so3::jacobian_left(&-v)
+                        .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+                    let d = -(jl * dv).cross(&g1);
+                    for c in 0..3 {
+                        dy[3 + c] += d[c];
+                    }
+                }
+            }
+            (Flow::Kick, TopParam::Gravity(dc)) => {
+                if let Some(g) = before.g {
+                    let d = g.cross(&dc) * tau;
+                    for c in 0..3 {
+                        dy[c] += d[c];
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// out += ∂f/∂θ (z) (without the attitude): a moment through Ω_k = M_k/I_k (∂Ṁ = M × ∂Ω,
+    /// ∂Γ̇ = Γ × ∂Ω), the gravity vector through Ṁ ∋ Γ × c.
+    pub(crate) fn field_parameter(&self, y: &[f64], p: TopParam, out: &mut [f64]) {
+        let m = Vector3::from_column_slice(&y[..3]);
+        let g = self.c.map(|_| Vector3::from_column_slice(&y[3..6]));
+        let (dm, dg) = match p {
+            TopParam::Moment(k) => {
+                let mut dw = Vector3::zeros();
+                dw[k] = -m[k] / (self.moments[k] * self.moments[k]);
+                (m.cross(&dw), g.map(|g| g.cross(&dw)))
+            }
+            TopParam::Gravity(dc) => (g.map_or(Vector3::zeros(), |g| g.cross(&dc)), None),
+        };
+        for c in 0..3 {
+            out[c] += dm[c];
+            if let Some(dg) = dg {
+                out[3 + c] += dg[c];
+            }
+        }
+    }
+
     /// The tangent map of flow i over τ on one direction dy (flat, principal frame, without the
     /// attitude), from the states before and after it: Axis(a) turns M and Γ about e_k by
     /// θ = τ·coef·M_k (v_i' = cos θ v_i + sin θ v_j, v_j' = cos θ v_j − sin θ v_i), so
@@ -823,6 +913,9 @@ macro_rules! top_kinds {
             fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
                 self.top.field_tangent(z, dz, out)
             }
+            fn field_parameter(&self, z: &[f64], m: usize, out: &mut [f64]) {
+                self.top.field_parameter(z, self.top_parameter(m), out)
+            }
         }
 
         impl $crate::integrate::tangent::SplitTangent for $t {
@@ -835,6 +928,18 @@ macro_rules! top_kinds {
                 dz: &mut [f64],
             ) {
                 self.top.flow_tangent(i, tau, before, after, dz)
+            }
+            fn flow_parameter(
+                &self,
+                i: usize,
+                tau: f64,
+                before: &Self::Work,
+                after: &Self::Work,
+                m: usize,
+                dz: &mut [f64],
+            ) {
+                self.top
+                    .flow_parameter(i, tau, before, after, self.top_parameter(m), dz)
             }
         }
 
