@@ -57,6 +57,18 @@ pub trait Problem: Send + Sync {
     /// Inverse of [`Problem::to_internal`].
     fn to_user(&self, _z: &mut [f64]) {}
 
+    /// Maps a tangent vector (left-trivialised on SO(3) blocks, [`Space::tangent_dim`] values)
+    /// at a state from the user's frame to the internal one: by default [`Problem::to_internal`]
+    /// applied to it as to a state (right for a linear chart without SO(3) blocks).
+    fn tangent_to_internal(&self, dz: &mut [f64]) {
+        self.to_internal(dz)
+    }
+
+    /// Inverse of [`Problem::tangent_to_internal`].
+    fn tangent_to_user(&self, dz: &mut [f64]) {
+        self.to_user(dz)
+    }
+
     /// The names of the system's parameters θ, in order, whose sensitivities ∂z/∂θ a tangent
     /// run carries ([`crate::integrate::tangent`]); none by default.
     fn parameters(&self) -> Vec<&'static str> {

@@ -42,6 +42,15 @@ impl Block {
         }
     }
 
+    /// The number of coordinates of a tangent vector in the block: 3 for SO(3) (left-trivialised,
+    /// δR = Rξ̂), else [`Block::len`] (tangent vectors in the block's own coordinates).
+    pub fn tangent_len(self) -> usize {
+        match self {
+            Block::SO3 => 3,
+            b => b.len(),
+        }
+    }
+
     /// Whether the block holds no value (ℝ⁰).
     pub fn is_empty(self) -> bool {
         self.len() == 0
@@ -172,6 +181,11 @@ impl Space {
     /// The length of a state vector.
     pub fn dim(&self) -> usize {
         self.blocks().iter().map(|(_, b)| b.len()).sum()
+    }
+
+    /// The length of a tangent vector ([`Block::tangent_len`]).
+    pub fn tangent_dim(&self) -> usize {
+        self.blocks().iter().map(|(_, b)| b.tangent_len()).sum()
     }
 
     /// The blocks with their names and value ranges.

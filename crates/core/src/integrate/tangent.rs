@@ -29,7 +29,10 @@
 //! (f′(z)δz + ∂f/∂θ_m; for a flow Dφ δz + ∂φ/∂θ_m): so k = d + p directions in all.
 //!
 //! **Layouts.** A separable lift stores (q, δq₁, …, δq_k, p, δp₁, …, δp_k) (its kind needs the
-//! positions before the momenta); a field or split lift (z, δz₁, …, δz_k). [`TangentSystem::seed`] and
+//! positions before the momenta); a field or split lift (z, δz₁, …, δz_k). On an SO(3) block a
+//! direction is left-trivialised (δR = Rξ̂, three values), so a direction has e ≤ d values; the
+//! split lift allows it (a flow's tangent map is exact in ξ), the field lift does not (a
+//! Runge–Kutta step leaves SO(3), and its derivative is one in ambient coordinates). [`TangentSystem::seed`] and
 //! [`TangentSystem::jacobian`] convert from and to the problem's flat layout, so nothing outside
 //! this module sees either. The problem's chart ([`Problem::to_internal`]) must be linear (a
 //! turn to principal axes): the lift applies it to the directions as to states.
@@ -115,7 +118,9 @@ enum Layout {
 #[derive(Clone, Debug)]
 pub struct Tangent<P> {
     problem: P,
+    /// The state's and a tangent vector's dimensions (they differ by 6 per SO(3) block).
     d: usize,
+    e: usize,
     /// The number of parameter directions (after the d state directions).
     np: usize,
     layout: Layout,
@@ -127,6 +132,9 @@ pub trait TangentSystem: System {
     /// The dimension d of the base state.
     fn base_dim(&self) -> usize;
 
+    /// The dimension e of a direction (d less 6 per SO(3) block, left-trivialised).
+    fn tangent_dim(&self) -> usize;
+
     /// The names of the parameters θ whose directions the lift carries.
     fn parameter_names(&self) -> Vec<&'static str>;
 
@@ -134,27 +142,38 @@ pub trait TangentSystem: System {
     /// ∂z₀/∂θ = 0).
     fn seed(&self, z0: &[f64]) -> Result<Vec<f64>>;
 
-    /// The base state (d values), the Jacobian ∂z/∂z₀ (d×d row-major, column j = δz_j) and the
-    /// parameter Jacobian ∂z/∂θ (d×p row-major) of a lifted state.
+    /// The base state (d values), the Jacobian ∂z/∂z₀ (e×e row-major, column j = δz_j) and the
+    /// parameter Jacobian ∂z/∂θ (e×p row-major) of a lifted state.
     fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]);
 }
 
 impl<P: Problem + Clone> Tangent<P> {
     fn with(problem: P, layout: Layout) -> Self {
-        let d = problem.space().dim();
+        let (d, e) = (problem.space().dim(), problem.space().tangent_dim());
         let np = problem.parameters().len();
         Tangent {
             problem,
             d,
+            e,
             np,
             layout,
         }
     }
 
-    /// The number k = d + p of directions.
+    /// The number k = e + p of directions.
     #[inline]
     fn k(&self) -> usize {
-        self.d + self.np
+        self.e + self.np
+    }
+
+    /// The length of block j: the state (j = 0) or a direction.
+    #[inline]
+    fn len_of(&self, j: usize) -> usize {
+        if j == 0 {
+            self.d
+        } else {
+            self.e
+        }
     }
 
     /// The base problem.
@@ -162,11 +181,12 @@ impl<P: Problem + Clone> Tangent<P> {
         &self.problem
     }
 
-    /// Index of component i of the base state (i < d) in direction j (0 = the state itself).
+    /// Index of component i of the base state (j = 0, i < d) or of direction j (i < e).
     #[inline]
     fn at(&self, j: usize, i: usize) -> usize {
         match self.layout {
-            Layout::Field => j * self.d + i,
+            Layout::Field if j == 0 => i,
+            Layout::Field => self.d + (j - 1) * self.e + i,
             Layout::Separable { dof } => {
                 let (half, c) = (i / dof, i % dof);
                 half * dof * (self.k() + 1) + j * dof + c
@@ -175,40 +195,54 @@ impl<P: Problem + Clone> Tangent<P> {
     }
 
     fn gather(&self, lifted: &[f64], j: usize, out: &mut [f64]) {
-        for (i, o) in out.iter_mut().enumerate() {
+        for (i, o) in out[..self.len_of(j)].iter_mut().enumerate() {
             *o = lifted[self.at(j, i)];
         }
     }
 
     fn scatter(&self, v: &[f64], j: usize, lifted: &mut [f64]) {
-        for (i, x) in v.iter().enumerate() {
+        for (i, x) in v[..self.len_of(j)].iter().enumerate() {
             lifted[self.at(j, i)] = *x;
         }
     }
 
-    /// Applies `map` to the base state and to every direction, each as a flat base state.
-    fn each(&self, z: &mut [f64], map: impl Fn(&mut [f64])) {
+    /// Applies `state` to the base state and `tangent` to every direction.
+    fn each(&self, z: &mut [f64], state: impl Fn(&mut [f64]), tangent: impl Fn(&mut [f64])) {
         let mut v = vec![0.0; self.d];
         for j in 0..=self.k() {
             self.gather(z, j, &mut v);
-            map(&mut v);
+            let n = self.len_of(j);
+            if j == 0 {
+                state(&mut v[..n]);
+            } else {
+                tangent(&mut v[..n]);
+            }
             self.scatter(&v, j, z);
         }
     }
 }
 
 impl<P: SeparableTangent + Clone> Tangent<P> {
-    /// The lift of a separable problem (its Verlet methods).
+    /// The lift of a separable problem (its Verlet methods; flat blocks only).
     pub fn separable(problem: P) -> Self {
         let dof = problem.dof();
         Tangent::with(problem, Layout::Separable { dof })
     }
 }
 
-impl<P: Problem + Clone> Tangent<P> {
-    /// The lift of a vector field (its Runge–Kutta methods) or of a split problem (its
-    /// splittings): (z, δz₁, …, δz_d).
+impl<P: VectorFieldTangent + Clone> Tangent<P> {
+    /// The lift of a vector field (its Runge–Kutta methods; flat blocks only, e = d: a
+    /// Runge–Kutta step on a curved block is differentiated in its ambient coordinates, which
+    /// a left-trivialised direction is not).
     pub fn field(problem: P) -> Self {
+        Tangent::with(problem, Layout::Field)
+    }
+}
+
+impl<P: SplitTangent + Clone> Tangent<P> {
+    /// The lift of a split problem (its splittings): (z, δz₁, …, δz_k), the directions
+    /// left-trivialised on SO(3) blocks.
+    pub fn split(problem: P) -> Self {
         Tangent::with(problem, Layout::Field)
     }
 }
@@ -218,9 +252,9 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.name()
     }
 
-    /// Flat: d(1 + k) values.
+    /// Flat: d + k·e values.
     fn space(&self) -> Space {
-        Space::new([("z", Block::Real(self.d * (self.k() + 1)))])
+        Space::new([("z", Block::Real(self.d + self.k() * self.e))])
     }
 
     fn energy(&self, z: &[f64]) -> Result<f64> {
@@ -241,11 +275,19 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
     }
 
     fn to_internal(&self, z: &mut [f64]) {
-        self.each(z, |v| self.problem.to_internal(v));
+        self.each(
+            z,
+            |v| self.problem.to_internal(v),
+            |v| self.problem.tangent_to_internal(v),
+        );
     }
 
     fn to_user(&self, z: &mut [f64]) {
-        self.each(z, |v| self.problem.to_user(v));
+        self.each(
+            z,
+            |v| self.problem.to_user(v),
+            |v| self.problem.tangent_to_user(v),
+        );
     }
 
     fn calls_out(&self) -> bool {
@@ -293,7 +335,7 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
         let n = self.problem.dof();
         let (f0, df) = f.split_at_mut(n);
         self.problem.force(&q[..n], f0, s)?;
-        let d = self.d;
+        let d = self.e;
         for (j, (dqj, dfj)) in q[n..]
             .chunks_exact(n)
             .zip(df.chunks_exact_mut(n))
@@ -310,6 +352,7 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
 
 /// (f(z), f′(z)δz_j).
 impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
+    /// (e = d here: [`Tangent::field`].)
     fn field(&self, z: &[f64], dz: &mut [f64]) {
         let d = self.d;
         let (f0, df) = dz.split_at_mut(d);
@@ -357,12 +400,12 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
     fn flow(&self, i: usize, tau: f64, w: &mut Self::Work) {
         let before = w.base.clone();
         self.problem.flow(i, tau, &mut w.base);
-        let d = self.d;
-        for (j, dz) in w.dirs.chunks_exact_mut(d).enumerate() {
+        let e = self.e;
+        for (j, dz) in w.dirs.chunks_exact_mut(e).enumerate() {
             self.problem.flow_tangent(i, tau, &before, &w.base, dz);
-            if j >= d {
+            if j >= e {
                 self.problem
-                    .flow_parameter(i, tau, &before, &w.base, j - d, dz);
+                    .flow_parameter(i, tau, &before, &w.base, j - e, dz);
             }
         }
     }
@@ -392,6 +435,10 @@ where
         self.d
     }
 
+    fn tangent_dim(&self) -> usize {
+        self.e
+    }
+
     fn parameter_names(&self) -> Vec<&'static str> {
         self.problem.parameters()
     }
@@ -404,23 +451,23 @@ where
                 format!("({},)", z0.len()),
             ));
         }
-        let mut z = vec![0.0; self.d * (self.k() + 1)];
+        let mut z = vec![0.0; self.d + self.k() * self.e];
         self.scatter(z0, 0, &mut z);
-        for j in 0..self.d {
+        for j in 0..self.e {
             z[self.at(j + 1, j)] = 1.0;
         }
         Ok(z)
     }
 
     fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]) {
-        let (d, np) = (self.d, self.np);
+        let (e, np) = (self.e, self.np);
         self.gather(lifted, 0, z);
-        for i in 0..d {
-            for j in 0..d {
-                jac[i * d + j] = lifted[self.at(j + 1, i)];
+        for i in 0..e {
+            for j in 0..e {
+                jac[i * e + j] = lifted[self.at(j + 1, i)];
             }
             for m in 0..np {
-                pjac[i * np + m] = lifted[self.at(d + 1 + m, i)];
+                pjac[i * np + m] = lifted[self.at(e + 1 + m, i)];
             }
         }
     }

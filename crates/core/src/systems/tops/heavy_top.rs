@@ -190,6 +190,12 @@ impl Problem for HeavyTop {
     fn to_user(&self, z: &mut [f64]) {
         self.top.to_user(z)
     }
+    fn tangent_to_internal(&self, dz: &mut [f64]) {
+        self.top.tangent_frame(dz, false)
+    }
+    fn tangent_to_user(&self, dz: &mut [f64]) {
+        self.top.tangent_frame(dz, true)
+    }
 }
 
 top_kinds!(HeavyTop);
@@ -216,10 +222,10 @@ impl Catalog for HeavyTop {
         Some(self.with_attitude())
     }
 
-    /// `rk4`'s tangent lift, without the attitude.
+    /// The tangent lift of the splittings (and, without the attitude, rk4); with the attitude
+    /// its directions are left-trivialised (δR = Rξ̂).
     fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
-        (!self.top.lifted)
-            .then(|| crate::integrate::tangent::Tangent::field(self.clone()).into_system())
+        Some(crate::integrate::tangent::Tangent::split(self.clone()).into_system())
     }
 }
 

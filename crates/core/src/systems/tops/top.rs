@@ -270,6 +270,27 @@ impl Top {
         }
     }
 
+    /// A tangent vector (δM, δΓ, ξ with δR = Rξ̂): every block is a body vector, v ↦ Qᵀv
+    /// (inverse: v ↦ Qv), since δ(RQ) = RQ (Qᵀξ)^.
+    pub(crate) fn tangent_frame(&self, dz: &mut [f64], inverse: bool) {
+        if let Some(q) = &self.frame {
+            let qm = if inverse { *q } else { q.transpose() };
+            for v in dz.chunks_exact_mut(3) {
+                let w = qm * Vector3::from_column_slice(v);
+                v.copy_from_slice(w.as_slice());
+            }
+        }
+    }
+
+    /// The index of ξ (the attitude's left-trivialised direction) in a tangent vector.
+    fn xi_at(&self) -> usize {
+        if self.c.is_some() {
+            6
+        } else {
+            3
+        }
+    }
+
     /// Body vectors v ↦ Qᵀv, R ↦ RQ (user frame → principal frame).
     pub(crate) fn to_internal(&self, z: &mut [f64]) {
         self.map_frame(z, false);
@@ -415,16 +436,28 @@ impl Top {
                     dy[3 + ii] += dtheta * g1[jj];
                     dy[3 + jj] -= dtheta * g1[ii];
                 }
+                if self.lifted {
+                    dy[self.xi_at() + k] += dtheta;
+                }
             }
             (Flow::Casimir, TopParam::Moment(q)) if q == r => {
+                let v = before.m * (tau * self.inv_ir);
+                let dv = before.m * (-tau * self.inv_ir * self.inv_ir);
                 if let Some(g1) = after.g {
-                    let v = before.m * (tau * self.inv_ir);
-                    let dv = before.m * (-tau * self.inv_ir * self.inv_ir);
                     let jl = crate::lie::so3::jacobian_left(&-v)
                         .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
                     let d = -(jl * dv).cross(&g1);
                     for c in 0..3 {
                         dy[3 + c] += d[c];
+                    }
+                }
+                if self.lifted {
+                    let jr = crate::lie::so3::jacobian_right(&v)
+                        .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+                    let d = jr * dv;
+                    let x = self.xi_at();
+                    for c in 0..3 {
+                        dy[x + c] += d[c];
                     }
                 }
             }
@@ -461,8 +494,9 @@ impl Top {
         }
     }
 
-    /// The tangent map of flow i over τ on one direction dy (flat, principal frame, without the
-    /// attitude), from the states before and after it: Axis(a) turns M and Γ about e_k by
+    /// The tangent map of flow i over τ on one direction dy = (δM, δΓ, ξ) (principal frame; ξ
+    /// the left-trivialised direction of the attitude when lifted), from the states before and
+    /// after it: Axis(a) turns M and Γ about e_k by
     /// θ = τ·coef·M_k (v_i' = cos θ v_i + sin θ v_j, v_j' = cos θ v_j − sin θ v_i), so
     /// δv' = Rot(θ)δv + δθ (v_j', −v_i') with δθ = τ·coef·δM_k; Casimir turns Γ by exp(−v̂),
     /// v = τM/I_r, so δΓ' = exp(−v̂)δΓ − (J_l(−v)δv) × Γ'; Kick: δM' = δM + τ δΓ × c.
@@ -495,15 +529,31 @@ impl Top {
                 if let (Some(dg), Some(g1)) = (dg, after.g) {
                     ndg = Some(turn(&dg, &g1));
                 }
+                if self.lifted {
+                    // R' = R Rot(θ)ᵀ with Rot(θ) = exp(−θê_k): ξ' = Rot ξ + δθ e_k.
+                    let x = self.xi_at();
+                    let (xi, xj) = (dy[x + ii], dy[x + jj]);
+                    dy[x + ii] = c * xi + s * xj;
+                    dy[x + jj] = c * xj - s * xi;
+                    dy[x + k] += dtheta;
+                }
             }
             Flow::Casimir => {
+                let v = before.m * (tau * self.inv_ir);
+                let dv = dm * (tau * self.inv_ir);
+                let e = crate::lie::so3::exp_unchecked(&-v);
                 if let (Some(dg), Some(g1)) = (dg, after.g) {
-                    let v = before.m * (tau * self.inv_ir);
-                    let dv = dm * (tau * self.inv_ir);
-                    let e = crate::lie::so3::exp_unchecked(&-v);
                     let jl = crate::lie::so3::jacobian_left(&-v)
                         .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
                     ndg = Some(e * dg - (jl * dv).cross(&g1));
+                }
+                if self.lifted {
+                    // R' = R exp(v̂): ξ' = exp(−v̂)ξ + J_r(v)δv.
+                    let x = self.xi_at();
+                    let jr = crate::lie::so3::jacobian_right(&v)
+                        .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
+                    let xi = Vector3::from_column_slice(&dy[x..x + 3]);
+                    dy[x..x + 3].copy_from_slice((e * xi + jr * dv).as_slice());
                 }
             }
             Flow::Kick => {
@@ -943,7 +993,7 @@ macro_rules! top_kinds {
             }
         }
 
-        /// The splittings and `rk4` on the tangent lift (without the attitude).
+        /// The splittings and (without the attitude) `rk4` on the tangent lift.
         impl $crate::integrate::Catalog for $crate::integrate::tangent::Tangent<$t> {
             fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
                 let mut c = $crate::systems::tops::top::splittings();
@@ -951,6 +1001,13 @@ macro_rules! top_kinds {
                     $crate::integrate::methods::Rk4
                 }));
                 c
+            }
+
+            fn catalog(&self) -> Vec<$crate::integrate::Entry<Self>> {
+                match self.problem().top.lifted {
+                    true => $crate::systems::tops::top::splittings(),
+                    false => Self::kind_catalog(),
+                }
             }
         }
 
