@@ -107,9 +107,9 @@ class System:
     @property
     def parameters(self) -> list[str]:
         """The parameters theta, the columns of `Trajectory.parameter_jacobian`."""
-    def sensitivity_methods(self) -> list[str]:
+    def sensitivity_methods(self, attitude: bool = False) -> list[str]:
         """The methods whose Jacobians `integrate(..., sensitivity=True)` computes."""
-    def _tangent(self) -> tuple[System, _Tangent] | None: ...
+    def _tangent(self, attitude: bool = False) -> tuple[System, _Tangent] | None: ...
     @property
     def state_dim(self) -> int: ...
     @property

@@ -275,9 +275,10 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             parameters (``traj.parameter_jacobian``, (k, d, p), columns ``system.parameters``);
             exact to round-off, not finite differences: the run integrates the system's tangent
             lift with the same method (about d + p + 1 times the work of the plain run);
-            ``traj.vjp(cotangent)`` gives the gradient of a loss. Available where the system gives the
-            derivatives its method needs (``system.sensitivity_methods()``); not yet with an
-            attitude or events.
+            ``traj.vjp(cotangent)`` gives the gradient of a loss. With an attitude, d counts its
+            three left-trivialised directions (δR = R ξ̂) in place of R's nine entries. Available
+            where the system gives the derivatives its method needs
+            (``system.sensitivity_methods(attitude=...)``); not yet with events.
 
     Returns:
         A ``Trajectory``. With events, ``traj.t_events`` and ``traj.state_events`` list the
@@ -373,15 +374,16 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
 def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, progress,
                       chunk_steps, threads, t0, t_eval, events):
     """``integrate(..., sensitivity=True)``: the run of the tangent lift, split into the states
-    and their Jacobians (see ``integrate``)."""
+    (and attitudes) and their Jacobians (see ``integrate``)."""
     name = type(system).__name__
-    if attitude is not None or events is not None:
-        what = "attitude" if attitude is not None else "events"
-        raise InvalidArgumentError(f"invalid {what}: sensitivity=True is not available with "
-                                   f"{'an attitude' if what == 'attitude' else 'events'} yet")
-    lift = system._tangent()
+    if events is not None:
+        raise InvalidArgumentError("invalid events: sensitivity=True is not available with "
+                                   "events yet")
+    with_attitude = attitude is not None
+    lift = system._tangent(with_attitude)
     if lift is None:
-        raise InvalidArgumentError(f"invalid sensitivity: {name} has no tangent maps yet "
+        what = " with an attitude" if with_attitude else ""
+        raise InvalidArgumentError(f"invalid sensitivity: {name} has no tangent maps{what} yet "
                                    f"({name}.sensitivity_methods() is empty)")
     lifted, layout = lift
     if method is None:
@@ -393,15 +395,31 @@ def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, p
             f"unsupported method {method!r} with sensitivity=True: the tangent maps of {name} are "
             f"available for {lifted.methods()} (method=...)")
     z0, batched = system._normalize_state(state0)
+    d = z0.shape[1]
+    if with_attitude:
+        a = np.asarray(attitude, dtype=float)
+        if a.ndim == 2:
+            a = np.broadcast_to(a, (z0.shape[0],) + a.shape)
+        if a.shape[0] != z0.shape[0] or a.shape[1:] != (3, 3):
+            raise ShapeError(f"attitude has the wrong shape: expected (3, 3) or "
+                             f"({z0.shape[0]}, 3, 3), got {np.shape(attitude)}")
+        z0 = np.concatenate([z0, a.reshape(z0.shape[0], 9)], axis=1)
     seeds = layout.seed(z0 if batched else z0[0])
     traj = integrate(lifted, seeds, dt, steps, method, save_every, None, progress, chunk_steps,
                      threads, t0=t0, t_eval=t_eval)
     states, jac, pjac = layout.split(traj.states)
     final, final_jac, final_pjac = layout.split(traj.final_state)
-    return Trajectory(system, traj.method, traj.t, states, None, final, None, traj.dt,
+    att = final_att = att0 = None
+    if with_attitude:
+        att = states[..., d:].reshape(states.shape[:-1] + (3, 3))
+        final_att = final[..., d:].reshape(final.shape[:-1] + (3, 3))
+        att0 = a if batched else a[0]
+        states, final = states[..., :d], final[..., :d]
+        z0 = z0[:, :d]
+    return Trajectory(system, traj.method, traj.t, states, att, final, final_att, traj.dt,
                       traj.save_every, t_final=traj.t_final, status=traj.status, t0=traj.t0,
-                      initial_state=z0 if batched else z0[0], jacobian=jac,
-                      final_jacobian=final_jac, parameter_jacobian=pjac,
+                      initial_state=z0 if batched else z0[0], initial_attitude=att0,
+                      jacobian=jac, final_jacobian=final_jac, parameter_jacobian=pjac,
                       final_parameter_jacobian=final_pjac)
 
 

@@ -76,8 +76,10 @@ class Trajectory:
         with grad = Σ_k J_kᵀ c_k over the samples (a run with ``sensitivity=True``).
 
         Args:
-            cotangent: (d,) on the final state, or (k, d) on every sample (``states``' shape);
-                for a batch (b, d) or (b, k, d), and the gradients are (b, d), (b, p).
+            cotangent: (e,) on the final state, or (k, e) on every sample, e the Jacobian's size
+                (d; with an attitude, the state's values and the attitude's three
+                left-trivialised directions); for a batch (b, e) or (b, k, e), and the gradients
+                are (b, e), (b, p).
         Raises:
             TypeError (not real numbers), InvalidArgumentError (a run without
             ``sensitivity=True``), ShapeError, NonFiniteError.
@@ -99,17 +101,16 @@ class Trajectory:
         c = c.astype(np.float64)
         if not np.all(np.isfinite(c)):
             raise NonFiniteError("invalid cotangent: it contains a non-finite value (NaN or inf)")
-        batched = self.states.ndim == 3
-        lead = self.states.shape[:1] if batched else ()
-        d = self.states.shape[-1]
-        if c.shape == lead + (d,):
+        every = self.jacobian.shape[:-1]           # (b,) k, e: a cotangent on every sample
+        final = self.final_jacobian.shape[:-1]     # (b,) e: on the final state
+        if c.shape == final:
             j, p = self.final_jacobian, self.final_parameter_jacobian
             return np.einsum("...ij,...i->...j", j, c), np.einsum("...ij,...i->...j", p, c)
-        if c.shape == self.states.shape:
+        if c.shape == every:
             return (np.einsum("...kij,...ki->...j", self.jacobian, c),
                     np.einsum("...kij,...ki->...j", self.parameter_jacobian, c))
-        raise ShapeError(f"invalid cotangent: expected shape {lead + (d,)} (the final state) or "
-                         f"{self.states.shape} (every sample), got {c.shape}")
+        raise ShapeError(f"invalid cotangent: expected shape {final} (the final state) or "
+                         f"{every} (every sample), got {c.shape}")
 
     @classmethod
     def concatenate(cls, trajectories):

@@ -98,8 +98,10 @@ def test_sensitivity_refuses_what_it_cannot_do_with_typed_errors():
     z0 = [0.3, -0.8, 1.1]
     with pytest.raises(lf.UnsupportedMethodError, match="available for"):
         lf.integrate(rb, z0, 0.1, 10, method="dmv", sensitivity=True)
-    with pytest.raises(lf.InvalidArgumentError, match="attitude"):
+    with pytest.raises(lf.UnsupportedMethodError, match="available for"):
         lf.integrate(rb, z0, 0.1, 10, method="rk4", attitude=np.eye(3), sensitivity=True)
+    with pytest.raises(lf.ShapeError, match="attitude"):
+        lf.integrate(rb, z0, 0.1, 10, attitude=np.eye(4), sensitivity=True)
     with pytest.raises(lf.InvalidArgumentError, match="events"):
         lf.integrate(rb, z0, 0.1, 10, method="rk4", events=lambda t, z: z[0], sensitivity=True)
     with pytest.raises(lf.InvalidArgumentError, match="no tangent maps"):
@@ -177,3 +179,44 @@ def test_vjp_is_the_gradient_of_a_loss():
                          save_every=20, sensitivity=True)
     gz2, gp2 = batch.vjp(np.ones((2, 3)))
     assert gz2.shape == (2, 3) and gp2.shape == (2, 3)
+
+
+def test_with_an_attitude_the_directions_are_left_trivialised():
+    """RigidBody with attitude, the default splitting: jacobian (k, 6, 6) over (M, xi) with
+    dR = R hat(xi); against central differences (R0 moved as R0 exp(h e_j), the final R read as
+    (R^T dR)^vee); the states and attitudes are the plain run's; the moments' column too."""
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    R0 = lf.lie.so3_exp([0.4, -0.7, 0.3])
+    M0 = np.array([0.3, -0.8, 1.1])
+    assert rb.sensitivity_methods(attitude=True)[0] == "splitting"
+    assert "rk4" not in rb.sensitivity_methods(attitude=True)
+    traj = lf.integrate(rb, M0, 0.05, 40, attitude=R0, save_every=20, sensitivity=True)
+    plain = lf.integrate(rb, M0, 0.05, 40, attitude=R0, save_every=20)
+    np.testing.assert_array_equal(traj.attitude, plain.attitude)
+    np.testing.assert_array_equal(traj.states, plain.states)
+    assert traj.jacobian.shape == (3, 6, 6) and traj.parameter_jacobian.shape == (3, 6, 3)
+
+    def end(M, R, inertia=(1.0, 2.0, 3.0)):
+        t = lf.integrate(lf.RigidBody(list(inertia)), M, 0.05, 40, attitude=R)
+        return t.final_state, t.final_attitude
+
+    def column(plus, minus, h):
+        (mp, rp), (mm, rm) = plus, minus
+        a = 0.5 * (rp + rm)
+        w = a.T @ (rp - rm) / (2 * h)
+        return np.concatenate([(mp - mm) / (2 * h), [w[2, 1], w[0, 2], w[1, 0]]])
+
+    h = 1e-6
+    for j in range(6):
+        e = np.zeros(3)
+        if j < 3:
+            e[j] = h
+            fd = column(end(M0 + e, R0), end(M0 - e, R0), h)
+        else:
+            e[j - 3] = h
+            fd = column(end(M0, R0 @ lf.lie.so3_exp(e)), end(M0, R0 @ lf.lie.so3_exp(-e)), h)
+        np.testing.assert_allclose(traj.final_jacobian[:, j], fd, atol=1e-7)
+    e = np.array([h, 0.0, 0.0])
+    fd = column(end(M0, R0, np.array([1.0, 2.0, 3.0]) + e),
+                end(M0, R0, np.array([1.0, 2.0, 3.0]) - e), h)
+    np.testing.assert_allclose(traj.final_parameter_jacobian[:, 0], fd, atol=1e-7)

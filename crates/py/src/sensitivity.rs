@@ -22,7 +22,8 @@ pub struct PyTangent {
 
 #[pymethods]
 impl PyTangent {
-    /// The lifted states (..., d(1 + d + p)) of states (..., d) with the identity as directions.
+    /// The lifted states (..., d + (e + p)e) of states (..., d) with the identity as directions
+    /// (e = d, or d − 6 with an attitude: its directions left-trivialised).
     fn seed<'py>(
         &self,
         py: Python<'py>,
@@ -40,7 +41,8 @@ impl PyTangent {
             )));
         }
         let data = read_all("state0", &v)?;
-        let width = d * (d + t.parameter_names().len() + 1);
+        let e = t.tangent_dim();
+        let width = d + (e + t.parameter_names().len()) * e;
         let mut out = Vec::with_capacity(data.len() / d * width);
         for z in data.chunks_exact(d) {
             out.extend(t.seed(z).py()?);
@@ -58,16 +60,16 @@ impl PyTangent {
         self.inner.parameter_names()
     }
 
-    /// (states (..., d), Jacobians (..., d, d), parameter Jacobians (..., d, p)) of lifted
-    /// states (..., d(1 + d + p)).
+    /// (states (..., d), Jacobians (..., e, e), parameter Jacobians (..., e, p)) of lifted
+    /// states (..., d + (e + p)e).
     fn split<'py>(
         &self,
         py: Python<'py>,
         lifted: ArrayIn<'py>,
     ) -> PyResult<(Array<'py>, Array<'py>, Array<'py>)> {
         let t = &self.inner;
-        let (d, np) = (t.base_dim(), t.parameter_names().len());
-        let width = d * (d + np + 1);
+        let (d, e, np) = (t.base_dim(), t.tangent_dim(), t.parameter_names().len());
+        let width = d + (e + np) * e;
         let v = lifted.as_array();
         let shape = v.shape().to_vec();
         if shape.last() != Some(&width) {
@@ -81,21 +83,21 @@ impl PyTangent {
         let n = data.len() / width;
         let (mut zs, mut js, mut ps) = (
             vec![0.0; n * d],
-            vec![0.0; n * d * d],
-            vec![0.0; n * d * np],
+            vec![0.0; n * e * e],
+            vec![0.0; n * e * np],
         );
         for (i, l) in data.chunks_exact(width).enumerate() {
             t.jacobian(
                 l,
                 &mut zs[i * d..(i + 1) * d],
-                &mut js[i * d * d..(i + 1) * d * d],
-                &mut ps[i * d * np..(i + 1) * d * np],
+                &mut js[i * e * e..(i + 1) * e * e],
+                &mut ps[i * e * np..(i + 1) * e * np],
             );
         }
         let lead = &shape[..shape.len() - 1];
         let zshape: Vec<usize> = lead.iter().copied().chain([d]).collect();
-        let jshape: Vec<usize> = lead.iter().copied().chain([d, d]).collect();
-        let pshape: Vec<usize> = lead.iter().copied().chain([d, np]).collect();
+        let jshape: Vec<usize> = lead.iter().copied().chain([e, e]).collect();
+        let pshape: Vec<usize> = lead.iter().copied().chain([e, np]).collect();
         let err = |e: numpy::ndarray::ShapeError| {
             to_py(Error::shape("states", "(..., D)", e.to_string()))
         };

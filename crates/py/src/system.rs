@@ -336,21 +336,35 @@ impl PySystem {
     }
 
     /// The methods whose Jacobians `lieflow.integrate(..., sensitivity=True)` computes for this
-    /// system (its tangent lift's catalog; empty where the system has none yet).
-    fn sensitivity_methods(&self) -> Vec<&'static str> {
-        self.sys
-            .tangent()
-            .map(|t| t.methods().into_iter().map(|(n, _)| n).collect())
+    /// system (its tangent lift's catalog; empty where the system has none yet); with
+    /// `attitude=True` those of a run that carries the attitude.
+    #[pyo3(signature = (attitude = false))]
+    fn sensitivity_methods(&self, attitude: bool) -> Vec<&'static str> {
+        let t = match attitude {
+            true => self.lifted.as_ref().and_then(|l| l.tangent()),
+            false => self.sys.tangent(),
+        };
+        t.map(|t| t.methods().into_iter().map(|(n, _)| n).collect())
             .unwrap_or_default()
     }
 
-    /// The tangent lift of the system for `lieflow.integrate(..., sensitivity=True)` (issue 26):
-    /// (a system object over the lift, its layout), or None where the system has none.
+    /// The tangent lift of the system (with `attitude`: of the system carrying its attitude) for
+    /// `lieflow.integrate(..., sensitivity=True)` (issue 26): (a system object over the lift, its
+    /// layout), or None where the system has none.
+    #[pyo3(signature = (attitude = false))]
     fn _tangent(
         &self,
         py: Python<'_>,
+        attitude: bool,
     ) -> PyResult<Option<(Py<PySystem>, Py<crate::sensitivity::PyTangent>)>> {
-        let Some(t) = self.sys.tangent() else {
+        let sys = match attitude {
+            true => match &self.lifted {
+                Some(l) => l.tangent(),
+                None => None,
+            },
+            false => self.sys.tangent(),
+        };
+        let Some(t) = sys else {
             return Ok(None);
         };
         let sys: Arc<dyn System> = t.clone();
