@@ -1,0 +1,50 @@
+"""Cost of the exact Jacobian of the discrete flow (issue 26): the run with sensitivity=True
+against the plain run of the same method and step, for the rigid body with attitude
+(splitting4; directions: 6 state + 3 moments), the heavy top (splitting4; 6 + 7) and the
+pseudo-rigid body n = 3 (verlet4, SVK + volumetric; 18 + 0). The lift carries k directions, so
+the ideal factor is 1 + k. Wall time is the best of 5 calls of 2000 steps (save_every = steps).
+
+    python benches/python/sensitivity_cost.py
+"""
+
+import numpy as np
+
+import lieflow as lf
+from timing import best_time, environment
+
+STEPS = 2000
+
+
+def cases():
+    R0 = lf.lie.so3_exp([0.4, -0.7, 0.3])
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    ht = lf.HeavyTop([1.0, 2.0, 3.0], 0.7, chi=[0.2, -0.3, 1.0])
+    prb = lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(1.0, 2.0)
+                             + lf.potentials.Volumetric(0.5, 1.4))
+    X = np.diag([1.3, 1.1, 0.9])
+    P = np.array([[0.1, -0.5, 0.2], [0.6, 0.05, -0.3], [-0.1, 0.4, 0.02]])
+    return [
+        ("RigidBody with attitude", rb, np.array([0.3, -0.8, 1.1]), R0, "splitting4", 6 + 3),
+        ("HeavyTop", ht, np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8]), None, "splitting4", 6 + 7),
+        ("PseudoRigidBody n = 3", prb, np.concatenate([X.ravel(), P.ravel()]), None, "verlet4",
+         18),
+    ]
+
+
+def main():
+    print(environment())
+    print(f"{'system':26s} {'method':11s} {'plain':>10s} {'Jacobian':>10s} {'factor':>7s} "
+          f"{'1 + k':>6s}")
+    for name, system, z0, att, method, k in cases():
+        def run(sensitivity):
+            return lf.integrate(system, z0, 0.01, STEPS, method=method, attitude=att,
+                                save_every=STEPS, sensitivity=sensitivity)
+        plain, _ = best_time(lambda: run(False), repeats=5)
+        tangent, traj = best_time(lambda: run(True), repeats=5)
+        assert traj.final_jacobian is not None
+        print(f"{name:26s} {method:11s} {plain * 1e3:8.2f}ms {tangent * 1e3:8.2f}ms "
+              f"{tangent / plain:7.1f} {1 + k:6d}")
+
+
+if __name__ == "__main__":
+    main()
