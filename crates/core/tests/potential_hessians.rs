@@ -312,3 +312,39 @@ fn stretch_needs_a_positive_stiffness() {
     assert_eq!(pot.k(), 2.0);
     assert!(!pot.needs_positive_det());
 }
+
+/// hessian3, the stack path of the n = 3 tangent lift, equals the general add_hessian for every
+/// potential that has it (and a sum of them).
+#[test]
+fn fixed_size_hessians_match_the_general_kernel() {
+    use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
+    use std::sync::Arc;
+    let mut rng = Rng(31);
+    let pots: Vec<Arc<dyn Potential>> = vec![
+        Arc::new(Harmonic::new(1.3).unwrap()),
+        Arc::new(SaintVenantKirchhoff::new(0.7, 1.9).unwrap()),
+        Arc::new(Volumetric::polytropic(0.5, 1.4).unwrap()),
+        Arc::new(Volumetric::polytropic(0.8, 1.0).unwrap()),
+        Arc::new(Sum::new(vec![
+            Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()),
+            Arc::new(Volumetric::polytropic(0.5, 1.4).unwrap()),
+        ])),
+    ];
+    for pot in &pots {
+        for _ in 0..10 {
+            let x = gl_plus(&mut rng, 3);
+            let v = rng.mat(3, 1.0);
+            let h = potential::hessian_product(&**pot, &x, &v).unwrap();
+            let h3 = pot
+                .hessian3(
+                    &Matrix3::from_fn(|i, j| x[(i, j)]),
+                    &Matrix3::from_fn(|i, j| v[(i, j)]),
+                )
+                .expect("a stack Hessian");
+            let err = (0..9)
+                .map(|k| (h[(k / 3, k % 3)] - h3[(k / 3, k % 3)]).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-12 * h.norm_l2().max(1.0), "{pot:?}: {err:.2e}");
+        }
+    }
+}

@@ -67,15 +67,17 @@ pub trait SeparableTangent: Separable {
 /// A [`Split`] problem with the tangent maps of its exact flows: the data of its tangent lift
 /// (whose flows are then the lifted flows (φ_τ(z), Dφ_τ(z)δz), exact again).
 pub trait SplitTangent: Split {
-    /// dz ← Dφ_i,τ(z)·dz for one direction dz (flat, internal frame), given the working state
-    /// `before` the flow and `after` it.
+    /// dz ← Dφ_i,τ(z)·dz for every direction dz in `dirs` (consecutive tangent vectors of
+    /// [`crate::integrate::Space::tangent_dim`] values, internal frame), given the working
+    /// state `before` the flow and `after` it: all at once, so that the flow's own quantities
+    /// (its angle, its exponential) are formed once.
     fn flow_tangent(
         &self,
         i: usize,
         tau: f64,
         before: &Self::Work,
         after: &Self::Work,
-        dz: &mut [f64],
+        dirs: &mut [f64],
     );
 
     /// dz += ∂φ_i,τ/∂θ_m (z) for the parameter m, after [`SplitTangent::flow_tangent`] on the
@@ -400,13 +402,11 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
     fn flow(&self, i: usize, tau: f64, w: &mut Self::Work) {
         let before = w.base.clone();
         self.problem.flow(i, tau, &mut w.base);
+        self.problem
+            .flow_tangent(i, tau, &before, &w.base, &mut w.dirs);
         let e = self.e;
-        for (j, dz) in w.dirs.chunks_exact_mut(e).enumerate() {
-            self.problem.flow_tangent(i, tau, &before, &w.base, dz);
-            if j >= e {
-                self.problem
-                    .flow_parameter(i, tau, &before, &w.base, j - e, dz);
-            }
+        for (m, dz) in w.dirs[e * e..].chunks_exact_mut(e).enumerate() {
+            self.problem.flow_parameter(i, tau, &before, &w.base, m, dz);
         }
     }
 

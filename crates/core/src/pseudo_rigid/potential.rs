@@ -125,6 +125,13 @@ pub trait Potential: Send + Sync + Debug {
         None
     }
 
+    /// Fixed-size fast path for n = 3 of the Hessian product D²U(X)\[V\], or `None` (callers
+    /// then use [`Potential::add_hessian`]). Must equal `add_hessian` (tested); lets the
+    /// tangent lift of the n = 3 body (its Jacobians) run on stack matrices.
+    fn hessian3(&self, _x: &Matrix3<f64>, _v: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        None
+    }
+
     /// The one dimension n at which U is defined, or `None` if it is defined for every n (the
     /// default). [`SelfGravity`] is `Some(3)`; a [`Sum`] has the dimension of its terms, and
     /// `Some(0)` (defined for no n) if two terms disagree. Kernels called at another n return NaN
@@ -278,6 +285,9 @@ impl Potential for Zero {
     fn gradient3(&self, _x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         Some(Matrix3::zeros())
     }
+    fn hessian3(&self, _x: &Matrix3<f64>, _v: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        Some(Matrix3::zeros())
+    }
 }
 
 /// Harmonic (isotropic linear-spring) potential U = (k/2) tr(XᵀX), ∂U/∂X = kX, D²U\[V\] = kV;
@@ -319,6 +329,9 @@ impl Potential for Harmonic {
     }
     fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         Some(x * self.k)
+    }
+    fn hessian3(&self, _x: &Matrix3<f64>, v: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        Some(v * self.k)
     }
 }
 
@@ -428,6 +441,19 @@ impl Potential for SaintVenantKirchhoff {
             st[(i, i)] += self.lambda * tr - self.mu;
         }
         Some(x * st)
+    }
+    fn hessian3(&self, x: &Matrix3<f64>, v: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        // V S + X dS, dS = μ(VᵀX + XᵀV) + λ tr(XᵀV) I, as add_hessian.
+        let c = x.transpose() * x;
+        let tr = 0.5 * (c.trace() - 3.0);
+        let mut st = c * self.mu;
+        let mut ds = (v.transpose() * x + x.transpose() * v) * self.mu;
+        let dtr = x.dot(v);
+        for i in 0..3 {
+            st[(i, i)] += self.lambda * tr - self.mu;
+            ds[(i, i)] += self.lambda * dtr;
+        }
+        Some(v * st + x * ds)
     }
 }
 
@@ -539,6 +565,18 @@ impl Potential for Volumetric {
         };
         let scale = if d > 0.0 { -pressure } else { f64::NAN };
         Some(cof * scale)
+    }
+    fn hessian3(&self, x: &Matrix3<f64>, v: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        // κ det^{−1−γ} (cof Vᵀ cof − (1−γ)⟨cof, V⟩ cof), as add_hessian.
+        let (c0, c1, c2) = (x.column(0), x.column(1), x.column(2));
+        let cof = Matrix3::from_columns(&[c1.cross(&c2), c2.cross(&c0), c0.cross(&c1)]);
+        let d = c0.dot(&cof.column(0));
+        let c = if d > 0.0 {
+            self.kappa * d.powf(-1.0 - self.gamma)
+        } else {
+            f64::NAN
+        };
+        Some((cof * v.transpose() * cof) * c - cof * (c * (1.0 - self.gamma) * cof.dot(v)))
     }
     fn needs_positive_det(&self) -> bool {
         true
@@ -702,6 +740,13 @@ impl Potential for Sum {
             g += t.gradient3(x)?;
         }
         Some(g)
+    }
+    fn hessian3(&self, x: &Matrix3<f64>, v: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        let mut h = Matrix3::zeros();
+        for t in &self.terms {
+            h += t.hessian3(x, v)?;
+        }
+        Some(h)
     }
     fn needs_positive_det(&self) -> bool {
         self.terms.iter().any(|t| t.needs_positive_det())

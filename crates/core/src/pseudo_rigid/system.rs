@@ -385,7 +385,18 @@ impl SeparableTangent for PseudoRigidBody {
         dv.copy_from_slice(dp);
     }
 
+    /// On stack matrices at n = 3 where the potential has [`Potential::hessian3`].
     fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], s: &mut ForceScratch) {
+        let pot = self.body.potential();
+        if let (Some(x), Some(v)) = (mat3(q), mat3(dq)) {
+            if let Some(h) = pot.hessian3(&x, &v) {
+                // Row-major values of −h are the column-major values of −hᵀ.
+                for (fk, hk) in df.iter_mut().zip(h.transpose().as_slice()) {
+                    *fk = -hk;
+                }
+                return;
+            }
+        }
         let n = s.ws.n();
         df.fill(0.0);
         self.body.potential().add_hessian(

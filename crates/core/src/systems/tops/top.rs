@@ -506,65 +506,73 @@ impl Top {
         tau: f64,
         before: &TopWork,
         after: &TopWork,
-        dy: &mut [f64],
+        dirs: &mut [f64],
     ) {
-        let dm = Vector3::from_column_slice(&dy[..3]);
-        let dg = self.c.map(|_| Vector3::from_column_slice(&dy[3..6]));
-        let (mut ndm, mut ndg) = (dm, dg);
+        let heavy = self.c.is_some();
+        let e = 3 + if heavy { 3 } else { 0 } + if self.lifted { 3 } else { 0 };
+        let x = self.xi_at();
         match self.kinds[i] {
             Flow::Axis(a) => {
+                // One (sin θ, cos θ) for every direction.
                 let k = self.axes[a];
                 let tc = tau * self.coef[a];
-                let theta = tc * before.m[k];
-                let dtheta = tc * dm[k];
-                let (s, c) = theta.sin_cos();
+                let (s, c) = (tc * before.m[k]).sin_cos();
                 let (ii, jj) = ((k + 1) % 3, (k + 2) % 3);
-                let turn = |v: &Vector3<f64>, after: &Vector3<f64>| {
-                    let mut out = *v;
-                    out[ii] = c * v[ii] + s * v[jj] + dtheta * after[jj];
-                    out[jj] = c * v[jj] - s * v[ii] - dtheta * after[ii];
-                    out
-                };
-                ndm = turn(&dm, &after.m);
-                if let (Some(dg), Some(g1)) = (dg, after.g) {
-                    ndg = Some(turn(&dg, &g1));
-                }
-                if self.lifted {
-                    // R' = R Rot(θ)ᵀ with Rot(θ) = exp(−θê_k): ξ' = Rot ξ + δθ e_k.
-                    let x = self.xi_at();
-                    let (xi, xj) = (dy[x + ii], dy[x + jj]);
-                    dy[x + ii] = c * xi + s * xj;
-                    dy[x + jj] = c * xj - s * xi;
-                    dy[x + k] += dtheta;
+                let g1 = after.g.unwrap_or_else(Vector3::zeros);
+                for dy in dirs.chunks_exact_mut(e) {
+                    let dtheta = tc * dy[k];
+                    let mut turn = |at: usize, after: &Vector3<f64>| {
+                        let (vi, vj) = (dy[at + ii], dy[at + jj]);
+                        dy[at + ii] = c * vi + s * vj + dtheta * after[jj];
+                        dy[at + jj] = c * vj - s * vi - dtheta * after[ii];
+                    };
+                    turn(0, &after.m);
+                    if heavy {
+                        turn(3, &g1);
+                    }
+                    if self.lifted {
+                        // R' = R Rot(θ)ᵀ with Rot(θ) = exp(−θê_k): ξ' = Rot ξ + δθ e_k.
+                        let (xi, xj) = (dy[x + ii], dy[x + jj]);
+                        dy[x + ii] = c * xi + s * xj;
+                        dy[x + jj] = c * xj - s * xi;
+                        dy[x + k] += dtheta;
+                    }
                 }
             }
             Flow::Casimir => {
-                let v = before.m * (tau * self.inv_ir);
-                let dv = dm * (tau * self.inv_ir);
-                let e = crate::lie::so3::exp_unchecked(&-v);
-                if let (Some(dg), Some(g1)) = (dg, after.g) {
-                    let jl = crate::lie::so3::jacobian_left(&-v)
-                        .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
-                    ndg = Some(e * dg - (jl * dv).cross(&g1));
-                }
-                if self.lifted {
-                    // R' = R exp(v̂): ξ' = exp(−v̂)ξ + J_r(v)δv.
-                    let x = self.xi_at();
-                    let jr = crate::lie::so3::jacobian_right(&v)
-                        .unwrap_or_else(|_| Matrix3::from_element(f64::NAN));
-                    let xi = Vector3::from_column_slice(&dy[x..x + 3]);
-                    dy[x..x + 3].copy_from_slice((e * xi + jr * dv).as_slice());
+                // One exp(−v̂), J_l(−v), J_r(v) for every direction.
+                let t = tau * self.inv_ir;
+                let v = before.m * t;
+                let ex = crate::lie::so3::exp_unchecked(&-v);
+                let nan = |_| Matrix3::from_element(f64::NAN);
+                let jl = heavy.then(|| crate::lie::so3::jacobian_left(&-v).unwrap_or_else(nan));
+                let jr = self
+                    .lifted
+                    .then(|| crate::lie::so3::jacobian_right(&v).unwrap_or_else(nan));
+                let g1 = after.g.unwrap_or_else(Vector3::zeros);
+                for dy in dirs.chunks_exact_mut(e) {
+                    let dv = Vector3::new(dy[0], dy[1], dy[2]) * t;
+                    if let Some(jl) = &jl {
+                        let dg = Vector3::new(dy[3], dy[4], dy[5]);
+                        dy[3..6].copy_from_slice((ex * dg - (jl * dv).cross(&g1)).as_slice());
+                    }
+                    if let Some(jr) = &jr {
+                        // R' = R exp(v̂): ξ' = exp(−v̂)ξ + J_r(v)δv.
+                        let xi = Vector3::from_column_slice(&dy[x..x + 3]);
+                        dy[x..x + 3].copy_from_slice((ex * xi + jr * dv).as_slice());
+                    }
                 }
             }
             Flow::Kick => {
-                if let (Some(dg), Some(c)) = (dg, self.c) {
-                    ndm = dm + dg.cross(&c) * tau;
+                if let Some(c) = self.c {
+                    for dy in dirs.chunks_exact_mut(e) {
+                        let dm = Vector3::new(dy[3], dy[4], dy[5]).cross(&c) * tau;
+                        for q in 0..3 {
+                            dy[q] += dm[q];
+                        }
+                    }
                 }
             }
-        }
-        dy[..3].copy_from_slice(ndm.as_slice());
-        if let Some(g) = ndg {
-            dy[3..6].copy_from_slice(g.as_slice());
         }
     }
 
@@ -975,9 +983,9 @@ macro_rules! top_kinds {
                 tau: f64,
                 before: &Self::Work,
                 after: &Self::Work,
-                dz: &mut [f64],
+                dirs: &mut [f64],
             ) {
-                self.top.flow_tangent(i, tau, before, after, dz)
+                self.top.flow_tangent(i, tau, before, after, dirs)
             }
             fn flow_parameter(
                 &self,
