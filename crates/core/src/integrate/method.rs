@@ -178,7 +178,7 @@ pub trait Catalog: Problem + Clone + 'static {
     /// The tangent lift of the system ([`crate::integrate::tangent`]), whose runs carry the
     /// Jacobian of the discrete flow, where the system gives the derivatives it needs; by
     /// default none.
-    fn tangent(&self) -> Option<Arc<dyn crate::integrate::tangent::TangentSystem>> {
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
         None
     }
 
@@ -256,7 +256,7 @@ pub trait System: Problem {
     fn lift(&self) -> Option<Arc<dyn System>>;
 
     /// The tangent lift ([`Catalog::tangent`]).
-    fn tangent(&self) -> Option<Arc<dyn crate::integrate::tangent::TangentSystem>>;
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>>;
 
     /// The system's own dissipative term of kind `d` ([`Catalog::dissipation`]).
     fn dissipation(
@@ -267,6 +267,28 @@ pub trait System: Problem {
     /// The concrete system, for bindings that downcast to their own type (a binding keeps one
     /// `Arc<dyn System>` and reaches the typed system through it).
     fn as_any(&self) -> &dyn std::any::Any;
+}
+
+/// A lifted system as the driver and the bindings see it ([`crate::integrate::tangent`]): a
+/// [`System`] whose states carry the directions, with the conversions from and to the base
+/// problem's flat layout.
+pub trait TangentSystem: System {
+    /// The dimension d of the base state.
+    fn base_dim(&self) -> usize;
+
+    /// The dimension e of a direction (d less 6 per SO(3) block, left-trivialised).
+    fn tangent_dim(&self) -> usize;
+
+    /// The names of the parameters θ whose directions the lift carries.
+    fn parameter_names(&self) -> Vec<&'static str>;
+
+    /// The lifted state of a base state (user frame) with the identity as directions (and
+    /// ∂z₀/∂θ = 0).
+    fn seed(&self, z0: &[f64]) -> Result<Vec<f64>>;
+
+    /// The base state (d values), the Jacobian ∂z/∂z₀ (e×e row-major, column j = δz_j) and the
+    /// parameter Jacobian ∂z/∂θ (e×p row-major) of a lifted state.
+    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]);
 }
 
 /// The method names of a kind of system, without an instance ([`Catalog::kind_catalog`]); the
@@ -306,7 +328,7 @@ impl<P: Catalog> System for P {
         self.lifted().map(|s| Arc::new(s) as Arc<dyn System>)
     }
 
-    fn tangent(&self) -> Option<Arc<dyn crate::integrate::tangent::TangentSystem>> {
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
         Catalog::tangent(self)
     }
 

@@ -42,9 +42,10 @@
 
 use std::sync::Arc;
 
-use super::method::{Catalog, System};
+pub use super::method::TangentSystem;
+
+use super::method::Catalog;
 use super::problem::{Problem, Separable, Split, VectorField, Violation};
-use super::run::check_state;
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
 
@@ -54,7 +55,7 @@ pub trait SeparableTangent: Separable {
     /// dv = v′(p)·dp, the derivative of the velocity along dp.
     fn velocity_tangent(&self, p: &[f64], dp: &[f64], dv: &mut [f64]);
 
-    /// df = f′(q)·dq, the derivative of the force along dq (for f = −∂U/∂q, −D²U(q)[dq]).
+    /// df = f′(q)·dq, the derivative of the force along dq (for f = −∂U/∂q, −D²U(q)\[dq\]).
     fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], s: &mut Self::Scratch);
 
     /// df += ∂f/∂θ_m (q) for the problem's parameter m ([`Problem::parameters`]); NaN unless
@@ -126,27 +127,6 @@ pub struct Tangent<P> {
     /// The number of parameter directions (after the d state directions).
     np: usize,
     layout: Layout,
-}
-
-/// A lifted system as the driver and the bindings see it: a [`System`] whose states carry the
-/// directions, with the conversions from and to the base problem's flat layout.
-pub trait TangentSystem: System {
-    /// The dimension d of the base state.
-    fn base_dim(&self) -> usize;
-
-    /// The dimension e of a direction (d less 6 per SO(3) block, left-trivialised).
-    fn tangent_dim(&self) -> usize;
-
-    /// The names of the parameters θ whose directions the lift carries.
-    fn parameter_names(&self) -> Vec<&'static str>;
-
-    /// The lifted state of a base state (user frame) with the identity as directions (and
-    /// ∂z₀/∂θ = 0).
-    fn seed(&self, z0: &[f64]) -> Result<Vec<f64>>;
-
-    /// The base state (d values), the Jacobian ∂z/∂z₀ (e×e row-major, column j = δz_j) and the
-    /// parameter Jacobian ∂z/∂θ (e×p row-major) of a lifted state.
-    fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]);
 }
 
 impl<P: Problem + Clone> Tangent<P> {
@@ -271,9 +251,11 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.invariant_count()
     }
 
-    /// The base state checked as the base problem checks it.
+    /// The base state checked as the base problem checks it (its space, its constraints).
     fn check_state(&self, z: &[f64]) -> Result<()> {
-        check_state(&self.problem, &self.base(z))
+        let base = self.base(z);
+        self.problem.space().check("state", &base)?;
+        self.problem.check_state(&base)
     }
 
     fn to_internal(&self, z: &mut [f64]) {

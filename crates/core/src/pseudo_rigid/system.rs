@@ -378,7 +378,7 @@ impl Separable for PseudoRigidBody {
     }
 }
 
-/// The tangent lift ([`crate::integrate::tangent`]): v′ = identity, f′(X)[V] = −D²U(X)[V] (the
+/// The tangent lift ([`crate::integrate::tangent`]): v′ = identity, f′(X)\[V\] = −D²U(X)\[V\] (the
 /// potential's Hessian, analytic for every built-in potential).
 impl SeparableTangent for PseudoRigidBody {
     fn velocity_tangent(&self, _p: &[f64], dp: &[f64], dv: &mut [f64]) {
