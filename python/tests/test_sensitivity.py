@@ -122,7 +122,7 @@ def test_parameter_jacobians_of_the_tops_against_rebuilt_systems():
     ht = lf.HeavyTop([1.0, 2.0, 3.0], 0.7, chi=chi)
     assert ht.parameters == ["I1", "I2", "I3", "mgl", "chi1", "chi2", "chi3"]
     assert lf.RigidBody([1.0, 2.0, 3.0]).parameters == ["I1", "I2", "I3"]
-    assert body().parameters == []
+    assert body().parameters == ["lambda", "mu", "kappa", "gamma"]
     z0 = np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8])
     traj = lf.integrate(ht, z0, 0.05, 40, save_every=20, sensitivity=True)
     assert traj.parameter_jacobian.shape == (3, 6, 7)
@@ -220,3 +220,21 @@ def test_with_an_attitude_the_directions_are_left_trivialised():
     fd = column(end(M0, R0, np.array([1.0, 2.0, 3.0]) + e),
                 end(M0, R0, np.array([1.0, 2.0, 3.0]) - e), h)
     np.testing.assert_allclose(traj.final_parameter_jacobian[:, 0], fd, atol=1e-7)
+
+
+def test_parameter_jacobian_of_the_pseudo_rigid_body_along_its_potential_constants():
+    def build(t):
+        return lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(t[0], t[1])
+                                  + lf.potentials.Volumetric(t[2], t[3]))
+
+    theta = np.array([1.0, 2.0, 0.5, 1.4])
+    z0 = np.concatenate([X0.ravel(), P0.ravel()])
+    traj = lf.integrate(build(theta), z0, 0.05, 40, method="verlet4", sensitivity=True)
+    assert traj.parameter_jacobian.shape == (41, 18, 4)
+    h = 1e-6
+    for m in range(4):
+        e = np.zeros(4)
+        e[m] = h
+        fd = (lf.integrate(build(theta + e), z0, 0.05, 40, method="verlet4").final_state
+              - lf.integrate(build(theta - e), z0, 0.05, 40, method="verlet4").final_state) / (2 * h)
+        np.testing.assert_allclose(traj.final_parameter_jacobian[:, m], fd, atol=1e-7)

@@ -348,3 +348,59 @@ fn fixed_size_hessians_match_the_general_kernel() {
         }
     }
 }
+
+/// ∂(∂U/∂X)/∂θ of every built-in potential's constants against central differences of the
+/// gradient in the constant.
+#[test]
+fn parameter_gradients_match_differences_in_the_constants() {
+    use lieflow::pseudo_rigid::potential::{
+        Harmonic, SaintVenantKirchhoff, SelfGravity, Stretch, Volumetric,
+    };
+    type Make = Box<dyn Fn(&[f64]) -> Arc<dyn Potential>>;
+    let cases: Vec<(Vec<f64>, Make)> = vec![
+        (
+            vec![1.3],
+            Box::new(|t| Arc::new(Harmonic::new(t[0]).unwrap())),
+        ),
+        (
+            vec![0.7, 1.9],
+            Box::new(|t| Arc::new(SaintVenantKirchhoff::new(t[0], t[1]).unwrap())),
+        ),
+        (
+            vec![0.5, 1.4],
+            Box::new(|t| Arc::new(Volumetric::polytropic(t[0], t[1]).unwrap())),
+        ),
+        (
+            vec![0.8, 1.0 + 1e-4],
+            Box::new(|t| Arc::new(Volumetric::polytropic(t[0], t[1]).unwrap())),
+        ),
+        (
+            vec![1.1],
+            Box::new(|t| Arc::new(Stretch::new(t[0]).unwrap())),
+        ),
+        (
+            vec![1.2, 0.9],
+            Box::new(|t| Arc::new(SelfGravity::new(t[0], t[1]).unwrap())),
+        ),
+    ];
+    let mut rng = Rng(41);
+    for (theta, make) in cases {
+        let pot = make(&theta);
+        assert_eq!(pot.parameters().len(), theta.len(), "{pot:?}");
+        let x = gl_plus(&mut rng, 3);
+        let mut ws = lieflow::pseudo_rigid::potential::Workspace::new(3);
+        for m in 0..theta.len() {
+            let mut d = Mat::zeros(3, 3);
+            pot.add_parameter_gradient(x.as_ref(), m, d.as_mut(), &mut ws);
+            let h = 1e-6 * theta[m];
+            let g = |s: f64| {
+                let mut t = theta.clone();
+                t[m] += s;
+                potential::gradient(&*make(&t), &x).unwrap()
+            };
+            let fd = (g(h) - g(-h)) * faer::Scale(0.5 / h);
+            let err = (&fd - &d).norm_l2() / fd.norm_l2().max(1e-300);
+            assert!(err < 1e-7, "{pot:?} θ_{m}: {err:.2e}");
+        }
+    }
+}

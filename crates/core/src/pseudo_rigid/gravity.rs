@@ -436,6 +436,20 @@ fn mat3(x: MatRef<'_, f64>) -> Option<Matrix3<f64>> {
 
 impl Potential for SelfGravity {
     /// −4πGρ R_F(σ₁², σ₂², σ₃²); NaN where X is not 3×3 or the SVD fails.
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["G", "rho"]
+    }
+    /// U is linear in G and in ρ.
+    fn add_parameter_gradient(
+        &self,
+        x: MatRef<'_, f64>,
+        m: usize,
+        out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        let theta = if m == 0 { self.g } else { self.rho };
+        super::potential::add_gradient_over(self, theta, x, out, ws);
+    }
     fn value(&self, x: MatRef<'_, f64>, _ws: &mut Workspace) -> f64 {
         match mat3(x).as_ref().and_then(svd3) {
             Some(svd) => self.value3(&svd),

@@ -81,6 +81,28 @@ impl Workspace {
     }
 }
 
+/// out += ∂U/∂X / θ for a U linear in its constant θ ≠ 0 (so ∂(∂U/∂X)/∂θ = ∂U/∂X / θ), without
+/// a temporary: out ← (θ·out + ∂U/∂X)/θ.
+pub(crate) fn add_gradient_over(
+    pot: &dyn Potential,
+    theta: f64,
+    x: MatRef<'_, f64>,
+    mut out: MatMut<'_, f64>,
+    ws: &mut Workspace,
+) {
+    scale(out.as_mut(), theta);
+    pot.add_gradient(x, out.as_mut(), ws);
+    scale(out, 1.0 / theta);
+}
+
+fn scale(mut out: MatMut<'_, f64>, c: f64) {
+    for j in 0..out.ncols() {
+        for i in 0..out.nrows() {
+            out[(i, j)] *= c;
+        }
+    }
+}
+
 /// A potential energy U(X) on n×n matrices (001 §4.1), with its gradient ∂U/∂X and Hessian.
 ///
 /// Implementations are kernels for hot loops: they assume `x` is n×n with n = `ws.n()`, finite,
@@ -106,6 +128,24 @@ pub trait Potential: Send + Sync + Debug {
         out: MatMut<'_, f64>,
         ws: &mut Workspace,
     );
+
+    /// The names of U's constants θ (`Harmonic`: k; `SaintVenantKirchhoff`: lambda, mu;
+    /// `Volumetric`: kappa, gamma; …), the parameters of a body's sensitivities; none by
+    /// default (a Python callable).
+    fn parameters(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
+
+    /// Adds ∂(∂U/∂X)/∂θ_m, the derivative of the gradient along the constant m, to `out` (for
+    /// m < `parameters().len()`; nothing by default).
+    fn add_parameter_gradient(
+        &self,
+        _x: MatRef<'_, f64>,
+        _m: usize,
+        _out: MatMut<'_, f64>,
+        _ws: &mut Workspace,
+    ) {
+    }
 
     /// Whether U is defined only on GL⁺(n) (det X > 0). Integrators then always check det X.
     fn needs_positive_det(&self) -> bool {
@@ -333,6 +373,19 @@ impl Potential for Harmonic {
     fn hessian3(&self, _x: &Matrix3<f64>, v: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         Some(v * self.k)
     }
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["k"]
+    }
+    /// ∂(kX)/∂k = X.
+    fn add_parameter_gradient(
+        &self,
+        x: MatRef<'_, f64>,
+        _m: usize,
+        out: MatMut<'_, f64>,
+        _ws: &mut Workspace,
+    ) {
+        axpy(out, 1.0, x);
+    }
 }
 
 /// Isotropic Saint Venant–Kirchhoff elastic energy U = (λ/2)(tr E)² + μ tr(E²) with the
@@ -454,6 +507,27 @@ impl Potential for SaintVenantKirchhoff {
             ds[(i, i)] += self.lambda * dtr;
         }
         Some(v * st + x * ds)
+    }
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["lambda", "mu"]
+    }
+    /// ∂U/∂X = X S with S = λ tr(E) I + 2μE: ∂/∂λ = tr(E) X, ∂/∂μ = 2XE = X(C − I).
+    fn add_parameter_gradient(
+        &self,
+        x: MatRef<'_, f64>,
+        m: usize,
+        out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        let (tr, _) = Self::strain(x, ws);
+        if m == 0 {
+            axpy(out, tr, x);
+        } else {
+            // ws.tmp holds C = XᵀX: 2XE = XC − X.
+            let mut out = out;
+            mul(out.as_mut(), Accum::Add, x, ws.tmp.as_ref(), 1.0);
+            axpy(out, -1.0, x);
+        }
     }
 }
 
@@ -578,6 +652,28 @@ impl Potential for Volumetric {
         };
         Some((cof * v.transpose() * cof) * c - cof * (c * (1.0 - self.gamma) * cof.dot(v)))
     }
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["kappa", "gamma"]
+    }
+    /// ∂U/∂X = −κ det^{−γ} cof X: ∂/∂κ = −det^{−γ} cof X, ∂/∂γ = κ ln(det) det^{−γ} cof X.
+    fn add_parameter_gradient(
+        &self,
+        x: MatRef<'_, f64>,
+        m: usize,
+        out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        let mut cof = std::mem::replace(&mut ws.tmp, Mat::new());
+        let d = det_cofactor(x, cof.as_mut(), ws);
+        let p = if d > 0.0 {
+            d.powf(-self.gamma)
+        } else {
+            f64::NAN
+        };
+        let c = if m == 0 { -p } else { self.kappa * d.ln() * p };
+        axpy(out, c, cof.as_ref());
+        ws.tmp = cof;
+    }
     fn needs_positive_det(&self) -> bool {
         true
     }
@@ -687,6 +783,19 @@ impl Potential for Stretch {
         );
         mul(out, Accum::Add, ws.tmp.as_ref(), s.transpose(), -self.k);
     }
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["k"]
+    }
+    /// U is linear in k.
+    fn add_parameter_gradient(
+        &self,
+        x: MatRef<'_, f64>,
+        _m: usize,
+        out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        add_gradient_over(self, self.k, x, out, ws);
+    }
     fn gradient3(&self, x: &Matrix3<f64>) -> Option<Matrix3<f64>> {
         // The same R diag(k(σ − 1)) Sᵀ with nalgebra's 3×3 SVD (None, i.e. the general kernel,
         // if it does not converge).
@@ -747,6 +856,27 @@ impl Potential for Sum {
             h += t.hessian3(x, v)?;
         }
         Some(h)
+    }
+    /// The terms' constants in the order of the terms (a name repeats where two terms have
+    /// it).
+    fn parameters(&self) -> Vec<&'static str> {
+        self.terms.iter().flat_map(|t| t.parameters()).collect()
+    }
+    fn add_parameter_gradient(
+        &self,
+        x: MatRef<'_, f64>,
+        m: usize,
+        out: MatMut<'_, f64>,
+        ws: &mut Workspace,
+    ) {
+        let mut m = m;
+        for t in &self.terms {
+            let k = t.parameters().len();
+            if m < k {
+                return t.add_parameter_gradient(x, m, out, ws);
+            }
+            m -= k;
+        }
     }
     fn needs_positive_det(&self) -> bool {
         self.terms.iter().any(|t| t.needs_positive_det())

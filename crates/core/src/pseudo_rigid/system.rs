@@ -241,6 +241,10 @@ impl Problem for PseudoRigidBody {
     fn calls_out(&self) -> bool {
         self.body.potential().calls_out()
     }
+    /// The potential's constants ([`Potential::parameters`]).
+    fn parameters(&self) -> Vec<&'static str> {
+        self.body.potential().parameters()
+    }
     fn name(&self) -> &'static str {
         "PseudoRigidBody"
     }
@@ -406,6 +410,29 @@ impl SeparableTangent for PseudoRigidBody {
             &mut s.ws,
         );
         df.iter_mut().for_each(|v| *v = -*v);
+    }
+
+    fn force_parameter(&self, q: &[f64], m: usize, df: &mut [f64], s: &mut ForceScratch) {
+        self.add_force_parameter(q, m, df, s);
+    }
+}
+
+impl PseudoRigidBody {
+    /// d(force)/dθ_m = −∂(∂U/∂X)/∂θ_m added to `df` (the potential's constants).
+    fn add_force_parameter(&self, q: &[f64], m: usize, df: &mut [f64], s: &mut ForceScratch) {
+        let n = s.ws.n();
+        for v in df.iter_mut() {
+            *v = -*v;
+        }
+        self.body.potential().add_parameter_gradient(
+            MatRef::from_row_major_slice(q, n, n),
+            m,
+            MatMut::from_row_major_slice_mut(df, n, n),
+            &mut s.ws,
+        );
+        for v in df.iter_mut() {
+            *v = -*v;
+        }
     }
 }
 
