@@ -613,3 +613,53 @@ fn momentum_maps_of_symmetric_systems() {
         true,
     );
 }
+
+/// Issue 26: every (system, method) pair of the suite whose system has a tangent lift: the
+/// Jacobian a lifted run carries against central differences of the same method (on the state
+/// values; a case with an attitude only along its flat blocks, the rest is `tests/tangent.rs`),
+/// 20 steps of the case's dt. Lists the systems without a lift yet.
+#[test]
+fn jacobians_of_every_lifted_pair_are_the_methods_derivative() {
+    let mut without = vec![];
+    for c in cases() {
+        let Some(t) = c.system.tangent() else {
+            without.push(c.name);
+            continue;
+        };
+        let (d, e) = (t.base_dim(), t.tangent_dim());
+        let flat = if d == e { d } else { d - 9 }; // the blocks before an attitude
+        let steps = 20;
+        for (name, _) in t.methods() {
+            let seed = t.seed(&c.z0).unwrap();
+            let lifted = integrate(&*t, name, &seed, c.dt, steps, steps).unwrap();
+            let np = t.parameter_names().len();
+            let (mut z, mut jac, mut pj) = (vec![0.0; d], vec![0.0; e * e], vec![0.0; e * np]);
+            t.jacobian(lifted.state(1), &mut z, &mut jac, &mut pj);
+            let mut worst = 0.0f64;
+            for j in 0..flat {
+                // A heavy top carrying its attitude ties Γ to R: only M moves alone.
+                if d != e && (3..flat).contains(&j) {
+                    continue;
+                }
+                let h = 1e-6 * c.z0[j].abs().max(1.0);
+                let end = |s: f64| {
+                    let mut z = c.z0.clone();
+                    z[j] += s;
+                    integrate(&*c.system, name, &z, c.dt, steps, steps)
+                        .unwrap()
+                        .state(1)
+                        .to_vec()
+                };
+                let (p, q) = (end(h), end(-h));
+                let scale = jac.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                for i in 0..flat {
+                    let fd = (p[i] - q[i]) / (2.0 * h);
+                    worst = worst.max((jac[i * e + j] - fd).abs() / scale);
+                }
+            }
+            eprintln!("{}: {name}: Jacobian vs differences {worst:.1e}", c.name);
+            assert!(worst < 1e-7, "{} {name}: {worst:e}", c.name);
+        }
+    }
+    eprintln!("without a tangent lift yet: {without:?}");
+}
