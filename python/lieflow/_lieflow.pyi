@@ -510,9 +510,11 @@ class Separable(System):
     def __new__(
         cls, mass: ArrayLike, potential: Callable[[_F64], float],
         gradient: Callable[[_F64], ArrayLike] | None = None, dof: int | None = None,
+        hessian: Callable[[_F64, _F64], ArrayLike] | None = None,
     ) -> Self:
         """mass: a number (then dof is required), a vector (d,) or an SPD (d, d) matrix;
-        potential(q) -> float; gradient(q) -> (d,), or None for central differences."""
+        potential(q) -> float; gradient(q) -> (d,), or None for central differences;
+        hessian(q, v) -> D^2U(q)[v] (d,): exact Jacobians of the Verlet methods."""
     @property
     def dof(self) -> int: ...
     @property

@@ -238,3 +238,37 @@ def test_parameter_jacobian_of_the_pseudo_rigid_body_along_its_potential_constan
         fd = (lf.integrate(build(theta + e), z0, 0.05, 40, method="verlet4").final_state
               - lf.integrate(build(theta - e), z0, 0.05, 40, method="verlet4").final_state) / (2 * h)
         np.testing.assert_allclose(traj.final_parameter_jacobian[:, m], fd, atol=1e-7)
+
+
+def _quartic(q):
+    return 0.25 * float(np.sum(q**4)) + 0.5 * q[0] * q[1]
+
+
+def _quartic_gradient(q):
+    return q**3 + 0.5 * np.array([q[1], q[0]])
+
+
+def _quartic_hessian(q, v):
+    return 3 * q**2 * v + 0.5 * np.array([v[1], v[0]])
+
+
+def test_a_user_separable_system_with_its_hessian():
+    """lf.Separable with gradient and hessian callables: the Verlet methods' exact Jacobians
+    (vs differences, symplectic); without the hessian no lift."""
+    sys = lf.Separable([1.0, 2.0], _quartic, gradient=_quartic_gradient, hessian=_quartic_hessian)
+    assert sys.sensitivity_methods() == ["verlet", "verlet4", "verlet6"]
+    assert lf.Separable([1.0, 2.0], _quartic, gradient=_quartic_gradient).sensitivity_methods() == []
+    z0 = np.array([0.7, -0.4, 0.3, 0.5])
+    traj = lf.integrate(sys, z0, 0.05, 60, method="verlet4", sensitivity=True)
+    fd = differences(sys, z0, "verlet4", 0.05, 60)
+    np.testing.assert_allclose(traj.final_jacobian, fd, atol=1e-8 * np.abs(fd).max())
+    J = traj.final_jacobian
+    omega = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.eye(2), np.zeros((2, 2))]])
+    assert np.abs(J.T @ omega @ J - omega).max() < 1e-12 * max(1.0, np.abs(J).max()) ** 2
+
+    def failing(q, v):
+        raise ZeroDivisionError("hessian fails")
+
+    bad = lf.Separable([1.0, 2.0], _quartic, gradient=_quartic_gradient, hessian=failing)
+    with pytest.raises(ZeroDivisionError, match="hessian fails"):
+        lf.integrate(bad, z0, 0.05, 5, sensitivity=True)

@@ -354,6 +354,10 @@ def user_du(q):
     return np.asarray(q, float)
 
 
+def user_ddu(q, v):
+    return np.asarray(v, float)
+
+
 def user_lp_h(mu):
     return 0.5 * float(mu @ (mu / A3))
 
@@ -400,6 +404,9 @@ def user_specs(add):
         A("dof", 1, "int", kw=True, positive=True))
     add("Separable[matrix]", "Separable", A("mass", I_SPH2, "mat"),
         A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True))
+    add("Separable[hessian]", "Separable", A("mass", I_SPH2, "mat"),
+        A("potential", user_u, "obj"), A("gradient", user_du, "obj"),
+        A("dof", None, "obj", opt=True), A("hessian", user_ddu, "obj", kw=True, opt=True))
     add("LiePoisson", "LiePoisson", A("algebra", "so3", "str"), A("hamiltonian", user_lp_h, "obj"),
         A("gradient", user_lp_grad, "obj", opt=True),
         A("casimirs", [user_casimir], "obj", opt=True))

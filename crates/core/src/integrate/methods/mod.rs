@@ -60,6 +60,9 @@ macro_rules! canonical_system {
         );
     };
     ($t:ty, $catalog:expr) => {
+        $crate::integrate::methods::canonical_system!($t, $catalog, |_: &$t| None);
+    };
+    ($t:ty, $catalog:expr, $tangent:expr) => {
         impl $crate::integrate::problem::VectorField for $t {
             /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
             fn field(&self, z: &[f64], dz: &mut [f64]) {
@@ -77,6 +80,12 @@ macro_rules! canonical_system {
                 d: &$crate::integrate::forcing::Dissipation,
             ) -> $crate::Result<std::sync::Arc<dyn $crate::integrate::forcing::Perturbation>> {
                 $crate::integrate::forcing::rayleigh(self, d)
+            }
+
+            fn tangent(
+                &self,
+            ) -> Option<std::sync::Arc<dyn $crate::integrate::method::TangentSystem>> {
+                ($tangent)(self)
             }
         }
     };

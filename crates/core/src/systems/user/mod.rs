@@ -95,7 +95,7 @@ pub use euler_poincare::{
     Action, EulerPoincare, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn, Legendre,
 };
 pub use lie_poisson::{LieHamiltonian, LiePoisson, LieScratch};
-pub use separable::{KineticMass, UserSeparable};
+pub use separable::{HessianProductFn, KineticMass, UserSeparable};
 
 /// H(q, p) of a [`UserCanonical`].
 pub type CanonicalFn = Arc<dyn Fn(&[f64], &[f64]) -> Result<f64> + Send + Sync>;

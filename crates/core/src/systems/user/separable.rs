@@ -8,6 +8,7 @@ use crate::integrate::hooks;
 use crate::integrate::methods::{canonical_catalog, Verlet};
 use crate::integrate::problem::{Canonical, Separable, Violation};
 use crate::integrate::space::Space;
+use crate::integrate::tangent::{SeparableTangent, Tangent};
 use crate::integrate::Problem;
 use crate::Mat;
 
@@ -77,7 +78,12 @@ pub struct UserSeparable {
     inverse: Arc<InverseMass>,
     u: ScalarFn,
     gradient: Option<GradientFn>,
+    /// D²U(q)\[v\], for the tangent lift (sensitivities); none: no lift.
+    hessian: Option<HessianProductFn>,
 }
+
+/// The Hessian product of a potential: (q, v, D²U(q)\[v\] out).
+pub type HessianProductFn = Arc<dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<()> + Send + Sync>;
 
 impl fmt::Debug for UserSeparable {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -85,6 +91,7 @@ impl fmt::Debug for UserSeparable {
             .field("dof", &self.dof)
             .field("inverse_mass", &self.inverse)
             .field("gradient", &self.gradient.is_some())
+            .field("hessian", &self.hessian.is_some())
             .finish()
     }
 }
@@ -149,12 +156,20 @@ impl UserSeparable {
             inverse: Arc::new(inverse),
             u,
             gradient,
+            hessian: None,
         })
     }
 
     /// Whether ∇U is computed by finite differences.
     pub fn finite_differences(&self) -> bool {
         self.gradient.is_none()
+    }
+
+    /// The same system with the Hessian product D²U(q)\[v\] (with an exact gradient, it makes
+    /// its Verlet methods' Jacobians exact: the tangent lift, [`crate::integrate::tangent`]).
+    pub fn with_hessian(mut self, hessian: HessianProductFn) -> Self {
+        self.hessian = Some(hessian);
+        self
     }
 
     /// U(q), checked finite.
@@ -280,6 +295,32 @@ impl Separable for UserSeparable {
     }
 }
 
+/// v′ = M⁻¹ (linear), f′(q)\[dq\] = −D²U(q)\[dq\] from the Hessian callable (a failure recorded
+/// as for the force; NaN).
+impl SeparableTangent for UserSeparable {
+    fn velocity_tangent(&self, _p: &[f64], dp: &[f64], dv: &mut [f64]) {
+        self.inverse.apply(dp, dv);
+    }
+
+    fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], _s: &mut ()) {
+        let ok = match &self.hessian {
+            Some(h) => hooks::call(|| h(q, dq, df)),
+            None => false,
+        };
+        if ok {
+            df.iter_mut().for_each(|x| *x = -*x);
+        } else {
+            df.fill(f64::NAN);
+        }
+    }
+}
+
+impl crate::integrate::Catalog for Tangent<UserSeparable> {
+    fn kind_catalog() -> Vec<crate::integrate::Entry<Self>> {
+        Verlet::family()
+    }
+}
+
 impl Canonical for UserSeparable {
     fn dof(&self) -> usize {
         self.dof
@@ -298,8 +339,14 @@ impl Canonical for UserSeparable {
 }
 
 // verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
-crate::integrate::methods::canonical_system!(UserSeparable, {
-    let mut entries = Verlet::family();
-    entries.extend(canonical_catalog());
-    entries
-});
+// The tangent lift (Verlet) where a gradient and a Hessian are given.
+crate::integrate::methods::canonical_system!(
+    UserSeparable,
+    {
+        let mut entries = Verlet::family();
+        entries.extend(canonical_catalog());
+        entries
+    },
+    |s: &UserSeparable| (s.hessian.is_some() && s.gradient.is_some())
+        .then(|| Tangent::separable(s.clone()).into_system())
+);

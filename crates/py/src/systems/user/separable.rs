@@ -47,6 +47,9 @@ fn kinetic_mass(m: &Any<'_>) -> PyResult<KineticMass> {
 ///     potential: callable q -> U(q), q a float64 array (d,).
 ///     gradient: callable q -> grad U (d,), or None for central differences (see `Canonical`).
 ///     dof: the number of degrees of freedom (needed for a scalar mass; must agree otherwise).
+///     hessian: callable (q, v) -> the Hessian product D^2 U(q)[v] (d,), or None. With it (and
+///         `gradient`) `lieflow.integrate(..., sensitivity=True)` gives the exact Jacobians of the
+///         Verlet methods (`sensitivity_methods()`).
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError (a mass that is not positive definite),
 ///     ShapeError (a mass of the wrong shape, a dof that disagrees).
@@ -60,12 +63,13 @@ pub struct PySeparable;
 #[pymethods]
 impl PySeparable {
     #[new]
-    #[pyo3(signature = (mass, potential, gradient=None, dof=None))]
+    #[pyo3(signature = (mass, potential, gradient=None, dof=None, hessian=None))]
     fn new(
         mass: Any<'_>,
         potential: Any<'_>,
         gradient: Option<Any<'_>>,
         dof: Option<Any<'_>>,
+        hessian: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = potential.py();
         let kinetic = self::kinetic_mass(&mass)?;
@@ -89,9 +93,17 @@ impl PySeparable {
         let grad_fn: Option<GradientFn> = g.map(|g| {
             Arc::new(move |q: &[f64], out: &mut [f64]| g.call(&[q], &[q.len()], out)) as GradientFn
         });
-        let sys = UserSeparable::new(kinetic, d, value, grad_fn).py()?;
-        let args = (mass, potential, gradient, dof).into_pyobject(py)?;
-        let names = &["mass", "potential", "gradient", "dof"];
+        let h = optional(hessian.as_ref())
+            .map(|h| Callee::new("hessian", h))
+            .transpose()?;
+        let mut sys = UserSeparable::new(kinetic, d, value, grad_fn).py()?;
+        if let Some(h) = h {
+            sys = sys.with_hessian(Arc::new(move |q: &[f64], v: &[f64], out: &mut [f64]| {
+                h.call(&[q, v], &[q.len()], out)
+            }));
+        }
+        let args = (mass, potential, gradient, dof, hessian).into_pyobject(py)?;
+        let names = &["mass", "potential", "gradient", "dof", "hessian"];
         Ok(PySystem::subclass(sys, args, names))
     }
 
