@@ -405,7 +405,7 @@ def user_specs(add):
     add("Separable[matrix]", "Separable", A("mass", I_SPH2, "mat"),
         A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True))
     add("Separable[hessian]", "Separable", A("mass", I_SPH2, "mat"),
-        A("potential", user_u, "obj"), A("gradient", user_du, "obj"),
+        A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True),
         A("dof", None, "obj", opt=True), A("hessian", user_ddu, "obj", kw=True, opt=True))
     add("LiePoisson", "LiePoisson", A("algebra", "so3", "str"), A("hamiltonian", user_lp_h, "obj"),
         A("gradient", user_lp_grad, "obj", opt=True),
