@@ -27,6 +27,7 @@ import numpy as np
 
 from ._lieflow import (InvalidArgumentError, NonFiniteError, ShapeError, System,
                        UnsupportedMethodError)
+from ._arrays import real_array
 from .trajectory import Trajectory, load
 
 __all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
@@ -153,21 +154,7 @@ def _time(name, value):
 def _times(t_eval):
     """t_eval as a 1-D float64 array of finite times (TypeError for anything but real numbers,
     ShapeError unless 1-D and non-empty); the native run checks their order and range."""
-    expected = "invalid t_eval: expected a 1-D array-like of real numbers (bool, int or float)"
-    if isinstance(t_eval, (str, bytes)):
-        raise TypeError(f"{expected}, got a {type(t_eval).__name__}")
-    try:
-        a = np.asarray(t_eval)
-    except (ValueError, TypeError) as e:
-        raise TypeError(f"{expected}, got a {type(t_eval).__name__} that numpy cannot read as "
-                        f"an array: {e}") from None
-    if a.dtype.kind == "O":
-        try:
-            a = a.astype(np.float64)
-        except (ValueError, TypeError):
-            raise TypeError(f"{expected}, got an object array") from None
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"{expected}, got a {type(t_eval).__name__} (numpy dtype {a.dtype})")
+    a = real_array("t_eval", t_eval)
     if a.ndim != 1 or a.size == 0:
         raise ShapeError(f"t_eval has the wrong shape: expected (k,) with k >= 1, got {a.shape}")
     a = np.ascontiguousarray(a, dtype=np.float64)
@@ -396,30 +383,48 @@ def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, p
             f"available for {lifted.methods()} (method=...)")
     z0, batched = system._normalize_state(state0)
     d = z0.shape[1]
+    a = None
     if with_attitude:
-        a = np.asarray(attitude, dtype=float)
+        a = real_array("attitude", attitude)
         if a.ndim == 2:
             a = np.broadcast_to(a, (z0.shape[0],) + a.shape)
-        if a.shape[0] != z0.shape[0] or a.shape[1:] != (3, 3):
+        if a.ndim != 3 or a.shape[0] != z0.shape[0] or a.shape[1:] != (3, 3):
             raise ShapeError(f"attitude has the wrong shape: expected (3, 3) or "
                              f"({z0.shape[0]}, 3, 3), got {np.shape(attitude)}")
+        a = a.astype(np.float64)
         z0 = np.concatenate([z0, a.reshape(z0.shape[0], 9)], axis=1)
     seeds = layout.seed(z0 if batched else z0[0])
-    traj = integrate(lifted, seeds, dt, steps, method, save_every, None, progress, chunk_steps,
-                     threads, t0=t0, t_eval=t_eval)
+    try:
+        traj = integrate(lifted, seeds, dt, steps, method, save_every, None, progress,
+                         chunk_steps, threads, t0=t0, t_eval=t_eval)
+    except BaseException as e:
+        # The partial trajectory of the lifted run, in the system's own terms.
+        partial = getattr(e, "partial", None)
+        if partial is not None:
+            try:
+                e.partial = _split_lifted(system, partial, layout, d, a, batched)
+            except Exception:     # never hide the original error behind one of the partial's
+                pass
+        raise
+    return _split_lifted(system, traj, layout, d, a, batched)
+
+
+def _split_lifted(system, traj, layout, d, attitude0, batched):
+    """The Trajectory of ``system`` (states, attitudes, Jacobians) from one of its tangent lift
+    (``d``: the system's state size; ``attitude0``: (b, 3, 3) when the run carries one)."""
     states, jac, pjac = layout.split(traj.states)
     final, final_jac, final_pjac = layout.split(traj.final_state)
+    z0 = layout.split(traj.initial_state)[0][..., :d]
     att = final_att = att0 = None
-    if with_attitude:
+    if attitude0 is not None:
         att = states[..., d:].reshape(states.shape[:-1] + (3, 3))
         final_att = final[..., d:].reshape(final.shape[:-1] + (3, 3))
-        att0 = a if batched else a[0]
+        att0 = attitude0 if batched else attitude0[0]
         states, final = states[..., :d], final[..., :d]
-        z0 = z0[:, :d]
     return Trajectory(system, traj.method, traj.t, states, att, final, final_att, traj.dt,
                       traj.save_every, t_final=traj.t_final, status=traj.status, t0=traj.t0,
-                      initial_state=z0 if batched else z0[0], initial_attitude=att0,
-                      jacobian=jac, final_jacobian=final_jac, parameter_jacobian=pjac,
+                      initial_state=z0, initial_attitude=att0, jacobian=jac,
+                      final_jacobian=final_jac, parameter_jacobian=pjac,
                       final_parameter_jacobian=final_pjac)
 
 

@@ -3,6 +3,7 @@ views and observables of the system) and ``load``, which reads one back from a f
 
 import numpy as np
 
+from ._arrays import real_array
 from ._lieflow import InvalidArgumentError
 
 __all__ = ["Trajectory", "load"]
@@ -88,16 +89,10 @@ class Trajectory:
             raise InvalidArgumentError("invalid vjp: this trajectory carries no Jacobians; "
                                        "integrate with sensitivity=True")
         from ._lieflow import NonFiniteError, ShapeError
-        expected = "invalid cotangent: expected an array-like of real numbers (bool, int or float)"
-        if isinstance(cotangent, (str, bytes)):
-            raise TypeError(f"{expected}, got a {type(cotangent).__name__}")
-        try:
-            c = np.asarray(cotangent)
-        except (ValueError, TypeError) as e:
-            raise TypeError(f"{expected}, got a {type(cotangent).__name__} that numpy cannot "
-                            f"read as an array: {e}") from None
-        if c.dtype.kind not in "biuf":
-            raise TypeError(f"{expected}, got numpy dtype {c.dtype}")
+        c = real_array("cotangent", cotangent)
+        if c.size > self.jacobian.size:
+            raise ShapeError(f"invalid cotangent: expected shape {self.final_jacobian.shape[:-1]} "
+                             f"or {self.jacobian.shape[:-1]}, got {c.shape}")
         c = c.astype(np.float64)
         if not np.all(np.isfinite(c)):
             raise NonFiniteError("invalid cotangent: it contains a non-finite value (NaN or inf)")

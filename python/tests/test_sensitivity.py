@@ -272,3 +272,28 @@ def test_a_user_separable_system_with_its_hessian():
     bad = lf.Separable([1.0, 2.0], _quartic, gradient=_quartic_gradient, hessian=failing)
     with pytest.raises(ZeroDivisionError, match="hessian fails"):
         lf.integrate(bad, z0, 0.05, 5, sensitivity=True)
+
+
+def test_an_exception_mid_run_leaves_a_partial_in_the_systems_terms():
+    """A callable raising at the 4th step: err.partial is the system's trajectory (its own
+    states, attitudes none, Jacobians) up to the last good step, not the lift's layout; a
+    string attitude is a TypeError."""
+    calls = {"n": 0}
+
+    def hessian(q, v):
+        calls["n"] += 1
+        if calls["n"] > 40:
+            raise ZeroDivisionError("hessian fails late")
+        return _quartic_hessian(q, v)
+
+    sys = lf.Separable([1.0, 2.0], _quartic, gradient=_quartic_gradient, hessian=hessian)
+    z0 = np.array([0.7, -0.4, 0.3, 0.5])
+    with pytest.raises(ZeroDivisionError) as info:
+        lf.integrate(sys, z0, 0.05, 50, sensitivity=True)
+    p = info.value.partial
+    assert p.states.shape[1] == 4 and p.jacobian.shape[1:] == (4, 4)
+    np.testing.assert_array_equal(p.initial_state, z0)
+    np.testing.assert_array_equal(p.jacobian[0], np.eye(4))
+    with pytest.raises(TypeError, match="attitude"):
+        lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), [0.3, -0.8, 1.1], 0.1, 10,
+                     attitude="R", sensitivity=True)

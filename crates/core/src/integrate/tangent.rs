@@ -212,17 +212,9 @@ impl<P: SeparableTangent + Clone> Tangent<P> {
     }
 }
 
-impl<P: VectorFieldTangent + Clone> Tangent<P> {
-    /// The lift of a vector field (its Runge–Kutta methods; flat blocks only, e = d: a
-    /// Runge–Kutta step on a curved block is differentiated in its ambient coordinates, which
-    /// a left-trivialised direction is not).
-    pub fn field(problem: P) -> Self {
-        Tangent::with(problem, Layout::Field)
-    }
-}
-
 impl<P: SplitTangent + Clone> Tangent<P> {
-    /// The lift of a split problem (its splittings): (z, δz₁, …, δz_k), the directions
+    /// The lift of a split problem (its splittings; and its Runge–Kutta methods where it is a
+    /// [`VectorFieldTangent`] without SO(3) blocks): (z, δz₁, …, δz_k), the directions
     /// left-trivialised on SO(3) blocks.
     pub fn split(problem: P) -> Self {
         Tangent::with(problem, Layout::Field)
@@ -336,9 +328,15 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
 
 /// (f(z), f′(z)δz_j).
 impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
-    /// (e = d here: [`Tangent::field`].)
+    /// Only where e = d (no SO(3) block): a Runge–Kutta step on a curved block is differentiated
+    /// in its ambient coordinates, which a left-trivialised direction is not; a lift with one
+    /// gets NaN here (its catalog offers no Runge–Kutta method).
     fn field(&self, z: &[f64], dz: &mut [f64]) {
         let d = self.d;
+        if self.e != d {
+            dz.fill(f64::NAN);
+            return;
+        }
         let (f0, df) = dz.split_at_mut(d);
         self.problem.field(&z[..d], f0);
         for (j, (dzj, dfj)) in z[d..]
