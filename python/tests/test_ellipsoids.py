@@ -78,6 +78,11 @@ def test_continuation_diagram():
     assert bp.e == pytest.approx(E.maclaurin_jacobi_bifurcation().e, abs=1e-10)
     lost = [s for s in mac.special_points if s.kind == "stability" and s.verdict == "spectral"]
     assert len(lost) == 1 and lost[0].e == pytest.approx(0.95289, abs=5e-6)
+    # The energy-momentum verdict is lost at the bifurcation itself, located with the exact
+    # Hessian to 1e-11 (by nested differences it was 7e-9).
+    em = [s for s in mac.special_points if s.kind == "stability" and s.verdict == "energy_momentum"]
+    assert len(em) == 1 and em[0].e == pytest.approx(bp.e, abs=1e-11)
+    assert em[0].e == pytest.approx(E.maclaurin_jacobi_bifurcation().e, abs=1e-11)
     assert mac.stability[0] and not mac.stability[-1]
     jac = mac.switch(bp, parameter="a2_over_a1", stop=0.5, )
     assert jac.end == "reached"

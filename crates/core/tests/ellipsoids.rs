@@ -223,6 +223,16 @@ fn continuation_maclaurin_to_jacobi() {
     assert_eq!(lost.len(), 1, "{:?}", b.special);
     let e_lost = lost[0].point.parameter;
     assert!((e_lost - 0.95289).abs() < 5e-6, "{e_lost}");
+    // The energy–momentum verdict changes at the bifurcation (secular instability): with the
+    // exact Hessian (issue 26) located to 1e-11 (it was 7e-9 by nested differences).
+    let em: Vec<_> = b
+        .special
+        .iter()
+        .filter(|s| s.kind == Kind::Stability && s.verdict == Some(1))
+        .collect();
+    assert_eq!(em.len(), 1, "{:?}", b.special);
+    let e_em = em[0].point.parameter;
+    assert!((e_em - bif.e).abs() < 1e-11, "{e_em} vs {}", bif.e);
     // Switch onto the Jacobi branch and follow it to a₂/a₁ = 0.3.
     let dir = family
         .switch_direction(&branch[0].point, ellipsoids::Sense::Splitting)

@@ -313,7 +313,9 @@ pub trait GroupField: Problem {
 }
 
 /// A system with a symmetry: a momentum map J: state → g* and the infinitesimal generators of
-/// the action (the data relative equilibria and their stability need).
+/// the action (the data relative equilibria and their stability need). For a canonical
+/// system the action is a cotangent lift and J its momentum map: ⟨J, ξ⟩ generates ξ_Z, i.e.
+/// ∇⟨J, ξ⟩ = (−ξ_Z^p, ξ_Z^q) (what [`crate::analysis::comoving`] relies on).
 pub trait Symmetric: Problem {
     /// dim g.
     fn symmetry_dim(&self) -> usize;
