@@ -448,3 +448,92 @@ fn parameter_jacobian_of_the_pseudo_rigid_body() {
     eprintln!("PseudoRigidBody verlet4: parameter Jacobian vs differences {worst:.2e}");
     assert!(worst < 1e-7, "{worst:e}");
 }
+
+/// Hénon–Heiles, U = (x² + y²)/2 + x²y − y³/3, as a user system with its Hessian.
+fn henon_heiles() -> lieflow::systems::UserSeparable {
+    use lieflow::systems::{KineticMass, UserSeparable};
+    let u = Arc::new(|q: &[f64]| -> lieflow::Result<f64> {
+        let (x, y) = (q[0], q[1]);
+        Ok(0.5 * (x * x + y * y) + x * x * y - y * y * y / 3.0)
+    });
+    let g = Arc::new(|q: &[f64], g: &mut [f64]| -> lieflow::Result<()> {
+        let (x, y) = (q[0], q[1]);
+        g[0] = x + 2.0 * x * y;
+        g[1] = y + x * x - y * y;
+        Ok(())
+    });
+    let h = Arc::new(
+        |q: &[f64], v: &[f64], out: &mut [f64]| -> lieflow::Result<()> {
+            let (x, y) = (q[0], q[1]);
+            out[0] = (1.0 + 2.0 * y) * v[0] + 2.0 * x * v[1];
+            out[1] = 2.0 * x * v[0] + (1.0 - 2.0 * y) * v[1];
+            Ok(())
+        },
+    );
+    UserSeparable::new(KineticMass::Scalar(1.0), Some(2), u, Some(g))
+        .unwrap()
+        .with_hessian(h)
+}
+
+/// |JᵀΩJ − Ω|_max for the canonical Ω of d/2 degrees of freedom.
+fn symplecticity_defect(jac: &[f64], d: usize) -> f64 {
+    let n = d / 2;
+    let omega = |i: usize, j: usize| {
+        if i < n && j == i + n {
+            1.0
+        } else if i >= n && i == j + n {
+            -1.0
+        } else {
+            0.0
+        }
+    };
+    let mut worst = 0.0f64;
+    for a in 0..d {
+        for c in 0..d {
+            let mut s = 0.0;
+            for i in 0..d {
+                for k in 0..d {
+                    s += jac[i * d + a] * omega(i, k) * jac[k * d + c];
+                }
+            }
+            worst = worst.max((s - omega(a, c)).abs());
+        }
+    }
+    worst
+}
+
+/// Issue 26: the implicit Gauss methods differentiate themselves through the implicit-function
+/// theorem (the lifted Newton matrix factored on the base block only) — against differences of
+/// the same method, symplectic to round-off (RK4, not symplectic, visibly is not); the Verlet
+/// methods of the same lift (separable layout) too.
+#[test]
+fn gauss_and_verlet_jacobians_of_a_user_system_are_symplectic() {
+    let sys = henon_heiles();
+    let t = sys.tangent().expect("gradient and Hessian given");
+    let z0 = [0.3, -0.2, 0.25, 0.31];
+    let (dt, steps) = (0.1, 100);
+    let names: Vec<_> = t.methods().into_iter().map(|(n, _)| n).collect();
+    assert_eq!(
+        names,
+        sys.methods()
+            .into_iter()
+            .map(|(n, _)| n)
+            .collect::<Vec<_>>()
+    );
+    for method in names {
+        let (z, jac) = lifted_end(&*t, method, &z0, dt, steps);
+        let plain = integrate(&sys, method, &z0, dt, steps, steps).unwrap();
+        let moved = max_rel(&z, plain.state(1));
+        assert!(moved < 1e-14, "{method}: the base state moved by {moved:e}");
+        let fd = differences(&sys, method, &z0, dt, steps, 1e-5);
+        let err = max_rel(&jac, &fd);
+        let defect = symplecticity_defect(&jac, 4);
+        eprintln!("{method}: vs differences {err:.1e}, |JᵀΩJ − Ω| {defect:.1e}");
+        assert!(err < 1e-8, "{method}: {err:e}");
+        if method == "rk4" {
+            assert!(defect > 1e-8, "rk4 is not symplectic: {defect:e}");
+        } else {
+            assert!(defect < 1e-12, "{method}: {defect:e}");
+        }
+    }
+}

@@ -87,6 +87,21 @@ pub trait Problem: Send + Sync {
 pub trait VectorField: Problem {
     /// Evaluates f(z) into `dz`.
     fn field(&self, z: &[f64], dz: &mut [f64]);
+
+    /// The number of equal diagonal blocks of f′ when it is block lower-triangular: a tangent
+    /// lift ([`crate::integrate::tangent`]) has 1 + k, the base field's Jacobian on each (its
+    /// directions enter the base field's equations linearly). An implicit method then factors
+    /// one block and solves each block with it (the implicit-function theorem's matrix). 1 by
+    /// default.
+    fn diagonal_blocks(&self) -> usize {
+        1
+    }
+
+    /// The index in the state of component i of diagonal block b ([`Self::diagonal_blocks`];
+    /// block 0 is the base state).
+    fn block_index(&self, _b: usize, i: usize) -> usize {
+        i
+    }
 }
 
 /// A Hamiltonian H = H₀ + … + H_{m−1} whose pieces have exact flows φ_i (Lie–Poisson splittings,

@@ -19,8 +19,11 @@
 //! So one lift per problem kind serves every method of that kind (no tangent twin of a method),
 //! and a system opts in by giving the directional derivatives of its kind's primitives
 //! ([`SeparableTangent`]: its force, from the potential's Hessian; [`VectorFieldTangent`]: its
-//! field; [`SplitTangent`]: its flows' tangent maps). The implicit methods' iterations converge on the lifted unknowns as on the plain ones
-//! (the lifted Newton matrix is block-triangular with the plain one on its diagonal). With k
+//! field; [`SplitTangent`]: its flows' tangent maps). The implicit methods' iterations converge
+//! on the lifted unknowns as on the plain ones: the lifted Jacobian is block lower-triangular
+//! with the plain one on its diagonal ([`VectorField::diagonal_blocks`]), so Gauss factors the
+//! plain Newton matrix once per step and solves every direction with it (the
+//! implicit-function theorem). With k
 //! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + k) plain
 //! runs.
 //!
@@ -106,6 +109,21 @@ pub trait VectorFieldTangent: VectorField {
     fn field_parameter(&self, _z: &[f64], _m: usize, out: &mut [f64]) {
         out.fill(f64::NAN);
     }
+}
+
+/// f′(z)dz = (v′(p)dp, f′(q)dq) of a separable problem's Hamilton field, from its
+/// [`SeparableTangent`] derivatives: the [`VectorFieldTangent`] of a separable system.
+pub fn separable_field_tangent<P: SeparableTangent>(
+    problem: &P,
+    z: &[f64],
+    dz: &[f64],
+    out: &mut [f64],
+    s: &mut P::Scratch,
+) {
+    let d = problem.dof();
+    let (ov, of) = out.split_at_mut(d);
+    problem.velocity_tangent(&z[d..], &dz[d..], ov);
+    problem.force_tangent(&z[..d], &dz[..d], of, s);
 }
 
 /// Where the lift keeps its directions.
@@ -326,7 +344,8 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
     }
 }
 
-/// (f(z), f′(z)δz_j).
+/// (f(z), f′(z)δz_j), in either layout (a separable problem's lift serves its Verlet methods
+/// and its Runge–Kutta and Gauss methods with one layout).
 impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
     /// Only where e = d (no SO(3) block): a Runge–Kutta step on a curved block is differentiated
     /// in its ambient coordinates, which a left-trivialised direction is not; a lift with one
@@ -337,17 +356,58 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
             dz.fill(f64::NAN);
             return;
         }
-        let (f0, df) = dz.split_at_mut(d);
-        self.problem.field(&z[..d], f0);
-        for (j, (dzj, dfj)) in z[d..]
-            .chunks_exact(d)
-            .zip(df.chunks_exact_mut(d))
-            .enumerate()
-        {
-            self.problem.field_tangent(&z[..d], dzj, dfj);
-            if j >= d {
-                self.problem.field_parameter(&z[..d], j - d, dfj);
+        if self.layout == Layout::Field {
+            let (f0, df) = dz.split_at_mut(d);
+            self.problem.field(&z[..d], f0);
+            for (j, (dzj, dfj)) in z[d..]
+                .chunks_exact(d)
+                .zip(df.chunks_exact_mut(d))
+                .enumerate()
+            {
+                self.problem.field_tangent(&z[..d], dzj, dfj);
+                if j >= d {
+                    self.problem.field_parameter(&z[..d], j - d, dfj);
+                }
             }
+            return;
+        }
+        // Separable layout: each block gathered into this thread's buffers (allocated once).
+        thread_local! {
+            static BUFFERS: std::cell::RefCell<[Vec<f64>; 3]> = Default::default();
+        }
+        BUFFERS.with_borrow_mut(|[base, dir, out]| {
+            for v in [&mut *base, &mut *dir, &mut *out] {
+                v.resize(d, 0.0);
+            }
+            self.gather(z, 0, base);
+            self.problem.field(base, out);
+            self.scatter(out, 0, dz);
+            for j in 1..=self.k() {
+                self.gather(z, j, dir);
+                self.problem.field_tangent(base, dir, out);
+                if j > d {
+                    self.problem.field_parameter(base, j - 1 - d, out);
+                }
+                self.scatter(out, j, dz);
+            }
+        });
+    }
+
+    /// The state and its k directions: f′ is block lower-triangular with f′(z) on each diagonal
+    /// block (an implicit method factors it once).
+    fn diagonal_blocks(&self) -> usize {
+        if self.e == self.d {
+            self.k() + 1
+        } else {
+            1
+        }
+    }
+
+    fn block_index(&self, b: usize, i: usize) -> usize {
+        if self.e == self.d {
+            self.at(b, i)
+        } else {
+            i
         }
     }
 }

@@ -1,5 +1,5 @@
-//! `Gauss(s)`: the s-stage Gauss–Legendre collocation method for a [`Canonical`] Hamiltonian
-//! system ż = (∂H/∂p, −∂H/∂q), of order 2s (Hairer, Lubich & Wanner, *Geometric Numerical
+//! `Gauss(s)`: the s-stage Gauss–Legendre collocation method for a [`VectorField`] — a
+//! Hamiltonian system ż = (∂H/∂p, −∂H/∂q) in the catalogs (symplectic there) — of order 2s (Hairer, Lubich & Wanner, *Geometric Numerical
 //! Integration*, 2nd ed., §II.1.3 for the coefficients; §VI.4 for symplecticity, §V.2 for
 //! symmetry, §IV.2 for quadratic invariants). `Gauss(1)` is the implicit midpoint rule
 //! ([`IMPLICIT_MIDPOINT`]).
@@ -11,8 +11,8 @@
 //! symmetric (a_ij + a_{s+1−i, s+1−j} = b_j), so time-reversible for reversible problems.
 //!
 //! **The implicit solve** (HLW §VIII.6, simplified Newton): with J ≈ f'(y), by forward
-//! differences of [`Canonical::gradient`] at the start of each step, the s·d̂ × s·d̂ matrix
-//! I − h A⊗J (d̂ = 2·dof) is LU-factored once per step (faer, partial pivoting, storage allocated
+//! differences of the field at the start of each step, the s·d̂ × s·d̂ matrix
+//! I − h A⊗J (d̂ the state's dimension) is LU-factored once per step (faer, partial pivoting, storage allocated
 //! with the stepper), and
 //! (I − h A⊗J) ΔZ = −Z + h (A⊗I) F(Z),  Z ← Z + ΔZ
 //! is iterated from Z_i = h c_i f(y) under the rule of [`crate::convergence`] ([`RULE`]: ‖ΔZ‖_∞
@@ -34,13 +34,21 @@
 //! effect of √ε s_j on f is lost in the rounding of f (a component at round-off level while f is
 //! not), the step is √ε‖y‖_∞ again.
 //!
+//! **Tangent lifts** ([`VectorField::diagonal_blocks`]): for a field whose Jacobian is block
+//! lower-triangular with 1 + k equal diagonal blocks (the lift (z, δz₁…δz_k) of
+//! [`crate::integrate::tangent`]), J is the base block only and each block of the update is
+//! solved with its LU: the implicit-function theorem's matrix, so a run with k directions costs
+//! about 1 + k plain runs (not (1 + k)³). The iteration converges on the directions as on the
+//! state (they enter linearly), and what it computes for them is the derivative of the Gauss
+//! map itself.
+//!
 //! The coefficients are the closed forms of HLW §II.1.3, evaluated in double precision
 //! (√3 and √15 correctly rounded; every coefficient within an ulp or two of its exact value).
 
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
-use crate::integrate::problem::Canonical;
+use crate::integrate::problem::VectorField;
 pub(crate) use crate::numerics::linalg::DenseLu;
 
 /// The s-stage Gauss–Legendre method, s = 1, 2, 3 (orders 2, 4, 6).
@@ -96,7 +104,7 @@ fn tableau(s: usize) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     }
 }
 
-impl<P: Canonical + Clone + 'static> Integrator<P> for Gauss {
+impl<P: VectorField + Clone + 'static> Integrator<P> for Gauss {
     fn properties(&self) -> Properties {
         Properties::geometric(u32::try_from(self.0).map_or(0, |s| s.saturating_mul(2)))
     }
@@ -110,8 +118,13 @@ impl<P: Canonical + Clone + 'static> Integrator<P> for Gauss {
                 format!("the Gauss–Legendre methods here have s = 1, 2 or 3 stages, got {s}"),
             )
         })?;
-        let d = problem.dof();
-        let n = 2 * d;
+        let n = problem.space().dim();
+        let blocks = problem.diagonal_blocks().max(1);
+        let nb = n / blocks;
+        let index = (0..blocks)
+            .flat_map(|b| (0..nb).map(move |i| (b, i)))
+            .map(|(b, i)| problem.block_index(b, i))
+            .collect();
         Ok(Box::new(GaussStepper {
             problem: problem.clone(),
             s,
@@ -125,12 +138,12 @@ impl<P: Canonical + Clone + 'static> Integrator<P> for Gauss {
             f: vec![0.0; s * n],
             dz: vec![0.0; s * n],
             f0: vec![0.0; n],
-            jac: vec![0.0; n * n],
+            jac: vec![0.0; nb * nb],
             yt: vec![0.0; n],
             ft: vec![0.0; n],
-            hq: vec![0.0; d],
-            hp: vec![0.0; d],
-            lu: DenseLu::new(s * n),
+            index,
+            block: vec![0.0; s * nb],
+            lu: DenseLu::new(s * nb),
         }))
     }
 }
@@ -150,31 +163,23 @@ struct GaussStepper<P> {
     z: Vec<f64>,
     f: Vec<f64>,
     dz: Vec<f64>,
-    /// f(y), the Jacobian f'(y) (row-major), a trial state and its derivative.
+    /// f(y), the Jacobian f'(y) of the base block (row-major), a trial state and its derivative.
     f0: Vec<f64>,
     jac: Vec<f64>,
     yt: Vec<f64>,
     ft: Vec<f64>,
-    hq: Vec<f64>,
-    hp: Vec<f64>,
+    /// The state index of component i of diagonal block b, at b·n_b + i (module docs).
+    index: Vec<usize>,
+    /// One block of the update (s·n_b values), the LU of I − h A⊗J.
+    block: Vec<f64>,
     lu: DenseLu,
-}
-
-/// f(y) = (∂H/∂p, −∂H/∂q) into `out`.
-fn field<P: Canonical>(problem: &P, y: &[f64], out: &mut [f64], hq: &mut [f64], hp: &mut [f64]) {
-    let d = hq.len();
-    problem.gradient(&y[..d], &y[d..], hq, hp);
-    out[..d].copy_from_slice(hp);
-    for (o, g) in out[d..].iter_mut().zip(hq.iter()) {
-        *o = -g;
-    }
 }
 
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
-impl<P: Canonical> GaussStepper<P> {
+impl<P: VectorField> GaussStepper<P> {
     /// One step; on failure the iterations taken and the last relative update (∞ when the
     /// iteration diverged or the stage matrix is singular).
     fn step(&mut self) -> std::result::Result<(), Failed> {
@@ -194,34 +199,38 @@ impl<P: Canonical> GaussStepper<P> {
             jac,
             yt,
             ft,
-            hq,
-            hp,
+            index,
+            block,
             lu,
         } = self;
         let (s, h, n) = (*s, *h, y.len());
-        field(problem, y, f0, hq, hp);
-        // J ≈ f'(y) by forward differences, column by column (module docs: the steps).
+        let nb = block.len() / s;
+        let base = &index[..nb];
+        problem.field(y, f0);
+        // J ≈ f'(y) on the base block by forward differences, column by column (module docs:
+        // the steps).
         let ynorm = max_abs(y);
+        let bnorm = base.iter().fold(0.0f64, |m, &k| m.max(y[k].abs()));
         let root = f64::EPSILON.sqrt();
-        let wide = root * if ynorm > 0.0 { ynorm } else { 1.0 };
-        for j in 0..n {
+        let wide = root * if bnorm > 0.0 { bnorm } else { 1.0 };
+        for (j, &yj) in base.iter().enumerate() {
             // The component's own scale (its size and its motion in one step), and √ε‖y‖_∞.
-            let own = y[j].abs().max((h * f0[j]).abs());
+            let own = y[yj].abs().max((h * f0[yj]).abs());
             let steps = [root * own, wide];
             let first = if own > 0.0 && own < wide { 0 } else { 1 };
             for (k, &step) in steps.iter().enumerate().skip(first) {
                 yt.copy_from_slice(y);
-                yt[j] += step;
-                field(problem, yt, ft, hq, hp);
+                yt[yj] += step;
+                problem.field(yt, ft);
                 let lost = k == 0
-                    && (0..n).any(|r| ft[r] != f0[r])
-                    && (0..n).all(|r| {
+                    && base.iter().any(|&r| ft[r] != f0[r])
+                    && base.iter().all(|&r| {
                         (ft[r] - f0[r]).abs() <= 4.0 * f64::EPSILON * f0[r].abs().max(ft[r].abs())
                     });
                 if !lost {
-                    let delta = yt[j] - y[j];
-                    for r in 0..n {
-                        jac[r * n + j] = (ft[r] - f0[r]) / delta;
+                    let delta = yt[yj] - y[yj];
+                    for (r, &yr) in base.iter().enumerate() {
+                        jac[r * nb + j] = (ft[yr] - f0[yr]) / delta;
                     }
                     break;
                 }
@@ -232,10 +241,10 @@ impl<P: Canonical> GaussStepper<P> {
         for bi in 0..s {
             for bj in 0..s {
                 let ha = h * a[bi * s + bj];
-                for r in 0..n {
-                    for col in 0..n {
+                for r in 0..nb {
+                    for col in 0..nb {
                         let id = if bi == bj && r == col { 1.0 } else { 0.0 };
-                        mat[(bi * n + r, bj * n + col)] = id - ha * jac[r * n + col];
+                        mat[(bi * nb + r, bj * nb + col)] = id - ha * jac[r * nb + col];
                     }
                 }
             }
@@ -258,7 +267,7 @@ impl<P: Canonical> GaussStepper<P> {
                 for k in 0..n {
                     yt[k] = y[k] + z[i * n + k];
                 }
-                field(problem, yt, &mut f[i * n..(i + 1) * n], hq, hp);
+                problem.field(yt, &mut f[i * n..(i + 1) * n]);
             }
             for i in 0..s {
                 for k in 0..n {
@@ -269,7 +278,20 @@ impl<P: Canonical> GaussStepper<P> {
                     dz[i * n + k] = h * acc - z[i * n + k];
                 }
             }
-            lu.solve(dz);
+            // Each diagonal block of the update solved with the one LU.
+            for idx in index.chunks_exact(nb) {
+                for i in 0..s {
+                    for (r, &k) in idx.iter().enumerate() {
+                        block[i * nb + r] = dz[i * n + k];
+                    }
+                }
+                lu.solve(block);
+                for i in 0..s {
+                    for (r, &k) in idx.iter().enumerate() {
+                        dz[i * n + k] = block[i * nb + r];
+                    }
+                }
+            }
             let norm = max_abs(dz);
             for (zk, dk) in z.iter_mut().zip(dz.iter()) {
                 *zk += dk;
@@ -295,7 +317,7 @@ impl<P: Canonical> GaussStepper<P> {
     }
 }
 
-impl<P: Canonical> Stepper for GaussStepper<P> {
+impl<P: VectorField> Stepper for GaussStepper<P> {
     fn set(&mut self, z: &[f64]) -> Result<()> {
         self.y.copy_from_slice(z);
         self.comp.fill(0.0);

@@ -22,12 +22,12 @@ pub use splitting::{ProcessedSplitting, Splitting};
 pub use verlet::Verlet;
 
 use crate::integrate::method::Entry;
-use crate::integrate::problem::{Canonical, GroupField, VectorField};
+use crate::integrate::problem::{GroupField, VectorField};
 
 /// The catalog of a general (non-separable) canonical system: the symplectic Gauss–Legendre
 /// methods "gauss4" (the default), "gauss6", "midpoint", and "rk4" as the non-geometric
 /// baseline.
-pub fn canonical_catalog<P: Canonical + VectorField + Clone + 'static>() -> Vec<Entry<P>> {
+pub fn canonical_catalog<P: VectorField + Clone + 'static>() -> Vec<Entry<P>> {
     vec![
         Entry::new("gauss4", || Gauss(2)),
         Entry::new("gauss6", || Gauss(3)),
@@ -52,6 +52,9 @@ pub fn group_field_catalog<P: GroupField + VectorField + Clone + 'static>() -> V
 /// Hamilton's equations ([`Canonical::hamilton_field`]) as its vector field, its catalog
 /// (`$catalog`, by default [`canonical_catalog`]) and Rayleigh damping as its own dissipation
 /// ([`crate::integrate::forcing::rayleigh`]).
+///
+/// [`Canonical`]: crate::integrate::problem::Canonical
+/// [`Canonical::hamilton_field`]: crate::integrate::problem::Canonical::hamilton_field
 macro_rules! canonical_system {
     ($t:ty) => {
         $crate::integrate::methods::canonical_system!(

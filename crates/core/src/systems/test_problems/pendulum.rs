@@ -17,8 +17,11 @@
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Gauss, Rk4, Verlet, IMPLICIT_MIDPOINT};
-use crate::integrate::problem::{Canonical, Separable, Violation};
+use crate::integrate::problem::{Canonical, Separable, VectorField, Violation};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{
+    separable_field_tangent, SeparableTangent, Tangent, VectorFieldTangent,
+};
 use crate::integrate::{Entry, Problem};
 use crate::numerics::elliptic::{ellipj, ellipk};
 
@@ -147,7 +150,8 @@ impl Separable for Pendulum {
     }
 }
 
-crate::integrate::methods::canonical_system!(Pendulum, {
+/// The pendulum's methods, for it and for its tangent lift.
+fn methods<P: Separable + VectorField + Clone + 'static>() -> Vec<Entry<P>> {
     vec![
         Entry::new("midpoint", || IMPLICIT_MIDPOINT),
         Entry::new("gauss4", || Gauss(2)),
@@ -155,4 +159,31 @@ crate::integrate::methods::canonical_system!(Pendulum, {
         Entry::new("verlet", Verlet::strang),
         Entry::new("rk4", || Rk4),
     ]
-});
+}
+
+/// v′ = 1/(ml²), f′(q)\[dq\] = −mgl cos q dq.
+impl SeparableTangent for Pendulum {
+    fn velocity_tangent(&self, _p: &[f64], dp: &[f64], dv: &mut [f64]) {
+        dv[0] = dp[0] / self.bob.inertia();
+    }
+    fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], _s: &mut ()) {
+        df[0] = -self.bob.mgl() * q[0].cos() * dq[0];
+    }
+}
+
+impl VectorFieldTangent for Pendulum {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        separable_field_tangent(self, z, dz, out, &mut ());
+    }
+}
+
+impl crate::integrate::Catalog for Tangent<Pendulum> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        methods()
+    }
+}
+
+// The tangent lift in the separable layout serves every method (Verlet, Gauss, RK4).
+crate::integrate::methods::canonical_system!(Pendulum, methods(), |p: &Pendulum| Some(
+    Tangent::separable(p.clone()).into_system()
+));

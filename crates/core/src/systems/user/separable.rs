@@ -8,7 +8,9 @@ use crate::integrate::hooks;
 use crate::integrate::methods::{canonical_catalog, Verlet};
 use crate::integrate::problem::{Canonical, Separable, Violation};
 use crate::integrate::space::Space;
-use crate::integrate::tangent::{SeparableTangent, Tangent};
+use crate::integrate::tangent::{
+    separable_field_tangent, SeparableTangent, Tangent, VectorFieldTangent,
+};
 use crate::integrate::Problem;
 use crate::Mat;
 
@@ -315,10 +317,25 @@ impl SeparableTangent for UserSeparable {
     }
 }
 
+impl VectorFieldTangent for UserSeparable {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        separable_field_tangent(self, z, dz, out, &mut ());
+    }
+}
+
 impl crate::integrate::Catalog for Tangent<UserSeparable> {
     fn kind_catalog() -> Vec<crate::integrate::Entry<Self>> {
-        Verlet::family()
+        methods()
     }
+}
+
+/// verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4: for the system and
+/// its tangent lift.
+fn methods<P: Separable + crate::integrate::problem::VectorField + Clone + 'static>(
+) -> Vec<crate::integrate::Entry<P>> {
+    let mut entries = Verlet::family();
+    entries.extend(canonical_catalog());
+    entries
 }
 
 impl Canonical for UserSeparable {
@@ -338,15 +355,9 @@ impl Canonical for UserSeparable {
     }
 }
 
-// verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4.
-// The tangent lift (Verlet) where a gradient and a Hessian are given.
-crate::integrate::methods::canonical_system!(
-    UserSeparable,
-    {
-        let mut entries = Verlet::family();
-        entries.extend(canonical_catalog());
-        entries
-    },
-    |s: &UserSeparable| (s.hessian.is_some() && s.gradient.is_some())
-        .then(|| Tangent::separable(s.clone()).into_system())
-);
+// The tangent lift (every method) where a gradient and a Hessian are given.
+crate::integrate::methods::canonical_system!(UserSeparable, methods(), |s: &UserSeparable| (s
+    .hessian
+    .is_some()
+    && s.gradient.is_some())
+.then(|| Tangent::separable(s.clone()).into_system()));
