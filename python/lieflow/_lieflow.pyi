@@ -494,9 +494,12 @@ class Canonical(System):
     def __new__(
         cls, hamiltonian: Callable[[_F64, _F64], float],
         gradient: Callable[[_F64, _F64], Any] | None = None, dof: int | None = None,
+        hessian: Callable[[_F64, _F64, _F64, _F64], Any] | None = None,
     ) -> Self:
         """hamiltonian(q, p) -> float; gradient(q, p) -> (dH/dq, dH/dp) of shape (2, d), or None
-        for central differences; dof: the number of degrees of freedom (required)."""
+        for central differences; dof: the number of degrees of freedom (required);
+        hessian(q, p, dq, dp) -> the gradient's derivative along (dq, dp), shape (2, d): exact
+        Jacobians of every method (sensitivity=True)."""
     @property
     def dof(self) -> int: ...
     @property

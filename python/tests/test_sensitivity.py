@@ -303,3 +303,47 @@ def test_an_exception_mid_run_leaves_a_partial_in_the_systems_terms():
     with pytest.raises(TypeError, match="attitude"):
         lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), [0.3, -0.8, 1.1], 0.1, 10,
                      attitude="R", sensitivity=True)
+
+
+def _hh_h(q, p):
+    x, y = q
+    return 0.5 * float(p @ p + x * x + y * y) + x * x * y - y**3 / 3
+
+
+def _hh_gradient(q, p):
+    x, y = q
+    return [x + 2 * x * y, y + x * x - y * y], p
+
+
+def _hh_hessian(q, p, dq, dp):
+    x, y = q
+    return [(1 + 2 * y) * dq[0] + 2 * x * dq[1], 2 * x * dq[0] + (1 - 2 * y) * dq[1]], dp
+
+
+@pytest.mark.parametrize("method", ["gauss4", "gauss6", "midpoint", "rk4"])
+def test_a_user_canonical_system_with_its_hessian(method):
+    """lf.Canonical with gradient and hessian callables (Hénon–Heiles): every method's exact
+    Jacobian (Gauss through the implicit-function theorem) against differences, symplectic for
+    the Gauss methods; a failing hessian's exception raised; without it no lift."""
+    sys = lf.Canonical(_hh_h, _hh_gradient, dof=2, hessian=_hh_hessian)
+    assert sys.sensitivity_methods() == sys.methods()
+    assert lf.Canonical(_hh_h, _hh_gradient, dof=2).sensitivity_methods() == []
+    z0 = np.array([0.3, -0.2, 0.25, 0.31])
+    traj = lf.integrate(sys, z0, 0.1, 50, method=method, sensitivity=True, save_every=25)
+    assert traj.jacobian.shape == (3, 4, 4)
+    fd = differences(sys, z0, method, 0.1, 50)
+    np.testing.assert_allclose(traj.final_jacobian, fd, atol=1e-8 * np.abs(fd).max())
+    J = traj.final_jacobian
+    omega = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.eye(2), np.zeros((2, 2))]])
+    defect = np.abs(J.T @ omega @ J - omega).max() / max(1.0, np.abs(J).max()) ** 2
+    assert defect > 1e-9 if method == "rk4" else defect < 1e-12
+
+    def failing(q, p, dq, dp):
+        raise ZeroDivisionError("hessian fails")
+
+    bad = lf.Canonical(_hh_h, _hh_gradient, dof=2, hessian=failing)
+    with pytest.raises(ZeroDivisionError, match="hessian fails"):
+        lf.integrate(bad, z0, 0.1, 5, method=method, sensitivity=True)
+    nan = lf.Canonical(_hh_h, _hh_gradient, dof=2, hessian=lambda q, p, dq, dp: [[np.nan] * 2] * 2)
+    with pytest.raises(lf.NonFiniteError, match="hessian"):
+        lf.integrate(nan, z0, 0.1, 5, method=method, sensitivity=True)

@@ -537,3 +537,57 @@ fn gauss_and_verlet_jacobians_of_a_user_system_are_symplectic() {
         }
     }
 }
+
+/// The same Hénon–Heiles as a general canonical system (H and its derivatives as closures): its
+/// field lift gives the Gauss and RK4 Jacobians of the separable system's lift (another layout,
+/// another kind of user system), to round-off.
+#[test]
+fn a_user_canonical_system_lifts_as_its_separable_twin() {
+    use lieflow::systems::UserCanonical;
+    let h = Arc::new(|q: &[f64], p: &[f64]| -> lieflow::Result<f64> {
+        let (x, y) = (q[0], q[1]);
+        Ok(0.5 * (p[0] * p[0] + p[1] * p[1] + x * x + y * y) + x * x * y - y * y * y / 3.0)
+    });
+    let g = Arc::new(
+        |q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]| -> lieflow::Result<()> {
+            let (x, y) = (q[0], q[1]);
+            hq[0] = x + 2.0 * x * y;
+            hq[1] = y + x * x - y * y;
+            hp.copy_from_slice(p);
+            Ok(())
+        },
+    );
+    let hess = Arc::new(
+        |q: &[f64], _p: &[f64], dq: &[f64], dp: &[f64], hq: &mut [f64], hp: &mut [f64]| {
+            let (x, y) = (q[0], q[1]);
+            hq[0] = (1.0 + 2.0 * y) * dq[0] + 2.0 * x * dq[1];
+            hq[1] = 2.0 * x * dq[0] + (1.0 - 2.0 * y) * dq[1];
+            hp.copy_from_slice(dp);
+            Ok(())
+        },
+    );
+    let canonical = UserCanonical::new(2, h.clone(), Some(g.clone())).unwrap();
+    assert!(canonical.tangent().is_none(), "no Hessian, no lift");
+    let canonical = canonical.with_hessian(hess);
+    let t = canonical.tangent().unwrap();
+    let twin = henon_heiles().tangent().unwrap();
+    let z0 = [0.3, -0.2, 0.25, 0.31];
+    for method in ["gauss4", "gauss6", "midpoint", "rk4"] {
+        let (z, jac) = lifted_end(&*t, method, &z0, 0.1, 100);
+        let (z2, jac2) = lifted_end(&*twin, method, &z0, 0.1, 100);
+        let (dz, dj) = (max_rel(&z, &z2), max_rel(&jac, &jac2));
+        eprintln!("{method}: states {dz:.1e}, Jacobians {dj:.1e}");
+        assert!(dz < 1e-13 && dj < 1e-12, "{method}: {dz:e} {dj:e}");
+    }
+    // A Hessian closure that returns NaN stops the run with a typed error.
+    let nan = Arc::new(
+        |_: &[f64], _: &[f64], _: &[f64], _: &[f64], hq: &mut [f64], _: &mut [f64]| {
+            hq.fill(f64::NAN);
+            Ok(())
+        },
+    );
+    let bad = UserCanonical::new(2, h, Some(g)).unwrap().with_hessian(nan);
+    let t = bad.tangent().unwrap();
+    let err = integrate(&*t, "gauss4", &t.seed(&z0).unwrap(), 0.1, 5, 5).unwrap_err();
+    assert!(err.to_string().contains("Hessian"), "{err}");
+}

@@ -346,6 +346,10 @@ def user_grad(q, p):
     return q, p
 
 
+def user_ddh(q, p, dq, dp):
+    return dq, dp
+
+
 def user_u(q):
     return 0.5 * float(q @ q)
 
@@ -399,6 +403,9 @@ def user_specs(add):
     """The specs of the user-defined systems (issue 15)."""
     add("Canonical", "Canonical", A("hamiltonian", user_h, "obj"),
         A("gradient", user_grad, "obj", opt=True), A("dof", 2, "int", positive=True))
+    add("Canonical[hessian]", "Canonical", A("hamiltonian", user_h, "obj"),
+        A("gradient", user_grad, "obj", opt=True), A("dof", 2, "int", positive=True),
+        A("hessian", user_ddh, "obj", kw=True, opt=True))
     add("Separable", "Separable", A("mass", 1.5, "float", positive=True),
         A("potential", user_u, "obj"), A("gradient", user_du, "obj", opt=True),
         A("dof", 1, "int", kw=True, positive=True))

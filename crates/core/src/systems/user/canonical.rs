@@ -3,8 +3,10 @@ use std::fmt;
 use super::*;
 use crate::error::Result;
 use crate::integrate::hooks;
+use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::Canonical;
 use crate::integrate::space::Space;
+use crate::integrate::tangent::{Tangent, VectorFieldTangent};
 use crate::integrate::Problem;
 
 /// A canonical Hamiltonian system H(q, p) on T*ℝᵈ given by functions (module docs); state
@@ -14,6 +16,7 @@ pub struct UserCanonical {
     dof: usize,
     h: CanonicalFn,
     gradient: Option<CanonicalGradientFn>,
+    hessian: Option<CanonicalHessianFn>,
 }
 
 impl fmt::Debug for UserCanonical {
@@ -21,6 +24,7 @@ impl fmt::Debug for UserCanonical {
         f.debug_struct("UserCanonical")
             .field("dof", &self.dof)
             .field("gradient", &self.gradient.is_some())
+            .field("hessian", &self.hessian.is_some())
             .finish()
     }
 }
@@ -29,7 +33,19 @@ impl UserCanonical {
     /// H with `dof` ≥ 1 degrees of freedom and its gradient, or `None` for finite differences.
     pub fn new(dof: usize, h: CanonicalFn, gradient: Option<CanonicalGradientFn>) -> Result<Self> {
         check_dof("dof", dof)?;
-        Ok(UserCanonical { dof, h, gradient })
+        Ok(UserCanonical {
+            dof,
+            h,
+            gradient,
+            hessian: None,
+        })
+    }
+
+    /// The same system with the Hessian product D²H(q, p)\[dq, dp\] (with an exact gradient,
+    /// it makes every method's Jacobian exact: the tangent lift, [`crate::integrate::tangent`]).
+    pub fn with_hessian(mut self, hessian: CanonicalHessianFn) -> Self {
+        self.hessian = Some(hessian);
+        self
     }
 
     /// Whether the gradient is computed by finite differences.
@@ -107,4 +123,38 @@ impl Canonical for UserCanonical {
     }
 }
 
-crate::integrate::methods::canonical_system!(UserCanonical);
+/// f′(z)dz = (∂²H/∂p∂z dz, −∂²H/∂q∂z dz) from the Hessian callable (a failure recorded as for
+/// the gradient; NaN).
+impl VectorFieldTangent for UserCanonical {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        let d = self.dof;
+        let (oq, op) = out.split_at_mut(d);
+        let ok = match &self.hessian {
+            Some(h) => hooks::call(|| {
+                h(&z[..d], &z[d..], &dz[..d], &dz[d..], op, oq)?;
+                finite_entries("the Hessian product of H", "d(dH/dq)", op)?;
+                finite_entries("the Hessian product of H", "d(dH/dp)", oq)
+            }),
+            None => false,
+        };
+        if ok {
+            op.iter_mut().for_each(|x| *x = -*x);
+        } else {
+            out.fill(f64::NAN);
+        }
+    }
+}
+
+impl crate::integrate::Catalog for Tangent<UserCanonical> {
+    fn kind_catalog() -> Vec<crate::integrate::Entry<Self>> {
+        canonical_catalog()
+    }
+}
+
+// The tangent lift (every method) where a gradient and a Hessian are given.
+crate::integrate::methods::canonical_system!(
+    UserCanonical,
+    canonical_catalog(),
+    |s: &UserCanonical| (s.hessian.is_some() && s.gradient.is_some())
+        .then(|| Tangent::field(s.clone()).into_system())
+);

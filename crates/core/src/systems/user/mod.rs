@@ -102,6 +102,10 @@ pub type CanonicalFn = Arc<dyn Fn(&[f64], &[f64]) -> Result<f64> + Send + Sync>;
 /// The gradient of a [`UserCanonical`]: (q, p, ∂H/∂q out, ∂H/∂p out).
 pub type CanonicalGradientFn =
     Arc<dyn Fn(&[f64], &[f64], &mut [f64], &mut [f64]) -> Result<()> + Send + Sync>;
+/// The Hessian product of a [`CanonicalFn`]: (q, p, dq, dp, ∂H_q out, ∂H_p out), the derivative
+/// of the gradient (∂H/∂q, ∂H/∂p) along (dq, dp).
+pub type CanonicalHessianFn =
+    Arc<dyn Fn(&[f64], &[f64], &[f64], &[f64], &mut [f64], &mut [f64]) -> Result<()> + Send + Sync>;
 /// A scalar function f(x) (a potential U(q), a Lie–Poisson H(μ), a Casimir).
 pub type ScalarFn = Arc<dyn Fn(&[f64]) -> Result<f64> + Send + Sync>;
 /// The gradient of a [`ScalarFn`]: (x, ∇f out).

@@ -16,6 +16,16 @@ use crate::system::{PySystem, Thin};
 
 use super::{count, missing, optional, Any, Callee};
 
+/// Calls `c` on `args` for a (2, d) value: its rows into `hq` and `hp`.
+fn call_pair(c: &Callee, args: &[&[f64]], hq: &mut [f64], hp: &mut [f64]) -> lieflow::Result<()> {
+    let d = hq.len();
+    let mut out = vec![0.0; 2 * d];
+    c.call(args, &[2, d], &mut out)?;
+    hq.copy_from_slice(&out[..d]);
+    hp.copy_from_slice(&out[d..]);
+    Ok(())
+}
+
 /// A canonical Hamiltonian system H(q, p) on T*R^d given by Python callables.
 ///
 /// State z = (q, p) (2d,); fields q, p. q' = dH/dp, p' = -dH/dq. Methods: gauss4 (default),
@@ -28,6 +38,9 @@ use super::{count, missing, optional, Any, Callee};
 ///         coordinate, 8d per gradient; relative accuracy about 1e-12 for smooth H varying on
 ///         the scale of the state; the methods are then symplectic only to that accuracy).
 ///     dof: the number d >= 1 of degrees of freedom (required).
+///     hessian: callable (q, p, dq, dp) -> the derivative of the gradient along (dq, dp),
+///         (d(dH/dq), d(dH/dp)) of shape (2, d), or None. With it (and `gradient`)
+///         `lieflow.integrate(..., sensitivity=True)` gives every method's exact Jacobians.
 /// Raises:
 ///     ArgumentTypeError (not callable, no dof), InvalidArgumentError (dof < 1).
 ///
@@ -42,11 +55,12 @@ pub struct PyCanonical;
 #[pymethods]
 impl PyCanonical {
     #[new]
-    #[pyo3(signature = (hamiltonian, gradient=None, dof=None))]
+    #[pyo3(signature = (hamiltonian, gradient=None, dof=None, hessian=None))]
     fn new(
         hamiltonian: Any<'_>,
         gradient: Option<Any<'_>>,
         dof: Option<Any<'_>>,
+        hessian: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = hamiltonian.py();
         let h = Callee::new("hamiltonian", &hamiltonian)?;
@@ -68,21 +82,29 @@ impl PyCanonical {
         let grad_fn: Option<CanonicalGradientFn> = g.map(|g| {
             Arc::new(
                 move |q: &[f64], p: &[f64], hq: &mut [f64], hp: &mut [f64]| {
-                    let d = q.len();
-                    let mut out = vec![0.0; 2 * d];
-                    g.call(&[q, p], &[2, d], &mut out)?;
-                    hq.copy_from_slice(&out[..d]);
-                    hp.copy_from_slice(&out[d..]);
-                    Ok(())
+                    call_pair(&g, &[q, p], hq, hp)
                 },
             ) as CanonicalGradientFn
         });
-        let sys = UserCanonical::new(d, value, grad_fn).py()?;
-        let args = (hamiltonian, gradient, dof).into_pyobject(py)?;
+        let hess = optional(hessian.as_ref())
+            .map(|h| Callee::new("hessian", h))
+            .transpose()?;
+        let mut sys = UserCanonical::new(d, value, grad_fn).py()?;
+        if let Some(h) = hess {
+            sys = sys.with_hessian(Arc::new(
+                move |q: &[f64],
+                      p: &[f64],
+                      dq: &[f64],
+                      dp: &[f64],
+                      hq: &mut [f64],
+                      hp: &mut [f64]| { call_pair(&h, &[q, p, dq, dp], hq, hp) },
+            ));
+        }
+        let args = (hamiltonian, gradient, dof, hessian).into_pyobject(py)?;
         Ok(PySystem::subclass(
             sys,
             args,
-            &["hamiltonian", "gradient", "dof"],
+            &["hamiltonian", "gradient", "dof", "hessian"],
         ))
     }
 
