@@ -48,7 +48,7 @@ use std::sync::Arc;
 pub use super::method::TangentSystem;
 
 use super::method::Catalog;
-use super::problem::{Problem, Separable, Split, VectorField, Violation};
+use super::problem::{Constrained, Problem, Separable, Split, VectorField, Violation};
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
 
@@ -305,13 +305,29 @@ impl<P: Problem + Clone> Tangent<P> {
     }
 }
 
+/// The work space of a separable lift's kernels: the base problem's, and for a constrained lift
+/// G(q), D²g(q)\[δq, ·\] and the polarisation's buffers (sized at their first use).
+pub struct LiftScratch<S> {
+    base: S,
+    jac: Vec<f64>,
+    second: Vec<f64>,
+    w: Vec<f64>,
+    c: Vec<f64>,
+}
+
 /// Positions (q, δq₁…δq_k), momenta (p, δp₁…δp_k), force (f(q), f′(q)δq_j), velocity
 /// (v(p), v′(p)δp_j).
 impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
-    type Scratch = P::Scratch;
+    type Scratch = LiftScratch<P::Scratch>;
 
-    fn scratch(&self) -> P::Scratch {
-        self.problem.scratch()
+    fn scratch(&self) -> Self::Scratch {
+        LiftScratch {
+            base: self.problem.scratch(),
+            jac: Vec::new(),
+            second: Vec::new(),
+            w: Vec::new(),
+            c: Vec::new(),
+        }
     }
 
     fn dof(&self) -> usize {
@@ -332,8 +348,9 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
         &self,
         q: &[f64],
         f: &mut [f64],
-        s: &mut P::Scratch,
+        s: &mut Self::Scratch,
     ) -> std::result::Result<(), Violation> {
+        let s = &mut s.base;
         let n = self.problem.dof();
         let (f0, df) = f.split_at_mut(n);
         self.problem.force(&q[..n], f0, s)?;
@@ -349,6 +366,105 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
             }
         }
         Ok(())
+    }
+}
+
+/// D²g(q)\[u, ·\] into `rows` (m × d, row-major), by polarisation of the quadratic form
+/// D²g(q)\[w, w\] ([`Constrained::constraint_curvature`]; exact up to round-off): `w` (d
+/// values) and `c` (2m values) are work space.
+pub fn constraint_second<P: Constrained>(
+    problem: &P,
+    q: &[f64],
+    u: &[f64],
+    rows: &mut [f64],
+    w: &mut [f64],
+    c: &mut [f64],
+    s: &mut P::Scratch,
+) {
+    let (d, m) = (problem.dof(), problem.constraints());
+    let (cp, cm) = c.split_at_mut(m);
+    w.copy_from_slice(u);
+    for k in 0..d {
+        w[k] = u[k] + 1.0;
+        problem.constraint_curvature(q, w, cp, s);
+        w[k] = u[k] - 1.0;
+        problem.constraint_curvature(q, w, cm, s);
+        w[k] = u[k];
+        for a in 0..m {
+            rows[a * d + k] = 0.25 * (cp[a] - cm[a]);
+        }
+    }
+}
+
+/// The lift of a constrained problem (RATTLE): the constraints g̃ = (g(q), G(q)δq₁, …,
+/// G(q)δq_k), whose Jacobian is block lower-triangular (G on the diagonal, D²g(q)\[δq_j, ·\]
+/// in the first column). A level-set problem's lift is one too (the level of G(q)δq_j is its
+/// initial value: the derivative of the level g(q₀) along δq₀); otherwise G(q)δq_j = 0, the
+/// derivative of the map as RATTLE extends it off the constraint manifold (its first step
+/// projects).
+impl<P: Constrained + SeparableTangent + Clone> Constrained for Tangent<P> {
+    fn constraints(&self) -> usize {
+        self.problem.constraints() * (self.k() + 1)
+    }
+
+    fn level_set(&self) -> bool {
+        self.problem.level_set()
+    }
+
+    fn constraint(&self, q: &[f64], g: &mut [f64], s: &mut Self::Scratch) {
+        let (n, m) = (self.problem.dof(), self.problem.constraints());
+        let LiftScratch { base, jac, .. } = s;
+        jac.resize(m * n, 0.0);
+        self.problem.constraint(&q[..n], &mut g[..m], base);
+        self.problem.constraint_jacobian(&q[..n], jac, base);
+        for (dq, gj) in q[n..].chunks_exact(n).zip(g[m..].chunks_exact_mut(m)) {
+            for (ga, row) in gj.iter_mut().zip(jac.chunks_exact(n)) {
+                *ga = row.iter().zip(dq).map(|(x, y)| x * y).sum();
+            }
+        }
+    }
+
+    fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64], s: &mut Self::Scratch) {
+        let (n, m, k) = (self.problem.dof(), self.problem.constraints(), self.k());
+        let cols = n * (k + 1);
+        let LiftScratch {
+            base,
+            jac: g,
+            second,
+            w,
+            c,
+        } = s;
+        g.resize(m * n, 0.0);
+        second.resize(m * n, 0.0);
+        w.resize(n, 0.0);
+        c.resize(2 * m, 0.0);
+        self.problem.constraint_jacobian(&q[..n], g, base);
+        jac.fill(0.0);
+        for j in 0..=k {
+            if j > 0 {
+                let dq = &q[j * n..(j + 1) * n];
+                constraint_second(&self.problem, &q[..n], dq, second, w, c, base);
+            }
+            for a in 0..m {
+                let row = &mut jac[(j * m + a) * cols..(j * m + a + 1) * cols];
+                row[j * n..(j + 1) * n].copy_from_slice(&g[a * n..(a + 1) * n]);
+                if j > 0 {
+                    row[..n].copy_from_slice(&second[a * n..(a + 1) * n]);
+                }
+            }
+        }
+    }
+
+    /// NaN: the lift's curvature needs D³g, which no constraint gives (RATTLE does not use it;
+    /// the index-1 field of a lift is not offered).
+    fn constraint_curvature(
+        &self,
+        _q: &[f64],
+        _v: &[f64],
+        out: &mut [f64],
+        _s: &mut Self::Scratch,
+    ) {
+        out.fill(f64::NAN);
     }
 }
 

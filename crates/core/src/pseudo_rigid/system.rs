@@ -57,7 +57,7 @@ use super::potential::{self, Potential, Workspace};
 use super::reduced::ReducedWork;
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::{Composition, Rattle, Splitting, Verlet};
+use crate::integrate::methods::{Rattle, Splitting, Verlet};
 use crate::integrate::problem::{Constrained, Separable, Split, Symmetric, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::tangent::{SeparableTangent, Tangent, TangentSystem};
@@ -440,6 +440,13 @@ impl Catalog for Tangent<PseudoRigidBody> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         Verlet::family()
     }
+
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        match self.problem().incompressible {
+            true => Rattle::family(),
+            false => Self::kind_catalog(),
+        }
+    }
 }
 
 impl PseudoRigidBody {
@@ -632,17 +639,14 @@ impl Catalog for PseudoRigidBody {
 
     fn catalog(&self) -> Vec<Entry<Self>> {
         match self.incompressible {
-            true => vec![
-                Entry::new("rattle", Rattle::new),
-                Entry::new("rattle4", || Rattle(Composition::suzuki4())),
-                Entry::new("rattle6", || Rattle(Composition::yoshida6())),
-            ],
+            true => Rattle::family(),
             false => Self::kind_catalog(),
         }
     }
 
-    /// The Verlet methods' tangent lift (the free body; not yet the incompressible one).
+    /// The tangent lift of the Verlet methods (the free body) or of RATTLE's (the
+    /// incompressible one).
     fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
-        (!self.incompressible).then(|| Tangent::separable(self.clone()).into_system())
+        Some(Tangent::separable(self.clone()).into_system())
     }
 }

@@ -40,7 +40,7 @@
 use super::gauss::DenseLu;
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
-use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
+use crate::integrate::method::{Clock, Entry, Integrator, Properties, Stepper};
 use crate::integrate::methods::Composition;
 use crate::integrate::problem::{Constrained, Separable, Violation};
 
@@ -53,6 +53,16 @@ impl Rattle {
     /// RATTLE itself (order 2).
     pub fn new() -> Self {
         Rattle(Composition::strang())
+    }
+
+    /// The catalog entries `rattle`, `rattle4`, `rattle6` (Strang, Suzuki's order 4, Yoshida's
+    /// order 6) of a constrained problem: one list for a system and its tangent lift.
+    pub fn family<P: Constrained + Clone + 'static>() -> Vec<Entry<P>> {
+        vec![
+            Entry::new("rattle", Rattle::new),
+            Entry::new("rattle4", || Rattle(Composition::suzuki4())),
+            Entry::new("rattle6", || Rattle(Composition::yoshida6())),
+        ]
     }
 }
 

@@ -18,8 +18,10 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::Rattle;
 use crate::integrate::problem::{Constrained, Separable, Violation};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{SeparableTangent, Tangent, TangentSystem};
 use crate::integrate::{Catalog, Entry, Problem};
 use nalgebra::Vector3;
+use std::sync::Arc;
 
 /// Relative tolerance of the constraints |q| = l and q·p = 0 on a state.
 pub const CONSTRAINT_TOL: f64 = 1e-10;
@@ -146,7 +148,28 @@ impl Constrained for SphereParticle {
     }
 }
 
+/// v′ = 1/m, f′ = 0 (uniform gravity).
+impl SeparableTangent for SphereParticle {
+    fn velocity_tangent(&self, _p: &[f64], dp: &[f64], dv: &mut [f64]) {
+        self.velocity(dp, dv);
+    }
+    fn force_tangent(&self, _q: &[f64], _dq: &[f64], df: &mut [f64], _s: &mut ()) {
+        df.fill(0.0);
+    }
+}
+
 impl Catalog for SphereParticle {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        vec![Entry::new("rattle", Rattle::new)]
+    }
+
+    /// RATTLE's tangent lift.
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
+        Some(Tangent::separable(self.clone()).into_system())
+    }
+}
+
+impl Catalog for Tangent<SphereParticle> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![Entry::new("rattle", Rattle::new)]
     }
