@@ -5,10 +5,10 @@
 use std::sync::Arc;
 
 use lieflow::integrate::tangent::TangentSystem;
-use lieflow::integrate::{integrate, System};
+use lieflow::integrate::{integrate, Clock, System};
 use lieflow::pseudo_rigid::potential::{SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::PseudoRigidBody;
-use lieflow::systems::{HeavyTop, RigidBody};
+use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
 
 /// (base state at the end, Jacobian d×d row-major) of `steps` steps of `method`.
 fn lifted_end(
@@ -447,4 +447,199 @@ fn parameter_jacobian_of_the_pseudo_rigid_body() {
     }
     eprintln!("PseudoRigidBody verlet4: parameter Jacobian vs differences {worst:.2e}");
     assert!(worst < 1e-7, "{worst:e}");
+}
+
+/// The end state of `steps` steps of `method` from any z (user frame) through the method's
+/// stepper: its map also off the constraints a run checks (|q| = 1, Q symmetric), which the
+/// lift differentiates across.
+fn stepped(sys: &dyn System, method: &str, z0: &[f64], dt: f64, steps: usize) -> Vec<f64> {
+    let (mut st, _) = sys.stepper(method, dt).unwrap();
+    let mut z = z0.to_vec();
+    sys.to_internal(&mut z);
+    st.set(&z).unwrap();
+    st.advance(
+        steps,
+        Clock {
+            t0: 0.0,
+            dt,
+            done: 0,
+        },
+    )
+    .unwrap();
+    st.get(&mut z);
+    sys.to_user(&mut z);
+    z
+}
+
+/// [`differences`] through [`stepped`].
+fn stepped_differences(
+    sys: &dyn System,
+    method: &str,
+    z0: &[f64],
+    dt: f64,
+    steps: usize,
+    h: f64,
+) -> Vec<f64> {
+    let d = z0.len();
+    let mut jac = vec![0.0; d * d];
+    for j in 0..d {
+        let hj = h * z0[j].abs().max(1.0);
+        let end = |s: f64| {
+            let mut z = z0.to_vec();
+            z[j] += s;
+            stepped(sys, method, &z, dt, steps)
+        };
+        let (p, m) = (end(hj), end(-hj));
+        for i in 0..d {
+            jac[i * d + j] = (p[i] - m[i]) / (2.0 * hj);
+        }
+    }
+    jac
+}
+
+/// max |∇C(z)ᵀJ − ∇C(z₀)ᵀ| over the gradients (∇C(z₀), ∇C(z)) of some invariants.
+fn casimir_defect(jac: &[f64], grads: &[(Vec<f64>, Vec<f64>)]) -> f64 {
+    let d = grads[0].0.len();
+    let mut worst = 0.0f64;
+    for (g0, g1) in grads {
+        for j in 0..d {
+            let s: f64 = (0..d).map(|i| g1[i] * jac[i * d + j]).sum();
+            worst = worst.max((s - g0[j]).abs());
+        }
+    }
+    worst
+}
+
+/// max |J B(z₀) Jᵀ − B(z)| for a Poisson tensor B.
+fn poisson_defect(jac: &[f64], b0: &[f64], b1: &[f64]) -> f64 {
+    let d = (b0.len() as f64).sqrt() as usize;
+    let mut worst = 0.0f64;
+    for i in 0..d {
+        for k in 0..d {
+            let mut s = 0.0;
+            for a in 0..d {
+                for c in 0..d {
+                    s += jac[i * d + a] * b0[a * d + c] * jac[k * d + c];
+                }
+            }
+            worst = worst.max((s - b1[i * d + k]).abs());
+        }
+    }
+    worst
+}
+
+/// The spherical pendulum (q, L) on e(3)*: every method's Jacobian against differences of its
+/// map (off the sphere too: both flows and the field are defined on R⁶); for the splittings,
+/// ∇C(z)ᵀJ = ∇C(z₀)ᵀ for the Casimirs |q|², q·L (their flows keep both on all of R⁶) and
+/// J B(z₀) Jᵀ = B(z) for the Lie–Poisson tensor B = [[0, q̂], [q̂, L̂]] (each flow is the exact
+/// flow of a piece of H: a Poisson map), to round-off.
+#[test]
+fn spherical_pendulum_jacobians_keep_the_casimirs_and_the_bracket() {
+    let pend = SphericalPendulum::new(2.0, 1.5, 9.81).unwrap();
+    let z0 = pend.state_from_spherical(0.8, 0.1, 0.3, 1.2).unwrap();
+    let t = pend.tangent().expect("a lift");
+    let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
+    assert_eq!(names, ["splitting", "splitting4", "splitting6", "rk4"]);
+    let (dt, steps) = (0.02, 100);
+    let tensor = |z: &[f64]| {
+        let (q, l) = (hat(&z[..3]), hat(&z[3..]));
+        let mut b = vec![0.0; 36];
+        for i in 0..3 {
+            for j in 0..3 {
+                b[i * 6 + j + 3] = q[i][j];
+                b[(i + 3) * 6 + j] = q[i][j];
+                b[(i + 3) * 6 + j + 3] = l[i][j];
+            }
+        }
+        b
+    };
+    let grads = |z: &[f64]| {
+        (
+            [z[..3].iter().map(|x| 2.0 * x).collect(), vec![0.0; 3]].concat(),
+            [z[3..].to_vec(), z[..3].to_vec()].concat(),
+        )
+    };
+    for method in names {
+        let (z, jac) = lifted_end(&*t, method, &z0, dt, steps);
+        let plain = integrate(&pend, method, &z0, dt, steps, steps).unwrap();
+        assert!(max_rel(&z, plain.state(1)) < 1e-14, "{method}: base state");
+        let fd = stepped_differences(&pend, method, &z0, dt, steps, 1e-5);
+        let err = max_rel(&jac, &fd);
+        eprintln!("SphericalPendulum {method}: Jacobian vs differences {err:.2e}");
+        assert!(err < 1e-8, "{method}: {err:e}");
+        if method == "rk4" {
+            continue;
+        }
+        let ((a0, b0), (a1, b1)) = (grads(&z0), grads(&z));
+        let cas = casimir_defect(&jac, &[(a0, a1), (b0, b1)]);
+        let poisson = poisson_defect(&jac, &tensor(&z0), &tensor(&z));
+        eprintln!(
+            "SphericalPendulum {method}: Casimir gradients {cas:.2e}, J B Jᵀ − B {poisson:.2e}"
+        );
+        assert!(cas < 1e-12, "{method}: {cas:e}");
+        assert!(poisson < 1e-12, "{method}: {poisson:e}");
+    }
+}
+
+/// ∂z/∂θ of the spherical pendulum along (mass, length, g), against pendulums rebuilt with a
+/// constant moved.
+#[test]
+fn parameter_jacobian_of_the_spherical_pendulum() {
+    let theta = [2.0, 1.5, 9.81];
+    let build = |t: [f64; 3]| SphericalPendulum::new(t[0], t[1], t[2]).unwrap();
+    let pend = build(theta);
+    let z0 = pend.state_from_spherical(0.8, 0.1, 0.3, 1.2).unwrap();
+    let t = pend.tangent().unwrap();
+    assert_eq!(t.parameter_names(), ["mass", "length", "g"]);
+    for method in ["splitting", "splitting6", "rk4"] {
+        let (_, _, pjac) = lifted_end_all(&*t, method, &z0, 0.02, 100);
+        let mut worst = 0.0f64;
+        for m in 0..3 {
+            let h = 1e-6 * theta[m];
+            let end = |s: f64| {
+                let mut th = theta;
+                th[m] += s;
+                integrate(&build(th), method, &z0, 0.02, 100, 100)
+                    .unwrap()
+                    .state(1)
+                    .to_vec()
+            };
+            let (p, q) = (end(h), end(-h));
+            for i in 0..6 {
+                worst = worst.max((pjac[i * 3 + m] - (p[i] - q[i]) / (2.0 * h)).abs());
+            }
+        }
+        eprintln!("SphericalPendulum {method}: parameter Jacobian vs differences {worst:.2e}");
+        assert!(worst < 1e-7, "{method}: {worst:e}");
+    }
+}
+
+/// The generalized rigid body on so(n)*: rk4's Jacobian (the only method of its lift) against
+/// differences, with J given as a matrix (the principal frame is the lift's chart), n = 3, 4, 5.
+#[test]
+fn rk4_jacobian_of_the_generalized_rigid_body() {
+    for n in 3..=5 {
+        let j = lieflow::Mat::from_fn(n, n, |a, b| {
+            if a == b {
+                1.0 + 0.7 * a as f64
+            } else {
+                0.1 / (1.0 + (a + b) as f64)
+            }
+        });
+        let body = GeneralizedRigidBody::from_matrix(&j).unwrap();
+        let t = body.tangent().expect("a lift");
+        let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, ["rk4"]);
+        assert!(t.parameter_names().is_empty());
+        let z0: Vec<f64> = (0..n * (n - 1) / 2)
+            .map(|k| (0.9 * k as f64 + 0.3).sin())
+            .collect();
+        let (z, jac) = lifted_end(&*t, "rk4", &z0, 0.02, 100);
+        let plain = integrate(&body, "rk4", &z0, 0.02, 100, 100).unwrap();
+        assert!(max_rel(&z, plain.state(1)) < 1e-14);
+        let fd = differences(&body, "rk4", &z0, 0.02, 100, 1e-5);
+        let err = max_rel(&jac, &fd);
+        eprintln!("GeneralizedRigidBody so({n}) rk4: Jacobian vs differences {err:.2e}");
+        assert!(err < 1e-8, "so({n}): {err:e}");
+    }
 }

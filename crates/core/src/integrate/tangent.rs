@@ -212,6 +212,14 @@ impl<P: SeparableTangent + Clone> Tangent<P> {
     }
 }
 
+impl<P: VectorFieldTangent + Clone> Tangent<P> {
+    /// The lift of a vector field without a split form (its Runge–Kutta methods; flat blocks
+    /// only): (z, δz₁, …, δz_k).
+    pub fn field(problem: P) -> Self {
+        Tangent::with(problem, Layout::Field)
+    }
+}
+
 impl<P: SplitTangent + Clone> Tangent<P> {
     /// The lift of a split problem (its splittings; and its Runge–Kutta methods where it is a
     /// [`VectorFieldTangent`] without SO(3) blocks): (z, δz₁, …, δz_k), the directions
