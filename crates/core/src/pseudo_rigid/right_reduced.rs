@@ -839,7 +839,7 @@ impl RightReduced {
 
 /// The kick: δN′ = δN − τ(δC Gᵀ + C D²U(C)\[δC\]ᵀ). The drift (Q′ = Q + τ(N + Nᵀ) + τ²K,
 /// N′ = N + τK, X′ = X + τWᵀT): δQ′ = δQ + τ(δN + δNᵀ) + τ²δK, δN′ = δN + τδK,
-/// δX′ = δX + τ(δWᵀT + WᵀδT) ([`Linear`]). NaN where Q is not positive definite.
+/// δX′ = δX + τ(δWᵀT + WᵀδT) (module docs, "Tangent lift"). NaN where Q is not positive definite.
 impl SplitTangent for RightReduced {
     fn flow_tangent(&self, i: usize, tau: f64, before: &Work, _after: &Work, dirs: &mut [f64]) {
         let n = self.n();
@@ -892,7 +892,7 @@ impl SplitTangent for RightReduced {
     }
 }
 
-/// δQ̇ = δN + δNᵀ, δṄ = δK − δC Gᵀ − C D²U(C)\[δC\]ᵀ, δẊ = δWᵀT + WᵀδT ([`Linear`]).
+/// δQ̇ = δN + δNᵀ, δṄ = δK − δC Gᵀ − C D²U(C)\[δC\]ᵀ, δẊ = δWᵀT + WᵀδT.
 impl VectorFieldTangent for RightReduced {
     fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
         let n = self.n();
