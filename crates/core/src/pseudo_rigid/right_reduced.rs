@@ -892,7 +892,8 @@ impl SplitTangent for RightReduced {
     }
 }
 
-/// δQ̇ = δN + δNᵀ, δṄ = δK − δC Gᵀ − C D²U(C)\[δC\]ᵀ, δẊ = δWᵀT + WᵀδT.
+/// The derivative of the Riemann field (001 (3.20)): δQ̇ = δN + δNᵀ,
+/// δṄ = δK − δC Gᵀ − C D²U(C)\[δC\]ᵀ, δẊ = δWᵀT + WᵀδT.
 impl VectorFieldTangent for RightReduced {
     fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
         let n = self.n();
