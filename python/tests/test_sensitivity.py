@@ -3,6 +3,7 @@ map (the tangent lift run by the same method). Each against central differences 
 method; the Verlet Jacobians symplectic; batches as single runs; typed refusals."""
 
 import numpy as np
+import scipy.linalg
 import pytest
 
 import lieflow as lf
@@ -104,14 +105,15 @@ def test_sensitivity_refuses_what_it_cannot_do_with_typed_errors():
         lf.integrate(rb, z0, 0.1, 10, attitude=np.eye(4), sensitivity=True)
     with pytest.raises(lf.InvalidArgumentError, match="events"):
         lf.integrate(rb, z0, 0.1, 10, method="rk4", events=lambda t, z: z[0], sensitivity=True)
-    particle = lf.SphereParticle(1.0, 1.0, 9.81)
+    disk = lf.RollingDisk(1.0, 0.5, 0.125, 0.0625, spring=0.4)
     with pytest.raises(lf.InvalidArgumentError, match="no tangent maps"):
-        lf.integrate(particle, [0.0, 0.6, 0.8, 0.0, 0.8, -0.6], 0.1, 10, sensitivity=True)
-    assert particle.sensitivity_methods() == []
+        lf.integrate(disk, disk.state([0.1, -0.2, 0.3, 0.7], 2.0, 0.5), 0.1, 10,
+                     sensitivity=True)
+    assert disk.sensitivity_methods() == []
     with pytest.raises(TypeError, match="sensitivity"):
         lf.integrate(rb, z0, 0.1, 10, method="rk4", sensitivity="yes")
     inc = lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(1.0, 2.0), incompressible=True)
-    assert inc.sensitivity_methods() == []
+    assert inc.sensitivity_methods() == ["rattle", "rattle4", "rattle6"]
     plain = lf.integrate(rb, z0, 0.1, 10, method="rk4")
     assert plain.jacobian is None and plain.final_jacobian is None
 
@@ -347,3 +349,49 @@ def test_a_user_canonical_system_with_its_hessian(method):
     nan = lf.Canonical(_hh_h, _hh_gradient, dof=2, hessian=lambda q, p, dq, dp: [[np.nan] * 2] * 2)
     with pytest.raises(lf.NonFiniteError, match="hessian"):
         lf.integrate(nan, z0, 0.1, 5, method=method, sensitivity=True)
+
+
+def _on_manifold(system, z0, eps):
+    """A curve through z0 on the system's constraint manifold, at parameter eps."""
+    w = eps * np.array([0.3, -0.5, 0.4])
+    if isinstance(system, (lf.SphericalPendulum, lf.SphereParticle)):
+        R = lf.lie.so3_exp(w)
+        return np.concatenate([R @ z0[:3], R @ z0[3:]])
+    # The incompressible body: (X e^{εA}, P e^{εA}), tr A = 0, keeps det X and <cof X, P> = 0.
+    A = eps * np.array([[0.2, 0.5, -0.1], [0.3, -0.4, 0.2], [0.1, -0.3, 0.2]])
+    E = scipy.linalg.expm(A)
+    return np.concatenate([(z0[:9].reshape(3, 3) @ E).ravel(), (z0[9:].reshape(3, 3) @ E).ravel()])
+
+
+def _constrained_cases():
+    pend = lf.SphericalPendulum(1.0, 1.2, 9.81)
+    particle = lf.SphereParticle(2.0, 1.5, 9.81)
+    inc = lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(1.0, 2.0), incompressible=True)
+    X = np.array([[1.3, 0.1, -0.05], [0.02, 1.1, 0.08], [-0.03, 0.05, 0.9]])
+    P = np.array([[0.1, -0.5, 0.2], [0.6, 0.05, -0.3], [-0.1, 0.4, 0.02]])
+    C = np.linalg.det(X) * np.linalg.inv(X).T
+    P = P - np.sum(C * P) / np.sum(C * C) * C
+    return [(pend, np.asarray(pend.state_from_spherical(0.8, 0.1, 0.3, 1.2))),
+            (particle, np.array([0.0, 0.9, 1.2, 0.4, 1.2, -0.9])),
+            (inc, np.concatenate([X.ravel(), P.ravel()]))]
+
+
+@pytest.mark.parametrize("case", range(3), ids=["SphericalPendulum", "SphereParticle",
+                                                "PseudoRigidBody-incompressible"])
+def test_jacobians_of_constrained_systems_along_their_manifold(case):
+    """Systems whose states carry constraints (|q| = 1 and q.L = 0; |q| = l and q.p = 0;
+    det X fixed and <cof X, P> = 0): J v for the velocity v of a curve on the manifold against
+    central differences along the curve, for each lifted method (splittings and rk4; RATTLE)."""
+    system, z0 = _constrained_cases()[case]
+    methods = system.sensitivity_methods()
+    assert methods == system.methods() or methods == [m for m in system.methods()
+                                                      if m != "reduced"]
+    h = 1e-5
+    v = (_on_manifold(system, z0, h) - _on_manifold(system, z0, -h)) / (2 * h)
+    for method in methods:
+        traj = lf.integrate(system, z0, 0.02, 50, method=method, sensitivity=True, save_every=50)
+        ends = [lf.integrate(system, _on_manifold(system, z0, s), 0.02, 50,
+                             method=method).final_state for s in (h, -h)]
+        fd = (ends[0] - ends[1]) / (2 * h)
+        np.testing.assert_allclose(traj.final_jacobian @ v, fd, atol=1e-8 * np.abs(fd).max(),
+                                   err_msg=method)

@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use lieflow::integrate::problem::Symmetric;
-use lieflow::integrate::{check_state, integrate, System};
+use lieflow::integrate::{check_state, integrate, Clock, System};
 use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::{PseudoRigidBody, RightReduced};
@@ -645,10 +645,26 @@ fn jacobians_of_every_lifted_pair_are_the_methods_derivative() {
                 let end = |s: f64| {
                     let mut z = c.z0.clone();
                     z[j] += s;
-                    integrate(&*c.system, name, &z, c.dt, steps, steps)
-                        .unwrap()
-                        .state(1)
-                        .to_vec()
+                    if check_state(&*c.system, &z).is_ok() {
+                        return integrate(&*c.system, name, &z, c.dt, steps, steps)
+                            .unwrap()
+                            .state(1)
+                            .to_vec();
+                    }
+                    // Off the constraint (|q| = 1, Q symmetric), which the lift differentiates
+                    // across: the method's own map, through its stepper.
+                    let (mut st, _) = c.system.stepper(name, c.dt).unwrap();
+                    c.system.to_internal(&mut z);
+                    st.set(&z).unwrap();
+                    let clock = Clock {
+                        t0: 0.0,
+                        dt: c.dt,
+                        done: 0,
+                    };
+                    st.advance(steps, clock).unwrap();
+                    st.get(&mut z);
+                    c.system.to_user(&mut z);
+                    z
                 };
                 let (p, q) = (end(h), end(-h));
                 let scale = jac.iter().fold(1.0f64, |m, x| m.max(x.abs()));

@@ -263,6 +263,15 @@ pub trait Constrained: Separable {
     /// (m values) — the curvature term of the acceleration constraint
     /// d²/dt² g(q(t)) = G(q) q̈ + D²g(q)[q̇, q̇] = 0.
     fn constraint_curvature(&self, q: &[f64], v: &[f64], out: &mut [f64], s: &mut Self::Scratch);
+
+    /// The rows F (m × d, row-major) along which the multipliers act on the momenta,
+    /// ṗ = f − Fᵀλ, when they differ from G(q): writes them and returns true. A mechanical
+    /// system's are G (false, the default); a tangent lift's are not
+    /// ([`crate::integrate::tangent`]: the lifted constraint forces pair the directions the
+    /// other way round).
+    fn constraint_forces(&self, _q: &[f64], _rows: &mut [f64], _s: &mut Self::Scratch) -> bool {
+        false
+    }
 }
 
 /// A [`Separable`] system with T = ½ pᵀM⁻¹p restricted by linear velocity constraints

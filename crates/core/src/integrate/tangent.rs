@@ -455,6 +455,43 @@ impl<P: Constrained + SeparableTangent + Clone> Constrained for Tangent<P> {
         }
     }
 
+    /// The force rows pair the other way round: the base multipliers λ act on the directions
+    /// through D²g(q)\[δq_j, ·\]ᵀλ (the derivative of G(q)ᵀλ), so F = (G, D²g\[δq₁, ·\], …)
+    /// for the base rows and G in its own block for each direction's; with G̃ as above,
+    /// G̃ M̃⁻¹F̃ᵀ is block lower-triangular with G M⁻¹Gᵀ on its diagonal.
+    fn constraint_forces(&self, q: &[f64], rows: &mut [f64], s: &mut Self::Scratch) -> bool {
+        let (n, m, k) = (self.problem.dof(), self.problem.constraints(), self.k());
+        let cols = n * (k + 1);
+        let LiftScratch {
+            base,
+            jac: g,
+            second,
+            w,
+            c,
+        } = s;
+        g.resize(m * n, 0.0);
+        second.resize(m * n, 0.0);
+        w.resize(n, 0.0);
+        c.resize(2 * m, 0.0);
+        self.problem.constraint_jacobian(&q[..n], g, base);
+        rows.fill(0.0);
+        for j in 0..=k {
+            if j > 0 {
+                let dq = &q[j * n..(j + 1) * n];
+                constraint_second(&self.problem, &q[..n], dq, second, w, c, base);
+            }
+            for a in 0..m {
+                let own = (j * m + a) * cols + j * n;
+                rows[own..own + n].copy_from_slice(&g[a * n..(a + 1) * n]);
+                if j > 0 {
+                    let at = a * cols + j * n;
+                    rows[at..at + n].copy_from_slice(&second[a * n..(a + 1) * n]);
+                }
+            }
+        }
+        true
+    }
+
     /// NaN: the lift's curvature needs D³g, which no constraint gives (RATTLE does not use it;
     /// the index-1 field of a lift is not offered).
     fn constraint_curvature(

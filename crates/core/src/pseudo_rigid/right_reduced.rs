@@ -38,6 +38,15 @@
 //! a kick leaves it. The reconstructed (X, NᵀX⁻ᵀ) is the full Verlet motion of the same steps,
 //! and its circulation stays the initial one ([`RightReduced::reconstruct`]).
 //!
+//! # Tangent lift
+//! The Jacobians of `verlet`, `verlet4`, `verlet6` and `rk4` (issue 26,
+//! [`crate::integrate::tangent`]) come from the tangent maps of the kick and the drift and the
+//! derivative of the field, built from the derivative of the Cholesky factor,
+//! δC = CΦ with Φ = the lower triangle of C⁻¹δQC⁻ᵀ, diagonal halved (δQ read from its lower
+//! triangle, as the factorisation reads Q), and the potential's Hessian D²U(C)\[δC\]; X
+//! (reconstruction) included; the parameters are the potential's constants. Directions are
+//! ambient (Q need not stay symmetric along them).
+//!
 //! # The reduced Euler–Lagrange equation (3.17)
 //! [`euler_lagrange`] is the reduced field of any right-invariant Lagrangian 𝓛(Q, N):
 //! d/dt(∂𝓛/∂N)ᵀ = (∂𝓛/∂N − (∂𝓛/∂N)ᵀ)NᵀQ⁻¹ + 2∂𝓛/∂Q, with Q̇ = N + Nᵀ; for 𝓛 = ½tr(NᵀQ⁻¹N) − U
@@ -56,12 +65,13 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Splitting};
 use crate::integrate::problem::{Split, VectorField, Violation};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{SplitTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::so::spectral_invariants;
 use crate::numerics::linalg;
 use crate::Mat;
 use faer::linalg::solvers::Solve;
-use faer::Accum;
+use faer::{Accum, MatMut, MatRef};
 
 /// Relative tolerance of a state's Q (symmetric: ‖Q − Qᵀ‖_F ≤ tol ‖Q‖_F) and, when
 /// reconstructing, of its X over Q (‖XXᵀ − Q‖_F ≤ tol ‖Q‖_F).
@@ -392,6 +402,11 @@ impl Problem for RightReduced {
         self.body.potential().calls_out()
     }
 
+    /// The potential's constants ([`Potential::parameters`]).
+    fn parameters(&self) -> Vec<&'static str> {
+        self.body.potential().parameters()
+    }
+
     fn space(&self) -> Space {
         let n = self.n();
         if self.reconstruct {
@@ -643,9 +658,305 @@ impl VectorField for RightReduced {
     }
 }
 
+/// The derivatives of the reduced flows and field at one state (Q, N\[, X\]) (module docs,
+/// "Tangent lift"): its representative C, G = ∂U/∂X(C), W = C⁻¹N, T = C⁻¹X, and the scratch of
+/// one direction; formed once for all the directions of a flow.
+struct Linear<'a> {
+    pot: &'a dyn Potential,
+    c: Mat,
+    g: Mat,
+    w: Mat,
+    t: Option<Mat>,
+    dc: Mat,
+    dw: Mat,
+    a: Mat,
+    b: Mat,
+    ws: Workspace,
+}
+
+/// A row-major n×n block of a flat direction.
+fn view(z: &mut [f64], n: usize) -> MatMut<'_, f64> {
+    MatMut::from_row_major_slice_mut(z, n, n)
+}
+
+impl<'a> Linear<'a> {
+    /// None where Q is not positive definite.
+    fn at(body: &'a RightReduced, q: &Mat, nn: &Mat, x: Option<&Mat>) -> Option<Self> {
+        let n = body.n();
+        let pot = body.body.potential();
+        let mut c = q.clone();
+        if !linalg::cholesky(c.as_mut()) {
+            return None;
+        }
+        let mut ws = body.body.workspace();
+        let mut g = Mat::zeros(n, n);
+        pot.add_gradient(c.as_ref(), g.as_mut(), &mut ws);
+        let mut w = nn.clone();
+        linalg::solve_lower(c.as_ref(), w.as_mut());
+        let t = x.map(|x| {
+            let mut t = x.clone();
+            linalg::solve_lower(c.as_ref(), t.as_mut());
+            t
+        });
+        Some(Linear {
+            pot,
+            c,
+            g,
+            w,
+            t,
+            dc: Mat::zeros(n, n),
+            dw: Mat::zeros(n, n),
+            a: Mat::zeros(n, n),
+            b: Mat::zeros(n, n),
+            ws,
+        })
+    }
+
+    /// dc ← δC = CΦ, Φ the lower triangle of C⁻¹SC⁻ᵀ with its diagonal halved, S the symmetric
+    /// matrix of δQ's lower triangle (from δQ = δC Cᵀ + C δCᵀ).
+    fn cholesky(&mut self, dq: MatRef<'_, f64>) {
+        let n = self.c.nrows();
+        for i in 0..n {
+            for j in 0..=i {
+                self.a[(i, j)] = dq[(i, j)];
+                self.a[(j, i)] = dq[(i, j)];
+            }
+        }
+        linalg::solve_lower(self.c.as_ref(), self.a.as_mut());
+        self.b.copy_from(self.a.transpose());
+        linalg::solve_lower(self.c.as_ref(), self.b.as_mut());
+        for i in 0..n {
+            for j in 0..n {
+                self.a[(i, j)] = match i.cmp(&j) {
+                    std::cmp::Ordering::Greater => self.b[(i, j)],
+                    std::cmp::Ordering::Equal => 0.5 * self.b[(i, i)],
+                    std::cmp::Ordering::Less => 0.0,
+                };
+            }
+        }
+        linalg::mul(
+            self.dc.as_mut(),
+            Accum::Replace,
+            self.c.as_ref(),
+            self.a.as_ref(),
+            1.0,
+        );
+    }
+
+    /// dn += α(δC Gᵀ + C D²U(C)\[δC\]ᵀ), the derivative of αCGᵀ (after [`Linear::cholesky`]).
+    fn force(&mut self, alpha: f64, mut dn: MatMut<'_, f64>) {
+        self.b.fill(0.0);
+        self.pot.add_hessian(
+            self.c.as_ref(),
+            self.dc.as_ref(),
+            self.b.as_mut(),
+            &mut self.ws,
+        );
+        linalg::mul(
+            dn.as_mut(),
+            Accum::Add,
+            self.dc.as_ref(),
+            self.g.transpose(),
+            alpha,
+        );
+        linalg::mul(dn, Accum::Add, self.c.as_ref(), self.b.transpose(), alpha);
+    }
+
+    /// a ← δK = δWᵀW + WᵀδW with δW = C⁻¹(δN − δC W) in dw (after [`Linear::cholesky`]): the
+    /// derivative of K = WᵀW.
+    fn kinetic(&mut self, dn: MatRef<'_, f64>) {
+        self.dw.copy_from(dn);
+        linalg::mul(
+            self.dw.as_mut(),
+            Accum::Add,
+            self.dc.as_ref(),
+            self.w.as_ref(),
+            -1.0,
+        );
+        linalg::solve_lower(self.c.as_ref(), self.dw.as_mut());
+        linalg::mul(
+            self.a.as_mut(),
+            Accum::Replace,
+            self.dw.transpose(),
+            self.w.as_ref(),
+            1.0,
+        );
+        linalg::mul(
+            self.a.as_mut(),
+            Accum::Add,
+            self.w.transpose(),
+            self.dw.as_ref(),
+            1.0,
+        );
+    }
+
+    /// b ← δT = C⁻¹(δX − δC T) (after [`Linear::cholesky`]).
+    fn reconstruction(&mut self, dx: MatRef<'_, f64>) {
+        let t = self.t.as_ref().expect("X is carried");
+        self.b.copy_from(dx);
+        linalg::mul(
+            self.b.as_mut(),
+            Accum::Add,
+            self.dc.as_ref(),
+            t.as_ref(),
+            -1.0,
+        );
+        linalg::solve_lower(self.c.as_ref(), self.b.as_mut());
+    }
+
+    /// out += α(δWᵀT + WᵀδT), the derivative of αWᵀT (after [`Linear::kinetic`] and
+    /// [`Linear::reconstruction`]).
+    fn add_reconstruction(&self, mut out: MatMut<'_, f64>, alpha: f64) {
+        let t = self.t.as_ref().expect("X is carried");
+        linalg::mul(
+            out.as_mut(),
+            Accum::Add,
+            self.dw.transpose(),
+            t.as_ref(),
+            alpha,
+        );
+        linalg::mul(out, Accum::Add, self.w.transpose(), self.b.as_ref(), alpha);
+    }
+
+    /// dn += α C (∂G/∂θ_m)ᵀ.
+    fn force_parameter(&mut self, m: usize, alpha: f64, dn: MatMut<'_, f64>) {
+        self.b.fill(0.0);
+        self.pot
+            .add_parameter_gradient(self.c.as_ref(), m, self.b.as_mut(), &mut self.ws);
+        linalg::mul(dn, Accum::Add, self.c.as_ref(), self.b.transpose(), alpha);
+    }
+}
+
+impl RightReduced {
+    /// The blocks (δQ, δN, δX) of a flat direction (δX empty without reconstruction).
+    fn blocks_of<'z>(&self, dz: &'z mut [f64]) -> (&'z mut [f64], &'z mut [f64], &'z mut [f64]) {
+        let nn = self.n() * self.n();
+        let (dq, rest) = dz.split_at_mut(nn);
+        let (dn, dx) = rest.split_at_mut(nn);
+        (dq, dn, dx)
+    }
+}
+
+/// The kick: δN′ = δN − τ(δC Gᵀ + C D²U(C)\[δC\]ᵀ). The drift (Q′ = Q + τ(N + Nᵀ) + τ²K,
+/// N′ = N + τK, X′ = X + τWᵀT): δQ′ = δQ + τ(δN + δNᵀ) + τ²δK, δN′ = δN + τδK,
+/// δX′ = δX + τ(δWᵀT + WᵀδT) (module docs, "Tangent lift"). NaN where Q is not positive definite.
+impl SplitTangent for RightReduced {
+    fn flow_tangent(&self, i: usize, tau: f64, before: &Work, _after: &Work, dirs: &mut [f64]) {
+        let n = self.n();
+        let Some(mut lin) = Linear::at(self, &before.q, &before.nn, before.x.as_ref()) else {
+            dirs.fill(f64::NAN);
+            return;
+        };
+        for dz in dirs.chunks_exact_mut(self.blocks() * n * n) {
+            let (dq, dn, dx) = self.blocks_of(dz);
+            lin.cholesky(MatRef::from_row_major_slice(dq, n, n));
+            if i == 0 {
+                lin.force(-tau, view(dn, n));
+                continue;
+            }
+            lin.kinetic(MatRef::from_row_major_slice(dn, n, n));
+            if !dx.is_empty() {
+                lin.reconstruction(MatRef::from_row_major_slice(dx, n, n));
+                lin.add_reconstruction(view(dx, n), tau);
+            }
+            let (mut q, mut m) = (view(dq, n), view(dn, n));
+            for r in 0..n {
+                for c in 0..n {
+                    q[(r, c)] += tau * (m[(r, c)] + m[(c, r)]) + tau * tau * lin.a[(r, c)];
+                }
+            }
+            linalg::axpy(m.as_mut(), tau, lin.a.as_ref());
+        }
+    }
+
+    /// The kick moves with the potential's constants: δN′ −= τ C (∂G/∂θ_m)ᵀ.
+    fn flow_parameter(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &Work,
+        _after: &Work,
+        m: usize,
+        dz: &mut [f64],
+    ) {
+        if i != 0 {
+            return;
+        }
+        let n = self.n();
+        let Some(mut lin) = Linear::at(self, &before.q, &before.nn, None) else {
+            dz.fill(f64::NAN);
+            return;
+        };
+        let (_, dn, _) = self.blocks_of(dz);
+        lin.force_parameter(m, -tau, view(dn, n));
+    }
+}
+
+/// The derivative of the Riemann field (001 (3.20)): δQ̇ = δN + δNᵀ,
+/// δṄ = δK − δC Gᵀ − C D²U(C)\[δC\]ᵀ, δẊ = δWᵀT + WᵀδT.
+impl VectorFieldTangent for RightReduced {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        let n = self.n();
+        let nn = n * n;
+        let (q, m) = (read(n, &z[..nn]), read(n, &z[nn..2 * nn]));
+        let x = self.reconstruct.then(|| read(n, &z[2 * nn..]));
+        let Some(mut lin) = Linear::at(self, &q, &m, x.as_ref()) else {
+            out.fill(f64::NAN);
+            return;
+        };
+        out.fill(0.0);
+        let (oq, on, ox) = self.blocks_of(out);
+        let dn = MatRef::from_row_major_slice(&dz[nn..2 * nn], n, n);
+        lin.cholesky(MatRef::from_row_major_slice(&dz[..nn], n, n));
+        lin.kinetic(dn);
+        if !ox.is_empty() {
+            lin.reconstruction(MatRef::from_row_major_slice(&dz[2 * nn..], n, n));
+            lin.add_reconstruction(view(ox, n), 1.0);
+        }
+        let (mut oq, mut on) = (view(oq, n), view(on, n));
+        for r in 0..n {
+            for c in 0..n {
+                oq[(r, c)] = dn[(r, c)] + dn[(c, r)];
+            }
+        }
+        on.copy_from(lin.a.as_ref());
+        lin.force(-1.0, on);
+    }
+
+    /// δṄ −= C (∂G/∂θ_m)ᵀ.
+    fn field_parameter(&self, z: &[f64], m: usize, out: &mut [f64]) {
+        let n = self.n();
+        let nn = n * n;
+        let (q, mm) = (read(n, &z[..nn]), read(n, &z[nn..2 * nn]));
+        let Some(mut lin) = Linear::at(self, &q, &mm, None) else {
+            out.fill(f64::NAN);
+            return;
+        };
+        let (_, on, _) = self.blocks_of(out);
+        lin.force_parameter(m, -1.0, view(on, n));
+    }
+}
+
 /// `verlet` (default), `verlet4`, `verlet6` (the reduced Störmer–Verlet and its Suzuki / Yoshida
 /// compositions), `rk4` (the Riemann field, a baseline that keeps nothing).
 impl Catalog for RightReduced {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("verlet", Splitting::strang),
+            Entry::new("verlet4", || Splitting(Composition::suzuki4())),
+            Entry::new("verlet6", || Splitting(Composition::yoshida6())),
+            Entry::new("rk4", || Rk4),
+        ]
+    }
+
+    /// The tangent lift of every method (module docs, "Tangent lift").
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
+        Some(Tangent::split(self.clone()).into_system())
+    }
+}
+
+/// Every method of the system, on its tangent lift.
+impl Catalog for Tangent<RightReduced> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("verlet", Splitting::strang),

@@ -118,7 +118,11 @@ pub(crate) struct Rows {
     d: usize,
     /// The rows C.
     pub(crate) c: Vec<f64>,
-    /// The rows W = M⁻¹Cᵀ.
+    /// The rows F along which the multipliers act (F = C unless `distinct`: a tangent lift,
+    /// [`Constrained::constraint_forces`]).
+    pub(crate) f: Vec<f64>,
+    pub(crate) distinct: bool,
+    /// The rows W = M⁻¹Fᵀ.
     pub(crate) w: Vec<f64>,
     lu: DenseLu,
     rhs: Vec<f64>,
@@ -131,20 +135,36 @@ impl Rows {
             m,
             d,
             c: vec![0.0; m * d],
+            f: Vec::new(),
+            distinct: false,
             w: vec![0.0; m * d],
             lu: DenseLu::new(m),
             rhs: vec![0.0; m],
         }
     }
 
-    /// W_b = M⁻¹C_b for the current rows C.
+    /// The force rows F (C unless they are distinct).
+    pub(crate) fn forces(&self) -> &[f64] {
+        if self.distinct {
+            &self.f
+        } else {
+            &self.c
+        }
+    }
+
+    /// C = G(q) and the force rows F at q ([`Constrained::constraint_forces`]).
+    pub(crate) fn load<P: Constrained>(&mut self, problem: &P, q: &[f64], s: &mut P::Scratch) {
+        problem.constraint_jacobian(q, &mut self.c, s);
+        self.f.resize(self.c.len(), 0.0);
+        self.distinct = problem.constraint_forces(q, &mut self.f, s);
+    }
+
+    /// W_b = M⁻¹F_b for the current rows F.
     pub(crate) fn update_w<P: Separable>(&mut self, problem: &P) {
-        for (cb, wb) in self
-            .c
-            .chunks_exact(self.d)
-            .zip(self.w.chunks_exact_mut(self.d))
-        {
-            problem.velocity(cb, wb);
+        let d = self.d;
+        let forces = if self.distinct { &self.f } else { &self.c };
+        for (fb, wb) in forces.chunks_exact(d).zip(self.w.chunks_exact_mut(d)) {
+            problem.velocity(fb, wb);
         }
     }
 
@@ -167,7 +187,7 @@ impl Rows {
         self.lu.solve(x);
     }
 
-    /// p ← p − Cᵀκ with κ such that C M⁻¹p = 0 afterwards (the projection of the last RATTLE
+    /// p ← p − Fᵀκ with κ such that C M⁻¹p = 0 afterwards (the projection of the last RATTLE
     /// substep; `v` is scratch of length d). False when C M⁻¹Cᵀ is singular.
     pub(crate) fn project<P: Separable>(
         &mut self,
@@ -187,8 +207,9 @@ impl Rows {
             self.rhs[a] = dot(&self.c[a * d..(a + 1) * d], v);
         }
         self.lu.solve(&mut self.rhs);
+        let forces = if self.distinct { &self.f } else { &self.c };
         for a in 0..m {
-            axpy(p, -self.rhs[a], &self.c[a * d..(a + 1) * d]);
+            axpy(p, -self.rhs[a], &forces[a * d..(a + 1) * d]);
         }
         true
     }
@@ -270,8 +291,7 @@ impl<P: Constrained> RattleStepper<P> {
     fn load(&mut self) -> std::result::Result<(), Violation> {
         self.problem
             .force(&self.q, &mut self.f, &mut self.scratch)?;
-        self.problem
-            .constraint_jacobian(&self.q, &mut self.rows.c, &mut self.scratch);
+        self.rows.load(&self.problem, &self.q, &mut self.scratch);
         self.rows.update_w(&self.problem);
         Ok(())
     }
@@ -339,11 +359,11 @@ impl<P: Constrained> RattleStepper<P> {
         }
         // p_{n+1/2} = p̃ − G(q_n)ᵀν/h.
         for (b, &nb) in nu.iter().enumerate() {
-            axpy(p, -nb / h, &rows.c[b * d..(b + 1) * d]);
+            axpy(p, -nb / h, &rows.forces()[b * d..(b + 1) * d]);
         }
         q.copy_from_slice(qn);
         problem.force(q, f, scratch).map_err(Failure::Domain)?;
-        problem.constraint_jacobian(q, &mut rows.c, scratch);
+        rows.load(problem, q, scratch);
         rows.update_w(problem);
         // p_{n+1} = p_{n+1/2} + h/2 f(q_{n+1}) − G(q_{n+1})ᵀκ, G M⁻¹p_{n+1} = 0.
         axpy(p, 0.5 * h, f);

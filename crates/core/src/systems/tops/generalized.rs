@@ -6,6 +6,10 @@
 //! coordinates of `lie::so::vee_n`. Sign check against so(3): the matrix of the physics hat map
 //! satisfies [hat M, hat Ω] = hat(M × Ω), so Ṁ = [M, Ω] is Euler's equation; in e_ij coordinates
 //! c = (−w₃, w₂, −w₁), and with J_i + J_j = I_k ({i, j, k} = {1, 2, 3}) the energies agree (tested).
+//!
+//! Tangent lift (issue 26, [`crate::integrate::tangent`]): the derivative of the field,
+//! δṀ = [δM, Ω] + [M, δΩ], for `rk4`; `isospectral` and `rkmk4` are group methods the lift
+//! does not cover, and J carries no parameter directions.
 
 use super::methods::isospectral::Isospectral;
 use crate::check;
@@ -13,6 +17,7 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::{Rk4, Rkmk4};
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::so;
 use crate::Mat;
@@ -219,6 +224,33 @@ impl VectorField for GeneralizedRigidBody {
     }
 }
 
+/// δṀ = [δM, Ω] + [M, δΩ], δΩ_ij = δM_ij/(J_i + J_j) (principal frame).
+impl VectorFieldTangent for GeneralizedRigidBody {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        let n = self.n;
+        let om = |v: &[f64], i: usize, k: usize| {
+            if i == k {
+                0.0
+            } else {
+                self.entry(v, i, k) / self.d[i * n + k]
+            }
+        };
+        let mut c = 0;
+        for i in 0..n {
+            for j in i + 1..n {
+                let mut s = 0.0;
+                for k in 0..n {
+                    s += self.entry(dz, i, k) * om(z, k, j) - om(z, i, k) * self.entry(dz, k, j)
+                        + self.entry(z, i, k) * om(dz, k, j)
+                        - om(dz, i, k) * self.entry(z, k, j);
+                }
+                out[c] = s;
+                c += 1;
+            }
+        }
+    }
+}
+
 impl Catalog for GeneralizedRigidBody {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
@@ -226,6 +258,11 @@ impl Catalog for GeneralizedRigidBody {
             Entry::new("rk4", || Rk4),
             Entry::new("rkmk4", || Rkmk4),
         ]
+    }
+
+    /// The tangent lift of `rk4` (module docs).
+    fn tangent(&self) -> Option<std::sync::Arc<dyn TangentSystem>> {
+        Some(Tangent::field(self.clone()).into_system())
     }
 
     fn dissipation(
@@ -411,5 +448,12 @@ fn matmul(n: usize, a: &[f64], b: &[f64], c: &mut [f64]) {
         for j in 0..n {
             c[i * n + j] = (0..n).map(|k| a[i * n + k] * b[k * n + j]).sum();
         }
+    }
+}
+
+/// `rk4` on the tangent lift (the group methods `isospectral`, `rkmk4` are not of its kind).
+impl Catalog for Tangent<GeneralizedRigidBody> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        vec![Entry::new("rk4", || Rk4)]
     }
 }

@@ -18,12 +18,17 @@
 //!
 //! Splitting: the kinetic flow rotates q about the fixed L by the angle t|L|/(ml²); the potential
 //! flow kicks L ↦ L + t mgl e₃ × q. Both are exact, keep |q|², q·L and L₃ exactly.
+//!
+//! Tangent lift (issue 26, [`crate::integrate::tangent`]): the tangent maps of both flows and the
+//! derivative of the field, in the ambient R⁶ (off the constraints too), with the parameters
+//! `mass`, `length`, `g` through ml² and mgl.
 
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Splitting};
 use crate::integrate::problem::{Split, Symmetric, VectorField};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{SplitTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::systems::test_problems::pendulum::Bob;
 use nalgebra::Vector3;
@@ -96,6 +101,10 @@ impl SphericalPendulum {
 impl Problem for SphericalPendulum {
     fn name(&self) -> &'static str {
         "SphericalPendulum"
+    }
+    /// The constructor's m, l, g.
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["mass", "length", "g"]
     }
     fn space(&self) -> Space {
         Space::new([("q", Block::Real(3)), ("L", Block::Real(3))])
@@ -193,7 +202,125 @@ impl VectorField for SphericalPendulum {
     }
 }
 
+impl SphericalPendulum {
+    /// (∂(ml²)/∂θ, ∂(mgl)/∂θ) for the parameter θ = m, l or g (0, 1, 2).
+    fn rates(&self, m: usize) -> (f64, f64) {
+        let Bob {
+            mass,
+            length: l,
+            gravity: g,
+        } = self.bob;
+        match m {
+            0 => (l * l, g * l),
+            1 => (2.0 * mass * l, mass * g),
+            _ => (0.0, mass * l),
+        }
+    }
+}
+
+fn v3(z: &[f64]) -> Vector3<f64> {
+    Vector3::new(z[0], z[1], z[2])
+}
+
+/// Flow 0, the kick: δL′ = δL + τ mgl e₃ × δq. Flow 1, q′ = exp(ŵ)q with w = τL/(ml²) and L
+/// fixed: exp(w + δw) = exp(hat(J_l(w)δw)) exp(ŵ) to first order, so
+/// δq′ = exp(ŵ)δq + (J_l(w)δw) × q′, δw = τδL/(ml²).
+impl SplitTangent for SphericalPendulum {
+    fn flow_tangent(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &Self::Work,
+        after: &Self::Work,
+        dirs: &mut [f64],
+    ) {
+        if i == 0 {
+            let k = tau * self.bob.mgl();
+            for dz in dirs.chunks_exact_mut(6) {
+                let (x, y) = (dz[0], dz[1]);
+                dz[3] -= k * y;
+                dz[4] += k * x;
+            }
+            return;
+        }
+        let t = tau / self.bob.inertia();
+        let (e, jl) = crate::lie::so3::exp_and_jacobian_left(&(before.1 * t));
+        let q1 = after.0;
+        for dz in dirs.chunks_exact_mut(6) {
+            let dq = e * v3(dz) + (jl * (v3(&dz[3..]) * t)).cross(&q1);
+            dz[..3].copy_from_slice(dq.as_slice());
+        }
+    }
+
+    /// Kick: τ ∂(mgl) e₃ × q. Rotation: w moves by ∂w = −(∂I/I)w, and J_l(w)w = w, so
+    /// δq′ = −(∂I/I) w × q′ (I = ml²).
+    fn flow_parameter(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &Self::Work,
+        after: &Self::Work,
+        m: usize,
+        dz: &mut [f64],
+    ) {
+        let (di, dk) = self.rates(m);
+        if i == 0 {
+            let q = before.0;
+            dz[3] -= tau * dk * q.y;
+            dz[4] += tau * dk * q.x;
+            return;
+        }
+        let i = self.bob.inertia();
+        let d = (before.1 * (-tau * di / (i * i))).cross(&after.0);
+        for c in 0..3 {
+            dz[c] += d[c];
+        }
+    }
+}
+
+/// δq̇ = (δL/(ml²)) × q + ω × δq, δL̇ = mgl e₃ × δq.
+impl VectorFieldTangent for SphericalPendulum {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        let i = self.bob.inertia();
+        let (q, l) = (v3(z), v3(&z[3..]));
+        let (dq, dl) = (v3(dz), v3(&dz[3..]));
+        out[..3].copy_from_slice(((dl.cross(&q) + l.cross(&dq)) / i).as_slice());
+        let k = self.bob.mgl();
+        out[3..].copy_from_slice(&[-k * dq.y, k * dq.x, 0.0]);
+    }
+
+    /// ∂q̇ = −(∂I/I²) L × q, ∂L̇ = ∂(mgl) e₃ × q.
+    fn field_parameter(&self, z: &[f64], m: usize, out: &mut [f64]) {
+        let (di, dk) = self.rates(m);
+        let i = self.bob.inertia();
+        let (q, l) = (v3(z), v3(&z[3..]));
+        let d = l.cross(&q) * (-di / (i * i));
+        for c in 0..3 {
+            out[c] += d[c];
+        }
+        out[3] -= dk * q.y;
+        out[4] += dk * q.x;
+    }
+}
+
 impl Catalog for SphericalPendulum {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        vec![
+            Entry::new("splitting", Splitting::strang),
+            Entry::new("splitting4", || Splitting(Composition::suzuki4())),
+            Entry::new("splitting6", || Splitting(Composition::yoshida6())),
+            Entry::new("rk4", || Rk4),
+        ]
+    }
+
+    /// The tangent lift of every method (the splittings' flows and rk4's field).
+    fn tangent(&self) -> Option<std::sync::Arc<dyn TangentSystem>> {
+        Some(Tangent::split(self.clone()).into_system())
+    }
+}
+
+/// Every method of the system, on its tangent lift.
+impl Catalog for Tangent<SphericalPendulum> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("splitting", Splitting::strang),
