@@ -1,8 +1,10 @@
 """Cost of the exact Jacobian of the discrete flow (issue 26): the run with sensitivity=True
 against the plain run of the same method and step, for the rigid body with attitude
-(splitting4; directions: 6 state + 3 moments), the heavy top (splitting4; 6 + 7) and the
-pseudo-rigid body n = 3 (verlet4, SVK + volumetric; 18 + 0). The lift carries k directions, so
-the ideal factor is 1 + k. Wall time is the best of 5 calls of 2000 steps (save_every = steps).
+(splitting4; directions: 6 state + 3 moments), the heavy top (splitting4; 6 + 7), the
+pseudo-rigid body n = 3 (verlet4, SVK + volumetric; 18 + 4), the incompressible one (rattle4: the
+constrained lift, 18 + 4) and the pendulum with the implicit Gauss method (gauss6, through the
+implicit-function theorem: one LU per step for all directions; 2 + 0). The lift carries k
+directions, so the ideal factor is 1 + k. Wall time is the best of 5 calls of 2000 steps (save_every = steps).
 
     python benches/python/sensitivity_cost.py
 """
@@ -23,11 +25,18 @@ def cases():
                              + lf.potentials.Volumetric(0.5, 1.4))
     X = np.diag([1.3, 1.1, 0.9])
     P = np.array([[0.1, -0.5, 0.2], [0.6, 0.05, -0.3], [-0.1, 0.4, 0.02]])
+    inc = lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(1.0, 2.0)
+                             + lf.potentials.Volumetric(0.5, 1.4), incompressible=True)
+    C = np.linalg.det(X) * np.linalg.inv(X).T
+    P_inc = P - np.sum(C * P) / np.sum(C * C) * C      # on T*{det X = det X0}
     return [
         ("RigidBody with attitude", rb, np.array([0.3, -0.8, 1.1]), R0, "splitting4", 6 + 3),
         ("HeavyTop", ht, np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8]), None, "splitting4", 6 + 7),
         ("PseudoRigidBody n = 3", prb, np.concatenate([X.ravel(), P.ravel()]), None, "verlet4",
-         18),
+         18 + 4),
+        ("PseudoRigidBody incompr.", inc, np.concatenate([X.ravel(), P_inc.ravel()]), None,
+         "rattle4", 18 + 4),
+        ("Pendulum", lf.Pendulum(1.0, 1.0, 9.81), np.array([1.0, 0.3]), None, "gauss6", 2),
     ]
 
 

@@ -25,6 +25,72 @@ def _check_method(attrs, system):
                                   f"{type(system).__name__}: {known}")
 
 
+def _check_parameters(attrs, system):
+    """FileFormatError unless the stored Jacobians' parameter names are ``system.parameters``."""
+    if "parameters" in attrs and _parameter_names(attrs) != list(system.parameters):
+        raise FileFormatError(f"the parameter Jacobian is along {_parameter_names(attrs)}, but "
+                              f"{type(system).__name__} has the parameters "
+                              f"{list(system.parameters)}")
+
+
+def _parameter_names(attrs):
+    text = attrs["parameters"]
+    try:
+        if not isinstance(text, str) or len(text) > 1 << 16:
+            raise ValueError("not a short JSON text")
+        names = json.loads(text)
+    except (ValueError, RecursionError) as e:
+        raise FileFormatError(f"the attribute parameters is not a JSON list of names: "
+                              f"{e}") from e
+    if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
+        raise FileFormatError(f"the attribute parameters is not a list of names: {text!r:.60}")
+    return names
+
+
+def _jacobians(ds, var, dims, lead, b, k, d):
+    """The Jacobians of a run with sensitivities (none: {}), their layout checked: e = d, or
+    d + 3 with an attitude (its left-trivialised directions); the parameter Jacobians zero-wide
+    when the system has no parameters (then not stored)."""
+    names = ("jacobian", "final_jacobian", "parameter_jacobian", "final_parameter_jacobian")
+    present = [n for n in names if n in ds.variables]
+    if not present and "parameters" not in ds.attrs:
+        return {}
+    if "jacobian" not in ds.variables or "parameters" not in ds.attrs:
+        raise FileFormatError(f"the Jacobians of a run with sensitivities are incomplete: it has "
+                              f"{present} and {'an' if 'parameters' in ds.attrs else 'no'} "
+                              f"attribute parameters")
+    e = ds.variables["jacobian"].shape[-1]
+    with_attitude = "initial_attitude" in ds.variables or "attitude" in ds.variables
+    if e != d + (3 if with_attitude else 0):
+        raise FileFormatError(f"the Jacobians have {e} directions; with states of {d} "
+                              f"components{' and an attitude' if with_attitude else ''} "
+                              f"expected {d + (3 if with_attitude else 0)}")
+    p = len(_parameter_names(ds.attrs))
+    jac, par = ("tangent", "direction"), ("tangent", "parameter")
+    layout = {"jacobian": (lead + ("time",) + jac, b + (k, e, e)),
+              "final_jacobian": (lead + jac, b + (e, e))}
+    if p:
+        layout["parameter_jacobian"] = (lead + ("time",) + par, b + (k, e, p))
+        layout["final_parameter_jacobian"] = (lead + par, b + (e, p))
+    if set(present) != set(layout):
+        raise FileFormatError(f"the Jacobians of a run with sensitivities along {p} parameters "
+                              f"are {sorted(layout)}; the file has {sorted(present)}")
+    out = {}
+    for name, (want_dims, want_shape) in layout.items():
+        x = var(name)
+        if dims(name) != want_dims or x.shape != want_shape or x.dtype.kind != "f":
+            raise FileFormatError(f"the variable {name} has dimensions {dims(name)} of shape "
+                                  f"{x.shape} ({x.dtype}); expected {want_dims} of shape "
+                                  f"{want_shape} (floats)")
+        if not np.all(np.isfinite(x)):
+            raise FileFormatError(f"the variable {name} holds non-finite values")
+        out[name] = x
+    if not p:
+        out["parameter_jacobian"] = np.zeros(b + (k, e, 0))
+        out["final_parameter_jacobian"] = np.zeros(b + (e, 0))
+    return out
+
+
 def _methods(attrs):
     text = attrs.get("methods")
     if text is None:
@@ -135,6 +201,7 @@ def _arguments(ds):
         raise FileFormatError(f"the attribute method is {a['method']!r:.60}; expected a name")
 
     events = _events(ds, var, dims, batched, d, status)
+    jacobians = _jacobians(ds, var, dims, lead, b, k, d)
     sampling = _check_times(a, t, t0, t_final, dt, save_every, status)
     for name, when, sample in (("initial_state", t0, 0), ("final_state", t_final, -1),
                                ("initial_attitude", t0, 0), ("final_attitude", t_final, -1)):
@@ -152,6 +219,23 @@ def _arguments(ds):
         if not same:
             raise FileFormatError(f"{name} differs from the {'first' if sample == 0 else 'last'} "
                                   f"sample of {series}, which is at the same time t = {when!r}")
+    if jacobians and k:
+        # The first sample at t0 is the start (J = I, ∂z/∂θ = 0); the last at t_final the end.
+        jac, pjac = jacobians["jacobian"], jacobians["parameter_jacobian"]
+        if t0 is not None and t[0] == t0 and not (
+                np.array_equal(jac[..., 0, :, :], np.broadcast_to(np.eye(jac.shape[-1]),
+                                                                  jac[..., 0, :, :].shape))
+                and not np.any(pjac[..., 0, :, :])):
+            raise FileFormatError("the Jacobian at the first sample (t0) is not the identity")
+        if t_final is not None and t[-1] == t_final:
+            exact = sampling == "grid" and status != 1
+            for name in ("jacobian", "parameter_jacobian"):
+                x, last = jacobians[f"final_{name}"], jacobians[name][..., -1, :, :]
+                same = np.array_equal(x, last) if exact else np.allclose(x, last, rtol=1e-9,
+                                                                         atol=1e-9)
+                if not same:
+                    raise FileFormatError(f"final_{name} differs from the last sample of {name}, "
+                                          f"which is at the same time t = {t_final!r}")
     for te in events.get("t_events", []):
         lo = -math.inf if t0 is None else t0 - _tol(t0, t0)
         hi = math.inf if t_final is None else t_final + _tol(t_final, t_final)
@@ -164,7 +248,7 @@ def _arguments(ds):
                 states=states, attitude=var("attitude"), final_state=var("final_state"),
                 final_attitude=var("final_attitude"), dt=dt, save_every=save_every,
                 t_final=t_final, status=status, t0=t0, initial_state=var("initial_state"),
-                initial_attitude=var("initial_attitude"), **events)
+                initial_attitude=var("initial_attitude"), **events, **jacobians)
 
 
 def _events(ds, var, dims, batched, d, status):

@@ -18,6 +18,10 @@ Layout of the Dataset (format 2):
 * ``initial_state``, ``final_state`` (and ``initial_attitude``, ``final_attitude``);
 * for runs with events, ``t_events_I`` (``event_I``) and ``state_events_I``
   (``event_I, component``) per event function I;
+* for runs with ``sensitivity=True``, ``jacobian`` (``[member,] time, tangent, direction``),
+  ``final_jacobian`` (``[member,] tangent, direction``) and, when the system has parameters,
+  ``parameter_jacobian`` (``[member,] time, tangent, parameter``) and
+  ``final_parameter_jacobian``; the attribute ``parameters`` (a JSON list) names them;
 * attributes: ``system`` (its repr), ``system_class``, one ``system_<parameter>`` per number,
   string or numeric list among the constructor arguments, ``system_spec`` (how to rebuild the
   system, as JSON), ``method`` (or ``methods``, a JSON list, for a joined run), ``dt``,
@@ -70,7 +74,8 @@ from ._checksum import (_CHECKSUMS, _attribute_form, _attributes_digest,  # noqa
                         _seal, _variable_digest, _verify)
 from ._errors import FileFormatError
 from ._lieflow import InvalidArgumentError, System, __version__
-from ._metadata import (_EPS, _arguments, _attr, _check_method, _check_times,  # noqa: F401
+from ._metadata import (_EPS, _arguments, _attr, _check_method, _check_parameters,
+                        _check_times,  # noqa: F401
                         _events, _grid_error, _methods, _tol)
 from ._netcdf import (_MAX_COMPRESSION, _check_sizes, _declared, _engine,  # noqa: F401
                       _open, _xarray)
@@ -403,7 +408,8 @@ def _field_dims(name, shape):
 
 
 _RESERVED = {"states", "energy", "invariants", "attitude", "initial_state", "final_state",
-             "initial_attitude", "final_attitude", "time", "member"}
+             "initial_attitude", "final_attitude", "time", "member", "jacobian",
+             "final_jacobian", "parameter_jacobian", "final_parameter_jacobian"}
 
 
 def to_xarray(traj: Any, *, observables: bool = True) -> xarray.Dataset:
@@ -426,43 +432,56 @@ def to_xarray(traj: Any, *, observables: bool = True) -> xarray.Dataset:
 
 
 def _dataset(traj, observables):
-    """The Dataset of `traj` without checksums."""
+    """The Dataset of `traj` without checksums (its arrays copies: editing the Dataset leaves
+    the trajectory as it was)."""
     xr = _xarray()
     lead = ("member",) if traj.batched else ()
-    ds = xr.Dataset(coords={"time": ("time", np.asarray(traj.t, dtype=np.float64))})
+    ds = xr.Dataset(coords={"time": ("time", np.array(traj.t, dtype=np.float64))})
     if traj.batched:
         ds = ds.assign_coords(member=("member", np.arange(traj.states.shape[0])))
-    ds["states"] = (lead + ("time", "component"), np.asarray(traj.states))
+    ds["states"] = (lead + ("time", "component"), np.array(traj.states))
     for name, value in traj._fields().items():
         if name in _RESERVED:
             continue
-        value = np.asarray(value)
+        value = np.array(value)
         ds[name] = (lead + ("time",) + _field_dims(name, value.shape[len(lead) + 1:]), value)
     if observables and len(traj.t):
-        ds["energy"] = (lead + ("time",), np.asarray(traj.energy(), dtype=np.float64))
-        inv = np.asarray(traj.invariants(), dtype=np.float64)
+        ds["energy"] = (lead + ("time",), np.array(traj.energy(), dtype=np.float64))
+        inv = np.array(traj.invariants(), dtype=np.float64)
         head = inv.shape[:len(lead) + 1]      # (-1 cannot size an empty batch's)
         ds["invariants"] = (lead + ("time", "invariant"),
                             inv.reshape(head + (math.prod(inv.shape[len(head):]),)))
     square = ("attitude_row", "attitude_col")
     if traj.attitude is not None:
-        ds["attitude"] = (lead + ("time",) + square, np.asarray(traj.attitude))
+        ds["attitude"] = (lead + ("time",) + square, np.array(traj.attitude))
     for name in ("initial_state", "final_state"):
         value = getattr(traj, name)
         if value is not None:
-            ds[name] = (lead + ("component",), np.asarray(value))
+            ds[name] = (lead + ("component",), np.array(value))
     for name in ("initial_attitude", "final_attitude"):
         value = getattr(traj, name)
         if value is not None:
-            ds[name] = (lead + square, np.asarray(value))
+            ds[name] = (lead + square, np.array(value))
     if traj.t_events is not None and traj.state_events is not None:
         for i, te in enumerate(traj.t_events):
-            ds[f"t_events_{i}"] = (f"event_{i}",), np.asarray(te, dtype=np.float64)
+            ds[f"t_events_{i}"] = (f"event_{i}",), np.array(te, dtype=np.float64)
             ds[f"state_events_{i}"] = ((f"event_{i}", "component"),
-                                       np.asarray(traj.state_events[i]))
+                                       np.array(traj.state_events[i]))
             if traj.attitude_events is not None:
                 ds[f"attitude_events_{i}"] = ((f"event_{i}",) + square,
-                                              np.asarray(traj.attitude_events[i]))
+                                              np.array(traj.attitude_events[i]))
+    if getattr(traj, "jacobian", None) is not None:
+        jac = ("tangent", "direction")
+        ds["jacobian"] = (lead + ("time",) + jac, np.array(traj.jacobian))
+        ds["final_jacobian"] = (lead + jac, np.array(traj.final_jacobian))
+        names = list(traj.system.parameters)
+        ds.attrs["parameters"] = json.dumps(names)
+        if names:     # (a dimension of length 0 is an unlimited one in NetCDF-4)
+            par = ("tangent", "parameter")
+            ds["parameter_jacobian"] = (lead + ("time",) + par,
+                                        np.array(traj.parameter_jacobian))
+            ds["final_parameter_jacobian"] = (lead + par,
+                                              np.array(traj.final_parameter_jacobian))
     ds.attrs.update(_attributes(traj))
     return ds
 
@@ -638,6 +657,7 @@ def read(path: str | os.PathLike[str] | xarray.Dataset, *,
             raise FileFormatError(f"system_spec: builds a {type(system).__name__}, not a "
                                   f"lieflow system")
         _check_method(ds.attrs, system)
+        _check_parameters(ds.attrs, system)
     except FileFormatError as e:
         e.args = (f"{where}: {e}",)
         raise

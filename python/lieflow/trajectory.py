@@ -115,13 +115,15 @@ class Trajectory:
         t0=traj.t_final)`` gives) on the same system. A sample repeated at the seam (the first
         of a continuation is the last of the one before when that was its final state) is kept
         once; events are joined per event function (None unless every part has the same number
-        of event functions). ``method``, ``dt`` and ``save_every`` are the parts' common values
+        of event functions); the Jacobians of runs with ``sensitivity=True`` are joined by the
+        chain rule (each continuation's are along its own start), so they stay ∂z/∂z₀ and
+        ∂z/∂θ of the whole run. ``method``, ``dt`` and ``save_every`` are the parts' common values
         (a tuple of the methods, None for dt and save_every, where they differ).
 
         Raises:
             TypeError (not Trajectories), InvalidArgumentError (nothing to join, other systems,
-            batch or state shapes, attitudes that come and go, a part that does not start where
-            the one before ended).
+            batch or state shapes, attitudes or Jacobians that come and go, a part that does not
+            start where the one before ended).
         """
         expected = "invalid trajectories: expected a list of Trajectory objects"
         if isinstance(trajectories, (str, bytes, dict)):
@@ -162,7 +164,13 @@ class Trajectory:
                     and not np.array_equal(b.initial_attitude, a.final_attitude)):
                 raise InvalidArgumentError(f"{where} does not start from the final attitude of "
                                            f"the one before")
+        have = [p.jacobian is not None for p in parts]
+        if any(have) and not all(have):
+            raise InvalidArgumentError("invalid trajectories: Jacobians (sensitivity=True) in "
+                                       "some parts only")
         t, states, atts = [first.t], [first.states], [first.attitude]
+        jac, pjac = [first.jacobian], [first.parameter_jacobian]
+        jac_end, pjac_end = first.final_jacobian, first.final_parameter_jacobian
         for a, b in zip(parts, parts[1:]):
             drop = (len(a.t) and len(b.t) and b.t[0] <= a.t[-1]
                     + 16 * np.finfo(float).eps * max(abs(a.t[-1]), 1.0) + 1e-9 * b.dt)
@@ -171,6 +179,14 @@ class Trajectory:
             states.append(b.states[..., s:, :])
             if b.attitude is not None:
                 atts.append(b.attitude[..., s:, :, :])
+            if b.jacobian is not None:
+                # A continuation's Jacobians are along its own start, the end of the part
+                # before: the chain rule joins them (∂z/∂θ gains the start's dependence).
+                jb = b.jacobian[..., s:, :, :]
+                jac.append(jb @ jac_end[..., None, :, :])
+                pjac.append(jb @ pjac_end[..., None, :, :] + b.parameter_jacobian[..., s:, :, :])
+                jac_end, pjac_end = (b.final_jacobian @ jac_end,
+                                     b.final_jacobian @ pjac_end + b.final_parameter_jacobian)
         axis = states[0].ndim - 2
         last = parts[-1]
 
@@ -190,6 +206,10 @@ class Trajectory:
             if all(p.attitude_events is not None for p in parts):
                 events["attitude_events"] = [np.concatenate([p.attitude_events[i] for p in parts])
                                              for i in range(n)]
+        if all(have):
+            events.update(jacobian=np.concatenate(jac, axis=axis), final_jacobian=jac_end,
+                          parameter_jacobian=np.concatenate(pjac, axis=axis),
+                          final_parameter_jacobian=pjac_end)
         return cls(first.system, method, np.concatenate(t), np.concatenate(states, axis=axis),
                    None if first.attitude is None else np.concatenate(atts, axis=axis),
                    last.final_state, last.final_attitude, common("dt"), common("save_every"),

@@ -220,3 +220,87 @@ def test_no_netcdf4_backend_is_a_clear_import_error(tmp_path, monkeypatch):
     assert not (tmp_path / "x.nc").exists()
     with pytest.raises(ImportError, match="NetCDF-4 backend"):
         lf.load(saved)
+
+
+# --- runs with sensitivities (issue 26): the Jacobians are saved, checked, joined ---
+
+def _sensitivity_run(attitude=True, **kw):
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    R0 = lf.lie.so3_exp([0.4, -0.7, 0.3]) if attitude else None
+    return lf.integrate(body, [0.3, -0.8, 1.1], 0.01, 100, save_every=10, attitude=R0,
+                        sensitivity=True, **kw)
+
+
+@pytest.mark.parametrize("attitude", [False, True])
+def test_jacobians_are_saved_and_loaded_exactly(tmp_path, attitude):
+    traj = _sensitivity_run(attitude)
+    ds = traj.to_xarray()
+    assert ds["jacobian"].dims == ("time", "tangent", "direction")
+    assert ds["parameter_jacobian"].dims == ("time", "tangent", "parameter")
+    assert json.loads(ds.attrs["parameters"]) == ["I1", "I2", "I3"]
+    traj.save(tmp_path / "sens.nc")
+    back = lf.load(tmp_path / "sens.nc")
+    for name in ("jacobian", "final_jacobian", "parameter_jacobian", "final_parameter_jacobian"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(traj, name), err_msg=name)
+    np.testing.assert_array_equal(back.vjp(np.ones(traj.final_jacobian.shape[-1]))[1],
+                                  traj.vjp(np.ones(traj.final_jacobian.shape[-1]))[1])
+
+
+def test_jacobians_of_a_system_without_parameters_round_trip(tmp_path):
+    pend = lf.Pendulum(1.0, 1.0, 9.81)
+    traj = lf.integrate(pend, [0.3, 0.1], 0.05, 40, method="gauss6", save_every=10,
+                        sensitivity=True)
+    assert traj.parameter_jacobian.shape == (5, 2, 0)
+    traj.save(tmp_path / "pend.nc")
+    back = lf.load(tmp_path / "pend.nc")
+    np.testing.assert_array_equal(back.jacobian, traj.jacobian)
+    assert back.parameter_jacobian.shape == (5, 2, 0)
+
+
+def _unsealed(ds):
+    """A Dataset edited by hand: format 1, no checksums (loads with a UserWarning)."""
+    ds.attrs.pop("lieflow_checksums")
+    ds.attrs["lieflow_format"] = 1
+    return ds
+
+
+def test_damaged_or_inconsistent_jacobians_are_refused(tmp_path):
+    traj = _sensitivity_run()
+    ds = traj.to_xarray()
+    ds["jacobian"].values[3, 0, 0] += 1e-9
+    with pytest.raises(lf.FileFormatError, match="jacobian"):
+        lf.load(ds)
+    cases = {
+        "final_jacobian differs": lambda d: d["final_jacobian"].values.__setitem__((0, 0), 7.0),
+        "identity": lambda d: d["jacobian"].values.__setitem__((0, 0, 1), 0.5),
+        "parameters": lambda d: d.attrs.__setitem__("parameters", json.dumps(["a", "b", "c"])),
+        "along 3 parameters": lambda d: d.__delitem__("parameter_jacobian"),
+        "non-finite": lambda d: d["parameter_jacobian"].values.__setitem__((2, 0, 0), np.nan),
+    }
+    for match, damage in cases.items():
+        ds = _unsealed(traj.to_xarray())
+        damage(ds)
+        with pytest.warns(UserWarning, match="format 1"), \
+                pytest.raises(lf.FileFormatError, match=match.split()[0]):
+            lf.load(ds)
+
+
+@pytest.mark.parametrize("attitude", [False, True])
+def test_concatenated_runs_join_their_jacobians_by_the_chain_rule(attitude):
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    R0 = lf.lie.so3_exp([0.4, -0.7, 0.3]) if attitude else None
+    whole = lf.integrate(body, [0.3, -0.8, 1.1], 0.01, 100, save_every=10, attitude=R0,
+                         sensitivity=True)
+    a = lf.integrate(body, [0.3, -0.8, 1.1], 0.01, 40, save_every=10, attitude=R0,
+                     sensitivity=True)
+    b = lf.integrate(body, a.final_state, 0.01, 60, save_every=10, t0=a.t_final,
+                     attitude=a.final_attitude, sensitivity=True)
+    joined = lf.Trajectory.concatenate([a, b])
+    np.testing.assert_allclose(joined.t, whole.t, rtol=1e-15)
+    for name in ("jacobian", "final_jacobian", "parameter_jacobian", "final_parameter_jacobian"):
+        np.testing.assert_allclose(getattr(joined, name), getattr(whole, name), rtol=1e-12,
+                                   atol=1e-12, err_msg=name)
+    plain = lf.integrate(body, a.final_state, 0.01, 60, save_every=10, t0=a.t_final,
+                         attitude=a.final_attitude)
+    with pytest.raises(lf.InvalidArgumentError, match="some parts only"):
+        lf.Trajectory.concatenate([a, plain])
