@@ -105,11 +105,13 @@ def test_sensitivity_refuses_what_it_cannot_do_with_typed_errors():
         lf.integrate(rb, z0, 0.1, 10, attitude=np.eye(4), sensitivity=True)
     with pytest.raises(lf.InvalidArgumentError, match="events"):
         lf.integrate(rb, z0, 0.1, 10, method="rk4", events=lambda t, z: z[0], sensitivity=True)
-    disk = lf.RollingDisk(1.0, 0.5, 0.125, 0.0625, spring=0.4)
+    disks = lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6)
     with pytest.raises(lf.InvalidArgumentError, match="no tangent maps"):
-        lf.integrate(disk, disk.state([0.1, -0.2, 0.3, 0.7], 2.0, 0.5), 0.1, 10,
-                     sensitivity=True)
-    assert disk.sensitivity_methods() == []
+        lf.integrate(disks, disks.state([0.1, -0.2], [0.3, 0.5]), 0.1, 10, sensitivity=True)
+    assert disks.sensitivity_methods() == []
+    disk = lf.RollingDisk(1.0, 0.5, 0.125, 0.0625, spring=0.4)
+    assert disk.sensitivity_methods() == ["nonholonomic"]
+    assert disk.parameters == ["spring", "tilt"]
     with pytest.raises(TypeError, match="sensitivity"):
         lf.integrate(rb, z0, 0.1, 10, method="rk4", sensitivity="yes")
     inc = lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(1.0, 2.0), incompressible=True)

@@ -275,13 +275,37 @@ pub trait Constrained: Separable {
 }
 
 /// A [`Separable`] system with T = ½ pᵀM⁻¹p restricted by linear velocity constraints
-/// A(q) q̇ = 0 (A: m × d of full rank), with the Lagrange–d'Alembert principle.
+/// A(q) q̇ = 0 (A: m × d of full rank), with the Lagrange–d'Alembert principle: the constraint
+/// forces are −A(q)ᵀλ.
+///
+/// The kernels take the problem's [`Separable::Scratch`] and do not allocate.
 pub trait Nonholonomic: Separable {
     /// The number m of constraints.
     fn constraints(&self) -> usize;
 
     /// A(q) into `a` (m × d, row-major).
-    fn constraint_matrix(&self, q: &[f64], a: &mut [f64]);
+    fn constraint_matrix(&self, q: &[f64], a: &mut [f64], s: &mut Self::Scratch);
+
+    /// The derivative of A along dq, DA(q)\[dq\] = d/dε A(q + ε dq) at ε = 0, into `out`
+    /// (m × d, row-major): the data of the tangent lift ([`crate::integrate::tangent`], whose
+    /// constraint A(q)v = 0 differentiates to DA(q)\[δq\]v + A(q)δv = 0). Required, as A is: it
+    /// is as basic as A itself, and a default (NaN) would only surface as a singular
+    /// constraint matrix in a lifted run.
+    fn constraint_matrix_tangent(
+        &self,
+        q: &[f64],
+        dq: &[f64],
+        out: &mut [f64],
+        s: &mut Self::Scratch,
+    );
+
+    /// The rows F (m × d, row-major) along which the multipliers act on the momenta,
+    /// ṗ = f − Fᵀλ, when they differ from A(q): writes them and returns true. A mechanical
+    /// system's are A (false, the default); a tangent lift's are not (as for
+    /// [`Constrained::constraint_forces`]).
+    fn constraint_forces(&self, _q: &[f64], _rows: &mut [f64], _s: &mut Self::Scratch) -> bool {
+        false
+    }
 }
 
 /// A vector field of the form ż = ξ(z)·z, where ξ(z) lies in a Lie algebra g (coordinates of

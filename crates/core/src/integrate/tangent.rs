@@ -48,7 +48,9 @@ use std::sync::Arc;
 pub use super::method::TangentSystem;
 
 use super::method::Catalog;
-use super::problem::{Constrained, Problem, Separable, Split, VectorField, Violation};
+use super::problem::{
+    Constrained, Nonholonomic, Problem, Separable, Split, VectorField, Violation,
+};
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
 
@@ -306,7 +308,8 @@ impl<P: Problem + Clone> Tangent<P> {
 }
 
 /// The work space of a separable lift's kernels: the base problem's, and for a constrained lift
-/// G(q), D²g(q)\[δq, ·\] and the polarisation's buffers (sized at their first use).
+/// G(q), D²g(q)\[δq, ·\] and the polarisation's buffers, for a nonholonomic lift A(q) and
+/// DA(q)\[δq\] (sized at their first use).
 pub struct LiftScratch<S> {
     base: S,
     jac: Vec<f64>,
@@ -425,34 +428,7 @@ impl<P: Constrained + SeparableTangent + Clone> Constrained for Tangent<P> {
     }
 
     fn constraint_jacobian(&self, q: &[f64], jac: &mut [f64], s: &mut Self::Scratch) {
-        let (n, m, k) = (self.problem.dof(), self.problem.constraints(), self.k());
-        let cols = n * (k + 1);
-        let LiftScratch {
-            base,
-            jac: g,
-            second,
-            w,
-            c,
-        } = s;
-        g.resize(m * n, 0.0);
-        second.resize(m * n, 0.0);
-        w.resize(n, 0.0);
-        c.resize(2 * m, 0.0);
-        self.problem.constraint_jacobian(&q[..n], g, base);
-        jac.fill(0.0);
-        for j in 0..=k {
-            if j > 0 {
-                let dq = &q[j * n..(j + 1) * n];
-                constraint_second(&self.problem, &q[..n], dq, second, w, c, base);
-            }
-            for a in 0..m {
-                let row = &mut jac[(j * m + a) * cols..(j * m + a + 1) * cols];
-                row[j * n..(j + 1) * n].copy_from_slice(&g[a * n..(a + 1) * n]);
-                if j > 0 {
-                    row[..n].copy_from_slice(&second[a * n..(a + 1) * n]);
-                }
-            }
-        }
+        self.constrained_rows(q, Coupling::Column, jac, s);
     }
 
     /// The force rows pair the other way round: the base multipliers λ act on the directions
@@ -460,35 +436,7 @@ impl<P: Constrained + SeparableTangent + Clone> Constrained for Tangent<P> {
     /// for the base rows and G in its own block for each direction's; with G̃ as above,
     /// G̃ M̃⁻¹F̃ᵀ is block lower-triangular with G M⁻¹Gᵀ on its diagonal.
     fn constraint_forces(&self, q: &[f64], rows: &mut [f64], s: &mut Self::Scratch) -> bool {
-        let (n, m, k) = (self.problem.dof(), self.problem.constraints(), self.k());
-        let cols = n * (k + 1);
-        let LiftScratch {
-            base,
-            jac: g,
-            second,
-            w,
-            c,
-        } = s;
-        g.resize(m * n, 0.0);
-        second.resize(m * n, 0.0);
-        w.resize(n, 0.0);
-        c.resize(2 * m, 0.0);
-        self.problem.constraint_jacobian(&q[..n], g, base);
-        rows.fill(0.0);
-        for j in 0..=k {
-            if j > 0 {
-                let dq = &q[j * n..(j + 1) * n];
-                constraint_second(&self.problem, &q[..n], dq, second, w, c, base);
-            }
-            for a in 0..m {
-                let own = (j * m + a) * cols + j * n;
-                rows[own..own + n].copy_from_slice(&g[a * n..(a + 1) * n]);
-                if j > 0 {
-                    let at = a * cols + j * n;
-                    rows[at..at + n].copy_from_slice(&second[a * n..(a + 1) * n]);
-                }
-            }
-        }
+        self.constrained_rows(q, Coupling::Row, rows, s);
         true
     }
 
@@ -498,6 +446,155 @@ impl<P: Constrained + SeparableTangent + Clone> Constrained for Tangent<P> {
         &self,
         _q: &[f64],
         _v: &[f64],
+        out: &mut [f64],
+        _s: &mut Self::Scratch,
+    ) {
+        out.fill(f64::NAN);
+    }
+}
+
+/// Where the coupling blocks of a constrained lift's rows sit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Coupling {
+    /// In the first block column, (j, 0): the constraint rows (the derivative of the base rows
+    /// along δq_j acts on the base velocity or position).
+    Column,
+    /// In the first block row, (0, j): the force rows (the base multipliers act on direction j
+    /// through the derivative of the base rows).
+    Row,
+}
+
+/// The m(k + 1) × n(k + 1) rows (row-major) of a constrained lift: the base rows `own` (m × n)
+/// in every diagonal block, and for each direction j ≥ 1 the block `coupling(j, buf)` (m × n,
+/// written to `buf`) at (j, 0) or (0, j) ([`Coupling`]); zero elsewhere. One layout for the
+/// holonomic lift (G, D²g\[δq_j, ·\]) and the nonholonomic one (A, DA\[δq_j\]).
+fn lifted_rows(
+    own: &[f64],
+    n: usize,
+    k: usize,
+    at: Coupling,
+    buf: &mut [f64],
+    mut coupling: impl FnMut(usize, &mut [f64]),
+    rows: &mut [f64],
+) {
+    let m = own.len() / n;
+    let cols = n * (k + 1);
+    rows.fill(0.0);
+    for j in 0..=k {
+        if j > 0 {
+            coupling(j, buf);
+        }
+        for a in 0..m {
+            let diag = (j * m + a) * cols + j * n;
+            rows[diag..diag + n].copy_from_slice(&own[a * n..(a + 1) * n]);
+            if j > 0 {
+                let off = match at {
+                    Coupling::Column => (j * m + a) * cols,
+                    Coupling::Row => a * cols + j * n,
+                };
+                rows[off..off + n].copy_from_slice(&buf[a * n..(a + 1) * n]);
+            }
+        }
+    }
+}
+
+impl<S> LiftScratch<S> {
+    /// The buffers for m base rows of length n.
+    fn sized(&mut self, m: usize, n: usize) {
+        self.jac.resize(m * n, 0.0);
+        self.second.resize(m * n, 0.0);
+        self.w.resize(n, 0.0);
+        self.c.resize(2 * m, 0.0);
+    }
+}
+
+impl<P: Constrained + SeparableTangent + Clone> Tangent<P> {
+    /// The holonomic lift's constraint rows (G̃) or force rows (F̃) at the lifted position q.
+    fn constrained_rows(
+        &self,
+        q: &[f64],
+        at: Coupling,
+        rows: &mut [f64],
+        s: &mut LiftScratch<P::Scratch>,
+    ) {
+        let (n, m, k) = (self.problem.dof(), self.problem.constraints(), self.k());
+        s.sized(m, n);
+        let LiftScratch {
+            base,
+            jac: g,
+            second,
+            w,
+            c,
+        } = s;
+        self.problem.constraint_jacobian(&q[..n], g, base);
+        let coupling = |j: usize, out: &mut [f64]| {
+            let dq = &q[j * n..(j + 1) * n];
+            constraint_second(&self.problem, &q[..n], dq, out, w, c, base);
+        };
+        lifted_rows(g, n, k, at, second, coupling, rows);
+    }
+}
+
+impl<P: Nonholonomic + SeparableTangent + Clone> Tangent<P> {
+    /// The nonholonomic lift's constraint rows (Ã) or force rows (F̃) at the lifted position q.
+    fn velocity_rows(
+        &self,
+        q: &[f64],
+        at: Coupling,
+        rows: &mut [f64],
+        s: &mut LiftScratch<P::Scratch>,
+    ) {
+        let (n, m, k) = (
+            self.problem.dof(),
+            Nonholonomic::constraints(&self.problem),
+            self.k(),
+        );
+        s.sized(m, n);
+        let LiftScratch {
+            base,
+            jac: a,
+            second,
+            ..
+        } = s;
+        self.problem.constraint_matrix(&q[..n], a, base);
+        let coupling = |j: usize, out: &mut [f64]| {
+            let dq = &q[j * n..(j + 1) * n];
+            self.problem
+                .constraint_matrix_tangent(&q[..n], dq, out, base);
+        };
+        lifted_rows(a, n, k, at, second, coupling, rows);
+    }
+}
+
+/// The lift of a nonholonomic problem (Lagrange–d'Alembert; `NonholonomicRattle`): the
+/// velocity constraints Ã(q̃)ṽ = 0 with Ã = \[\[A(q), 0\], \[DA(q)\[δq_j\], A(q)\]\] (the derivative
+/// of A(q)v = 0: DA(q)\[δq_j\]v + A(q)δv_j = 0), block lower-triangular, and the force rows
+/// paired the other way round (the derivative of −A(q)ᵀλ is −DA(q)\[δq_j\]ᵀλ − A(q)ᵀδλ_j): as for
+/// the holonomic lift, every matrix of the method's step is block lower-triangular with the
+/// plain one on its diagonal, and the method applied to the lift is the derivative of the
+/// method. A direction needs not satisfy the linearised constraint at the start: like the
+/// method's map off the constraint (its steps project), the lift differentiates across it.
+impl<P: Nonholonomic + SeparableTangent + Clone> Nonholonomic for Tangent<P> {
+    fn constraints(&self) -> usize {
+        Nonholonomic::constraints(&self.problem) * (self.k() + 1)
+    }
+
+    fn constraint_matrix(&self, q: &[f64], a: &mut [f64], s: &mut Self::Scratch) {
+        self.velocity_rows(q, Coupling::Column, a, s);
+    }
+
+    /// F̃: the base rows (A, DA\[δq₁\], …, DA\[δq_k\]) and A in its own block for each
+    /// direction's.
+    fn constraint_forces(&self, q: &[f64], rows: &mut [f64], s: &mut Self::Scratch) -> bool {
+        self.velocity_rows(q, Coupling::Row, rows, s);
+        true
+    }
+
+    /// NaN: the lift's derivative needs D²A, which no system gives (a lift is not lifted again).
+    fn constraint_matrix_tangent(
+        &self,
+        _q: &[f64],
+        _dq: &[f64],
         out: &mut [f64],
         _s: &mut Self::Scratch,
     ) {

@@ -30,6 +30,14 @@
 //! iteration with the matrix A(q̄^{(k)}) Wᵀ (the neglected derivative of A along q̄ is O(h)), under
 //! the rule of [`crate::convergence`] ([`RULE`]: the momentum update relative to ‖p̃‖_∞); the
 //! last substep is the linear projection of RATTLE ([`super::rattle`]).
+//!
+//! **Force rows.** The multipliers act on the momenta along the rows F(q) of
+//! [`Nonholonomic::constraint_forces`] (A(q) for a mechanical system): A(q_n)ᵀw above is F(q_n)ᵀw,
+//! W_b = M⁻¹F_b(q_n)ᵀ, and the projection is p ← p − F(q_{n+1})ᵀκ; the conditions use A. On a
+//! tangent lift ([`crate::integrate::tangent`]) the constraint rows Ã = \[\[A, 0\], \[DA\[δq\], A\]\]
+//! and the force rows (the derivative of −Aᵀλ, paired the other way) make every matrix of the
+//! step block lower-triangular with the plain one on its diagonal: the base unknowns iterate as in
+//! the plain run, and the converged step is the derivative of the plain one.
 
 use super::rattle::{axpy, dot, max_abs, singular, Failure, Rows};
 use crate::convergence::{self, Monitor, Rule, Verdict};
@@ -93,7 +101,7 @@ struct NonholonomicStepper<P: Separable> {
     /// p̃ = p_n + h/2 f(q_n), and the iterate of p_{n+1/2}.
     ph: Vec<f64>,
     qbar: Vec<f64>,
-    /// A(q) and W = M⁻¹Aᵀ at the current q.
+    /// A(q), the force rows F (A unless a lift's) and W = M⁻¹Fᵀ at the current q.
     rows: Rows,
     /// A at the midpoint iterate, the residual F, the multipliers w = (h/2)μ.
     abar: Vec<f64>,
@@ -102,21 +110,31 @@ struct NonholonomicStepper<P: Separable> {
 }
 
 impl<P: Nonholonomic> NonholonomicStepper<P> {
-    /// f, A and W at the current q.
+    /// f, A, the force rows F and W = M⁻¹Fᵀ at the current q.
     fn load(&mut self) -> std::result::Result<(), Violation> {
-        self.problem
-            .force(&self.q, &mut self.f, &mut self.scratch)?;
-        self.problem.constraint_matrix(&self.q, &mut self.rows.c);
-        self.rows.update_w(&self.problem);
+        let NonholonomicStepper {
+            problem,
+            scratch,
+            q,
+            f,
+            rows,
+            ..
+        } = self;
+        problem.force(q, f, scratch)?;
+        rows.fill(|a, forces| {
+            problem.constraint_matrix(q, a, scratch);
+            problem.constraint_forces(q, forces, scratch)
+        });
+        rows.update_w(problem);
         Ok(())
     }
 
-    /// p_{n+1/2} = p̃ − A(q_n)ᵀw into `ph`, its velocity into `v`, the midpoint into `qbar`.
+    /// p_{n+1/2} = p̃ − F(q_n)ᵀw into `ph`, its velocity into `v`, the midpoint into `qbar`.
     fn half_step(&mut self) {
         let d = self.q.len();
         self.ph.copy_from_slice(&self.p);
         for (b, &wb) in self.w.iter().enumerate() {
-            axpy(&mut self.ph, -wb, &self.rows.c[b * d..(b + 1) * d]);
+            axpy(&mut self.ph, -wb, &self.rows.forces()[b * d..(b + 1) * d]);
         }
         self.problem.velocity(&self.ph, &mut self.v);
         self.qbar.copy_from_slice(&self.q);
@@ -133,7 +151,8 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
             let scale = max_abs(&self.p).max(f64::MIN_POSITIVE);
             let mut monitor = Monitor::new(RULE);
             loop {
-                self.problem.constraint_matrix(&self.qbar, &mut self.abar);
+                self.problem
+                    .constraint_matrix(&self.qbar, &mut self.abar, &mut self.scratch);
                 for a in 0..m {
                     self.r[a] = dot(&self.abar[a * d..(a + 1) * d], &self.v);
                 }
@@ -144,7 +163,8 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
                 axpy(&mut self.w, 1.0, &self.r);
                 let mut norm = 0.0f64;
                 for k in 0..d {
-                    let dp: f64 = (0..m).map(|b| self.r[b] * self.rows.c[b * d + k]).sum();
+                    let forces = self.rows.forces();
+                    let dp: f64 = (0..m).map(|b| self.r[b] * forces[b * d + k]).sum();
                     norm = norm.max(dp.abs());
                 }
                 self.half_step();
@@ -159,7 +179,7 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
         axpy(&mut self.q, h, &self.v);
         self.p.copy_from_slice(&self.ph);
         self.load().map_err(Failure::Domain)?;
-        // p_{n+1} = p_{n+1/2} + h/2 f(q_{n+1}) − A(q_{n+1})ᵀ(h/2)ν, A M⁻¹p_{n+1} = 0.
+        // p_{n+1} = p_{n+1/2} + h/2 f(q_{n+1}) − F(q_{n+1})ᵀ(h/2)ν, A M⁻¹p_{n+1} = 0.
         axpy(&mut self.p, 0.5 * h, &self.f);
         if !self.rows.project(&self.problem, &mut self.p, &mut self.v) {
             return Err(Failure::Domain(singular(self.problem.name())));

@@ -119,7 +119,7 @@ pub(crate) struct Rows {
     /// The rows C.
     pub(crate) c: Vec<f64>,
     /// The rows F along which the multipliers act (F = C unless `distinct`: a tangent lift,
-    /// [`Constrained::constraint_forces`]).
+    /// [`Constrained::constraint_forces`], [`crate::integrate::problem::Nonholonomic::constraint_forces`]).
     pub(crate) f: Vec<f64>,
     pub(crate) distinct: bool,
     /// The rows W = M⁻¹Fᵀ.
@@ -152,11 +152,19 @@ impl Rows {
         }
     }
 
+    /// The rows C and F from `fill(c, f)`, which writes C and returns whether it wrote distinct
+    /// force rows F (the storage of F is sized at the first call).
+    pub(crate) fn fill(&mut self, fill: impl FnOnce(&mut [f64], &mut [f64]) -> bool) {
+        self.f.resize(self.c.len(), 0.0);
+        self.distinct = fill(&mut self.c, &mut self.f);
+    }
+
     /// C = G(q) and the force rows F at q ([`Constrained::constraint_forces`]).
     pub(crate) fn load<P: Constrained>(&mut self, problem: &P, q: &[f64], s: &mut P::Scratch) {
-        problem.constraint_jacobian(q, &mut self.c, s);
-        self.f.resize(self.c.len(), 0.0);
-        self.distinct = problem.constraint_forces(q, &mut self.f, s);
+        self.fill(|c, f| {
+            problem.constraint_jacobian(q, c, s);
+            problem.constraint_forces(q, f, s)
+        });
     }
 
     /// W_b = M⁻¹F_b for the current rows F.

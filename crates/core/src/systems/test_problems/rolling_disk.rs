@@ -21,11 +21,14 @@
 //! with the energy ½(I + mR²)θ̇² + ½Jφ̇² + U conserved. Without potential (k = g̃ = 0) θ̇ and φ̇
 //! are constant and the contact point runs on a circle of radius Rθ̇/φ̇ ([`RollingDisk::exact`]).
 
+use std::sync::Arc;
+
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::NonholonomicRattle;
 use crate::integrate::problem::{Nonholonomic, Separable, Violation};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{SeparableTangent, Tangent, TangentSystem};
 use crate::integrate::{Catalog, Entry, Problem};
 
 /// Relative tolerance of the rolling constraints A(q) M⁻¹p = 0 on a state (relative to |M⁻¹p|).
@@ -159,6 +162,12 @@ impl Problem for RollingDisk {
     fn invariant_count(&self) -> usize {
         0
     }
+    /// The potential's constants: the spring k and the tilt g̃ (the sensitivities ∂z/∂k,
+    /// ∂z/∂g̃ of a tangent run; the inertias and the radius enter M and A, which the lift does
+    /// not differentiate).
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["spring", "tilt"]
+    }
     /// The rolling constraints to [`CONSTRAINT_TOL`] ([`RollingDisk::constraint_residual`]).
     fn check_state(&self, z: &[f64]) -> Result<()> {
         let r = self.constraint_residual(z)?;
@@ -200,8 +209,8 @@ impl Nonholonomic for RollingDisk {
     fn constraints(&self) -> usize {
         2
     }
-    /// A(q) = [[1, 0, −R cos φ, 0], [0, 1, −R sin φ, 0]].
-    fn constraint_matrix(&self, q: &[f64], a: &mut [f64]) {
+    /// A(q) = \[\[1, 0, −R cos φ, 0\], \[0, 1, −R sin φ, 0\]\].
+    fn constraint_matrix(&self, q: &[f64], a: &mut [f64], _s: &mut ()) {
         let (s, c) = q[3].sin_cos();
         a.copy_from_slice(&[
             1.0,
@@ -214,9 +223,44 @@ impl Nonholonomic for RollingDisk {
             0.0,
         ]);
     }
+
+    /// DA(q)\[dq\] = dφ \[\[0, 0, R sin φ, 0\], \[0, 0, −R cos φ, 0\]\].
+    fn constraint_matrix_tangent(&self, q: &[f64], dq: &[f64], out: &mut [f64], _s: &mut ()) {
+        let (s, c) = q[3].sin_cos();
+        let r = self.radius * dq[3];
+        out.copy_from_slice(&[0.0, 0.0, r * s, 0.0, 0.0, 0.0, -r * c, 0.0]);
+    }
+}
+
+/// v′ = M⁻¹; f′(q)dq = (0, 0, 0, −k cos φ dφ); ∂f/∂k = (0, 0, 0, −sin φ), ∂f/∂g̃ = (−m, 0, 0, 0).
+impl SeparableTangent for RollingDisk {
+    fn velocity_tangent(&self, _p: &[f64], dp: &[f64], dv: &mut [f64]) {
+        self.velocity(dp, dv);
+    }
+    fn force_tangent(&self, q: &[f64], dq: &[f64], df: &mut [f64], _s: &mut ()) {
+        df.copy_from_slice(&[0.0, 0.0, 0.0, -self.spring * q[3].cos() * dq[3]]);
+    }
+    fn force_parameter(&self, q: &[f64], m: usize, df: &mut [f64], _s: &mut ()) {
+        match m {
+            0 => df[3] -= q[3].sin(),
+            1 => df[0] -= self.mass,
+            _ => df.fill(f64::NAN),
+        }
+    }
 }
 
 impl Catalog for RollingDisk {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        vec![Entry::new("nonholonomic", || NonholonomicRattle)]
+    }
+
+    /// The nonholonomic lift (Lagrange–d'Alembert with the lifted constraints and force rows).
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
+        Some(Tangent::separable(self.clone()).into_system())
+    }
+}
+
+impl Catalog for Tangent<RollingDisk> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![Entry::new("nonholonomic", || NonholonomicRattle)]
     }
