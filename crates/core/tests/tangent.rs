@@ -1072,3 +1072,32 @@ fn nonholonomic_jacobian_of_the_rolling_disk() {
     assert!(err < 1e-7 && perr < 1e-7, "{err:e} {perr:e}");
     assert!(tangent < 1e-13 && every < 1e-13, "{tangent:e} {every:e}");
 }
+
+/// The incompressible body's closed-form D²det(X)\[U, ·\] (what its RATTLE lift uses) is the
+/// polarisation of its curvature form D²det(X)\[W, W\].
+#[test]
+fn the_incompressible_bodys_second_derivative_is_its_curvatures_polarisation() {
+    use lieflow::integrate::problem::{Constrained, Separable};
+    let inc =
+        PseudoRigidBody::incompressible(3, Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()))
+            .unwrap();
+    let mut s = inc.scratch();
+    let x = [1.3, 0.1, -0.05, 0.02, 1.1, 0.08, -0.03, 0.05, 0.9];
+    let u = [0.3, -0.2, 0.5, 0.1, 0.7, -0.4, 0.2, 0.6, -0.1];
+    let mut rows = [0.0; 9];
+    assert!(inc.constraint_second(&x, &u, &mut rows, &mut s));
+    let (mut cp, mut cm) = ([0.0], [0.0]);
+    for k in 0..9 {
+        let (mut wp, mut wm) = (u, u);
+        wp[k] += 1.0;
+        wm[k] -= 1.0;
+        inc.constraint_curvature(&x, &wp, &mut cp, &mut s);
+        inc.constraint_curvature(&x, &wm, &mut cm, &mut s);
+        let polar = 0.25 * (cp[0] - cm[0]);
+        assert!(
+            (rows[k] - polar).abs() < 1e-14,
+            "{k}: {} vs {polar}",
+            rows[k]
+        );
+    }
+}

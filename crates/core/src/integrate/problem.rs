@@ -264,6 +264,19 @@ pub trait Constrained: Separable {
     /// d²/dt² g(q(t)) = G(q) q̈ + D²g(q)[q̇, q̇] = 0.
     fn constraint_curvature(&self, q: &[f64], v: &[f64], out: &mut [f64], s: &mut Self::Scratch);
 
+    /// D²g(q)\[u, ·\] (the derivative of G along u) into `rows` (m × d, row-major) where the
+    /// problem has it in closed form: returns true then; false by default, and a tangent lift
+    /// takes it by polarisation of [`Constrained::constraint_curvature`] (2d calls).
+    fn constraint_second(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _rows: &mut [f64],
+        _s: &mut Self::Scratch,
+    ) -> bool {
+        false
+    }
+
     /// The rows F (m × d, row-major) along which the multipliers act on the momenta,
     /// ṗ = f − Fᵀλ, when they differ from G(q): writes them and returns true. A mechanical
     /// system's are G (false, the default); a tangent lift's are not

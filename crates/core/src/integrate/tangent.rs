@@ -384,6 +384,9 @@ pub fn constraint_second<P: Constrained>(
     c: &mut [f64],
     s: &mut P::Scratch,
 ) {
+    if problem.constraint_second(q, u, rows, s) {
+        return;
+    }
     let (d, m) = (problem.dof(), problem.constraints());
     let (cp, cm) = c.split_at_mut(m);
     w.copy_from_slice(u);

@@ -524,6 +524,28 @@ impl Constrained for PseudoRigidBody {
         }
     }
 
+    /// D cof(X)\[U\] at n = 3 (columns (cof X)_i = x_{i+1} × x_{i+2}, cyclic, so their
+    /// derivatives u_{i+1} × x_{i+2} + x_{i+1} × u_{i+2}); polarisation elsewhere.
+    fn constraint_second(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        rows: &mut [f64],
+        _s: &mut ForceScratch,
+    ) -> bool {
+        let (Some(x), Some(v), true) = (mat3(q), mat3(u), self.incompressible) else {
+            return false;
+        };
+        for i in 0..3 {
+            let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+            let col = v.column(a).cross(&x.column(b)) + x.column(a).cross(&v.column(b));
+            for r in 0..3 {
+                rows[r * 3 + i] = col[r];
+            }
+        }
+        true
+    }
+
     /// D² det(X)[V, V] = d²/dε² det(X + εV) at ε = 0: 2 det V at n = 2; 2⟨X, cof V⟩ at n = 3
     /// (det(X + εV) = det X + ε⟨cof X, V⟩ + ε²⟨X, cof V⟩ + ε³ det V); 2 det(X) e₂(X⁻¹V) with
     /// e₂(B) = ½((tr B)² − tr B²) above, i.e. (⟨C, V⟩² − tr((CᵀV)²))/det X with C = cof X.
