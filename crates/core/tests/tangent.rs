@@ -1187,11 +1187,37 @@ fn exact_jacobian_against_differences() {
     let ej = max_rel(&jac, &differences(&rb, "exact", &z0, 0.2, 50, h));
     eprintln!("exact, inertia matrix: vs differences {ej:.1e}");
     assert!(worst.0.max(worst.1).max(ej) < 1e-8, "{worst:?} {ej:e}");
+    // A symmetric body (closed form): along I₁ or I₂ alone the symmetry breaks, and the
+    // differences run the elliptic flow of the nearby asymmetric bodies.
+    let moments = [2.0, 2.0, 1.0];
+    let rb = RigidBody::new(moments).unwrap();
+    let z0 = [0.3, -0.8, 1.1];
+    let (_, jac, pjac) = lifted_end_all(&*rb.tangent().unwrap(), "exact", &z0, 3.0, 4);
+    let ej = max_rel(&jac, &differences(&rb, "exact", &z0, 3.0, 4, h));
+    let mut pfd = vec![0.0; 9];
+    for m in 0..3 {
+        let end = |s: f64| {
+            let mut i = moments;
+            i[m] += s;
+            integrate(&RigidBody::new(i).unwrap(), "exact", &z0, 3.0, 4, 4)
+                .unwrap()
+                .state(1)
+                .to_vec()
+        };
+        let (p, q) = (end(h), end(-h));
+        for i in 0..3 {
+            pfd[i * 3 + m] = (p[i] - q[i]) / (2.0 * h);
+        }
+    }
+    let ep = max_rel(&pjac, &pfd);
+    eprintln!("exact, symmetric body: vs differences J {ej:.1e}, ∂M/∂I {ep:.1e}");
+    assert!(ej.max(ep) < 1e-8, "{ej:e} {ep:e}");
 }
 
 /// The exact Jacobian keeps the invariants' gradients: ∇C(M)ᵀJ = ∇C(M₀)ᵀ for C = ½|M|² and
 /// H = ½M·I⁻¹M, and along the moments ∇C(M)·∂M/∂I_q = 0, ∇H(M)·∂M/∂I_q + ∂H/∂I_q (M) =
-/// ∂H/∂I_q (M₀) (H(M(t); I) = H(M₀; I) for every I), to round-off.
+/// ∂H/∂I_q (M₀) (H(M(t); I) = H(M₀; I) for every I), to round-off (1e-14 relative to |J|;
+/// near the separatrix, k′ = 0.025, to ε/k′²: 1.3e-13 measured at t = 0.5).
 #[test]
 fn exact_jacobian_keeps_the_invariants_gradients() {
     let moments = [1.0, 2.0, 3.0];
@@ -1216,8 +1242,16 @@ fn exact_jacobian_keeps_the_invariants_gradients() {
             }
             let rel = defect / scale;
             eprintln!("exact, {name}, t = {time}: |J| {scale:.1}, invariants' gradients {rel:.1e}");
+            // Near the separatrix the m-derivative's 1/k′² cancels (module docs of
+            // `methods::exact`): ε/k′² ≈ 3.5e-13 at k′ = 0.025.
+            let bound = if name.starts_with("separatrix") {
+                3.5e-13
+            } else {
+                1e-14
+            };
+            assert!(rel < bound, "{name}, t = {time}: {rel:e}");
             worst = worst.max(rel);
         }
     }
-    assert!(worst < 1e-14, "{worst:e}");
+    eprintln!("worst {worst:.1e}");
 }
