@@ -56,7 +56,7 @@
 //! measured, for the elliptic formula of M); S is evaluated relative to its own value at t = 0
 //! (a base point), so S(0) = I exactly and the rounding of the formulas cancels in short steps.
 //!
-//! **Tangent map** (issue 26; [`FreeFlow::momentum_tangent`], the method `exact` on the tangent
+//! **Tangent map** (issue 26; `FreeFlow::momentum_tangent`, the method `exact` on the tangent
 //! lift of the body without attitude). Dφ_t(M₀) = ∂M(t)/∂M₀ and ∂M(t)/∂I by the chain rule
 //! through the parametrisation: M(t) = (σa₁ cos φ, a₂ sin φ, εa₃ Δ(φ)), φ = am(u | m),
 //! Δ = √(1 − m sin²φ), where a₁², a₂², a₃², m, λ and φ₀ (sin φ₀ = sn u₀, cos φ₀ = cn u₀) are
@@ -82,7 +82,7 @@
 //! stable axes, cosh/sinh about the middle one; ∂M/∂I = 0); a sphere, Dφ_t = I and
 //! ∂M/∂I_q = t M₀ × ∂Ω/∂I_q; a symmetric body, the rotation's derivative (δθ = t δw), and
 //! along one of its two equal moments (which breaks the symmetry) the variational equation
-//! solved in closed form ([`symmetric_parameter`]).
+//! solved in closed form (`symmetric_parameter`).
 //!
 //! **Heavy top.** The flow of T(M) on se(3)* carries Γ with the attitude, the spatial vertical
 //! RΓ being fixed: Γ(t) = R(t)ᵀR₀Γ₀ = S(t)ᵀΓ₀ (then Γ̇ = −hat(Ω)Γ = Γ × Ω), R(t) = R₀S(t).
