@@ -925,7 +925,10 @@ impl Stepper for ExactTangentStepper {
     }
 
     fn get(&self, z: &mut [f64]) {
-        z.copy_from_slice(&self.z);
+        // Nothing before `set`.
+        if self.z.len() == z.len() {
+            z.copy_from_slice(&self.z);
+        }
     }
 
     fn advance(&mut self, steps: usize, _clock: Clock) -> Result<()> {
