@@ -941,6 +941,10 @@ pub(crate) fn splittings<P: Split + Clone + 'static>() -> Vec<Entry<P>> {
 /// splitting), [`VectorField`] (RK4) and the [`super::methods::lgvi::Lgvi`] method.
 macro_rules! top_kinds {
     ($t:ty) => {
+        $crate::systems::tops::top::top_kinds!($t;);
+    };
+    // Further methods of the lift without the attitude (name => constructor).
+    ($t:ty; $($name:literal => $make:expr),*) => {
         impl $crate::integrate::problem::Split for $t {
             type Work = $crate::systems::tops::top::TopWork;
             fn load(&self, z: &[f64]) -> $crate::Result<Self::Work> {
@@ -1001,13 +1005,15 @@ macro_rules! top_kinds {
             }
         }
 
-        /// The splittings and (without the attitude) `rk4` on the tangent lift.
+        /// The splittings and (without the attitude) `rk4` and the further methods on the
+        /// tangent lift.
         impl $crate::integrate::Catalog for $crate::integrate::tangent::Tangent<$t> {
             fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
                 let mut c = $crate::systems::tops::top::splittings();
                 c.push($crate::integrate::Entry::new("rk4", || {
                     $crate::integrate::methods::Rk4
                 }));
+                $(c.push($crate::integrate::Entry::new($name, $make));)*
                 c
             }
 

@@ -56,6 +56,34 @@
 //! measured, for the elliptic formula of M); S is evaluated relative to its own value at t = 0
 //! (a base point), so S(0) = I exactly and the rounding of the formulas cancels in short steps.
 //!
+//! **Tangent map** (issue 26; `FreeFlow::momentum_tangent`, the method `exact` on the tangent
+//! lift of the body without attitude). Dφ_t(M₀) = ∂M(t)/∂M₀ and ∂M(t)/∂I by the chain rule
+//! through the parametrisation: M(t) = (σa₁ cos φ, a₂ sin φ, εa₃ Δ(φ)), φ = am(u | m),
+//! Δ = √(1 − m sin²φ), where a₁², a₂², a₃², m, λ and φ₀ (sin φ₀ = sn u₀, cos φ₀ = cn u₀) are
+//! rational in M₀ and (g, h, d₁₃), so their differentials are elementary
+//! (dφ₀ = cn₀ dM₂/a₂ − σ sn₀ dM₁/a₁ + sn₀cn₀ dg/(2g) since a₁² = g a₂²). The amplitude moves with u
+//! and m: u = F(φ | m), and ∂F/∂m|_φ = (G(φ) − sin φ cos φ/Δ)/(2k′²) (DLMF 19.4.1) with
+//! G = (E − k′²F)/m = F − D, D(φ | m) = (F − E)/m = ⅓ sin³φ R_D(cos²φ, Δ², 1); along the
+//! continued amplitude D(u) = D(r) + 2j D(K) on the reduced r = u − 2Kj (D(K) = ⅓R_D(0, k′², 1)).
+//! With du = dφ₀/dn₀ + t dλ + Q dm, Q = (D(u) − D(u₀) − λt − sn₀cn₀/dn₀)/(2k′²) (the u₀ and u
+//! terms of ∂F/∂m combined, G(u₀) − G(u) = D(u) − D(u₀) − λt) and c = dm/(2k′²):
+//!
+//! dφ = dn·du + sn cn·c,   dΔ = −m sn cn·du − sn² dn·c,
+//!
+//! dM = (σ da₁ cn − σa₁ sn dφ, da₂ sn + a₂ cn dφ, ε da₃ dn + εa₃ dΔ) (no division by dn). One
+//! closed form for the directions of M₀ and of the moments (dg, dh = −dg, dd₁₃). Checked against
+//! the variational equations integrated in double-double (`tests/tangent.rs`: 2e-15 to 1.4e-13
+//! relative to |J| over t = 60, k′ ≥ 0.025). **Where it degrades**: the 1/k′² of ∂F/∂m cancels
+//! (the derivative at fixed u is analytic at m = 1), so near the separatrix the error grows like
+//! ε(1 + |u|)/k′² (measured 6.6e-12 at k′ = 5e-3, 2e-10 at k′ = 7e-4, relative to |J|, which
+//! itself grows like t/k′²); exactly on it (k′ = 0) the directions are NaN and a lifted run stops
+//! with its non-finite error. The closed forms have theirs: a steady rotation about a principal
+//! axis, Dφ_t = exp(tA) of the constant-coefficient variational equation (cos/sin about the
+//! stable axes, cosh/sinh about the middle one; ∂M/∂I = 0); a sphere, Dφ_t = I and
+//! ∂M/∂I_q = t M₀ × ∂Ω/∂I_q; a symmetric body, the rotation's derivative (δθ = t δw), and
+//! along one of its two equal moments (which breaks the symmetry) the variational equation
+//! solved in closed form (`symmetric_parameter`).
+//!
 //! **Heavy top.** The flow of T(M) on se(3)* carries Γ with the attitude, the spatial vertical
 //! RΓ being fixed: Γ(t) = R(t)ᵀR₀Γ₀ = S(t)ᵀΓ₀ (then Γ̇ = −hat(Ω)Γ = Γ × Ω), R(t) = R₀S(t).
 //! H = T + V(Γ) splits into this flow and the kick of V, M ↦ M + τ Γ × c
@@ -216,6 +244,153 @@ impl FreeFlow {
             Kind::Elliptic(e) => e.o.lambda.abs() + e.omega,
         }
     }
+}
+
+impl FreeFlow {
+    /// The tangent map of the momentum's flow at t (module docs, "Tangent map"):
+    /// (Dφ_t(M₀) = ∂M(t)/∂M₀, ∂M(t)/∂I with column q the derivative along the moment I_q),
+    /// principal frame, from the moments `inertia` this flow was built with. NaN on the
+    /// separatrix itself (k′ = 0; module docs).
+    pub(crate) fn momentum_tangent(
+        &self,
+        inertia: &[f64; 3],
+        t: f64,
+    ) -> (Matrix3<f64>, Matrix3<f64>) {
+        let m0 = &self.m0;
+        match &self.kind {
+            Kind::Uniform(_) => uniform_tangent(inertia, m0, t),
+            Kind::Symmetric { s, w, inv_io } => {
+                // M(t) = Rot_s(−θ)M₀, θ = t w(M₀, I): δM(t) = Rot δM₀ + δθ (M_j(t), −M_i(t)).
+                let (s, (i, j)) = (*s, ((*s + 1) % 3, (*s + 2) % 3));
+                let mt = self.momentum(t);
+                let (sin, cm1) = crate::numerics::simd::angle_sin_cosm1(t * w);
+                let mut jac = Matrix3::identity();
+                for c in [i, j] {
+                    let mut e = Vector3::zeros();
+                    e[c] = 1.0;
+                    top::rotate_axis_sc(&mut e, s, sin, cm1);
+                    jac.set_column(c, &e);
+                }
+                let turn = Vector3::from_fn(|r, _| {
+                    if r == i {
+                        mt[j]
+                    } else if r == j {
+                        -mt[i]
+                    } else {
+                        0.0
+                    }
+                });
+                let coef = 1.0 / inertia[s] - inv_io;
+                jac.set_column(s, &(jac.column(s) + turn * (t * coef)));
+                // Along I_s: δθ = −t M_s/I_s²; along the equal moments, `symmetric_parameter`.
+                let mut par = Matrix3::zeros();
+                par.set_column(s, &(turn * (-t * m0[s] / (inertia[s] * inertia[s]))));
+                let di = symmetric_parameter(m0, &mt, (i, j, s), *w, *inv_io, 1.0 / inertia[s], t);
+                // I_j: the sum of the two (δθ = t M_s/I_o², the rotation rate) less I_i's.
+                let dsum = turn * (t * m0[s] * inv_io * inv_io);
+                par.set_column(i, &di);
+                par.set_column(j, &(dsum - di));
+                (jac, par)
+            }
+            Kind::Elliptic(e) => e.tangent(inertia, m0, t),
+        }
+    }
+}
+
+/// ∂M(t)/∂I_i for a symmetric body (I_i = I_j = I_o, symmetry axis e_s, (i, j, s) cyclic) along
+/// one of its equal moments, which breaks the symmetry: with a = 1/I_o, b = 1/I_s, w =
+/// M_s(b − a) (M_i + iM_j = z₀e^{−iwt}), the variational equation δ̇ = δ × Ω + M × I⁻¹δ +
+/// M × ∂Ω/∂I_i (∂Ω = −a²M_i e_i) from δ(0) = 0 integrates in closed form:
+/// δ_s = (a²/2)(M_i M⁰_j + M_j M⁰_i) S, S = sin(wt)/w, and δ_i + iδ_j = −i z(t) A − i z̄₀ B with
+/// A = (b − a)∫₀ᵗδ_s + a²M_s t/2, B = a²M_s S/2, ∫₀ᵗδ_s = (a²t²/4)(2M⁰_iM⁰_j sinc²(wt) +
+/// (M⁰_i² − M⁰_j²) 2(sin y − y)/y²), y = 2wt (series for small y: no cancellation at w → 0).
+fn symmetric_parameter(
+    m0: &Vector3<f64>,
+    mt: &Vector3<f64>,
+    (i, j, s): (usize, usize, usize),
+    w: f64,
+    a: f64,
+    b: f64,
+    t: f64,
+) -> Vector3<f64> {
+    let x = w * t;
+    let sinc = if x.abs() < 1e-4 {
+        1.0 - x * x / 6.0
+    } else {
+        x.sin() / x
+    };
+    let y = 2.0 * x;
+    // 2(sin y − y)/y² = 2 Σ_{k≥1} (−1)^k y^{2k−1}/(2k+1)!.
+    let defect = if y.abs() < 0.5 {
+        let (mut term, mut sum) = (-y / 6.0, 0.0);
+        for k in 1..12 {
+            sum += term;
+            term *= -y * y / (((2 * k + 2) * (2 * k + 3)) as f64);
+        }
+        2.0 * sum
+    } else {
+        2.0 * (y.sin() - y) / (y * y)
+    };
+    let (p, q) = (m0[i], m0[j]);
+    let a2 = a * a;
+    let big_s = t * sinc;
+    let int_ds = a2 * t * t / 4.0 * (2.0 * p * q * sinc * sinc + (p * p - q * q) * defect);
+    let big_a = (b - a) * int_ds + a2 * m0[s] * t / 2.0;
+    let big_b = a2 * m0[s] * big_s / 2.0;
+    let mut d = Vector3::zeros();
+    d[i] = big_a * mt[j] - big_b * q;
+    d[j] = -big_a * mt[i] - big_b * p;
+    d[s] = a2 / 2.0 * (mt[i] * q + mt[j] * p) * big_s;
+    d
+}
+
+/// The tangent map of a uniform motion: M₀ = 0 or a spherical body (Dφ = I; a sphere's
+/// ∂M/∂I_q = t M₀ × ∂Ω/∂I_q with ∂Ω = −M₀_q/I_q² e_q, the field being constant to first
+/// order), or a steady rotation M₀ = μe_k about a principal axis of three distinct moments: the
+/// variational equation at an equilibrium has constant coefficients, δṀ_i = αδM_j,
+/// δṀ_j = βδM_i (α = μ(1/I_k − 1/I_j), β = μ(1/I_i − 1/I_k), (i, j, k) cyclic), so
+/// Dφ_t = exp(tA) in closed form (cos/sin about a stable axis, cosh/sinh about the middle one);
+/// M stays μe_k for every I, so ∂M/∂I = 0.
+fn uniform_tangent(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> (Matrix3<f64>, Matrix3<f64>) {
+    let mut jac = Matrix3::identity();
+    let mut par = Matrix3::zeros();
+    let nonzero: Vec<usize> = (0..3).filter(|&k| m0[k] != 0.0).collect();
+    let (lo, hi) = (
+        inertia.iter().copied().fold(f64::INFINITY, f64::min),
+        inertia.iter().copied().fold(0.0, f64::max),
+    );
+    if nonzero.is_empty() {
+        return (jac, par);
+    }
+    if (hi - lo).abs() <= 1e-14 * hi || nonzero.len() != 1 {
+        // A sphere (the only uniform motion with more than one nonzero component).
+        for q in 0..3 {
+            let mut dw = Vector3::zeros();
+            dw[q] = -m0[q] / (inertia[q] * inertia[q]);
+            par.set_column(q, &(m0.cross(&dw) * t));
+        }
+        return (jac, par);
+    }
+    let k = nonzero[0];
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let mu = m0[k];
+    let alpha = mu * (1.0 / inertia[k] - 1.0 / inertia[j]);
+    let beta = mu * (1.0 / inertia[i] - 1.0 / inertia[k]);
+    let kappa = alpha * beta;
+    let (c, s) = if kappa < 0.0 {
+        let w = (-kappa).sqrt();
+        ((w * t).cos(), (w * t).sin() / w)
+    } else if kappa > 0.0 {
+        let w = kappa.sqrt();
+        ((w * t).cosh(), (w * t).sinh() / w)
+    } else {
+        (1.0, t)
+    };
+    jac[(i, i)] = c;
+    jac[(j, j)] = c;
+    jac[(i, j)] = alpha * s;
+    jac[(j, i)] = beta * s;
+    (jac, par)
 }
 
 /// The constants of the motion from M₀ (principal frame, finite): a closed form (M = 0, a
@@ -521,6 +696,81 @@ impl Elliptic {
     }
 }
 
+impl Elliptic {
+    /// (∂M(t)/∂M₀, ∂M(t)/∂I) on an elliptic orbit by the chain rule through the parametrisation
+    /// (module docs, "Tangent map"); NaN on the separatrix (k′ = 0).
+    fn tangent(
+        &self,
+        inertia: &[f64; 3],
+        m0: &Vector3<f64>,
+        t: f64,
+    ) -> (Matrix3<f64>, Matrix3<f64>) {
+        let o = &self.o;
+        let [p, mid, s] = o.axes;
+        let (sigma, sg, eps) = (o.amp[0].signum(), o.amp[1].signum(), o.amp[2].signum());
+        let (a1, a2, a3) = (o.amp[0].abs(), o.amp[1].abs(), o.amp[2].abs());
+        let y = m0 / o.scale;
+        let (y1, y2, y3) = (y[p], sg * y[mid], y[s]);
+        // The same g, h, d₁₃ as `shape`.
+        let (i1, i2, i3) = (inertia[p], inertia[mid], inertia[s]);
+        let g = i1 * (i3 - i2) / (i2 * (i3 - i1));
+        let h = i3 * (i2 - i1) / (i2 * (i3 - i1));
+        let d13 = (i3 - i1) / (i1 * i3);
+        let (sn0, cn0, dn0) = o.jac0;
+        let (m, kp2, lambda) = (o.m, o.kp * o.kp, o.lambda);
+        let u = self.u0 + lambda * t;
+        let (sn, cn, dn) = elliptic::ellipj_kprime_unchecked(u, o.kp, m);
+        // D(u) = (F − E)/m along the continued amplitude: D(r) + 2j D(K) on the reduced r.
+        let dfun = |sn: f64, cn: f64, dn: f64| {
+            sn * sn * sn * elliptic::rd_kernel(cn * cn, dn * dn, 1.0) / 3.0
+        };
+        let j = (u / self.two_k).round();
+        let sr = if j.rem_euclid(2.0) == 0.0 { sn } else { -sn };
+        let dc = elliptic::rd_kernel(0.0, kp2, 1.0) / 3.0;
+        let du = dfun(sr, cn.abs(), dn) + 2.0 * j * dc;
+        // Q = (G(u₀) − G(u) − sn₀cn₀/dn₀)/(2k′²), G = F − D = (E − k′²F)/m.
+        let q = (du - dfun(sn0, cn0, dn0) - lambda * t - sn0 * cn0 / dn0) / (2.0 * kp2);
+        let one = |dy: &Vector3<f64>, dg: f64, dh: f64, dd13: f64| {
+            let (dy1, dy2, dy3) = (dy[p], sg * dy[mid], dy[s]);
+            let da1sq = 2.0 * y1 * dy1 + 2.0 * g * y2 * dy2 + y2 * y2 * dg;
+            let da2sq = 2.0 * y2 * dy2 + 2.0 * y1 * dy1 / g - y1 * y1 * dg / (g * g);
+            let da3sq = 2.0 * y3 * dy3 + 2.0 * h * y2 * dy2 + y2 * y2 * dh;
+            let dm = (dh * a2 * a2 + h * da2sq - m * da3sq) / (a3 * a3);
+            let dlam = lambda * (da3sq / (2.0 * a3 * a3) + dd13 / d13 + dg / (2.0 * g));
+            let dphi0 = cn0 * dy2 / a2 - sigma * sn0 * dy1 / a1 + sn0 * cn0 * dg / (2.0 * g);
+            let w = dphi0 / dn0 + t * dlam + q * dm;
+            let c = dm / (2.0 * kp2);
+            let dphi = dn * w + sn * cn * c;
+            let ddn = -m * sn * cn * w - sn * sn * dn * c;
+            let mut out = Vector3::zeros();
+            out[p] = sigma * da1sq / (2.0 * a1) * cn - o.amp[0] * sn * dphi;
+            out[mid] = sg * da2sq / (2.0 * a2) * sn + o.amp[1] * cn * dphi;
+            out[s] = eps * da3sq / (2.0 * a3) * dn + o.amp[2] * ddn;
+            out
+        };
+        let mut jac = Matrix3::zeros();
+        for c in 0..3 {
+            let mut e = Vector3::zeros();
+            e[c] = 1.0;
+            jac.set_column(c, &one(&e, 0.0, 0.0, 0.0));
+        }
+        // ∂(g, d₁₃)/∂(I₁, I₂, I₃) in the working axes (h = 1 − g).
+        let den = (i3 - i1) * (i3 - i1);
+        let dg = [
+            (i3 - i2) / i2 * i3 / den,
+            -i1 / (i3 - i1) * i3 / (i2 * i2),
+            i1 / i2 * (i2 - i1) / den,
+        ];
+        let dd = [-1.0 / (i1 * i1), 0.0, 1.0 / (i3 * i3)];
+        let mut par = Matrix3::zeros();
+        for (w, &axis) in o.axes.iter().enumerate() {
+            let col = one(&Vector3::zeros(), dg[w], -dg[w], dd[w]) * o.scale;
+            par.set_column(axis, &col);
+        }
+        (jac, par)
+    }
+}
+
 /// P(r) = (1 − q) r − (ν/3) sn³r R_J(cn²r, dn²r, 1, 1 + ν sn²r) for |r| ≤ K, from sn r, cn r ≥ 0
 /// and dn r (module docs); `jk` = 1 − q.
 #[inline]
@@ -634,6 +884,78 @@ impl Stepper for ExactStepper {
     }
 }
 
+impl Exact {
+    /// The stepper of the tangent lift of a free body without attitude, state (M, δM₁, …,
+    /// δM_k) with k = 3 + 3 (the directions of M₀ and of I₁, I₂, I₃): like [`ExactStepper`],
+    /// every step is evaluated from the state last handed to it at the time t = k·dt since, M
+    /// by the same [`FreeFlow::momentum`] (the same bits as the plain run) and each direction
+    /// by the exact tangent map, δM(t) = Dφ_t δM_ref (+ ∂M(t)/∂I_q for the parameter q's).
+    pub(crate) fn tangent_stepper_for(&self, top: &Top, dt: f64) -> Box<dyn Stepper> {
+        Box::new(ExactTangentStepper {
+            moments: top.moments,
+            dt,
+            flow: None,
+            steps: 0,
+            z_ref: Vec::new(),
+            z: Vec::new(),
+        })
+    }
+}
+
+struct ExactTangentStepper {
+    moments: [f64; 3],
+    dt: f64,
+    flow: Option<FreeFlow>,
+    steps: u64,
+    /// The lifted state handed to `set` and the current one.
+    z_ref: Vec<f64>,
+    z: Vec<f64>,
+}
+
+impl Stepper for ExactTangentStepper {
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        let m = Vector3::from_column_slice(&z[..3]);
+        check::finite_slice("state", m.as_slice())?;
+        self.z_ref.clear();
+        self.z_ref.extend_from_slice(z);
+        self.z.clone_from(&self.z_ref);
+        self.flow = Some(FreeFlow::new(&self.moments, &m));
+        self.steps = 0;
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        // Nothing before `set`.
+        if self.z.len() == z.len() {
+            z.copy_from_slice(&self.z);
+        }
+    }
+
+    fn advance(&mut self, steps: usize, _clock: Clock) -> Result<()> {
+        let Some(flow) = &self.flow else {
+            return Ok(());
+        };
+        if steps == 0 {
+            return Ok(());
+        }
+        self.steps += steps as u64;
+        let t = self.steps as f64 * self.dt;
+        self.z[..3].copy_from_slice(flow.momentum(t).as_slice());
+        let (jac, par) = flow.momentum_tangent(&self.moments, t);
+        let dirs = self.z_ref[3..]
+            .chunks_exact(3)
+            .zip(self.z[3..].chunks_exact_mut(3));
+        for (j, (from, to)) in dirs.enumerate() {
+            let mut d = jac * Vector3::from_column_slice(from);
+            if j >= 3 {
+                d += par.column(j - 3);
+            }
+            to.copy_from_slice(d.as_slice());
+        }
+        Ok(())
+    }
+}
+
 /// The splitting of the heavy top H = T(M) + V(Γ) into the exact free flow of T (M by the
 /// exact flow, Γ ↦ S(τ)ᵀΓ, R ↦ R S(τ)) and the kick of V (M ↦ M + τ Γ × c), with the
 /// composition's weights (catalog names `exact_splitting`, `exact_splitting4`,
@@ -674,6 +996,65 @@ mod tests {
         assert!(
             used > 300 && worst < 1e-14,
             "{used} steps, max difference {worst:e}"
+        );
+    }
+
+    /// The tangent map against central differences of the flow in M₀ and in the moments, on
+    /// both sides of the separatrix, for a symmetric body and at steady rotations.
+    #[test]
+    fn momentum_tangent_is_the_flows_derivative() {
+        let mut worst = (0.0f64, 0.0f64);
+        let cases: Vec<([f64; 3], Vector3<f64>)> = vec![
+            ([1.0, 2.0, 3.0], Vector3::new(1.0, 0.3, 0.2)),
+            ([1.0, 2.0, 3.0], Vector3::new(0.2, 0.3, -1.0)),
+            ([1.0, 2.0, 3.0], Vector3::new(-0.3, 1.0, 0.1)),
+            ([3.0, 2.9, 1.0], Vector3::new(0.7, -0.4, 0.9)),
+            ([1.0, 1.5, 4.0], Vector3::new(0.1, 1.2, -0.6)),
+            ([1.0, 2.0, 2.0], Vector3::new(0.5, -0.4, 0.3)),
+            ([3.0, 2.0, 3.0], Vector3::new(0.5, -0.4, 0.3)),
+            ([3.0, 2.0, 3.0], Vector3::new(0.5, 0.0, 0.3)),
+            ([3.0, 3.0, 1.0], Vector3::new(0.2, 0.7, 0.0)),
+            ([1.0, 2.0, 2.0 + 1e-5], Vector3::new(0.5, -0.4, 0.3)),
+            ([1.0, 2.0, 3.0], Vector3::new(0.0, 0.0, 1.3)),
+            ([1.0, 2.0, 3.0], Vector3::new(0.0, 1.3, 0.0)),
+            ([2.0, 2.0, 2.0], Vector3::new(0.4, 0.5, 0.6)),
+        ];
+        for (inertia, m0) in cases {
+            for t in [0.3, 2.0, 7.5, -4.0] {
+                let (jac, par) = FreeFlow::new(&inertia, &m0).momentum_tangent(&inertia, t);
+                let h = 1e-6;
+                let scale = jac.amax().max(1.0);
+                for c in 0..3 {
+                    let mut e = Vector3::zeros();
+                    e[c] = h;
+                    let fd = (FreeFlow::momentum_at(&inertia, &(m0 + e), t)
+                        - FreeFlow::momentum_at(&inertia, &(m0 - e), t))
+                        / (2.0 * h);
+                    let err = (jac.column(c) - fd).amax() / scale;
+                    assert!(
+                        err < 1e-7,
+                        "{inertia:?} {m0:?} t {t} column {c}: {err:e}\n{jac}\n{fd}"
+                    );
+                    worst.0 = worst.0.max(err);
+                    let (mut ip, mut im) = (inertia, inertia);
+                    ip[c] += h;
+                    im[c] -= h;
+                    let pc = par.column(c);
+                    let fd = (FreeFlow::momentum_at(&ip, &m0, t)
+                        - FreeFlow::momentum_at(&im, &m0, t))
+                        / (2.0 * h);
+                    let err = (pc - fd).amax() / scale;
+                    assert!(
+                        err < 1e-6,
+                        "{inertia:?} {m0:?} t {t} I{c}: {err:e}\n{par}\n{fd}"
+                    );
+                    worst.1 = worst.1.max(err);
+                }
+            }
+        }
+        eprintln!(
+            "tangent vs differences: M₀ {:.1e}, I {:.1e}",
+            worst.0, worst.1
         );
     }
 
