@@ -186,6 +186,14 @@ pub trait Separable: Problem {
     /// The number d of degrees of freedom.
     fn dof(&self) -> usize;
 
+    /// The number of equal diagonal blocks of the problem's constraint matrices when they are
+    /// block lower-triangular: 1 + k for a tangent lift ([`crate::integrate::tangent`]), whose
+    /// RATTLE and nonholonomic solves then factor one block ([`VectorField::diagonal_blocks`]
+    /// is the same for a field). 1 by default.
+    fn diagonal_blocks(&self) -> usize {
+        1
+    }
+
     /// The velocity v = ∂T/∂p (linear in p, v = M⁻¹p, for the constrained kinds).
     fn velocity(&self, p: &[f64], v: &mut [f64]);
 

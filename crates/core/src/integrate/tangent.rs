@@ -337,6 +337,12 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
         self.problem.dof() * (self.k() + 1)
     }
 
+    /// The state and its k directions (the constrained and nonholonomic lifts' matrices are
+    /// block lower-triangular with the base one on the diagonal).
+    fn diagonal_blocks(&self) -> usize {
+        self.k() + 1
+    }
+
     /// The velocity does not depend on the parameters (T(p) is the problem's own).
     fn velocity(&self, p: &[f64], v: &mut [f64]) {
         let n = self.problem.dof();

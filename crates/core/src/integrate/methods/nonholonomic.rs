@@ -81,7 +81,7 @@ impl<P: Nonholonomic + Clone + 'static> Integrator<P> for NonholonomicRattle {
             v: vec![0.0; d],
             ph: vec![0.0; d],
             qbar: vec![0.0; d],
-            rows: Rows::new(m, d),
+            rows: Rows::new(problem, m, d),
             abar: vec![0.0; m * d],
             r: vec![0.0; m],
             w: vec![0.0; m],

@@ -124,13 +124,26 @@ pub(crate) struct Rows {
     pub(crate) distinct: bool,
     /// The rows W = M⁻¹Fᵀ.
     pub(crate) w: Vec<f64>,
+    /// The number B of diagonal blocks of S = C M⁻¹Fᵀ ([`Separable::diagonal_blocks`]: 1 + k
+    /// for a tangent lift, whose S is block lower-triangular with one repeated diagonal block
+    /// S₀₀; 1 otherwise), and its blocks S_j0 below the diagonal.
+    blocks: usize,
+    low: Vec<f64>,
+    /// The LU of S₀₀ (of S when B = 1).
     lu: DenseLu,
     rhs: Vec<f64>,
 }
 
 impl Rows {
-    /// Storage for m rows of length d.
-    pub(crate) fn new(m: usize, d: usize) -> Self {
+    /// Storage for the m rows of length d of `problem` (its diagonal blocks).
+    pub(crate) fn new<P: Separable>(problem: &P, m: usize, d: usize) -> Self {
+        let blocks = problem.diagonal_blocks().max(1);
+        let blocks = if m % blocks == 0 && d % blocks == 0 {
+            blocks
+        } else {
+            1
+        };
+        let m0 = m / blocks;
         Rows {
             m,
             d,
@@ -138,7 +151,9 @@ impl Rows {
             f: Vec::new(),
             distinct: false,
             w: vec![0.0; m * d],
-            lu: DenseLu::new(m),
+            blocks,
+            low: vec![0.0; (blocks - 1) * m0 * m0],
+            lu: DenseLu::new(m0),
             rhs: vec![0.0; m],
         }
     }
@@ -178,21 +193,37 @@ impl Rows {
 
     /// Factors the m×m matrix S_ab = B_a · W_b for rows B (m×d, row-major; `None`: B = C) and
     /// the current W; false when S is singular or not finite.
+    ///
+    /// With B diagonal blocks only S₀₀ and the S_j0 are formed, from the columns where the rows
+    /// of a lift are not zero (block 0 and block j): O(B m₀² d/B) instead of O(m² d).
     pub(crate) fn factor_with(&mut self, rows: Option<&[f64]>) -> bool {
-        let (m, d) = (self.m, self.d);
+        let (m, d, blocks) = (self.m, self.d, self.blocks);
         let rows = rows.unwrap_or(&self.c);
+        let (m0, n0) = (m / blocks, d / blocks);
         let mat = self.lu.matrix();
-        for a in 0..m {
-            for b in 0..m {
-                mat[(a, b)] = dot(&rows[a * d..(a + 1) * d], &self.w[b * d..(b + 1) * d]);
+        let w = &self.w;
+        // Row a of the rows, and of W, over the columns of block j.
+        let part = |a: usize, j: usize| a * d + j * n0..a * d + (j + 1) * n0;
+        for a in 0..m0 {
+            for b in 0..m0 {
+                mat[(a, b)] = dot(&rows[part(a, 0)], &w[part(b, 0)]);
+            }
+        }
+        for j in 1..blocks {
+            for a in 0..m0 {
+                let r = j * m0 + a;
+                for b in 0..m0 {
+                    self.low[((j - 1) * m0 + a) * m0 + b] = dot(&rows[part(r, 0)], &w[part(b, 0)])
+                        + dot(&rows[part(r, j)], &w[part(b, j)]);
+                }
             }
         }
         self.lu.factor()
     }
 
-    /// Solves the factored system in place (m values).
+    /// Solves the factored system in place (m values): block forward substitution with S₀₀.
     pub(crate) fn solve(&mut self, x: &mut [f64]) {
-        self.lu.solve(x);
+        solve_blocks(&mut self.lu, &self.low, self.blocks, x);
     }
 
     /// p ← p − Fᵀκ with κ such that C M⁻¹p = 0 afterwards (the projection of the last RATTLE
@@ -214,12 +245,26 @@ impl Rows {
         for a in 0..m {
             self.rhs[a] = dot(&self.c[a * d..(a + 1) * d], v);
         }
-        self.lu.solve(&mut self.rhs);
+        solve_blocks(&mut self.lu, &self.low, self.blocks, &mut self.rhs);
         let forces = if self.distinct { &self.f } else { &self.c };
         for a in 0..m {
             axpy(p, -self.rhs[a], &forces[a * d..(a + 1) * d]);
         }
         true
+    }
+}
+
+/// x ← S⁻¹x for S block lower-triangular with B diagonal blocks S₀₀ (factored in `lu`) and
+/// the blocks S_j0 (`low`) below: x₀ = S₀₀⁻¹x₀, x_j = S₀₀⁻¹(x_j − S_j0 x₀).
+fn solve_blocks(lu: &mut DenseLu, low: &[f64], blocks: usize, x: &mut [f64]) {
+    let m0 = x.len() / blocks;
+    let (x0, rest) = x.split_at_mut(m0);
+    lu.solve(x0);
+    for (j, xj) in rest.chunks_exact_mut(m0).enumerate() {
+        for (a, xa) in xj.iter_mut().enumerate() {
+            *xa -= dot(&low[(j * m0 + a) * m0..(j * m0 + a + 1) * m0], x0);
+        }
+        lu.solve(xj);
     }
 }
 
@@ -262,7 +307,7 @@ impl<P: Constrained + Clone + 'static> Integrator<P> for Rattle {
             f: vec![0.0; d],
             v: vec![0.0; d],
             qn: vec![0.0; d],
-            rows: Rows::new(m, d),
+            rows: Rows::new(problem, m, d),
             jac: vec![0.0; m * d],
             g: vec![0.0; m],
             g0: vec![0.0; m],
@@ -436,7 +481,7 @@ impl FieldWork {
     pub fn new<P: Constrained>(problem: &P) -> Self {
         let (d, m) = (problem.dof(), problem.constraints());
         FieldWork {
-            rows: Rows::new(m, d),
+            rows: Rows::new(problem, m, d),
             f: vec![0.0; d],
             v: vec![0.0; d],
         }
