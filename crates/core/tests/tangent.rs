@@ -76,6 +76,43 @@ fn max_rel(a: &[f64], b: &[f64]) -> f64 {
         / scale
 }
 
+/// Central differences of the end state along each parameter θ_m, the system rebuilt by
+/// `build` with θ_m moved by h·max(1, |θ_m|) (d × p, row-major).
+fn parameter_differences<S: System, const P: usize>(
+    build: impl Fn([f64; P]) -> S,
+    theta: [f64; P],
+    method: &str,
+    z0: &[f64],
+    (dt, steps): (f64, usize),
+    h: f64,
+) -> Vec<f64> {
+    let d = z0.len();
+    let mut out = vec![0.0; d * P];
+    for m in 0..P {
+        let hm = h * theta[m].abs().max(1.0);
+        let end = |s: f64| {
+            let mut th = theta;
+            th[m] += s;
+            integrate(&build(th), method, z0, dt, steps, steps)
+                .unwrap()
+                .state(1)
+                .to_vec()
+        };
+        let (a, b) = (end(hm), end(-hm));
+        for i in 0..d {
+            out[i * P + m] = (a[i] - b[i]) / (2.0 * hm);
+        }
+    }
+    out
+}
+
+/// max |a − b| (absolute).
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
 fn body() -> PseudoRigidBody {
     let elastic = Arc::new(Sum::new(vec![
         Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap()),
@@ -266,55 +303,25 @@ fn parameter_jacobians_of_the_tops() {
         let t = rb.tangent().unwrap();
         assert_eq!(t.parameter_names(), ["I1", "I2", "I3"]);
         let (_, _, pjac) = lifted_end_all(&*t, method, &z_rb, 0.05, 40);
-        for m in 0..3 {
-            let end = |s: f64| {
-                let mut i = moments;
-                i[m] += s;
-                integrate(&RigidBody::new(i).unwrap(), method, &z_rb, 0.05, 40, 40)
-                    .unwrap()
-                    .state(1)
-                    .to_vec()
-            };
-            let (p, q) = (end(h), end(-h));
-            for i in 0..3 {
-                let fd = (p[i] - q[i]) / (2.0 * h);
-                assert!(
-                    (pjac[i * 3 + m] - fd).abs() < 1e-7,
-                    "{method} I{}: {} vs {fd}",
-                    m + 1,
-                    pjac[i * 3 + m]
-                );
-            }
-        }
-        // The heavy top.
+        let free = |i: [f64; 3]| RigidBody::new(i).unwrap();
+        let fd = parameter_differences(free, moments, method, &z_rb, (0.05, 40), h);
+        let worst = max_abs_diff(&pjac, &fd);
+        assert!(worst < 1e-7, "RigidBody {method}: {worst:e}");
+        // The heavy top; χ moved without its normalisation (mgl scaled by |χ|).
         let ht = heavy(moments, mgl, chi);
         let t = ht.tangent().unwrap();
-        let np = t.parameter_names().len();
-        assert_eq!(np, 7);
+        assert_eq!(t.parameter_names().len(), 7);
         let (_, _, pjac) = lifted_end_all(&*t, method, &z_ht, 0.05, 40);
-        let mut worst = 0.0f64;
-        for m in 0..np {
-            let end = |s: f64| {
-                let (mut i, mut g, mut c) = (moments, mgl, chi);
-                match m {
-                    0..=2 => i[m] += s,
-                    3 => g += s,
-                    _ => {
-                        c[m - 4] += s;
-                        g *= (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-                    }
-                }
-                integrate(&heavy(i, g, c), method, &z_ht, 0.05, 40, 40)
-                    .unwrap()
-                    .state(1)
-                    .to_vec()
-            };
-            let (p, q) = (end(h), end(-h));
-            for i in 0..6 {
-                let fd = (p[i] - q[i]) / (2.0 * h);
-                worst = worst.max((pjac[i * np + m] - fd).abs());
-            }
-        }
+        let build = |th: [f64; 7]| {
+            let c = [th[4], th[5], th[6]];
+            let g = th[3] * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+            heavy([th[0], th[1], th[2]], g, c)
+        };
+        let theta = [
+            moments[0], moments[1], moments[2], mgl, chi[0], chi[1], chi[2],
+        ];
+        let fd = parameter_differences(build, theta, method, &z_ht, (0.05, 40), h);
+        let worst = max_abs_diff(&pjac, &fd);
         eprintln!("HeavyTop {method}: parameter Jacobian vs differences {worst:.2e}");
         assert!(worst < 1e-7, "HeavyTop {method}: {worst:e}");
     }
@@ -439,22 +446,8 @@ fn parameter_jacobian_of_the_pseudo_rigid_body() {
             }
         }
         let (_, _, pjac) = lifted_end_all(&*t, method, &z0, 0.05, 40);
-        let h = 1e-6;
-        let mut worst = 0.0f64;
-        for m in 0..4 {
-            let end = |s: f64| {
-                let mut th = theta;
-                th[m] += s;
-                integrate(&build(th), method, &z0, 0.05, 40, 40)
-                    .unwrap()
-                    .state(1)
-                    .to_vec()
-            };
-            let (p, q) = (end(h), end(-h));
-            for i in 0..18 {
-                worst = worst.max((pjac[i * 4 + m] - (p[i] - q[i]) / (2.0 * h)).abs());
-            }
-        }
+        let fd = parameter_differences(build, theta, method, &z0, (0.05, 40), 1e-6);
+        let worst = max_abs_diff(&pjac, &fd);
         eprintln!("PseudoRigidBody {method}: parameter Jacobian vs differences {worst:.2e}");
         assert!(worst < 1e-7, "{method}: {worst:e}");
     }
@@ -821,22 +814,8 @@ fn parameter_jacobian_of_the_spherical_pendulum() {
     assert_eq!(t.parameter_names(), ["mass", "length", "g"]);
     for method in ["splitting", "splitting6", "rk4"] {
         let (_, _, pjac) = lifted_end_all(&*t, method, &z0, 0.02, 100);
-        let mut worst = 0.0f64;
-        for m in 0..3 {
-            let h = 1e-6 * theta[m];
-            let end = |s: f64| {
-                let mut th = theta;
-                th[m] += s;
-                integrate(&build(th), method, &z0, 0.02, 100, 100)
-                    .unwrap()
-                    .state(1)
-                    .to_vec()
-            };
-            let (p, q) = (end(h), end(-h));
-            for i in 0..6 {
-                worst = worst.max((pjac[i * 3 + m] - (p[i] - q[i]) / (2.0 * h)).abs());
-            }
-        }
+        let fd = parameter_differences(build, theta, method, &z0, (0.02, 100), 1e-6);
+        let worst = max_abs_diff(&pjac, &fd);
         eprintln!("SphericalPendulum {method}: parameter Jacobian vs differences {worst:.2e}");
         assert!(worst < 1e-7, "{method}: {worst:e}");
     }
@@ -914,26 +893,12 @@ fn jacobians_of_the_right_reduced_body() {
                 "RightReduced (X: {reconstruct}) {method}: Jacobian vs differences {err:.2e}"
             );
             assert!(err < 1e-8, "{method}: {err:e}");
-            let mut worst = 0.0f64;
-            for m in 0..4 {
-                let h = 1e-6 * theta[m];
-                let end = |s: f64| {
-                    let mut th = theta;
-                    th[m] += s;
-                    let b = match reconstruct {
-                        false => build(th),
-                        true => build(th).reconstructing(),
-                    };
-                    integrate(&b, method, &z0, dt, steps, steps)
-                        .unwrap()
-                        .state(1)
-                        .to_vec()
-                };
-                let (a, b) = (end(h), end(-h));
-                for i in 0..d {
-                    worst = worst.max((pjac[i * 4 + m] - (a[i] - b[i]) / (2.0 * h)).abs());
-                }
-            }
+            let rebuild = |th: [f64; 4]| match reconstruct {
+                false => build(th),
+                true => build(th).reconstructing(),
+            };
+            let fd = parameter_differences(rebuild, theta, method, &z0, (dt, steps), 1e-6);
+            let worst = max_abs_diff(&pjac, &fd);
             eprintln!("RightReduced (X: {reconstruct}) {method}: parameter Jacobian {worst:.2e}");
             assert!(worst < 1e-7, "{method}: {worst:e}");
             if method == "rk4" {
@@ -986,22 +951,8 @@ fn nonholonomic_jacobian_of_the_rolling_disk() {
     // h = 1e-5: the end state's round-off (~1e-14, the multiplier iteration stopping at
     // round-off) over 2h stays below the O(h²) truncation (1e-6 gave 1.3e-8 along g̃, 1e-7
     // 4.3e-8, the lifted value the same).
-    let mut perr = 0.0f64;
-    for m in 0..2 {
-        let h = 1e-5;
-        let end = |s: f64| {
-            let mut th = theta;
-            th[m] += s;
-            integrate(&build(th), "nonholonomic", &z0, dt, steps, steps)
-                .unwrap()
-                .state(1)
-                .to_vec()
-        };
-        let (a, b) = (end(h), end(-h));
-        for i in 0..8 {
-            perr = perr.max((pjac[i * 2 + m] - (a[i] - b[i]) / (2.0 * h)).abs());
-        }
-    }
+    let pfd = parameter_differences(build, theta, "nonholonomic", &z0, (dt, steps), 1e-5);
+    let perr = max_abs_diff(&pjac, &pfd);
     // The linearised constraint at a state: L(z)(δq, δp) = DA(q)[δq]M⁻¹p + A(q)M⁻¹δp (2 × 8).
     let linearised = |z: &[f64]| -> [[f64; 8]; 2] {
         let (s, c) = z[3].sin_cos();
@@ -1307,21 +1258,8 @@ fn exact_jacobian_against_differences() {
             let (_, jac, pjac) = lifted_end_all(&*t, "exact", &z0, dt, steps);
             let fd = differences(&rb, "exact", &z0, dt, steps, h);
             let ej = max_rel(&jac, &fd);
-            let mut pfd = vec![0.0; 9];
-            for m in 0..3 {
-                let end = |s: f64| {
-                    let mut i = moments;
-                    i[m] += s;
-                    integrate(&RigidBody::new(i).unwrap(), "exact", &z0, dt, steps, steps)
-                        .unwrap()
-                        .state(1)
-                        .to_vec()
-                };
-                let (p, q) = (end(h), end(-h));
-                for i in 0..3 {
-                    pfd[i * 3 + m] = (p[i] - q[i]) / (2.0 * h);
-                }
-            }
+            let free = |i: [f64; 3]| RigidBody::new(i).unwrap();
+            let pfd = parameter_differences(free, moments, "exact", &z0, (dt, steps), h);
             let ep = max_rel(&pjac, &pfd);
             eprintln!("exact, {name}, {steps} steps: vs differences J {ej:.1e}, ∂M/∂I {ep:.1e}");
             worst = (worst.0.max(ej), worst.1.max(ep));
@@ -1341,21 +1279,8 @@ fn exact_jacobian_against_differences() {
     let z0 = [0.3, -0.8, 1.1];
     let (_, jac, pjac) = lifted_end_all(&*rb.tangent().unwrap(), "exact", &z0, 3.0, 4);
     let ej = max_rel(&jac, &differences(&rb, "exact", &z0, 3.0, 4, h));
-    let mut pfd = vec![0.0; 9];
-    for m in 0..3 {
-        let end = |s: f64| {
-            let mut i = moments;
-            i[m] += s;
-            integrate(&RigidBody::new(i).unwrap(), "exact", &z0, 3.0, 4, 4)
-                .unwrap()
-                .state(1)
-                .to_vec()
-        };
-        let (p, q) = (end(h), end(-h));
-        for i in 0..3 {
-            pfd[i * 3 + m] = (p[i] - q[i]) / (2.0 * h);
-        }
-    }
+    let free = |i: [f64; 3]| RigidBody::new(i).unwrap();
+    let pfd = parameter_differences(free, moments, "exact", &z0, (3.0, 4), h);
     let ep = max_rel(&pjac, &pfd);
     eprintln!("exact, symmetric body: vs differences J {ej:.1e}, ∂M/∂I {ep:.1e}");
     assert!(ej.max(ep) < 1e-8, "{ej:e} {ep:e}");
