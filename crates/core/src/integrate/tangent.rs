@@ -128,6 +128,12 @@ pub fn separable_field_tangent<P: SeparableTangent>(
     problem.force_tangent(&z[..d], &dz[..d], of, s);
 }
 
+thread_local! {
+    /// Work space of the separable layout's gathers (three state-sized vectors per thread,
+    /// sized at their first use).
+    static BUFFERS: std::cell::RefCell<[Vec<f64>; 3]> = Default::default();
+}
+
 /// Where the lift keeps its directions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Layout {
@@ -209,18 +215,28 @@ impl<P: Problem + Clone> Tangent<P> {
     }
 
     /// Applies `state` to the base state and `tangent` to every direction.
+    /// In place in the field layout; the separable one through this thread's buffer
+    /// (allocated once, not per saved sample).
     fn each(&self, z: &mut [f64], state: impl Fn(&mut [f64]), tangent: impl Fn(&mut [f64])) {
-        let mut v = vec![0.0; self.d];
-        for j in 0..=self.k() {
-            self.gather(z, j, &mut v);
-            let n = self.len_of(j);
-            if j == 0 {
-                state(&mut v[..n]);
-            } else {
-                tangent(&mut v[..n]);
-            }
-            self.scatter(&v, j, z);
+        if self.layout == Layout::Field {
+            let (base, dirs) = z.split_at_mut(self.d);
+            state(base);
+            dirs.chunks_exact_mut(self.e).for_each(tangent);
+            return;
         }
+        BUFFERS.with_borrow_mut(|[v, ..]| {
+            v.resize(self.d, 0.0);
+            for j in 0..=self.k() {
+                self.gather(z, j, v);
+                let n = self.len_of(j);
+                if j == 0 {
+                    state(&mut v[..n]);
+                } else {
+                    tangent(&mut v[..n]);
+                }
+                self.scatter(v, j, z);
+            }
+        });
     }
 }
 
@@ -639,9 +655,6 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
             return;
         }
         // Separable layout: each block gathered into this thread's buffers (allocated once).
-        thread_local! {
-            static BUFFERS: std::cell::RefCell<[Vec<f64>; 3]> = Default::default();
-        }
         BUFFERS.with_borrow_mut(|[base, dir, out]| {
             for v in [&mut *base, &mut *dir, &mut *out] {
                 v.resize(d, 0.0);
