@@ -304,3 +304,14 @@ def test_concatenated_runs_join_their_jacobians_by_the_chain_rule(attitude):
                          attitude=a.final_attitude)
     with pytest.raises(lf.InvalidArgumentError, match="some parts only"):
         lf.Trajectory.concatenate([a, plain])
+
+
+def test_a_batch_with_jacobians_round_trips(tmp_path):
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    z0 = np.array([[0.3, -0.8, 1.1], [0.5, 0.2, -0.9]])
+    traj = lf.integrate(body, z0, 0.01, 50, save_every=10, attitude=np.eye(3), sensitivity=True)
+    assert traj.jacobian.shape == (2, 6, 6, 6)
+    traj.save(tmp_path / "batch.nc")
+    back = lf.load(tmp_path / "batch.nc")
+    for name in ("jacobian", "final_jacobian", "parameter_jacobian", "final_parameter_jacobian"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(traj, name), err_msg=name)

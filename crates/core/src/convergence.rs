@@ -43,6 +43,22 @@ pub struct Rule {
     pub max_iter: usize,
 }
 
+impl Rule {
+    /// The rule for a tangent lift's solve with `blocks` diagonal blocks (the state and its
+    /// directions, [`crate::integrate::tangent`]): the directions start converging when the
+    /// state has, at its rate, so twice the iterations (with the plain limit a step that
+    /// converges plainly could fail with its directions). The rule itself for `blocks` ≤ 1.
+    pub fn for_blocks(self, blocks: usize) -> Rule {
+        match blocks > 1 {
+            true => Rule {
+                max_iter: 2 * self.max_iter,
+                ..self
+            },
+            false => self,
+        }
+    }
+}
+
 /// A solve that failed: the iterations taken and the last update relative to the scale (∞ for
 /// a diverged iteration or a singular linear system).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -131,7 +131,17 @@ pub fn separable_field_tangent<P: SeparableTangent>(
 thread_local! {
     /// Work space of the separable layout's gathers (three state-sized vectors per thread,
     /// sized at their first use).
-    static BUFFERS: std::cell::RefCell<[Vec<f64>; 3]> = Default::default();
+    static BUFFERS: std::cell::Cell<[Vec<f64>; 3]> = Default::default();
+}
+
+/// Runs `f` on this thread's buffers, taken out for the call: a user function called inside
+/// (a Hessian that runs another lifted integration) finds none and gets fresh ones, never a
+/// buffer in use.
+fn with_buffers<R>(f: impl FnOnce(&mut [Vec<f64>; 3]) -> R) -> R {
+    let mut buffers = BUFFERS.take();
+    let r = f(&mut buffers);
+    BUFFERS.set(buffers);
+    r
 }
 
 /// Where the lift keeps its directions.
@@ -224,7 +234,7 @@ impl<P: Problem + Clone> Tangent<P> {
             dirs.chunks_exact_mut(self.e).for_each(tangent);
             return;
         }
-        BUFFERS.with_borrow_mut(|[v, ..]| {
+        with_buffers(|[v, ..]| {
             v.resize(self.d, 0.0);
             for j in 0..=self.k() {
                 self.gather(z, j, v);
@@ -655,7 +665,7 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
             return;
         }
         // Separable layout: each block gathered into this thread's buffers (allocated once).
-        BUFFERS.with_borrow_mut(|[base, dir, out]| {
+        with_buffers(|[base, dir, out]| {
             for v in [&mut *base, &mut *dir, &mut *out] {
                 v.resize(d, 0.0);
             }

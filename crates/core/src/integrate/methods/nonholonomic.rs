@@ -149,7 +149,7 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
         self.half_step();
         if m > 0 {
             let scale = max_abs(&self.p).max(f64::MIN_POSITIVE);
-            let mut monitor = Monitor::new(RULE);
+            let mut monitor = Monitor::new(RULE.for_blocks(self.rows.blocks));
             loop {
                 self.problem
                     .constraint_matrix(&self.qbar, &mut self.abar, &mut self.scratch);

@@ -127,7 +127,7 @@ pub(crate) struct Rows {
     /// The number B of diagonal blocks of S = C M⁻¹Fᵀ ([`Separable::diagonal_blocks`]: 1 + k
     /// for a tangent lift, whose S is block lower-triangular with one repeated diagonal block
     /// S₀₀; 1 otherwise), and its blocks S_j0 below the diagonal.
-    blocks: usize,
+    pub(crate) blocks: usize,
     low: Vec<f64>,
     /// The LU of S₀₀ (of S when B = 1).
     lu: DenseLu,
@@ -376,7 +376,7 @@ impl<P: Constrained> RattleStepper<P> {
         nu.fill(0.0);
         if m > 0 {
             let scale = max_abs(q).max(f64::MIN_POSITIVE);
-            let mut monitor = Monitor::new(RULE);
+            let mut monitor = Monitor::new(RULE.for_blocks(rows.blocks));
             loop {
                 problem.constraint(qn, g, scratch);
                 for (gb, cb) in g.iter_mut().zip(g0.iter()) {
