@@ -367,6 +367,12 @@ pub trait GroupField: Problem {
         false
     }
 
+    /// The number of blocks of an iteration over the algebra coordinates: 1, or the state and
+    /// its directions for a tangent lift ([`crate::convergence::Rule::for_blocks`]).
+    fn diagonal_blocks(&self) -> usize {
+        1
+    }
+
     /// dexp⁻¹_u(v) ∈ g (the inverse of the right-trivialized derivative of exp at u, applied to
     /// v); non-finite values where u lies outside the domain the implementation supports.
     fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut Self::Scratch);

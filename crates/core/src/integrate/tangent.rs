@@ -49,7 +49,7 @@ pub use super::method::TangentSystem;
 
 use super::method::Catalog;
 use super::problem::{
-    Constrained, Nonholonomic, Problem, Separable, Split, VectorField, Violation,
+    Constrained, GroupField, Nonholonomic, Problem, Separable, Split, VectorField, Violation,
 };
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
@@ -111,6 +111,38 @@ pub trait VectorFieldTangent: VectorField {
     fn field_parameter(&self, _z: &[f64], _m: usize, out: &mut [f64]) {
         out.fill(f64::NAN);
     }
+}
+
+/// A [`GroupField`] with the derivatives of its generator, its action and its dexp: the data of
+/// its tangent lift, on which the Lie-group methods (RKMK, the Lie midpoint) compute the
+/// derivative of their own step (each of their operations replaced by its derivative: the
+/// generator by ξ′(z)δz, the action by its derivative in (u, z), dexp⁻¹ by its derivative in
+/// (u, v)).
+pub trait GroupFieldTangent: GroupField {
+    /// dξ = ξ′(z)·dz.
+    fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], s: &mut Self::Scratch);
+
+    /// dξ += ∂ξ/∂θ_m (z) for the parameter m; NaN unless a problem with parameters implements
+    /// it.
+    fn generator_parameter(&self, _z: &[f64], _m: usize, dxi: &mut [f64], _s: &mut Self::Scratch) {
+        dxi.fill(f64::NAN);
+    }
+
+    /// dz ← D(exp(u)·z)\[du, dz\] = exp(u)·dz + (dexp_u du)·y, the derivative of the action
+    /// along (du, dz), given its result y = exp(u)·z (dexp right-trivialised, as
+    /// [`GroupField::dexp_inv`]'s inverse).
+    fn act_tangent(&self, u: &[f64], du: &[f64], y: &[f64], dz: &mut [f64], s: &mut Self::Scratch);
+
+    /// out = D_u(dexp_u w)\[du\], the derivative of dexp_u w in u (then
+    /// D(dexp⁻¹_u v)\[du, dv\] = dexp⁻¹_u(dv − D_u(dexp_u w)\[du\]) at w = dexp⁻¹_u v).
+    fn dexp_tangent(
+        &self,
+        u: &[f64],
+        du: &[f64],
+        w: &[f64],
+        out: &mut [f64],
+        s: &mut Self::Scratch,
+    );
 }
 
 /// f′(z)dz = (v′(p)dp, f′(q)dq) of a separable problem's Hamilton field, from its
@@ -262,6 +294,15 @@ impl<P: VectorFieldTangent + Clone> Tangent<P> {
     /// The lift of a vector field (its Runge–Kutta and Gauss methods; flat blocks only):
     /// (z, δz₁, …, δz_k).
     pub fn field(problem: P) -> Self {
+        Tangent::with(problem, Layout::Field)
+    }
+}
+
+impl<P: GroupFieldTangent + Clone> Tangent<P> {
+    /// The lift of a group field (its Lie-group methods; and its Runge–Kutta methods where it is
+    /// a [`VectorFieldTangent`] without SO(3) blocks): (z, δz₁, …, δz_k), the directions
+    /// left-trivialised on SO(3) blocks.
+    pub fn group_field(problem: P) -> Self {
         Tangent::with(problem, Layout::Field)
     }
 }
@@ -699,6 +740,118 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
         } else {
             i
         }
+    }
+}
+
+/// The work space of a group-field lift's kernels: the base problem's, the base result of an
+/// action, two algebra vectors.
+pub struct GroupLiftScratch<S> {
+    base: S,
+    y: Vec<f64>,
+    t: Vec<f64>,
+    v: Vec<f64>,
+}
+
+/// The generator (ξ(z), ξ′(z)δz_j), the action (exp(u)·z, D(exp(u)·z)\[δu_j, δz_j\]) and
+/// dexp⁻¹ (dexp⁻¹_u v, its derivative along (δu_j, δv_j)) of the lift, in the algebra
+/// coordinates (u, δu₁, …, δu_k): each the derivative of the base one, so a Lie-group method's
+/// step on the lift (built from these and linear combinations) is the derivative of its step.
+impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
+    type Scratch = GroupLiftScratch<P::Scratch>;
+
+    fn scratch(&self) -> Self::Scratch {
+        let g = self.problem.algebra_dim();
+        GroupLiftScratch {
+            base: self.problem.scratch(),
+            y: vec![0.0; self.d],
+            t: vec![0.0; g],
+            v: vec![0.0; g],
+        }
+    }
+
+    fn algebra_dim(&self) -> usize {
+        self.problem.algebra_dim() * (self.k() + 1)
+    }
+
+    /// The state and its k directions (the lifted iteration's blocks).
+    fn diagonal_blocks(&self) -> usize {
+        self.k() + 1
+    }
+
+    fn generator(&self, z: &[f64], xi: &mut [f64], s: &mut Self::Scratch) {
+        let (d, e, g) = (self.d, self.e, self.problem.algebra_dim());
+        let (x0, dx) = xi.split_at_mut(g);
+        self.problem.generator(&z[..d], x0, &mut s.base);
+        for (j, (dz, dxj)) in z[d..]
+            .chunks_exact(e)
+            .zip(dx.chunks_exact_mut(g))
+            .enumerate()
+        {
+            self.problem
+                .generator_tangent(&z[..d], dz, dxj, &mut s.base);
+            if j >= e {
+                self.problem
+                    .generator_parameter(&z[..d], j - e, dxj, &mut s.base);
+            }
+        }
+    }
+
+    fn act(&self, u: &[f64], z: &mut [f64], s: &mut Self::Scratch) {
+        let (d, e, g) = (self.d, self.e, self.problem.algebra_dim());
+        let (z0, dz) = z.split_at_mut(d);
+        self.problem.act(&u[..g], z0, &mut s.base);
+        for (dzj, du) in dz.chunks_exact_mut(e).zip(u[g..].chunks_exact(g)) {
+            self.problem.act_tangent(&u[..g], du, z0, dzj, &mut s.base);
+        }
+    }
+
+    /// The base state's increment as the base problem forms it (so the lifted run's states
+    /// are the plain run's), the directions' as new minus old.
+    fn act_increment(&self, u: &[f64], z: &[f64], inc: &mut [f64], s: &mut Self::Scratch) -> bool {
+        let (d, e, g) = (self.d, self.e, self.problem.algebra_dim());
+        let (i0, di) = inc.split_at_mut(d);
+        if !self
+            .problem
+            .act_increment(&u[..g], &z[..d], i0, &mut s.base)
+        {
+            return false;
+        }
+        for ((y, zi), dzi) in s.y.iter_mut().zip(&z[..d]).zip(i0.iter()) {
+            *y = zi + dzi;
+        }
+        for ((dij, du), dz) in di
+            .chunks_exact_mut(e)
+            .zip(u[g..].chunks_exact(g))
+            .zip(z[d..].chunks_exact(e))
+        {
+            dij.copy_from_slice(dz);
+            self.problem
+                .act_tangent(&u[..g], du, &s.y, dij, &mut s.base);
+            dij.iter_mut().zip(dz).for_each(|(a, b)| *a -= b);
+        }
+        true
+    }
+
+    fn dexp_inv(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut Self::Scratch) {
+        let g = self.problem.algebra_dim();
+        let (w, dw) = out.split_at_mut(g);
+        self.problem.dexp_inv(&u[..g], &v[..g], w, &mut s.base);
+        for ((du, dv), dwj) in u[g..]
+            .chunks_exact(g)
+            .zip(v[g..].chunks_exact(g))
+            .zip(dw.chunks_exact_mut(g))
+        {
+            self.problem
+                .dexp_tangent(&u[..g], du, w, &mut s.t, &mut s.base);
+            for ((vi, dvi), ti) in s.v.iter_mut().zip(dv).zip(&s.t) {
+                *vi = dvi - ti;
+            }
+            self.problem.dexp_inv(&u[..g], &s.v, dwj, &mut s.base);
+        }
+    }
+
+    fn solve_tolerance(&self) -> f64 {
+        self.problem.solve_tolerance()
     }
 }
 

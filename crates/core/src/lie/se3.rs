@@ -114,50 +114,6 @@ pub fn log(g: &SE3) -> Result<Vector6<f64>> {
     Ok(log_unchecked(g))
 }
 
-/// The coefficients (θ − sin θ)/θ³, (θ²/2 + cos θ − 1)/θ⁴ and
-/// ½ [(θ²/2 + cos θ − 1)/θ⁴ + 3 (θ − sin θ − θ³/6)/θ⁵] of Barfoot's Q at θ² = `t2`: by their
-/// Taylor series Σ (−1)ᵏ θ²ᵏ/(2k + j)! below θ = 1 (the closed forms cancel like ε/θ⁵ there;
-/// twelve terms leave a truncation error below 1e-30), closed forms above.
-fn q_coefficients(t2: f64) -> (f64, f64, f64) {
-    if t2 < 1.0 {
-        // s[j] = Σ_k (−1)ᵏ θ²ᵏ/(2k + j)! for j = 3, 4, 5.
-        let series = |j: u32| {
-            let mut fact: f64 = (1..=j).map(f64::from).product();
-            let (mut sum, mut pow) = (0.0, 1.0);
-            for k in 0..12u32 {
-                sum += pow / fact;
-                pow *= -t2;
-                fact *= f64::from((2 * k + j + 1) * (2 * k + j + 2));
-            }
-            sum
-        };
-        let (c1, c2) = (series(3), series(4));
-        return (c1, c2, 0.5 * (c2 - 3.0 * series(5)));
-    }
-    let t = t2.sqrt();
-    let (s, c) = t.sin_cos();
-    let c2 = (0.5 * t2 + c - 1.0) / (t2 * t2);
-    (
-        (t - s) / (t2 * t),
-        c2,
-        0.5 * (c2 + 3.0 * (t - s - t2 * t / 6.0) / (t2 * t2 * t)),
-    )
-}
-
-/// Barfoot's Q(ω, v) (Barfoot, "State Estimation for Robotics", 2017, §7.1.5; ρ = v, φ = ω):
-/// the lower-left block of the SE(3) left Jacobian,
-/// Q = ½ v̂ + c₁ (ω̂v̂ + v̂ω̂ + ω̂v̂ω̂) + c₂ (ω̂²v̂ + v̂ω̂² − 3 ω̂v̂ω̂) + c₃ (ω̂v̂ω̂² + ω̂²v̂ω̂) with the
-/// coefficients of `q_coefficients` (checked against central differences of exp in the tests).
-fn q_block(w: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
-    let (c1, c2, c3) = q_coefficients(w.norm_squared());
-    let (wh, vh) = (so3::hat(w), so3::hat(v));
-    let (wv, vw, wvw) = (wh * vh, vh * wh, wh * vh * wh);
-    vh * 0.5
-        + (wv + vw + wvw) * c1
-        + (wh * wv + vw * wh - wvw * 3.0) * c2
-        + (wvw * wh + wh * wvw) * c3
-}
-
 /// The 6×6 left Jacobian [[J_l(ω), 0], [Q(ω, v), J_l(ω)]] of exp on (ω, v) coordinates
 /// (Barfoot's 𝒥 with the blocks reordered), or its inverse [[J_l⁻¹, 0], [−J_l⁻¹ Q J_l⁻¹, J_l⁻¹]]:
 /// exp(ξ + δ) = exp(J_l(ξ) δ) exp(ξ) to first order. Checked as [`so3::jacobian_left`] (and
@@ -170,7 +126,7 @@ fn jacobian_left_block(xi: &Vector6<f64>, inverse: bool) -> Result<Matrix6<f64>>
     } else {
         so3::jacobian_left(&w)?
     };
-    let q = q_block(&w, &v);
+    let q = so3::jacobian_left_derivative(&w, &v);
     let q = if inverse { -(j * q * j) } else { q };
     if q.iter().any(|x| !x.is_finite()) {
         return Err(check::overflow_error("xi", "the SE(3) Jacobian"));
@@ -401,25 +357,5 @@ impl MatrixLieGroup for SE3 {
     /// [`jacobian_left_inv`].
     fn jacobian_left_inv(xi: &Vector6<f64>) -> Result<Mat> {
         jacobian_left_inv(xi).map(|j| super::to_mat(&j))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The series and the closed forms of Q's coefficients agree at the switch θ = 1.
-    #[test]
-    fn q_coefficients_continuous_at_the_switch() {
-        let (below, above) = (q_coefficients(1.0 - f64::EPSILON), q_coefficients(1.0));
-        for (a, b) in [(below.0, above.0), (below.1, above.1), (below.2, above.2)] {
-            assert!((a - b).abs() < 1e-14 * b.abs(), "{a} vs {b}");
-        }
-        // θ → 0: 1/6, 1/24, 1/120.
-        let zero = q_coefficients(0.0);
-        assert_eq!(
-            zero,
-            (1.0 / 6.0, 1.0 / 24.0, 0.5 * (1.0 / 24.0 - 3.0 / 120.0))
-        );
     }
 }

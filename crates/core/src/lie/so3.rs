@@ -495,6 +495,52 @@ pub fn jacobian_left(w: &Vector3<f64>) -> Result<Matrix3<f64>> {
     Ok(jacobian_left_unchecked(w))
 }
 
+/// The coefficients (θ − sin θ)/θ³, (θ²/2 + cos θ − 1)/θ⁴ and
+/// ½ [(θ²/2 + cos θ − 1)/θ⁴ + 3 (θ − sin θ − θ³/6)/θ⁵] of Barfoot's Q at θ² = `t2`: by their
+/// Taylor series Σ (−1)ᵏ θ²ᵏ/(2k + j)! below θ = 1 (the closed forms cancel like ε/θ⁵ there;
+/// twelve terms leave a truncation error below 1e-30), closed forms above.
+pub(crate) fn q_coefficients(t2: f64) -> (f64, f64, f64) {
+    if t2 < 1.0 {
+        // s[j] = Σ_k (−1)ᵏ θ²ᵏ/(2k + j)! for j = 3, 4, 5.
+        let series = |j: u32| {
+            let mut fact: f64 = (1..=j).map(f64::from).product();
+            let (mut sum, mut pow) = (0.0, 1.0);
+            for k in 0..12u32 {
+                sum += pow / fact;
+                pow *= -t2;
+                fact *= f64::from((2 * k + j + 1) * (2 * k + j + 2));
+            }
+            sum
+        };
+        let (c1, c2) = (series(3), series(4));
+        return (c1, c2, 0.5 * (c2 - 3.0 * series(5)));
+    }
+    let t = t2.sqrt();
+    let (s, c) = t.sin_cos();
+    let c2 = (0.5 * t2 + c - 1.0) / (t2 * t2);
+    (
+        (t - s) / (t2 * t),
+        c2,
+        0.5 * (c2 + 3.0 * (t - s - t2 * t / 6.0) / (t2 * t2 * t)),
+    )
+}
+
+/// The derivative of the left Jacobian, DJ_l(ω)\[v\] = Σ_{n,m ≥ 0} ω̂ⁿ v̂ ω̂ᵐ/(n + m + 2)! (the
+/// series of J_l = Σ ω̂ⁿ/(n + 1)! differentiated term by term), in closed form: Barfoot's
+/// Q(ω, v) (Barfoot, "State Estimation for Robotics", 2017, §7.1.5; ρ = v, φ = ω), the
+/// lower-left block of the SE(3) left Jacobian,
+/// Q = ½ v̂ + c₁ (ω̂v̂ + v̂ω̂ + ω̂v̂ω̂) + c₂ (ω̂²v̂ + v̂ω̂² − 3 ω̂v̂ω̂) + c₃ (ω̂v̂ω̂² + ω̂²v̂ω̂) with the
+/// coefficients of `q_coefficients` (checked against central differences of exp in the tests).
+pub fn jacobian_left_derivative(w: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
+    let (c1, c2, c3) = q_coefficients(w.norm_squared());
+    let (wh, vh) = (hat(w), hat(v));
+    let (wv, vw, wvw) = (wh * vh, vh * wh, wh * vh * wh);
+    vh * 0.5
+        + (wv + vw + wvw) * c1
+        + (wh * wv + vw * wh - wvw * 3.0) * c2
+        + (wvw * wh + wh * wvw) * c3
+}
+
 /// J_r⁻¹ and J_l⁻¹ are singular where sin(θ/2) = 0, θ = 2πk (k ≥ 1); they error when
 /// |sin(θ/2)| < `JACOBIAN_INV_TOL` there.
 pub const JACOBIAN_INV_TOL: f64 = 1e-12;
@@ -701,6 +747,39 @@ impl MatrixLieGroup for SO3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The series and the closed forms of Q's coefficients agree at the switch θ = 1.
+    #[test]
+    fn q_coefficients_continuous_at_the_switch() {
+        let (below, above) = (q_coefficients(1.0 - f64::EPSILON), q_coefficients(1.0));
+        for (a, b) in [(below.0, above.0), (below.1, above.1), (below.2, above.2)] {
+            assert!((a - b).abs() < 1e-14 * b.abs(), "{a} vs {b}");
+        }
+        // θ → 0: 1/6, 1/24, 1/120.
+        let zero = q_coefficients(0.0);
+        assert_eq!(
+            zero,
+            (1.0 / 6.0, 1.0 / 24.0, 0.5 * (1.0 / 24.0 - 3.0 / 120.0))
+        );
+    }
+
+    /// DJ_l(ω)\[v\] against central differences of J_l, below, at and above the series switch.
+    #[test]
+    fn jacobian_left_derivative_is_the_derivative() {
+        let v = Vector3::new(0.3, -1.1, 0.7);
+        for w in [
+            Vector3::new(1e-3, -2e-3, 5e-4),
+            Vector3::new(0.4, 0.5, -0.6),
+            Vector3::new(1.5, -2.0, 0.8),
+        ] {
+            let h = 1e-6;
+            let fd = (jacobian_left_unchecked(&(w + v * h))
+                - jacobian_left_unchecked(&(w - v * h)))
+                / (2.0 * h);
+            let err = (jacobian_left_derivative(&w, &v) - fd).abs().max();
+            assert!(err < 1e-9, "|ω| = {}: {err:e}", w.norm());
+        }
+    }
 
     #[test]
     fn hat_is_cross_product() {

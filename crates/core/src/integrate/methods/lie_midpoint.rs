@@ -138,10 +138,13 @@ impl<P: GroupField> MidpointStepper<P> {
         } = self;
         problem.generator(y, k, scratch);
         k.iter_mut().for_each(|x| *x *= h);
-        let mut monitor = Monitor::new(Rule {
-            tol: problem.solve_tolerance().max(RULE.tol),
-            ..RULE
-        });
+        let mut monitor = Monitor::new(
+            Rule {
+                tol: problem.solve_tolerance().max(RULE.tol),
+                ..RULE
+            }
+            .for_blocks(problem.diagonal_blocks()),
+        );
         loop {
             for (hi, ki) in half.iter_mut().zip(k.iter()) {
                 *hi = 0.5 * ki;

@@ -173,7 +173,7 @@ impl Problem for RigidBody {
     }
 }
 
-top_kinds!(RigidBody; "exact" => || Exact);
+top_kinds!(RigidBody; "exact" => || Exact; "rkmk4" => || Rkmk4);
 
 /// so(3) in physics coordinates acting on M, or on (M, R) with the attitude (principal frame):
 /// ξ(z) = −Ω = −I⁻¹M, and g = exp(ξ̂) acts by g·(M, R) = (gM, R gᵀ), a left action whose
@@ -216,6 +216,40 @@ impl GroupField for RigidBody {
             Ok(j) => out.copy_from_slice((j * Vector3::from_column_slice(v)).as_slice()),
             Err(_) => out.fill(f64::NAN),
         }
+    }
+}
+
+/// The derivatives of the action of [`GroupField`] for its tangent lift (RKMK4 with
+/// sensitivities): g = exp(û), δg = ŵ g with w = J_l(u)δu, so δ(gM) = g δM + w × gM and, for
+/// R' = R gᵀ with δR = R η̂, δR' = R'((gη)^ − ŵ): η' = gη − w; D_u(J_l(u)w)\[δu\] is
+/// [`so3::jacobian_left_derivative`].
+impl crate::integrate::tangent::GroupFieldTangent for RigidBody {
+    fn generator_tangent(&self, _z: &[f64], dz: &[f64], dxi: &mut [f64], _s: &mut ()) {
+        for (i, x) in dxi.iter_mut().enumerate() {
+            *x = -dz[i] / self.top.moments[i];
+        }
+    }
+    /// ∂(−M_m/I_m)/∂I_m = M_m/I_m².
+    fn generator_parameter(&self, z: &[f64], m: usize, dxi: &mut [f64], _s: &mut ()) {
+        dxi[m] += z[m] / (self.top.moments[m] * self.top.moments[m]);
+    }
+    fn act_tangent(&self, u: &[f64], du: &[f64], y: &[f64], dz: &mut [f64], _s: &mut ()) {
+        let (g, jl) = so3::exp_and_jacobian_left(&Vector3::from_column_slice(u));
+        let w = jl * Vector3::from_column_slice(du);
+        let dm = g * Vector3::from_column_slice(&dz[..3])
+            + w.cross(&Vector3::from_column_slice(&y[..3]));
+        dz[..3].copy_from_slice(dm.as_slice());
+        if self.top.lifted {
+            let eta = g * Vector3::from_column_slice(&dz[3..6]) - w;
+            dz[3..6].copy_from_slice(eta.as_slice());
+        }
+    }
+    fn dexp_tangent(&self, u: &[f64], du: &[f64], w: &[f64], out: &mut [f64], _s: &mut ()) {
+        let q = so3::jacobian_left_derivative(
+            &Vector3::from_column_slice(u),
+            &Vector3::from_column_slice(du),
+        );
+        out.copy_from_slice((q * Vector3::from_column_slice(w)).as_slice());
     }
 }
 

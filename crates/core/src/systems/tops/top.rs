@@ -941,10 +941,11 @@ pub(crate) fn splittings<P: Split + Clone + 'static>() -> Vec<Entry<P>> {
 /// splitting), [`VectorField`] (RK4) and the [`super::methods::lgvi::Lgvi`] method.
 macro_rules! top_kinds {
     ($t:ty) => {
-        $crate::systems::tops::top::top_kinds!($t;);
+        $crate::systems::tops::top::top_kinds!($t;;);
     };
-    // Further methods of the lift without the attitude (name => constructor).
-    ($t:ty; $($name:literal => $make:expr),*) => {
+    // Further methods of the lift: without the attitude only; with or without it
+    // (name => constructor).
+    ($t:ty; $($name:literal => $make:expr),*; $($any:literal => $amake:expr),*) => {
         impl $crate::integrate::problem::Split for $t {
             type Work = $crate::systems::tops::top::TopWork;
             fn load(&self, z: &[f64]) -> $crate::Result<Self::Work> {
@@ -1014,12 +1015,18 @@ macro_rules! top_kinds {
                     $crate::integrate::methods::Rk4
                 }));
                 $(c.push($crate::integrate::Entry::new($name, $make));)*
+                $(c.push($crate::integrate::Entry::new($any, $amake));)*
                 c
             }
 
             fn catalog(&self) -> Vec<$crate::integrate::Entry<Self>> {
                 match self.problem().top.lifted {
-                    true => $crate::systems::tops::top::splittings(),
+                    true => {
+                        #[allow(unused_mut)]
+                        let mut c = $crate::systems::tops::top::splittings();
+                        $(c.push($crate::integrate::Entry::new($any, $amake));)*
+                        c
+                    }
                     false => Self::kind_catalog(),
                 }
             }
