@@ -387,8 +387,10 @@ fn jacobians_with_the_attitude_left_trivialised() {
         let (d, e) = (t.base_dim(), t.tangent_dim());
         assert_eq!(d - e, 6);
         let mut methods = vec!["splitting", "splitting4"];
-        if t.methods().iter().any(|(n, _)| *n == "rkmk4") {
-            methods.push("rkmk4");
+        for m in ["rkmk4", "exact"] {
+            if t.methods().iter().any(|(n, _)| *n == m) {
+                methods.push(m);
+            }
         }
         for method in methods {
             let (_, jac, _) = lifted_end_all(&*t, method, &z0, 0.05, 40);
@@ -1162,32 +1164,37 @@ fn dd_cross(a: &[Dd], b: &[Dd]) -> [Dd; 3] {
 }
 
 /// The free body's variational equations in double-double: M, the directions δM_j (j < 3) and
-/// ∂M/∂I_q, Ṁ = M × Ω, δṀ = δM × Ω + M × I⁻¹δM (+ M × ∂Ω/∂I_q, ∂Ω = −M_q/I_q² e_q), by RK4
-/// with `n` steps of `time`/n: (M, J row-major, ∂M/∂I row-major).
-fn variational_dd(moments: [f64; 3], m0: &[f64], time: f64, n: usize) -> [Vec<f64>; 3] {
+/// ∂M/∂I_q, Ṁ = M × Ω, δṀ = δM × Ω + M × δΩ, and the attitude's left-trivialised directions
+/// σ̇ = σ × Ω + δΩ (Ṡ = SΩ̂ differentiated with δS = Sσ̂), δΩ = I⁻¹δM (+ ∂Ω/∂I_q = −M_q/I_q² e_q),
+/// by RK4 with `n` steps of `time`/n: (M, J row-major, ∂M/∂I row-major, σ row-major 3 × 6
+/// (the three directions of M₀, then the three moments)).
+fn variational_dd(moments: [f64; 3], m0: &[f64], time: f64, n: usize) -> [Vec<f64>; 4] {
+    const N: usize = 39;
     let inv = moments.map(Dd::recip);
-    let field = |y: &[Dd; 21]| -> [Dd; 21] {
+    let field = |y: &[Dd; N]| -> [Dd; N] {
         let m = &y[..3];
         let w: Vec<Dd> = (0..3).map(|i| m[i] * inv[i]).collect();
-        let mut out = [Dd(0.0, 0.0); 21];
+        let mut out = [Dd(0.0, 0.0); N];
         out[..3].copy_from_slice(&dd_cross(m, &w));
         for j in 0..6 {
             let d = &y[3 + 3 * j..6 + 3 * j];
-            let dw: Vec<Dd> = (0..3).map(|i| d[i] * inv[i]).collect();
-            let (a, b) = (dd_cross(d, &w), dd_cross(m, &dw));
-            let mut v = [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+            let mut dw: Vec<Dd> = (0..3).map(|i| d[i] * inv[i]).collect();
             if j >= 3 {
                 let q = j - 3;
-                let mut dq = [Dd(0.0, 0.0); 3];
-                dq[q] = Dd(0.0, 0.0) - m[q] * inv[q] * inv[q];
-                let c = dd_cross(m, &dq);
-                v = [v[0] + c[0], v[1] + c[1], v[2] + c[2]];
+                dw[q] = dw[q] - m[q] * inv[q] * inv[q];
             }
-            out[3 + 3 * j..6 + 3 * j].copy_from_slice(&v);
+            let (a, b) = (dd_cross(d, &w), dd_cross(m, &dw));
+            out[3 + 3 * j..6 + 3 * j].copy_from_slice(&[a[0] + b[0], a[1] + b[1], a[2] + b[2]]);
+            let c = dd_cross(&y[21 + 3 * j..24 + 3 * j], &w);
+            out[21 + 3 * j..24 + 3 * j].copy_from_slice(&[
+                c[0] + dw[0],
+                c[1] + dw[1],
+                c[2] + dw[2],
+            ]);
         }
         out
     };
-    let mut y = [Dd(0.0, 0.0); 21];
+    let mut y = [Dd(0.0, 0.0); N];
     for i in 0..3 {
         y[i] = Dd(m0[i], 0.0);
         y[3 + 4 * i] = Dd(1.0, 0.0);
@@ -1196,9 +1203,8 @@ fn variational_dd(moments: [f64; 3], m0: &[f64], time: f64, n: usize) -> [Vec<f6
     assert_eq!(time / n as f64 * n as f64, time, "an exact step");
     let (half, sixth) = (Dd(0.5, 0.0) * h, h * Dd::recip(6.0));
     let two = Dd(2.0, 0.0);
-    let axpy = |y: &[Dd; 21], a: Dd, k: &[Dd; 21]| -> [Dd; 21] {
-        std::array::from_fn(|i| y[i] + a * k[i])
-    };
+    let axpy =
+        |y: &[Dd; N], a: Dd, k: &[Dd; N]| -> [Dd; N] { std::array::from_fn(|i| y[i] + a * k[i]) };
     for _ in 0..n {
         let k1 = field(&y);
         let k2 = field(&axpy(&y, half, &k1));
@@ -1212,6 +1218,7 @@ fn variational_dd(moments: [f64; 3], m0: &[f64], time: f64, n: usize) -> [Vec<f6
         // Row i, column j: component i of direction j.
         (0..9).map(|k| at(3 + 3 * (k % 3) + k / 3)).collect(),
         (0..9).map(|k| at(12 + 3 * (k % 3) + k / 3)).collect(),
+        (0..18).map(|k| at(21 + 3 * (k % 6) + k / 6)).collect(),
     ]
 }
 
@@ -1363,4 +1370,130 @@ fn exact_jacobian_keeps_the_invariants_gradients() {
         }
     }
     eprintln!("worst {worst:.1e}");
+}
+
+/// The exact flow with the attitude: (M, R) bit for bit the plain run's, and the whole
+/// Jacobian, attitude rows ξ = (Rᵀδ R)^∨ and parameter columns included, against central
+/// differences (R₀ moved as R₀exp(hê_j), the moments moved), for a generic body, a symmetric
+/// one (closed form, and ∂/∂I along an equal moment), a sphere and a steady rotation, over
+/// t = 8 (σ·M grows like t: the secular part of the phase).
+#[test]
+fn exact_jacobian_with_the_attitude() {
+    use lieflow::lie::so3;
+    use nalgebra::{Matrix3, Vector3};
+    let r0 = so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
+    let rows = |r: &Matrix3<f64>| (0..9).map(|k| r[(k / 3, k % 3)]).collect::<Vec<f64>>();
+    let (dt, steps) = (0.2, 40);
+    for (moments, m0) in [
+        ([1.0, 2.0, 3.0], [0.3, -0.8, 1.1]),
+        ([1.0, 2.0, 3.0], [1.2, 0.1, -0.2]),
+        ([1.5, 1.5, 3.0], [0.3, -0.8, 1.1]),
+        ([2.0, 2.0, 2.0], [0.3, -0.8, 1.1]),
+        ([1.0, 2.0, 3.0], [0.0, 0.0, 1.3]),
+    ] {
+        let body = |i: [f64; 3]| RigidBody::new(i).unwrap().with_attitude();
+        let sys = body(moments);
+        let z0 = [m0.to_vec(), rows(&r0)].concat();
+        let t = sys.tangent().unwrap();
+        let (z, jac, pjac) = lifted_end_all(&*t, "exact", &z0, dt, steps);
+        let plain = integrate(&sys, "exact", &z0, dt, steps, steps).unwrap();
+        assert_eq!(z, plain.state(1), "{moments:?}: base state");
+        // (δM, ξ) at the end between two end states.
+        let delta = |p: &[f64], q: &[f64], h: f64| {
+            let (rp, rq) = (
+                Matrix3::from_row_slice(&p[3..]),
+                Matrix3::from_row_slice(&q[3..]),
+            );
+            let xi = so3::vee_unchecked(&(((rp + rq) * 0.5).transpose() * (rp - rq) / (2.0 * h)));
+            [
+                (p[0] - q[0]) / (2.0 * h),
+                (p[1] - q[1]) / (2.0 * h),
+                (p[2] - q[2]) / (2.0 * h),
+                xi[0],
+                xi[1],
+                xi[2],
+            ]
+        };
+        let end = |sys: &RigidBody, z: &[f64]| {
+            integrate(sys, "exact", z, dt, steps, steps)
+                .unwrap()
+                .state(1)
+                .to_vec()
+        };
+        let h = 1e-6;
+        let mut worst = 0.0f64;
+        for j in 0..6 {
+            let moved = |s: f64| {
+                let mut z = z0.clone();
+                if j < 3 {
+                    z[j] += s;
+                } else {
+                    let r = r0 * so3::exp_unchecked(&(Vector3::ith(j - 3, s)));
+                    z[3..].copy_from_slice(&rows(&r));
+                }
+                end(&sys, &z)
+            };
+            let fd = delta(&moved(h), &moved(-h), h);
+            for i in 0..6 {
+                worst = worst.max((jac[i * 6 + j] - fd[i]).abs());
+            }
+        }
+        for q in 0..3 {
+            let moved = |s: f64| {
+                let mut i = moments;
+                i[q] += s;
+                end(&body(i), &z0)
+            };
+            let fd = delta(&moved(h), &moved(-h), h);
+            for i in 0..6 {
+                worst = worst.max((pjac[i * 3 + q] - fd[i]).abs());
+            }
+        }
+        let scale = jac.iter().chain(&pjac).fold(1.0f64, |m, x| m.max(x.abs()));
+        eprintln!(
+            "exact with attitude {moments:?} {m0:?}: vs differences {worst:.2e} (|J| ≤ {scale:.1})"
+        );
+        assert!(worst < 1e-8 * scale, "{moments:?} {m0:?}: {worst:e}");
+    }
+}
+
+/// With the attitude, the exact flow's attitude rows against the variational equations of the
+/// continuous flow (σ̇ = σ × Ω + δΩ, double-double RK4, Romberg-extrapolated as in
+/// `exact_jacobian_is_the_variational_equations`) over t = 60: ξ(t) along δM₀ and along the
+/// moments, to 1e-12 relative to max |J| (σ·M grows like t: |J| ~ 10²).
+#[test]
+fn exact_attitude_jacobian_is_the_variational_equations() {
+    let moments = [1.0, 2.0, 3.0];
+    let sys = RigidBody::new(moments).unwrap().with_attitude();
+    let t = sys.tangent().unwrap();
+    let time = 60.0;
+    let id = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+    let rich = |a: &[f64], b: &[f64], f: f64| -> Vec<f64> {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (f * y - x) / (f - 1.0))
+            .collect()
+    };
+    for (name, m0) in exact_orbits() {
+        let z0 = [m0.clone(), id.to_vec()].concat();
+        let (_, jac, pjac) = lifted_end_all(&*t, "exact", &z0, time, 1);
+        let dd = [15_360, 30_720, 61_440].map(|n| variational_dd(moments, &m0, time, n));
+        let (r1, r2) = (
+            rich(&dd[0][3], &dd[1][3], 16.0),
+            rich(&dd[1][3], &dd[2][3], 16.0),
+        );
+        let sigma = rich(&r1, &r2, 64.0);
+        // Rows 3..6 of the lifted Jacobian: ξ along δM₀ (columns 0..3) and along I (pjac).
+        let mut lifted = vec![0.0; 18];
+        for i in 0..3 {
+            for j in 0..3 {
+                lifted[i * 6 + j] = jac[(3 + i) * 6 + j];
+                lifted[i * 6 + 3 + j] = pjac[(3 + i) * 3 + j];
+            }
+        }
+        let err = max_rel(&lifted, &sigma);
+        let scale = sigma.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        eprintln!("{name}: attitude rows vs variational equations {err:.2e} (|σ| ≤ {scale:.0})");
+        assert!(err < 1e-12, "{name}: {err:e}");
+    }
 }

@@ -173,7 +173,7 @@ impl Problem for RigidBody {
     }
 }
 
-top_kinds!(RigidBody; "exact" => || Exact; "rkmk4" => || Rkmk4);
+top_kinds!(RigidBody; ; "exact" => || Exact, "rkmk4" => || Rkmk4);
 
 /// so(3) in physics coordinates acting on M, or on (M, R) with the attitude (principal frame):
 /// ξ(z) = −Ω = −I⁻¹M, and g = exp(ξ̂) acts by g·(M, R) = (gM, R gᵀ), a left action whose
@@ -292,9 +292,9 @@ impl Integrator<RigidBody> for Exact {
     }
 }
 
-/// The exact flow on the tangent lift of the body without attitude: M(t) as the plain method's
-/// and the directions by the exact tangent map Dφ_t (and ∂M(t)/∂I) of the elliptic solution
-/// (module docs of `methods::exact`, "Tangent map").
+/// The exact flow on the tangent lift: (M(t), R(t)) as the plain method's and the directions by
+/// the exact tangent map Dφ_t (and ∂/∂I) of the elliptic solution (module docs of
+/// `methods::exact`, "Tangent map").
 impl Integrator<crate::integrate::tangent::Tangent<RigidBody>> for Exact {
     fn properties(&self) -> Properties {
         Properties::exact()
@@ -305,14 +305,7 @@ impl Integrator<crate::integrate::tangent::Tangent<RigidBody>> for Exact {
         lift: &crate::integrate::tangent::Tangent<RigidBody>,
         dt: f64,
     ) -> Result<Box<dyn Stepper>> {
-        let top = &lift.problem().top;
-        if top.lifted {
-            return Err(crate::error::Error::invalid(
-                "method",
-                "the exact method's tangent lift carries no attitude (use a splitting)",
-            ));
-        }
-        Ok(self.tangent_stepper_for(top, dt))
+        Ok(self.tangent_stepper_for(&lift.problem().top, dt))
     }
 }
 
