@@ -232,7 +232,11 @@ fn splitting_jacobians_of_the_tops_are_poisson() {
     for (sys, z0) in cases {
         let t = sys.tangent().expect("a lift");
         let d = z0.len();
-        for method in ["splitting", "splitting4", "splitting6"] {
+        let mut methods = vec!["splitting", "splitting4", "splitting6"];
+        if t.methods().iter().any(|(n, _)| *n == "exact_splitting4") {
+            methods.extend(["exact_splitting", "exact_splitting4"]);
+        }
+        for method in methods {
             let (z, jac) = lifted_end(&*t, method, &z0, 0.05, 60);
             let plain = integrate(sys, method, &z0, 0.05, 60, 60).unwrap();
             assert!(max_rel(&z, plain.state(1)) < 1e-14, "{method}: base state");
@@ -325,6 +329,21 @@ fn parameter_jacobians_of_the_tops() {
         eprintln!("HeavyTop {method}: parameter Jacobian vs differences {worst:.2e}");
         assert!(worst < 1e-7, "HeavyTop {method}: {worst:e}");
     }
+    // The heavy top's exact splitting (∂/∂I through the exact free flow, σ included).
+    let t = heavy(moments, mgl, chi).tangent().unwrap();
+    let (_, _, pjac) = lifted_end_all(&*t, "exact_splitting4", &z_ht, 0.05, 40);
+    let build = |th: [f64; 7]| {
+        let c = [th[4], th[5], th[6]];
+        let g = th[3] * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        heavy([th[0], th[1], th[2]], g, c)
+    };
+    let theta = [
+        moments[0], moments[1], moments[2], mgl, chi[0], chi[1], chi[2],
+    ];
+    let fd = parameter_differences(build, theta, "exact_splitting4", &z_ht, (0.05, 40), h);
+    let worst = max_abs_diff(&pjac, &fd);
+    eprintln!("HeavyTop exact_splitting4: parameter Jacobian vs differences {worst:.2e}");
+    assert!(worst < 1e-7, "HeavyTop exact_splitting4: {worst:e}");
     // The free body's RKMK4 (the lifted generator's ∂ξ/∂I).
     let t = RigidBody::new(moments).unwrap().tangent().unwrap();
     let (_, _, pjac) = lifted_end_all(&*t, "rkmk4", &z_rb, 0.05, 40);
@@ -387,7 +406,7 @@ fn jacobians_with_the_attitude_left_trivialised() {
         let (d, e) = (t.base_dim(), t.tangent_dim());
         assert_eq!(d - e, 6);
         let mut methods = vec!["splitting", "splitting4"];
-        for m in ["rkmk4", "exact"] {
+        for m in ["rkmk4", "exact", "exact_splitting4"] {
             if t.methods().iter().any(|(n, _)| *n == m) {
                 methods.push(m);
             }

@@ -13,7 +13,7 @@
 //! Lagrangian with Γ = R⁻¹e₃ and obtains IΩ̇ = IΩ × Ω + gΓ × X_b: the same equations with
 //! mgl χ = g X_b (mass absorbed in X_b).
 
-use super::methods::exact::{relative_attitude, ExactSplitting};
+use super::methods::exact::{relative_attitude, ExactSplitting, FreeFlow, FreeTangent};
 use super::methods::lgvi::Lgvi;
 use super::top::TopWork;
 use super::top::{self, top_kinds, Top};
@@ -22,6 +22,7 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Splitting};
 use crate::integrate::problem::Split;
 use crate::integrate::space::Space;
+use crate::integrate::tangent::{SplitTangent, Tangent};
 use crate::integrate::{Catalog, Entry, Integrator, Problem, Properties, Stepper};
 use nalgebra::{Matrix3, Vector3};
 
@@ -198,7 +199,10 @@ impl Problem for HeavyTop {
     }
 }
 
-top_kinds!(HeavyTop);
+top_kinds!(HeavyTop; ;
+    "exact_splitting" => || ExactSplitting(Composition::strang()),
+    "exact_splitting4" => || ExactSplitting(Composition::suzuki4()),
+    "exact_splitting6" => || ExactSplitting(Composition::yoshida6()));
 
 impl Catalog for HeavyTop {
     fn kind_catalog() -> Vec<Entry<Self>> {
@@ -239,6 +243,18 @@ impl Integrator<HeavyTop> for ExactSplitting {
     }
 }
 
+/// The exact splittings on the tangent lift: the same composition of the lifted flows
+/// ([`FreeKick`]'s [`SplitTangent`]).
+impl Integrator<Tangent<HeavyTop>> for ExactSplitting {
+    fn properties(&self) -> Properties {
+        Properties::geometric(self.0.order())
+    }
+
+    fn stepper(&self, lift: &Tangent<HeavyTop>, dt: f64) -> Result<Box<dyn Stepper>> {
+        Splitting(self.0.clone()).stepper(&Tangent::split(FreeKick(lift.problem().clone())), dt)
+    }
+}
+
 /// The heavy top as a [`Split`] problem of two flows: 0 the kick of V, 1 the exact free flow.
 #[derive(Clone, Debug)]
 struct FreeKick(HeavyTop);
@@ -258,6 +274,98 @@ impl Problem for FreeKick {
     }
     fn invariant_count(&self) -> usize {
         self.0.invariant_count()
+    }
+    fn parameters(&self) -> Vec<&'static str> {
+        self.0.parameters()
+    }
+}
+
+/// The kick's tangent map is the top's; the free flow's (δM, δΓ, ξ) ↦ (δM(τ), S(τ)ᵀδΓ − σ × Γ(τ),
+/// S(τ)ᵀξ + σ) with δM(τ) and σ (δS = Sσ̂) from the exact flow's tangent map
+/// ([`FreeTangent`]; Γ(τ) = S(τ)ᵀΓ₀, R(τ) = R S(τ)); the moments' columns add ∂M(τ)/∂I_q and
+/// their σ.
+impl SplitTangent for FreeKick {
+    fn flow_tangent(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &TopWork,
+        after: &TopWork,
+        dirs: &mut [f64],
+    ) {
+        let top = &self.0.top;
+        if i == 0 {
+            if let Some(k) = top.kick_index() {
+                top.flow_tangent(k, tau, before, after, dirs);
+            }
+            return;
+        }
+        let flow = FreeFlow::new(&top.moments, &before.m);
+        let ft = FreeTangent::of(&flow, &top.moments, tau);
+        let e = top.xi_at() + if top.lifted { 3 } else { 0 };
+        for dy in dirs.chunks_exact_mut(e) {
+            let (dm, sigma) = ft.apply(&flow, &Vector3::from_column_slice(&dy[..3]), None);
+            self.free_direction(&ft.s, after, dm, sigma, false, dy);
+        }
+    }
+
+    fn flow_parameter(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &TopWork,
+        after: &TopWork,
+        m: usize,
+        dz: &mut [f64],
+    ) {
+        let top = &self.0.top;
+        match (i, self.0.top_parameter(m)) {
+            (0, p) => {
+                if let Some(k) = top.kick_index() {
+                    top.flow_parameter(k, tau, before, after, p, dz);
+                }
+            }
+            (_, top::TopParam::Moment(q)) => {
+                let flow = FreeFlow::new(&top.moments, &before.m);
+                let ft = FreeTangent::of(&flow, &top.moments, tau);
+                let (dm, sigma) = ft.apply(&flow, &Vector3::zeros(), Some(q));
+                self.free_direction(&ft.s, after, dm, sigma, true, dz);
+            }
+            _ => {}
+        }
+    }
+}
+
+impl FreeKick {
+    /// dy ← (δM, SᵀδΓ − σ × Γ′, Sᵀξ + σ) for a direction dy (δM from the tangent map), or with
+    /// `add` (a moment's column, whose own δM₀, δΓ, ξ are carried by the state part)
+    /// dy += (δM, −σ × Γ′, σ).
+    fn free_direction(
+        &self,
+        s: &Matrix3<f64>,
+        after: &TopWork,
+        dm: Vector3<f64>,
+        sigma: Vector3<f64>,
+        add: bool,
+        dy: &mut [f64],
+    ) {
+        let top = &self.0.top;
+        let x = top.lifted.then(|| top.xi_at());
+        let part = |at: usize| match add {
+            true => Vector3::zeros(),
+            false => s.transpose() * Vector3::from_column_slice(&dy[at..at + 3]),
+        };
+        let dg = part(3) - sigma.cross(&after.g.unwrap_or_else(Vector3::zeros));
+        let xi = x.map(|x| part(x) + sigma);
+        let keep = if add { 1.0 } else { 0.0 };
+        let blocks = [(0, Some(dm)), (3, Some(dg)), (x.unwrap_or(0), xi)];
+        for (at, v) in blocks {
+            if let Some(v) = v {
+                for c in 0..3 {
+                    dy[at + c] = keep * dy[at + c] + v[c];
+                }
+            }
+        }
     }
 }
 

@@ -283,7 +283,7 @@ impl Top {
     }
 
     /// The index of ξ (the attitude's left-trivialised direction) in a tangent vector.
-    fn xi_at(&self) -> usize {
+    pub(crate) fn xi_at(&self) -> usize {
         if self.c.is_some() {
             6
         } else {
@@ -345,12 +345,16 @@ impl Top {
     /// The exact flow of the heavy-top potential V = Γ·c over time τ: M ↦ M + τ Γ × c (the
     /// identity for a free body).
     pub(crate) fn kick(&self, tau: f64, b: &mut TopWork) {
-        if let Some(i) = self.kinds[..self.flows]
-            .iter()
-            .position(|&k| k == Flow::Kick)
-        {
+        if let Some(i) = self.kick_index() {
             self.flow(i, tau, b);
         }
+    }
+
+    /// The index of the gravity kick among the flows (a heavy top's).
+    pub(crate) fn kick_index(&self) -> Option<usize> {
+        self.kinds[..self.flows]
+            .iter()
+            .position(|&k| k == Flow::Kick)
     }
 
     /// The kernel of the flows ([`TopLanes`]) for this body.

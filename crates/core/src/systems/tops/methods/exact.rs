@@ -853,6 +853,61 @@ impl FreeFlow {
     }
 }
 
+/// The tangent map of the free motion from M₀ at t, once per (M₀, t): S(t), M(t) = S(t)ᵀM₀,
+/// Dφ_t, ∂M(t)/∂I and the square integrals, for [`FreeTangent::apply`].
+pub(crate) struct FreeTangent {
+    pub(crate) m: Vector3<f64>,
+    pub(crate) s: Matrix3<f64>,
+    jac: Matrix3<f64>,
+    par: Matrix3<f64>,
+    x: Vector3<f64>,
+    inertia: [f64; 3],
+    t: f64,
+}
+
+impl FreeTangent {
+    /// At t along `flow` (built from the moments `inertia`).
+    pub(crate) fn of(flow: &FreeFlow, inertia: &[f64; 3], t: f64) -> FreeTangent {
+        let (m, s) = flow.motion(t);
+        let (jac, par) = flow.momentum_tangent(inertia, t);
+        FreeTangent {
+            m,
+            s,
+            jac,
+            par,
+            x: flow.square_integrals(t),
+            inertia: *inertia,
+            t,
+        }
+    }
+
+    /// (δM(t), σ) of the direction δM₀ (and, for `moment` = Some(q), of ∂/∂I_q added): the
+    /// momentum's and the attitude's (δS = Sσ̂) directions (module docs, "With the attitude").
+    pub(crate) fn apply(
+        &self,
+        flow: &FreeFlow,
+        dm0: &Vector3<f64>,
+        moment: Option<usize>,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let mut dm = self.jac * dm0;
+        let mut di = Vector3::zeros();
+        if let Some(q) = moment {
+            dm += self.par.column(q);
+            di[q] = 1.0;
+        }
+        let sigma = flow.attitude_tangent(
+            &self.inertia,
+            self.t,
+            (&self.m, &self.s),
+            &self.x,
+            dm0,
+            &di,
+            &dm,
+        );
+        (dm, sigma)
+    }
+}
+
 /// P(r) = (1 − q) r − (ν/3) sn³r R_J(cn²r, dn²r, 1, 1 + ν sn²r) for |r| ≤ K, from sn r, cn r ≥ 0
 /// and dn r (module docs); `jk` = 1 − q.
 #[inline]
@@ -1031,8 +1086,8 @@ impl Stepper for ExactTangentStepper {
         }
         self.steps += steps as u64;
         let t = self.steps as f64 * self.dt;
-        let (jac, par) = flow.momentum_tangent(&self.moments, t);
         if !self.lifted {
+            let (jac, par) = flow.momentum_tangent(&self.moments, t);
             self.z[..3].copy_from_slice(flow.momentum(t).as_slice());
             let dirs = self.z_ref[3..]
                 .chunks_exact(3)
@@ -1046,23 +1101,16 @@ impl Stepper for ExactTangentStepper {
             }
             return Ok(());
         }
-        let (m, s) = flow.motion(t);
-        self.z[..3].copy_from_slice(m.as_slice());
-        self.z[3..12].copy_from_slice(&top::row_major(&(self.r_ref * s)));
-        let x = flow.square_integrals(t);
+        let ft = FreeTangent::of(flow, &self.moments, t);
+        self.z[..3].copy_from_slice(ft.m.as_slice());
+        self.z[3..12].copy_from_slice(&top::row_major(&(self.r_ref * ft.s)));
         let dirs = self.z_ref[12..]
             .chunks_exact(6)
             .zip(self.z[12..].chunks_exact_mut(6));
         for (j, (from, to)) in dirs.enumerate() {
             let dm0 = Vector3::from_column_slice(&from[..3]);
-            let mut dm = jac * dm0;
-            let mut di = Vector3::zeros();
-            if j >= 6 {
-                dm += par.column(j - 6);
-                di[j - 6] = 1.0;
-            }
-            let sigma = flow.attitude_tangent(&self.moments, t, (&m, &s), &x, &dm0, &di, &dm);
-            let xi = s.transpose() * Vector3::from_column_slice(&from[3..]) + sigma;
+            let (dm, sigma) = ft.apply(flow, &dm0, j.checked_sub(6));
+            let xi = ft.s.transpose() * Vector3::from_column_slice(&from[3..]) + sigma;
             to[..3].copy_from_slice(dm.as_slice());
             to[3..].copy_from_slice(xi.as_slice());
         }
