@@ -8,8 +8,9 @@
 //! c = (−w₃, w₂, −w₁), and with J_i + J_j = I_k ({i, j, k} = {1, 2, 3}) the energies agree (tested).
 //!
 //! Tangent lift (issue 26, [`crate::integrate::tangent`]): the derivative of the field,
-//! δṀ = [δM, Ω] + [M, δΩ], for `rk4`; `isospectral` and `rkmk4` are group methods the lift
-//! does not cover, and J carries no parameter directions.
+//! δṀ = [δM, Ω] + [M, δΩ], for `rk4`; `isospectral` differentiates its own step (module docs
+//! of `methods::isospectral`, "Tangent map"); `rkmk4` is a group method the lift does not
+//! cover, and J carries no parameter directions.
 
 use super::methods::isospectral::Isospectral;
 use crate::check;
@@ -260,7 +261,7 @@ impl Catalog for GeneralizedRigidBody {
         ]
     }
 
-    /// The tangent lift of `rk4` (module docs).
+    /// The tangent lift of `isospectral` and `rk4` (module docs).
     fn tangent(&self) -> Option<std::sync::Arc<dyn TangentSystem>> {
         Some(Tangent::field(self.clone()).into_system())
     }
@@ -451,9 +452,13 @@ fn matmul(n: usize, a: &[f64], b: &[f64], c: &mut [f64]) {
     }
 }
 
-/// `rk4` on the tangent lift (the group methods `isospectral`, `rkmk4` are not of its kind).
+/// `isospectral` (its own tangent stepper) and `rk4` on the tangent lift (the group method
+/// `rkmk4` is not of its kind).
 impl Catalog for Tangent<GeneralizedRigidBody> {
     fn kind_catalog() -> Vec<Entry<Self>> {
-        vec![Entry::new("rk4", || Rk4)]
+        vec![
+            Entry::new("isospectral", || Isospectral),
+            Entry::new("rk4", || Rk4),
+        ]
     }
 }

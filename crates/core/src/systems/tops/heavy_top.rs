@@ -226,7 +226,7 @@ impl Catalog for HeavyTop {
         Some(self.with_attitude())
     }
 
-    /// The tangent lift of the splittings (and, without the attitude, rk4); with the attitude
+    /// The tangent lift of the splittings and lgvi (and, without the attitude, rk4); with the attitude
     /// its directions are left-trivialised (δR = Rξ̂).
     fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
         Some(crate::integrate::tangent::Tangent::split(self.clone()).into_system())

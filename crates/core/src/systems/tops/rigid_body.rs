@@ -173,7 +173,7 @@ impl Problem for RigidBody {
     }
 }
 
-top_kinds!(RigidBody; ; "exact" => || Exact, "rkmk4" => || Rkmk4);
+top_kinds!(RigidBody; ; "exact" => || Exact, "rkmk4" => || Rkmk4, "isospectral" => || Isospectral);
 
 /// so(3) in physics coordinates acting on M, or on (M, R) with the attitude (principal frame):
 /// ξ(z) = −Ω = −I⁻¹M, and g = exp(ξ̂) acts by g·(M, R) = (gM, R gᵀ), a left action whose
@@ -348,8 +348,8 @@ impl Catalog for RigidBody {
         Some(self.with_attitude())
     }
 
-    /// The tangent lift of the splittings (and, without the attitude, rk4); with the attitude
-    /// its directions are left-trivialised (δR = Rξ̂).
+    /// The tangent lift of the splittings, lgvi and isospectral (and, without the attitude,
+    /// rk4 and exact); with the attitude its directions are left-trivialised (δR = Rξ̂).
     fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
         Some(crate::integrate::tangent::Tangent::split(self.clone()).into_system())
     }

@@ -942,14 +942,15 @@ pub(crate) fn splittings<P: Split + Clone + 'static>() -> Vec<Entry<P>> {
 }
 
 /// The problem kinds of a body on SO(3) with a field `top: Top`: [`Split`] (the Lie–Poisson
-/// splitting), [`VectorField`] (RK4) and the [`super::methods::lgvi::Lgvi`] method.
+/// splitting), [`VectorField`] (RK4) and the [`super::methods::lgvi::Lgvi`] method, each with
+/// its tangent lift.
 macro_rules! top_kinds {
     ($t:ty) => {
-        $crate::systems::tops::top::top_kinds!($t;;);
+        $crate::systems::tops::top::top_kinds!($t;);
     };
-    // Further methods of the lift: without the attitude only; with or without it
-    // (name => constructor).
-    ($t:ty; $($name:literal => $make:expr),*; $($any:literal => $amake:expr),*) => {
+    // Further methods of the lift without the attitude (name => constructor); after a second
+    // `;`, further methods of the lift with and without it.
+    ($t:ty; $($name:literal => $make:expr),* $(; $($both:literal => $bmake:expr),*)?) => {
         impl $crate::integrate::problem::Split for $t {
             type Work = $crate::systems::tops::top::TopWork;
             fn load(&self, z: &[f64]) -> $crate::Result<Self::Work> {
@@ -1010,29 +1011,55 @@ macro_rules! top_kinds {
             }
         }
 
-        /// The splittings and (without the attitude) `rk4` and the further methods on the
-        /// tangent lift.
+        impl $crate::integrate::tangent::Tangent<$t> {
+            /// The methods of the tangent lift with the attitude: the splittings, `lgvi` and the
+            /// further methods of both lifts.
+            fn attitude_catalog() -> Vec<$crate::integrate::Entry<Self>> {
+                let mut c = $crate::systems::tops::top::splittings();
+                c.push($crate::integrate::Entry::new("lgvi", || {
+                    $crate::systems::tops::methods::lgvi::Lgvi
+                }));
+                $($(c.push($crate::integrate::Entry::new($both, $bmake));)*)?
+                c
+            }
+        }
+
+        /// The splittings, `lgvi`, and (without the attitude) `rk4` and the further methods on
+        /// the tangent lift.
         impl $crate::integrate::Catalog for $crate::integrate::tangent::Tangent<$t> {
             fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
-                let mut c = $crate::systems::tops::top::splittings();
+                let mut c = Self::attitude_catalog();
                 c.push($crate::integrate::Entry::new("rk4", || {
                     $crate::integrate::methods::Rk4
                 }));
                 $(c.push($crate::integrate::Entry::new($name, $make));)*
-                $(c.push($crate::integrate::Entry::new($any, $amake));)*
                 c
             }
 
             fn catalog(&self) -> Vec<$crate::integrate::Entry<Self>> {
                 match self.problem().top.lifted {
-                    true => {
-                        #[allow(unused_mut)]
-                        let mut c = $crate::systems::tops::top::splittings();
-                        $(c.push($crate::integrate::Entry::new($any, $amake));)*
-                        c
-                    }
+                    true => Self::attitude_catalog(),
                     false => Self::kind_catalog(),
                 }
+            }
+        }
+
+        /// The LGVI on the tangent lift (module docs of `methods::lgvi`, "Tangent map").
+        impl $crate::integrate::Integrator<$crate::integrate::tangent::Tangent<$t>>
+            for $crate::systems::tops::methods::lgvi::Lgvi
+        {
+            fn properties(&self) -> $crate::integrate::Properties {
+                $crate::integrate::Properties::geometric(2)
+            }
+            fn stepper(
+                &self,
+                lift: &$crate::integrate::tangent::Tangent<$t>,
+                dt: f64,
+            ) -> $crate::Result<Box<dyn $crate::integrate::Stepper>> {
+                use $crate::integrate::Problem;
+                let p = lift.problem();
+                let params = (0..p.parameters().len()).map(|m| p.top_parameter(m)).collect();
+                Ok(self.tangent_stepper_for(&p.top, params, dt))
             }
         }
 

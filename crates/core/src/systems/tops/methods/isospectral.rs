@@ -20,12 +20,33 @@
 //!
 //! The method value is [`Isospectral`], in the catalogs of [`crate::systems::RigidBody`] (through the
 //! so(3) matrix hat(M), with the attitude) and [`crate::systems::GeneralizedRigidBody`].
+//!
+//! **Tangent map** (issue 26; `isospectral` on the tangent lifts of both bodies, the rigid body
+//! with and without the attitude). With a = h/2, W = L(M) the linear map M_ij ↦ M_ij/d_ij,
+//! the step is G(M̃) = M_n, M_{n+1} = H(M̃) with G, H(M̃) = M̃ ± a[W̃, M̃] − a² W̃M̃W̃. For a
+//! direction X = δM̃ and δW = LX + δL M̃ (δL = ∂(1/d_ij)/∂θ along a parameter, else 0), let
+//! S₁ = [δW, M̃] + [W̃, X] and S₂ = δW M̃W̃ + W̃XW̃ + W̃M̃ δW (both skew); then δG = X + aS₁ − a²S₂
+//! and δH = X − aS₁ − a²S₂. By the implicit-function theorem X solves
+//!
+//! DG(M̃)X = δM_n − (aS₁ − a²S₂)|_{X=0, δL}   (the inhomogeneous term only along a parameter),
+//!
+//! with DG(M̃) formed in the e_ij coordinates (column c from X = E_c, δW = E_c/d_c) and factored
+//! once per step for all the directions ([`crate::numerics::linalg::DenseLu`]), and
+//! δM_{n+1} = δH. With the attitude R_{n+1} = R_n cay(v), v = h ω̃ (ω̃ the vector of W̃), the
+//! left-trivialised direction is ξ_{n+1} = cay(v)ᵀ ξ_n + (δv − v × δv/2)/(1 + |v|²/4), δv = h δω
+//! (the derivative of the Cayley map, as for the LGVI). The base state is advanced by the plain
+//! step itself (the same bits); the fixed-point iteration converges to round-off (the rule of
+//! [`crate::convergence`]), so the implicit-function theorem at its M̃ is the derivative of the
+//! computed map to round-off. Cost per step: O(n⁵) for DG (N = n(n−1)/2 columns of O(n³)),
+//! O(N³) for its factorisation, O(n³) per direction.
 
 use super::super::top;
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::Result;
+use crate::integrate::tangent::Tangent;
 use crate::integrate::{Clock, Integrator, Properties, Stepper};
 use crate::lie::so3;
+use crate::numerics::linalg::DenseLu;
 use crate::systems::tops::{GeneralizedRigidBody, RigidBody};
 use nalgebra::{Matrix3, Vector3};
 
@@ -48,6 +69,24 @@ pub struct IsospectralMidpoint {
     w: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
+    /// The tangent map's parameter tables and work space (module docs; built by
+    /// [`IsospectralMidpoint::with_parameters`]).
+    tangent: Option<Box<TangentWork>>,
+}
+
+/// The work space of [`IsospectralMidpoint::tangent`]: the tables ∂(1/d_ij)/∂θ_m (n×n), the
+/// factored DG(M̃) (N×N), dense n×n scratch and the e_ij coordinates of S₁, S₂.
+struct TangentWork {
+    dinv: Vec<Vec<f64>>,
+    lu: DenseLu,
+    x: Vec<f64>,
+    dw: Vec<f64>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+    d: Vec<f64>,
+    s1: Vec<f64>,
+    s2: Vec<f64>,
 }
 
 impl IsospectralMidpoint {
@@ -66,7 +105,27 @@ impl IsospectralMidpoint {
             w: vec![0.0; n * n],
             p: vec![0.0; n * n],
             q: vec![0.0; n * n],
+            tangent: None,
         }
+    }
+
+    /// The same stepper with its tangent map ([`IsospectralMidpoint::tangent`]), along the
+    /// parameters whose tables ∂(1/d_ij)/∂θ_m (n×n, row-major) are `dinv`.
+    pub(crate) fn with_parameters(mut self, dinv: Vec<Vec<f64>>) -> Self {
+        let (n, big) = (self.n, self.n * (self.n - 1) / 2);
+        self.tangent = Some(Box::new(TangentWork {
+            dinv,
+            lu: DenseLu::new(big),
+            x: vec![0.0; n * n],
+            dw: vec![0.0; n * n],
+            a: vec![0.0; n * n],
+            b: vec![0.0; n * n],
+            c: vec![0.0; n * n],
+            d: vec![0.0; n * n],
+            s1: vec![0.0; big],
+            s2: vec![0.0; big],
+        }));
+        self
     }
 
     /// Ω̃ = Ω(M̃) of the last step (row-major), for the attitude update.
@@ -136,6 +195,132 @@ impl IsospectralMidpoint {
     }
 }
 
+impl IsospectralMidpoint {
+    /// The tangent map of the last [`IsospectralMidpoint::step`] (module docs, "Tangent map";
+    /// needs [`IsospectralMidpoint::with_parameters`]): `dirs` holds k directions δM_n one after
+    /// another, each in the N = n(n−1)/2 e_ij coordinates (the upper triangle row by row), the
+    /// last `dinv.len()` along the parameters, and gets δM_{n+1}; `dw`, if given (same layout),
+    /// gets δW̃ = δΩ̃ of each. NaN where DG(M̃) is singular.
+    pub(crate) fn tangent(&mut self, dirs: &mut [f64], mut dw: Option<&mut [f64]>) {
+        let Some(mut t) = self.tangent.take() else {
+            dirs.fill(f64::NAN);
+            return;
+        };
+        let (n, big) = (self.n, self.n * (self.n - 1) / 2);
+        let (a, a2) = (0.5 * self.h, 0.25 * self.h * self.h);
+        let k = dirs.len() / big;
+        let first_param = k - t.dinv.len();
+        // DG(M̃) column by column: X = E_c, δW = E_c/d_c.
+        let mut col = 0;
+        for i in 0..n {
+            for j in i + 1..n {
+                t.x.fill(0.0);
+                t.x[i * n + j] = 1.0;
+                t.x[j * n + i] = -1.0;
+                let inv = self.inv_d[i * n + j];
+                for (dw, x) in t.dw.iter_mut().zip(&t.x) {
+                    *dw = x * inv;
+                }
+                self.variation(&mut t);
+                for r in 0..big {
+                    let unit = if r == col { 1.0 } else { 0.0 };
+                    t.lu.matrix()[(r, col)] = unit + a * t.s1[r] - a2 * t.s2[r];
+                }
+                col += 1;
+            }
+        }
+        if !t.lu.factor() {
+            dirs.fill(f64::NAN);
+            self.tangent = Some(t);
+            return;
+        }
+        // The right-hand sides: δM_n, less the inhomogeneous term along a parameter.
+        for (m, rhs) in dirs.chunks_exact_mut(big).skip(first_param).enumerate() {
+            t.x.fill(0.0);
+            self.parameter_part(&mut t, m);
+            self.variation(&mut t);
+            for ((y, s1), s2) in rhs.iter_mut().zip(&t.s1).zip(&t.s2) {
+                *y -= a * s1 - a2 * s2;
+            }
+        }
+        // At most N columns at a time (the factor's scratch is sized for N).
+        for block in dirs.chunks_mut(big * big) {
+            let cols = block.len() / big;
+            t.lu.solve_columns(faer::MatMut::from_column_major_slice_mut(block, big, cols));
+        }
+        // δM_{n+1} = δH from X = δM̃.
+        for (l, xc) in dirs.chunks_exact_mut(big).enumerate() {
+            upper_to_dense(n, xc, &mut t.x);
+            match l.checked_sub(first_param) {
+                Some(m) => self.parameter_part(&mut t, m),
+                None => t.dw.fill(0.0),
+            }
+            for ((dw, x), inv) in t.dw.iter_mut().zip(&t.x).zip(&self.inv_d) {
+                *dw += x * inv;
+            }
+            self.variation(&mut t);
+            for ((y, s1), s2) in xc.iter_mut().zip(&t.s1).zip(&t.s2) {
+                *y += -a * s1 - a2 * s2;
+            }
+            if let Some(out) = dw.as_deref_mut() {
+                dense_to_upper(n, &t.dw, &mut out[l * big..(l + 1) * big]);
+            }
+        }
+        self.tangent = Some(t);
+    }
+
+    /// t.dw ← δL M̃ along parameter m.
+    fn parameter_part(&self, t: &mut TangentWork, m: usize) {
+        for ((dw, x), dl) in t.dw.iter_mut().zip(&self.mt).zip(&t.dinv[m]) {
+            *dw = x * dl;
+        }
+    }
+
+    /// S₁ = [δW, M̃] + [W̃, X] and S₂ = δW M̃W̃ + W̃XW̃ + W̃M̃ δW (e_ij coordinates) for X = t.x and
+    /// δW = t.dw (dense, skew), after a step (M̃, W̃ in place): with A = δW M̃, B = W̃X,
+    /// [δW, M̃] = A − Aᵀ, [W̃, X] = B − Bᵀ, W̃XW̃ = BW̃, δW M̃W̃ + W̃M̃ δW = AW̃ − (AW̃)ᵀ.
+    fn variation(&self, t: &mut TangentWork) {
+        let n = self.n;
+        matmul(n, &t.dw, &self.mt, &mut t.a);
+        matmul(n, &self.w, &t.x, &mut t.b);
+        matmul(n, &t.b, &self.w, &mut t.c);
+        matmul(n, &t.a, &self.w, &mut t.d);
+        let mut r = 0;
+        for i in 0..n {
+            for j in i + 1..n {
+                let (ij, ji) = (i * n + j, j * n + i);
+                t.s1[r] = (t.a[ij] - t.a[ji]) + (t.b[ij] - t.b[ji]);
+                t.s2[r] = t.c[ij] + (t.d[ij] - t.d[ji]);
+                r += 1;
+            }
+        }
+    }
+}
+
+/// The skew n×n matrix (row-major) of e_ij coordinates (the upper triangle row by row).
+fn upper_to_dense(n: usize, u: &[f64], m: &mut [f64]) {
+    let mut r = 0;
+    for i in 0..n {
+        m[i * n + i] = 0.0;
+        for j in i + 1..n {
+            m[i * n + j] = u[r];
+            m[j * n + i] = -u[r];
+            r += 1;
+        }
+    }
+}
+
+/// The e_ij coordinates of a skew n×n matrix.
+fn dense_to_upper(n: usize, m: &[f64], u: &mut [f64]) {
+    let mut r = 0;
+    for i in 0..n {
+        for j in i + 1..n {
+            u[r] = m[i * n + j];
+            r += 1;
+        }
+    }
+}
+
 /// c = a·b for dense row-major n×n matrices.
 fn matmul(n: usize, a: &[f64], b: &[f64], c: &mut [f64]) {
     for i in 0..n {
@@ -169,15 +354,25 @@ impl Integrator<RigidBody> for Isospectral {
 
     /// On so(3) through the matrix hat(M): d_12 = I₃, d_13 = I₂, d_23 = I₁.
     fn stepper(&self, body: &RigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
-        let [i1, i2, i3] = body.top.moments;
-        let d = [0.0, i3, i2, i3, 0.0, i1, i2, i1, 0.0];
-        Ok(Box::new(So3Stepper {
-            kernel: IsospectralMidpoint::new(3, &d, dt),
-            h: dt,
-            mat: [0.0; 9],
-            r: None,
-            lifted: body.top.lifted,
-        }))
+        Ok(Box::new(So3Stepper::new(body, dt, None)))
+    }
+}
+
+/// The isospectral midpoint on the tangent lift of the rigid body, with or without the
+/// attitude (module docs, "Tangent map"); parameters I1, I2, I3.
+impl Integrator<Tangent<RigidBody>> for Isospectral {
+    fn properties(&self) -> Properties {
+        Properties::geometric(2)
+    }
+
+    fn stepper(&self, lift: &Tangent<RigidBody>, dt: f64) -> Result<Box<dyn Stepper>> {
+        let body = lift.problem();
+        let dirs = So3Lift {
+            dirs: Vec::new(),
+            upper: Vec::new(),
+            dw: Vec::new(),
+        };
+        Ok(Box::new(So3Stepper::new(body, dt, Some(dirs))))
     }
 }
 
@@ -187,12 +382,105 @@ struct So3Stepper {
     mat: [f64; 9],
     r: Option<Matrix3<f64>>,
     lifted: bool,
+    lift: Option<So3Lift>,
+}
+
+/// The directions of a tangent lift, (δM, [ξ]) one after another (principal frame), and their
+/// δM and δΩ̃ in e_ij coordinates for the kernel.
+struct So3Lift {
+    dirs: Vec<f64>,
+    upper: Vec<f64>,
+    dw: Vec<f64>,
+}
+
+/// The e_ij coordinates of hat(v): (−v₃, v₂, −v₁) (an involution up to sign: its own inverse
+/// is u ↦ (−u₃, u₂, −u₁)).
+fn so3_upper(v: &[f64]) -> [f64; 3] {
+    [-v[2], v[1], -v[0]]
+}
+
+impl So3Stepper {
+    fn new(body: &RigidBody, dt: f64, lift: Option<So3Lift>) -> Self {
+        let [i1, i2, i3] = body.top.moments;
+        let d = [0.0, i3, i2, i3, 0.0, i1, i2, i1, 0.0];
+        let mut kernel = IsospectralMidpoint::new(3, &d, dt);
+        if lift.is_some() {
+            // ∂(1/d_ij)/∂I_q = −1/I_q² where d_ij = I_q.
+            let at = [[5, 7], [2, 6], [1, 3]];
+            let dinv = (0..3)
+                .map(|q| {
+                    let mut t = vec![0.0; 9];
+                    for k in at[q] {
+                        t[k] = -1.0 / (d[k] * d[k]);
+                    }
+                    t
+                })
+                .collect();
+            kernel = kernel.with_parameters(dinv);
+        }
+        So3Stepper {
+            kernel,
+            h: dt,
+            mat: [0.0; 9],
+            r: None,
+            lifted: body.top.lifted,
+            lift,
+        }
+    }
+
+    /// The values of the base state and of a direction.
+    fn dims(&self) -> (usize, usize) {
+        match self.lifted {
+            true => (12, 6),
+            false => (3, 3),
+        }
+    }
+
+    /// The tangent map of the last step on every direction (module docs, "Tangent map").
+    fn tangent(&mut self, lift: &mut So3Lift) {
+        let e = self.dims().1;
+        for (dz, u) in lift
+            .dirs
+            .chunks_exact(e)
+            .zip(lift.upper.chunks_exact_mut(3))
+        {
+            u.copy_from_slice(&so3_upper(&dz[..3]));
+        }
+        self.kernel.tangent(&mut lift.upper, Some(&mut lift.dw));
+        let w = self.kernel.omega();
+        let v = Vector3::new(w[7], w[2], w[3]) * self.h;
+        let back = so3::Rodrigues::cayley(&-v);
+        let s = 1.0 + 0.25 * v.norm_squared();
+        let dirs = lift.dirs.chunks_exact_mut(e);
+        for ((dz, u), dw) in dirs
+            .zip(lift.upper.chunks_exact(3))
+            .zip(lift.dw.chunks_exact(3))
+        {
+            dz[..3].copy_from_slice(&so3_upper(u));
+            if self.lifted {
+                let dv = Vector3::from(so3_upper(dw)) * self.h;
+                let mut xi = Vector3::from_column_slice(&dz[3..6]);
+                back.apply(&mut xi);
+                xi += (dv - v.cross(&dv) * 0.5) / s;
+                dz[3..6].copy_from_slice(xi.as_slice());
+            }
+        }
+    }
 }
 
 impl Stepper for So3Stepper {
+    /// The base state, and on a lift its directions after it.
     fn set(&mut self, z: &[f64]) -> Result<()> {
         self.mat = top::row_major(&so3::hat(&Vector3::from_column_slice(&z[..3])));
         self.r = self.lifted.then(|| Matrix3::from_row_slice(&z[3..12]));
+        let (d, e) = self.dims();
+        if let Some(lift) = self.lift.as_mut() {
+            let k = (z.len() - d) / e;
+            lift.dirs.clear();
+            lift.dirs.extend_from_slice(&z[d..]);
+            lift.upper.resize(3 * k, 0.0);
+            lift.dw.resize(3 * k, 0.0);
+        }
         Ok(())
     }
 
@@ -202,6 +490,12 @@ impl Stepper for So3Stepper {
         if let Some(r) = &self.r {
             z[3..12].copy_from_slice(&top::row_major(r));
         }
+        if let Some(lift) = &self.lift {
+            let d = self.dims().0;
+            if z.len() == d + lift.dirs.len() {
+                z[d..].copy_from_slice(&lift.dirs);
+            }
+        }
     }
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
@@ -209,6 +503,10 @@ impl Stepper for So3Stepper {
             self.kernel
                 .step(&mut self.mat)
                 .map_err(|e| failed(&clock, k, e))?;
+            if let Some(mut lift) = self.lift.take() {
+                self.tangent(&mut lift);
+                self.lift = Some(lift);
+            }
             if let Some(r) = self.r.as_mut() {
                 let w = self.kernel.omega();
                 // R cay(hΩ̃) by increments of R's rows (no bias at a steady rotation:
@@ -226,12 +524,23 @@ impl Integrator<GeneralizedRigidBody> for Isospectral {
     }
 
     fn stepper(&self, body: &GeneralizedRigidBody, dt: f64) -> Result<Box<dyn Stepper>> {
-        let n = body.n();
-        Ok(Box::new(SonStepper {
-            kernel: IsospectralMidpoint::new(n, body.denominators(), dt),
-            body: body.clone(),
-            mat: vec![0.0; n * n],
-        }))
+        Ok(Box::new(SonStepper::new(body, dt, None)))
+    }
+}
+
+/// The isospectral midpoint on the tangent lift of the generalized rigid body (module docs,
+/// "Tangent map"; no parameters): the directions are e_ij coordinates, the kernel's own.
+impl Integrator<Tangent<GeneralizedRigidBody>> for Isospectral {
+    fn properties(&self) -> Properties {
+        Properties::geometric(2)
+    }
+
+    fn stepper(&self, lift: &Tangent<GeneralizedRigidBody>, dt: f64) -> Result<Box<dyn Stepper>> {
+        Ok(Box::new(SonStepper::new(
+            lift.problem(),
+            dt,
+            Some(Vec::new()),
+        )))
     }
 }
 
@@ -239,16 +548,46 @@ struct SonStepper {
     kernel: IsospectralMidpoint,
     body: GeneralizedRigidBody,
     mat: Vec<f64>,
+    /// A lift's directions (after the state in the lifted state).
+    dirs: Option<Vec<f64>>,
+}
+
+impl SonStepper {
+    fn new(body: &GeneralizedRigidBody, dt: f64, dirs: Option<Vec<f64>>) -> Self {
+        let n = body.n();
+        let mut kernel = IsospectralMidpoint::new(n, body.denominators(), dt);
+        if dirs.is_some() {
+            kernel = kernel.with_parameters(Vec::new());
+        }
+        SonStepper {
+            kernel,
+            body: body.clone(),
+            mat: vec![0.0; n * n],
+            dirs,
+        }
+    }
 }
 
 impl Stepper for SonStepper {
     fn set(&mut self, z: &[f64]) -> Result<()> {
         self.body.dense(z, &mut self.mat);
+        let n = self.body.n();
+        if let Some(dirs) = self.dirs.as_mut() {
+            dirs.clear();
+            dirs.extend_from_slice(&z[n * (n - 1) / 2..]);
+        }
         Ok(())
     }
 
     fn get(&self, z: &mut [f64]) {
         self.body.coords(&self.mat, z);
+        let n = self.body.n();
+        if let Some(dirs) = &self.dirs {
+            let d = n * (n - 1) / 2;
+            if z.len() == d + dirs.len() {
+                z[d..].copy_from_slice(dirs);
+            }
+        }
     }
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
@@ -256,6 +595,9 @@ impl Stepper for SonStepper {
             self.kernel
                 .step(&mut self.mat)
                 .map_err(|e| failed(&clock, k, e))?;
+            if let Some(dirs) = self.dirs.as_mut() {
+                self.kernel.tangent(dirs, None);
+            }
         }
         Ok(())
     }
