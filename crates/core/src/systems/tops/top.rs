@@ -943,8 +943,9 @@ macro_rules! top_kinds {
     ($t:ty) => {
         $crate::systems::tops::top::top_kinds!($t;);
     };
-    // Further methods of the lift without the attitude (name => constructor).
-    ($t:ty; $($name:literal => $make:expr),*) => {
+    // Further methods of the lift (name => constructor): without the attitude only, then
+    // (after `;`) with and without it.
+    ($t:ty; $($name:literal => $make:expr),* $(; $($any:literal => $anymake:expr),*)?) => {
         impl $crate::integrate::problem::Split for $t {
             type Work = $crate::systems::tops::top::TopWork;
             fn load(&self, z: &[f64]) -> $crate::Result<Self::Work> {
@@ -1005,8 +1006,8 @@ macro_rules! top_kinds {
             }
         }
 
-        /// The splittings and (without the attitude) `rk4` and the further methods on the
-        /// tangent lift.
+        /// The splittings, (without the attitude) `rk4` and the further methods, and those
+        /// further methods that also take the attitude, on the tangent lift.
         impl $crate::integrate::Catalog for $crate::integrate::tangent::Tangent<$t> {
             fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
                 let mut c = $crate::systems::tops::top::splittings();
@@ -1014,14 +1015,26 @@ macro_rules! top_kinds {
                     $crate::integrate::methods::Rk4
                 }));
                 $(c.push($crate::integrate::Entry::new($name, $make));)*
+                c.extend(Self::attitude_methods());
                 c
             }
 
             fn catalog(&self) -> Vec<$crate::integrate::Entry<Self>> {
                 match self.problem().top.lifted {
-                    true => $crate::systems::tops::top::splittings(),
+                    true => {
+                        let mut c = $crate::systems::tops::top::splittings();
+                        c.extend(Self::attitude_methods());
+                        c
+                    }
                     false => Self::kind_catalog(),
                 }
+            }
+        }
+
+        impl $crate::integrate::tangent::Tangent<$t> {
+            /// The further methods of the lift that also take the attitude.
+            fn attitude_methods() -> Vec<$crate::integrate::Entry<Self>> {
+                vec![$($($crate::integrate::Entry::new($any, $anymake)),*)?]
             }
         }
 
