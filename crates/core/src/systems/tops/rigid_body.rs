@@ -173,7 +173,10 @@ impl Problem for RigidBody {
     }
 }
 
-top_kinds!(RigidBody; ; "exact" => || Exact, "rkmk4" => || Rkmk4, "isospectral" => || Isospectral);
+top_kinds!(RigidBody; ;
+    "exact" => || Exact, "rkmk4" => || Rkmk4, "isospectral" => || Isospectral,
+    "dmv" => || Dmv(2), "dmv4" => || Dmv(4), "dmv6" => || Dmv(6), "dmv8" => || Dmv(8),
+    "dmv10" => || Dmv(10));
 
 /// so(3) in physics coordinates acting on M, or on (M, R) with the attitude (principal frame):
 /// ξ(z) = −Ω = −I⁻¹M, and g = exp(ξ̂) acts by g·(M, R) = (gM, R gᵀ), a left action whose
@@ -319,6 +322,23 @@ impl Integrator<RigidBody> for Dmv {
     }
 }
 
+/// DMV on the tangent lift, with or without the attitude: the base state as the plain method's
+/// and the directions by the derivative of its step (module docs of `methods::dmv`, "Tangent
+/// map").
+impl Integrator<crate::integrate::tangent::Tangent<RigidBody>> for Dmv {
+    fn properties(&self) -> Properties {
+        Dmv::properties(self)
+    }
+
+    fn stepper(
+        &self,
+        lift: &crate::integrate::tangent::Tangent<RigidBody>,
+        dt: f64,
+    ) -> Result<Box<dyn Stepper>> {
+        self.tangent_stepper_for(&lift.problem().top, dt)
+    }
+}
+
 impl Catalog for RigidBody {
     fn kind_catalog() -> Vec<Entry<Self>> {
         let mut catalog = top::splittings();
@@ -348,8 +368,8 @@ impl Catalog for RigidBody {
         Some(self.with_attitude())
     }
 
-    /// The tangent lift of the splittings, lgvi and isospectral (and, without the attitude,
-    /// rk4 and exact); with the attitude its directions are left-trivialised (δR = Rξ̂).
+    /// The tangent lift of every method (`rk4` without the attitude only); with the attitude
+    /// its directions are left-trivialised (δR = Rξ̂).
     fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
         Some(crate::integrate::tangent::Tangent::split(self.clone()).into_system())
     }

@@ -55,6 +55,33 @@
 //! once, when a stepper's state is set (at the start of a run; the driver sets it again only after
 //! its retractions of R, every 256 steps, from a state with the same invariants to round-off).
 //!
+//! **Tangent map** (issue 26; the methods on the tangent lift of [`crate::systems::RigidBody`],
+//! with and without the attitude). The exact derivative of the map above (HV06 (16)–(18) with
+//! the modified moments), to round-off: the base state is stepped by the plain stepper's own
+//! code (the same bits), and each direction (δM, and ξ with δR = Rξ̂) by the derivative of that
+//! step.
+//! - The e-equation G(e; b, fac) = e − α b − fac∘(e_j e_k) = 0, b = a∘M with
+//!   a_j = (h/2)/Ĩ_j, by the implicit-function theorem: δe = G_e⁻¹(α δb + δfac∘(e_j e_k)),
+//!   δb = δa∘M + a∘δM (a, fac, fad of the kernel below), with G_e (Newton's matrix) formed and
+//!   inverted once per step for all k directions.
+//! - M_{n+1} = M_n + fad∘(e_j e_k)/α: δM_{n+1} = δM_n + δ(fad∘(e_j e_k)/α), with
+//!   δα = 2e·δe.
+//! - R_{n+1} = R_n F_n, F = cay(e): the left-trivialised ξ_{n+1} = F_nᵀξ_n + dcay_e δe, where
+//!   F⁻¹δF = (dcay_e δe)^ with dcay_e δe = (2/α)(δe − e × δe) (twice the vector part of r̄ δr
+//!   for the unit quaternion r = (1, e)/√α of F; its scalar part vanishes).
+//! - The modified moments depend on M₀ through H and C and on I (HV06 (6)): δĨ =
+//!   ∂Ĩ/∂M₀ δM₀ + ∂Ĩ/∂I δI, formed per direction when the stepper is set and entering every
+//!   step through δa, δfac and δfad (for order 2, δĨ = δI). A stepper set again mid-run (the
+//!   driver after its retractions of R) differentiates the preprocessing at the state it is set
+//!   to along that state's directions: the derivative of the map it computes, equal to the
+//!   one without the re-set since H and C are invariants of every DMV step.
+//!
+//! The lift's space is flat, so the driver neither retracts it nor sets its stepper again; with
+//! the attitude the tangent stepper does itself what the driver does to the plain run after
+//! every [`RETRACT_EVERY`]-th step (retracts R, sets the stepper again), so that its base states
+//! are the plain run's bit for bit over any number of steps (a shortened step ending exactly
+//! there is retracted too: it moves by round-off).
+//!
 //! **Properties** (HV06 Proposition 2.3, Table 2): order 2r; |M|² and the spatial momentum R M
 //! are kept (the step is a rotation of M and R M is unchanged by it), R ∈ SO(3) to round-off;
 //! the energy H too: DMV with the constant Ĩ keeps H̃ = ½ Σ M_j²/Ĩ_j = sH + dC and C, hence H;
@@ -65,7 +92,8 @@
 use super::super::top::Top;
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
-use crate::integrate::{Clock, Properties, Stepper};
+use crate::integrate::space::Block;
+use crate::integrate::{Clock, Properties, Stepper, RETRACT_EVERY};
 use crate::lie::rotations::{matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix};
 use nalgebra::{Matrix3, Vector3};
 
@@ -216,6 +244,27 @@ fn coefficients(terms: &[Term], p: [f64; 3], k: usize) -> [f64; 5] {
     out
 }
 
+/// The gradients in (p₁, p₂, p₃) of [`coefficients`] (for the derivative of the modified moments
+/// along the principal moments).
+fn coefficient_gradients(terms: &[Term], p: [f64; 3], k: usize) -> [[f64; 3]; 5] {
+    let mut out = [[0.0; 3]; 5];
+    for t in terms.iter().filter(|t| usize::from(t.k) == k) {
+        let c = f64::from(t.num) / f64::from(t.den);
+        let row = &mut out[usize::from(t.i)];
+        for (a, g) in row.iter_mut().enumerate().filter(|&(a, _)| t.p[a] > 0) {
+            // ∂/∂p_a of p₁^a₁ p₂^a₂ p₃^a₃.
+            let d: f64 = (0..3)
+                .map(|b| match b == a {
+                    true => f64::from(t.p[b]) * p[b].powi(i32::from(t.p[b]) - 1),
+                    false => p[b].powi(i32::from(t.p[b])),
+                })
+                .product();
+            *g += c * d;
+        }
+    }
+    out
+}
+
 /// The coefficients of H^{k−i} C^i (i = 0…k) in s_{2k+1} and d_{2k+1}, k = 1…4, of principal
 /// moments I (unscaled: s = 1 + Σ_k h^{2k} Σ_i s_i H^{k−i} C^i, likewise d); for tests against
 /// HV06 Table 1. Zeros for other k.
@@ -233,6 +282,9 @@ struct Series {
     mu: [f64; 3],
     s: [[f64; 5]; 4],
     d: [[f64; 5]; 4],
+    /// The gradients of `s` and `d` in the elementary polynomials p̂ of μ.
+    s_grad: [[[f64; 3]; 5]; 4],
+    d_grad: [[[f64; 3]; 5]; 4],
 }
 
 impl Series {
@@ -255,10 +307,14 @@ impl Series {
             mu,
             s: [[0.0; 5]; 4],
             d: [[0.0; 5]; 4],
+            s_grad: [[[0.0; 3]; 5]; 4],
+            d_grad: [[[0.0; 3]; 5]; 4],
         };
         for k in 1..(order as usize / 2) {
             series.s[k - 1] = coefficients(&S, p, k);
             series.d[k - 1] = coefficients(&D, p, k);
+            series.s_grad[k - 1] = coefficient_gradients(&S, p, k);
+            series.d_grad[k - 1] = coefficient_gradients(&D, p, k);
         }
         Ok(series)
     }
@@ -304,6 +360,65 @@ impl Series {
         }
         Ok(out)
     }
+
+    /// δĨ, the derivative of [`Series::moments`] (= `tilde`) along δM = `dm` and the principal
+    /// `moments` moving by δI = `di` (HV06 (6): 1/Ĩ_j = s u_j + d, u = 1/I). Scale-free as there:
+    /// s and d are functions of u alone (each term of degree zero in u_ref), so u_ref is held
+    /// fixed and μ_j = u_j/u_ref moves by −μ_j u_j δI_j; X = ½ Σ μ_j v_j² and Y = ½ Σ v_j² with
+    /// v = h u_ref M; p̂ moves by (Σ δμ_j, Σ δμ_j(p̂₁ − μ_j), Σ δμ_j p̂₃/μ_j).
+    fn moments_tangent(
+        &self,
+        m: &[f64; 3],
+        h: f64,
+        moments: &[f64; 3],
+        tilde: &[f64; 3],
+        dm: &[f64; 3],
+        di: &[f64; 3],
+    ) -> [f64; 3] {
+        let (mu, u_ref) = (self.mu, self.u_ref);
+        let dmu = [0, 1, 2].map(|j| -mu[j] * di[j] / moments[j]);
+        let v = [0, 1, 2].map(|j| h * u_ref * m[j]);
+        let dv = [0, 1, 2].map(|j| h * u_ref * dm[j]);
+        let x = 0.5 * (0..3).map(|j| mu[j] * v[j] * v[j]).sum::<f64>();
+        let y = 0.5 * v.iter().map(|a| a * a).sum::<f64>();
+        let dx = (0..3)
+            .map(|j| 0.5 * dmu[j] * v[j] * v[j] + mu[j] * v[j] * dv[j])
+            .sum::<f64>();
+        let dy = (0..3).map(|j| v[j] * dv[j]).sum::<f64>();
+        let p = elementary(mu);
+        let others = |j: usize| mu[(j + 1) % 3] * mu[(j + 2) % 3];
+        let dp = [
+            dmu.iter().sum::<f64>(),
+            (0..3).map(|j| dmu[j] * (p[0] - mu[j])).sum::<f64>(),
+            (0..3).map(|j| dmu[j] * others(j)).sum::<f64>(),
+        ];
+        // (Σ c x^{k−i} y^i, its derivative), term by term.
+        let pow = |z: f64, n: usize| z.powi(n as i32);
+        let dpow = |z: f64, n: usize| match n {
+            0 => 0.0,
+            _ => n as f64 * z.powi(n as i32 - 1),
+        };
+        let sum = |c: &[[f64; 5]; 4], g: &[[[f64; 3]; 5]; 4]| {
+            let (mut val, mut der) = (0.0, 0.0);
+            for k in 1..(self.order as usize / 2) {
+                for i in 0..=k {
+                    let (c, g) = (c[k - 1][i], g[k - 1][i]);
+                    let (xa, yb) = (pow(x, k - i), pow(y, i));
+                    val += c * xa * yb;
+                    der += (g[0] * dp[0] + g[1] * dp[1] + g[2] * dp[2]) * xa * yb
+                        + c * (dpow(x, k - i) * dx * yb + xa * dpow(y, i) * dy);
+                }
+            }
+            (val, der)
+        };
+        let (s, ds) = sum(&self.s, &self.s_grad);
+        let (_, dd) = sum(&self.d, &self.d_grad);
+        let s = 1.0 + s;
+        [0, 1, 2].map(|j| {
+            let dinv = u_ref * (ds * mu[j] + s * dmu[j] + dd);
+            -tilde[j] * tilde[j] * dinv
+        })
+    }
 }
 
 /// The modified principal moments Ĩ of the preprocessed DMV of `order` (2 returns I) for the
@@ -333,16 +448,18 @@ impl Dmv {
     ///
     /// Errors: an order not in [`ORDERS`] ([`Error::InvalidArgument`]).
     pub(crate) fn stepper_for(&self, top: &Top, dt: f64) -> Result<Box<dyn Stepper>> {
-        let moments = top.moments;
-        Ok(Box::new(DmvStepper {
-            series: Series::new(&moments, self.0)?,
-            moments,
-            h: dt,
-            lifted: top.lifted,
-            m: Vector3::zeros(),
-            carry: Vector3::zeros(),
-            q: [1.0, 0.0, 0.0, 0.0],
-            kernel: Kernel::new(&moments, dt),
+        Ok(Box::new(DmvStepper::new(top, dt, self.0)?))
+    }
+
+    /// The stepper of the tangent lift of a free body `top` (module docs, "Tangent map").
+    ///
+    /// Errors: as [`Dmv::stepper_for`].
+    pub(crate) fn tangent_stepper_for(&self, top: &Top, dt: f64) -> Result<Box<dyn Stepper>> {
+        Ok(Box::new(DmvTangentStepper {
+            base: DmvStepper::new(top, dt, self.0)?,
+            e: if top.lifted { 6 } else { 3 },
+            dirs: Vec::new(),
+            dkernel: Vec::new(),
         }))
     }
 }
@@ -357,6 +474,23 @@ struct Kernel {
 }
 
 impl Kernel {
+    /// The derivative of [`Kernel::new`] at Ĩ = `inertia` along δĨ = `d` (δa_j = −a_j δĨ_j/Ĩ_j,
+    /// δfac_i = (δĨ_j − δĨ_k − fac_i δĨ_i)/Ĩ_i, δfad_i = 4(δĨ_j − δĨ_k)/h).
+    fn tangent(&self, inertia: &[f64; 3], d: &[f64; 3], h: f64) -> Self {
+        let cyc = |i: usize| ((i + 1) % 3, (i + 2) % 3);
+        Kernel {
+            a: [0, 1, 2].map(|j| -self.a[j] * d[j] / inertia[j]),
+            fac: [0, 1, 2].map(|i| {
+                let (j, k) = cyc(i);
+                (d[j] - d[k] - self.fac[i] * d[i]) / inertia[i]
+            }),
+            fad: [0, 1, 2].map(|i| {
+                let (j, k) = cyc(i);
+                4.0 * (d[j] - d[k]) / h
+            }),
+        }
+    }
+
     fn new(inertia: &[f64; 3], h: f64) -> Self {
         let cyc = |i: usize| ((i + 1) % 3, (i + 2) % 3);
         Kernel {
@@ -373,6 +507,23 @@ impl Kernel {
     }
 }
 
+/// ∂G/∂e for G(e) = e − α b − fac∘(e_j e_k), α = 1 + |e|² (the e-equation, module docs):
+/// 1 − 2 b eᵀ − ∂(fac∘(e_j e_k))/∂e. Newton's matrix, and that of the implicit-function theorem
+/// in the tangent map.
+fn newton_matrix(b: &[f64; 3], e: &[f64; 3], f: &[f64; 3]) -> Matrix3<f64> {
+    Matrix3::new(
+        1.0 - 2.0 * b[0] * e[0],
+        -2.0 * b[0] * e[1] - f[0] * e[2],
+        -2.0 * b[0] * e[2] - f[0] * e[1],
+        -2.0 * b[1] * e[0] - f[1] * e[2],
+        1.0 - 2.0 * b[1] * e[1],
+        -2.0 * b[1] * e[2] - f[1] * e[0],
+        -2.0 * b[2] * e[0] - f[2] * e[1],
+        -2.0 * b[2] * e[1] - f[2] * e[0],
+        1.0 - 2.0 * b[2] * e[2],
+    )
+}
+
 /// The DMV stepper on M (principal frame) and the attitude quaternion.
 struct DmvStepper {
     series: Series,
@@ -383,10 +534,27 @@ struct DmvStepper {
     carry: Vector3<f64>,
     /// The attitude (w, x, y, z), |q| = 1.
     q: [f64; 4],
+    /// The modified moments Ĩ of the kernel (I for order 2).
+    inertia: [f64; 3],
     kernel: Kernel,
 }
 
 impl DmvStepper {
+    fn new(top: &Top, h: f64, order: u32) -> Result<Self> {
+        let moments = top.moments;
+        Ok(DmvStepper {
+            series: Series::new(&moments, order)?,
+            moments,
+            h,
+            lifted: top.lifted,
+            m: Vector3::zeros(),
+            carry: Vector3::zeros(),
+            q: [1.0, 0.0, 0.0, 0.0],
+            inertia: moments,
+            kernel: Kernel::new(&moments, h),
+        })
+    }
+
     /// Solves e_i = α b_i + fac_i e_j e_k, α = 1 + |e|² ((i, j, k) cyclic): Gauss–Seidel sweeps
     /// from the predictor under the rule [`FIXED_POINT`] while they contract fast (ratio of
     /// successive updates ρ ≤ [`SLOW_CONTRACTION`]), ended early where the error left after an
@@ -444,19 +612,7 @@ impl DmvStepper {
                 e[1] - alpha * b[1] - f[1] * e[2] * e[0],
                 e[2] - alpha * b[2] - f[2] * e[0] * e[1],
             ];
-            // J = 1 − 2 b eᵀ − ∂(fac ∘ (e_j e_k))/∂e.
-            let j = Matrix3::new(
-                1.0 - 2.0 * b[0] * e[0],
-                -2.0 * b[0] * e[1] - f[0] * e[2],
-                -2.0 * b[0] * e[2] - f[0] * e[1],
-                -2.0 * b[1] * e[0] - f[1] * e[2],
-                1.0 - 2.0 * b[1] * e[1],
-                -2.0 * b[1] * e[2] - f[1] * e[0],
-                -2.0 * b[2] * e[0] - f[2] * e[1],
-                -2.0 * b[2] * e[1] - f[2] * e[0],
-                1.0 - 2.0 * b[2] * e[2],
-            );
-            let Some(inv) = j.try_inverse() else {
+            let Some(inv) = newton_matrix(&b, &e, &f).try_inverse() else {
                 let size = e[0].abs() + e[1].abs() + e[2].abs();
                 return Err(monitor.failed((g[0].abs() + g[1].abs() + g[2].abs()) / size));
             };
@@ -475,9 +631,15 @@ impl DmvStepper {
         }
     }
 
-    fn step(&mut self) -> std::result::Result<(), Failed> {
+    /// b = a∘M, the right-hand side of the e-equation at the current M.
+    fn rhs(&self) -> [f64; 3] {
+        [0, 1, 2].map(|j| self.kernel.a[j] * self.m[j])
+    }
+
+    /// One step; returns the Cayley vector e it solved for.
+    fn step(&mut self) -> std::result::Result<[f64; 3], Failed> {
         let k = &self.kernel;
-        let b = [0, 1, 2].map(|j| k.a[j] * self.m[j]);
+        let b = self.rhs();
         let e = self.solve(b)?;
         let alpha = 1.0 + e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
         let inc = Vector3::new(
@@ -495,7 +657,17 @@ impl DmvStepper {
             let inv = 1.0 / (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]).sqrt();
             self.q = p.map(|c| c * inv);
         }
-        Ok(())
+        Ok(e)
+    }
+
+    /// The error of a step k of a chunk that did not converge.
+    fn failed(clock: Clock, k: usize, failed: Failed) -> Error {
+        clock.not_converged(
+            k,
+            "DMV iteration for the relative rotation",
+            failed,
+            NEWTON.tol,
+        )
     }
 }
 
@@ -507,12 +679,12 @@ impl Stepper for DmvStepper {
         if self.lifted {
             self.q = matrix_to_quaternion(&Matrix3::from_row_slice(&z[3..12]));
         }
-        let inertia = if self.series.order == 2 {
+        self.inertia = if self.series.order == 2 {
             self.moments
         } else {
             self.series.moments(&self.m.into(), self.h)?
         };
-        self.kernel = Kernel::new(&inertia, self.h);
+        self.kernel = Kernel::new(&self.inertia, self.h);
         Ok(())
     }
 
@@ -526,14 +698,140 @@ impl Stepper for DmvStepper {
 
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
         for k in 0..steps {
-            self.step().map_err(|failed| {
-                clock.not_converged(
-                    k,
-                    "DMV iteration for the relative rotation",
-                    failed,
-                    NEWTON.tol,
-                )
-            })?;
+            self.step().map_err(|f| DmvStepper::failed(clock, k, f))?;
+        }
+        Ok(())
+    }
+}
+
+/// The DMV stepper on the tangent lift (module docs, "Tangent map"): the base state by
+/// [`DmvStepper`] itself, the directions (δM, and ξ with the attitude) by the derivative of its
+/// step.
+struct DmvTangentStepper {
+    base: DmvStepper,
+    /// Values per direction: 3 (δM) or 6 (δM, ξ).
+    e: usize,
+    /// The k directions (k·e values: the first e along the state, then the moments I₁, I₂, I₃).
+    dirs: Vec<f64>,
+    /// Per direction, the derivative of the kernel's constants along its δĨ (constant between
+    /// two sets).
+    dkernel: Vec<Kernel>,
+}
+
+impl DmvTangentStepper {
+    /// The base state's dimension (M, or M and R row-major).
+    fn d(&self) -> usize {
+        if self.base.lifted {
+            12
+        } else {
+            3
+        }
+    }
+
+    /// δĨ of every direction from its δM and its parameter (module docs): the preprocessing
+    /// differentiated at the state the base stepper was set to.
+    fn preprocess(&mut self) {
+        let b = &self.base;
+        let m: [f64; 3] = b.m.into();
+        self.dkernel.clear();
+        for (j, dir) in self.dirs.chunks_exact(self.e).enumerate() {
+            let mut di = [0.0; 3];
+            if j >= self.e {
+                di[j - self.e] = 1.0;
+            }
+            let dm = [dir[0], dir[1], dir[2]];
+            let dtilde = match b.series.order {
+                2 => di,
+                _ => b
+                    .series
+                    .moments_tangent(&m, b.h, &b.moments, &b.inertia, &dm, &di),
+            };
+            self.dkernel
+                .push(b.kernel.tangent(&b.inertia, &dtilde, b.h));
+        }
+    }
+
+    /// The directions through one step from M = `m` that solved for `e` (module docs):
+    /// δe = G_e⁻¹(α δb + δfac∘(e_j e_k)) with G_e formed once, δM' = δM + δ(inc), and
+    /// ξ' = Fᵀξ + (2/α)(δe − e × δe).
+    fn tangent_step(&mut self, m: &Vector3<f64>, e: [f64; 3]) {
+        let k = &self.base.kernel;
+        let b = [0, 1, 2].map(|j| k.a[j] * m[j]);
+        let ge = newton_matrix(&b, &e, &k.fac)
+            .try_inverse()
+            .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
+        let ev = Vector3::from(e);
+        let alpha = 1.0 + ev.norm_squared();
+        let p = Vector3::new(e[1] * e[2], e[2] * e[0], e[0] * e[1]);
+        let fad = Vector3::from(k.fad);
+        for (dir, dk) in self.dirs.chunks_exact_mut(self.e).zip(&self.dkernel) {
+            let dm = Vector3::new(dir[0], dir[1], dir[2]);
+            let rhs = Vector3::from_fn(|i, _| {
+                alpha * (dk.a[i] * m[i] + k.a[i] * dm[i]) + dk.fac[i] * p[i]
+            });
+            let de = ge * rhs;
+            let dalpha = 2.0 * ev.dot(&de);
+            let dp = Vector3::new(
+                de[1] * e[2] + e[1] * de[2],
+                de[2] * e[0] + e[2] * de[0],
+                de[0] * e[1] + e[0] * de[1],
+            );
+            let dinc = (Vector3::from(dk.fad).component_mul(&p) + fad.component_mul(&dp)) / alpha
+                - fad.component_mul(&p) * (dalpha / (alpha * alpha));
+            dir[..3].copy_from_slice((dm + dinc).as_slice());
+            if self.e == 6 {
+                // R' = R F, F = cay(e): ξ' = Fᵀξ + (F⁻¹δF)^∨, Fᵀ = 1 + 2(ê² − ê)/α.
+                let xi = Vector3::new(dir[3], dir[4], dir[5]);
+                let ex = ev.cross(&xi);
+                let turned = xi + (ev.cross(&ex) - ex) * (2.0 / alpha);
+                let dcay = (de - ev.cross(&de)) * (2.0 / alpha);
+                dir[3..].copy_from_slice((turned + dcay).as_slice());
+            }
+        }
+    }
+}
+
+impl Stepper for DmvTangentStepper {
+    /// The base state as [`DmvStepper::set`] (its modified moments from the invariants of M),
+    /// and their derivative along the directions given.
+    fn set(&mut self, z: &[f64]) -> Result<()> {
+        let d = self.d();
+        self.base.set(&z[..d])?;
+        self.dirs.clear();
+        self.dirs.extend_from_slice(&z[d..]);
+        self.preprocess();
+        Ok(())
+    }
+
+    fn get(&self, z: &mut [f64]) {
+        let d = self.d();
+        self.base.get(&mut z[..d]);
+        // Nothing before `set`.
+        if z.len() == d + self.dirs.len() {
+            z[d..].copy_from_slice(&self.dirs);
+        }
+    }
+
+    /// With the attitude, after every [`RETRACT_EVERY`]-th step of the run, what the driver does
+    /// to the plain run there (the lift's space is flat: the driver does not): R retracted and
+    /// the stepper set again, its modified moments from the M of that state. The retraction's
+    /// derivative on SO(3) is the identity in ξ; the preprocessing is differentiated along the
+    /// directions of that state.
+    fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
+        for k in 0..steps {
+            let m = self.base.m;
+            let e = self
+                .base
+                .step()
+                .map_err(|f| DmvStepper::failed(clock, k, f))?;
+            self.tangent_step(&m, e);
+            if self.base.lifted && (clock.done + k as u64 + 1) % RETRACT_EVERY == 0 {
+                let mut z = [0.0; 12];
+                self.base.get(&mut z);
+                Block::SO3.retract(&mut z[3..]);
+                self.base.set(&z)?;
+                self.preprocess();
+            }
         }
         Ok(())
     }
