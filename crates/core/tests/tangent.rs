@@ -879,7 +879,7 @@ fn parameter_jacobian_of_the_spherical_pendulum() {
     }
 }
 
-/// The generalized rigid body on so(n)*: rk4's Jacobian against
+/// The generalized rigid body on so(n)*: rk4's Jacobian (rkmk4: below) against
 /// differences, with J given as a matrix (the principal frame is the lift's chart), n = 3, 4, 5.
 #[test]
 fn rk4_jacobian_of_the_generalized_rigid_body() {
@@ -894,7 +894,7 @@ fn rk4_jacobian_of_the_generalized_rigid_body() {
         let body = GeneralizedRigidBody::from_matrix(&j).unwrap();
         let t = body.tangent().expect("a lift");
         let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
-        assert!(names.contains(&"rk4"));
+        assert_eq!(names, ["isospectral", "rk4", "rkmk4"]);
         assert!(t.parameter_names().is_empty());
         let z0: Vec<f64> = (0..n * (n - 1) / 2)
             .map(|k| (0.9 * k as f64 + 0.3).sin())
@@ -1826,7 +1826,7 @@ fn isospectral_jacobian_of_the_generalized_rigid_body_keeps_the_casimirs() {
         let body = GeneralizedRigidBody::from_matrix(&j).unwrap();
         let t = body.tangent().expect("a lift");
         let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
-        assert_eq!(names, ["isospectral", "rk4"]);
+        assert_eq!(names, ["isospectral", "rk4", "rkmk4"]);
         let z0: Vec<f64> = (0..n * (n - 1) / 2)
             .map(|k| (0.9 * k as f64 + 0.3).sin())
             .collect();
@@ -2159,4 +2159,523 @@ fn dmv_jacobian_cost() {
             );
         }
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The group-field lift of the so(n) body and of the user Lie–Poisson and Euler–Poincaré
+// systems: each (system, method) against differences of the method's map, the base states
+// against the plain run's, the Casimirs' gradients mapped by the Jacobian.
+
+use lieflow::systems::{Algebra, LieHamiltonian, LiePoisson, Side};
+
+/// Central differences of `steps` steps of `method` (through its stepper: a matrix attitude is
+/// moved off its group too, which the lift differentiates across) in the lift's coordinates:
+/// flat components moved by h·max(1, |z_j|); with an SO(3) attitude (`so3_block`, the last 9
+/// values) the initial R₀ moved as R₀exp(hê_j) and the final one read as (Rᵀ δR)^∨ (e × e).
+fn group_differences(
+    sys: &dyn System,
+    method: &str,
+    z0: &[f64],
+    (dt, steps): (f64, usize),
+    h: f64,
+    so3_block: bool,
+) -> Vec<f64> {
+    use lieflow::lie::so3;
+    use nalgebra::{Matrix3, Vector3};
+    let d = z0.len();
+    let e = if so3_block { d - 6 } else { d };
+    let flat = if so3_block { e - 3 } else { e };
+    let r0 = if so3_block {
+        Matrix3::from_row_slice(&z0[d - 9..])
+    } else {
+        Matrix3::identity()
+    };
+    let mut jac = vec![0.0; e * e];
+    for j in 0..e {
+        let hj = if j < flat {
+            h * z0[j].abs().max(1.0)
+        } else {
+            h
+        };
+        let end = |s: f64| {
+            let mut z = z0.to_vec();
+            if j < flat {
+                z[j] += s;
+            } else {
+                let r = r0 * so3::exp_unchecked(&Vector3::ith(j - flat, s));
+                for k in 0..9 {
+                    z[d - 9 + k] = r[(k / 3, k % 3)];
+                }
+            }
+            stepped(sys, method, &z, dt, steps)
+        };
+        let (p, q) = (end(hj), end(-hj));
+        for i in 0..flat {
+            jac[i * e + j] = (p[i] - q[i]) / (2.0 * hj);
+        }
+        if so3_block {
+            let (rp, rq) = (
+                Matrix3::from_row_slice(&p[d - 9..]),
+                Matrix3::from_row_slice(&q[d - 9..]),
+            );
+            let xi = so3::vee_unchecked(&(((rp + rq) * 0.5).transpose() * (rp - rq) / (2.0 * hj)));
+            for i in 0..3 {
+                jac[(flat + i) * e + j] = xi[i];
+            }
+        }
+    }
+    jac
+}
+
+/// The gradients of some Casimirs of the momentum (the first `gradient(z).len()` values),
+/// padded with zeros to the lift's e coordinates.
+type CasimirGradients = fn(&[f64]) -> Vec<Vec<f64>>;
+
+/// Every method of `sys`'s lift (named `methods`): the lifted run's base state against the
+/// plain run's (rkmk4 bit for bit, the midpoints to round-off: their lifted iteration runs on
+/// until the directions have converged too), its Jacobian against [`group_differences`] (≤ 1e-8
+/// relative to the largest entry) and ∇C(z)ᵀJ = ∇C(z₀)ᵀ (≤ 1e-12 relative to |∇C||J|) for the
+/// Casimirs of `casimirs`, over 40 steps of 0.05. Returns the rkmk4 Jacobian.
+fn check_group_lift(
+    name: &str,
+    sys: &dyn System,
+    z0: &[f64],
+    methods: &[&str],
+    casimirs: CasimirGradients,
+) -> Vec<f64> {
+    check_group_lift_over(name, sys, z0, methods, casimirs, (0.05, 40))
+}
+
+/// [`check_group_lift`] over `steps` steps of `dt`.
+fn check_group_lift_over(
+    name: &str,
+    sys: &dyn System,
+    z0: &[f64],
+    methods: &[&str],
+    casimirs: CasimirGradients,
+    (dt, steps): (f64, usize),
+) -> Vec<f64> {
+    let t = sys.tangent().unwrap_or_else(|| panic!("{name}: a lift"));
+    let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
+    assert_eq!(names, methods, "{name}");
+    let (d, e) = (t.base_dim(), t.tangent_dim());
+    let so3_block = d != e;
+    let mut rkmk4 = Vec::new();
+    for &method in methods {
+        let (z, jac) = lifted_end(&*t, method, z0, dt, steps);
+        let plain = stepped(sys, method, z0, dt, steps);
+        let base = max_rel(&z, &plain);
+        let fd = group_differences(sys, method, z0, (dt, steps), 1e-5, so3_block);
+        let err = max_rel(&jac, &fd);
+        let pad = |g: Vec<f64>| {
+            let mut v = vec![0.0; e];
+            v[..g.len()].copy_from_slice(&g);
+            v
+        };
+        let grads: Vec<(Vec<f64>, Vec<f64>)> = casimirs(z0)
+            .into_iter()
+            .zip(casimirs(&z))
+            .map(|(a, b)| (pad(a), pad(b)))
+            .collect();
+        let (jn, gn) = (
+            jac.iter().fold(1.0f64, |m, x| m.max(x.abs())),
+            grads
+                .iter()
+                .flat_map(|(a, _)| a.iter())
+                .fold(1e-300f64, |m, x| m.max(x.abs())),
+        );
+        let cas = if grads.is_empty() {
+            0.0
+        } else {
+            casimir_defect(&jac, &grads) / (jn * gn)
+        };
+        eprintln!(
+            "{name} {method}: base vs plain {base:.1e}, Jacobian vs differences {err:.2e}, \
+             Casimir gradients {cas:.1e}"
+        );
+        if method == "rkmk4" {
+            assert_eq!(z, plain, "{name} rkmk4: base state bit for bit");
+            rkmk4 = jac.clone();
+        } else {
+            assert!(base < 1e-13, "{name} {method}: base state {base:e}");
+        }
+        assert!(err < 1e-8, "{name} {method}: {err:e}");
+        if method != "rk4" {
+            assert!(cas < 1e-12, "{name} {method}: Casimir gradients {cas:e}");
+        }
+    }
+    rkmk4
+}
+
+/// ∇C_k of the spectral invariants C_k = ½ tr((MᵀM)ᵏ) = ½ (−1)ᵏ tr(M²ᵏ) of M ∈ so(n)* in e_ij
+/// coordinates: ∂C_k/∂M_ij = 2k (−1)^{k+1} (M^{2k−1})_ij (M^{odd} is skew), k = 1…⌊n/2⌋.
+fn spectral_gradients(n: usize, z: &[f64]) -> Vec<Vec<f64>> {
+    let m = nalgebra::DMatrix::from_fn(n, n, |i, j| {
+        let (lo, hi, s) = if i < j { (i, j, 1.0) } else { (j, i, -1.0) };
+        if i == j {
+            0.0
+        } else {
+            s * z[lo * n - lo * (lo + 1) / 2 + (hi - lo - 1)]
+        }
+    });
+    let m2 = &m * &m;
+    let mut odd = m.clone();
+    (1..=n / 2)
+        .map(|k| {
+            if k > 1 {
+                odd = &odd * &m2;
+            }
+            let c = 2.0 * k as f64 * if k % 2 == 1 { 1.0 } else { -1.0 };
+            (0..n)
+                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+                .map(|(i, j)| c * odd[(i, j)])
+                .collect()
+        })
+        .collect()
+}
+
+fn spectral_so3(z: &[f64]) -> Vec<Vec<f64>> {
+    spectral_gradients(3, z)
+}
+fn spectral_so4(z: &[f64]) -> Vec<Vec<f64>> {
+    spectral_gradients(4, &z[..6])
+}
+fn spectral_so5(z: &[f64]) -> Vec<Vec<f64>> {
+    spectral_gradients(5, z)
+}
+
+/// |M|² of so(3)* in the physics basis.
+fn norm_so3(z: &[f64]) -> Vec<Vec<f64>> {
+    vec![z[..3].iter().map(|x| 2.0 * x).collect()]
+}
+
+/// |Γ|² and M·Γ of se(3)* (μ = (M, Γ)).
+fn casimirs_se3(z: &[f64]) -> Vec<Vec<f64>> {
+    vec![
+        [vec![0.0; 3], z[3..6].iter().map(|x| 2.0 * x).collect()].concat(),
+        [z[3..6].to_vec(), z[..3].to_vec()].concat(),
+    ]
+}
+
+/// The generalized rigid body's RKMK4 (dexp's derivative by its series differentiated term by
+/// term): so(3), so(4), so(5) with J a matrix (the principal frame is the lift's chart); the
+/// spectral invariants' gradients mapped consistently.
+#[test]
+fn rkmk4_jacobian_of_the_generalized_rigid_body() {
+    let grads: [CasimirGradients; 3] = [spectral_so3, spectral_so4, spectral_so5];
+    for (n, casimirs) in (3..=5).zip(grads) {
+        let j = lieflow::Mat::from_fn(n, n, |a, b| {
+            if a == b {
+                1.0 + 0.7 * a as f64
+            } else {
+                0.1 / (1.0 + (a + b) as f64)
+            }
+        });
+        let body = GeneralizedRigidBody::from_matrix(&j).unwrap();
+        let z0: Vec<f64> = (0..n * (n - 1) / 2)
+            .map(|k| (0.9 * k as f64 + 0.3).sin())
+            .collect();
+        let name = format!("GeneralizedRigidBody so({n})");
+        check_group_lift(&name, &body, &z0, &["isospectral", "rk4", "rkmk4"], casimirs);
+    }
+    // Large steps (|Ω| ≈ 0.7: |u| up to ≈ 1.4 at dt = 2, where the dexp series has its most
+    // terms), RKMK4 only.
+    let body = GeneralizedRigidBody::new(&[1.0, 1.5, 2.5, 3.0]).unwrap();
+    let t = body.tangent().unwrap();
+    let z0 = [0.9, -0.6, 1.5, 0.3, 1.2, -1.8];
+    for (dt, steps) in [(0.5, 40), (1.0, 20), (2.0, 10)] {
+        let (z, jac) = lifted_end(&*t, "rkmk4", &z0, dt, steps);
+        assert_eq!(z, stepped(&body, "rkmk4", &z0, dt, steps));
+        let fd = group_differences(&body, "rkmk4", &z0, (dt, steps), 1e-5, false);
+        let err = max_rel(&jac, &fd);
+        let grads: Vec<_> = spectral_so4(&z0)
+            .into_iter()
+            .zip(spectral_so4(&z))
+            .collect();
+        let scale = jac.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        let cas = casimir_defect(&jac, &grads) / scale;
+        eprintln!("so(4) rkmk4 dt = {dt}: Jacobian vs differences {err:.1e}, Casimir {cas:.1e}");
+        assert!(err < 1e-8, "dt = {dt}: {err:e}");
+        assert!(cas < 1e-12, "dt = {dt}: {cas:e}");
+    }
+}
+
+/// H = ½ Σ μ_k²/I_k + ¼ ε Σ μ_k⁴ on a d-dimensional g* (ε = 0: the free rigid body on so(3)),
+/// with its gradient and Hessian product.
+fn quartic_lie_poisson(algebra: Algebra, i: Vec<f64>, eps: f64) -> LiePoisson {
+    use lieflow::systems::user::{GradientFn, LieHessianFn, ScalarFn};
+    let (a, b, c) = (i.clone(), i.clone(), i);
+    let value: ScalarFn = Arc::new(move |m: &[f64]| {
+        Ok((0..m.len())
+            .map(|k| 0.5 * m[k] * m[k] / a[k] + 0.25 * eps * m[k].powi(4))
+            .sum())
+    });
+    let gradient: GradientFn = Arc::new(move |m: &[f64], out: &mut [f64]| {
+        for k in 0..m.len() {
+            out[k] = m[k] / b[k] + eps * m[k].powi(3);
+        }
+        Ok(())
+    });
+    let hessian: LieHessianFn = Arc::new(move |m: &[f64], dm: &[f64], out: &mut [f64]| {
+        for k in 0..m.len() {
+            out[k] = dm[k] / c[k] + 3.0 * eps * m[k] * m[k] * dm[k];
+        }
+        Ok(())
+    });
+    let h = LieHamiltonian::Function {
+        value,
+        gradient: Some(gradient),
+    };
+    LiePoisson::new(algebra, h, None)
+        .unwrap()
+        .with_hessian(hessian)
+}
+
+/// A symmetric positive definite d×d matrix (row-major) with couplings.
+fn spd(d: usize) -> Vec<f64> {
+    let mut a = vec![0.0; d * d];
+    for i in 0..d {
+        for j in 0..d {
+            a[i * d + j] = if i == j {
+                0.6 + 0.3 * i as f64
+            } else {
+                0.05 * ((i + 2 * j) as f64).sin() + 0.05 * ((j + 2 * i) as f64).sin()
+            };
+        }
+    }
+    a
+}
+
+fn rows3(r: &nalgebra::Matrix3<f64>) -> Vec<f64> {
+    (0..9).map(|k| r[(k / 3, k % 3)]).collect()
+}
+
+/// A user Lie–Poisson system with its Hessian product: the free rigid body as a LiePoisson on
+/// so(3) (H = ½ Σ μ_k²/I_k as a function) has the built-in RigidBody's RKMK4 Jacobian (a second
+/// route: the coadjoint action and dexp of the user system, the body's own), to round-off.
+#[test]
+fn the_user_free_body_has_the_rigid_bodys_rkmk4_jacobian() {
+    let i = [1.0, 2.0, 3.0];
+    let lp = quartic_lie_poisson(Algebra::So3, i.to_vec(), 0.0);
+    let z0 = [0.3, -0.8, 1.1];
+    let all = ["rkmk4", "midpoint", "midpoint4", "rk4"];
+    let jl = check_group_lift("LiePoisson so(3), free body", &lp, &z0, &all, norm_so3);
+    let rb = RigidBody::new(i).unwrap();
+    let (_, jr) = lifted_end(&*rb.tangent().unwrap(), "rkmk4", &z0, 0.05, 40);
+    let err = max_rel(&jl, &jr);
+    eprintln!("LiePoisson so(3) vs RigidBody rkmk4 Jacobians: {err:.1e}");
+    assert!(err < 1e-13, "{err:e}");
+    // Without the Hessian product: no lift; a quadratic H has its own.
+    let value: lieflow::systems::user::ScalarFn = Arc::new(|m: &[f64]| Ok(m[0] * m[0]));
+    let bare = LiePoisson::new(
+        Algebra::So3,
+        LieHamiltonian::Function {
+            value,
+            gradient: None,
+        },
+        None,
+    )
+    .unwrap();
+    assert!(bare.tangent().is_none());
+    let quadratic = LiePoisson::new(
+        Algebra::So3,
+        LieHamiltonian::Quadratic(vec![1.0, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 1.0 / 3.0]),
+        None,
+    )
+    .unwrap();
+    let (_, jq) = lifted_end(&*quadratic.tangent().unwrap(), "rkmk4", &z0, 0.05, 40);
+    let err = max_rel(&jq, &jr);
+    eprintln!("LiePoisson so(3) quadratic vs RigidBody rkmk4 Jacobians: {err:.1e}");
+    assert!(err < 1e-13, "{err:e}");
+}
+
+/// User Lie–Poisson systems on every kind of algebra, left and right, with and without the
+/// attitude: so(3) quartic (attitude R, left-trivialised: no rk4), so(4) quadratic with
+/// couplings (attitude g ∈ SO(4), ambient), se(3) quadratic (Kirchhoff's body, attitude SE(3)),
+/// sl(2) by structure constants with a quartic H (the generic action and dexp series; Casimir
+/// h² + 4ef).
+#[test]
+fn jacobians_of_user_lie_poisson_systems() {
+    use lieflow::lie::so3;
+    use nalgebra::Vector3;
+    let all = ["rkmk4", "midpoint", "midpoint4", "rk4"];
+    let no_rk4 = &all[..3];
+    let r0 = so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
+    // so(3), quartic, with R.
+    for side in [Side::Left, Side::Right] {
+        let lp = quartic_lie_poisson(Algebra::So3, vec![1.0, 2.0, 3.0], 0.3)
+            .with_side(side)
+            .with_attitude()
+            .unwrap();
+        let z0 = [vec![0.3, -0.8, 1.1], rows3(&r0)].concat();
+        let name = format!("LiePoisson so(3) quartic with R, {}", side.name());
+        check_group_lift(&name, &lp, &z0, no_rk4, norm_so3);
+    }
+    // so(4), quadratic with couplings, with g ∈ SO(4).
+    let g4 =
+        lieflow::lie::so::exp(&lieflow::lie::so::hat_n(&[0.3, -0.2, 0.5, 0.1, 0.4, -0.6]).unwrap())
+            .unwrap();
+    let g4: Vec<f64> = (0..16).map(|k| g4[(k / 4, k % 4)]).collect();
+    for side in [Side::Left, Side::Right] {
+        let lp = LiePoisson::new(Algebra::So(4), LieHamiltonian::Quadratic(spd(6)), None)
+            .unwrap()
+            .with_side(side);
+        let z0 = vec![0.3, -0.2, 0.5, 0.1, 0.4, -0.6];
+        let name = format!("LiePoisson so(4), {}", side.name());
+        check_group_lift(&name, &lp, &z0, &all, spectral_so4);
+        let name = format!("LiePoisson so(4) with g, {}", side.name());
+        let lifted = lp.with_attitude().unwrap();
+        check_group_lift(
+            &name,
+            &lifted,
+            &[z0, g4.clone()].concat(),
+            &all,
+            spectral_so4,
+        );
+    }
+    // se(3), quadratic (Kirchhoff), with g ∈ SE(3).
+    let g =
+        lieflow::lie::se3::exp_unchecked(&nalgebra::Vector6::new(0.4, -0.7, 0.3, 0.5, -0.2, 0.8))
+            .matrix4();
+    let g: Vec<f64> = (0..16).map(|k| g[(k / 4, k % 4)]).collect();
+    for side in [Side::Left, Side::Right] {
+        let lp = LiePoisson::new(Algebra::Se3, LieHamiltonian::Quadratic(spd(6)), None)
+            .unwrap()
+            .with_side(side)
+            .with_attitude()
+            .unwrap();
+        let z0 = [vec![0.3, -0.8, 1.1, 0.2, 0.5, -0.4], g.clone()].concat();
+        let name = format!("LiePoisson se(3) with g, {}", side.name());
+        check_group_lift(&name, &lp, &z0, &all, casimirs_se3);
+    }
+    // sl(2) by structure constants (basis h, e, f: [h, e] = 2e, [h, f] = −2f, [e, f] = h).
+    let mut c = vec![0.0; 27];
+    let mut set = |i: usize, j: usize, k: usize, v: f64| {
+        c[(i * 3 + j) * 3 + k] = v;
+        c[(j * 3 + i) * 3 + k] = -v;
+    };
+    set(0, 1, 1, 2.0);
+    set(0, 2, 2, -2.0);
+    set(1, 2, 0, 1.0);
+    let lp = quartic_lie_poisson(Algebra::Constants(c), vec![1.0, 2.0, 1.5], 0.2);
+    fn sl2(z: &[f64]) -> Vec<Vec<f64>> {
+        vec![vec![2.0 * z[0], 4.0 * z[2], 4.0 * z[1]]]
+    }
+    let z0 = [0.3, -0.5, 0.4];
+    let tr = integrate(&lp, "rkmk4", &z0, 0.05, 40, 40).unwrap();
+    let cas = |z: &[f64]| z[0] * z[0] + 4.0 * z[1] * z[2];
+    assert!((cas(tr.state(1)) - cas(&z0)).abs() < 1e-14, "sl(2) Casimir");
+    check_group_lift("LiePoisson sl(2), constants", &lp, &z0, &all, sl2);
+}
+
+/// ℓ(Ω, Γ) = ½⟨Ω, 𝕀Ω⟩ − mgl⟨Γ, χ⟩ + ¼ε(Ω·Γ)² on so(3) ⋉ ℝ³ (a heavy top with a coupling, so
+/// that the mixed second derivatives ℓ_ΩΓ, ℓ_ΓΓ are not zero) with its Hessian product.
+fn coupled_top(eps: f64) -> EulerPoincareSystem {
+    use lieflow::systems::user::{
+        Action, EulerPoincare, Lagrangian, LagrangianFn, LagrangianGradientFn, LagrangianHessianFn,
+    };
+    let (inertia, mgl, chi) = ([1.0, 2.0, 3.0], 0.7, [0.2, -0.3, 1.0]);
+    let dot = |a: &[f64], b: &[f64]| (0..3).map(|k| a[k] * b[k]).sum::<f64>();
+    let value: LagrangianFn = Arc::new(move |w: &[f64], g: &[f64]| {
+        let t: f64 = (0..3).map(|k| 0.5 * inertia[k] * w[k] * w[k]).sum();
+        Ok(t - mgl * dot(g, &chi) + 0.25 * eps * dot(w, g).powi(2))
+    });
+    let gradient: LagrangianGradientFn = Arc::new(
+        move |w: &[f64], g: &[f64], dw: &mut [f64], dg: &mut [f64]| {
+            let c = eps * dot(w, g);
+            for k in 0..3 {
+                dw[k] = inertia[k] * w[k] + 0.5 * c * g[k];
+                dg[k] = -mgl * chi[k] + 0.5 * c * w[k];
+            }
+            Ok(())
+        },
+    );
+    let product: LagrangianHessianFn = Arc::new(
+        move |w: &[f64], g: &[f64], vw: &[f64], vg: &[f64], ow: &mut [f64], og: &mut [f64]| {
+            let (c, dc) = (eps * dot(w, g), eps * (dot(vw, g) + dot(w, vg)));
+            for k in 0..3 {
+                ow[k] = inertia[k] * vw[k] + 0.5 * (dc * g[k] + c * vg[k]);
+                og[k] = 0.5 * (dc * w[k] + c * vw[k]);
+            }
+            Ok(())
+        },
+    );
+    let l = Lagrangian::Function {
+        value,
+        gradient: Some(gradient),
+        hessian: None,
+    };
+    let ep = EulerPoincare::new(Algebra::So3, l, Side::Left, Some((Action::Vector, 3))).unwrap();
+    assert!(
+        ep.tangent().is_none(),
+        "a parameter needs the Lagrangian's Hessian product"
+    );
+    ep.with_hessian(product)
+}
+
+type EulerPoincareSystem = lieflow::systems::user::EulerPoincare;
+
+/// Euler–Poincaré systems (the Hamiltonian's D²H from the Lagrangian's second derivatives
+/// through the Legendre transform): the coupled heavy top on se(3)* (its Hessian product in
+/// (Ω, Γ)), without and with the attitude R; a non-quadratic ℓ(ξ) = ½⟨ξ, 𝕀ξ⟩ + ¼ε|ξ|⁴ on
+/// so(3), right-invariant, whose own Hessian ∂²ℓ/∂ξ² is all it takes.
+#[test]
+fn jacobians_of_euler_poincare_systems() {
+    use lieflow::lie::so3;
+    use lieflow::systems::user::{
+        EulerPoincare, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn,
+    };
+    use nalgebra::Vector3;
+    let all = ["rkmk4", "midpoint", "midpoint4", "rk4"];
+    let top = coupled_top(0.4);
+    let z0 = vec![1.0, 0.5, -0.3, 0.1, 0.2, 0.95f64.sqrt()];
+    check_group_lift("EulerPoincare coupled top", &top, &z0, &all, casimirs_se3);
+    let r0 = so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
+    let lifted = top.with_attitude().unwrap();
+    let zl = [z0, rows3(&r0)].concat();
+    check_group_lift(
+        "EulerPoincare coupled top with R",
+        &lifted,
+        &zl,
+        &all[..3],
+        casimirs_se3,
+    );
+
+    let (inertia, eps) = ([1.0, 2.0, 3.0], 0.3);
+    let value: LagrangianFn = Arc::new(move |w: &[f64], _: &[f64]| {
+        let n2: f64 = w.iter().map(|x| x * x).sum();
+        Ok((0..3).map(|k| 0.5 * inertia[k] * w[k] * w[k]).sum::<f64>() + 0.25 * eps * n2 * n2)
+    });
+    let gradient: LagrangianGradientFn =
+        Arc::new(move |w: &[f64], _: &[f64], dw: &mut [f64], _: &mut [f64]| {
+            let n2: f64 = w.iter().map(|x| x * x).sum();
+            for k in 0..3 {
+                dw[k] = inertia[k] * w[k] + eps * n2 * w[k];
+            }
+            Ok(())
+        });
+    let hessian: HessianFn = Arc::new(move |w: &[f64], _: &[f64], h: &mut [f64]| {
+        let n2: f64 = w.iter().map(|x| x * x).sum();
+        for a in 0..3 {
+            for b in 0..3 {
+                let diag = if a == b { inertia[a] + eps * n2 } else { 0.0 };
+                h[a * 3 + b] = diag + 2.0 * eps * w[a] * w[b];
+            }
+        }
+        Ok(())
+    });
+    let l = Lagrangian::Function {
+        value,
+        gradient: Some(gradient),
+        hessian: Some(hessian),
+    };
+    let ep = EulerPoincare::new(Algebra::So3, l, Side::Right, None).unwrap();
+    let z0 = [0.3, -0.8, 1.1];
+    check_group_lift(
+        "EulerPoincare quartic so(3), right",
+        &ep,
+        &z0,
+        &all,
+        norm_so3,
+    );
 }

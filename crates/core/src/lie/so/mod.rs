@@ -16,9 +16,10 @@ mod exp;
 mod log;
 
 pub use cayley::{cayley, cayley_inv, CAYLEY_TOL};
-pub(crate) use dexp::bernoulli_coefficients;
+pub(crate) use dexp::{bernoulli_coefficients, dexp_series_dense};
 pub use dexp::{
-    dexp, dexp_inv, jacobian_left, jacobian_left_inv, jacobian_right, jacobian_right_inv,
+    dexp, dexp_derivative, dexp_inv, jacobian_left, jacobian_left_inv, jacobian_right,
+    jacobian_right_inv,
 };
 pub use exp::{exp, exp_into, exp_unchecked, ExpWork};
 use log::log_rotation;

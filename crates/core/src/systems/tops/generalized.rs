@@ -8,9 +8,9 @@
 //! c = (−w₃, w₂, −w₁), and with J_i + J_j = I_k ({i, j, k} = {1, 2, 3}) the energies agree (tested).
 //!
 //! Tangent lift (issue 26, [`crate::integrate::tangent`]): the derivative of the field,
-//! δṀ = [δM, Ω] + [M, δΩ], for `rk4`; `isospectral` differentiates its own step (module docs
-//! of `methods::isospectral`, "Tangent map"); `rkmk4` is a group method the lift does not
-//! cover, and J carries no parameter directions.
+//! δṀ = [δM, Ω] + [M, δΩ], for `rk4`; the derivatives of the generator, the action and dexp
+//! ([`GroupFieldTangent`]) for `rkmk4`; `isospectral` differentiates its own step (module docs
+//! of `methods::isospectral`, "Tangent map"); J carries no parameter directions.
 
 use super::methods::isospectral::Isospectral;
 use crate::check;
@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::{Rk4, Rkmk4};
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
-use crate::integrate::tangent::{Tangent, TangentSystem, VectorFieldTangent};
+use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::so;
 use crate::Mat;
@@ -366,6 +366,55 @@ impl GroupField for GeneralizedRigidBody {
     }
 }
 
+/// The derivatives of the so(n) action for the tangent lift (RKMK4 with sensitivities):
+/// g = exp(u), δg = ŵg with w = dexp_u δu (right-trivialised, as the dexp⁻¹ above), so
+/// δ(gMgᵀ) = g δM gᵀ + ŵ gMgᵀ − gMgᵀ ŵ = g δM gᵀ + [ŵ, Y] at Y = gMgᵀ (the generator of the
+/// action at Y, [ξ, M]); D_u(dexp_u w)\[δu\] by the dexp series differentiated term by term
+/// ([`so::dexp_derivative`]). Both on the scratch's dense matrices, without allocation.
+impl GroupFieldTangent for GeneralizedRigidBody {
+    fn generator_tangent(&self, _z: &[f64], dz: &[f64], dxi: &mut [f64], s: &mut SoScratch) {
+        self.generator(dz, dxi, s);
+    }
+    fn act_tangent(&self, u: &[f64], du: &[f64], y: &[f64], dz: &mut [f64], s: &mut SoScratch) {
+        self.act(u, dz, s);
+        let n = self.n;
+        let [uu, dd, ww, yy, t, d, p, _] = s.lift_buffers();
+        self.dense(u, uu);
+        self.dense(du, dd);
+        so::dexp_series_dense(n, uu, dd, None, ww, None, [t, d, p]);
+        self.dense(y, yy);
+        matmul(n, ww, yy, p);
+        let mut c = 0;
+        for i in 0..n {
+            for j in i + 1..n {
+                dz[c] += p[i * n + j] - p[j * n + i];
+                c += 1;
+            }
+        }
+    }
+    fn dexp_tangent(&self, u: &[f64], du: &[f64], w: &[f64], out: &mut [f64], s: &mut SoScratch) {
+        let n = self.n;
+        let [uu, dd, ww, value, t, d, p, deriv] = s.lift_buffers();
+        self.dense(u, uu);
+        self.dense(du, dd);
+        self.dense(w, ww);
+        so::dexp_series_dense(n, uu, ww, Some(dd), value, Some(deriv), [t, d, p]);
+        self.coords(deriv, out);
+    }
+}
+
+impl GeneralizedRigidBody {
+    /// out = dexp_u v (e_ij coordinates), by the series of [`so::dexp_derivative`]'s kernel.
+    pub(crate) fn dexp_apply(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut SoScratch) {
+        let n = self.n;
+        let [uu, vv, ww, _, t, d, p, _] = s.lift_buffers();
+        self.dense(u, uu);
+        self.dense(v, vv);
+        so::dexp_series_dense(n, uu, vv, None, ww, None, [t, d, p]);
+        self.coords(ww, out);
+    }
+}
+
 /// Scratch of the so(n) kernels of [`GeneralizedRigidBody`]'s [`GroupField`]: dense n×n
 /// matrices (row-major).
 #[derive(Clone, Debug)]
@@ -378,6 +427,8 @@ pub struct SoScratch {
     t: Vec<f64>,
     /// The increment of [`GroupField::act`] (e_ij coordinates).
     dz: Vec<f64>,
+    /// The dense buffers of the tangent lift's kernels (sized at their first use).
+    lift: Vec<Vec<f64>>,
 }
 
 impl SoScratch {
@@ -390,7 +441,19 @@ impl SoScratch {
             m: vec![0.0; n * n],
             t: vec![0.0; n * n],
             dz: vec![0.0; n * (n - 1) / 2],
+            lift: Vec::new(),
         }
+    }
+
+    /// The lift's eight dense n×n buffers, allocated at their first use.
+    fn lift_buffers(&mut self) -> [&mut [f64]; 8] {
+        if self.lift.is_empty() {
+            self.lift = vec![vec![0.0; self.n * self.n]; 8];
+        }
+        let [a, b, c, d, e, f, g, h] = &mut self.lift[..] else {
+            unreachable!("eight buffers")
+        };
+        [a, b, c, d, e, f, g, h]
     }
 
     /// exp(A) − I of a dense n×n matrix A (row-major; any matrix: the series below does not use
@@ -452,13 +515,13 @@ fn matmul(n: usize, a: &[f64], b: &[f64], c: &mut [f64]) {
     }
 }
 
-/// `isospectral` (its own tangent stepper) and `rk4` on the tangent lift (the group method
-/// `rkmk4` is not of its kind).
+/// `isospectral` (its own tangent stepper), `rk4` and `rkmk4` on the tangent lift.
 impl Catalog for Tangent<GeneralizedRigidBody> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
             Entry::new("isospectral", || Isospectral),
             Entry::new("rk4", || Rk4),
+            Entry::new("rkmk4", || Rkmk4),
         ]
     }
 }

@@ -329,6 +329,73 @@ impl Group {
         }
     }
 
+    /// The derivative of [`Group::follow`] for a tangent lift: given the new configuration g'
+    /// and w = dexp_θ δθ (right-trivialised, the G-part of the algebra's), dg ← D(follow)\[δθ, dg\]:
+    /// on a matrix block (ambient directions) dg exp(−θ) − g'ŵ (left) or exp(θ) dg + ŵg'
+    /// (right); on `R` (left-trivialised, δR = Rη̂) η' = exp(θ)η − w (left) or η + R'ᵀw
+    /// (right). From exp(θ + εδθ) = exp(εw) exp(θ) to first order, and for the left side
+    /// g ŵ_r exp(−θ) = g'(Ad_{exp θ} ŵ_r) with Ad_{exp θ} dexp_{−θ} = dexp_θ.
+    pub(crate) fn follow_tangent(
+        self,
+        side: Side,
+        theta: &[f64],
+        w: &[f64],
+        g_new: &[f64],
+        dg: &mut [f64],
+        s: &mut GroupScratch,
+    ) {
+        if self == Group::So3 {
+            let mut eta = Vector3::new(dg[0], dg[1], dg[2]);
+            let w = Vector3::new(w[0], w[1], w[2]);
+            let eta = match side {
+                Side::Left => {
+                    so3::Rodrigues::exp(&Vector3::new(theta[0], theta[1], theta[2]))
+                        .apply(&mut eta);
+                    eta - w
+                }
+                Side::Right => eta + Matrix3::from_row_slice(g_new).transpose() * w,
+            };
+            dg[..3].copy_from_slice(eta.as_slice());
+            return;
+        }
+        self.follow(side, theta, dg, s);
+        let mut a = std::mem::take(&mut s.a);
+        self.velocity(side, w, g_new, &mut a);
+        let sign = -side.sign();
+        dg.iter_mut().zip(&a).for_each(|(x, y)| *x += sign * y);
+        s.a = a;
+    }
+
+    /// The derivative of [`Group::velocity`] along (δξ, δg): δg ξ̂ + g δξ̂ (left) or
+    /// ξ̂ δg + δξ̂ g (right), into `out` (matrix blocks).
+    pub(crate) fn velocity_tangent(
+        self,
+        side: Side,
+        (xi, dxi): (&[f64], &[f64]),
+        (g, dg): (&[f64], &[f64]),
+        out: &mut [f64],
+    ) {
+        let n = self.size();
+        for i in 0..n {
+            for j in 0..n {
+                out[i * n + j] = match side {
+                    Side::Left => (0..n)
+                        .map(|k| {
+                            dg[i * n + k] * self.hat_entry(xi, k, j)
+                                + g[i * n + k] * self.hat_entry(dxi, k, j)
+                        })
+                        .sum(),
+                    Side::Right => (0..n)
+                        .map(|k| {
+                            self.hat_entry(xi, i, k) * dg[k * n + j]
+                                + self.hat_entry(dxi, i, k) * g[k * n + j]
+                        })
+                        .sum(),
+                };
+            }
+        }
+    }
+
     /// The entry (i, j) of ξ̂ (n×n).
     fn hat_entry(self, xi: &[f64], i: usize, j: usize) -> f64 {
         match self {

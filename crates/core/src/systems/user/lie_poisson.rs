@@ -10,6 +10,7 @@ use crate::integrate::hooks;
 use crate::integrate::methods::group_field_catalog;
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::structure::{Algebra, Kind, Structure};
 use crate::lie::{se3, so, so3};
@@ -31,12 +32,18 @@ pub enum LieHamiltonian {
     },
 }
 
+/// The Hessian product of a [`LiePoisson`] Hamiltonian: (μ, δμ, D²H(μ)\[δμ\] out), the
+/// derivative of ∇H along δμ.
+pub type LieHessianFn = Arc<dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<()> + Send + Sync>;
+
 /// A Lie–Poisson system μ̇ = ±ad*_{∇H} μ on g* (module docs).
 #[derive(Clone)]
 pub struct LiePoisson {
     algebra: Arc<Structure>,
     side: Side,
     hamiltonian: LieHamiltonian,
+    /// D²H(μ)\[δμ\] of a function H ([`LiePoisson::with_hessian`]).
+    hessian: Option<LieHessianFn>,
     casimirs: Option<Vec<ScalarFn>>,
     /// The group G of the configuration g (None: structure constants, no matrices) and whether
     /// the state carries g after μ ([`LiePoisson::with_attitude`]).
@@ -55,6 +62,7 @@ impl fmt::Debug for LiePoisson {
                 "quadratic",
                 &matches!(self.hamiltonian, LieHamiltonian::Quadratic(_)),
             )
+            .field("hessian", &self.hessian.is_some())
             .finish()
     }
 }
@@ -86,11 +94,62 @@ impl LiePoisson {
             algebra: Arc::new(algebra),
             side: Side::Left,
             hamiltonian,
+            hessian: None,
             casimirs,
             group,
             lifted: false,
             so_kernels,
         })
+    }
+
+    /// The same system with the Hessian product D²H(μ)\[δμ\] of a function H ([`LieHessianFn`]):
+    /// with the gradient given too, its tangent lift (the Jacobian of every method,
+    /// [`crate::integrate::tangent`]). A quadratic H has its own (A δμ); this one is then unused.
+    pub fn with_hessian(mut self, hessian: LieHessianFn) -> Self {
+        self.hessian = Some(hessian);
+        self
+    }
+
+    /// Whether the derivatives the tangent lift needs are exact: a quadratic H, or a function
+    /// H with its gradient and its Hessian product.
+    pub fn has_tangent(&self) -> bool {
+        match &self.hamiltonian {
+            LieHamiltonian::Quadratic(_) => true,
+            LieHamiltonian::Function { gradient, .. } => {
+                gradient.is_some() && self.hessian.is_some()
+            }
+        }
+    }
+
+    /// D²H(μ)\[δμ\] into `out`, checked finite: A δμ for a quadratic H, else the Hessian
+    /// product given ([`LiePoisson::with_hessian`]).
+    ///
+    /// Errors: a function H without a Hessian product; the function's error; a non-finite entry.
+    pub fn hessian_product(&self, mu: &[f64], dmu: &[f64], out: &mut [f64]) -> Result<()> {
+        match (&self.hamiltonian, &self.hessian) {
+            (LieHamiltonian::Quadratic(a), _) => {
+                let d = self.algebra.dim;
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = (0..d).map(|j| a[i * d + j] * dmu[j]).sum();
+                }
+            }
+            (LieHamiltonian::Function { .. }, Some(h)) => h(mu, dmu, out)?,
+            (LieHamiltonian::Function { .. }, None) => {
+                return Err(Error::invalid(
+                    "hessian",
+                    "the Hamiltonian is a function given without its Hessian product \
+                     (with_hessian)",
+                ))
+            }
+        }
+        finite_entries("the Hessian product of H", "d(dH/dmu)", out)
+    }
+
+    /// D²H(μ)\[δμ\] for a kernel: on failure NaN and the error recorded.
+    fn kernel_hessian(&self, mu: &[f64], dmu: &[f64], out: &mut [f64]) {
+        if !hooks::call(|| self.hessian_product(mu, dmu, out)) {
+            out.fill(f64::NAN);
+        }
     }
 
     /// The same system reduced from the other invariance: `side` fixes the sign of the
@@ -317,6 +376,27 @@ impl LiePoisson {
         }
     }
 
+    /// μ ← exp(ξ)·μ on g* (the momentum alone): the built-in group's map, or
+    /// [`LiePoisson::act_generic`].
+    fn act_momentum(&self, xi: &[f64], z: &mut [f64], s: &mut LieScratch) {
+        match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
+            (Kind::So3, _, _) => {
+                // By the increment (so3::Rodrigues: no per-step bias of |M|²).
+                let mut m = Vector3::from_column_slice(z);
+                so3::Rodrigues::exp(&Vector3::from_column_slice(xi)).apply(&mut m);
+                z.copy_from_slice(m.as_slice());
+            }
+            (Kind::Se3, _, _) => {
+                let x = Vector6::from_column_slice(xi);
+                let ad = se3::exp_unchecked(&(-x)).adjoint_matrix();
+                let m = ad.transpose() * Vector6::from_column_slice(z);
+                z.copy_from_slice(m.as_slice());
+            }
+            (Kind::So(_), Some(body), Some(so)) => body.act(xi, z, so),
+            _ => self.act_generic(xi, z, s),
+        }
+    }
+
     /// dexp⁻¹_u v by its Bernoulli series ([`Structure::dexp_inv_series`]).
     fn dexp_inv_generic(&self, u: &[f64], v: &[f64], out: &mut [f64], s: &mut LieScratch) {
         let LieScratch {
@@ -337,6 +417,8 @@ pub struct LieScratch {
     term: Vec<f64>,
     next: Vec<f64>,
     group: Option<GroupScratch>,
+    /// The tangent lift's: w = dexp_u δu, the dexp series' three vectors.
+    lift: [Vec<f64>; 4],
 }
 
 impl Problem for LiePoisson {
@@ -445,6 +527,7 @@ impl GroupField for LiePoisson {
                 (true, Some(g)) => Some(g.scratch()),
                 _ => None,
             },
+            lift: std::array::from_fn(|_| vec![0.0; d]),
         }
     }
     fn algebra_dim(&self) -> usize {
@@ -461,22 +544,7 @@ impl GroupField for LiePoisson {
         if let (Some(group), Some(gs)) = (self.group, &mut s.group) {
             group.follow(self.side, &xi[..group.dim()], g, gs);
         }
-        match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
-            (Kind::So3, _, _) => {
-                // By the increment (so3::Rodrigues: no per-step bias of |M|²).
-                let mut m = Vector3::from_column_slice(z);
-                so3::Rodrigues::exp(&Vector3::from_column_slice(xi)).apply(&mut m);
-                z.copy_from_slice(m.as_slice());
-            }
-            (Kind::Se3, _, _) => {
-                let x = Vector6::from_column_slice(xi);
-                let ad = se3::exp_unchecked(&(-x)).adjoint_matrix();
-                let m = ad.transpose() * Vector6::from_column_slice(z);
-                z.copy_from_slice(m.as_slice());
-            }
-            (Kind::So(_), Some(body), Some(so)) => body.act(xi, z, so),
-            _ => self.act_generic(xi, z, s),
-        }
+        self.act_momentum(xi, z, s);
     }
     /// exp(ξ)·z − z formed as an increment on so(3) (Rodrigues) and so(n) (the generalized
     /// body's kernels), so that the methods add it with compensated summation; with the
@@ -515,6 +583,114 @@ impl GroupField for LiePoisson {
     }
 }
 
+/// The derivative of the field (rk4 on the lift): ±(ad*_{D²H δμ} μ + ad*_{∇H} δμ), and with a
+/// matrix attitude δġ = δg ξ̂ + g δξ̂ (left) or ξ̂ δg + δξ̂ g (right), ξ = ∇H. (With the
+/// attitude on SO(3), whose directions are left-trivialised, the lift offers no Runge–Kutta
+/// method and this is not used.)
+impl VectorFieldTangent for LiePoisson {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        let d = self.algebra.dim;
+        let mut stack = [0.0; 96];
+        let mut heap = Vec::new();
+        let buf = if 3 * d <= stack.len() {
+            &mut stack[..3 * d]
+        } else {
+            heap.resize(3 * d, 0.0);
+            &mut heap[..]
+        };
+        let (grad, rest) = buf.split_at_mut(d);
+        let (dgrad, t) = rest.split_at_mut(d);
+        self.kernel_gradient(&z[..d], grad);
+        self.kernel_hessian(&z[..d], &dz[..d], dgrad);
+        let (om, og) = out.split_at_mut(d);
+        match (self.lifted, self.group) {
+            (true, Some(Group::So3)) => og.fill(f64::NAN),
+            (true, Some(group)) => {
+                let k = group.dim();
+                let g = (&z[d..], &dz[d..]);
+                group.velocity_tangent(self.side, (&grad[..k], &dgrad[..k]), g, og);
+            }
+            _ => {}
+        }
+        if self.side == Side::Right {
+            grad.iter_mut().for_each(|x| *x = -*x);
+            dgrad.iter_mut().for_each(|x| *x = -*x);
+        }
+        self.algebra.ad_star(dgrad, &z[..d], om);
+        self.algebra.ad_star(grad, &dz[..d], t);
+        om.iter_mut().zip(t.iter()).for_each(|(o, x)| *o += x);
+    }
+}
+
+/// The derivatives of the coadjoint action for the tangent lift ([`GroupFieldTangent`]):
+/// ξ′(μ)δμ = ∓D²H(μ)\[δμ\]; with w = dexp_u δu (exp(u + εδu) = exp(εw) exp(u) to first order),
+/// δ(exp(u)·μ) = exp(u)·δμ + w·y = exp(u)·δμ − ad*_w y at y = exp(u)·μ (the action is linear
+/// in μ, its generator −ad*); with the attitude, `Group::follow_tangent` (left-trivialised on
+/// SO(3), ambient on the matrix blocks). dexp and its derivative: so(3) J_l and
+/// [`so3::jacobian_left_derivative`]; so(n) the generalized body's dense series; otherwise the
+/// structure constants' (`Structure::dexp_series`).
+impl GroupFieldTangent for LiePoisson {
+    fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], _s: &mut LieScratch) {
+        let d = self.algebra.dim;
+        self.kernel_hessian(&z[..d], &dz[..d], dxi);
+        if self.side == Side::Left {
+            dxi.iter_mut().for_each(|x| *x = -*x);
+        }
+    }
+
+    fn act_tangent(&self, u: &[f64], du: &[f64], y: &[f64], dz: &mut [f64], s: &mut LieScratch) {
+        let d = self.algebra.dim;
+        let (dm, dg) = dz.split_at_mut(d);
+        let (ym, yg) = y.split_at(d);
+        let attitude = self.lifted && self.group.is_some();
+        match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
+            (Kind::So3, _, _) => {
+                let (g, jl) = so3::exp_and_jacobian_left(&Vector3::from_column_slice(u));
+                let w = jl * Vector3::from_column_slice(du);
+                let m =
+                    g * Vector3::from_column_slice(dm) + w.cross(&Vector3::from_column_slice(ym));
+                dm.copy_from_slice(m.as_slice());
+                s.lift[0][..3].copy_from_slice(w.as_slice());
+            }
+            (Kind::So(_), Some(body), Some(so)) => {
+                body.act_tangent(u, du, ym, dm, so);
+                if attitude {
+                    body.dexp_apply(u, du, &mut s.lift[0], so);
+                }
+            }
+            _ => {
+                self.act_momentum(u, dm, s);
+                let [w, t, e, p] = &mut s.lift;
+                self.algebra.dexp_series(u, du, None, w, None, [t, e, p]);
+                self.algebra.ad_star(w, ym, p);
+                dm.iter_mut().zip(p.iter()).for_each(|(x, a)| *x -= a);
+            }
+        }
+        if let (true, Some(group), Some(gs)) = (attitude, self.group, &mut s.group) {
+            let k = group.dim();
+            group.follow_tangent(self.side, &u[..k], &s.lift[0][..k], yg, dg, gs);
+        }
+    }
+
+    fn dexp_tangent(&self, u: &[f64], du: &[f64], w: &[f64], out: &mut [f64], s: &mut LieScratch) {
+        match (&self.algebra.kind, &self.so_kernels, &mut s.so) {
+            (Kind::So3, _, _) => {
+                let q = so3::jacobian_left_derivative(
+                    &Vector3::from_column_slice(u),
+                    &Vector3::from_column_slice(du),
+                );
+                out.copy_from_slice((q * Vector3::from_column_slice(w)).as_slice());
+            }
+            (Kind::So(_), Some(body), Some(so)) => body.dexp_tangent(u, du, w, out, so),
+            _ => {
+                let [value, t, e, p] = &mut s.lift;
+                self.algebra
+                    .dexp_series(u, w, Some(du), value, Some(out), [t, e, p]);
+            }
+        }
+    }
+}
+
 impl Catalog for LiePoisson {
     /// rkmk4 (default), midpoint, midpoint4 (the Lie midpoint and its Suzuki composition),
     /// rk4.
@@ -527,6 +703,13 @@ impl Catalog for LiePoisson {
     /// The system with its configuration g ([`LiePoisson::with_attitude`]).
     fn lifted(&self) -> Option<Self> {
         self.with_attitude()
+    }
+
+    /// The tangent lift of every method ([`crate::integrate::tangent`]; rk4 not with the
+    /// attitude on SO(3)) where the derivatives are exact ([`LiePoisson::has_tangent`]).
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
+        self.has_tangent()
+            .then(|| Tangent::group_field(self.clone()).into_system())
     }
 
     fn dissipation(
@@ -542,4 +725,29 @@ impl Catalog for LiePoisson {
         }
         crate::integrate::forcing::double_bracket(self, d)
     }
+}
+
+/// The Lie–Poisson methods on the tangent lift (each the derivative of its own step): rkmk4,
+/// midpoint, midpoint4 and rk4, rk4 only without an SO(3) attitude (a Runge–Kutta step is not
+/// differentiated in left-trivialised directions).
+impl Catalog for Tangent<LiePoisson> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        group_field_catalog()
+    }
+
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        lifted_catalog(self.problem())
+    }
+}
+
+/// [`group_field_catalog`] of a lift, without rk4 where `p` carries an SO(3) attitude.
+pub(crate) fn lifted_catalog<P>(p: &P) -> Vec<Entry<Tangent<P>>>
+where
+    P: GroupFieldTangent + VectorFieldTangent + Clone + 'static,
+{
+    let mut c = group_field_catalog();
+    if p.space().dim() != p.space().tangent_dim() {
+        c.retain(|e| e.name != "rk4");
+    }
+    c
 }

@@ -92,9 +92,10 @@ pub use crate::lie::structure::Algebra;
 pub use attitude::Side;
 pub use canonical::UserCanonical;
 pub use euler_poincare::{
-    Action, EulerPoincare, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn, Legendre,
+    Action, EulerPoincare, HessianFn, Lagrangian, LagrangianFn, LagrangianGradientFn,
+    LagrangianHessianFn, Legendre,
 };
-pub use lie_poisson::{LieHamiltonian, LiePoisson, LieScratch};
+pub use lie_poisson::{LieHamiltonian, LieHessianFn, LiePoisson, LieScratch};
 pub use separable::{HessianProductFn, KineticMass, UserSeparable};
 
 /// H(q, p) of a [`UserCanonical`].

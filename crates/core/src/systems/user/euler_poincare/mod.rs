@@ -45,6 +45,7 @@ use crate::error::{fmt_num, Error, Result};
 use crate::integrate::methods::{group_field_catalog, Composition};
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::Space;
+use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::so;
 use crate::lie::structure::{Algebra, Structure};
@@ -56,6 +57,11 @@ pub type LagrangianGradientFn =
     Arc<dyn Fn(&[f64], &[f64], &mut [f64], &mut [f64]) -> Result<()> + Send + Sync>;
 /// ∂²ℓ/∂ξ² at (ξ, a) into a d×d row-major output.
 pub type HessianFn = Arc<dyn Fn(&[f64], &[f64], &mut [f64]) -> Result<()> + Send + Sync>;
+/// The Hessian product of ℓ in (ξ, a): (ξ, a, δξ, δa, out_ξ, out_a) with
+/// (out_ξ, out_a) = D²ℓ(ξ, a)\[δξ, δa\], the derivative of (∂ℓ/∂ξ, ∂ℓ/∂a) along (δξ, δa)
+/// ([`EulerPoincare::with_hessian`]).
+pub type LagrangianHessianFn =
+    Arc<dyn Fn(&[f64], &[f64], &[f64], &[f64], &mut [f64], &mut [f64]) -> Result<()> + Send + Sync>;
 
 /// The reduced Lagrangian of an [`EulerPoincare`] system.
 #[derive(Clone)]
@@ -292,6 +298,78 @@ impl Legendre {
         Ok(dot(mu, &xi) - self.lagrangian(&xi, a)?)
     }
 
+    /// D²H(μ, a)\[δμ, δa\] (d + m values into `out`), the derivative of the gradient
+    /// (∂H/∂μ, ∂H/∂a) = (ξ, −∂ℓ/∂a) at the velocity ξ of μ: from ∂ℓ/∂ξ(ξ, a) = μ,
+    /// ℓ_ξξ δξ = δμ − ℓ_ξa δa, and δ(∂H/∂a) = −(ℓ_aξ δξ + ℓ_aa δa). ℓ_ξξ is built from
+    /// `product` (d calls) where given, else it is the Lagrangian's Hessian ∂²ℓ/∂ξ² (which,
+    /// without a parameter, is all it takes); the parameter's terms need `product`.
+    ///
+    /// Errors: a parameter without `product`; those of [`Legendre::velocity`] and of the
+    /// functions; a singular ℓ_ξξ.
+    pub fn hamiltonian_hessian(
+        &self,
+        z: &[f64],
+        dz: &[f64],
+        product: Option<&LagrangianHessianFn>,
+        out: &mut [f64],
+    ) -> Result<()> {
+        let (d, m) = (self.d, self.m);
+        let (mu, a) = z.split_at(d);
+        let (dmu, da) = dz.split_at(d);
+        let mut xi = vec![0.0; d];
+        self.velocity(mu, a, &mut xi)?;
+        let (mut gx, mut ga) = (vec![0.0; d], vec![0.0; m]);
+        let h = match product {
+            Some(p) => {
+                let mut h = DMatrix::zeros(d, d);
+                let (mut e, zero) = (vec![0.0; d], vec![0.0; m]);
+                for j in 0..d {
+                    e[j] = 1.0;
+                    p(&xi, a, &e, &zero, &mut gx, &mut ga)?;
+                    e[j] = 0.0;
+                    h.column_mut(j).copy_from_slice(&gx);
+                }
+                h
+            }
+            None if m == 0 => self.hessian(&xi, a)?,
+            None => {
+                return Err(Error::invalid(
+                    "hessian",
+                    "the derivative of the Hamiltonian with an advected parameter needs the \
+                     Lagrangian's mixed second derivatives: give its Hessian product \
+                     (with_hessian)",
+                ))
+            }
+        };
+        let mut rhs = dmu.to_vec();
+        if let (Some(p), true) = (product, m > 0) {
+            p(&xi, a, &vec![0.0; d], da, &mut gx, &mut ga)?;
+            rhs.iter_mut().zip(&gx).for_each(|(r, g)| *r -= g);
+        }
+        let dxi = h
+            .lu()
+            .solve(&nalgebra::DVector::from_column_slice(&rhs))
+            .filter(|x| x.iter().all(|v| v.is_finite()))
+            .ok_or_else(|| {
+                Error::invalid(
+                    "state",
+                    format!(
+                        "the Hessian d2l/dxi2 is singular at xi = {}: the Legendre map has no \
+                         derivative there",
+                        fmt_vec(&xi)
+                    ),
+                )
+            })?;
+        out[..d].copy_from_slice(dxi.as_slice());
+        if m > 0 {
+            if let Some(p) = product {
+                p(&xi, a, dxi.as_slice(), da, &mut gx, &mut ga)?;
+                out[d..].iter_mut().zip(&ga).for_each(|(o, g)| *o = -g);
+            }
+        }
+        Ok(())
+    }
+
     /// (∂H/∂μ, ∂H/∂a) = (ξ, −∂ℓ/∂a) into `out` (d + m).
     pub fn hamiltonian_gradient(&self, mu: &[f64], a: &[f64], out: &mut [f64]) -> Result<()> {
         let (d, m) = (self.d, self.m);
@@ -376,7 +454,7 @@ impl EulerPoincare {
                 }
             }
         };
-        let system = LiePoisson::new(semidirect, hamiltonian, None)
+        let mut system = LiePoisson::new(semidirect, hamiltonian, None)
             .map_err(|e| match e {
                 Error::InvalidArgument { message, .. } if action.is_some() => Error::invalid(
                     "action",
@@ -386,12 +464,45 @@ impl EulerPoincare {
             })?
             .with_side(side)
             .with_group(Group::of(&algebra));
+        // Without a parameter, ∂²ℓ/∂ξ² is all the tangent lift needs (D²H = ℓ_ξξ⁻¹).
+        if let Lagrangian::Function {
+            gradient: Some(_),
+            hessian: Some(_),
+            ..
+        } = &lagrangian
+        {
+            if m == 0 {
+                system = system.with_hessian(hamiltonian_hessian(&legendre, None));
+            }
+        }
         Ok(EulerPoincare {
             algebra,
             system,
             legendre,
             rho: Arc::new(rho),
         })
+    }
+
+    /// The same system with the Hessian product of its Lagrangian in (ξ, a)
+    /// ([`LagrangianHessianFn`]), from which the Hamiltonian's D²H follows
+    /// ([`Legendre::hamiltonian_hessian`]): with the Lagrangian's gradient given too, the
+    /// tangent lift of the Lie–Poisson methods (the Jacobian of each step). Without a parameter
+    /// the Lagrangian's own Hessian ∂²ℓ/∂ξ² suffices and this is not needed; a quadratic ℓ has
+    /// its own. Unused where the gradient is taken by finite differences (no exact lift).
+    pub fn with_hessian(mut self, hessian: LagrangianHessianFn) -> Self {
+        if let Lagrangian::Function {
+            gradient: Some(_), ..
+        } = &self.legendre.lagrangian
+        {
+            let h = hamiltonian_hessian(&self.legendre, Some(hessian));
+            self.system = self.system.with_hessian(h);
+        }
+        self
+    }
+
+    /// Whether the system has a tangent lift ([`LiePoisson::has_tangent`] of its form).
+    pub fn has_tangent(&self) -> bool {
+        self.system.has_tangent()
     }
 
     /// The Lie–Poisson form (with the configuration where the system carries it).
@@ -455,6 +566,17 @@ impl EulerPoincare {
                 .sum();
         }
     }
+}
+
+/// D²H of the Lie–Poisson form as its Hessian-product function ([`Legendre::hamiltonian_hessian`]).
+fn hamiltonian_hessian(
+    legendre: &Arc<Legendre>,
+    product: Option<LagrangianHessianFn>,
+) -> super::LieHessianFn {
+    let legendre = legendre.clone();
+    Arc::new(move |z: &[f64], dz: &[f64], out: &mut [f64]| {
+        legendre.hamiltonian_hessian(z, dz, product.as_ref(), out)
+    })
 }
 
 /// ρ(e_i) (m×m each) of `action` on the algebra.
@@ -642,6 +764,38 @@ impl GroupField for EulerPoincare {
     }
 }
 
+/// The Lie–Poisson form's derivatives ([`LiePoisson`]'s [`VectorFieldTangent`]).
+impl VectorFieldTangent for EulerPoincare {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        self.system.field_tangent(z, dz, out)
+    }
+}
+
+/// The Lie–Poisson form's derivatives ([`LiePoisson`]'s [`GroupFieldTangent`]).
+impl GroupFieldTangent for EulerPoincare {
+    fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], s: &mut LieScratch) {
+        self.system.generator_tangent(z, dz, dxi, s)
+    }
+    fn act_tangent(&self, u: &[f64], du: &[f64], y: &[f64], dz: &mut [f64], s: &mut LieScratch) {
+        self.system.act_tangent(u, du, y, dz, s)
+    }
+    fn dexp_tangent(&self, u: &[f64], du: &[f64], w: &[f64], out: &mut [f64], s: &mut LieScratch) {
+        self.system.dexp_tangent(u, du, w, out, s)
+    }
+}
+
+/// The Lie–Poisson methods on the tangent lift (not the variational ones, of another kind):
+/// rkmk4, midpoint, midpoint4, and rk4 without an SO(3) attitude.
+impl Catalog for Tangent<EulerPoincare> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        group_field_catalog()
+    }
+
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        super::lie_poisson::lifted_catalog(self.problem())
+    }
+}
+
 impl Catalog for EulerPoincare {
     /// variational (default; the discrete Euler–Poincaré method, order 2), variational4 and
     /// variational6 (its Suzuki and Yoshida compositions), then the Lie–Poisson methods of the
@@ -659,6 +813,15 @@ impl Catalog for EulerPoincare {
     /// The system with its configuration ([`EulerPoincare::with_attitude`]).
     fn lifted(&self) -> Option<Self> {
         self.with_attitude()
+    }
+
+    /// The tangent lift of the Lie–Poisson methods where the derivatives are exact
+    /// ([`EulerPoincare::has_tangent`]: a quadratic ℓ; or ℓ with its gradient and either its
+    /// Hessian ∂²ℓ/∂ξ² without a parameter or its Hessian product
+    /// ([`EulerPoincare::with_hessian`])).
+    fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
+        self.has_tangent()
+            .then(|| Tangent::group_field(self.clone()).into_system())
     }
 
     /// The Lie–Poisson form's double-bracket dissipation (left-invariant systems).
