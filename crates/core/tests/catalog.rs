@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use lieflow::integrate::problem::Symmetric;
-use lieflow::integrate::{check_state, integrate, Clock, System};
+use lieflow::integrate::{check_state, integrate, Block, Clock, System};
 use lieflow::lie::so3;
 use lieflow::pseudo_rigid::potential::{Harmonic, SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::{PseudoRigidBody, RightReduced};
@@ -616,8 +616,8 @@ fn momentum_maps_of_symmetric_systems() {
 
 /// Issue 26: every (system, method) pair of the suite whose system has a tangent lift: the
 /// Jacobian a lifted run carries against central differences of the same method (on the state
-/// values; a case with an attitude only along its flat blocks, the rest is `tests/tangent.rs`),
-/// 20 steps of the case's dt. Lists the systems without a lift yet.
+/// values; a case with SO(3) blocks only along its other blocks, the rest is
+/// `tests/tangent.rs`), 20 steps of the case's dt. Lists the systems without a lift yet.
 #[test]
 fn jacobians_of_every_lifted_pair_are_the_methods_derivative() {
     let mut without = vec![];
@@ -627,7 +627,17 @@ fn jacobians_of_every_lifted_pair_are_the_methods_derivative() {
             continue;
         };
         let (d, e) = (t.base_dim(), t.tangent_dim());
-        let flat = if d == e { d } else { d - 9 }; // the blocks before an attitude
+        // (state index, direction index) of the values outside SO(3) blocks.
+        let mut flat = vec![];
+        let (mut at, mut dir) = (0, 0);
+        for (_, b) in c.system.space().blocks() {
+            if *b != Block::SO3 {
+                flat.extend((0..b.len()).map(|i| (at + i, dir + i)));
+            }
+            at += b.len();
+            dir += b.tangent_len();
+        }
+        assert_eq!((at, dir), (d, e));
         let steps = 20;
         for (name, _) in t.methods() {
             let seed = t.seed(&c.z0).unwrap();
@@ -636,12 +646,16 @@ fn jacobians_of_every_lifted_pair_are_the_methods_derivative() {
             let (mut z, mut jac, mut pj) = (vec![0.0; d], vec![0.0; e * e], vec![0.0; e * np]);
             t.jacobian(lifted.state(1), &mut z, &mut jac, &mut pj);
             let mut worst = 0.0f64;
-            for j in 0..flat {
+            for &(j, jd) in &flat {
                 // A heavy top carrying its attitude ties Γ to R: only M moves alone.
-                if d != e && (3..flat).contains(&j) {
+                if c.name == "HeavyTop with attitude" && (3..6).contains(&j) {
                     continue;
                 }
-                let h = 1e-6 * c.z0[j].abs().max(1.0);
+                // The Riemannian chart's geometry comes from differences of its closures (∂C
+                // to ≈ 1e-11 of round-off), which central differences at h = 1e-6 amplify to
+                // ~4e-6: fourth-order differences at h = 3e-3 there (`tests/tangent.rs`).
+                let noisy = c.name.contains("Riemannian");
+                let h = if noisy { 3e-3 } else { 1e-6 } * c.z0[j].abs().max(1.0);
                 let end = |s: f64| {
                     let mut z = c.z0.clone();
                     z[j] += s;
@@ -667,10 +681,19 @@ fn jacobians_of_every_lifted_pair_are_the_methods_derivative() {
                     z
                 };
                 let (p, q) = (end(h), end(-h));
+                let (p2, q2) = if noisy {
+                    (end(2.0 * h), end(-2.0 * h))
+                } else {
+                    (p.clone(), q.clone())
+                };
                 let scale = jac.iter().fold(1.0f64, |m, x| m.max(x.abs()));
-                for i in 0..flat {
-                    let fd = (p[i] - q[i]) / (2.0 * h);
-                    worst = worst.max((jac[i * e + j] - fd).abs() / scale);
+                for &(i, id) in &flat {
+                    let fd = if noisy {
+                        (8.0 * (p[i] - q[i]) - (p2[i] - q2[i])) / (12.0 * h)
+                    } else {
+                        (p[i] - q[i]) / (2.0 * h)
+                    };
+                    worst = worst.max((jac[id * e + jd] - fd).abs() / scale);
                 }
             }
             eprintln!("{}: {name}: Jacobian vs differences {worst:.1e}", c.name);

@@ -2376,7 +2376,13 @@ fn rkmk4_jacobian_of_the_generalized_rigid_body() {
             .map(|k| (0.9 * k as f64 + 0.3).sin())
             .collect();
         let name = format!("GeneralizedRigidBody so({n})");
-        check_group_lift(&name, &body, &z0, &["isospectral", "rk4", "rkmk4"], casimirs);
+        check_group_lift(
+            &name,
+            &body,
+            &z0,
+            &["isospectral", "rk4", "rkmk4"],
+            casimirs,
+        );
     }
     // Large steps (|Ω| ≈ 0.7: |u| up to ≈ 1.4 at dt = 2, where the dexp series has its most
     // terms), RKMK4 only.
@@ -2678,4 +2684,392 @@ fn jacobians_of_euler_poincare_systems() {
         &all,
         norm_so3,
     );
+}
+
+// Issue 26: the lifts of the rolling spheres and the frame tops.
+
+/// (base state, Jacobian e×e) at the end of a lifted run (e the tangent dimension).
+fn lifted_trivialised(
+    t: &dyn TangentSystem,
+    method: &str,
+    z0: &[f64],
+    dt: f64,
+    steps: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let (d, e) = (t.base_dim(), t.tangent_dim());
+    let traj = integrate(t, method, &t.seed(z0).unwrap(), dt, steps, steps).unwrap();
+    let (mut z, mut jac) = (vec![0.0; d], vec![0.0; e * e]);
+    t.jacobian(traj.state(1), &mut z, &mut jac, &mut []);
+    (z, jac)
+}
+
+/// z moved along direction j of its tangent space by s: an SO(3) block as R exp(sê), the
+/// others along their own coordinates (off a sphere too).
+fn along(space: &lieflow::integrate::Space, z0: &[f64], j: usize, s: f64) -> Vec<f64> {
+    use lieflow::integrate::Block;
+    use lieflow::lie::so3;
+    use nalgebra::{Matrix3, Vector3};
+    let mut z = z0.to_vec();
+    let (mut at, mut dir) = (0, 0);
+    for (_, b) in space.blocks() {
+        if (dir..dir + b.tangent_len()).contains(&j) {
+            if *b == Block::SO3 {
+                let r = Matrix3::from_row_slice(&z[at..at + 9])
+                    * so3::exp_unchecked(&(Vector3::ith(j - dir, 1.0) * s));
+                for k in 0..9 {
+                    z[at + k] = r[(k / 3, k % 3)];
+                }
+            } else {
+                z[at + j - dir] += s;
+            }
+        }
+        at += b.len();
+        dir += b.tangent_len();
+    }
+    z
+}
+
+/// The coordinates of z around `base` whose derivative is the left-trivialised direction: an
+/// SO(3) block as log(R_baseᵀR), the others as they are (e values).
+fn around(space: &lieflow::integrate::Space, base: &[f64], z: &[f64]) -> Vec<f64> {
+    use lieflow::integrate::Block;
+    use lieflow::lie::so3;
+    use nalgebra::Matrix3;
+    let mut out = vec![];
+    let mut at = 0;
+    for (_, b) in space.blocks() {
+        if *b == Block::SO3 {
+            let r0 = Matrix3::from_row_slice(&base[at..at + 9]);
+            let r = Matrix3::from_row_slice(&z[at..at + 9]);
+            out.extend(so3::log_unchecked(&(r0.transpose() * r)).iter());
+        } else {
+            out.extend_from_slice(&z[at..at + b.len()]);
+        }
+        at += b.len();
+    }
+    out
+}
+
+/// Differences of the method's own map ([`stepped`]) along each left-trivialised direction
+/// (e×e): central (h) or fourth-order (h, 2h).
+fn trivialised_differences(
+    sys: &dyn System,
+    method: &str,
+    z0: &[f64],
+    (dt, steps): (f64, usize),
+    h: f64,
+    fourth: bool,
+) -> Vec<f64> {
+    let space = sys.space();
+    let e = space.tangent_dim();
+    let base = stepped(sys, method, z0, dt, steps);
+    let mut jac = vec![0.0; e * e];
+    for j in 0..e {
+        let end = |s: f64| {
+            around(
+                &space,
+                &base,
+                &stepped(sys, method, &along(&space, z0, j, s), dt, steps),
+            )
+        };
+        let (p1, m1) = (end(h), end(-h));
+        let (p2, m2) = if fourth {
+            (end(2.0 * h), end(-2.0 * h))
+        } else {
+            (vec![], vec![])
+        };
+        for i in 0..e {
+            jac[i * e + j] = if fourth {
+                (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h)
+            } else {
+                (p1[i] - m1[i]) / (2.0 * h)
+            };
+        }
+    }
+    jac
+}
+
+/// max over columns j of |Σ_i g(z)_i J_ij − g(z₀)_j| for each gradient pair, relative to
+/// max(1, |J|)·max(1, |g|) (the size of the terms summed).
+fn gradient_defect(jac: &[f64], grads: &[(Vec<f64>, Vec<f64>)]) -> f64 {
+    let scale = jac.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+    let g = grads
+        .iter()
+        .flat_map(|(a, b)| a.iter().chain(b))
+        .fold(1.0f64, |m, x| m.max(x.abs()));
+    casimir_defect(jac, grads) / (scale * g)
+}
+
+fn catalog_spheres_state(s: &lieflow::systems::RollingSpheres) -> Vec<f64> {
+    use lieflow::lie::so3;
+    use nalgebra::Vector3;
+    let rows = |w: Vector3<f64>| {
+        let r = so3::exp_unchecked(&w);
+        std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]))
+    };
+    s.state(
+        rows(Vector3::new(0.3, -0.2, 0.5)),
+        rows(Vector3::new(-0.4, 0.1, 0.2)),
+        [0.6, 0.0, 0.8],
+        [0.5, -0.3, 0.8],
+        [-0.2, 0.4, 0.1],
+    )
+    .unwrap()
+}
+
+/// The rolling spheres (003 §2) on SO(3)² × S² × ℝ⁶ in the momentum chart P = M(z)ω: the lifted
+/// Lie-group methods (no rk4: SO(3) blocks) carry the derivative of their own map in
+/// left-trivialised coordinates (central differences, u moved off S² through the stepper, ≤
+/// 1e-8 relative), their base states are the plain runs' (bit for bit for rkmk4), and they map
+/// the gradients of what they keep consistently: |u|² (the sphere block) and the angular
+/// momentum J = P₁ + P₂ (its gradient in user coordinates from the lift's chart at the state).
+#[test]
+fn rolling_spheres_jacobians_keep_the_sphere_and_the_momentum() {
+    // The catalog's spheres (full inertia tensors, offset centres of mass).
+    let s = lieflow::systems::RollingSpheres::new(
+        0.7,
+        1.3,
+        [0.1, -0.2, 0.15],
+        [-0.3, 0.2, 0.4],
+        2.0,
+        3.5,
+        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
+        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
+    )
+    .unwrap();
+    let t = s.tangent().expect("the spheres have a lift");
+    let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
+    assert_eq!(names, ["midpoint", "midpoint4", "rkmk4"]);
+    let z0 = catalog_spheres_state(&s);
+    let (d, e) = (t.base_dim(), t.tangent_dim());
+    assert_eq!((d, e), (27, 15));
+    // ∇J at z (user frame, rows of the three components): the lift's chart of the identity.
+    let grad_j = |z: &[f64]| -> Vec<Vec<f64>> {
+        let mut l = t.seed(z).unwrap();
+        t.to_internal(&mut l);
+        (0..3)
+            .map(|c| {
+                (0..e)
+                    .map(|j| l[d + j * e + 9 + c] + l[d + j * e + 12 + c])
+                    .collect()
+            })
+            .collect()
+    };
+    let grad_u = |z: &[f64]| -> Vec<f64> {
+        (0..e)
+            .map(|j| {
+                if (6..9).contains(&j) {
+                    2.0 * z[18 + j - 6]
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    };
+    let (dt, steps) = (0.02, 50);
+    for method in names {
+        let (z, jac) = lifted_trivialised(&*t, method, &z0, dt, steps);
+        let plain = integrate(&s, method, &z0, dt, steps, steps).unwrap();
+        let base = max_rel(&z, plain.state(1));
+        if method == "rkmk4" {
+            assert_eq!(z, plain.state(1), "{method}: base state");
+        }
+        let fd = trivialised_differences(&s, method, &z0, (dt, steps), 1e-6, false);
+        let err = max_rel(&jac, &fd);
+        let mut grads = vec![(grad_u(&z0), grad_u(&z))];
+        grads.extend(grad_j(&z0).into_iter().zip(grad_j(&z)));
+        let defect = gradient_defect(&jac, &grads);
+        eprintln!(
+            "RollingSpheres {method}: base vs plain {base:.1e}, Jacobian vs differences \
+             {err:.2e}, gradients of |u|², J {defect:.1e}"
+        );
+        assert!(base < 1e-14, "{method}: base state {base:e}");
+        assert!(err < 1e-8, "{method}: {err:e}");
+        assert!(defect < 1e-12, "{method}: gradients {defect:e}");
+    }
+}
+
+/// The tangent Euler top on S³, H³ and ℝ³ (002 §V): every method of its catalog on the lift
+/// (`exact` by the free body's closed-form tangent map, the splittings by their flows', rk4 by
+/// the field's derivative) against central differences of the method's map (g moved off its
+/// group through the stepper) ≤ 1e-8 relative; base states the plain runs' bit for bit; the
+/// methods that keep C₁ = Π·P, C₂ = |P|² + κ|Π|² and T = |P|²/2m (all but rk4) map their
+/// gradients consistently, and on S³ that of |g|²_F (right multiplication by rotations).
+#[test]
+fn frame_top_jacobians_keep_the_casimirs() {
+    use lieflow::lie::so3;
+    use lieflow::systems::{FrameTop, SpaceForm, SpaceTop};
+    use nalgebra::Vector3;
+    let inertia = [2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2];
+    let r = so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
+    let omega = Vector3::new(0.7, -0.4, 1.1);
+    let h3 = 1.5f64;
+    let cases = [
+        (
+            SpaceForm::sphere(1.0).unwrap(),
+            vec![0.8, 0.0, 0.6, 0.0],
+            vec![0.0, 0.5, 0.0, -0.4],
+        ),
+        (
+            SpaceForm::hyperbolic(h3).unwrap(),
+            {
+                let v: [f64; 3] = [0.3, -0.2, 0.5];
+                vec![
+                    (h3 * h3 + v.iter().map(|a| a * a).sum::<f64>()).sqrt(),
+                    v[0],
+                    v[1],
+                    v[2],
+                ]
+            },
+            vec![],
+        ),
+        (
+            SpaceForm::Euclidean,
+            vec![0.3, -0.2, 0.5],
+            vec![0.4, 0.1, -0.3],
+        ),
+    ];
+    for (space, x, xdot) in cases {
+        let top = FrameTop::new(space, 1.3, &inertia).unwrap();
+        let xdot = if xdot.is_empty() {
+            // Tangent to H³: x₀ẋ₀ = x⃗·ẋ⃗.
+            let v = [0.4, 0.1, -0.3];
+            let dot = x[1] * v[0] + x[2] * v[1] + x[3] * v[2];
+            vec![dot / x[0], v[0], v[1], v[2]]
+        } else {
+            xdot
+        };
+        let z0 = top.state(&x, &r, &xdot, &omega).unwrap();
+        let t = top.tangent().expect("a lift");
+        let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
+        assert_eq!(
+            names,
+            ["exact", "splitting", "splitting4", "splitting6", "rk4"]
+        );
+        let kappa = space.curvature();
+        let grads = |z: &[f64]| -> Vec<Vec<f64>> {
+            let (pi, p) = (&z[16..19], &z[19..22]);
+            let mut c1 = vec![0.0; 22];
+            let mut c2 = vec![0.0; 22];
+            let mut tr = vec![0.0; 22];
+            for k in 0..3 {
+                c1[16 + k] = p[k];
+                c1[19 + k] = pi[k];
+                c2[16 + k] = 2.0 * kappa * pi[k];
+                c2[19 + k] = 2.0 * p[k];
+                tr[19 + k] = p[k] / 1.3;
+            }
+            let mut g = vec![c1, c2, tr];
+            if kappa > 0.0 {
+                g.push(
+                    (0..22)
+                        .map(|k| if k < 16 { 2.0 * z[k] } else { 0.0 })
+                        .collect(),
+                );
+            }
+            g
+        };
+        let (dt, steps) = (0.05, 40);
+        for method in names {
+            let (z, jac) = lifted_trivialised(&*t, method, &z0, dt, steps);
+            let plain = integrate(&top, method, &z0, dt, steps, steps).unwrap();
+            assert_eq!(z, plain.state(1), "{} {method}: base state", space.name());
+            let fd = stepped_differences(&top, method, &z0, dt, steps, 1e-6);
+            let err = max_rel(&jac, &fd);
+            let pairs: Vec<_> = grads(&z0).into_iter().zip(grads(&z)).collect();
+            let defect = gradient_defect(&jac, &pairs);
+            eprintln!(
+                "FrameTop on {} {method}: Jacobian vs differences {err:.2e}, Casimir gradients \
+                 {defect:.1e}",
+                space.name()
+            );
+            assert!(err < 1e-8, "{} {method}: {err:e}", space.name());
+            if method != "rk4" {
+                assert!(
+                    defect < 1e-12,
+                    "{} {method}: gradients {defect:e}",
+                    space.name()
+                );
+            }
+        }
+    }
+}
+
+/// The top on a Riemannian chart (002 §V, the catalog's conformally flat chart with a rotating
+/// frame): the lifted Lie-group methods (no rk4: the frame R is an SO(3) block) against
+/// differences of the method's map in left-trivialised coordinates. The chart's geometry comes
+/// from differences of its closures (∂C carries ≈ 1e-11 of round-off, a non-smooth function of
+/// x), which central differences of a whole run at h = 1e-6 amplify to ~4e-6 in every column
+/// (each moves the path x(t)); so fourth-order differences at h = 3e-3 (truncation ~1e-10,
+/// round-off ~1e-9; measured: the error is 8e-9 at h = 1e-2 (truncation) and 1.4e-8 at
+/// h = 1e-3 (round-off), the lift's own, from the geometry's second derivatives by
+/// differences, being below both). The spin moves by the free body's exact flow: the gradients of |Π|² and
+/// H − T = ½Π·𝕀⁻¹Π are mapped consistently.
+#[test]
+fn riemannian_frame_top_jacobians() {
+    use lieflow::lie::so3;
+    use lieflow::systems::{Riemannian, RiemannianFrameTop, SpaceTop};
+    use nalgebra::Vector3;
+    let lambda = |x: [f64; 3]| 1.0 + 0.1 * (x[0] * x[0] + 0.5 * x[1] * x[2]);
+    let chart = Riemannian::new(
+        move |x| {
+            let l2 = lambda(x).powi(2);
+            [[l2, 0.0, 0.0], [0.0, l2, 0.0], [0.0, 0.0, l2]]
+        },
+        move |x| {
+            let q = so3::exp_unchecked(&Vector3::new(0.3 * x[0], -0.2 * x[2], 0.4 * x[0] * x[1]))
+                / lambda(x);
+            std::array::from_fn(|a| std::array::from_fn(|i| q[(i, a)]))
+        },
+        None,
+    );
+    let inertia = [2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2];
+    let top = RiemannianFrameTop::new(chart, 1.3, &inertia).unwrap();
+    let z0 = top
+        .state(
+            &[0.3, -0.2, 0.5],
+            &so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3)),
+            &[0.4, 0.1, -0.3],
+            &Vector3::new(0.7, -0.4, 1.1),
+        )
+        .unwrap();
+    let t = top.tangent().expect("a lift");
+    let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
+    assert_eq!(names, ["midpoint", "midpoint4", "midpoint6", "rkmk4"]);
+    let e = t.tangent_dim();
+    assert_eq!(e, 12);
+    let inv = nalgebra::Matrix3::from_row_slice(&inertia)
+        .try_inverse()
+        .unwrap();
+    let grads = |z: &[f64]| -> Vec<Vec<f64>> {
+        let pi = Vector3::new(z[15], z[16], z[17]);
+        let w = inv * pi;
+        let mut a = vec![0.0; 12];
+        let mut b = vec![0.0; 12];
+        for k in 0..3 {
+            a[9 + k] = 2.0 * pi[k];
+            b[9 + k] = w[k];
+        }
+        vec![a, b]
+    };
+    let (dt, steps) = (0.05, 20);
+    for method in names {
+        let (z, jac) = lifted_trivialised(&*t, method, &z0, dt, steps);
+        let plain = integrate(&top, method, &z0, dt, steps, steps).unwrap();
+        let base = max_rel(&z, plain.state(1));
+        if method == "rkmk4" {
+            assert_eq!(z, plain.state(1), "{method}: base state");
+        }
+        let fd = trivialised_differences(&top, method, &z0, (dt, steps), 3e-3, true);
+        let err = max_rel(&jac, &fd);
+        let pairs: Vec<_> = grads(&z0).into_iter().zip(grads(&z)).collect();
+        let defect = gradient_defect(&jac, &pairs);
+        eprintln!(
+            "RiemannianFrameTop {method}: base vs plain {base:.1e}, Jacobian vs fourth-order \
+             differences {err:.2e}, spin gradients {defect:.1e}"
+        );
+        assert!(base < 1e-11, "{method}: base state {base:e}");
+        assert!(err < 1e-8, "{method}: {err:e}");
+        assert!(defect < 1e-12, "{method}: gradients {defect:e}");
+    }
 }

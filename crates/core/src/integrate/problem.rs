@@ -69,6 +69,18 @@ pub trait Problem: Send + Sync {
         self.to_user(dz)
     }
 
+    /// [`Problem::tangent_to_internal`] at the state `z` (user frame): the chart's tangent map
+    /// there, for a chart that depends on the state (momenta P = M(q)ω); by default the
+    /// state-free map.
+    fn tangent_to_internal_at(&self, _z: &[f64], dz: &mut [f64]) {
+        self.tangent_to_internal(dz)
+    }
+
+    /// Inverse of [`Problem::tangent_to_internal_at`], at the state `z` (internal frame).
+    fn tangent_to_user_at(&self, _z: &[f64], dz: &mut [f64]) {
+        self.tangent_to_user(dz)
+    }
+
     /// The names of the system's parameters θ, in order, whose sensitivities ∂z/∂θ a tangent
     /// run carries ([`crate::integrate::tangent`]); none by default.
     fn parameters(&self) -> Vec<&'static str> {

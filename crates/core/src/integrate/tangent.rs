@@ -37,8 +37,9 @@
 //! split lift allows it (a flow's tangent map is exact in ξ), the field lift does not (a
 //! Runge–Kutta step leaves SO(3), and its derivative is one in ambient coordinates). [`TangentSystem::seed`] and
 //! [`TangentSystem::jacobian`] convert from and to the problem's flat layout, so nothing outside
-//! this module sees either. The problem's chart ([`Problem::to_internal`]) must be linear (a
-//! turn to principal axes): the lift applies it to the directions as to states.
+//! this module sees either. The problem's chart ([`Problem::to_internal`]) maps the directions by
+//! its tangent map at the base state ([`Problem::tangent_to_internal_at`]; by default the chart
+//! itself, right for a linear one such as a turn to principal axes).
 //!
 //! **What the lift keeps.** Its space is flat (no block is retracted during the run, which
 //! would not be differentiated), its energy and invariants are the base state's.
@@ -256,28 +257,32 @@ impl<P: Problem + Clone> Tangent<P> {
         }
     }
 
-    /// Applies `state` to the base state and `tangent` to every direction.
-    /// In place in the field layout; the separable one through this thread's buffer
-    /// (allocated once, not per saved sample).
-    fn each(&self, z: &mut [f64], state: impl Fn(&mut [f64]), tangent: impl Fn(&mut [f64])) {
+    /// Applies `tangent` to every direction, given the base state as it was, then `state` to
+    /// the base state. In place in the field layout; the separable one through this thread's
+    /// buffers (allocated once, not per saved sample).
+    fn each(
+        &self,
+        z: &mut [f64],
+        state: impl Fn(&mut [f64]),
+        tangent: impl Fn(&[f64], &mut [f64]),
+    ) {
         if self.layout == Layout::Field {
             let (base, dirs) = z.split_at_mut(self.d);
+            dirs.chunks_exact_mut(self.e).for_each(|v| tangent(base, v));
             state(base);
-            dirs.chunks_exact_mut(self.e).for_each(tangent);
             return;
         }
-        with_buffers(|[v, ..]| {
+        with_buffers(|[v, base, _]| {
             v.resize(self.d, 0.0);
-            for j in 0..=self.k() {
+            base.resize(self.d, 0.0);
+            self.gather(z, 0, base);
+            for j in 1..=self.k() {
                 self.gather(z, j, v);
-                let n = self.len_of(j);
-                if j == 0 {
-                    state(&mut v[..n]);
-                } else {
-                    tangent(&mut v[..n]);
-                }
+                tangent(base, &mut v[..self.e]);
                 self.scatter(v, j, z);
             }
+            state(base);
+            self.scatter(base, 0, z);
         });
     }
 }
@@ -349,7 +354,7 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.each(
             z,
             |v| self.problem.to_internal(v),
-            |v| self.problem.tangent_to_internal(v),
+            |b, v| self.problem.tangent_to_internal_at(b, v),
         );
     }
 
@@ -357,7 +362,7 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.each(
             z,
             |v| self.problem.to_user(v),
-            |v| self.problem.tangent_to_user(v),
+            |b, v| self.problem.tangent_to_user_at(b, v),
         );
     }
 

@@ -345,23 +345,10 @@ impl SpaceForm {
 /// the same X every step (which made the frame's orthogonality drift linearly, as
 /// `so3::Rodrigues` explains).
 pub fn expm1(x: &Matrix4<f64>) -> Matrix4<f64> {
-    let norm = (0..4)
-        .map(|i| (0..4).map(|j| x[(i, j)].abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    if !norm.is_finite() {
+    let Some((s, terms)) = expm1_plan(x) else {
         return Matrix4::from_element(f64::NAN);
-    }
-    // The smallest s ≥ 0 with ‖X‖∞/2ˢ ≤ ½.
-    let s = (2.0 * norm).log2().ceil().max(0.0) as i32;
+    };
     let y = x * 0.5f64.powi(s);
-    let ny = norm * 0.5f64.powi(s);
-    // Terms: the first k with ‖Y‖^(k−1)/k! ≤ 2⁻⁵⁶ (relative to the first term ‖Y‖).
-    let mut terms = 1;
-    let mut t = 1.0;
-    while terms < 17 && t > f64::EPSILON / 4.0 {
-        terms += 1;
-        t *= ny / f64::from(terms);
-    }
     // Horner: Y(1 + Y/2(1 + Y/3(… (1 + Y/terms)))).
     let mut d = Matrix4::identity();
     for k in (2..=terms).rev() {
@@ -372,6 +359,52 @@ pub fn expm1(x: &Matrix4<f64>) -> Matrix4<f64> {
         d = d * (d + Matrix4::identity() * 2.0);
     }
     d
+}
+
+/// The scaling s and the number of terms of [`expm1`] at X (None for a non-finite X).
+fn expm1_plan(x: &Matrix4<f64>) -> Option<(i32, u32)> {
+    let norm = (0..4)
+        .map(|i| (0..4).map(|j| x[(i, j)].abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    if !norm.is_finite() {
+        return None;
+    }
+    // The smallest s ≥ 0 with ‖X‖∞/2ˢ ≤ ½.
+    let s = (2.0 * norm).log2().ceil().max(0.0) as i32;
+    let ny = norm * 0.5f64.powi(s);
+    // Terms: the first k with ‖Y‖^(k−1)/k! ≤ 2⁻⁵⁶ (relative to the first term ‖Y‖).
+    let mut terms = 1;
+    let mut t = 1.0;
+    while terms < 17 && t > f64::EPSILON / 4.0 {
+        terms += 1;
+        t *= ny / f64::from(terms);
+    }
+    Some((s, terms))
+}
+
+/// D expm1(X)\[δX\]: [`expm1`]'s scaling, series and doublings differentiated step by step
+/// (forward mode, the scaling and the number of terms held), so the derivative of the function
+/// as it is computed (issue 26: the tangent map of the frame top's flow of T).
+pub fn expm1_tangent(x: &Matrix4<f64>, dx: &Matrix4<f64>) -> Matrix4<f64> {
+    let Some((s, terms)) = expm1_plan(x) else {
+        return Matrix4::from_element(f64::NAN);
+    };
+    let scale = 0.5f64.powi(s);
+    let (y, dy) = (x * scale, dx * scale);
+    let one = Matrix4::identity();
+    let (mut d, mut dd) = (one, Matrix4::zeros());
+    for k in (2..=terms).rev() {
+        let kf = f64::from(k);
+        dd = (dy * d + y * dd) / kf;
+        d = one + y * d / kf;
+    }
+    let (mut d, mut dd) = (y * d, dy * d + y * dd);
+    for _ in 0..s {
+        let two = d + one * 2.0;
+        dd = dd * two + d * dd;
+        d *= two;
+    }
+    dd
 }
 
 /// r > 0, finite, with a finite curvature 1/r² (r ≥ 1e-150).

@@ -68,6 +68,14 @@ impl Problem for RollingSpheres {
             z[21 + 3 * i..24 + 3 * i].copy_from_slice(o.as_slice());
         }
     }
+    /// The chart's tangent map at z, δP = M δω + DM\[δz\]ω (`tangent.rs`).
+    fn tangent_to_internal_at(&self, z: &[f64], dz: &mut [f64]) {
+        self.chart_tangent(z, dz)
+    }
+    /// Its inverse at the internal state z.
+    fn tangent_to_user_at(&self, z: &[f64], dz: &mut [f64]) {
+        self.chart_tangent_inverse(z, dz)
+    }
 }
 
 impl RollingSpheres {
@@ -85,7 +93,7 @@ impl RollingSpheres {
 
     /// The spatial angular velocities ω from the momenta P = Mω of an internal state (NaN if M
     /// is not positive definite, which valid bodies exclude).
-    fn omegas_from_momenta(
+    pub(super) fn omegas_from_momenta(
         &self,
         z: &[Matrix3<f64>; 2],
         u: &Vector3<f64>,
@@ -177,5 +185,10 @@ impl Catalog for RollingSpheres {
             Entry::new("rkmk4", || Rkmk4),
             Entry::new("rk4", || Rk4),
         ]
+    }
+
+    /// The lift of the Lie-group methods (`tangent`).
+    fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        Some(self.lift())
     }
 }

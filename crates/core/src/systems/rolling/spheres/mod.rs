@@ -122,6 +122,10 @@
 //! nonholonomic, so no bound is guaranteed; 7.5e-9 then 1.5e-8 for rkmk4 and 2.7e-7 then 8.3e-7
 //! for rk4 — growing; |ΔJ|/|J| ≤ 2e-14 for the Lie-group methods.
 //!
+//! **Tangent lift** (issue 26): the Lie-group methods carry the exact derivative of their own
+//! map, in left-trivialised directions on the SO(3) blocks (the chart's, the generator's, the
+//! action's and dexp's derivatives: `tangent.rs`); not `rk4` (SO(3) blocks), no parameters.
+//!
 //! [`LieMidpoint`]: crate::integrate::methods::LieMidpoint
 //! [`GroupField`]: crate::integrate::problem::GroupField
 
@@ -129,6 +133,7 @@ mod curvature;
 mod dynamics;
 mod methods;
 mod planar;
+mod tangent;
 
 use nalgebra::{Matrix3, Vector3};
 

@@ -51,8 +51,14 @@
 //! State z = (g row-major, 16 values; Π; P), 22 values; [`SpaceTop::state`] makes it from
 //! (x, R, ẋ, ω) with R the frame relative to the reference field Ê(x). The kernels work in the
 //! principal axes of 𝕀 (`to_internal`).
+//!
+//! # Tangent lift
+//! (Issue 26.) Every method above is lifted: the splittings through their flows' tangent maps,
+//! `exact` through the free body's closed-form tangent map and that of T's flow (its own
+//! stepper), `rk4` through the field's derivative (`tangent.rs`).
 
 mod riemannian;
+mod tangent;
 
 pub use riemannian::RiemannianFrameTop;
 
@@ -592,5 +598,10 @@ impl Catalog for FrameTop {
             Entry::new("splitting6", || Splitting(Composition::yoshida6())),
             Entry::new("rk4", || Rk4),
         ]
+    }
+
+    /// The lift of every method (module docs, "Tangent lift").
+    fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        Some(crate::integrate::tangent::Tangent::split(self.clone()).into_system())
     }
 }
