@@ -611,10 +611,12 @@ class LiePoisson(System):
         gradient: Callable[[_F64], ArrayLike] | None = None,
         casimirs: Sequence[Callable[[_F64], float]] | None = None,
         side: Literal["left", "right"] | None = None,
+        hessian: Callable[[_F64, _F64], ArrayLike] | None = None,
     ) -> Self:
         """hamiltonian: a callable mu -> float, or a symmetric (d, d) matrix A for H = mu.A mu/2
         (the native path); gradient: mu -> (d,) or None (finite differences; None for a
-        matrix); side: the invariance reduced from, "left" (default) or "right"."""
+        matrix); side: the invariance reduced from, "left" (default) or "right"; hessian:
+        (mu, dmu) -> D²H(mu)[dmu] or None (with it, runs with sensitivity=True)."""
     @property
     def side(self) -> Literal["left", "right"]: ...
     @property

@@ -25,12 +25,21 @@ def _check_method(attrs, system):
                                   f"{type(system).__name__}: {known}")
 
 
-def _check_parameters(attrs, system):
-    """FileFormatError unless the stored Jacobians' parameter names are ``system.parameters``."""
+def _check_parameters(attrs, system, directions=None, attitude=False):
+    """FileFormatError unless the stored Jacobians' parameter names are ``system.parameters``
+    and their ``directions`` (when given) those of the system's tangent lift."""
     if "parameters" in attrs and _parameter_names(attrs) != list(system.parameters):
         raise FileFormatError(f"the parameter Jacobian is along {_parameter_names(attrs)}, but "
                               f"{type(system).__name__} has the parameters "
                               f"{list(system.parameters)}")
+    if directions is None:
+        return
+    lift = system._tangent(attitude)
+    if lift is None or lift[1].directions != directions:
+        want = "no tangent maps" if lift is None else f"{lift[1].directions} directions"
+        raise FileFormatError(f"the Jacobians have {directions} directions; "
+                              f"{type(system).__name__}{' with an attitude' if attitude else ''} "
+                              f"has {want}")
 
 
 def _parameter_names(attrs):
@@ -48,8 +57,9 @@ def _parameter_names(attrs):
 
 
 def _jacobians(ds, var, dims, lead, b, k, d):
-    """The Jacobians of a run with sensitivities (none: {}), their layout checked: e = d, or
-    d + 3 with an attitude (its left-trivialised directions); the parameter Jacobians zero-wide
+    """The Jacobians of a run with sensitivities (none: {}), their layout checked: e ≤ d, or
+    d + 3 with an attitude (left-trivialised directions; the system's lift fixes e, checked by
+    ``_check_parameters`` once the system is rebuilt); the parameter Jacobians zero-wide
     when the system has no parameters (then not stored)."""
     names = ("jacobian", "final_jacobian", "parameter_jacobian", "final_parameter_jacobian")
     present = [n for n in names if n in ds.variables]
@@ -61,10 +71,10 @@ def _jacobians(ds, var, dims, lead, b, k, d):
                               f"attribute parameters")
     e = ds.variables["jacobian"].shape[-1]
     with_attitude = "initial_attitude" in ds.variables or "attitude" in ds.variables
-    if e != d + (3 if with_attitude else 0):
+    if not 0 < e <= d + (3 if with_attitude else 0):
         raise FileFormatError(f"the Jacobians have {e} directions; with states of {d} "
                               f"components{' and an attitude' if with_attitude else ''} "
-                              f"expected {d + (3 if with_attitude else 0)}")
+                              f"expected at most {d + (3 if with_attitude else 0)}")
     p = len(_parameter_names(ds.attrs))
     jac, par = ("tangent", "direction"), ("tangent", "parameter")
     layout = {"jacobian": (lead + ("time",) + jac, b + (k, e, e)),

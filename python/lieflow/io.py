@@ -657,7 +657,9 @@ def read(path: str | os.PathLike[str] | xarray.Dataset, *,
             raise FileFormatError(f"system_spec: builds a {type(system).__name__}, not a "
                                   f"lieflow system")
         _check_method(ds.attrs, system)
-        _check_parameters(ds.attrs, system)
+        jac = ds.variables.get("jacobian")
+        _check_parameters(ds.attrs, system, None if jac is None else jac.shape[-1],
+                          "initial_attitude" in ds.variables or "attitude" in ds.variables)
     except FileFormatError as e:
         e.args = (f"{where}: {e}",)
         raise

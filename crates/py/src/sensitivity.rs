@@ -54,6 +54,13 @@ impl PyTangent {
             .map_err(|e| to_py(Error::shape("state0", "(..., d)", e.to_string())))
     }
 
+    /// The number e of a direction's values (the state's d less 6 per SO(3) block:
+    /// left-trivialised).
+    #[getter]
+    fn directions(&self) -> usize {
+        self.inner.tangent_dim()
+    }
+
     /// The names of the parameters the lift differentiates along.
     #[getter]
     fn parameters(&self) -> Vec<&'static str> {

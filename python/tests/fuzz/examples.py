@@ -370,6 +370,10 @@ def user_lp_grad(mu):
     return np.asarray(mu, float) / A3
 
 
+def user_lp_hess(mu, dmu):
+    return np.asarray(dmu, float) / A3
+
+
 def user_casimir(mu):
     return float(mu @ mu)
 
@@ -417,6 +421,9 @@ def user_specs(add):
     add("LiePoisson", "LiePoisson", A("algebra", "so3", "str"), A("hamiltonian", user_lp_h, "obj"),
         A("gradient", user_lp_grad, "obj", opt=True),
         A("casimirs", [user_casimir], "obj", opt=True))
+    add("LiePoisson[hessian]", "LiePoisson", A("algebra", "so3", "str"),
+        A("hamiltonian", user_lp_h, "obj"), A("gradient", user_lp_grad, "obj", opt=True),
+        A("hessian", user_lp_hess, "obj", kw=True, opt=True))
     add("LiePoisson[quadratic]", "LiePoisson", A("algebra", "se3", "str"),
         A("hamiltonian", KIRCHHOFF, "mat"))
     add("LiePoisson[so(n)]", "LiePoisson", A("algebra", ("so", 4), "obj"),

@@ -110,6 +110,9 @@ pub(super) fn side(s: Option<&Any<'_>>) -> PyResult<Side> {
 ///     casimirs: None (the algebra's), or a sequence of callables mu -> float to monitor as
 ///         `invariants` in their place.
 ///     side: "left" (default) or "right".
+///     hessian: a callable (mu, dmu) -> D^2 H(mu)[dmu] (d,), the derivative of `gradient` along
+///         dmu, or None. With `gradient` it gives the runs with ``sensitivity=True`` (every
+///         method: the exact Jacobian of the discrete flow); a matrix hamiltonian needs none.
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError, ShapeError, NonFiniteError.
 #[pyclass(name = "LiePoisson", module = "lieflow", extends = PySystem, frozen)]
@@ -119,13 +122,14 @@ pub struct PyLiePoisson;
 #[pymethods]
 impl PyLiePoisson {
     #[new]
-    #[pyo3(signature = (algebra, hamiltonian, gradient=None, casimirs=None, side=None))]
+    #[pyo3(signature = (algebra, hamiltonian, gradient=None, casimirs=None, side=None, hessian=None))]
     fn new(
         algebra: Any<'_>,
         hamiltonian: Any<'_>,
         gradient: Option<Any<'_>>,
         casimirs: Option<Any<'_>>,
         side: Option<Any<'_>>,
+        hessian: Option<Any<'_>>,
     ) -> PyResult<PyClassInitializer<Self>> {
         let py = hamiltonian.py();
         let alg = self::algebra(&algebra)?;
@@ -143,11 +147,16 @@ impl PyLiePoisson {
                 }),
             }
         } else {
-            if optional(gradient.as_ref()).is_some() {
-                return Err(to_py(Error::invalid(
-                    "gradient",
-                    "a quadratic Hamiltonian (a matrix) has its gradient A mu; pass gradient=None",
-                )));
+            for (name, v) in [("gradient", &gradient), ("hessian", &hessian)] {
+                if optional(v.as_ref()).is_some() {
+                    return Err(to_py(Error::invalid(
+                        name,
+                        format!(
+                            "a quadratic Hamiltonian (a matrix) has its derivatives A mu, A dmu; \
+                             pass {name}=None"
+                        ),
+                    )));
+                }
             }
             let a = ArrayIn::named("hamiltonian", &hamiltonian).map_err(|e| {
                 if e.is_instance_of::<pyo3::exceptions::PyTypeError>(py) {
@@ -192,10 +201,25 @@ impl PyLiePoisson {
                 Some(fs)
             }
         };
-        let sys = CoreLiePoisson::new(alg, ham, cas).py()?.with_side(side_of);
+        let mut sys = CoreLiePoisson::new(alg, ham, cas).py()?.with_side(side_of);
+        if let Some(h) = optional(hessian.as_ref())
+            .map(|h| Callee::new("hessian", h))
+            .transpose()?
+        {
+            sys = sys.with_hessian(Arc::new(move |mu: &[f64], dmu: &[f64], out: &mut [f64]| {
+                h.call(&[mu, dmu], &[mu.len()], out)
+            }));
+        }
         let side = side_of.name();
-        let args = (algebra, hamiltonian, gradient, casimirs, side).into_pyobject(py)?;
-        let names = &["algebra", "hamiltonian", "gradient", "casimirs", "side"];
+        let args = (algebra, hamiltonian, gradient, casimirs, side, hessian).into_pyobject(py)?;
+        let names = &[
+            "algebra",
+            "hamiltonian",
+            "gradient",
+            "casimirs",
+            "side",
+            "hessian",
+        ];
         Ok(PySystem::subclass(sys, args, names))
     }
 
