@@ -3073,3 +3073,145 @@ fn riemannian_frame_top_jacobians() {
         assert!(defect < 1e-12, "{method}: gradients {defect:e}");
     }
 }
+
+/// Sweeps dt up to steps where the plain iteration stops converging: the lifted run fails
+/// exactly where the plain one does (same step, same message), and where it converges its base
+/// state is the plain run's, bit for bit (the state's unknowns iterate as in the plain solve and
+/// stay fixed once accepted, while the directions converge against their own scales).
+fn lifted_fails_only_where_the_plain_run_does(sys: &dyn System, method: &str, z0: &[f64]) {
+    let t = sys.tangent().unwrap();
+    let seed = t.seed(z0).unwrap();
+    let mut failures = 0;
+    for dt in [0.01, 0.1, 0.3, 0.6, 1.0, 1.5, 2.0, 2.5] {
+        let plain = integrate(sys, method, z0, dt, 50, 1);
+        let lifted = integrate(&*t, method, &seed, dt, 50, 1);
+        match (&plain, &lifted) {
+            (Ok(plain), Ok(lifted)) => {
+                let d = t.base_dim();
+                let (mut z, mut jac) = (vec![0.0; d], vec![0.0; d * t.tangent_dim()]);
+                let mut pjac = vec![0.0; d * t.parameter_names().len()];
+                for k in 0..=50 {
+                    t.jacobian(lifted.state(k), &mut z, &mut jac, &mut pjac);
+                    assert_eq!(z, plain.state(k), "{method}, dt = {dt}, sample {k}");
+                    assert!(jac.iter().chain(&pjac).all(|x| x.is_finite()));
+                }
+            }
+            (Err(a), Err(b)) => {
+                assert_eq!(a.to_string(), b.to_string(), "{method}, dt = {dt}");
+                failures += usize::from(matches!(a, lieflow::Error::NotConverged { .. }));
+            }
+            _ => panic!(
+                "{method}, dt = {dt}: plain {:?}, lifted {:?}",
+                plain.err(),
+                lifted.err()
+            ),
+        }
+    }
+    eprintln!("{method}: the plain and lifted iterations fail at the same {failures} of 8 steps");
+}
+
+/// The rolling disk (with spring and tilt, so its directions grow to 10¹⁰ at dt ≥ 1.5): the
+/// lifted multiplier iteration stagnated at 2.7e-12 of the lifted momenta (tolerance 1e-12)
+/// where the plain one had converged, its state chasing round-off and its directions chasing
+/// the state.
+#[test]
+fn nonholonomic_lift_fails_only_where_the_plain_run_does() {
+    use lieflow::systems::RollingDisk;
+    let disk = RollingDisk::new(1.0, 0.5, 0.125, 0.0625)
+        .unwrap()
+        .with_potential(0.4, 0.3)
+        .unwrap();
+    let z0 = disk.state([0.1, -0.2, 0.3, 0.7], 2.0, 0.5).unwrap();
+    lifted_fails_only_where_the_plain_run_does(&disk, "nonholonomic", &z0);
+    // Without a potential: a direction whose momenta start at zero (δφ₀) and the parameter
+    // directions, zero at the start, are measured against the solutions they converge to.
+    let free = RollingDisk::new(1.0, 0.5, 0.125, 0.0625).unwrap();
+    lifted_fails_only_where_the_plain_run_does(&free, "nonholonomic", &z0);
+}
+
+/// The same sweep for RATTLE and the Gauss methods, which solve their lifts block by block too.
+#[test]
+fn rattle_and_gauss_lifts_fail_only_where_the_plain_runs_do() {
+    use lieflow::systems::{Pendulum, SphereParticle};
+    let pendulum = Pendulum::new(1.0, 1.0, 9.81).unwrap();
+    for method in ["gauss6", "gauss4", "midpoint"] {
+        lifted_fails_only_where_the_plain_run_does(&pendulum, method, &[2.5, 0.0]);
+    }
+    let particle = SphereParticle::new(2.0, 1.5, 9.81).unwrap();
+    lifted_fails_only_where_the_plain_run_does(
+        &particle,
+        "rattle",
+        &[0.0, 0.9, 1.2, 0.4, 1.2, -0.9],
+    );
+    // The incompressible body (RATTLE compositions; 22 directions), from a state on
+    // T*{det X = det X₀}: P projected off cof X.
+    let elastic = Arc::new(SaintVenantKirchhoff::new(1.0, 2.0).unwrap());
+    let body = PseudoRigidBody::incompressible(3, elastic).unwrap();
+    let mut z0 = body_state();
+    let x = nalgebra::Matrix3::from_row_slice(&z0[..9]);
+    let cof = x.determinant() * x.try_inverse().unwrap().transpose();
+    let c: Vec<f64> = (0..9).map(|k| cof[(k / 3, k % 3)]).collect();
+    let along =
+        (0..9).map(|k| c[k] * z0[9 + k]).sum::<f64>() / c.iter().map(|x| x * x).sum::<f64>();
+    (0..9).for_each(|k| z0[9 + k] -= along * c[k]);
+    for method in ["rattle", "rattle4"] {
+        lifted_fails_only_where_the_plain_run_does(&body, method, &z0);
+    }
+}
+
+/// The Lie midpoint on the free body's group-field lift (no catalog offers it yet): the same dt
+/// sweep through `integrate_with`, same outcomes and bit-equal base states; and where it
+/// converges its Jacobian is the derivative of the plain midpoint map (central differences).
+#[test]
+fn lie_midpoint_lift_fails_only_where_the_plain_run_does() {
+    use lieflow::integrate::integrate_with;
+    use lieflow::integrate::methods::LieMidpoint;
+    use lieflow::integrate::tangent::Tangent;
+    let rb = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
+    let lift = Tangent::group_field(rb.clone());
+    let z0 = [0.3, -0.8, 1.1];
+    let seed = lift.seed(&z0).unwrap();
+    let method = LieMidpoint::new();
+    let steps = 50;
+    let mut failures = 0;
+    for dt in [0.01, 0.1, 0.3, 0.6, 1.0, 1.5, 2.0, 2.5] {
+        let plain = integrate_with(&rb, &method, &z0, dt, steps, 1);
+        let lifted = integrate_with(&lift, &method, &seed, dt, steps, 1);
+        match (&plain, &lifted) {
+            (Ok(plain), Ok(lifted)) => {
+                let (mut z, mut jac, mut pjac) = (vec![0.0; 3], vec![0.0; 9], vec![0.0; 9]);
+                for k in 0..=steps {
+                    lift.jacobian(lifted.state(k), &mut z, &mut jac, &mut pjac);
+                    assert_eq!(z, plain.state(k), "dt = {dt}, sample {k}");
+                }
+                let h = 1e-6;
+                let mut worst = 0.0f64;
+                for j in 0..3 {
+                    let end = |s: f64| {
+                        let mut z = z0;
+                        z[j] += s;
+                        let traj = integrate_with(&rb, &method, &z, dt, steps, steps).unwrap();
+                        traj.state(1).to_vec()
+                    };
+                    let (p, m) = (end(h), end(-h));
+                    for i in 0..3 {
+                        worst = worst.max((jac[i * 3 + j] - (p[i] - m[i]) / (2.0 * h)).abs());
+                    }
+                }
+                let scale = jac.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                eprintln!("Lie midpoint dt = {dt}: Jacobian vs differences {worst:.1e} (|J| ≤ {scale:.1})");
+                assert!(worst < 1e-7 * scale, "dt = {dt}: {worst:e}");
+            }
+            (Err(a), Err(b)) => {
+                assert_eq!(a.to_string(), b.to_string(), "dt = {dt}");
+                failures += 1;
+            }
+            _ => panic!(
+                "dt = {dt}: plain {:?}, lifted {:?}",
+                plain.err(),
+                lifted.err()
+            ),
+        }
+    }
+    eprintln!("Lie midpoint: the plain and lifted runs fail at the same {failures} of 8 steps");
+}

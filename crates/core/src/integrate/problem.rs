@@ -380,7 +380,7 @@ pub trait GroupField: Problem {
     }
 
     /// The number of blocks of an iteration over the algebra coordinates: 1, or the state and
-    /// its directions for a tangent lift ([`crate::convergence::Rule::for_blocks`]).
+    /// its directions for a tangent lift ([`crate::convergence::Blocks`]).
     fn diagonal_blocks(&self) -> usize {
         1
     }

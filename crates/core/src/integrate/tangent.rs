@@ -23,7 +23,9 @@
 //! on the lifted unknowns as on the plain ones: the lifted Jacobian is block lower-triangular
 //! with the plain one on its diagonal ([`VectorField::diagonal_blocks`]), so Gauss factors the
 //! plain Newton matrix once per step and solves every direction with it (the
-//! implicit-function theorem). With k
+//! implicit-function theorem). Each block (the state, each direction) is measured against its
+//! own scale ([`crate::convergence::Blocks`]): the state stops where the plain iteration does,
+//! and its directions then converge at the accepted state. With k
 //! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + k) plain
 //! runs.
 //!

@@ -40,14 +40,16 @@
 //! solved with its LU: the implicit-function theorem's matrix, so a run with k directions costs
 //! about 1 + k plain runs (not (1 + k)³). The iteration converges on the directions as on the
 //! state (they enter linearly), and what it computes for them is the derivative of the Gauss
-//! map itself. They start converging when the state has, so a lift's iteration may take twice
-//! [`RULE`]`.max_iter` iterations ([`Rule::for_blocks`]) (with the plain limit, a pendulum at dt = 1 that `gauss6`
-//! solves plainly failed with its directions).
+//! map itself. Each block's update is measured against its own scale ([`Blocks`]): the state's
+//! as in the plain solve, which it stops where the plain solve does and then leaves alone (its
+//! stage derivatives F those of that iteration: the base state is the plain run's, bit for
+//! bit); each direction's against the larger of its ‖δy‖_∞ and its stage increments', until it
+//! is accepted too (so up to about twice [`RULE`]`.max_iter` iterations).
 //!
 //! The coefficients are the closed forms of HLW §II.1.3, evaluated in double precision
 //! (√3 and √15 correctly rounded; every coefficient within an ulp or two of its exact value).
 
-use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
+use crate::convergence::{self, Blocks, Failed, Rule, Verdict};
 use crate::error::{Error, Result};
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::VectorField;
@@ -146,6 +148,10 @@ impl<P: VectorField + Clone + 'static> Integrator<P> for Gauss {
             index,
             block: vec![0.0; s * nb],
             lu: DenseLu::new(s * nb),
+            monitor: Blocks::new(RULE, blocks),
+            updates: vec![0.0; blocks],
+            scales: vec![0.0; blocks],
+            kept: vec![0.0; s * nb],
         }))
     }
 }
@@ -175,10 +181,13 @@ struct GaussStepper<P> {
     /// One block of the update (s·n_b values), the LU of I − h A⊗J.
     block: Vec<f64>,
     lu: DenseLu,
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+    /// The rule on the diagonal blocks (one but for a lift), each block's update and scale,
+    /// and the state's stage derivatives F of the iteration that accepted it (a lift's
+    /// directions iterate on; the state's step is then the plain one).
+    monitor: Blocks,
+    updates: Vec<f64>,
+    scales: Vec<f64>,
+    kept: Vec<f64>,
 }
 
 impl<P: VectorField> GaussStepper<P> {
@@ -204,6 +213,10 @@ impl<P: VectorField> GaussStepper<P> {
             index,
             block,
             lu,
+            monitor,
+            updates,
+            scales,
+            kept,
         } = self;
         let (s, h, n) = (*s, *h, y.len());
         let nb = block.len() / s;
@@ -211,7 +224,6 @@ impl<P: VectorField> GaussStepper<P> {
         problem.field(y, f0);
         // J ≈ f'(y) on the base block by forward differences, column by column (module docs:
         // the steps).
-        let ynorm = max_abs(y);
         let bnorm = base.iter().fold(0.0f64, |m, &k| m.max(y[k].abs()));
         let root = f64::EPSILON.sqrt();
         let wide = root * if bnorm > 0.0 { bnorm } else { 1.0 };
@@ -262,8 +274,7 @@ impl<P: VectorField> GaussStepper<P> {
                 z[i * n + k] = h * c[i] * f0[k];
             }
         }
-        let scale = ynorm.max(f64::MIN_POSITIVE);
-        let mut monitor = Monitor::new(RULE.for_blocks(index.len() / nb));
+        monitor.start();
         loop {
             for i in 0..s {
                 for k in 0..n {
@@ -280,28 +291,55 @@ impl<P: VectorField> GaussStepper<P> {
                     dz[i * n + k] = h * acc - z[i * n + k];
                 }
             }
-            // Each diagonal block of the update solved with the one LU.
-            for idx in index.chunks_exact(nb) {
+            // Each diagonal block of the update solved with the one LU (zero for a block
+            // already accepted), its size, and its scale: the state's ‖y‖_∞ as in the plain
+            // solve, a direction's also its stage increments' (a parameter direction starts at
+            // zero).
+            for (b, idx) in index.chunks_exact(nb).enumerate() {
+                let active = monitor.active(b);
                 for i in 0..s {
                     for (r, &k) in idx.iter().enumerate() {
-                        block[i * nb + r] = dz[i * n + k];
+                        block[i * nb + r] = if active { dz[i * n + k] } else { 0.0 };
                     }
                 }
-                lu.solve(block);
+                if active {
+                    lu.solve(block);
+                }
+                let (mut size, mut scale) = (0.0f64, 0.0f64);
                 for i in 0..s {
                     for (r, &k) in idx.iter().enumerate() {
                         dz[i * n + k] = block[i * nb + r];
+                        z[i * n + k] += block[i * nb + r];
+                        size = size.max(block[i * nb + r].abs());
+                        if b > 0 {
+                            scale = scale.max(z[i * n + k].abs());
+                        }
+                    }
+                }
+                let own = idx.iter().fold(0.0f64, |m, &k| m.max(y[k].abs()));
+                updates[b] = size;
+                scales[b] = own.max(scale).max(f64::MIN_POSITIVE);
+            }
+            let accepted = !monitor.active(0);
+            let verdict = monitor.check(updates, scales);
+            if monitor.blocks() > 1 && !accepted && !monitor.active(0) {
+                for i in 0..s {
+                    for (r, &k) in base.iter().enumerate() {
+                        kept[i * nb + r] = f[i * n + k];
                     }
                 }
             }
-            let norm = max_abs(dz);
-            for (zk, dk) in z.iter_mut().zip(dz.iter()) {
-                *zk += dk;
-            }
-            match monitor.check(norm, scale) {
+            match verdict {
                 Verdict::Continue => {}
                 Verdict::Converged => break,
                 Verdict::Failed(failed) => return Err(failed),
+            }
+        }
+        if monitor.blocks() > 1 {
+            for i in 0..s {
+                for (r, &k) in base.iter().enumerate() {
+                    f[i * n + k] = kept[i * nb + r];
+                }
             }
         }
         // y ← y + h Σ b_i F_i, Kahan-compensated.

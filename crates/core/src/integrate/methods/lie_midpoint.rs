@@ -26,9 +26,11 @@
 //! so that an early stop does not leave a systematic O(tol) energy drift);
 //! [`crate::Error::NotConverged`] names a step whose update is still above the tolerance after
 //! [`RULE`]`.max_iter` iterations. A non-finite increment stops the run with
-//! [`crate::Error::LeftDomain`].
+//! [`crate::Error::LeftDomain`]. On a tangent lift ([`GroupField::diagonal_blocks`]) each
+//! block of k is measured against its own scale ([`Blocks`]): the state's as in the plain
+//! solve, a direction's the larger of its iterate's and its first iterate's.
 
-use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
+use crate::convergence::{self, Blocks, Failed, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::methods::Composition;
@@ -78,6 +80,12 @@ impl<P: GroupField + Clone + 'static> Integrator<P> for LieMidpoint {
 
     fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
         let (n, g) = (problem.space().dim(), problem.algebra_dim());
+        let blocks = problem.diagonal_blocks().max(1);
+        let blocks = if g % blocks == 0 { blocks } else { 1 };
+        let rule = Rule {
+            tol: problem.solve_tolerance().max(RULE.tol),
+            ..RULE
+        };
         Ok(Box::new(MidpointStepper {
             scratch: problem.scratch(),
             problem: problem.clone(),
@@ -90,6 +98,10 @@ impl<P: GroupField + Clone + 'static> Integrator<P> for LieMidpoint {
             knew: vec![0.0; g],
             dz: vec![0.0; n],
             carry: vec![0.0; n],
+            start: vec![0.0; g],
+            monitor: Blocks::new(rule, blocks),
+            updates: vec![0.0; blocks],
+            scales: vec![0.0; blocks],
         }))
     }
 }
@@ -109,6 +121,12 @@ struct MidpointStepper<P: GroupField> {
     /// ([`GroupField::act_increment`]), and the carry of its compensated sum.
     dz: Vec<f64>,
     carry: Vec<f64>,
+    /// The first iterate h ξ(y), the rule on the blocks of k (one but for a lift: the state's
+    /// and each direction's algebra coordinates), each block's update and scale.
+    start: Vec<f64>,
+    monitor: Blocks,
+    updates: Vec<f64>,
+    scales: Vec<f64>,
 }
 
 /// Why a substep failed.
@@ -134,17 +152,17 @@ impl<P: GroupField> MidpointStepper<P> {
             knew,
             dz,
             carry,
+            start,
+            monitor,
+            updates,
+            scales,
             ..
         } = self;
         problem.generator(y, k, scratch);
         k.iter_mut().for_each(|x| *x *= h);
-        let mut monitor = Monitor::new(
-            Rule {
-                tol: problem.solve_tolerance().max(RULE.tol),
-                ..RULE
-            }
-            .for_blocks(problem.diagonal_blocks()),
-        );
+        start.copy_from_slice(k);
+        let g0 = k.len() / monitor.blocks();
+        monitor.start();
         loop {
             for (hi, ki) in half.iter_mut().zip(k.iter()) {
                 *hi = 0.5 * ki;
@@ -152,16 +170,28 @@ impl<P: GroupField> MidpointStepper<P> {
             yt.copy_from_slice(y);
             problem.act(half, yt, scratch);
             problem.generator(yt, knew, scratch);
-            let mut d = 0.0f64;
-            for (kn, ki) in knew.iter_mut().zip(k.iter_mut()) {
-                *kn *= h;
-                d = d.max((*kn - *ki).abs());
-                *ki = *kn;
+            // Each block's update (none once accepted) and scale: the state's max(‖k‖_∞, 1),
+            // a direction's the larger of its iterate's and its first iterate's.
+            let parts = knew.chunks_exact_mut(g0).zip(k.chunks_exact_mut(g0));
+            for (b, ((kn, kb), sb)) in parts.zip(start.chunks_exact(g0)).enumerate() {
+                let mut d = 0.0f64;
+                if monitor.active(b) {
+                    for (kn, ki) in kn.iter_mut().zip(kb.iter_mut()) {
+                        *kn *= h;
+                        d = d.max((*kn - *ki).abs());
+                        *ki = *kn;
+                    }
+                }
+                if !d.is_finite() {
+                    return Err(Failure::NotFinite);
+                }
+                updates[b] = d;
+                scales[b] = match b {
+                    0 => inf_norm(kb).max(1.0),
+                    _ => inf_norm(kb).max(inf_norm(sb)).max(f64::MIN_POSITIVE),
+                };
             }
-            if !d.is_finite() {
-                return Err(Failure::NotFinite);
-            }
-            match monitor.check(d, inf_norm(k).max(1.0)) {
+            match monitor.check(updates, scales) {
                 Verdict::Continue => {}
                 Verdict::Converged => break,
                 Verdict::Failed(failed) => return Err(Failure::NotConverged(failed)),

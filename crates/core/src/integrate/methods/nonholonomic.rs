@@ -28,8 +28,9 @@
 //! **Solves.** With w = (h/2)μ and the rows W_b = M⁻¹A_b(q_n)ᵀ, the midpoint condition
 //! F(w) = A(q̄(w)) M⁻¹(p̃ − A(q_n)ᵀw) = 0 (p̃ = p_n + h/2 f(q_n)) is solved by a simplified Newton
 //! iteration with the matrix A(q̄^{(k)}) Wᵀ (the neglected derivative of A along q̄ is O(h)), under
-//! the rule of [`crate::convergence`] ([`RULE`]: the momentum update relative to ‖p̃‖_∞); the
-//! last substep is the linear projection of RATTLE ([`super::rattle`]).
+//! the rule of [`crate::convergence`] ([`RULE`]: the momentum update relative to ‖p̃‖_∞; on a
+//! tangent lift each block's against its own, [`crate::convergence::Blocks`]); the last
+//! substep is the linear projection of RATTLE ([`super::rattle`]).
 //!
 //! **Force rows.** The multipliers act on the momenta along the rows F(q) of
 //! [`Nonholonomic::constraint_forces`] (A(q) for a mechanical system): A(q_n)ᵀw above is F(q_n)ᵀw,
@@ -37,10 +38,11 @@
 //! tangent lift ([`crate::integrate::tangent`]) the constraint rows Ã = \[\[A, 0\], \[DA\[δq\], A\]\]
 //! and the force rows (the derivative of −Aᵀλ, paired the other way) make every matrix of the
 //! step block lower-triangular with the plain one on its diagonal: the base unknowns iterate as in
-//! the plain run, and the converged step is the derivative of the plain one.
+//! the plain run (and stay once accepted), and the converged step is the derivative of the plain
+//! one.
 
-use super::rattle::{axpy, dot, max_abs, singular, Failure, Rows};
-use crate::convergence::{self, Monitor, Rule, Verdict};
+use super::rattle::{axpy, block_scales, dot, singular, Failure, Rows};
+use crate::convergence::{self, Blocks, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::method::{Clock, Integrator, Properties, Stepper};
 use crate::integrate::problem::{Nonholonomic, Separable, Violation};
@@ -71,6 +73,8 @@ impl<P: Nonholonomic + Clone + 'static> Integrator<P> for NonholonomicRattle {
 
     fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
         let (d, m) = (problem.dof(), problem.constraints());
+        let rows = Rows::new(problem, m, d);
+        let blocks = rows.blocks;
         Ok(Box::new(NonholonomicStepper {
             scratch: problem.scratch(),
             problem: problem.clone(),
@@ -81,10 +85,13 @@ impl<P: Nonholonomic + Clone + 'static> Integrator<P> for NonholonomicRattle {
             v: vec![0.0; d],
             ph: vec![0.0; d],
             qbar: vec![0.0; d],
-            rows: Rows::new(problem, m, d),
+            rows,
             abar: vec![0.0; m * d],
             r: vec![0.0; m],
             w: vec![0.0; m],
+            monitor: Blocks::new(RULE, blocks),
+            updates: vec![0.0; blocks],
+            scales: vec![0.0; blocks],
         }))
     }
 }
@@ -107,6 +114,11 @@ struct NonholonomicStepper<P: Separable> {
     abar: Vec<f64>,
     r: Vec<f64>,
     w: Vec<f64>,
+    /// The rule on the blocks of the unknowns (one but for a lift), each block's momentum
+    /// update and scale.
+    monitor: Blocks,
+    updates: Vec<f64>,
+    scales: Vec<f64>,
 }
 
 impl<P: Nonholonomic> NonholonomicStepper<P> {
@@ -148,8 +160,8 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
         self.w.fill(0.0);
         self.half_step();
         if m > 0 {
-            let scale = max_abs(&self.p).max(f64::MIN_POSITIVE);
-            let mut monitor = Monitor::new(RULE.for_blocks(self.rows.blocks));
+            let n0 = d / self.monitor.blocks();
+            self.monitor.start();
             loop {
                 self.problem
                     .constraint_matrix(&self.qbar, &mut self.abar, &mut self.scratch);
@@ -159,16 +171,17 @@ impl<P: Nonholonomic> NonholonomicStepper<P> {
                 if !self.rows.factor_with(Some(&self.abar)) {
                     return Err(Failure::Domain(singular(self.problem.name())));
                 }
-                self.rows.solve(&mut self.r);
+                self.rows.solve_active(&mut self.r, &self.monitor);
                 axpy(&mut self.w, 1.0, &self.r);
-                let mut norm = 0.0f64;
+                self.updates.fill(0.0);
+                let forces = self.rows.forces();
                 for k in 0..d {
-                    let forces = self.rows.forces();
                     let dp: f64 = (0..m).map(|b| self.r[b] * forces[b * d + k]).sum();
-                    norm = norm.max(dp.abs());
+                    self.updates[k / n0] = self.updates[k / n0].max(dp.abs());
                 }
                 self.half_step();
-                match monitor.check(norm, scale) {
+                block_scales(&self.p, &self.ph, &mut self.scales);
+                match self.monitor.check(&self.updates, &self.scales) {
                     Verdict::Continue => {}
                     Verdict::Converged => break,
                     Verdict::Failed(failed) => return Err(Failure::NotConverged(failed)),

@@ -28,7 +28,8 @@
 //! linear), the position is q_{n+1} = q̃ − Σ_b ν_b W_b with q̃ = q_n + h M⁻¹(p_n + h/2 f(q_n)), and
 //! ν solves g(q̃ − Σ ν_b W_b) = c by Newton's method (the m×m Jacobian G(q_{n+1}^{(k)}) Wᵀ is
 //! refactored every iteration) under the rule of [`crate::convergence`] ([`RULE`]: the position
-//! update relative to ‖q‖_∞); then p_{n+1/2} = p̃ − G(q_n)ᵀν/h. The multiplier μ solves the
+//! update relative to ‖q‖_∞; on a tangent lift each block's against its own, [`Blocks`]); then
+//! p_{n+1/2} = p̃ − G(q_n)ᵀν/h. The multiplier μ solves the
 //! linear m×m system (G M⁻¹Gᵀ)(q_{n+1}) κ = G M⁻¹ p̃ (κ = hμ/2). G, W and f at
 //! q_{n+1} are reused by the next (sub)step.
 //!
@@ -38,7 +39,7 @@
 //! multiplier for which d²/dt² g(q(t)) = 0), the limit of RATTLE's λ and μ as h → 0.
 
 use super::gauss::DenseLu;
-use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
+use crate::convergence::{self, Blocks, Failed, Rule, Verdict};
 use crate::error::Result;
 use crate::integrate::method::{Clock, Entry, Integrator, Properties, Stepper};
 use crate::integrate::methods::Composition;
@@ -223,7 +224,15 @@ impl Rows {
 
     /// Solves the factored system in place (m values): block forward substitution with S₀₀.
     pub(crate) fn solve(&mut self, x: &mut [f64]) {
-        solve_blocks(&mut self.lu, &self.low, self.blocks, x);
+        solve_blocks(&mut self.lu, &self.low, self.blocks, x, |_| true);
+    }
+
+    /// [`Rows::solve`] for the blocks the monitor still iterates: an accepted block's update is
+    /// zero (its unknowns stay), so a direction's is S₀₀⁻¹x_j once the state's is accepted.
+    pub(crate) fn solve_active(&mut self, x: &mut [f64], monitor: &Blocks) {
+        solve_blocks(&mut self.lu, &self.low, self.blocks, x, |b| {
+            monitor.active(b)
+        });
     }
 
     /// p ← p − Fᵀκ with κ such that C M⁻¹p = 0 afterwards (the projection of the last RATTLE
@@ -245,7 +254,9 @@ impl Rows {
         for a in 0..m {
             self.rhs[a] = dot(&self.c[a * d..(a + 1) * d], v);
         }
-        solve_blocks(&mut self.lu, &self.low, self.blocks, &mut self.rhs);
+        solve_blocks(&mut self.lu, &self.low, self.blocks, &mut self.rhs, |_| {
+            true
+        });
         let forces = if self.distinct { &self.f } else { &self.c };
         for a in 0..m {
             axpy(p, -self.rhs[a], &forces[a * d..(a + 1) * d]);
@@ -255,16 +266,49 @@ impl Rows {
 }
 
 /// x ← S⁻¹x for S block lower-triangular with B diagonal blocks S₀₀ (factored in `lu`) and
-/// the blocks S_j0 (`low`) below: x₀ = S₀₀⁻¹x₀, x_j = S₀₀⁻¹(x_j − S_j0 x₀).
-fn solve_blocks(lu: &mut DenseLu, low: &[f64], blocks: usize, x: &mut [f64]) {
+/// the blocks S_j0 (`low`) below: x₀ = S₀₀⁻¹x₀, x_j = S₀₀⁻¹(x_j − S_j0 x₀); x_b = 0 for a
+/// block b that is not `active`.
+fn solve_blocks(
+    lu: &mut DenseLu,
+    low: &[f64],
+    blocks: usize,
+    x: &mut [f64],
+    active: impl Fn(usize) -> bool,
+) {
     let m0 = x.len() / blocks;
     let (x0, rest) = x.split_at_mut(m0);
-    lu.solve(x0);
+    if active(0) {
+        lu.solve(x0);
+    } else {
+        x0.fill(0.0);
+    }
     for (j, xj) in rest.chunks_exact_mut(m0).enumerate() {
+        if !active(j + 1) {
+            xj.fill(0.0);
+            continue;
+        }
         for (a, xa) in xj.iter_mut().enumerate() {
             *xa -= dot(&low[(j * m0 + a) * m0..(j * m0 + a + 1) * m0], x0);
         }
         lu.solve(xj);
+    }
+}
+
+/// The scales of a block solve ([`Blocks`]) of unknowns in `blocks` equal blocks (the state's
+/// and its directions' parts of `data` and `iterate`): the state's its data's ‖·‖_∞, as in the
+/// plain solve; a direction's the larger of its data's and its iterate's (a direction's data
+/// may vanish where its solution does not: a parameter direction at t = 0). At least the least
+/// positive number.
+pub(crate) fn block_scales(data: &[f64], iterate: &[f64], scales: &mut [f64]) {
+    let n = data.len() / scales.len();
+    for (b, s) in scales.iter_mut().enumerate() {
+        let part = b * n..(b + 1) * n;
+        let own = max_abs(&data[part.clone()]);
+        *s = match b {
+            0 => own,
+            _ => own.max(max_abs(&iterate[part])),
+        }
+        .max(f64::MIN_POSITIVE);
     }
 }
 
@@ -297,6 +341,8 @@ impl<P: Constrained + Clone + 'static> Integrator<P> for Rattle {
 
     fn stepper(&self, problem: &P, dt: f64) -> Result<Box<dyn Stepper>> {
         let (d, m) = (problem.dof(), problem.constraints());
+        let rows = Rows::new(problem, m, d);
+        let blocks = rows.blocks;
         Ok(Box::new(RattleStepper {
             scratch: problem.scratch(),
             problem: problem.clone(),
@@ -307,11 +353,14 @@ impl<P: Constrained + Clone + 'static> Integrator<P> for Rattle {
             f: vec![0.0; d],
             v: vec![0.0; d],
             qn: vec![0.0; d],
-            rows: Rows::new(problem, m, d),
+            rows,
             jac: vec![0.0; m * d],
             g: vec![0.0; m],
             g0: vec![0.0; m],
             nu: vec![0.0; m],
+            monitor: Blocks::new(RULE, blocks),
+            updates: vec![0.0; blocks],
+            scales: vec![0.0; blocks],
         }))
     }
 }
@@ -337,6 +386,11 @@ struct RattleStepper<P: Separable> {
     /// The level c of the constraint g(q) = c (0, or g(q₀) for a level set).
     g0: Vec<f64>,
     nu: Vec<f64>,
+    /// The rule on the blocks of the unknowns (one but for a lift), each block's position
+    /// update and scale.
+    monitor: Blocks,
+    updates: Vec<f64>,
+    scales: Vec<f64>,
 }
 
 impl<P: Constrained> RattleStepper<P> {
@@ -364,6 +418,9 @@ impl<P: Constrained> RattleStepper<P> {
             g,
             g0,
             nu,
+            monitor,
+            updates,
+            scales,
             ..
         } = self;
         let (d, m) = (q.len(), g.len());
@@ -375,8 +432,8 @@ impl<P: Constrained> RattleStepper<P> {
         // Newton for ν: g(q̃ − Σ ν_b W_b) = c.
         nu.fill(0.0);
         if m > 0 {
-            let scale = max_abs(q).max(f64::MIN_POSITIVE);
-            let mut monitor = Monitor::new(RULE.for_blocks(rows.blocks));
+            let n0 = d / monitor.blocks();
+            monitor.start();
             loop {
                 problem.constraint(qn, g, scratch);
                 for (gb, cb) in g.iter_mut().zip(g0.iter()) {
@@ -386,15 +443,16 @@ impl<P: Constrained> RattleStepper<P> {
                 if !rows.factor_with(Some(jac)) {
                     return Err(Failure::Domain(singular(problem.name())));
                 }
-                rows.solve(g);
-                let mut norm = 0.0f64;
+                rows.solve_active(g, monitor);
+                updates.fill(0.0);
                 for (k, qk) in qn.iter_mut().enumerate() {
                     let dq: f64 = (0..m).map(|b| g[b] * rows.w[b * d + k]).sum();
                     *qk -= dq;
-                    norm = norm.max(dq.abs());
+                    updates[k / n0] = updates[k / n0].max(dq.abs());
                 }
                 axpy(nu, 1.0, g);
-                match monitor.check(norm, scale) {
+                block_scales(q, qn, scales);
+                match monitor.check(updates, scales) {
                     Verdict::Continue => {}
                     Verdict::Converged => break,
                     Verdict::Failed(failed) => return Err(Failure::NotConverged(failed)),
