@@ -1478,7 +1478,7 @@ fn hessian_defect<S: lieflow::integrate::tangent::CanonicalTangent>(
     let mut hv = vec![0.0; 2 * d];
     let (hq, hp) = hv.split_at_mut(d);
     s.gradient_tangent(&z[..d], &z[d..], &dz[..d], &dz[d..], hq, hp);
-    let h = 1e-3;
+    let h = 5e-4;
     let at = |t: f64| {
         let y: Vec<f64> = z.iter().zip(dz).map(|(a, b)| a + t * b).collect();
         flat_gradient(s, &y)
@@ -1490,8 +1490,8 @@ fn hessian_defect<S: lieflow::integrate::tangent::CanonicalTangent>(
     max_rel(&hv, &fd)
 }
 
-/// max |∂∇H/∂θ_m − (fourth-order difference of ∇H of the rebuilt system)| relative to
-/// max(1, |∂∇H/∂θ|), over the parameters.
+/// max |∂∇H/∂θ_m − (fourth-order difference of ∇H of the rebuilt system, step 1e-3·|θ_m|)|
+/// relative to max(1, |∂∇H/∂θ|), over the parameters (θ_m ≠ 0).
 fn gradient_parameter_defect<S, const P: usize>(
     build: impl Fn([f64; P]) -> S,
     theta: [f64; P],
@@ -1508,7 +1508,8 @@ where
         let mut g = vec![0.0; 2 * d];
         let (hq, hp) = g.split_at_mut(d);
         s.gradient_parameter(&z[..d], &z[d..], m, hq, hp);
-        let h = 1e-3 * theta[m].abs().max(1.0);
+        // A step relative to θ_m (a small inertia changes H on its own scale).
+        let h = 1e-3 * theta[m].abs();
         let at = |t: f64| {
             let mut th = theta;
             th[m] += t;
@@ -1727,4 +1728,135 @@ fn parameter_jacobians_of_the_tangent_tops_and_the_disks() {
         let fd = parameter_differences(rolling_disks_with, DISKS, method, &z0, (dt, steps), 1e-5);
         report("RollingDisks", method, &pj, &fd);
     }
+}
+
+/// A Legendre top of 002 §IV built from its parameters (m, 𝕀), checked whole: the Hessian of H
+/// (implicit-function theorem on the Legendre map) and ∂∇H/∂θ against differences of the
+/// gradient (≤ 1e-8), every lifted method's Jacobian (and the Gauss ones symplectic) and the
+/// gauss4 parameter Jacobian against differences of the runs (≤ 1e-8). Returns the worst
+/// (Hessian, parameter) defects.
+fn check_legendre_top<S>(
+    name: &str,
+    build: impl Fn([f64; 2]) -> S + Copy,
+    theta: [f64; 2],
+    z0: &[f64],
+) -> (f64, f64)
+where
+    S: lieflow::integrate::tangent::CanonicalTangent + System,
+{
+    let top = build(theta);
+    let h = probe_directions(6)
+        .iter()
+        .fold(0.0f64, |m, dz| m.max(hessian_defect(&top, z0, dz)));
+    let p = gradient_parameter_defect(build, theta, z0);
+    eprintln!("{name}: Hessian {h:.1e}, parameters {p:.1e}");
+    assert!(h < 1e-8 && p < 1e-8, "{name}: {h:e} {p:e}");
+    let (dt, steps) = (0.05, 20);
+    check_canonical_lift(name, &top, z0, dt, steps);
+    let t = top.tangent().unwrap();
+    assert_eq!(t.parameter_names(), ["mass", "inertia"]);
+    let (_, _, pj) = lifted_end_all(&*t, "gauss4", z0, dt, steps);
+    // A step of 1e-6 (θ = 0.07 moved by 1e-5 would leave a truncation of 2e-8).
+    let fd = parameter_differences(build, theta, "gauss4", z0, (dt, steps), 1e-6);
+    let err = max_rel(&pj, &fd);
+    eprintln!("{name}: gauss4: parameter Jacobian vs differences {err:.1e}");
+    assert!(err < 1e-8, "{name}: {err:e}");
+    (h, p)
+}
+
+/// Issue 26: the relativistic tops of 002 §IV (Minkowski, symmetric and anisotropic; on the
+/// sphere and the hyperbolic plane, symmetric and anisotropic, the anisotropic kernel reading
+/// the frame's derivative), the weak-field top (point mass, uniform field) and the static-field
+/// top (flat, on the sphere) lift through the implicit-function theorem on their Legendre maps;
+/// a custom potential (no third derivatives) or a graph (no second derivatives) gives no lift.
+#[test]
+fn legendre_tops_lift_through_the_inverse_legendre_map() {
+    use lieflow::systems::{
+        Graph, HyperbolicPlane, Potential, PotentialValue, RelativisticTangentTop, Sphere,
+        StaticFieldTop, Surface, WeakFieldTop,
+    };
+    let (x, th, xd, td) = ([0.3, 0.6], 0.4, [0.25, -0.15], 1.2);
+    // Minkowski, anisotropic and symmetric.
+    let moments = [0.05, 0.01, 0.02];
+    let tr = moments[0] + moments[2];
+    let mink =
+        |t: [f64; 2]| RelativisticTangentTop::new(t[0], moments.map(|i| i * t[1] / tr)).unwrap();
+    let z0 = mink([1.2, tr]).state(x, th, xd, td).unwrap();
+    check_legendre_top("Minkowski, anisotropic", mink, [1.2, tr], &z0);
+    let sym = |t: [f64; 2]| RelativisticTangentTop::symmetric(t[0], t[1]).unwrap();
+    let z0 = sym([1.0, 0.2]).state(x, th, xd, td).unwrap();
+    check_legendre_top("Minkowski, symmetric", sym, [1.0, 0.2], &z0);
+    // On surfaces.
+    let sphere: Arc<dyn Surface> = Arc::new(Sphere::new(1.0).unwrap());
+    let hyp: Arc<dyn Surface> = Arc::new(HyperbolicPlane);
+    for (sname, surface) in [("sphere", sphere.clone()), ("hyperbolic plane", hyp)] {
+        let s1 = surface.clone();
+        let curved =
+            move |t: [f64; 2]| RelativisticTangentTop::on_surface(s1.clone(), t[0], t[1]).unwrap();
+        let z0 = curved([1.0, 0.2]).state(x, th, xd, td).unwrap();
+        check_legendre_top(&format!("{sname}, symmetric"), &curved, [1.0, 0.2], &z0);
+        let moments = [0.15, 0.04, 0.05];
+        let tr = moments[0] + moments[2];
+        let s2 = surface.clone();
+        let aniso = move |t: [f64; 2]| {
+            RelativisticTangentTop::on_surface_with_moments(
+                s2.clone(),
+                t[0],
+                moments.map(|i| i * t[1] / tr),
+            )
+            .unwrap()
+        };
+        let z0 = aniso([1.0, tr]).state(x, th, xd, td).unwrap();
+        check_legendre_top(&format!("{sname}, anisotropic"), &aniso, [1.0, tr], &z0);
+    }
+    // The weak field and the static field.
+    let weak =
+        |t: [f64; 2]| WeakFieldTop::new(t[0], t[1], Potential::point_mass(1.0).unwrap()).unwrap();
+    let z0 = weak([1.0, 0.2])
+        .state([1.0, 0.2], 0.0, [-0.1, 0.6], 1.0)
+        .unwrap();
+    check_legendre_top("weak field, point mass", weak, [1.0, 0.2], &z0);
+    let uniform = |t: [f64; 2]| {
+        WeakFieldTop::new(t[0], t[1], Potential::uniform([0.3, -0.8]).unwrap()).unwrap()
+    };
+    let z0 = uniform([1.0, 0.2])
+        .state([1.0, 0.2], 0.0, [-0.1, 0.6], 1.0)
+        .unwrap();
+    check_legendre_top("weak field, uniform", uniform, [1.0, 0.2], &z0);
+    let flat = |t: [f64; 2]| {
+        StaticFieldTop::new(t[0], t[1], Potential::point_mass(0.15).unwrap()).unwrap()
+    };
+    let z0 = flat([1.0, 0.2])
+        .state([1.0, 0.2], 0.3, [-0.1, 0.4], 1.0)
+        .unwrap();
+    check_legendre_top("static field, point mass", flat, [1.0, 0.2], &z0);
+    let s3 = sphere.clone();
+    let on_sphere = move |t: [f64; 2]| {
+        StaticFieldTop::on_surface(s3.clone(), t[0], t[1], Potential::point_mass(0.1).unwrap())
+            .unwrap()
+    };
+    let z0 = on_sphere([1.0, 0.2])
+        .state([1.0, 0.4], 0.3, [0.2, -0.3], 1.0)
+        .unwrap();
+    check_legendre_top(
+        "static field, point mass, sphere",
+        &on_sphere,
+        [1.0, 0.2],
+        &z0,
+    );
+    // No lift without the data's higher derivatives.
+    let custom = Potential::custom(|x| PotentialValue {
+        phi: 0.1 * x[0],
+        grad: [0.1, 0.0],
+        hess: [0.0; 3],
+    });
+    assert!(WeakFieldTop::new(1.0, 0.2, custom)
+        .unwrap()
+        .tangent()
+        .is_none());
+    let graph = Arc::new(Graph::quadric(0.5, -0.3).unwrap());
+    assert!(RelativisticTangentTop::on_surface(graph, 1.0, 0.2)
+        .unwrap()
+        .tangent()
+        .is_none());
 }
