@@ -3215,3 +3215,499 @@ fn lie_midpoint_lift_fails_only_where_the_plain_run_does() {
     }
     eprintln!("Lie midpoint: the plain and lifted runs fail at the same {failures} of 8 steps");
 }
+
+// ---- Issue 26: the canonical systems of 002 and 003 through CanonicalTangent (the tangent
+// Euler top, its charged particle, the rolling disks). ----
+
+/// The tangent tops of these tests: (name, top) on the sphere, intrinsic and embedded
+/// anisotropic, on the hyperbolic plane, on a torus (intrinsic), embedded in the plane.
+fn tangent_tops() -> Vec<(&'static str, lieflow::systems::TangentTop)> {
+    use lieflow::systems::{HyperbolicPlane, Plane, Revolution, Sphere, TangentTop};
+    vec![
+        (
+            "sphere",
+            TangentTop::new(Arc::new(Sphere::new(1.0).unwrap()), 1.0, 0.6).unwrap(),
+        ),
+        (
+            "sphere, embedded, anisotropic",
+            TangentTop::with_tensor(
+                Arc::new(Sphere::new(1.4).unwrap()),
+                0.9,
+                [0.5, 0.1, 0.1, 0.2],
+            )
+            .unwrap()
+            .embedded()
+            .unwrap(),
+        ),
+        (
+            "hyperbolic plane",
+            TangentTop::new(Arc::new(HyperbolicPlane), 1.2, 0.7).unwrap(),
+        ),
+        (
+            "torus",
+            TangentTop::with_tensor(
+                Arc::new(Revolution::torus(2.0, 0.7).unwrap()),
+                0.8,
+                [0.4, -0.1, -0.1, 0.3],
+            )
+            .unwrap(),
+        ),
+        (
+            "plane, embedded, anisotropic",
+            TangentTop::with_tensor(Arc::new(Plane), 1.1, [0.3, 0.05, 0.05, 0.6])
+                .unwrap()
+                .embedded()
+                .unwrap(),
+        ),
+    ]
+}
+
+/// A state of each top: x = (1.1, 0.6) (y > 0 on the half-plane), θ = 0.4.
+fn tangent_top_state(top: &lieflow::systems::TangentTop) -> Vec<f64> {
+    top.state([1.1, 0.6], 0.4, [0.5, -0.3], 0.8).unwrap()
+}
+
+/// The charged particles: of the sphere's intrinsic top (e = 0.7) and of a symmetric top
+/// embedded in the sphere (G = m g + (𝕀/2)WᵀW, e = −0.4).
+fn charged_particles() -> Vec<(&'static str, lieflow::systems::ChargedParticle)> {
+    use lieflow::systems::{Sphere, TangentTop};
+    let sphere = Arc::new(Sphere::new(1.0).unwrap());
+    vec![
+        (
+            "charged particle, sphere",
+            TangentTop::new(sphere.clone(), 1.0, 0.6)
+                .unwrap()
+                .magnetic_analogue(0.7)
+                .unwrap(),
+        ),
+        (
+            "charged particle, sphere, embedded",
+            TangentTop::new(Arc::new(Sphere::new(1.3).unwrap()), 0.9, 0.5)
+                .unwrap()
+                .embedded()
+                .unwrap()
+                .magnetic_analogue(-0.4)
+                .unwrap(),
+        ),
+    ]
+}
+
+/// The rolling disks of the catalog (tests/common): r = (1, 0.7), γ = ((0.3, 0.1),
+/// (−0.2, 0.25)), m = (1, 1.5), I = (0.8, 0.6), c = 0.4 — from its parameters
+/// (r₁, r₂, m₁, m₂, I₁, I₂, c).
+fn rolling_disks_with(th: [f64; 7]) -> lieflow::systems::RollingDisks {
+    lieflow::systems::RollingDisks::new(
+        [th[0], th[1]],
+        [[0.3, 0.1], [-0.2, 0.25]],
+        [th[2], th[3]],
+        [th[4], th[5]],
+    )
+    .unwrap()
+    .with_rolling_constant(th[6])
+    .unwrap()
+}
+
+const DISKS: [f64; 7] = [1.0, 0.7, 1.0, 1.5, 0.8, 0.6, 0.4];
+
+/// The gradient (∂H/∂q, ∂H/∂p) of a canonical system at z, flat.
+fn flat_gradient<S: lieflow::integrate::problem::Canonical>(s: &S, z: &[f64]) -> Vec<f64> {
+    let d = s.dof();
+    let mut g = vec![0.0; 2 * d];
+    let (hq, hp) = g.split_at_mut(d);
+    s.gradient(&z[..d], &z[d..], hq, hp);
+    g
+}
+
+/// max over the components of |D²H(z)dz − (fourth-order central difference of ∇H along dz)|
+/// relative to max(1, |D²H dz|).
+fn hessian_defect<S: lieflow::integrate::tangent::CanonicalTangent>(
+    s: &S,
+    z: &[f64],
+    dz: &[f64],
+) -> f64 {
+    let d = s.dof();
+    let mut hv = vec![0.0; 2 * d];
+    let (hq, hp) = hv.split_at_mut(d);
+    s.gradient_tangent(&z[..d], &z[d..], &dz[..d], &dz[d..], hq, hp);
+    let h = 5e-4;
+    let at = |t: f64| {
+        let y: Vec<f64> = z.iter().zip(dz).map(|(a, b)| a + t * b).collect();
+        flat_gradient(s, &y)
+    };
+    let (p1, m1, p2, m2) = (at(h), at(-h), at(2.0 * h), at(-2.0 * h));
+    let fd: Vec<f64> = (0..2 * d)
+        .map(|i| (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h))
+        .collect();
+    max_rel(&hv, &fd)
+}
+
+/// max |∂∇H/∂θ_m − (fourth-order difference of ∇H of the rebuilt system, step 1e-3·|θ_m|)|
+/// relative to max(1, |∂∇H/∂θ|), over the parameters (θ_m ≠ 0).
+fn gradient_parameter_defect<S, const P: usize>(
+    build: impl Fn([f64; P]) -> S,
+    theta: [f64; P],
+    z: &[f64],
+) -> f64
+where
+    S: lieflow::integrate::tangent::CanonicalTangent,
+{
+    let s = build(theta);
+    let d = s.dof();
+    assert_eq!(s.parameters().len(), P);
+    let mut worst = 0.0f64;
+    for m in 0..P {
+        let mut g = vec![0.0; 2 * d];
+        let (hq, hp) = g.split_at_mut(d);
+        s.gradient_parameter(&z[..d], &z[d..], m, hq, hp);
+        // A step relative to θ_m (a small inertia changes H on its own scale).
+        let h = 1e-3 * theta[m].abs();
+        let at = |t: f64| {
+            let mut th = theta;
+            th[m] += t;
+            flat_gradient(&build(th), z)
+        };
+        let (p1, m1, p2, m2) = (at(h), at(-h), at(2.0 * h), at(-2.0 * h));
+        let fd: Vec<f64> = (0..2 * d)
+            .map(|i| (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h))
+            .collect();
+        worst = worst.max(max_rel(&g, &fd));
+    }
+    worst
+}
+
+/// Directions: the unit vectors and two dense ones.
+fn probe_directions(n: usize) -> Vec<Vec<f64>> {
+    let mut dirs: Vec<Vec<f64>> = (0..n)
+        .map(|j| (0..n).map(|i| f64::from(u8::from(i == j))).collect())
+        .collect();
+    dirs.push((0..n).map(|i| 0.3 + 0.17 * i as f64).collect());
+    dirs.push((0..n).map(|i| (1.3 * i as f64 + 0.2).sin()).collect());
+    dirs
+}
+
+/// Issue 26, before the lifts: the closed-form Hessian products D²H\[dz\] of the tangent top
+/// (intrinsic on the sphere, the hyperbolic plane and a torus; embedded and anisotropic on the
+/// sphere and the plane), of its charged particle and of the rolling disks are the derivatives
+/// of their gradients (fourth-order differences, ≤ 1e-8), and so are the parameter derivatives
+/// ∂∇H/∂θ (mass, inertia, charge; radii, masses, moments, rolling constant).
+#[test]
+fn hessians_of_the_tangent_tops_and_the_disks_are_their_gradients_derivatives() {
+    use lieflow::systems::{ChargedParticle, TangentTop};
+    let mut worst = 0.0f64;
+    for (name, top) in tangent_tops() {
+        let z = tangent_top_state(&top);
+        let h = probe_directions(6)
+            .iter()
+            .fold(0.0f64, |m, dz| m.max(hessian_defect(&top, &z, dz)));
+        // Parameters: m, and 𝕀 with the tensor's shape kept.
+        let tensor = top.tensor();
+        let tr = top.inertia();
+        let surface = top.surface().clone();
+        let embedded = top.is_embedded();
+        let build = |th: [f64; 2]| {
+            let t = TangentTop::with_tensor(surface.clone(), th[0], tensor.map(|v| v * th[1] / tr))
+                .unwrap();
+            if embedded {
+                t.embedded().unwrap()
+            } else {
+                t
+            }
+        };
+        let p = gradient_parameter_defect(build, [top.mass(), tr], &z);
+        eprintln!("TangentTop on the {name}: Hessian {h:.1e}, parameters {p:.1e}");
+        assert!(h < 1e-8 && p < 1e-8, "{name}: {h:e} {p:e}");
+        worst = worst.max(h).max(p);
+    }
+    for (name, cp) in charged_particles() {
+        let z = cp.state([1.1, 0.6], [0.5, -0.3]).unwrap();
+        let h = probe_directions(4)
+            .iter()
+            .fold(0.0f64, |m, dz| m.max(hessian_defect(&cp, &z, dz)));
+        let top = cp.top().clone();
+        let surface = top.surface().clone();
+        let embedded = top.is_embedded();
+        let build = |th: [f64; 3]| -> ChargedParticle {
+            let t = TangentTop::new(surface.clone(), th[0], th[1]).unwrap();
+            let t = if embedded { t.embedded().unwrap() } else { t };
+            t.magnetic_analogue(th[2]).unwrap()
+        };
+        let p = gradient_parameter_defect(build, [top.mass(), top.inertia(), cp.charge()], &z);
+        eprintln!("{name}: Hessian {h:.1e}, parameters {p:.1e}");
+        assert!(h < 1e-8 && p < 1e-8, "{name}: {h:e} {p:e}");
+        worst = worst.max(h).max(p);
+    }
+    let disks = rolling_disks_with(DISKS);
+    for z in [
+        disks.state([0.3, -1.1], [0.7, 0.2]).unwrap(),
+        disks.state([2.0, 0.5], [-0.4, 1.1]).unwrap(),
+    ] {
+        let h = probe_directions(4)
+            .iter()
+            .fold(0.0f64, |m, dz| m.max(hessian_defect(&disks, &z, dz)));
+        let p = gradient_parameter_defect(rolling_disks_with, DISKS, &z);
+        eprintln!("RollingDisks: Hessian {h:.1e}, parameters {p:.1e}");
+        assert!(h < 1e-8 && p < 1e-8, "disks: {h:e} {p:e}");
+        worst = worst.max(h).max(p);
+    }
+    eprintln!("worst {worst:.1e}");
+}
+
+/// Every lifted method of a canonical system from z0: the base state is the plain run's (to
+/// 1e-14), the Jacobian the method's derivative (central differences, ≤ 1e-8 relative), and
+/// the Gauss methods' Jacobians are symplectic (|JᵀΩJ − Ω| ≤ 1e-12; RK4's defect is printed:
+/// it is not symplectic, though exact on the free motion of the plane). Returns the worst
+/// difference over the Gauss methods.
+fn check_canonical_lift(name: &str, sys: &dyn System, z0: &[f64], dt: f64, steps: usize) -> f64 {
+    let t = sys.tangent().unwrap_or_else(|| panic!("{name} has a lift"));
+    let d = z0.len();
+    let mut worst = 0.0f64;
+    for (method, _) in t.methods() {
+        let (z, jac) = lifted_end(&*t, method, z0, dt, steps);
+        let plain = integrate(sys, method, z0, dt, steps, steps).unwrap();
+        let moved = max_rel(&z, plain.state(1));
+        let fd = differences(sys, method, z0, dt, steps, 1e-5);
+        let err = max_rel(&jac, &fd);
+        let defect = symplecticity_defect(&jac, d);
+        eprintln!(
+            "{name}: {method}: moved {moved:.1e}, vs differences {err:.1e}, |JᵀΩJ − Ω| \
+             {defect:.1e}"
+        );
+        assert!(
+            moved < 1e-14,
+            "{name} {method}: the base state moved by {moved:e}"
+        );
+        assert!(err < 1e-8, "{name} {method}: {err:e}");
+        if method != "rk4" {
+            assert!(defect < 1e-12, "{name} {method}: {defect:e}");
+            worst = worst.max(err);
+        }
+    }
+    worst
+}
+
+/// Issue 26: the tangent top (five surfaces, intrinsic and embedded anisotropic), its charged
+/// particles and the rolling disks lift through `CanonicalTangent`: every method's Jacobian
+/// is its derivative and the Gauss ones are symplectic; a surface without second derivatives
+/// (a graph, a metric given by closures) gives no lift.
+#[test]
+fn jacobians_of_the_tangent_tops_and_the_disks_are_symplectic() {
+    use lieflow::systems::{Graph, TangentTop};
+    let (dt, steps) = (0.05, 40);
+    for (name, top) in tangent_tops() {
+        let z0 = tangent_top_state(&top);
+        check_canonical_lift(&format!("TangentTop on the {name}"), &top, &z0, dt, steps);
+    }
+    for (name, cp) in charged_particles() {
+        let z0 = cp.state([1.1, 0.6], [0.5, -0.3]).unwrap();
+        check_canonical_lift(name, &cp, &z0, dt, steps);
+    }
+    let disks = rolling_disks_with(DISKS);
+    let z0 = disks.state([0.3, -1.1], [0.7, 0.2]).unwrap();
+    check_canonical_lift("RollingDisks", &disks, &z0, dt, steps);
+    let graph = TangentTop::new(Arc::new(Graph::quadric(0.5, -0.3).unwrap()), 1.0, 0.6).unwrap();
+    assert!(graph.tangent().is_none(), "a graph gives no ∂²α");
+    let bowl = TangentTop::with_tensor(
+        Arc::new(lieflow::systems::Revolution::torus(2.0, 0.7).unwrap()),
+        1.0,
+        [0.4, 0.0, 0.0, 0.2],
+    )
+    .unwrap()
+    .embedded()
+    .unwrap();
+    assert!(
+        bowl.tangent().is_none(),
+        "an embedded revolution gives no ∂²W"
+    );
+}
+
+/// Issue 26: the parameter Jacobians ∂z/∂θ of the Gauss runs against differences of rebuilt
+/// systems: the top's mass and inertia (intrinsic on the sphere, embedded anisotropic), the
+/// charged particle's mass, inertia and charge, and the disks' radii, masses, moments and
+/// rolling constant.
+#[test]
+fn parameter_jacobians_of_the_tangent_tops_and_the_disks() {
+    use lieflow::systems::TangentTop;
+    let (dt, steps) = (0.05, 40);
+    let report = |name: &str, method: &str, pj: &[f64], fd: &[f64]| {
+        let err = max_rel(pj, fd);
+        eprintln!("{name}: {method}: parameter Jacobian vs differences {err:.1e}");
+        assert!(err < 1e-8, "{name} {method}: {err:e}");
+    };
+    for (name, top) in tangent_tops().into_iter().take(2) {
+        let z0 = tangent_top_state(&top);
+        let t = top.tangent().unwrap();
+        assert_eq!(t.parameter_names(), ["mass", "inertia"]);
+        let (tensor, tr) = (top.tensor(), top.inertia());
+        let surface = top.surface().clone();
+        let embedded = top.is_embedded();
+        let build = |th: [f64; 2]| {
+            let t = TangentTop::with_tensor(surface.clone(), th[0], tensor.map(|v| v * th[1] / tr))
+                .unwrap();
+            if embedded {
+                t.embedded().unwrap()
+            } else {
+                t
+            }
+        };
+        for method in ["gauss4", "midpoint"] {
+            let (_, _, pj) = lifted_end_all(&*t, method, &z0, dt, steps);
+            let fd = parameter_differences(build, [top.mass(), tr], method, &z0, (dt, steps), 1e-5);
+            report(&format!("TangentTop on the {name}"), method, &pj, &fd);
+        }
+    }
+    for (name, cp) in charged_particles() {
+        let z0 = cp.state([1.1, 0.6], [0.5, -0.3]).unwrap();
+        let t = cp.tangent().unwrap();
+        let top = cp.top().clone();
+        let surface = top.surface().clone();
+        let embedded = top.is_embedded();
+        let build = |th: [f64; 3]| {
+            let t = TangentTop::new(surface.clone(), th[0], th[1]).unwrap();
+            let t = if embedded { t.embedded().unwrap() } else { t };
+            t.magnetic_analogue(th[2]).unwrap()
+        };
+        let theta = [top.mass(), top.inertia(), cp.charge()];
+        let (_, _, pj) = lifted_end_all(&*t, "gauss4", &z0, dt, steps);
+        let fd = parameter_differences(build, theta, "gauss4", &z0, (dt, steps), 1e-5);
+        report(name, "gauss4", &pj, &fd);
+    }
+    let disks = rolling_disks_with(DISKS);
+    let z0 = disks.state([0.3, -1.1], [0.7, 0.2]).unwrap();
+    let t = disks.tangent().unwrap();
+    for method in ["gauss4", "gauss6"] {
+        let (_, _, pj) = lifted_end_all(&*t, method, &z0, dt, steps);
+        let fd = parameter_differences(rolling_disks_with, DISKS, method, &z0, (dt, steps), 1e-5);
+        report("RollingDisks", method, &pj, &fd);
+    }
+}
+
+/// A Legendre top of 002 §IV built from its parameters (m, 𝕀), checked whole: the Hessian of H
+/// (implicit-function theorem on the Legendre map) and ∂∇H/∂θ against differences of the
+/// gradient (≤ 1e-8), every lifted method's Jacobian (and the Gauss ones symplectic) and the
+/// gauss4 parameter Jacobian against differences of the runs (≤ 1e-8). Returns the worst
+/// (Hessian, parameter) defects.
+fn check_legendre_top<S>(
+    name: &str,
+    build: impl Fn([f64; 2]) -> S + Copy,
+    theta: [f64; 2],
+    z0: &[f64],
+) -> (f64, f64)
+where
+    S: lieflow::integrate::tangent::CanonicalTangent + System,
+{
+    let top = build(theta);
+    let h = probe_directions(6)
+        .iter()
+        .fold(0.0f64, |m, dz| m.max(hessian_defect(&top, z0, dz)));
+    let p = gradient_parameter_defect(build, theta, z0);
+    eprintln!("{name}: Hessian {h:.1e}, parameters {p:.1e}");
+    assert!(h < 1e-8 && p < 1e-8, "{name}: {h:e} {p:e}");
+    let (dt, steps) = (0.05, 20);
+    check_canonical_lift(name, &top, z0, dt, steps);
+    let t = top.tangent().unwrap();
+    assert_eq!(t.parameter_names(), ["mass", "inertia"]);
+    let (_, _, pj) = lifted_end_all(&*t, "gauss4", z0, dt, steps);
+    // A step of 1e-6 (θ = 0.07 moved by 1e-5 would leave a truncation of 2e-8).
+    let fd = parameter_differences(build, theta, "gauss4", z0, (dt, steps), 1e-6);
+    let err = max_rel(&pj, &fd);
+    eprintln!("{name}: gauss4: parameter Jacobian vs differences {err:.1e}");
+    assert!(err < 1e-8, "{name}: {err:e}");
+    (h, p)
+}
+
+/// Issue 26: the relativistic tops of 002 §IV (Minkowski, symmetric and anisotropic; on the
+/// sphere and the hyperbolic plane, symmetric and anisotropic, the anisotropic kernel reading
+/// the frame's derivative), the weak-field top (point mass, uniform field) and the static-field
+/// top (flat, on the sphere) lift through the implicit-function theorem on their Legendre maps;
+/// a custom potential (no third derivatives) or a graph (no second derivatives) gives no lift.
+#[test]
+fn legendre_tops_lift_through_the_inverse_legendre_map() {
+    use lieflow::systems::{
+        Graph, HyperbolicPlane, Potential, PotentialValue, RelativisticTangentTop, Sphere,
+        StaticFieldTop, Surface, WeakFieldTop,
+    };
+    let (x, th, xd, td) = ([0.3, 0.6], 0.4, [0.25, -0.15], 1.2);
+    // Minkowski, anisotropic and symmetric.
+    let moments = [0.05, 0.01, 0.02];
+    let tr = moments[0] + moments[2];
+    let mink =
+        |t: [f64; 2]| RelativisticTangentTop::new(t[0], moments.map(|i| i * t[1] / tr)).unwrap();
+    let z0 = mink([1.2, tr]).state(x, th, xd, td).unwrap();
+    check_legendre_top("Minkowski, anisotropic", mink, [1.2, tr], &z0);
+    let sym = |t: [f64; 2]| RelativisticTangentTop::symmetric(t[0], t[1]).unwrap();
+    let z0 = sym([1.0, 0.2]).state(x, th, xd, td).unwrap();
+    check_legendre_top("Minkowski, symmetric", sym, [1.0, 0.2], &z0);
+    // On surfaces.
+    let sphere: Arc<dyn Surface> = Arc::new(Sphere::new(1.0).unwrap());
+    let hyp: Arc<dyn Surface> = Arc::new(HyperbolicPlane);
+    for (sname, surface) in [("sphere", sphere.clone()), ("hyperbolic plane", hyp)] {
+        let s1 = surface.clone();
+        let curved =
+            move |t: [f64; 2]| RelativisticTangentTop::on_surface(s1.clone(), t[0], t[1]).unwrap();
+        let z0 = curved([1.0, 0.2]).state(x, th, xd, td).unwrap();
+        check_legendre_top(&format!("{sname}, symmetric"), &curved, [1.0, 0.2], &z0);
+        let moments = [0.15, 0.04, 0.05];
+        let tr = moments[0] + moments[2];
+        let s2 = surface.clone();
+        let aniso = move |t: [f64; 2]| {
+            RelativisticTangentTop::on_surface_with_moments(
+                s2.clone(),
+                t[0],
+                moments.map(|i| i * t[1] / tr),
+            )
+            .unwrap()
+        };
+        let z0 = aniso([1.0, tr]).state(x, th, xd, td).unwrap();
+        check_legendre_top(&format!("{sname}, anisotropic"), &aniso, [1.0, tr], &z0);
+    }
+    // The weak field and the static field.
+    let weak =
+        |t: [f64; 2]| WeakFieldTop::new(t[0], t[1], Potential::point_mass(1.0).unwrap()).unwrap();
+    let z0 = weak([1.0, 0.2])
+        .state([1.0, 0.2], 0.0, [-0.1, 0.6], 1.0)
+        .unwrap();
+    check_legendre_top("weak field, point mass", weak, [1.0, 0.2], &z0);
+    let uniform = |t: [f64; 2]| {
+        WeakFieldTop::new(t[0], t[1], Potential::uniform([0.3, -0.8]).unwrap()).unwrap()
+    };
+    let z0 = uniform([1.0, 0.2])
+        .state([1.0, 0.2], 0.0, [-0.1, 0.6], 1.0)
+        .unwrap();
+    check_legendre_top("weak field, uniform", uniform, [1.0, 0.2], &z0);
+    let flat = |t: [f64; 2]| {
+        StaticFieldTop::new(t[0], t[1], Potential::point_mass(0.15).unwrap()).unwrap()
+    };
+    let z0 = flat([1.0, 0.2])
+        .state([1.0, 0.2], 0.3, [-0.1, 0.4], 1.0)
+        .unwrap();
+    check_legendre_top("static field, point mass", flat, [1.0, 0.2], &z0);
+    let s3 = sphere.clone();
+    let on_sphere = move |t: [f64; 2]| {
+        StaticFieldTop::on_surface(s3.clone(), t[0], t[1], Potential::point_mass(0.1).unwrap())
+            .unwrap()
+    };
+    let z0 = on_sphere([1.0, 0.2])
+        .state([1.0, 0.4], 0.3, [0.2, -0.3], 1.0)
+        .unwrap();
+    check_legendre_top(
+        "static field, point mass, sphere",
+        &on_sphere,
+        [1.0, 0.2],
+        &z0,
+    );
+    // No lift without the data's higher derivatives.
+    let custom = Potential::custom(|x| PotentialValue {
+        phi: 0.1 * x[0],
+        grad: [0.1, 0.0],
+        hess: [0.0; 3],
+    });
+    assert!(WeakFieldTop::new(1.0, 0.2, custom)
+        .unwrap()
+        .tangent()
+        .is_none());
+    let graph = Arc::new(Graph::quadric(0.5, -0.3).unwrap());
+    assert!(RelativisticTangentTop::on_surface(graph, 1.0, 0.2)
+        .unwrap()
+        .tangent()
+        .is_none());
+}

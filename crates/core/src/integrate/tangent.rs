@@ -19,7 +19,8 @@
 //! So one lift per problem kind serves every method of that kind (no tangent twin of a method),
 //! and a system opts in by giving the directional derivatives of its kind's primitives
 //! ([`SeparableTangent`]: its force, from the potential's Hessian; [`VectorFieldTangent`]: its
-//! field; [`SplitTangent`]: its flows' tangent maps). The implicit methods' iterations converge
+//! field, for a canonical system through [`CanonicalTangent`], its Hamiltonian's Hessian
+//! product; [`SplitTangent`]: its flows' tangent maps). The implicit methods' iterations converge
 //! on the lifted unknowns as on the plain ones: the lifted Jacobian is block lower-triangular
 //! with the plain one on its diagonal ([`VectorField::diagonal_blocks`]), so Gauss factors the
 //! plain Newton matrix once per step and solves every direction with it (the
@@ -52,7 +53,8 @@ pub use super::method::TangentSystem;
 
 use super::method::Catalog;
 use super::problem::{
-    Constrained, GroupField, Nonholonomic, Problem, Separable, Split, VectorField, Violation,
+    Canonical, Constrained, GroupField, Nonholonomic, Problem, Separable, Split, VectorField,
+    Violation,
 };
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
@@ -113,6 +115,57 @@ pub trait VectorFieldTangent: VectorField {
     /// implements it.
     fn field_parameter(&self, _z: &[f64], _m: usize, out: &mut [f64]) {
         out.fill(f64::NAN);
+    }
+}
+
+/// A [`Canonical`] system with the Hessian product of its Hamiltonian: the data of its tangent
+/// lift, one route for every canonical system. Its Hamilton field f = (∂H/∂p, −∂H/∂q) has
+/// f′(z)dz = (D(∂H/∂p)\[dz\], −D(∂H/∂q)\[dz\]), the blanket [`VectorFieldTangent`] below; the
+/// lift is then `Tangent::field` (Gauss, implicit midpoint, RK4).
+pub trait CanonicalTangent: Canonical {
+    /// (dhq, dhp) = D²H(q, p)\[dq, dp\], the derivative of the gradient (∂H/∂q, ∂H/∂p) along
+    /// (dq, dp) (every entry written; NaN where the gradient is NaN).
+    fn gradient_tangent(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        dq: &[f64],
+        dp: &[f64],
+        dhq: &mut [f64],
+        dhp: &mut [f64],
+    );
+
+    /// dhq += ∂²H/∂θ_m∂q, dhp += ∂²H/∂θ_m∂p for the parameter m ([`Problem::parameters`]);
+    /// NaN unless a system with parameters implements it.
+    fn gradient_parameter(
+        &self,
+        _q: &[f64],
+        _p: &[f64],
+        _m: usize,
+        dhq: &mut [f64],
+        dhp: &mut [f64],
+    ) {
+        dhq.fill(f64::NAN);
+        dhp.fill(f64::NAN);
+    }
+}
+
+/// f′(z)dz = (D(∂H/∂p)\[dz\], −D(∂H/∂q)\[dz\]) and ∂f/∂θ_m = (∂²H/∂θ_m∂p, −∂²H/∂θ_m∂q): the
+/// Hamilton field's derivatives, in place (the ṗ half negated around the call, exactly).
+impl<P: CanonicalTangent + VectorField> VectorFieldTangent for P {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        let d = self.dof();
+        let (oq, op) = out.split_at_mut(d);
+        self.gradient_tangent(&z[..d], &z[d..], &dz[..d], &dz[d..], op, oq);
+        op.iter_mut().for_each(|x| *x = -*x);
+    }
+
+    fn field_parameter(&self, z: &[f64], m: usize, out: &mut [f64]) {
+        let d = self.dof();
+        let (oq, op) = out.split_at_mut(d);
+        op.iter_mut().for_each(|x| *x = -*x);
+        self.gradient_parameter(&z[..d], &z[d..], m, op, oq);
+        op.iter_mut().for_each(|x| *x = -*x);
     }
 }
 

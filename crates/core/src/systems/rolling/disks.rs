@@ -20,6 +20,14 @@
 //!
 //! H = ½ pᵀM⁻¹p, integrated with the symplectic Gauss methods; ∂H/∂θ = −∂T/∂θ at fixed θ̇.
 //!
+//! **Tangent lift** (issue 26, [`CanonicalTangent`]). With s = Aθ̇₁ − Bθ̇₂ (= −iẇ),
+//! Mθ̇ = (I_kᶜθ̇_k + e Re(c_k s̄))_k, c = (A, −B), and ∂H/∂θ_k = −e Re(s̄ s_k),
+//! s_k = ∂_kA θ̇₁ − ∂_kB θ̇₂; one variation δ of (A, B, ∂A, ∂B, e, I_kᶜ, p) gives
+//! δθ̇ = M⁻¹(δp − δM θ̇) and δ(∂H/∂θ_k) = −δe Re(s̄ s_k) − e Re(δs̄ s_k + s̄ δs_k): along a state
+//! direction from ∂_k∂_lu = −(r_k r_l/R²)u, ∂²_{θ_1}a = −a, ∂²_{θ_2}b = −b; along the radii, the
+//! masses, the moments and the rolling constant (all entering M) from how they move u, A, B, e
+//! and I_kᶜ.
+//!
 //! **Symmetry.** The rotations e^{iψ} act by z_k, u ↦ e^{iψ}z_k, e^{iψ}u, i.e. θ ↦ θ + ψ(1, 1)
 //! (the constraint is invariant); the momentum J = p₁ + p₂ is the total angular momentum about
 //! the centre of mass (linear in z: every Gauss method keeps it to round-off). The locked
@@ -50,9 +58,11 @@ use nalgebra::Complex;
 
 use crate::check;
 use crate::error::{fmt_num, Error, Result};
+use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::{Canonical, Symmetric};
 use crate::integrate::space::{Block, Space};
-use crate::integrate::Problem;
+use crate::integrate::tangent::{CanonicalTangent, Tangent};
+use crate::integrate::{Entry, Problem};
 
 type C = Complex<f64>;
 
@@ -77,6 +87,21 @@ struct Local {
     b: C,
     big_a: C,
     big_b: C,
+}
+
+/// The pieces of T = ½Σ I_kᶜ θ̇_k² + ½e|s|², s = Aθ̇₁ − Bθ̇₂ (= −iẇ), at one configuration, with
+/// ∂_kA, ∂_kB: M θ̇ = (I_kᶜθ̇_k + e Re(c_k s̄))_k with c = (A, −B), ∂H/∂θ_k = −e Re(s̄ s_k),
+/// s_k = ∂_kA θ̇₁ − ∂_kB θ̇₂. A [`Pieces`] is also a variation δ of these (along a state
+/// direction or a parameter, with δp).
+#[derive(Clone, Copy, Default)]
+struct Pieces {
+    a: C,
+    b: C,
+    da: [C; 2],
+    db: [C; 2],
+    e: f64,
+    central: [f64; 2],
+    p: [f64; 2],
 }
 
 /// Where the pieces of the pair are, in the centre-of-mass frame (003 (4)).
@@ -383,6 +408,191 @@ impl RollingDisks {
     }
 }
 
+/// Derivatives of the gradient (the tangent lift, 003 (6)).
+impl RollingDisks {
+    /// ∂u/∂θ_k = i(r_k/R)u, ∂_k∂_lu = −(r_k r_l/R²)u.
+    fn du(&self, u: C) -> [C; 2] {
+        let big_r = self.big_r();
+        self.r.map(|rk| u * C::new(0.0, rk / big_r))
+    }
+
+    /// A, B, ∂A, ∂B, e, I_kᶜ at θ (∂A = (ia − r₁∂₁u, −r₁∂₂u), ∂B = (r₂∂₁u, ib + r₂∂₂u)).
+    fn pieces(&self, l: &Local, p: [f64; 2]) -> Pieces {
+        let i = C::i();
+        let [r1, r2] = self.r;
+        let du = self.du(l.u);
+        Pieces {
+            a: l.big_a,
+            b: l.big_b,
+            da: [i * l.a - du[0] * r1, -du[1] * r1],
+            db: [du[0] * r2, i * l.b + du[1] * r2],
+            e: self.reduced_mass(),
+            central: [self.central(0), self.central(1)],
+            p,
+        }
+    }
+
+    /// The variation of the pieces along dθ (δp = dp): ∂_l∂_kA = −δ_{k1}δ_{l1}a − r₁∂_k∂_lu,
+    /// ∂_l∂_kB = −δ_{k2}δ_{l2}b + r₂∂_k∂_lu (indices from 1).
+    fn state_variation(&self, l: &Local, x: &Pieces, dq: &[f64], dp: &[f64]) -> Pieces {
+        let [r1, r2] = self.r;
+        let big_r = self.big_r();
+        let mut v = Pieces {
+            p: [dp[0], dp[1]],
+            ..Pieces::default()
+        };
+        for (k, &dqk) in dq[..2].iter().enumerate() {
+            v.a += x.da[k] * dqk;
+            v.b += x.db[k] * dqk;
+            for (j, &dqj) in dq[..2].iter().enumerate() {
+                let ddu = l.u * (-self.r[k] * self.r[j] / (big_r * big_r));
+                let mut dda = -ddu * r1;
+                let mut ddb = ddu * r2;
+                if k == j {
+                    if k == 0 {
+                        dda -= l.a;
+                    } else {
+                        ddb -= l.b;
+                    }
+                }
+                v.da[k] += dda * dqj;
+                v.db[k] += ddb * dqj;
+            }
+        }
+        v
+    }
+
+    /// The variation of the pieces along the parameter m ([`RollingDisks::PARAMETERS`]): r_j
+    /// moves φ by (θ_j − φ)/R and A, B directly (A = a − r₁u, B = b + r₂u); m_k moves
+    /// e = m₁m₂/(m₁ + m₂) and I_kᶜ = I_k − m_k|γ_k|²; I_k moves I_kᶜ; c moves φ by 1/R.
+    fn parameter_variation(&self, l: &Local, theta: [f64; 2], m: usize) -> Pieces {
+        let [r1, r2] = self.r;
+        let big_r = self.big_r();
+        let du = self.du(l.u);
+        let mut v = Pieces::default();
+        // The rate of φ and of the factor r_k/R in ∂_ku, for r₁, r₂, c.
+        let moves_u = |dphi: f64, dfac: [f64; 2]| -> (C, [C; 2]) {
+            let i = C::i();
+            let dpu = l.u * (i * dphi);
+            let ddu = std::array::from_fn(|k| l.u * (i * dfac[k]) + du[k] * (i * dphi));
+            (dpu, ddu)
+        };
+        // A parameter that moves u moves A = a − r₁u and B = b + r₂u (and their ∂_k) with it.
+        let through_u = |v: &mut Pieces, dpu: C, ddu: [C; 2]| {
+            v.a -= dpu * r1;
+            v.b += dpu * r2;
+            for (k, dd) in ddu.iter().enumerate() {
+                v.da[k] -= dd * r1;
+                v.db[k] += dd * r2;
+            }
+        };
+        match m {
+            0 | 1 => {
+                let phi = self.phi(theta);
+                let dfac = std::array::from_fn(|k| {
+                    (if k == m { 1.0 } else { 0.0 }) / big_r - self.r[k] / (big_r * big_r)
+                });
+                let (dpu, ddu) = moves_u((theta[m] - phi) / big_r, dfac);
+                through_u(&mut v, dpu, ddu);
+                // and r_m directly: δA = −u, δ∂_kA = −∂_ku (m = r₁); δB = u, δ∂_kB = ∂_ku (r₂).
+                let sign = if m == 0 { -1.0 } else { 1.0 };
+                let (x, dx) = if m == 0 {
+                    (&mut v.a, &mut v.da)
+                } else {
+                    (&mut v.b, &mut v.db)
+                };
+                *x += l.u * sign;
+                for (dxk, duk) in dx.iter_mut().zip(du) {
+                    *dxk += duk * sign;
+                }
+            }
+            2 | 3 => {
+                let k = m - 2;
+                let total = self.mass[0] + self.mass[1];
+                let other = self.mass[1 - k];
+                v.e = other * other / (total * total);
+                v.central[k] = -self.gamma[k].norm_sqr();
+            }
+            4 | 5 => v.central[m - 4] = 1.0,
+            _ => {
+                let (dpu, ddu) = moves_u(1.0 / big_r, [0.0; 2]);
+                through_u(&mut v, dpu, ddu);
+            }
+        }
+        v
+    }
+
+    /// The derivative of the gradient along a variation δ of the pieces: δv = M⁻¹(δp − δM v)
+    /// with (δM v)_i = δI_iᶜv_i + δe Re(c_i s̄) + e Re(δc_i s̄ + c_i δs̄) (δs = δAv₁ − δBv₂ at
+    /// fixed v), then δ(∂H/∂θ_k) = −δe Re(s̄ s_k) − e Re(δs̄ s_k + s̄ δs_k) with the total δs,
+    /// δs_k. Returns (δ∂H/∂θ, δ∂H/∂p).
+    fn gradient_variation(&self, l: &Local, x: &Pieces, d: &Pieces) -> ([f64; 2], [f64; 2]) {
+        let m = self.metric(l);
+        let v = velocity(&m, x.p);
+        let s = x.a * v[0] - x.b * v[1];
+        let ds_v = d.a * v[0] - d.b * v[1];
+        let (c, dc) = ([x.a, -x.b], [d.a, -d.b]);
+        let dmv: [f64; 2] = std::array::from_fn(|i| {
+            d.central[i] * v[i]
+                + d.e * (c[i] * s.conj()).re
+                + x.e * (dc[i] * s.conj() + c[i] * ds_v.conj()).re
+        });
+        let dv = velocity(&m, [d.p[0] - dmv[0], d.p[1] - dmv[1]]);
+        let ds = ds_v + x.a * dv[0] - x.b * dv[1];
+        let dhq = std::array::from_fn(|k| {
+            let sk = x.da[k] * v[0] - x.db[k] * v[1];
+            let dsk = d.da[k] * v[0] - d.db[k] * v[1] + x.da[k] * dv[0] - x.db[k] * dv[1];
+            -d.e * (s.conj() * sk).re - x.e * (ds.conj() * sk + s.conj() * dsk).re
+        });
+        (dhq, dv)
+    }
+
+    /// The parameters of [`Problem::parameters`], in order.
+    const PARAMETERS: [&'static str; 7] = [
+        "r1",
+        "r2",
+        "m1",
+        "m2",
+        "inertia1",
+        "inertia2",
+        "rolling_constant",
+    ];
+}
+
+/// D²H\[dq, dp\] of H = ½pᵀM(θ)⁻¹p through its pieces (module docs; the second derivatives of
+/// A, B from those of u = e^{iφ}), and ∂∇H/∂θ_m for the radii, masses, moments and the rolling
+/// constant.
+impl CanonicalTangent for RollingDisks {
+    fn gradient_tangent(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        dq: &[f64],
+        dp: &[f64],
+        dhq: &mut [f64],
+        dhp: &mut [f64],
+    ) {
+        let l = self.local([q[0], q[1]]);
+        let x = self.pieces(&l, [p[0], p[1]]);
+        let d = self.state_variation(&l, &x, dq, dp);
+        let (a, b) = self.gradient_variation(&l, &x, &d);
+        dhq[..2].copy_from_slice(&a);
+        dhp[..2].copy_from_slice(&b);
+    }
+
+    fn gradient_parameter(&self, q: &[f64], p: &[f64], m: usize, dhq: &mut [f64], dhp: &mut [f64]) {
+        let theta = [q[0], q[1]];
+        let l = self.local(theta);
+        let x = self.pieces(&l, [p[0], p[1]]);
+        let d = self.parameter_variation(&l, theta, m);
+        let (a, b) = self.gradient_variation(&l, &x, &d);
+        for i in 0..2 {
+            dhq[i] += a[i];
+            dhp[i] += b[i];
+        }
+    }
+}
+
 impl DisksEquilibrium {
     /// The state of the rotation with angular velocity ω (θ̇ = (ω, ω)).
     pub fn state(&self, disks: &RollingDisks, omega: f64) -> Result<Vec<f64>> {
@@ -402,6 +612,11 @@ fn velocity(m: &[[f64; 2]; 2], p: [f64; 2]) -> [f64; 2] {
 impl Problem for RollingDisks {
     fn name(&self) -> &'static str {
         "RollingDisks"
+    }
+    /// The radii r₁, r₂, masses m₁, m₂, moments I₁, I₂ (about the disks' centres) and the
+    /// rolling constant c (the centres of mass γ_k are not parameters here).
+    fn parameters(&self) -> Vec<&'static str> {
+        RollingDisks::PARAMETERS.to_vec()
     }
     fn space(&self) -> Space {
         Space::new([("theta", Block::Real(2)), ("p", Block::Real(2))])
@@ -466,4 +681,15 @@ impl Symmetric for RollingDisks {
     }
 }
 
-crate::integrate::methods::canonical_system!(RollingDisks);
+impl crate::integrate::Catalog for Tangent<RollingDisks> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        canonical_catalog()
+    }
+}
+
+// The tangent lift: Gauss, midpoint and RK4 differentiate their own steps.
+crate::integrate::methods::canonical_system!(
+    RollingDisks,
+    canonical_catalog(),
+    |d: &RollingDisks| Some(Tangent::field(d.clone()).into_system())
+);

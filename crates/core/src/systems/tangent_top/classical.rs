@@ -37,6 +37,18 @@
 //! the surface, lifted to (x, θ) as in [`crate::systems::tangent_top::surface`], the momentum J = p_A X^A
 //! (Noether; it generates the isometry that moves the frame along, 002 §III.A, §III.C).
 //!
+//! **Tangent lift** (issue 26, [`crate::integrate::tangent::CanonicalTangent`]). The Hessian
+//! product of H follows from the gradient above by one variation δ of its pieces (G, ∂_kG,
+//! ∂_θG, α, ∂α, p, p_θ, 1/𝕀; `gradient_variation`): δv = G⁻¹(δπ − δG v), δπ = δp_x − δp_θ α − p_θ δα,
+//! δθ̇ = δp_θ/𝕀 − δα·v − α·δv, δ(∂H/∂x^k) = −vᵀ∂_kG δv − ½vᵀδ(∂_kG)v − δp_θ ∂_kα·v
+//! − p_θ δ(∂_kα)·v − p_θ ∂_kα·δv, δ(∂H/∂θ) = −vᵀ∂_θG δv − ½vᵀδ(∂_θG)v. Along a state direction
+//! the variations need ∂²g, ∂²α of the surface and, embedded, ∂²W
+//! ([`super::surface::SecondGeometry`], [`Surface::has_second_derivatives`]; a surface without
+//! them — a graph, a metric given by closures, an embedded surface of revolution — leaves the
+//! top without a lift, [`TangentTop::has_hessian`]). The same variation, with δG = g or
+//! δG = WᵀQW/𝕀, gives the sensitivities to the mass and the inertia; the surface's own
+//! constants (a radius) are not parameters.
+//!
 //! **Embedded surfaces** (002 §II.D, (29)–(39), derived again). On a surface in ℝ³ a body point
 //! c + ξ^a E_a moves with ∇̃_ċ E_a = ∇_ċ E_a + B(ċ, E_a), and the normal parts add
 //! ½ I_ab h(ċ, E_a) h(ċ, E_b) to L (002 (37); the cross terms vanish since B ⊥ TM). In the
@@ -56,9 +68,11 @@ use std::sync::Arc;
 use super::surface::{self, add, inner, inverse, mul, Mat2, Shape, Surface, Vec2};
 use crate::check;
 use crate::error::{Error, Result};
+use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::Canonical;
 use crate::integrate::space::{Block, Space};
-use crate::integrate::Problem;
+use crate::integrate::tangent::{CanonicalTangent, Tangent};
+use crate::integrate::{Entry, Problem};
 
 /// The tangent Euler top of mass m and Euler tensor I (002 (42)) on a surface, intrinsic or
 /// embedded (module docs); state z = (x¹, x², θ, p₁, p₂, p_θ).
@@ -71,13 +85,59 @@ pub struct TangentTop {
     embedded: bool,
 }
 
-/// The pieces of H at one configuration: G = m g + WᵀQW with ∂_k G and ∂_θ G, α and ∂α.
+/// The pieces of H at one configuration: G = m g + WᵀQW with ∂_k G and ∂_θ G, α and ∂α (and
+/// the surface's g, ∂g, for the mass sensitivity).
 struct Local {
     g: Mat2,
     dg: [Mat2; 2],
     dtheta: Mat2,
     alpha: Vec2,
     dalpha: Mat2,
+    metric: Mat2,
+    dmetric: [Mat2; 2],
+}
+
+/// The second derivatives of G and α at one configuration (the Hessian of H): ∂_k∂_lG,
+/// ∂_θ∂_kG, ∂²_θG, ∂_k∂_lα.
+struct Second {
+    ddg: [[Mat2; 2]; 2],
+    dthetadg: [Mat2; 2],
+    dtheta2: Mat2,
+    ddalpha: [[Vec2; 2]; 2],
+}
+
+/// A variation δ of the pieces of H, along a state direction or a parameter: δG, δ(∂_kG),
+/// δ(∂_θG), δα, δ(∂_kα), δp_x, δp_θ (or δe), δ(1/𝕀).
+#[derive(Default)]
+struct Variation {
+    g: Mat2,
+    dg: [Mat2; 2],
+    dtheta: Mat2,
+    alpha: Vec2,
+    dalpha: Mat2,
+    p: Vec2,
+    pt: f64,
+    inv_inertia: f64,
+}
+
+fn scale(a: &Mat2, c: f64) -> Mat2 {
+    a.map(|r| r.map(|v| c * v))
+}
+
+/// a + c b.
+fn axpy(a: &Mat2, c: f64, b: &Mat2) -> Mat2 {
+    add(a, &scale(b, c))
+}
+
+fn apply(m: &Mat2, v: Vec2) -> Vec2 {
+    [
+        m[0][0] * v[0] + m[0][1] * v[1],
+        m[1][0] * v[0] + m[1][1] * v[1],
+    ]
+}
+
+fn dot(a: Vec2, b: Vec2) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
 }
 
 fn transpose(a: &Mat2) -> Mat2 {
@@ -168,8 +228,8 @@ impl TangentTop {
     fn local(&self, x: Vec2, theta: f64) -> Local {
         let geo = self.surface.geometry(x);
         let m = self.mass;
-        let mut g = geo.g.map(|r| r.map(|v| m * v));
-        let mut dg = geo.dg.map(|d| d.map(|r| r.map(|v| m * v)));
+        let mut g = scale(&geo.g, m);
+        let mut dg = geo.dg.map(|d| scale(&d, m));
         let mut dtheta = [[0.0; 2]; 2];
         if self.embedded {
             let emb = self.surface.embedding().expect("checked by embedded()");
@@ -194,6 +254,113 @@ impl TangentTop {
             dtheta,
             alpha: geo.alpha,
             dalpha: geo.dalpha,
+            metric: geo.g,
+            dmetric: geo.dg,
+        }
+    }
+
+    /// Whether the surface gives the second derivatives the Hessian of H needs (∂²g, ∂²α, and
+    /// ∂²W when embedded): then the top has a tangent lift.
+    pub fn has_hessian(&self) -> bool {
+        self.surface.has_second_derivatives()
+            && (!self.embedded
+                || self
+                    .surface
+                    .embedding()
+                    .is_some_and(|e| e.has_shape_second()))
+    }
+
+    /// The second derivatives of G and α at (x, θ) (module docs: G = m g + WᵀQ(θ)W, so
+    /// ∂_k∂_l(WᵀQW) = B + Bᵀ + C + Cᵀ with B = (∂_k∂_lW)ᵀQW, C = (∂_kW)ᵀQ∂_lW,
+    /// ∂_θ∂_k(WᵀQW) = A + Aᵀ with A = (∂_kW)ᵀQ′W, ∂²_θ(WᵀQW) = WᵀQ″W, Q″ = S(JC − CJ)Sᵀ with
+    /// C = JI − IJ).
+    fn second(&self, x: Vec2, theta: f64) -> Second {
+        let sg = self.surface.second_derivatives(x);
+        let m = self.mass;
+        let mut ddg = sg.d2g.map(|r| r.map(|d| scale(&d, m)));
+        let mut dthetadg = [[[0.0; 2]; 2]; 2];
+        let mut dtheta2 = [[0.0; 2]; 2];
+        if self.embedded {
+            let emb = self.surface.embedding().expect("checked by embedded()");
+            let Shape { w, dw } = emb.shape(x);
+            let ddw = emb.shape_second(x);
+            let (sn, cs) = theta.sin_cos();
+            let st = [[cs, sn], [-sn, cs]];
+            let j = [[0.0, -1.0], [1.0, 0.0]];
+            let i = &self.tensor;
+            let q = sandwich(&st, i, &st);
+            let comm = axpy(&mul(&j, i), -1.0, &mul(i, &j));
+            let dq = sandwich(&st, &comm, &st);
+            let comm2 = axpy(&mul(&j, &comm), -1.0, &mul(&comm, &j));
+            let ddq = sandwich(&st, &comm2, &st);
+            for k in 0..2 {
+                for l in 0..2 {
+                    let b = sandwich(&ddw[k][l], &q, &w);
+                    let c = sandwich(&dw[k], &q, &dw[l]);
+                    let t = add(&add(&b, &transpose(&b)), &add(&c, &transpose(&c)));
+                    ddg[k][l] = add(&ddg[k][l], &t);
+                }
+                let a = sandwich(&dw[k], &dq, &w);
+                dthetadg[k] = add(&a, &transpose(&a));
+            }
+            dtheta2 = sandwich(&w, &ddq, &w);
+        }
+        Second {
+            ddg,
+            dthetadg,
+            dtheta2,
+            ddalpha: sg.d2alpha,
+        }
+    }
+
+    /// The variation of the pieces along a state direction (dx, dθ, dp_x, dp_θ).
+    fn state_variation(l: &Local, s: &Second, dq: &[f64], dp: &[f64]) -> Variation {
+        let (dx, dth) = ([dq[0], dq[1]], dq.get(2).copied().unwrap_or(0.0));
+        let mut var = Variation {
+            g: scale(&l.dtheta, dth),
+            dg: s.dthetadg.map(|d| scale(&d, dth)),
+            dtheta: scale(&s.dtheta2, dth),
+            p: [dp[0], dp[1]],
+            pt: dp.get(2).copied().unwrap_or(0.0),
+            ..Variation::default()
+        };
+        for (k, &dxk) in dx.iter().enumerate() {
+            var.g = axpy(&var.g, dxk, &l.dg[k]);
+            var.dtheta = axpy(&var.dtheta, dxk, &s.dthetadg[k]);
+            for i in 0..2 {
+                var.alpha[i] += l.dalpha[k][i] * dxk;
+            }
+            for j in 0..2 {
+                var.dg[j] = axpy(&var.dg[j], dxk, &s.ddg[j][k]);
+                for i in 0..2 {
+                    var.dalpha[j][i] += s.ddalpha[j][k][i] * dxk;
+                }
+            }
+        }
+        var
+    }
+
+    /// The variation of the pieces along the parameter m: 0 the mass (δG = g, δ∂G = ∂g),
+    /// 1 the inertia 𝕀 with the tensor's shape I/𝕀 kept (δG = WᵀQW/𝕀, δ(1/𝕀) = −1/𝕀²).
+    fn parameter_variation(&self, l: &Local, m: usize) -> Variation {
+        match m {
+            0 => Variation {
+                g: l.metric,
+                dg: l.dmetric,
+                ..Variation::default()
+            },
+            _ => {
+                let (i, mass) = (self.inertia(), self.mass);
+                Variation {
+                    g: scale(&axpy(&l.g, -mass, &l.metric), 1.0 / i),
+                    dg: std::array::from_fn(|k| {
+                        scale(&axpy(&l.dg[k], -mass, &l.dmetric[k]), 1.0 / i)
+                    }),
+                    dtheta: scale(&l.dtheta, 1.0 / i),
+                    inv_inertia: -1.0 / (i * i),
+                    ..Variation::default()
+                }
+            }
         }
     }
 
@@ -337,6 +504,11 @@ impl Problem for TangentTop {
     fn name(&self) -> &'static str {
         "TangentTop"
     }
+    /// The mass m and the inertia 𝕀 = tr I (the Euler tensor scaled with it; the surface's own
+    /// constants are not parameters here).
+    fn parameters(&self) -> Vec<&'static str> {
+        TangentTop::PARAMETERS.to_vec()
+    }
     fn space(&self) -> Space {
         Space::new([
             ("x", Block::Real(2)),
@@ -424,7 +596,104 @@ fn charged_particle(l: &Local, p: Vec2, e: f64) -> (Vec2, Vec2) {
     (v, force)
 }
 
-crate::integrate::methods::canonical_system!(TangentTop);
+/// The derivative of the gradient of H = ½ πᵀG⁻¹π + p_θ²/(2𝕀), π = p − eα (e = p_θ), along a
+/// variation of its pieces (δπ = δp − δe α − e δα, δv = G⁻¹(δπ − δG v)):
+/// δ(∂H/∂p) = (δv, δe/𝕀 + e δ(1/𝕀) − δα·v − α·δv),
+/// δ(∂H/∂x^k) = −vᵀ∂_kG δv − ½ vᵀδ(∂_kG)v − (δe ∂_kα + e δ(∂_kα))·v − e ∂_kα·δv,
+/// δ(∂H/∂θ) = −vᵀ∂_θG δv − ½ vᵀδ(∂_θG)v. Returns (δ∂H/∂q, δ∂H/∂p), three entries each (the
+/// charged particle uses the first two).
+fn gradient_variation(
+    l: &Local,
+    p: Vec2,
+    e: f64,
+    inv_inertia: f64,
+    var: &Variation,
+) -> ([f64; 3], [f64; 3]) {
+    let gi = inverse(&l.g);
+    let pi = [p[0] - e * l.alpha[0], p[1] - e * l.alpha[1]];
+    let v = apply(&gi, pi);
+    let dgv = apply(&var.g, v);
+    let dpi: Vec2 =
+        std::array::from_fn(|i| var.p[i] - var.pt * l.alpha[i] - e * var.alpha[i] - dgv[i]);
+    let dv = apply(&gi, dpi);
+    let dhp = [
+        dv[0],
+        dv[1],
+        var.pt * inv_inertia + e * var.inv_inertia - dot(var.alpha, v) - dot(l.alpha, dv),
+    ];
+    let dhq: [f64; 3] = std::array::from_fn(|k| {
+        if k == 2 {
+            return -(inner(&l.dtheta, v, dv) + 0.5 * quad(&var.dtheta, v));
+        }
+        let (da, dda) = (l.dalpha[k], var.dalpha[k]);
+        -(inner(&l.dg[k], v, dv)
+            + 0.5 * quad(&var.dg[k], v)
+            + var.pt * dot(da, v)
+            + e * dot(dda, v)
+            + e * dot(da, dv))
+    });
+    (dhq, dhp)
+}
+
+/// The mass m and the inertia 𝕀 = tr I (the tensor scaled with it: I ↦ I 𝕀′/𝕀).
+impl TangentTop {
+    const PARAMETERS: [&'static str; 2] = ["mass", "inertia"];
+}
+
+/// D²H\[dq, dp\] by `gradient_variation` along the state direction, with the second
+/// derivatives of the surface (and of its shape operator when embedded); NaN outside the
+/// domain or on a surface without them ([`TangentTop::has_hessian`]).
+impl CanonicalTangent for TangentTop {
+    fn gradient_tangent(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        dq: &[f64],
+        dp: &[f64],
+        dhq: &mut [f64],
+        dhp: &mut [f64],
+    ) {
+        let x = [q[0], q[1]];
+        if !self.surface.contains(x) {
+            dhq[..3].fill(f64::NAN);
+            dhp[..3].fill(f64::NAN);
+            return;
+        }
+        let l = self.local(x, q[2]);
+        let var = TangentTop::state_variation(&l, &self.second(x, q[2]), dq, dp);
+        let (a, b) = gradient_variation(&l, [p[0], p[1]], p[2], 1.0 / self.inertia(), &var);
+        dhq[..3].copy_from_slice(&a);
+        dhp[..3].copy_from_slice(&b);
+    }
+
+    /// ∂∇H/∂m, ∂∇H/∂𝕀 ([`TangentTop::parameters`]).
+    fn gradient_parameter(&self, q: &[f64], p: &[f64], m: usize, dhq: &mut [f64], dhp: &mut [f64]) {
+        let x = [q[0], q[1]];
+        if !self.surface.contains(x) {
+            dhq[..3].fill(f64::NAN);
+            dhp[..3].fill(f64::NAN);
+            return;
+        }
+        let l = self.local(x, q[2]);
+        let var = self.parameter_variation(&l, m);
+        let (a, b) = gradient_variation(&l, [p[0], p[1]], p[2], 1.0 / self.inertia(), &var);
+        for i in 0..3 {
+            dhq[i] += a[i];
+            dhp[i] += b[i];
+        }
+    }
+}
+
+impl crate::integrate::Catalog for Tangent<TangentTop> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        canonical_catalog()
+    }
+}
+
+// The tangent lift (Gauss, midpoint, RK4) on the surfaces with second derivatives.
+crate::integrate::methods::canonical_system!(TangentTop, canonical_catalog(), |t: &TangentTop| t
+    .has_hessian()
+    .then(|| Tangent::field(t.clone()).into_system()));
 
 /// The charged particle equivalent to a tangent top (002 §III.B): with p_θ fixed, the centre of
 /// the top moves as a particle of mass m on the surface in the magnetic potential A = α (the
@@ -550,6 +819,11 @@ impl Problem for ChargedParticle {
     fn name(&self) -> &'static str {
         "ChargedParticle"
     }
+    /// The top's mass m and inertia 𝕀 (which enters G when the top is embedded), and the
+    /// charge e = p_θ.
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["mass", "inertia", "charge"]
+    }
     fn space(&self) -> Space {
         Space::new([("x", Block::Real(2)), ("p", Block::Real(2))])
     }
@@ -602,4 +876,68 @@ impl Canonical for ChargedParticle {
     }
 }
 
-crate::integrate::methods::canonical_system!(ChargedParticle);
+/// D²H\[dq, dp\] of H = ½ πᵀG⁻¹π by the top's `gradient_variation` at θ = 0, p_θ = e;
+/// NaN outside the domain or without the surface's second derivatives.
+impl CanonicalTangent for ChargedParticle {
+    fn gradient_tangent(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        dq: &[f64],
+        dp: &[f64],
+        dhq: &mut [f64],
+        dhp: &mut [f64],
+    ) {
+        let x = [q[0], q[1]];
+        if !self.top.surface.contains(x) {
+            dhq[..2].fill(f64::NAN);
+            dhp[..2].fill(f64::NAN);
+            return;
+        }
+        let l = self.top.local(x, 0.0);
+        let var = TangentTop::state_variation(&l, &self.top.second(x, 0.0), dq, dp);
+        let (a, b) = gradient_variation(&l, [p[0], p[1]], self.charge, 0.0, &var);
+        dhq[..2].copy_from_slice(&a[..2]);
+        dhp[..2].copy_from_slice(&b[..2]);
+    }
+
+    /// ∂∇H/∂m, ∂∇H/∂𝕀 (as the top's), ∂∇H/∂e (δπ = −α).
+    fn gradient_parameter(&self, q: &[f64], p: &[f64], m: usize, dhq: &mut [f64], dhp: &mut [f64]) {
+        let x = [q[0], q[1]];
+        if !self.top.surface.contains(x) {
+            dhq[..2].fill(f64::NAN);
+            dhp[..2].fill(f64::NAN);
+            return;
+        }
+        let l = self.top.local(x, 0.0);
+        let var = if m == 2 {
+            Variation {
+                pt: 1.0,
+                ..Variation::default()
+            }
+        } else {
+            self.top.parameter_variation(&l, m)
+        };
+        let (a, b) = gradient_variation(&l, [p[0], p[1]], self.charge, 0.0, &var);
+        for i in 0..2 {
+            dhq[i] += a[i];
+            dhp[i] += b[i];
+        }
+    }
+}
+
+impl crate::integrate::Catalog for Tangent<ChargedParticle> {
+    fn kind_catalog() -> Vec<Entry<Self>> {
+        canonical_catalog()
+    }
+}
+
+// The tangent lift where the top has one.
+crate::integrate::methods::canonical_system!(
+    ChargedParticle,
+    canonical_catalog(),
+    |c: &ChargedParticle| c
+        .top
+        .has_hessian()
+        .then(|| Tangent::field(c.clone()).into_system())
+);

@@ -6,7 +6,7 @@ use crate::integrate::hooks;
 use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::Canonical;
 use crate::integrate::space::Space;
-use crate::integrate::tangent::{Tangent, VectorFieldTangent};
+use crate::integrate::tangent::{CanonicalTangent, Tangent};
 use crate::integrate::Problem;
 
 /// A canonical Hamiltonian system H(q, p) on T*ℝᵈ given by functions (module docs); state
@@ -123,24 +123,29 @@ impl Canonical for UserCanonical {
     }
 }
 
-/// f′(z)dz = (∂²H/∂p∂z dz, −∂²H/∂q∂z dz) from the Hessian callable (a failure recorded as for
-/// the gradient; NaN).
-impl VectorFieldTangent for UserCanonical {
-    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
-        let d = self.dof;
-        let (oq, op) = out.split_at_mut(d);
+/// D²H(q, p)\[dq, dp\] from the Hessian callable (a failure recorded as for the gradient;
+/// NaN): the field lift through [`CanonicalTangent`].
+impl CanonicalTangent for UserCanonical {
+    fn gradient_tangent(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        dq: &[f64],
+        dp: &[f64],
+        dhq: &mut [f64],
+        dhp: &mut [f64],
+    ) {
         let ok = match &self.hessian {
             Some(h) => hooks::call(|| {
-                h(&z[..d], &z[d..], &dz[..d], &dz[d..], op, oq)?;
-                finite_entries("the Hessian product of H", "d(dH/dq)", op)?;
-                finite_entries("the Hessian product of H", "d(dH/dp)", oq)
+                h(q, p, dq, dp, dhq, dhp)?;
+                finite_entries("the Hessian product of H", "d(dH/dq)", dhq)?;
+                finite_entries("the Hessian product of H", "d(dH/dp)", dhp)
             }),
             None => false,
         };
-        if ok {
-            op.iter_mut().for_each(|x| *x = -*x);
-        } else {
-            out.fill(f64::NAN);
+        if !ok {
+            dhq.fill(f64::NAN);
+            dhp.fill(f64::NAN);
         }
     }
 }

@@ -271,6 +271,18 @@
 //! add θ through Q(θ) = SISᵀ: L = −m√b + 𝕀θ̇²/(2√b) − e^{2φ}GᵀQG/(2√b) + aᵀQa/(2b^{3/2}) with
 //! a = e^{2φ}G − θ̇Jᵀẋ (not implemented).
 //!
+//! # Tangent lift (issue 26)
+//! H(q, p) = p·q̇ − L at the q̇ of the Legendre map ∂L/∂q̇ = p, so its Hessian follows from the
+//! implicit-function theorem: δq̇ = L_q̇q̇⁻¹(δp − L_q̇q δq), δ(∂H/∂p) = δq̇,
+//! δ(∂H/∂q) = −(L_qq δq + L_qq̇ δq̇) (`lift`). The kernels are written once over a scalar type
+//! that is f64 for a run and a dual number for its lift, so the mixed and position second
+//! derivatives of L come from the same code as ∂L/∂q̇ and ∂L/∂q, exact to round-off; what they
+//! read at x (the surface's g, ∂g, α, ∂α, the frame, the potential's φ, ∇φ, ∇²φ) is lifted with
+//! its derivative along δx, which needs the surface's second derivatives and the potential's
+//! third ([`Potential::third`]: the point mass and the uniform field; a custom potential or a
+//! surface without them leaves the top without a lift). Parameters: the mass and 𝕀 (the
+//! tensor scaled with it).
+//!
 //! # State
 //! All three systems: z = (x, y, θ, p_x, p_y, p_θ) (canonical, q = (x, y, θ); on a surface x = (x¹, x²)
 //! are its chart's coordinates and p₁, p₂ their momenta); build one from velocities with `state`,
@@ -279,6 +291,7 @@
 //! [`Surface`]: super::surface::Surface
 //! [`TangentTop`]: super::TangentTop
 
+mod lift;
 mod spacetime;
 mod static_field;
 mod weak_field;
@@ -288,9 +301,13 @@ use nalgebra::{Matrix3, Vector3};
 use crate::check;
 use crate::convergence::{self, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
+use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::Canonical;
 use crate::integrate::space::{Block, Space};
+use crate::integrate::tangent::{CanonicalTangent, Tangent};
 use crate::integrate::Problem;
+use crate::numerics::dual::Dual;
+use lift::DerivsT;
 
 pub use spacetime::RelativisticTangentTop;
 pub use static_field::StaticFieldTop;
@@ -380,6 +397,20 @@ trait Legendre: Problem {
     fn check_point(&self, _q: &[f64]) -> Result<()> {
         Ok(())
     }
+
+    /// The kernel at q + ε dq, q̇ + ε dq̇ with the parameter m (if any) moved at unit rate, in
+    /// [`Dual`] numbers: the ε parts of ∂L/∂q̇ and ∂L/∂q are their directional derivatives (the
+    /// tangent lift, [`lift`]); None where L is not defined or the data lack the derivatives.
+    fn derivs_dual(
+        &self,
+        q: [Dual; 3],
+        v: [Dual; 3],
+        parameter: Option<usize>,
+    ) -> Option<DerivsT<Dual>>;
+
+    /// Whether [`Legendre::derivs_dual`] has what it needs (a surface's second derivatives, a
+    /// potential's third): then the top has a tangent lift.
+    fn has_hessian(&self) -> bool;
 }
 
 /// L(q, q̇), checked.
@@ -443,7 +474,43 @@ macro_rules! legendre_kinds {
             }
         }
 
-        $crate::integrate::methods::canonical_system!($t);
+        /// D²H\\[dq, dp\\] and ∂∇H/∂θ through the implicit-function theorem on the Legendre
+        /// map (`lift`).
+        impl CanonicalTangent for $t {
+            fn gradient_tangent(
+                &self,
+                q: &[f64],
+                p: &[f64],
+                dq: &[f64],
+                dp: &[f64],
+                dhq: &mut [f64],
+                dhp: &mut [f64],
+            ) {
+                lift::gradient_tangent(self, q, p, dq, dp, dhq, dhp);
+            }
+
+            fn gradient_parameter(
+                &self,
+                q: &[f64],
+                p: &[f64],
+                m: usize,
+                dhq: &mut [f64],
+                dhp: &mut [f64],
+            ) {
+                lift::gradient_parameter(self, q, p, m, dhq, dhp);
+            }
+        }
+
+        impl $crate::integrate::Catalog for Tangent<$t> {
+            fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
+                canonical_catalog()
+            }
+        }
+
+        // The tangent lift where the kernel's data have the derivatives it needs.
+        $crate::integrate::methods::canonical_system!($t, canonical_catalog(), |t: &$t| t
+            .has_hessian()
+            .then(|| Tangent::field(t.clone()).into_system()));
     };
 }
 

@@ -4,17 +4,17 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
+use super::lift::{self, inner, mul, DerivsT, GeoT, M2, V2};
 use super::{energy, lagrangian, legendre_inverse, space, state, velocities, Derivs, Legendre};
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::space::Space;
 use crate::integrate::Problem;
+use crate::numerics::dual::{Dual, Real};
 use crate::systems::tangent_top::classical::TangentTop;
-use crate::systems::tangent_top::surface::{
-    self, inner, inverse, mul, Geometry, Mat2, Plane, Surface,
-};
+use crate::systems::tangent_top::surface::{self, inverse, Plane, Surface};
 
 /// The relativistic tangent Euler top in 1+2 Minkowski space-time, 002 (87)–(96) (module docs):
 /// L = −m/γ + ½θ̇²(𝕀γ + γ³ẋᵀK(θ)ẋ), K(θ) = R(θ) J I Jᵀ R(θ)ᵀ, physical sign (−L of 002 (90));
@@ -172,16 +172,18 @@ impl RelativisticTangentTop {
 
     /// K(θ) = R(θ) J I Jᵀ R(θ)ᵀ and its first θ-derivative K' = JK − KJ, as (K₁₁, K₁₂, K₂₂).
     fn k(&self, theta: f64) -> ([f64; 3], [f64; 3]) {
-        let [a, b, c] = self.moments;
-        // J I Jᵀ = [[c, −b], [−b, a]]; rotate by θ.
-        let (s, co) = theta.sin_cos();
-        let (p, q, r) = (c, -b, a);
-        // R M Rᵀ for symmetric M = [[p, q], [q, r]].
-        let k11 = co * co * p - 2.0 * co * s * q + s * s * r;
-        let k12 = co * s * (p - r) + (co * co - s * s) * q;
-        let k22 = s * s * p + 2.0 * co * s * q + co * co * r;
-        // K' = JK − KJ = [[−2K12, K11 − K22], [K11 − K22, 2K12]].
-        ([k11, k12, k22], [-2.0 * k12, k11 - k22, 2.0 * k12])
+        k_of(self.moments, theta)
+    }
+
+    /// m and I = (I₁₁, I₁₂, I₂₂) over [`Real`], the parameter (0: the mass, 1: the inertia 𝕀
+    /// with I scaled) moved at unit rate.
+    fn constants<T: Real>(&self, parameter: Option<usize>) -> (T, [T; 3]) {
+        let tr = self.inertia();
+        let rate = f64::from(u8::from(parameter == Some(1))) / tr;
+        (
+            T::with(self.mass, f64::from(u8::from(parameter == Some(0)))),
+            self.moments.map(|i| T::with(i, i * rate)),
+        )
     }
 
     /// L(q, q̇) of 002 (90) (physical sign, module docs), q = (x, y, θ), q̇ = (ẋ, ẏ, θ̇).
@@ -347,6 +349,11 @@ impl Problem for RelativisticTangentTop {
     fn name(&self) -> &'static str {
         "RelativisticTangentTop"
     }
+    /// The mass m and the inertia 𝕀 (I scaled with it): the sensitivities of a tangent run (the
+    /// potential's and the surface's constants are not parameters here).
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["mass", "inertia"]
+    }
     fn space(&self) -> Space {
         space()
     }
@@ -390,20 +397,63 @@ impl Problem for RelativisticTangentTop {
     }
 }
 
+/// K(θ) = R(θ) J I Jᵀ R(θ)ᵀ and K′ = JK − KJ as (K₁₁, K₁₂, K₂₂) for I = (I₁₁, I₁₂, I₂₂), over
+/// [`Real`].
+fn k_of<T: Real>(moments: [T; 3], theta: T) -> ([T; 3], [T; 3]) {
+    let k = |x: f64| T::from(x);
+    let [a, b, c] = moments;
+    // J I Jᵀ = [[c, −b], [−b, a]]; rotate by θ.
+    let (s, co) = theta.sin_cos();
+    let (p, q, r) = (c, -b, a);
+    // R M Rᵀ for symmetric M = [[p, q], [q, r]].
+    let k11 = co * co * p - k(2.0) * co * s * q + s * s * r;
+    let k12 = co * s * (p - r) + (co * co - s * s) * q;
+    let k22 = s * s * p + k(2.0) * co * s * q + co * co * r;
+    // K' = JK − KJ = [[−2K12, K11 − K22], [K11 − K22, 2K12]].
+    ([k11, k12, k22], [k(-2.0) * k12, k11 - k22, k(2.0) * k12])
+}
+
 impl Legendre for RelativisticTangentTop {
     /// Derivatives of L at (q, q̇); None where v ≥ 1, x is outside the chart or the input is not
     /// finite.
     fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
+        let (q, v) = ([q[0], q[1], q[2]], [v[0], v[1], v[2]]);
+        let c = self.constants(None);
         match &self.surface {
-            None => self.minkowski_derivs(q, v),
-            Some(surface) => self.curved_derivs(&self.local(&**surface, q)?, q[2], v),
+            None => self.minkowski_derivs(q, v, c)?.finite(),
+            Some(surface) => self
+                .curved_derivs(&self.local(&**surface, q)?, q[2], v, c)?
+                .finite(),
         }
     }
 
     fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
         match &self.surface {
             None => self.minkowski_solve(q, p),
-            Some(surface) => self.curved_solve(&self.local(&**surface, q)?, q[2], p),
+            Some(surface) => {
+                self.curved_solve(&self.local(&**surface, [q[0], q[1], q[2]])?, q[2], p)
+            }
+        }
+    }
+
+    fn derivs_dual(
+        &self,
+        q: [Dual; 3],
+        v: [Dual; 3],
+        parameter: Option<usize>,
+    ) -> Option<DerivsT<Dual>> {
+        let c = self.constants(parameter);
+        match &self.surface {
+            None => self.minkowski_derivs(q, v, c),
+            Some(surface) => self.curved_derivs(&self.local(&**surface, q)?, q[2], v, c),
+        }
+    }
+
+    /// In the Minkowski plane; on a surface with second derivatives.
+    fn has_hessian(&self) -> bool {
+        match &self.surface {
+            None => true,
+            Some(s) => s.has_second_derivatives(),
         }
     }
 
@@ -430,31 +480,32 @@ impl Legendre for RelativisticTangentTop {
 }
 
 /// What the kernel of a top on a surface needs at one point x: the geometry (g, ∂g, α, ∂α) and,
-/// for an anisotropic body, the orthonormal frame `e[a][i]` = e_a^i (for u = e g ẋ).
-struct Local {
-    geo: Geometry,
-    frame: Option<Mat2>,
+/// for an anisotropic body, the orthonormal frame `e[a][i]` = e_a^i (for u = e g ẋ); over
+/// [`Real`] (f64, or [`Dual`] along a direction for the tangent lift).
+struct Local<T> {
+    geo: GeoT<T>,
+    frame: Option<M2<T>>,
 }
 
 /// The body's part of L on a surface at (x, θ, ẋ): P = uᵀK(θ)u with u the frame components of ẋ
 /// (module docs, "Anisotropic top"), ∂P/∂ẋ = 2k, ∂²P/∂ẋ² = 2N, ∂P/∂x^k and ∂P/∂θ.
-struct BodyTerm {
-    p: f64,
-    k: [f64; 2],
-    n: Mat2,
-    px: [f64; 2],
-    ptheta: f64,
+struct BodyTerm<T> {
+    p: T,
+    k: V2<T>,
+    n: M2<T>,
+    px: V2<T>,
+    ptheta: T,
 }
 
 impl RelativisticTangentTop {
     /// The geometry at x (and the frame, for an anisotropic body); None outside the chart.
-    fn local(&self, surface: &dyn Surface, q: &[f64]) -> Option<Local> {
+    fn local<T: Real>(&self, surface: &dyn Surface, q: [T; 3]) -> Option<Local<T>> {
         let x = [q[0], q[1]];
-        if !(surface.contains(x) && q[2].is_finite()) {
+        if !(surface.contains([x[0].re(), x[1].re()]) && q[2].is_finite()) {
             return None;
         }
-        let geo = surface.geometry(x);
-        let frame = (!self.is_symmetric()).then(|| surface.frame(x));
+        let geo = lift::geometry(surface, x);
+        let frame = (!self.is_symmetric()).then(|| lift::frame(surface, x));
         Some(Local { geo, frame })
     }
 
@@ -462,11 +513,12 @@ impl RelativisticTangentTop {
     /// P = (𝕀/2) g(ẋ, ẋ). Otherwise with the coframe F = e g (u = Fẋ), N = FᵀKF, k = Nẋ,
     /// ∂_k u = p_k − α_k J u, (p_k)_a = ½ e_a^l ẋ^i (∂_k g_il + ∂_i g_kl − ∂_l g_ik),
     /// ∂P/∂x^k = 2 (∂_k u)·Ku and ∂P/∂θ = uᵀK′u.
-    fn body_term(&self, local: &Local, theta: f64, xd: [f64; 2]) -> BodyTerm {
+    fn body_term<T: Real>(local: &Local<T>, theta: T, xd: V2<T>, moments: [T; 3]) -> BodyTerm<T> {
+        let c = |x: f64| T::from(x);
         let geo = &local.geo;
         let g = &geo.g;
         let Some(e) = &local.frame else {
-            let h = 0.5 * self.inertia();
+            let h = c(0.5) * (moments[0] + moments[2]);
             let gx = [
                 g[0][0] * xd[0] + g[0][1] * xd[1],
                 g[1][0] * xd[0] + g[1][1] * xd[1],
@@ -476,7 +528,7 @@ impl RelativisticTangentTop {
                 k: [h * gx[0], h * gx[1]],
                 n: g.map(|r| r.map(|v| h * v)),
                 px: std::array::from_fn(|k| h * inner(&geo.dg[k], xd, xd)),
-                ptheta: 0.0,
+                ptheta: c(0.0),
             };
         };
         let f = mul(e, g);
@@ -484,7 +536,7 @@ impl RelativisticTangentTop {
             f[0][0] * xd[0] + f[0][1] * xd[1],
             f[1][0] * xd[0] + f[1][1] * xd[1],
         ];
-        let (kk, kp) = self.k(theta);
+        let (kk, kp) = k_of(moments, theta);
         let km = [[kk[0], kk[1]], [kk[1], kk[2]]];
         let ku = [
             km[0][0] * u[0] + km[0][1] * u[1],
@@ -501,17 +553,17 @@ impl RelativisticTangentTop {
         let dg = &geo.dg;
         let px = std::array::from_fn(|kx| {
             // ∂_k u = p_k − α_k J u, J u = (−u₂, u₁).
-            let du: [f64; 2] = std::array::from_fn(|a| {
-                let mut pa = 0.0;
+            let du: [T; 2] = std::array::from_fn(|a| {
+                let mut pa = c(0.0);
                 for i in 0..2 {
                     for l in 0..2 {
                         pa += e[a][l] * xd[i] * (dg[kx][i][l] + dg[i][kx][l] - dg[l][i][kx]);
                     }
                 }
                 let ju = if a == 0 { -u[1] } else { u[0] };
-                0.5 * pa - geo.alpha[kx] * ju
+                c(0.5) * pa - geo.alpha[kx] * ju
             });
-            2.0 * (du[0] * ku[0] + du[1] * ku[1])
+            c(2.0) * (du[0] * ku[0] + du[1] * ku[1])
         });
         BodyTerm {
             p: u[0] * ku[0] + u[1] * ku[1],
@@ -523,9 +575,17 @@ impl RelativisticTangentTop {
     }
 
     /// The top on a surface (module docs, "Derivatives"): L, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇² at the local
-    /// data of x, the angle θ and q̇ = (ẋ, θ̇); None where g(ẋ, ẋ) ≥ 1 or a value is not finite.
-    fn curved_derivs(&self, local: &Local, theta: f64, v: &Vector3<f64>) -> Option<Derivs> {
-        let (m, tr) = (self.mass, self.inertia());
+    /// data of x, the angle θ and q̇ = (ẋ, θ̇), with the constants m, I; None where
+    /// g(ẋ, ẋ) ≥ 1 or a value is not finite.
+    fn curved_derivs<T: Real>(
+        &self,
+        local: &Local<T>,
+        theta: T,
+        v: [T; 3],
+        (m, moments): (T, [T; 3]),
+    ) -> Option<DerivsT<T>> {
+        let c = |x: f64| T::from(x);
+        let tr = moments[0] + moments[2];
         let geo = &local.geo;
         let (xd, w) = ([v[0], v[1]], v[2]);
         let g = &geo.g;
@@ -534,68 +594,73 @@ impl RelativisticTangentTop {
             g[1][0] * xd[0] + g[1][1] * xd[1],
         ];
         let qq = n[0] * xd[0] + n[1] * xd[1];
-        if !(qq.is_finite() && qq < 1.0 && w.is_finite()) {
+        if !(qq.is_finite() && qq.re() < 1.0 && w.is_finite()) {
             return None;
         }
-        let body = self.body_term(local, theta, xd);
+        let body = Self::body_term(local, theta, xd, moments);
         let pp = body.p;
         if !pp.is_finite() {
             return None;
         }
         let a = geo.alpha;
         let s = w + a[0] * xd[0] + a[1] * xd[1];
-        let g1 = 1.0 / (1.0 - qq).sqrt();
+        let g1 = c(1.0) / (c(1.0) - qq).sqrt();
         let g3 = g1 * g1 * g1;
         let g5 = g3 * g1 * g1;
         let g7 = g5 * g1 * g1;
         let s2 = s * s;
-        let l = -m / g1 + 0.5 * s2 * (tr * g1 + g3 * pp);
-        let l_q = 0.5 * m * g1 + 0.25 * s2 * (tr * g3 + 3.0 * g5 * pp); // ∂L/∂Q
+        let l = -m / g1 + c(0.5) * s2 * (tr * g1 + g3 * pp);
+        let l_q = c(0.5) * m * g1 + c(0.25) * s2 * (tr * g3 + c(3.0) * g5 * pp); // ∂L/∂Q
         let l_s = s * (tr * g1 + g3 * pp); // ∂L/∂s = p_θ
-        let l_p = 0.5 * s2 * g3; // ∂L/∂P
-        let l_qq = 0.25 * m * g3 + 0.375 * s2 * (tr * g5 + 5.0 * g7 * pp);
-        let l_qs = s * (0.5 * tr * g3 + 1.5 * g5 * pp);
-        let l_qp = 0.75 * s2 * g5;
+        let l_p = c(0.5) * s2 * g3; // ∂L/∂P
+        let l_qq = c(0.25) * m * g3 + c(0.375) * s2 * (tr * g5 + c(5.0) * g7 * pp);
+        let l_qs = s * (c(0.5) * tr * g3 + c(1.5) * g5 * pp);
+        let l_qp = c(0.75) * s2 * g5;
         let l_ss = tr * g1 + g3 * pp;
         let l_sp = s * g3;
         let k = body.k;
-        let lv = Vector3::new(
-            2.0 * l_q * n[0] + l_s * a[0] + 2.0 * l_p * k[0],
-            2.0 * l_q * n[1] + l_s * a[1] + 2.0 * l_p * k[1],
+        let lv = [
+            c(2.0) * l_q * n[0] + l_s * a[0] + c(2.0) * l_p * k[0],
+            c(2.0) * l_q * n[1] + l_s * a[1] + c(2.0) * l_p * k[1],
             l_s,
-        );
-        let mut lq = Vector3::zeros();
-        for kx in 0..2 {
+        ];
+        let mut lq = [c(0.0); 3];
+        for (kx, lqk) in lq.iter_mut().enumerate().take(2) {
             let da = geo.dalpha[kx];
-            lq[kx] = l_q * inner(&geo.dg[kx], xd, xd)
+            *lqk = l_q * inner(&geo.dg[kx], xd, xd)
                 + l_s * (da[0] * xd[0] + da[1] * xd[1])
                 + l_p * body.px[kx];
         }
         lq[2] = l_p * body.ptheta;
-        let mut hess = Matrix3::zeros();
+        let mut hess = [[c(0.0); 3]; 3];
         for i in 0..2 {
             for j in 0..2 {
-                hess[(i, j)] = 2.0 * l_q * g[i][j]
-                    + 2.0 * l_p * body.n[i][j]
-                    + 4.0 * l_qq * n[i] * n[j]
-                    + 4.0 * l_qp * (n[i] * k[j] + k[i] * n[j])
-                    + 2.0 * l_qs * (n[i] * a[j] + a[i] * n[j])
-                    + 2.0 * l_sp * (k[i] * a[j] + a[i] * k[j])
+                hess[i][j] = c(2.0) * l_q * g[i][j]
+                    + c(2.0) * l_p * body.n[i][j]
+                    + c(4.0) * l_qq * n[i] * n[j]
+                    + c(4.0) * l_qp * (n[i] * k[j] + k[i] * n[j])
+                    + c(2.0) * l_qs * (n[i] * a[j] + a[i] * n[j])
+                    + c(2.0) * l_sp * (k[i] * a[j] + a[i] * k[j])
                     + l_ss * a[i] * a[j];
             }
-            let h = 2.0 * l_qs * n[i] + 2.0 * l_sp * k[i] + l_ss * a[i];
-            hess[(i, 2)] = h;
-            hess[(2, i)] = h;
+            let h = c(2.0) * l_qs * n[i] + c(2.0) * l_sp * k[i] + l_ss * a[i];
+            hess[i][2] = h;
+            hess[2][i] = h;
         }
-        hess[(2, 2)] = l_ss;
+        hess[2][2] = l_ss;
         let finite = l.is_finite() && lq.iter().all(|x| x.is_finite());
-        finite.then_some(Derivs { l, lv, lq, hess })
+        finite.then_some(DerivsT { l, lv, lq, hess })
     }
 
     /// The inverse Legendre map of the top on a surface: from a free particle of mass
     /// m + 𝕀 s² (exact at low speed for the symmetric top) carrying π = p_x − p_θ α at spin
     /// s = p_θ/𝕀, slower than light; failing that, from rest.
-    fn curved_solve(&self, local: &Local, theta: f64, p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
+    fn curved_solve(
+        &self,
+        local: &Local<f64>,
+        theta: f64,
+        p: &[f64],
+    ) -> Option<(Vector3<f64>, Derivs)> {
         let tr = self.inertia();
         let geo = &local.geo;
         let s = p[2] / tr;
@@ -610,54 +675,63 @@ impl RelativisticTangentTop {
         let e = (mm * mm + up[0] * pi[0] + up[1] * pi[1]).sqrt();
         let xd = [up[0] / e, up[1] / e];
         let guess = Vector3::new(xd[0], xd[1], s - a[0] * xd[0] - a[1] * xd[1]);
-        let derivs = |v: &Vector3<f64>| self.curved_derivs(local, theta, v);
+        let c = self.constants(None);
+        let derivs = |v: &Vector3<f64>| {
+            self.curved_derivs(local, theta, [v[0], v[1], v[2]], c)?
+                .finite()
+        };
         legendre_inverse(p, guess, derivs)
             .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, s), derivs))
     }
 
-    /// Derivatives of the Minkowski L (002 (90)) at (q, q̇); None where |ẋ| ≥ 1 or the input is
-    /// not finite.
-    fn minkowski_derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
+    /// Derivatives of the Minkowski L (002 (90)) at (q, q̇) with the constants m, I; None where
+    /// |ẋ| ≥ 1 or the input is not finite.
+    fn minkowski_derivs<T: Real>(
+        &self,
+        q: [T; 3],
+        v: [T; 3],
+        (m, moments): (T, [T; 3]),
+    ) -> Option<DerivsT<T>> {
+        let c = |x: f64| T::from(x);
         let (u, w) = ([v[0], v[1]], v[2]);
         let s = u[0] * u[0] + u[1] * u[1];
-        if !(s.is_finite() && s < 1.0 && w.is_finite() && q[2].is_finite()) {
+        if !(s.is_finite() && s.re() < 1.0 && w.is_finite() && q[2].is_finite()) {
             return None;
         }
-        let m = self.mass;
-        let tr = self.inertia();
-        let g = 1.0 / (1.0 - s).sqrt();
+        let tr = moments[0] + moments[2];
+        let g = c(1.0) / (c(1.0) - s).sqrt();
         let (g3, g5) = (g * g * g, g * g * g * g * g);
         let g7 = g5 * g * g;
-        let (k, kp) = self.k(q[2]);
+        let (k, kp) = k_of(moments, q[2]);
         let ku = [k[0] * u[0] + k[1] * u[1], k[1] * u[0] + k[2] * u[1]];
         let qk = u[0] * ku[0] + u[1] * ku[1];
-        let qkp = kp[0] * u[0] * u[0] + 2.0 * kp[1] * u[0] * u[1] + kp[2] * u[1] * u[1];
+        let qkp = kp[0] * u[0] * u[0] + c(2.0) * kp[1] * u[0] * u[1] + kp[2] * u[1] * u[1];
         let w2 = w * w;
-        let l = -m / g + 0.5 * w2 * (tr * g + g3 * qk);
-        let a_s = m * g + 0.5 * w2 * tr * g3 + 1.5 * w2 * g5 * qk;
-        let b_s = m * g3 + 1.5 * w2 * tr * g5 + 7.5 * w2 * g7 * qk;
-        let lv = Vector3::new(
+        let l = -m / g + c(0.5) * w2 * (tr * g + g3 * qk);
+        let a_s = m * g + c(0.5) * w2 * tr * g3 + c(1.5) * w2 * g5 * qk;
+        let b_s = m * g3 + c(1.5) * w2 * tr * g5 + c(7.5) * w2 * g7 * qk;
+        let lv = [
             a_s * u[0] + w2 * g3 * ku[0],
             a_s * u[1] + w2 * g3 * ku[1],
             w * (tr * g + g3 * qk),
-        );
-        let lq = Vector3::new(0.0, 0.0, 0.5 * w2 * g3 * qkp);
-        let mut hess = Matrix3::zeros();
+        ];
+        let lq = [c(0.0), c(0.0), c(0.5) * w2 * g3 * qkp];
+        let mut hess = [[c(0.0); 3]; 3];
         let kk = [[k[0], k[1]], [k[1], k[2]]];
         for i in 0..2 {
             for j in 0..2 {
-                let delta = if i == j { 1.0 } else { 0.0 };
-                hess[(i, j)] = a_s * delta
+                let delta = c(if i == j { 1.0 } else { 0.0 });
+                hess[i][j] = a_s * delta
                     + b_s * u[i] * u[j]
-                    + 3.0 * w2 * g5 * (u[i] * ku[j] + ku[i] * u[j])
+                    + c(3.0) * w2 * g5 * (u[i] * ku[j] + ku[i] * u[j])
                     + w2 * g3 * kk[i][j];
             }
-            let huw = w * ((tr * g3 + 3.0 * g5 * qk) * u[i] + 2.0 * g3 * ku[i]);
-            hess[(i, 2)] = huw;
-            hess[(2, i)] = huw;
+            let huw = w * ((tr * g3 + c(3.0) * g5 * qk) * u[i] + c(2.0) * g3 * ku[i]);
+            hess[i][2] = huw;
+            hess[2][i] = huw;
         }
-        hess[(2, 2)] = tr * g + g3 * qk;
-        Some(Derivs { l, lv, lq, hess })
+        hess[2][2] = tr * g + g3 * qk;
+        Some(DerivsT { l, lv, lq, hess })
     }
 
     fn minkowski_solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
@@ -669,10 +743,10 @@ impl RelativisticTangentTop {
         let mm = self.mass + 1.5 * w * w * tr;
         let e = (mm * mm + p[0] * p[0] + p[1] * p[1]).sqrt();
         let guess = Vector3::new(p[0] / e, p[1] / e, w);
-        legendre_inverse(p, guess, |v| self.minkowski_derivs(q, v)).or_else(|| {
-            legendre_inverse(p, Vector3::new(0.0, 0.0, w), |v| {
-                self.minkowski_derivs(q, v)
-            })
-        })
+        let q = [q[0], q[1], q[2]];
+        let c = self.constants(None);
+        let derivs = |v: &Vector3<f64>| self.minkowski_derivs(q, [v[0], v[1], v[2]], c)?.finite();
+        legendre_inverse(p, guess, derivs)
+            .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, w), derivs))
     }
 }

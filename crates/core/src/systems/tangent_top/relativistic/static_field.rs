@@ -4,8 +4,9 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
+use super::lift::{self, det, inner, inv, DerivsT, GeoT, M2, V2};
 use super::weak_field::{angular_momentum, outside_potential};
 use super::{
     energy, lagrangian, legendre_inverse, space, state, velocities, Derivs, Legendre, Potential,
@@ -14,9 +15,8 @@ use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::space::Space;
 use crate::integrate::Problem;
-use crate::systems::tangent_top::surface::{
-    self, det, inner, inverse, Geometry, Mat2, Plane, Surface,
-};
+use crate::numerics::dual::{Dual, Real};
+use crate::systems::tangent_top::surface::{self, inverse, Mat2, Plane, Surface};
 
 /// The symmetric relativistic tangent top on the static space-time
 /// ds² = −e^{2φ}dt² + γ_ij dxⁱdxʲ of a potential φ(x¹, x²), the Lagrangian 002 (117) (derived
@@ -184,6 +184,11 @@ impl Problem for StaticFieldTop {
     fn name(&self) -> &'static str {
         "StaticFieldTop"
     }
+    /// The mass m and the inertia 𝕀: the sensitivities of a tangent run (the
+    /// potential's and the surface's constants are not parameters here).
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["mass", "inertia"]
+    }
     fn space(&self) -> Space {
         space()
     }
@@ -222,20 +227,20 @@ impl Problem for StaticFieldTop {
 /// What the kernel needs at one point x, whatever the velocities (computed once per Legendre
 /// inversion): the slice's geometry, the field's ε = e^{2φ}, |G|² = g⁻¹(dφ, dφ),
 /// h = gφ⊥/√det g (φ⊥ = (∂₂φ, −∂₁φ); c = h·ẋ) and their x-derivatives (module docs, "Static
-/// field").
-struct Local {
-    geo: Geometry,
+/// field"); over [`Real`] (f64, or [`Dual`] along a direction for the tangent lift).
+struct Local<T> {
+    geo: GeoT<T>,
     /// φ (the local light speed is e^φ).
-    phi: f64,
-    eps: f64,
-    g2: f64,
-    h: [f64; 2],
+    phi: T,
+    eps: T,
+    g2: T,
+    h: V2<T>,
     /// `dh[k][j]` = ∂_k h_j.
-    dh: Mat2,
+    dh: M2<T>,
     /// ∂_k ε = 2ε∂_kφ.
-    deps: [f64; 2],
+    deps: V2<T>,
     /// ∂_k|G|² = 2∂_k∂_iφ (g⁻¹dφ)ⁱ − (g⁻¹dφ)ᵀ∂_kg(g⁻¹dφ).
-    dg2: [f64; 2],
+    dg2: V2<T>,
 }
 
 impl StaticFieldTop {
@@ -243,22 +248,23 @@ impl StaticFieldTop {
     /// φ, its derivatives or e^{2φ} are not finite. In the plane (g = Id, ∂g = 0) the terms with
     /// ∂g are exact zeros and the products with g, g⁻¹ and √det g = 1 exact: h = (G_y, −G_x),
     /// |G|² = G_x² + G_y², ∂_k|G|² = 2(HG)_k, ∂_kh = ∂_kφ⊥, bit for bit the flat formulas.
-    fn local(&self, q: &[f64]) -> Option<Local> {
+    fn local<T: Real>(&self, q: [T; 3]) -> Option<Local<T>> {
+        let k = |x: f64| T::from(x);
         let x = [q[0], q[1]];
         let slice = self.slice();
-        if !slice.contains(x) {
+        if !slice.contains([x[0].re(), x[1].re()]) {
             return None;
         }
-        let geo = slice.geometry(x);
-        let pv = self.potential.eval(x);
-        let [gx, gy] = pv.grad;
-        let [hxx, hxy, hyy] = pv.hess;
-        let eps = (2.0 * pv.phi).exp();
+        let geo = lift::geometry(slice, x);
+        let (phi, grad, hess) = lift::potential(&self.potential, x)?;
+        let [gx, gy] = grad;
+        let [hxx, hxy, hyy] = hess;
+        let eps = (k(2.0) * phi).exp();
         if ![eps, gx, gy, hxx, hxy, hyy].iter().all(|v| v.is_finite()) {
             return None;
         }
         let g = &geo.g;
-        let gi = inverse(g);
+        let gi = inv(g);
         let sd = det(g).sqrt();
         let perp = [gy, -gx];
         let h = [
@@ -268,18 +274,19 @@ impl StaticFieldTop {
         let grad_up = [gi[0][0] * gx + gi[0][1] * gy, gi[1][0] * gx + gi[1][1] * gy]; // g⁻¹dφ
         let g2 = gx * grad_up[0] + gy * grad_up[1];
         let hess_rows = [[hxx, hxy], [hxy, hyy]];
-        let mut dh = [[0.0; 2]; 2];
-        let (mut deps, mut dg2) = ([0.0; 2], [0.0; 2]);
-        for k in 0..2 {
-            let dg = &geo.dg[k];
-            let hr = hess_rows[k];
-            deps[k] = 2.0 * eps * pv.grad[k];
-            dg2[k] = 2.0 * (hr[0] * grad_up[0] + hr[1] * grad_up[1]) - inner(dg, grad_up, grad_up);
+        let mut dh = [[k(0.0); 2]; 2];
+        let (mut deps, mut dg2) = ([k(0.0); 2], [k(0.0); 2]);
+        for kk in 0..2 {
+            let dg = &geo.dg[kk];
+            let hr = hess_rows[kk];
+            deps[kk] = k(2.0) * eps * grad[kk];
+            dg2[kk] =
+                k(2.0) * (hr[0] * grad_up[0] + hr[1] * grad_up[1]) - inner(dg, grad_up, grad_up);
             // ∂_k h = (g ∂_kφ⊥ + ∂_kg φ⊥)/√det g − h ½tr(g⁻¹∂_kg).
             let dperp = [hr[1], -hr[0]];
-            let dlog = 0.5 * (gi[0][0] * dg[0][0] + gi[0][1] * dg[1][0])
-                + 0.5 * (gi[1][0] * dg[0][1] + gi[1][1] * dg[1][1]);
-            dh[k] = std::array::from_fn(|j| {
+            let dlog = k(0.5) * (gi[0][0] * dg[0][0] + gi[0][1] * dg[1][0])
+                + k(0.5) * (gi[1][0] * dg[0][1] + gi[1][1] * dg[1][1]);
+            dh[kk] = std::array::from_fn(|j| {
                 ((dperp[0] * g[0][j] + dperp[1] * g[1][j])
                     + (perp[0] * dg[0][j] + perp[1] * dg[1][j]))
                     / sd
@@ -288,7 +295,7 @@ impl StaticFieldTop {
         }
         Some(Local {
             geo,
-            phi: pv.phi,
+            phi,
             eps,
             g2,
             h,
@@ -298,13 +305,27 @@ impl StaticFieldTop {
         })
     }
 
+    /// m and I₀, the parameter (0: the mass, 1: the inertia 𝕀 = 2I₀) moved at unit rate.
+    fn constants<T: Real>(&self, parameter: Option<usize>) -> (T, T) {
+        (
+            T::with(self.mass, f64::from(u8::from(parameter == Some(0)))),
+            T::with(self.i0, 0.5 * f64::from(u8::from(parameter == Some(1)))),
+        )
+    }
+
     /// The kernel (module docs, "Static field"): L, ∂L/∂q̇, ∂L/∂q, ∂²L/∂q̇² at the data `lo` of
     /// x, the angle θ and q̇ = (ẋ, θ̇), through the invariants Q = g(ẋ, ẋ), c = h·ẋ,
-    /// s = θ̇ + α·ẋ and the field's ε, |G|². In the plane (g = Id, α = 0) every added term is an
-    /// exact zero, so the numbers are those of the flat kernel. None where Q ≥ e^{2φ} or a
-    /// value is not finite.
-    fn kernel(&self, lo: &Local, theta: f64, v: &Vector3<f64>) -> Option<Derivs> {
-        let (m, i0) = (self.mass, self.i0);
+    /// s = θ̇ + α·ẋ and the field's ε, |G|², with the constants m, I₀. In the plane (g = Id,
+    /// α = 0) every added term is an exact zero, so the numbers are those of the flat kernel.
+    /// None where Q ≥ e^{2φ} or a value is not finite.
+    fn kernel<T: Real>(
+        &self,
+        lo: &Local<T>,
+        theta: T,
+        v: [T; 3],
+        (m, i0): (T, T),
+    ) -> Option<DerivsT<T>> {
+        let k = |x: f64| T::from(x);
         let (u, w) = ([v[0], v[1]], v[2]);
         let geo = &lo.geo;
         let (g, a, h) = (&geo.g, geo.alpha, lo.h);
@@ -315,68 +336,65 @@ impl StaticFieldTop {
         ]; // gẋ
         let qq = n[0] * u[0] + n[1] * u[1];
         let b = eps - qq;
-        if !(b > 0.0 && w.is_finite() && theta.is_finite()) {
+        if !(b.re() > 0.0 && w.is_finite() && theta.is_finite()) {
             return None;
         }
         let s = w + (a[0] * u[0] + a[1] * u[1]);
         let c = h[0] * u[0] + h[1] * u[1];
-        let b1 = 1.0 / b.sqrt(); // β = b^{−1/2}
+        let b1 = k(1.0) / b.sqrt(); // β = b^{−1/2}
         let b3 = b1 * b1 * b1;
         let b5 = b3 * b1 * b1;
         let b7 = b5 * b1 * b1;
         let s2 = s * s;
-        let t = s2 * qq + 2.0 * eps * s * c + eps * eps * g2;
-        let l = -m * b * b1 + i0 * s2 * b1 - 0.5 * i0 * eps * g2 * b1 + 0.5 * i0 * b3 * t;
-        let l_q = 0.5 * m * b1 + i0 * s2 * b3 - 0.25 * i0 * eps * g2 * b3 + 0.75 * i0 * b5 * t;
+        let t = s2 * qq + k(2.0) * eps * s * c + eps * eps * g2;
+        let l = -m * b * b1 + i0 * s2 * b1 - k(0.5) * i0 * eps * g2 * b1 + k(0.5) * i0 * b3 * t;
+        let l_q =
+            k(0.5) * m * b1 + i0 * s2 * b3 - k(0.25) * i0 * eps * g2 * b3 + k(0.75) * i0 * b5 * t;
         let l_c = i0 * b3 * eps * s;
-        let l_s = 2.0 * i0 * s * b1 + i0 * b3 * (s * qq + eps * c);
-        let l_qq =
-            0.25 * m * b3 + 2.25 * i0 * s2 * b5 - 0.375 * i0 * eps * g2 * b5 + 1.875 * i0 * b7 * t;
-        let l_qc = 1.5 * i0 * b5 * eps * s;
-        let l_qs = 2.0 * i0 * s * b3 + 1.5 * i0 * b5 * (s * qq + eps * c);
+        let l_s = k(2.0) * i0 * s * b1 + i0 * b3 * (s * qq + eps * c);
+        let l_qq = k(0.25) * m * b3 + k(2.25) * i0 * s2 * b5 - k(0.375) * i0 * eps * g2 * b5
+            + k(1.875) * i0 * b7 * t;
+        let l_qc = k(1.5) * i0 * b5 * eps * s;
+        let l_qs = k(2.0) * i0 * s * b3 + k(1.5) * i0 * b5 * (s * qq + eps * c);
         let l_cs = i0 * b3 * eps;
-        let l_ss = 2.0 * i0 * b1 + i0 * b3 * qq;
+        let l_ss = k(2.0) * i0 * b1 + i0 * b3 * qq;
         // ∂L/∂ε and ∂L/∂|G|² at fixed (Q, c, s).
-        let l_eps = -0.5 * m * b1 - 0.5 * i0 * s2 * b3 - 0.5 * i0 * g2 * b1
-            + 0.25 * i0 * eps * g2 * b3
-            - 0.75 * i0 * b5 * t
+        let l_eps = -k(0.5) * m * b1 - k(0.5) * i0 * s2 * b3 - k(0.5) * i0 * g2 * b1
+            + k(0.25) * i0 * eps * g2 * b3
+            - k(0.75) * i0 * b5 * t
             + i0 * b3 * (s * c + eps * g2);
-        let l_g2 = -0.5 * i0 * eps * b1 + 0.5 * i0 * b3 * eps * eps;
-        let lv = Vector3::new(
-            2.0 * l_q * n[0] + l_c * h[0] + l_s * a[0],
-            2.0 * l_q * n[1] + l_c * h[1] + l_s * a[1],
+        let l_g2 = -k(0.5) * i0 * eps * b1 + k(0.5) * i0 * b3 * eps * eps;
+        let lv = [
+            k(2.0) * l_q * n[0] + l_c * h[0] + l_s * a[0],
+            k(2.0) * l_q * n[1] + l_c * h[1] + l_s * a[1],
             l_s,
-        );
+        ];
         // Through x: ∂_kQ = ẋᵀ∂_kgẋ, ∂_kc = ∂_kh·ẋ, ∂_ks = ∂_kα·ẋ, and ∂_kε, ∂_k|G|² of `lo`.
-        let mut lq = Vector3::zeros();
-        for k in 0..2 {
-            let dh = lo.dh[k];
+        let mut lq = [k(0.0); 3];
+        for (kk, lqk) in lq.iter_mut().enumerate().take(2) {
+            let dh = lo.dh[kk];
             let dc = dh[0] * u[0] + dh[1] * u[1];
-            let dq = inner(&geo.dg[k], u, u);
-            let da = geo.dalpha[k];
+            let dq = inner(&geo.dg[kk], u, u);
+            let da = geo.dalpha[kk];
             let ds = da[0] * u[0] + da[1] * u[1];
-            lq[k] = lo.deps[k] * l_eps + lo.dg2[k] * l_g2 + l_c * dc + l_q * dq + l_s * ds;
+            *lqk = lo.deps[kk] * l_eps + lo.dg2[kk] * l_g2 + l_c * dc + l_q * dq + l_s * ds;
         }
-        let mut hess = Matrix3::zeros();
+        let mut hess = [[k(0.0); 3]; 3];
         for i in 0..2 {
             for j in 0..2 {
-                hess[(i, j)] = 2.0 * l_q * g[i][j]
-                    + 4.0 * l_qq * n[i] * n[j]
-                    + 2.0 * l_qc * (n[i] * h[j] + h[i] * n[j])
-                    + 2.0 * l_qs * (n[i] * a[j] + a[i] * n[j])
+                hess[i][j] = k(2.0) * l_q * g[i][j]
+                    + k(4.0) * l_qq * n[i] * n[j]
+                    + k(2.0) * l_qc * (n[i] * h[j] + h[i] * n[j])
+                    + k(2.0) * l_qs * (n[i] * a[j] + a[i] * n[j])
                     + l_cs * (h[i] * a[j] + a[i] * h[j])
                     + l_ss * a[i] * a[j];
             }
-            let hw = 2.0 * l_qs * n[i] + l_cs * h[i] + l_ss * a[i];
-            hess[(i, 2)] = hw;
-            hess[(2, i)] = hw;
+            let hw = k(2.0) * l_qs * n[i] + l_cs * h[i] + l_ss * a[i];
+            hess[i][2] = hw;
+            hess[2][i] = hw;
         }
-        hess[(2, 2)] = l_ss;
-        let finite = l.is_finite()
-            && lv.iter().all(|x| x.is_finite())
-            && lq.iter().all(|x| x.is_finite())
-            && hess.iter().all(|x| x.is_finite());
-        finite.then_some(Derivs { l, lv, lq, hess })
+        hess[2][2] = l_ss;
+        Some(DerivsT { l, lv, lq, hess })
     }
 }
 
@@ -384,14 +402,21 @@ impl Legendre for StaticFieldTop {
     /// The kernel at the geometry and field of x (module docs, "Static field"); None outside
     /// the chart and where [`StaticFieldTop::kernel`] is.
     fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
-        self.kernel(&self.local(q)?, q[2], v)
+        let q = [q[0], q[1], q[2]];
+        self.kernel(
+            &self.local(q)?,
+            q[2],
+            [v[0], v[1], v[2]],
+            self.constants(None),
+        )?
+        .finite()
     }
 
     /// From a free particle of mass m + 𝕀s² (the low-speed form of the momenta) carrying
     /// π = p_x − p_θα at spin s = p_θ/𝕀, slower than the local light speed e^φ; failing that,
     /// from rest. The geometry and the field are evaluated once.
     fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {
-        let lo = self.local(q)?;
+        let lo = self.local([q[0], q[1], q[2]])?;
         let c = lo.phi.exp();
         if !(c.is_finite() && c > 0.0) {
             return None;
@@ -409,9 +434,27 @@ impl Legendre for StaticFieldTop {
         let e = (mm * mm + up[0] * pi[0] + up[1] * pi[1]).sqrt();
         let xd = [c * up[0] / e, c * up[1] / e];
         let guess = Vector3::new(xd[0], xd[1], s - (a[0] * xd[0] + a[1] * xd[1]));
-        let derivs = |v: &Vector3<f64>| self.kernel(&lo, q[2], v);
+        let constants = self.constants(None);
+        let derivs = |v: &Vector3<f64>| {
+            self.kernel(&lo, q[2], [v[0], v[1], v[2]], constants)?
+                .finite()
+        };
         legendre_inverse(p, guess, derivs)
             .or_else(|| legendre_inverse(p, Vector3::new(0.0, 0.0, s), derivs))
+    }
+
+    fn derivs_dual(
+        &self,
+        q: [Dual; 3],
+        v: [Dual; 3],
+        parameter: Option<usize>,
+    ) -> Option<DerivsT<Dual>> {
+        self.kernel(&self.local(q)?, q[2], v, self.constants(parameter))
+    }
+
+    /// On a slice with second derivatives in a potential with third derivatives.
+    fn has_hessian(&self) -> bool {
+        self.slice().has_second_derivatives() && self.potential.has_third()
     }
 
     fn undefined(&self, q: [f64; 3], v: [f64; 3]) -> Error {

@@ -4,13 +4,15 @@
 use std::fmt;
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
+use super::lift::{self, DerivsT};
 use super::{energy, lagrangian, legendre_inverse, space, state, velocities, Derivs, Legendre};
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::space::Space;
 use crate::integrate::Problem;
+use crate::numerics::dual::{Dual, Real};
 
 /// The rotation by π/2 applied to a 2-vector: J(a, b) = (−b, a).
 fn rot90(a: [f64; 2]) -> [f64; 2] {
@@ -108,6 +110,34 @@ impl Potential {
 }
 
 impl Potential {
+    /// The third derivatives (φ_xxx, φ_xxy, φ_xyy, φ_yyy) at x, which the tangent lift of a
+    /// top in the field needs: for the point mass
+    /// ∂_i∂_j∂_kφ = GM(15x_ix_jx_k/r⁷ − 3(δ_ijx_k + δ_ikx_j + δ_jkx_i)/r⁵), zero for the uniform
+    /// field; None for a custom potential (its value gives no third derivatives).
+    pub fn third(&self, x: [f64; 2]) -> Option<[f64; 4]> {
+        match &self.kind {
+            PotentialKind::PointMass { gm } => {
+                let r2 = x[0] * x[0] + x[1] * x[1];
+                let r5 = r2 * r2 * r2.sqrt();
+                let r7 = r5 * r2;
+                let (a, b) = (x[0], x[1]);
+                Some([
+                    gm * (15.0 * a * a * a / r7 - 9.0 * a / r5),
+                    gm * (15.0 * a * a * b / r7 - 3.0 * b / r5),
+                    gm * (15.0 * a * b * b / r7 - 3.0 * a / r5),
+                    gm * (15.0 * b * b * b / r7 - 9.0 * b / r5),
+                ])
+            }
+            PotentialKind::Uniform { .. } => Some([0.0; 4]),
+            PotentialKind::Custom(_) => None,
+        }
+    }
+
+    /// Whether [`Potential::third`] is given.
+    pub fn has_third(&self) -> bool {
+        !matches!(self.kind, PotentialKind::Custom(_))
+    }
+
     /// Whether φ is a closure from outside lieflow.
     pub(super) fn calls_out(&self) -> bool {
         matches!(self.kind, PotentialKind::Custom(_))
@@ -248,6 +278,11 @@ impl Problem for WeakFieldTop {
     fn name(&self) -> &'static str {
         "WeakFieldTop"
     }
+    /// The mass m and the inertia 𝕀: the sensitivities of a tangent run (the
+    /// potential's and the surface's constants are not parameters here).
+    fn parameters(&self) -> Vec<&'static str> {
+        vec!["mass", "inertia"]
+    }
     fn space(&self) -> Space {
         space()
     }
@@ -267,42 +302,74 @@ impl Problem for WeakFieldTop {
     }
 }
 
-impl Legendre for WeakFieldTop {
-    /// Derivatives of L at (q, q̇); None where φ or q̇ is not finite.
-    fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
-        let pv = self.potential.eval([q[0], q[1]]);
-        let (m, i0) = (self.mass, self.i0);
+impl WeakFieldTop {
+    /// The kernel of (118) over [`Real`] (f64 for the run, [`Dual`] for its tangent lift) at
+    /// (q, q̇) with the mass m and I₀ = 𝕀/2; None where φ, its derivatives or q̇ are not finite.
+    fn kernel<T: Real>(&self, q: [T; 3], v: [T; 3], m: T, i0: T) -> Option<DerivsT<T>> {
+        let k = |x: f64| T::from(x);
+        let (phi, grad, hess) = lift::potential(&self.potential, [q[0], q[1]])?;
         let (u, w) = ([v[0], v[1]], v[2]);
         let s = u[0] * u[0] + u[1] * u[1];
-        let [gx, gy] = pv.grad;
-        let [hxx, hxy, hyy] = pv.hess;
+        let [gx, gy] = grad;
+        let [hxx, hxy, hyy] = hess;
         let c = gy * u[0] - gx * u[1];
-        let l = 0.5 * m * s - m * pv.phi + i0 * w * w * (1.0 - pv.phi + s) + i0 * w * c;
+        let l = k(0.5) * m * s - m * phi + i0 * w * w * (k(1.0) - phi + s) + i0 * w * c;
         if !(l.is_finite() && hxx.is_finite() && hxy.is_finite() && hyy.is_finite()) {
             return None;
         }
-        let a = m + 2.0 * i0 * w * w;
-        let lv = Vector3::new(
+        let a = m + k(2.0) * i0 * w * w;
+        let lv = [
             a * u[0] + i0 * w * gy,
             a * u[1] - i0 * w * gx,
-            2.0 * i0 * w * (1.0 - pv.phi + s) + i0 * c,
-        );
+            k(2.0) * i0 * w * (k(1.0) - phi + s) + i0 * c,
+        ];
         let f = m + i0 * w * w;
         // ∂c/∂x_k = H_yk u_x − H_xk u_y.
-        let lq = Vector3::new(
+        let lq = [
             -f * gx + i0 * w * (hxy * u[0] - hxx * u[1]),
             -f * gy + i0 * w * (hyy * u[0] - hxy * u[1]),
-            0.0,
-        );
-        let mut hess = Matrix3::zeros();
-        hess[(0, 0)] = a;
-        hess[(1, 1)] = a;
-        hess[(0, 2)] = 4.0 * i0 * w * u[0] + i0 * gy;
-        hess[(1, 2)] = 4.0 * i0 * w * u[1] - i0 * gx;
-        hess[(2, 0)] = hess[(0, 2)];
-        hess[(2, 1)] = hess[(1, 2)];
-        hess[(2, 2)] = 2.0 * i0 * (1.0 - pv.phi + s);
-        Some(Derivs { l, lv, lq, hess })
+            k(0.0),
+        ];
+        let h02 = k(4.0) * i0 * w * u[0] + i0 * gy;
+        let h12 = k(4.0) * i0 * w * u[1] - i0 * gx;
+        let hess = [
+            [a, k(0.0), h02],
+            [k(0.0), a, h12],
+            [h02, h12, k(2.0) * i0 * (k(1.0) - phi + s)],
+        ];
+        Some(DerivsT { l, lv, lq, hess })
+    }
+
+    /// m and I₀, the parameter (0: the mass, 1: the inertia 𝕀 = 2I₀) moved at unit rate.
+    fn constants<T: Real>(&self, parameter: Option<usize>) -> (T, T) {
+        (
+            T::with(self.mass, f64::from(u8::from(parameter == Some(0)))),
+            T::with(self.i0, 0.5 * f64::from(u8::from(parameter == Some(1)))),
+        )
+    }
+}
+
+impl Legendre for WeakFieldTop {
+    /// Derivatives of L at (q, q̇); None where φ or q̇ is not finite.
+    fn derivs(&self, q: &[f64], v: &Vector3<f64>) -> Option<Derivs> {
+        let (m, i0) = self.constants(None);
+        self.kernel([q[0], q[1], q[2]], [v[0], v[1], v[2]], m, i0)?
+            .finite()
+    }
+
+    fn derivs_dual(
+        &self,
+        q: [Dual; 3],
+        v: [Dual; 3],
+        parameter: Option<usize>,
+    ) -> Option<DerivsT<Dual>> {
+        let (m, i0) = self.constants(parameter);
+        self.kernel(q, v, m, i0)
+    }
+
+    /// Where the potential gives its third derivatives (the point mass, the uniform field).
+    fn has_hessian(&self) -> bool {
+        self.potential.has_third()
     }
 
     fn solve(&self, q: &[f64], p: &[f64]) -> Option<(Vector3<f64>, Derivs)> {

@@ -2,7 +2,10 @@
 //! (K = 0, SE(2)), the round [`Sphere`] (K = 1/R², SO(3)) and the [`HyperbolicPlane`] (K = −1,
 //! SL(2, ℝ), 002 (67)–(77)).
 
-use super::{finite2, normal_and_invertible, Embedding, Mat2, Shape, Surface, Vec2, Vec3, ZERO2};
+use super::{
+    finite2, normal_and_invertible, Embedding, Mat2, SecondGeometry, Shape, Surface, Vec2, Vec3,
+    ZERO2,
+};
 use crate::check;
 use crate::error::Result;
 
@@ -37,6 +40,12 @@ impl Surface for Plane {
     }
     fn connection_derivatives(&self, _x: Vec2) -> Mat2 {
         ZERO2
+    }
+    fn has_second_derivatives(&self) -> bool {
+        true
+    }
+    fn second_derivatives(&self, _x: Vec2) -> SecondGeometry {
+        SecondGeometry::ZERO
     }
     fn curvature(&self, _x: Vec2) -> f64 {
         0.0
@@ -81,6 +90,12 @@ impl Embedding for Plane {
             w: ZERO2,
             dw: [ZERO2; 2],
         }
+    }
+    fn has_shape_second(&self) -> bool {
+        true
+    }
+    fn shape_second(&self, _x: Vec2) -> [[Mat2; 2]; 2] {
+        [[ZERO2; 2]; 2]
     }
 }
 
@@ -145,6 +160,17 @@ impl Surface for Sphere {
     fn connection_derivatives(&self, x: Vec2) -> Mat2 {
         [[0.0, -x[0].sin()], [0.0, 0.0]]
     }
+    fn has_second_derivatives(&self) -> bool {
+        true
+    }
+    /// ∂²_ϑ g₂₂ = 2R² cos 2ϑ, ∂²_ϑ α₂ = −cos ϑ; the rest zero.
+    fn second_derivatives(&self, x: Vec2) -> SecondGeometry {
+        let r2 = self.radius * self.radius;
+        let mut s = SecondGeometry::ZERO;
+        s.d2g[0][0][1][1] = 2.0 * r2 * (2.0 * x[0]).cos();
+        s.d2alpha[0][0][1] = -x[0].cos();
+        s
+    }
     fn curvature(&self, _x: Vec2) -> f64 {
         1.0 / (self.radius * self.radius)
     }
@@ -205,6 +231,15 @@ impl Embedding for Sphere {
             dw: [[[0.0, 0.0], [0.0, -c]], ZERO2],
         }
     }
+    fn has_shape_second(&self) -> bool {
+        true
+    }
+    /// ∂²_ϑ W₂₂ = sin ϑ; the rest zero.
+    fn shape_second(&self, x: Vec2) -> [[Mat2; 2]; 2] {
+        let mut d = [[ZERO2; 2]; 2];
+        d[0][0][1][1] = x[0].sin();
+        d
+    }
 }
 
 /// The hyperbolic plane in the Poincaré half-plane x = (x, y), y > 0, g = (dx² + dy²)/y²
@@ -249,6 +284,18 @@ impl Surface for HyperbolicPlane {
     }
     fn connection_derivatives(&self, x: Vec2) -> Mat2 {
         [[0.0, 0.0], [-1.0 / (x[1] * x[1]), 0.0]]
+    }
+    fn has_second_derivatives(&self) -> bool {
+        true
+    }
+    /// ∂²_y g = 6/y⁴ Id, ∂²_y α₁ = 2/y³; the rest zero.
+    fn second_derivatives(&self, x: Vec2) -> SecondGeometry {
+        let y = x[1];
+        let mut s = SecondGeometry::ZERO;
+        let d = 6.0 / (y * y * y * y);
+        s.d2g[1][1] = [[d, 0.0], [0.0, d]];
+        s.d2alpha[1][1][0] = 2.0 / (y * y * y);
+        s
     }
     fn curvature(&self, _x: Vec2) -> f64 {
         -1.0

@@ -10,6 +10,9 @@
 //! - the Gaussian curvature K, with Cartan's second structure equation dw = −K dA, i.e.
 //!   K = −(∂₁α₂ − ∂₂α₁)/√det g (the sign follows from w(v) = ⟨∇_v Ê₁, Ê₂⟩; on the unit sphere
 //!   α = (0, cos ϑ) gives dw = −sin ϑ dϑ∧dφ = −dA, K = 1);
+//! - optionally the second derivatives ∂²g, ∂²α ([`SecondGeometry`]; and ∂²W of an embedding),
+//!   in closed form for [`Plane`], [`Sphere`], [`HyperbolicPlane`] and (intrinsically)
+//!   [`Revolution`]: the Hessian of the tangent top's Hamiltonian, its tangent lift, needs them;
 //! - its domain, the Killing fields of its isometry group lifted to the frame bundle (the
 //!   generators on (x¹, x², θ) that [`crate::systems::TangentTop`] turns into momenta), and
 //!   optionally an [`Embedding`] in ℝ³.
@@ -59,6 +62,31 @@ pub struct Geometry {
     pub dalpha: Mat2,
 }
 
+/// The second derivatives of g and α at one point, for the Hessian of the tangent top's
+/// Hamiltonian (its tangent lift): `d2g[k][l]` = ∂_k∂_l g, `d2alpha[k][l]` = ∂_k∂_l α (both
+/// symmetric in k, l).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SecondGeometry {
+    /// `d2g[k][l][i][j]` = ∂_k∂_l g_ij.
+    pub d2g: [[Mat2; 2]; 2],
+    /// `d2alpha[k][l][i]` = ∂_k∂_l α_i.
+    pub d2alpha: [[Vec2; 2]; 2],
+}
+
+impl SecondGeometry {
+    /// Zero (a flat chart with a parallel frame).
+    pub const ZERO: SecondGeometry = SecondGeometry {
+        d2g: [[ZERO2; 2]; 2],
+        d2alpha: [[[0.0; 2]; 2]; 2],
+    };
+
+    /// NaN (a surface without second derivatives).
+    pub const NAN: SecondGeometry = SecondGeometry {
+        d2g: [[[[f64::NAN; 2]; 2]; 2]; 2],
+        d2alpha: [[[f64::NAN; 2]; 2]; 2],
+    };
+}
+
 /// The shape operator of an embedded surface in the reference frame, W_aμ = e_a^α h_αμ
 /// = −⟨Ê_a, ∂_μ n⟩, and its first derivatives: the normal turns by dn(v) = −(W v)_a Ê_a, so a body
 /// point ξ^a E_a of the tangent top moves out of the tangent plane at the rate ⟨W v, ξ⟩ in the
@@ -85,6 +113,16 @@ pub trait Embedding {
     fn tangent(&self, x: Vec2, v: Vec2) -> [f64; 3];
     /// W = e h and ∂W at x ([`Shape`]).
     fn shape(&self, x: Vec2) -> Shape;
+
+    /// Whether [`Embedding::shape_second`] is given (the embedded top's tangent lift needs it).
+    fn has_shape_second(&self) -> bool {
+        false
+    }
+
+    /// `[k][l][a][μ]` = ∂_k∂_l W_aμ at x; NaN unless [`Embedding::has_shape_second`].
+    fn shape_second(&self, _x: Vec2) -> [[Mat2; 2]; 2] {
+        [[[[f64::NAN; 2]; 2]; 2]; 2]
+    }
 }
 
 /// A two-dimensional Riemannian surface in a local chart with an orthonormal frame (module docs).
@@ -146,6 +184,18 @@ pub trait Surface: Send + Sync + fmt::Debug {
             alpha: self.connection(x),
             dalpha: self.connection_derivatives(x),
         }
+    }
+
+    /// Whether [`Surface::second_derivatives`] is given in closed form (the tangent lift of a
+    /// top on the surface needs it: the Hessian of its Hamiltonian).
+    fn has_second_derivatives(&self) -> bool {
+        false
+    }
+
+    /// ∂²g and ∂²α at x ([`SecondGeometry`]); NaN unless
+    /// [`Surface::has_second_derivatives`].
+    fn second_derivatives(&self, _x: Vec2) -> SecondGeometry {
+        SecondGeometry::NAN
     }
 
     /// The Gaussian curvature K = −(∂₁α₂ − ∂₂α₁)/√det g (Cartan: dw = −K dA).

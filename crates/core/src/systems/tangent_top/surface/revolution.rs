@@ -5,7 +5,8 @@ use std::fmt;
 use std::sync::Arc;
 
 use super::{
-    finite2, normal_and_invertible, Embedding, Geometry, Mat2, Shape, Surface, Vec2, Vec3, ZERO2,
+    finite2, normal_and_invertible, Embedding, Geometry, Mat2, SecondGeometry, Shape, Surface,
+    Vec2, Vec3, ZERO2,
 };
 use crate::check;
 use crate::error::{Error, Result};
@@ -181,6 +182,28 @@ impl Surface for Revolution {
             alpha: [0.0, dr / l],
             dalpha: [[0.0, dz * (ddr * dz - dr * ddz) / (l * l * l)], [0.0, 0.0]],
         }
+    }
+    fn has_second_derivatives(&self) -> bool {
+        true
+    }
+    /// ∂²_s g₁₁ = 2(r″² + r′r‴ + z″² + z′z‴), ∂²_s g₂₂ = 2(r′² + r r″); ∂_s α₂ = N/λ³ with
+    /// N = z′(r″z′ − r′z″), so ∂²_s α₂ = N′/λ³ − 3Nλ′/λ⁴, N′ = r‴z′² + r″z′z″ − r′z″² − r′z′z‴,
+    /// λ′ = (r′r″ + z′z″)/λ. (The embedded top's ∂²W would need fourth derivatives of the
+    /// profile: not given.)
+    fn second_derivatives(&self, x: Vec2) -> SecondGeometry {
+        let [r, dr, ddr, dddr] = (self.r)(x[0]);
+        let [_, dz, ddz, dddz] = (self.z)(x[0]);
+        let l = (dr * dr + dz * dz).sqrt();
+        let dl = (dr * ddr + dz * ddz) / l;
+        let n = dz * (ddr * dz - dr * ddz);
+        let dn = dddr * dz * dz + ddr * dz * ddz - dr * ddz * ddz - dr * dz * dddz;
+        let mut s = SecondGeometry::ZERO;
+        s.d2g[0][0] = [
+            [2.0 * (ddr * ddr + dr * dddr + ddz * ddz + dz * dddz), 0.0],
+            [0.0, 2.0 * (dr * dr + r * ddr)],
+        ];
+        s.d2alpha[0][0][1] = dn / (l * l * l) - 3.0 * n * dl / (l * l * l * l);
+        s
     }
     fn curvature(&self, x: Vec2) -> f64 {
         let (r, dr, ddr, dz, ddz, l) = self.profile(x[0]);
