@@ -103,10 +103,12 @@ def test_sensitivity_refuses_what_it_cannot_do_with_typed_errors():
         lf.integrate(rb, z0, 0.1, 10, attitude=np.eye(4), sensitivity=True)
     with pytest.raises(lf.InvalidArgumentError, match="events"):
         lf.integrate(rb, z0, 0.1, 10, method="rk4", events=lambda t, z: z[0], sensitivity=True)
-    disks = lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6)
+    bare = lf.LiePoisson("so3", lambda mu: 0.5 * float(mu @ mu), gradient=lambda mu: mu)
     with pytest.raises(lf.InvalidArgumentError, match="no tangent maps"):
-        lf.integrate(disks, disks.state([0.1, -0.2], [0.3, 0.5]), 0.1, 10, sensitivity=True)
-    assert disks.sensitivity_methods() == []
+        lf.integrate(bare, z0, 0.1, 10, sensitivity=True)
+    assert bare.sensitivity_methods() == []
+    disks = lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6)
+    assert disks.sensitivity_methods() == disks.methods()
     disk = lf.RollingDisk(1.0, 0.5, 0.125, 0.0625, spring=0.4)
     assert disk.sensitivity_methods() == ["nonholonomic"]
     assert disk.parameters == ["spring", "tilt"]
