@@ -244,7 +244,7 @@ impl Integrator<HeavyTop> for ExactSplitting {
 }
 
 /// The exact splittings on the tangent lift: the same composition of the lifted flows
-/// ([`FreeKick`]'s [`SplitTangent`]).
+/// (`FreeKick`'s [`SplitTangent`]).
 impl Integrator<Tangent<HeavyTop>> for ExactSplitting {
     fn properties(&self) -> Properties {
         Properties::geometric(self.0.order())

@@ -31,7 +31,7 @@
 //! DG(M̃)X = δM_n − (aS₁ − a²S₂)|_{X=0, δL}   (the inhomogeneous term only along a parameter),
 //!
 //! with DG(M̃) formed in the e_ij coordinates (column c from X = E_c, δW = E_c/d_c) and factored
-//! once per step for all the directions ([`crate::numerics::linalg::DenseLu`]), and
+//! once per step for all the directions (`DenseLu`), and
 //! δM_{n+1} = δH. With the attitude R_{n+1} = R_n cay(v), v = h ω̃ (ω̃ the vector of W̃), the
 //! left-trivialised direction is ξ_{n+1} = cay(v)ᵀ ξ_n + (δv − v × δv/2)/(1 + |v|²/4), δv = h δω
 //! (the derivative of the Cayley map, as for the LGVI). The base state is advanced by the plain
