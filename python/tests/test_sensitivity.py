@@ -489,3 +489,31 @@ def test_jacobians_with_the_attitude_round_trip_through_a_file(tmp_path, system,
     back = lf.load(path)
     np.testing.assert_array_equal(back.jacobian, traj.jacobian)
     np.testing.assert_array_equal(back.parameter_jacobian, traj.parameter_jacobian)
+
+
+def test_a_user_hessian_that_raises_or_lies_ends_the_run_with_its_error():
+    """lf.LiePoisson(hessian=): a callback raising once ends the run with that exception and a
+    consistent partial (states and Jacobians of the same samples); a wrong shape or a NaN is a
+    typed error naming the callable."""
+    I = np.array([1.0, 2.0, 3.0])
+    h = lambda mu: 0.5 * float(mu @ (mu / I))
+    g = lambda mu: mu / I
+    calls = [0]
+
+    def hess(mu, dmu):
+        calls[0] += 1
+        if calls[0] == 50:
+            raise KeyError("boom")
+        return dmu / I
+    with pytest.raises(KeyError, match="boom") as info:
+        lf.integrate(lf.LiePoisson("so3", h, gradient=g, hessian=hess), [0.3, -0.8, 1.1], 0.05,
+                     40, method="midpoint", sensitivity=True)
+    partial = info.value.partial
+    assert partial.jacobian.shape == partial.states.shape + (3,)
+    np.testing.assert_array_equal(partial.jacobian[0], np.eye(3))
+    with pytest.raises(lf.ShapeError, match="hessian"):
+        lf.integrate(lf.LiePoisson("so3", h, gradient=g, hessian=lambda mu, d: np.zeros(2)),
+                     [0.3, -0.8, 1.1], 0.05, 4, sensitivity=True)
+    with pytest.raises(lf.NonFiniteError, match="hessian"):
+        lf.integrate(lf.LiePoisson("so3", h, gradient=g, hessian=lambda mu, d: d * np.nan),
+                     [0.3, -0.8, 1.1], 0.05, 4, sensitivity=True)
