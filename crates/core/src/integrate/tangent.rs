@@ -91,6 +91,14 @@ pub trait SplitTangent: Split {
         dirs: &mut [f64],
     );
 
+    /// The directions (all of them, consecutive) from the state's coordinates into the working
+    /// form's own, at the working point `w` just loaded (a work in other coordinates than the
+    /// state, e.g. the reduced pseudo-rigid body's); the identity by default.
+    fn directions_in(&self, _w: &Self::Work, _dirs: &mut [f64]) {}
+
+    /// The inverse of [`SplitTangent::directions_in`], at the working point `w` being stored.
+    fn directions_out(&self, _w: &Self::Work, _dirs: &mut [f64]) {}
+
     /// dz += ∂φ_i,τ/∂θ_m (z) for the parameter m, after [`SplitTangent::flow_tangent`] on the
     /// same dz; NaN unless a problem with parameters implements it.
     fn flow_parameter(
@@ -919,23 +927,48 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
 #[derive(Clone, Debug)]
 pub struct SplitWork<W> {
     base: W,
+    /// The base before the current flow (its storage reused from flow to flow).
+    before: W,
     dirs: Vec<f64>,
 }
 
-/// The flows (φ_τ(z), Dφ_τ(z)δz_j) (field layout).
+/// The flows (φ_τ(z), Dφ_τ(z)δz_j), in either layout (a separable problem's lift serves its
+/// Verlet methods and its splittings with one layout); the directions in the working form's
+/// coordinates ([`SplitTangent::directions_in`]) while loaded.
 impl<P: SplitTangent + Clone> Split for Tangent<P> {
     type Work = SplitWork<P::Work>;
 
     fn load(&self, z: &[f64]) -> Result<Self::Work> {
+        let e = self.e;
+        let mut dirs = vec![0.0; self.k() * e];
+        for (j, v) in dirs.chunks_exact_mut(e).enumerate() {
+            self.gather(z, j + 1, v);
+        }
+        let base = with_buffers(|[b, ..]| {
+            b.resize(self.d, 0.0);
+            self.gather(z, 0, b);
+            self.problem.load(b)
+        })?;
+        self.problem.directions_in(&base, &mut dirs);
         Ok(SplitWork {
-            base: self.problem.load(&z[..self.d])?,
-            dirs: z[self.d..].to_vec(),
+            before: base.clone(),
+            base,
+            dirs,
         })
     }
 
     fn store(&self, w: &Self::Work, z: &mut [f64]) {
-        self.problem.store(&w.base, &mut z[..self.d]);
-        z[self.d..].copy_from_slice(&w.dirs);
+        with_buffers(|[b, v, _]| {
+            b.resize(self.d, 0.0);
+            self.problem.store(&w.base, b);
+            self.scatter(b, 0, z);
+            v.clear();
+            v.extend_from_slice(&w.dirs);
+            self.problem.directions_out(&w.base, v);
+            for (j, dz) in v.chunks_exact(self.e).enumerate() {
+                self.scatter(dz, j + 1, z);
+            }
+        });
     }
 
     fn flows(&self) -> usize {
@@ -943,13 +976,14 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
     }
 
     fn flow(&self, i: usize, tau: f64, w: &mut Self::Work) {
-        let before = w.base.clone();
+        w.before.clone_from(&w.base);
         self.problem.flow(i, tau, &mut w.base);
         self.problem
-            .flow_tangent(i, tau, &before, &w.base, &mut w.dirs);
+            .flow_tangent(i, tau, &w.before, &w.base, &mut w.dirs);
         let e = self.e;
         for (m, dz) in w.dirs[e * e..].chunks_exact_mut(e).enumerate() {
-            self.problem.flow_parameter(i, tau, &before, &w.base, m, dz);
+            self.problem
+                .flow_parameter(i, tau, &w.before, &w.base, m, dz);
         }
     }
 

@@ -61,10 +61,13 @@
 //! Each K_ij flow costs O(n) (two Givens conjugations, two column rotations), so a step costs
 //! O(n³) (n(n−1)/2 pairs, plus one gradient of U at diag(a)).
 
+use faer::{Accum, MatMut, MatRef};
+
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::problem::Violation;
 use crate::lie::{gl, so};
+use crate::numerics::linalg;
 use crate::pseudo_rigid::dynamics::FullBody;
 use crate::pseudo_rigid::momentum::{self, momentum_map_unchecked};
 use crate::pseudo_rigid::potential::{Potential, Workspace};
@@ -368,6 +371,22 @@ impl Clone for ReducedWork {
             angle: self.angle,
         }
     }
+
+    /// Without allocation (the tangent lift keeps the point before each flow).
+    fn clone_from(&mut self, other: &Self) {
+        if self.state.a.len() != other.state.a.len() {
+            *self = other.clone();
+            return;
+        }
+        let (s, o) = (&mut self.state, &other.state);
+        s.a.copy_from_slice(&o.a);
+        s.p_a.copy_from_slice(&o.p_a);
+        s.p_omega.copy_from(&o.p_omega);
+        s.p_lambda.copy_from(&o.p_lambda);
+        self.r.copy_from(&other.r);
+        self.s.copy_from(&other.s);
+        self.angle = other.angle;
+    }
 }
 
 impl ReducedWork {
@@ -478,6 +497,351 @@ impl ReducedWork {
             });
         }
         Ok(())
+    }
+}
+
+/// The tangent maps of the reduced splitting (issue 26, [`crate::integrate::tangent`]).
+///
+/// A direction (δX, δP) at the working point is carried in the working form's coordinates
+/// (δa, δp_a, δμ, δν, ξ, η) with δR = Rξ, δS = Sη (the skew δμ, δν, ξ, η by their entries
+/// i < j in pair order): 2n² values, as many as (δX, δP). From X = RASᵀ,
+/// RᵀδXS = ξA + δA − Aη, so δa_i is its diagonal and, for i < j, with M = RᵀδXS,
+/// ξ_ij = (a_j M_ij + a_i M_ji)/(a_j² − a_i²), η_ij = (a_i M_ij + a_j M_ji)/(a_j² − a_i²)
+/// (solvable on the principal stratum). From P = RΠSᵀ with Π = ΩA + diag(p_a) − AΛ, the pair
+/// formulas give Π_ij = −s/(2d₋) + d/(2d₊), Π_ji = −s/(2d₋) − d/(2d₊) (s = μ_ij + ν_ij,
+/// d = μ_ij − ν_ij, d∓ = a_i ∓ a_j), i.e. s = −d₋(Π_ij + Π_ji), d = d₊(Π_ij − Π_ji): δΠ =
+/// RᵀδPS − ξΠ + Πη, δp_a its diagonal, and (δμ_ij, δν_ij) from the derivatives of s and d.
+///
+/// The flows' tangent maps in these coordinates: T: δa += τδp_a; U: δp_a −= τ D²U(A)δa on the
+/// diagonal; K_ij (a, μ_ij, ν_ij fixed, so δΩ_ij, δΛ_ij are constant along it):
+/// δp_a −= τ δ(∂K_ij/∂a), δμ ← G(δμ + τδΩ_ij[μ, E_ij])Gᵀ, ξ ← GξGᵀ + τδΩ_ij E_ij with the
+/// flow's G = exp(−τΩ_ij E_ij) (from R′ = RGᵀ: R′ᵀδR′ = GξGᵀ + GδGᵀ), and the same for (ν, η)
+/// with Λ_ij.
+impl ReducedWork {
+    /// (δX, δP) ↦ (δa, δp_a, δμ, δν, ξ, η) at this point, for every direction in `dirs`.
+    pub fn tangent_in(&self, dirs: &mut [f64]) {
+        TangentScratch::with(self.state.a.len(), |t| self.tangent_in_with(t, dirs));
+    }
+
+    fn tangent_in_with(&self, t: &mut TangentScratch, dirs: &mut [f64]) {
+        let n = self.state.a.len();
+        let nn = n * n;
+        let pi = self.pi();
+        let a = &self.state.a;
+        for dz in dirs.chunks_exact_mut(2 * nn) {
+            for (k, m) in [&mut t.ms, &mut t.ns].into_iter().enumerate() {
+                let v = MatRef::from_row_major_slice(&dz[k * nn..(k + 1) * nn], n, n);
+                linalg::mul(t.tmp.as_mut(), Accum::Replace, self.r.transpose(), v, 1.0);
+                linalg::mul(
+                    m.as_mut(),
+                    Accum::Replace,
+                    t.tmp.as_ref(),
+                    self.s.as_ref(),
+                    1.0,
+                );
+            }
+            for (k, &(i, j)) in self.pairs.iter().enumerate() {
+                let (mij, mji) = (t.ms[(i, j)], t.ms[(j, i)]);
+                let den = a[j] * a[j] - a[i] * a[i];
+                let (x, e) = (
+                    (a[j] * mij + a[i] * mji) / den,
+                    (a[i] * mij + a[j] * mji) / den,
+                );
+                (t.xi[(i, j)], t.xi[(j, i)], t.eta[(i, j)], t.eta[(j, i)]) = (x, -x, e, -e);
+                t.out[Slot::Xi.at(n, k)] = x;
+                t.out[Slot::Eta.at(n, k)] = e;
+            }
+            // δΠ = N − ξΠ + Πη.
+            linalg::mul(t.ns.as_mut(), Accum::Add, t.xi.as_ref(), pi.as_ref(), -1.0);
+            linalg::mul(t.ns.as_mut(), Accum::Add, pi.as_ref(), t.eta.as_ref(), 1.0);
+            for i in 0..n {
+                t.out[i] = t.ms[(i, i)];
+                t.out[n + i] = t.ns[(i, i)];
+            }
+            for (k, &(i, j)) in self.pairs.iter().enumerate() {
+                let (dm, dp) = (a[i] - a[j], a[i] + a[j]);
+                let (ddm, ddp) = (t.out[i] - t.out[j], t.out[i] + t.out[j]);
+                let ds = -ddm * (pi[(i, j)] + pi[(j, i)]) - dm * (t.ns[(i, j)] + t.ns[(j, i)]);
+                let dd = ddp * (pi[(i, j)] - pi[(j, i)]) + dp * (t.ns[(i, j)] - t.ns[(j, i)]);
+                t.out[Slot::Mu.at(n, k)] = 0.5 * (ds + dd);
+                t.out[Slot::Nu.at(n, k)] = 0.5 * (ds - dd);
+            }
+            dz.copy_from_slice(&t.out);
+        }
+    }
+
+    /// (δa, δp_a, δμ, δν, ξ, η) ↦ (δX, δP) at this point: δX = R(ξA + δA − Aη)Sᵀ,
+    /// δP = R(ξΠ + δΠ − Πη)Sᵀ.
+    pub fn tangent_out(&self, dirs: &mut [f64]) {
+        TangentScratch::with(self.state.a.len(), |t| self.tangent_out_with(t, dirs));
+    }
+
+    fn tangent_out_with(&self, t: &mut TangentScratch, dirs: &mut [f64]) {
+        let n = self.state.a.len();
+        let nn = n * n;
+        let pi = self.pi();
+        let (a, mu, nu) = (&self.state.a, &self.state.p_omega, &self.state.p_lambda);
+        for dz in dirs.chunks_exact_mut(2 * nn) {
+            t.load(n, &self.pairs, dz);
+            let da = &dz[..n];
+            for i in 0..n {
+                t.ms[(i, i)] = da[i];
+                t.ns[(i, i)] = dz[n + i];
+            }
+            for (k, &(i, j)) in self.pairs.iter().enumerate() {
+                let (x, e) = (t.xi[(i, j)], t.eta[(i, j)]);
+                t.ms[(i, j)] = x * a[j] - a[i] * e;
+                t.ms[(j, i)] = -x * a[i] + a[j] * e;
+                let (dm, dp) = (a[i] - a[j], a[i] + a[j]);
+                let (ddm, ddp) = (da[i] - da[j], da[i] + da[j]);
+                let (s, d) = (mu[(i, j)] + nu[(i, j)], mu[(i, j)] - nu[(i, j)]);
+                let (dmu, dnu) = (dz[Slot::Mu.at(n, k)], dz[Slot::Nu.at(n, k)]);
+                let (ds, dd) = (dmu + dnu, dmu - dnu);
+                let sym = -0.5 * ds / dm + 0.5 * s * ddm / (dm * dm);
+                let anti = 0.5 * dd / dp - 0.5 * d * ddp / (dp * dp);
+                t.ns[(i, j)] = sym + anti;
+                t.ns[(j, i)] = sym - anti;
+            }
+            linalg::mul(t.ns.as_mut(), Accum::Add, t.xi.as_ref(), pi.as_ref(), 1.0);
+            linalg::mul(t.ns.as_mut(), Accum::Add, pi.as_ref(), t.eta.as_ref(), -1.0);
+            for (k, m) in [&t.ms, &t.ns].into_iter().enumerate() {
+                linalg::mul(
+                    t.tmp.as_mut(),
+                    Accum::Replace,
+                    self.r.as_ref(),
+                    m.as_ref(),
+                    1.0,
+                );
+                let v = MatMut::from_row_major_slice_mut(&mut dz[k * nn..(k + 1) * nn], n, n);
+                linalg::mul(v, Accum::Replace, t.tmp.as_ref(), self.s.transpose(), 1.0);
+            }
+        }
+    }
+
+    /// dz ← Dφ_i,τ dz for every direction (working coordinates), `self` the point before the
+    /// flow.
+    pub fn flow_tangent(&self, i: usize, tau: f64, potential: &dyn Potential, dirs: &mut [f64]) {
+        let n = self.state.a.len();
+        TangentScratch::with(n, |t| self.flow_tangent_with(t, i, tau, potential, dirs));
+    }
+
+    fn flow_tangent_with(
+        &self,
+        t: &mut TangentScratch,
+        i: usize,
+        tau: f64,
+        potential: &dyn Potential,
+        dirs: &mut [f64],
+    ) {
+        let n = self.state.a.len();
+        let e = 2 * n * n;
+        match i {
+            0 => {
+                for dz in dirs.chunks_exact_mut(e) {
+                    let (da, dp) = dz.split_at_mut(n);
+                    da.iter_mut().zip(&dp[..n]).for_each(|(a, p)| *a += tau * p);
+                }
+            }
+            1 => {
+                // H_kl = ∂²U/∂a_k∂a_l = D²U(A)[E_ll]_kk, formed once.
+                let (amat, unit, out) = (&mut t.tmp, &mut t.ms, &mut t.ns);
+                amat.fill(0.0);
+                unit.fill(0.0);
+                for k in 0..n {
+                    amat[(k, k)] = self.state.a[k];
+                }
+                for l in 0..n {
+                    unit[(l, l)] = 1.0;
+                    out.fill(0.0);
+                    potential.add_hessian(amat.as_ref(), unit.as_ref(), out.as_mut(), &mut t.ws);
+                    unit[(l, l)] = 0.0;
+                    for k in 0..n {
+                        t.h[(k, l)] = out[(k, k)];
+                    }
+                }
+                for dz in dirs.chunks_exact_mut(e) {
+                    for k in 0..n {
+                        let hk: f64 = (0..n).map(|l| t.h[(k, l)] * dz[l]).sum();
+                        dz[n + k] -= tau * hk;
+                    }
+                }
+            }
+            f => {
+                let k = f - 2;
+                let (i, j) = self.pairs[k];
+                let st = &self.state;
+                let q = st.pair(i, j);
+                let (mu, nu) = (&st.p_omega, &st.p_lambda);
+                let (s, d) = (mu[(i, j)] + nu[(i, j)], mu[(i, j)] - nu[(i, j)]);
+                let (dm, dp) = (st.a[i] - st.a[j], st.a[i] + st.a[j]);
+                let (sw, cw) = (tau * q.omega).sin_cos();
+                let (sl, cl) = (tau * q.lambda).sin_cos();
+                for dz in dirs.chunks_exact_mut(e) {
+                    let (ddm, ddp) = (dz[i] - dz[j], dz[i] + dz[j]);
+                    let (dmu, dnu) = (dz[Slot::Mu.at(n, k)], dz[Slot::Nu.at(n, k)]);
+                    let (ds, dd) = (dmu + dnu, dmu - dnu);
+                    // δ(s/d₋²), δ(d/d₊²); δ(s²/d₋³), δ(d²/d₊³).
+                    let dqm = ds / (dm * dm) - 2.0 * s * ddm / (dm * dm * dm);
+                    let dqp = dd / (dp * dp) - 2.0 * d * ddp / (dp * dp * dp);
+                    let dcm = (2.0 * s * ds - 3.0 * s * s * ddm / dm) / (dm * dm * dm);
+                    let dcp = (2.0 * d * dd - 3.0 * d * d * ddp / dp) / (dp * dp * dp);
+                    let (d_omega, d_lambda) = (0.5 * (dqm + dqp), 0.5 * (dqm - dqp));
+                    dz[n + i] += tau * 0.5 * (dcm + dcp);
+                    dz[n + j] -= tau * 0.5 * (dcm - dcp);
+                    t.load(n, &self.pairs, dz);
+                    for (m, dm_, frame, turn, c, sn) in [
+                        (mu, &mut t.ms, &mut t.xi, d_omega, cw, sw),
+                        (nu, &mut t.ns, &mut t.eta, d_lambda, cl, sl),
+                    ] {
+                        // δm + τδΩ[m, E]: [m, E] = mE − Em touches rows and columns i, j.
+                        let c_ = tau * turn;
+                        for r in 0..n {
+                            dm_[(r, j)] += c_ * m[(r, i)];
+                            dm_[(r, i)] -= c_ * m[(r, j)];
+                            dm_[(i, r)] -= c_ * m[(j, r)];
+                            dm_[(j, r)] += c_ * m[(i, r)];
+                        }
+                        givens_conj(dm_, i, j, c, sn);
+                        givens_conj(frame, i, j, c, sn);
+                        frame[(i, j)] += c_;
+                        frame[(j, i)] -= c_;
+                    }
+                    t.store(n, &self.pairs, dz);
+                }
+            }
+        }
+    }
+
+    /// dz += ∂φ_i,τ/∂θ_m: only U's flow moves with the potential's constants,
+    /// δp_a −= τ ∂(∂U/∂a)/∂θ_m.
+    pub fn flow_parameter(
+        &self,
+        i: usize,
+        tau: f64,
+        potential: &dyn Potential,
+        m: usize,
+        dz: &mut [f64],
+    ) {
+        if i != 1 {
+            return;
+        }
+        let n = self.state.a.len();
+        let mut ws = Workspace::new(n);
+        let mut g = Mat::zeros(n, n);
+        potential.add_parameter_gradient(diag(&self.state.a).as_ref(), m, g.as_mut(), &mut ws);
+        for k in 0..n {
+            dz[n + k] -= tau * g[(k, k)];
+        }
+    }
+
+    /// Π = RᵀPS = ΩA + diag(p_a) − AΛ by the pair formulas (module docs of the tangent maps).
+    fn pi(&self) -> Mat {
+        let st = &self.state;
+        let n = st.a.len();
+        let mut pi = diag(&st.p_a);
+        for &(i, j) in &self.pairs {
+            let (s, d) = (
+                st.p_omega[(i, j)] + st.p_lambda[(i, j)],
+                st.p_omega[(i, j)] - st.p_lambda[(i, j)],
+            );
+            let (sym, anti) = (
+                -0.5 * s / (st.a[i] - st.a[j]),
+                0.5 * d / (st.a[i] + st.a[j]),
+            );
+            pi[(i, j)] = sym + anti;
+            pi[(j, i)] = sym - anti;
+        }
+        debug_assert_eq!(pi.nrows(), n);
+        pi
+    }
+}
+
+/// The skew blocks of a direction in working coordinates, after (δa, δp_a).
+#[derive(Clone, Copy)]
+enum Slot {
+    Mu,
+    Nu,
+    Xi,
+    Eta,
+}
+
+impl Slot {
+    /// The index of entry k (the k-th pair i < j) of this block.
+    fn at(self, n: usize, k: usize) -> usize {
+        2 * n + (self as usize) * (n * (n - 1) / 2) + k
+    }
+}
+
+/// The matrices of the tangent maps: one per thread, kept from call to call
+/// ([`TangentScratch::with`]).
+struct TangentScratch {
+    ms: Mat,
+    ns: Mat,
+    xi: Mat,
+    eta: Mat,
+    tmp: Mat,
+    h: Mat,
+    out: Vec<f64>,
+    ws: Workspace,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::Cell<Option<TangentScratch>> = const { std::cell::Cell::new(None) };
+}
+
+impl TangentScratch {
+    fn new(n: usize) -> Self {
+        TangentScratch {
+            ms: Mat::zeros(n, n),
+            ns: Mat::zeros(n, n),
+            xi: Mat::zeros(n, n),
+            eta: Mat::zeros(n, n),
+            tmp: Mat::zeros(n, n),
+            h: Mat::zeros(n, n),
+            out: vec![0.0; 2 * n * n],
+            ws: Workspace::new(n),
+        }
+    }
+
+    /// `f` on this thread's scratch for dimension n (made at the first call, or for a new n).
+    fn with<R>(n: usize, f: impl FnOnce(&mut TangentScratch) -> R) -> R {
+        let mut t = SCRATCH
+            .take()
+            .filter(|t| t.ws.n() == n)
+            .unwrap_or_else(|| TangentScratch::new(n));
+        let r = f(&mut t);
+        SCRATCH.set(Some(t));
+        r
+    }
+
+    /// The skew blocks of a direction (working coordinates) into ms = δμ, ns = δν, xi, eta.
+    fn load(&mut self, n: usize, pairs: &[(usize, usize)], dz: &[f64]) {
+        for (m, slot) in [
+            (&mut self.ms, Slot::Mu),
+            (&mut self.ns, Slot::Nu),
+            (&mut self.xi, Slot::Xi),
+            (&mut self.eta, Slot::Eta),
+        ] {
+            m.fill(0.0);
+            for (k, &(i, j)) in pairs.iter().enumerate() {
+                m[(i, j)] = dz[slot.at(n, k)];
+                m[(j, i)] = -dz[slot.at(n, k)];
+            }
+        }
+    }
+
+    /// The inverse of [`TangentScratch::load`] (the entries i < j).
+    fn store(&self, n: usize, pairs: &[(usize, usize)], dz: &mut [f64]) {
+        for (m, slot) in [
+            (&self.ms, Slot::Mu),
+            (&self.ns, Slot::Nu),
+            (&self.xi, Slot::Xi),
+            (&self.eta, Slot::Eta),
+        ] {
+            for (k, &(i, j)) in pairs.iter().enumerate() {
+                dz[slot.at(n, k)] = m[(i, j)];
+            }
+        }
     }
 }
 

@@ -60,7 +60,7 @@ use crate::error::{Error, Result};
 use crate::integrate::methods::{Rattle, Splitting, Verlet};
 use crate::integrate::problem::{Constrained, Separable, Split, Symmetric, Violation};
 use crate::integrate::space::{Block, Space};
-use crate::integrate::tangent::{SeparableTangent, Tangent, TangentSystem};
+use crate::integrate::tangent::{SeparableTangent, SplitTangent, Tangent, TangentSystem};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::gl;
 use crate::lie::so::{self, spectral_invariants};
@@ -436,9 +436,48 @@ impl PseudoRigidBody {
     }
 }
 
+/// The tangent maps of the reduced flows, in the reduced coordinates while a run is loaded
+/// ([`ReducedWork::tangent_in`]): the lift of method `reduced`.
+impl SplitTangent for PseudoRigidBody {
+    fn flow_tangent(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &ReducedWork,
+        _after: &ReducedWork,
+        dirs: &mut [f64],
+    ) {
+        before.flow_tangent(i, tau, self.body.potential(), dirs);
+    }
+
+    fn directions_in(&self, w: &ReducedWork, dirs: &mut [f64]) {
+        w.tangent_in(dirs);
+    }
+
+    fn directions_out(&self, w: &ReducedWork, dirs: &mut [f64]) {
+        w.tangent_out(dirs);
+    }
+
+    fn flow_parameter(
+        &self,
+        i: usize,
+        tau: f64,
+        before: &ReducedWork,
+        _after: &ReducedWork,
+        m: usize,
+        dz: &mut [f64],
+    ) {
+        before.flow_parameter(i, tau, self.body.potential(), m, dz);
+    }
+}
+
+/// The methods of [`PseudoRigidBody`]'s catalog on its lift: Verlet's and the reduced flows for
+/// the free body, RATTLE's for the incompressible one.
 impl Catalog for Tangent<PseudoRigidBody> {
     fn kind_catalog() -> Vec<Entry<Self>> {
-        Verlet::family()
+        let mut catalog = Verlet::family();
+        catalog.push(Entry::new("reduced", Splitting::strang));
+        catalog
     }
 
     fn catalog(&self) -> Vec<Entry<Self>> {
@@ -666,8 +705,8 @@ impl Catalog for PseudoRigidBody {
         }
     }
 
-    /// The tangent lift of the Verlet methods (the free body) or of RATTLE's (the
-    /// incompressible one).
+    /// The tangent lift of the Verlet methods and the reduced flows (the free body) or of
+    /// RATTLE's (the incompressible one).
     fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
         Some(Tangent::separable(self.clone()).into_system())
     }
