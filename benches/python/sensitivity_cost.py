@@ -4,7 +4,10 @@ against the plain run of the same method and step, for the rigid body with attit
 pseudo-rigid body n = 3 (verlet4, SVK + volumetric; 18 + 4), the incompressible one (rattle4: the
 constrained lift, 18 + 4) and the pendulum with the implicit Gauss method (gauss6, through the
 implicit-function theorem: one LU per step for all directions; 2 + 0). The lift carries k
-directions, so the ideal factor is 1 + k. Wall time is the best of 5 calls of 2000 steps (save_every = steps).
+directions, so the ideal factor is 1 + k. Then the free body with attitude under the methods
+that differentiate their own implicit equations or group operations (exact, rkmk4, dmv, dmv8,
+lgvi, isospectral), the heavy top's exact splitting, the pseudo-rigid body's reduced flows, the
+rolling disks and the tangent top on the sphere (gauss4). Wall time is the best of 5 calls of 2000 steps (save_every = steps).
 
     python benches/python/sensitivity_cost.py
 """
@@ -37,6 +40,20 @@ def cases():
         ("PseudoRigidBody incompr.", inc, np.concatenate([X.ravel(), P_inc.ravel()]), None,
          "rattle4", 18 + 4),
         ("Pendulum", lf.Pendulum(1.0, 1.0, 9.81), np.array([1.0, 0.3]), None, "gauss6", 2),
+    ] + [
+        # The methods of no kind (own tangent steppers) and the Lie-group methods (the group-field
+        # lift), on the free body with attitude; the heavy top's exact splitting.
+        ("RigidBody with attitude", rb, np.array([0.3, -0.8, 1.1]), R0, m, 6 + 3)
+        for m in ["exact", "rkmk4", "dmv", "dmv8", "lgvi", "isospectral"]
+    ] + [
+        ("HeavyTop", ht, np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8]), None, "exact_splitting4",
+         6 + 7),
+        ("PseudoRigidBody n = 3", prb, np.concatenate([np.diag([1.6, 1.1, 0.7]).ravel(),
+                                                       0.2 * P.ravel()]), None, "reduced", 18 + 4),
+        ("RollingDisks", lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6),
+         np.array([0.1, 0.2, 0.5, -0.3]), None, "gauss4", 4 + 7),
+        ("TangentTop on the sphere", lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
+         np.array([0.3, 0.2, 0.1, 0.4, -0.2, 0.3]), None, "gauss4", 6 + 2),
     ]
 
 

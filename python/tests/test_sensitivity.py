@@ -35,7 +35,7 @@ def differences(system, z0, method, dt, steps, h=1e-5):
 @pytest.mark.parametrize("method", ["verlet", "verlet4"])
 def test_pseudo_rigid_body_verlet_jacobians_are_the_methods_derivative_and_symplectic(method):
     prb = body()
-    assert prb.sensitivity_methods() == ["verlet", "verlet4", "verlet6"]
+    assert prb.sensitivity_methods() == ["verlet", "verlet4", "verlet6", "reduced"]
     z0 = np.concatenate([X0.ravel(), P0.ravel()])
     traj = lf.integrate(prb, z0, 0.05, 40, method=method, save_every=10, sensitivity=True)
     plain = lf.integrate(prb, z0, 0.05, 40, method=method, save_every=10)
@@ -47,6 +47,33 @@ def test_pseudo_rigid_body_verlet_jacobians_are_the_methods_derivative_and_sympl
     np.testing.assert_allclose(traj.final_jacobian, fd, atol=1e-8 * np.abs(fd).max())
     for J in traj.jacobian:
         assert np.abs(J.T @ OMEGA @ J - OMEGA).max() < 1e-12 * max(1.0, np.abs(J).max()) ** 2
+
+
+def test_the_reduced_flows_jacobians_are_the_methods_derivative_and_symplectic():
+    """Method ``reduced`` (001 §7): the directions travel in the reduced coordinates and come
+    back as (δX, δP); against differences of the method, in the state and in the potential's
+    constants."""
+    def build(t):
+        return lf.PseudoRigidBody(3, lf.potentials.SaintVenantKirchhoff(t[0], t[1])
+                                  + lf.potentials.Volumetric(t[2], t[3]))
+
+    theta = np.array([1.0, 2.0, 0.5, 1.4])
+    x0 = np.array([[1.6, 0.1, -0.05], [0.02, 1.1, 0.08], [-0.03, 0.05, 0.7]])
+    z0 = np.concatenate([x0.ravel(), P0.ravel()])
+    traj = lf.integrate(build(theta), z0, 0.02, 25, method="reduced", sensitivity=True)
+    np.testing.assert_array_equal(
+        traj.states, lf.integrate(build(theta), z0, 0.02, 25, method="reduced").states)
+    J = traj.final_jacobian
+    fd = differences(build(theta), z0, "reduced", 0.02, 25)
+    np.testing.assert_allclose(J, fd, atol=1e-8 * np.abs(fd).max())
+    assert np.abs(J.T @ OMEGA @ J - OMEGA).max() < 1e-12 * np.abs(J).max() ** 2
+    h = 1e-6
+    for m in range(4):
+        e = np.zeros(4)
+        e[m] = h
+        fd = (lf.integrate(build(theta + e), z0, 0.02, 25, method="reduced").final_state
+              - lf.integrate(build(theta - e), z0, 0.02, 25, method="reduced").final_state) / (2 * h)
+        np.testing.assert_allclose(traj.final_parameter_jacobian[:, m], fd, atol=1e-7)
 
 
 TOPS = [

@@ -50,21 +50,13 @@ pub fn group_field_catalog<P: GroupField + VectorField + Clone + 'static>() -> V
 
 /// The kind boilerplate of a canonical system `$t` (a [`Canonical`] problem), written once:
 /// Hamilton's equations ([`Canonical::hamilton_field`]) as its vector field, its catalog
-/// (`$catalog`, by default [`canonical_catalog`]) and Rayleigh damping as its own dissipation
-/// ([`crate::integrate::forcing::rayleigh`]).
+/// (`$catalog`, e.g. [`canonical_catalog`]) for it and for its tangent lift, Rayleigh damping as
+/// its own dissipation ([`crate::integrate::forcing::rayleigh`]), and `$tangent` (`&$t` ↦ its
+/// lift, where it has one) as [`Catalog::tangent`](crate::integrate::method::Catalog::tangent).
 ///
 /// [`Canonical`]: crate::integrate::problem::Canonical
 /// [`Canonical::hamilton_field`]: crate::integrate::problem::Canonical::hamilton_field
 macro_rules! canonical_system {
-    ($t:ty) => {
-        $crate::integrate::methods::canonical_system!(
-            $t,
-            $crate::integrate::methods::canonical_catalog()
-        );
-    };
-    ($t:ty, $catalog:expr) => {
-        $crate::integrate::methods::canonical_system!($t, $catalog, |_: &$t| None);
-    };
     ($t:ty, $catalog:expr, $tangent:expr) => {
         impl $crate::integrate::problem::VectorField for $t {
             /// Hamilton's equations q̇ = ∂H/∂p, ṗ = −∂H/∂q.
@@ -89,6 +81,13 @@ macro_rules! canonical_system {
                 &self,
             ) -> Option<std::sync::Arc<dyn $crate::integrate::method::TangentSystem>> {
                 ($tangent)(self)
+            }
+        }
+
+        /// The same methods on the tangent lift.
+        impl $crate::integrate::method::Catalog for $crate::integrate::tangent::Tangent<$t> {
+            fn kind_catalog() -> Vec<$crate::integrate::method::Entry<Self>> {
+                $catalog
             }
         }
     };

@@ -62,7 +62,7 @@ use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::{Canonical, Symmetric};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::tangent::{CanonicalTangent, Tangent};
-use crate::integrate::{Entry, Problem};
+use crate::integrate::Problem;
 
 type C = Complex<f64>;
 
@@ -678,12 +678,6 @@ impl Symmetric for RollingDisks {
         self.check_z(z)?;
         check::len_of("xi", xi, 1)?;
         Ok(vec![xi[0], xi[0], 0.0, 0.0])
-    }
-}
-
-impl crate::integrate::Catalog for Tangent<RollingDisks> {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        canonical_catalog()
     }
 }
 

@@ -72,7 +72,7 @@ use crate::integrate::methods::canonical_catalog;
 use crate::integrate::problem::Canonical;
 use crate::integrate::space::{Block, Space};
 use crate::integrate::tangent::{CanonicalTangent, Tangent};
-use crate::integrate::{Entry, Problem};
+use crate::integrate::Problem;
 
 /// The tangent Euler top of mass m and Euler tensor I (002 (42)) on a surface, intrinsic or
 /// embedded (module docs); state z = (x¹, x², θ, p₁, p₂, p_θ).
@@ -684,12 +684,6 @@ impl CanonicalTangent for TangentTop {
     }
 }
 
-impl crate::integrate::Catalog for Tangent<TangentTop> {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        canonical_catalog()
-    }
-}
-
 // The tangent lift (Gauss, midpoint, RK4) on the surfaces with second derivatives.
 crate::integrate::methods::canonical_system!(TangentTop, canonical_catalog(), |t: &TangentTop| t
     .has_hessian()
@@ -923,12 +917,6 @@ impl CanonicalTangent for ChargedParticle {
             dhq[i] += a[i];
             dhp[i] += b[i];
         }
-    }
-}
-
-impl crate::integrate::Catalog for Tangent<ChargedParticle> {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        canonical_catalog()
     }
 }
 

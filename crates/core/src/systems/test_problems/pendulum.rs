@@ -177,12 +177,6 @@ impl VectorFieldTangent for Pendulum {
     }
 }
 
-impl crate::integrate::Catalog for Tangent<Pendulum> {
-    fn kind_catalog() -> Vec<Entry<Self>> {
-        methods()
-    }
-}
-
 // The tangent lift in the separable layout serves every method (Verlet, Gauss, RK4).
 crate::integrate::methods::canonical_system!(Pendulum, methods(), |p: &Pendulum| Some(
     Tangent::separable(p.clone()).into_system()

@@ -150,12 +150,6 @@ impl CanonicalTangent for UserCanonical {
     }
 }
 
-impl crate::integrate::Catalog for Tangent<UserCanonical> {
-    fn kind_catalog() -> Vec<crate::integrate::Entry<Self>> {
-        canonical_catalog()
-    }
-}
-
 // The tangent lift (every method) where a gradient and a Hessian are given.
 crate::integrate::methods::canonical_system!(
     UserCanonical,

@@ -323,12 +323,6 @@ impl VectorFieldTangent for UserSeparable {
     }
 }
 
-impl crate::integrate::Catalog for Tangent<UserSeparable> {
-    fn kind_catalog() -> Vec<crate::integrate::Entry<Self>> {
-        methods()
-    }
-}
-
 /// verlet (default), verlet4, verlet6, then gauss4, gauss6, midpoint, rk4: for the system and
 /// its tangent lift.
 fn methods<P: Separable + crate::integrate::problem::VectorField + Clone + 'static>(

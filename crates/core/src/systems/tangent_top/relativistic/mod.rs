@@ -501,12 +501,6 @@ macro_rules! legendre_kinds {
             }
         }
 
-        impl $crate::integrate::Catalog for Tangent<$t> {
-            fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
-                canonical_catalog()
-            }
-        }
-
         // The tangent lift where the kernel's data have the derivatives it needs.
         $crate::integrate::methods::canonical_system!($t, canonical_catalog(), |t: &$t| t
             .has_hessian()
