@@ -44,8 +44,14 @@
 //! its tangent map at the base state ([`Problem::tangent_to_internal_at`]; by default the chart
 //! itself, right for a linear one such as a turn to principal axes).
 //!
-//! **What the lift keeps.** Its space is flat (no block is retracted during the run, which
-//! would not be differentiated), its energy and invariants are the base state's.
+//! **What the lift keeps.** Its space is the base's blocks and then the directions, so a run
+//! retracts the base state's curved blocks exactly when the plain run does (every
+//! [`crate::integrate::RETRACT_EVERY`] steps of a method that keeps the manifold): its base
+//! states are the plain run's bit for bit however long the run. The directions are left as
+//! they are: at a point of the manifold (to round-off) the retraction's derivative is the
+//! identity on tangent directions (R(3I − RᵀR)/2 at RᵀR = I + E maps Rξ̂ to Rξ̂ + O(|E||ξ|)), so
+//! the Jacobian is that of the retracted map to round-off. Its energy and invariants are the
+//! base state's.
 
 use std::sync::Arc;
 
@@ -389,9 +395,19 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.name()
     }
 
-    /// Flat: d + k·e values.
+    /// The base problem's blocks, then the directions (d + k·e values in all): a run retracts
+    /// the base state's curved blocks as the plain run does (module docs); the separable
+    /// layout interleaves its values and is flat (its problems are).
     fn space(&self) -> Space {
-        Space::new([("z", Block::Real(self.d + self.k() * self.e))])
+        match self.layout {
+            Layout::Field => self
+                .problem
+                .space()
+                .with("directions", Block::Real(self.k() * self.e)),
+            Layout::Separable { .. } => {
+                Space::new([("z", Block::Real(self.d + self.k() * self.e))])
+            }
+        }
     }
 
     fn energy(&self, z: &[f64]) -> Result<f64> {

@@ -76,11 +76,9 @@
 //!   to along that state's directions: the derivative of the map it computes, equal to the
 //!   one without the re-set since H and C are invariants of every DMV step.
 //!
-//! The lift's space is flat, so the driver neither retracts it nor sets its stepper again; with
-//! the attitude the tangent stepper does itself what the driver does to the plain run after
-//! every [`RETRACT_EVERY`]-th step (retracts R, sets the stepper again), so that its base states
-//! are the plain run's bit for bit over any number of steps (a shortened step ending exactly
-//! there is retracted too: it moves by round-off).
+//! With the attitude the driver retracts the lift's R and sets its stepper again exactly where it
+//! does so for the plain run (every [`crate::integrate::RETRACT_EVERY`]-th step), so its base
+//! states are the plain run's bit for bit over any number of steps.
 //!
 //! **Properties** (HV06 Proposition 2.3, Table 2): order 2r; |M|² and the spatial momentum R M
 //! are kept (the step is a rotation of M and R M is unchanged by it), R ∈ SO(3) to round-off;
@@ -92,8 +90,7 @@
 use super::super::top::Top;
 use crate::convergence::{self, Failed, Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
-use crate::integrate::space::Block;
-use crate::integrate::{Clock, Properties, Stepper, RETRACT_EVERY};
+use crate::integrate::{Clock, Properties, Stepper};
 use crate::lie::rotations::{matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix};
 use nalgebra::{Matrix3, Vector3};
 
@@ -812,11 +809,6 @@ impl Stepper for DmvTangentStepper {
         }
     }
 
-    /// With the attitude, after every [`RETRACT_EVERY`]-th step of the run, what the driver does
-    /// to the plain run there (the lift's space is flat: the driver does not): R retracted and
-    /// the stepper set again, its modified moments from the M of that state. The retraction's
-    /// derivative on SO(3) is the identity in ξ; the preprocessing is differentiated along the
-    /// directions of that state.
     fn advance(&mut self, steps: usize, clock: Clock) -> Result<()> {
         for k in 0..steps {
             let m = self.base.m;
@@ -825,13 +817,6 @@ impl Stepper for DmvTangentStepper {
                 .step()
                 .map_err(|f| DmvStepper::failed(clock, k, f))?;
             self.tangent_step(&m, e);
-            if self.base.lifted && (clock.done + k as u64 + 1) % RETRACT_EVERY == 0 {
-                let mut z = [0.0; 12];
-                self.base.get(&mut z);
-                Block::SO3.retract(&mut z[3..]);
-                self.base.set(&z)?;
-                self.preprocess();
-            }
         }
         Ok(())
     }
