@@ -657,7 +657,12 @@ fn jacobians_of_every_lifted_pair_are_the_methods_derivative() {
             let mut z = vec![0.0; d];
             let (mut jac, mut pj) = (vec![0.0; e * e], vec![0.0; e * t.parameter_names().len()]);
             t.jacobian(lifted.state(1), &mut z, &mut jac, &mut pj);
-            assert_eq!(z, plain.state(1), "{} {name}: the base state after {long} steps", c.name);
+            assert_eq!(
+                z,
+                plain.state(1),
+                "{} {name}: the base state after {long} steps",
+                c.name
+            );
             let lifted = integrate(&*t, name, &seed, c.dt, steps, steps).unwrap();
             let np = t.parameter_names().len();
             let (mut z, mut jac, mut pj) = (vec![0.0; d], vec![0.0; e * e], vec![0.0; e * np]);

@@ -222,6 +222,7 @@ fn continuation_maclaurin_to_jacobi() {
         .collect();
     assert_eq!(lost.len(), 1, "{:?}", b.special);
     let e_lost = lost[0].point.parameter;
+    eprintln!("spectral stability lost at e = {e_lost:.12}");
     assert!((e_lost - 0.95289).abs() < 5e-6, "{e_lost}");
     // The energy–momentum verdict changes at the bifurcation (secular instability): with the
     // exact Hessian (issue 26) located to 1e-11 (it was 7e-9 by nested differences).

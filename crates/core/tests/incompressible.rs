@@ -436,6 +436,94 @@ fn cofactor_and_curvature_of_det_match_finite_differences() {
     }
 }
 
+/// D³ det(X)\[U, V, ·\] at n = 3 (closed form) against central differences of the closed-form
+/// D² det(X)\[U, ·\] along V (exact for a cubic up to round-off), and symmetric in (U, V).
+#[test]
+fn third_derivative_of_det_matches_differences_of_the_second() {
+    let body = PseudoRigidBody::incompressible(3, harmonic()).unwrap();
+    let mut s = body.scratch();
+    let mut rng = Rng::new(7);
+    let x = Mat::from_fn(3, 3, |i, j| if i == j { 1.3 } else { 0.0 }) + rng.mat(3, 0.3);
+    let flat = |m: &Mat| (0..9).map(|k| m[(k / 3, k % 3)]).collect::<Vec<f64>>();
+    let (q, u, v) = (flat(&x), flat(&rng.mat(3, 1.0)), flat(&rng.mat(3, 1.0)));
+    let (mut third, mut swapped) = ([0.0; 9], [0.0; 9]);
+    assert!(body.constraint_third(&q, &u, &v, &mut third, &mut s));
+    assert!(body.constraint_third(&q, &v, &u, &mut swapped, &mut s));
+    let h = 1e-3;
+    let second = |sign: f64| {
+        let qe: Vec<f64> = q.iter().zip(&v).map(|(a, b)| a + sign * h * b).collect();
+        let mut rows = [0.0; 9];
+        assert!(body.constraint_second(&qe, &u, &mut rows, &mut body.scratch()));
+        rows
+    };
+    let (up, down) = (second(1.0), second(-1.0));
+    let fd: Vec<f64> = (0..9).map(|k| (up[k] - down[k]) / (2.0 * h)).collect();
+    let err = dist(&third, &fd);
+    eprintln!("D³det[U, V, ·] vs differences of D²det[U, ·] {err:.1e}");
+    assert!(err < 1e-12 * norm(&fd), "{err:e}");
+    assert!(dist(&third, &swapped) < 1e-14 * norm(&fd));
+    let compressible = PseudoRigidBody::new(3, harmonic(), true).unwrap();
+    assert!(!compressible.constraint_third(&q, &u, &v, &mut third, &mut s));
+}
+
+/// The derivative of the index-1 field (`constrained_field_tangent`: the multiplier's
+/// derivative through D²g and D³g) against central differences of the field, for the
+/// incompressible body (n = 3 with D³ det in closed form; n = 4 by differences of the curvature)
+/// and the particle on a sphere; directions in every coordinate, off the constraint too.
+#[test]
+fn the_constrained_fields_derivative_matches_differences() {
+    use lieflow::integrate::methods::rattle::constrained_field_tangent;
+    fn check<P: Constrained + lieflow::integrate::tangent::SeparableTangent>(
+        name: &str,
+        problem: &P,
+        z: &[f64],
+        tol: f64,
+    ) {
+        let nz = z.len();
+        let mut dirs = vec![0.0; nz * nz];
+        for j in 0..nz {
+            dirs[j * nz + j] = 1.0;
+        }
+        let mut out = vec![0.0; nz * nz];
+        constrained_field_tangent(problem, z, &dirs, &mut out).unwrap();
+        let mut worst = 0.0f64;
+        let scale = out.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        for j in 0..nz {
+            let h = 1e-4 * z[j].abs().max(1.0);
+            let field = |sign: f64| {
+                let mut zs = z.to_vec();
+                zs[j] += sign * h;
+                let mut dz = vec![0.0; nz];
+                constrained_field(problem, &zs, &mut dz, &mut problem.scratch()).unwrap();
+                dz
+            };
+            let (a, b, a2, b2) = (field(1.0), field(-1.0), field(2.0), field(-2.0));
+            for i in 0..nz {
+                let fd = (8.0 * (a[i] - b[i]) - (a2[i] - b2[i])) / (12.0 * h);
+                worst = worst.max((out[j * nz + i] - fd).abs() / scale);
+            }
+        }
+        eprintln!("{name}: DF vs differences {worst:.1e}");
+        assert!(worst < tol, "{name}: {worst:e}");
+    }
+    for n in [3, 4] {
+        let body = PseudoRigidBody::incompressible(n, svk()).unwrap();
+        check(
+            &format!("incompressible n = {n}"),
+            &body,
+            &state(&body, 3, 0.5),
+            1e-9,
+        );
+    }
+    let part = SphereParticle::new(0.7, 1.3, 9.81).unwrap();
+    check(
+        "sphere particle",
+        &part,
+        &[0.3, -0.4, 1.1, 0.5, 0.2, 0.1],
+        1e-10,
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // The index-1 constrained field
 

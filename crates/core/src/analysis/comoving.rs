@@ -22,8 +22,9 @@
 //! # Spectral verdict
 //! L = Cᵀ DF(z₀) C. DF maps S into S (J is conserved and equivariant, ξ ∈ g_μ) and the orbit
 //! directions into themselves (DF η_Z = [η, ξ]_Z for η ∈ g_μ, a subalgebra containing ξ), so L
-//! is the linearisation on the quotient. DF by central differences of the analytic field with one
-//! Richardson extrapolation.
+//! is the linearisation on the quotient. DF from the derivative of the constrained field
+//! ([`constrained_field_tangent`]: the system's force Hessian, the constraints' second and, where
+//! given, third derivatives) and of the generator (linear in z).
 //!
 //! # Energy–momentum verdict
 //! H_ξ = H − ⟨J, ξ⟩ is critical at z₀ on N (z₀ is a relative equilibrium), so
@@ -44,17 +45,20 @@
 //! D²U = −f′ and M⁻¹ from [`SeparableTangent`] (analytic potential Hessians), ∇⟨J, ξ⟩ =
 //! (−ξ_Z^p, ξ_Z^q) from the generator (J is the momentum map of a cotangent-lifted linear
 //! action, so ⟨J, ξ⟩ generates ξ_Z and its Hessian is linear in z), dJ the same way, D²g by
-//! polarisation of the curvature form. Only D³g(q)\[M⁻¹p, ·, ·\], which multiplies the hidden
-//! constraints' multipliers (zero at a relative equilibrium), is taken by central differences.
+//! polarisation of the curvature form, D³g(q)\[M⁻¹p, ·, ·\] (which multiplies the hidden
+//! constraints' multipliers, zero at a relative equilibrium) from
+//! [`Constrained::constraint_third`] where given, else by central differences.
 //! So the verdict's margin is accurate to round-off and a change of the verdict along a family
 //! is located to ~1e-12 (the Maclaurin–Jacobi bifurcation; by nested differences it was 7e-9).
-//! The spectral verdict's DF is central differences of the constrained field with one
-//! Richardson extrapolation (λ(q, p) would need D³g, which the constraints do not give).
+//! The spectral verdict's DF is exact likewise: the multiplier's derivative needs
+//! D³g\[δq, v, v\], in closed form where the constraint gives it
+//! ([`Constrained::constraint_third`]: the incompressible body at n = 3, the sphere), else by
+//! central differences of the curvature along δq.
 
 use super::Verdict;
 use crate::check;
 use crate::error::{Error, Result};
-use crate::integrate::methods::rattle::constrained_field;
+use crate::integrate::methods::rattle::{constrained_field, constrained_field_tangent};
 use crate::integrate::problem::{Constrained, Symmetric};
 use crate::integrate::tangent::SeparableTangent;
 use crate::numerics::fd::{self, Scheme::Richardson};
@@ -68,9 +72,9 @@ pub const EQUILIBRIUM_TOL: f64 = 1e-8;
 /// Relative tolerance of the energy–momentum verdict (of the Hessian's eigenvalues).
 pub const HESSIAN_TOL: f64 = 1e-7;
 
-/// Relative tolerance of the spectral verdict (of max Re λ against the spectral radius): the
-/// Jacobian carries a finite-difference error of ~1e-11, which moves eigenvalues that meet
-/// (Krein collisions) by its square root.
+/// Relative tolerance of the spectral verdict (of max Re λ against the spectral radius): an
+/// error δ in the Jacobian (round-off, or ~1e-11 where D³g comes from differences) moves
+/// eigenvalues that meet (Krein collisions) by √δ.
 pub const SPECTRAL_TOL: f64 = 1e-5;
 
 /// Rank tolerance for the subspaces (singular values below this times the largest are zero).
@@ -164,12 +168,6 @@ pub fn stability<P: Constrained + Symmetric + SeparableTangent>(
         let mut dz = vec![0.0; nz];
         constrained_field(problem, z, &mut dz, s)?;
         Ok(dz)
-    };
-    let cell = std::cell::RefCell::new(problem.scratch());
-    let comoving = |z: &[f64]| -> Result<Vec<f64>> {
-        let f = field(z, &mut cell.borrow_mut())?;
-        let gen = problem.generator(xi, z)?;
-        Ok(f.iter().zip(&gen).map(|(a, b)| a - b).collect())
     };
     let f0 = field(z0, &mut scratch)?;
     let gen0 = problem.generator(xi, z0)?;
@@ -265,7 +263,7 @@ pub fn stability<P: Constrained + Symmetric + SeparableTangent>(
         .zip(&wz)
         .map(|(x, w)| 1e-4 * x.abs().max(1e-2 * w))
         .collect();
-    let df = fd::jacobian(&comoving, z0, &hz, Richardson)?;
+    let df = comoving_jacobian(problem, xi, z0, &hz)?;
     check::finite_mat("co-moving Jacobian", &df)?;
     let lin = &c_left * &df * &c;
     let spectral = Verdict::spectral(&lin, SPECTRAL_TOL)?;
@@ -376,11 +374,44 @@ fn pairing_gradient<P: Constrained + Symmetric>(
         .collect())
 }
 
+/// DF(z₀) of the co-moving field F = f − ξ_Z (2d × 2d): the constrained field's derivative
+/// exact ([`constrained_field_tangent`]; D³g of the constraints in closed form where the
+/// system gives it), ξ_Z's by central differences with the steps `h` (exact: ξ_Z is linear
+/// in z for the cotangent lift of a linear action).
+fn comoving_jacobian<P: Constrained + Symmetric + SeparableTangent>(
+    problem: &P,
+    xi: &[f64],
+    z0: &[f64],
+    h: &[f64],
+) -> Result<Mat> {
+    let nz = z0.len();
+    let mut dirs = vec![0.0; nz * nz];
+    for j in 0..nz {
+        dirs[j * nz + j] = 1.0;
+    }
+    let mut out = vec![0.0; nz * nz];
+    constrained_field_tangent(problem, z0, &dirs, &mut out)?;
+    let mut df = Mat::from_fn(nz, nz, |i, j| out[j * nz + i]);
+    let mut z = z0.to_vec();
+    for j in 0..nz {
+        z[j] = z0[j] + h[j];
+        let up = problem.generator(xi, &z)?;
+        z[j] = z0[j] - h[j];
+        let down = problem.generator(xi, &z)?;
+        z[j] = z0[j];
+        for i in 0..nz {
+            df[(i, j)] -= (up[i] - down[i]) / (2.0 * h[j]);
+        }
+    }
+    Ok(df)
+}
+
 /// D²ℒ(z₀) of ℒ = H − ⟨J, ξ⟩ − κ·Φ (module docs), 2d × 2d: D²H from the system's derivatives
 /// (D²U = −f′ and M⁻¹ of [`SeparableTangent`]), D²⟨J, ξ⟩ from the generator (linear in z:
-/// central differences with a step of the state's size are exact), D²g by polarisation. Only
-/// D³g(q)\[M⁻¹p, ·, ·\] of the hidden constraints is taken by differences (central, Richardson);
-/// its multipliers vanish at a relative equilibrium (the velocity is the generator's).
+/// central differences with a step of the state's size are exact), D²g by polarisation.
+/// D³g(q)\[M⁻¹p, ·, ·\] of the hidden constraints from [`Constrained::constraint_third`] where
+/// given, else by differences (central, Richardson); its multipliers vanish at a relative
+/// equilibrium (the velocity is the generator's).
 fn lagrange_hessian<P: Constrained + Symmetric + SeparableTangent>(
     problem: &P,
     xi: &[f64],
@@ -430,10 +461,24 @@ fn lagrange_hessian<P: Constrained + Symmetric + SeparableTangent>(
             hess[(i, k)] -= (up[i] - down[i]) / (2.0 * zscale);
         }
     }
-    // −Σ κ_{m+a} D³g_a[M⁻¹p, ·, ·] (qq), by differences of the polarised rows.
+    // −Σ κ_{m+a} D³g_a[M⁻¹p, ·, ·] (qq): closed form where the constraint gives it, else by
+    // differences of the polarised rows.
     if kappa[m..].iter().any(|&k| k != 0.0) {
         let mut v = vec![0.0; d];
         problem.velocity(p0, &mut v);
+        let mut rows = vec![0.0; m * d];
+        e.fill(0.0);
+        if problem.constraint_third(q0, &v, &e, &mut rows, s) {
+            for k in 0..d {
+                e[k] = 1.0;
+                problem.constraint_third(q0, &v, &e, &mut rows, s);
+                e[k] = 0.0;
+                for i in 0..d {
+                    hess[(i, k)] -= (0..m).map(|a| kappa[m + a] * rows[a * d + i]).sum::<f64>();
+                }
+            }
+            return Ok(hess);
+        }
         let cell = std::cell::RefCell::new(problem.scratch());
         let hidden = |q: &[f64]| -> Result<Vec<f64>> {
             let rows = curvature_rows(problem, q, &v, &mut cell.borrow_mut());

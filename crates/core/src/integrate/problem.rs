@@ -297,6 +297,21 @@ pub trait Constrained: Separable {
         false
     }
 
+    /// D³g(q)\[u, v, ·\] into `rows` (m × d, row-major) where the problem has it in closed
+    /// form: returns true then; false by default, and [`crate::integrate::methods::rattle::constrained_field_tangent`]
+    /// takes the D³g\[δq, v, v\] it needs by central differences of
+    /// [`Constrained::constraint_curvature`].
+    fn constraint_third(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _v: &[f64],
+        _rows: &mut [f64],
+        _s: &mut Self::Scratch,
+    ) -> bool {
+        false
+    }
+
     /// The rows F (m × d, row-major) along which the multipliers act on the momenta,
     /// ṗ = f − Fᵀλ, when they differ from G(q): writes them and returns true. A mechanical
     /// system's are G (false, the default); a tangent lift's are not

@@ -585,6 +585,30 @@ impl Constrained for PseudoRigidBody {
         true
     }
 
+    /// D³ det(X)\[U, V, ·\] at n = 3 (det is cubic: constant in X): the mixed determinant is
+    /// linear in W, and its coefficient in column c is u_a × v_b + v_a × u_b with
+    /// (c, a, b) cyclic (det = x_c · (x_a × x_b)).
+    fn constraint_third(
+        &self,
+        _q: &[f64],
+        u: &[f64],
+        v: &[f64],
+        rows: &mut [f64],
+        _s: &mut ForceScratch,
+    ) -> bool {
+        let (Some(u), Some(v), true) = (mat3(u), mat3(v), self.incompressible) else {
+            return false;
+        };
+        for c in 0..3 {
+            let (a, b) = ((c + 1) % 3, (c + 2) % 3);
+            let col = u.column(a).cross(&v.column(b)) + v.column(a).cross(&u.column(b));
+            for r in 0..3 {
+                rows[r * 3 + c] = col[r];
+            }
+        }
+        true
+    }
+
     /// D² det(X)[V, V] = d²/dε² det(X + εV) at ε = 0: 2 det V at n = 2; 2⟨X, cof V⟩ at n = 3
     /// (det(X + εV) = det X + ε⟨cof X, V⟩ + ε²⟨X, cof V⟩ + ε³ det V); 2 det(X) e₂(X⁻¹V) with
     /// e₂(B) = ½((tr B)² − tr B²) above, i.e. (⟨C, V⟩² − tr((CᵀV)²))/det X with C = cof X.

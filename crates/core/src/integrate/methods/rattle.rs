@@ -44,6 +44,8 @@ use crate::error::Result;
 use crate::integrate::method::{Clock, Entry, Integrator, Properties, Stepper};
 use crate::integrate::methods::Composition;
 use crate::integrate::problem::{Constrained, Separable, Violation};
+use crate::integrate::tangent::{constraint_second, SeparableTangent};
+use crate::numerics::linalg::norm;
 
 /// RATTLE composed with the weights of a [`Composition`] (`Composition::strang()`: RATTLE
 /// itself, order 2). Symplectic on the constraint manifold, symmetric.
@@ -594,6 +596,91 @@ pub fn constrained_field_into<P: Constrained>(
     dp.copy_from_slice(f);
     for (a, &la) in lambda.iter().enumerate() {
         axpy(dp, -la, &rows.c[a * d..(a + 1) * d]);
+    }
+    Ok(())
+}
+
+/// The derivative of the index-1 field ([`constrained_field_into`]) along each direction of
+/// `dirs` (consecutive 2d values, internal frame) into `out`: δq̇ = v′(p)δp and
+/// δṗ = δf − δGᵀλ − Gᵀδλ with δf = f′(q)δq, δG = D²g(q)\[δq, ·\] and, from
+/// (G M⁻¹Gᵀ)λ = G M⁻¹f + D²g\[v, v\] differentiated,
+///
+/// (G M⁻¹Gᵀ)δλ = δG a + G M⁻¹(δf − δGᵀλ) + D³g\[δq, v, v\] + 2D²g\[v, δv\],
+///
+/// a = M⁻¹(f − Gᵀλ) the acceleration. D²g from [`Constrained::constraint_second`] (else by
+/// polarisation, exact to round-off), D³g from [`Constrained::constraint_third`], else by
+/// central differences of the curvature along δq (the only approximation, documented where
+/// used). A state outside the problem's domain is [`crate::Error::InvalidArgument`].
+pub fn constrained_field_tangent<P: Constrained + SeparableTangent>(
+    problem: &P,
+    z: &[f64],
+    dirs: &[f64],
+    out: &mut [f64],
+) -> Result<()> {
+    let (d, m) = (problem.dof(), problem.constraints());
+    let mut s = problem.scratch();
+    let mut w = FieldWork::new(problem);
+    let mut lambda = vec![0.0; m];
+    let mut field = vec![0.0; 2 * d];
+    constrained_field_into(problem, z, &mut field, &mut lambda, &mut s, &mut w)
+        .map_err(|v| v.at_start())?;
+    let (q, p) = z.split_at(d);
+    let v = w.v.clone();
+    // a = M⁻¹(f − Gᵀλ); D²g[v, ·].
+    let mut acc = vec![0.0; d];
+    problem.velocity_tangent(p, &field[d..], &mut acc);
+    let (mut rows_v, mut rows_dq) = (vec![0.0; m * d], vec![0.0; m * d]);
+    let (mut wk, mut ck) = (vec![0.0; d], vec![0.0; 2 * m]);
+    constraint_second(problem, q, &v, &mut rows_v, &mut wk, &mut ck, &mut s);
+    let (mut dv, mut df, mut third, mut qs) =
+        (vec![0.0; d], vec![0.0; d], vec![0.0; m * d], vec![0.0; d]);
+    let mut rhs = vec![0.0; m];
+    for (dz, o) in dirs.chunks_exact(2 * d).zip(out.chunks_exact_mut(2 * d)) {
+        let (dq, dp) = dz.split_at(d);
+        problem.velocity_tangent(p, dp, &mut dv);
+        problem.force_tangent(q, dq, &mut df, &mut s);
+        constraint_second(problem, q, dq, &mut rows_dq, &mut wk, &mut ck, &mut s);
+        // δf − δGᵀλ.
+        for (a, &la) in lambda.iter().enumerate() {
+            axpy(&mut df, -la, &rows_dq[a * d..(a + 1) * d]);
+        }
+        // D³g[δq, v, v]: closed form, or central differences of D²g(q ± hδq)[v, v].
+        let cubic: Vec<f64> = if m == 0 {
+            Vec::new()
+        } else if problem.constraint_third(q, dq, &v, &mut third, &mut s) {
+            (0..m)
+                .map(|a| dot(&third[a * d..(a + 1) * d], &v))
+                .collect()
+        } else {
+            let h = 1e-4 * norm(q).max(1.0) / norm(dq).max(f64::MIN_POSITIVE);
+            let (mut up, mut down) = (vec![0.0; m], vec![0.0; m]);
+            for (sign, out) in [(1.0, &mut up), (-1.0, &mut down)] {
+                for k in 0..d {
+                    qs[k] = q[k] + sign * h * dq[k];
+                }
+                problem.constraint_curvature(&qs, &v, out, &mut s);
+            }
+            up.iter()
+                .zip(&down)
+                .map(|(u, l)| (u - l) / (2.0 * h))
+                .collect()
+        };
+        for a in 0..m {
+            let r = a * d..(a + 1) * d;
+            rhs[a] = dot(&rows_dq[r.clone()], &acc)
+                + dot(&w.rows.w[r.clone()], &df)
+                + cubic[a]
+                + 2.0 * dot(&rows_v[r], &dv);
+        }
+        if m > 0 {
+            w.rows.solve(&mut rhs);
+        }
+        let (oq, op) = o.split_at_mut(d);
+        oq.copy_from_slice(&dv);
+        op.copy_from_slice(&df);
+        for (a, &dl) in rhs.iter().enumerate() {
+            axpy(op, -dl, &w.rows.c[a * d..(a + 1) * d]);
+        }
     }
     Ok(())
 }

@@ -146,6 +146,23 @@ impl Constrained for SphereParticle {
     fn constraint_curvature(&self, _q: &[f64], v: &[f64], out: &mut [f64], _s: &mut ()) {
         out[0] = v.iter().map(|x| x * x).sum();
     }
+    /// D²g(q)\[u, ·\] = uᵀ.
+    fn constraint_second(&self, _q: &[f64], u: &[f64], rows: &mut [f64], _s: &mut ()) -> bool {
+        rows.copy_from_slice(u);
+        true
+    }
+    /// D³g = 0 (g is quadratic).
+    fn constraint_third(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _v: &[f64],
+        rows: &mut [f64],
+        _s: &mut (),
+    ) -> bool {
+        rows.fill(0.0);
+        true
+    }
 }
 
 /// v′ = 1/m, f′ = 0 (uniform gravity).
