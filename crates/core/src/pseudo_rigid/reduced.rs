@@ -122,6 +122,45 @@ fn pair(ai: f64, aj: f64, m: f64, v: f64) -> Pair {
     }
 }
 
+/// The derivative of a [`Pair`]'s rates and forces along (δa_i, δa_j, δm, δv): with s = m + v,
+/// d = m − v, d∓ = a_i ∓ a_j, Ω_ij ± Λ_ij = s/d₋², d/d₊² (·2/2) and ∂K/∂a_{i,j} =
+/// ∓½ s²/d₋³ − ½ d²/d₊³ (signs per the module docs).
+#[derive(Debug, Clone, Copy)]
+struct PairTangent {
+    omega: f64,
+    lambda: f64,
+    dk_dai: f64,
+    dk_daj: f64,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn pair_tangent(
+    ai: f64,
+    aj: f64,
+    m: f64,
+    v: f64,
+    dai: f64,
+    daj: f64,
+    dm: f64,
+    dv: f64,
+) -> PairTangent {
+    let (dmi, dpl) = (ai - aj, ai + aj);
+    let (s, d) = (m + v, m - v);
+    let (ds, dd) = (dm + dv, dm - dv);
+    let (ddm, ddp) = (dai - daj, dai + daj);
+    // δ(s/d₋²), δ(d/d₊²); δ(s²/d₋³), δ(d²/d₊³).
+    let dqm = ds / (dmi * dmi) - 2.0 * s * ddm / (dmi * dmi * dmi);
+    let dqp = dd / (dpl * dpl) - 2.0 * d * ddp / (dpl * dpl * dpl);
+    let dcm = (2.0 * s * ds - 3.0 * s * s * ddm / dmi) / (dmi * dmi * dmi);
+    let dcp = (2.0 * d * dd - 3.0 * d * d * ddp / dpl) / (dpl * dpl * dpl);
+    PairTangent {
+        omega: 0.5 * (dqm + dqp),
+        lambda: 0.5 * (dqm - dqp),
+        dk_dai: -0.5 * (dcm + dcp),
+        dk_daj: 0.5 * (dcm - dcp),
+    }
+}
+
 impl ReducedState {
     /// Checks lengths, finiteness, a_i > 0 distinct, μ, ν skew; returns n.
     pub fn validate(&self) -> Result<usize> {
@@ -253,6 +292,73 @@ impl ReducedState {
             p_omega_dot: so::bracket(&self.p_omega, &omega),
             p_lambda_dot: so::bracket(&self.p_lambda, &lambda),
         })
+    }
+
+    /// The derivatives (δΩ, δΛ) of the body velocities Ω ⊕ Λ = B_A⁻¹(μ ⊕ ν) along a tangent
+    /// vector `d` = (δa, δp_a, δμ, δν) (a [`ReducedState`] read as a direction; 001 (7.9)
+    /// differentiated pair by pair).
+    pub fn velocities_tangent(&self, d: &ReducedState) -> (Mat, Mat) {
+        let n = self.a.len();
+        let (mut om, mut la) = (Mat::zeros(n, n), Mat::zeros(n, n));
+        for i in 0..n {
+            for j in i + 1..n {
+                let q = self.pair_tangent(i, j, d);
+                (om[(i, j)], om[(j, i)]) = (q.omega, -q.omega);
+                (la[(i, j)], la[(j, i)]) = (q.lambda, -q.lambda);
+            }
+        }
+        (om, la)
+    }
+
+    /// The derivative of the reduced vector field ([`ReducedState::vector_field`]) along `d` =
+    /// (δa, δp_a, δμ, δν): δȧ = δp_a, δṗ_a = −D²U(A)δa − δ(∂K/∂a), δμ̇ = [δμ, Ω] + [μ, δΩ],
+    /// δν̇ = [δν, Λ] + [ν, δΛ] — exact (the potential's Hessian, the pair formulas' derivatives).
+    pub fn vector_field_tangent(&self, body: &FullBody, d: &ReducedState) -> Result<ReducedRates> {
+        let n = self.check_body(body)?;
+        for (what, len) in [("δa", d.a.len()), ("δp_a", d.p_a.len())] {
+            if len != n {
+                return Err(Error::shape(what, format!("({n},)"), format!("({len},)")));
+            }
+        }
+        so::check_algebra_of("δp_omega", &d.p_omega, n)?;
+        so::check_algebra_of("δp_lambda", &d.p_lambda, n)?;
+        let (omega, lambda) = self.velocities_unchecked(n);
+        let (domega, dlambda) = self.velocities_tangent(d);
+        let mut ws = Workspace::new(n);
+        let mut h = Mat::zeros(n, n);
+        body.potential().add_hessian(
+            diag(&self.a).as_ref(),
+            diag(&d.a).as_ref(),
+            h.as_mut(),
+            &mut ws,
+        );
+        let mut p_a_dot: Vec<f64> = (0..n).map(|i| -h[(i, i)]).collect();
+        for i in 0..n {
+            for j in i + 1..n {
+                let q = self.pair_tangent(i, j, d);
+                p_a_dot[i] -= q.dk_dai;
+                p_a_dot[j] -= q.dk_daj;
+            }
+        }
+        Ok(ReducedRates {
+            a_dot: d.p_a.clone(),
+            p_a_dot,
+            p_omega_dot: so::bracket(&d.p_omega, &omega) + so::bracket(&self.p_omega, &domega),
+            p_lambda_dot: so::bracket(&d.p_lambda, &lambda) + so::bracket(&self.p_lambda, &dlambda),
+        })
+    }
+
+    fn pair_tangent(&self, i: usize, j: usize, d: &ReducedState) -> PairTangent {
+        pair_tangent(
+            self.a[i],
+            self.a[j],
+            self.p_omega[(i, j)],
+            self.p_lambda[(i, j)],
+            d.a[i],
+            d.a[j],
+            d.p_omega[(i, j)],
+            d.p_lambda[(i, j)],
+        )
     }
 
     fn check_body(&self, body: &FullBody) -> Result<usize> {
@@ -672,26 +778,25 @@ impl ReducedWork {
                 let st = &self.state;
                 let q = st.pair(i, j);
                 let (mu, nu) = (&st.p_omega, &st.p_lambda);
-                let (s, d) = (mu[(i, j)] + nu[(i, j)], mu[(i, j)] - nu[(i, j)]);
-                let (dm, dp) = (st.a[i] - st.a[j], st.a[i] + st.a[j]);
                 let (sw, cw) = (tau * q.omega).sin_cos();
                 let (sl, cl) = (tau * q.lambda).sin_cos();
                 for dz in dirs.chunks_exact_mut(e) {
-                    let (ddm, ddp) = (dz[i] - dz[j], dz[i] + dz[j]);
-                    let (dmu, dnu) = (dz[Slot::Mu.at(n, k)], dz[Slot::Nu.at(n, k)]);
-                    let (ds, dd) = (dmu + dnu, dmu - dnu);
-                    // δ(s/d₋²), δ(d/d₊²); δ(s²/d₋³), δ(d²/d₊³).
-                    let dqm = ds / (dm * dm) - 2.0 * s * ddm / (dm * dm * dm);
-                    let dqp = dd / (dp * dp) - 2.0 * d * ddp / (dp * dp * dp);
-                    let dcm = (2.0 * s * ds - 3.0 * s * s * ddm / dm) / (dm * dm * dm);
-                    let dcp = (2.0 * d * dd - 3.0 * d * d * ddp / dp) / (dp * dp * dp);
-                    let (d_omega, d_lambda) = (0.5 * (dqm + dqp), 0.5 * (dqm - dqp));
-                    dz[n + i] += tau * 0.5 * (dcm + dcp);
-                    dz[n + j] -= tau * 0.5 * (dcm - dcp);
+                    let dq = pair_tangent(
+                        st.a[i],
+                        st.a[j],
+                        mu[(i, j)],
+                        nu[(i, j)],
+                        dz[i],
+                        dz[j],
+                        dz[Slot::Mu.at(n, k)],
+                        dz[Slot::Nu.at(n, k)],
+                    );
+                    dz[n + i] -= tau * dq.dk_dai;
+                    dz[n + j] -= tau * dq.dk_daj;
                     t.load(n, &self.pairs, dz);
                     for (m, dm_, frame, turn, c, sn) in [
-                        (mu, &mut t.ms, &mut t.xi, d_omega, cw, sw),
-                        (nu, &mut t.ns, &mut t.eta, d_lambda, cl, sl),
+                        (mu, &mut t.ms, &mut t.xi, dq.omega, cw, sw),
+                        (nu, &mut t.ns, &mut t.eta, dq.lambda, cl, sl),
                     ] {
                         // δm + τδΩ[m, E]: [m, E] = mE − Em touches rows and columns i, j.
                         let c_ = tau * turn;

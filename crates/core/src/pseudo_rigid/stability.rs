@@ -23,11 +23,11 @@
 //! H = ½|p_a|² + K(a, μ, ν) + U(a) with K = ½⟨μ ⊕ ν, B_A⁻¹(μ ⊕ ν)⟩ (001 (6.30), (7.24)). At the
 //! point the gradient of H in the chart vanishes (this is (8.9), Prop. 8.2), and the Hessian is
 //! - (δa, δa): ∂²(K + U)/∂a² at fixed (μ, ν) — the Hessian of the amended potential (8.8) in the
-//!   shape directions — by central differences of the analytic gradient −ṗ_a of the reduced
-//!   vector field, with one Richardson extrapolation (error O(h⁴));
+//!   shape directions — exact: the potential's Hessian and the pair formulas' second derivatives
+//!   ([`ReducedState::vector_field_tangent`]);
 //! - (δp_a, δp_a) = I, and no (δp_a, ·) coupling;
-//! - (δa, c): ∂/∂a_l ⟨[v_k, μ], Ω(a)⟩ (the first variation of (8.9) differentiated in a), by
-//!   central differences of Ω ⊕ Λ = B_A⁻¹(μ ⊕ ν) (001 (7.9)) with Richardson;
+//! - (δa, c): ∂/∂a_l ⟨[v_k, μ], Ω(a)⟩ (the first variation of (8.9) differentiated in a), exact
+//!   from the derivative of Ω ⊕ Λ = B_A⁻¹(μ ⊕ ν) (001 (7.9); [`ReducedState::velocities_tangent`]);
 //! - (c, c) exact: e^{ζ}μe^{−ζ} = μ + [ζ, μ] + ½[ζ, [ζ, μ]] + O(ζ³) and K is quadratic in (μ, ν),
 //!   so with δm_k = [v_k, μ] ⊕ 0 (or 0 ⊕ [w_k, ν])
 //!
@@ -50,7 +50,8 @@
 //! The eigenvalues of L are reported; `stable` = max Re λ ≤ tol · (spectral radius).
 //!
 //! A second route, independent of the chart, is [`Stability::full_spectrum`]: the Jacobian of
-//! the reduced vector field in all coordinates (a, p_a, vee μ, vee ν) by central differences.
+//! the reduced vector field in all coordinates (a, p_a, vee μ, vee ν), exact
+//! ([`ReducedState::vector_field_tangent`]).
 //! Its spectrum is that of L together with one zero per direction transverse to the leaf (the
 //! Casimirs ½tr((μᵀμ)^k), ½tr((νᵀν)^k) are conserved, so the Jacobian maps into the tangent space
 //! of the leaf at a point where the orbits are regular). These symmetry-forced zeros are listed in
@@ -71,7 +72,6 @@ use crate::Mat;
 
 pub use crate::analysis::Verdict;
 use crate::analysis::{general_eigenvalues, sorted};
-use crate::numerics::fd::{self, Scheme::Richardson};
 
 /// Relative tolerance of the equilibrium check (residual of the reduced vector field relative
 /// to the scales of its terms).
@@ -278,15 +278,6 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
     let (mu, nu) = (&base.p_omega, &base.p_lambda);
     let d = so::dim(n);
 
-    // Steps: small against the gaps between semi-axes (K has (a_i − a_j)⁻² terms).
-    let mut gap = a.iter().copied().fold(f64::INFINITY, f64::min);
-    for i in 0..n {
-        for j in i + 1..n {
-            gap = gap.min((a[i] - a[j]).abs());
-        }
-    }
-    let ha = 1e-3 * gap;
-
     // The reduced field at the point and its scales.
     let rates = base.vector_field(body)?;
     let (om, la) = base.velocities()?;
@@ -298,15 +289,28 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
         .map(|(f, gu)| -f - gu)
         .collect();
 
-    // (δa, δa): central differences of ∂H/∂a = −ṗ_a (Richardson).
-    let force = |x: &[f64]| -> Result<Vec<f64>> {
-        let s = ReducedState {
-            a: x.to_vec(),
-            ..base.clone()
+    // (δa, δa): ∂(∂H/∂a)/∂a_l = −δṗ_a along e_l (the field's exact derivative), and the
+    // orbit velocities' derivatives δΩ, δΛ along it.
+    let along_a = |l: usize| {
+        let mut e = ReducedState {
+            a: vec![0.0; n],
+            p_a: vec![0.0; n],
+            p_omega: Mat::zeros(n, n),
+            p_lambda: Mat::zeros(n, n),
         };
-        Ok(s.vector_field(body)?.p_a_dot.iter().map(|f| -f).collect())
+        e.a[l] = 1.0;
+        e
     };
-    let haa = fd::jacobian(&force, a, &vec![ha; n], Richardson)?;
+    let mut haa = Mat::zeros(n, n);
+    let mut dvel = Vec::with_capacity(n);
+    for l in 0..n {
+        let e = along_a(l);
+        let rates = base.vector_field_tangent(body, &e)?;
+        for k in 0..n {
+            haa[(k, l)] = -rates.p_a_dot[k];
+        }
+        dvel.push(base.velocities_tangent(&e));
+    }
     // (δa, c): ∂/∂a_l of the orbit gradients ⟨[v_k, μ], Ω(a)⟩, ⟨[w_k, ν], Λ(a)⟩.
     let tang_mu: Vec<Mat> = leaf
         .basis_omega
@@ -318,20 +322,17 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
         .iter()
         .map(|w| so::bracket(w, nu))
         .collect();
-    let orbit_grad = |x: &[f64]| -> Result<Vec<f64>> {
-        let s = ReducedState {
-            a: x.to_vec(),
-            ..base.clone()
-        };
-        let (o, l) = s.velocities()?;
-        Ok(tang_mu
+    let orbit_grad = |(o, l): &(Mat, Mat)| -> Vec<f64> {
+        tang_mu
             .iter()
-            .map(|t| so::pairing(t, &o))
-            .chain(tang_nu.iter().map(|t| so::pairing(t, &l)))
-            .collect())
+            .map(|t| so::pairing(t, o))
+            .chain(tang_nu.iter().map(|t| so::pairing(t, l)))
+            .collect()
     };
-    let hac = fd::jacobian(&orbit_grad, a, &vec![ha; n], Richardson)?; // rows: orbit directions, columns: a_l
-    let g_orbit = orbit_grad(a)?;
+    // Rows: orbit directions, columns: a_l.
+    let columns: Vec<Vec<f64>> = dvel.iter().map(orbit_grad).collect();
+    let hac = Mat::from_fn(columns[0].len(), n, |k, l| columns[l][k]);
+    let g_orbit = orbit_grad(&(om.clone(), la.clone()));
 
     // (c, c): exact second variation of K along the orbits.
     let r1 = tang_mu.len();
@@ -445,35 +446,30 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
         .chain(so::vee_n_unchecked(mu))
         .chain(so::vee_n_unchecked(nu))
         .collect();
-    let field = |z: &[f64]| -> Result<Vec<f64>> {
-        let s = ReducedState {
-            a: z[..n].to_vec(),
-            p_a: z[n..2 * n].to_vec(),
-            p_omega: so::hat_n_unchecked(n, &z[2 * n..2 * n + d]),
-            p_lambda: so::hat_n_unchecked(n, &z[2 * n + d..]),
-        };
-        let f = s.vector_field(body)?;
-        Ok(f.a_dot
+    let state_of = |z: &[f64]| ReducedState {
+        a: z[..n].to_vec(),
+        p_a: z[n..2 * n].to_vec(),
+        p_omega: so::hat_n_unchecked(n, &z[2 * n..2 * n + d]),
+        p_lambda: so::hat_n_unchecked(n, &z[2 * n + d..]),
+    };
+    let nz = z0.len();
+    let mut jac = Mat::zeros(nz, nz);
+    let mut e = vec![0.0; nz];
+    for l in 0..nz {
+        e[l] = 1.0;
+        let f = base.vector_field_tangent(body, &state_of(&e))?;
+        e[l] = 0.0;
+        let col = f
+            .a_dot
             .into_iter()
             .chain(f.p_a_dot)
             .chain(so::vee_n_unchecked(&f.p_omega_dot))
-            .chain(so::vee_n_unchecked(&f.p_lambda_dot))
-            .collect())
-    };
-    let m_scale = mu.norm_l2().max(nu.norm_l2());
-    let steps: Vec<f64> = (0..z0.len())
-        .map(|i| {
-            // The field is linear in p_a and quadratic in (μ, ν): any step is exact there.
-            if i < 2 * n {
-                ha
-            } else if m_scale > 0.0 {
-                1e-3 * m_scale
-            } else {
-                1e-3
-            }
-        })
-        .collect();
-    let jac = fd::jacobian(&field, &z0, &steps, Richardson)?;
+            .chain(so::vee_n_unchecked(&f.p_lambda_dot));
+        for (k, x) in col.enumerate() {
+            jac[(k, l)] = x;
+        }
+    }
+    debug_assert_eq!(z0.len(), nz);
     check::finite_mat("Jacobian of the reduced vector field", &jac)?;
     let mut full = general_eigenvalues(&jac)?;
     let transverse = 2 * d - rr;
