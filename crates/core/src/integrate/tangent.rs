@@ -58,6 +58,8 @@ use super::problem::{
 };
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
+use crate::lie::so3;
+use nalgebra::{Matrix3, Vector3};
 
 /// A [`Separable`] problem with the directional derivatives of its velocity and force: the data
 /// of its tangent lift.
@@ -108,8 +110,21 @@ pub trait SplitTangent: Split {
 
 /// A [`VectorField`] with the directional derivative of its field: the data of its tangent lift.
 pub trait VectorFieldTangent: VectorField {
-    /// out = f′(z)·dz.
+    /// out = f′(z)·dz, in ambient coordinates ([`Space::dim`] values; an SO(3) block's δR a
+    /// 3×3 matrix, not necessarily tangent: the exact derivative of the field as a map of the
+    /// flat values, which a Runge–Kutta stage evaluates off the manifold).
     fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]);
+
+    /// out_j = f′(z)·dz_j for the consecutive directions dz_j of `dirs` (`out` alike): all at
+    /// once, so that a field whose derivative has costly parts shared by every direction (a
+    /// geometry's second derivatives) forms them once; by default one
+    /// [`VectorFieldTangent::field_tangent`] each.
+    fn field_tangents(&self, z: &[f64], dirs: &[f64], out: &mut [f64]) {
+        let d = z.len();
+        for (dz, o) in dirs.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
+            self.field_tangent(z, dz, o);
+        }
+    }
 
     /// out += ∂f/∂θ_m (z) for the parameter m; NaN unless a problem with parameters
     /// implements it.
@@ -241,29 +256,41 @@ enum Layout {
     Field,
 }
 
-/// The tangent lift of a problem with k = d directions (module docs).
+/// The tangent lift of a problem with k = e + p directions (module docs).
 #[derive(Clone, Debug)]
 pub struct Tangent<P> {
     problem: P,
-    /// The state's and a tangent vector's dimensions (they differ by 6 per SO(3) block).
+    /// The state's and a tangent vector's dimensions (they differ by 6 per SO(3) block): e
+    /// state directions, and the Jacobian is e × e.
     d: usize,
     e: usize,
-    /// The number of parameter directions (after the d state directions).
+    /// The values of a direction: e (left-trivialised), or d (ambient: the field lift).
+    w: usize,
+    /// The number of parameter directions (after the e state directions).
     np: usize,
     layout: Layout,
 }
 
 impl<P: Problem + Clone> Tangent<P> {
-    fn with(problem: P, layout: Layout) -> Self {
+    /// The lift with directions of e values (left-trivialised), or of d values (`ambient`).
+    fn with(problem: P, layout: Layout, ambient: bool) -> Self {
         let (d, e) = (problem.space().dim(), problem.space().tangent_dim());
         let np = problem.parameters().len();
         Tangent {
             problem,
             d,
             e,
+            w: if ambient { d } else { e },
             np,
             layout,
         }
+    }
+
+    /// Whether the directions are ambient on SO(3) blocks (δR a 3×3 matrix): the field lift of
+    /// a state with SO(3) blocks ([`Tangent::field`]), whose catalog is its Runge–Kutta
+    /// methods.
+    pub fn ambient(&self) -> bool {
+        self.w != self.e
     }
 
     /// The number k = e + p of directions.
@@ -278,7 +305,7 @@ impl<P: Problem + Clone> Tangent<P> {
         if j == 0 {
             self.d
         } else {
-            self.e
+            self.w
         }
     }
 
@@ -287,12 +314,12 @@ impl<P: Problem + Clone> Tangent<P> {
         &self.problem
     }
 
-    /// Index of component i of the base state (j = 0, i < d) or of direction j (i < e).
+    /// Index of component i of the base state (j = 0, i < d) or of direction j (i < w).
     #[inline]
     fn at(&self, j: usize, i: usize) -> usize {
         match self.layout {
             Layout::Field if j == 0 => i,
-            Layout::Field => self.d + (j - 1) * self.e + i,
+            Layout::Field => self.d + (j - 1) * self.w + i,
             Layout::Separable { dof } => {
                 let (half, c) = (i / dof, i % dof);
                 half * dof * (self.k() + 1) + j * dof + c
@@ -323,7 +350,7 @@ impl<P: Problem + Clone> Tangent<P> {
     ) {
         if self.layout == Layout::Field {
             let (base, dirs) = z.split_at_mut(self.d);
-            dirs.chunks_exact_mut(self.e).for_each(|v| tangent(base, v));
+            dirs.chunks_exact_mut(self.w).for_each(|v| tangent(base, v));
             state(base);
             return;
         }
@@ -333,7 +360,7 @@ impl<P: Problem + Clone> Tangent<P> {
             self.gather(z, 0, base);
             for j in 1..=self.k() {
                 self.gather(z, j, v);
-                tangent(base, &mut v[..self.e]);
+                tangent(base, &mut v[..self.w]);
                 self.scatter(v, j, z);
             }
             state(base);
@@ -346,15 +373,37 @@ impl<P: SeparableTangent + Clone> Tangent<P> {
     /// The lift of a separable problem (its Verlet methods; flat blocks only).
     pub fn separable(problem: P) -> Self {
         let dof = problem.dof();
-        Tangent::with(problem, Layout::Separable { dof })
+        Tangent::with(problem, Layout::Separable { dof }, false)
     }
 }
 
 impl<P: VectorFieldTangent + Clone> Tangent<P> {
-    /// The lift of a vector field (its Runge–Kutta and Gauss methods; flat blocks only):
-    /// (z, δz₁, …, δz_k).
+    /// The lift of a vector field (its Runge–Kutta and Gauss methods): (z, δz₁, …, δz_k), each
+    /// direction of d values, ambient on SO(3) blocks (module docs, "Layouts").
     pub fn field(problem: P) -> Self {
-        Tangent::with(problem, Layout::Field)
+        Tangent::with(problem, Layout::Field, true)
+    }
+}
+
+impl<P: VectorFieldTangent + Clone> Tangent<P>
+where
+    Tangent<P>: Catalog,
+{
+    /// [`Catalog::tangent_for`] of a system whose state has SO(3) blocks: the field lift for the
+    /// methods of its catalog (the Runge–Kutta methods), `other` (the system's left-trivialised
+    /// lift) for the rest.
+    pub fn routed(
+        problem: &P,
+        method: &str,
+        other: impl FnOnce() -> Option<Arc<dyn TangentSystem>>,
+    ) -> Option<Arc<dyn TangentSystem>> {
+        let field = Tangent::field(problem.clone());
+        let ours = field.ambient() && field.catalog().iter().any(|e| e.name == method);
+        if ours {
+            Some(field.into_system())
+        } else {
+            other()
+        }
     }
 }
 
@@ -363,7 +412,7 @@ impl<P: GroupFieldTangent + Clone> Tangent<P> {
     /// a [`VectorFieldTangent`] without SO(3) blocks): (z, δz₁, …, δz_k), the directions
     /// left-trivialised on SO(3) blocks.
     pub fn group_field(problem: P) -> Self {
-        Tangent::with(problem, Layout::Field)
+        Tangent::with(problem, Layout::Field, false)
     }
 }
 
@@ -372,7 +421,7 @@ impl<P: SplitTangent + Clone> Tangent<P> {
     /// [`VectorFieldTangent`] without SO(3) blocks): (z, δz₁, …, δz_k), the directions
     /// left-trivialised on SO(3) blocks.
     pub fn split(problem: P) -> Self {
-        Tangent::with(problem, Layout::Field)
+        Tangent::with(problem, Layout::Field, false)
     }
 }
 
@@ -381,9 +430,9 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.name()
     }
 
-    /// Flat: d + k·e values.
+    /// Flat: d + k·w values (w = e, or d for the field lift).
     fn space(&self) -> Space {
-        Space::new([("z", Block::Real(self.d + self.k() * self.e))])
+        Space::new([("z", Block::Real(self.d + self.k() * self.w))])
     }
 
     fn energy(&self, z: &[f64]) -> Result<f64> {
@@ -405,19 +454,29 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.check_state(&base)
     }
 
+    /// The directions by the chart's tangent map at the base state: ambient
+    /// ([`Problem::ambient_to_internal_at`]) or left-trivialised.
     fn to_internal(&self, z: &mut [f64]) {
+        let ambient = self.ambient();
         self.each(
             z,
             |v| self.problem.to_internal(v),
-            |b, v| self.problem.tangent_to_internal_at(b, v),
+            |b, v| match ambient {
+                true => self.problem.ambient_to_internal_at(b, v),
+                false => self.problem.tangent_to_internal_at(b, v),
+            },
         );
     }
 
     fn to_user(&self, z: &mut [f64]) {
+        let ambient = self.ambient();
         self.each(
             z,
             |v| self.problem.to_user(v),
-            |b, v| self.problem.tangent_to_user_at(b, v),
+            |b, v| match ambient {
+                true => self.problem.ambient_to_user_at(b, v),
+                false => self.problem.tangent_to_user_at(b, v),
+            },
         );
     }
 
@@ -490,15 +549,15 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
         let n = self.problem.dof();
         let (f0, df) = f.split_at_mut(n);
         self.problem.force(&q[..n], f0, s)?;
-        let d = self.e;
+        let e = self.e;
         for (j, (dqj, dfj)) in q[n..]
             .chunks_exact(n)
             .zip(df.chunks_exact_mut(n))
             .enumerate()
         {
             self.problem.force_tangent(&q[..n], dqj, dfj, s);
-            if j >= d {
-                self.problem.force_parameter(&q[..n], j - d, dfj, s);
+            if j >= e {
+                self.problem.force_parameter(&q[..n], j - e, dfj, s);
             }
         }
         Ok(())
@@ -741,27 +800,22 @@ impl<P: Nonholonomic + SeparableTangent + Clone> Nonholonomic for Tangent<P> {
 /// (f(z), f′(z)δz_j), in either layout (a separable problem's lift serves its Verlet methods
 /// and its Runge–Kutta and Gauss methods with one layout).
 impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
-    /// Only where e = d (no SO(3) block): a Runge–Kutta step on a curved block is differentiated
-    /// in its ambient coordinates, which a left-trivialised direction is not; a lift with one
-    /// gets NaN here (its catalog offers no Runge–Kutta method).
+    /// Only with directions of d values (the field lift, or a lift of a state without SO(3)
+    /// blocks): a Runge–Kutta step on a curved block is differentiated in its ambient
+    /// coordinates, which a left-trivialised direction is not; such a lift gets NaN here (its
+    /// catalog offers no Runge–Kutta method).
     fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let d = self.d;
-        if self.e != d {
+        let (d, e) = (self.d, self.e);
+        if self.w != d {
             dz.fill(f64::NAN);
             return;
         }
         if self.layout == Layout::Field {
             let (f0, df) = dz.split_at_mut(d);
             self.problem.field(&z[..d], f0);
-            for (j, (dzj, dfj)) in z[d..]
-                .chunks_exact(d)
-                .zip(df.chunks_exact_mut(d))
-                .enumerate()
-            {
-                self.problem.field_tangent(&z[..d], dzj, dfj);
-                if j >= d {
-                    self.problem.field_parameter(&z[..d], j - d, dfj);
-                }
+            self.problem.field_tangents(&z[..d], &z[d..], df);
+            for (m, dfj) in df[e * d..].chunks_exact_mut(d).enumerate() {
+                self.problem.field_parameter(&z[..d], m, dfj);
             }
             return;
         }
@@ -776,8 +830,8 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
             for j in 1..=self.k() {
                 self.gather(z, j, dir);
                 self.problem.field_tangent(base, dir, out);
-                if j > d {
-                    self.problem.field_parameter(base, j - 1 - d, out);
+                if j > e {
+                    self.problem.field_parameter(base, j - 1 - e, out);
                 }
                 self.scatter(out, j, dz);
             }
@@ -787,7 +841,7 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
     /// The state and its k directions: f′ is block lower-triangular with f′(z) on each diagonal
     /// block (an implicit method factors it once).
     fn diagonal_blocks(&self) -> usize {
-        if self.e == self.d {
+        if self.w == self.d {
             self.k() + 1
         } else {
             1
@@ -795,7 +849,7 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
     }
 
     fn block_index(&self, b: usize, i: usize) -> usize {
-        if self.e == self.d {
+        if self.w == self.d {
             self.at(b, i)
         } else {
             i
@@ -843,7 +897,7 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
         let (x0, dx) = xi.split_at_mut(g);
         self.problem.generator(&z[..d], x0, &mut s.base);
         for (j, (dz, dxj)) in z[d..]
-            .chunks_exact(e)
+            .chunks_exact(self.w)
             .zip(dx.chunks_exact_mut(g))
             .enumerate()
         {
@@ -857,10 +911,10 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
     }
 
     fn act(&self, u: &[f64], z: &mut [f64], s: &mut Self::Scratch) {
-        let (d, e, g) = (self.d, self.e, self.problem.algebra_dim());
+        let (d, w, g) = (self.d, self.w, self.problem.algebra_dim());
         let (z0, dz) = z.split_at_mut(d);
         self.problem.act(&u[..g], z0, &mut s.base);
-        for (dzj, du) in dz.chunks_exact_mut(e).zip(u[g..].chunks_exact(g)) {
+        for (dzj, du) in dz.chunks_exact_mut(w).zip(u[g..].chunks_exact(g)) {
             self.problem.act_tangent(&u[..g], du, z0, dzj, &mut s.base);
         }
     }
@@ -868,7 +922,7 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
     /// The base state's increment as the base problem forms it (so the lifted run's states
     /// are the plain run's), the directions' as new minus old.
     fn act_increment(&self, u: &[f64], z: &[f64], inc: &mut [f64], s: &mut Self::Scratch) -> bool {
-        let (d, e, g) = (self.d, self.e, self.problem.algebra_dim());
+        let (d, w, g) = (self.d, self.w, self.problem.algebra_dim());
         let (i0, di) = inc.split_at_mut(d);
         if !self
             .problem
@@ -880,9 +934,9 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
             *y = zi + dzi;
         }
         for ((dij, du), dz) in di
-            .chunks_exact_mut(e)
+            .chunks_exact_mut(w)
             .zip(u[g..].chunks_exact(g))
-            .zip(z[d..].chunks_exact(e))
+            .zip(z[d..].chunks_exact(w))
         {
             dij.copy_from_slice(dz);
             self.problem
@@ -947,8 +1001,10 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
         self.problem.flow(i, tau, &mut w.base);
         self.problem
             .flow_tangent(i, tau, &before, &w.base, &mut w.dirs);
-        let e = self.e;
-        for (m, dz) in w.dirs[e * e..].chunks_exact_mut(e).enumerate() {
+        for (m, dz) in w.dirs[self.e * self.w..]
+            .chunks_exact_mut(self.w)
+            .enumerate()
+        {
             self.problem.flow_parameter(i, tau, &before, &w.base, m, dz);
         }
     }
@@ -994,24 +1050,63 @@ where
                 format!("({},)", z0.len()),
             ));
         }
-        let mut z = vec![0.0; self.d + self.k() * self.e];
+        let ambient = self.ambient();
+        let mut z = vec![0.0; self.d + self.k() * self.w];
         self.scatter(z0, 0, &mut z);
-        for j in 0..self.e {
-            z[self.at(j + 1, j)] = 1.0;
+        let (mut at, mut dir) = (0, 0);
+        for &(_, b) in self.problem.space().blocks() {
+            if ambient && b == Block::SO3 {
+                // δR = Rê_c for the left-trivialised direction c.
+                let r = Matrix3::from_row_slice(&z0[at..at + 9]);
+                for c in 0..3 {
+                    let dr = r * so3::hat(&Vector3::ith(c, 1.0));
+                    for k in 0..9 {
+                        z[self.at(dir + c + 1, at + k)] = dr[(k / 3, k % 3)];
+                    }
+                }
+            } else {
+                let pos = if ambient { at } else { dir };
+                for i in 0..b.tangent_len() {
+                    z[self.at(dir + i + 1, pos + i)] = 1.0;
+                }
+            }
+            at += b.len();
+            dir += b.tangent_len();
         }
         Ok(z)
     }
 
+    /// An ambient direction's SO(3) block is read by the derivative of the polar factor at the
+    /// run's R ([`so3::PolarTangent`]: a Runge–Kutta run leaves SO(3)), NaN where R has none;
+    /// the base state as computed.
     fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]) {
-        let (e, np) = (self.e, self.np);
+        let (e, np, k, ambient) = (self.e, self.np, self.k(), self.ambient());
         self.gather(lifted, 0, z);
-        for i in 0..e {
-            for j in 0..e {
-                jac[i * e + j] = lifted[self.at(j + 1, i)];
+        let mut put = |i: usize, j: usize, v: f64| match j < e {
+            true => jac[i * e + j] = v,
+            false => pjac[i * np + j - e] = v,
+        };
+        let (mut at, mut dir) = (0, 0);
+        for &(_, b) in self.problem.space().blocks() {
+            if ambient && b == Block::SO3 {
+                let polar = so3::PolarTangent::new(&Matrix3::from_row_slice(&z[at..at + 9])).ok();
+                for j in 0..k {
+                    let dr = Matrix3::from_fn(|r, c| lifted[self.at(j + 1, at + 3 * r + c)]);
+                    let xi = polar.map_or(Vector3::repeat(f64::NAN), |p| p.apply(&dr));
+                    for (c, x) in xi.iter().enumerate() {
+                        put(dir + c, j, *x);
+                    }
+                }
+            } else {
+                let pos = if ambient { at } else { dir };
+                for i in 0..b.tangent_len() {
+                    for j in 0..k {
+                        put(dir + i, j, lifted[self.at(j + 1, pos + i)]);
+                    }
+                }
             }
-            for m in 0..np {
-                pjac[i * np + m] = lifted[self.at(e + 1 + m, i)];
-            }
+            at += b.len();
+            dir += b.tangent_len();
         }
     }
 }
