@@ -297,8 +297,8 @@ pub trait TangentSystem: System {
     /// The names of the parameters θ whose directions the lift carries.
     fn parameter_names(&self) -> Vec<&'static str>;
 
-    /// The lifted state of a base state (user frame) with the identity as directions (and
-    /// ∂z₀/∂θ = 0).
+    /// The lifted state of a base state (user frame) with the identity as directions (on an
+    /// SO(3) block δR = Rê_j, in ambient directions too) and ∂z₀/∂θ = 0.
     fn seed(&self, z0: &[f64]) -> Result<Vec<f64>>;
 
     /// The base state (d values), the Jacobian ∂z/∂z₀ (e×e row-major, column j = δz_j) and the

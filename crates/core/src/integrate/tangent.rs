@@ -27,22 +27,31 @@
 //! implicit-function theorem). Each block (the state, each direction) is measured against its
 //! own scale ([`crate::convergence::Blocks`]): the state stops where the plain iteration does,
 //! and its directions then converge at the accepted state. With k
-//! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + k) plain
-//! runs.
+//! directions the lifted state has at most d(1 + k) values, so a Jacobian run costs about
+//! (1 + k) plain runs.
 //!
 //! **Parameters.** The problem's parameters θ ([`Problem::parameters`]) get p more directions
 //! δz_{θ_m} = ∂z/∂θ_m, from 0 at the start, whose pieces carry the inhomogeneous term
-//! (f′(z)δz + ∂f/∂θ_m; for a flow Dφ δz + ∂φ/∂θ_m): so k = d + p directions in all.
+//! (f′(z)δz + ∂f/∂θ_m; for a flow Dφ δz + ∂φ/∂θ_m): so k = e + p directions in all (e below).
 //!
 //! **Layouts.** A separable lift stores (q, δq₁, …, δq_k, p, δp₁, …, δp_k) (its kind needs the
-//! positions before the momenta); a field or split lift (z, δz₁, …, δz_k). On an SO(3) block a
-//! direction is left-trivialised (δR = Rξ̂, three values), so a direction has e ≤ d values; the
-//! split lift allows it (a flow's tangent map is exact in ξ), the field lift does not (a
-//! Runge–Kutta step leaves SO(3), and its derivative is one in ambient coordinates). [`TangentSystem::seed`] and
-//! [`TangentSystem::jacobian`] convert from and to the problem's flat layout, so nothing outside
-//! this module sees either. The problem's chart ([`Problem::to_internal`]) maps the directions by
-//! its tangent map at the base state ([`Problem::tangent_to_internal_at`]; by default the chart
-//! itself, right for a linear one such as a turn to principal axes).
+//! positions before the momenta); a field, group-field or split lift (z, δz₁, …, δz_k). There
+//! are e state directions, e = d less 6 per SO(3) block: the Jacobian is e × e, an SO(3) block's
+//! directions left-trivialised (δR = Rξ̂). In a split or group-field lift a direction has those
+//! e values (a flow's or a group action's tangent map is exact in ξ). In the field lift
+//! ([`Tangent::field`]) it has all d values, ambient (δR a 3×3 matrix): a Runge–Kutta step
+//! leaves SO(3), and its derivative is one of the flat values, which the field lift computes
+//! with the field's derivative off the manifold ([`VectorFieldTangent::field_tangent`]). It
+//! starts at δR = Rξ̂ and is read back by the derivative of the polar factor U of the run's R
+//! ([`so3::PolarTangent`]: δU = Uξ̂), the flat blocks as they are, the base state as computed:
+//! so every lift has the same e and Jacobian, and a system whose state has SO(3) blocks routes
+//! its Runge–Kutta methods to the field lift ([`Catalog::tangent_for`], [`Tangent::routed`]),
+//! the others to its left-trivialised lift. Without SO(3) blocks the layouts coincide (e = d).
+//! [`TangentSystem::seed`] and [`TangentSystem::jacobian`] convert from and to the problem's
+//! flat layout, so nothing outside this module sees either. The problem's chart
+//! ([`Problem::to_internal`]) maps the directions by its tangent map at the base state
+//! ([`Problem::tangent_to_internal_at`], ambient [`Problem::ambient_to_internal_at`]; by default
+//! the chart itself, right for a linear one such as a turn to principal axes).
 //!
 //! **What the lift keeps.** Its space is flat (no block is retracted during the run, which
 //! would not be differentiated), its energy and invariants are the base state's.

@@ -602,13 +602,10 @@ impl VectorFieldTangent for LiePoisson {
         self.kernel_gradient(&z[..d], grad);
         self.kernel_hessian(&z[..d], &dz[..d], dgrad);
         let (om, og) = out.split_at_mut(d);
-        match (self.lifted, self.group) {
-            (true, Some(group)) => {
-                let k = group.dim();
-                let g = (&z[d..], &dz[d..]);
-                group.velocity_tangent(self.side, (&grad[..k], &dgrad[..k]), g, og);
-            }
-            _ => {}
+        if let (true, Some(group)) = (self.lifted, self.group) {
+            let k = group.dim();
+            let g = (&z[d..], &dz[d..]);
+            group.velocity_tangent(self.side, (&grad[..k], &dgrad[..k]), g, og);
         }
         if self.side == Side::Right {
             grad.iter_mut().for_each(|x| *x = -*x);
@@ -734,7 +731,8 @@ impl Catalog for LiePoisson {
 }
 
 /// The Lie–Poisson methods on the tangent lift (each the derivative of its own step): rkmk4,
-/// midpoint, midpoint4 and rk4 ([`lifted_catalog`]).
+/// midpoint, midpoint4 and rk4 (with an SO(3) attitude rk4 on the field lift:
+/// `lifted_catalog`).
 impl Catalog for Tangent<LiePoisson> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         group_field_catalog()

@@ -550,7 +550,7 @@ impl VectorFieldTangent for RiemannianFrameTop {
 
 /// The tangent lift (module docs, "Tangent lift"): directions (δx, δp, η, δΠ), δR = Rη̂.
 impl GroupFieldTangent for RiemannianFrameTop {
-    /// Wong's derivative ([`RiemannianFrameTop::wong_tangent`]) with δσ = R(η × Π + δΠ);
+    /// Wong's derivative (`wong_tangent`) with δσ = R(η × Π + δΠ);
     /// δ(−Cu), and 0 for the free body's time.
     fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], s: &mut FrameScratch) {
         let st = parts(z);
