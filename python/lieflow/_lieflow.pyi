@@ -111,7 +111,8 @@ class System:
         """The parameters theta, the columns of `Trajectory.parameter_jacobian`."""
     def sensitivity_methods(self, attitude: bool = False) -> list[str]:
         """The methods whose Jacobians `integrate(..., sensitivity=True)` computes."""
-    def _tangent(self, attitude: bool = False) -> tuple[System, _Tangent] | None: ...
+    def _tangent(self, attitude: bool = False,
+                 method: str | None = None) -> tuple[System, _Tangent] | None: ...
     @property
     def state_dim(self) -> int: ...
     @property

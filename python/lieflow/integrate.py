@@ -263,7 +263,8 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             exact to round-off, not finite differences: the run integrates the system's tangent
             lift with the same method (about d + p + 1 times the work of the plain run);
             ``traj.vjp(cotangent)`` gives the gradient of a loss. With an attitude, d counts its
-            three left-trivialised directions (δR = R ξ̂) in place of R's nine entries. Available
+            three left-trivialised directions (δR = R ξ̂) in place of R's nine entries (rk4,
+            which leaves SO(3), reads the final ones through R's polar factor). Available
             where the system gives the derivatives its method needs
             (``system.sensitivity_methods(attitude=...)``); not yet with events.
 
@@ -367,20 +368,21 @@ def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, p
         raise InvalidArgumentError("invalid events: sensitivity=True is not available with "
                                    "events yet")
     with_attitude = attitude is not None
-    lift = system._tangent(with_attitude)
-    if lift is None:
+    methods = system.sensitivity_methods(with_attitude)
+    if not methods:
         what = " with an attitude" if with_attitude else ""
         raise InvalidArgumentError(f"invalid sensitivity: {name} has no tangent maps{what} yet "
                                    f"({name}.sensitivity_methods() is empty)")
-    lifted, layout = lift
     if method is None:
         method = system.methods()[0]
     if not isinstance(method, str):
         raise TypeError(f"invalid method: expected a str, got {type(method).__name__} {method!r}")
-    if method not in lifted.methods():
+    if method not in methods:
         raise UnsupportedMethodError(
             f"unsupported method {method!r} with sensitivity=True: the tangent maps of {name} are "
-            f"available for {lifted.methods()} (method=...)")
+            f"available for {methods} (method=...)")
+    # The lift of this method's runs (a Runge–Kutta method's directions are ambient on SO(3)).
+    lifted, layout = system._tangent(with_attitude, method)
     z0, batched = system._normalize_state(state0)
     d = z0.shape[1]
     a = None

@@ -125,7 +125,8 @@ def test_sensitivity_refuses_what_it_cannot_do_with_typed_errors():
     rb = lf.RigidBody([1.0, 2.0, 3.0])
     z0 = [0.3, -0.8, 1.1]
     with pytest.raises(lf.UnsupportedMethodError, match="available for"):
-        lf.integrate(rb, z0, 0.1, 10, method="rk4", attitude=np.eye(3), sensitivity=True)
+        lf.integrate(body(), np.concatenate([X0.ravel(), P0.ravel()]), 0.1, 10,
+                     method="reduced", sensitivity=True)
     with pytest.raises(lf.ShapeError, match="attitude"):
         lf.integrate(rb, z0, 0.1, 10, attitude=np.eye(4), sensitivity=True)
     with pytest.raises(lf.InvalidArgumentError, match="events"):
@@ -220,8 +221,7 @@ def test_with_an_attitude_the_directions_are_left_trivialised():
     rb = lf.RigidBody([1.0, 2.0, 3.0])
     R0 = lf.lie.so3_exp([0.4, -0.7, 0.3])
     M0 = np.array([0.3, -0.8, 1.1])
-    assert rb.sensitivity_methods(attitude=True)[0] == "splitting"
-    assert "rk4" not in rb.sensitivity_methods(attitude=True)
+    assert rb.sensitivity_methods(attitude=True) == rb.methods()
     traj = lf.integrate(rb, M0, 0.05, 40, attitude=R0, save_every=20, sensitivity=True)
     plain = lf.integrate(rb, M0, 0.05, 40, attitude=R0, save_every=20)
     np.testing.assert_array_equal(traj.attitude, plain.attitude)
@@ -252,6 +252,54 @@ def test_with_an_attitude_the_directions_are_left_trivialised():
     fd = column(end(M0, R0, np.array([1.0, 2.0, 3.0]) + e),
                 end(M0, R0, np.array([1.0, 2.0, 3.0]) - e), h)
     np.testing.assert_allclose(traj.final_parameter_jacobian[:, 0], fd, atol=1e-7)
+
+
+def test_rk4_with_an_attitude_reads_the_attitude_by_its_polar_factor():
+    """RigidBody with attitude and rk4 (its own lift: directions ambient on R, which RK4 leaves
+    SO(3)): jacobian (k, 6, 6) over (M, xi) against central differences, the final attitudes
+    read by their polar factors U (xi = log(U0^T U) / h); the moments' columns too; the states
+    and attitudes the plain run's, bit for bit."""
+    rb = lf.RigidBody([1.0, 2.0, 3.0])
+    R0 = lf.lie.so3_exp([0.4, -0.7, 0.3])
+    M0 = np.array([0.3, -0.8, 1.1])
+    run = dict(method="rk4", attitude=R0)
+    traj = lf.integrate(rb, M0, 0.2, 40, save_every=20, sensitivity=True, **run)
+    plain = lf.integrate(rb, M0, 0.2, 40, save_every=20, **run)
+    np.testing.assert_array_equal(traj.states, plain.states)
+    np.testing.assert_array_equal(traj.attitude, plain.attitude)
+    assert traj.jacobian.shape == (3, 6, 6) and traj.parameter_jacobian.shape == (3, 6, 3)
+    R = plain.final_attitude
+    assert np.linalg.norm(R.T @ R - np.eye(3)) > 1e-6     # off SO(3): the polar read matters
+
+    def polar(R):
+        u, _, vt = np.linalg.svd(R)
+        return u @ vt
+
+    U0 = polar(R)
+
+    def end(M, R, inertia=(1.0, 2.0, 3.0)):
+        t = lf.integrate(lf.RigidBody(list(inertia)), M, 0.2, 40, method="rk4", attitude=R)
+        return t.final_state, lf.lie.so3_log(U0.T @ polar(t.final_attitude))
+
+    def column(plus, minus, h):
+        return np.concatenate([(plus[0] - minus[0]) / (2 * h), (plus[1] - minus[1]) / (2 * h)])
+
+    h = 1e-6
+    fd = np.empty((6, 6))
+    for j in range(6):
+        e = np.zeros(3)
+        e[j % 3] = h
+        if j < 3:
+            fd[:, j] = column(end(M0 + e, R0), end(M0 - e, R0), h)
+        else:
+            fd[:, j] = column(end(M0, R0 @ lf.lie.so3_exp(e)),
+                              end(M0, R0 @ lf.lie.so3_exp(-e)), h)
+    np.testing.assert_allclose(traj.final_jacobian, fd, rtol=0, atol=1e-7)
+    inertia = np.array([1.0, 2.0, 3.0])
+    for m in range(3):
+        e = np.eye(3)[m] * h
+        fd = column(end(M0, R0, inertia + e), end(M0, R0, inertia - e), h)
+        np.testing.assert_allclose(traj.final_parameter_jacobian[:, m], fd, rtol=0, atol=1e-7)
 
 
 def test_parameter_jacobian_of_the_pseudo_rigid_body_along_its_potential_constants():

@@ -2229,7 +2229,8 @@ use lieflow::systems::{Algebra, LieHamiltonian, LiePoisson, Side};
 /// Central differences of `steps` steps of `method` (through its stepper: a matrix attitude is
 /// moved off its group too, which the lift differentiates across) in the lift's coordinates:
 /// flat components moved by h·max(1, |z_j|); with an SO(3) attitude (`so3_block`, the last 9
-/// values) the initial R₀ moved as R₀exp(hê_j) and the final one read as (Rᵀ δR)^∨ (e × e).
+/// values) the initial R₀ moved as R₀exp(hê_j) and the final one read as (Uᵀ δU)^∨ of its
+/// polar factor U (R itself but for rk4, which leaves SO(3)) (e × e).
 fn group_differences(
     sys: &dyn System,
     method: &str,
@@ -2272,10 +2273,8 @@ fn group_differences(
             jac[i * e + j] = (p[i] - q[i]) / (2.0 * hj);
         }
         if so3_block {
-            let (rp, rq) = (
-                Matrix3::from_row_slice(&p[d - 9..]),
-                Matrix3::from_row_slice(&q[d - 9..]),
-            );
+            let u = |v: &[f64]| so3::project(&Matrix3::from_row_slice(&v[d - 9..])).unwrap();
+            let (rp, rq) = (u(&p), u(&q));
             let xi = so3::vee_unchecked(&(((rp + rq) * 0.5).transpose() * (rp - rq) / (2.0 * hj)));
             for i in 0..3 {
                 jac[(flat + i) * e + j] = xi[i];
@@ -2289,11 +2288,13 @@ fn group_differences(
 /// padded with zeros to the lift's e coordinates.
 type CasimirGradients = fn(&[f64]) -> Vec<Vec<f64>>;
 
-/// Every method of `sys`'s lift (named `methods`): the lifted run's base state against the
-/// plain run's (rkmk4 bit for bit, the midpoints to round-off: their lifted iteration runs on
-/// until the directions have converged too), its Jacobian against [`group_differences`] (≤ 1e-8
-/// relative to the largest entry) and ∇C(z)ᵀJ = ∇C(z₀)ᵀ (≤ 1e-12 relative to |∇C||J|) for the
-/// Casimirs of `casimirs`, over 40 steps of 0.05. Returns the rkmk4 Jacobian.
+/// Every lifted method of `sys` (named `methods`), each on its own lift
+/// ([`System::tangent_for`]: rk4 with an SO(3) attitude on the field lift): the lifted run's
+/// base state against the plain run's (rkmk4 bit for bit, the midpoints to round-off: their
+/// lifted iteration runs on until the directions have converged too), its Jacobian against
+/// [`group_differences`] (≤ 1e-8 relative to the largest entry) and ∇C(z)ᵀJ = ∇C(z₀)ᵀ
+/// (≤ 1e-12 relative to |∇C||J|) for the Casimirs of `casimirs`, over 40 steps of 0.05.
+/// Returns the rkmk4 Jacobian.
 fn check_group_lift(
     name: &str,
     sys: &dyn System,
@@ -2313,14 +2314,14 @@ fn check_group_lift_over(
     casimirs: CasimirGradients,
     (dt, steps): (f64, usize),
 ) -> Vec<f64> {
-    let t = sys.tangent().unwrap_or_else(|| panic!("{name}: a lift"));
-    let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
-    assert_eq!(names, methods, "{name}");
-    let (d, e) = (t.base_dim(), t.tangent_dim());
+    assert_eq!(sys.tangent_methods(), methods, "{name}");
+    let space = sys.space();
+    let (d, e) = (space.dim(), space.tangent_dim());
     let so3_block = d != e;
     let mut rkmk4 = Vec::new();
     for &method in methods {
-        let (z, jac) = lifted_end(&*t, method, z0, dt, steps);
+        let t = sys.tangent_for(method).expect("a lift");
+        let (z, jac) = lifted_trivialised(&*t, method, z0, dt, steps);
         let plain = stepped(sys, method, z0, dt, steps);
         let base = max_rel(&z, &plain);
         let fd = group_differences(sys, method, z0, (dt, steps), 1e-5, so3_block);
@@ -2554,7 +2555,7 @@ fn the_user_free_body_has_the_rigid_bodys_rkmk4_jacobian() {
 }
 
 /// User Lie–Poisson systems on every kind of algebra, left and right, with and without the
-/// attitude: so(3) quartic (attitude R, left-trivialised: no rk4), so(4) quadratic with
+/// attitude: so(3) quartic (attitude R, left-trivialised; rk4's ambient), so(4) quadratic with
 /// couplings (attitude g ∈ SO(4), ambient), se(3) quadratic (Kirchhoff's body, attitude SE(3)),
 /// sl(2) by structure constants with a quartic H (the generic action and dexp series; Casimir
 /// h² + 4ef).
@@ -2563,7 +2564,6 @@ fn jacobians_of_user_lie_poisson_systems() {
     use lieflow::lie::so3;
     use nalgebra::Vector3;
     let all = ["rkmk4", "midpoint", "midpoint4", "rk4"];
-    let no_rk4 = &all[..3];
     let r0 = so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
     // so(3), quartic, with R.
     for side in [Side::Left, Side::Right] {
@@ -2573,7 +2573,7 @@ fn jacobians_of_user_lie_poisson_systems() {
             .unwrap();
         let z0 = [vec![0.3, -0.8, 1.1], rows3(&r0)].concat();
         let name = format!("LiePoisson so(3) quartic with R, {}", side.name());
-        check_group_lift(&name, &lp, &z0, no_rk4, norm_so3);
+        check_group_lift(&name, &lp, &z0, &all, norm_so3);
     }
     // so(4), quadratic with couplings, with g ∈ SO(4).
     let g4 =
@@ -2701,7 +2701,7 @@ fn jacobians_of_euler_poincare_systems() {
         "EulerPoincare coupled top with R",
         &lifted,
         &zl,
-        &all[..3],
+        &all,
         casimirs_se3,
     );
 
@@ -2754,11 +2754,23 @@ fn lifted_trivialised(
     dt: f64,
     steps: usize,
 ) -> (Vec<f64>, Vec<f64>) {
-    let (d, e) = (t.base_dim(), t.tangent_dim());
-    let traj = integrate(t, method, &t.seed(z0).unwrap(), dt, steps, steps).unwrap();
-    let (mut z, mut jac) = (vec![0.0; d], vec![0.0; e * e]);
-    t.jacobian(traj.state(1), &mut z, &mut jac, &mut []);
+    let (z, jac, _) = lifted_trivialised_all(t, method, z0, dt, steps);
     (z, jac)
+}
+
+/// (base state, Jacobian e×e, parameter Jacobian e×p) at the end of a lifted run.
+fn lifted_trivialised_all(
+    t: &dyn TangentSystem,
+    method: &str,
+    z0: &[f64],
+    dt: f64,
+    steps: usize,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (d, e, np) = (t.base_dim(), t.tangent_dim(), t.parameter_names().len());
+    let traj = integrate(t, method, &t.seed(z0).unwrap(), dt, steps, steps).unwrap();
+    let (mut z, mut jac, mut pjac) = (vec![0.0; d], vec![0.0; e * e], vec![0.0; e * np]);
+    t.jacobian(traj.state(1), &mut z, &mut jac, &mut pjac);
+    (z, jac, pjac)
 }
 
 /// z moved along direction j of its tangent space by s: an SO(3) block as R exp(sê), the
@@ -2788,7 +2800,8 @@ fn along(space: &lieflow::integrate::Space, z0: &[f64], j: usize, s: f64) -> Vec
 }
 
 /// The coordinates of z around `base` whose derivative is the left-trivialised direction: an
-/// SO(3) block as log(R_baseᵀR), the others as they are (e values).
+/// SO(3) block as log(U_baseᵀU) of the polar factors (U = R to round-off for a method that
+/// keeps SO(3); a Runge–Kutta lift reads its attitude so), the others as they are (e values).
 fn around(space: &lieflow::integrate::Space, base: &[f64], z: &[f64]) -> Vec<f64> {
     use lieflow::integrate::Block;
     use lieflow::lie::so3;
@@ -2797,9 +2810,8 @@ fn around(space: &lieflow::integrate::Space, base: &[f64], z: &[f64]) -> Vec<f64
     let mut at = 0;
     for (_, b) in space.blocks() {
         if *b == Block::SO3 {
-            let r0 = Matrix3::from_row_slice(&base[at..at + 9]);
-            let r = Matrix3::from_row_slice(&z[at..at + 9]);
-            out.extend(so3::log_unchecked(&(r0.transpose() * r)).iter());
+            let u = |v: &[f64]| so3::project(&Matrix3::from_row_slice(&v[at..at + 9])).unwrap();
+            out.extend(so3::log_unchecked(&(u(base).transpose() * u(z))).iter());
         } else {
             out.extend_from_slice(&z[at..at + b.len()]);
         }
@@ -2847,6 +2859,36 @@ fn trivialised_differences(
     jac
 }
 
+/// [`trivialised_differences`] along the parameters θ_m, the system rebuilt by `build` with θ_m
+/// moved by h·max(1, |θ_m|) (e × p, row-major).
+fn trivialised_parameter_differences<S: System, const P: usize>(
+    build: impl Fn([f64; P]) -> S,
+    theta: [f64; P],
+    method: &str,
+    z0: &[f64],
+    (dt, steps): (f64, usize),
+    h: f64,
+) -> Vec<f64> {
+    let sys = build(theta);
+    let space = sys.space();
+    let e = space.tangent_dim();
+    let base = stepped(&sys, method, z0, dt, steps);
+    let mut out = vec![0.0; e * P];
+    for m in 0..P {
+        let hm = h * theta[m].abs().max(1.0);
+        let end = |s: f64| {
+            let mut th = theta;
+            th[m] += s;
+            around(&space, &base, &stepped(&build(th), method, z0, dt, steps))
+        };
+        let (a, b) = (end(hm), end(-hm));
+        for i in 0..e {
+            out[i * P + m] = (a[i] - b[i]) / (2.0 * hm);
+        }
+    }
+    out
+}
+
 /// max over columns j of |Σ_i g(z)_i J_ij − g(z₀)_j| for each gradient pair, relative to
 /// max(1, |J|)·max(1, |g|) (the size of the terms summed).
 fn gradient_defect(jac: &[f64], grads: &[(Vec<f64>, Vec<f64>)]) -> f64 {
@@ -2856,6 +2898,21 @@ fn gradient_defect(jac: &[f64], grads: &[(Vec<f64>, Vec<f64>)]) -> f64 {
         .flat_map(|(a, b)| a.iter().chain(b))
         .fold(1.0f64, |m, x| m.max(x.abs()));
     casimir_defect(jac, grads) / (scale * g)
+}
+
+/// The catalog's spheres (full inertia tensors, offset centres of mass).
+fn catalog_spheres() -> lieflow::systems::RollingSpheres {
+    lieflow::systems::RollingSpheres::new(
+        0.7,
+        1.3,
+        [0.1, -0.2, 0.15],
+        [-0.3, 0.2, 0.4],
+        2.0,
+        3.5,
+        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
+        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
+    )
+    .unwrap()
 }
 
 fn catalog_spheres_state(s: &lieflow::systems::RollingSpheres) -> Vec<f64> {
@@ -2883,18 +2940,7 @@ fn catalog_spheres_state(s: &lieflow::systems::RollingSpheres) -> Vec<f64> {
 /// momentum J = P₁ + P₂ (its gradient in user coordinates from the lift's chart at the state).
 #[test]
 fn rolling_spheres_jacobians_keep_the_sphere_and_the_momentum() {
-    // The catalog's spheres (full inertia tensors, offset centres of mass).
-    let s = lieflow::systems::RollingSpheres::new(
-        0.7,
-        1.3,
-        [0.1, -0.2, 0.15],
-        [-0.3, 0.2, 0.4],
-        2.0,
-        3.5,
-        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
-        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
-    )
-    .unwrap();
+    let s = catalog_spheres();
     let t = s.tangent().expect("the spheres have a lift");
     let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
     assert_eq!(names, ["midpoint", "midpoint4", "rkmk4"]);
@@ -3065,32 +3111,9 @@ fn frame_top_jacobians_keep_the_casimirs() {
 /// H − T = ½Π·𝕀⁻¹Π are mapped consistently.
 #[test]
 fn riemannian_frame_top_jacobians() {
-    use lieflow::lie::so3;
-    use lieflow::systems::{Riemannian, RiemannianFrameTop, SpaceTop};
     use nalgebra::Vector3;
-    let lambda = |x: [f64; 3]| 1.0 + 0.1 * (x[0] * x[0] + 0.5 * x[1] * x[2]);
-    let chart = Riemannian::new(
-        move |x| {
-            let l2 = lambda(x).powi(2);
-            [[l2, 0.0, 0.0], [0.0, l2, 0.0], [0.0, 0.0, l2]]
-        },
-        move |x| {
-            let q = so3::exp_unchecked(&Vector3::new(0.3 * x[0], -0.2 * x[2], 0.4 * x[0] * x[1]))
-                / lambda(x);
-            std::array::from_fn(|a| std::array::from_fn(|i| q[(i, a)]))
-        },
-        None,
-    );
+    let (top, z0) = riemannian_top();
     let inertia = [2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2];
-    let top = RiemannianFrameTop::new(chart, 1.3, &inertia).unwrap();
-    let z0 = top
-        .state(
-            &[0.3, -0.2, 0.5],
-            &so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3)),
-            &[0.4, 0.1, -0.3],
-            &Vector3::new(0.7, -0.4, 1.1),
-        )
-        .unwrap();
     let t = top.tangent().expect("a lift");
     let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
     assert_eq!(names, ["midpoint", "midpoint4", "midpoint6", "rkmk4"]);
@@ -3130,6 +3153,148 @@ fn riemannian_frame_top_jacobians() {
         assert!(err < 1e-8, "{method}: {err:e}");
         assert!(defect < 1e-12, "{method}: gradients {defect:e}");
     }
+}
+
+/// The catalog's top on a Riemannian chart (a conformally flat metric with a rotating frame)
+/// and a state of it.
+fn riemannian_top() -> (lieflow::systems::RiemannianFrameTop, Vec<f64>) {
+    use lieflow::lie::so3;
+    use lieflow::systems::{Riemannian, RiemannianFrameTop, SpaceTop};
+    use nalgebra::Vector3;
+    let lambda = |x: [f64; 3]| 1.0 + 0.1 * (x[0] * x[0] + 0.5 * x[1] * x[2]);
+    let chart = Riemannian::new(
+        move |x| {
+            let l2 = lambda(x).powi(2);
+            [[l2, 0.0, 0.0], [0.0, l2, 0.0], [0.0, 0.0, l2]]
+        },
+        move |x| {
+            let q = so3::exp_unchecked(&Vector3::new(0.3 * x[0], -0.2 * x[2], 0.4 * x[0] * x[1]))
+                / lambda(x);
+            std::array::from_fn(|a| std::array::from_fn(|i| q[(i, a)]))
+        },
+        None,
+    );
+    let inertia = [2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2];
+    let top = RiemannianFrameTop::new(chart, 1.3, &inertia).unwrap();
+    let z0 = top
+        .state(
+            &[0.3, -0.2, 0.5],
+            &so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3)),
+            &[0.4, 0.1, -0.3],
+            &Vector3::new(0.7, -0.4, 1.1),
+        )
+        .unwrap();
+    (top, z0)
+}
+
+/// RK4 on states with SO(3) blocks (the tops carrying their attitude, the rolling spheres, the
+/// top on a Riemannian chart) through the field lift, whose directions are ambient and whose
+/// attitude is read by the derivative of the polar factor of the run's R (RK4 leaves SO(3)):
+/// the full Jacobian (the attitude's left-trivialised rows and columns included; the heavy
+/// top's Γ alone too, off its constraint Γ = Rᵀe₃, through the stepper) and the tops'
+/// parameter Jacobians against central differences of the method's own map (R₀exp(hê_j), the
+/// end states' polar factors compared by log(U₀ᵀU)), ≤ 1e-7 relative (the Riemannian chart by
+/// fourth-order differences, as `riemannian_frame_top_jacobians`; the body given by an inertia
+/// matrix with steps of 0.3, after which R is 6e-6 off SO(3)); the base states are the plain
+/// runs', bit for bit.
+#[test]
+fn rk4_jacobians_with_so3_blocks() {
+    use lieflow::lie::so3;
+    use nalgebra::{Matrix3, Vector3};
+    let r0 = so3::exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
+    let moments = [1.0, 2.0, 3.0];
+    let (mgl, chi) = (0.7, [0.2, -0.3, 1.0]);
+    let free = |i: [f64; 3]| RigidBody::new(i).unwrap().with_attitude();
+    let heavy = |th: [f64; 7]| {
+        // χ moved without its normalisation (mgl scaled by |χ|).
+        let c = [th[4], th[5], th[6]];
+        let g = th[3] * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        HeavyTop::new([th[0], th[1], th[2]], g, c)
+            .unwrap()
+            .with_attitude()
+    };
+    let chi_unit = {
+        let n: f64 = chi[0] * chi[0] + chi[1] * chi[1] + chi[2] * chi[2];
+        chi.map(|c| c / n.sqrt())
+    };
+    let theta = [
+        moments[0],
+        moments[1],
+        moments[2],
+        mgl,
+        chi_unit[0],
+        chi_unit[1],
+        chi_unit[2],
+    ];
+    let matrix = RigidBody::from_matrix(&[2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2])
+        .unwrap()
+        .with_attitude();
+    let spheres = catalog_spheres();
+    let (riemannian, z_riemannian) = riemannian_top();
+    let z_free = [vec![0.3, -0.8, 1.1], matrix_rows(&r0)].concat();
+    let z_heavy = [
+        vec![1.0, 0.5, -0.3],
+        (r0.transpose() * Vector3::z()).as_slice().to_vec(),
+        matrix_rows(&r0),
+    ]
+    .concat();
+    /// (system, z₀, (dt, steps), whether by fourth-order differences at h = 3e-3).
+    type Case<'a> = (&'a dyn System, Vec<f64>, (f64, usize), bool);
+    let cases: [Case; 5] = [
+        (&matrix, z_free.clone(), (0.3, 40), false),
+        (&free(moments), z_free.clone(), (0.05, 40), false),
+        (&heavy(theta), z_heavy.clone(), (0.05, 40), false),
+        (&spheres, catalog_spheres_state(&spheres), (0.02, 50), false),
+        (&riemannian, z_riemannian, (0.05, 20), true),
+    ];
+    for (sys, z0, run, fourth) in cases {
+        let h = if fourth { 3e-3 } else { 1e-6 };
+        assert!(sys.tangent_methods().contains(&"rk4"), "{}", sys.name());
+        let t = sys.tangent_for("rk4").expect("a lift");
+        let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, ["rk4"], "{}", sys.name());
+        let space = sys.space();
+        let (d, e, np) = (space.dim(), space.tangent_dim(), t.parameter_names().len());
+        assert_eq!((t.base_dim(), t.tangent_dim()), (d, e));
+        // Each of the e + p directions has the state's d values.
+        assert_eq!(t.space().dim(), d * (1 + e + np));
+        let (z, jac, _) = lifted_trivialised_all(&*t, "rk4", &z0, run.0, run.1);
+        let plain = integrate(sys, "rk4", &z0, run.0, run.1, run.1).unwrap();
+        assert_eq!(z, plain.state(1), "{}: base state", sys.name());
+        let r = Matrix3::from_row_slice(&z[space.range("z1").or(space.range("R")).unwrap()]);
+        let (orth, _) = so3::rotation_defect(&r);
+        let fd = trivialised_differences(sys, "rk4", &z0, run, h, fourth);
+        let err = max_rel(&jac, &fd);
+        eprintln!(
+            "{} rk4: ‖RᵀR − I‖ {orth:.1e} at the end, Jacobian vs differences {err:.2e}",
+            sys.name()
+        );
+        assert!(err < 1e-7, "{}: {err:e}", sys.name());
+    }
+    // The parameter Jacobians (∂Ṙ/∂I_k = R(∂Ω/∂I_k)^ in the field's).
+    let run = (0.05, 40);
+    let (_, _, pjac) = lifted_trivialised_all(
+        &*free(moments).tangent_for("rk4").unwrap(),
+        "rk4",
+        &z_free,
+        run.0,
+        run.1,
+    );
+    let fd = trivialised_parameter_differences(free, moments, "rk4", &z_free, run, 1e-6);
+    let err = max_rel(&pjac, &fd);
+    eprintln!("RigidBody with attitude rk4: parameter Jacobian vs differences {err:.2e}");
+    assert!(err < 1e-7, "RigidBody parameters: {err:e}");
+    let (_, _, pjac) = lifted_trivialised_all(
+        &*heavy(theta).tangent_for("rk4").unwrap(),
+        "rk4",
+        &z_heavy,
+        run.0,
+        run.1,
+    );
+    let fd = trivialised_parameter_differences(heavy, theta, "rk4", &z_heavy, run, 1e-6);
+    let err = max_rel(&pjac, &fd);
+    eprintln!("HeavyTop with attitude rk4: parameter Jacobian vs differences {err:.2e}");
+    assert!(err < 1e-7, "HeavyTop parameters: {err:e}");
 }
 
 /// Sweeps dt up to steps where the plain iteration stops converging: the lifted run fails

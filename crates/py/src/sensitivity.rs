@@ -22,8 +22,9 @@ pub struct PyTangent {
 
 #[pymethods]
 impl PyTangent {
-    /// The lifted states (..., d + (e + p)e) of states (..., d) with the identity as directions
-    /// (e = d, or d − 6 with an attitude: its directions left-trivialised).
+    /// The lifted states (..., n) of states (..., d) with the identity as directions (e = d, or
+    /// d − 6 with an attitude: its directions left-trivialised): n = d + (e + p)·w, each
+    /// direction of w = e values, or of w = d for a Runge–Kutta lift (ambient on SO(3) blocks).
     fn seed<'py>(
         &self,
         py: Python<'py>,
@@ -41,8 +42,7 @@ impl PyTangent {
             )));
         }
         let data = read_all("state0", &v)?;
-        let e = t.tangent_dim();
-        let width = d + (e + t.parameter_names().len()) * e;
+        let width = t.space().dim();
         let mut out = Vec::with_capacity(data.len() / d * width);
         for z in data.chunks_exact(d) {
             out.extend(t.seed(z).py()?);
@@ -54,8 +54,8 @@ impl PyTangent {
             .map_err(|e| to_py(Error::shape("state0", "(..., d)", e.to_string())))
     }
 
-    /// The number e of a direction's values (the state's d less 6 per SO(3) block:
-    /// left-trivialised).
+    /// The number e of directions and of a Jacobian's rows (the state's d less 6 per SO(3)
+    /// block: left-trivialised).
     #[getter]
     fn directions(&self) -> usize {
         self.inner.tangent_dim()
@@ -68,7 +68,7 @@ impl PyTangent {
     }
 
     /// (states (..., d), Jacobians (..., e, e), parameter Jacobians (..., e, p)) of lifted
-    /// states (..., d + (e + p)e).
+    /// states (..., n).
     fn split<'py>(
         &self,
         py: Python<'py>,
@@ -76,7 +76,7 @@ impl PyTangent {
     ) -> PyResult<(Array<'py>, Array<'py>, Array<'py>)> {
         let t = &self.inner;
         let (d, e, np) = (t.base_dim(), t.tangent_dim(), t.parameter_names().len());
-        let width = d + (e + np) * e;
+        let width = t.space().dim();
         let v = lifted.as_array();
         let shape = v.shape().to_vec();
         if shape.last() != Some(&width) {

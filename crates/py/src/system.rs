@@ -45,6 +45,14 @@ pub struct PySystem {
 type MethodOf = (bool, Option<String>, Arc<Resolved>);
 
 impl PySystem {
+    /// The core system, or with `attitude` the one carrying its attitude (None where it cannot).
+    fn carrying(&self, attitude: bool) -> Option<&Arc<dyn System>> {
+        match attitude {
+            true => self.lifted.as_ref(),
+            false => Some(&self.sys),
+        }
+    }
+
     /// The base part of a system object over `sys`, built from the constructor arguments `args`
     /// (named `names`, used by `__repr__`; `__reduce__` passes them to the class again).
     pub(crate) fn new<S: lieflow::integrate::Catalog>(
@@ -336,35 +344,31 @@ impl PySystem {
     }
 
     /// The methods whose Jacobians `lieflow.integrate(..., sensitivity=True)` computes for this
-    /// system (its tangent lift's catalog; empty where the system has none yet); with
-    /// `attitude=True` those of a run that carries the attitude.
+    /// system (those of its catalog that a tangent lift lists; empty where the system has none
+    /// yet); with `attitude=True` those of a run that carries the attitude.
     #[pyo3(signature = (attitude = false))]
     fn sensitivity_methods(&self, attitude: bool) -> Vec<&'static str> {
-        let t = match attitude {
-            true => self.lifted.as_ref().and_then(|l| l.tangent()),
-            false => self.sys.tangent(),
-        };
-        t.map(|t| t.methods().into_iter().map(|(n, _)| n).collect())
+        self.carrying(attitude)
+            .map(|s| s.tangent_methods())
             .unwrap_or_default()
     }
 
     /// The tangent lift of the system (with `attitude`: of the system carrying its attitude) for
-    /// `lieflow.integrate(..., sensitivity=True)` (issue 26): (a system object over the lift, its
-    /// layout), or None where the system has none.
-    #[pyo3(signature = (attitude = false))]
+    /// `lieflow.integrate(..., sensitivity=True)` (issue 26): (a system object over the lift
+    /// that runs `method`, its layout), or None where the system has none; without a method the
+    /// system's lift of its non-Runge–Kutta methods (the same directions and Jacobians' shape).
+    #[pyo3(signature = (attitude = false, method = None))]
     fn _tangent(
         &self,
         py: Python<'_>,
         attitude: bool,
+        method: Option<&str>,
     ) -> PyResult<Option<(Py<PySystem>, Py<crate::sensitivity::PyTangent>)>> {
-        let sys = match attitude {
-            true => match &self.lifted {
-                Some(l) => l.tangent(),
-                None => None,
-            },
-            false => self.sys.tangent(),
-        };
-        let Some(t) = sys else {
+        let lift = self.carrying(attitude).and_then(|s| match method {
+            Some(m) => s.tangent_for(m),
+            None => s.tangent(),
+        });
+        let Some(t) = lift else {
             return Ok(None);
         };
         let sys: Arc<dyn System> = t.clone();

@@ -182,6 +182,14 @@ pub trait Catalog: Problem + Clone + 'static {
         None
     }
 
+    /// The tangent lift whose runs of `method` carry its Jacobian, if any (it lists `method`
+    /// then): by default [`Catalog::tangent`]; a system whose state has SO(3) blocks gives its
+    /// Runge–Kutta methods the field lift with ambient directions
+    /// ([`crate::integrate::tangent::Tangent::routed`]).
+    fn tangent_for(&self, _method: &str) -> Option<Arc<dyn TangentSystem>> {
+        self.tangent()
+    }
+
     /// The system's own dissipative term of kind `d` (Rayleigh damping of a canonical system,
     /// double-bracket dissipation of a Lie–Poisson system), for
     /// [`crate::integrate::forcing::Forced`]; by default none.
@@ -258,6 +266,13 @@ pub trait System: Problem {
     /// The tangent lift ([`Catalog::tangent`]).
     fn tangent(&self) -> Option<Arc<dyn TangentSystem>>;
 
+    /// The tangent lift for runs of `method` ([`Catalog::tangent_for`]).
+    fn tangent_for(&self, method: &str) -> Option<Arc<dyn TangentSystem>>;
+
+    /// The methods whose Jacobians a lifted run computes: those of the system's catalog that
+    /// their lift ([`System::tangent_for`]) lists, in the catalog's order.
+    fn tangent_methods(&self) -> Vec<&'static str>;
+
     /// The system's own dissipative term of kind `d` ([`Catalog::dissipation`]).
     fn dissipation(
         &self,
@@ -270,8 +285,8 @@ pub trait System: Problem {
 }
 
 /// A lifted system as the driver and the bindings see it ([`crate::integrate::tangent`]): a
-/// [`System`] whose states carry the directions, with the conversions from and to the base
-/// problem's flat layout.
+/// [`System`] whose states (`space().dim()` values) carry the directions, with the conversions
+/// from and to the base problem's flat layout.
 pub trait TangentSystem: System {
     /// The dimension d of the base state.
     fn base_dim(&self) -> usize;
@@ -282,8 +297,8 @@ pub trait TangentSystem: System {
     /// The names of the parameters θ whose directions the lift carries.
     fn parameter_names(&self) -> Vec<&'static str>;
 
-    /// The lifted state of a base state (user frame) with the identity as directions (and
-    /// ∂z₀/∂θ = 0).
+    /// The lifted state of a base state (user frame) with the identity as directions (on an
+    /// SO(3) block δR = Rê_j, in ambient directions too) and ∂z₀/∂θ = 0.
     fn seed(&self, z0: &[f64]) -> Result<Vec<f64>>;
 
     /// The base state (d values), the Jacobian ∂z/∂z₀ (e×e row-major, column j = δz_j) and the
@@ -330,6 +345,21 @@ impl<P: Catalog> System for P {
 
     fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
         Catalog::tangent(self)
+    }
+
+    fn tangent_for(&self, method: &str) -> Option<Arc<dyn TangentSystem>> {
+        Catalog::tangent_for(self, method)
+    }
+
+    fn tangent_methods(&self) -> Vec<&'static str> {
+        self.catalog()
+            .iter()
+            .map(|e| e.name)
+            .filter(|m| {
+                Catalog::tangent_for(self, m)
+                    .is_some_and(|t| t.methods().iter().any(|(n, _)| n == m))
+            })
+            .collect()
     }
 
     fn dissipation(

@@ -81,6 +81,22 @@ pub trait Problem: Send + Sync {
         self.tangent_to_user(dz)
     }
 
+    /// The derivative of [`Problem::to_internal`] at the state `z` (user frame) applied to an
+    /// ambient tangent vector ([`Space::dim`] values: an SO(3) block's δR as a 3×3 matrix, not
+    /// necessarily tangent), the directions of a Runge–Kutta lift
+    /// ([`crate::integrate::tangent::Tangent::field`]); by default [`Problem::to_internal`]
+    /// applied to it (right for a linear chart).
+    fn ambient_to_internal_at(&self, _z: &[f64], dz: &mut [f64]) {
+        self.to_internal(dz)
+    }
+
+    /// The derivative of [`Problem::to_user`] at the internal state `z` (which a Runge–Kutta run
+    /// leaves off its manifold) applied to an ambient tangent vector; by default
+    /// [`Problem::to_user`] applied to it.
+    fn ambient_to_user_at(&self, _z: &[f64], dz: &mut [f64]) {
+        self.to_user(dz)
+    }
+
     /// The names of the system's parameters θ, in order, whose sensitivities ∂z/∂θ a tangent
     /// run carries ([`crate::integrate::tangent`]); none by default.
     fn parameters(&self) -> Vec<&'static str> {

@@ -27,22 +27,31 @@
 //! implicit-function theorem). Each block (the state, each direction) is measured against its
 //! own scale ([`crate::convergence::Blocks`]): the state stops where the plain iteration does,
 //! and its directions then converge at the accepted state. With k
-//! directions the lifted state has d(1 + k) values, so a Jacobian run costs about (1 + k) plain
-//! runs.
+//! directions the lifted state has at most d(1 + k) values, so a Jacobian run costs about
+//! (1 + k) plain runs.
 //!
 //! **Parameters.** The problem's parameters θ ([`Problem::parameters`]) get p more directions
 //! δz_{θ_m} = ∂z/∂θ_m, from 0 at the start, whose pieces carry the inhomogeneous term
-//! (f′(z)δz + ∂f/∂θ_m; for a flow Dφ δz + ∂φ/∂θ_m): so k = d + p directions in all.
+//! (f′(z)δz + ∂f/∂θ_m; for a flow Dφ δz + ∂φ/∂θ_m): so k = e + p directions in all (e below).
 //!
 //! **Layouts.** A separable lift stores (q, δq₁, …, δq_k, p, δp₁, …, δp_k) (its kind needs the
-//! positions before the momenta); a field or split lift (z, δz₁, …, δz_k). On an SO(3) block a
-//! direction is left-trivialised (δR = Rξ̂, three values), so a direction has e ≤ d values; the
-//! split lift allows it (a flow's tangent map is exact in ξ), the field lift does not (a
-//! Runge–Kutta step leaves SO(3), and its derivative is one in ambient coordinates). [`TangentSystem::seed`] and
-//! [`TangentSystem::jacobian`] convert from and to the problem's flat layout, so nothing outside
-//! this module sees either. The problem's chart ([`Problem::to_internal`]) maps the directions by
-//! its tangent map at the base state ([`Problem::tangent_to_internal_at`]; by default the chart
-//! itself, right for a linear one such as a turn to principal axes).
+//! positions before the momenta); a field, group-field or split lift (z, δz₁, …, δz_k). There
+//! are e state directions, e = d less 6 per SO(3) block: the Jacobian is e × e, an SO(3) block's
+//! directions left-trivialised (δR = Rξ̂). In a split or group-field lift a direction has those
+//! e values (a flow's or a group action's tangent map is exact in ξ). In the field lift
+//! ([`Tangent::field`]) it has all d values, ambient (δR a 3×3 matrix): a Runge–Kutta step
+//! leaves SO(3), and its derivative is one of the flat values, which the field lift computes
+//! with the field's derivative off the manifold ([`VectorFieldTangent::field_tangent`]). It
+//! starts at δR = Rξ̂ and is read back by the derivative of the polar factor U of the run's R
+//! ([`so3::PolarTangent`]: δU = Uξ̂), the flat blocks as they are, the base state as computed:
+//! so every lift has the same e and Jacobian, and a system whose state has SO(3) blocks routes
+//! its Runge–Kutta methods to the field lift ([`Catalog::tangent_for`], [`Tangent::routed`]),
+//! the others to its left-trivialised lift. Without SO(3) blocks the layouts coincide (e = d).
+//! [`TangentSystem::seed`] and [`TangentSystem::jacobian`] convert from and to the problem's
+//! flat layout, so nothing outside this module sees either. The problem's chart
+//! ([`Problem::to_internal`]) maps the directions by its tangent map at the base state
+//! ([`Problem::tangent_to_internal_at`], ambient [`Problem::ambient_to_internal_at`]; by default
+//! the chart itself, right for a linear one such as a turn to principal axes).
 //!
 //! **What the lift keeps.** Its space is the base's blocks and then the directions, so a run
 //! retracts the base state's curved blocks exactly when the plain run does (every
@@ -64,6 +73,8 @@ use super::problem::{
 };
 use super::space::{Block, Space};
 use crate::error::{Error, Result};
+use crate::lie::so3;
+use nalgebra::{Matrix3, Vector3};
 
 /// A [`Separable`] problem with the directional derivatives of its velocity and force: the data
 /// of its tangent lift.
@@ -122,8 +133,21 @@ pub trait SplitTangent: Split {
 
 /// A [`VectorField`] with the directional derivative of its field: the data of its tangent lift.
 pub trait VectorFieldTangent: VectorField {
-    /// out = f′(z)·dz.
+    /// out = f′(z)·dz, in ambient coordinates ([`Space::dim`] values; an SO(3) block's δR a
+    /// 3×3 matrix, not necessarily tangent: the exact derivative of the field as a map of the
+    /// flat values, which a Runge–Kutta stage evaluates off the manifold).
     fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]);
+
+    /// out_j = f′(z)·dz_j for the consecutive directions dz_j of `dirs` (`out` alike): all at
+    /// once, so that a field whose derivative has costly parts shared by every direction (a
+    /// geometry's second derivatives) forms them once; by default one
+    /// [`VectorFieldTangent::field_tangent`] each.
+    fn field_tangents(&self, z: &[f64], dirs: &[f64], out: &mut [f64]) {
+        let d = z.len();
+        for (dz, o) in dirs.chunks_exact(d).zip(out.chunks_exact_mut(d)) {
+            self.field_tangent(z, dz, o);
+        }
+    }
 
     /// out += ∂f/∂θ_m (z) for the parameter m; NaN unless a problem with parameters
     /// implements it.
@@ -255,29 +279,41 @@ enum Layout {
     Field,
 }
 
-/// The tangent lift of a problem with k = d directions (module docs).
+/// The tangent lift of a problem with k = e + p directions (module docs).
 #[derive(Clone, Debug)]
 pub struct Tangent<P> {
     problem: P,
-    /// The state's and a tangent vector's dimensions (they differ by 6 per SO(3) block).
+    /// The state's and a tangent vector's dimensions (they differ by 6 per SO(3) block): e
+    /// state directions, and the Jacobian is e × e.
     d: usize,
     e: usize,
-    /// The number of parameter directions (after the d state directions).
+    /// The values of a direction: e (left-trivialised), or d (ambient: the field lift).
+    w: usize,
+    /// The number of parameter directions (after the e state directions).
     np: usize,
     layout: Layout,
 }
 
 impl<P: Problem + Clone> Tangent<P> {
-    fn with(problem: P, layout: Layout) -> Self {
+    /// The lift with directions of e values (left-trivialised), or of d values (`ambient`).
+    fn with(problem: P, layout: Layout, ambient: bool) -> Self {
         let (d, e) = (problem.space().dim(), problem.space().tangent_dim());
         let np = problem.parameters().len();
         Tangent {
             problem,
             d,
             e,
+            w: if ambient { d } else { e },
             np,
             layout,
         }
+    }
+
+    /// Whether the directions are ambient on SO(3) blocks (δR a 3×3 matrix): the field lift of
+    /// a state with SO(3) blocks ([`Tangent::field`]), whose catalog is its Runge–Kutta
+    /// methods.
+    pub fn ambient(&self) -> bool {
+        self.w != self.e
     }
 
     /// The number k = e + p of directions.
@@ -292,7 +328,7 @@ impl<P: Problem + Clone> Tangent<P> {
         if j == 0 {
             self.d
         } else {
-            self.e
+            self.w
         }
     }
 
@@ -301,12 +337,12 @@ impl<P: Problem + Clone> Tangent<P> {
         &self.problem
     }
 
-    /// Index of component i of the base state (j = 0, i < d) or of direction j (i < e).
+    /// Index of component i of the base state (j = 0, i < d) or of direction j (i < w).
     #[inline]
     fn at(&self, j: usize, i: usize) -> usize {
         match self.layout {
             Layout::Field if j == 0 => i,
-            Layout::Field => self.d + (j - 1) * self.e + i,
+            Layout::Field => self.d + (j - 1) * self.w + i,
             Layout::Separable { dof } => {
                 let (half, c) = (i / dof, i % dof);
                 half * dof * (self.k() + 1) + j * dof + c
@@ -337,7 +373,7 @@ impl<P: Problem + Clone> Tangent<P> {
     ) {
         if self.layout == Layout::Field {
             let (base, dirs) = z.split_at_mut(self.d);
-            dirs.chunks_exact_mut(self.e).for_each(|v| tangent(base, v));
+            dirs.chunks_exact_mut(self.w).for_each(|v| tangent(base, v));
             state(base);
             return;
         }
@@ -347,7 +383,7 @@ impl<P: Problem + Clone> Tangent<P> {
             self.gather(z, 0, base);
             for j in 1..=self.k() {
                 self.gather(z, j, v);
-                tangent(base, &mut v[..self.e]);
+                tangent(base, &mut v[..self.w]);
                 self.scatter(v, j, z);
             }
             state(base);
@@ -360,15 +396,37 @@ impl<P: SeparableTangent + Clone> Tangent<P> {
     /// The lift of a separable problem (its Verlet methods; flat blocks only).
     pub fn separable(problem: P) -> Self {
         let dof = problem.dof();
-        Tangent::with(problem, Layout::Separable { dof })
+        Tangent::with(problem, Layout::Separable { dof }, false)
     }
 }
 
 impl<P: VectorFieldTangent + Clone> Tangent<P> {
-    /// The lift of a vector field (its Runge–Kutta and Gauss methods; flat blocks only):
-    /// (z, δz₁, …, δz_k).
+    /// The lift of a vector field (its Runge–Kutta and Gauss methods): (z, δz₁, …, δz_k), each
+    /// direction of d values, ambient on SO(3) blocks (module docs, "Layouts").
     pub fn field(problem: P) -> Self {
-        Tangent::with(problem, Layout::Field)
+        Tangent::with(problem, Layout::Field, true)
+    }
+}
+
+impl<P: VectorFieldTangent + Clone> Tangent<P>
+where
+    Tangent<P>: Catalog,
+{
+    /// [`Catalog::tangent_for`] of a system whose state has SO(3) blocks: the field lift for the
+    /// methods of its catalog (the Runge–Kutta methods), `other` (the system's left-trivialised
+    /// lift) for the rest.
+    pub fn routed(
+        problem: &P,
+        method: &str,
+        other: impl FnOnce() -> Option<Arc<dyn TangentSystem>>,
+    ) -> Option<Arc<dyn TangentSystem>> {
+        let field = Tangent::field(problem.clone());
+        let ours = field.ambient() && field.catalog().iter().any(|e| e.name == method);
+        if ours {
+            Some(field.into_system())
+        } else {
+            other()
+        }
     }
 }
 
@@ -377,7 +435,7 @@ impl<P: GroupFieldTangent + Clone> Tangent<P> {
     /// a [`VectorFieldTangent`] without SO(3) blocks): (z, δz₁, …, δz_k), the directions
     /// left-trivialised on SO(3) blocks.
     pub fn group_field(problem: P) -> Self {
-        Tangent::with(problem, Layout::Field)
+        Tangent::with(problem, Layout::Field, false)
     }
 }
 
@@ -386,7 +444,7 @@ impl<P: SplitTangent + Clone> Tangent<P> {
     /// [`VectorFieldTangent`] without SO(3) blocks): (z, δz₁, …, δz_k), the directions
     /// left-trivialised on SO(3) blocks.
     pub fn split(problem: P) -> Self {
-        Tangent::with(problem, Layout::Field)
+        Tangent::with(problem, Layout::Field, false)
     }
 }
 
@@ -395,17 +453,17 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.name()
     }
 
-    /// The base problem's blocks, then the directions (d + k·e values in all): a run retracts
-    /// the base state's curved blocks as the plain run does (module docs); the separable
-    /// layout interleaves its values and is flat (its problems are).
+    /// The base problem's blocks, then the directions (d + k·w values in all, w = e, or d for
+    /// the field lift): a run retracts the base state's curved blocks as the plain run does
+    /// (module docs); the separable layout interleaves its values and is flat (its problems are).
     fn space(&self) -> Space {
         match self.layout {
             Layout::Field => self
                 .problem
                 .space()
-                .with("directions", Block::Real(self.k() * self.e)),
+                .with("directions", Block::Real(self.k() * self.w)),
             Layout::Separable { .. } => {
-                Space::new([("z", Block::Real(self.d + self.k() * self.e))])
+                Space::new([("z", Block::Real(self.d + self.k() * self.w))])
             }
         }
     }
@@ -429,19 +487,29 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.check_state(&base)
     }
 
+    /// The directions by the chart's tangent map at the base state: ambient
+    /// ([`Problem::ambient_to_internal_at`]) or left-trivialised.
     fn to_internal(&self, z: &mut [f64]) {
+        let ambient = self.ambient();
         self.each(
             z,
             |v| self.problem.to_internal(v),
-            |b, v| self.problem.tangent_to_internal_at(b, v),
+            |b, v| match ambient {
+                true => self.problem.ambient_to_internal_at(b, v),
+                false => self.problem.tangent_to_internal_at(b, v),
+            },
         );
     }
 
     fn to_user(&self, z: &mut [f64]) {
+        let ambient = self.ambient();
         self.each(
             z,
             |v| self.problem.to_user(v),
-            |b, v| self.problem.tangent_to_user_at(b, v),
+            |b, v| match ambient {
+                true => self.problem.ambient_to_user_at(b, v),
+                false => self.problem.tangent_to_user_at(b, v),
+            },
         );
     }
 
@@ -514,15 +582,15 @@ impl<P: SeparableTangent + Clone> Separable for Tangent<P> {
         let n = self.problem.dof();
         let (f0, df) = f.split_at_mut(n);
         self.problem.force(&q[..n], f0, s)?;
-        let d = self.e;
+        let e = self.e;
         for (j, (dqj, dfj)) in q[n..]
             .chunks_exact(n)
             .zip(df.chunks_exact_mut(n))
             .enumerate()
         {
             self.problem.force_tangent(&q[..n], dqj, dfj, s);
-            if j >= d {
-                self.problem.force_parameter(&q[..n], j - d, dfj, s);
+            if j >= e {
+                self.problem.force_parameter(&q[..n], j - e, dfj, s);
             }
         }
         Ok(())
@@ -765,27 +833,22 @@ impl<P: Nonholonomic + SeparableTangent + Clone> Nonholonomic for Tangent<P> {
 /// (f(z), f′(z)δz_j), in either layout (a separable problem's lift serves its Verlet methods
 /// and its Runge–Kutta and Gauss methods with one layout).
 impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
-    /// Only where e = d (no SO(3) block): a Runge–Kutta step on a curved block is differentiated
-    /// in its ambient coordinates, which a left-trivialised direction is not; a lift with one
-    /// gets NaN here (its catalog offers no Runge–Kutta method).
+    /// Only with directions of d values (the field lift, or a lift of a state without SO(3)
+    /// blocks): a Runge–Kutta step on a curved block is differentiated in its ambient
+    /// coordinates, which a left-trivialised direction is not; such a lift gets NaN here (its
+    /// catalog offers no Runge–Kutta method).
     fn field(&self, z: &[f64], dz: &mut [f64]) {
-        let d = self.d;
-        if self.e != d {
+        let (d, e) = (self.d, self.e);
+        if self.w != d {
             dz.fill(f64::NAN);
             return;
         }
         if self.layout == Layout::Field {
             let (f0, df) = dz.split_at_mut(d);
             self.problem.field(&z[..d], f0);
-            for (j, (dzj, dfj)) in z[d..]
-                .chunks_exact(d)
-                .zip(df.chunks_exact_mut(d))
-                .enumerate()
-            {
-                self.problem.field_tangent(&z[..d], dzj, dfj);
-                if j >= d {
-                    self.problem.field_parameter(&z[..d], j - d, dfj);
-                }
+            self.problem.field_tangents(&z[..d], &z[d..], df);
+            for (m, dfj) in df[e * d..].chunks_exact_mut(d).enumerate() {
+                self.problem.field_parameter(&z[..d], m, dfj);
             }
             return;
         }
@@ -800,8 +863,8 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
             for j in 1..=self.k() {
                 self.gather(z, j, dir);
                 self.problem.field_tangent(base, dir, out);
-                if j > d {
-                    self.problem.field_parameter(base, j - 1 - d, out);
+                if j > e {
+                    self.problem.field_parameter(base, j - 1 - e, out);
                 }
                 self.scatter(out, j, dz);
             }
@@ -811,7 +874,7 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
     /// The state and its k directions: f′ is block lower-triangular with f′(z) on each diagonal
     /// block (an implicit method factors it once).
     fn diagonal_blocks(&self) -> usize {
-        if self.e == self.d {
+        if self.w == self.d {
             self.k() + 1
         } else {
             1
@@ -819,7 +882,7 @@ impl<P: VectorFieldTangent + Clone> VectorField for Tangent<P> {
     }
 
     fn block_index(&self, b: usize, i: usize) -> usize {
-        if self.e == self.d {
+        if self.w == self.d {
             self.at(b, i)
         } else {
             i
@@ -867,7 +930,7 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
         let (x0, dx) = xi.split_at_mut(g);
         self.problem.generator(&z[..d], x0, &mut s.base);
         for (j, (dz, dxj)) in z[d..]
-            .chunks_exact(e)
+            .chunks_exact(self.w)
             .zip(dx.chunks_exact_mut(g))
             .enumerate()
         {
@@ -881,10 +944,10 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
     }
 
     fn act(&self, u: &[f64], z: &mut [f64], s: &mut Self::Scratch) {
-        let (d, e, g) = (self.d, self.e, self.problem.algebra_dim());
+        let (d, w, g) = (self.d, self.w, self.problem.algebra_dim());
         let (z0, dz) = z.split_at_mut(d);
         self.problem.act(&u[..g], z0, &mut s.base);
-        for (dzj, du) in dz.chunks_exact_mut(e).zip(u[g..].chunks_exact(g)) {
+        for (dzj, du) in dz.chunks_exact_mut(w).zip(u[g..].chunks_exact(g)) {
             self.problem.act_tangent(&u[..g], du, z0, dzj, &mut s.base);
         }
     }
@@ -892,7 +955,7 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
     /// The base state's increment as the base problem forms it (so the lifted run's states
     /// are the plain run's), the directions' as new minus old.
     fn act_increment(&self, u: &[f64], z: &[f64], inc: &mut [f64], s: &mut Self::Scratch) -> bool {
-        let (d, e, g) = (self.d, self.e, self.problem.algebra_dim());
+        let (d, w, g) = (self.d, self.w, self.problem.algebra_dim());
         let (i0, di) = inc.split_at_mut(d);
         if !self
             .problem
@@ -904,9 +967,9 @@ impl<P: GroupFieldTangent + Clone> GroupField for Tangent<P> {
             *y = zi + dzi;
         }
         for ((dij, du), dz) in di
-            .chunks_exact_mut(e)
+            .chunks_exact_mut(w)
             .zip(u[g..].chunks_exact(g))
-            .zip(z[d..].chunks_exact(e))
+            .zip(z[d..].chunks_exact(w))
         {
             dij.copy_from_slice(dz);
             self.problem
@@ -955,9 +1018,8 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
     type Work = SplitWork<P::Work>;
 
     fn load(&self, z: &[f64]) -> Result<Self::Work> {
-        let e = self.e;
-        let mut dirs = vec![0.0; self.k() * e];
-        for (j, v) in dirs.chunks_exact_mut(e).enumerate() {
+        let mut dirs = vec![0.0; self.k() * self.w];
+        for (j, v) in dirs.chunks_exact_mut(self.w).enumerate() {
             self.gather(z, j + 1, v);
         }
         let base = with_buffers(|[b, ..]| {
@@ -981,7 +1043,7 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
             v.clear();
             v.extend_from_slice(&w.dirs);
             self.problem.directions_out(&w.base, v);
-            for (j, dz) in v.chunks_exact(self.e).enumerate() {
+            for (j, dz) in v.chunks_exact(self.w).enumerate() {
                 self.scatter(dz, j + 1, z);
             }
         });
@@ -996,8 +1058,10 @@ impl<P: SplitTangent + Clone> Split for Tangent<P> {
         self.problem.flow(i, tau, &mut w.base);
         self.problem
             .flow_tangent(i, tau, &w.before, &w.base, &mut w.dirs);
-        let e = self.e;
-        for (m, dz) in w.dirs[e * e..].chunks_exact_mut(e).enumerate() {
+        for (m, dz) in w.dirs[self.e * self.w..]
+            .chunks_exact_mut(self.w)
+            .enumerate()
+        {
             self.problem
                 .flow_parameter(i, tau, &w.before, &w.base, m, dz);
         }
@@ -1044,24 +1108,63 @@ where
                 format!("({},)", z0.len()),
             ));
         }
-        let mut z = vec![0.0; self.d + self.k() * self.e];
+        let ambient = self.ambient();
+        let mut z = vec![0.0; self.d + self.k() * self.w];
         self.scatter(z0, 0, &mut z);
-        for j in 0..self.e {
-            z[self.at(j + 1, j)] = 1.0;
+        let (mut at, mut dir) = (0, 0);
+        for &(_, b) in self.problem.space().blocks() {
+            if ambient && b == Block::SO3 {
+                // δR = Rê_c for the left-trivialised direction c.
+                let r = Matrix3::from_row_slice(&z0[at..at + 9]);
+                for c in 0..3 {
+                    let dr = r * so3::hat(&Vector3::ith(c, 1.0));
+                    for k in 0..9 {
+                        z[self.at(dir + c + 1, at + k)] = dr[(k / 3, k % 3)];
+                    }
+                }
+            } else {
+                let pos = if ambient { at } else { dir };
+                for i in 0..b.tangent_len() {
+                    z[self.at(dir + i + 1, pos + i)] = 1.0;
+                }
+            }
+            at += b.len();
+            dir += b.tangent_len();
         }
         Ok(z)
     }
 
+    /// An ambient direction's SO(3) block is read by the derivative of the polar factor at the
+    /// run's R ([`so3::PolarTangent`]: a Runge–Kutta run leaves SO(3)), NaN where R has none;
+    /// the base state as computed.
     fn jacobian(&self, lifted: &[f64], z: &mut [f64], jac: &mut [f64], pjac: &mut [f64]) {
-        let (e, np) = (self.e, self.np);
+        let (e, np, k, ambient) = (self.e, self.np, self.k(), self.ambient());
         self.gather(lifted, 0, z);
-        for i in 0..e {
-            for j in 0..e {
-                jac[i * e + j] = lifted[self.at(j + 1, i)];
+        let mut put = |i: usize, j: usize, v: f64| match j < e {
+            true => jac[i * e + j] = v,
+            false => pjac[i * np + j - e] = v,
+        };
+        let (mut at, mut dir) = (0, 0);
+        for &(_, b) in self.problem.space().blocks() {
+            if ambient && b == Block::SO3 {
+                let polar = so3::PolarTangent::new(&Matrix3::from_row_slice(&z[at..at + 9])).ok();
+                for j in 0..k {
+                    let dr = Matrix3::from_fn(|r, c| lifted[self.at(j + 1, at + 3 * r + c)]);
+                    let xi = polar.map_or(Vector3::repeat(f64::NAN), |p| p.apply(&dr));
+                    for (c, x) in xi.iter().enumerate() {
+                        put(dir + c, j, *x);
+                    }
+                }
+            } else {
+                let pos = if ambient { at } else { dir };
+                for i in 0..b.tangent_len() {
+                    for j in 0..k {
+                        put(dir + i, j, lifted[self.at(j + 1, pos + i)]);
+                    }
+                }
             }
-            for m in 0..np {
-                pjac[i * np + m] = lifted[self.at(e + 1 + m, i)];
-            }
+            at += b.len();
+            dir += b.tangent_len();
         }
     }
 }

@@ -312,6 +312,52 @@ pub fn project(m: &Matrix3<f64>) -> Result<Matrix3<f64>> {
     Ok(u * d * vt)
 }
 
+/// The rotation factor U of the polar decomposition R = UH of a matrix near SO(3) (U = [`project`]
+/// of R, H = UᵀR symmetric) and its derivative: δU = Uω̂ with (tr H·I − H)ω = (UᵀδR − δRᵀU)^∨.
+/// (From UᵀδR = ω̂H + δH, δH symmetric: UᵀδR − δRᵀU = ω̂H + Hω̂ = ((tr H·I − H)ω)^; tr H·I − H
+/// has the eigenvalues σ_i + σ_j of pairs of singular values, so it is invertible for rank ≥ 2.)
+/// What a Runge–Kutta lift's Jacobian reads an attitude's direction by, since the method leaves
+/// SO(3) ([`crate::integrate::tangent`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PolarTangent {
+    u: Matrix3<f64>,
+    /// (tr H·I − H)⁻¹.
+    inv: Matrix3<f64>,
+}
+
+impl PolarTangent {
+    /// The polar factors of `r`; errors as [`project`], and [`Error::NotInGroup`] where
+    /// tr H·I − H is singular (rank R < 2).
+    pub fn new(r: &Matrix3<f64>) -> Result<Self> {
+        let u = project(r)?;
+        let x = u.transpose() * r;
+        let h = (x + x.transpose()) * 0.5;
+        let a = Matrix3::identity() * h.trace() - h;
+        let Some(inv) = a.try_inverse().filter(|m| m.iter().all(|v| v.is_finite())) else {
+            return Err(Error::NotInGroup {
+                what: "R".into(),
+                group: "GL(3) of rank ≥ 2 (a polar factor with a derivative)".into(),
+                defect_name: "det(tr H·I − H)".into(),
+                defect: a.determinant(),
+                tol: 0.0,
+            });
+        };
+        Ok(PolarTangent { u, inv })
+    }
+
+    /// The rotation factor U.
+    pub fn rotation(&self) -> &Matrix3<f64> {
+        &self.u
+    }
+
+    /// ω of δU = Uω̂ for the variation δR of R.
+    pub fn apply(&self, dr: &Matrix3<f64>) -> Vector3<f64> {
+        let s = self.u.transpose() * dr;
+        let skew = s - s.transpose();
+        self.inv * Vector3::new(skew[(2, 1)], skew[(0, 2)], skew[(1, 0)])
+    }
+}
+
 /// Cayley map cay(w) = (I − ŵ/2)⁻¹ (I + ŵ/2) = I + 4/(4 + |w|²) (ŵ + ŵ²/2).
 ///
 /// Scaling: the ½ makes cay agree with exp to second order (cay(w) = exp(ŵ) + O(|w|³)); cay(w)
@@ -844,6 +890,34 @@ mod tests {
                 rot.inverse().apply(&mut y);
                 assert!((y - v).norm() < 1e-15 * v.norm(), "{w:?}");
             }
+        }
+    }
+
+    /// The identity ω̂H + Hω̂ = ((tr H·I − H)ω)^ for symmetric H, and δU = Uω̂ of
+    /// [`PolarTangent`] against central differences of the polar factor (ω from
+    /// log(U₋ᵀU₊)/2h), near SO(3) (a Runge–Kutta attitude) and far from it.
+    #[test]
+    fn polar_tangent_is_the_polar_factors_derivative() {
+        let h = Matrix3::new(1.3, 0.2, -0.1, 0.2, 0.7, 0.4, -0.1, 0.4, 1.1);
+        let w = Vector3::new(0.3, -0.8, 0.5);
+        let lhs = hat(&w) * h + h * hat(&w);
+        let rhs = hat(&((Matrix3::identity() * h.trace() - h) * w));
+        assert!(
+            (lhs - rhs).norm() < 1e-15,
+            "identity: {:e}",
+            (lhs - rhs).norm()
+        );
+        let dr = Matrix3::new(0.3, -0.5, 0.2, 0.7, 0.1, -0.4, -0.2, 0.6, 0.9);
+        let q = exp_unchecked(&Vector3::new(0.4, -0.7, 0.3));
+        let near = Matrix3::new(1e-6, 3e-7, 0.0, 3e-7, -2e-6, 1e-6, 0.0, 1e-6, 5e-7);
+        for r in [q * (Matrix3::identity() + near), q * h] {
+            let p = PolarTangent::new(&r).unwrap();
+            let step = 1e-6;
+            let u = |s: f64| project(&(r + dr * s)).unwrap();
+            let fd = log_unchecked(&(u(-step).transpose() * u(step))) / (2.0 * step);
+            let err = (p.apply(&dr) - fd).norm() / fd.norm();
+            assert!(err < 1e-9, "{err:e}");
+            assert!((p.rotation() - u(0.0)).norm() < 1e-15);
         }
     }
 }

@@ -231,6 +231,14 @@ impl Catalog for HeavyTop {
     fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
         Some(crate::integrate::tangent::Tangent::split(self.clone()).into_system())
     }
+
+    /// With the attitude, `rk4` on the field lift (ambient directions).
+    fn tangent_for(
+        &self,
+        method: &str,
+    ) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        crate::integrate::tangent::Tangent::routed(self, method, || self.tangent())
+    }
 }
 
 impl Integrator<HeavyTop> for ExactSplitting {

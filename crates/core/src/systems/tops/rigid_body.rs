@@ -368,9 +368,17 @@ impl Catalog for RigidBody {
         Some(self.with_attitude())
     }
 
-    /// The tangent lift of every method (`rk4` without the attitude only); with the attitude
+    /// The tangent lift of every method (with the attitude `rk4` through [`Catalog::tangent_for`]); with the attitude
     /// its directions are left-trivialised (δR = Rξ̂).
     fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
         Some(crate::integrate::tangent::Tangent::split(self.clone()).into_system())
+    }
+
+    /// With the attitude, `rk4` on the field lift (ambient directions).
+    fn tangent_for(
+        &self,
+        method: &str,
+    ) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        crate::integrate::tangent::Tangent::routed(self, method, || self.tangent())
     }
 }

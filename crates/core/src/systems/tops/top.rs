@@ -477,14 +477,14 @@ impl Top {
         }
     }
 
-    /// out += ∂f/∂θ (z) (without the attitude): a moment through Ω_k = M_k/I_k (∂Ṁ = M × ∂Ω,
-    /// ∂Γ̇ = Γ × ∂Ω), the gravity vector through Ṁ ∋ Γ × c.
+    /// out += ∂f/∂θ (z): a moment through Ω_k = M_k/I_k (∂Ṁ = M × ∂Ω, ∂Γ̇ = Γ × ∂Ω,
+    /// ∂Ṙ = R(∂Ω)^), the gravity vector through Ṁ ∋ Γ × c.
     pub(crate) fn field_parameter(&self, y: &[f64], p: TopParam, out: &mut [f64]) {
         let m = Vector3::from_column_slice(&y[..3]);
         let g = self.c.map(|_| Vector3::from_column_slice(&y[3..6]));
+        let mut dw = Vector3::zeros();
         let (dm, dg) = match p {
             TopParam::Moment(k) => {
-                let mut dw = Vector3::zeros();
                 dw[k] = -m[k] / (self.moments[k] * self.moments[k]);
                 (m.cross(&dw), g.map(|g| g.cross(&dw)))
             }
@@ -495,6 +495,14 @@ impl Top {
             if let Some(dg) = dg {
                 out[3 + c] += dg[c];
             }
+        }
+        if let Some(r) = self.attitude(y) {
+            let at = self.r_at();
+            let dr = row_major(&(r * crate::lie::so3::hat(&dw)));
+            out[at..at + 9]
+                .iter_mut()
+                .zip(dr)
+                .for_each(|(o, x)| *o += x);
         }
     }
 
@@ -580,8 +588,9 @@ impl Top {
         }
     }
 
-    /// The derivative of [`Top::field`] along dy (without the attitude): δṀ = δM × Ω + M × δΩ
-    /// (+ δΓ × c), δΓ̇ = δΓ × Ω + Γ × δΩ, δΩ = I⁻¹δM (principal frame).
+    /// The derivative of [`Top::field`] along dy (ambient: the attitude's δR a 3×3 matrix):
+    /// δṀ = δM × Ω + M × δΩ (+ δΓ × c), δΓ̇ = δΓ × Ω + Γ × δΩ, δṘ = δR Ω̂ + R(δΩ)^,
+    /// δΩ = I⁻¹δM (principal frame).
     pub(crate) fn field_tangent(&self, y: &[f64], dy: &[f64], out: &mut [f64]) {
         let m = Vector3::from_column_slice(&y[..3]);
         let dm = Vector3::from_column_slice(&dy[..3]);
@@ -595,6 +604,12 @@ impl Top {
             out[3..6].copy_from_slice((dg.cross(&w) + g.cross(&dw)).as_slice());
         }
         out[..3].copy_from_slice(ddm.as_slice());
+        if let Some(r) = self.attitude(y) {
+            let at = self.r_at();
+            let dr = Matrix3::from_row_slice(&dy[at..at + 9]);
+            let hat = crate::lie::so3::hat;
+            out[at..at + 9].copy_from_slice(&row_major(&(dr * hat(&w) + r * hat(&dw))));
+        }
     }
 }
 
@@ -1022,24 +1037,28 @@ macro_rules! top_kinds {
                 $($(c.push($crate::integrate::Entry::new($both, $bmake));)*)?
                 c
             }
+
+            fn rk4() -> $crate::integrate::Entry<Self> {
+                $crate::integrate::Entry::new("rk4", || $crate::integrate::methods::Rk4)
+            }
         }
 
         /// The splittings, `lgvi`, and (without the attitude) `rk4` and the further methods on
-        /// the tangent lift.
+        /// the tangent lift; with the attitude, `rk4` alone on the field lift (its directions
+        /// ambient).
         impl $crate::integrate::Catalog for $crate::integrate::tangent::Tangent<$t> {
             fn kind_catalog() -> Vec<$crate::integrate::Entry<Self>> {
                 let mut c = Self::attitude_catalog();
-                c.push($crate::integrate::Entry::new("rk4", || {
-                    $crate::integrate::methods::Rk4
-                }));
+                c.push(Self::rk4());
                 $(c.push($crate::integrate::Entry::new($name, $make));)*
                 c
             }
 
             fn catalog(&self) -> Vec<$crate::integrate::Entry<Self>> {
-                match self.problem().top.lifted {
-                    true => Self::attitude_catalog(),
-                    false => Self::kind_catalog(),
+                match (self.ambient(), self.problem().top.lifted) {
+                    (true, _) => vec![Self::rk4()],
+                    (false, true) => Self::attitude_catalog(),
+                    (false, false) => Self::kind_catalog(),
                 }
             }
         }

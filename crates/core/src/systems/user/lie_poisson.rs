@@ -583,10 +583,9 @@ impl GroupField for LiePoisson {
     }
 }
 
-/// The derivative of the field (rk4 on the lift): ±(ad*_{D²H δμ} μ + ad*_{∇H} δμ), and with a
-/// matrix attitude δġ = δg ξ̂ + g δξ̂ (left) or ξ̂ δg + δξ̂ g (right), ξ = ∇H. (With the
-/// attitude on SO(3), whose directions are left-trivialised, the lift offers no Runge–Kutta
-/// method and this is not used.)
+/// The derivative of the field (rk4 on the lift): ±(ad*_{D²H δμ} μ + ad*_{∇H} δμ), and with an
+/// attitude δġ = δg ξ̂ + g δξ̂ (left) or ξ̂ δg + δξ̂ g (right), ξ = ∇H, in ambient coordinates
+/// (on SO(3) too: the field lift's directions).
 impl VectorFieldTangent for LiePoisson {
     fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
         let d = self.algebra.dim;
@@ -603,14 +602,10 @@ impl VectorFieldTangent for LiePoisson {
         self.kernel_gradient(&z[..d], grad);
         self.kernel_hessian(&z[..d], &dz[..d], dgrad);
         let (om, og) = out.split_at_mut(d);
-        match (self.lifted, self.group) {
-            (true, Some(Group::So3)) => og.fill(f64::NAN),
-            (true, Some(group)) => {
-                let k = group.dim();
-                let g = (&z[d..], &dz[d..]);
-                group.velocity_tangent(self.side, (&grad[..k], &dgrad[..k]), g, og);
-            }
-            _ => {}
+        if let (true, Some(group)) = (self.lifted, self.group) {
+            let k = group.dim();
+            let g = (&z[d..], &dz[d..]);
+            group.velocity_tangent(self.side, (&grad[..k], &dgrad[..k]), g, og);
         }
         if self.side == Side::Right {
             grad.iter_mut().for_each(|x| *x = -*x);
@@ -705,11 +700,19 @@ impl Catalog for LiePoisson {
         self.with_attitude()
     }
 
-    /// The tangent lift of every method ([`crate::integrate::tangent`]; rk4 not with the
-    /// attitude on SO(3)) where the derivatives are exact ([`LiePoisson::has_tangent`]).
+    /// The tangent lift of every method ([`crate::integrate::tangent`]; with the attitude on
+    /// SO(3) all but rk4) where the derivatives are exact ([`LiePoisson::has_tangent`]).
     fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
         self.has_tangent()
             .then(|| Tangent::group_field(self.clone()).into_system())
+    }
+
+    /// With the attitude on SO(3), rk4 on the field lift (ambient directions).
+    fn tangent_for(&self, method: &str) -> Option<Arc<dyn TangentSystem>> {
+        match self.has_tangent() {
+            true => Tangent::routed(self, method, || self.tangent()),
+            false => None,
+        }
     }
 
     fn dissipation(
@@ -728,26 +731,30 @@ impl Catalog for LiePoisson {
 }
 
 /// The Lie–Poisson methods on the tangent lift (each the derivative of its own step): rkmk4,
-/// midpoint, midpoint4 and rk4, rk4 only without an SO(3) attitude (a Runge–Kutta step is not
-/// differentiated in left-trivialised directions).
+/// midpoint, midpoint4 and rk4 (with an SO(3) attitude rk4 on the field lift:
+/// `lifted_catalog`).
 impl Catalog for Tangent<LiePoisson> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         group_field_catalog()
     }
 
     fn catalog(&self) -> Vec<Entry<Self>> {
-        lifted_catalog(self.problem())
+        lifted_catalog(self)
     }
 }
 
-/// [`group_field_catalog`] of a lift, without rk4 where `p` carries an SO(3) attitude.
-pub(crate) fn lifted_catalog<P>(p: &P) -> Vec<Entry<Tangent<P>>>
+/// [`group_field_catalog`] of a lift; where the state carries an SO(3) attitude, rk4 alone on
+/// the field lift (its directions ambient: a Runge–Kutta step is not differentiated in
+/// left-trivialised ones) and the others on the group-field lift.
+pub(crate) fn lifted_catalog<P>(lift: &Tangent<P>) -> Vec<Entry<Tangent<P>>>
 where
     P: GroupFieldTangent + VectorFieldTangent + Clone + 'static,
 {
     let mut c = group_field_catalog();
-    if p.space().dim() != p.space().tangent_dim() {
-        c.retain(|e| e.name != "rk4");
+    let space = lift.problem().space();
+    if space.dim() != space.tangent_dim() {
+        let ambient = lift.ambient();
+        c.retain(|e| (e.name == "rk4") == ambient);
     }
     c
 }

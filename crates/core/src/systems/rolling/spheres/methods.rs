@@ -70,11 +70,19 @@ impl Problem for RollingSpheres {
     }
     /// The chart's tangent map at z, δP = M δω + DM\[δz\]ω (`tangent.rs`).
     fn tangent_to_internal_at(&self, z: &[f64], dz: &mut [f64]) {
-        self.chart_tangent(z, dz)
+        self.chart_tangent(z, dz, false)
     }
     /// Its inverse at the internal state z.
     fn tangent_to_user_at(&self, z: &[f64], dz: &mut [f64]) {
-        self.chart_tangent_inverse(z, dz)
+        self.chart_tangent_inverse(z, dz, false)
+    }
+    /// The chart's tangent map on an ambient direction (δz_k a 3×3 matrix).
+    fn ambient_to_internal_at(&self, z: &[f64], dz: &mut [f64]) {
+        self.chart_tangent(z, dz, true)
+    }
+    /// The derivative of [`Problem::to_user`] at the internal state z (off SO(3) too), ambient.
+    fn ambient_to_user_at(&self, z: &[f64], dz: &mut [f64]) {
+        self.chart_tangent_inverse(z, dz, true)
     }
 }
 
@@ -187,8 +195,16 @@ impl Catalog for RollingSpheres {
         ]
     }
 
-    /// The lift of the Lie-group methods (`tangent`).
+    /// The lift of the Lie-group methods (`tangent.rs`).
     fn tangent(&self) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
         Some(self.lift())
+    }
+
+    /// `rk4` on the field lift (ambient directions), the others on [`Catalog::tangent`]'s.
+    fn tangent_for(
+        &self,
+        method: &str,
+    ) -> Option<std::sync::Arc<dyn crate::integrate::tangent::TangentSystem>> {
+        self.lift_for(method)
     }
 }

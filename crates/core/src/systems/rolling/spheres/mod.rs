@@ -124,7 +124,8 @@
 //!
 //! **Tangent lift** (issue 26): the Lie-group methods carry the exact derivative of their own
 //! map, in left-trivialised directions on the SO(3) blocks (the chart's, the generator's, the
-//! action's and dexp's derivatives: `tangent.rs`); not `rk4` (SO(3) blocks), no parameters.
+//! action's and dexp's derivatives: `tangent.rs`); `rk4` on the field lift, whose directions are
+//! ambient (the field's derivative off SO(3) and S² too); no parameters.
 //!
 //! [`LieMidpoint`]: crate::integrate::methods::LieMidpoint
 //! [`GroupField`]: crate::integrate::problem::GroupField

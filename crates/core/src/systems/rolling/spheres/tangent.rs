@@ -4,15 +4,18 @@
 //!
 //! **Directions** (internal frame): (η₁, η₂, δu, δP₁, δP₂) with δz_k = z_kη̂_k (left-trivialised,
 //! [`crate::integrate::space::Block::SO3`]) and δu ambient; in the user frame (η₁, η₂, δu, δΩ₁,
-//! δΩ₂). With ζ_k = z_kη_k (the same variation as a spatial vector, δz_k = ζ̂_kz_k), the
-//! configuration's quantities vary by δε_k = ζ_k × ε_k, δs₁ = α₁(δu − δε₁), δs₂ = α₂(δu + δε₂),
-//! δ(K_k^s a) = ζ_k × K_k^s a − K_k^s(ζ_k × a) (module docs of [`super`], "Momentum form").
+//! δΩ₂). The `rk4` lift's are ambient, (δz₁, δz₂, δu, δP₁, δP₂) with δz_k any 3×3 matrix. Every
+//! derivative below is that of the code's map of the flat values along δz_k (a left-trivialised
+//! direction being δz_k = z_kη̂_k): the configuration's quantities vary by δε_k = δz_ke_k,
+//! δs₁ = α₁(δu − δε₁), δs₂ = α₂(δu + δε₂), δK_k^s = δz_kK_kz_kᵀ + z_kK_kδz_kᵀ (module docs of
+//! [`super`], "Momentum form").
 //!
 //! **Chart** (P = Mω, P_k = K_k^sω_k + s_k × w, w = ω₁ × s₁ + ω₂ × s₂, 003 §2 re-derived):
 //! δP = M δω + DM\[δz\]ω with (DM\[δz\]ω)_k = δK_k^s ω_k + δs_k × w + s_k × (ω₁ × δs₁ + ω₂ × δs₂),
-//! and δω_k = ζ_k × ω_k + z_kδΩ_k (ω_k = z_kΩ_k); back, δω = M⁻¹(δP − DM\[δz\]ω) and
-//! δΩ_k = z_kᵀ(δω_k − ζ_k × ω_k). The chart depends on the state, so the lift converts the
-//! directions at the base state ([`Problem::tangent_to_internal_at`]).
+//! and δω_k = δz_kΩ_k + z_kδΩ_k (ω_k = z_kΩ_k); back (Ω_k = z_kᵀω_k), δω = M⁻¹(δP − DM\[δz\]ω)
+//! and δΩ_k = δz_kᵀω_k + z_kᵀδω_k. The chart depends on the state, so the lift converts the
+//! directions at the base state ([`Problem::tangent_to_internal_at`],
+//! [`Problem::ambient_to_internal_at`]).
 //!
 //! **Generator** ξ = (ω₁, ω₂, b, ṡ₁ × w, ṡ₂ × w), b = α₁ω₁ + α₂ω₂, u̇ = b × u (10),
 //! ṡ₁ = α₁(u̇ − ω₁ × ε₁), ṡ₂ = α₂(u̇ + ω₂ × ε₂): its derivative by the product rule from δω
@@ -24,28 +27,30 @@
 //! δu' = exp(ξ̂_u)δu + w_u × u', δP' = δP + δξ_P; dexp_u w = J_l(u)w on each so(3) factor, its
 //! derivative [`so3::jacobian_left_derivative`].
 //!
-//! The field lift (RK4) is not offered: the state has SO(3) blocks, on which a Runge–Kutta
-//! step's derivative is one in ambient coordinates ([`crate::integrate::tangent`]). Nor are
-//! parameters: the chart P = M(θ)ω itself depends on the bodies' constants, which the lift's
+//! **Field** (`rk4`, ambient directions): δż_k = (δω_k)^z_k + ω̂_kδz_k, δu̇ as above, δṖ_k the
+//! rates' derivative, from the same δω and δṡ_k as the generator's.
+//!
+//! No parameters: the chart P = M(θ)ω itself depends on the bodies' constants, which the lift's
 //! state-to-state conversions do not carry.
 //!
 //! [`Problem::tangent_to_internal_at`]: crate::integrate::Problem::tangent_to_internal_at
+//! [`Problem::ambient_to_internal_at`]: crate::integrate::Problem::ambient_to_internal_at
 
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use super::{local, Kin, RollingSpheres};
-use crate::integrate::methods::{Composition, LieMidpoint, Rkmk4};
-use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem};
+use super::{local, put_rows, Kin, RollingSpheres};
+use crate::integrate::methods::{Composition, LieMidpoint, Rk4, Rkmk4};
+use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry};
 use crate::lie::so3;
 
-/// A configuration (z₁, z₂, u) and a direction of it as spatial vectors (ζ₁, ζ₂, δu).
+/// A configuration (z₁, z₂, u) and a variation of it (δz₁, δz₂, δu).
 struct Config {
     z: [Matrix3<f64>; 2],
     u: Vector3<f64>,
-    zeta: [Vector3<f64>; 2],
+    dz: [Matrix3<f64>; 2],
     du: Vector3<f64>,
 }
 
@@ -54,39 +59,65 @@ fn v3(s: &[f64]) -> Vector3<f64> {
 }
 
 impl Config {
-    /// From a flat state (27 values) and a direction (15 values, η_k body-side).
-    fn new(z: &[f64], dz: &[f64]) -> Config {
+    /// From a flat state (27 values) and a direction, left-trivialised (15 values,
+    /// δz_k = z_kη̂_k) or `ambient` (27), with the offset of the direction's velocity (user
+    /// frame) or momentum (internal) part.
+    fn new(z: &[f64], dz: &[f64], ambient: bool) -> (Config, usize) {
         let l = local(z);
-        Config {
-            zeta: [l.z[0] * v3(&dz[0..3]), l.z[1] * v3(&dz[3..6])],
+        let (dz, du, rest) = match ambient {
+            true => (
+                [
+                    Matrix3::from_row_slice(&dz[0..9]),
+                    Matrix3::from_row_slice(&dz[9..18]),
+                ],
+                v3(&dz[18..21]),
+                21,
+            ),
+            false => (
+                [
+                    l.z[0] * so3::hat(&v3(&dz[0..3])),
+                    l.z[1] * so3::hat(&v3(&dz[3..6])),
+                ],
+                v3(&dz[6..9]),
+                9,
+            ),
+        };
+        let c = Config {
             z: l.z,
             u: l.u,
-            du: v3(&dz[6..9]),
-        }
+            dz,
+            du,
+        };
+        (c, rest)
     }
 }
 
 /// The variations of the lever arms and of the rolling direction's quantities.
 struct DKin {
-    /// δε_k = ζ_k × ε_k.
+    /// δε_k = δz_ke_k.
     eps: [Vector3<f64>; 2],
     /// δs₁ = α₁(δu − δε₁), δs₂ = α₂(δu + δε₂).
     s: [Vector3<f64>; 2],
 }
 
+/// The derivative of the field's parts (ξ of the group field, the flat field's rates) along a
+/// variation: ω and δω, δb (b = α₁ω₁ + α₂ω₂), δu̇ and the momentum rates' δ(ṡ_k × w).
+struct RatesTangent {
+    w: [Vector3<f64>; 2],
+    dw: [Vector3<f64>; 2],
+    db: Vector3<f64>,
+    dudot: Vector3<f64>,
+    drates: [Vector3<f64>; 2],
+}
+
 impl RollingSpheres {
-    fn dkin(&self, c: &Config, k: &Kin) -> DKin {
-        let eps = [c.zeta[0].cross(&k.eps[0]), c.zeta[1].cross(&k.eps[1])];
+    fn dkin(&self, c: &Config) -> DKin {
+        let eps = [c.dz[0] * self.e[0], c.dz[1] * self.e[1]];
         let s = [
             (c.du - eps[0]) * self.alpha[0],
             (c.du + eps[1]) * self.alpha[1],
         ];
         DKin { eps, s }
-    }
-
-    /// K_k^s = z_kK_kz_kᵀ.
-    fn spatial_inertia(&self, z: &[Matrix3<f64>; 2], i: usize) -> Matrix3<f64> {
-        z[i] * self.k[i] * z[i].transpose()
     }
 
     /// DM\[δz\]ω at fixed ω (module docs).
@@ -95,9 +126,9 @@ impl RollingSpheres {
         let dw = w[0].cross(&dk.s[0]) + w[1].cross(&dk.s[1]);
         let mut out = Vector6::zeros();
         for (i, wi) in w.iter().enumerate() {
-            let ks = self.spatial_inertia(&c.z, i);
-            let dks = c.zeta[i].cross(&(ks * wi)) - ks * c.zeta[i].cross(wi);
-            let d = dks + dk.s[i].cross(&ww) + k.s[i].cross(&dw);
+            let kz = self.k[i] * c.z[i].transpose();
+            let dks = c.dz[i] * kz + kz.transpose() * c.dz[i].transpose();
+            let d = dks * wi + dk.s[i].cross(&ww) + k.s[i].cross(&dw);
             out.fixed_rows_mut::<3>(3 * i).copy_from(&d);
         }
         out
@@ -112,65 +143,25 @@ impl RollingSpheres {
 
     /// δω = M⁻¹(δP − DM\[δz\]ω) at an internal state with ω = M⁻¹P (NaN where M is not positive
     /// definite, as the generator).
-    fn omega_tangent(
-        &self,
-        c: &Config,
-        w: &[Vector3<f64>; 2],
-        dp: &[f64],
-    ) -> (Kin, [Vector3<f64>; 2]) {
+    fn omega_tangent(&self, c: &Config, w: &[Vector3<f64>; 2], dp: &[f64]) -> [Vector3<f64>; 2] {
         let (k, m) = self.config_mass(c);
-        let dk = self.dkin(c, &k);
+        let dk = self.dkin(c);
         let rhs = Vector6::from_column_slice(dp) - self.dm_omega(c, &k, &dk, w);
         let x = match m.cholesky() {
             Some(ch) => ch.solve(&rhs),
             None => Vector6::repeat(f64::NAN),
         };
-        (
-            k,
-            [x.fixed_rows::<3>(0).into(), x.fixed_rows::<3>(3).into()],
-        )
-    }
-}
-
-impl RollingSpheres {
-    /// The chart's tangent map at the user state z: (η, δu, δΩ) ↦ (η, δu, δP) (module docs).
-    pub(super) fn chart_tangent(&self, z: &[f64], dz: &mut [f64]) {
-        let l = local(z);
-        let c = Config::new(z, dz);
-        let w = [l.z[0] * l.omega[0], l.z[1] * l.omega[1]];
-        let (k, m) = self.config_mass(&c);
-        let dk = self.dkin(&c, &k);
-        let mut dw = Vector6::zeros();
-        for i in 0..2 {
-            let d = c.zeta[i].cross(&w[i]) + l.z[i] * v3(&dz[9 + 3 * i..]);
-            dw.fixed_rows_mut::<3>(3 * i).copy_from(&d);
-        }
-        let dp = m * dw + self.dm_omega(&c, &k, &dk, &w);
-        dz[9..15].copy_from_slice(dp.as_slice());
+        [x.fixed_rows::<3>(0).into(), x.fixed_rows::<3>(3).into()]
     }
 
-    /// The inverse of [`RollingSpheres::chart_tangent`] at the internal state z.
-    pub(super) fn chart_tangent_inverse(&self, z: &[f64], dz: &mut [f64]) {
+    /// The derivative of the field's parts at the internal state z along the variation c and
+    /// the momenta's δP (module docs, "Generator").
+    fn rates_tangent(&self, z: &[f64], c: &Config, dp: &[f64]) -> RatesTangent {
         let l = local(z);
-        let c = Config::new(z, dz);
         let w = self.omegas_from_momenta(&l.z, &l.u, &z[21..27]);
-        let (_, dw) = self.omega_tangent(&c, &w, &dz[9..15]);
-        for i in 0..2 {
-            let d = l.z[i].transpose() * (dw[i] - c.zeta[i].cross(&w[i]));
-            dz[9 + 3 * i..12 + 3 * i].copy_from_slice(d.as_slice());
-        }
-    }
-}
-
-/// The derivatives of the generator, the action and dexp (module docs), internal frame.
-impl GroupFieldTangent for RollingSpheres {
-    fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], _s: &mut ()) {
-        let l = local(z);
-        let c = Config::new(z, dz);
-        let w = self.omegas_from_momenta(&l.z, &l.u, &z[21..27]);
-        let (_, dw) = self.omega_tangent(&c, &w, &dz[9..15]);
+        let dw = self.omega_tangent(c, &w, dp);
         let k = self.kin_spatial(&l.z, &l.u, w);
-        let dk = self.dkin(&c, &k);
+        let dk = self.dkin(c);
         let [a1, a2] = self.alpha;
         let b = w[0] * a1 + w[1] * a2;
         let db = dw[0] * a1 + dw[1] * a2;
@@ -185,13 +176,75 @@ impl GroupFieldTangent for RollingSpheres {
             + w[0].cross(&dk.s[0])
             + dw[1].cross(&k.s[1])
             + w[1].cross(&dk.s[1]);
-        dxi[0..3].copy_from_slice(dw[0].as_slice());
-        dxi[3..6].copy_from_slice(dw[1].as_slice());
-        dxi[6..9].copy_from_slice(db.as_slice());
-        for i in 0..2 {
-            let d = dsd[i].cross(&ww) + sd[i].cross(&dww);
-            dxi[9 + 3 * i..12 + 3 * i].copy_from_slice(d.as_slice());
+        let drates = [0, 1].map(|i| dsd[i].cross(&ww) + sd[i].cross(&dww));
+        RatesTangent {
+            w,
+            dw,
+            db,
+            dudot,
+            drates,
         }
+    }
+}
+
+impl RollingSpheres {
+    /// The chart's tangent map at the user state z: (·, δΩ) ↦ (·, δP) for a left-trivialised
+    /// or `ambient` direction (module docs).
+    pub(super) fn chart_tangent(&self, z: &[f64], dz: &mut [f64], ambient: bool) {
+        let l = local(z);
+        let (c, at) = Config::new(z, dz, ambient);
+        let w = [l.z[0] * l.omega[0], l.z[1] * l.omega[1]];
+        let (k, m) = self.config_mass(&c);
+        let dk = self.dkin(&c);
+        let mut dw = Vector6::zeros();
+        for i in 0..2 {
+            let d = c.dz[i] * l.omega[i] + l.z[i] * v3(&dz[at + 3 * i..]);
+            dw.fixed_rows_mut::<3>(3 * i).copy_from(&d);
+        }
+        let dp = m * dw + self.dm_omega(&c, &k, &dk, &w);
+        dz[at..at + 6].copy_from_slice(dp.as_slice());
+    }
+
+    /// The derivative of the chart's inverse at the internal state z (off SO(3) too):
+    /// (·, δP) ↦ (·, δΩ), the inverse of [`RollingSpheres::chart_tangent`] on SO(3).
+    pub(super) fn chart_tangent_inverse(&self, z: &[f64], dz: &mut [f64], ambient: bool) {
+        let l = local(z);
+        let (c, at) = Config::new(z, dz, ambient);
+        let w = self.omegas_from_momenta(&l.z, &l.u, &z[21..27]);
+        let dw = self.omega_tangent(&c, &w, &dz[at..at + 6]);
+        for i in 0..2 {
+            let d = c.dz[i].transpose() * w[i] + l.z[i].transpose() * dw[i];
+            dz[at + 3 * i..at + 3 * i + 3].copy_from_slice(d.as_slice());
+        }
+    }
+}
+
+/// The derivative of the flat field of `rk4` along an ambient direction (module docs, "Field"),
+/// internal frame.
+impl VectorFieldTangent for RollingSpheres {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        let (c, at) = Config::new(z, dz, true);
+        let t = self.rates_tangent(z, &c, &dz[at..at + 6]);
+        for i in 0..2 {
+            let d = so3::hat(&t.dw[i]) * c.z[i] + so3::hat(&t.w[i]) * c.dz[i];
+            put_rows(&d, &mut out[9 * i..9 * i + 9]);
+        }
+        out[18..21].copy_from_slice(t.dudot.as_slice());
+        out[21..24].copy_from_slice(t.drates[0].as_slice());
+        out[24..27].copy_from_slice(t.drates[1].as_slice());
+    }
+}
+
+/// The derivatives of the generator, the action and dexp (module docs), internal frame.
+impl GroupFieldTangent for RollingSpheres {
+    fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], _s: &mut ()) {
+        let (c, at) = Config::new(z, dz, false);
+        let t = self.rates_tangent(z, &c, &dz[at..at + 6]);
+        dxi[0..3].copy_from_slice(t.dw[0].as_slice());
+        dxi[3..6].copy_from_slice(t.dw[1].as_slice());
+        dxi[6..9].copy_from_slice(t.db.as_slice());
+        dxi[9..12].copy_from_slice(t.drates[0].as_slice());
+        dxi[12..15].copy_from_slice(t.drates[1].as_slice());
     }
 
     fn act_tangent(&self, u: &[f64], du: &[f64], y: &[f64], dz: &mut [f64], _s: &mut ()) {
@@ -222,7 +275,8 @@ impl GroupFieldTangent for RollingSpheres {
     }
 }
 
-/// `midpoint`, `midpoint4`, `rkmk4` on the lift (not `rk4`: module docs).
+/// `midpoint`, `midpoint4`, `rkmk4` on the group-field lift, `rk4` on the field lift (ambient
+/// directions).
 impl Catalog for Tangent<RollingSpheres> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         vec![
@@ -231,12 +285,24 @@ impl Catalog for Tangent<RollingSpheres> {
             Entry::new("rkmk4", || Rkmk4),
         ]
     }
+
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        match self.ambient() {
+            true => vec![Entry::new("rk4", || Rk4)],
+            false => Self::kind_catalog(),
+        }
+    }
 }
 
 impl RollingSpheres {
     /// The tangent lift as a trait object (`Catalog::tangent`).
     pub(super) fn lift(&self) -> Arc<dyn TangentSystem> {
         Tangent::group_field(self.clone()).into_system()
+    }
+
+    /// The lift for runs of `method` (`Catalog::tangent_for`).
+    pub(super) fn lift_for(&self, method: &str) -> Option<Arc<dyn TangentSystem>> {
+        Tangent::routed(self, method, || Some(self.lift()))
     }
 }
 
@@ -330,13 +396,13 @@ mod tests {
         };
         let fd = read(&chart(h), &chart(-h), h);
         let mut d = dz.clone();
-        s.chart_tangent(&z, &mut d);
+        s.chart_tangent(&z, &mut d, false);
         let err = worst(&d, &fd);
         eprintln!("chart tangent vs differences {err:.1e}");
         assert!(err < 1e-9, "chart: {err:e}");
         let mut zi = z.clone();
         s.to_internal(&mut zi);
-        s.chart_tangent_inverse(&zi, &mut d);
+        s.chart_tangent_inverse(&zi, &mut d, false);
         let err = worst(&d, &dz);
         assert!(err < 1e-14, "round trip: {err:e}");
     }
@@ -412,5 +478,60 @@ mod tests {
         let err = worst(&d, &fd);
         eprintln!("dexp tangent vs differences {err:.1e}");
         assert!(err < 1e-9, "dexp: {err:e}");
+    }
+
+    /// Along an ambient direction (δz_k any 3×3 matrix) at a state off SO(3) and S² (where a
+    /// Runge–Kutta stage evaluates them): the flat field's derivative and the chart's (both
+    /// ways) against central differences of the field, `to_internal` and `to_user`.
+    #[test]
+    fn ambient_field_and_chart_tangents_are_their_derivatives() {
+        let s = spheres();
+        let (z, _) = state();
+        let off = |v: &[f64]| -> Vec<f64> {
+            v.iter()
+                .enumerate()
+                .map(|(k, x)| x + 1e-3 * (0.9 * k as f64).sin())
+                .collect()
+        };
+        let dz: Vec<f64> = (0..27).map(|k| 0.5 * (1.7 * k as f64).cos()).collect();
+        let moved =
+            |v: &[f64], t: f64| -> Vec<f64> { v.iter().zip(&dz).map(|(a, b)| a + t * b).collect() };
+        let h = 1e-6;
+        let quotient = |f: &dyn Fn(&[f64]) -> Vec<f64>, v: &[f64]| -> Vec<f64> {
+            let (p, q) = (f(&moved(v, h)), f(&moved(v, -h)));
+            p.iter().zip(&q).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+        };
+        let user = off(&z);
+        let mut internal = z.clone();
+        s.to_internal(&mut internal);
+        let internal = off(&internal);
+        let field = |v: &[f64]| {
+            let mut f = vec![0.0; 27];
+            s.field(v, &mut f);
+            f
+        };
+        let mut d = vec![0.0; 27];
+        s.field_tangent(&internal, &dz, &mut d);
+        let err = worst(&d, &quotient(&field, &internal));
+        eprintln!("ambient field tangent vs differences {err:.1e}");
+        assert!(err < 1e-9, "field: {err:e}");
+        for (inverse, at) in [(false, &user), (true, &internal)] {
+            let chart = |v: &[f64]| {
+                let mut w = v.to_vec();
+                match inverse {
+                    false => s.to_internal(&mut w),
+                    true => s.to_user(&mut w),
+                }
+                w
+            };
+            let mut d = dz.clone();
+            match inverse {
+                false => s.ambient_to_internal_at(at, &mut d),
+                true => s.ambient_to_user_at(at, &mut d),
+            }
+            let err = worst(&d, &quotient(&chart, at));
+            eprintln!("ambient chart tangent (inverse: {inverse}) vs differences {err:.1e}");
+            assert!(err < 1e-9, "chart (inverse: {inverse}): {err:e}");
+        }
     }
 }

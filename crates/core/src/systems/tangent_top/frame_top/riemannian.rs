@@ -53,8 +53,9 @@
 //! see ≈ 4e-6 of the geometry's round-off, since ∂C is itself a difference). The action's
 //! derivative: translations add δξ; R' = Q R S(τ) varies by η' = R'ᵀw + Sᵀη + η_S
 //! (w = J_l(ω)δω) and Π' = SᵀΠ by the free body's exact tangent map (`frame_top/tangent.rs`). The
-//! midpoint rules, their compositions and `rkmk4` are lifted; `rk4` is not (an SO(3) block),
-//! nor are parameters.
+//! midpoint rules, their compositions and `rkmk4` are lifted so; `rk4` on the field lift, whose
+//! directions (δx, δp, δR, δΠ) are ambient (δR a 3×3 matrix: the field's derivative off SO(3)
+//! too, from the same derivative of Wong's equations). No parameters.
 
 use std::sync::Arc;
 
@@ -67,7 +68,7 @@ use crate::error::Result;
 use crate::integrate::methods::{Composition, LieMidpoint, Rk4, Rkmk4};
 use crate::integrate::problem::{GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
-use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem};
+use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::so3;
 use crate::numerics::fd::diff4;
@@ -370,6 +371,11 @@ impl Catalog for RiemannianFrameTop {
     fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
         Some(Tangent::group_field(self.clone()).into_system())
     }
+
+    /// `rk4` on the field lift (ambient directions), the others on [`Catalog::tangent`]'s.
+    fn tangent_for(&self, method: &str) -> Option<Arc<dyn TangentSystem>> {
+        Tangent::routed(self, method, || self.tangent())
+    }
 }
 
 fn lie_methods<P: GroupField + Clone + 'static>() -> Vec<Entry<P>> {
@@ -381,10 +387,17 @@ fn lie_methods<P: GroupField + Clone + 'static>() -> Vec<Entry<P>> {
     ]
 }
 
-/// The Lie-group methods on the lift (not `rk4`: the state has an SO(3) block).
+/// The Lie-group methods on the group-field lift, `rk4` on the field lift (ambient directions).
 impl Catalog for Tangent<RiemannianFrameTop> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         lie_methods()
+    }
+
+    fn catalog(&self) -> Vec<Entry<Self>> {
+        match self.ambient() {
+            true => vec![Entry::new("rk4", || Rk4)],
+            false => lie_methods(),
+        }
     }
 }
 
@@ -454,20 +467,30 @@ fn v3(s: &[f64]) -> Vector3<f64> {
     Vector3::from_column_slice(&s[..3])
 }
 
-/// The tangent lift (module docs, "Tangent lift"): directions (δx, δp, η, δΠ), δR = Rη̂.
-impl GroupFieldTangent for RiemannianFrameTop {
-    /// With σ = RΠ, δσ = R(η × Π + δΠ), and along δx the geometry's derivatives (δg = Σδx_j∂_jg,
-    /// δC, δ∂_kg, δ∂_kC): m g δu = δp − δCᵀσ − Cᵀδσ − m δg u,
+/// The derivative of Wong's equations at a state along (δx, δp, δσ): Cu there (u the
+/// velocity), δu, δṗ and δ(Cu).
+struct WongTangent {
+    cu: Vector3<f64>,
+    du: Vector3<f64>,
+    dpdot: Vector3<f64>,
+    dcu: Vector3<f64>,
+}
+
+impl RiemannianFrameTop {
+    /// With σ = RΠ and along δx the geometry's derivatives (δg = Σδx_j∂_jg, δC, δ∂_kg, δ∂_kC):
+    /// m g δu = δp − δCᵀσ − Cᵀδσ − m δg u,
     /// δṗ_k = m uᵀ∂_kg δu + ½m uᵀδ(∂_kg)u + δσᵀ∂_kC u + σᵀδ(∂_kC)u + σᵀ∂_kC δu,
-    /// δ(−Cu) = −δC u − C δu, and 0 for the free body's time.
-    fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], s: &mut FrameScratch) {
-        let st = parts(z);
-        let (dx, dp, eta, dpi) = (v3(&dz[0..]), v3(&dz[3..]), v3(&dz[6..]), v3(&dz[9..]));
+    /// δ(Cu) = δC u + C δu.
+    fn wong_tangent(
+        &self,
+        st: &Parts,
+        (dx, dp, dsigma): (Vector3<f64>, Vector3<f64>, Vector3<f64>),
+        s: &mut FrameScratch,
+    ) -> WongTangent {
         let (geo, sec) = self.second(st.x, s);
         let m = self.body.mass;
-        let u = self.velocity_at(geo, &st);
+        let u = self.velocity_at(geo, st);
         let sigma = st.r * st.pi;
-        let dsigma = st.r * (eta.cross(&st.pi) + dpi);
         let along = |a: &[Matrix3<f64>; 3]| a[0] * dx[0] + a[1] * dx[1] + a[2] * dx[2];
         let (dg, dc) = (along(&geo.dg), along(&geo.dc));
         let du =
@@ -482,9 +505,60 @@ impl GroupFieldTangent for RiemannianFrameTop {
                 + sigma.dot(&(ddc * u))
                 + sigma.dot(&(geo.dc[k] * du));
         }
-        dxi[..3].copy_from_slice(du.as_slice());
-        dxi[3..6].copy_from_slice(dpdot.as_slice());
-        dxi[6..9].copy_from_slice((-(dc * u + geo.c * du)).as_slice());
+        WongTangent {
+            cu: geo.c * u,
+            du,
+            dpdot,
+            dcu: dc * u + geo.c * du,
+        }
+    }
+
+    /// [`VectorFieldTangent::field_tangent`] with the geometry's derivatives cached in `s`.
+    fn field_tangent_with(&self, z: &[f64], dz: &[f64], out: &mut [f64], s: &mut FrameScratch) {
+        let st = parts(z);
+        let dr = Matrix3::from_row_slice(&dz[6..15]);
+        let dpi = v3(&dz[15..]);
+        let dsigma = dr * st.pi + st.r * dpi;
+        let t = self.wong_tangent(&st, (v3(dz), v3(&dz[3..]), dsigma), s);
+        let m = self.body.moments();
+        let omega = Vector3::from_fn(|k, _| st.pi[k] / m[k]);
+        let domega = Vector3::from_fn(|k, _| dpi[k] / m[k]);
+        let hat = so3::hat;
+        let drdot = dr * hat(&omega) + st.r * hat(&domega) - hat(&t.dcu) * st.r - hat(&t.cu) * dr;
+        let dpidot = dpi.cross(&omega) + st.pi.cross(&domega);
+        let dx = [t.du[0], t.du[1], t.du[2]];
+        write(&dx, &t.dpdot, &drdot, &dpidot, out);
+    }
+}
+
+/// The derivative of the `rk4` field along an ambient direction (δx, δp, δR, δΠ), δR a 3×3
+/// matrix: Wong's with δσ = δRΠ + RδΠ, δṘ = δRω̂ + R(δω)^ − (δ(Cu))^R − (Cu)^δR,
+/// δΠ̇ = δΠ × ω + Π × δω.
+impl VectorFieldTangent for RiemannianFrameTop {
+    fn field_tangent(&self, z: &[f64], dz: &[f64], out: &mut [f64]) {
+        self.field_tangent_with(z, dz, out, &mut FrameScratch::default());
+    }
+
+    /// The geometry's second derivatives formed once for every direction.
+    fn field_tangents(&self, z: &[f64], dirs: &[f64], out: &mut [f64]) {
+        let mut s = FrameScratch::default();
+        for (dz, o) in dirs.chunks_exact(18).zip(out.chunks_exact_mut(18)) {
+            self.field_tangent_with(z, dz, o, &mut s);
+        }
+    }
+}
+
+/// The tangent lift (module docs, "Tangent lift"): directions (δx, δp, η, δΠ), δR = Rη̂.
+impl GroupFieldTangent for RiemannianFrameTop {
+    /// Wong's derivative (`wong_tangent`) with δσ = R(η × Π + δΠ);
+    /// δ(−Cu), and 0 for the free body's time.
+    fn generator_tangent(&self, z: &[f64], dz: &[f64], dxi: &mut [f64], s: &mut FrameScratch) {
+        let st = parts(z);
+        let dsigma = st.r * (v3(&dz[6..]).cross(&st.pi) + v3(&dz[9..]));
+        let t = self.wong_tangent(&st, (v3(dz), v3(&dz[3..]), dsigma), s);
+        dxi[..3].copy_from_slice(t.du.as_slice());
+        dxi[3..6].copy_from_slice(t.dpdot.as_slice());
+        dxi[6..9].copy_from_slice((-t.dcu).as_slice());
         dxi[9] = 0.0;
     }
 
@@ -686,5 +760,75 @@ mod tests {
         t.dexp_tangent(&xi, &dxi, &w, &mut d, &mut s);
         let err = worst(&d, &fd);
         assert!(err < 1e-9, "dexp: {err:e}");
+    }
+
+    /// The `rk4` field's derivative along ambient directions (δR any 3×3 matrix) at a state
+    /// with R off SO(3), against differences of the field: along (δp, δR, δΠ) central to 1e-9,
+    /// along δx fourth-order (the geometry's round-off, as for the generator); and all
+    /// directions at once as each alone, bit for bit.
+    #[test]
+    fn field_tangent_is_the_fields_derivative() {
+        let t = top();
+        let mut z = state(&t);
+        for (k, v) in z[6..15].iter_mut().enumerate() {
+            *v += 1e-3 * (0.7 * k as f64).sin();
+        }
+        let field = |v: &[f64]| {
+            let mut f = vec![0.0; 18];
+            t.field(v, &mut f);
+            f
+        };
+        let mut dirs = vec![];
+        for (dz, h, fourth, tol) in [
+            (
+                (0..18)
+                    .map(|k| {
+                        if k < 3 {
+                            0.0
+                        } else {
+                            0.4 * (1.3 * k as f64).cos()
+                        }
+                    })
+                    .collect::<Vec<f64>>(),
+                1e-6,
+                false,
+                1e-9,
+            ),
+            (
+                (0..18)
+                    .map(|k| if k < 3 { 0.5 - 0.3 * k as f64 } else { 0.0 })
+                    .collect(),
+                1e-3,
+                true,
+                1e-7,
+            ),
+        ] {
+            let at = |s_: f64| {
+                let v: Vec<f64> = z.iter().zip(&dz).map(|(a, b)| a + s_ * b).collect();
+                field(&v)
+            };
+            let fd: Vec<f64> = if fourth {
+                let (p1, m1, p2, m2) = (at(h), at(-h), at(2.0 * h), at(-2.0 * h));
+                (0..18)
+                    .map(|i| (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h))
+                    .collect()
+            } else {
+                let (p, q) = (at(h), at(-h));
+                p.iter().zip(&q).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+            };
+            let mut d = vec![0.0; 18];
+            t.field_tangent(&z, &dz, &mut d);
+            let err = worst(&d, &fd);
+            eprintln!("field tangent vs differences {err:.1e}");
+            assert!(err < tol, "{err:e}");
+            dirs.extend(dz);
+        }
+        let mut one = vec![0.0; 36];
+        for (dz, o) in dirs.chunks_exact(18).zip(one.chunks_exact_mut(18)) {
+            t.field_tangent(&z, dz, o);
+        }
+        let mut all = vec![0.0; 36];
+        t.field_tangents(&z, &dirs, &mut all);
+        assert_eq!(one, all);
     }
 }

@@ -785,14 +785,14 @@ impl GroupFieldTangent for EulerPoincare {
 }
 
 /// The Lie–Poisson methods on the tangent lift (not the variational ones, of another kind):
-/// rkmk4, midpoint, midpoint4, and rk4 without an SO(3) attitude.
+/// rkmk4, midpoint, midpoint4, and rk4 (with an SO(3) attitude on the field lift).
 impl Catalog for Tangent<EulerPoincare> {
     fn kind_catalog() -> Vec<Entry<Self>> {
         group_field_catalog()
     }
 
     fn catalog(&self) -> Vec<Entry<Self>> {
-        super::lie_poisson::lifted_catalog(self.problem())
+        super::lie_poisson::lifted_catalog(self)
     }
 }
 
@@ -822,6 +822,14 @@ impl Catalog for EulerPoincare {
     fn tangent(&self) -> Option<Arc<dyn TangentSystem>> {
         self.has_tangent()
             .then(|| Tangent::group_field(self.clone()).into_system())
+    }
+
+    /// With the attitude on SO(3), rk4 on the field lift (ambient directions).
+    fn tangent_for(&self, method: &str) -> Option<Arc<dyn TangentSystem>> {
+        match self.has_tangent() {
+            true => Tangent::routed(self, method, || self.tangent()),
+            false => None,
+        }
     }
 
     /// The Lie–Poisson form's double-bracket dissipation (left-invariant systems).
