@@ -312,7 +312,7 @@ impl SplitTangent for FreeKick {
         let ft = FreeTangent::of(&flow, &top.moments, tau);
         let e = top.xi_at() + if top.lifted { 3 } else { 0 };
         for dy in dirs.chunks_exact_mut(e) {
-            let (dm, sigma) = ft.apply(&flow, &Vector3::from_column_slice(&dy[..3]), None);
+            let (dm, sigma) = ft.apply(&Vector3::from_column_slice(&dy[..3]), None);
             self.free_direction(&ft.s, after, dm, sigma, false, dy);
         }
     }
@@ -336,7 +336,7 @@ impl SplitTangent for FreeKick {
             (_, top::TopParam::Moment(q)) => {
                 let flow = FreeFlow::new(&top.moments, &before.m);
                 let ft = FreeTangent::of(&flow, &top.moments, tau);
-                let (dm, sigma) = ft.apply(&flow, &Vector3::zeros(), Some(q));
+                let (dm, sigma) = ft.apply(&Vector3::zeros(), Some(q));
                 self.free_direction(&ft.s, after, dm, sigma, true, dz);
             }
             _ => {}

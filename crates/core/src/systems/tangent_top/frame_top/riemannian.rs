@@ -61,7 +61,6 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::tangent::FreeTangent;
 use super::{Body, SpaceTop};
 use crate::check;
 use crate::error::Result;
@@ -74,6 +73,7 @@ use crate::lie::so3;
 use crate::numerics::fd::diff4;
 use crate::systems::tangent_top::riemannian::{Geometry, Riemannian};
 use crate::systems::tops::methods::exact::relative_attitude;
+use crate::systems::tops::methods::exact::FreeTangent;
 
 /// The tangent Euler top on a Riemannian 3-manifold in a chart (module docs).
 #[derive(Clone, Debug)]
@@ -583,7 +583,7 @@ impl GroupFieldTangent for RiemannianFrameTop {
             dz[k] += du[k];
         }
         let w = jl * v3(&du[6..]);
-        let (dpi, eta_s) = free.apply(&v3(&dz[9..]), du[9]);
+        let (dpi, eta_s) = free.apply_timed(&v3(&dz[9..]), du[9]);
         let eta = out.r.transpose() * w + free.turn(&v3(&dz[6..])) + eta_s;
         dz[6..9].copy_from_slice(eta.as_slice());
         dz[9..12].copy_from_slice(dpi.as_slice());

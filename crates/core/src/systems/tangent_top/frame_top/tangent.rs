@@ -24,7 +24,7 @@
 //! is the plain run's bit for bit); no parameters (the free body's attitude along a moment of
 //! inertia needs ∫M_q² dt, an integral of the second kind not formed here).
 
-use nalgebra::{Matrix3, Matrix4, Vector3};
+use nalgebra::{Matrix4, Vector3};
 
 use super::{unflat, write, Exact, FrameTop, FrameWork};
 use crate::error::Result;
@@ -34,63 +34,7 @@ use crate::integrate::tangent::{SplitTangent, Tangent, VectorFieldTangent};
 use crate::integrate::{Catalog, Clock, Entry, Integrator, Properties, Stepper};
 use crate::lie::so3;
 use crate::systems::tangent_top::space_form::{expm1, expm1_tangent};
-use crate::systems::tops::methods::exact::{relative_attitude, FreeFlow, Relative};
-
-/// The tangent map of the free rigid body's exact flow (R, Π) ↦ (R S(τ), S(τ)ᵀΠ) from Π₀ over
-/// τ (principal frame), for the frame tops.
-///
-/// δΠ' = Dφ_τ δΠ₀ + δτ Π' × Ω' (Euler's equation for a change of τ). For the attitude, δS = Sη̂:
-/// Π' = SᵀΠ₀ identically gives Π' × η = δΠ' − SᵀδΠ₀ =: D, which fixes η across Π'; along Π',
-/// η̇ = η × Ω + δΩ gives d(η·M)/dt = δΩ·M = Ω·δM, the derivative of the energy, constant along
-/// the flow: η·Π' = τ Ω₀·δΠ₀ + δτ Ω'·Π'. So
-/// η = ((τ Ω₀·δΠ₀ + δτ Ω'·Π') Π' + D × Π')/|Π'|², and η = τ𝕀⁻¹δΠ₀ at Π₀ = 0 (the flow at rest).
-/// Near Π₀ = 0 the first formula loses digits like ε/|Π₀| (D cancels).
-pub(super) struct FreeTangent {
-    rel: Relative,
-    jac: Matrix3<f64>,
-    tau: f64,
-    inv: Vector3<f64>,
-    omega0: Vector3<f64>,
-    pi1: Vector3<f64>,
-}
-
-impl FreeTangent {
-    pub(super) fn new(moments: &[f64; 3], pi0: &Vector3<f64>, tau: f64) -> Self {
-        let rel = relative_attitude(moments, pi0, tau);
-        let mut pi1 = *pi0;
-        rel.apply_momentum(&mut pi1);
-        let (jac, _) = FreeFlow::new(moments, pi0).momentum_tangent(moments, tau);
-        let inv = Vector3::from_fn(|k, _| 1.0 / moments[k]);
-        FreeTangent {
-            rel,
-            jac,
-            tau,
-            inv,
-            omega0: pi0.component_mul(&inv),
-            pi1,
-        }
-    }
-
-    /// Sᵀv.
-    pub(super) fn turn(&self, v: &Vector3<f64>) -> Vector3<f64> {
-        let mut x = *v;
-        self.rel.apply(&mut x);
-        x
-    }
-
-    /// (δΠ', η) along (δΠ₀, δτ).
-    pub(super) fn apply(&self, dpi: &Vector3<f64>, dtau: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let omega1 = self.pi1.component_mul(&self.inv);
-        let dpi1 = self.jac * dpi + self.pi1.cross(&omega1) * dtau;
-        let n2 = self.pi1.norm_squared();
-        if n2 == 0.0 {
-            return (dpi1, dpi.component_mul(&self.inv) * self.tau);
-        }
-        let d = dpi1 - self.turn(dpi);
-        let along = self.tau * self.omega0.dot(dpi) + dtau * omega1.dot(&self.pi1);
-        (dpi1, (self.pi1 * along + d.cross(&self.pi1)) / n2)
-    }
-}
+use crate::systems::tops::methods::exact::FreeTangent;
 
 /// The frame block's row `row` (columns 1–3) of g.
 fn frame_row(g: &Matrix4<f64>, row: usize) -> Vector3<f64> {
@@ -162,7 +106,7 @@ impl FrameTop {
         let free = FreeTangent::new(self.body.moments(), &before.pi, tau);
         for dy in dirs.chunks_exact_mut(22) {
             let (mut dg, dpi, dp) = unflat(dy);
-            let (dpi1, eta) = free.apply(&dpi, 0.0);
+            let (dpi1, eta) = free.apply(&dpi, None);
             for row in 0..4 {
                 let v = frame_row(&after.g, row).cross(&eta) + free.turn(&frame_row(&dg, row));
                 set_frame_row(&mut dg, row, &v);
@@ -285,6 +229,8 @@ mod tests {
     use crate::integrate::problem::VectorField;
     use crate::integrate::Problem;
     use crate::systems::tangent_top::frame_top::SpaceTop;
+    use crate::systems::tops::methods::exact::relative_attitude;
+    use nalgebra::Matrix3;
 
     fn tops() -> Vec<FrameTop> {
         let inertia = [2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2];
@@ -444,7 +390,7 @@ mod tests {
                 let s0 = at(0.0).0;
                 let eta_fd = so3::vee_unchecked(&(s0.transpose() * (sp - sq) / (2.0 * h)));
                 let dm_fd = (mp - mq) / (2.0 * h);
-                let (dm, eta) = FreeTangent::new(&moments, &pi0, tau).apply(&dpi, dtau);
+                let (dm, eta) = FreeTangent::new(&moments, &pi0, tau).apply_timed(&dpi, dtau);
                 let err = (eta - eta_fd).amax().max((dm - dm_fd).amax());
                 eprintln!(
                     "I = {moments:?}, |Π₀| = {:.1}, δτ = {dtau}: {err:.1e}",

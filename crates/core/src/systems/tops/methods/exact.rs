@@ -854,8 +854,10 @@ impl FreeFlow {
 }
 
 /// The tangent map of the free motion from M₀ at t, once per (M₀, t): S(t), M(t) = S(t)ᵀM₀,
-/// Dφ_t, ∂M(t)/∂I and the square integrals, for [`FreeTangent::apply`].
+/// Dφ_t, ∂M(t)/∂I and the square integrals, for [`FreeTangent::apply`] (the free body's
+/// `exact`, the heavy top's exact splittings, the frame tops).
 pub(crate) struct FreeTangent {
+    flow: FreeFlow,
     pub(crate) m: Vector3<f64>,
     pub(crate) s: Matrix3<f64>,
     jac: Matrix3<f64>,
@@ -871,6 +873,7 @@ impl FreeTangent {
         let (m, s) = flow.motion(t);
         let (jac, par) = flow.momentum_tangent(inertia, t);
         FreeTangent {
+            flow: flow.clone(),
             m,
             s,
             jac,
@@ -881,14 +884,32 @@ impl FreeTangent {
         }
     }
 
+    /// At t from M₀ for the moments `inertia`.
+    pub(crate) fn new(inertia: &[f64; 3], m0: &Vector3<f64>, t: f64) -> FreeTangent {
+        FreeTangent::of(&FreeFlow::new(inertia, m0), inertia, t)
+    }
+
+    /// S(t)ᵀv.
+    pub(crate) fn turn(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        self.s.transpose() * v
+    }
+
+    /// (δM(t), σ) along (δM₀, δt): a change of the flow's time adds δt (M × Ω, Ω) with
+    /// Ω = 𝕀⁻¹M(t) (Euler's equation, and Ṡ = SΩ̂).
+    pub(crate) fn apply_timed(&self, dm0: &Vector3<f64>, dt: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let (dm, sigma) = self.apply(dm0, None);
+        let omega = Vector3::from_fn(|q, _| self.m[q] / self.inertia[q]);
+        (dm + self.m.cross(&omega) * dt, sigma + omega * dt)
+    }
+
     /// (δM(t), σ) of the direction δM₀ (and, for `moment` = Some(q), of ∂/∂I_q added): the
     /// momentum's and the attitude's (δS = Sσ̂) directions (module docs, "With the attitude").
     pub(crate) fn apply(
         &self,
-        flow: &FreeFlow,
         dm0: &Vector3<f64>,
         moment: Option<usize>,
     ) -> (Vector3<f64>, Vector3<f64>) {
+        let flow = &self.flow;
         let mut dm = self.jac * dm0;
         let mut di = Vector3::zeros();
         if let Some(q) = moment {
@@ -1109,7 +1130,7 @@ impl Stepper for ExactTangentStepper {
             .zip(self.z[12..].chunks_exact_mut(6));
         for (j, (from, to)) in dirs.enumerate() {
             let dm0 = Vector3::from_column_slice(&from[..3]);
-            let (dm, sigma) = ft.apply(flow, &dm0, j.checked_sub(6));
+            let (dm, sigma) = ft.apply(&dm0, j.checked_sub(6));
             let xi = ft.s.transpose() * Vector3::from_column_slice(&from[3..]) + sigma;
             to[..3].copy_from_slice(dm.as_slice());
             to[3..].copy_from_slice(xi.as_slice());
