@@ -235,7 +235,9 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             shared by a batch, or one per batch member (b, n, n).
         progress: show a progress bar (tqdm if installed, else a line on stderr).
         chunk_steps: steps per native call (default: ``CHUNK_WORK // batch size``, at least
-            ``MIN_CHUNK_STEPS``). Ctrl-C is noticed between calls. Results do not depend on it.
+            ``MIN_CHUNK_STEPS``; with ``sensitivity=True`` both divided by 1 + k, the k
+            directions of the lift). Ctrl-C is noticed between calls. Results do not depend on
+            it.
         threads: threads for a batch (default: all cores).
         t0: the time of ``state0`` (default 0); every time of the run is absolute.
         t_eval: save the states at exactly these times (1-D, strictly increasing, within
@@ -291,10 +293,13 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
         _check_system(system)
     if sensitivity is not False:
         if sensitivity is not True:
-            raise TypeError(f"invalid sensitivity: expected True or False, got "
-                            f"{type(sensitivity).__name__} {sensitivity!r}")
-        return _with_sensitivity(system, state0, dt, steps, method, save_every, attitude,
-                                 progress, chunk_steps, threads, t0, t_eval, events)
+            if not isinstance(sensitivity, np.bool_):
+                raise TypeError(f"invalid sensitivity: expected True or False, got "
+                                f"{type(sensitivity).__name__} {sensitivity!r}")
+            sensitivity = bool(sensitivity)      # numpy's bool, e.g. of a comparison
+        if sensitivity:
+            return _with_sensitivity(system, state0, dt, steps, method, save_every, attitude,
+                                     progress, chunk_steps, threads, t0, t_eval, events)
     if steps is None and t_eval is None:
         raise TypeError("invalid steps: expected an integer >= 1, got NoneType None (steps may be "
                         "None only with t_eval, whose last time is then the end of the run)")
@@ -325,8 +330,14 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
         except BaseException as e:
             _attach_partial(e, system, run, [], None, None)
             raise
-        return Trajectory(system, run.method, t, states, att, z, za, run.dt, run.save_every,
-                          t_final=t_final, t0=run.t0, initial_state=z0, initial_attitude=za0)
+        whole = (system, run.method, t, states, att, z, za, run.dt, run.save_every)
+        rest = dict(t_final=t_final, t0=run.t0, initial_state=z0, initial_attitude=za0)
+        try:
+            return Trajectory(*whole, **rest)
+        except BaseException as e:
+            # Ctrl-C after the run: the whole run is the partial.
+            _attach(e, lambda: Trajectory(*whole, status=-1, **rest), steps)
+            raise
     if ev is not None:
         _native(run, "set_events", "events")(*ev, float(event_tol))
     chunk = run._chunk
@@ -355,8 +366,13 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
     finally:
         if bar is not None:
             bar.close()
-    stopped = run.stopped_by if ev is not None else None
-    return _trajectory(system, run, chunks, times, 1 if stopped is not None else 0, ev)
+    try:
+        stopped = run.stopped_by if ev is not None else None
+        return _trajectory(system, run, chunks, times, 1 if stopped is not None else 0, ev)
+    except BaseException as e:
+        # Ctrl-C while the chunks are joined: the run's chunks are the partial.
+        _attach_partial(e, system, run, chunks, times, ev)
+        raise
 
 
 def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, progress,
@@ -394,26 +410,60 @@ def _with_sensitivity(system, state0, dt, steps, method, save_every, attitude, p
             raise ShapeError(f"attitude has the wrong shape: expected (3, 3) or "
                              f"({z0.shape[0]}, 3, 3), got {np.shape(attitude)}")
         a = a.astype(np.float64)
+        bad = np.argwhere(~np.isfinite(a))
+        if len(bad):
+            # Named as the attitude (the plain run's words), not as an entry of the state the
+            # lift's seed is made of.
+            k, i, j = bad[0]
+            member = f"batch member {k}: " if batched else ""
+            raise NonFiniteError(f"{member}attitude contains a non-finite value (NaN or inf) at "
+                                 f"({i}, {j})")
         z0 = np.concatenate([z0, a.reshape(z0.shape[0], 9)], axis=1)
     seeds = layout.seed(z0 if batched else z0[0])
+    if chunk_steps is None:
+        # A lifted step does the work of about 1 + k plain steps (k = e + p directions): so
+        # many fewer steps per native call keep Ctrl-C as prompt as in a plain run.
+        per_step = 1 + layout.directions + len(layout.parameters)
+        chunk_steps = max(1, MIN_CHUNK_STEPS // per_step,
+                          CHUNK_WORK // (per_step * max(z0.shape[0], 1)))
     try:
         traj = integrate(lifted, seeds, dt, steps, method, save_every, None, progress,
                          chunk_steps, threads, t0=t0, t_eval=t_eval)
     except BaseException as e:
-        # The partial trajectory of the lifted run, in the system's own terms.
+        # The partial trajectory of the lifted run, in the system's own terms (never the
+        # lift's layout: without its conversion no partial).
         partial = getattr(e, "partial", None)
         if partial is not None:
-            try:
-                e.partial = _split_lifted(system, partial, layout, d, a, batched)
-            except Exception:     # never hide the original error behind one of the partial's
-                pass
+            e.partial = None
+            _attach(e, lambda: _split_lifted(system, partial, layout, d, a, batched))
         raise
-    return _split_lifted(system, traj, layout, d, a, batched)
+    try:
+        return _split_lifted(system, traj, layout, d, a, batched)
+    except BaseException as e:
+        # Ctrl-C while the Jacobians are split out: the whole run is the partial.
+        _attach(e, lambda: _split_lifted(system, traj, layout, d, a, batched, status=-1))
+        raise
 
 
-def _split_lifted(system, traj, layout, d, attitude0, batched):
+def _attach(err, partial, steps=None):
+    """Sets ``err.partial`` to ``partial()`` unless the error carries one already (and the note
+    naming it when ``steps`` is given); never hides the error behind one of the partial's."""
+    if getattr(err, "partial", None) is not None:
+        return
+    try:
+        p = partial()
+        err.partial = p
+        if steps is not None and hasattr(err, "add_note"):
+            err.add_note(f"the trajectory computed before this (to step {steps}, "
+                         f"t = {p.t_final:g}) is err.partial")
+    except Exception:
+        pass
+
+
+def _split_lifted(system, traj, layout, d, attitude0, batched, status=None):
     """The Trajectory of ``system`` (states, attitudes, Jacobians) from one of its tangent lift
-    (``d``: the system's state size; ``attitude0``: (b, 3, 3) when the run carries one)."""
+    (``d``: the system's state size; ``attitude0``: (b, 3, 3) when the run carries one;
+    ``status``: the lifted trajectory's unless given)."""
     states, jac, pjac = layout.split(traj.states)
     final, final_jac, final_pjac = layout.split(traj.final_state)
     z0 = layout.split(traj.initial_state)[0][..., :d]
@@ -424,7 +474,8 @@ def _split_lifted(system, traj, layout, d, attitude0, batched):
         att0 = attitude0 if batched else attitude0[0]
         states, final = states[..., :d], final[..., :d]
     return Trajectory(system, traj.method, traj.t, states, att, final, final_att, traj.dt,
-                      traj.save_every, t_final=traj.t_final, status=traj.status, t0=traj.t0,
+                      traj.save_every, t_final=traj.t_final,
+                      status=traj.status if status is None else status, t0=traj.t0,
                       initial_state=z0, initial_attitude=att0, jacobian=jac,
                       final_jacobian=final_jac, parameter_jacobian=pjac,
                       final_parameter_jacobian=final_pjac)

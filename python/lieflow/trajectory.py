@@ -83,7 +83,8 @@ class Trajectory:
                 are (b, e), (b, p).
         Raises:
             TypeError (not real numbers), InvalidArgumentError (a run without
-            ``sensitivity=True``), ShapeError, NonFiniteError.
+            ``sensitivity=True``), ShapeError, NonFiniteError (a non-finite cotangent, or a
+            gradient beyond the float range).
         """
         if self.jacobian is None:
             raise InvalidArgumentError("invalid vjp: this trajectory carries no Jacobians; "
@@ -99,13 +100,23 @@ class Trajectory:
         every = self.jacobian.shape[:-1]           # (b,) k, e: a cotangent on every sample
         final = self.final_jacobian.shape[:-1]     # (b,) e: on the final state
         if c.shape == final:
-            j, p = self.final_jacobian, self.final_parameter_jacobian
-            return np.einsum("...ij,...i->...j", j, c), np.einsum("...ij,...i->...j", p, c)
-        if c.shape == every:
-            return (np.einsum("...kij,...ki->...j", self.jacobian, c),
-                    np.einsum("...kij,...ki->...j", self.parameter_jacobian, c))
-        raise ShapeError(f"invalid cotangent: expected shape {final} (the final state) or "
-                         f"{every} (every sample), got {c.shape}")
+            jacs, rule = (self.final_jacobian, self.final_parameter_jacobian), "...ij,...i->...j"
+        elif c.shape == every:
+            jacs, rule = (self.jacobian, self.parameter_jacobian), "...kij,...ki->...j"
+        else:
+            raise ShapeError(f"invalid cotangent: expected shape {final} (the final state) or "
+                             f"{every} (every sample), got {c.shape}")
+        with np.errstate(over="ignore", invalid="ignore"):
+            grads = tuple(np.einsum(rule, j, c) for j in jacs)
+            if not all(np.all(np.isfinite(g)) for g in grads):
+                # An intermediate sum beyond the float range: again with the cotangent scaled
+                # to at most 1, the gradient scaled back.
+                s = float(np.max(np.abs(c)))
+                grads = tuple(np.einsum(rule, j, c / s) * s for j in jacs)
+        if not all(np.all(np.isfinite(g)) for g in grads):
+            raise NonFiniteError("invalid cotangent: the gradient J^T c overflows the float "
+                                 "range (beyond 1.8e308); scale the loss down")
+        return grads
 
     @classmethod
     def concatenate(cls, trajectories):

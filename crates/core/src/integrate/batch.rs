@@ -465,7 +465,7 @@ fn step_block<P: Problem + ?Sized>(
             }
             next.clone_from(&run.buf);
             lanes.stepper.get(j, &mut next);
-            let r = match check::finite_slice("state", &next) {
+            let r = match problem.check_finite(&next) {
                 Ok(()) => {
                     run.buf.copy_from_slice(&next);
                     let retracted = run.retract_at(problem, stop);

@@ -6,7 +6,6 @@ use super::events::Events;
 use super::method::Clock;
 use super::problem::Problem;
 use super::run::{too_many, Make, Run, Until, RETRACT_EVERY};
-use crate::check;
 use crate::error::{Error, Result};
 
 impl Run {
@@ -126,7 +125,7 @@ impl Run {
         let mut r = self.failed(r, 0);
         if r.is_ok() {
             self.stepper.get(&mut self.next);
-            if let Err(e) = check::finite_slice("state", &self.next) {
+            if let Err(e) = problem.check_finite(&self.next) {
                 r = Err(self.non_finite(problem.name(), done, stop, e));
             }
         }
@@ -153,7 +152,7 @@ impl Run {
             let r = self.stepper.advance(1, self.clock);
             self.failed(r, done + 1)?;
             self.stepper.get(&mut self.next);
-            if let Err(e) = check::finite_slice("state", &self.next) {
+            if let Err(e) = problem.check_finite(&self.next) {
                 return Err(self.non_finite(problem.name(), done, done + 1, e));
             }
             std::mem::swap(&mut self.buf, &mut self.next);
@@ -184,7 +183,7 @@ impl Run {
             let mut r = self.stepper.advance(1, clock);
             if r.is_ok() {
                 self.stepper.get(&mut self.next);
-                if let Err(e) = check::finite_slice("state", &self.next) {
+                if let Err(e) = problem.check_finite(&self.next) {
                     r = Err(self.non_finite(problem.name(), done + k, done + k + 1, e));
                 }
             }
@@ -252,7 +251,7 @@ impl Run {
         };
         z.extend_from_slice(&self.buf);
         problem.to_user(&mut z[at..]);
-        if let Err(e) = check::finite_slice("state", &z[at..]) {
+        if let Err(e) = problem.check_finite(&z[at..]) {
             if save {
                 z.truncate(at);
             }
@@ -281,7 +280,7 @@ impl Run {
                 let mut r = self.failed(r, j + 1);
                 if r.is_ok() {
                     self.stepper.get(&mut self.next);
-                    if let Err(e) = check::finite_slice("state", &self.next) {
+                    if let Err(e) = problem.check_finite(&self.next) {
                         r = Err(self.non_finite(problem.name(), j, j + 1, e));
                     }
                 }
@@ -365,7 +364,7 @@ impl Run {
         self.failed_at(r, j + 1, t_j + h)?;
         let mut z = self.buf.clone();
         stepper.get(&mut z);
-        if let Err(e) = check::finite_slice("state", &z) {
+        if let Err(e) = problem.check_finite(&z) {
             return Err(Error::LeftDomain {
                 what: format!("{} state", problem.name()),
                 t: t_j + h,
@@ -411,7 +410,7 @@ impl Run {
             } else {
                 break;
             };
-            if let Err(e) = check::finite_slice("state", &z) {
+            if let Err(e) = problem.check_finite(&z) {
                 let j = self.clock.done;
                 return Err(self.non_finite(problem.name(), j, j + 1, e));
             }

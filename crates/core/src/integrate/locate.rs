@@ -5,7 +5,6 @@
 use super::events::{Events, Hit};
 use super::problem::Problem;
 use super::run::{Make, Run};
-use crate::check;
 use crate::error::Result;
 
 /// Whether g going from `a` to `b` over a step is an event of the given direction.
@@ -28,7 +27,7 @@ impl Run {
     ) -> Result<Option<(f64, Vec<f64>)>> {
         self.user.copy_from_slice(&self.next);
         problem.to_user(&mut self.user);
-        if let Err(e) = check::finite_slice("state", &self.user) {
+        if let Err(e) = problem.check_finite(&self.user) {
             let j = self.clock.done;
             return Err(self.non_finite(problem.name(), j, j + 1, e));
         }

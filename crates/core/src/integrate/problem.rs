@@ -50,6 +50,13 @@ pub trait Problem: Send + Sync {
         Ok(())
     }
 
+    /// The driver's finiteness guard on a state of a run (either frame): [`Error::NonFinite`]
+    /// naming its first non-finite entry, by default by its index (a tangent lift names an
+    /// entry of a Jacobian by its row and column).
+    fn check_finite(&self, z: &[f64]) -> Result<()> {
+        crate::check::finite_slice("state", z)
+    }
+
     /// Maps a state from the user's frame to the frame the kernels work in (e.g. the principal
     /// axes of an inertia given as a full matrix). The identity by default.
     fn to_internal(&self, _z: &mut [f64]) {}

@@ -400,13 +400,25 @@ impl Run {
         } else {
             format!("one of the steps {} to {stop}", done + 1)
         };
+        // A tangent lift's Jacobian beyond the float range while its state is finite
+        // (`Problem::check_finite` of the lift names it so): the derivatives outgrew it.
+        let derivatives = matches!(&e, Error::NonFinite { what, .. } if what.contains("Jacobian"));
+        let why = match derivatives {
+            true => {
+                "the derivatives outgrew the float range while the state stayed finite (an \
+                 unstable motion's exponential growth, or a long run of a fast one); run \
+                 shorter, or from a state of smaller scale"
+            }
+            false => {
+                "the step is too large for this motion (|dt·ω| beyond the range where rotation \
+                 angles are resolved, or an overflow), or the motion blows up"
+            }
+        };
         Error::LeftDomain {
             what: format!("{name} state"),
             t: self.clock.t0 + stop as f64 * self.clock.dt,
             message: format!(
-                "{steps} (dt = {}, from t = {}) produced a non-finite value ({e}); the step is \
-                 too large for this motion (|dt·ω| beyond the range where rotation angles are \
-                 resolved, or an overflow), or the motion blows up",
+                "{steps} (dt = {}, from t = {}) produced a non-finite value ({e}); {why}",
                 fmt_num(self.clock.dt),
                 fmt_num(self.clock.t0 + done as f64 * self.clock.dt),
             ),

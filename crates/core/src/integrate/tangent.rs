@@ -516,6 +516,37 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
     fn calls_out(&self) -> bool {
         self.problem.calls_out()
     }
+
+    /// A non-finite entry named by what it is to the user: of the base state (its index), else
+    /// of the Jacobian or the parameter Jacobian (row and column, the parameter's name), never
+    /// by its place in the lift's layout (e.g. ∂M/∂I beyond the float range while M is not).
+    fn check_finite(&self, z: &[f64]) -> Result<()> {
+        if z.iter().all(|x| x.is_finite()) {
+            return Ok(());
+        }
+        let names = self.problem.parameters();
+        for j in 0..=self.k() {
+            let Some(i) = (0..self.len_of(j)).find(|&i| !z[self.at(j, i)].is_finite()) else {
+                continue;
+            };
+            let (what, location) = match j {
+                0 => ("state".to_string(), format!("index {i}")),
+                j if j <= self.e => (
+                    "the Jacobian ∂z/∂z₀ (sensitivity=True)".to_string(),
+                    format!("row {i}, column {}", j - 1),
+                ),
+                j => {
+                    let m = j - 1 - self.e;
+                    (
+                        "the parameter Jacobian ∂z/∂θ (sensitivity=True)".to_string(),
+                        format!("row {i}, column {m} ({})", names.get(m).unwrap_or(&"?")),
+                    )
+                }
+            };
+            return Err(Error::NonFinite { what, location });
+        }
+        crate::check::finite_slice("state", z)
+    }
 }
 
 impl<P: Problem + Clone> Tangent<P> {

@@ -217,10 +217,15 @@ impl Integration {
     }
 
     /// `_chunk`'s tuple of a run before its first call completed: its initial samples and
-    /// states, at step 0 and time t₀.
+    /// states, at step 0 and time t₀ — also when a call did complete but its result never
+    /// reached the caller (Ctrl-C raised as the call returned), so the initial sample is
+    /// always there.
     fn _head<'py>(&mut self, py: Python<'py>) -> PyResult<Chunk<'py>> {
         let current = self.initial_states(py)?;
-        let mut c = self.chunk_of(py, &[], 0, None, None, current, false)?;
+        let saved = std::mem::replace(&mut self.saved, 0);
+        let c = self.chunk_of(py, &[], 0, None, None, current, false);
+        self.saved = saved;
+        let mut c = c?;
         (c.5, c.7) = (0, (self.t0, self.t0));
         Ok(c)
     }
