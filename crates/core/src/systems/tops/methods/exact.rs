@@ -176,9 +176,13 @@ struct Elliptic {
     jk: f64,
     /// ω̄ (absolute units).
     omega: f64,
-    /// The base point (the formulas at t = 0): P(u₀) and B(W₀)ᵀ.
+    /// The base point (the formulas at t = 0): P(u₀), B(W₀)ᵀ and (sn, cn, dn)(u₀).
     p0: f64,
     b0t: Matrix3<f64>,
+    jac0: (f64, f64, f64),
+    /// (Df(0), ∂f(0)/∂I) of the elliptic formula (≈ (I, 0)), once per flow (the tangent map is
+    /// taken relative to it, like M(t); [`FreeFlow::momentum_tangent`]).
+    tangent0: std::sync::OnceLock<(Matrix3<f64>, Matrix3<f64>)>,
 }
 
 impl FreeFlow {
@@ -198,9 +202,9 @@ impl FreeFlow {
         match shape(inertia, m0) {
             Shape::Closed(kind) => FreeFlow { m0: *m0, kind }.momentum(t),
             Shape::Elliptic(o) => {
-                let (sn0, cn0, dn0) = o.jac0;
-                let u = elliptic::ellipf_from_jacobi(sn0, cn0, dn0) + o.lambda * t;
-                o.momentum(elliptic::ellipj_kprime_unchecked(u, o.kp, o.m)) * o.scale
+                let (u0, jac0) = o.base();
+                let jac = elliptic::ellipj_kprime_unchecked(u0 + o.lambda * t, o.kp, o.m);
+                o.relative_momentum(m0, jac, jac0)
             }
         }
     }
@@ -214,7 +218,7 @@ impl FreeFlow {
                 top::rotate_axis(&mut m, *s, t * w);
                 m
             }
-            Kind::Elliptic(e) => e.scaled(t).0 * e.o.scale,
+            Kind::Elliptic(e) => e.momentum(&self.m0, t),
         }
     }
 
@@ -509,6 +513,30 @@ fn shape(inertia: &[f64; 3], m0: &Vector3<f64>) -> Shape {
 }
 
 impl Orbit {
+    /// u₀ = F(sn₀, cn₀, dn₀) from (sn₀, cn₀, dn₀) read off M₀, and (sn, cn, dn)(u₀).
+    fn base(&self) -> (f64, (f64, f64, f64)) {
+        let (sn0, cn0, dn0) = self.jac0;
+        let u0 = elliptic::ellipf_from_jacobi(sn0, cn0, dn0);
+        (u0, elliptic::ellipj_kprime_unchecked(u0, self.kp, self.m))
+    }
+
+    /// M(t) = M₀ + amp·((cn, sn, dn)(u) − (cn, sn, dn)(u₀))·scale (principal frame) from
+    /// (sn, cn, dn) at u and at the base point u₀.
+    #[inline]
+    fn relative_momentum(
+        &self,
+        m0: &Vector3<f64>,
+        (sn, cn, dn): (f64, f64, f64),
+        (sn0, cn0, dn0): (f64, f64, f64),
+    ) -> Vector3<f64> {
+        let mut m = *m0;
+        for (w, d) in [cn - cn0, sn - sn0, dn - dn0].into_iter().enumerate() {
+            let i = self.axes[w];
+            m[i] += self.amp[w] * d * self.scale;
+        }
+        m
+    }
+
     /// M in units of `scale` (principal frame) from (sn, cn, dn)(u).
     #[inline]
     fn momentum(&self, (sn, cn, dn): (f64, f64, f64)) -> Vector3<f64> {
@@ -652,8 +680,7 @@ pub(crate) fn relative_attitude(inertia: &[f64; 3], m0: &Vector3<f64>, tau: f64)
 impl Elliptic {
     /// u₀, the secular part and the base point of an orbit.
     fn new(o: Orbit) -> Elliptic {
-        let (sn0, cn0, dn0) = o.jac0;
-        let u0 = elliptic::ellipf_from_jacobi(sn0, cn0, dn0);
+        let (u0, jac) = o.base();
         let nu = o.nu;
         let (two_k, jk) = if o.kp == 0.0 {
             (f64::INFINITY, nu / (1.0 + nu))
@@ -670,18 +697,28 @@ impl Elliptic {
             omega: o.norm * o.scale * (jk / o.ia + (1.0 - jk) / o.ib),
             p0: 0.0,
             b0t: Matrix3::identity(),
+            jac0: jac,
+            tangent0: std::sync::OnceLock::new(),
         };
-        // The base point: the formulas evaluated at t = 0, so that S(0) = I and P(u) − P(u₀) = 0
-        // exactly: the rounding of the formulas cancels in short steps instead of biasing every
-        // step the same way.
-        let (y0, jac) = e.scaled(0.0);
+        // The base point: the formulas evaluated at t = 0, so that M(0) = M₀, S(0) = I and
+        // P(u) − P(u₀) = 0 exactly: the rounding of the formulas cancels in short steps instead
+        // of biasing every step the same way.
         e.p0 = e.periodic_at(u0, jac);
-        e.b0t = body_frame(&o.polar(&y0)).transpose();
+        e.b0t = body_frame(&o.polar(&o.momentum(jac))).transpose();
         e
     }
 }
 
 impl Elliptic {
+    /// M(t) = M₀ + amp·((cn, sn, dn)(u) − (cn, sn, dn)(u₀))·scale (module docs, "Momentum"):
+    /// M(0) = M₀ bit for bit.
+    #[inline]
+    fn momentum(&self, m0: &Vector3<f64>, t: f64) -> Vector3<f64> {
+        let u = self.u0 + self.o.lambda * t;
+        let jac = elliptic::ellipj_kprime_unchecked(u, self.o.kp, self.o.m);
+        self.o.relative_momentum(m0, jac, self.jac0)
+    }
+
     /// M(t) in units of `scale` (principal frame) and (sn, cn, dn)(u).
     #[inline]
     fn scaled(&self, t: f64) -> (Vector3<f64>, (f64, f64, f64)) {
@@ -707,9 +744,25 @@ impl Elliptic {
 }
 
 impl Elliptic {
-    /// (∂M(t)/∂M₀, ∂M(t)/∂I) on an elliptic orbit by the chain rule through the parametrisation
-    /// (module docs, "Tangent map"); NaN on the separatrix (k′ = 0).
+    /// (∂M(t)/∂M₀, ∂M(t)/∂I) on an elliptic orbit, of M(t) = M₀ + (f(t) − f(0))·scale:
+    /// (I + Df(t) − Df(0), ∂f(t)/∂I − ∂f(0)/∂I), with Df(0) once per flow (module docs,
+    /// "Tangent map"); NaN on the separatrix (k′ = 0).
     fn tangent(
+        &self,
+        inertia: &[f64; 3],
+        m0: &Vector3<f64>,
+        t: f64,
+    ) -> (Matrix3<f64>, Matrix3<f64>) {
+        let (jac0, par0) = self
+            .tangent0
+            .get_or_init(|| self.formula_tangent(inertia, m0, 0.0));
+        let (jac, par) = self.formula_tangent(inertia, m0, t);
+        (Matrix3::identity() + (jac - jac0), par - par0)
+    }
+
+    /// (Df(t), ∂f(t)/∂I) of the elliptic formula f by the chain rule through the
+    /// parametrisation (module docs, "Tangent map").
+    fn formula_tangent(
         &self,
         inertia: &[f64; 3],
         m0: &Vector3<f64>,
