@@ -286,10 +286,18 @@ fn the_composed_exact_flow_random_walks() {
     let lifted = plain.with_attitude();
     let attitude: Vec<f64> = (0..9).map(|i| if i % 4 == 0 { 1.0 } else { 0.0 }).collect();
     // (name, system, inertia, M₀, dt, steps (a prefix of N))
-    let cases: [(&str, &RigidBody, [f64; 3], [f64; 3], f64, usize); 3] = [
+    type Case<'a> = (&'a str, &'a RigidBody, [f64; 3], [f64; 3], f64, usize);
+    let cases: [Case; 3] = [
         ("M", &plain, [1.0, 2.0, 3.0], [0.3, -0.8, 1.1], 0.1, 3),
         // Close to the separatrix (k′ ≈ 0.02) with longer steps.
-        ("M near the separatrix", &plain, [1.0, 2.0, 3.0], [0.02, 1.0, 0.03], 0.5, 3),
+        (
+            "M near the separatrix",
+            &plain,
+            [1.0, 2.0, 3.0],
+            [0.02, 1.0, 0.03],
+            0.5,
+            3,
+        ),
         ("(M, R)", &lifted, [1.0, 2.0, 3.0], [0.3, -0.8, 1.1], 0.1, 2),
     ];
     let mut fails = Vec::new();
