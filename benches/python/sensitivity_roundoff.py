@@ -14,7 +14,8 @@ A. The free rigid body with `exact` (I = 1, 2, 3, M0 = (0.3, -0.8, 1.1), dt = 0.
        |∇C(z_N)| |J_N|), for the chain and for the jump. Then the chain's drift traced to its
        cause: one evaluation of the elliptic formula M = (σa₁ cn u, a₂ sn u, εa₃ dn u) from a
        fresh M₀, |M(t)|² against |M₀|² over many M₀ on the orbit (a mean away from 0 is a bias
-       per evaluation, which composed evaluations add up linearly).
+       per evaluation, which composed evaluations add up linearly; M(t) is evaluated relative to
+       its base point, so M(0) = M₀ bit for bit).
    A3. The closed form alone at large t: J(t) against J(t/2 at z(t/2)) · J(t/2), t up to 1e7.
 B. Symplectic Verlet on the pseudo-rigid body (n = 3, canonical (X, P), Ω the standard form):
    ‖JᵀΩJ − Ω‖_max along one run (dt = 0.05), for a harmonic potential (10⁷ steps; linear

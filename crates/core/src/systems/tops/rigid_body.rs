@@ -105,7 +105,10 @@ impl RigidBody {
     /// e₂ = 2H I₂ − |M|² = Σ_k M_k² (I₂ − I_k)/I_k = A² − B² = (A − B)(A + B) (one positive and
     /// one negative term: the distance to the separatrix, exactly as accurate as the components);
     /// u₀ = sn₀ R_F(cn₀², dn₀², 1) with sn₀ = M₂/a₂, cn₀ = |M₁|/a₁, dn₀ = |M₃|/a₃ (no amplitude
-    /// angle); sn, cn, dn from k′ ([`crate::numerics::elliptic::ellipj_kprime`]), accurate as k′ → 0. On the
+    /// angle); sn, cn, dn from k′ ([`crate::numerics::elliptic::ellipj_kprime`]), accurate as k′ → 0. M is
+    /// evaluated relative to u₀, M(t) = M0 + (a₁(cn u − cn u₀), …) (differences before the
+    /// products), so M(0) = M0 exactly and the amplitudes' rounding does not bias a step: the
+    /// method `exact` composed with itself random-walks in |M|² and H. On the
     /// separatrix (k′ = 0) this is the heteroclinic solution sn = tanh, cn = dn = sech. Steady
     /// rotations about a principal axis (unstable included) are returned unchanged, and a
     /// symmetric body rotates M uniformly about its symmetry axis.
