@@ -18,6 +18,7 @@ import lieflow as lf
 from timing import best_time, environment
 
 STEPS = 2000
+SPIN = 2.0 * np.array([[0.0, 1.0, 0.5], [-1.0, 0.0, 0.8], [-0.5, -0.8, 0.0]])
 
 
 def cases():
@@ -48,8 +49,11 @@ def cases():
     ] + [
         ("HeavyTop", ht, np.array([1.0, 0.5, -0.3, 0.0, 0.6, 0.8]), None, "exact_splitting4",
          6 + 7),
+        # A spinning body (P = W X, W skew): the semi-axes stay apart (the reduced coordinates
+        # need distinct a_i).
         ("PseudoRigidBody n = 3", prb, np.concatenate([np.diag([1.6, 1.1, 0.7]).ravel(),
-                                                       0.2 * P.ravel()]), None, "reduced", 18 + 4),
+                                                       (SPIN @ np.diag([1.6, 1.1, 0.7])).ravel()]),
+         None, "reduced", 18 + 4),
         ("RollingDisks", lf.RollingDisks(1.0, 0.7, 0.3 + 0.1j, [-0.2, 0.25], 1.0, 1.5, 0.8, 0.6),
          np.array([0.1, 0.2, 0.5, -0.3]), None, "gauss4", 4 + 7),
         ("TangentTop on the sphere", lf.TangentTop(lf.surfaces.Sphere(1.0), 1.0, 0.5),
