@@ -10,6 +10,8 @@ use lieflow::pseudo_rigid::potential::{SaintVenantKirchhoff, Sum, Volumetric};
 use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
 
+mod common;
+
 /// (base state at the end, Jacobian d×d row-major) of `steps` steps of `method`.
 fn lifted_end(
     t: &dyn TangentSystem,
@@ -2900,21 +2902,6 @@ fn gradient_defect(jac: &[f64], grads: &[(Vec<f64>, Vec<f64>)]) -> f64 {
     casimir_defect(jac, grads) / (scale * g)
 }
 
-/// The catalog's spheres (full inertia tensors, offset centres of mass).
-fn catalog_spheres() -> lieflow::systems::RollingSpheres {
-    lieflow::systems::RollingSpheres::new(
-        0.7,
-        1.3,
-        [0.1, -0.2, 0.15],
-        [-0.3, 0.2, 0.4],
-        2.0,
-        3.5,
-        [[0.40, 0.05, -0.02], [0.05, 0.30, 0.04], [-0.02, 0.04, 0.25]],
-        [[0.90, -0.10, 0.05], [-0.10, 1.10, 0.08], [0.05, 0.08, 0.70]],
-    )
-    .unwrap()
-}
-
 fn catalog_spheres_state(s: &lieflow::systems::RollingSpheres) -> Vec<f64> {
     use lieflow::lie::so3;
     use nalgebra::Vector3;
@@ -2940,7 +2927,7 @@ fn catalog_spheres_state(s: &lieflow::systems::RollingSpheres) -> Vec<f64> {
 /// momentum J = P₁ + P₂ (its gradient in user coordinates from the lift's chart at the state).
 #[test]
 fn rolling_spheres_jacobians_keep_the_sphere_and_the_momentum() {
-    let s = catalog_spheres();
+    let s = common::rolling_spheres();
     let t = s.tangent().expect("the spheres have a lift");
     let names: Vec<_> = t.methods().iter().map(|(n, _)| *n).collect();
     assert_eq!(names, ["midpoint", "midpoint4", "rkmk4"]);
@@ -3229,7 +3216,7 @@ fn rk4_jacobians_with_so3_blocks() {
     let matrix = RigidBody::from_matrix(&[2.0, 0.3, -0.1, 0.3, 3.1, 0.2, -0.1, 0.2, 4.2])
         .unwrap()
         .with_attitude();
-    let spheres = catalog_spheres();
+    let spheres = common::rolling_spheres();
     let (riemannian, z_riemannian) = riemannian_top();
     let z_free = [vec![0.3, -0.8, 1.1], matrix_rows(&r0)].concat();
     let z_heavy = [
