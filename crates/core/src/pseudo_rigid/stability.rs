@@ -469,7 +469,6 @@ pub fn stability(body: &FullBody, a: &[f64], omega: &Mat, lambda: &Mat) -> Resul
             jac[(k, l)] = x;
         }
     }
-    debug_assert_eq!(z0.len(), nz);
     check::finite_mat("Jacobian of the reduced vector field", &jac)?;
     let mut full = general_eigenvalues(&jac)?;
     let transverse = 2 * d - rr;
