@@ -12,7 +12,7 @@ use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendu
 
 mod common;
 
-/// (base state at the end, Jacobian d×d row-major) of `steps` steps of `method`.
+/// (base state at the end, Jacobian e×e row-major) of `steps` steps of `method`.
 fn lifted_end(
     t: &dyn TangentSystem,
     method: &str,
@@ -24,7 +24,7 @@ fn lifted_end(
     (z, jac)
 }
 
-/// (base state, Jacobian, parameter Jacobian d×p) at the end.
+/// (base state, Jacobian e×e, parameter Jacobian e×p) at the end (e the tangent dimension).
 fn lifted_end_all(
     t: &dyn TangentSystem,
     method: &str,
@@ -32,11 +32,10 @@ fn lifted_end_all(
     dt: f64,
     steps: usize,
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let d = t.base_dim();
-    let np = t.parameter_names().len();
+    let (d, e, np) = (t.base_dim(), t.tangent_dim(), t.parameter_names().len());
     let seed = t.seed(z0).unwrap();
     let traj = integrate(t, method, &seed, dt, steps, steps).unwrap();
-    let (mut z, mut jac, mut pjac) = (vec![0.0; d], vec![0.0; d * d], vec![0.0; d * np]);
+    let (mut z, mut jac, mut pjac) = (vec![0.0; d], vec![0.0; e * e], vec![0.0; e * np]);
     t.jacobian(traj.state(1), &mut z, &mut jac, &mut pjac);
     (z, jac, pjac)
 }
@@ -2323,7 +2322,7 @@ fn check_group_lift_over(
     let mut rkmk4 = Vec::new();
     for &method in methods {
         let t = sys.tangent_for(method).expect("a lift");
-        let (z, jac) = lifted_trivialised(&*t, method, z0, dt, steps);
+        let (z, jac) = lifted_end(&*t, method, z0, dt, steps);
         let plain = stepped(sys, method, z0, dt, steps);
         let base = max_rel(&z, &plain);
         let fd = group_differences(sys, method, z0, (dt, steps), 1e-5, so3_block);
@@ -2748,33 +2747,6 @@ fn jacobians_of_euler_poincare_systems() {
 
 // Issue 26: the lifts of the rolling spheres and the frame tops.
 
-/// (base state, Jacobian e×e) at the end of a lifted run (e the tangent dimension).
-fn lifted_trivialised(
-    t: &dyn TangentSystem,
-    method: &str,
-    z0: &[f64],
-    dt: f64,
-    steps: usize,
-) -> (Vec<f64>, Vec<f64>) {
-    let (z, jac, _) = lifted_trivialised_all(t, method, z0, dt, steps);
-    (z, jac)
-}
-
-/// (base state, Jacobian e×e, parameter Jacobian e×p) at the end of a lifted run.
-fn lifted_trivialised_all(
-    t: &dyn TangentSystem,
-    method: &str,
-    z0: &[f64],
-    dt: f64,
-    steps: usize,
-) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let (d, e, np) = (t.base_dim(), t.tangent_dim(), t.parameter_names().len());
-    let traj = integrate(t, method, &t.seed(z0).unwrap(), dt, steps, steps).unwrap();
-    let (mut z, mut jac, mut pjac) = (vec![0.0; d], vec![0.0; e * e], vec![0.0; e * np]);
-    t.jacobian(traj.state(1), &mut z, &mut jac, &mut pjac);
-    (z, jac, pjac)
-}
-
 /// z moved along direction j of its tangent space by s: an SO(3) block as R exp(sê), the
 /// others along their own coordinates (off a sphere too).
 fn along(space: &lieflow::integrate::Space, z0: &[f64], j: usize, s: f64) -> Vec<f64> {
@@ -2959,7 +2931,7 @@ fn rolling_spheres_jacobians_keep_the_sphere_and_the_momentum() {
     };
     let (dt, steps) = (0.02, 50);
     for method in names {
-        let (z, jac) = lifted_trivialised(&*t, method, &z0, dt, steps);
+        let (z, jac) = lifted_end(&*t, method, &z0, dt, steps);
         let plain = integrate(&s, method, &z0, dt, steps, steps).unwrap();
         let base = max_rel(&z, plain.state(1));
         if method == "rkmk4" {
@@ -3062,7 +3034,7 @@ fn frame_top_jacobians_keep_the_casimirs() {
         };
         let (dt, steps) = (0.05, 40);
         for method in names {
-            let (z, jac) = lifted_trivialised(&*t, method, &z0, dt, steps);
+            let (z, jac) = lifted_end(&*t, method, &z0, dt, steps);
             let plain = integrate(&top, method, &z0, dt, steps, steps).unwrap();
             assert_eq!(z, plain.state(1), "{} {method}: base state", space.name());
             let fd = stepped_differences(&top, method, &z0, dt, steps, 1e-6);
@@ -3122,7 +3094,7 @@ fn riemannian_frame_top_jacobians() {
     };
     let (dt, steps) = (0.05, 20);
     for method in names {
-        let (z, jac) = lifted_trivialised(&*t, method, &z0, dt, steps);
+        let (z, jac) = lifted_end(&*t, method, &z0, dt, steps);
         let plain = integrate(&top, method, &z0, dt, steps, steps).unwrap();
         let base = max_rel(&z, plain.state(1));
         if method == "rkmk4" {
@@ -3245,7 +3217,7 @@ fn rk4_jacobians_with_so3_blocks() {
         assert_eq!((t.base_dim(), t.tangent_dim()), (d, e));
         // Each of the e + p directions has the state's d values.
         assert_eq!(t.space().dim(), d * (1 + e + np));
-        let (z, jac, _) = lifted_trivialised_all(&*t, "rk4", &z0, run.0, run.1);
+        let (z, jac, _) = lifted_end_all(&*t, "rk4", &z0, run.0, run.1);
         let plain = integrate(sys, "rk4", &z0, run.0, run.1, run.1).unwrap();
         assert_eq!(z, plain.state(1), "{}: base state", sys.name());
         let r = Matrix3::from_row_slice(&z[space.range("z1").or(space.range("R")).unwrap()]);
@@ -3260,7 +3232,7 @@ fn rk4_jacobians_with_so3_blocks() {
     }
     // The parameter Jacobians (∂Ṙ/∂I_k = R(∂Ω/∂I_k)^ in the field's).
     let run = (0.05, 40);
-    let (_, _, pjac) = lifted_trivialised_all(
+    let (_, _, pjac) = lifted_end_all(
         &*free(moments).tangent_for("rk4").unwrap(),
         "rk4",
         &z_free,
@@ -3271,7 +3243,7 @@ fn rk4_jacobians_with_so3_blocks() {
     let err = max_rel(&pjac, &fd);
     eprintln!("RigidBody with attitude rk4: parameter Jacobian vs differences {err:.2e}");
     assert!(err < 1e-7, "RigidBody parameters: {err:e}");
-    let (_, _, pjac) = lifted_trivialised_all(
+    let (_, _, pjac) = lifted_end_all(
         &*heavy(theta).tangent_for("rk4").unwrap(),
         "rk4",
         &z_heavy,
