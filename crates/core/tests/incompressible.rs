@@ -596,6 +596,14 @@ fn the_constrained_field_matches_rattle_trajectories() {
     zero[..9].fill(0.0);
     let e = constrained_field(&body, &zero, &mut dz, &mut s).unwrap_err();
     assert!(matches!(e, Error::InvalidArgument { .. }), "{e}");
+    // Its derivative refuses it alike, and leaves the output alone.
+    let (dirs, mut out) = (vec![1.0; 18], vec![7.0; 18]);
+    let e = lieflow::integrate::methods::rattle::constrained_field_tangent(
+        &body, &zero, &dirs, &mut out,
+    )
+    .unwrap_err();
+    assert!(matches!(e, Error::InvalidArgument { .. }), "{e}");
+    assert!(out.iter().all(|&x| x == 7.0));
 }
 
 #[test]

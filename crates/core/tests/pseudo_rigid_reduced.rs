@@ -184,6 +184,14 @@ fn reduced_field_tangent_matches_differences() {
             eprintln!("n = {n}: δ(field) vs differences {err:.1e}");
             assert!(err < 1e-9, "n = {n}: {err:e}");
         }
+        // A direction of the wrong size, or not skew, is a typed error.
+        let mut bad = dirs[0].clone();
+        bad.a.push(0.0);
+        let e = red.vector_field_tangent(&full, &bad).unwrap_err();
+        assert!(matches!(e, Error::Shape { .. }), "{e}");
+        let mut bad = dirs[0].clone();
+        bad.p_omega[(0, 1)] += 1.0;
+        assert!(red.vector_field_tangent(&full, &bad).is_err());
     }
 }
 
