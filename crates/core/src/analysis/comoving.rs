@@ -77,9 +77,6 @@ pub const HESSIAN_TOL: f64 = 1e-7;
 /// eigenvalues that meet (Krein collisions) by √δ.
 pub const SPECTRAL_TOL: f64 = 1e-5;
 
-/// Rank tolerance for the subspaces (singular values below this times the largest are zero).
-const RANK_TOL: f64 = 1e-9;
-
 /// The stability of a relative equilibrium in the co-moving frame ([`stability`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stability {
@@ -96,38 +93,6 @@ pub struct Stability {
     pub multipliers: Vec<f64>,
     /// |F(z₀)| relative to |f(z₀)| + |ξ_Z(z₀)|.
     pub residual: f64,
-}
-
-/// An orthonormal basis (columns) of the null space of `m` (rows × cols), by the SVD.
-fn null_space(m: &Mat) -> Result<Mat> {
-    let (r, c) = (m.nrows(), m.ncols());
-    if r == 0 {
-        return Ok(Mat::identity(c, c));
-    }
-    // Pad with zero rows so that all c right singular vectors are returned.
-    let rows = r.max(c);
-    let mp = Mat::from_fn(rows, c, |i, j| if i < r { m[(i, j)] } else { 0.0 });
-    let svd = mp
-        .svd()
-        .map_err(|e| super::eig_error("SVD (null space)", e))?;
-    let (s, v) = (svd.S().column_vector(), svd.V());
-    let smax = if c > 0 { s[0] } else { 0.0 };
-    let rank = (0..c).filter(|&k| s[k] > RANK_TOL * smax).count();
-    Ok(Mat::from_fn(c, c - rank, |i, j| v[(i, rank + j)]))
-}
-
-/// An orthonormal basis of the column space of `m`.
-fn range(m: &Mat) -> Result<Mat> {
-    if m.ncols() == 0 {
-        return Ok(Mat::zeros(m.nrows(), 0));
-    }
-    let svd = m
-        .thin_svd()
-        .map_err(|e| super::eig_error("SVD (range)", e))?;
-    let (u, s) = (svd.U(), svd.S().column_vector());
-    let smax = s[0];
-    let rank = (0..s.nrows()).filter(|&k| s[k] > RANK_TOL * smax).count();
-    Ok(Mat::from_fn(m.nrows(), rank, |i, j| u[(i, j)]))
 }
 
 /// Stability of the relative equilibrium z(t) = exp(tξ)·z₀ (module docs): z₀ a state (user
@@ -242,12 +207,12 @@ pub fn stability<P: Constrained + Symmetric + SeparableTangent>(
             }
     });
     let gens_s = Mat::from_fn(nz, g, |i, j| gens[(i, j)] / wz[i]);
-    let s_basis = null_space(&stack)?;
-    let iso = null_space(&(&dj * &gens))?;
-    let w_basis = range(&(&gens_s * &iso))?;
+    let s_basis = super::null_space(&stack)?;
+    let iso = super::null_space(&(&dj * &gens))?;
+    let w_basis = super::range(&(&gens_s * &iso))?;
     // Coordinates of W in S, then the complement inside S.
     let w_in_s = s_basis.transpose() * &w_basis;
-    let comp = null_space(&w_in_s.transpose().to_owned())?;
+    let comp = super::null_space(&w_in_s.transpose().to_owned())?;
     let cs = &s_basis * &comp;
     let k = cs.ncols();
     // C in z (columns diag(w)·c̃) and its left inverse on the normal space, c̃ᵀ diag(1/w).

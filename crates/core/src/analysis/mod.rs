@@ -6,6 +6,7 @@
 
 pub mod comoving;
 pub mod continuation;
+pub mod periodic;
 
 use crate::error::{Error, Result};
 use crate::Mat;
@@ -104,4 +105,36 @@ pub(crate) fn eig_error(what: &str, e: impl std::fmt::Debug) -> Error {
 pub(crate) fn sorted(mut v: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     v.sort_by(|x, y| y.0.total_cmp(&x.0).then(y.1.total_cmp(&x.1)));
     v
+}
+
+/// Rank tolerance of the subspaces ([`null_space`], [`range`]): singular values below this
+/// times the largest are zero.
+const RANK_TOL: f64 = 1e-9;
+
+/// An orthonormal basis (columns) of the null space of `m` (rows × cols), by the SVD.
+pub(crate) fn null_space(m: &Mat) -> Result<Mat> {
+    let (r, c) = (m.nrows(), m.ncols());
+    if r == 0 {
+        return Ok(Mat::identity(c, c));
+    }
+    // Pad with zero rows so that all c right singular vectors are returned.
+    let rows = r.max(c);
+    let mp = Mat::from_fn(rows, c, |i, j| if i < r { m[(i, j)] } else { 0.0 });
+    let svd = mp.svd().map_err(|e| eig_error("SVD (null space)", e))?;
+    let (s, v) = (svd.S().column_vector(), svd.V());
+    let smax = if c > 0 { s[0] } else { 0.0 };
+    let rank = (0..c).filter(|&k| s[k] > RANK_TOL * smax).count();
+    Ok(Mat::from_fn(c, c - rank, |i, j| v[(i, rank + j)]))
+}
+
+/// An orthonormal basis of the column space of `m`.
+pub(crate) fn range(m: &Mat) -> Result<Mat> {
+    if m.ncols() == 0 {
+        return Ok(Mat::zeros(m.nrows(), 0));
+    }
+    let svd = m.thin_svd().map_err(|e| eig_error("SVD (range)", e))?;
+    let (u, s) = (svd.U(), svd.S().column_vector());
+    let smax = s[0];
+    let rank = (0..s.nrows()).filter(|&k| s[k] > RANK_TOL * smax).count();
+    Ok(Mat::from_fn(m.nrows(), rank, |i, j| u[(i, j)]))
 }

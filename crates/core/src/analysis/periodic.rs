@@ -1,0 +1,450 @@
+//! Periodic orbits of a method's own map by shooting, their monodromy matrix and Floquet
+//! multipliers; relative periodic orbits of the bodies that carry an attitude (issue 27).
+//!
+//! A periodic orbit of period T is sought as a fixed point of the method's map over N steps of
+//! size h = T/N: Φ_h^N(z₀) = z₀ — the orbit the run computes, closing to round-off, not an orbit
+//! of the continuous flow approximated afterwards. A periodic orbit of a conservative system is
+//! never isolated: it comes with its phase (every point of the orbit is a start), in a family
+//! along the energy (fix the energy E or the period T, the other is an unknown) and along the
+//! levels of the invariants the method keeps (Casimirs, momentum maps). The shooting equations
+//! therefore are, for the unknowns (z₀, T) (fix = energy) or z₀ (fix = period):
+//!
+//! * Φ_{T/N}^N(z₀) − z₀ = 0 (d equations);
+//! * H(z₀) = E (fix = energy, E the guess's energy);
+//! * ⟨v, z₀ − ẑ⟩ = 0, the phase: a hyperplane through the guess ẑ across the flow v at ẑ;
+//! * I_j(z₀) = I_j(ẑ), the levels of the invariants ([`Problem::invariants`]).
+//!
+//! They are more equations than unknowns but consistent at an orbit, and solved by the
+//! Gauss–Newton iteration (the minimum-norm least-squares update, by the SVD): quadratic
+//! convergence at an orbit whose only degeneracies are the ones removed. The Jacobian of the
+//! first block is [M − I, ∂z_N/∂T] with M = ∂z_N/∂z₀ the monodromy of the method's map, exact to
+//! round-off from the tangent lift (the sensitivities of [`crate::integrate::tangent`]); the
+//! derivative along the period, at N fixed (the step changes with T), is the central difference
+//! of two plain runs over T ± δ (δ = T·ε^(1/3), error ≈ 1e-11 relative: a column of the Newton
+//! matrix, never of the result). The gradients of H and of the invariants (rows of the matrix
+//! only) are differences too. The iteration stops under the rule of [`crate::convergence`]
+//! and the orbit is evaluated once more at the accepted point, so the reported monodromy and
+//! residual are those of the returned state.
+//!
+//! **Floquet multipliers.** The eigenvalues of M. At a periodic orbit of a system with k
+//! independent conserved quantities c_j (the energy and the invariants), M maps the tangent
+//! space of their common level set into itself and fixes the flow direction f; the
+//! multipliers of the orbit's *normal* motion are those of the map M induces on the quotient
+//! T(level)/⟨f⟩ (represented on V = T(level) ∩ f⊥ as Vᵀ(I − f̂f̂ᵀ)MV); the other k + 1 are
+//! *trivial* (equal to 1 for an exact flow: in Jordan blocks where the period varies along the
+//! family). The trivial ones are flagged among the eigenvalues of M as the k + 1 nearest to 1.
+//! The orbit is (spectrally) stable when every normal multiplier lies on or inside the unit
+//! circle to [`STABLE_TOL`]. For a method that keeps a modified energy H̃ = H + O(hᵖ) (the
+//! symplectic ones), f and T(level) are those of the modified flow to O(hᵖ), and so are the
+//! normal multipliers.
+
+use super::{eig_error, general_eigenvalues, null_space};
+use crate::convergence::{Monitor, Rule, Verdict};
+use crate::error::{Error, Result};
+use crate::integrate::tangent::TangentSystem;
+use crate::integrate::{integrate, System};
+use crate::numerics::fd::{self, Scheme};
+use crate::Mat;
+
+/// What the shooting keeps fixed along the family of the orbit (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fix {
+    /// The energy of the guess; the period is an unknown.
+    Energy,
+    /// The period given; the energy is an unknown.
+    Period,
+}
+
+/// The shooting's discretisation and stopping rule ([`periodic_orbit`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// N, the method's steps per period (the step is T/N).
+    pub steps: usize,
+    /// Energy or period fixed.
+    pub fix: Fix,
+    /// An update of the unknowns below tol (relative: the state to max(1, ‖ẑ‖∞), the period to
+    /// itself) is accepted; the iteration then goes on while the update decreases.
+    pub tol: f64,
+    /// Gauss–Newton iterations allowed.
+    pub max_iter: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            steps: 1000,
+            fix: Fix::Energy,
+            tol: 1e-10,
+            max_iter: 30,
+        }
+    }
+}
+
+/// A normal multiplier of modulus above 1 + STABLE_TOL makes the orbit unstable.
+pub const STABLE_TOL: f64 = 1e-6;
+
+/// An orbit whose relative residual ‖Φ(z₀) − z₀‖∞/max(1, ‖z₀‖∞) exceeds this after the
+/// iteration stopped is not returned (the equations had no solution near the guess).
+const RESIDUAL_LIMIT: f64 = 1e-6;
+
+/// Singular values below this times the largest are zero in the least-squares update.
+const RCOND: f64 = 1e-12;
+
+/// A periodic orbit of a method's map ([`periodic_orbit`]).
+#[derive(Clone, Debug)]
+pub struct PeriodicOrbit {
+    /// The point of the orbit on the phase hyperplane (user frame).
+    pub state0: Vec<f64>,
+    /// The period T.
+    pub period: f64,
+    /// The method's steps per period (the step is T/steps).
+    pub steps: usize,
+    /// H(state0).
+    pub energy: f64,
+    /// M = ∂z_N/∂z₀ at state0 (e × e).
+    pub monodromy: Mat,
+    /// The eigenvalues of M (re, im), by descending modulus.
+    pub multipliers: Vec<(f64, f64)>,
+    /// Which of [`PeriodicOrbit::multipliers`] are trivial (module docs).
+    pub trivial: Vec<bool>,
+    /// The normal multipliers: the eigenvalues of the map M induces across the flow on the
+    /// level set of the conserved quantities, by descending modulus.
+    pub normal: Vec<(f64, f64)>,
+    /// ‖Φ(state0) − state0‖∞, absolute.
+    pub residual: f64,
+    /// The Gauss–Newton iterations taken.
+    pub iterations: usize,
+}
+
+impl PeriodicOrbit {
+    /// Whether every normal multiplier has modulus at most 1 + [`STABLE_TOL`] (spectral
+    /// stability; for a symplectic map all lie on the unit circle then).
+    pub fn stable(&self) -> bool {
+        self.normal
+            .iter()
+            .all(|&(re, im)| re.hypot(im) <= 1.0 + STABLE_TOL)
+    }
+}
+
+/// One shot from z₀ over T: the end state, the monodromy and the end's derivative along T.
+struct Shot {
+    end: Vec<f64>,
+    monodromy: Mat,
+    along: Vec<f64>,
+}
+
+/// The system's lift for `method`, refused where its directions are not the state's values.
+fn lift_of(system: &dyn System, method: &str) -> Result<std::sync::Arc<dyn TangentSystem>> {
+    system.resolve(method)?;
+    let lift = Some(())
+        .filter(|_| system.tangent_methods().contains(&method))
+        .and_then(|_| system.tangent_for(method))
+        .ok_or_else(|| Error::InvalidArgument {
+            what: "method".into(),
+            message: format!(
+                "{} has no tangent maps for {method:?}, which the monodromy matrix needs \
+                 (methods with them: {:?})",
+                system.name(),
+                system.tangent_methods()
+            ),
+        })?;
+    if lift.tangent_dim() != lift.base_dim() {
+        return Err(Error::InvalidArgument {
+            what: "system".into(),
+            message: format!(
+                "periodic orbits of states with SO(3) blocks ({}: {} values, {} directions) are \
+                 not built; shoot the reduced state and pass its attitude for the drift",
+                system.name(),
+                lift.base_dim(),
+                lift.tangent_dim()
+            ),
+        });
+    }
+    Ok(lift)
+}
+
+/// The end of N steps of size T/N from z₀ (a plain run).
+fn end_of(
+    system: &dyn System,
+    method: &str,
+    z0: &[f64],
+    period: f64,
+    n: usize,
+) -> Result<Vec<f64>> {
+    let traj = integrate(system, method, z0, period / n as f64, n, n)?;
+    Ok(traj.state(1).to_vec())
+}
+
+fn shoot(
+    system: &dyn System,
+    lift: &dyn TangentSystem,
+    method: &str,
+    z0: &[f64],
+    period: f64,
+    n: usize,
+) -> Result<Shot> {
+    let (d, p) = (lift.base_dim(), lift.parameter_names().len());
+    let seed = lift.seed(z0)?;
+    let traj = integrate(lift, method, &seed, period / n as f64, n, n)?;
+    let (mut end, mut jac, mut pjac) = (vec![0.0; d], vec![0.0; d * d], vec![0.0; d * p]);
+    lift.jacobian(traj.state(1), &mut end, &mut jac, &mut pjac);
+    // ∂z_N/∂T at N fixed: the step is T/N, so T ± δ changes every step.
+    let delta = period * f64::EPSILON.cbrt();
+    let (tp, tm) = (period + delta, period - delta);
+    let (zp, zm) = (
+        end_of(system, method, z0, tp, n)?,
+        end_of(system, method, z0, tm, n)?,
+    );
+    let span = (tp / n as f64 - tm / n as f64) * n as f64;
+    let along = zp.iter().zip(&zm).map(|(a, b)| (a - b) / span).collect();
+    Ok(Shot {
+        end,
+        monodromy: Mat::from_fn(d, d, |i, j| jac[i * d + j]),
+        along,
+    })
+}
+
+/// The conserved quantities' values (H, then the invariants) and their gradients (rows).
+fn conserved(system: &dyn System, z: &[f64]) -> Result<(Vec<f64>, Mat)> {
+    let values = |x: &[f64]| -> Result<Vec<f64>> {
+        let mut v = vec![system.energy(x)?];
+        v.extend(system.invariants(x)?);
+        Ok(v)
+    };
+    let h: Vec<f64> = z.iter().map(|x| 1e-4 * x.abs().max(1.0)).collect();
+    Ok((
+        values(z)?,
+        fd::jacobian(&values, z, &h, Scheme::Richardson)?,
+    ))
+}
+
+/// The minimum-norm least-squares solution of A x = b (thin SVD, singular values below
+/// [`RCOND`]·σ_max dropped).
+fn least_squares(a: &Mat, b: &[f64]) -> Result<Vec<f64>> {
+    let svd = a
+        .thin_svd()
+        .map_err(|e| eig_error("SVD of the shooting matrix", e))?;
+    let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
+    let smax = if s.nrows() > 0 { s[0] } else { 0.0 };
+    let mut x = vec![0.0; a.ncols()];
+    for k in 0..s.nrows() {
+        if s[k] <= RCOND * smax || s[k] == 0.0 {
+            continue;
+        }
+        let c = (0..a.nrows()).map(|i| u[(i, k)] * b[i]).sum::<f64>() / s[k];
+        for (j, xj) in x.iter_mut().enumerate() {
+            *xj += c * v[(j, k)];
+        }
+    }
+    Ok(x)
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+fn unit(v: &[f64]) -> Result<Vec<f64>> {
+    let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(n > 0.0 && n.is_finite()) {
+        return Err(Error::InvalidArgument {
+            what: "state0".into(),
+            message: "the flow vanishes there (an equilibrium has no period)".into(),
+        });
+    }
+    Ok(v.iter().map(|x| x / n).collect())
+}
+
+/// Finds a periodic orbit of `method`'s map near the guess `z0` with period near `period`
+/// (module docs): the Gauss–Newton iteration on the shooting equations.
+///
+/// # Errors
+/// [`Error::InvalidArgument`] (period ≤ 0 or not finite, steps = 0, a method without tangent
+/// maps, a state with SO(3) blocks, a guess at an equilibrium), the errors of the runs (shape,
+/// constraints, [`Error::NotConverged`] of an implicit step), and [`Error::NotConverged`] when
+/// the iteration fails or stops on a point that is not periodic (relative residual above 1e-6).
+pub fn periodic_orbit(
+    system: &dyn System,
+    method: &str,
+    z0: &[f64],
+    period: f64,
+    options: &Options,
+) -> Result<PeriodicOrbit> {
+    if !(period > 0.0 && period.is_finite()) {
+        return Err(Error::InvalidArgument {
+            what: "period".into(),
+            message: format!("expected a finite time > 0, got {period}"),
+        });
+    }
+    let n = options.steps;
+    if n == 0 {
+        return Err(Error::InvalidArgument {
+            what: "steps".into(),
+            message: "expected an integer >= 1 (steps per period), got 0".into(),
+        });
+    }
+    let lift = lift_of(system, method)?;
+    let d = lift.base_dim();
+    let energy_fixed = options.fix == Fix::Energy;
+    let guess = z0.to_vec();
+    let scale = inf_norm(&guess).max(1.0);
+    // The phase hyperplane: across the flow at the guess, estimated by one step.
+    let v = {
+        let z1 = end_of(system, method, &guess, period / n as f64, 1)?;
+        unit(
+            &z1.iter()
+                .zip(&guess)
+                .map(|(a, b)| a - b)
+                .collect::<Vec<_>>(),
+        )?
+    };
+    let (levels, _) = conserved(system, &guess)?;
+    let (mut z, mut t) = (guess.clone(), period);
+    let unknowns = d + usize::from(energy_fixed);
+    let rule = Rule {
+        tol: options.tol,
+        floor: 4.0 * f64::EPSILON,
+        max_iter: options.max_iter,
+    };
+    let mut monitor = Monitor::new(rule);
+    let mut accepted = false;
+    loop {
+        let shot = shoot(system, lift.as_ref(), method, &z, t, n)?;
+        let gap: Vec<f64> = shot.end.iter().zip(&z).map(|(a, b)| a - b).collect();
+        if accepted {
+            return finish(system, z, t, n, shot, &gap, monitor.iterations());
+        }
+        // Rows: the map (d), then each conserved quantity and the phase, each scaled to a unit
+        // normal; the energy's row only with the energy fixed.
+        let (values, grads) = conserved(system, &z)?;
+        let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
+        for (c, (&value, &level)) in values.iter().zip(&levels).enumerate() {
+            if c == 0 && !energy_fixed {
+                continue;
+            }
+            let g: Vec<f64> = (0..d).map(|j| grads[(c, j)]).collect();
+            let norm = g.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm > 0.0 && norm.is_finite() {
+                rows.push((g.iter().map(|x| x / norm).collect(), (level - value) / norm));
+            }
+        }
+        let phase = -(0..d).map(|j| v[j] * (z[j] - guess[j])).sum::<f64>();
+        rows.push((v.clone(), phase));
+        let m = d + rows.len();
+        let a = Mat::from_fn(m, unknowns, |i, j| {
+            if i < d {
+                if j < d {
+                    shot.monodromy[(i, j)] - if i == j { 1.0 } else { 0.0 }
+                } else {
+                    shot.along[i] * t // the unknown τ = δT/T
+                }
+            } else if j < d {
+                rows[i - d].0[j]
+            } else {
+                0.0
+            }
+        });
+        let b: Vec<f64> = (0..m)
+            .map(|i| if i < d { -gap[i] } else { rows[i - d].1 })
+            .collect();
+        let step = least_squares(&a, &b)?;
+        for (zj, s) in z.iter_mut().zip(&step) {
+            *zj += s;
+        }
+        let mut update = inf_norm(&step[..d]) / scale;
+        if energy_fixed {
+            t *= 1.0 + step[d];
+            update = update.max(step[d].abs());
+            if !(t > 0.0) {
+                update = f64::INFINITY;
+            }
+        }
+        match monitor.check(update, 1.0) {
+            Verdict::Continue => {}
+            Verdict::Converged => accepted = true,
+            Verdict::Failed(failed) => {
+                return Err(Error::NotConverged {
+                    what: format!(
+                        "periodic orbit (Gauss–Newton on the shooting equations; last \
+                         ‖Φ(z) − z‖∞ = {:.3e})",
+                        inf_norm(&gap)
+                    ),
+                    iterations: failed.iterations,
+                    residual: failed.residual,
+                    tol: rule.tol,
+                })
+            }
+        }
+    }
+}
+
+/// The orbit at the accepted point: residual, multipliers, their split.
+fn finish(
+    system: &dyn System,
+    z: Vec<f64>,
+    period: f64,
+    steps: usize,
+    shot: Shot,
+    gap: &[f64],
+    iterations: usize,
+) -> Result<PeriodicOrbit> {
+    let residual = inf_norm(gap);
+    if !(residual <= RESIDUAL_LIMIT * inf_norm(&z).max(1.0)) {
+        return Err(Error::NotConverged {
+            what: "periodic orbit (the shooting settled on a point that is not periodic: no \
+                   orbit of this period or energy near the guess)"
+                .into(),
+            iterations,
+            residual,
+            tol: RESIDUAL_LIMIT,
+        });
+    }
+    let d = z.len();
+    let m = &shot.monodromy;
+    let multipliers = by_modulus(general_eigenvalues(m)?);
+    // The quotient across the flow on the level set (module docs).
+    let (values, grads) = conserved(system, &z)?;
+    let f = unit(&shot.along)?;
+    let stack = Mat::from_fn(values.len() + 1, d, |i, j| {
+        if i < values.len() {
+            grads[(i, j)]
+        } else {
+            f[j]
+        }
+    });
+    let basis = null_space(&stack)?;
+    let q = basis.ncols();
+    let pm = Mat::from_fn(d, d, |i, j| {
+        m[(i, j)] - f[i] * (0..d).map(|k| f[k] * m[(k, j)]).sum::<f64>()
+    });
+    let reduced = basis.transpose() * &pm * &basis;
+    let normal = by_modulus(general_eigenvalues(&reduced.to_owned())?);
+    let mut order: Vec<usize> = (0..d).collect();
+    let distance = |k: usize| (multipliers[k].0 - 1.0).hypot(multipliers[k].1);
+    order.sort_by(|&a, &b| distance(a).total_cmp(&distance(b)));
+    let mut trivial = vec![false; d];
+    for &k in &order[..d - q] {
+        trivial[k] = true;
+    }
+    Ok(PeriodicOrbit {
+        energy: system.energy(&z)?,
+        state0: z,
+        period,
+        steps,
+        monodromy: shot.monodromy,
+        multipliers,
+        trivial,
+        normal,
+        residual,
+        iterations,
+    })
+}
+
+/// By descending modulus, then descending argument.
+fn by_modulus(mut v: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    v.sort_by(|x, y| {
+        y.0.hypot(y.1)
+            .total_cmp(&x.0.hypot(x.1))
+            .then(y.1.atan2(y.0).total_cmp(&x.1.atan2(x.0)))
+    });
+    v
+}

@@ -1,0 +1,242 @@
+//! Periodic orbits by shooting (`analysis::periodic`): the free rigid body's period against the
+//! closed form 4K(k)/λ on both sides of the separatrix (exact flow and DMV10), the Jordan
+//! structure of its monodromy, a nonlinear oscillator's normal multipliers against the
+//! linearisation, and the errors of bad input. Measured values are printed (`--nocapture`).
+
+use lieflow::analysis::periodic::{periodic_orbit, Fix, Options};
+use lieflow::integrate::Problem;
+use lieflow::numerics::elliptic::ellipk;
+use lieflow::systems::RigidBody;
+
+const I: [f64; 3] = [1.0, 2.0, 3.0];
+
+/// The period of M(t) in closed form (Landau–Lifshitz §37): 4K(k)/λ, the axes relabelled so
+/// that the orbit circles axis 1 or 3 as the case requires.
+fn closed_form_period(m: [f64; 3]) -> f64 {
+    let l2: f64 = m.iter().map(|x| x * x).sum();
+    let e2: f64 = (0..3).map(|k| m[k] * m[k] / I[k]).sum();
+    // Landau's I1 < I2 < I3 with M² > 2E I2; otherwise 1 and 3 exchange.
+    let (i1, i2, i3) = if l2 > e2 * I[1] {
+        (I[0], I[1], I[2])
+    } else {
+        (I[2], I[1], I[0])
+    };
+    let lambda = ((i3 - i2) * (l2 - e2 * i1) / (i1 * i2 * i3)).sqrt();
+    let k2 = (i2 - i1) * (e2 * i3 - l2) / ((i3 - i2) * (l2 - e2 * i1));
+    4.0 * ellipk(k2).unwrap() / lambda
+}
+
+fn options(steps: usize, fix: Fix) -> Options {
+    Options {
+        steps,
+        fix,
+        ..Options::default()
+    }
+}
+
+#[test]
+fn the_free_body_period_is_the_closed_form_on_both_sides_of_the_separatrix() {
+    let body = RigidBody::new(I).unwrap();
+    // About the least axis (M² < 2E I2 relabelled) and about the largest; one near the separatrix.
+    for m0 in [
+        [1.0, 0.3, 0.2],
+        [0.2, 0.3, 1.0],
+        [0.3, 1.0, 0.25],
+        [0.25, 1.0, 0.3],
+    ] {
+        // The shooting keeps the guess's energy and Casimir: the orbit is the one through m0,
+        // found from a period off by 2 %.
+        let exact = closed_form_period(m0);
+        for (method, steps) in [("exact", 8), ("dmv10", 400)] {
+            let orbit = periodic_orbit(
+                &body,
+                method,
+                &m0,
+                exact * 1.02,
+                &options(steps, Fix::Energy),
+            )
+            .unwrap();
+            let err = (orbit.period - exact).abs() / exact;
+            println!(
+                "M0 = {m0:?} {method}: T = {:.15} closed form {exact:.15} rel {err:.2e}, \
+                 residual {:.1e}, {} iterations",
+                orbit.period, orbit.residual, orbit.iterations
+            );
+            assert!(err <= 1e-10, "{method}: {err:e}");
+            assert!(orbit.residual <= 1e-13, "{}", orbit.residual);
+            // On the levels of m0 (energy fixed, Casimir kept).
+            assert!((orbit.energy - body.energy(&m0).unwrap()).abs() <= 1e-14);
+        }
+    }
+}
+
+#[test]
+fn the_free_body_monodromy_is_one_jordan_block_and_a_simple_one() {
+    // M fixes the flow; along the family the period varies (shear): (M − I)² = 0, M ≠ I, every
+    // multiplier trivial (one degree of freedom on the momentum sphere leaves no normal motion).
+    let body = RigidBody::new(I).unwrap();
+    for m0 in [[1.0, 0.3, 0.2], [0.25, 1.0, 0.3]] {
+        let orbit = periodic_orbit(
+            &body,
+            "exact",
+            &m0,
+            closed_form_period(m0),
+            &options(8, Fix::Energy),
+        )
+        .unwrap();
+        let m = &orbit.monodromy;
+        let n = lieflow::Mat::from_fn(3, 3, |i, j| m[(i, j)] - if i == j { 1.0 } else { 0.0 });
+        let n2 = &n * &n;
+        let size = |a: &lieflow::Mat| {
+            (0..3)
+                .flat_map(|i| (0..3).map(move |j| (i, j)))
+                .fold(0.0_f64, |s, (i, j)| s.max(a[(i, j)].abs()))
+        };
+        let spread = orbit
+            .multipliers
+            .iter()
+            .fold(0.0_f64, |s, &(re, im)| s.max((re - 1.0).hypot(im)));
+        println!(
+            "M0 = {m0:?}: |M − I| = {:.3e}, |(M − I)²| = {:.3e}, multipliers within {spread:.1e} \
+             of 1",
+            size(&n),
+            size(&n2)
+        );
+        assert!(size(&n) > 0.1, "the period varies along the family");
+        assert!(size(&n2) <= 1e-9 * size(&n).powi(2), "{}", size(&n2));
+        // A Jordan block of size 2 splits its eigenvalues by √ε.
+        assert!(spread <= 1e-6, "{spread:e}");
+        assert!(orbit.trivial.iter().all(|&t| t) && orbit.normal.is_empty());
+        assert!(orbit.stable());
+    }
+}
+
+/// ½|p|² + ½x² + ½ω²y² + ½βx²y²: the orbits y = 0 are the harmonic x-oscillations (period 2π),
+/// and the motion across them obeys Mathieu's equation δÿ + (ω² + βA²cos²t)δy = 0.
+fn coupled(omega: f64, beta: f64) -> lieflow::systems::UserSeparable {
+    use lieflow::systems::{KineticMass, UserSeparable};
+    use std::sync::Arc;
+    let w2 = omega * omega;
+    let u = Arc::new(move |q: &[f64]| -> lieflow::Result<f64> {
+        let (x, y) = (q[0], q[1]);
+        Ok(0.5 * (x * x + w2 * y * y + beta * x * x * y * y))
+    });
+    let g = Arc::new(move |q: &[f64], g: &mut [f64]| -> lieflow::Result<()> {
+        let (x, y) = (q[0], q[1]);
+        g[0] = x + beta * x * y * y;
+        g[1] = w2 * y + beta * x * x * y;
+        Ok(())
+    });
+    let h = Arc::new(
+        move |q: &[f64], v: &[f64], out: &mut [f64]| -> lieflow::Result<()> {
+            let (x, y) = (q[0], q[1]);
+            out[0] = (1.0 + beta * y * y) * v[0] + 2.0 * beta * x * y * v[1];
+            out[1] = 2.0 * beta * x * y * v[0] + (w2 + beta * x * x) * v[1];
+            Ok(())
+        },
+    );
+    UserSeparable::new(KineticMass::Scalar(1.0), Some(2), u, Some(g))
+        .unwrap()
+        .with_hessian(h)
+}
+
+/// The eigenvalues of Mathieu's monodromy over 2π (classical RK4, 20000 steps).
+fn mathieu_multipliers(omega: f64, beta: f64, amplitude: f64) -> [(f64, f64); 2] {
+    let f = |t: f64, y: [f64; 2]| {
+        let c = t.cos();
+        [
+            y[1],
+            -(omega * omega + beta * amplitude * amplitude * c * c) * y[0],
+        ]
+    };
+    let n = 20000;
+    let h = 2.0 * std::f64::consts::PI / n as f64;
+    let mut cols = [[1.0, 0.0], [0.0, 1.0]];
+    for col in cols.iter_mut() {
+        let mut y = *col;
+        for k in 0..n {
+            let t = k as f64 * h;
+            let k1 = f(t, y);
+            let k2 = f(
+                t + h / 2.0,
+                [y[0] + h / 2.0 * k1[0], y[1] + h / 2.0 * k1[1]],
+            );
+            let k3 = f(
+                t + h / 2.0,
+                [y[0] + h / 2.0 * k2[0], y[1] + h / 2.0 * k2[1]],
+            );
+            let k4 = f(t + h, [y[0] + h * k3[0], y[1] + h * k3[1]]);
+            for i in 0..2 {
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        *col = y;
+    }
+    // Eigenvalues of [[a, b], [c, d]] with columns cols.
+    let (a, b, c, d) = (cols[0][0], cols[1][0], cols[0][1], cols[1][1]);
+    let (tr, det) = (a + d, a * d - b * c);
+    let disc = tr * tr / 4.0 - det;
+    if disc < 0.0 {
+        [(tr / 2.0, (-disc).sqrt()), (tr / 2.0, -(-disc).sqrt())]
+    } else {
+        [(tr / 2.0 + disc.sqrt(), 0.0), (tr / 2.0 - disc.sqrt(), 0.0)]
+    }
+}
+
+#[test]
+fn normal_multipliers_are_those_of_the_linearisation_across_the_orbit() {
+    let (omega, beta) = (1.3, 0.4);
+    let sys = coupled(omega, beta);
+    // A guess off the orbit (y ≠ 0) and off in period: the orbit found is y = 0 at the
+    // guess's energy.
+    let guess = [0.8, 0.01, 0.0, 0.005];
+    for (method, steps, tol) in [("gauss6", 200, 1e-10), ("verlet4", 2000, 1e-10)] {
+        let orbit =
+            periodic_orbit(&sys, method, &guess, 6.0, &options(steps, Fix::Energy)).unwrap();
+        let z = &orbit.state0;
+        let amplitude = (z[0] * z[0] + z[2] * z[2]).sqrt();
+        let reference = mathieu_multipliers(omega, beta, amplitude);
+        let err = orbit
+            .normal
+            .iter()
+            .zip(&reference)
+            .fold(0.0_f64, |m, (a, b)| m.max((a.0 - b.0).hypot(a.1 - b.1)));
+        println!(
+            "{method}: T − 2π = {:.2e}, y = {:.1e}, normal {:?} vs Mathieu {reference:?}: {err:.1e}",
+            orbit.period - 2.0 * std::f64::consts::PI,
+            z[1].abs().max(z[3].abs()),
+            orbit.normal
+        );
+        assert_eq!(orbit.normal.len(), 2);
+        assert!(err <= tol, "{method}: {err:e}");
+        assert!((orbit.period - 2.0 * std::f64::consts::PI).abs() <= 10.0 * tol);
+        assert!(orbit.stable());
+        assert_eq!(orbit.trivial.iter().filter(|&&t| t).count(), 2);
+    }
+}
+
+#[test]
+fn bad_input_is_refused_with_what_was_expected() {
+    let body = RigidBody::new(I).unwrap();
+    let m0 = [1.0, 0.3, 0.2];
+    let err = |r: lieflow::Result<_>| {
+        r.map(|_: lieflow::analysis::periodic::PeriodicOrbit| ())
+            .unwrap_err()
+            .to_string()
+    };
+    let o = options(8, Fix::Energy);
+    assert!(err(periodic_orbit(&body, "exact", &m0, -1.0, &o)).contains("invalid period"));
+    assert!(err(periodic_orbit(&body, "exact", &m0, f64::NAN, &o)).contains("invalid period"));
+    assert!(err(periodic_orbit(
+        &body,
+        "exact",
+        &m0,
+        1.0,
+        &options(0, Fix::Energy)
+    ))
+    .contains("steps"));
+    assert!(err(periodic_orbit(&body, "exact", &[1.0, 0.0], 1.0, &o)).contains("shape"));
+    assert!(err(periodic_orbit(&body, "nope", &m0, 1.0, &o)).contains("not supported"));
+    // A steady rotation is an equilibrium of M: no period.
+    assert!(err(periodic_orbit(&body, "exact", &[1.0, 0.0, 0.0], 1.0, &o)).contains("equilibrium"));
+}
