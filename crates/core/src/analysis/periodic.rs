@@ -354,7 +354,7 @@ pub fn periodic_orbit(
         if energy_fixed {
             t *= 1.0 + step[d];
             update = update.max(step[d].abs());
-            if !(t > 0.0) {
+            if t.is_nan() || t <= 0.0 {
                 update = f64::INFINITY;
             }
         }
@@ -388,7 +388,7 @@ fn finish(
     iterations: usize,
 ) -> Result<PeriodicOrbit> {
     let residual = inf_norm(gap);
-    if !(residual <= RESIDUAL_LIMIT * inf_norm(&z).max(1.0)) {
+    if residual.is_nan() || residual > RESIDUAL_LIMIT * inf_norm(&z).max(1.0) {
         return Err(Error::NotConverged {
             what: "periodic orbit (the shooting settled on a point that is not periodic: no \
                    orbit of this period or energy near the guess)"
