@@ -240,3 +240,60 @@ fn bad_input_is_refused_with_what_was_expected() {
     // A steady rotation is an equilibrium of M: no period.
     assert!(err(periodic_orbit(&body, "exact", &[1.0, 0.0, 0.0], 1.0, &o)).contains("equilibrium"));
 }
+
+/// The solid angle Λ = ∮(1 − cos ϑ) dφ enclosed by M(t)/‖M‖ over one period, the pole on the
+/// principal axis the orbit circles, oriented by the motion: the periodic trapezoidal rule on
+/// samples of the exact solution (exponentially accurate for a smooth periodic integrand).
+fn solid_angle(body: &RigidBody, m0: [f64; 3], period: f64) -> f64 {
+    let n = 4000;
+    let traj = lieflow::integrate::integrate(body, "exact", &m0, period / n as f64, n, 1).unwrap();
+    let l: f64 = m0.iter().map(|x| x * x).sum::<f64>().sqrt();
+    // The pole: the axis whose component keeps its sign.
+    let pole = if m0[0].abs() > m0[2].abs() && traj.states.chunks(3).all(|m| m[0] * m0[0] > 0.0) {
+        0
+    } else {
+        2
+    };
+    let (a, b) = ((pole + 1) % 3, (pole + 2) % 3);
+    let sign = m0[pole].signum();
+    let mut sum = 0.0;
+    for m in traj.states.chunks(3).take(n) {
+        let w = [m[0] / I[0], m[1] / I[1], m[2] / I[2]];
+        let mdot = [m[1] * w[2] - m[2] * w[1], m[2] * w[0] - m[0] * w[2], m[0] * w[1] - m[1] * w[0]];
+        let phidot = (m[a] * mdot[b] - m[b] * mdot[a]) / (m[a] * m[a] + m[b] * m[b]);
+        // About the pole's positive direction (ϑ from +pole): a pole at −axis flips both.
+        sum += (1.0 - sign * m[pole] / l) * phidot * sign;
+    }
+    sum * period / n as f64
+}
+
+#[test]
+fn the_relative_orbit_drift_is_montgomery_s_angle() {
+    use lieflow::analysis::periodic::attitude_drift;
+    use lieflow::lie::so3;
+    let body = RigidBody::new(I).unwrap();
+    let r0 = so3::exp_unchecked(&nalgebra::Vector3::new(0.4, -0.7, 0.3));
+    let rows: [f64; 9] = std::array::from_fn(|k| r0[(k / 3, k % 3)]);
+    for m0 in [[1.0, 0.3, 0.2], [0.2, 0.3, 1.0], [0.25, 1.0, 0.3], [-0.3, 1.0, -0.25]] {
+        let t = closed_form_period(m0);
+        let l = m0.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let e = body.energy(&m0).unwrap();
+        let expected = 2.0 * e * t / l - solid_angle(&body, m0, t);
+        let pi = r0 * nalgebra::Vector3::from(m0) / l;
+        for (method, steps) in [("exact", 8), ("dmv10", 400)] {
+            let orbit = periodic_orbit(&body, method, &m0, t, &options(steps, Fix::Energy)).unwrap();
+            let w = nalgebra::Vector3::from(attitude_drift(&body, method, &orbit, &rows).unwrap());
+            // g = exp(θ π̂): ω ∥ π, θ = ω·π̂ modulo 2π.
+            let theta = w.dot(&pi);
+            let across = (w - pi * theta).norm();
+            let tau = 2.0 * std::f64::consts::PI;
+            let diff = (theta - expected).rem_euclid(tau);
+            let err = diff.min(tau - diff);
+            println!(
+                "M0 = {m0:?} {method}: drift {theta:.15} Montgomery {expected:.15} (mod 2π) \
+                 err {err:.1e}, across π {across:.1e}"
+            );
+            assert!(err <= 1e-9 && across <= 1e-12, "{method}: {err:e} {across:e}");
+        }
+    }
+}

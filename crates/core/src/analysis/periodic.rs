@@ -448,3 +448,37 @@ fn by_modulus(mut v: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     });
     v
 }
+
+/// The drift of a relative periodic orbit of a body that carries an SO(3) attitude R
+/// ([`System::lift`]): its momentum (the reduced state) returns after the period while R
+/// does not; R(T) = g R(0) with g = exp(ω̂) a rotation of space (for the free rigid body about
+/// the spatial momentum R M, by the angle of Montgomery's formula). Returns ω, the rotation
+/// vector of g (‖ω‖ ≤ π), from a run of the system carrying `attitude` (rows of R(0)) over the
+/// orbit's steps with the same method.
+///
+/// # Errors
+/// [`Error::InvalidArgument`] for a system without an attitude; the errors of the run
+/// ([`Error::NotInGroup`] for an attitude that is not a rotation).
+pub fn attitude_drift(
+    system: &dyn System,
+    method: &str,
+    orbit: &PeriodicOrbit,
+    attitude: &[f64; 9],
+) -> Result<[f64; 3]> {
+    let d = orbit.state0.len();
+    let lifted = system
+        .lift()
+        .filter(|l| l.space().dim() == d + 9)
+        .ok_or_else(|| Error::InvalidArgument {
+            what: "attitude".into(),
+            message: format!("{} carries no SO(3) attitude", system.name()),
+        })?;
+    let mut z0 = orbit.state0.clone();
+    z0.extend_from_slice(attitude);
+    let n = orbit.steps;
+    let traj = integrate(lifted.as_ref(), method, &z0, orbit.period / n as f64, n, n)?;
+    let rows = |z: &[f64]| nalgebra::Matrix3::from_row_slice(&z[d..d + 9]);
+    let (r0, r1) = (rows(&z0), rows(traj.state(1)));
+    let w = crate::lie::so3::log_unchecked(&(r1 * r0.transpose()));
+    Ok([w[0], w[1], w[2]])
+}
