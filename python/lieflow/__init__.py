@@ -86,6 +86,7 @@ from . import (continuation, ellipsoids, elliptic, io, lie, plot, potentials, ps
 from . import ensemble  # imports dask and xarray only when its functions are called
 from .integrate import Trajectory, integrate, load
 from .io import FileFormatError
+from .periodic import PeriodicOrbit, periodic_orbit
 
 #: The former name of the base class of the Lie–Poisson systems (kept for existing code).
 LiePoissonSystem = System
@@ -112,6 +113,7 @@ __all__ = [
     "NonFiniteError",
     "NotInGroupError",
     "Pendulum",
+    "PeriodicOrbit",
     "PseudoRigidBody",
     "RelativisticTangentTop",
     "RigidBody",
@@ -138,6 +140,7 @@ __all__ = [
     "lie",
     "load",
     "mass_matrix",
+    "periodic_orbit",
     "plot",
     "potentials",
     "pseudo_rigid",

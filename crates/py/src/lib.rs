@@ -11,6 +11,7 @@ mod errors;
 mod integrate;
 mod items;
 mod lie;
+mod periodic;
 mod pseudo_rigid;
 mod sensitivity;
 mod system;
@@ -51,6 +52,7 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;
     m.add_class::<sensitivity::PyTangent>()?;
+    m.add_function(wrap_pyfunction!(periodic::_periodic_orbit, m)?)?;
     systems::register(m)?;
     system::add_system::<
         pseudo_rigid::system::PyPseudoRigidBody,

@@ -1,0 +1,102 @@
+//! `lieflow.periodic_orbit`'s native part: the binding of `lieflow::analysis::periodic`
+//! (shooting, monodromy, multipliers, the attitude's drift). Conversions only; the
+//! `PeriodicOrbit` object is built in Python (python/lieflow/periodic.py).
+
+use lieflow::analysis::periodic::{self as core, Fix, Options};
+use lieflow::Error;
+use numpy::{Complex64, IntoPyArray};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{py_mat, py_vec, real, real_matrix, size};
+use crate::errors::{checked, to_py};
+use crate::system::PySystem;
+
+fn complex(v: &[(f64, f64)]) -> Vec<Complex64> {
+    v.iter().map(|&(re, im)| Complex64::new(re, im)).collect()
+}
+
+/// The periodic orbit of `method`'s map with `steps` steps per period near `state0` and
+/// `period` (`lieflow.periodic_orbit`, which checks the arguments' kinds): a dict of its
+/// quantities (state0, period, energy, monodromy, multipliers, trivial, normal, stable,
+/// residual, iterations, drift: the rotation vector of R(T) R(0)ᵀ with an attitude, else None).
+#[pyfunction]
+#[pyo3(signature = (system, state0, period, method, steps, fix, tol, max_iter, attitude = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn _periodic_orbit<'py>(
+    py: Python<'py>,
+    system: PyRef<'py, PySystem>,
+    state0: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = real)] period: f64,
+    method: &str,
+    #[pyo3(from_py_with = size)] steps: usize,
+    fix: &str,
+    #[pyo3(from_py_with = real)] tol: f64,
+    #[pyo3(from_py_with = size)] max_iter: usize,
+    attitude: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let fix = match fix {
+        "energy" => Fix::Energy,
+        "period" => Fix::Period,
+        other => {
+            return Err(to_py(Error::invalid(
+                "fix",
+                format!("expected \"energy\" or \"period\", got {other:?}"),
+            )))
+        }
+    };
+    if !(tol > 0.0 && tol < 1.0) || max_iter == 0 {
+        return Err(to_py(Error::invalid(
+            "tol",
+            format!("expected 0 < tol < 1 and max_iter >= 1, got tol = {tol}, max_iter = {max_iter}"),
+        )));
+    }
+    let (z0, batched) = system.normalize(state0)?;
+    if batched {
+        return Err(to_py(Error::invalid(
+            "state0",
+            "one initial state: the shooting solves for one orbit",
+        )));
+    }
+    let attitude: Option<[f64; 9]> = attitude
+        .map(|a| {
+            real_matrix::<3, 3>(a).map(|m| std::array::from_fn(|k| m[k / 3][k % 3]))
+        })
+        .transpose()?;
+    let sys = system.sys.clone();
+    let options = Options {
+        steps,
+        fix,
+        tol,
+        max_iter,
+    };
+    let solve = || {
+        checked(|| {
+            let orbit = core::periodic_orbit(sys.as_ref(), method, &z0, period, &options)?;
+            let drift = attitude
+                .as_ref()
+                .map(|a| core::attitude_drift(sys.as_ref(), method, &orbit, a))
+                .transpose()?;
+            Ok((orbit, drift))
+        })
+    };
+    let (orbit, drift) = if sys.calls_out() {
+        solve()?
+    } else {
+        py.detach(solve)?
+    };
+    let out = PyDict::new(py);
+    out.set_item("state0", py_vec(py, &orbit.state0))?;
+    out.set_item("period", orbit.period)?;
+    out.set_item("steps", orbit.steps)?;
+    out.set_item("energy", orbit.energy)?;
+    out.set_item("monodromy", py_mat(py, &orbit.monodromy))?;
+    out.set_item("multipliers", complex(&orbit.multipliers).into_pyarray(py))?;
+    out.set_item("trivial", orbit.trivial.clone().into_pyarray(py))?;
+    out.set_item("normal", complex(&orbit.normal).into_pyarray(py))?;
+    out.set_item("stable", orbit.stable())?;
+    out.set_item("residual", orbit.residual)?;
+    out.set_item("iterations", orbit.iterations)?;
+    out.set_item("drift", drift.map(|w| py_vec(py, &w)))?;
+    Ok(out)
+}
