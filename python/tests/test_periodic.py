@@ -1,0 +1,189 @@
+"""lf.periodic_orbit: periodic and relative periodic orbits by shooting (issue 27).
+
+Checked against closed forms (the free rigid body's period 4K(k)/λ, Montgomery's drift angle)
+and an independent linearisation (Mathieu's equation across the harmonic orbits of two coupled
+oscillators, integrated by scipy), plus the errors of bad input.
+"""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import lieflow as lf
+
+I = np.array([1.0, 2.0, 3.0])
+
+
+def closed_form_period(m):
+    """4K(k)/λ (Landau–Lifshitz §37), axes 1 and 3 exchanged below the separatrix."""
+    l2 = m @ m
+    e2 = m @ (m / I)
+    i1, i2, i3 = (I[0], I[1], I[2]) if l2 > e2 * I[1] else (I[2], I[1], I[0])
+    lam = np.sqrt((i3 - i2) * (l2 - e2 * i1) / (i1 * i2 * i3))
+    k2 = (i2 - i1) * (e2 * i3 - l2) / ((i3 - i2) * (l2 - e2 * i1))
+    return 4 * lf.elliptic.ellipk(k2) / lam
+
+
+ORBITS = [np.array(m) for m in ([1.0, 0.3, 0.2], [0.2, 0.3, 1.0], [0.25, 1.0, 0.3])]
+
+
+@pytest.mark.parametrize("m0", ORBITS, ids=["least-axis", "largest-axis", "near-separatrix"])
+@pytest.mark.parametrize("method,dt", [("exact", 2.0), ("dmv10", 0.05)])
+def test_free_body_period_is_the_closed_form(m0, method, dt):
+    body = lf.RigidBody(I)
+    exact = closed_form_period(m0)
+    orbit = lf.periodic_orbit(body, m0, 1.03 * exact, method=method, dt=dt)
+    assert abs(orbit.period - exact) <= 1e-10 * exact
+    assert orbit.residual <= 1e-13
+    assert orbit.trivial.all() and orbit.normal_multipliers.size == 0 and orbit.stable
+    # The monodromy: one Jordan block and a simple one at 1.
+    n = orbit.monodromy - np.eye(3)
+    assert np.abs(n).max() > 0.1 and np.abs(n @ n).max() <= 1e-9 * np.abs(n).max() ** 2
+    traj = orbit.trajectory()
+    np.testing.assert_allclose(traj.states[-1], orbit.state0, atol=1e-13)
+    assert traj.t[-1] == pytest.approx(orbit.period, rel=1e-15)
+
+
+def test_fix_period_finds_the_energy_of_a_given_period():
+    body = lf.RigidBody(I)
+    m0 = ORBITS[0]
+    target = 1.01 * closed_form_period(m0)
+    orbit = lf.periodic_orbit(body, m0, target, method="exact", dt=2.0, fix="period")
+    assert orbit.period == target
+    assert abs(closed_form_period(orbit.state0) - target) <= 1e-10 * target
+    # The Casimir of the guess is kept; its energy is not.
+    assert orbit.state0 @ orbit.state0 == pytest.approx(m0 @ m0, rel=1e-13)
+    assert orbit.energy != pytest.approx(body.energy(m0), rel=1e-6)
+
+
+def solid_angle(body, m0, period, n=4000):
+    """Λ = ∮(1 − cos ϑ) dφ of M(t)/‖M‖ about the principal axis the orbit circles, oriented by
+    the motion: the periodic trapezoidal rule on the exact solution."""
+    t = np.arange(n) * period / n
+    m = body.exact_solution(m0, t)
+    l = np.linalg.norm(m0)
+    pole = 0 if np.all(m[:, 0] * m0[0] > 0) else 2
+    a, b = (pole + 1) % 3, (pole + 2) % 3
+    w = m / I
+    mdot = np.cross(m, w)
+    phidot = (m[:, a] * mdot[:, b] - m[:, b] * mdot[:, a]) / (m[:, a] ** 2 + m[:, b] ** 2)
+    s = np.sign(m0[pole])
+    return np.sum((1 - s * m[:, pole] / l) * phidot * s) * period / n
+
+
+@pytest.mark.parametrize("m0", ORBITS + [np.array([-0.3, 1.0, -0.25])])
+@pytest.mark.parametrize("method,dt", [("exact", 2.0), ("dmv10", 0.05)])
+def test_relative_orbit_drift_is_montgomery_s_angle(m0, method, dt):
+    body = lf.RigidBody(I)
+    r0 = lf.lie.so3_exp([0.4, -0.7, 0.3])
+    t = closed_form_period(m0)
+    orbit = lf.periodic_orbit(body, m0, t, method=method, dt=dt, attitude=r0)
+    pi = r0 @ orbit.state0
+    expected = 2 * orbit.energy * orbit.period / np.linalg.norm(pi) - solid_angle(
+        body, orbit.state0, orbit.period)
+    # ω ∥ π, and its angle is Montgomery's modulo 2π.
+    w = orbit.drift
+    assert np.linalg.norm(np.cross(w, pi)) <= 1e-12 * np.linalg.norm(pi)
+    diff = np.mod(orbit.drift_angle - expected, 2 * np.pi)
+    assert min(diff, 2 * np.pi - diff) <= 1e-9
+    # The attitude's run ends at g R(0).
+    traj = orbit.trajectory()
+    np.testing.assert_allclose(traj.attitude[-1], lf.lie.so3_exp(w) @ r0, atol=1e-12)
+
+
+def coupled(omega, beta):
+    """½‖p‖² + ½x² + ½ω²y² + ½βx²y²: the orbits y = 0 are harmonic (period 2π); across them
+    Mathieu's equation δÿ + (ω² + βA²cos²t)δy = 0."""
+    w2 = omega * omega
+
+    def potential(q):
+        return 0.5 * (q[0] ** 2 + w2 * q[1] ** 2 + beta * q[0] ** 2 * q[1] ** 2)
+
+    def gradient(q):
+        x, y = q
+        return [x + beta * x * y * y, w2 * y + beta * x * x * y]
+
+    def hessian(q, v):
+        x, y = q
+        return [(1 + beta * y * y) * v[0] + 2 * beta * x * y * v[1],
+                2 * beta * x * y * v[0] + (w2 + beta * x * x) * v[1]]
+
+    return lf.Separable(1.0, potential, gradient, dof=2, hessian=hessian)
+
+
+def mathieu_multipliers(omega, beta, amplitude):
+    def f(t, y):
+        return [y[1], -(omega ** 2 + beta * amplitude ** 2 * np.cos(t) ** 2) * y[0]]
+    cols = [solve_ivp(f, (0, 2 * np.pi), e, method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]
+            for e in ([1.0, 0.0], [0.0, 1.0])]
+    return np.linalg.eigvals(np.array(cols).T)
+
+
+@pytest.mark.parametrize("method,dt", [("gauss6", 0.03), ("verlet4", 0.003)])
+def test_normal_multipliers_are_mathieu_s(method, dt):
+    omega, beta = 1.3, 0.4
+    sys = coupled(omega, beta)
+    guess = np.array([0.8, 0.01, 0.0, 0.005])
+    before = guess.copy()
+    orbit = lf.periodic_orbit(sys, guess, 6.0, method=method, dt=dt)
+    np.testing.assert_array_equal(guess, before)
+    z = orbit.state0
+    reference = mathieu_multipliers(omega, beta, np.hypot(z[0], z[2]))
+    got = orbit.normal_multipliers
+    assert got.shape == (2,) and orbit.trivial.sum() == 2 and orbit.stable
+    assert np.abs(np.sort_complex(got) - np.sort_complex(reference)).max() <= 1e-9
+    assert abs(orbit.period - 2 * np.pi) <= 1e-9
+
+
+def test_an_unstable_orbit_is_reported_unstable():
+    # ω² + βA²/2 = 1: Mathieu's first resonance tongue (parametric resonance) at A = 0.8.
+    sys = coupled(np.sqrt(1 - 0.8 * 0.64 / 2), 0.8)
+    orbit = lf.periodic_orbit(sys, [0.8, 0.0, 0.0, 0.0], 6.3, method="gauss6", dt=0.03)
+    mods = np.abs(orbit.normal_multipliers)
+    assert not orbit.stable and mods.max() > 1.01
+    assert np.prod(mods) == pytest.approx(1.0, rel=1e-9)   # a symplectic pair μ, 1/μ
+
+
+def test_a_raising_callable_ends_the_solve_with_its_exception():
+    class Boom(Exception):
+        pass
+
+    calls = []
+
+    def hessian(q, v):
+        calls.append(1)
+        if len(calls) > 500:
+            raise Boom("from the Hessian")
+        return v
+
+    sys = lf.Separable(1.0, lambda q: 0.5 * float(q @ q), lambda q: q, dof=1, hessian=hessian)
+    with pytest.raises(Boom, match="from the Hessian"):
+        lf.periodic_orbit(sys, [1.0, 0.0], 6.0, method="verlet", dt=0.1)
+    assert len(calls) == 501
+
+
+def test_bad_input_is_refused():
+    body = lf.RigidBody(I)
+    m0 = np.array([1.0, 0.3, 0.2])
+    with pytest.raises(lf.InvalidArgumentError, match="period"):
+        lf.periodic_orbit(body, m0, -1.0)
+    with pytest.raises(TypeError, match="period"):
+        lf.periodic_orbit(body, m0, "10")
+    with pytest.raises(lf.InvalidArgumentError, match="fix"):
+        lf.periodic_orbit(body, m0, 10.0, fix="time")
+    with pytest.raises(lf.InvalidArgumentError, match="dt"):
+        lf.periodic_orbit(body, m0, 10.0, dt=0.0)
+    with pytest.raises(lf.UnsupportedMethodError):
+        lf.periodic_orbit(body, m0, 10.0, method="nope")
+    with pytest.raises(lf.ShapeError):
+        lf.periodic_orbit(body, [1.0, 0.3], 10.0)
+    with pytest.raises(lf.InvalidArgumentError, match="one initial state"):
+        lf.periodic_orbit(body, np.stack([m0, m0]), 10.0)
+    with pytest.raises(lf.InvalidArgumentError, match="equilibrium"):
+        lf.periodic_orbit(body, [1.0, 0.0, 0.0], 10.0)
+    with pytest.raises(lf.NotInGroupError):
+        lf.periodic_orbit(body, m0, 10.0, method="exact", dt=2.0, attitude=2 * np.eye(3))
+    with pytest.raises(lf.InvalidArgumentError, match="attitude"):
+        lf.periodic_orbit(lf.Pendulum(), [1.0, 0.0], 6.0, relative=True)
+    with pytest.raises(TypeError):
+        lf.periodic_orbit("body", m0, 10.0)
