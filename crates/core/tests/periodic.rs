@@ -53,6 +53,7 @@ fn the_free_body_period_is_the_closed_form_on_both_sides_of_the_separatrix() {
                 method,
                 &m0,
                 exact * 1.02,
+                None,
                 &options(steps, Fix::Energy),
             )
             .unwrap();
@@ -81,6 +82,7 @@ fn the_free_body_monodromy_is_one_jordan_block_and_a_simple_one() {
             "exact",
             &m0,
             closed_form_period(m0),
+            None,
             &options(8, Fix::Energy),
         )
         .unwrap();
@@ -191,8 +193,15 @@ fn normal_multipliers_are_those_of_the_linearisation_across_the_orbit() {
     // guess's energy.
     let guess = [0.8, 0.01, 0.0, 0.005];
     for (method, steps, tol) in [("gauss6", 200, 1e-10), ("verlet4", 2000, 1e-10)] {
-        let orbit =
-            periodic_orbit(&sys, method, &guess, 6.0, &options(steps, Fix::Energy)).unwrap();
+        let orbit = periodic_orbit(
+            &sys,
+            method,
+            &guess,
+            6.0,
+            None,
+            &options(steps, Fix::Energy),
+        )
+        .unwrap();
         let z = &orbit.state0;
         let amplitude = (z[0] * z[0] + z[2] * z[2]).sqrt();
         let reference = mathieu_multipliers(omega, beta, amplitude);
@@ -225,20 +234,29 @@ fn bad_input_is_refused_with_what_was_expected() {
             .to_string()
     };
     let o = options(8, Fix::Energy);
-    assert!(err(periodic_orbit(&body, "exact", &m0, -1.0, &o)).contains("invalid period"));
-    assert!(err(periodic_orbit(&body, "exact", &m0, f64::NAN, &o)).contains("invalid period"));
+    assert!(err(periodic_orbit(&body, "exact", &m0, -1.0, None, &o)).contains("invalid period"));
+    assert!(err(periodic_orbit(&body, "exact", &m0, f64::NAN, None, &o)).contains("invalid period"));
     assert!(err(periodic_orbit(
         &body,
         "exact",
         &m0,
         1.0,
+        None,
         &options(0, Fix::Energy)
     ))
     .contains("steps"));
-    assert!(err(periodic_orbit(&body, "exact", &[1.0, 0.0], 1.0, &o)).contains("shape"));
-    assert!(err(periodic_orbit(&body, "nope", &m0, 1.0, &o)).contains("not supported"));
+    assert!(err(periodic_orbit(&body, "exact", &[1.0, 0.0], 1.0, None, &o)).contains("shape"));
+    assert!(err(periodic_orbit(&body, "nope", &m0, 1.0, None, &o)).contains("not supported"));
     // A steady rotation is an equilibrium of M: no period.
-    assert!(err(periodic_orbit(&body, "exact", &[1.0, 0.0, 0.0], 1.0, &o)).contains("equilibrium"));
+    assert!(err(periodic_orbit(
+        &body,
+        "exact",
+        &[1.0, 0.0, 0.0],
+        1.0,
+        None,
+        &o
+    ))
+    .contains("equilibrium"));
 }
 
 /// The solid angle Λ = ∮(1 − cos ϑ) dφ enclosed by M(t)/‖M‖ over one period, the pole on the
@@ -259,7 +277,11 @@ fn solid_angle(body: &RigidBody, m0: [f64; 3], period: f64) -> f64 {
     let mut sum = 0.0;
     for m in traj.states.chunks(3).take(n) {
         let w = [m[0] / I[0], m[1] / I[1], m[2] / I[2]];
-        let mdot = [m[1] * w[2] - m[2] * w[1], m[2] * w[0] - m[0] * w[2], m[0] * w[1] - m[1] * w[0]];
+        let mdot = [
+            m[1] * w[2] - m[2] * w[1],
+            m[2] * w[0] - m[0] * w[2],
+            m[0] * w[1] - m[1] * w[0],
+        ];
         let phidot = (m[a] * mdot[b] - m[b] * mdot[a]) / (m[a] * m[a] + m[b] * m[b]);
         // About the pole's positive direction (ϑ from +pole): a pole at −axis flips both.
         sum += (1.0 - sign * m[pole] / l) * phidot * sign;
@@ -274,14 +296,20 @@ fn the_relative_orbit_drift_is_montgomery_s_angle() {
     let body = RigidBody::new(I).unwrap();
     let r0 = so3::exp_unchecked(&nalgebra::Vector3::new(0.4, -0.7, 0.3));
     let rows: [f64; 9] = std::array::from_fn(|k| r0[(k / 3, k % 3)]);
-    for m0 in [[1.0, 0.3, 0.2], [0.2, 0.3, 1.0], [0.25, 1.0, 0.3], [-0.3, 1.0, -0.25]] {
+    for m0 in [
+        [1.0, 0.3, 0.2],
+        [0.2, 0.3, 1.0],
+        [0.25, 1.0, 0.3],
+        [-0.3, 1.0, -0.25],
+    ] {
         let t = closed_form_period(m0);
         let l = m0.iter().map(|x| x * x).sum::<f64>().sqrt();
         let e = body.energy(&m0).unwrap();
         let expected = 2.0 * e * t / l - solid_angle(&body, m0, t);
         let pi = r0 * nalgebra::Vector3::from(m0) / l;
         for (method, steps) in [("exact", 8), ("dmv10", 400)] {
-            let orbit = periodic_orbit(&body, method, &m0, t, &options(steps, Fix::Energy)).unwrap();
+            let orbit =
+                periodic_orbit(&body, method, &m0, t, None, &options(steps, Fix::Energy)).unwrap();
             let w = nalgebra::Vector3::from(attitude_drift(&body, method, &orbit, &rows).unwrap());
             // g = exp(θ π̂): ω ∥ π, θ = ω·π̂ modulo 2π.
             let theta = w.dot(&pi);
@@ -293,7 +321,77 @@ fn the_relative_orbit_drift_is_montgomery_s_angle() {
                 "M0 = {m0:?} {method}: drift {theta:.15} Montgomery {expected:.15} (mod 2π) \
                  err {err:.1e}, across π {across:.1e}"
             );
-            assert!(err <= 1e-9 && across <= 1e-12, "{method}: {err:e} {across:e}");
+            assert!(
+                err <= 1e-9 && across <= 1e-12,
+                "{method}: {err:e} {across:e}"
+            );
         }
+    }
+}
+
+/// A Lyapunov orbit about a stable Jacobi ellipsoid (the incompressible self-gravitating body,
+/// RATTLE): started from a normal mode of the co-moving linearisation, shot as a relative
+/// periodic orbit X(T) = e^ζ X(0) e^{−η}. As the amplitude shrinks its period tends to the
+/// mode's 2π/ω and its drift to T·(Ω ⊕ 0); its normal multipliers lie on the unit circle (the
+/// linear analysis says stable) and tend to e^{±iω_k T} of the other modes.
+#[test]
+fn a_lyapunov_orbit_of_the_jacobi_ellipsoid_is_the_normal_mode_at_small_amplitude() {
+    use lieflow::analysis::comoving;
+    use lieflow::pseudo_rigid::ellipsoids::Fluid;
+    let fl = Fluid::new(1.0, 1.0).unwrap();
+    let fig = fl.jacobi(0.6).unwrap();
+    let (ze, xi) = Fluid::state(&fig);
+    let body = fl.body().unwrap();
+    let st = comoving::stability(&body, &ze, &xi).unwrap();
+    assert!(st.spectral.stable);
+    let omegas: Vec<f64> = st.modes.iter().map(|m| m.eigenvalue.1).collect();
+    println!("Jacobi a2/a1 = 0.6: mode frequencies {omegas:?}, normal dim {}", st.normal_dim);
+    let mode = &st.modes[0];
+    let omega = mode.eigenvalue.1;
+    let size = ze.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let mut previous = f64::INFINITY;
+    for amplitude in [1e-2, 5e-3] {
+        let z0: Vec<f64> = ze
+            .iter()
+            .zip(&mode.re)
+            .map(|(z, v)| z + amplitude * size * v)
+            .collect();
+        let t = 2.0 * std::f64::consts::PI / omega;
+        let zeta: Vec<f64> = xi.iter().map(|x| x * t).collect();
+        let opts = Options {
+            relative: true,
+            ..options(200, Fix::Energy)
+        };
+        let orbit = periodic_orbit(&body, "rattle6", &z0, t, Some(&zeta), &opts).unwrap();
+        let drift = orbit.drift.as_ref().unwrap();
+        let dz: f64 = drift
+            .iter()
+            .zip(&zeta)
+            .fold(0.0, |m, (a, b)| m.max((a - b).abs()));
+        let dt = (orbit.period - t).abs() / t;
+        let on_circle = orbit
+            .normal
+            .iter()
+            .fold(0.0_f64, |m, &(re, im)| m.max((re.hypot(im) - 1.0).abs()));
+        println!(
+            "amplitude {amplitude:.0e}: T = {:.10} (2π/ω = {t:.10}, rel {dt:.1e}), drift − Tξ {dz:.1e}, \
+             {} iterations, residual {:.1e}, normal {:?} (|μ| − 1 ≤ {on_circle:.1e})",
+            orbit.period, orbit.iterations, orbit.residual, orbit.normal
+        );
+        assert!(orbit.stable() && on_circle <= 1e-9, "{on_circle:e}");
+        assert_eq!(orbit.normal.len(), 2 * (omegas.len() - 1));
+        // The other modes turn by e^{±iω_k T} over the period, to O(amplitude²).
+        for w in &omegas[1..] {
+            let (c, s) = ((w * orbit.period).cos(), (w * orbit.period).sin().abs());
+            let near = orbit
+                .normal
+                .iter()
+                .fold(f64::INFINITY, |m, &(re, im)| m.min((re - c).hypot(im.abs() - s)));
+            assert!(near <= 100.0 * amplitude * amplitude, "ω = {w}: {near:e}");
+        }
+        // The period's offset from 2π/ω and the drift's from Tξ are O(amplitude²).
+        assert!(dt <= 2.0 * amplitude * amplitude && dz <= 5.0 * amplitude * amplitude);
+        assert!(dt < previous / 3.0);
+        previous = dt;
     }
 }

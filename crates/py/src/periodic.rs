@@ -48,7 +48,9 @@ pub fn _periodic_orbit<'py>(
     if !(tol > 0.0 && tol < 1.0) || max_iter == 0 {
         return Err(to_py(Error::invalid(
             "tol",
-            format!("expected 0 < tol < 1 and max_iter >= 1, got tol = {tol}, max_iter = {max_iter}"),
+            format!(
+                "expected 0 < tol < 1 and max_iter >= 1, got tol = {tol}, max_iter = {max_iter}"
+            ),
         )));
     }
     let (z0, batched) = system.normalize(state0)?;
@@ -59,9 +61,7 @@ pub fn _periodic_orbit<'py>(
         )));
     }
     let attitude: Option<[f64; 9]> = attitude
-        .map(|a| {
-            real_matrix::<3, 3>(a).map(|m| std::array::from_fn(|k| m[k / 3][k % 3]))
-        })
+        .map(|a| real_matrix::<3, 3>(a).map(|m| std::array::from_fn(|k| m[k / 3][k % 3])))
         .transpose()?;
     let sys = system.sys.clone();
     let options = Options {
@@ -69,10 +69,11 @@ pub fn _periodic_orbit<'py>(
         fix,
         tol,
         max_iter,
+        relative: false,
     };
     let solve = || {
         checked(|| {
-            let orbit = core::periodic_orbit(sys.as_ref(), method, &z0, period, &options)?;
+            let orbit = core::periodic_orbit(sys.as_ref(), method, &z0, period, None, &options)?;
             let drift = attitude
                 .as_ref()
                 .map(|a| core::attitude_drift(sys.as_ref(), method, &orbit, a))

@@ -93,6 +93,69 @@ pub struct Stability {
     pub multipliers: Vec<f64>,
     /// |F(z₀)| relative to |f(z₀)| + |ξ_Z(z₀)|.
     pub residual: f64,
+    /// The oscillatory normal modes of the linearisation (eigenvalues with Im λ > 0), by
+    /// ascending frequency.
+    pub modes: Vec<Mode>,
+}
+
+/// A normal mode of a relative equilibrium: an eigenvalue λ = σ + iω (ω > 0) of the co-moving
+/// linearisation on the symplectic normal space and its eigenvector in the state's coordinates;
+/// the linear motion about z₀ in the co-moving frame is Re(v e^{λt}).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mode {
+    /// λ = (σ, ω).
+    pub eigenvalue: (f64, f64),
+    /// Re v (user frame), v scaled to unit length in the scaled coordinates (q/‖q₀‖, p/π)
+    /// and turned so that its real part is the longest.
+    pub re: Vec<f64>,
+    /// Im v.
+    pub im: Vec<f64>,
+}
+
+/// The oscillatory eigenpairs of `lin` (k × k, scaled coordinates) as modes in z through the
+/// basis `cs` (scaled) and the scales `w` (z = diag(w)·cs·v).
+fn modes(lin: &Mat, cs: &Mat, w: &[f64], tol: f64) -> Result<Vec<Mode>> {
+    if lin.nrows() == 0 {
+        return Ok(Vec::new());
+    }
+    let evd = lin
+        .eigen()
+        .map_err(|e| super::eig_error("eigenvectors of the linearisation", e))?;
+    let (u, s) = (evd.U(), evd.S().column_vector());
+    let mut out = Vec::new();
+    for k in 0..s.nrows() {
+        let lam = s[k];
+        if lam.im <= tol {
+            continue;
+        }
+        // In scaled coordinates: a + ib = cs·v.
+        let nz = cs.nrows();
+        let a: Vec<f64> = (0..nz)
+            .map(|i| (0..cs.ncols()).map(|j| cs[(i, j)] * u[(j, k)].re).sum())
+            .collect();
+        let b: Vec<f64> = (0..nz)
+            .map(|i| (0..cs.ncols()).map(|j| cs[(i, j)] * u[(j, k)].im).sum())
+            .collect();
+        let (aa, bb, ab) = (
+            a.iter().map(|x| x * x).sum::<f64>(),
+            b.iter().map(|x| x * x).sum::<f64>(),
+            a.iter().zip(&b).map(|(x, y)| x * y).sum::<f64>(),
+        );
+        let length = (aa + bb).sqrt();
+        if !(length > 0.0 && length.is_finite()) {
+            continue;
+        }
+        // e^{iθ}(a + ib) has the longest real part a cos θ − b sin θ at tan 2θ = −2ab/(aa − bb).
+        let theta = 0.5 * (-2.0 * ab).atan2(aa - bb);
+        let (sn, cs_) = theta.sin_cos();
+        out.push(Mode {
+            eigenvalue: (lam.re, lam.im),
+            re: (0..nz).map(|i| w[i] * (a[i] * cs_ - b[i] * sn) / length).collect(),
+            im: (0..nz).map(|i| w[i] * (a[i] * sn + b[i] * cs_) / length).collect(),
+        });
+    }
+    out.sort_by(|x, y| x.eigenvalue.1.total_cmp(&y.eigenvalue.1));
+    Ok(out)
 }
 
 /// Stability of the relative equilibrium z(t) = exp(tξ)·z₀ (module docs): z₀ a state (user
@@ -232,6 +295,7 @@ pub fn stability<P: Constrained + Symmetric + SeparableTangent>(
     check::finite_mat("co-moving Jacobian", &df)?;
     let lin = &c_left * &df * &c;
     let spectral = Verdict::spectral(&lin, SPECTRAL_TOL)?;
+    let modes = modes(&lin, &cs, &wz, spectral.tol)?;
 
     // Energy–momentum: multipliers κ from ∇H_ξ = dΦᵀκ, then Cᵀ D²ℒ C.
     let mut gh0 = vec![0.0; nz];
@@ -268,6 +332,7 @@ pub fn stability<P: Constrained + Symmetric + SeparableTangent>(
         isotropy_orbit_dim: w_basis.ncols(),
         multipliers,
         residual,
+        modes,
     })
 }
 

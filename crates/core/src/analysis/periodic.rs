@@ -38,9 +38,10 @@
 //! symplectic ones), f and T(level) are those of the modified flow to O(hᵖ), and so are the
 //! normal multipliers.
 
-use super::{eig_error, general_eigenvalues, null_space};
+use super::{eig_error, general_eigenvalues, null_space, range};
 use crate::convergence::{Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
+use crate::integrate::problem::Symmetric;
 use crate::integrate::tangent::TangentSystem;
 use crate::integrate::{integrate, System};
 use crate::numerics::fd::{self, Scheme};
@@ -67,6 +68,8 @@ pub struct Options {
     pub tol: f64,
     /// Gauss–Newton iterations allowed.
     pub max_iter: usize,
+    /// A relative periodic orbit Φ_T(z₀) = exp(ζ)·z₀ of the system's symmetry.
+    pub relative: bool,
 }
 
 impl Default for Options {
@@ -76,6 +79,7 @@ impl Default for Options {
             fix: Fix::Energy,
             tol: 1e-10,
             max_iter: 30,
+            relative: false,
         }
     }
 }
@@ -101,7 +105,7 @@ pub struct PeriodicOrbit {
     pub steps: usize,
     /// H(state0).
     pub energy: f64,
-    /// M = ∂z_N/∂z₀ at state0 (e × e).
+    /// M = ∂z_N/∂z₀ at state0 (e × e); of exp(−ζ)·z_N for a relative orbit.
     pub monodromy: Mat,
     /// The eigenvalues of M (re, im), by descending modulus.
     pub multipliers: Vec<(f64, f64)>,
@@ -114,6 +118,9 @@ pub struct PeriodicOrbit {
     pub residual: f64,
     /// The Gauss–Newton iterations taken.
     pub iterations: usize,
+    /// ζ of a relative orbit: Φ_T(state0) = exp(ζ)·state0 (the monodromy and the
+    /// multipliers are those of exp(−ζ)·Φ_T); None for a periodic one.
+    pub drift: Option<Vec<f64>>,
 }
 
 impl PeriodicOrbit {
@@ -204,18 +211,48 @@ fn shoot(
     })
 }
 
-/// The conserved quantities' values (H, then the invariants) and their gradients (rows).
-fn conserved(system: &dyn System, z: &[f64]) -> Result<(Vec<f64>, Mat)> {
+/// The conserved quantities' values and their gradients (rows): H, the invariants, and for a
+/// relative orbit the momentum map.
+fn conserved(
+    system: &dyn System,
+    sym: Option<&dyn Symmetric>,
+    z: &[f64],
+) -> Result<(Vec<f64>, Mat)> {
     let values = |x: &[f64]| -> Result<Vec<f64>> {
         let mut v = vec![system.energy(x)?];
         v.extend(system.invariants(x)?);
+        if let Some(s) = sym {
+            v.extend(s.momentum_map(x)?);
+        }
         Ok(v)
     };
-    let h: Vec<f64> = z.iter().map(|x| 1e-4 * x.abs().max(1.0)).collect();
     Ok((
         values(z)?,
-        fd::jacobian(&values, z, &h, Scheme::Richardson)?,
+        fd::jacobian(&values, z, &steps_of(z), Scheme::Richardson)?,
     ))
+}
+
+/// Difference steps 1e-4·max(1, |x_k|).
+fn steps_of(x: &[f64]) -> Vec<f64> {
+    x.iter().map(|v| 1e-4 * v.abs().max(1.0)).collect()
+}
+
+/// The columns ∂(exp(ζ)·z)/∂z (d × d) and ∂(exp(ζ)·z)/∂ζ (d × g) by central differences
+/// (one Richardson extrapolation: exact to round-off for a linear action in z).
+fn action_jacobians(sym: &dyn Symmetric, zeta: &[f64], z: &[f64]) -> Result<(Mat, Mat)> {
+    let in_z = fd::jacobian(
+        &|w: &[f64]| sym.act(zeta, w),
+        z,
+        &steps_of(z),
+        Scheme::Richardson,
+    )?;
+    let in_zeta = fd::jacobian(
+        &|x: &[f64]| sym.act(x, z),
+        zeta,
+        &vec![1e-4; zeta.len()],
+        Scheme::Richardson,
+    )?;
+    Ok((in_z, in_zeta))
 }
 
 /// The minimum-norm least-squares solution of A x = b (thin SVD, singular values below
@@ -243,8 +280,12 @@ fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
 }
 
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
 fn unit(v: &[f64]) -> Result<Vec<f64>> {
-    let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let n = dot(v, v).sqrt();
     if !(n > 0.0 && n.is_finite()) {
         return Err(Error::InvalidArgument {
             what: "state0".into(),
@@ -254,19 +295,45 @@ fn unit(v: &[f64]) -> Result<Vec<f64>> {
     Ok(v.iter().map(|x| x / n).collect())
 }
 
+/// The generators e_k·z of a basis of g at z, as columns (d × g).
+fn generators(sym: &dyn Symmetric, z: &[f64]) -> Result<Mat> {
+    let g = sym.symmetry_dim();
+    let mut e = vec![0.0; g];
+    let mut cols = Vec::with_capacity(g);
+    for k in 0..g {
+        e[k] = 1.0;
+        cols.push(sym.generator(&e, z)?);
+        e[k] = 0.0;
+    }
+    Ok(Mat::from_fn(z.len(), g, |i, k| cols[k][i]))
+}
+
+/// The generators of the isotropy algebra g_μ of μ = J(z) at z, as columns: ξ_Z(z) for ξ in
+/// ker(dJ(z)·ξ_Z(z)), the group directions tangent to the level set of J.
+fn isotropy_generators(sym: &dyn Symmetric, z: &[f64]) -> Result<Mat> {
+    let gens = generators(sym, z)?;
+    let mom = |x: &[f64]| sym.momentum_map(x);
+    let dj = fd::jacobian(&mom, z, &steps_of(z), Scheme::Richardson)?;
+    Ok(&gens * null_space(&(&dj * &gens))?)
+}
+
 /// Finds a periodic orbit of `method`'s map near the guess `z0` with period near `period`
-/// (module docs): the Gauss–Newton iteration on the shooting equations.
+/// (module docs): the Gauss–Newton iteration on the shooting equations. With
+/// [`Options::relative`] a relative periodic orbit Φ_T(z₀) = exp(ζ)·z₀ of the system's
+/// [`Problem::symmetry`], ζ found with T, from the guess `drift` of ζ (zero by default).
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] (period ≤ 0 or not finite, steps = 0, a method without tangent
-/// maps, a state with SO(3) blocks, a guess at an equilibrium), the errors of the runs (shape,
-/// constraints, [`Error::NotConverged`] of an implicit step), and [`Error::NotConverged`] when
-/// the iteration fails or stops on a point that is not periodic (relative residual above 1e-6).
+/// maps, a state with SO(3) blocks, a guess at an equilibrium, a relative orbit of a system
+/// without a symmetry's action), the errors of the runs (shape, constraints,
+/// [`Error::NotConverged`] of an implicit step), and [`Error::NotConverged`] when the iteration
+/// fails or stops on a point that is not periodic (relative residual above 1e-6).
 pub fn periodic_orbit(
     system: &dyn System,
     method: &str,
     z0: &[f64],
     period: f64,
+    drift: Option<&[f64]>,
     options: &Options,
 ) -> Result<PeriodicOrbit> {
     if !(period > 0.0 && period.is_finite()) {
@@ -283,23 +350,53 @@ pub fn periodic_orbit(
         });
     }
     let lift = lift_of(system, method)?;
+    let sym = match options.relative {
+        false => None,
+        true => Some(system.symmetry().ok_or_else(|| Error::InvalidArgument {
+            what: "relative".into(),
+            message: format!(
+                "{} has no symmetry whose action lieflow knows (relative orbits of the \
+                 bodies with an attitude: pass the attitude)",
+                system.name()
+            ),
+        })?),
+    };
+    let g = sym.map_or(0, |s| s.symmetry_dim());
+    let mut zeta = match drift {
+        Some(x) if x.len() == g => x.to_vec(),
+        Some(x) => {
+            return Err(Error::shape(
+                "drift",
+                format!("({g},)"),
+                format!("({},)", x.len()),
+            ))
+        }
+        None => vec![0.0; g],
+    };
     let d = lift.base_dim();
     let energy_fixed = options.fix == Fix::Energy;
-    let guess = z0.to_vec();
+    let mut guess = z0.to_vec();
+    system.project(&mut guess)?;
     let scale = inf_norm(&guess).max(1.0);
-    // The phase hyperplane: across the flow at the guess, estimated by one step.
+    // The slice through the guess: across the orbit of the isotropy group G_μ of its momentum
+    // (the other group directions change μ, which its rows fix) and across the flow there (one
+    // step's direction, its part along that orbit removed).
+    let gens0 = match sym {
+        Some(s) => range(&isotropy_generators(s, &guess)?)?,
+        None => Mat::zeros(d, 0),
+    };
     let v = {
         let z1 = end_of(system, method, &guess, period / n as f64, 1)?;
-        unit(
-            &z1.iter()
-                .zip(&guess)
-                .map(|(a, b)| a - b)
-                .collect::<Vec<_>>(),
-        )?
+        let mut v: Vec<f64> = z1.iter().zip(&guess).map(|(a, b)| a - b).collect();
+        for k in 0..gens0.ncols() {
+            let c = (0..d).map(|i| gens0[(i, k)] * v[i]).sum::<f64>();
+            (0..d).for_each(|i| v[i] -= c * gens0[(i, k)]);
+        }
+        unit(&v)?
     };
-    let (levels, _) = conserved(system, &guess)?;
+    let (levels, _) = conserved(system, sym, &guess)?;
     let (mut z, mut t) = (guess.clone(), period);
-    let unknowns = d + usize::from(energy_fixed);
+    let unknowns = d + usize::from(energy_fixed) + g;
     let rule = Rule {
         tol: options.tol,
         floor: 4.0 * f64::EPSILON,
@@ -309,33 +406,64 @@ pub fn periodic_orbit(
     let mut accepted = false;
     loop {
         let shot = shoot(system, lift.as_ref(), method, &z, t, n)?;
-        let gap: Vec<f64> = shot.end.iter().zip(&z).map(|(a, b)| a - b).collect();
+        let target = match sym {
+            Some(s) => s.act(&zeta, &z)?,
+            None => z.clone(),
+        };
+        let gap: Vec<f64> = shot.end.iter().zip(&target).map(|(a, b)| a - b).collect();
         if accepted {
-            return finish(system, z, t, n, shot, &gap, monitor.iterations());
+            let drift = sym.map(|_| zeta.clone());
+            return finish(
+                system,
+                sym,
+                z,
+                t,
+                n,
+                drift,
+                shot,
+                &gap,
+                monitor.iterations(),
+            );
         }
-        // Rows: the map (d), then each conserved quantity and the phase, each scaled to a unit
-        // normal; the energy's row only with the energy fixed.
-        let (values, grads) = conserved(system, &z)?;
+        // Rows: the map (d), then each conserved quantity, the phase and the slice, each
+        // scaled to a unit normal; the energy's row only with the energy fixed.
+        let (values, grads) = conserved(system, sym, &z)?;
         let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
         for (c, (&value, &level)) in values.iter().zip(&levels).enumerate() {
             if c == 0 && !energy_fixed {
                 continue;
             }
-            let g: Vec<f64> = (0..d).map(|j| grads[(c, j)]).collect();
-            let norm = g.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let row: Vec<f64> = (0..d).map(|j| grads[(c, j)]).collect();
+            let norm = dot(&row, &row).sqrt();
             if norm > 0.0 && norm.is_finite() {
-                rows.push((g.iter().map(|x| x / norm).collect(), (level - value) / norm));
+                rows.push((
+                    row.iter().map(|x| x / norm).collect(),
+                    (level - value) / norm,
+                ));
             }
         }
-        let phase = -(0..d).map(|j| v[j] * (z[j] - guess[j])).sum::<f64>();
-        rows.push((v.clone(), phase));
+        let offset: Vec<f64> = z.iter().zip(&guess).map(|(a, b)| a - b).collect();
+        rows.push((v.clone(), -dot(&v, &offset)));
+        for k in 0..gens0.ncols() {
+            let row: Vec<f64> = (0..d).map(|i| gens0[(i, k)]).collect();
+            let c = -dot(&row, &offset);
+            rows.push((row, c));
+        }
+        let (act_z, act_zeta) = match sym {
+            Some(s) => action_jacobians(s, &zeta, &z)?,
+            None => (Mat::identity(d, d), Mat::zeros(d, 0)),
+        };
         let m = d + rows.len();
+        let tcol = d;
+        let zcol = d + usize::from(energy_fixed);
         let a = Mat::from_fn(m, unknowns, |i, j| {
             if i < d {
                 if j < d {
-                    shot.monodromy[(i, j)] - if i == j { 1.0 } else { 0.0 }
-                } else {
+                    shot.monodromy[(i, j)] - act_z[(i, j)]
+                } else if j < zcol {
                     shot.along[i] * t // the unknown τ = δT/T
+                } else {
+                    -act_zeta[(i, j - zcol)]
                 }
             } else if j < d {
                 rows[i - d].0[j]
@@ -350,13 +478,18 @@ pub fn periodic_orbit(
         for (zj, s) in z.iter_mut().zip(&step) {
             *zj += s;
         }
+        system.project(&mut z)?;
         let mut update = inf_norm(&step[..d]) / scale;
         if energy_fixed {
-            t *= 1.0 + step[d];
-            update = update.max(step[d].abs());
+            t *= 1.0 + step[tcol];
+            update = update.max(step[tcol].abs());
             if t.is_nan() || t <= 0.0 {
                 update = f64::INFINITY;
             }
+        }
+        for (x, s) in zeta.iter_mut().zip(&step[zcol..]) {
+            *x += s;
+            update = update.max(s.abs());
         }
         match monitor.check(update, 1.0) {
             Verdict::Continue => {}
@@ -377,12 +510,15 @@ pub fn periodic_orbit(
     }
 }
 
-/// The orbit at the accepted point: residual, multipliers, their split.
+/// The orbit at the accepted point: residual, multipliers, their split (module docs).
+#[allow(clippy::too_many_arguments)]
 fn finish(
     system: &dyn System,
+    sym: Option<&dyn Symmetric>,
     z: Vec<f64>,
     period: f64,
     steps: usize,
+    drift: Option<Vec<f64>>,
     shot: Shot,
     gap: &[f64],
     iterations: usize,
@@ -399,25 +535,39 @@ fn finish(
         });
     }
     let d = z.len();
-    let m = &shot.monodromy;
-    let multipliers = by_modulus(general_eigenvalues(m)?);
-    // The quotient across the flow on the level set (module docs).
-    let (values, grads) = conserved(system, &z)?;
-    let f = unit(&shot.along)?;
-    let stack = Mat::from_fn(values.len() + 1, d, |i, j| {
-        if i < values.len() {
-            grads[(i, j)]
-        } else {
-            f[j]
+    // The monodromy of exp(−ζ)·Φ_T, and its flow direction.
+    let (m, along) = match (sym, &drift) {
+        (Some(s), Some(zeta)) => {
+            let back: Vec<f64> = zeta.iter().map(|x| -x).collect();
+            let (a, _) = action_jacobians(s, &back, &shot.end)?;
+            let along = (0..d)
+                .map(|i| (0..d).map(|k| a[(i, k)] * shot.along[k]).sum())
+                .collect::<Vec<f64>>();
+            (&a * &shot.monodromy, along)
         }
-    });
-    let basis = null_space(&stack)?;
-    let q = basis.ncols();
-    let pm = Mat::from_fn(d, d, |i, j| {
-        m[(i, j)] - f[i] * (0..d).map(|k| f[k] * m[(k, j)]).sum::<f64>()
-    });
-    let reduced = basis.transpose() * &pm * &basis;
+        _ => (shot.monodromy, shot.along),
+    };
+    let multipliers = by_modulus(general_eigenvalues(&m)?);
+    // The level set of the conserved quantities inside the range of M (the states M reaches:
+    // for a constrained system the constraint manifold's tangent space).
+    let (_, grads) = conserved(system, sym, &z)?;
+    let reach = range(&m)?;
+    let level = &reach * null_space(&(&grads * &reach))?;
+    // W: the flow and the generators tangent to the level set (the isotropy's).
+    let f = unit(&along)?;
+    let mut w_cols: Vec<Vec<f64>> = vec![f];
+    if let Some(s) = sym {
+        let iso = isotropy_generators(s, &z)?;
+        w_cols.extend((0..iso.ncols()).map(|k| (0..d).map(|i| iso[(i, k)]).collect()));
+    }
+    let w = range(&Mat::from_fn(d, w_cols.len(), |i, k| w_cols[k][i]))?;
+    // V = level ⊖ W, and the map M induces on level/W: Vᵀ(I − WWᵀ)MV.
+    let w_in_level = level.transpose() * &w;
+    let v = &level * null_space(&w_in_level.transpose().to_owned())?;
+    let pm = &m - &w * (w.transpose() * &m);
+    let reduced = v.transpose() * &pm * &v;
     let normal = by_modulus(general_eigenvalues(&reduced.to_owned())?);
+    let q = v.ncols();
     let mut order: Vec<usize> = (0..d).collect();
     let distance = |k: usize| (multipliers[k].0 - 1.0).hypot(multipliers[k].1);
     order.sort_by(|&a, &b| distance(a).total_cmp(&distance(b)));
@@ -430,12 +580,13 @@ fn finish(
         state0: z,
         period,
         steps,
-        monodromy: shot.monodromy,
+        monodromy: m,
         multipliers,
         trivial,
         normal,
         residual,
         iterations,
+        drift,
     })
 }
 

@@ -110,6 +110,19 @@ pub trait Problem: Send + Sync {
         Vec::new()
     }
 
+    /// The system's symmetry (momentum map, generators, action) where it has one: the relative
+    /// equilibria's and relative periodic orbits' data ([`crate::analysis`]). None by default.
+    fn symmetry(&self) -> Option<&dyn Symmetric> {
+        None
+    }
+
+    /// Moves a state (user frame) onto the manifold of the system's constraints, hidden ones
+    /// included (for the iterates of a solver, [`crate::analysis::periodic`]): the nearest
+    /// point in the momenta for a velocity constraint. The identity by default.
+    fn project(&self, _z: &mut [f64]) -> Result<()> {
+        Ok(())
+    }
+
     /// Whether the kernels call functions from outside lieflow (user closures, a binding's
     /// callables), which may fail or have side effects: a run then steps one step at a time and
     /// ends at the first failure without taking any step again ([`super::hooks`]).
@@ -451,6 +464,19 @@ pub trait Symmetric: Problem {
     /// The infinitesimal generator ξ_Z(z) (the velocity of the state under the one-parameter
     /// group exp(tξ)), user frame.
     fn generator(&self, xi: &[f64], z: &[f64]) -> Result<Vec<f64>>;
+
+    /// The action exp(ξ)·z of the group element exp(ξ) on a state (user frame): the drift of a
+    /// relative periodic orbit ([`crate::analysis::periodic`]). By default an
+    /// [`Error::InvalidArgument`] (not built for this system).
+    fn act(&self, _xi: &[f64], _z: &[f64]) -> Result<Vec<f64>> {
+        Err(Error::invalid(
+            "system",
+            format!(
+                "the finite action of {}'s symmetry is not built",
+                self.name()
+            ),
+        ))
+    }
 }
 
 /// A non-conservative term g(t, z) of an open system

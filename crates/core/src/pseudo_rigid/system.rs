@@ -279,6 +279,26 @@ impl Problem for PseudoRigidBody {
         2 * (self.n() / 2) + usize::from(self.incompressible)
     }
 
+    fn symmetry(&self) -> Option<&dyn Symmetric> {
+        Some(self)
+    }
+
+    /// For the incompressible body, P onto the hidden constraint ⟨cof X, P⟩ = 0 (along
+    /// cof X, the nearest such P); the free body has no constraint.
+    fn project(&self, z: &mut [f64]) -> Result<()> {
+        if self.incompressible {
+            let (x, mut p) = self.split(z)?;
+            let c = unit_cofactor(&x);
+            let c2 = linalg::frob2(c.as_ref());
+            if c2 > 0.0 {
+                let k = linalg::inner(c.as_ref(), p.as_ref()) / c2;
+                p -= &c * faer::Scale(k);
+                write_back(self.n(), &x, &p, z);
+            }
+        }
+        Ok(())
+    }
+
     /// det X > 0 when checked; for the incompressible body also the hidden constraint
     /// ⟨cof X, P⟩ = 0 to [`VOLUME_RATE_TOL`] relative to ‖cof X‖_F ‖P‖_F.
     fn check_state(&self, z: &[f64]) -> Result<()> {
@@ -707,6 +727,25 @@ impl Symmetric for PseudoRigidBody {
         );
         let mut out = vec![0.0; 2 * n * n];
         write_back(n, &(&a * &x - &x * &b), &(&a * &p - &p * &b), &mut out);
+        Ok(out)
+    }
+
+    /// (e^ξ X e^{−η}, e^ξ P e^{−η}).
+    fn act(&self, xi: &[f64], z: &[f64]) -> Result<Vec<f64>> {
+        let n = self.n();
+        let d = so::dim(n);
+        check::len_of("xi ⊕ eta", xi, 2 * d)?;
+        check::finite_slice("xi ⊕ eta", xi)?;
+        let (x, p) = self.split(z)?;
+        let g = so::exp(&so::hat_n_unchecked(n, &xi[..d]))?;
+        let h = so::exp(&so::hat_n_unchecked(n, &xi[d..]))?;
+        let mut out = vec![0.0; 2 * n * n];
+        write_back(
+            n,
+            &(&g * &x * h.transpose()),
+            &(&g * &p * h.transpose()),
+            &mut out,
+        );
         Ok(out)
     }
 }
