@@ -2,7 +2,10 @@
 //! (binding of `lieflow::analysis::continuation` for the ellipsoid families of
 //! `lieflow::pseudo_rigid::ellipsoids`). Conversions only; `Branch.plot` calls the Python
 //! presentation in `lieflow.continuation`.
+//! The Lyapunov spectrum (`lieflow.lyapunov`) is in `analysis/lyapunov.rs`, as in core.
 #![allow(non_snake_case)]
+
+pub(crate) mod lyapunov;
 
 use lieflow::analysis::continuation::{self as cont, End, Options};
 use lieflow::pseudo_rigid::ellipsoids::{self as ell, EllipsoidFamily, Sense};

@@ -51,6 +51,7 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;
     m.add_class::<sensitivity::PyTangent>()?;
+    m.add_class::<analysis::lyapunov::PyLyapunov>()?;
     systems::register(m)?;
     system::add_system::<
         pseudo_rigid::system::PyPseudoRigidBody,
