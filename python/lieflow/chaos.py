@@ -8,12 +8,13 @@ calls (the native work runs with the GIL released, unless the system calls Pytho
 ``poincare_section`` is one ``lieflow.integrate`` run with a terminal event.
 """
 
+import math
 import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ._lieflow import InvalidArgumentError, UnsupportedMethodError, _Lyapunov
+from ._lieflow import InvalidArgumentError, NonFiniteError, UnsupportedMethodError, _Lyapunov
 from .integrate import CHUNK_WORK, _check_method, _check_system, _count, _real, integrate
 
 __all__ = ["lyapunov", "LyapunovSpectrum", "poincare_section"]
@@ -172,7 +173,16 @@ def poincare_section(system, state0, section, *, direction=1, crossings=100, met
                         f"{type(direction).__name__} {direction!r:.60}")
 
     def g(t, state):
-        return section(state)
+        v = section(state)
+        if type(v) is not float:
+            if not _real(v):
+                raise TypeError(f"invalid section: section(state) must return a real number, "
+                                f"got {type(v).__name__} {v!r:.60}")
+            v = float(v)
+        if not math.isfinite(v):
+            raise NonFiniteError(f"the value returned by section contains a non-finite value "
+                                 f"(NaN or inf) at t = {t:g}: {v}")
+        return v
 
     g.direction = direction
     g.terminal = crossings
