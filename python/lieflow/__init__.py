@@ -33,6 +33,12 @@ integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 load(path)                                                      a Trajectory saved with
                                                                 Trajectory.save (NetCDF)
 
+Chaos (docs/chaos.md)
+---------------------
+lyapunov(system, state0, dt=..., steps=...)                     -> LyapunovSpectrum: all the
+                                                                Lyapunov exponents (repeated QR)
+poincare_section(system, state0, section, dt=...)               -> (times, states) of crossings
+
 Errors are subclasses of :class:`LieflowError` (itself a ``ValueError``); an argument of the
 wrong type (complex, string or object arrays, ragged lists) is an :class:`ArgumentTypeError`
 (a ``TypeError`` naming the argument).
@@ -85,6 +91,7 @@ from . import (continuation, ellipsoids, elliptic, io, lie, plot, potentials, ps
                surfaces)
 from . import ensemble  # imports dask and xarray only when its functions are called
 from .integrate import Trajectory, integrate, load
+from .chaos import LyapunovSpectrum, lyapunov, poincare_section
 from .io import FileFormatError
 from .periodic import PeriodicOrbit, periodic_orbit
 
@@ -109,6 +116,7 @@ __all__ = [
     "LiePoisson",
     "LiePoissonSystem",
     "LieflowError",
+    "LyapunovSpectrum",
     "NoUniqueLogError",
     "NonFiniteError",
     "NotInGroupError",
@@ -139,9 +147,11 @@ __all__ = [
     "io",
     "lie",
     "load",
+    "lyapunov",
     "mass_matrix",
     "periodic_orbit",
     "plot",
+    "poincare_section",
     "potentials",
     "pseudo_rigid",
     "spaces",

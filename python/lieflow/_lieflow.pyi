@@ -21,7 +21,7 @@ __all__ = [
     "LieflowError", "NotInGroupError", "ShapeError", "NonFiniteError", "DegenerateStratumError",
     "NoUniqueLogError", "InvalidArgumentError", "UnsupportedMethodError", "ConvergenceError",
     "LeftDomainError", "ArgumentTypeError", "lie", "pseudo_rigid", "potentials", "spaces", "surfaces",
-    "elliptic", "ellipsoids", "continuation", "System", "Integration", "_Tangent", "RigidBody",
+    "elliptic", "ellipsoids", "continuation", "System", "Integration", "_Tangent", "_Lyapunov", "RigidBody",
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
     "RelativisticTangentTop", "WeakFieldTop", "StaticFieldTop", "TangentTop", "ChargedParticle",
@@ -98,6 +98,18 @@ class _Tangent:
     @property
     def parameters(self) -> list[str]: ...
     def split(self, lifted: ArrayLike) -> tuple[_F64, _F64, _F64]: ...
+
+@final
+class _Lyapunov:
+    """A Lyapunov computation in progress (internal to `lieflow.lyapunov`)."""
+    def __new__(cls, system: System, state0: Any, dt: Any, steps: Any, method: Any,
+                renormalise_every: Any) -> Self: ...
+    def advance(self, segments: int) -> int: ...
+    @property
+    def segments(self) -> int: ...
+    @property
+    def segments_done(self) -> int: ...
+    def result(self) -> tuple[_F64, _F64, _F64, _F64]: ...
 
 @disjoint_base
 class System:

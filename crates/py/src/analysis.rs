@@ -2,7 +2,12 @@
 //! (binding of `lieflow::analysis::continuation` for the ellipsoid families of
 //! `lieflow::pseudo_rigid::ellipsoids`). Conversions only; `Branch.plot` calls the Python
 //! presentation in `lieflow.continuation`.
+//! The Lyapunov spectrum (`lieflow.lyapunov`) and the periodic orbits (`lieflow.periodic_orbit`)
+//! are in `analysis/lyapunov.rs` and `analysis/periodic.rs`, as in core.
 #![allow(non_snake_case)]
+
+pub(crate) mod lyapunov;
+pub(crate) mod periodic;
 
 use lieflow::analysis::continuation::{self as cont, End, Options};
 use lieflow::pseudo_rigid::ellipsoids::{self as ell, EllipsoidFamily, Sense};

@@ -11,7 +11,6 @@ mod errors;
 mod integrate;
 mod items;
 mod lie;
-mod periodic;
 mod pseudo_rigid;
 mod sensitivity;
 mod system;
@@ -52,7 +51,8 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;
     m.add_class::<sensitivity::PyTangent>()?;
-    m.add_function(wrap_pyfunction!(periodic::_periodic_orbit, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::periodic::_periodic_orbit, m)?)?;
+    m.add_class::<analysis::lyapunov::PyLyapunov>()?;
     systems::register(m)?;
     system::add_system::<
         pseudo_rigid::system::PyPseudoRigidBody,

@@ -211,6 +211,11 @@ def _turning_box(lf):
                                 steps=4, attitude=np.eye(3)))
 
 
+def section_gamma1(state):
+    """A Poincaré section of the heavy top (lf.poincare_section): Gamma_1 = 0."""
+    return float(state[3])
+
+
 def event_m2(t, state):
     """An event function of the rigid body (lf.integrate(events=...)): M₂, zero at t ≈ 1.6."""
     return state[1]
@@ -1031,6 +1036,18 @@ def build_specs() -> list[Spec]:
         A("dt", 0.01, "float", kw=True), A("steps", 20, "int", kw=True),
         A("save_every", 5, "int", kw=True, positive=True),
         A("sensitivity", True, "bool", kw=True))
+    # ---- chaos (issue 27): lf.lyapunov, lf.poincare_section ----
+    add("lyapunov[ht]", "lyapunov", A("system", lazy_recv("ht"), "obj"),
+        A("state0", state_of("ht"), "vec"), A("dt", 0.01, "float", kw=True, positive=True),
+        A("steps", 30, "int", kw=True, positive=True),
+        A("method", None, "str", kw=True, opt=True),
+        A("renormalise_every", 10, "int", kw=True, positive=True), module="integrate")
+    add("poincare_section[ht]", "poincare_section", A("system", lazy_recv("ht"), "obj"),
+        A("state0", state_of("ht"), "vec"), A("section", section_gamma1, "fn"),
+        A("direction", 1.0, "float", kw=True), A("crossings", 2, "int", kw=True, positive=True),
+        A("method", None, "str", kw=True, opt=True),
+        A("dt", 0.02, "float", kw=True, positive=True),
+        A("max_steps", 3000, "int", kw=True, positive=True), module="integrate")
     # ---- user-defined systems (issue 15) ----
     user_specs(add)
     forced_specs(add)

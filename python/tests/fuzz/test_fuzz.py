@@ -76,6 +76,7 @@ SKIP = {  # public names that are not callables to fuzz, with the reason
     "lieflow.LiePoissonSystem": "alias of System",
     "lieflow.Integration": "made by System._start only; advance/state are fuzzed on a run",
     "lieflow.Trajectory": "made by integrate only; its methods are fuzzed on a trajectory",
+    "lieflow.LyapunovSpectrum": "made by lyapunov; a record (attributes only)",
     "lieflow.RollingDisksEquilibrium": "made by RollingDisks.relative_equilibria; state is fuzzed",
     "lieflow.pseudo_rigid.RelativeEquilibrium": "made by relative_equilibria; motion/stability fuzzed",
     "lieflow.pseudo_rigid.Stability": "a record (no methods)",

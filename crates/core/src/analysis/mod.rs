@@ -1,11 +1,13 @@
 //! Analysis of relative equilibria and their families: the two stability verdicts
 //! ([`Verdict`]), the linear stability of relative equilibria of constrained mechanical systems in
 //! the co-moving frame ([`comoving`]), and pseudo-arclength continuation with special points
-//! ([`continuation`]). Generic: these layers know no system; systems enter through the problem
-//! kinds of [`crate::integrate::problem`] or the [`continuation::Family`] trait.
+//! ([`continuation`]), and the Lyapunov spectrum of a run ([`lyapunov`]). Generic: these layers
+//! know no system; systems enter through the problem kinds of [`crate::integrate::problem`], the
+//! [`continuation::Family`] trait or a tangent lift ([`crate::integrate::tangent`]).
 
 pub mod comoving;
 pub mod continuation;
+pub mod lyapunov;
 pub mod periodic;
 
 use crate::error::{Error, Result};

@@ -246,6 +246,38 @@ impl Run {
         z
     }
 
+    /// [`Run::checked_state`] written to `z` (the state's length) instead of a new vector.
+    pub fn checked_state_into<P: Problem + ?Sized>(&self, problem: &P, z: &mut [f64]) {
+        z.copy_from_slice(&self.buf);
+        problem.to_user(z);
+    }
+
+    /// Replaces the current state by `z` (user frame, checked as a run's initial state) and goes
+    /// on from it with the same clock, stepper and retraction schedule: a run that restarts its
+    /// directions (a tangent lift re-seeded at its own base state, [`crate::analysis::lyapunov`])
+    /// keeps the times and steps of one run.
+    ///
+    /// Errors: those of the initial state of [`Run::new`]; an ended run
+    /// ([`Error::InvalidArgument`]).
+    pub fn restart_from<P: Problem + ?Sized>(&mut self, problem: &P, z: &[f64]) -> Result<()> {
+        if self.ended.is_some() {
+            return Err(Error::invalid(
+                "run",
+                "the run has ended between grid times; it cannot go on",
+            ));
+        }
+        let _ = hooks::take_failure();
+        let checked = check_state(problem, z);
+        if let Some(e) = hooks::take_failure() {
+            return Err(e);
+        }
+        checked?;
+        self.buf.copy_from_slice(z);
+        problem.to_internal(&mut self.buf);
+        let r = self.stepper.set(&self.buf);
+        self.failed(r, self.clock.done)
+    }
+
     /// Saves the states at the times `times` (strictly increasing, none before the current
     /// time) instead of every `save_every`-th state: one state per time, by a shortened step
     /// from the grid state before it when the time is not a grid time (within round-off,
