@@ -33,6 +33,14 @@ integrate(system, state0, dt=..., steps=..., method=...)        -> Trajectory
 load(path)                                                      a Trajectory saved with
                                                                 Trajectory.save (NetCDF)
 
+Periodic orbits (docs/periodic_orbits.md)
+-----------------------------------------
+periodic_orbit(system, state0, period)                          -> PeriodicOrbit: shooting on the
+                                                                method's map (monodromy, Floquet
+                                                                multipliers; relative orbits)
+periodic_orbit.from_mode(equilibrium, mode, amplitude)          the start of a Lyapunov family
+continuation.periodic_family(system, orbit)                     -> PeriodicBranch
+
 Chaos (docs/chaos.md)
 ---------------------
 lyapunov(system, state0, dt=..., steps=...)                     -> LyapunovSpectrum: all the

@@ -12,6 +12,9 @@ from . import _lieflow
 from ._reexport import reexport as _reexport
 
 __all__ = _reexport(_lieflow.continuation, globals())
+from .periodic import PeriodicBranch, PeriodicSpecialPoint, periodic_family  # noqa: E402
+
+__all__ += ["PeriodicBranch", "PeriodicSpecialPoint", "periodic_family"]
 
 _LABELS = {
     "e": "eccentricity $e$",

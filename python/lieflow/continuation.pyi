@@ -10,7 +10,12 @@ from .pseudo_rigid import RelativeEquilibrium
 
 _F64 = NDArray[np.float64]
 
-__all__ = ["Branch", "SpecialPoint", "follow"]
+from .periodic import PeriodicBranch as PeriodicBranch
+from .periodic import PeriodicSpecialPoint as PeriodicSpecialPoint
+from .periodic import periodic_family as periodic_family
+
+__all__ = ["Branch", "PeriodicBranch", "PeriodicSpecialPoint", "SpecialPoint", "follow",
+           "periodic_family"]
 
 @final
 class SpecialPoint:

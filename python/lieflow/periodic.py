@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._lieflow import InvalidArgumentError, System, _periodic_orbit
+from ._lieflow import InvalidArgumentError, LieflowError, System, _periodic_orbit
 from .integrate import _check_method, _check_system, _count, _real, _step, integrate
 
-__all__ = ["PeriodicOrbit", "periodic_orbit"]
+__all__ = ["PeriodicBranch", "PeriodicOrbit", "PeriodicSpecialPoint", "periodic_family",
+           "periodic_orbit"]
 
 #: The method's steps per period when ``dt`` is not given.
 DEFAULT_STEPS = 1000
@@ -41,9 +42,11 @@ class PeriodicOrbit:
         residual: max abs(z(T) − z(0)) of the method's run, absolute.
         iterations: the Gauss–Newton iterations taken.
         attitude: the initial attitude R(0) of a relative orbit, else None.
-        drift: for a relative orbit, the rotation vector ω of g = R(T) R(0)ᵀ (3,) (a rotation of
-            space by abs(ω) ≤ π about ω; for the free rigid body about the spatial momentum,
-            by Montgomery's angle modulo 2π), else None.
+        drift: for a relative orbit of a body with an attitude, the rotation vector ω of
+            g = R(T) R(0)ᵀ (3,) (a rotation of space by abs(ω) ≤ π about ω; for the free rigid
+            body about the spatial momentum, by Montgomery's angle modulo 2π); for a relative
+            orbit of the system's symmetry, ζ with z(T) = exp(ζ)·z(0) (for ``PseudoRigidBody``
+            ξ ⊕ η in the e_ij coordinates of ``lie.vee_n``); else None.
     """
 
     __slots__ = ("system", "method", "state0", "period", "steps", "energy", "monodromy",
@@ -86,6 +89,8 @@ class PeriodicOrbit:
         w = self.drift
         angle = float(np.linalg.norm(w))
         spatial = getattr(self.system, "spatial_momentum", None)
+        if self.attitude is None:
+            return None
         if spatial is not None:
             pi = np.asarray(spatial(self.state0, self.attitude), dtype=float)
             if float(w @ pi) < 0:
@@ -109,7 +114,10 @@ class PeriodicOrbit:
 
     def __repr__(self):
         normal = ", ".join(f"{m:.6g}" for m in self.normal_multipliers)
-        drift = "" if self.drift is None else f", drift_angle={self.drift_angle:.10g}"
+        angle = self.drift_angle
+        drift = "" if self.drift is None else (
+            f", drift={np.array2string(self.drift, precision=6)}" if angle is None
+            else f", drift_angle={angle:.10g}")
         return (f"PeriodicOrbit({type(self.system).__name__}, method={self.method!r}, "
                 f"period={self.period:.15g}, energy={self.energy:.10g}, steps={self.steps}, "
                 f"stable={self.stable}, normal_multipliers=[{normal}], "
@@ -117,7 +125,7 @@ class PeriodicOrbit:
 
 
 def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy", relative=False,
-                   attitude=None, tol=1e-10, max_iter=30):
+                   attitude=None, drift=None, tol=1e-10, max_iter=30):
     """Finds a periodic orbit of ``method``'s map near ``state0`` with period near ``period``.
 
     The orbit is a fixed point of the method's map over N = round(period / dt) steps of size
@@ -140,12 +148,18 @@ def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy"
         dt: the step's size on the guess: N = max(1, round(period / dt)) steps per period
             (default: 1000 steps per period).
         fix: "energy" (keep the guess's energy) or "period".
-        relative: also compute the drift of the attitude over the period (a relative periodic
-            orbit: the state returns, the attitude R(T) = g R(0)); for systems that carry an
-            attitude (``RigidBody``, ``HeavyTop``, ``LiePoisson`` on so(3) with an attitude).
+        relative: a relative periodic orbit, periodic up to a symmetry. For a system with a
+            symmetry lieflow can act with (``PseudoRigidBody`` and its ``RelativeEquilibrium.
+            system``: (X, P) ↦ (gXhᵀ, gPhᵀ)) the shooting solves z(T) = exp(ζ)·z(0) for T and
+            ζ together (momentum map fixed, the slice across the orbit of its isotropy group);
+            ``drift`` is ζ, and the monodromy and multipliers are those of exp(−ζ)·z(T). For a
+            body that carries an attitude (``RigidBody``, ``HeavyTop``, …) the state returns
+            and the attitude does not: R(T) = g R(0), and ``drift`` is g's rotation vector.
             Implied by ``attitude``.
-        attitude: R(0) (3, 3) of a relative orbit (default with ``relative=True``: the
-            identity).
+        attitude: R(0) (3, 3) of a relative orbit of a body with an attitude (default with
+            ``relative=True``: the identity).
+        drift: a guess of ζ for a relative orbit of the system's symmetry (default 0; for an
+            orbit about a relative equilibrium with velocity ξ, about T·ξ).
         tol: the iteration's tolerance on the update (relative to the state's size and the
             period); it goes on while the update decreases.
         max_iter: Gauss–Newton iterations allowed.
@@ -185,10 +199,278 @@ def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy"
     if not isinstance(relative, (bool, np.bool_)):
         raise TypeError(f"invalid relative: expected True or False, got "
                         f"{type(relative).__name__} {relative!r}")
-    if attitude is None and relative:
-        attitude = np.eye(3)
     fields = _periodic_orbit(system, state0, period, method, steps, fix, tol, _count(
-        "max_iter", max_iter), attitude)
-    if attitude is not None:
-        attitude = np.array(attitude, dtype=float)
-    return PeriodicOrbit(system, method, attitude, fields)
+        "max_iter", max_iter), attitude, bool(relative), drift)
+    return PeriodicOrbit(system, method, fields["attitude"], fields)
+
+
+def from_mode(equilibrium, mode, amplitude, *, method=None, dt=None, fix="energy", tol=1e-10,
+              max_iter=30):
+    """The Lyapunov orbit of a normal mode of a relative equilibrium at a small amplitude: the
+    start of its Lyapunov family (``lieflow.continuation.periodic_family``).
+
+    The linear motion about the equilibrium in the co-moving frame is Re(v exp(iωt)); the
+    orbit is shot as a relative periodic orbit of ``equilibrium.system`` from
+    z(0) = z_eq + amplitude·Re(v), T = 2π/ω and the drift T·(ξ ⊕ η) of the equilibrium's
+    velocities, at the energy of z(0) (``fix="energy"``): its period tends to 2π/ω as the
+    amplitude shrinks (Lyapunov's centre theorem, for a mode not resonant with the others).
+
+    Args:
+        equilibrium: a ``RelativeEquilibrium`` (of ``lieflow.ellipsoids`` or a pseudo-rigid
+            body).
+        mode: a ``NormalMode`` of ``equilibrium.normal_modes()`` or its index.
+        amplitude: the displacement's size relative to the state's (v is unit length in the
+            state scaled by its positions' and momenta's sizes), e.g. 1e-3.
+        method, dt, fix, tol, max_iter: as in ``periodic_orbit`` (default method: the body's).
+
+    Returns:
+        A ``PeriodicOrbit`` (relative: ``drift`` is ζ).
+    """
+    modes = equilibrium.normal_modes()
+    if isinstance(mode, (int, np.integer)) and not isinstance(mode, bool):
+        if not 0 <= mode < len(modes):
+            raise InvalidArgumentError(f"invalid mode: expected an index in [0, {len(modes)}), "
+                                       f"got {mode} (the equilibrium has {len(modes)} "
+                                       f"oscillatory normal modes)")
+        mode = modes[int(mode)]
+    elif not hasattr(mode, "vector"):
+        raise TypeError(f"invalid mode: expected a NormalMode or an index, got "
+                        f"{type(mode).__name__} {mode!r}")
+    if not _real(amplitude):
+        raise TypeError(f"invalid amplitude: expected a real number, got "
+                        f"{type(amplitude).__name__} {amplitude!r}")
+    system = equilibrium.system
+    state0 = equilibrium.state + float(amplitude) * mode.vector.real
+    period = mode.period
+    from .lie import vee_n
+    velocity = np.concatenate([vee_n(equilibrium.xi), vee_n(equilibrium.eta)])
+    return periodic_orbit(system, state0, period, method=method, dt=dt, fix=fix, relative=True,
+                          drift=period * velocity, tol=tol, max_iter=max_iter)
+
+
+periodic_orbit.from_mode = from_mode  # type: ignore[attr-defined]
+
+
+#: Bisections that locate a change of stability along a family (the secant step / 2**12).
+_BISECTIONS = 12
+
+
+class PeriodicSpecialPoint:
+    """A special point of a ``PeriodicBranch``.
+
+    Attributes:
+        kind: "period_doubling" (a normal multiplier through −1), "tangent" (through +1: a
+            fold or branch point of orbits of the same period), "krein" (two pairs of
+            multipliers collide on the unit circle and leave it), "fold" (the parameter turns
+            back along the branch; not located beyond the points).
+        index: the branch point after which it lies.
+        value: the parameter's value there (located by bisection for a change of stability).
+        orbit: the orbit at the located point (on the unstable side, to 2**-12 of the step).
+    """
+
+    __slots__ = ("kind", "index", "value", "orbit")
+
+    def __init__(self, kind, index, value, orbit):
+        self.kind, self.index, self.value, self.orbit = kind, index, value, orbit
+
+    def __repr__(self):
+        return (f"PeriodicSpecialPoint(kind={self.kind!r}, index={self.index}, "
+                f"value={self.value:.10g})")
+
+
+class PeriodicBranch:
+    """A family of periodic orbits (``lieflow.continuation.periodic_family``).
+
+    Attributes:
+        points: the ``PeriodicOrbit``s in the order of continuation.
+        parameter: "energy" or "period".
+        values: the parameter along the branch.
+        energies, periods: (k,) arrays.
+        stable: (k,) bool: every normal multiplier on or inside the unit circle.
+        special_points: ``PeriodicSpecialPoint``s in the order met.
+        end: why the continuation stopped.
+    """
+
+    __slots__ = ("points", "parameter", "special_points", "end")
+
+    def __init__(self, points, parameter, special_points, end):
+        self.points, self.parameter = points, parameter
+        self.special_points, self.end = special_points, end
+
+    @property
+    def energies(self):
+        return np.array([p.energy for p in self.points])
+
+    @property
+    def periods(self):
+        return np.array([p.period for p in self.points])
+
+    @property
+    def values(self):
+        return self.energies if self.parameter == "energy" else self.periods
+
+    @property
+    def stable(self):
+        return np.array([p.stable for p in self.points])
+
+    def __len__(self):
+        return len(self.points)
+
+    def plot(self, ax=None, *, x="energy", y="period", **kwargs):
+        """Draws y against x ("energy" or "period"): stable orbits solid, unstable dashed,
+        special points marked and named. Returns the axes."""
+        import matplotlib.pyplot as plt
+        if ax is None:
+            ax = plt.gca()
+        xs = self.energies if x == "energy" else self.periods
+        ys = self.energies if y == "energy" else self.periods
+        st = self.stable
+        color = kwargs.pop("color", "C0")
+        for k in range(len(xs) - 1):
+            ax.plot(xs[k:k + 2], ys[k:k + 2], "-" if st[k] and st[k + 1] else "--", color=color,
+                    **kwargs)
+        for sp in self.special_points:
+            px = sp.orbit.energy if x == "energy" else sp.orbit.period
+            py = sp.orbit.energy if y == "energy" else sp.orbit.period
+            ax.plot([px], [py], "o", color="k")
+            ax.annotate(sp.kind.replace("_", " "), (px, py), textcoords="offset points",
+                        xytext=(5, 5), fontsize=8)
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        return ax
+
+    def __repr__(self):
+        return (f"PeriodicBranch({len(self.points)} orbits, {self.parameter} "
+                f"{self.values[0]:.6g} -> {self.values[-1]:.6g}, "
+                f"{len(self.special_points)} special points, end={self.end!r})")
+
+
+def _kind(orbit):
+    """How an unstable orbit's normal multipliers left the unit circle."""
+    mu = orbit.normal_multipliers
+    out = mu[np.abs(mu) > 1 + 1e-6]
+    if out.size == 0:
+        return "tangent"
+    m = out[np.argmax(np.abs(out))]
+    if abs(m.imag) > 1e-6 * abs(m):
+        return "krein"
+    return "period_doubling" if m.real < 0 else "tangent"
+
+
+def _pack(orbit):
+    drift = orbit.drift if orbit.attitude is None and orbit.drift is not None else None
+    return orbit.state0, orbit.period, drift
+
+
+def _shoot(system, like, z, t, drift, fix, tol):
+    return periodic_orbit(system, z, t, method=like.method, dt=t / like.steps, fix=fix,
+                          relative=drift is not None or like.attitude is not None,
+                          attitude=like.attitude, drift=drift, tol=tol)
+
+
+def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
+                    max_step=0.1, max_points=40, direction=1, tol=1e-10):
+    """Follows the family of periodic (or relative periodic) orbits through ``orbit``.
+
+    A secant predictor in the orbit's unknowns (state, period, drift) and the shooting of
+    ``periodic_orbit`` as corrector, at the energy the prediction lands on (at a fold in the
+    energy, at its period instead); steps grow and shrink with the corrector's success. Between
+    consecutive orbits the normal multipliers are compared: a change of stability is located
+    by bisection on the secant and named by how the multipliers left the unit circle
+    (``PeriodicSpecialPoint.kind``: period doubling, tangent, Krein collision); a turn of the
+    parameter is reported as a fold. Every orbit keeps the method and the steps per period of
+    ``orbit``.
+
+    Args:
+        system: the system of ``orbit``.
+        orbit: a ``PeriodicOrbit`` (e.g. from ``periodic_orbit.from_mode``).
+        parameter: "energy" or "period", what ``values``, ``stop`` and folds refer to.
+        stop: stop once the parameter passes this value (default: ``max_points`` only).
+        step, max_step: the first and the largest step, relative to the state's size.
+        max_points: the largest number of orbits.
+        direction: +1 to start towards higher energy, −1 lower.
+        tol: the shooting's tolerance.
+
+    Returns:
+        A ``PeriodicBranch``.
+    """
+    if parameter not in ("energy", "period"):
+        raise InvalidArgumentError(f"invalid parameter: expected \"energy\" or \"period\", "
+                                   f"got {parameter!r}")
+    if not isinstance(orbit, PeriodicOrbit):
+        raise TypeError(f"invalid orbit: expected a PeriodicOrbit, got {type(orbit).__name__}")
+    max_points = _count("max_points", max_points)
+    value = (lambda o: o.energy) if parameter == "energy" else (lambda o: o.period)
+    z0, t0, drift0 = _pack(orbit)
+    scale = max(1.0, float(np.abs(z0).max()))
+    # The first step: along the energy's gradient, by `step` of the state's size.
+    h = 1e-6 * scale
+    grad = np.array([(system.energy(z0 + h * e) - system.energy(z0 - h * e)) / (2 * h)
+                     for e in np.eye(z0.size)])
+    dz = float(np.sign(direction) or 1) * step * scale * grad / np.linalg.norm(grad)
+    points, specials = [orbit], []
+    ds, end = step, "max_points"
+    previous = None         # (Δz, ΔT, Δdrift) of the last secant, per unit step
+    while len(points) < max_points:
+        z, t, drift = _pack(points[-1])
+        if previous is None:
+            guess = (z + dz, t, drift)
+        else:
+            pz, pt, pd = previous
+            guess = (z + ds * pz, t + ds * pt, None if drift is None else drift + ds * pd)
+        new = None
+        for fix in ("energy", "period"):
+            try:
+                new = _shoot(system, orbit, *guess, fix, tol)
+                break
+            except LieflowError:
+                continue
+        if new is None:
+            if ds <= 1e-4 * step:
+                end = "stuck: the corrector failed at the smallest step"
+                break
+            ds *= 0.5
+            if previous is None:
+                dz = 0.5 * dz
+            continue
+        # The secant per unit step (length `ds` relative to the scale).
+        nz, nt, nd = _pack(new)
+        length = float(np.abs(nz - z).max()) / scale
+        if length == 0:
+            end = "stuck: the corrector returned the same orbit"
+            break
+        previous = ((nz - z) / length * (1 / scale) * scale, (nt - t) / length,
+                    None if nd is None else (nd - drift) / length)
+        # Special points between the last orbit and the new one.
+        last = points[-1]
+        if len(points) >= 2:
+            a, b, c = value(points[-2]), value(last), value(new)
+            if (b - a) * (c - b) < 0:
+                specials.append(PeriodicSpecialPoint("fold", len(points) - 1, b, last))
+        if last.stable != new.stable:
+            specials.append(_locate(system, orbit, last, new, len(points) - 1, value, tol))
+        points.append(new)
+        ds = min(max_step, 1.5 * ds) if new.iterations <= 5 else ds
+        if stop is not None and (value(new) - stop) * (value(orbit) - stop) <= 0:
+            end = "stop"
+            break
+    return PeriodicBranch(points, parameter, specials, end)
+
+
+def _locate(system, like, a, b, index, value, tol):
+    """The change of stability between orbits a and b, by bisection on their secant."""
+    (za, ta, da), (zb, tb, db) = _pack(a), _pack(b)
+    lo, hi, unstable = 0.0, 1.0, (b if not b.stable else a)
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        guess = (za + mid * (zb - za), ta + mid * (tb - ta),
+                 None if da is None else da + mid * (db - da))
+        try:
+            o = _shoot(system, like, *guess, "energy", tol)
+        except LieflowError:
+            break
+        if o.stable == a.stable:
+            lo = mid
+        else:
+            hi, unstable = mid, o
+    return PeriodicSpecialPoint(_kind(unstable), index, value(unstable), unstable)

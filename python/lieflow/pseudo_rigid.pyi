@@ -235,6 +235,22 @@ class RelativeEquilibrium:
     def motion(self, t: ArrayLike) -> tuple[_F64, _F64]:
         """(X(t), P(t)), each (k, n, n)."""
     def stability(self) -> Stability: ...
+    @property
+    def system(self) -> System:
+        """The body of the equilibrium over (X, P), for integrating or shooting its orbits."""
+    @property
+    def state(self) -> _F64:
+        """(X0, P0) flat, (2 n^2,)."""
+    def normal_modes(self) -> list[NormalMode]:
+        """The oscillatory normal modes of the co-moving linearisation, by frequency."""
+
+@final
+class NormalMode:
+    index: int
+    frequency: float
+    period: float
+    eigenvalue: complex
+    vector: NDArray[np.complex128]
 
 def loop_circulation(X: ArrayLike, V: ArrayLike, labels: ArrayLike) -> float:
     """Kelvin's circulation of the material loop X(C0), C0 the closed polygon through the rows

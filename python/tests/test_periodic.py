@@ -187,3 +187,57 @@ def test_bad_input_is_refused():
         lf.periodic_orbit(lf.Pendulum(), [1.0, 0.0], 6.0, relative=True)
     with pytest.raises(TypeError):
         lf.periodic_orbit("body", m0, 10.0)
+
+
+def test_normal_modes_and_the_lyapunov_orbit_of_a_jacobi_ellipsoid():
+    jacobi = lf.ellipsoids.jacobi(0.6)
+    modes = jacobi.normal_modes()
+    # The co-moving spectrum: a stable Jacobi figure has only imaginary pairs.
+    freqs = np.array([m.frequency for m in modes])
+    assert len(modes) == 4 and np.all(np.diff(freqs) > 0)
+    ev = np.sort(jacobi.stability().spectral.eigenvalues.imag)
+    np.testing.assert_allclose(freqs, ev[ev > 0], rtol=1e-12)
+    assert all(abs(m.eigenvalue.real) <= 1e-12 * m.frequency for m in modes)
+    mode = modes[0]
+    assert mode.period == pytest.approx(2 * np.pi / mode.frequency)
+    assert mode.vector.shape == (18,) and mode.vector.dtype == np.complex128
+    orbit = lf.periodic_orbit.from_mode(jacobi, 0, 1e-3, method="rattle6", dt=mode.period / 100)
+    assert orbit.stable and orbit.residual <= 1e-12
+    assert orbit.period == pytest.approx(mode.period, rel=1e-5)
+    assert orbit.normal_multipliers.shape == (6,)
+    np.testing.assert_allclose(np.abs(orbit.normal_multipliers), 1.0, atol=1e-9)
+    # ζ ≈ T·(Ω ⊕ 0): a turn about the rotation axis, no internal rotation.
+    velocity = np.concatenate([lf.lie.vee_n(jacobi.xi), lf.lie.vee_n(jacobi.eta)])
+    np.testing.assert_allclose(orbit.drift, orbit.period * velocity, atol=1e-4)
+    # Its run returns to exp(ζ)·z(0): X(T) = e^ξ X(0) e^{-η}.
+    traj = orbit.trajectory()
+    x0, xt = orbit.state0[:9].reshape(3, 3), traj.states[-1][:9].reshape(3, 3)
+    g = lf.lie.so_exp(lf.lie.hat_n(orbit.drift[:3]))
+    h = lf.lie.so_exp(lf.lie.hat_n(orbit.drift[3:]))
+    np.testing.assert_allclose(xt, g @ x0 @ h.T, atol=1e-12)
+    with pytest.raises(lf.InvalidArgumentError, match="mode"):
+        lf.periodic_orbit.from_mode(jacobi, 4, 1e-3)
+
+
+def test_a_family_crosses_mathieu_s_tongues_and_locates_them():
+    # ω² + βA²/2 = 4 at A = √10 ≈ 3.16 (the second tongue, a multiplier through +1 over the
+    # period 2π: cos²t has period π).
+    omega, beta = 1.2, 0.8
+    sys = coupled(omega, beta)
+    start = lf.periodic_orbit(sys, [0.3, 0.0, 0.0, 0.0], 6.3, method="gauss6", dt=0.1)
+    branch = lf.continuation.periodic_family(sys, start, max_points=16, step=0.1, max_step=0.3)
+    assert len(branch) == 16 and branch.parameter == "energy"
+    assert np.all(np.diff(branch.energies) > 0)
+    np.testing.assert_allclose(branch.periods, 2 * np.pi, rtol=1e-9)   # isochronous in x
+    first = branch.special_points[0]
+    assert first.kind == "tangent" and not first.orbit.stable
+    amplitude = np.hypot(first.orbit.state0[0], first.orbit.state0[2])
+    # The first tongue crossed: Mathieu's multiplier through +1 at this amplitude.
+    mu = mathieu_multipliers(omega, beta, amplitude)
+    assert np.abs(mu).max() > 1
+    inside = mathieu_multipliers(omega, beta, amplitude * (1 - 2e-3))
+    assert np.abs(inside).max() == pytest.approx(1.0, abs=1e-9)
+    # Stable where Mathieu is, along the branch.
+    for orbit in branch.points[::3]:
+        a = np.hypot(orbit.state0[0], orbit.state0[2])
+        assert orbit.stable == (np.abs(mathieu_multipliers(omega, beta, a)).max() <= 1 + 1e-6)

@@ -8,7 +8,9 @@ use numpy::{Complex64, IntoPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{py_mat, py_vec, real, real_matrix, size};
+use crate::convert::{py_mat, py_vec, real, real_matrix, real_vec, size};
+
+const IDENTITY: [f64; 9] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
 use crate::errors::{checked, to_py};
 use crate::system::PySystem;
 
@@ -19,9 +21,13 @@ fn complex(v: &[(f64, f64)]) -> Vec<Complex64> {
 /// The periodic orbit of `method`'s map with `steps` steps per period near `state0` and
 /// `period` (`lieflow.periodic_orbit`, which checks the arguments' kinds): a dict of its
 /// quantities (state0, period, energy, monodromy, multipliers, trivial, normal, stable,
-/// residual, iterations, drift: the rotation vector of R(T) R(0)ᵀ with an attitude, else None).
+/// residual, iterations, drift). A relative orbit: with an attitude, of the body carrying it
+/// (drift: the rotation vector of R(T) R(0)ᵀ); else `relative` of the system's symmetry
+/// (drift: ζ with z(T) = exp(ζ)·z(0), from the guess `drift`), or of the body carrying the
+/// identity attitude where the system has no symmetry lieflow can act with.
 #[pyfunction]
-#[pyo3(signature = (system, state0, period, method, steps, fix, tol, max_iter, attitude = None))]
+#[pyo3(signature = (system, state0, period, method, steps, fix, tol, max_iter, attitude = None,
+                    relative = false, drift = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn _periodic_orbit<'py>(
     py: Python<'py>,
@@ -34,6 +40,8 @@ pub fn _periodic_orbit<'py>(
     #[pyo3(from_py_with = real)] tol: f64,
     #[pyo3(from_py_with = size)] max_iter: usize,
     attitude: Option<&Bound<'py, PyAny>>,
+    relative: bool,
+    drift: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let fix = match fix {
         "energy" => Fix::Energy,
@@ -60,24 +68,47 @@ pub fn _periodic_orbit<'py>(
             "one initial state: the shooting solves for one orbit",
         )));
     }
-    let attitude: Option<[f64; 9]> = attitude
-        .map(|a| real_matrix::<3, 3>(a).map(|m| std::array::from_fn(|k| m[k / 3][k % 3])))
-        .transpose()?;
     let sys = system.sys.clone();
+    let symmetric = attitude.is_none() && relative && sys.symmetry().is_some();
+    let attitude = match attitude {
+        None if relative && !symmetric => {
+            if sys.lift().is_none() {
+                return Err(to_py(Error::invalid(
+                    "relative",
+                    format!(
+                        "{} has neither a symmetry whose action lieflow knows nor an attitude",
+                        sys.name()
+                    ),
+                )));
+            }
+            Some(IDENTITY)
+        }
+        None => None,
+        Some(a) => Some(
+            real_matrix::<3, 3>(a).map(|m| std::array::from_fn(|k| m[k / 3][k % 3]))?,
+        ),
+    };
+    let drift = drift.map(real_vec).transpose()?;
+    if drift.is_some() && !symmetric {
+        return Err(to_py(Error::invalid(
+            "drift",
+            "a guess of ζ is for a relative orbit of the system's symmetry (relative=True)",
+        )));
+    }
     let options = Options {
         steps,
         fix,
         tol,
         max_iter,
-        relative: false,
+        relative: symmetric,
     };
     let solve = || {
         checked(|| {
-            let orbit = core::periodic_orbit(sys.as_ref(), method, &z0, period, None, &options)?;
-            let drift = attitude
-                .as_ref()
-                .map(|a| core::attitude_drift(sys.as_ref(), method, &orbit, a))
-                .transpose()?;
+            let orbit = core::periodic_orbit(sys.as_ref(), method, &z0, period, drift.as_deref(), &options)?;
+            let drift = match &attitude {
+                Some(a) => Some(core::attitude_drift(sys.as_ref(), method, &orbit, a)?.to_vec()),
+                None => orbit.drift.clone(),
+            };
             Ok((orbit, drift))
         })
     };
@@ -99,5 +130,7 @@ pub fn _periodic_orbit<'py>(
     out.set_item("residual", orbit.residual)?;
     out.set_item("iterations", orbit.iterations)?;
     out.set_item("drift", drift.map(|w| py_vec(py, &w)))?;
+    let attitude = attitude.map(|a| py_mat(py, &lieflow::Mat::from_fn(3, 3, |i, j| a[3 * i + j])));
+    out.set_item("attitude", attitude)?;
     Ok(out)
 }

@@ -20,6 +20,7 @@ use super::potential::PyPotential;
 use crate::convert::{mat, py_mat, py_vec, vector, ArrayIn};
 use crate::convert::{real_pair, size};
 use crate::errors::{checked, to_py, IntoPy};
+use crate::system::PySystem;
 
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
 type Arr3<'py> = Bound<'py, PyArray3<f64>>;
@@ -542,6 +543,44 @@ impl RelativeEquilibrium {
         })
     }
 
+    /// The body whose relative equilibrium this is (the incompressible body for the
+    /// ellipsoids), as a ``lieflow.System`` over (X, P): for integrating or shooting its orbits.
+    #[getter]
+    fn system(&self, py: Python<'_>) -> PyResult<Py<PySystem>> {
+        let body: Arc<dyn lieflow::integrate::System> = Arc::new(self.body()?);
+        Py::new(py, PySystem::derived(py, body))
+    }
+
+    /// The state (X0, P0) at t = 0, flat (2 n^2,) in the layout of ``system``.
+    #[getter]
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let z = self.body()?.state(&self.inner.x0(), &self.inner.p0()).py()?;
+        Ok(py_vec(py, &z))
+    }
+
+    /// The oscillatory normal modes of the linearised motion about the equilibrium in the
+    /// co-moving frame, on the symplectic normal space (the spectral verdict's eigenvalues
+    /// with positive imaginary part), by ascending frequency: the starts of its Lyapunov
+    /// families (``lieflow.periodic_orbit.from_mode``).
+    ///
+    /// Returns:
+    ///     A list of ``NormalMode``.
+    ///
+    /// Raises:
+    ///     InvalidArgumentError (not a relative equilibrium to 1e-8).
+    fn normal_modes(&self) -> PyResult<Vec<NormalMode>> {
+        let body = self.body()?;
+        let z = body.state(&self.inner.x0(), &self.inner.p0()).py()?;
+        let mut xi = lieflow::lie::so::vee_n(&self.inner.xi).py()?;
+        xi.extend(lieflow::lie::so::vee_n(&self.inner.eta).py()?);
+        let s = lieflow::analysis::comoving::stability(&body, &z, &xi).py()?;
+        Ok(s.modes
+            .into_iter()
+            .enumerate()
+            .map(|(index, m)| NormalMode { index, inner: m })
+            .collect())
+    }
+
     fn __repr__(&self) -> String {
         if let Some((_, _, q)) = &self.figure {
             return format!(
@@ -553,6 +592,76 @@ impl RelativeEquilibrium {
         format!(
             "RelativeEquilibrium(shape={:?}, energy={:.6e}, residual={:.1e})",
             self.inner.a, self.inner.energy, self.inner.residuals.motion
+        )
+    }
+}
+
+impl RelativeEquilibrium {
+    /// The body of this equilibrium: incompressible or free, with its potential.
+    fn body(&self) -> PyResult<PseudoRigidBody> {
+        let n = self.inner.n();
+        match self.incompressible {
+            true => PseudoRigidBody::incompressible(n, self.potential.clone()),
+            false => PseudoRigidBody::new(n, self.potential.clone(), true),
+        }
+        .py()
+    }
+}
+
+/// A normal mode of a relative equilibrium (``RelativeEquilibrium.normal_modes``): an
+/// eigenvalue λ = σ + iω of the co-moving linearisation (σ = 0 for a stable equilibrium) and
+/// its eigenvector v in the state's coordinates; the linear motion about the equilibrium in
+/// the co-moving frame is Re(v exp(λt)).
+#[pyclass(module = "lieflow.pseudo_rigid", name = "NormalMode", frozen)]
+pub struct NormalMode {
+    index: usize,
+    inner: lieflow::analysis::comoving::Mode,
+}
+
+#[pymethods]
+impl NormalMode {
+    /// Its position in ``normal_modes()`` (by ascending frequency).
+    #[getter]
+    fn index(&self) -> usize {
+        self.index
+    }
+
+    /// ω, the imaginary part of the eigenvalue: the mode's angular frequency.
+    #[getter]
+    fn frequency(&self) -> f64 {
+        self.inner.eigenvalue.1
+    }
+
+    /// 2π/ω.
+    #[getter]
+    fn period(&self) -> f64 {
+        std::f64::consts::TAU / self.inner.eigenvalue.1
+    }
+
+    /// λ = σ + iω.
+    #[getter]
+    fn eigenvalue<'py>(&self, py: Python<'py>) -> Bound<'py, pyo3::types::PyComplex> {
+        pyo3::types::PyComplex::from_doubles(py, self.inner.eigenvalue.0, self.inner.eigenvalue.1)
+    }
+
+    /// v (complex, (2 n^2,)), unit length in the state scaled by its positions' and momenta's
+    /// sizes, turned so that its real part (the displacement at t = 0) is the longest.
+    #[getter]
+    fn vector<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<Complex64>> {
+        let v: Vec<Complex64> = self
+            .inner
+            .re
+            .iter()
+            .zip(&self.inner.im)
+            .map(|(&a, &b)| Complex64::new(a, b))
+            .collect();
+        v.into_pyarray(py)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "NormalMode(index={}, frequency={:.10}, eigenvalue={:.3e}{:+.10}j)",
+            self.index, self.inner.eigenvalue.1, self.inner.eigenvalue.0, self.inner.eigenvalue.1
         )
     }
 }
@@ -642,6 +751,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(equilibrium_directions, m)?)?;
     m.add_function(wrap_pyfunction!(relative_equilibria, m)?)?;
     m.add_class::<RelativeEquilibrium>()?;
+    m.add_class::<NormalMode>()?;
     m.add_class::<Stability>()?;
     m.add_class::<Verdict>()?;
     Ok(())
