@@ -41,6 +41,11 @@ class PeriodicOrbit:
         stable: every normal multiplier has modulus at most 1 + 1e-6 (spectral stability).
         residual: max abs(z(T) − z(0)) of the method's run, absolute.
         iterations: the Gauss–Newton iterations taken.
+        levels: the levels the orbit keeps: the invariants (``system.invariants``), then for a
+            relative orbit of the system's symmetry its momentum map.
+        tangent: the tangent of the orbit's family at these levels, (δz, δT, δζ) of unit
+            length ((d + 1 + dim g,), ζ only for a relative orbit of the system's symmetry),
+            the direction in which the energy grows.
         attitude: the initial attitude R(0) of a relative orbit, else None.
         drift: for a relative orbit of a body with an attitude, the rotation vector ω of
             g = R(T) R(0)ᵀ (3,) (a rotation of space by abs(ω) ≤ π about ω; for the free rigid
@@ -51,7 +56,7 @@ class PeriodicOrbit:
 
     __slots__ = ("system", "method", "state0", "period", "steps", "energy", "monodromy",
                  "multipliers", "trivial", "normal_multipliers", "stable", "residual",
-                 "iterations", "attitude", "drift")
+                 "iterations", "attitude", "drift", "levels", "tangent")
 
     def __init__(self, system, method, attitude, fields):
         self.system = system
@@ -69,8 +74,10 @@ class PeriodicOrbit:
         self.residual = fields["residual"]
         self.iterations = fields["iterations"]
         self.drift = fields["drift"]
+        self.levels = fields["levels"]
+        self.tangent = fields["tangent"]
         for a in (self.state0, self.monodromy, self.multipliers, self.trivial,
-                  self.normal_multipliers, self.drift, self.attitude):
+                  self.normal_multipliers, self.drift, self.attitude, self.levels, self.tangent):
             if a is not None:
                 a.flags.writeable = False
 
@@ -125,7 +132,7 @@ class PeriodicOrbit:
 
 
 def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy", relative=False,
-                   attitude=None, drift=None, tol=1e-10, max_iter=30):
+                   attitude=None, drift=None, levels=None, tol=1e-10, max_iter=30):
     """Finds a periodic orbit of ``method``'s map near ``state0`` with period near ``period``.
 
     The orbit is a fixed point of the method's map over N = round(period / dt) steps of size
@@ -160,6 +167,8 @@ def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy"
             ``relative=True``: the identity).
         drift: a guess of ζ for a relative orbit of the system's symmetry (default 0; for an
             orbit about a relative equilibrium with velocity ξ, about T·ξ).
+        levels: the levels to keep instead of the guess's (as ``PeriodicOrbit.levels``: the
+            invariants, then the momentum map of a relative orbit).
         tol: the iteration's tolerance on the update (relative to the state's size and the
             period); it goes on while the update decreases.
         max_iter: Gauss–Newton iterations allowed.
@@ -200,7 +209,7 @@ def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy"
         raise TypeError(f"invalid relative: expected True or False, got "
                         f"{type(relative).__name__} {relative!r}")
     fields = _periodic_orbit(system, state0, period, method, steps, fix, tol, _count(
-        "max_iter", max_iter), attitude, bool(relative), drift)
+        "max_iter", max_iter), attitude, bool(relative), drift, levels)
     return PeriodicOrbit(system, method, fields["attitude"], fields)
 
 
@@ -365,14 +374,16 @@ def _pack(orbit):
 def _shoot(system, like, z, t, drift, fix, tol):
     return periodic_orbit(system, z, t, method=like.method, dt=t / like.steps, fix=fix,
                           relative=drift is not None or like.attitude is not None,
-                          attitude=like.attitude, drift=drift, tol=tol)
+                          attitude=like.attitude, drift=drift, levels=like.levels, tol=tol)
 
 
 def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
                     max_step=0.1, max_points=40, direction=1, tol=1e-10):
     """Follows the family of periodic (or relative periodic) orbits through ``orbit``.
 
-    A secant predictor in the orbit's unknowns (state, period, drift) and the shooting of
+    The family at the levels of ``orbit`` (its invariants and momentum, ``orbit.levels``): a
+    tangent predictor (``PeriodicOrbit.tangent``, the null vector of the shooting equations
+    without the energy's, in the orbit's unknowns: state, period, drift) and the shooting of
     ``periodic_orbit`` as corrector, at the energy the prediction lands on (at a fold in the
     energy, at its period instead); steps grow and shrink with the corrector's success. Between
     consecutive orbits the normal multipliers are compared: a change of stability is located
@@ -401,23 +412,23 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
         raise TypeError(f"invalid orbit: expected a PeriodicOrbit, got {type(orbit).__name__}")
     max_points = _count("max_points", max_points)
     value = (lambda o: o.energy) if parameter == "energy" else (lambda o: o.period)
-    z0, t0, drift0 = _pack(orbit)
-    scale = max(1.0, float(np.abs(z0).max()))
-    # The first step: along the energy's gradient, by `step` of the state's size.
-    h = 1e-6 * scale
-    grad = np.array([(system.energy(z0 + h * e) - system.energy(z0 - h * e)) / (2 * h)
-                     for e in np.eye(z0.size)])
-    dz = float(np.sign(direction) or 1) * step * scale * grad / np.linalg.norm(grad)
+    scale = max(1.0, float(np.abs(orbit.state0).max()))
+    sense = float(np.sign(direction) or 1)
     points, specials = [orbit], []
     ds, end = step, "max_points"
-    previous = None         # (Δz, ΔT, Δdrift) of the last secant, per unit step
     while len(points) < max_points:
-        z, t, drift = _pack(points[-1])
-        if previous is None:
-            guess = (z + dz, t, drift)
-        else:
-            pz, pt, pd = previous
-            guess = (z + ds * pz, t + ds * pt, None if drift is None else drift + ds * pd)
+        last = points[-1]
+        z, t, drift = _pack(last)
+        d = z.size
+        # The tangent predictor, oriented along the way the branch goes; the state moves by
+        # ds of its size.
+        tan = sense * last.tangent
+        if len(points) >= 2:
+            pz, pt, _ = _pack(points[-2])
+            if float(tan[:d] @ (z - pz)) + float(tan[d] * (t - pt)) < 0:
+                tan = -tan
+        h = ds * scale / max(float(np.abs(tan[:d]).max()), 1e-300)
+        guess = (z + h * tan[:d], t + h * tan[d], None if drift is None else drift + h * tan[d + 1:])
         new = None
         for fix in ("energy", "period"):
             try:
@@ -430,19 +441,7 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
                 end = "stuck: the corrector failed at the smallest step"
                 break
             ds *= 0.5
-            if previous is None:
-                dz = 0.5 * dz
             continue
-        # The secant per unit step (length `ds` relative to the scale).
-        nz, nt, nd = _pack(new)
-        length = float(np.abs(nz - z).max()) / scale
-        if length == 0:
-            end = "stuck: the corrector returned the same orbit"
-            break
-        previous = ((nz - z) / length * (1 / scale) * scale, (nt - t) / length,
-                    None if nd is None else (nd - drift) / length)
-        # Special points between the last orbit and the new one.
-        last = points[-1]
         if len(points) >= 2:
             a, b, c = value(points[-2]), value(last), value(new)
             if (b - a) * (c - b) < 0:

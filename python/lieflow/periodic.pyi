@@ -32,6 +32,8 @@ class PeriodicOrbit:
     iterations: int
     attitude: _F64 | None
     drift: _F64 | None
+    levels: _F64
+    tangent: _F64
     def __init__(self, system: System, method: str, attitude: _F64 | None,
                  fields: dict[str, Any]) -> None: ...
     @property
@@ -45,8 +47,8 @@ class _PeriodicOrbitFunction(Protocol):
     def __call__(
         self, system: System, state0: ArrayLike, period: float, *, method: str | None = None,
         dt: float | None = None, fix: str = "energy", relative: bool = False,
-        attitude: ArrayLike | None = None, drift: ArrayLike | None = None, tol: float = 1e-10,
-        max_iter: int = 30,
+        attitude: ArrayLike | None = None, drift: ArrayLike | None = None,
+        levels: ArrayLike | None = None, tol: float = 1e-10, max_iter: int = 30,
     ) -> PeriodicOrbit: ...
     def from_mode(
         self, equilibrium: RelativeEquilibrium, mode: NormalMode | int, amplitude: float, *,

@@ -345,7 +345,10 @@ fn a_lyapunov_orbit_of_the_jacobi_ellipsoid_is_the_normal_mode_at_small_amplitud
     let st = comoving::stability(&body, &ze, &xi).unwrap();
     assert!(st.spectral.stable);
     let omegas: Vec<f64> = st.modes.iter().map(|m| m.eigenvalue.1).collect();
-    println!("Jacobi a2/a1 = 0.6: mode frequencies {omegas:?}, normal dim {}", st.normal_dim);
+    println!(
+        "Jacobi a2/a1 = 0.6: mode frequencies {omegas:?}, normal dim {}",
+        st.normal_dim
+    );
     let mode = &st.modes[0];
     let omega = mode.eigenvalue.1;
     let size = ze.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
@@ -383,15 +386,69 @@ fn a_lyapunov_orbit_of_the_jacobi_ellipsoid_is_the_normal_mode_at_small_amplitud
         // The other modes turn by e^{±iω_k T} over the period, to O(amplitude²).
         for w in &omegas[1..] {
             let (c, s) = ((w * orbit.period).cos(), (w * orbit.period).sin().abs());
-            let near = orbit
-                .normal
-                .iter()
-                .fold(f64::INFINITY, |m, &(re, im)| m.min((re - c).hypot(im.abs() - s)));
+            let near = orbit.normal.iter().fold(f64::INFINITY, |m, &(re, im)| {
+                m.min((re - c).hypot(im.abs() - s))
+            });
             assert!(near <= 100.0 * amplitude * amplitude, "ω = {w}: {near:e}");
         }
         // The period's offset from 2π/ω and the drift's from Tξ are O(amplitude²).
         assert!(dt <= 2.0 * amplitude * amplitude && dz <= 5.0 * amplitude * amplitude);
         assert!(dt < previous / 3.0);
         previous = dt;
+    }
+}
+
+/// The family's tangent is the secant of two orbits of the family at nearby energies (the
+/// same levels, the same phase hyperplane), to O(δ).
+#[test]
+fn the_family_tangent_is_the_secant_of_nearby_orbits() {
+    let body = RigidBody::new(I).unwrap();
+    let m0 = [1.0, 0.3, 0.2];
+    let t0 = closed_form_period(m0);
+    let casimir: f64 = m0.iter().map(|x| x * x).sum();
+    let o = options(8, Fix::Energy);
+    let orbit = periodic_orbit(&body, "exact", &m0, t0, None, &o).unwrap();
+    assert_eq!(orbit.levels.len(), 1);
+    assert!((orbit.levels[0] - casimir).abs() <= 1e-14);
+    let tan = &orbit.tangent;
+    assert_eq!(tan.len(), 4);
+    // Nearby orbits on m0's sphere, on the phase plane through m0 (across the flow f there):
+    // the guesses m0 ± δu, u = m0 × f(m0), lie on their own orbits.
+    let w: Vec<f64> = (0..3).map(|k| m0[k] / I[k]).collect();
+    let f = [
+        m0[1] * w[2] - m0[2] * w[1],
+        m0[2] * w[0] - m0[0] * w[2],
+        m0[0] * w[1] - m0[1] * w[0],
+    ];
+    let u = [
+        m0[1] * f[2] - m0[2] * f[1],
+        m0[2] * f[0] - m0[0] * f[2],
+        m0[0] * f[1] - m0[1] * f[0],
+    ];
+    let delta = 1e-5;
+    let shoot = |s: f64| {
+        let g: Vec<f64> = (0..3).map(|k| m0[k] + s * u[k]).collect();
+        let opts = Options {
+            levels: Some(vec![casimir]),
+            ..o.clone()
+        };
+        periodic_orbit(&body, "exact", &g, t0, None, &opts).unwrap()
+    };
+    let (p, m) = (shoot(delta), shoot(-delta));
+    let mut secant: Vec<f64> = (0..3).map(|i| p.state0[i] - m.state0[i]).collect();
+    secant.push(p.period - m.period);
+    let norm = secant.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let sign = if p.energy > m.energy { 1.0 } else { -1.0 };
+    let err = secant
+        .iter()
+        .zip(tan)
+        .fold(0.0_f64, |e, (s, t)| e.max((sign * s / norm - t).abs()));
+    println!("tangent {tan:?}, secant {:?} error {err:.1e}", secant.iter().map(|s| sign * s / norm).collect::<Vec<_>>());
+    // The phase plane's normal is the chord of a step of 1e-5·T: f to O(1e-5).
+    assert!(err <= 1e-4, "{err:e}");
+    // Both orbits keep m0's Casimir.
+    for q in [&p, &m] {
+        let c: f64 = q.state0.iter().map(|x| x * x).sum();
+        assert!((c - casimir).abs() <= 1e-13);
     }
 }

@@ -150,8 +150,12 @@ fn modes(lin: &Mat, cs: &Mat, w: &[f64], tol: f64) -> Result<Vec<Mode>> {
         let (sn, cs_) = theta.sin_cos();
         out.push(Mode {
             eigenvalue: (lam.re, lam.im),
-            re: (0..nz).map(|i| w[i] * (a[i] * cs_ - b[i] * sn) / length).collect(),
-            im: (0..nz).map(|i| w[i] * (a[i] * sn + b[i] * cs_) / length).collect(),
+            re: (0..nz)
+                .map(|i| w[i] * (a[i] * cs_ - b[i] * sn) / length)
+                .collect(),
+            im: (0..nz)
+                .map(|i| w[i] * (a[i] * sn + b[i] * cs_) / length)
+                .collect(),
         });
     }
     out.sort_by(|x, y| x.eigenvalue.1.total_cmp(&y.eigenvalue.1));

@@ -11,7 +11,8 @@
 //!
 //! * Φ_{T/N}^N(z₀) − z₀ = 0 (d equations);
 //! * H(z₀) = E (fix = energy, E the guess's energy);
-//! * ⟨v, z₀ − ẑ⟩ = 0, the phase: a hyperplane through the guess ẑ across the flow v at ẑ;
+//! * ⟨v, z₀ − ẑ⟩ = 0, the phase: a hyperplane through the guess ẑ across the flow v at ẑ (the
+//!   chord of one step of 1e-5·T);
 //! * I_j(z₀) = I_j(ẑ), the levels of the invariants ([`Problem::invariants`]).
 //!
 //! They are more equations than unknowns but consistent at an orbit, and solved by the
@@ -70,6 +71,9 @@ pub struct Options {
     pub max_iter: usize,
     /// A relative periodic orbit Φ_T(z₀) = exp(ζ)·z₀ of the system's symmetry.
     pub relative: bool,
+    /// The levels to keep (the invariants, then for a relative orbit the momentum map);
+    /// default: the guess's.
+    pub levels: Option<Vec<f64>>,
 }
 
 impl Default for Options {
@@ -80,6 +84,7 @@ impl Default for Options {
             tol: 1e-10,
             max_iter: 30,
             relative: false,
+            levels: None,
         }
     }
 }
@@ -90,6 +95,10 @@ pub const STABLE_TOL: f64 = 1e-6;
 /// An orbit whose relative residual ‖Φ(z₀) − z₀‖∞/max(1, ‖z₀‖∞) exceeds this after the
 /// iteration stopped is not returned (the equations had no solution near the guess).
 const RESIDUAL_LIMIT: f64 = 1e-6;
+
+/// The step, relative to the period, whose chord gives the flow's direction at the guess
+/// (the phase plane's normal).
+const PHASE_STEP: f64 = 1e-5;
 
 /// Singular values below this times the largest are zero in the least-squares update.
 const RCOND: f64 = 1e-12;
@@ -121,6 +130,12 @@ pub struct PeriodicOrbit {
     /// ζ of a relative orbit: Φ_T(state0) = exp(ζ)·state0 (the monodromy and the
     /// multipliers are those of exp(−ζ)·Φ_T); None for a periodic one.
     pub drift: Option<Vec<f64>>,
+    /// The levels the orbit keeps: the invariants, then (relative) the momentum map.
+    pub levels: Vec<f64>,
+    /// The tangent of the orbit's family at fixed levels: (δz, δT, δζ) of unit length (d + 1
+    /// + dim g values), the direction in which the energy grows (the null vector of the
+    /// shooting equations without the energy's).
+    pub tangent: Vec<f64>,
 }
 
 impl PeriodicOrbit {
@@ -386,7 +401,8 @@ pub fn periodic_orbit(
         None => Mat::zeros(d, 0),
     };
     let v = {
-        let z1 = end_of(system, method, &guess, period / n as f64, 1)?;
+        // One short step: its chord is the flow to O(h) (an exact flow's steps may be long).
+        let z1 = end_of(system, method, &guess, PHASE_STEP * period, 1)?;
         let mut v: Vec<f64> = z1.iter().zip(&guess).map(|(a, b)| a - b).collect();
         for k in 0..gens0.ncols() {
             let c = (0..d).map(|i| gens0[(i, k)] * v[i]).sum::<f64>();
@@ -394,9 +410,21 @@ pub fn periodic_orbit(
         }
         unit(&v)?
     };
-    let (levels, _) = conserved(system, sym, &guess)?;
+    let (mut levels, _) = conserved(system, sym, &guess)?;
+    if let Some(target) = &options.levels {
+        if target.len() != levels.len() - 1 {
+            return Err(Error::shape(
+                "levels",
+                format!(
+                    "({},) (the invariants, then the momentum map)",
+                    levels.len() - 1
+                ),
+                format!("({},)", target.len()),
+            ));
+        }
+        levels[1..].copy_from_slice(target);
+    }
     let (mut z, mut t) = (guess.clone(), period);
-    let unknowns = d + usize::from(energy_fixed) + g;
     let rule = Rule {
         tol: options.tol,
         floor: 4.0 * f64::EPSILON,
@@ -411,37 +439,19 @@ pub fn periodic_orbit(
             None => z.clone(),
         };
         let gap: Vec<f64> = shot.end.iter().zip(&target).map(|(a, b)| a - b).collect();
-        if accepted {
-            let drift = sym.map(|_| zeta.clone());
-            return finish(
-                system,
-                sym,
-                z,
-                t,
-                n,
-                drift,
-                shot,
-                &gap,
-                monitor.iterations(),
-            );
-        }
-        // Rows: the map (d), then each conserved quantity, the phase and the slice, each
-        // scaled to a unit normal; the energy's row only with the energy fixed.
+        // The equations but the energy's in the unknowns (z, τ = δT/T, ζ), and the energy's.
         let (values, grads) = conserved(system, sym, &z)?;
-        let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
-        for (c, (&value, &level)) in values.iter().zip(&levels).enumerate() {
-            if c == 0 && !energy_fixed {
-                continue;
-            }
+        let unit_row = |c: usize| -> Option<(Vec<f64>, f64)> {
             let row: Vec<f64> = (0..d).map(|j| grads[(c, j)]).collect();
             let norm = dot(&row, &row).sqrt();
-            if norm > 0.0 && norm.is_finite() {
-                rows.push((
+            (norm > 0.0 && norm.is_finite()).then(|| {
+                (
                     row.iter().map(|x| x / norm).collect(),
-                    (level - value) / norm,
-                ));
-            }
-        }
+                    (levels[c] - values[c]) / norm,
+                )
+            })
+        };
+        let mut rows: Vec<(Vec<f64>, f64)> = (1..values.len()).filter_map(unit_row).collect();
         let offset: Vec<f64> = z.iter().zip(&guess).map(|(a, b)| a - b).collect();
         rows.push((v.clone(), -dot(&v, &offset)));
         for k in 0..gens0.ncols() {
@@ -453,17 +463,14 @@ pub fn periodic_orbit(
             Some(s) => action_jacobians(s, &zeta, &z)?,
             None => (Mat::identity(d, d), Mat::zeros(d, 0)),
         };
-        let m = d + rows.len();
-        let tcol = d;
-        let zcol = d + usize::from(energy_fixed);
-        let a = Mat::from_fn(m, unknowns, |i, j| {
+        let full = Mat::from_fn(d + rows.len(), d + 1 + g, |i, j| {
             if i < d {
                 if j < d {
                     shot.monodromy[(i, j)] - act_z[(i, j)]
-                } else if j < zcol {
-                    shot.along[i] * t // the unknown τ = δT/T
+                } else if j == d {
+                    shot.along[i] * t
                 } else {
-                    -act_zeta[(i, j - zcol)]
+                    -act_zeta[(i, j - d - 1)]
                 }
             } else if j < d {
                 rows[i - d].0[j]
@@ -471,23 +478,69 @@ pub fn periodic_orbit(
                 0.0
             }
         });
+        if accepted {
+            let tangent = family_tangent(&full, &grads, t)?;
+            let drift = sym.map(|_| zeta.clone());
+            let mut orbit = finish(
+                system,
+                sym,
+                z,
+                t,
+                n,
+                drift,
+                shot,
+                &gap,
+                monitor.iterations(),
+            )?;
+            orbit.tangent = tangent;
+            orbit.levels = levels[1..].to_vec();
+            return Ok(orbit);
+        }
+        // Newton's matrix: with the energy's row (fix = energy), or without the period's
+        // column (fix = period).
+        let energy = if energy_fixed { unit_row(0) } else { None };
+        let m = full.nrows() + usize::from(energy.is_some());
+        let cols: Vec<usize> = (0..d + 1 + g).filter(|&j| energy_fixed || j != d).collect();
+        let a = Mat::from_fn(m, cols.len(), |i, k| {
+            let j = cols[k];
+            match &energy {
+                Some((row, _)) if i == full.nrows() => {
+                    if j < d {
+                        row[j]
+                    } else {
+                        0.0
+                    }
+                }
+                _ => full[(i, j)],
+            }
+        });
         let b: Vec<f64> = (0..m)
-            .map(|i| if i < d { -gap[i] } else { rows[i - d].1 })
+            .map(|i| {
+                if i < d {
+                    -gap[i]
+                } else if i < full.nrows() {
+                    rows[i - d].1
+                } else {
+                    energy.as_ref().map_or(0.0, |e| e.1)
+                }
+            })
             .collect();
         let step = least_squares(&a, &b)?;
-        for (zj, s) in z.iter_mut().zip(&step) {
+        let mut full_step = vec![0.0; d + 1 + g];
+        for (k, &j) in cols.iter().enumerate() {
+            full_step[j] = step[k];
+        }
+        for (zj, s) in z.iter_mut().zip(&full_step) {
             *zj += s;
         }
         system.project(&mut z)?;
-        let mut update = inf_norm(&step[..d]) / scale;
-        if energy_fixed {
-            t *= 1.0 + step[tcol];
-            update = update.max(step[tcol].abs());
-            if t.is_nan() || t <= 0.0 {
-                update = f64::INFINITY;
-            }
+        let mut update = inf_norm(&full_step[..d]) / scale;
+        t *= 1.0 + full_step[d];
+        update = update.max(full_step[d].abs());
+        if t.is_nan() || t <= 0.0 {
+            update = f64::INFINITY;
         }
-        for (x, s) in zeta.iter_mut().zip(&step[zcol..]) {
+        for (x, s) in zeta.iter_mut().zip(&full_step[d + 1..]) {
             *x += s;
             update = update.max(s.abs());
         }
@@ -508,6 +561,36 @@ pub fn periodic_orbit(
             }
         }
     }
+}
+
+/// The family's tangent at an orbit: the null vector of the shooting equations without the
+/// energy's (columns z, τ = δT/T, ζ), as (δz, δT, δζ) of unit length, oriented so that the
+/// energy grows (rows of `grads`: the energy's first).
+fn family_tangent(full: &Mat, grads: &Mat, period: f64) -> Result<Vec<f64>> {
+    let n = full.ncols();
+    let rows = full.nrows().max(n);
+    let padded = Mat::from_fn(
+        rows,
+        n,
+        |i, j| {
+            if i < full.nrows() {
+                full[(i, j)]
+            } else {
+                0.0
+            }
+        },
+    );
+    let svd = padded
+        .svd()
+        .map_err(|e| eig_error("SVD (the family's tangent)", e))?;
+    let v = svd.V();
+    let d = grads.ncols();
+    let mut t: Vec<f64> = (0..n).map(|j| v[(j, n - 1)]).collect();
+    t[d] *= period;
+    let de: f64 = (0..d).map(|j| grads[(0, j)] * t[j]).sum();
+    let sign = if de < 0.0 { -1.0 } else { 1.0 };
+    let norm = dot(&t, &t).sqrt();
+    Ok(t.iter().map(|x| sign * x / norm).collect())
 }
 
 /// The orbit at the accepted point: residual, multipliers, their split (module docs).
@@ -587,6 +670,8 @@ fn finish(
         residual,
         iterations,
         drift,
+        levels: Vec::new(),
+        tangent: Vec::new(),
     })
 }
 

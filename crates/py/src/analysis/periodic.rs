@@ -21,13 +21,14 @@ fn complex(v: &[(f64, f64)]) -> Vec<Complex64> {
 /// The periodic orbit of `method`'s map with `steps` steps per period near `state0` and
 /// `period` (`lieflow.periodic_orbit`, which checks the arguments' kinds): a dict of its
 /// quantities (state0, period, energy, monodromy, multipliers, trivial, normal, stable,
-/// residual, iterations, drift). A relative orbit: with an attitude, of the body carrying it
+/// residual, iterations, drift, levels, tangent; `levels` to keep instead of the guess's).
+/// A relative orbit: with an attitude, of the body carrying it
 /// (drift: the rotation vector of R(T) R(0)ᵀ); else `relative` of the system's symmetry
 /// (drift: ζ with z(T) = exp(ζ)·z(0), from the guess `drift`), or of the body carrying the
 /// identity attitude where the system has no symmetry lieflow can act with.
 #[pyfunction]
 #[pyo3(signature = (system, state0, period, method, steps, fix, tol, max_iter, attitude = None,
-                    relative = false, drift = None))]
+                    relative = false, drift = None, levels = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn _periodic_orbit<'py>(
     py: Python<'py>,
@@ -42,7 +43,9 @@ pub fn _periodic_orbit<'py>(
     attitude: Option<&Bound<'py, PyAny>>,
     relative: bool,
     drift: Option<&Bound<'py, PyAny>>,
+    levels: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let levels = levels.map(real_vec).transpose()?;
     let fix = match fix {
         "energy" => Fix::Energy,
         "period" => Fix::Period,
@@ -84,9 +87,7 @@ pub fn _periodic_orbit<'py>(
             Some(IDENTITY)
         }
         None => None,
-        Some(a) => Some(
-            real_matrix::<3, 3>(a).map(|m| std::array::from_fn(|k| m[k / 3][k % 3]))?,
-        ),
+        Some(a) => Some(real_matrix::<3, 3>(a).map(|m| std::array::from_fn(|k| m[k / 3][k % 3]))?),
     };
     let drift = drift.map(real_vec).transpose()?;
     if drift.is_some() && !symmetric {
@@ -101,10 +102,18 @@ pub fn _periodic_orbit<'py>(
         tol,
         max_iter,
         relative: symmetric,
+        levels,
     };
     let solve = || {
         checked(|| {
-            let orbit = core::periodic_orbit(sys.as_ref(), method, &z0, period, drift.as_deref(), &options)?;
+            let orbit = core::periodic_orbit(
+                sys.as_ref(),
+                method,
+                &z0,
+                period,
+                drift.as_deref(),
+                &options,
+            )?;
             let drift = match &attitude {
                 Some(a) => Some(core::attitude_drift(sys.as_ref(), method, &orbit, a)?.to_vec()),
                 None => orbit.drift.clone(),
@@ -129,6 +138,8 @@ pub fn _periodic_orbit<'py>(
     out.set_item("stable", orbit.stable())?;
     out.set_item("residual", orbit.residual)?;
     out.set_item("iterations", orbit.iterations)?;
+    out.set_item("levels", py_vec(py, &orbit.levels))?;
+    out.set_item("tangent", py_vec(py, &orbit.tangent))?;
     out.set_item("drift", drift.map(|w| py_vec(py, &w)))?;
     let attitude = attitude.map(|a| py_mat(py, &lieflow::Mat::from_fn(3, 3, |i, j| a[3 * i + j])));
     out.set_item("attitude", attitude)?;

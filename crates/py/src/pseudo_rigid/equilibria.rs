@@ -554,7 +554,10 @@ impl RelativeEquilibrium {
     /// The state (X0, P0) at t = 0, flat (2 n^2,) in the layout of ``system``.
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let z = self.body()?.state(&self.inner.x0(), &self.inner.p0()).py()?;
+        let z = self
+            .body()?
+            .state(&self.inner.x0(), &self.inner.p0())
+            .py()?;
         Ok(py_vec(py, &z))
     }
 
