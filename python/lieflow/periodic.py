@@ -263,6 +263,12 @@ periodic_orbit.from_mode = from_mode  # type: ignore[attr-defined]
 #: Bisections that locate a change of stability along a family (the secant step / 2**12).
 _BISECTIONS = 12
 
+#: A corrected orbit further than this many steps from its prediction, or whose family tangent
+#: turned by more than arccos(_MIN_COSINE) from the last orbit's, is not accepted (the step is
+#: halved): the corrector may have reached another family.
+_MAX_CORRECTION = 0.5
+_MIN_COSINE = 0.9
+
 
 class PeriodicSpecialPoint:
     """A special point of a ``PeriodicBranch``.
@@ -366,26 +372,37 @@ def _kind(orbit):
     return "period_doubling" if m.real < 0 else "tangent"
 
 
-def _pack(orbit):
-    drift = orbit.drift if orbit.attitude is None and orbit.drift is not None else None
-    return orbit.state0, orbit.period, drift
+def _unknowns(orbit):
+    """u = (z, T, ζ) of an orbit (ζ only for a relative orbit of the system's symmetry)."""
+    parts = [orbit.state0, [orbit.period]]
+    if orbit.attitude is None and orbit.drift is not None:
+        parts.append(orbit.drift)
+    return np.concatenate(parts)
 
 
-def _shoot(system, like, z, t, drift, fix, tol):
-    return periodic_orbit(system, z, t, method=like.method, dt=t / like.steps, fix=fix,
-                          relative=drift is not None or like.attitude is not None,
-                          attitude=like.attitude, drift=drift, levels=like.levels, tol=tol)
+def _correct(system, like, u0, tangent, h, tol):
+    """The orbit of ``like``'s family at arclength h from u0 along ``tangent``: the shooting with
+    the pseudo-arclength condition, from the prediction u0 + h·tangent."""
+    d = like.state0.size
+    u = u0 + h * tangent
+    drift = u[d + 1:] if u.size > d + 1 else None
+    fields = _periodic_orbit(system, u[:d], float(u[d]), like.method, like.steps, "arclength",
+                             tol, 30, like.attitude, drift is not None or like.attitude is not None,
+                             drift, like.levels, (u0, tangent, float(h)))
+    return PeriodicOrbit(system, like.method, fields["attitude"], fields)
 
 
 def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
-                    max_step=0.1, max_points=40, direction=1, tol=1e-10):
+                    max_step=0.05, max_points=40, direction=1, tol=1e-10):
     """Follows the family of periodic (or relative periodic) orbits through ``orbit``.
 
     The family at the levels of ``orbit`` (its invariants and momentum, ``orbit.levels``): a
     tangent predictor (``PeriodicOrbit.tangent``, the null vector of the shooting equations
     without the energy's, in the orbit's unknowns: state, period, drift) and the shooting of
-    ``periodic_orbit`` as corrector, at the energy the prediction lands on (at a fold in the
-    energy, at its period instead); steps grow and shrink with the corrector's success. Between
+    ``periodic_orbit`` with the pseudo-arclength condition as corrector (which passes folds of
+    the energy and of the period); steps grow and shrink with the corrector's success, and an
+    orbit the corrector finds too far from the prediction or whose family tangent turned too
+    much (another family) is refused for a shorter step. Between
     consecutive orbits the normal multipliers are compared: a change of stability is located
     by bisection on the secant and named by how the multipliers left the unit circle
     (``PeriodicSpecialPoint.kind``: period doubling, tangent, Krein collision); a turn of the
@@ -412,30 +429,27 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
         raise TypeError(f"invalid orbit: expected a PeriodicOrbit, got {type(orbit).__name__}")
     max_points = _count("max_points", max_points)
     value = (lambda o: o.energy) if parameter == "energy" else (lambda o: o.period)
+    d = orbit.state0.size
     scale = max(1.0, float(np.abs(orbit.state0).max()))
-    sense = float(np.sign(direction) or 1)
     points, specials = [orbit], []
     ds, end = step, "max_points"
+    tan = float(np.sign(direction) or 1) * orbit.tangent
     while len(points) < max_points:
         last = points[-1]
-        z, t, drift = _pack(last)
-        d = z.size
-        # The tangent predictor, oriented along the way the branch goes; the state moves by
-        # ds of its size.
-        tan = sense * last.tangent
-        if len(points) >= 2:
-            pz, pt, _ = _pack(points[-2])
-            if float(tan[:d] @ (z - pz)) + float(tan[d] * (t - pt)) < 0:
-                tan = -tan
+        u0 = _unknowns(last)
+        # The state moves by ds of its size along the tangent.
         h = ds * scale / max(float(np.abs(tan[:d]).max()), 1e-300)
-        guess = (z + h * tan[:d], t + h * tan[d], None if drift is None else drift + h * tan[d + 1:])
-        new = None
-        for fix in ("energy", "period"):
-            try:
-                new = _shoot(system, orbit, *guess, fix, tol)
-                break
-            except LieflowError:
-                continue
+        try:
+            new = _correct(system, orbit, u0, tan, h, tol)
+        except LieflowError:
+            new = None
+        # The new orbit continues the branch when the corrector stayed near the prediction
+        # and the tangent turned little; else (another family, or none) a shorter step.
+        if new is not None:
+            moved = float(np.abs(new.state0 - (u0[:d] + h * tan[:d])).max()) / (ds * scale)
+            turn = abs(float(new.tangent @ tan))
+            if moved > _MAX_CORRECTION or turn < _MIN_COSINE:
+                new = None
         if new is None:
             if ds <= 1e-4 * step:
                 end = "stuck: the corrector failed at the smallest step"
@@ -449,7 +463,9 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
         if last.stable != new.stable:
             specials.append(_locate(system, orbit, last, new, len(points) - 1, value, tol))
         points.append(new)
-        ds = min(max_step, 1.5 * ds) if new.iterations <= 5 else ds
+        # The new tangent, oriented as the branch goes (it may turn at a fold of the energy).
+        tan = new.tangent if float(new.tangent @ tan) >= 0 else -new.tangent
+        ds = min(max_step, 1.5 * ds) if new.iterations <= 7 else ds
         if stop is not None and (value(new) - stop) * (value(orbit) - stop) <= 0:
             end = "stop"
             break
@@ -457,15 +473,17 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
 
 
 def _locate(system, like, a, b, index, value, tol):
-    """The change of stability between orbits a and b, by bisection on their secant."""
-    (za, ta, da), (zb, tb, db) = _pack(a), _pack(b)
+    """The change of stability between orbits a and b, by bisection on their secant (the
+    shooting with the arclength condition across it)."""
+    ua, ub = _unknowns(a), _unknowns(b)
+    chord = ub - ua
+    length = float(np.linalg.norm(chord))
+    direction = chord / length
     lo, hi, unstable = 0.0, 1.0, (b if not b.stable else a)
     for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
-        guess = (za + mid * (zb - za), ta + mid * (tb - ta),
-                 None if da is None else da + mid * (db - da))
         try:
-            o = _shoot(system, like, *guess, "energy", tol)
+            o = _correct(system, like, ua, direction, mid * length, tol)
         except LieflowError:
             break
         if o.stable == a.stable:

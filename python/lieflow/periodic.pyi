@@ -92,6 +92,6 @@ class PeriodicBranch:
 
 def periodic_family(
     system: System, orbit: PeriodicOrbit, *, parameter: str = "energy",
-    stop: float | None = None, step: float = 0.02, max_step: float = 0.1, max_points: int = 40,
+    stop: float | None = None, step: float = 0.02, max_step: float = 0.05, max_points: int = 40,
     direction: float = 1, tol: float = 1e-10,
 ) -> PeriodicBranch: ...

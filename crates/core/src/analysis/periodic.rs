@@ -49,12 +49,23 @@ use crate::numerics::fd::{self, Scheme};
 use crate::Mat;
 
 /// What the shooting keeps fixed along the family of the orbit (module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Fix {
     /// The energy of the guess; the period is an unknown.
     Energy,
     /// The period given; the energy is an unknown.
     Period,
+    /// The pseudo-arclength condition of a continuation: ⟨t, u − u₀⟩ = s in the unknowns
+    /// u = (z, T, ζ) (d + 1 + dim g values; [`PeriodicOrbit::tangent`]'s layout), which passes
+    /// folds of both the energy and the period.
+    Arclength {
+        /// u₀, the last orbit of the family.
+        from: Vec<f64>,
+        /// t, its tangent.
+        tangent: Vec<f64>,
+        /// s.
+        step: f64,
+    },
 }
 
 /// The shooting's discretisation and stopping rule ([`periodic_orbit`]).
@@ -389,7 +400,16 @@ pub fn periodic_orbit(
         None => vec![0.0; g],
     };
     let d = lift.base_dim();
-    let energy_fixed = options.fix == Fix::Energy;
+    if let Fix::Arclength { from, tangent, step } = &options.fix {
+        let k = d + 1 + g;
+        if from.len() != k || tangent.len() != k || !step.is_finite() {
+            return Err(Error::invalid(
+                "fix",
+                format!("an arclength condition needs u₀ and t of {k} values and a finite step"),
+            ));
+        }
+    }
+    let period_free = options.fix != Fix::Period;
     let mut guess = z0.to_vec();
     system.project(&mut guess)?;
     let scale = inf_norm(&guess).max(1.0);
@@ -496,21 +516,36 @@ pub fn periodic_orbit(
             orbit.levels = levels[1..].to_vec();
             return Ok(orbit);
         }
-        // Newton's matrix: with the energy's row (fix = energy), or without the period's
-        // column (fix = period).
-        let energy = if energy_fixed { unit_row(0) } else { None };
-        let m = full.nrows() + usize::from(energy.is_some());
-        let cols: Vec<usize> = (0..d + 1 + g).filter(|&j| energy_fixed || j != d).collect();
+        // Newton's matrix: with the energy's row (fix = energy), without the period's column
+        // (fix = period), or with the arclength's row.
+        let extra: Option<(Vec<f64>, f64)> = match &options.fix {
+            Fix::Energy => unit_row(0).map(|(row, c)| {
+                let mut r = row;
+                r.resize(d + 1 + g, 0.0);
+                (r, c)
+            }),
+            Fix::Period => None,
+            Fix::Arclength {
+                from,
+                tangent,
+                step,
+            } => {
+                let mut u = z.clone();
+                u.push(t);
+                u.extend_from_slice(&zeta);
+                let along: f64 = (0..u.len()).map(|k| tangent[k] * (u[k] - from[k])).sum();
+                // The row in the unknowns (z, τ = δT/T, ζ).
+                let mut row = tangent.clone();
+                row[d] *= t;
+                Some((row, step - along))
+            }
+        };
+        let m = full.nrows() + usize::from(extra.is_some());
+        let cols: Vec<usize> = (0..d + 1 + g).filter(|&j| period_free || j != d).collect();
         let a = Mat::from_fn(m, cols.len(), |i, k| {
             let j = cols[k];
-            match &energy {
-                Some((row, _)) if i == full.nrows() => {
-                    if j < d {
-                        row[j]
-                    } else {
-                        0.0
-                    }
-                }
+            match &extra {
+                Some((row, _)) if i == full.nrows() => row[j],
                 _ => full[(i, j)],
             }
         });
@@ -521,7 +556,7 @@ pub fn periodic_orbit(
                 } else if i < full.nrows() {
                     rows[i - d].1
                 } else {
-                    energy.as_ref().map_or(0.0, |e| e.1)
+                    extra.as_ref().map_or(0.0, |e| e.1)
                 }
             })
             .collect();

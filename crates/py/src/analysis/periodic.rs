@@ -21,14 +21,15 @@ fn complex(v: &[(f64, f64)]) -> Vec<Complex64> {
 /// The periodic orbit of `method`'s map with `steps` steps per period near `state0` and
 /// `period` (`lieflow.periodic_orbit`, which checks the arguments' kinds): a dict of its
 /// quantities (state0, period, energy, monodromy, multipliers, trivial, normal, stable,
-/// residual, iterations, drift, levels, tangent; `levels` to keep instead of the guess's).
+/// residual, iterations, drift, levels, tangent; `levels` to keep instead of the guess's;
+/// `fix = "arclength"` with `arclength = (u0, tangent, step)`: the continuation's corrector).
 /// A relative orbit: with an attitude, of the body carrying it
 /// (drift: the rotation vector of R(T) R(0)ᵀ); else `relative` of the system's symmetry
 /// (drift: ζ with z(T) = exp(ζ)·z(0), from the guess `drift`), or of the body carrying the
 /// identity attitude where the system has no symmetry lieflow can act with.
 #[pyfunction]
 #[pyo3(signature = (system, state0, period, method, steps, fix, tol, max_iter, attitude = None,
-                    relative = false, drift = None, levels = None))]
+                    relative = false, drift = None, levels = None, arclength = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn _periodic_orbit<'py>(
     py: Python<'py>,
@@ -44,12 +45,18 @@ pub fn _periodic_orbit<'py>(
     relative: bool,
     drift: Option<&Bound<'py, PyAny>>,
     levels: Option<&Bound<'py, PyAny>>,
+    arclength: Option<(Bound<'py, PyAny>, Bound<'py, PyAny>, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let levels = levels.map(real_vec).transpose()?;
-    let fix = match fix {
-        "energy" => Fix::Energy,
-        "period" => Fix::Period,
-        other => {
+    let fix = match (fix, arclength) {
+        ("arclength", Some((from, tangent, step))) => Fix::Arclength {
+            from: real_vec(&from)?,
+            tangent: real_vec(&tangent)?,
+            step,
+        },
+        ("energy", None) => Fix::Energy,
+        ("period", None) => Fix::Period,
+        (other, _) => {
             return Err(to_py(Error::invalid(
                 "fix",
                 format!("expected \"energy\" or \"period\", got {other:?}"),
