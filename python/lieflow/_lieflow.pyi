@@ -21,7 +21,8 @@ __all__ = [
     "LieflowError", "NotInGroupError", "ShapeError", "NonFiniteError", "DegenerateStratumError",
     "NoUniqueLogError", "InvalidArgumentError", "UnsupportedMethodError", "ConvergenceError",
     "LeftDomainError", "ArgumentTypeError", "lie", "pseudo_rigid", "potentials", "spaces", "surfaces",
-    "elliptic", "ellipsoids", "continuation", "System", "Integration", "_Tangent", "_Lyapunov", "RigidBody",
+    "elliptic", "ellipsoids", "continuation", "System", "Integration", "_Tangent", "_Lyapunov", "_periodic_orbit",
+    "RigidBody",
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
     "RelativisticTangentTop", "WeakFieldTop", "StaticFieldTop", "TangentTop", "ChargedParticle",
@@ -110,6 +111,13 @@ class _Lyapunov:
     @property
     def segments_done(self) -> int: ...
     def result(self) -> tuple[_F64, _F64, _F64, _F64]: ...
+
+def _periodic_orbit(
+    system: System, state0: Any, period: Any, method: str, steps: Any, fix: str, tol: Any,
+    max_iter: Any, attitude: Any = None, relative: bool = False, drift: Any = None,
+    levels: Any = None, arclength: Any = None,
+) -> dict[str, Any]:
+    """One shooting (internal to `lieflow.periodic_orbit`)."""
 
 @disjoint_base
 class System:

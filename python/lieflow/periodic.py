@@ -406,7 +406,9 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
     consecutive orbits the normal multipliers are compared: a change of stability is located
     by bisection on the secant and named by how the multipliers left the unit circle
     (``PeriodicSpecialPoint.kind``: period doubling, tangent, Krein collision); a turn of the
-    parameter is reported as a fold. Every orbit keeps the method and the steps per period of
+    parameter is reported as a fold. Where the energy and the period turn back together the
+    continuation would retrace the family in invariant terms: it ends there (``end`` says
+    where). Every orbit keeps the method and the steps per period of
     ``orbit``.
 
     Args:
@@ -457,6 +459,14 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
             ds *= 0.5
             continue
         if len(points) >= 2:
+            turns = [(f(last) - f(points[-2])) * (f(new) - f(last)) < 0
+                     for f in (lambda o: o.energy, lambda o: o.period)]
+            if all(turns):
+                # Energy and period reverse together: the continuation retraces the family
+                # (in invariant terms), which a fold of one of them does not do.
+                end = (f"turned back: energy and period reverse together after E = "
+                       f"{last.energy:.10g}, T = {last.period:.10g}")
+                break
             a, b, c = value(points[-2]), value(last), value(new)
             if (b - a) * (c - b) < 0:
                 specials.append(PeriodicSpecialPoint("fold", len(points) - 1, b, last))

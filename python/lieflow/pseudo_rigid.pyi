@@ -15,7 +15,7 @@ from .potentials import Potential
 
 _F64 = NDArray[np.float64]
 __all__ = [
-    "RelativeEquilibrium", "RightReduced", "Stability", "Verdict", "adjoint_motion", "amended_hessian",
+    "NormalMode", "RelativeEquilibrium", "RightReduced", "Stability", "Verdict", "adjoint_motion", "amended_hessian",
     "amended_potential", "angular_momentum", "augmented_gradient", "augmented_hessian",
     "augmented_potential", "bi_connection", "bi_inertia", "bi_inertia_apply", "bi_inertia_eigen",
     "bi_inertia_quadratic_form", "bi_inertia_solve", "circulation", "e_term",

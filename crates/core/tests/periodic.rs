@@ -443,7 +443,10 @@ fn the_family_tangent_is_the_secant_of_nearby_orbits() {
         .iter()
         .zip(tan)
         .fold(0.0_f64, |e, (s, t)| e.max((sign * s / norm - t).abs()));
-    println!("tangent {tan:?}, secant {:?} error {err:.1e}", secant.iter().map(|s| sign * s / norm).collect::<Vec<_>>());
+    println!(
+        "tangent {tan:?}, secant {:?} error {err:.1e}",
+        secant.iter().map(|s| sign * s / norm).collect::<Vec<_>>()
+    );
     // The phase plane's normal is the chord of a step of 1e-5·T: f to O(1e-5).
     assert!(err <= 1e-4, "{err:e}");
     // Both orbits keep m0's Casimir.

@@ -13,7 +13,7 @@
 //! * H(z₀) = E (fix = energy, E the guess's energy);
 //! * ⟨v, z₀ − ẑ⟩ = 0, the phase: a hyperplane through the guess ẑ across the flow v at ẑ (the
 //!   chord of one step of 1e-5·T);
-//! * I_j(z₀) = I_j(ẑ), the levels of the invariants ([`Problem::invariants`]).
+//! * I_j(z₀) = I_j(ẑ), the levels of the invariants ([`crate::integrate::Problem::invariants`]).
 //!
 //! They are more equations than unknowns but consistent at an orbit, and solved by the
 //! Gauss–Newton iteration (the minimum-norm least-squares update, by the SVD): quadratic
@@ -143,9 +143,9 @@ pub struct PeriodicOrbit {
     pub drift: Option<Vec<f64>>,
     /// The levels the orbit keeps: the invariants, then (relative) the momentum map.
     pub levels: Vec<f64>,
-    /// The tangent of the orbit's family at fixed levels: (δz, δT, δζ) of unit length (d + 1
-    /// + dim g values), the direction in which the energy grows (the null vector of the
-    /// shooting equations without the energy's).
+    /// The tangent of the orbit's family at fixed levels: (δz, δT, δζ) of unit length, d + 1 +
+    /// dim g values, the direction in which the energy grows (the null vector of the shooting
+    /// equations without the energy's).
     pub tangent: Vec<f64>,
 }
 
@@ -346,7 +346,7 @@ fn isotropy_generators(sym: &dyn Symmetric, z: &[f64]) -> Result<Mat> {
 /// Finds a periodic orbit of `method`'s map near the guess `z0` with period near `period`
 /// (module docs): the Gauss–Newton iteration on the shooting equations. With
 /// [`Options::relative`] a relative periodic orbit Φ_T(z₀) = exp(ζ)·z₀ of the system's
-/// [`Problem::symmetry`], ζ found with T, from the guess `drift` of ζ (zero by default).
+/// [`crate::integrate::Problem::symmetry`], ζ found with T, from the guess `drift` of ζ (zero by default).
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] (period ≤ 0 or not finite, steps = 0, a method without tangent
@@ -400,7 +400,12 @@ pub fn periodic_orbit(
         None => vec![0.0; g],
     };
     let d = lift.base_dim();
-    if let Fix::Arclength { from, tangent, step } = &options.fix {
+    if let Fix::Arclength {
+        from,
+        tangent,
+        step,
+    } = &options.fix
+    {
         let k = d + 1 + g;
         if from.len() != k || tangent.len() != k || !step.is_finite() {
             return Err(Error::invalid(
