@@ -33,8 +33,10 @@ class PeriodicOrbit:
         energy: the energy of ``state0``.
         monodromy: M = ∂z(T)/∂z(0) of the method's map, (d, d).
         multipliers: the eigenvalues of M (complex, by descending modulus).
-        trivial: which multipliers are trivial (bool, (d,)): the flow's, the energy's and the
-            invariants' (``system.invariants``), equal to 1 up to the method's error.
+        trivial: which multipliers are trivial (bool, (d,)): the flow's, the energy's, the
+            invariants' (``system.invariants``) and a relative orbit's symmetry directions
+            (equal to 1 for a periodic orbit, up to the method's error); the others are the
+            normal multipliers.
         normal_multipliers: the multipliers of the motion across the orbit on the level set of
             the conserved quantities (complex, by descending modulus; empty for one degree of
             freedom).

@@ -33,7 +33,9 @@
 //! multipliers of the orbit's *normal* motion are those of the map M induces on the quotient
 //! T(level)/⟨f⟩ (represented on V = T(level) ∩ f⊥ as Vᵀ(I − f̂f̂ᵀ)MV); the other k + 1 are
 //! *trivial* (equal to 1 for an exact flow: in Jordan blocks where the period varies along the
-//! family). The trivial ones are flagged among the eigenvalues of M as the k + 1 nearest to 1.
+//! family; for a relative orbit also the turns exp(−ζ) gives the group directions). The
+//! trivial ones are flagged among the eigenvalues of M as those left when each normal
+//! multiplier has taken its nearest.
 //! The orbit is (spectrally) stable when every normal multiplier lies on or inside the unit
 //! circle to [`STABLE_TOL`]. For a method that keeps a modified energy H̃ = H + O(hᵖ) (the
 //! symplectic ones), f and T(level) are those of the modified flow to O(hᵖ), and so are the
@@ -112,7 +114,10 @@ const RESIDUAL_LIMIT: f64 = 1e-6;
 const PHASE_STEP: f64 = 1e-5;
 
 /// Singular values below this times the largest are zero in the least-squares update.
-const RCOND: f64 = 1e-12;
+const RCOND: f64 = 1e-10;
+
+/// Equations that hold to this relative size are solved (round-off of a run of N steps).
+const ROUNDOFF: f64 = 1e3 * f64::EPSILON;
 
 /// A periodic orbit of a method's map ([`periodic_orbit`]).
 #[derive(Clone, Debug)]
@@ -503,7 +508,14 @@ pub fn periodic_orbit(
                 0.0
             }
         });
-        if accepted {
+        // An iterate whose equations hold to round-off is an orbit whatever the update (which
+        // then is round-off amplified along the family's near-null directions).
+        let settled = monitor.iterations() > 0
+            && inf_norm(&gap) <= ROUNDOFF * scale
+            && rows.iter().all(|r| r.1.abs() <= ROUNDOFF * scale)
+            && (options.fix != Fix::Energy
+                || unit_row(0).is_none_or(|r| r.1.abs() <= ROUNDOFF * scale));
+        if accepted || settled {
             let tangent = family_tangent(&full, &grads, t)?;
             let drift = sym.map(|_| zeta.clone());
             let mut orbit = finish(
@@ -690,13 +702,19 @@ fn finish(
     let pm = &m - &w * (w.transpose() * &m);
     let reduced = v.transpose() * &pm * &v;
     let normal = by_modulus(general_eigenvalues(&reduced.to_owned())?);
-    let q = v.ncols();
-    let mut order: Vec<usize> = (0..d).collect();
-    let distance = |k: usize| (multipliers[k].0 - 1.0).hypot(multipliers[k].1);
-    order.sort_by(|&a, &b| distance(a).total_cmp(&distance(b)));
-    let mut trivial = vec![false; d];
-    for &k in &order[..d - q] {
-        trivial[k] = true;
+    // The trivial multipliers: those of M left when each normal one has taken its nearest.
+    let mut trivial = vec![true; d];
+    for &(re, im) in &normal {
+        let nearest = (0..d)
+            .filter(|&k| trivial[k])
+            .min_by(|&a, &b| {
+                let da = (multipliers[a].0 - re).hypot(multipliers[a].1 - im);
+                let db = (multipliers[b].0 - re).hypot(multipliers[b].1 - im);
+                da.total_cmp(&db)
+            });
+        if let Some(k) = nearest {
+            trivial[k] = false;
+        }
     }
     Ok(PeriodicOrbit {
         energy: system.energy(&z)?,
