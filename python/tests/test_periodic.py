@@ -241,3 +241,22 @@ def test_a_family_crosses_mathieu_s_tongues_and_locates_them():
     for orbit in branch.points[::3]:
         a = np.hypot(orbit.state0[0], orbit.state0[2])
         assert orbit.stable == (np.abs(mathieu_multipliers(omega, beta, a)).max() <= 1 + 1e-6)
+
+
+def test_a_stretch_body_lyapunov_orbit_converges_where_its_update_stagnates():
+    # Its equations hold to 3e-14 while the minimum-norm update stalls at 1.6e-9 (round-off
+    # along the family's near-null directions): an orbit, not a ConvergenceError.
+    st = lf.potentials.Stretch(1.0)
+    eq = [q for q in lf.pseudo_rigid.relative_equilibria(st, shape=[2.85, 0.35, 1.0], plane=(0, 1))
+          if q.xi[0, 1] > 0][0]
+    modes = eq.normal_modes()
+    assert eq.stability().spectral.stable and len(modes) == 5
+    orbit = lf.periodic_orbit.from_mode(eq, 0, 1e-3, method="verlet4", dt=modes[0].period / 800)
+    assert orbit.residual <= 1e-12 and orbit.stable
+    # Across the orbit the other modes turn by e^{±iω_k T}, to the amplitude's and the
+    # method's error.
+    mu = orbit.normal_multipliers
+    assert mu.shape == (8,) and orbit.trivial.sum() == 10
+    for m in modes[1:]:
+        w = np.exp(1j * m.frequency * orbit.period)
+        assert np.abs(mu - w).min() <= 5e-3 and np.abs(mu - w.conjugate()).min() <= 5e-3

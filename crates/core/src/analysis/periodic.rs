@@ -38,8 +38,9 @@
 //! multiplier has taken its nearest.
 //! The orbit is (spectrally) stable when every normal multiplier lies on or inside the unit
 //! circle to [`STABLE_TOL`]. For a method that keeps a modified energy H̃ = H + O(hᵖ) (the
-//! symplectic ones), f and T(level) are those of the modified flow to O(hᵖ), and so are the
-//! normal multipliers.
+//! symplectic ones), the exact f and T(level) are the modified flow's only to O(hᵖ), and so
+//! are the quotient's eigenvalues: they only tell the normal multipliers apart, and the ones
+//! reported are M's own eigenvalues nearest to them (exact for the map).
 
 use super::{eig_error, general_eigenvalues, null_space, range};
 use crate::convergence::{Monitor, Rule, Verdict};
@@ -462,6 +463,8 @@ pub fn periodic_orbit(
     };
     let mut monitor = Monitor::new(rule);
     let mut accepted = false;
+    // The last two updates.
+    let mut updates = [0.0_f64; 2];
     loop {
         let shot = shoot(system, lift.as_ref(), method, &z, t, n)?;
         let target = match sym {
@@ -508,9 +511,10 @@ pub fn periodic_orbit(
                 0.0
             }
         });
-        // An iterate whose equations hold to round-off is an orbit whatever the update (which
-        // then is round-off amplified along the family's near-null directions).
-        let settled = monitor.iterations() > 0
+        // An iterate whose equations hold to round-off while the update stopped decreasing is
+        // an orbit: the update is then round-off amplified along near-null directions.
+        let settled = updates[1] > 0.0
+            && updates[0] >= 0.5 * updates[1]
             && inf_norm(&gap) <= ROUNDOFF * scale
             && rows.iter().all(|r| r.1.abs() <= ROUNDOFF * scale)
             && (options.fix != Fix::Energy
@@ -596,6 +600,7 @@ pub fn periodic_orbit(
             *x += s;
             update = update.max(s.abs());
         }
+        updates = [update, updates[0]];
         match monitor.check(update, 1.0) {
             Verdict::Continue => {}
             Verdict::Converged => accepted = true,
@@ -705,17 +710,21 @@ fn finish(
     // The trivial multipliers: those of M left when each normal one has taken its nearest.
     let mut trivial = vec![true; d];
     for &(re, im) in &normal {
-        let nearest = (0..d)
-            .filter(|&k| trivial[k])
-            .min_by(|&a, &b| {
-                let da = (multipliers[a].0 - re).hypot(multipliers[a].1 - im);
-                let db = (multipliers[b].0 - re).hypot(multipliers[b].1 - im);
-                da.total_cmp(&db)
-            });
+        let nearest = (0..d).filter(|&k| trivial[k]).min_by(|&a, &b| {
+            let da = (multipliers[a].0 - re).hypot(multipliers[a].1 - im);
+            let db = (multipliers[b].0 - re).hypot(multipliers[b].1 - im);
+            da.total_cmp(&db)
+        });
         if let Some(k) = nearest {
             trivial[k] = false;
         }
     }
+    // Reported: M's own eigenvalues (exact for the map); the quotient only told them apart,
+    // with the method's error in its flow and level set (module docs).
+    let normal: Vec<(f64, f64)> = (0..d)
+        .filter(|&k| !trivial[k])
+        .map(|k| multipliers[k])
+        .collect();
     Ok(PeriodicOrbit {
         energy: system.energy(&z)?,
         state0: z,
