@@ -45,7 +45,8 @@ def main():
         e = branch.energies
         for o, ek in zip(branch.points, e):
             args = np.angle(o.normal_multipliers)
-            b.plot(np.full(args.shape, ek), args[args > 0], ".", color="C1", ms=4)
+            up = args[args > 0]
+            b.plot(np.full(up.shape, ek), up, ".", color="C1", ms=4)
         b.set_xlabel("energy")
         b.set_ylabel(r"arg $\mu$ of the normal multipliers (upper half)")
         b.set_title(r"Floquet multipliers: $|\mu| = 1$ " + f"to {worst:.0e}")

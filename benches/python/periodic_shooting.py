@@ -85,7 +85,7 @@ def scipy_bvp():
 
 def main():
     print(environment())
-    print(f"free rigid body I = (1, 2, 3), M0 = {tuple(M0)}: T = 4K(k)/λ = {EXACT:.15f}")
+    print(f"free rigid body I = (1, 2, 3), M0 = (1, 0.3, 0.2): T = 4K(k)/λ = {EXACT:.15f}")
     print(f"{'solver':<46} {'period error':>13} {'closes to':>10} {'time':>10}")
     rows = []
     for name, method, dt in (("lieflow exact (8 steps)", "exact", 2.0),
