@@ -518,7 +518,7 @@ pub fn periodic_orbit(
             && inf_norm(&gap) <= ROUNDOFF * scale
             && rows.iter().all(|r| r.1.abs() <= ROUNDOFF * scale)
             && (options.fix != Fix::Energy
-                || unit_row(0).is_none_or(|r| r.1.abs() <= ROUNDOFF * scale));
+                || unit_row(0).map_or(true, |r| r.1.abs() <= ROUNDOFF * scale));
         if accepted || settled {
             let tangent = family_tangent(&full, &grads, t)?;
             let drift = sym.map(|_| zeta.clone());
