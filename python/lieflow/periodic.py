@@ -336,6 +336,13 @@ class PeriodicBranch:
     def plot(self, ax=None, *, x="energy", y="period", **kwargs):
         """Draws y against x ("energy" or "period"): stable orbits solid, unstable dashed,
         special points marked and named. Returns the axes."""
+        for name, v in (("x", x), ("y", y)):
+            if not isinstance(v, str):
+                raise TypeError(f"invalid {name}: expected \"energy\" or \"period\", got "
+                                f"{type(v).__name__} {v!r}")
+            if v not in ("energy", "period"):
+                raise InvalidArgumentError(f"invalid {name}: expected \"energy\" or "
+                                           f"\"period\", got {v!r}")
         import matplotlib.pyplot as plt
         if ax is None:
             ax = plt.gca()
@@ -426,7 +433,7 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
     Returns:
         A ``PeriodicBranch``.
     """
-    if parameter not in ("energy", "period"):
+    if not isinstance(parameter, str) or parameter not in ("energy", "period"):
         raise InvalidArgumentError(f"invalid parameter: expected \"energy\" or \"period\", "
                                    f"got {parameter!r}")
     if not isinstance(orbit, PeriodicOrbit):

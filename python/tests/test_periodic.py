@@ -260,3 +260,41 @@ def test_a_stretch_body_lyapunov_orbit_converges_where_its_update_stagnates():
     for m in modes[1:]:
         w = np.exp(1j * m.frequency * orbit.period)
         assert np.abs(mu - w).min() <= 5e-3 and np.abs(mu - w.conjugate()).min() <= 5e-3
+
+
+def test_a_period_doubling_along_a_family_is_located_and_named():
+    # ½‖p‖² + ½x² + ½ω²y² + βxy²: across the harmonic orbits x = A cos t the motion obeys
+    # δÿ + (ω² + 2βA cos t)δy = 0, whose coefficient has the orbit's period 2π: a multiplier
+    # through −1 where the amplitude opens the tongue at ω = 1/2.
+    omega, beta = 0.6, 0.5
+    w2 = omega * omega
+
+    def potential(q):
+        return 0.5 * (q[0] ** 2 + w2 * q[1] ** 2) + beta * q[0] * q[1] ** 2
+
+    def gradient(q):
+        x, y = q
+        return [x + beta * y * y, w2 * y + 2 * beta * x * y]
+
+    def hessian(q, v):
+        x, y = q
+        return [v[0] + 2 * beta * y * v[1], 2 * beta * y * v[0] + (w2 + 2 * beta * x) * v[1]]
+
+    sys = lf.Separable(1.0, potential, gradient, dof=2, hessian=hessian)
+    start = lf.periodic_orbit(sys, [0.05, 0.0, 0.0, 0.0], 6.3, method="gauss6", dt=0.05)
+    branch = lf.continuation.periodic_family(sys, start, max_points=14, step=0.02, max_step=0.05)
+    first = branch.special_points[0]
+    assert first.kind == "period_doubling", branch.special_points
+    amplitude = np.hypot(first.orbit.state0[0], first.orbit.state0[2])
+
+    def hill(a):
+        def f(t, y):
+            return [y[1], -(w2 + 2 * beta * a * np.cos(t)) * y[0]]
+        cols = [solve_ivp(f, (0, 2 * np.pi), e, method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]
+                for e in ([1.0, 0.0], [0.0, 1.0])]
+        return np.linalg.eigvals(np.array(cols).T)
+
+    # The tongue's edge: on the circle just before, a real pair below −1 just after.
+    assert np.abs(hill(amplitude * (1 - 5e-3))).max() == pytest.approx(1.0, abs=1e-8)
+    after = hill(amplitude * (1 + 5e-3))
+    assert np.abs(after).max() > 1 and np.all(np.abs(after.imag) < 1e-9) and after.real.min() < -1

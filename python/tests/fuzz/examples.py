@@ -272,6 +272,9 @@ RECEIVERS: dict[str, Callable[[Any], Any]] = {
     "stretch": lambda lf: lf.potentials.Stretch(1.1),
     "selfgrav": lambda lf: lf.potentials.SelfGravity(1.0, 1.0),
     "branch": lambda lf: _maclaurin_branch(lf),
+    "porb": lambda lf: _free_body_orbit(lf),
+    "pbranch": lambda lf: lf.continuation.periodic_family(lf.RigidBody([1.0, 2.0, 3.0]),
+                                                           _free_body_orbit(lf), max_points=3),
     "zero": lambda lf: lf.potentials.Zero(),
     "sum": lambda lf: lf.potentials.Harmonic(1.0) + _svk(lf),
     "callable": lambda lf: lf.potentials.Callable(u_value, u_gradient, u_hessian),
@@ -291,6 +294,7 @@ RECEIVER_MODULE = {**{k: "potentials" for k in ("harmonic", "svk", "volumetric",
                    **{k: "surfaces" for k in ("plane", "sphere", "hyp", "torus", "quadric",
                                               "revolution", "graph", "metric")},
                    "releq": "pseudo_rigid", "branch": "pseudo_rigid", "s3": "spaces",
+                   "porb": "integrate", "pbranch": "integrate",
                    "chart": "spaces"}
 # The point of each surface's chart used for its methods.
 SURFACE_POINT = {"plane": [0.2, -0.1], "sphere": [1.0, 0.3], "hyp": [0.1, 1.0],
@@ -544,6 +548,12 @@ def _scipy_rotation(lf):
     from scipy.spatial.transform import Rotation
 
     return Rotation.from_matrix(np.stack([R3, R3B]))
+
+
+def _free_body_orbit(lf):
+    """A periodic orbit of the free rigid body (lf.periodic_orbit, the exact flow)."""
+    return lf.periodic_orbit(lf.RigidBody([1.0, 2.0, 3.0]), [1.0, 0.3, 0.2], 10.86,
+                             method="exact", dt=2.0)
 
 
 def lazy_recv(key):
@@ -1048,6 +1058,25 @@ def build_specs() -> list[Spec]:
         A("method", None, "str", kw=True, opt=True),
         A("dt", 0.02, "float", kw=True, positive=True),
         A("max_steps", 3000, "int", kw=True, positive=True), module="integrate")
+    # ---- periodic orbits (issue 27) ----
+    add("periodic_orbit[rb]", "periodic_orbit", A("system", lazy_recv("rb"), "obj"),
+        A("state0", np.array([1.0, 0.3, 0.2]), "vec"), A("period", 10.86, "float", positive=True),
+        A("method", "exact", "str", kw=True, opt=True),
+        A("dt", 2.0, "float", kw=True, positive=True, opt=True),
+        A("fix", "energy", "str", kw=True), A("relative", False, "bool", kw=True),
+        A("tol", 1e-10, "float", kw=True, positive=True),
+        A("max_iter", 30, "int", kw=True, positive=True), module="integrate")
+    add("PeriodicOrbit.trajectory", "@porb.trajectory",
+        A("steps", 8, "int", positive=True, opt=True),
+        A("periods", 1, "int", kw=True, positive=True), module="integrate")
+    add("RelativeEquilibrium.normal_modes", "@releq.normal_modes")
+    add("continuation.periodic_family", "continuation.periodic_family",
+        A("system", lazy_recv("rb"), "obj"), A("orbit", lazy_recv("porb"), "obj"),
+        A("parameter", "energy", "str", kw=True),
+        A("step", 0.02, "float", kw=True, positive=True),
+        A("max_points", 3, "int", kw=True, positive=True), slow=True, module="integrate")
+    add("PeriodicBranch.plot", "@pbranch.plot", A("x", "energy", "str", kw=True), slow=True,
+        module="integrate")
     # ---- user-defined systems (issue 15) ----
     user_specs(add)
     forced_specs(add)

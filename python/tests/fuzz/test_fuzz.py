@@ -86,10 +86,15 @@ SKIP = {  # public names that are not callables to fuzz, with the reason
     "lieflow.spaces.Space": "made by Euclidean, Sphere, Hyperbolic; methods fuzzed on a sphere",
     "lieflow.continuation.Branch": "made by follow; its methods are fuzzed on a branch",
     "lieflow.continuation.SpecialPoint": "made by follow; a record (attributes only)",
+    "lieflow.PeriodicOrbit": "made by periodic_orbit; trajectory is fuzzed on an orbit",
+    "lieflow.pseudo_rigid.NormalMode": "made by RelativeEquilibrium.normal_modes; a record",
+    "lieflow.continuation.PeriodicBranch": "made by periodic_family; plot is fuzzed on a branch",
+    "lieflow.continuation.PeriodicSpecialPoint": "made by periodic_family; a record",
 }
 CLASS_RECEIVER = {**CONSTRUCTORS, "Integration": "run", "Trajectory": "traj",
                   "RollingDisksEquilibrium": "rdeq", "RelativeEquilibrium": "releq",
-                  "Potential": "harmonic", "Surface": "sphere", "Branch": "branch", "Space": "s3"}
+                  "Potential": "harmonic", "Surface": "sphere", "Branch": "branch", "Space": "s3",
+                  "PeriodicOrbit": "porb", "PeriodicBranch": "pbranch"}
 
 
 def public_callables():

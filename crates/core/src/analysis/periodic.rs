@@ -117,8 +117,14 @@ const PHASE_STEP: f64 = 1e-5;
 /// Singular values below this times the largest are zero in the least-squares update.
 const RCOND: f64 = 1e-10;
 
-/// Equations that hold to this relative size are solved (round-off of a run of N steps).
-const ROUNDOFF: f64 = 1e3 * f64::EPSILON;
+/// Equations that hold to this size times √N, relative, are solved (the round-off of a run of
+/// N steps, whose implicit solves stop at their own round-off) once the update stagnates
+/// below [`SETTLED_UPDATE`].
+const ROUNDOFF: f64 = 1e4 * f64::EPSILON;
+
+/// A stagnating update at most this (relative) is round-off amplified along the family's
+/// near-null directions.
+const SETTLED_UPDATE: f64 = 1e-6;
 
 /// A periodic orbit of a method's map ([`periodic_orbit`]).
 #[derive(Clone, Debug)]
@@ -513,12 +519,13 @@ pub fn periodic_orbit(
         });
         // An iterate whose equations hold to round-off while the update stopped decreasing is
         // an orbit: the update is then round-off amplified along near-null directions.
+        let floor = ROUNDOFF * (n as f64).sqrt() * scale;
         let settled = updates[1] > 0.0
             && updates[0] >= 0.5 * updates[1]
-            && inf_norm(&gap) <= ROUNDOFF * scale
-            && rows.iter().all(|r| r.1.abs() <= ROUNDOFF * scale)
-            && (options.fix != Fix::Energy
-                || unit_row(0).map_or(true, |r| r.1.abs() <= ROUNDOFF * scale));
+            && updates[0] <= SETTLED_UPDATE
+            && inf_norm(&gap) <= floor
+            && rows.iter().all(|r| r.1.abs() <= floor)
+            && (options.fix != Fix::Energy || unit_row(0).map_or(true, |r| r.1.abs() <= floor));
         if accepted || settled {
             let tangent = family_tangent(&full, &grads, t)?;
             let drift = sym.map(|_| zeta.clone());
