@@ -25,7 +25,7 @@ def main():
     t0 = time.perf_counter()
     start = lf.periodic_orbit.from_mode(jacobi, 0, 1e-3, method="rattle6",
                                         dt=modes[0].period / 100)
-    branch = lf.continuation.periodic_family(jacobi.system, start, max_points=40)
+    branch = lf.continuation.periodic_family(jacobi.body, start, max_points=40)
     seconds = time.perf_counter() - t0
     print(f"{branch} in {seconds:.0f} s")
     for sp in branch.special_points:

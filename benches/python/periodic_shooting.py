@@ -108,7 +108,7 @@ def main():
     t0 = time.perf_counter()
     start = lf.periodic_orbit.from_mode(jacobi, mode, 1e-3, method="rattle6", dt=mode.period / 100)
     t1 = time.perf_counter()
-    branch = lf.continuation.periodic_family(jacobi.system, start, max_points=20)
+    branch = lf.continuation.periodic_family(jacobi.body, start, max_points=20)
     t2 = time.perf_counter()
     print(f"Jacobi a2/a1 = 0.6, mode ω = {mode.frequency:.6f}: first orbit {t1 - t0:.2f} s "
           f"({start.iterations} iterations), family of {len(branch)} orbits {t2 - t1:.1f} s "

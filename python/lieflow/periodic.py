@@ -159,7 +159,7 @@ def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy"
         fix: "energy" (keep the guess's energy) or "period".
         relative: a relative periodic orbit, periodic up to a symmetry. For a system with a
             symmetry lieflow can act with (``PseudoRigidBody`` and its ``RelativeEquilibrium.
-            system``: (X, P) ↦ (gXhᵀ, gPhᵀ)) the shooting solves z(T) = exp(ζ)·z(0) for T and
+            body``: (X, P) ↦ (gXhᵀ, gPhᵀ)) the shooting solves z(T) = exp(ζ)·z(0) for T and
             ζ together (momentum map fixed, the slice across the orbit of its isotropy group);
             ``drift`` is ζ, and the monodromy and multipliers are those of exp(−ζ)·z(T). For a
             body that carries an attitude (``RigidBody``, ``HeavyTop``, …) the state returns
@@ -221,7 +221,7 @@ def from_mode(equilibrium, mode, amplitude, *, method=None, dt=None, fix="energy
     start of its Lyapunov family (``lieflow.continuation.periodic_family``).
 
     The linear motion about the equilibrium in the co-moving frame is Re(v exp(iωt)); the
-    orbit is shot as a relative periodic orbit of ``equilibrium.system`` from
+    orbit is shot as a relative periodic orbit of ``equilibrium.body`` from
     z(0) = z_eq + amplitude·Re(v), T = 2π/ω and the drift T·(ξ ⊕ η) of the equilibrium's
     velocities, at the energy of z(0) (``fix="energy"``): its period tends to 2π/ω as the
     amplitude shrinks (Lyapunov's centre theorem, for a mode not resonant with the others).
@@ -250,7 +250,7 @@ def from_mode(equilibrium, mode, amplitude, *, method=None, dt=None, fix="energy
     if not _real(amplitude):
         raise TypeError(f"invalid amplitude: expected a real number, got "
                         f"{type(amplitude).__name__} {amplitude!r}")
-    system = equilibrium.system
+    system = equilibrium.body
     state0 = equilibrium.state + float(amplitude) * mode.vector.real
     period = mode.period
     from .lie import vee_n
@@ -299,12 +299,12 @@ class PeriodicBranch:
     """A family of periodic orbits (``lieflow.continuation.periodic_family``).
 
     Attributes:
-        points: the ``PeriodicOrbit``s in the order of continuation.
+        points: the orbits (``PeriodicOrbit``) in the order of continuation.
         parameter: "energy" or "period".
         values: the parameter along the branch.
         energies, periods: (k,) arrays.
         stable: (k,) bool: every normal multiplier on or inside the unit circle.
-        special_points: ``PeriodicSpecialPoint``s in the order met.
+        special_points: the special points (``PeriodicSpecialPoint``) in the order met.
         end: why the continuation stopped.
     """
 

@@ -236,7 +236,7 @@ class RelativeEquilibrium:
         """(X(t), P(t)), each (k, n, n)."""
     def stability(self) -> Stability: ...
     @property
-    def system(self) -> System:
+    def body(self) -> System:
         """The body of the equilibrium over (X, P), for integrating or shooting its orbits."""
     @property
     def state(self) -> _F64:

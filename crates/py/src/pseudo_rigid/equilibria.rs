@@ -546,16 +546,16 @@ impl RelativeEquilibrium {
     /// The body whose relative equilibrium this is (the incompressible body for the
     /// ellipsoids), as a ``lieflow.System`` over (X, P): for integrating or shooting its orbits.
     #[getter]
-    fn system(&self, py: Python<'_>) -> PyResult<Py<PySystem>> {
-        let body: Arc<dyn lieflow::integrate::System> = Arc::new(self.body()?);
+    fn body(&self, py: Python<'_>) -> PyResult<Py<PySystem>> {
+        let body: Arc<dyn lieflow::integrate::System> = Arc::new(self.core_body()?);
         Py::new(py, PySystem::derived(py, body))
     }
 
-    /// The state (X0, P0) at t = 0, flat (2 n^2,) in the layout of ``system``.
+    /// The state (X0, P0) at t = 0, flat (2 n^2,) in the layout of ``body``.
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let z = self
-            .body()?
+            .core_body()?
             .state(&self.inner.x0(), &self.inner.p0())
             .py()?;
         Ok(py_vec(py, &z))
@@ -572,7 +572,7 @@ impl RelativeEquilibrium {
     /// Raises:
     ///     InvalidArgumentError (not a relative equilibrium to 1e-8).
     fn normal_modes(&self) -> PyResult<Vec<NormalMode>> {
-        let body = self.body()?;
+        let body = self.core_body()?;
         let z = body.state(&self.inner.x0(), &self.inner.p0()).py()?;
         let mut xi = lieflow::lie::so::vee_n(&self.inner.xi).py()?;
         xi.extend(lieflow::lie::so::vee_n(&self.inner.eta).py()?);
@@ -601,7 +601,7 @@ impl RelativeEquilibrium {
 
 impl RelativeEquilibrium {
     /// The body of this equilibrium: incompressible or free, with its potential.
-    fn body(&self) -> PyResult<PseudoRigidBody> {
+    fn core_body(&self) -> PyResult<PseudoRigidBody> {
         let n = self.inner.n();
         match self.incompressible {
             true => PseudoRigidBody::incompressible(n, self.potential.clone()),
