@@ -11,6 +11,7 @@ use lieflow::pseudo_rigid::PseudoRigidBody;
 use lieflow::systems::{GeneralizedRigidBody, HeavyTop, RigidBody, SphericalPendulum};
 
 mod common;
+use common::henon_heiles;
 
 /// (base state at the end, Jacobian e×e row-major) of `steps` steps of `method`.
 fn lifted_end(
@@ -642,32 +643,6 @@ fn rattle_jacobian_is_symplectic_on_the_constraint_manifold() {
          base state moved {moved:.1e}"
     );
     assert!(sym < 1e-12 && tangent < 1e-12, "{sym:e} {tangent:e}");
-}
-
-/// Hénon–Heiles, U = (x² + y²)/2 + x²y − y³/3, as a user system with its Hessian.
-fn henon_heiles() -> lieflow::systems::UserSeparable {
-    use lieflow::systems::{KineticMass, UserSeparable};
-    let u = Arc::new(|q: &[f64]| -> lieflow::Result<f64> {
-        let (x, y) = (q[0], q[1]);
-        Ok(0.5 * (x * x + y * y) + x * x * y - y * y * y / 3.0)
-    });
-    let g = Arc::new(|q: &[f64], g: &mut [f64]| -> lieflow::Result<()> {
-        let (x, y) = (q[0], q[1]);
-        g[0] = x + 2.0 * x * y;
-        g[1] = y + x * x - y * y;
-        Ok(())
-    });
-    let h = Arc::new(
-        |q: &[f64], v: &[f64], out: &mut [f64]| -> lieflow::Result<()> {
-            let (x, y) = (q[0], q[1]);
-            out[0] = (1.0 + 2.0 * y) * v[0] + 2.0 * x * v[1];
-            out[1] = 2.0 * x * v[0] + (1.0 - 2.0 * y) * v[1];
-            Ok(())
-        },
-    );
-    UserSeparable::new(KineticMass::Scalar(1.0), Some(2), u, Some(g))
-        .unwrap()
-        .with_hessian(h)
 }
 
 /// |JᵀΩJ − Ω|_max for the canonical Ω of d/2 degrees of freedom.

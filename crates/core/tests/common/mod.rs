@@ -121,3 +121,30 @@ pub fn rolling_spheres() -> RollingSpheres {
     )
     .unwrap()
 }
+
+/// Hénon–Heiles, U = (x² + y²)/2 + x²y − y³/3, as a user system with its Hessian.
+pub fn henon_heiles() -> lieflow::systems::UserSeparable {
+    use lieflow::systems::{KineticMass, UserSeparable};
+    use std::sync::Arc;
+    let u = Arc::new(|q: &[f64]| -> lieflow::Result<f64> {
+        let (x, y) = (q[0], q[1]);
+        Ok(0.5 * (x * x + y * y) + x * x * y - y * y * y / 3.0)
+    });
+    let g = Arc::new(|q: &[f64], g: &mut [f64]| -> lieflow::Result<()> {
+        let (x, y) = (q[0], q[1]);
+        g[0] = x + 2.0 * x * y;
+        g[1] = y + x * x - y * y;
+        Ok(())
+    });
+    let h = Arc::new(
+        |q: &[f64], v: &[f64], out: &mut [f64]| -> lieflow::Result<()> {
+            let (x, y) = (q[0], q[1]);
+            out[0] = (1.0 + 2.0 * y) * v[0] + 2.0 * x * v[1];
+            out[1] = 2.0 * x * v[0] + (1.0 - 2.0 * y) * v[1];
+            Ok(())
+        },
+    );
+    UserSeparable::new(KineticMass::Scalar(1.0), Some(2), u, Some(g))
+        .unwrap()
+        .with_hessian(h)
+}
