@@ -455,3 +455,50 @@ fn the_family_tangent_is_the_secant_of_nearby_orbits() {
         assert!((c - casimir).abs() <= 1e-13);
     }
 }
+
+/// The error paths of the relative and continuation options: a drift guess, levels or an
+/// arclength condition of the wrong size, a relative orbit of a system without an action.
+#[test]
+fn wrong_sizes_of_the_relative_and_continuation_options_are_refused() {
+    use lieflow::pseudo_rigid::ellipsoids::Fluid;
+    let body = RigidBody::new(I).unwrap();
+    let m0 = [1.0, 0.3, 0.2];
+    let err = |o: Options, drift: Option<&[f64]>| {
+        periodic_orbit(&body, "exact", &m0, 10.9, drift, &o)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    };
+    let base = options(8, Fix::Energy);
+    let relative = Options {
+        relative: true,
+        ..base.clone()
+    };
+    assert!(err(relative, None).contains("no symmetry"));
+    let levels = Options {
+        levels: Some(vec![1.0, 2.0]),
+        ..base.clone()
+    };
+    assert!(err(levels, None).contains("levels"));
+    let arclength = Options {
+        fix: Fix::Arclength {
+            from: vec![0.0; 3],
+            tangent: vec![0.0; 4],
+            step: 0.1,
+        },
+        ..base.clone()
+    };
+    assert!(err(arclength, None).contains("arclength"));
+    // A drift guess of the wrong length for SO(3)×SO(3) (6 values).
+    let fl = Fluid::new(1.0, 1.0).unwrap();
+    let (ze, _) = Fluid::state(&fl.jacobi(0.6).unwrap());
+    let jbody = fl.body().unwrap();
+    let o = Options {
+        relative: true,
+        ..options(50, Fix::Energy)
+    };
+    let e = periodic_orbit(&jbody, "rattle", &ze, 2.0, Some(&[0.0; 3]), &o)
+        .map(|_| ())
+        .unwrap_err();
+    assert!(matches!(e, lieflow::Error::Shape { .. }), "{e}");
+}
