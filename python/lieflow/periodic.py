@@ -417,7 +417,8 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
     (``PeriodicSpecialPoint.kind``: period doubling, tangent, Krein collision); a turn of the
     parameter is reported as a fold. Where the energy and the period turn back together the
     continuation would retrace the family in invariant terms: it ends there (``end`` says
-    where). Every orbit keeps the method and the steps per period of
+    where). That is how a family ends on another (relative) equilibrium: its orbits shrink
+    onto it, and past it the same orbits return half a period on. Every orbit keeps the method and the steps per period of
     ``orbit``.
 
     Args:
@@ -472,9 +473,12 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
                      for f in (lambda o: o.energy, lambda o: o.period)]
             if all(turns):
                 # Energy and period reverse together: the continuation retraces the family
-                # (in invariant terms), which a fold of one of them does not do.
+                # (in invariant terms), which a fold of one of them does not do. So it does
+                # past the family's end where its orbits shrink onto a relative equilibrium
+                # (their amplitude changes sign: the same orbits, half a period on).
                 end = (f"turned back: energy and period reverse together after E = "
-                       f"{last.energy:.10g}, T = {last.period:.10g}")
+                       f"{last.energy:.10g}, T = {last.period:.10g} (the family's end, e.g. "
+                       f"on an equilibrium its orbits shrink onto)")
                 break
             a, b, c = value(points[-2]), value(last), value(new)
             if (b - a) * (c - b) < 0:

@@ -298,3 +298,34 @@ def test_a_period_doubling_along_a_family_is_located_and_named():
     assert np.abs(hill(amplitude * (1 - 5e-3))).max() == pytest.approx(1.0, abs=1e-8)
     after = hill(amplitude * (1 + 5e-3))
     assert np.abs(after).max() > 1 and np.all(np.abs(after.imag) < 1e-9) and after.real.min() < -1
+
+
+def test_the_jacobi_ellipsoid_s_first_lyapunov_families():
+    # a₂/a₁ = 0.6 (benches/python/jacobi_lyapunov_family.py prints and draws both families).
+    jacobi = lf.ellipsoids.jacobi(0.6)
+    modes = jacobi.normal_modes()
+
+    def family(k, points):
+        start = lf.periodic_orbit.from_mode(jacobi, k, 1e-3, method="rattle6",
+                                            dt=modes[k].period / 60)
+        return lf.continuation.periodic_family(jacobi.body, start, max_points=points)
+
+    # Mode 0: stable all along (as the linear analysis says at its start), up to its end on a
+    # Riemann ellipsoid of type I with the same momentum and circulation, E = −15.1227717
+    # (scipy's least squares on the co-moving field, in the bench): there the continuation
+    # passes through and turns back.
+    first = family(0, 40)
+    assert first.end.startswith("turned back"), first
+    assert first.stable.all() and not first.special_points
+    assert max(np.abs(np.abs(o.normal_multipliers) - 1).max() for o in first.points) <= 1e-9
+    assert np.all(np.diff(first.energies) > 0) and np.all(np.diff(first.periods) < 0)
+    assert first.energies[-1] == pytest.approx(-15.1227717, abs=1e-3)
+    # Mode 1: stable up to a period doubling: a normal multiplier through −1 (the bisection
+    # locates it to 2⁻¹² of the step: ≈ 6e-5 in energy).
+    second = family(1, 12)
+    assert [sp.kind for sp in second.special_points] == ["period_doubling"], second
+    sp = second.special_points[0]
+    assert sp.value == pytest.approx(-14.85149, abs=2e-4)
+    assert second.stable[:sp.index + 1].all() and not second.stable[sp.index + 1:].any()
+    real = sp.orbit.normal_multipliers[np.abs(sp.orbit.normal_multipliers.imag) < 1e-9]
+    assert real.size == 2 and np.abs(real + 1).max() <= 1e-2
