@@ -329,3 +329,56 @@ def test_the_jacobi_ellipsoid_s_first_lyapunov_families():
     assert second.stable[:sp.index + 1].all() and not second.stable[sp.index + 1:].any()
     real = sp.orbit.normal_multipliers[np.abs(sp.orbit.normal_multipliers.imag) < 1e-9]
     assert real.size == 2 and np.abs(real + 1).max() <= 1e-2
+
+
+def test_a_krein_collision_along_a_family_is_located_and_named():
+    # H = H₁(1 + κC) + (ω₂/2)(p₂² + q₂²) − (ω₃/2)(p₃² + q₃²), H₁ = ½(q₁² + p₁²), C = q₂q₃ − p₂p₃:
+    # the orbits x₁ = A cos t (period 2π, E = H₁) carry the normal system of
+    # H₂₃ + c·C with c = κE, autonomous: eigenvalues ±i(ω̄ ± √(δ² − c²)), ω̄ = (ω₂ + ω₃)/2,
+    # δ = (ω₂ − ω₃)/2. The two oscillators have opposite Krein signatures: at c = δ their
+    # multipliers collide (at e^{±2πiω̄} = ±i) and leave the circle as a quadruplet.
+    w2, w3, kappa = 1.3, 1.2, 1.0
+    mean, half = (w2 + w3) / 2, (w2 - w3) / 2
+
+    def parts(q, p):
+        return 0.5 * (q[0] ** 2 + p[0] ** 2), q[1] * q[2] - p[1] * p[2]
+
+    def hamiltonian(q, p):
+        h1, c = parts(q, p)
+        return (h1 * (1 + kappa * c) + 0.5 * w2 * (q[1] ** 2 + p[1] ** 2)
+                - 0.5 * w3 * (q[2] ** 2 + p[2] ** 2))
+
+    def gradient(q, p):
+        h1, c = parts(q, p)
+        k = kappa * h1
+        return ([q[0] * (1 + kappa * c), w2 * q[1] + k * q[2], -w3 * q[2] + k * q[1]],
+                [p[0] * (1 + kappa * c), w2 * p[1] - k * p[2], -w3 * p[2] - k * p[1]])
+
+    def hessian(q, p, dq, dp):
+        h1, c = parts(q, p)
+        dc = dq[1] * q[2] + q[1] * dq[2] - dp[1] * p[2] - p[1] * dp[2]
+        k, dk = kappa * h1, kappa * (q[0] * dq[0] + p[0] * dp[0])
+        return ([dq[0] * (1 + kappa * c) + q[0] * kappa * dc,
+                 w2 * dq[1] + dk * q[2] + k * dq[2], -w3 * dq[2] + dk * q[1] + k * dq[1]],
+                [dp[0] * (1 + kappa * c) + p[0] * kappa * dc,
+                 w2 * dp[1] - dk * p[2] - k * dp[2], -w3 * dp[2] - dk * p[1] - k * dp[1]])
+
+    sys = lf.Canonical(hamiltonian, gradient, dof=3, hessian=hessian)
+    start = lf.periodic_orbit(sys, [0.2, 0, 0, 0, 0, 0], 2 * np.pi, method="gauss6",
+                              dt=2 * np.pi / 60)
+    branch = lf.continuation.periodic_family(sys, start, stop=0.07, max_points=20)
+    assert [sp.kind for sp in branch.special_points] == ["krein"], branch
+    sp = branch.special_points[0]
+    # Located on the unstable side within 2⁻¹² of the secant (≈ 4e-6 in energy).
+    assert 0.05 <= sp.value <= 0.05 + 5e-6
+    # The multipliers on both sides against the closed form (gauss6, 60 steps: ~1e-8).
+    for orbit in branch.points:
+        root = np.sqrt(complex(half ** 2 - (kappa * orbit.energy) ** 2))
+        exact = np.exp(2j * np.pi * np.array([mean + root, mean - root]))
+        exact = np.concatenate([exact, exact.conj()])
+        got = orbit.normal_multipliers
+        assert np.abs(got[:, None] - exact[None, :]).min(axis=0).max() <= 1e-6, orbit
+        assert orbit.stable == (orbit.energy < 0.05)
+    mu = sp.orbit.normal_multipliers
+    assert np.all(np.abs(mu.imag) > 0.99) and np.abs(np.abs(mu) - 1).max() < 1e-2
+    assert np.abs(mu).max() > 1 + 1e-6
