@@ -21,7 +21,7 @@ __all__ = [
     "LieflowError", "NotInGroupError", "ShapeError", "NonFiniteError", "DegenerateStratumError",
     "NoUniqueLogError", "InvalidArgumentError", "UnsupportedMethodError", "ConvergenceError",
     "LeftDomainError", "ArgumentTypeError", "lie", "pseudo_rigid", "potentials", "spaces", "surfaces",
-    "elliptic", "ellipsoids", "continuation", "System", "Integration", "_Tangent", "_Lyapunov", "_periodic_orbit",
+    "elliptic", "ellipsoids", "continuation", "System", "Integration", "_Tangent", "_Lyapunov", "_periodic_orbit", "_periodic_family",
     "RigidBody",
     "GeneralizedRigidBody", "HeavyTop", "SphericalPendulum", "Pendulum", "SphereParticle",
     "RollingDisk", "RollingSpheres", "RollingDisks", "RollingDisksEquilibrium",
@@ -118,6 +118,12 @@ def _periodic_orbit(
     levels: Any = None, arclength: Any = None,
 ) -> dict[str, Any]:
     """One shooting (internal to `lieflow.periodic_orbit`)."""
+
+def _periodic_family(
+    system: System, orbit: Any, method: str, parameter: str, stop: float | None, step: Any,
+    max_step: Any, max_points: Any, direction: Any, tol: Any,
+) -> dict[str, Any]:
+    """A family's continuation (internal to `lieflow.continuation.periodic_family`)."""
 
 @disjoint_base
 class System:

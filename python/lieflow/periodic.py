@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._lieflow import InvalidArgumentError, LieflowError, System, _periodic_orbit
+from ._lieflow import InvalidArgumentError, System, _periodic_family, _periodic_orbit
 from .integrate import _check_method, _check_system, _count, _real, _step, integrate
 
 __all__ = ["PeriodicBranch", "PeriodicOrbit", "PeriodicSpecialPoint", "periodic_family",
@@ -262,16 +262,6 @@ def from_mode(equilibrium, mode, amplitude, *, method=None, dt=None, fix="energy
 periodic_orbit.from_mode = from_mode  # type: ignore[attr-defined]
 
 
-#: Bisections that locate a change of stability along a family (the secant step / 2**12).
-_BISECTIONS = 12
-
-#: A corrected orbit further than this many steps from its prediction, or whose family tangent
-#: turned by more than arccos(_MIN_COSINE) from the last orbit's, is not accepted (the step is
-#: halved): the corrector may have reached another family.
-_MAX_CORRECTION = 0.5
-_MIN_COSINE = 0.9
-
-
 class PeriodicSpecialPoint:
     """A special point of a ``PeriodicBranch``.
 
@@ -369,57 +359,26 @@ class PeriodicBranch:
                 f"{len(self.special_points)} special points, end={self.end!r})")
 
 
-def _kind(orbit):
-    """How an unstable orbit's normal multipliers left the unit circle."""
-    mu = orbit.normal_multipliers
-    out = mu[np.abs(mu) > 1 + 1e-6]
-    if out.size == 0:
-        return "tangent"
-    m = out[np.argmax(np.abs(out))]
-    if abs(m.imag) > 1e-6 * abs(m):
-        return "krein"
-    return "period_doubling" if m.real < 0 else "tangent"
-
-
-def _unknowns(orbit):
-    """u = (z, T, ζ) of an orbit (ζ only for a relative orbit of the system's symmetry)."""
-    parts = [orbit.state0, [orbit.period]]
-    if orbit.attitude is None and orbit.drift is not None:
-        parts.append(orbit.drift)
-    return np.concatenate(parts)
-
-
-def _correct(system, like, u0, tangent, h, tol):
-    """The orbit of ``like``'s family at arclength h from u0 along ``tangent``: the shooting with
-    the pseudo-arclength condition, from the prediction u0 + h·tangent."""
-    d = like.state0.size
-    u = u0 + h * tangent
-    drift = u[d + 1:] if u.size > d + 1 else None
-    fields = _periodic_orbit(system, u[:d], float(u[d]), like.method, like.steps, "arclength",
-                             tol, 30, like.attitude, drift is not None or like.attitude is not None,
-                             drift, like.levels, (u0, tangent, float(h)))
-    return PeriodicOrbit(system, like.method, fields["attitude"], fields)
-
-
 def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
                     max_step=0.05, max_points=40, direction=1, tol=1e-10):
     """Follows the family of periodic (or relative periodic) orbits through ``orbit``.
 
-    The family at the levels of ``orbit`` (its invariants and momentum, ``orbit.levels``): a
-    tangent predictor (``PeriodicOrbit.tangent``, the null vector of the shooting equations
-    without the energy's, in the orbit's unknowns: state, period, drift) and the shooting of
+    The family at the levels of ``orbit`` (its invariants and momentum, ``orbit.levels``),
+    followed natively (``lieflow::analysis::periodic::periodic_family``): a tangent predictor
+    (``PeriodicOrbit.tangent``, the null vector of the shooting equations without the
+    energy's, in the orbit's unknowns: state, period, drift) and the shooting of
     ``periodic_orbit`` with the pseudo-arclength condition as corrector (which passes folds of
     the energy and of the period); steps grow and shrink with the corrector's success, and an
     orbit the corrector finds too far from the prediction or whose family tangent turned too
-    much (another family) is refused for a shorter step. Between
-    consecutive orbits the normal multipliers are compared: a change of stability is located
-    by bisection on the secant and named by how the multipliers left the unit circle
-    (``PeriodicSpecialPoint.kind``: period doubling, tangent, Krein collision); a turn of the
-    parameter is reported as a fold. Where the energy and the period turn back together the
-    continuation would retrace the family in invariant terms: it ends there (``end`` says
-    where). That is how a family ends on another (relative) equilibrium: its orbits shrink
-    onto it, and past it the same orbits return half a period on. Every orbit keeps the method and the steps per period of
-    ``orbit``.
+    much (another family) is refused for a shorter step. Between consecutive orbits the normal
+    multipliers are compared: a change of stability is located by bisection on the secant and
+    named by how the multipliers left the unit circle (``PeriodicSpecialPoint.kind``: period
+    doubling, tangent, Krein collision); a turn of the parameter is reported as a fold. Where
+    the energy and the period turn back together the continuation would retrace the family in
+    invariant terms: it ends there (``end`` says where). That is how a family ends on another
+    (relative) equilibrium: its orbits shrink onto it, and past it the same orbits return half
+    a period on. Every orbit keeps the method and the steps per period of ``orbit``. Ctrl-C
+    ends the continuation between orbits (``KeyboardInterrupt``).
 
     Args:
         system: the system of ``orbit``.
@@ -440,77 +399,20 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
     if not isinstance(orbit, PeriodicOrbit):
         raise TypeError(f"invalid orbit: expected a PeriodicOrbit, got {type(orbit).__name__}")
     max_points = _count("max_points", max_points)
-    value = (lambda o: o.energy) if parameter == "energy" else (lambda o: o.period)
-    d = orbit.state0.size
-    scale = max(1.0, float(np.abs(orbit.state0).max()))
-    points, specials = [orbit], []
-    ds, end = step, "max_points"
-    tan = float(np.sign(direction) or 1) * orbit.tangent
-    while len(points) < max_points:
-        last = points[-1]
-        u0 = _unknowns(last)
-        # The state moves by ds of its size along the tangent.
-        h = ds * scale / max(float(np.abs(tan[:d]).max()), 1e-300)
-        try:
-            new = _correct(system, orbit, u0, tan, h, tol)
-        except LieflowError:
-            new = None
-        # The new orbit continues the branch when the corrector stayed near the prediction
-        # and the tangent turned little; else (another family, or none) a shorter step.
-        if new is not None:
-            moved = float(np.abs(new.state0 - (u0[:d] + h * tan[:d])).max()) / (ds * scale)
-            turn = abs(float(new.tangent @ tan))
-            if moved > _MAX_CORRECTION or turn < _MIN_COSINE:
-                new = None
-        if new is None:
-            if ds <= 1e-4 * step:
-                end = "stuck: the corrector failed at the smallest step"
-                break
-            ds *= 0.5
-            continue
-        if len(points) >= 2:
-            turns = [(f(last) - f(points[-2])) * (f(new) - f(last)) < 0
-                     for f in (lambda o: o.energy, lambda o: o.period)]
-            if all(turns):
-                # Energy and period reverse together: the continuation retraces the family
-                # (in invariant terms), which a fold of one of them does not do. So it does
-                # past the family's end where its orbits shrink onto a relative equilibrium
-                # (their amplitude changes sign: the same orbits, half a period on).
-                end = (f"turned back: energy and period reverse together after E = "
-                       f"{last.energy:.10g}, T = {last.period:.10g} (the family's end, e.g. "
-                       f"on an equilibrium its orbits shrink onto)")
-                break
-            a, b, c = value(points[-2]), value(last), value(new)
-            if (b - a) * (c - b) < 0:
-                specials.append(PeriodicSpecialPoint("fold", len(points) - 1, b, last))
-        if last.stable != new.stable:
-            specials.append(_locate(system, orbit, last, new, len(points) - 1, value, tol))
-        points.append(new)
-        # The new tangent, oriented as the branch goes (it may turn at a fold of the energy).
-        tan = new.tangent if float(new.tangent @ tan) >= 0 else -new.tangent
-        ds = min(max_step, 1.5 * ds) if new.iterations <= 7 else ds
-        if stop is not None and (value(new) - stop) * (value(orbit) - stop) <= 0:
-            end = "stop"
-            break
-    return PeriodicBranch(points, parameter, specials, end)
+    for name, v in (("stop", stop), ("step", step), ("max_step", max_step),
+                    ("direction", direction), ("tol", tol)):
+        if not (v is None and name == "stop") and not _real(v):
+            raise TypeError(f"invalid {name}: expected a real number, got "
+                            f"{type(v).__name__} {v!r}")
+    found = _periodic_family(system, orbit, orbit.method, parameter,
+                             None if stop is None else float(stop), step, max_step, max_points,
+                             direction, tol)
+    attitude = orbit.attitude
 
+    def wrap(fields):
+        return PeriodicOrbit(system, orbit.method, attitude, fields)
 
-def _locate(system, like, a, b, index, value, tol):
-    """The change of stability between orbits a and b, by bisection on their secant (the
-    shooting with the arclength condition across it)."""
-    ua, ub = _unknowns(a), _unknowns(b)
-    chord = ub - ua
-    length = float(np.linalg.norm(chord))
-    direction = chord / length
-    lo, hi, unstable = 0.0, 1.0, (b if not b.stable else a)
-    for _ in range(_BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        try:
-            o = _correct(system, like, ua, direction, mid * length, tol)
-        except LieflowError:
-            break
-        if o.stable == a.stable:
-            lo = mid
-        else:
-            hi, unstable = mid, o
-    return PeriodicSpecialPoint(_kind(unstable), index, value(unstable), unstable)
+    points = [orbit] + [wrap(f) for f in found["points"]]
+    specials = [PeriodicSpecialPoint(kind, index, value, wrap(f))
+                for kind, index, value, f in found["special"]]
+    return PeriodicBranch(points, parameter, specials, found["end"])

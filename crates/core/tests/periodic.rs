@@ -502,3 +502,163 @@ fn wrong_sizes_of_the_relative_and_continuation_options_are_refused() {
         .unwrap_err();
     assert!(matches!(e, lieflow::Error::Shape { .. }), "{e}");
 }
+
+/// H = H₁(1 + C) + (ω₂/2)(p₂² + q₂²) − (ω₃/2)(p₃² + q₃²), H₁ = ½(q₁² + p₁²), C = q₂q₃ − p₂p₃:
+/// across the orbits x₁ = A cos t (period 2π, E = H₁) the normal system is H₂₃ + E·C,
+/// autonomous, with eigenvalues ±i(ω̄ ± √(δ² − E²)) (ω̄, δ the mean and half the difference of
+/// ω₂, ω₃): two oscillators of opposite Krein signature whose multipliers collide at E = δ.
+fn krein(w2: f64, w3: f64) -> lieflow::systems::UserCanonical {
+    use lieflow::systems::UserCanonical;
+    use std::sync::Arc;
+    let parts =
+        |q: &[f64], p: &[f64]| (0.5 * (q[0] * q[0] + p[0] * p[0]), q[1] * q[2] - p[1] * p[2]);
+    let h = Arc::new(move |q: &[f64], p: &[f64]| -> lieflow::Result<f64> {
+        let (h1, c) = parts(q, p);
+        Ok(h1 * (1.0 + c) + 0.5 * w2 * (q[1] * q[1] + p[1] * p[1])
+            - 0.5 * w3 * (q[2] * q[2] + p[2] * p[2]))
+    });
+    let g = Arc::new(
+        move |q: &[f64], p: &[f64], gq: &mut [f64], gp: &mut [f64]| -> lieflow::Result<()> {
+            let (h1, c) = parts(q, p);
+            gq.copy_from_slice(&[
+                q[0] * (1.0 + c),
+                w2 * q[1] + h1 * q[2],
+                -w3 * q[2] + h1 * q[1],
+            ]);
+            gp.copy_from_slice(&[
+                p[0] * (1.0 + c),
+                w2 * p[1] - h1 * p[2],
+                -w3 * p[2] - h1 * p[1],
+            ]);
+            Ok(())
+        },
+    );
+    let hess = Arc::new(
+        move |q: &[f64],
+              p: &[f64],
+              dq: &[f64],
+              dp: &[f64],
+              oq: &mut [f64],
+              op: &mut [f64]|
+              -> lieflow::Result<()> {
+            let (h1, c) = parts(q, p);
+            let dh1 = q[0] * dq[0] + p[0] * dp[0];
+            let dc = dq[1] * q[2] + q[1] * dq[2] - dp[1] * p[2] - p[1] * dp[2];
+            oq.copy_from_slice(&[
+                dq[0] * (1.0 + c) + q[0] * dc,
+                w2 * dq[1] + dh1 * q[2] + h1 * dq[2],
+                -w3 * dq[2] + dh1 * q[1] + h1 * dq[1],
+            ]);
+            op.copy_from_slice(&[
+                dp[0] * (1.0 + c) + p[0] * dc,
+                w2 * dp[1] - dh1 * p[2] - h1 * dp[2],
+                -w3 * dp[2] - dh1 * p[1] - h1 * dp[1],
+            ]);
+            Ok(())
+        },
+    );
+    UserCanonical::new(3, h, Some(g))
+        .unwrap()
+        .with_hessian(hess)
+}
+
+/// A family crosses a Krein collision: located, named, its multipliers the closed form's on
+/// both sides; the step control, stop and progress hook; bad options refused.
+#[test]
+fn a_family_through_a_krein_collision() {
+    use lieflow::analysis::periodic::{periodic_family, End, FamilyOptions, Kind};
+    use lieflow::Error;
+    let (w2, w3) = (1.3, 1.2);
+    let (mean, half) = ((w2 + w3) / 2.0, (w2 - w3) / 2.0);
+    let sys = krein(w2, w3);
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let start = periodic_orbit(
+        &sys,
+        "gauss6",
+        &[0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
+        two_pi,
+        None,
+        &options(60, Fix::Energy),
+    )
+    .unwrap();
+    let opts = FamilyOptions {
+        stop: Some(0.07),
+        max_points: 20,
+        ..FamilyOptions::default()
+    };
+    let mut seen = 0;
+    let family = periodic_family(&sys, "gauss6", &start, &opts, &mut |_| {
+        seen += 1;
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(family.end, End::Stop);
+    assert_eq!(seen, family.points.len() - 1);
+    assert!(family.points.last().unwrap().energy >= 0.07);
+    assert_eq!(family.special.len(), 1, "{:?}", family.special);
+    let sp = &family.special[0];
+    assert_eq!(sp.kind, Kind::Krein);
+    assert!((0.05..=0.05 + 5e-6).contains(&sp.value), "{}", sp.value);
+    for o in &family.points {
+        // ±i(ω̄ ± √(δ² − E²)): on the circle before E = δ, a quadruplet after.
+        let r = half * half - o.energy * o.energy;
+        let (re, im) = if r >= 0.0 {
+            (0.0, r.sqrt())
+        } else {
+            ((-r).sqrt(), 0.0)
+        };
+        let mut exact = Vec::new();
+        for (a, b) in [
+            (re, mean + im),
+            (-re, mean - im),
+            (re, -mean - im),
+            (-re, -mean + im),
+        ] {
+            let m = (two_pi * a).exp();
+            exact.push((m * (two_pi * b).cos(), m * (two_pi * b).sin()));
+        }
+        let err = exact.iter().fold(0.0_f64, |e, x| {
+            e.max(
+                o.normal
+                    .iter()
+                    .fold(f64::INFINITY, |m, y| m.min((x.0 - y.0).hypot(x.1 - y.1))),
+            )
+        });
+        assert!(err <= 1e-6, "E = {}: {err:e}", o.energy);
+        assert_eq!(o.stable(), o.energy < half);
+        assert!((o.period - two_pi).abs() <= 1e-9);
+    }
+    // The hook ends the continuation with its error.
+    let stopped = periodic_family(&sys, "gauss6", &start, &opts, &mut |_| {
+        Err(Error::Interrupted { steps_done: 1 })
+    });
+    assert!(matches!(stopped, Err(Error::Interrupted { steps_done: 1 })));
+    // Bad options and a start without its tangent.
+    for bad in [
+        FamilyOptions {
+            step: 0.0,
+            ..opts.clone()
+        },
+        FamilyOptions {
+            max_step: 0.01,
+            ..opts.clone()
+        },
+        FamilyOptions {
+            max_points: 0,
+            ..opts.clone()
+        },
+        FamilyOptions {
+            tol: 1.5,
+            ..opts.clone()
+        },
+    ] {
+        let err = periodic_family(&sys, "gauss6", &start, &bad, &mut |_| Ok(())).unwrap_err();
+        assert!(matches!(err, Error::InvalidArgument { .. }), "{err}");
+    }
+    let bare = lieflow::analysis::periodic::PeriodicOrbit {
+        tangent: Vec::new(),
+        ..start.clone()
+    };
+    let err = periodic_family(&sys, "gauss6", &bare, &opts, &mut |_| Ok(())).unwrap_err();
+    assert!(err.to_string().contains("tangent"), "{err}");
+}

@@ -4,7 +4,7 @@
 
 use lieflow::analysis::periodic::{self as core, Fix, Options};
 use lieflow::Error;
-use numpy::{Complex64, IntoPyArray};
+use numpy::{Complex64, IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -133,6 +133,16 @@ pub fn _periodic_orbit<'py>(
     } else {
         py.detach(solve)?
     };
+    fields(py, &orbit, drift, attitude)
+}
+
+/// An orbit's quantities as the dict `PeriodicOrbit` is built from.
+fn fields<'py>(
+    py: Python<'py>,
+    orbit: &core::PeriodicOrbit,
+    drift: Option<Vec<f64>>,
+    attitude: Option<[f64; 9]>,
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("state0", py_vec(py, &orbit.state0))?;
     out.set_item("period", orbit.period)?;
@@ -150,5 +160,126 @@ pub fn _periodic_orbit<'py>(
     out.set_item("drift", drift.map(|w| py_vec(py, &w)))?;
     let attitude = attitude.map(|a| py_mat(py, &lieflow::Mat::from_fn(3, 3, |i, j| a[3 * i + j])));
     out.set_item("attitude", attitude)?;
+    Ok(out)
+}
+
+/// The fields of a Python `PeriodicOrbit` the continuation reads (its state, period, steps,
+/// energy, normal multipliers, drift ζ of the system's symmetry, levels and tangent), as the
+/// core's orbit (the monodromy and the rest are not read: left empty).
+fn start_of(orbit: &Bound<'_, PyAny>) -> PyResult<(core::PeriodicOrbit, Option<[f64; 9]>)> {
+    let get = |name: &str| orbit.getattr(name);
+    let attitude = get("attitude")?;
+    let attitude = match attitude.is_none() {
+        true => None,
+        false => {
+            Some(real_matrix::<3, 3>(&attitude).map(|m| std::array::from_fn(|k| m[k / 3][k % 3]))?)
+        }
+    };
+    let drift = get("drift")?;
+    let drift = match attitude.is_none() && !drift.is_none() {
+        true => Some(real_vec(&drift)?),
+        false => None,
+    };
+    let normal = get("normal_multipliers")?;
+    let normal: Vec<Complex64> = normal
+        .cast::<numpy::PyArray1<Complex64>>()?
+        .readonly()
+        .as_array()
+        .to_vec();
+    let orbit = core::PeriodicOrbit {
+        state0: real_vec(&get("state0")?)?,
+        period: real(&get("period")?)?,
+        steps: size(&get("steps")?)?,
+        energy: real(&get("energy")?)?,
+        monodromy: lieflow::Mat::zeros(0, 0),
+        multipliers: Vec::new(),
+        trivial: Vec::new(),
+        normal: normal.iter().map(|c| (c.re, c.im)).collect(),
+        residual: real(&get("residual")?)?,
+        iterations: size(&get("iterations")?)?,
+        drift,
+        levels: real_vec(&get("levels")?)?,
+        tangent: real_vec(&get("tangent")?)?,
+    };
+    Ok((orbit, attitude))
+}
+
+/// The family of periodic orbits through `orbit` (a `PeriodicOrbit`;
+/// `lieflow.continuation.periodic_family`, which checks the arguments' kinds): a dict with
+/// `points` (the orbits after the start, as `_periodic_orbit`'s dicts), `special` (tuples
+/// kind, index, value, orbit dict) and `end`. Ctrl-C ends it between orbits.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn _periodic_family<'py>(
+    py: Python<'py>,
+    system: PyRef<'py, PySystem>,
+    orbit: &Bound<'py, PyAny>,
+    method: &str,
+    parameter: &str,
+    stop: Option<f64>,
+    #[pyo3(from_py_with = real)] step: f64,
+    #[pyo3(from_py_with = real)] max_step: f64,
+    #[pyo3(from_py_with = size)] max_points: usize,
+    #[pyo3(from_py_with = real)] direction: f64,
+    #[pyo3(from_py_with = real)] tol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let parameter = match parameter {
+        "energy" => core::Parameter::Energy,
+        "period" => core::Parameter::Period,
+        other => {
+            return Err(to_py(Error::invalid(
+                "parameter",
+                format!("expected \"energy\" or \"period\", got {other:?}"),
+            )))
+        }
+    };
+    let (start, attitude) = start_of(orbit)?;
+    let options = core::FamilyOptions {
+        parameter,
+        stop,
+        step,
+        max_step,
+        max_points,
+        direction,
+        tol,
+    };
+    let sys = system.sys.clone();
+    let follow = || {
+        checked(|| {
+            let mut found = 0;
+            let mut progress = |_: &core::PeriodicOrbit| {
+                found += 1;
+                Python::attach(|py| py.check_signals())
+                    .map_err(|_| Error::Interrupted { steps_done: found })
+            };
+            core::periodic_family(sys.as_ref(), method, &start, &options, &mut progress)
+        })
+    };
+    let family = if sys.calls_out() {
+        follow()?
+    } else {
+        py.detach(follow)?
+    };
+    // Each orbit as `_periodic_orbit` gives it (with an attitude: its drift).
+    let dict = |o: &core::PeriodicOrbit| -> PyResult<Bound<'py, PyDict>> {
+        let drift = match &attitude {
+            Some(a) => Some(checked(|| core::attitude_drift(sys.as_ref(), method, o, a))?.to_vec()),
+            None => o.drift.clone(),
+        };
+        fields(py, o, drift, attitude)
+    };
+    let out = PyDict::new(py);
+    let points = family.points[1..]
+        .iter()
+        .map(&dict)
+        .collect::<PyResult<Vec<_>>>()?;
+    out.set_item("points", points)?;
+    let special = family
+        .special
+        .iter()
+        .map(|sp| Ok((sp.kind.name(), sp.index, sp.value, dict(&sp.orbit)?)))
+        .collect::<PyResult<Vec<_>>>()?;
+    out.set_item("special", special)?;
+    out.set_item("end", family.end.to_string())?;
     Ok(out)
 }

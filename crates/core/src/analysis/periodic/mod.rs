@@ -42,6 +42,12 @@
 //! are the quotient's eigenvalues: they only tell the normal multipliers apart, and the ones
 //! reported are M's own eigenvalues nearest to them (exact for the map).
 
+mod family;
+
+pub use family::{
+    periodic_family, End, FamilyOptions, Kind, Parameter, PeriodicFamily, SpecialPoint,
+};
+
 use super::{eig_error, general_eigenvalues, null_space, range};
 use crate::convergence::{Monitor, Rule, Verdict};
 use crate::error::{Error, Result};
