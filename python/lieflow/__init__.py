@@ -101,6 +101,7 @@ from . import ensemble  # imports dask and xarray only when its functions are ca
 from .integrate import Trajectory, integrate, load
 from .chaos import LyapunovSpectrum, lyapunov, poincare_section
 from .io import FileFormatError
+from ._errors import LieflowWarning
 from .periodic import PeriodicOrbit, periodic_orbit
 
 #: The former name of the base class of the Lie–Poisson systems (kept for existing code).
@@ -114,6 +115,7 @@ __all__ = [
     "DegenerateStratumError",
     "EulerPoincare",
     "FileFormatError",
+    "LieflowWarning",
     "Forced",
     "FrameTop",
     "GeneralizedRigidBody",

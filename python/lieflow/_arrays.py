@@ -6,6 +6,8 @@ import numbers
 
 import numpy as np
 
+from ._text import brief
+
 
 def real_array(what, value):
     """``value`` as a numpy array of real numbers (not yet copied or converted to float64: a
@@ -26,7 +28,7 @@ def real_array(what, value):
         for x in a.flat:
             if not isinstance(x, numbers.Real):
                 raise TypeError(f"{expected}, got a {type(value).__name__} containing a "
-                                f"{type(x).__name__} {x!r:.40}")
+                                f"{type(x).__name__} {brief(x, 40)}")
         try:
             a = a.astype(np.float64)
         except (ValueError, TypeError):

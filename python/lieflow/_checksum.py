@@ -9,6 +9,7 @@ import json
 import numpy as np
 
 from ._errors import FileFormatError
+from ._text import brief
 
 _CHECKSUMS = "lieflow_checksums"
 
@@ -41,7 +42,7 @@ def _attribute_form(name, value):
         return ["s", str(value)]
     a = np.atleast_1d(np.asarray(value))
     if a.dtype.kind not in "biuf":
-        raise FileFormatError(f"attribute {name!r}: {value!r:.60} is neither text nor numbers")
+        raise FileFormatError(f"attribute {name!r}: {brief(value, 60)} is neither text nor numbers")
     return ["n", [float(x).hex() for x in a.astype(np.float64).ravel()]]
 
 

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ._errors import FileFormatError
+from ._text import brief
 
 
 def _check_method(attrs, system):
@@ -21,7 +22,7 @@ def _check_method(attrs, system):
     known = list(system.methods())
     for name in names:
         if not isinstance(name, str) or name not in known:
-            raise FileFormatError(f"the method {name!r:.60} is not one of the methods of "
+            raise FileFormatError(f"the method {brief(name, 60)} is not one of the methods of "
                                   f"{type(system).__name__}: {known}")
 
 
@@ -52,7 +53,7 @@ def _parameter_names(attrs):
         raise FileFormatError(f"the attribute parameters is not a JSON list of names: "
                               f"{e}") from e
     if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
-        raise FileFormatError(f"the attribute parameters is not a list of names: {text!r:.60}")
+        raise FileFormatError(f"the attribute parameters is not a list of names: {brief(text, 60)}")
     return names
 
 
@@ -112,7 +113,7 @@ def _methods(attrs):
     except (ValueError, RecursionError) as e:
         raise FileFormatError(f"the attribute methods is not a JSON list of names: {e}") from e
     if not (isinstance(names, list) and names and all(isinstance(n, str) for n in names)):
-        raise FileFormatError(f"the attribute methods is not a list of names: {text!r:.60}")
+        raise FileFormatError(f"the attribute methods is not a list of names: {brief(text, 60)}")
     return names
 
 
@@ -128,7 +129,7 @@ def _attr(attrs, name, kind):
     a = np.asarray(value) if not isinstance(value, (str, bytes)) else None
     kinds = "iu" if kind == "int" else "iuf"
     if a is None or a.dtype.kind not in kinds or a.size != 1:
-        raise FileFormatError(f"the attribute {name} is {value!r:.60}; expected "
+        raise FileFormatError(f"the attribute {name} is {brief(value, 60)}; expected "
                               f"{'an integer' if kind == 'int' else 'a real number'}")
     v = a.reshape(())[()]
     return int(v) if kind == "int" else float(v)
@@ -208,7 +209,7 @@ def _arguments(ds):
     if "method" not in a:
         _methods(a)
     elif not isinstance(a["method"], str):
-        raise FileFormatError(f"the attribute method is {a['method']!r:.60}; expected a name")
+        raise FileFormatError(f"the attribute method is {brief(a['method'], 60)}; expected a name")
 
     events = _events(ds, var, dims, batched, d, status)
     jacobians = _jacobians(ds, var, dims, lead, b, k, d)
@@ -251,7 +252,7 @@ def _arguments(ds):
         hi = math.inf if t_final is None else t_final + _tol(t_final, t_final)
         if te.size and not (np.all(np.isfinite(te)) and np.all(np.diff(te) >= 0)
                             and te[0] >= lo and te[-1] <= hi):
-            raise FileFormatError(f"event times {te!r:.80} are not increasing times within "
+            raise FileFormatError(f"event times {brief(te, 80)} are not increasing times within "
                                   f"[t0, t_final] = [{t0!r}, {t_final!r}]")
 
     return dict(method=a["method"] if "method" in a else tuple(_methods(a)), t=t,
@@ -323,8 +324,8 @@ def _check_times(a, t, t0, t_final, dt, save_every, status):
                               f"{t_final!r}")
     sampling = a.get("sampling")
     if sampling not in (None, "grid", "irregular"):
-        raise FileFormatError(f"the attribute sampling is {sampling!r:.40}; expected 'grid' or "
-                              f"'irregular'")
+        raise FileFormatError(f"the attribute sampling is {brief(sampling, 40)}; expected "
+                              f"'grid' or 'irregular'")
     inferred = sampling is None
     if inferred:             # format 1, or a Dataset made by hand: a run with save_every
         sampling = "grid" if None not in (dt, save_every, t0, t_final) else "irregular"

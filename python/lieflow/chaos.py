@@ -16,6 +16,7 @@ import numpy as np
 
 from ._lieflow import InvalidArgumentError, NonFiniteError, UnsupportedMethodError, _Lyapunov
 from .integrate import CHUNK_WORK, _check_method, _check_system, _count, _real, integrate
+from ._text import brief
 
 __all__ = ["lyapunov", "LyapunovSpectrum", "poincare_section"]
 
@@ -162,7 +163,7 @@ def poincare_section(system, state0, section, *, direction=1, crossings=100, met
     _check_system(system)
     if not callable(section):
         raise TypeError(f"invalid section: expected a callable g(state) -> float, got "
-                        f"{type(section).__name__} {section!r:.60}")
+                        f"{type(section).__name__} {brief(section, 60)}")
     if dt is None:
         raise TypeError("invalid dt: poincare_section needs a time step dt > 0 (a real number), "
                         "got None")
@@ -170,14 +171,14 @@ def poincare_section(system, state0, section, *, direction=1, crossings=100, met
     max_steps = _count("max_steps", max_steps)
     if not _real(direction):
         raise TypeError(f"invalid direction: expected a real number, got "
-                        f"{type(direction).__name__} {direction!r:.60}")
+                        f"{type(direction).__name__} {brief(direction, 60)}")
 
     def g(t, state):
         v = section(state)
         if type(v) is not float:
             if not _real(v):
                 raise TypeError(f"invalid section: section(state) must return a real number, "
-                                f"got {type(v).__name__} {v!r:.60}")
+                                f"got {type(v).__name__} {brief(v, 60)}")
             v = float(v)
         if not math.isfinite(v):
             raise NonFiniteError(f"the value returned by section contains a non-finite value "

@@ -32,6 +32,7 @@ import numpy as np
 from ._lieflow import InvalidArgumentError, ShapeError, __version__
 from .integrate import _MAX_COUNT, _check_method, _check_system, _count, _step, _time
 from .integrate import integrate as _integrate
+from ._text import brief
 
 if TYPE_CHECKING:  # pragma: no cover
     import xarray
@@ -112,7 +113,7 @@ def default_chunks(members: int, cores: int | None = None) -> int:
     """
     if isinstance(members, bool) or not isinstance(members, (numbers.Integral, np.integer)):
         raise TypeError(f"invalid members: expected an integer >= 0, got "
-                        f"{type(members).__name__} {members!r:.60}")
+                        f"{type(members).__name__} {brief(members, 60)}")
     members = operator.index(members)
     if not 0 <= members <= _MAX_COUNT:
         raise InvalidArgumentError(f"invalid members: expected an integer in [0, 2**63 - 1], "
@@ -167,7 +168,7 @@ def _sweep_task(make_system, value, index, z0, dt, steps, method, save_every, t0
                "energy": np.asarray(traj.energy(), dtype=np.float64)[None],
                "final_state": traj.final_state[None]}
     except Exception as e:
-        _note(e, f"in the lieflow.ensemble.sweep task of params[{index}] = {value!r:.80}")
+        _note(e, f"in the lieflow.ensemble.sweep task of params[{index}] = {brief(value, 80)}")
         raise
     return out
 
@@ -304,7 +305,7 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
     _check_system(system)
     if not callable(getattr(system, "_run", None)):   # a task runs System._run
         raise TypeError(f"invalid system: expected a lieflow.System (e.g. lf.RigidBody([1, 2, "
-                        f"3])), got {type(system).__name__} {system!r:.60}, which has no _run")
+                        f"3])), got {type(system).__name__} {brief(system, 60)}, which has no _run")
     steps = _count("steps", steps)
     save_every = _count("save_every", save_every)
     dt = _step(dt)
@@ -455,12 +456,12 @@ def sweep(make_system: Callable[[Any], Any], params: Sequence[Any], state0: Arra
     dask, da, xr = _require()
     if not callable(make_system):
         raise TypeError(f"invalid make_system: expected a callable make_system(p) returning a "
-                        f"system, got {type(make_system).__name__} {make_system!r:.60}")
+                        f"system, got {type(make_system).__name__} {brief(make_system, 60)}")
     expected = "invalid params: expected a sequence of parameter values"
     if isinstance(params, (str, bytes, dict)) or not hasattr(params, "__iter__"):
-        raise TypeError(f"{expected}, got {type(params).__name__} {params!r:.60}")
+        raise TypeError(f"{expected}, got {type(params).__name__} {brief(params, 60)}")
     if isinstance(params, np.ndarray) and params.ndim == 0:
-        raise TypeError(f"{expected}, got a 0-d array {params!r:.60}")
+        raise TypeError(f"{expected}, got a 0-d array {brief(params, 60)}")
     values = list(params)
     if not values:
         raise InvalidArgumentError("invalid params: expected at least one parameter value")
@@ -472,7 +473,7 @@ def sweep(make_system: Callable[[Any], Any], params: Sequence[Any], state0: Arra
     try:
         system = make_system(values[0])
     except Exception as e:
-        _note(e, f"raised by make_system(params[0]) with params[0] = {values[0]!r:.80}")
+        _note(e, f"raised by make_system(params[0]) with params[0] = {brief(values[0], 80)}")
         raise
     try:
         _check_system(system)

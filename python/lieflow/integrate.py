@@ -19,9 +19,11 @@ attitude | None)`` and ``state()`` is driven through them (every ``save_every``-
 ``steps_to``.
 """
 
+import math
 import numbers
 import operator
 import sys
+import warnings
 
 import numpy as np
 
@@ -29,6 +31,8 @@ from ._lieflow import (InvalidArgumentError, NonFiniteError, ShapeError, System,
                        UnsupportedMethodError)
 from ._arrays import real_array
 from .trajectory import Trajectory, load
+from ._errors import LieflowWarning
+from ._text import brief
 
 __all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]
 
@@ -102,7 +106,7 @@ def _check_system(system):
                         f"first, e.g. {system.__name__}(...)")
     if not all(callable(getattr(system, a, None)) for a in ("_normalize_state", "_start")):
         raise TypeError(f"expected a lieflow system (e.g. lf.RigidBody([1, 2, 3])), got "
-                        f"{type(system).__name__} {system!r:.60}")
+                        f"{type(system).__name__} {brief(system, 60)}")
 
 
 class _Progress:
@@ -144,11 +148,29 @@ def _time(name, value):
     """A time as a float: TypeError unless a real number, InvalidArgumentError unless finite."""
     if not _real(value):
         raise TypeError(f"invalid {name}: expected a real number, got {type(value).__name__} "
-                        f"{value!r:.60}")
+                        f"{brief(value, 60)}")
     value = float(value)
     if not -np.inf < value < np.inf:
         raise InvalidArgumentError(f"invalid {name}: expected a finite number, got {value!r}")
     return value
+
+
+def _span(t_span, dt, steps, t0):
+    """(t0, dt, steps) of ``t_span = (t0, t1)``: n = ceil((t1 - t0)/dt) equal steps of
+    (t1 - t0)/n <= dt (n = round((t1 - t0)/dt) where that ratio is an integer to 1e-9)."""
+    if steps is not None or t0 is not None:
+        raise InvalidArgumentError("invalid t_span: give either t_span = (t0, t1) or steps "
+                                   "(and t0), not both")
+    if isinstance(t_span, (str, bytes)) or not hasattr(t_span, "__len__") or len(t_span) != 2:
+        raise TypeError(f"invalid t_span: expected (t0, t1), got {type(t_span).__name__} "
+                        f"{brief(t_span, 60)}")
+    start, end = _time("t_span[0]", t_span[0]), _time("t_span[1]", t_span[1])
+    dt = _step(dt)
+    if not end > start:
+        raise InvalidArgumentError(f"invalid t_span: expected t0 < t1, got ({start!r}, {end!r})")
+    ratio = (end - start) / dt
+    n = round(ratio) if abs(ratio - round(ratio)) <= 1e-9 * ratio else math.ceil(ratio)
+    return start, (end - start) / max(n, 1), max(n, 1)
 
 
 def _times(t_eval):
@@ -171,7 +193,7 @@ def _events(events):
     fns = [events] if callable(events) else events
     if not isinstance(fns, (list, tuple)) or not all(callable(f) for f in fns):
         raise TypeError(f"invalid events: expected a callable g(t, state) or a list of them, got "
-                        f"{type(events).__name__} {events!r:.60}")
+                        f"{type(events).__name__} {brief(events, 60)}")
     directions, terminal = [], []
     for i, f in enumerate(fns):
         d = getattr(f, "direction", 0.0)
@@ -179,7 +201,7 @@ def _events(events):
             d = 0.0
         if isinstance(d, bool) or not isinstance(d, numbers.Real):
             raise TypeError(f"invalid events[{i}].direction: expected a real number, got "
-                            f"{type(d).__name__} {d!r:.60}")
+                            f"{type(d).__name__} {brief(d, 60)}")
         d = float(d)
         if not np.isfinite(d):
             raise InvalidArgumentError(f"invalid events[{i}].direction: expected a finite number "
@@ -194,7 +216,7 @@ def _events(events):
                 n = operator.index(n)
             except TypeError:
                 raise TypeError(f"invalid events[{i}].terminal: expected a bool or an int >= 0, "
-                                f"got {type(n).__name__} {n!r:.60}") from None
+                                f"got {type(n).__name__} {brief(n, 60)}") from None
             if not 0 <= n <= _MAX_COUNT:
                 raise InvalidArgumentError(f"invalid events[{i}].terminal: expected a bool or an "
                                            f"int >= 0, got {n}")
@@ -214,8 +236,8 @@ def _native(run, name, argument):
 
 
 def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitude=None,
-              progress=False, chunk_steps=None, threads=None, *, t0=0.0, t_eval=None,
-              events=None, event_tol=0.0, sensitivity=False):
+              progress=False, chunk_steps=None, threads=None, *, t0=None, t_span=None,
+              t_eval=None, events=None, event_tol=0.0, sensitivity=False):
     """Integrates ``system`` from ``state0`` by ``steps`` fixed steps of size ``dt``.
 
     Args:
@@ -240,6 +262,9 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             it.
         threads: threads for a batch (default: all cores).
         t0: the time of ``state0`` (default 0); every time of the run is absolute.
+        t_span: ``(t0, t1)`` instead of ``steps`` and ``t0`` (scipy's ``solve_ivp`` habit): the
+            run takes n = ceil((t1 - t0)/dt) equal steps of (t1 - t0)/n <= dt and ends exactly
+            at t1 (``traj.dt`` is that step).
         t_eval: save the states at exactly these times (1-D, strictly increasing, within
             [t0, t0 + steps * dt]) instead of every ``save_every``-th state: ``traj.t`` is
             ``t_eval``. The run still steps with ``dt`` on the grid t0 + k * dt; a time between
@@ -291,6 +316,10 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
     """
     if not isinstance(system, System):
         _check_system(system)
+    if t_span is not None:
+        t0, dt, steps = _span(t_span, dt, steps, t0)
+    elif t0 is None:
+        t0 = 0.0
     if sensitivity is not False:
         if sensitivity is not True:
             if not isinstance(sensitivity, np.bool_):
@@ -319,6 +348,10 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
                         ev is not None)
     if not hasattr(run, "_chunk"):
         run = _Plain(run, system, state0, attitude, dt, t0, save_every)
+    if times is None and steps is not None and run.save_every > steps:
+        warnings.warn(f"save_every = {run.save_every} exceeds steps = {steps}: the trajectory "
+                      f"holds only the initial state (the last one is traj.final_state); pass "
+                      f"save_every <= steps", LieflowWarning, stacklevel=2)
     if chunk_steps is None:
         cap = max(MIN_CHUNK_STEPS, CHUNK_WORK // max(run.members, 1))
     else:

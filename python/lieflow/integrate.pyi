@@ -80,7 +80,8 @@ def integrate(
     chunk_steps: int | None = None,
     threads: int | None = None,
     *,
-    t0: float = 0.0,
+    t0: float | None = None,
+    t_span: tuple[float, float] | None = None,
     t_eval: ArrayLike | None = None,
     events: _EventFunction | list[_EventFunction] | None = None,
     event_tol: float = 0.0,
@@ -88,7 +89,8 @@ def integrate(
 ) -> Trajectory:
     """Integrate `steps` fixed steps of size `dt` from time `t0`; k = steps // save_every + 1
     samples, or the states at the times `t_eval` (shortened steps between grid times; with
-    steps=None the run ends at t_eval[-1]). `events`: scipy-style event functions (attributes
+    steps=None the run ends at t_eval[-1]; `t_span=(t0, t1)`: ceil((t1 - t0)/dt) equal steps
+    ending at t1). `events`: scipy-style event functions (attributes
     `terminal`, `direction`), located on the method's trajectory by shortened steps. An
     exception during the run carries `err.partial`, the trajectory computed before it.
     `sensitivity=True`: also the Jacobians of the method's discrete map (`traj.jacobian`)."""

@@ -74,6 +74,7 @@ from ._checksum import (_CHECKSUMS, _attribute_form, _attributes_digest,  # noqa
                         _seal, _variable_digest, _verify)
 from ._errors import FileFormatError
 from ._lieflow import InvalidArgumentError, System, __version__
+from ._text import brief
 from ._metadata import (_EPS, _arguments, _attr, _check_method, _check_parameters,
                         _check_times,  # noqa: F401
                         _events, _grid_error, _methods, _tol)
@@ -178,7 +179,7 @@ def _encode(value):
         return items if isinstance(value, list) else {"tuple": items}
     name = _allowed_name(value)
     if name is None:
-        raise _NotData(f"{type(value).__name__} {value!r:.60}")
+        raise _NotData(f"{type(value).__name__} {brief(value, 60)}")
     return {"call": name, "args": [_encode(a) for a in value.__reduce__()[1]]}
 
 
@@ -272,7 +273,7 @@ def _parse(data, path, depth, budget):
         name = data["call"]
         if not isinstance(name, str) or name not in ALLOWED_CALLS:
             raise FileFormatError(
-                f"{path}.call: {name!r:.80} is not a lieflow callable that rebuilds systems "
+                f"{path}.call: {brief(name, 80)} is not a lieflow callable that rebuilds systems "
                 f"(a system spec may call only the entries of lieflow.io.ALLOWED_CALLS)")
         args = data["args"]
         if not isinstance(args, list):
@@ -299,7 +300,7 @@ def _parse(data, path, depth, budget):
     if keys == {"array", "dtype"}:
         return _parse_array(data, path, budget)
     raise FileFormatError(
-        f"{path}: an entry with the keys {sorted(keys)!r:.80}; expected one of "
+        f"{path}: an entry with the keys {brief(sorted(keys), 80)}; expected one of "
         f"{{call, args}}, {{array, dtype}}, {{tuple}}, {{complex}}")
 
 
@@ -308,7 +309,7 @@ def _parse_array(data, path, budget):
     it is made."""
     spelled = data["dtype"]
     if not (isinstance(spelled, str) and _DTYPE.fullmatch(spelled)):
-        raise FileFormatError(f"{path}.dtype: {spelled!r:.40} is not the dtype of a numeric "
+        raise FileFormatError(f"{path}.dtype: {brief(spelled, 40)} is not the dtype of a numeric "
                               f"array (booleans, integers or floats, e.g. '<f8')")
     dtype = np.dtype(spelled)
     top = data["array"]
@@ -392,7 +393,7 @@ def _path(path):
         return os.fspath(path)
     except TypeError:
         raise TypeError(f"invalid path: expected a str or os.PathLike, got "
-                        f"{type(path).__name__} {path!r:.60}") from None
+                        f"{type(path).__name__} {brief(path, 60)}") from None
 
 
 # --- Trajectory <-> Dataset ----------------------------------------------------------------
@@ -544,8 +545,8 @@ def save(traj: Any, path: str | os.PathLike[str], *, allow_pickle: bool = False)
     if "system_spec" not in ds.attrs:
         if not allow_pickle:
             raise InvalidArgumentError(
-                f"invalid system: {traj.system!r:.80} holds Python callables (or arrays beyond "
-                f"lieflow.io.SPEC_LIMITS) and cannot be stored as data; pass allow_pickle=True "
+                f"invalid system: {brief(traj.system, 80)} holds Python callables (or arrays "
+                f"beyond lieflow.io.SPEC_LIMITS) and cannot be stored as data; pass allow_pickle=True "
                 f"to store it pickled (lf.load then needs allow_pickle=True too)")
         try:
             import cloudpickle as pickler  # type: ignore[import-untyped]
@@ -554,7 +555,7 @@ def save(traj: Any, path: str | os.PathLike[str], *, allow_pickle: bool = False)
         try:
             blob = pickler.dumps(traj.system)
         except Exception as e:
-            raise InvalidArgumentError(f"invalid system: cannot pickle {traj.system!r:.80}: "
+            raise InvalidArgumentError(f"invalid system: cannot pickle {brief(traj.system, 80)}: "
                                        f"{e}") from None
         ds.attrs["system_pickle"] = base64.b64encode(blob).decode("ascii")
     try:

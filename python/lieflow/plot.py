@@ -21,6 +21,7 @@ import numpy as np
 
 from ._lieflow import InvalidArgumentError
 from .integrate import _MAX_COUNT
+from ._text import brief
 
 if TYPE_CHECKING:
     from matplotlib.animation import FuncAnimation
@@ -51,7 +52,7 @@ def _trajectory(traj):
 
     if not isinstance(traj, Trajectory):
         raise TypeError(f"invalid traj: expected a lieflow Trajectory (from lf.integrate), got "
-                        f"{type(traj).__name__} {traj!r:.60}")
+                        f"{type(traj).__name__} {brief(traj, 60)}")
     return traj
 
 
@@ -146,7 +147,7 @@ def states(traj: Trajectory, *, fields: str | Sequence[str] | None = None, membe
         if isinstance(member, bool) or not isinstance(member, (int, np.integer)) \
                 or not -b <= member < b:
             raise InvalidArgumentError(f"invalid member: expected an integer in [0, {b}), got "
-                                       f"{member!r:.60}")
+                                       f"{brief(member, 60)}")
     t = np.asarray(traj.t)
     for ax, name in zip(panels, names):
         v = np.asarray(views[name])
@@ -252,13 +253,13 @@ def animate(traj: Trajectory, path: str | os.PathLike[str] | None = None, *, eve
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) \
             or not 1 <= every <= _MAX_COUNT:
         raise InvalidArgumentError(f"invalid every: expected an integer in [1, 2**63 - 1], "
-                                   f"got {every!r:.60}")
+                                   f"got {brief(every, 60)}")
     every = int(every)
     if isinstance(interval, bool) or not isinstance(interval, (int, float, np.integer,
                                                                np.floating)) \
             or not 0 < interval < np.inf:
         raise InvalidArgumentError(f"invalid interval: expected milliseconds > 0, got "
-                                   f"{interval!r:.60}")
+                                   f"{brief(interval, 60)}")
     suffix = None
     if path is not None:
         suffix = str(path).rsplit(".", 1)[-1].lower() if "." in str(path) else ""

@@ -199,8 +199,10 @@ def index_symbols(a: ArrayLike) -> tuple[_F64, _F64]:
 @final
 class Verdict:
     eigenvalues: NDArray[np.complex128]
+    kind: str
     stable: bool
     conclusive: bool
+    min_real_part: float
     max_real_part: float
     tol: float
 

@@ -5,6 +5,7 @@ import numpy as np
 
 from ._arrays import real_array
 from ._lieflow import InvalidArgumentError
+from ._text import brief
 
 __all__ = ["Trajectory", "load"]
 
@@ -154,8 +155,8 @@ class Trajectory:
             same = a.system is b.system or (type(a.system) is type(b.system)
                                             and repr(a.system) == repr(b.system))
             if not same:
-                raise InvalidArgumentError(f"{where} integrates another system ({b.system!r:.60} "
-                                           f"after {a.system!r:.60})")
+                raise InvalidArgumentError(f"{where} integrates another system ({brief(b.system, 60)} "
+                                           f"after {brief(a.system, 60)})")
             if a.states.shape[:-2] != b.states.shape[:-2] or a.states.shape[-1] != b.states.shape[-1]:
                 raise InvalidArgumentError(f"{where} has states of shape {b.states.shape} after "
                                            f"{a.states.shape}")

@@ -90,6 +90,9 @@ def test_continuation_diagram():
     assert last.a2_over_a1 == pytest.approx(0.5, abs=1e-12)
     assert last.a3_over_a1 == pytest.approx(E.jacobi(0.5).a3_over_a1, abs=1e-10)
     assert jac.stability.all()
+    # Energy–momentum definite at every point past the branch point; at the branch point itself
+    # (the first point) the Hessian is singular along the bifurcating direction: inconclusive.
+    assert not jac.energy_momentum[0] and jac.energy_momentum[1:].all()
     with pytest.raises(lf.InvalidArgumentError):
         mac.switch(lost[0])
 

@@ -225,3 +225,19 @@ def test_coincident_solutions_found_beside_principal_ones_are_named_in_a_warning
         found = pr.relative_equilibria(SVK, velocities=(0.6 * e(0, 1), 0.4 * e(0, 1)),
                                        bounds=(0.05, 3.0), starts=5)
     assert found and all(len(set(np.round(q.shape, 8))) == 3 for q in found)
+
+
+def test_verdict_reprs_speak_python_and_name_the_deciding_number():
+    s = lf.ellipsoids.jacobi(0.6).stability()
+    em, sp = s.energy_momentum, s.spectral
+    assert (em.kind, sp.kind) == ("energy_momentum", "spectral")
+    # The Hessian's verdict rests on its smallest eigenvalue, the spectrum's on its largest
+    # real part.
+    assert em.min_real_part == pytest.approx(np.min(em.eigenvalues.real))
+    assert em.min_real_part > 0 and em.stable and em.conclusive
+    assert sp.max_real_part == pytest.approx(np.max(sp.eigenvalues.real), abs=1e-15)
+    r_em, r_sp = repr(em), repr(sp)
+    assert "stable=True" in r_em and "conclusive=True" in r_em and "min_eigenvalue=" in r_em
+    assert "max_real_part" not in r_em
+    assert "stable=True" in r_sp and "conclusive=False" in r_sp and "max_real_part=" in r_sp
+    assert "true" not in repr(s) and "false" not in repr(s)

@@ -3,10 +3,9 @@ error path) and the integrated dynamics of each system against independent refer
 rigid-body solution, scipy's DOP853 at rtol 1e-12, conservation laws)."""
 
 import os
-import signal
-import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -55,7 +54,12 @@ def test_default_method_is_splitting(body):
 @pytest.mark.parametrize("steps, save_every", [(10, 3), (9, 3), (5, 7), (1, 1)])
 def test_save_every_semantics(body, steps, save_every):
     every = lf.integrate(body, M0, dt=0.05, steps=steps, method="splitting4")
-    tr = lf.integrate(body, M0, dt=0.05, steps=steps, method="splitting4", save_every=save_every)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tr = lf.integrate(body, M0, dt=0.05, steps=steps, method="splitting4",
+                          save_every=save_every)
+    # Only the start kept (save_every beyond steps) is worth a warning.
+    assert len(caught) == (save_every > steps)
     k = steps // save_every + 1
     assert tr.states.shape == (k, 3)
     np.testing.assert_allclose(tr.t, np.arange(k) * save_every * 0.05)
@@ -155,30 +159,18 @@ def test_progress_bar_tqdm_and_fallback(body, capsys, monkeypatch):
     assert capsys.readouterr().err == ""
 
 
-def test_ctrl_c_stops_a_long_run():
+def test_ctrl_c_stops_a_long_run(interrupted):
     """SIGINT during a long integration: KeyboardInterrupt between chunks, promptly."""
-    code = (
+    out, err, code, _ = interrupted(
         "import signal, sys, lieflow as lf\n"
-        # A shell that starts pytest in the background ignores SIGINT, and children inherit
-        # that: install Python's handler explicitly so that the signal raises KeyboardInterrupt.
         "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "body = lf.RigidBody([1, 2, 3])\n"
         "print('start', flush=True)\n"
         "lf.integrate(body, [1, .5, -.3], dt=1e-3, steps=10**11, save_every=10**11)\n"
         "print('finished', flush=True)\n"
     )
-    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
-    try:
-        assert p.stdout.readline().strip() == "start"
-        time.sleep(0.5)
-        p.send_signal(signal.SIGINT)
-        out, err = p.communicate(timeout=30)
-    finally:
-        if p.poll() is None:
-            p.kill()
     assert "KeyboardInterrupt" in err and "finished" not in out
-    assert p.returncode != 0
+    assert code != 0
 
 
 # ---------------------------------------------------------------- errors
@@ -522,3 +514,36 @@ def test_integration_releases_the_gil():
         stop.set()
         t.join()
     assert seconds > 0.05 and during > 0.15 * rate * seconds, (seconds, during, rate)
+
+
+def test_save_every_beyond_steps_warns_that_only_the_start_is_kept():
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    with pytest.warns(lf.LieflowWarning, match=r"save_every = 100 exceeds steps = 10"):
+        traj = lf.integrate(body, [1.0, 0.5, -0.3], 0.01, 10, save_every=100)
+    assert len(traj) == 1 and traj.t_final == pytest.approx(0.1)
+    assert issubclass(lf.LieflowWarning, UserWarning)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lf.integrate(body, [1.0, 0.5, -0.3], 0.01, 10, save_every=10)   # the last kept: quiet
+
+
+def test_t_span_ends_exactly_at_t1_in_equal_steps_no_longer_than_dt():
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    m0 = [1.0, 0.5, -0.3]
+    traj = lf.integrate(body, m0, 0.03, t_span=(0.5, 1.5))      # 1/0.03 = 33.3: 34 steps
+    assert len(traj) == 35 and traj.dt == pytest.approx(1 / 34, rel=1e-15)
+    assert traj.t[0] == 0.5 and traj.t_final == pytest.approx(1.5, abs=1e-15)
+    same = lf.integrate(body, m0, 1 / 34, 34, t0=0.5)
+    np.testing.assert_array_equal(traj.states, same.states)
+    # A span that dt divides: that many steps of dt exactly.
+    assert len(lf.integrate(body, m0, 0.1, t_span=(0, 1))) == 11
+    with pytest.raises(lf.InvalidArgumentError, match="t_span"):
+        lf.integrate(body, m0, 0.1, 10, t_span=(0, 1))
+    with pytest.raises(lf.InvalidArgumentError, match="t_span"):
+        lf.integrate(body, m0, 0.1, t0=0.0, t_span=(0, 1))
+    with pytest.raises(lf.InvalidArgumentError, match="t0 < t1"):
+        lf.integrate(body, m0, 0.1, t_span=(1, 1))
+    with pytest.raises(TypeError, match="t_span"):
+        lf.integrate(body, m0, 0.1, t_span=1.0)
+    with pytest.raises(TypeError, match=r"t_span\[1\]"):
+        lf.integrate(body, m0, 0.1, t_span=(0, "1"))

@@ -3,11 +3,6 @@ given times by shortened steps), events (zeros located on the method's own traje
 the partial trajectory of a failed or interrupted run, and concatenation of continued runs.
 Checked on the free rigid body against its exact solution."""
 
-import signal
-import subprocess
-import sys
-import time
-
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -307,8 +302,8 @@ def test_left_domain_error_carries_the_partial_trajectory():
     assert p.states.shape == (2, 13, 18) and p.t_final == pytest.approx(0.6)
 
 
-def test_ctrl_c_carries_the_partial_trajectory():
-    code = (
+def test_ctrl_c_carries_the_partial_trajectory(interrupted):
+    out, err, _, _ = interrupted(
         "import signal, lieflow as lf, numpy as np\n"
         "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "body = lf.RigidBody([1, 2, 3])\n"
@@ -320,18 +315,8 @@ def test_ctrl_c_carries_the_partial_trajectory():
         "    again = lf.integrate(body, [1, .5, -.3], dt=1e-3, steps=round(p.t_final / 1e-3),\n"
         "                         save_every=10**6)\n"
         "    print(p.status, len(p), p.t_final, np.abs(again.final_state - p.final_state).max(),\n"
-        "          any('err.partial' in n for n in e.__notes__), flush=True)\n"
-    )
-    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
-    try:
-        assert p.stdout.readline().strip() == "start"
-        time.sleep(1.0)
-        p.send_signal(signal.SIGINT)
-        out, err = p.communicate(timeout=60)
-    finally:
-        if p.poll() is None:
-            p.kill()
+        "          any('err.partial' in n for n in e.__notes__), flush=True)\n",
+        after=1.0)
     status, k, t_final, diff, noted = out.split()
     assert status == "-1" and int(k) >= 1 and float(t_final) > 0 and noted == "True", err
     assert float(diff) < 1e-12

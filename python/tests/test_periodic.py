@@ -5,11 +5,6 @@ and an independent linearisation (Mathieu's equation across the harmonic orbits 
 oscillators, integrated by scipy), plus the errors of bad input.
 """
 
-import signal
-import subprocess
-import sys
-import time
-
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -389,9 +384,9 @@ def test_a_krein_collision_along_a_family_is_located_and_named():
     assert np.abs(mu).max() > 1 + 1e-6
 
 
-def test_ctrl_c_ends_a_family_between_orbits():
+def test_ctrl_c_ends_a_family_between_orbits(interrupted):
     """SIGINT during a native continuation: KeyboardInterrupt after the orbit in progress."""
-    code = (
+    out, err, code, waited = interrupted(
         "import signal, lieflow as lf\n"
         "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "j = lf.ellipsoids.jacobi(0.6)\n"
@@ -402,18 +397,6 @@ def test_ctrl_c_ends_a_family_between_orbits():
         " max_step=1e-4)\n"
         "print('finished', flush=True)\n"
     )
-    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
-    try:
-        assert p.stdout.readline().strip() == "start"
-        time.sleep(0.5)
-        sent = time.perf_counter()
-        p.send_signal(signal.SIGINT)
-        out, err = p.communicate(timeout=60)
-        waited = time.perf_counter() - sent
-    finally:
-        if p.poll() is None:
-            p.kill()
     assert "KeyboardInterrupt" in err and "finished" not in out, err
-    assert p.returncode != 0
+    assert code != 0
     print(f"ended {waited:.1f} s after SIGINT")

@@ -434,3 +434,35 @@ fn module_constants() {
         matrix_to_quaternion(&r)
     );
 }
+
+proptest! {
+    /// At θ = π exactly (R = 2aaᵀ − I, symmetric) the logarithm and the canonical quaternion
+    /// name the same axis: one tie rule (the first nonzero component positive).
+    #[test]
+    fn the_logarithm_and_the_quaternion_break_the_tie_at_pi_alike(a in vec3(1.0)) {
+        prop_assume!(a.norm() > 0.1);
+        let a = a / a.norm();
+        let r = a * a.transpose() * 2.0 - Matrix3::identity();
+        let r = (r + r.transpose()) * 0.5;
+        let w = so3::log_unchecked(&r);
+        let q = to_quaternion(&r).unwrap();
+        let axis = Vector3::new(q[1], q[2], q[3]);
+        prop_assert!((w / PI - axis).amax() <= 1e-9, "log {w:?}, quaternion {q:?}");
+    }
+
+    /// A matrix within the tolerance of SO(3) but 1e-11 off orthogonal is read as its nearest
+    /// rotation: its quaternion's matrix is that rotation to round-off, not to 1e-11.
+    #[test]
+    fn a_nearly_orthogonal_matrix_is_read_as_the_nearest_rotation(
+        r in rot(), e in proptest::array::uniform9(-1.0f64..1.0)
+    ) {
+        let m = r + Matrix3::from_row_slice(&e) * 1e-11;
+        let nearest = so3::project(&m).unwrap();
+        let q = to_quaternion(&m).unwrap();
+        prop_assert!((from_quaternion(&q).unwrap() - nearest).amax() <= 1e-15);
+        let g = so3::SO3::new(m).unwrap();
+        prop_assert!((g.matrix3() - nearest).amax() <= 1e-15);
+        // An exact rotation is kept as it is.
+        prop_assert_eq!(*so3::SO3::new(r).unwrap().matrix3(), r);
+    }
+}

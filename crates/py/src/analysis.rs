@@ -105,7 +105,7 @@ fn run(
 ///     Branch.
 ///
 /// Raises:
-///     InvalidArgumentError (start not an ellipsoid, unknown parameter), NotConvergedError.
+///     InvalidArgumentError (start not an ellipsoid, unknown parameter), ConvergenceError.
 #[pyfunction]
 #[pyo3(signature = (start, parameter = "e", stop = 0.9, *, stability = true, step = 1e-2,
                     max_step = 5e-2, max_points = 2000))]

@@ -261,11 +261,11 @@ pub fn matrix_to_quaternion(r: &Matrix3<f64>) -> Quat {
 }
 
 /// [`matrix_to_quaternion`] of a checked rotation: `r` finite ([`Error::NonFinite`]) with
-/// ‖RᵀR − I‖_F and |det R − 1| at most [`so3::ROTATION_TOL`] ([`Error::NotInGroup`]).
-/// Returns the canonical unit quaternion (w, x, y, z) with w ≥ 0.
+/// ‖RᵀR − I‖_F and |det R − 1| at most [`so3::ROTATION_TOL`] ([`Error::NotInGroup`]), read as
+/// the nearest rotation ([`so3::rotation_of`]). Returns the canonical unit quaternion
+/// (w, x, y, z) with w ≥ 0.
 pub fn to_quaternion(r: &Matrix3<f64>) -> Result<Quat> {
-    so3::check_rotation("R", r)?;
-    Ok(matrix_to_quaternion(r))
+    Ok(matrix_to_quaternion(&so3::rotation_of("R", r)?))
 }
 
 /// q/|q|, computed scale-safely (q is first divided by its largest |component|, so quaternions

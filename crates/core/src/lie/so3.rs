@@ -215,8 +215,9 @@ fn angle_cos_sin(r: &Matrix3<f64>) -> (f64, f64, Vector3<f64>) {
 /// its column with the largest diagonal entry, normalized, with the sign of s.
 ///
 /// Exactly at θ = π (s = 0) both ±π a are logarithms; this function returns the one whose
-/// component at the largest diagonal entry of R is positive. [`log`] refuses angles within
-/// [`LOG_PI_TOL`] of π instead. No checks: `r` is assumed to be a rotation (see [`log`]).
+/// first nonzero component is positive (the tie rule of the canonical quaternion,
+/// [`super::rotations::canonical`]: the logarithm and the quaternion name the same axis).
+/// [`log`] refuses angles within [`LOG_PI_TOL`] of π instead. No checks: `r` is assumed to be a rotation (see [`log`]).
 pub fn log_unchecked(r: &Matrix3<f64>) -> Vector3<f64> {
     let (theta, c, s) = angle_cos_sin(r);
     if c > 0.0 {
@@ -245,7 +246,11 @@ pub fn log_unchecked(r: &Matrix3<f64>) -> Vector3<f64> {
         }
     });
     axis /= axis.norm();
-    if axis.dot(&s) < 0.0 {
+    // The sign of sin θ·axis; at θ = π exactly (s = 0) the rule of the canonical quaternion
+    // (rotations::canonical): the first nonzero component positive.
+    let along = axis.dot(&s);
+    let first = axis.iter().copied().find(|&c| c != 0.0).unwrap_or(1.0);
+    if along < 0.0 || (along == 0.0 && first < 0.0) {
         axis = -axis;
     }
     axis * theta
@@ -655,6 +660,22 @@ pub fn check_rotation(what: &str, r: &Matrix3<f64>) -> Result<()> {
     Ok(())
 }
 
+/// Below this ‖RᵀR − I‖_F a matrix is a rotation to round-off and [`rotation_of`] keeps it.
+const ROUNDOFF_DEFECT: f64 = 1e-14;
+
+/// The rotation a matrix within [`ROTATION_TOL`] of SO(3) stands for: `r` itself where it is
+/// orthogonal to round-off (‖RᵀR − I‖_F ≤ 1e-14), else the nearest rotation ([`project`]), so
+/// that every conversion reads the same rotation to round-off (a matrix 1e-10 off keeps no
+/// 1e-10 error in its quaternion, logarithm or angles). Errors: those of [`check_rotation`].
+pub fn rotation_of(what: &str, r: &Matrix3<f64>) -> Result<Matrix3<f64>> {
+    check_rotation(what, r)?;
+    if rotation_defect(r).0 <= ROUNDOFF_DEFECT {
+        Ok(*r)
+    } else {
+        project(r)
+    }
+}
+
 /// A rotation: a 3×3 matrix R with RᵀR = I and det R = 1 (to [`ROTATION_TOL`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SO3(Matrix3<f64>);
@@ -663,8 +684,7 @@ impl SO3 {
     /// Validates `r`: finite ([`Error::NonFinite`]), ‖RᵀR − I‖_F ≤ [`ROTATION_TOL`] and
     /// |det R − 1| ≤ [`ROTATION_TOL`] ([`Error::NotInGroup`] with the measured defect).
     pub fn new(r: Matrix3<f64>) -> Result<Self> {
-        check_rotation("R", &r)?;
-        Ok(SO3(r))
+        Ok(SO3(rotation_of("R", &r)?))
     }
 
     /// Wraps `r` without checks (for matrices known to be rotations, e.g. outputs of [`exp`]).

@@ -29,6 +29,8 @@ fn store(m: &Matrix3<f64>, out: &mut [f64]) {
 ///
 /// Args: R — (..., 3, 3) rotations (any leading axes); scalar_first — (w, x, y, z) if True
 /// (default), scipy's default order (x, y, z, w) if False.
+/// A matrix within that tolerance but not orthogonal to round-off is read as the nearest
+/// rotation (as scipy's `from_matrix`), as by every function taking rotations.
 /// Returns: (..., 4). Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or
 /// abs(det R − 1) > 1e-10).
 #[pyfunction]
@@ -76,8 +78,11 @@ fn from_quaternion<'py>(
     })
 }
 
-/// `to_euler(R, seq)`: the Euler angles (radians) of rotations in scipy's sequence convention,
-/// equal to scipy's `Rotation.from_matrix(R).as_euler(seq)`.
+/// `to_euler(R, seq)`: the Euler angles (radians) of rotations in scipy's sequence convention:
+/// those of scipy's `Rotation.from_matrix(R).as_euler(seq)` (the same method, Bernardes &
+/// Viollet 2022), equal except that an angle of exactly ±π may come out with the other sign
+/// (the same rotation): lieflow starts from the canonical quaternion (w ≥ 0), scipy from the
+/// sign its `from_matrix` returns.
 ///
 /// seq: 3 letters from x, y, z; upper case = intrinsic (about the rotating axes: "XYZ" is
 /// R = Rx(a) Ry(b) Rz(c)), lower case = extrinsic (about the fixed axes: "xyz" is

@@ -44,8 +44,10 @@ fn so3_exp<'py>(py: Python<'py>, w: ArrayIn<'py>) -> PyResult<Out<'py>> {
 /// accurate near θ = 0 and near θ = π (axis from the symmetric part of R there).
 ///
 /// At θ = π exactly both ±π·axis are logarithms: with `strict=False` one of them is returned
-/// (the one whose component at the largest diagonal entry of R is positive); with `strict=True`
-/// NoUniqueLogError is raised when π − θ ≤ 1e-12.
+/// (the one whose first nonzero component is positive: the tie rule of `to_quaternion`'s
+/// canonical w ≥ 0, so both give the same axis); with `strict=True` NoUniqueLogError is raised
+/// when π − θ ≤ 1e-12. A matrix within the tolerance of a rotation but not orthogonal to
+/// round-off is read as the nearest rotation.
 ///
 /// Args: R — a rotation (3, 3) or (..., 3, 3). Returns (3,) or (..., 3).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or abs(det R − 1) > 1e-10),
@@ -59,7 +61,7 @@ fn so3_log<'py>(py: Python<'py>, R: ArrayIn<'py>, strict: bool) -> PyResult<Out<
         if strict {
             g.log()
         } else {
-            Ok(so3::log_unchecked(m))
+            Ok(so3::log_unchecked(g.matrix3()))
         }
     })
 }

@@ -518,8 +518,8 @@ impl RelativeEquilibrium {
         if let Some((fluid, fig)) = self.figure() {
             let s = fluid.stability(fig).py()?;
             return Ok(Stability {
-                energy_momentum: s.energy_momentum.into(),
-                spectral: s.spectral.into(),
+                energy_momentum: Verdict::new(s.energy_momentum, ENERGY_MOMENTUM),
+                spectral: Verdict::new(s.spectral, SPECTRAL),
             });
         }
         if self.incompressible {
@@ -530,16 +530,16 @@ impl RelativeEquilibrium {
             xi.extend(lieflow::lie::so::vee_n(&self.inner.eta).py()?);
             let s = lieflow::analysis::comoving::stability(&body, &z, &xi).py()?;
             return Ok(Stability {
-                energy_momentum: s.energy_momentum.into(),
-                spectral: s.spectral.into(),
+                energy_momentum: Verdict::new(s.energy_momentum, ENERGY_MOMENTUM),
+                spectral: Verdict::new(s.spectral, SPECTRAL),
             });
         }
         let n = self.inner.n();
         let body = FullBody::new(n, self.potential.clone()).py()?;
         let s = st::stability(&body, &self.inner.a, &self.inner.xi, &self.inner.eta).py()?;
         Ok(Stability {
-            energy_momentum: s.energy_momentum.into(),
-            spectral: s.spectral.into(),
+            energy_momentum: Verdict::new(s.energy_momentum, ENERGY_MOMENTUM),
+            spectral: Verdict::new(s.spectral, SPECTRAL),
         })
     }
 
@@ -678,11 +678,19 @@ pub struct Stability {
     spectral: Verdict,
 }
 
+/// `Verdict.kind` of the energy–momentum verdict.
+const ENERGY_MOMENTUM: &str = "energy_momentum";
+/// `Verdict.kind` of the spectral verdict.
+const SPECTRAL: &str = "spectral";
+
 /// One verdict: the eigenvalues it rests on and whether they prove stability.
 #[pyclass(module = "lieflow.pseudo_rigid", name = "Verdict", frozen)]
 #[derive(Clone)]
 pub struct Verdict {
     eigenvalues: Vec<Complex64>,
+    /// "energy_momentum" (eigenvalues of a Hessian, real) or "spectral" (of a linearisation).
+    #[pyo3(get)]
+    kind: &'static str,
     /// Whether the verdict is "stable".
     #[pyo3(get)]
     stable: bool,
@@ -690,7 +698,12 @@ pub struct Verdict {
     /// real part; an indefinite Hessian or a purely imaginary spectrum is not conclusive.
     #[pyo3(get)]
     conclusive: bool,
-    /// The largest real part of the eigenvalues.
+    /// The smallest real part of the eigenvalues (for the energy–momentum Hessian its smallest
+    /// eigenvalue: positive where definite).
+    #[pyo3(get)]
+    min_real_part: f64,
+    /// The largest real part of the eigenvalues (for the spectral verdict: positive where
+    /// unstable).
     #[pyo3(get)]
     max_real_part: f64,
     /// The tolerance the verdict used.
@@ -698,16 +711,18 @@ pub struct Verdict {
     tol: f64,
 }
 
-impl From<st::Verdict> for Verdict {
-    fn from(v: st::Verdict) -> Self {
+impl Verdict {
+    fn new(v: st::Verdict, kind: &'static str) -> Self {
         Verdict {
             eigenvalues: v
                 .eigenvalues
                 .iter()
                 .map(|&(re, im)| Complex64::new(re, im))
                 .collect(),
+            kind,
             stable: v.stable,
             conclusive: v.conclusive,
+            min_real_part: v.min_real_part,
             max_real_part: v.max_real_part,
             tol: v.tol,
         }
@@ -722,12 +737,19 @@ impl Verdict {
         PyArray1::from_vec(py, self.eigenvalues.clone())
     }
 
+    /// Python spelling; the number that decides: the Hessian's smallest eigenvalue, or the
+    /// spectrum's largest real part.
     fn __repr__(&self) -> String {
+        let py_bool = |b: bool| if b { "True" } else { "False" };
+        let (name, value) = match self.kind {
+            ENERGY_MOMENTUM => ("min_eigenvalue", self.min_real_part),
+            _ => ("max_real_part", self.max_real_part),
+        };
         format!(
-            "Verdict(stable={}, conclusive={}, max_real_part={:.3e}, {} eigenvalues)",
-            self.stable,
-            self.conclusive,
-            self.max_real_part,
+            "Verdict(kind='{}', stable={}, conclusive={}, {name}={value:.3e}, {} eigenvalues)",
+            self.kind,
+            py_bool(self.stable),
+            py_bool(self.conclusive),
             self.eigenvalues.len()
         )
     }

@@ -255,7 +255,7 @@ impl PyEulerPoincare {
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError, InvalidArgumentError (a singular d2l/dxi2 on the way),
-    ///     NotConvergedError, the callables' errors.
+    ///     ConvergenceError, the callables' errors.
     fn velocity<'py>(
         &self,
         py: Python<'py>,
