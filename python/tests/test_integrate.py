@@ -547,3 +547,36 @@ def test_t_span_ends_exactly_at_t1_in_equal_steps_no_longer_than_dt():
         lf.integrate(body, m0, 0.1, t_span=1.0)
     with pytest.raises(TypeError, match=r"t_span\[1\]"):
         lf.integrate(body, m0, 0.1, t_span=(0, "1"))
+
+
+def test_a_step_that_resolves_the_rotation_badly_warns_once_per_run():
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    m0 = [1.0, 0.5, -0.3]                                  # |Ω| = 1.0356
+    with pytest.warns(lf.LieflowWarning, match=r"103\.\d* rad per step.*dt <= 1\.51") as rec:
+        traj = lf.integrate(body, m0, 100.0, 100, method="splitting4")
+    assert len(rec) == 1
+    # The run is still returned as asked (and its energy error shows why).
+    assert np.ptp(traj.energy()) > 0.1
+    # The batch's fastest member decides; the exact flow never warns; a resolved step is quiet.
+    with pytest.warns(lf.LieflowWarning, match="rad per step"):
+        lf.integrate(body, np.array([[0.01, 0, 0], [2.0, 0, 0]]), 1.0, 5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lf.integrate(body, m0, 100.0, 10, method="exact")
+        lf.integrate(body, m0, 0.5, 10)
+        lf.integrate(body, np.array([[0.01, 0, 0], [1.0, 0, 0]]), 1.0, 5)
+    # The heavy top: its pendulum frequency √(mgl|Γ|/I_min) counts too.
+    with pytest.warns(lf.LieflowWarning, match="rad per step"):
+        lf.integrate(lf.HeavyTop([1.0, 1.0, 0.5], 50.0), [0, 0, 0, 0, 0, 1.0], 0.2, 5)
+
+
+def test_moments_no_body_has_are_accepted_with_a_warning():
+    with pytest.warns(lf.LieflowWarning, match="I3 exceeds the sum of the other two"):
+        body = lf.RigidBody([1.0, 1.0, 5.0])
+    assert list(body.moments) == [1.0, 1.0, 5.0]
+    with pytest.warns(lf.LieflowWarning, match="I1 exceeds"):
+        lf.HeavyTop([3.0, 1.0, 1.5], 1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lf.RigidBody([1.0, 1.0, 2.0])                         # a flat body: equality
+        lf.RigidBody(np.diag([1.0, 2.0, 3.0]))

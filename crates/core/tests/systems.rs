@@ -632,3 +632,25 @@ fn heavy_top_noether_with_symmetry_breaking_theorem_4_11() {
         "the horizontal components should move: {horizontal}"
     );
 }
+
+/// The rate of rotation the driver's bindings warn by: |I⁻¹M| in the principal frame, the
+/// same for an inertia given as a rotated matrix; the heavy top's includes √(mgl|Γ|/I_min).
+#[test]
+fn rates_are_the_angular_velocity_and_the_pendulum_frequency() {
+    let m = [1.0, 0.5, -0.3];
+    let body = RigidBody::new([1.0, 2.0, 3.0]).unwrap();
+    let omega = (1.0f64 + 0.0625 + 0.01).sqrt();
+    assert!((body.rate(&m).unwrap() - omega).abs() <= 1e-15);
+    let q = so3::exp_unchecked(&Vector3::new(0.3, -0.2, 0.5));
+    let i = q * Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 3.0)) * q.transpose();
+    let rotated = RigidBody::from_matrix(&row_major(&i)).unwrap();
+    let mq = q * Vector3::from(m);
+    assert!((rotated.rate(mq.as_slice()).unwrap() - omega).abs() <= 1e-14);
+    // A huge momentum: a finite rate, not an overflow.
+    assert!(body.rate(&[1e300, 1e300, 0.0]).unwrap().is_finite());
+    let top = HeavyTop::new([1.0, 1.0, 0.5], 50.0, [0.0, 0.0, 1.0]).unwrap();
+    let z = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    assert!((top.rate(&z).unwrap() - 10.0).abs() <= 1e-14);
+    let pendulum = SphericalPendulum::new(1.0, 1.0, 9.81).unwrap();
+    assert_eq!(pendulum.rate(&[0.0, 0.0, -1.0, 0.0, 0.0, 0.0]), None);
+}

@@ -163,6 +163,14 @@ pub fn checked<T>(f: impl FnOnce() -> lieflow::Result<T>) -> PyResult<T> {
     }
 }
 
+/// Issues a `lieflow.LieflowWarning` attributed to the Python frame `level` up (1: the caller
+/// of the native function; 2: the caller of the lieflow function that called it).
+pub fn warn(py: Python<'_>, message: &str, level: i32) -> PyResult<()> {
+    let category = py.import("lieflow._errors")?.getattr("LieflowWarning")?;
+    let message = std::ffi::CString::new(message.replace('\0', " "))?;
+    PyErr::warn(py, &category, &message, level)
+}
+
 /// Converts a core error into the matching Python exception (a Python exception carried by
 /// [`lieflow::Error::Raised`] is raised again, with a note naming the step of the run it ended).
 pub fn to_py(e: lieflow::Error) -> PyErr {

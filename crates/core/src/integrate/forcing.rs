@@ -582,6 +582,9 @@ impl Problem for Forced {
     fn invariant_count(&self) -> usize {
         self.base.invariant_count()
     }
+    fn rate(&self, z: &[f64]) -> Option<f64> {
+        self.base.rate(z)
+    }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.base.check_state(z)
     }

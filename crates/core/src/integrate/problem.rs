@@ -104,6 +104,14 @@ pub trait Problem: Send + Sync {
         self.to_user(dz)
     }
 
+    /// The fastest angular rate of the motion at z (rad per unit time) where the system knows
+    /// one (a body's |Ω|, a pendulum's frequency): a step h with h·rate beyond about 1 rad
+    /// leaves fewer than ~6 steps per turn, which a method of finite order resolves badly.
+    /// None by default.
+    fn rate(&self, _z: &[f64]) -> Option<f64> {
+        None
+    }
+
     /// The names of the system's parameters θ, in order, whose sensitivities ∂z/∂θ a tangent
     /// run carries ([`crate::integrate::tangent`]); none by default.
     fn parameters(&self) -> Vec<&'static str> {

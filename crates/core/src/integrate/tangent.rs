@@ -472,6 +472,10 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.energy(&self.base(z))
     }
 
+    fn rate(&self, z: &[f64]) -> Option<f64> {
+        self.problem.rate(&self.base(z))
+    }
+
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         self.problem.invariants(&self.base(z))
     }

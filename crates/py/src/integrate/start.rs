@@ -87,6 +87,9 @@ impl Integration {
             None => e,
         })
         .py()?;
+        if let Ok(m) = &resolved {
+            warn_unresolved(&*sys, m, &members, dt)?;
+        }
         drop(members);
         let mut run = Integration {
             method: method.to_string(),
@@ -141,4 +144,64 @@ impl Integration {
         self.at = Some(times);
         Ok(())
     }
+}
+
+/// Rotation per step beyond which a method of finite order resolves the motion badly: a
+/// quarter turn (fewer than 4 steps per turn; the errors go like (h·rate)^p).
+const MAX_TURN_PER_STEP: f64 = std::f64::consts::FRAC_PI_2;
+
+/// A `LieflowWarning` where a step turns the fastest member by more than
+/// [`MAX_TURN_PER_STEP`] rad at the start ([`lieflow::integrate::Problem::rate`]); never for an
+/// exact flow.
+fn warn_unresolved(
+    sys: &dyn System,
+    method: &Resolved,
+    members: &[&[f64]],
+    dt: f64,
+) -> PyResult<()> {
+    if method.properties.exact {
+        return Ok(());
+    }
+    let rate = members
+        .iter()
+        .filter_map(|z| sys.rate(z))
+        .fold(0.0_f64, f64::max);
+    let turn = rate * dt;
+    // A rate beyond f64 (a state near overflow) says nothing a step could act on.
+    if turn > MAX_TURN_PER_STEP && turn.is_finite() {
+        Python::attach(|py| {
+            crate::errors::warn(
+                py,
+                &format!(
+                    "dt = {} turns the motion by {} rad per step (rate {} rad per unit time at \
+                     the start): beyond a quarter turn per step {} (order {}) resolves it badly \
+                     and its errors are no longer small; take dt <= {}",
+                    args::float_repr(dt),
+                    args::float_repr(four_digits(turn)),
+                    args::float_repr(four_digits(rate)),
+                    method.name,
+                    method.properties.order,
+                    args::float_repr(three_digits_below(MAX_TURN_PER_STEP / rate))
+                ),
+                2,
+            )
+        })?;
+    }
+    Ok(())
+}
+
+/// x rounded to four significant digits (for a message).
+fn four_digits(x: f64) -> f64 {
+    let p = 10f64.powi(3 - x.abs().log10().floor() as i32);
+    if p.is_finite() && p > 0.0 {
+        (x * p).round() / p
+    } else {
+        x
+    }
+}
+
+/// x rounded down to three significant digits (a step that is safely below).
+fn three_digits_below(x: f64) -> f64 {
+    let p = 10f64.powi(2 - x.log10().floor() as i32);
+    (x * p).floor() / p
 }

@@ -152,6 +152,20 @@ impl Problem for HeavyTop {
         let t = self.top.kinetic_energy(&z[..3]);
         Ok(t + self.mgl * Vector3::from_column_slice(&z[3..6]).dot(&self.chi))
     }
+    /// The larger of |Ω| and the small-swing pendulum frequency √(mgl|Γ|/I_min).
+    fn rate(&self, z: &[f64]) -> Option<f64> {
+        let gamma = Vector3::from_column_slice(&z[3..6]).norm();
+        let smallest = self
+            .top
+            .moments
+            .iter()
+            .fold(f64::INFINITY, |m, &i| m.min(i));
+        Some(
+            self.top
+                .rate(&z[..3])
+                .max((self.mgl * gamma / smallest).sqrt()),
+        )
+    }
     /// [|Γ|², M·Γ].
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         let m = Vector3::from_column_slice(&z[..3]);

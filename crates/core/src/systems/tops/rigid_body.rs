@@ -147,6 +147,10 @@ impl Problem for RigidBody {
     fn energy(&self, z: &[f64]) -> Result<f64> {
         Ok(self.top.kinetic_energy(&z[..3]))
     }
+    /// |Ω| = |I⁻¹M|.
+    fn rate(&self, z: &[f64]) -> Option<f64> {
+        Some(self.top.rate(&z[..3]))
+    }
     /// [|M|²], and with the attitude also the spatial momentum R M.
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         let mut c = vec![z[..3].iter().map(|x| x * x).sum()];

@@ -244,6 +244,13 @@ impl Top {
     }
 
     /// Kinetic energy ½ M·I⁻¹M of a body momentum given in the user frame (000 §3–§4).
+    /// |Ω| = |I⁻¹M|, the rate of rotation (scale-safe).
+    pub(crate) fn rate(&self, m: &[f64]) -> f64 {
+        let m = to_frame(&self.frame, m);
+        let w: Vec<f64> = (0..3).map(|i| m[i] / self.moments[i]).collect();
+        crate::lie::scaled_norm(w.iter())
+    }
+
     pub(crate) fn kinetic_energy(&self, m: &[f64]) -> f64 {
         let m = to_frame(&self.frame, m);
         0.5 * (0..3).map(|i| m[i] * m[i] / self.moments[i]).sum::<f64>()

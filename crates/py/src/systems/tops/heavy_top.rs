@@ -62,6 +62,7 @@ impl PyHeavyTop {
         }
         .py()?;
         let py = inertia.py();
+        super::warn_unphysical(py, top.moments())?;
         let args = (inertia, mgl, py_vec(py, &chi)).into_pyobject(py)?;
         Ok(PySystem::subclass(top, args, &["inertia", "mgl", "chi"]))
     }

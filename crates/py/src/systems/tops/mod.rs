@@ -22,6 +22,26 @@ pub(crate) enum Inertia {
     Matrix([f64; 9]),
 }
 
+/// A `LieflowWarning` for principal moments that no mass distribution has: one larger than
+/// the sum of the other two (I₃ ≤ I₁ + I₂ for every body, equality for a flat one). Accepted:
+/// generalised bodies (and the Euler equations) take any positive moments.
+pub(crate) fn warn_unphysical(py: Python<'_>, moments: [f64; 3]) -> PyResult<()> {
+    let sum: f64 = moments.iter().sum();
+    if let Some(k) = (0..3).find(|&k| moments[k] > (sum - moments[k]) * (1.0 + 1e-12)) {
+        crate::errors::warn(
+            py,
+            &format!(
+                "principal moments {moments:?}: I{} exceeds the sum of the other two, which no \
+                 rigid body's mass distribution gives (I_i <= I_j + I_k; equality for a flat \
+                 one); accepted as a generalised body",
+                k + 1
+            ),
+            1,
+        )?;
+    }
+    Ok(())
+}
+
 pub(crate) fn inertia(a: &ArrayIn<'_>) -> PyResult<Inertia> {
     let v = a.as_array();
     let data: Vec<f64> = v.iter().copied().collect();

@@ -46,6 +46,7 @@ impl PyRigidBody {
             Inertia::Matrix(m) => core::RigidBody::from_matrix(&m),
         }
         .py()?;
+        super::warn_unphysical(inertia.py(), body.moments())?;
         let args = (inertia,).into_pyobject(inertia.py())?;
         Ok(PySystem::subclass(body, args, &["inertia"]))
     }
