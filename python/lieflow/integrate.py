@@ -155,6 +155,23 @@ def _time(name, value):
     return value
 
 
+def _warn_square(system, state0):
+    """A LieflowWarning for a (d, d) state0 of a system of d values: read as a batch of d
+    states (one per row), though one state in matrix form may have been meant."""
+    d = system.state_dim
+    if d > 1 and isinstance(state0, (np.ndarray, list)):
+        try:
+            shape = np.shape(state0)
+        except ValueError:          # ragged
+            return
+        if shape == (d, d):
+            warnings.warn(f"state0 of shape ({d}, {d}) is read as a batch of {d} states of "
+                          f"{type(system).__name__} (one per row; a state has shape ({d},)); "
+                          f"if a batch is meant, silence this with warnings.filterwarnings("
+                          f"\"ignore\", \"state0 of shape\", lieflow.LieflowWarning)",
+                          LieflowWarning, stacklevel=3)
+
+
 def _span(t_span, dt, steps, t0):
     """(t0, dt, steps) of ``t_span = (t0, t1)``: n = ceil((t1 - t0)/dt) equal steps of
     (t1 - t0)/n <= dt (n = round((t1 - t0)/dt) where that ratio is an integer to 1e-9)."""
@@ -316,6 +333,7 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
     """
     if not isinstance(system, System):
         _check_system(system)
+    _warn_square(system, state0)
     if t_span is not None:
         t0, dt, steps = _span(t_span, dt, steps, t0)
     elif t0 is None:

@@ -580,3 +580,16 @@ def test_moments_no_body_has_are_accepted_with_a_warning():
         warnings.simplefilter("error")
         lf.RigidBody([1.0, 1.0, 2.0])                         # a flat body: equality
         lf.RigidBody(np.diag([1.0, 2.0, 3.0]))
+
+
+def test_a_square_state0_is_read_as_a_batch_with_a_warning():
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    with pytest.warns(lf.LieflowWarning, match=r"state0 of shape \(3, 3\) is read as a batch"):
+        traj = lf.integrate(body, np.eye(3), 0.01, 10)
+    assert traj.states.shape == (3, 11, 3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lf.integrate(body, np.eye(3)[:2], 0.01, 10)          # (2, 3): a batch, unambiguous
+        traj = lf.integrate(body, [1.0, 0.5, -0.3], 0.01, 2)
+        traj.energy()                                         # (3, 3) states inside: quiet
+        lf.integrate(lf.HeavyTop([1, 2, 3], 1.0), (np.ones(3), np.ones(3)), 0.01, 2)

@@ -281,3 +281,18 @@ def test_se3_compose_broadcasts_and_accepts_empty_batches():
     np.testing.assert_allclose(lie.se3_compose(g, hs), g @ hs, atol=1e-14)
     for args in [(g, np.zeros((0, 4, 4))), (np.zeros((0, 4, 4)), g)]:
         assert lie.se3_compose(*args).shape == (0, 4, 4)
+
+
+def test_a_square_array_of_vectors_is_read_as_rows_with_a_warning():
+    import warnings
+    w = np.array([0.1, 0.2, 0.3])
+    with pytest.warns(lf.LieflowWarning, match=r"w of shape \(3, 3\) is read as 3 items"):
+        r = lf.lie.so3_exp(lf.lie.hat(w))
+    assert r.shape == (3, 3, 3)
+    with pytest.warns(lf.LieflowWarning, match=r"xi of shape \(6, 6\)"):
+        lf.lie.se3_exp(np.zeros((6, 6)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lf.lie.so3_exp(w)
+        lf.lie.so3_exp(np.zeros((4, 3)))
+        lf.lie.so3_log(np.eye(3))                            # a (3, 3) item: not ambiguous

@@ -53,9 +53,25 @@ where
     B: Item,
     F: Fn(&A) -> lieflow::Result<B> + Sync + Send,
 {
+    let item = A::shape();
+    if let ([n], [a, b]) = (item.as_slice(), x.as_array().shape()) {
+        if a == n && b == n {
+            crate::errors::warn(
+                py,
+                &format!(
+                    "{what} of shape ({n}, {n}) is read as {n} items of shape ({n},), one per \
+                     row (the last axis is the item, the leading ones a batch); for one item \
+                     pass shape ({n},) (a matrix's vector by vee); if {n} items are meant, \
+                     silence this with warnings.filterwarnings(\"ignore\", \"{what} of \
+                     shape\", lieflow.LieflowWarning)"
+                ),
+                1,
+            )?;
+        }
+    }
     par_map_items(
         py,
-        &[Input::finite(what, x, &A::shape())],
+        &[Input::finite(what, x, &item)],
         &B::shape(),
         |x, out| f(&A::load(x[0])).map(|b| b.store(out)),
     )
