@@ -15,6 +15,11 @@ def demo(figure=None, animation=None) -> None:
     print(f"lieflow {lf.__version__}: an elastic pseudo-rigid body in 3-D (001 §3–§7)")
     pot = lf.potentials.SaintVenantKirchhoff(1.0, 2.0) + lf.potentials.Volumetric(0.5, 1.4)
     body = lf.PseudoRigidBody(3, potential=pot)
+    print("H = tr(P^T P)/2 + U(X), U = Saint Venant-Kirchhoff (lam = 1, mu = 2) + polytropic "
+          "gas (kappa = 0.5, gamma = 1.4):", repr(pot))
+    print("units: nondimensional; length = the radius of the reference ball (X = I), the body's "
+          "inertia (second moment of mass) = 1; the moduli lam, mu, kappa are energies in those "
+          "units and set the time scale")
     # A stretched ellipsoid that spins (L != 0) and has internal vortical flow (Γ != 0).
     X0 = np.diag([1.3, 1.0, 0.8])
     W, V = lf.lie.hat([0.1, 0.3, 1.0]), lf.lie.hat([0.4, -0.2, 0.6])

@@ -17,7 +17,10 @@ def test_demo_runs_and_writes_nothing_unasked(tmp_path, monkeypatch, capsys):
 
     monkeypatch.chdir(tmp_path)
     assert main(["demo"]) == 0
-    assert "lieflow" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "lieflow" in out
+    # It says what it simulates and in which units.
+    assert "SaintVenantKirchhoff(1, 2) + Volumetric(0.5, 1.4)" in out and "units:" in out
     assert list(tmp_path.iterdir()) == []
 
 
