@@ -70,7 +70,7 @@ def demo(figure=None, animation=None) -> None:
         fig.savefig(figure, dpi=120)
         print(f"figure (semi-axes and invariant drifts) saved to {figure}")
     if animation is not None:
-        plot.animate(traj, animation, every=10, interval=50)
+        plot.animate(traj, animation, every=20, interval=100)
         print(f"animation of the ellipsoid X·ball saved to {animation}")
 
 

@@ -223,7 +223,8 @@ def animate(traj: Trajectory, path: str | os.PathLike[str] | None = None, *, eve
     * ``TangentTop`` on a surface with an embedding in R³: the centre's path and the body's
       frame (E1, E2) carried along it.
 
-    For a batch, the first member.
+    For a batch, the first member. Every frame is stamped with its time ("t = …", top left)
+    and the axes are labelled (x, y, z); a saved file is drawn at 80 dpi.
 
     Parameters
     ----------
@@ -281,8 +282,9 @@ def animate(traj: Trajectory, path: str | os.PathLike[str] | None = None, *, eve
                                    f"for {', '.join(drawers)}")
     anim = drawers[kind](system, traj, every, interval, ax)
     if path is not None:
+        # 80 dpi: a 5-inch figure at 400 px, a GIF of ~100 frames well under a megabyte.
         anim.save(str(path), writer="pillow" if suffix == "gif" else "ffmpeg",
-                  fps=max(1.0, 1000.0 / interval))
+                  fps=max(1.0, 1000.0 / interval), dpi=80)
     return anim
 
 
@@ -295,8 +297,26 @@ def _samples(traj, every, field=None):
     return s[::every], None if a is None else np.asarray(a)[::every]
 
 
-def _box(system, traj, every, interval, ax):
+def _animation(ax, draw, times, interval, blit):
+    """The animation of ``draw(i)`` (which returns the artists it changed) over the frames at
+    ``times``, each stamped "t = …" in the corner of ``ax``."""
     from matplotlib.animation import FuncAnimation
+    text = ax.text2D if hasattr(ax, "text2D") else ax.text
+    stamp = text(0.02, 0.98, "", transform=ax.transAxes, ha="left", va="top", fontsize=9)
+
+    def frame(i):
+        stamp.set_text(f"t = {times[i]:.4g}")
+        return tuple(draw(i)) + (stamp,)
+
+    return FuncAnimation(ax.figure, frame, frames=len(times), interval=interval, blit=blit)
+
+
+def _times(traj, every):
+    """The times of the frames."""
+    return np.asarray(traj.t)[::every]
+
+
+def _box(system, traj, every, interval, ax):
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # type: ignore[import-untyped]
 
     momentum, att = _samples(traj, every, "M")
@@ -339,11 +359,10 @@ def _box(system, traj, every, interval, ax):
             trail.set_data_3d(*tips[: i + 1].T)
         return box, arrow, rod, trail
 
-    return FuncAnimation(ax.figure, draw, frames=len(att), interval=interval, blit=False)
+    return _animation(ax, draw, _times(traj, every), interval, blit=False)
 
 
 def _ellipsoid(system, traj, every, interval, ax):
-    from matplotlib.animation import FuncAnimation
 
     n = system.n
     if n not in (2, 3):
@@ -356,19 +375,21 @@ def _ellipsoid(system, traj, every, interval, ax):
         s = np.linspace(0, 2 * np.pi, 121)
         circle = np.stack([np.cos(s), np.sin(s)])
         curve, = ax.plot([], [], lw=2)
-        ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal")
+        ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal", xlabel="x",
+               ylabel="y", title=f"PseudoRigidBody: X·disk ({_method(traj)})")
 
         def draw(i):
             curve.set_data(*(X[i] @ circle))
             return (curve,)
 
-        return FuncAnimation(ax.figure, draw, frames=len(X), interval=interval, blit=True)
+        return _animation(ax, draw, _times(traj, every), interval, blit=True)
     if ax is None:
         fig = _pyplot().figure(figsize=(5, 5))
         ax = fig.add_subplot(projection="3d")
     u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 25), np.linspace(0, np.pi, 13))
     ball = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)])
-    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(-reach, reach))
+    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(-reach, reach), xlabel="x",
+           ylabel="y", zlabel="z")
     ax.set_box_aspect((1, 1, 1))
     ax.set_title(f"PseudoRigidBody: X·ball ({_method(traj)})")
     surface = [None]
@@ -377,18 +398,17 @@ def _ellipsoid(system, traj, every, interval, ax):
         if surface[0] is not None:
             surface[0].remove()
         x = np.einsum("ij,jab->iab", X[i], ball)
-        surface[0] = ax.plot_surface(*x, color="tab:blue", alpha=0.6, linewidth=0.2,
+        surface[0] = ax.plot_surface(*x, color="tab:blue", linewidth=0.2, shade=True,
                                      edgecolor="k")
         return (surface[0],)
 
-    return FuncAnimation(ax.figure, draw, frames=len(X), interval=interval, blit=False)
+    return _animation(ax, draw, _times(traj, every), interval, blit=False)
 
 
 def _rolling_disks(system, traj, every, interval, ax):
     """Both disks as circles about their centres, a spoke from each centre to its centre of mass
     (turning with the disk), the contact point and the trails of the centres of mass, in the
     centre-of-mass frame of the pair (003 §1)."""
-    from matplotlib.animation import FuncAnimation
     from matplotlib.patches import Circle
 
     states, _ = _samples(traj, every)
@@ -397,7 +417,7 @@ def _rolling_disks(system, traj, every, interval, ax):
     radii = [np.linalg.norm(contact[0] - centres[0, 0]), np.linalg.norm(contact[0] - centres[0, 1])]
     ax = _axes(ax, figsize=(5, 5))
     reach = np.abs(centres).max() + max(radii)
-    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal")
+    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal", xlabel="x", ylabel="y")
     colours = ("tab:blue", "tab:orange")
     disks = [ax.add_patch(Circle(centres[0, k], radii[k], fill=False, lw=1.5, color=c))
              for k, c in enumerate(colours)]
@@ -413,7 +433,7 @@ def _rolling_disks(system, traj, every, interval, ax):
         point.set_data([contact[i, 0]], [contact[i, 1]])
         return (*disks, *spokes, *trails, point)
 
-    return FuncAnimation(ax.figure, draw, frames=len(states), interval=interval, blit=True)
+    return _animation(ax, draw, _times(traj, every), interval, blit=True)
 
 
 def _new_3d(ax):
@@ -427,7 +447,6 @@ def _new_3d(ax):
 def _rolling_spheres(system, traj, every, interval, ax):
     """Both spheres as wireframes about their centres, a spoke from each centre to its centre
     of mass and the contact point (003 §2), in the frame of the computation."""
-    from matplotlib.animation import FuncAnimation
 
     states, _ = _samples(traj, every)
     centres = system.centres(states)
@@ -436,7 +455,7 @@ def _rolling_spheres(system, traj, every, interval, ax):
     radii = np.linalg.norm(contact[0] - centres[0], axis=1)
     ax = _new_3d(ax)
     lo, hi = centres.min() - radii.max(), centres.max() + radii.max()
-    ax.set(xlim=(lo, hi), ylim=(lo, hi), zlim=(lo, hi))
+    ax.set(xlim=(lo, hi), ylim=(lo, hi), zlim=(lo, hi), xlabel="x", ylabel="y", zlabel="z")
     ax.set_title(f"RollingSpheres ({_method(traj)})")
     u, v = np.mgrid[0:2 * np.pi:16j, 0:np.pi:9j]
     ball = np.stack([np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v)])
@@ -455,13 +474,12 @@ def _rolling_spheres(system, traj, every, interval, ax):
         point.set_data_3d(*contact[i][:, None])
         return (*wires, *spokes, point)
 
-    return FuncAnimation(ax.figure, draw, frames=len(states), interval=interval, blit=False)
+    return _animation(ax, draw, _times(traj, every), interval, blit=False)
 
 
 def _tangent_top(system, traj, every, interval, ax):
     """The centre's path on the embedded surface and the body frame E1, E2 at the centre
     (002 §II)."""
-    from matplotlib.animation import FuncAnimation
 
     states, _ = _samples(traj, every)
     try:
@@ -473,7 +491,7 @@ def _tangent_top(system, traj, every, interval, ax):
     ax = _new_3d(ax)
     size = 0.15 * max(np.ptp(centre, axis=0).max(), 1e-3)
     lo, hi = centre.min() - 2 * size, centre.max() + 2 * size
-    ax.set(xlim=(lo, hi), ylim=(lo, hi), zlim=(lo, hi))
+    ax.set(xlim=(lo, hi), ylim=(lo, hi), zlim=(lo, hi), xlabel="x", ylabel="y", zlabel="z")
     surface = system.__reduce__()[1][0]           # the constructor's first argument
     ax.set_title(f"TangentTop on {surface!r} ({_method(traj)})")
     trail, = ax.plot([], [], [], color="0.4", lw=0.8)
@@ -487,4 +505,4 @@ def _tangent_top(system, traj, every, interval, ax):
             line.set_data_3d(*np.stack([centre[i], centre[i] + size * e[i]]).T)
         return (trail, *axes)
 
-    return FuncAnimation(ax.figure, draw, frames=len(states), interval=interval, blit=False)
+    return _animation(ax, draw, _times(traj, every), interval, blit=False)

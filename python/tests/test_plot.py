@@ -127,7 +127,24 @@ def test_animate_heavy_top_pseudo_rigid_and_disks(tmp_path):
                         save_every=4)
     anim = plot.animate(traj, every=2)
     anim._init_draw()
-    assert len(anim._func(5)) == 7
+    artists = anim._func(5)
+    # The disks' seven artists and the time stamp of frame 5 (sample 10).
+    assert len(artists) == 8 and artists[-1].get_text() == f"t = {traj.t[10]:.4g}"
+
+
+def test_animations_carry_a_time_stamp_and_axis_labels():
+    prb = lf.PseudoRigidBody(3, potential=lf.potentials.Harmonic(1.0))
+    x = np.diag([1.3, 1.0, 0.8])
+    traj = lf.integrate(prb, (x, lf.lie.hat([0.5, 0.1, 0.2]) @ x), dt=0.1, steps=6)
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    turning = lf.integrate(body, [1.0, 0.5, -0.3], dt=0.1, steps=6, attitude=np.eye(3))
+    for t in (traj, turning):
+        anim = plot.animate(t, every=3)
+        ax = anim._fig.axes[0]
+        assert ax.get_xlabel() == "x" and ax.get_ylabel() == "y"
+        stamp = anim._func(2)[-1]
+        assert stamp.get_text() == f"t = {t.t[6]:.4g}"
+        plt.close(anim._fig)
 
 
 def test_animate_rolling_spheres_and_tangent_top():
