@@ -59,6 +59,7 @@ from ._lieflow import (
     InvalidArgumentError,
     LeftDomainError,
     LieflowError,
+    LieflowWarning,
     NoUniqueLogError,
     NonFiniteError,
     NotInGroupError,
@@ -101,7 +102,6 @@ from . import ensemble  # imports dask and xarray only when its functions are ca
 from .integrate import Trajectory, integrate, load
 from .chaos import LyapunovSpectrum, lyapunov, poincare_section
 from .io import FileFormatError
-from ._errors import LieflowWarning
 from .periodic import PeriodicOrbit, periodic_orbit
 
 #: The former name of the base class of the Lie–Poisson systems (kept for existing code).

@@ -27,11 +27,10 @@ import warnings
 
 import numpy as np
 
-from ._lieflow import (InvalidArgumentError, NonFiniteError, ShapeError, System,
-                       UnsupportedMethodError)
+from ._lieflow import (InvalidArgumentError, LieflowWarning, NonFiniteError, ShapeError,
+                       System, UnsupportedMethodError)
 from ._arrays import real_array
 from .trajectory import Trajectory, load
-from ._errors import LieflowWarning
 from ._text import brief
 
 __all__ = ["integrate", "load", "Trajectory", "CHUNK_WORK", "MIN_CHUNK_STEPS"]

@@ -67,6 +67,14 @@ create_exception!(
     "A trajectory left its configuration space (e.g. det X ≤ 0)."
 );
 
+create_exception!(
+    lieflow,
+    LieflowWarning,
+    pyo3::exceptions::PyUserWarning,
+    "A warning of lieflow: the reading it chose of ambiguous input, or a setting that makes a \
+     result empty or inaccurate; each names what it saw and how to silence it."
+);
+
 /// `lieflow.ArgumentTypeError`, a `TypeError` whose message names the argument. pyo3 records the
 /// argument an extraction failed on in a note ("while processing 'w'", Python ≥ 3.11) after the
 /// error is made, so the name is read from the note when the message is shown. (Defined in
@@ -166,7 +174,7 @@ pub fn checked<T>(f: impl FnOnce() -> lieflow::Result<T>) -> PyResult<T> {
 /// Issues a `lieflow.LieflowWarning` attributed to the Python frame `level` up (1: the caller
 /// of the native function; 2: the caller of the lieflow function that called it).
 pub fn warn(py: Python<'_>, message: &str, level: i32) -> PyResult<()> {
-    let category = py.import("lieflow._errors")?.getattr("LieflowWarning")?;
+    let category = py.get_type::<LieflowWarning>();
     let message = std::ffi::CString::new(message.replace('\0', " "))?;
     PyErr::warn(py, &category, &message, level)
 }
@@ -244,6 +252,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("LeftDomainError", py.get_type::<LeftDomainError>())?;
+    m.add("LieflowWarning", py.get_type::<LieflowWarning>())?;
     m.add("ArgumentTypeError", argument_type_error_type(py)?.bind(py))?;
     Ok(())
 }

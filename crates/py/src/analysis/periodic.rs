@@ -133,11 +133,11 @@ pub fn _periodic_orbit<'py>(
     } else {
         py.detach(solve)?
     };
-    fields(py, &orbit, drift, attitude)
+    orbit_dict(py, &orbit, drift, attitude)
 }
 
 /// An orbit's quantities as the dict `PeriodicOrbit` is built from.
-fn fields<'py>(
+fn orbit_dict<'py>(
     py: Python<'py>,
     orbit: &core::PeriodicOrbit,
     drift: Option<Vec<f64>>,
@@ -205,7 +205,7 @@ fn start_of(orbit: &Bound<'_, PyAny>) -> PyResult<(core::PeriodicOrbit, Option<[
 }
 
 /// The family of periodic orbits through `orbit` (a `PeriodicOrbit`;
-/// `lieflow.continuation.periodic_family`, which checks the arguments' kinds): a dict with
+/// Python's `periodic_family`, which checks the arguments' kinds): a dict with
 /// `points` (the orbits after the start, as `_periodic_orbit`'s dicts), `special` (tuples
 /// kind, index, value, orbit dict) and `end`. Ctrl-C ends it between orbits.
 #[pyfunction]
@@ -266,7 +266,7 @@ pub fn _periodic_family<'py>(
             Some(a) => Some(checked(|| core::attitude_drift(sys.as_ref(), method, o, a))?.to_vec()),
             None => o.drift.clone(),
         };
-        fields(py, o, drift, attitude)
+        orbit_dict(py, o, drift, attitude)
     };
     let out = PyDict::new(py);
     let points = family.points[1..]
