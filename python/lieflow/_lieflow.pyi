@@ -121,8 +121,8 @@ def _periodic_orbit(
     """One shooting (internal to `lieflow.periodic_orbit`)."""
 
 def _periodic_family(
-    system: System, orbit: Any, method: str, parameter: str, stop: float | None, step: Any,
-    max_step: Any, max_points: Any, direction: Any, tol: Any,
+    system: System, start: tuple[Any, ...], method: str, parameter: str, stop: float | None,
+    step: Any, max_step: Any, max_points: Any, direction: Any, tol: Any,
 ) -> dict[str, Any]:
     """A family's continuation (internal to `lieflow.continuation.periodic_family`)."""
 

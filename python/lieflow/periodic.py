@@ -404,7 +404,10 @@ def periodic_family(system, orbit, *, parameter="energy", stop=None, step=0.02,
         if not (v is None and name == "stop") and not _real(v):
             raise TypeError(f"invalid {name}: expected a real number, got "
                             f"{type(v).__name__} {v!r}")
-    found = _periodic_family(system, orbit, orbit.method, parameter,
+    start = (orbit.state0, orbit.period, orbit.steps, orbit.energy, orbit.normal_multipliers,
+             orbit.residual, orbit.iterations, orbit.drift, orbit.levels, orbit.tangent,
+             orbit.attitude)
+    found = _periodic_family(system, start, orbit.method, parameter,
                              None if stop is None else float(stop), step, max_step, max_points,
                              direction, tol)
     attitude = orbit.attitude

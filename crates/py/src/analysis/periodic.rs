@@ -163,48 +163,50 @@ fn orbit_dict<'py>(
     Ok(out)
 }
 
-/// The fields of a Python `PeriodicOrbit` the continuation reads (its state, period, steps,
+/// The fields of the start orbit the continuation reads (a tuple, in the order below) (its state, period, steps,
 /// energy, normal multipliers, drift ζ of the system's symmetry, levels and tangent), as the
 /// core's orbit (the monodromy and the rest are not read: left empty).
 fn start_of(orbit: &Bound<'_, PyAny>) -> PyResult<(core::PeriodicOrbit, Option<[f64; 9]>)> {
-    let get = |name: &str| orbit.getattr(name);
-    let attitude = get("attitude")?;
+    // (state0, period, steps, energy, normal multipliers, residual, iterations, drift, levels,
+    // tangent, attitude), as Python's `periodic_family` passes them.
+    let get = |k: usize| orbit.get_item(k);
+    let attitude = get(10)?;
     let attitude = match attitude.is_none() {
         true => None,
         false => {
             Some(real_matrix::<3, 3>(&attitude).map(|m| std::array::from_fn(|k| m[k / 3][k % 3]))?)
         }
     };
-    let drift = get("drift")?;
+    let drift = get(7)?;
     let drift = match attitude.is_none() && !drift.is_none() {
         true => Some(real_vec(&drift)?),
         false => None,
     };
-    let normal = get("normal_multipliers")?;
+    let normal = get(4)?;
     let normal: Vec<Complex64> = normal
         .cast::<numpy::PyArray1<Complex64>>()?
         .readonly()
         .as_array()
         .to_vec();
     let orbit = core::PeriodicOrbit {
-        state0: real_vec(&get("state0")?)?,
-        period: real(&get("period")?)?,
-        steps: size(&get("steps")?)?,
-        energy: real(&get("energy")?)?,
+        state0: real_vec(&get(0)?)?,
+        period: real(&get(1)?)?,
+        steps: size(&get(2)?)?,
+        energy: real(&get(3)?)?,
         monodromy: lieflow::Mat::zeros(0, 0),
         multipliers: Vec::new(),
         trivial: Vec::new(),
         normal: normal.iter().map(|c| (c.re, c.im)).collect(),
-        residual: real(&get("residual")?)?,
-        iterations: size(&get("iterations")?)?,
+        residual: real(&get(5)?)?,
+        iterations: size(&get(6)?)?,
         drift,
-        levels: real_vec(&get("levels")?)?,
-        tangent: real_vec(&get("tangent")?)?,
+        levels: real_vec(&get(8)?)?,
+        tangent: real_vec(&get(9)?)?,
     };
     Ok((orbit, attitude))
 }
 
-/// The family of periodic orbits through `orbit` (a `PeriodicOrbit`;
+/// The family of periodic orbits through the orbit whose fields `start` holds ([`start_of`];
 /// Python's `periodic_family`, which checks the arguments' kinds): a dict with
 /// `points` (the orbits after the start, as `_periodic_orbit`'s dicts), `special` (tuples
 /// kind, index, value, orbit dict) and `end`. Ctrl-C ends it between orbits.
@@ -213,7 +215,7 @@ fn start_of(orbit: &Bound<'_, PyAny>) -> PyResult<(core::PeriodicOrbit, Option<[
 pub fn _periodic_family<'py>(
     py: Python<'py>,
     system: PyRef<'py, PySystem>,
-    orbit: &Bound<'py, PyAny>,
+    start: &Bound<'py, PyAny>,
     method: &str,
     parameter: &str,
     stop: Option<f64>,
@@ -233,7 +235,7 @@ pub fn _periodic_family<'py>(
             )))
         }
     };
-    let (start, attitude) = start_of(orbit)?;
+    let (start, attitude) = start_of(start)?;
     let options = core::FamilyOptions {
         parameter,
         stop,
