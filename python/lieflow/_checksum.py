@@ -16,8 +16,12 @@ _CHECKSUMS = "lieflow_checksums"
 
 def _variable_digest(name, var):
     """SHA-256 of a variable: its name, dimensions, dtype (kind and size; little-endian),
-    shape and values (C order)."""
+    shape and values (C order); of a text variable (the labels of the ``invariant`` axis), its
+    name, dimensions and strings."""
     a = np.asarray(var.values)
+    if a.dtype.kind in "UO" and a.ndim == 1 and all(isinstance(s, str) for s in a):
+        text = json.dumps([name, list(var.dims), "text", [str(s) for s in a]])
+        return hashlib.sha256(text.encode("utf-8")).hexdigest()
     if a.dtype.kind not in "biuf":
         raise FileFormatError(f"variable {name!r}: of dtype {a.dtype}; a lieflow trajectory "
                               f"holds numbers only")

@@ -161,6 +161,9 @@ class System:
         """(..., d) -> (...)."""
     def invariants(self, states: ArrayLike) -> _F64:
         """(..., d) -> (..., c): what the geometric methods keep exactly."""
+    @property
+    def invariant_names(self) -> list[str]:
+        """A label for each value of `invariants` (``"|M|²"``, ``"M·Γ"``, …)."""
     def casimirs(self, states: ArrayLike) -> _F64:
         """The same as `invariants`."""
     def __reduce__(self) -> tuple[type, tuple[Any, ...]]: ...

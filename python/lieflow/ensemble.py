@@ -351,7 +351,8 @@ def integrate(system: Any, state0: ArrayLike, dt: float, steps: int, method: str
             "attitude": ("member", "time", "attitude_row", "attitude_col"),
             "final_attitude": ("member", "attitude_row", "attitude_col")}
     return xr.Dataset({v: (dims[v], a) for v, a in arrays.items()},
-                      coords={"member": np.arange(b), "time": t},
+                      coords={"member": np.arange(b), "time": t,
+                              "invariant": list(system.invariant_names)},
                       attrs={"system": repr(system), **_attrs(method, dt, save_every, t0, steps)})
 
 
@@ -508,6 +509,7 @@ def sweep(make_system: Callable[[Any], Any], params: Sequence[Any], state0: Arra
     data = {v: (dims[v], a) for v, a in arrays.items()}
     data.update(extra)
     name = getattr(make_system, "__qualname__", None) or repr(make_system)
-    return xr.Dataset(data, coords={"param": coord, "time": t},
+    return xr.Dataset(data, coords={"param": coord, "time": t,
+                                    "invariant": list(system.invariant_names)},
                       attrs={"make_system": str(name), "system": repr(system),
                              **_attrs(method, dt, save_every, t0, steps)})

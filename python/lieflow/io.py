@@ -452,6 +452,7 @@ def _dataset(traj, observables):
         head = inv.shape[:len(lead) + 1]      # (-1 cannot size an empty batch's)
         ds["invariants"] = (lead + ("time", "invariant"),
                             inv.reshape(head + (math.prod(inv.shape[len(head):]),)))
+        ds = ds.assign_coords(invariant=("invariant", traj.invariant_names))
     square = ("attitude_row", "attitude_col")
     if traj.attitude is not None:
         ds["attitude"] = (lead + ("time",) + square, np.array(traj.attitude))

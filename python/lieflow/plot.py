@@ -46,6 +46,11 @@ def _axes(ax, **subplot):
     return _pyplot().subplots(**subplot)[1]
 
 
+def _legend_beside(ax, fontsize="small"):
+    """The legend to the right of the axes, where it covers no data."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=fontsize)
+
+
 def _trajectory(traj):
     """TypeError unless `traj` is a Trajectory."""
     from .trajectory import Trajectory
@@ -82,11 +87,11 @@ def invariants(traj: Trajectory, *, ax: Axes | None = None) -> Axes:
     matplotlib.axes.Axes
     """
     _trajectory(traj)
-    ax = _axes(ax, figsize=(6, 3.5))
+    ax = _axes(ax, figsize=(7, 3.5), layout="constrained")
     t = np.asarray(traj.t)
     energy: Any = np.asarray(traj.energy(), dtype=float)[..., None]
     inv: Any = np.asarray(traj.invariants(), dtype=float).reshape(energy.shape[:-1] + (-1,))
-    labels = ["energy"] + [f"invariant {i}" for i in range(inv.shape[-1])]
+    labels = ["energy"] + traj.invariant_names
     drift = _relative_drift(np.concatenate([energy, inv], axis=-1))
     for label, d in zip(labels, drift.T):
         ax.plot(t, np.where(d > 0, d, np.nan), label=label)
@@ -95,7 +100,7 @@ def invariants(traj: Trajectory, *, ax: Axes | None = None) -> Axes:
     ax.set(xlabel="t", ylabel="relative drift",
            title=f"{type(traj.system).__name__}, {_method(traj)}"
                  + (f" (max over {traj.states.shape[0]} members)" if traj.batched else ""))
-    ax.legend(fontsize="small")
+    _legend_beside(ax)
     return ax
 
 
@@ -136,8 +141,8 @@ def states(traj: Trajectory, *, fields: str | Sequence[str] | None = None, membe
                                    f"{fields!r}")
     if axes is None:
         plt = _pyplot()
-        _, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False,
-                               figsize=(6, 1.2 + 1.6 * len(names)))
+        _, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False, layout="constrained",
+                               figsize=(7, 1.2 + 1.6 * len(names)))
     panels = np.asarray(axes).ravel()
     if len(panels) != len(names):
         raise InvalidArgumentError(f"invalid axes: expected {len(names)} (one per field), got "
@@ -161,7 +166,7 @@ def states(traj: Trajectory, *, fields: str | Sequence[str] | None = None, membe
             ax.plot(t, v[:, j], lw=1, label=label)
         ax.set_ylabel(name)
         if v.shape[1] <= 9:
-            ax.legend(fontsize="x-small", ncol=min(v.shape[1], 3), loc="upper right")
+            _legend_beside(ax, fontsize="x-small")
     panels[-1].set_xlabel("t")
     return panels
 
@@ -187,7 +192,7 @@ def work_precision(results: Mapping[str, tuple[Any, Any]], *, ax: Axes | None = 
     if not isinstance(results, dict) or not results:
         raise InvalidArgumentError("invalid results: expected a non-empty dict {label: "
                                    "(errors, costs)}")
-    ax = _axes(ax, figsize=(6, 4))
+    ax = _axes(ax, figsize=(7, 4), layout="constrained")
     for label, value in results.items():
         try:
             err, work = (np.asarray(v, dtype=float).ravel() for v in value)
@@ -201,7 +206,7 @@ def work_precision(results: Mapping[str, tuple[Any, Any]], *, ax: Axes | None = 
         ax.loglog(err[order], work[order], "o-", ms=4, label=str(label))
     ax.set(xlabel="error", ylabel=cost)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize="small")
+    _legend_beside(ax)
     return ax
 
 

@@ -256,6 +256,11 @@ class Trajectory:
         """The same as ``invariants()`` (the Casimirs of the Lie–Poisson systems)."""
         return self.invariants()
 
+    @property
+    def invariant_names(self):
+        """The system's label for each column of ``invariants()`` (``"|M|²"``, ``"M·Γ"``, …)."""
+        return list(self.system.invariant_names)
+
     def to_xarray(self, *, observables=True):
         """The trajectory as an ``xarray.Dataset``: coordinates ``time`` (and ``member`` for a
         batch), ``states``, the named fields (``M``, ``Gamma``, ``X``, ...), ``energy`` and

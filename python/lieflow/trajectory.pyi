@@ -66,6 +66,9 @@ class Trajectory:
     def __len__(self) -> int: ...
     def energy(self) -> _F64:
         """(k,) or (b, k)."""
+    @property
+    def invariant_names(self) -> list[str]:
+        """The system's label for each column of ``invariants()``."""
     def invariants(self) -> _F64:
         """(k, c) or (b, k, c)."""
     def casimirs(self) -> _F64:

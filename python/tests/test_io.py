@@ -114,6 +114,7 @@ def test_to_xarray_layout_fields_and_attributes():
     np.testing.assert_array_equal(ds["Gamma"], traj.Gamma)
     np.testing.assert_array_equal(ds["energy"], traj.energy())
     np.testing.assert_array_equal(ds["invariants"], traj.invariants())
+    assert list(ds["invariant"].values) == ["|Γ|²", "M·Γ"] == traj.invariant_names
     assert ds["energy"].dims == ("member", "time")
     a = ds.attrs
     assert a["system"] == repr(hv) and a["system_class"] == "HeavyTop"

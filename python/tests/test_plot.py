@@ -37,7 +37,7 @@ def test_invariants_draws_the_relative_drifts():
     traj = lf.integrate(lf.RigidBody([1.0, 2.0, 3.0]), M0, dt=0.1, steps=200, method="rk4")
     ax = plot.invariants(traj)
     lines = {ln.get_label(): ln for ln in ax.get_lines()}
-    assert set(lines) == {"energy", "invariant 0", "machine ε"}
+    assert set(lines) == {"energy", "|M|²", "machine ε"}     # the system's invariant_names
     e = traj.energy()
     expected = np.abs(e - e[0]) / abs(e[0])
     x, y = lines["energy"].get_data()
@@ -54,6 +54,20 @@ def test_invariants_draws_the_relative_drifts():
     d = (np.abs(e - e[:, :1]) / np.abs(e[:, :1])).max(axis=0)
     np.testing.assert_allclose(ax.get_lines()[0].get_ydata()[1:], d[1:], rtol=1e-15)
     assert "max over 2 members" in ax.get_title()
+
+
+def test_legends_name_the_invariants_and_cover_no_data():
+    top = lf.HeavyTop([1.0, 2.0, 3.0], 0.7)
+    traj = lf.integrate(top, (M0, [0.0, 0.6, 0.8]), dt=0.1, steps=100, method="rk4")
+    for ax in [plot.invariants(traj), plot.states(traj)[0],
+               plot.work_precision({"a": ([1e-3, 1e-6], [1.0, 2.0])})]:
+        ax.figure.canvas.draw()
+        legend = ax.get_legend().get_window_extent()
+        assert legend.x0 >= ax.get_window_extent().x1          # beside the axes, not on them
+        # ... and inside the figure (the constrained layout made room for it)
+        assert legend.x1 <= ax.figure.bbox.x1 + 1
+    labels = [t.get_text() for t in plot.invariants(traj).get_legend().get_texts()]
+    assert labels == ["energy", "|Γ|²", "M·Γ", "machine ε"]
 
 
 def test_states_one_panel_per_field():

@@ -70,6 +70,8 @@ def test_every_system_speaks_the_protocol(system, state0, method):
     assert list(views) == system.fields
     assert sum(np.asarray(v).size for v in views.values()) >= system.state_dim
     c = system.invariants(np.stack([z[0], z[0]]))
+    names = system.invariant_names
+    assert len(names) == c.shape[-1] == len(set(names)) and all(names)
     assert c.shape[0] == 2 and np.array_equal(c, system.casimirs(np.stack([z[0], z[0]])))
     tr = lf.integrate(system, z[0], dt=0.01, steps=50, method=method, save_every=10)
     inv = tr.invariants()

@@ -474,6 +474,10 @@ fn observed_orders_match_the_claims() {
 fn claimed_invariants_are_kept_to_round_off() {
     for c in cases() {
         let i0 = c.system.invariants(&c.z0).unwrap();
+        let names = c.system.invariant_names();
+        assert_eq!(names.len(), i0.len(), "{}: {names:?}", c.name);
+        let distinct: std::collections::BTreeSet<_> = names.iter().collect();
+        assert!(distinct.len() == names.len() && names.iter().all(|n| !n.is_empty()));
         let scale = i0.iter().fold(1.0f64, |s, x| s.max(x.abs()));
         for (name, p) in c.system.methods() {
             let traj = integrate(&*c.system, name, &c.z0, c.dt, 10_000, 100).unwrap();

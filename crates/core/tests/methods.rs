@@ -169,8 +169,8 @@ impl Problem for HenonHeiles {
     fn invariants(&self, _z: &[f64]) -> lieflow::Result<Vec<f64>> {
         Ok(Vec::new())
     }
-    fn invariant_count(&self) -> usize {
-        0
+    fn invariant_names(&self) -> Vec<String> {
+        Vec::new()
     }
 }
 

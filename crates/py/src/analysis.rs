@@ -3,11 +3,11 @@
 //! `lieflow::pseudo_rigid::ellipsoids`). Conversions only; `Branch.plot` calls the Python
 //! presentation in `lieflow.continuation`.
 //! The Lyapunov spectrum (`lieflow.lyapunov`) and the periodic orbits (`lieflow.periodic_orbit`)
-//! are in `analysis/lyapunov.rs` and `analysis/periodic.rs`, as in core.
+//! are in `analysis/lyapunov.rs` and `analysis/shooting.rs` (core: `analysis::periodic`).
 #![allow(non_snake_case)]
 
 pub(crate) mod lyapunov;
-pub(crate) mod periodic;
+pub(crate) mod shooting;
 
 use lieflow::analysis::continuation::{self as cont, End, Options};
 use lieflow::pseudo_rigid::ellipsoids::{self as ell, EllipsoidFamily, Sense};

@@ -51,8 +51,8 @@ fn _lieflow(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<system::PySystem>()?;
     m.add_class::<integrate::Integration>()?;
     m.add_class::<sensitivity::PyTangent>()?;
-    m.add_function(wrap_pyfunction!(analysis::periodic::_periodic_orbit, m)?)?;
-    m.add_function(wrap_pyfunction!(analysis::periodic::_periodic_family, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::shooting::_periodic_orbit, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::shooting::_periodic_family, m)?)?;
     m.add_class::<analysis::lyapunov::PyLyapunov>()?;
     systems::register(m)?;
     system::add_system::<

@@ -564,6 +564,13 @@ impl PySystem {
         })
     }
 
+    /// A short label for each value `invariants` returns, in its order (``"|M|²"``,
+    /// ``"M·Γ"``, ``"J(rotation about z)"``, …): what plots and tables name them by.
+    #[getter]
+    fn invariant_names(&self) -> Vec<String> {
+        self.sys.invariant_names()
+    }
+
     /// The same as `invariants` (the Casimirs of the Lie–Poisson systems).
     fn casimirs<'py>(&self, py: Python<'py>, states: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.invariants(py, states)

@@ -450,8 +450,8 @@ impl<P: Problem> Problem for DoubleBracket<P> {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         self.problem.invariants(z)
     }
-    fn invariant_count(&self) -> usize {
-        self.problem.invariant_count()
+    fn invariant_names(&self) -> Vec<String> {
+        self.problem.invariant_names()
     }
 }
 
@@ -579,8 +579,8 @@ impl Problem for Forced {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         self.base.invariants(z)
     }
-    fn invariant_count(&self) -> usize {
-        self.base.invariant_count()
+    fn invariant_names(&self) -> Vec<String> {
+        self.base.invariant_names()
     }
     fn rate(&self, z: &[f64]) -> Option<f64> {
         self.base.rate(z)

@@ -27,6 +27,20 @@ pub use super::clock::{Clock, Violation};
 use super::space::Space;
 use crate::error::{Error, Result};
 
+/// `symbol` indexed 1…count with subscript digits ("J₁", "J₂", …): labels for
+/// [`Problem::invariant_names`] of a vector-valued invariant.
+pub fn indexed_names(symbol: &str, count: usize) -> Vec<String> {
+    const SUBSCRIPT: [char; 10] = ['₀', '₁', '₂', '₃', '₄', '₅', '₆', '₇', '₈', '₉'];
+    (1..=count)
+        .map(|k| {
+            let digits: String = (k.to_string().bytes())
+                .map(|d| SUBSCRIPT[usize::from(d - b'0')])
+                .collect();
+            format!("{symbol}{digits}")
+        })
+        .collect()
+}
+
 /// What every system offers: its state space, energy and invariants.
 pub trait Problem: Send + Sync {
     /// A short name for messages ("RigidBody", …).
@@ -39,11 +53,18 @@ pub trait Problem: Send + Sync {
     fn energy(&self, z: &[f64]) -> Result<f64>;
 
     /// The exact invariants the system's geometric methods keep (Casimirs, momentum maps, …) of a
-    /// state in the user's frame (`z.len()` = the space's dim); [`Problem::invariant_count`] values.
+    /// state in the user's frame (`z.len()` = the space's dim), in the order of
+    /// [`Problem::invariant_names`].
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>>;
 
+    /// A short label for each value [`Problem::invariants`] returns, as a plot or a table names
+    /// it ("|M|²", "M·Γ", "J(rotation about z)", …).
+    fn invariant_names(&self) -> Vec<String>;
+
     /// The number of values [`Problem::invariants`] returns.
-    fn invariant_count(&self) -> usize;
+    fn invariant_count(&self) -> usize {
+        self.invariant_names().len()
+    }
 
     /// Checks constraints of a state beyond its space (|q| = 1 and q·L = 0, det X > 0, …).
     fn check_state(&self, _z: &[f64]) -> Result<()> {

@@ -480,8 +480,8 @@ impl<P: Problem + Clone> Problem for Tangent<P> {
         self.problem.invariants(&self.base(z))
     }
 
-    fn invariant_count(&self) -> usize {
-        self.problem.invariant_count()
+    fn invariant_names(&self) -> Vec<String> {
+        self.problem.invariant_names()
     }
 
     /// The base state checked as the base problem checks it (its space, its constraints).

@@ -67,7 +67,7 @@ use crate::integrate::problem::{Split, VectorField, Violation};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::tangent::{SplitTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
-use crate::lie::so::spectral_invariants;
+use crate::lie::so::{spectral_invariants, spectral_names};
 use crate::numerics::linalg;
 use crate::Mat;
 use faer::linalg::solvers::Solve;
@@ -433,8 +433,10 @@ impl Problem for RightReduced {
         Ok(c)
     }
 
-    fn invariant_count(&self) -> usize {
-        2 * (self.n() / 2)
+    fn invariant_names(&self) -> Vec<String> {
+        let mut names = spectral_names("L", self.n());
+        names.extend(spectral_names("Γ", self.n()));
+        names
     }
 
     /// Q symmetric to [`STATE_TOL`] and positive definite; U right-invariant there

@@ -63,7 +63,7 @@ use crate::integrate::space::{Block, Space};
 use crate::integrate::tangent::{SeparableTangent, SplitTangent, Tangent, TangentSystem};
 use crate::integrate::{Catalog, Entry, Problem};
 use crate::lie::gl;
-use crate::lie::so::{self, spectral_invariants};
+use crate::lie::so::{self, spectral_invariants, spectral_names};
 use crate::numerics::linalg;
 use crate::Mat;
 use faer::{Accum, MatMut, MatRef};
@@ -274,9 +274,13 @@ impl Problem for PseudoRigidBody {
         Ok(c)
     }
 
-    /// 2⌊n/2⌋, plus 1 (det X) for the incompressible body.
-    fn invariant_count(&self) -> usize {
-        2 * (self.n() / 2) + usize::from(self.incompressible)
+    fn invariant_names(&self) -> Vec<String> {
+        let mut names = spectral_names("L", self.n());
+        names.extend(spectral_names("Γ", self.n()));
+        if self.incompressible {
+            names.push("det X".into());
+        }
+        names
     }
 
     fn symmetry(&self) -> Option<&dyn Symmetric> {

@@ -294,6 +294,25 @@ pub fn spectral_invariants(xi: &Mat) -> Vec<f64> {
     out
 }
 
+/// The labels of [`spectral_invariants`] of a skew matrix named `symbol` in so(n):
+/// "½tr(XᵀX)", "½tr((XᵀX)²)", … (⌊n/2⌋ of them).
+pub fn spectral_names(symbol: &str, n: usize) -> Vec<String> {
+    const SUPERSCRIPT: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    (1..=n / 2)
+        .map(|k| match k {
+            1 => format!("½tr({symbol}ᵀ{symbol})"),
+            _ => {
+                let power: String = k
+                    .to_string()
+                    .bytes()
+                    .map(|d| SUPERSCRIPT[usize::from(d - b'0')])
+                    .collect();
+                format!("½tr(({symbol}ᵀ{symbol}){power})")
+            }
+        })
+        .collect()
+}
+
 // ---------------------------------------------------------------------------------------------
 // Projection
 

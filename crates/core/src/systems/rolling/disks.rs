@@ -630,8 +630,8 @@ impl Problem for RollingDisks {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         Ok(vec![self.angular_momentum(z)?])
     }
-    fn invariant_count(&self) -> usize {
-        1
+    fn invariant_names(&self) -> Vec<String> {
+        vec!["J".into()]
     }
 }
 

@@ -535,11 +535,10 @@ impl Problem for TangentTop {
         v.extend(self.killing_values(z, true));
         Ok(v)
     }
-    fn invariant_count(&self) -> usize {
-        usize::from(!self.depends_on_theta())
-            + (0..self.surface.killing_count())
-                .filter(|&k| self.surface.killing_is_affine(k))
-                .count()
+    fn invariant_names(&self) -> Vec<String> {
+        let spin = (!self.depends_on_theta()).then(|| "p_θ".to_string());
+        let killing = surface::killing_momentum_names(&*self.surface, true);
+        spin.into_iter().chain(killing).collect()
     }
     /// x in the surface's domain.
     fn check_state(&self, z: &[f64]) -> Result<()> {
@@ -831,8 +830,8 @@ impl Problem for ChargedParticle {
         self.check_z(z)?;
         Ok(self.killing_values(z, true))
     }
-    fn invariant_count(&self) -> usize {
-        self.top.invariant_count() - 1
+    fn invariant_names(&self) -> Vec<String> {
+        surface::killing_momentum_names(&*self.top.surface, true)
     }
     /// x in the surface's domain.
     fn check_state(&self, z: &[f64]) -> Result<()> {

@@ -159,8 +159,8 @@ impl Problem for RollingDisk {
     fn invariants(&self, _z: &[f64]) -> Result<Vec<f64>> {
         Ok(Vec::new())
     }
-    fn invariant_count(&self) -> usize {
-        0
+    fn invariant_names(&self) -> Vec<String> {
+        Vec::new()
     }
     /// The potential's constants: the spring k and the tilt g̃ (the sensitivities ∂z/∂k,
     /// ∂z/∂g̃ of a tangent run; the inertias and the radius enter M and A, which the lift does

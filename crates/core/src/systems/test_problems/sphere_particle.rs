@@ -87,8 +87,8 @@ impl Problem for SphereParticle {
         let q = "the angular momentum (q × p)₃";
         Ok(vec![check::cross2("state", q, [z[0], z[1]], [z[3], z[4]])?])
     }
-    fn invariant_count(&self) -> usize {
-        1
+    fn invariant_names(&self) -> Vec<String> {
+        vec!["(q×p)₃".into()]
     }
     /// |q| = l and q·p = 0, to [`CONSTRAINT_TOL`] relative to l and l|p|.
     fn check_state(&self, z: &[f64]) -> Result<()> {

@@ -189,8 +189,8 @@ impl Problem for GeneralizedRigidBody {
         let m = so::hat_n_unchecked(self.n, z);
         Ok(crate::lie::so::spectral_invariants(&m))
     }
-    fn invariant_count(&self) -> usize {
-        self.n / 2
+    fn invariant_names(&self) -> Vec<String> {
+        crate::lie::so::spectral_names("M", self.n)
     }
     fn to_internal(&self, z: &mut [f64]) {
         self.conjugate(z, true);

@@ -172,8 +172,8 @@ impl Problem for HeavyTop {
         let g = Vector3::from_column_slice(&z[3..6]);
         Ok(vec![g.norm_squared(), m.dot(&g)])
     }
-    fn invariant_count(&self) -> usize {
-        2
+    fn invariant_names(&self) -> Vec<String> {
+        vec!["|Γ|²".into(), "M·Γ".into()]
     }
     /// Γ ≠ 0 (the vertical seen in the body; its length is a Casimir, and scaling it scales
     /// mgl), and with the attitude Γ must equal Rᵀe₃ (to 1e-9).
@@ -294,8 +294,8 @@ impl Problem for FreeKick {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         self.0.invariants(z)
     }
-    fn invariant_count(&self) -> usize {
-        self.0.invariant_count()
+    fn invariant_names(&self) -> Vec<String> {
+        self.0.invariant_names()
     }
     fn parameters(&self) -> Vec<&'static str> {
         self.0.parameters()

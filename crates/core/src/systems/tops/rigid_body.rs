@@ -159,12 +159,12 @@ impl Problem for RigidBody {
         }
         Ok(c)
     }
-    fn invariant_count(&self) -> usize {
+    fn invariant_names(&self) -> Vec<String> {
+        let mut names = vec!["|M|²".to_string()];
         if self.top.lifted {
-            4
-        } else {
-            1
+            names.extend(["(RM)₁", "(RM)₂", "(RM)₃"].map(String::from));
         }
+        names
     }
     fn to_internal(&self, z: &mut [f64]) {
         self.top.to_internal(z)

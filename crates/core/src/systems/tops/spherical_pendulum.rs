@@ -118,8 +118,8 @@ impl Problem for SphericalPendulum {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         Ok(Self::casimirs(z).to_vec())
     }
-    fn invariant_count(&self) -> usize {
-        2
+    fn invariant_names(&self) -> Vec<String> {
+        vec!["|q|²".into(), "q·L".into()]
     }
     /// |q| = 1 and q·L = 0 to [`CONSTRAINT_TOL`].
     fn check_state(&self, z: &[f64]) -> Result<()> {

@@ -8,7 +8,7 @@ use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::hooks;
 use crate::integrate::methods::group_field_catalog;
-use crate::integrate::problem::{GroupField, VectorField};
+use crate::integrate::problem::{indexed_names, GroupField, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::tangent::{GroupFieldTangent, Tangent, TangentSystem, VectorFieldTangent};
 use crate::integrate::{Catalog, Entry, Problem};
@@ -464,16 +464,20 @@ impl Problem for LiePoisson {
         }
         Ok(out)
     }
-    fn invariant_count(&self) -> usize {
-        let casimirs = match (&self.casimirs, &self.algebra.kind) {
-            (Some(fs), _) => fs.len(),
-            (None, Kind::So3) => 1,
-            (None, Kind::Se3) => 2,
-            (None, Kind::So(n)) => n / 2,
-            (None, Kind::Generic) => 0,
+    /// "casimir k" for the functions given; the built-in Casimirs by their formulas; the
+    /// Noether momentum as J₁, J₂, ….
+    fn invariant_names(&self) -> Vec<String> {
+        let mut names = match (&self.casimirs, &self.algebra.kind) {
+            (Some(fs), _) => (0..fs.len()).map(|k| format!("casimir {k}")).collect(),
+            (None, Kind::So3) => vec!["|M|²".to_string()],
+            (None, Kind::Se3) => vec!["|Γ|²".to_string(), "M·Γ".into()],
+            (None, Kind::So(n)) => so::spectral_names("M", *n),
+            (None, Kind::Generic) => Vec::new(),
         };
-        let noether = self.lifted && self.noether_conserved();
-        casimirs + if noether { self.algebra.dim } else { 0 }
+        if self.lifted && self.noether_conserved() && self.group.is_some() {
+            names.extend(indexed_names("J", self.algebra.dim));
+        }
+        names
     }
     /// The attitude, if carried, is in the group.
     fn check_state(&self, z: &[f64]) -> Result<()> {

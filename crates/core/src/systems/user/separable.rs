@@ -267,8 +267,8 @@ impl Problem for UserSeparable {
     fn invariants(&self, _z: &[f64]) -> Result<Vec<f64>> {
         Ok(Vec::new())
     }
-    fn invariant_count(&self) -> usize {
-        0
+    fn invariant_names(&self) -> Vec<String> {
+        Vec::new()
     }
 }
 

@@ -48,8 +48,8 @@ impl Problem for RollingSpheres {
         check::len_of("state", z, STATE_DIM)?;
         Ok(arr(&(self.noether(&local(z)) * self.scale())).to_vec())
     }
-    fn invariant_count(&self) -> usize {
-        3
+    fn invariant_names(&self) -> Vec<String> {
+        vec!["J₁".into(), "J₂".into(), "J₃".into()]
     }
     /// (z₁, z₂, u, Ω₁, Ω₂) ↦ (z₁, z₂, u, P₁, P₂), the spatial momenta P = Mω (rescaled units).
     fn to_internal(&self, z: &mut [f64]) {

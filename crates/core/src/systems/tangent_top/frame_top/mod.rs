@@ -66,7 +66,7 @@ use super::space_form::SpaceForm;
 use crate::check;
 use crate::error::{Error, Result};
 use crate::integrate::methods::{Composition, Rk4, Splitting};
-use crate::integrate::problem::{Split, VectorField};
+use crate::integrate::problem::{indexed_names, Split, VectorField};
 use crate::integrate::space::{Block, Space};
 use crate::integrate::{Catalog, Clock, Entry, Integrator, Problem, Properties, Stepper};
 use crate::lie::so3;
@@ -469,8 +469,15 @@ impl Problem for FrameTop {
         Ok(c)
     }
 
-    fn invariant_count(&self) -> usize {
-        9
+    fn invariant_names(&self) -> Vec<String> {
+        let mut names = vec!["Π·P".to_string(), "|P|² + κ|Π|²".into(), "T".into()];
+        let (angular, linear) = match self.space {
+            SpaceForm::Euclidean => ("L", "p"),
+            _ => ("J_Π", "J_P"),
+        };
+        names.extend(indexed_names(angular, 3));
+        names.extend(indexed_names(linear, 3));
+        names
     }
 
     /// g in the space's frame group.

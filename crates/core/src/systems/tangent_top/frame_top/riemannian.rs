@@ -241,8 +241,8 @@ impl Problem for RiemannianFrameTop {
         Ok(vec![self.rotational_energy(z)?, pi.norm_squared()])
     }
 
-    fn invariant_count(&self) -> usize {
-        2
+    fn invariant_names(&self) -> Vec<String> {
+        vec!["H − T".into(), "|Π|²".into()]
     }
 
     /// x in the chart.

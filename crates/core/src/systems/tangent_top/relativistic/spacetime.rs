@@ -381,15 +381,14 @@ impl Problem for RelativisticTangentTop {
         let spin = self.is_symmetric().then_some(z[5]);
         Ok(spin.into_iter().chain(affine).collect())
     }
-    fn invariant_count(&self) -> usize {
+    fn invariant_names(&self) -> Vec<String> {
+        let spin = self.is_symmetric().then(|| "p_θ".to_string());
         match &self.surface {
-            None => 2 + usize::from(self.is_symmetric()),
-            Some(surface) => {
-                usize::from(self.is_symmetric())
-                    + (0..surface.killing_count())
-                        .filter(|&k| surface.killing_is_affine(k))
-                        .count()
-            }
+            None => ["p_x".to_string(), "p_y".to_string()].into_iter().chain(spin).collect(),
+            Some(surface) => spin
+                .into_iter()
+                .chain(surface::killing_momentum_names(&**surface, true))
+                .collect(),
         }
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {

@@ -213,11 +213,12 @@ impl Problem for StaticFieldTop {
         });
         Ok(std::iter::once(z[5]).chain(momenta).collect())
     }
-    fn invariant_count(&self) -> usize {
-        match &self.surface {
-            None => self.potential.invariant_count(),
-            Some(_) => 1 + self.symmetries.len(),
-        }
+    fn invariant_names(&self) -> Vec<String> {
+        let Some(surface) = &self.surface else {
+            return self.potential.invariant_names();
+        };
+        let momenta = self.symmetries.iter().map(|&k| surface::killing_momentum_name(&**surface, k));
+        std::iter::once("p_θ".to_string()).chain(momenta).collect()
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.velocities(z).map(|_| ())

@@ -187,12 +187,15 @@ impl Potential {
     }
 
     /// The number of [`Potential::invariants`].
-    pub(super) fn invariant_count(&self) -> usize {
-        1 + match &self.kind {
-            PotentialKind::PointMass { .. } => 1,
-            PotentialKind::Uniform { g } => usize::from(g[0].hypot(g[1]) > 0.0),
-            PotentialKind::Custom(_) => 0,
+    /// The labels of [`Potential::invariants`].
+    pub(super) fn invariant_names(&self) -> Vec<String> {
+        let mut names = vec!["p_θ".to_string()];
+        match &self.kind {
+            PotentialKind::PointMass { .. } => names.push("x p_y − y p_x".into()),
+            PotentialKind::Uniform { g } if g[0].hypot(g[1]) > 0.0 => names.push("p⊥g".into()),
+            PotentialKind::Uniform { .. } | PotentialKind::Custom(_) => {}
         }
+        names
     }
 }
 
@@ -294,8 +297,8 @@ impl Problem for WeakFieldTop {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         self.potential.invariants(z)
     }
-    fn invariant_count(&self) -> usize {
-        self.potential.invariant_count()
+    fn invariant_names(&self) -> Vec<String> {
+        self.potential.invariant_names()
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.velocities(z).map(|_| ())

@@ -304,7 +304,7 @@ impl Surface for HyperbolicPlane {
         3
     }
     fn killing_names(&self) -> &'static [&'static str] {
-        &["E (translation)", "H (dilation)", "F"]
+        &["translation E", "dilation H", "special conformal F"]
     }
     fn killing(&self, k: usize, x: Vec2) -> Vec3 {
         let (a, b) = (x[0], x[1]);

@@ -232,6 +232,23 @@ pub trait Surface: Send + Sync + fmt::Debug {
     }
 }
 
+/// The label of the k-th Killing momentum: "J(name)" with the generator's name
+/// ([`Surface::killing_names`]; "J(generator k)" for a generator without one).
+pub fn killing_momentum_name(surface: &dyn Surface, k: usize) -> String {
+    match surface.killing_names().get(k) {
+        Some(name) => format!("J({name})"),
+        None => format!("J(generator {k})"),
+    }
+}
+
+/// The labels of [`killing_momenta`] ([`killing_momentum_name`]).
+pub fn killing_momentum_names(surface: &dyn Surface, affine_only: bool) -> Vec<String> {
+    (0..surface.killing_count())
+        .filter(|&k| !affine_only || surface.killing_is_affine(k))
+        .map(|k| killing_momentum_name(surface, k))
+        .collect()
+}
+
 /// The momenta J_k = p_A X_k^A of a surface's Killing generators lifted to the frame bundle, at
 /// a state z = (x¹, x², θ, p₁, p₂, p_θ) of a body carried by a frame (the tangent tops), in the
 /// order of [`Surface::killing`]; with `affine_only`, those of the affine generators only (the

@@ -728,8 +728,8 @@ impl Problem for EulerPoincare {
     fn invariants(&self, z: &[f64]) -> Result<Vec<f64>> {
         self.system.invariants(z)
     }
-    fn invariant_count(&self) -> usize {
-        self.system.invariant_count()
+    fn invariant_names(&self) -> Vec<String> {
+        self.system.invariant_names()
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
         self.system.check_state(z)
