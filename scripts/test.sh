@@ -33,10 +33,20 @@ VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --release
 step "pytest"
 "$venv/bin/python" -m pytest -q python/tests
 
-step "docs (sphinx-build -W)"
-# docs/ -> docs/_build/html: MyST pages, the API reference from the built package, and the
-# gallery, which executes every script in examples/ (docs/conf.py).
-"$venv/bin/python" -m sphinx -W --keep-going -b html docs docs/_build/html
+step "wheel (maturin build --release) installed into a fresh venv with only the docs extra"
+# The path a lab takes (docs/guide/installation.md): one abi3 wheel, built once (it reuses the
+# extension just compiled), installed where there is no Rust; then the demo, and the docs built
+# by that venv: docs/ -> docs/_build/html, MyST pages, the API reference from the installed
+# wheel and the gallery, which executes every script in examples/ (docs/conf.py).
+rm -rf target/wheels
+"$venv/bin/maturin" build --release -q
+wheel=$(ls target/wheels/lieflow-*-abi3-*.whl)
+fresh=$(mktemp -d)
+python3 -m venv "$fresh/venv"
+"$fresh/venv/bin/python" -m pip install -q --disable-pip-version-check "$wheel[docs]"
+(cd "$fresh" && "$fresh/venv/bin/python" -c "import lieflow, sys; assert 'site-packages' in lieflow.__file__, lieflow.__file__" && "$fresh/venv/bin/lieflow" demo)
+"$fresh/venv/bin/python" -m sphinx -W --keep-going -b html docs docs/_build/html
+rm -rf "$fresh"
 
 step "typing (mypy.stubtest, mypy examples)"
 # The .pyi stubs against the built module (allow-list: only what stubtest cannot see, each entry
