@@ -31,6 +31,7 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx-mathjax-offline",  # MathJax served from _static: equations render offline too
     "sphinx_gallery.gen_gallery",
+    "citations",  # docs/_ext/citations.py: citations in docstrings link to sources.md
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
