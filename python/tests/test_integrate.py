@@ -570,6 +570,21 @@ def test_a_step_that_resolves_the_rotation_badly_warns_once_per_run():
         lf.integrate(lf.HeavyTop([1.0, 1.0, 0.5], 50.0), [0, 0, 0, 0, 0, 1.0], 0.2, 5)
 
 
+def test_warnings_point_at_the_user_s_line_whatever_lieflow_calls_in_between():
+    body = lf.RigidBody([1.0, 2.0, 3.0])
+    m0 = [1.0, 0.5, -0.3]
+    calls = [lambda: lf.integrate(body, m0, 100.0, 3),
+             # integrate calls itself on the tangent lift: two of lieflow's frames between
+             lambda: lf.integrate(body, m0, 100.0, 3, sensitivity=True),
+             lambda: lf.RigidBody([1.0, 1.0, 5.0]),
+             lambda: lf.lie.so3_exp(lf.lie.so3_hat([0.1, 0.2, 0.3])),
+             lambda: lf.integrate(body, np.eye(3), 0.01, 2)]
+    for call in calls:
+        with pytest.warns(lf.LieflowWarning) as rec:
+            call()
+        assert {w.filename for w in rec} == {__file__}, [(w.filename, w.message) for w in rec]
+
+
 def test_moments_no_body_has_are_accepted_with_a_warning():
     with pytest.warns(lf.LieflowWarning, match="I3 exceeds the sum of the other two"):
         body = lf.RigidBody([1.0, 1.0, 5.0])

@@ -65,7 +65,6 @@ where
                      silence this with warnings.filterwarnings(\"ignore\", \"{what} of \
                      shape\", lieflow.LieflowWarning)"
                 ),
-                1,
             )?;
         }
     }

@@ -171,12 +171,31 @@ pub fn checked<T>(f: impl FnOnce() -> lieflow::Result<T>) -> PyResult<T> {
     }
 }
 
-/// Issues a `lieflow.LieflowWarning` attributed to the Python frame `level` up (1: the caller
-/// of the native function; 2: the caller of the lieflow function that called it).
-pub fn warn(py: Python<'_>, message: &str, level: i32) -> PyResult<()> {
+/// Issues a `lieflow.LieflowWarning` attributed to the user's line: the innermost Python frame
+/// outside the lieflow package, however many of lieflow's own functions lie between (as
+/// `warnings.warn(skip_file_prefixes=...)` does from Python 3.12 on).
+pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
     let category = py.get_type::<LieflowWarning>();
     let message = std::ffi::CString::new(message.replace('\0', " "))?;
-    PyErr::warn(py, &category, &message, level)
+    PyErr::warn(py, &category, &message, user_level(py).unwrap_or(1))
+}
+
+/// The `warnings` stack level of the innermost frame whose module is not lieflow's (1: the frame
+/// that called the native function).
+fn user_level(py: Python<'_>) -> PyResult<i32> {
+    let mut frame = py.import("sys")?.getattr("_getframe")?.call1((0,))?;
+    let mut level = 1;
+    loop {
+        let module: String = (frame.getattr("f_globals")?.get_item("__name__"))
+            .and_then(|name| name.extract())
+            .unwrap_or_default();
+        let back = frame.getattr("f_back")?;
+        if !(module == "lieflow" || module.starts_with("lieflow.")) || back.is_none() {
+            return Ok(level);
+        }
+        frame = back;
+        level += 1;
+    }
 }
 
 /// Converts a core error into the matching Python exception (a Python exception carried by

@@ -183,7 +183,6 @@ fn warn_unresolved(
                     method.properties.order,
                     args::float_repr(three_digits_below(MAX_TURN_PER_STEP / rate))
                 ),
-                2,
             )
         })?;
     }

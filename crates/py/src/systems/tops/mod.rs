@@ -36,7 +36,6 @@ pub(crate) fn warn_unphysical(py: Python<'_>, moments: [f64; 3]) -> PyResult<()>
                  one); accepted as a generalised body",
                 k + 1
             ),
-            1,
         )?;
     }
     Ok(())

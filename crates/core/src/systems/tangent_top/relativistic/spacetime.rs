@@ -384,7 +384,10 @@ impl Problem for RelativisticTangentTop {
     fn invariant_names(&self) -> Vec<String> {
         let spin = self.is_symmetric().then(|| "p_θ".to_string());
         match &self.surface {
-            None => ["p_x".to_string(), "p_y".to_string()].into_iter().chain(spin).collect(),
+            None => ["p_x".to_string(), "p_y".to_string()]
+                .into_iter()
+                .chain(spin)
+                .collect(),
             Some(surface) => spin
                 .into_iter()
                 .chain(surface::killing_momentum_names(&**surface, true))

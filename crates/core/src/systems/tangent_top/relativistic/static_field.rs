@@ -217,7 +217,10 @@ impl Problem for StaticFieldTop {
         let Some(surface) = &self.surface else {
             return self.potential.invariant_names();
         };
-        let momenta = self.symmetries.iter().map(|&k| surface::killing_momentum_name(&**surface, k));
+        let momenta = self
+            .symmetries
+            .iter()
+            .map(|&k| surface::killing_momentum_name(&**surface, k));
         std::iter::once("p_θ".to_string()).chain(momenta).collect()
     }
     fn check_state(&self, z: &[f64]) -> Result<()> {
