@@ -60,13 +60,12 @@ def demo(figure=None, animation=None) -> None:
     from . import plot
 
     if figure is not None:
-        fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, layout="constrained")
         for i in range(3):
             top.plot(t, a[:, i], label=f"$a_{i + 1}$")
-        top.set(ylabel="semi-axes", title="Elastic pseudo-rigid body: semi-axes a_i(t)")
-        top.legend()
+        top.set(ylabel="semi-axes", title=r"Elastic pseudo-rigid body: semi-axes $a_i(t)$")
+        plot._legend_beside(top)
         plot.invariants(traj, ax=bottom)
-        fig.tight_layout()
         fig.savefig(figure, dpi=120)
         print(f"figure (semi-axes and invariant drifts) saved to {figure}")
     if animation is not None:
