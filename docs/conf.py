@@ -92,7 +92,8 @@ sphinx_gallery_conf = {
 # -- HTML ------------------------------------------------------------------------------------
 html_theme = "pydata_sphinx_theme"
 html_title = f"lieflow {release}"
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["lieflow.css"]  # code blocks and long signatures wrap
 html_theme_options = {
     "navbar_align": "left",
     "show_toc_level": 2,

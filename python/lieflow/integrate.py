@@ -254,7 +254,7 @@ def _native(run, name, argument):
 def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitude=None,
               progress=False, chunk_steps=None, threads=None, *, t0=None, t_span=None,
               t_eval=None, events=None, event_tol=0.0, sensitivity=False):
-    """Integrates ``system`` from ``state0`` by ``steps`` fixed steps of size ``dt``.
+    r"""Integrates ``system`` from ``state0`` by ``steps`` fixed steps of size ``dt``.
 
     Args:
         system: a system object, e.g. ``RigidBody([1, 2, 3])``.
@@ -279,8 +279,8 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
         threads: threads for a batch (default: all cores).
         t0: the time of ``state0`` (default 0); every time of the run is absolute.
         t_span: ``(t0, t1)`` instead of ``steps`` and ``t0`` (scipy's ``solve_ivp`` habit): the
-            run takes n = ceil((t1 - t0)/dt) equal steps of (t1 - t0)/n <= dt and ends exactly
-            at t1 (``traj.dt`` is that step).
+            run takes :math:`n = \lceil (t_1 - t_0)/dt \rceil` equal steps of
+            :math:`(t_1 - t_0)/n \le dt` and ends exactly at t1 (``traj.dt`` is that step).
         t_eval: save the states at exactly these times (1-D, strictly increasing, within
             [t0, t0 + steps * dt]) instead of every ``save_every``-th state: ``traj.t`` is
             ``t_eval``. The run still steps with ``dt`` on the grid t0 + k * dt; a time between
@@ -300,14 +300,16 @@ def integrate(system, state0, dt, steps=None, method=None, save_every=1, attitud
             of the method. A g exactly 0 at a step is an event there; a start at g = 0 is not.
             Single initial states only (a batch is an InvalidArgumentError).
         event_tol: an absolute tolerance in time (>= 0) added to round-off when locating events.
-        sensitivity: also compute the Jacobian ∂z_k/∂z_0 of the method's own discrete map at
-            every sample (``traj.jacobian``, (k, d, d)) and its derivative along the system's
+        sensitivity: also compute the Jacobian :math:`\partial z_k/\partial z_0` of the
+            method's own discrete map at every sample (``traj.jacobian``, (k, d, d)) and its
+            derivative along the system's
             parameters (``traj.parameter_jacobian``, (k, d, p), columns ``system.parameters``);
             exact to round-off, not finite differences: the run integrates the system's tangent
             lift with the same method (about d + p + 1 times the work of the plain run);
             ``traj.vjp(cotangent)`` gives the gradient of a loss. With an attitude, d counts its
-            three left-trivialised directions (δR = R ξ̂) in place of R's nine entries (rk4,
-            which leaves SO(3), reads the final ones through R's polar factor). Available
+            three left-trivialised directions (:math:`\delta R = R \hat\xi`) in place of R's
+            nine entries (rk4, which leaves SO(3), reads the final ones through R's polar
+            factor). Available
             where the system gives the derivatives its method needs
             (``system.sensitivity_methods(attitude=...)``); not yet with events.
 

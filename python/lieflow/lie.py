@@ -1,15 +1,16 @@
-"""Matrix Lie groups and algebras (bindings of ``lieflow::lie``).
+r"""Matrix Lie groups and algebras (bindings of ``lieflow::lie``).
 
 All functions take numpy float64 arrays (or array-likes) and return new arrays; see each
 function's docstring for the equation it implements.
 
 Group verbs: every group has the same verbs under one prefix, ``so3_*`` (SO(3), algebra
-vectors w with hat(w) @ x = w × x), ``se3_*`` (SE(3), 4×4 homogeneous matrices, algebra
-vectors (ω, v) with the rotation first) and ``so_*`` (SO(n) for any n ≥ 2, algebra as skew
+vectors w with :math:`\hat w x = w \times x`), ``se3_*`` (SE(3), 4×4 homogeneous matrices,
+algebra vectors :math:`(\omega, v)` with the rotation first) and ``so_*`` (SO(n) for any
+:math:`n \ge 2`, algebra as skew
 matrices, coordinates in the e_ij basis): ``exp``, ``log``, ``compose``, ``inverse``, ``act``,
 ``Ad``, ``ad``, ``ad_star``, ``hat``, ``vee``, ``jacobian_left``, ``jacobian_right`` (the
 Jacobians with ``inverse=True`` for their inverses). Every function is checked: invalid input
-raises a typed error (``lieflow.errors``), never returns NaN. SO(n) × SO(n) has ``product_Ad``
+raises a typed error (``lieflow.errors``), never returns NaN. :math:`SO(n) \times SO(n)` has ``product_Ad``
 and ``product_bracket``.
 
 Aliases (the names before the prefixes, kept working): ``hat`` and ``vee`` of ``so3_hat`` and
@@ -114,11 +115,11 @@ def _scipy_rotation(function):
 
 
 def to_scipy(R):
-    """The rotations ``R`` as a ``scipy.spatial.transform.Rotation``.
+    r"""The rotations ``R`` as a ``scipy.spatial.transform.Rotation``.
 
     Args:
-        R: (3, 3) or (..., 3, 3) rotation matrices (checked: ‖RᵀR − I‖_F and abs(det R − 1)
-            at most 1e-10).
+        R: (3, 3) or (..., 3, 3) rotation matrices (checked: :math:`\|R^\top R - I\|_F` and
+            :math:`|\det R - 1|` at most :math:`10^{-10}`).
     Returns:
         ``Rotation.from_quat(to_quaternion(R, scalar_first=False))``: a single rotation for a
         (3, 3) input, else one of shape R.shape[:-2] (leading axes beyond one need scipy ≥ 1.16).

@@ -22,7 +22,7 @@ DEFAULT_STEPS = 1000
 
 
 class PeriodicOrbit:
-    """A periodic orbit of a method's map (``lieflow.periodic_orbit``).
+    r"""A periodic orbit of a method's map (``lieflow.periodic_orbit``).
 
     Attributes:
         system: the system.
@@ -31,7 +31,7 @@ class PeriodicOrbit:
         period: the period T.
         steps: the method's steps per period; ``dt`` = T / steps.
         energy: the energy of ``state0``.
-        monodromy: M = ∂z(T)/∂z(0) of the method's map, (d, d).
+        monodromy: :math:`M = \partial z(T)/\partial z(0)` of the method's map, (d, d).
         multipliers: the eigenvalues of M (complex, by descending modulus).
         trivial: which multipliers are trivial (bool, (d,)): the flow's, the energy's, the
             invariants' (``system.invariants``) and a relative orbit's symmetry directions
@@ -45,15 +45,18 @@ class PeriodicOrbit:
         iterations: the Gauss–Newton iterations taken.
         levels: the levels the orbit keeps: the invariants (``system.invariants``), then for a
             relative orbit of the system's symmetry its momentum map.
-        tangent: the tangent of the orbit's family at these levels, (δz, δT, δζ) of unit
-            length ((d + 1 + dim g,), ζ only for a relative orbit of the system's symmetry),
+        tangent: the tangent of the orbit's family at these levels,
+            :math:`(\delta z, \delta T, \delta\zeta)` of unit length ((d + 1 + dim g,),
+            :math:`\zeta` only for a relative orbit of the system's symmetry),
             the direction in which the energy grows.
         attitude: the initial attitude R(0) of a relative orbit, else None.
-        drift: for a relative orbit of a body with an attitude, the rotation vector ω of
-            g = R(T) R(0)ᵀ (3,) (a rotation of space by abs(ω) ≤ π about ω; for the free rigid
-            body about the spatial momentum, by Montgomery's angle modulo 2π); for a relative
-            orbit of the system's symmetry, ζ with z(T) = exp(ζ)·z(0) (for ``PseudoRigidBody``
-            ξ ⊕ η in the e_ij coordinates of ``lie.vee_n``); else None.
+        drift: for a relative orbit of a body with an attitude, the rotation vector
+            :math:`\omega` of :math:`g = R(T) R(0)^\top` (3,) (a rotation of space by
+            :math:`|\omega| \le \pi` about :math:`\omega`; for the free rigid body about the
+            spatial momentum, by Montgomery's angle modulo :math:`2\pi`); for a relative orbit
+            of the system's symmetry, :math:`\zeta` with :math:`z(T) = \exp(\zeta) \cdot z(0)`
+            (for ``PseudoRigidBody`` :math:`\xi \oplus \eta` in the :math:`e_{ij}` coordinates
+            of ``lie.vee_n``); else None.
     """
 
     __slots__ = ("system", "method", "state0", "period", "steps", "energy", "monodromy",
@@ -90,9 +93,9 @@ class PeriodicOrbit:
 
     @property
     def drift_angle(self):
-        """abs(ω) of ``drift`` signed by its direction against the system's spatial momentum
-        where the system has one (``RigidBody``, ``HeavyTop``, …), else abs(ω); None for an
-        orbit that is not relative."""
+        r""":math:`|\omega|` of ``drift`` signed by its direction against the system's spatial
+        momentum where the system has one (``RigidBody``, ``HeavyTop``, …), else
+        :math:`|\omega|`; None for an orbit that is not relative."""
         if self.drift is None:
             return None
         w = self.drift
@@ -135,7 +138,7 @@ class PeriodicOrbit:
 
 def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy", relative=False,
                    attitude=None, drift=None, levels=None, tol=1e-10, max_iter=30):
-    """Finds a periodic orbit of ``method``'s map near ``state0`` with period near ``period``.
+    r"""Finds a periodic orbit of ``method``'s map near ``state0`` with period near ``period``.
 
     The orbit is a fixed point of the method's map over N = round(period / dt) steps of size
     T / N (the step follows the period): the run closes to round-off. A conservative system's
@@ -159,16 +162,19 @@ def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy"
         fix: "energy" (keep the guess's energy) or "period".
         relative: a relative periodic orbit, periodic up to a symmetry. For a system with a
             symmetry lieflow can act with (``PseudoRigidBody`` and its ``RelativeEquilibrium.
-            body``: (X, P) ↦ (gXhᵀ, gPhᵀ)) the shooting solves z(T) = exp(ζ)·z(0) for T and
-            ζ together (momentum map fixed, the slice across the orbit of its isotropy group);
-            ``drift`` is ζ, and the monodromy and multipliers are those of exp(−ζ)·z(T). For a
-            body that carries an attitude (``RigidBody``, ``HeavyTop``, …) the state returns
-            and the attitude does not: R(T) = g R(0), and ``drift`` is g's rotation vector.
+            body``: :math:`(X, P) \mapsto (g X h^\top, g P h^\top)`) the shooting solves
+            :math:`z(T) = \exp(\zeta) \cdot z(0)` for T and :math:`\zeta` together (momentum map
+            fixed, the slice across the orbit of its isotropy group); ``drift`` is
+            :math:`\zeta`, and the monodromy and multipliers are those of
+            :math:`\exp(-\zeta) \cdot z(T)`. For a body that carries an attitude
+            (``RigidBody``, ``HeavyTop``, …) the state returns and the attitude does not:
+            :math:`R(T) = g R(0)`, and ``drift`` is g's rotation vector.
             Implied by ``attitude``.
         attitude: R(0) (3, 3) of a relative orbit of a body with an attitude (default with
             ``relative=True``: the identity).
-        drift: a guess of ζ for a relative orbit of the system's symmetry (default 0; for an
-            orbit about a relative equilibrium with velocity ξ, about T·ξ).
+        drift: a guess of :math:`\zeta` for a relative orbit of the system's symmetry
+            (default 0; for an orbit about a relative equilibrium with velocity :math:`\xi`,
+            about :math:`T\xi`).
         levels: the levels to keep instead of the guess's (as ``PeriodicOrbit.levels``: the
             invariants, then the momentum map of a relative orbit).
         tol: the iteration's tolerance on the update (relative to the state's size and the
@@ -217,13 +223,16 @@ def periodic_orbit(system, state0, period, *, method=None, dt=None, fix="energy"
 
 def from_mode(equilibrium, mode, amplitude, *, method=None, dt=None, fix="energy", tol=1e-10,
               max_iter=30):
-    """The Lyapunov orbit of a normal mode of a relative equilibrium at a small amplitude: the
+    r"""The Lyapunov orbit of a normal mode of a relative equilibrium at a small amplitude: the
     start of its Lyapunov family (``lieflow.continuation.periodic_family``).
 
-    The linear motion about the equilibrium in the co-moving frame is Re(v exp(iωt)); the
-    orbit is shot as a relative periodic orbit of ``equilibrium.body`` from
-    z(0) = z_eq + amplitude·Re(v), T = 2π/ω and the drift T·(ξ ⊕ η) of the equilibrium's
-    velocities, at the energy of z(0) (``fix="energy"``): its period tends to 2π/ω as the
+    The linear motion about the equilibrium in the co-moving frame is
+    :math:`\operatorname{Re}(v e^{i\omega t})`; the orbit is shot as a relative periodic orbit
+    of ``equilibrium.body`` from
+    :math:`z(0) = z_\mathrm{eq} + \mathrm{amplitude} \cdot \operatorname{Re}(v)`,
+    :math:`T = 2\pi/\omega` and the drift :math:`T (\xi \oplus \eta)` of the equilibrium's
+    velocities, at the energy of z(0) (``fix="energy"``): its period tends to
+    :math:`2\pi/\omega` as the
     amplitude shrinks (Lyapunov's centre theorem, for a mode not resonant with the others).
 
     Args:
@@ -235,7 +244,7 @@ def from_mode(equilibrium, mode, amplitude, *, method=None, dt=None, fix="energy
         method, dt, fix, tol, max_iter: as in ``periodic_orbit`` (default method: the body's).
 
     Returns:
-        A ``PeriodicOrbit`` (relative: ``drift`` is ζ).
+        A ``PeriodicOrbit`` (relative: ``drift`` is :math:`\zeta`).
     """
     modes = equilibrium.normal_modes()
     if isinstance(mode, (int, np.integer)) and not isinstance(mode, bool):

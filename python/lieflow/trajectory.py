@@ -11,7 +11,7 @@ __all__ = ["Trajectory", "load"]
 
 
 class Trajectory:
-    """A computed trajectory.
+    r"""A computed trajectory.
 
     Attributes:
         system, method, dt: as passed to ``integrate``.
@@ -31,9 +31,11 @@ class Trajectory:
             (n_i,) and the states (n_i, d) of its zeros (``attitude_events`` (n_i, n, n) with an
             attitude); None without events.
         jacobian: with ``sensitivity=True``, (k, d, d) (or (b, k, d, d)) the Jacobians
-            ∂z_k/∂z_0 of the method's own discrete map at the samples (``final_jacobian`` at
+            :math:`\partial z_k/\partial z_0` of the method's own discrete map at the samples
+            (``final_jacobian`` at
             the final state); None otherwise.
-        parameter_jacobian: with ``sensitivity=True``, (k, d, p) the derivatives ∂z_k/∂θ along
+        parameter_jacobian: with ``sensitivity=True``, (k, d, p) the derivatives
+            :math:`\partial z_k/\partial\theta` along
             ``system.parameters`` (``final_parameter_jacobian`` at the final state).
         Named views from the system (e.g. ``M``, ``Gamma``, ``q``, ``L``) as attributes.
 
@@ -73,9 +75,10 @@ class Trajectory:
         self._field_cache = None
 
     def vjp(self, cotangent):
-        """The gradient of a loss L of this trajectory with respect to the initial state and the
-        system's parameters, from the cotangent ∂L/∂z: (grad_state0 (d,), grad_parameters (p,))
-        with grad = Σ_k J_kᵀ c_k over the samples (a run with ``sensitivity=True``).
+        r"""The gradient of a loss L of this trajectory with respect to the initial state and the
+        system's parameters, from the cotangent :math:`\partial L/\partial z`: (grad_state0 (d,),
+        grad_parameters (p,)) with :math:`\mathrm{grad} = \sum_k J_k^\top c_k` over the samples
+        (a run with ``sensitivity=True``).
 
         Args:
             cotangent: (e,) on the final state, or (k, e) on every sample, e the Jacobian's size
@@ -121,15 +124,15 @@ class Trajectory:
 
     @classmethod
     def concatenate(cls, trajectories):
-        """One trajectory from a run and its continuations: each must start where the one
+        r"""One trajectory from a run and its continuations: each must start where the one
         before ended (its ``t0`` equal to the previous ``t_final`` and its initial state equal
         to the previous ``final_state``, as ``integrate(system, traj.final_state, ...,
         t0=traj.t_final)`` gives) on the same system. A sample repeated at the seam (the first
         of a continuation is the last of the one before when that was its final state) is kept
         once; events are joined per event function (None unless every part has the same number
         of event functions); the Jacobians of runs with ``sensitivity=True`` are joined by the
-        chain rule (each continuation's are along its own start), so they stay ∂z/∂z₀ and
-        ∂z/∂θ of the whole run. ``method``, ``dt`` and ``save_every`` are the parts' common values
+        chain rule (each continuation's are along its own start), so they stay
+        :math:`\partial z/\partial z_0` and :math:`\partial z/\partial\theta` of the whole run. ``method``, ``dt`` and ``save_every`` are the parts' common values
         (a tuple of the methods, None for dt and save_every, where they differ).
 
         Raises:

@@ -96,3 +96,24 @@ def test_brief_reprs_are_cut_at_a_separator_and_marked():
     # Cut after a separator: the last number shown is whole.
     assert b[:-1].rstrip().endswith(",")
     assert brief("x" * 100, 20) == repr("x" * 100)[:19] + "…"  # no separator: cut, marked
+
+
+def test_docstrings_write_formulas_as_math():
+    """Formulas in the public docstrings are reST math (``:math:`R^\\top e_3```, ``.. math::``),
+    rendered on the API pages, not plain-text or Unicode pseudo-math (``R^T e3``,
+    ``ad*_{dH/dmu}``, ``I^{-1} M``, ``Rᵀe₃``, ``‖M‖``) outside of them."""
+    import re
+    plain = re.compile(r"\^T\b|\^-?1\b|\^\{-1\}|\b[Aa]d\*_|[ᵀ‖⁻¹₀₁₂₃₄₅₆₇₈₉]")
+    literal = re.compile(r":math:`[^`]*`|``.*?``|`[^`]*`", re.S)
+    wrong = []
+    for name, doc in _public_docstrings():
+        lines, prose, block = doc.splitlines(), [], None
+        for line in lines:  # drop the bodies of ``.. math::`` directives and literal blocks
+            indent = len(line) - len(line.lstrip())
+            if block is not None and (not line.strip() or indent > block):
+                continue
+            block = indent if line.rstrip().endswith("::") else None
+            prose.append(line)
+        for hit in plain.finditer(literal.sub("", "\n".join(prose))):
+            wrong.append(f"{name}: {hit.group(0)!r}")
+    assert not wrong, wrong

@@ -83,7 +83,7 @@ fn run(
 }
 
 /// Follows the family of `start` (a relative equilibrium from `lieflow.ellipsoids`; the family
-/// keeps its f = zeta/Omega and its volume) in the named `parameter` ("e", "a2_over_a1",
+/// keeps its :math:`f = \zeta/\Omega` and its volume) in the named `parameter` ("e", "a2_over_a1",
 /// "a3_over_a1", "Omega2_over_piGrho", "L", "f") until it reaches `stop`, by pseudo-arclength
 /// continuation of the reduced equations (semi-axes, velocities, pressure: no symmetry
 /// degeneracy). Branch points and folds of the parameter and, with `stability=True`, changes of

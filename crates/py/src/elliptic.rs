@@ -14,11 +14,13 @@ fn scalar<'a, 'py>(what: &'a str, a: &'a ArrayIn<'py>) -> Input<'a, 'py> {
     Input::new(what, a, &[])
 }
 
-/// Jacobi elliptic functions (sn, cn, dn)(u | m) by the descending Landen transformation
-/// (Abramowitz & Stegun 16.4), as `scipy.special.ellipj` (which also returns the amplitude).
+/// Jacobi elliptic functions
+/// :math:`(\operatorname{sn}, \operatorname{cn}, \operatorname{dn})(u \mid m)` by the descending
+/// Landen transformation (Abramowitz & Stegun 16.4), as `scipy.special.ellipj` (which also returns
+/// the amplitude).
 ///
 /// Args:
-///     u: argument; m: parameter m = k^2, 0 <= m < 1. Broadcast together.
+///     u: argument; m: parameter :math:`m = k^2`, :math:`0 \le m < 1`. Broadcast together.
 /// Returns:
 ///     (sn, cn, dn), floats or arrays of the broadcast shape.
 /// Raises:

@@ -13,16 +13,18 @@ use crate::errors::IntoPy;
 
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
 
-/// SVD coordinates of X in GL+(n) (001 (2.4)): X = R @ diag(a) @ S.T with R, S in SO(n) and
-/// a[0] >= ... >= a[n-1] > 0 (sign fix: the last columns of U and V are flipped together when
-/// det U < 0).
+/// SVD coordinates of :math:`X \in GL^+(n)` (001 (2.4)):
+/// :math:`X = R \operatorname{diag}(a) S^\top` with :math:`R, S \in SO(n)` and
+/// :math:`a_0 \ge \dots \ge a_{n-1} > 0` (sign fix: the last columns of U and V are flipped
+/// together when :math:`\det U < 0`).
 ///
 /// Args:
-///     X: (n, n) array with det X > 0.
+///     X: (n, n) array with :math:`\det X > 0`.
 /// Returns:
 ///     (R, a, S): (n, n), (n,), (n, n) arrays.
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0, the determinant is in the message).
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`, the determinant is in
+///     the message).
 #[pyfunction]
 pub fn svd_coordinates<'py>(
     py: Python<'py>,
@@ -32,13 +34,14 @@ pub fn svd_coordinates<'py>(
     Ok((py_mat(py, &c.r), py_vec(py, &c.a), py_mat(py, &c.s)))
 }
 
-/// X = R @ diag(a) @ S.T from SVD coordinates (001 (2.6)), the inverse of `svd_coordinates`.
+/// :math:`X = R \operatorname{diag}(a) S^\top` from SVD coordinates (001 (2.6)), the inverse of
+/// `svd_coordinates`.
 ///
 /// Args:
 ///     R, S: (n, n) rotations; a: (n,) positive singular values (any order).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (R or S not in SO(n)),
-///     InvalidArgumentError (some a_i <= 0).
+///     InvalidArgumentError (some :math:`a_i \le 0`).
 #[pyfunction]
 pub fn from_svd<'py>(
     py: Python<'py>,
@@ -50,24 +53,25 @@ pub fn from_svd<'py>(
     Ok(py_mat(py, &x))
 }
 
-/// Polar decomposition X = R @ P of X in GL+(n): R in SO(n) (the nearest rotation) and
-/// P = (X.T @ X)^(1/2) symmetric positive definite.
+/// Polar decomposition :math:`X = R P` of :math:`X \in GL^+(n)`: :math:`R \in SO(n)` (the nearest
+/// rotation) and :math:`P = (X^\top X)^{1/2}` symmetric positive definite.
 ///
 /// Returns:
 ///     (R, P): two (n, n) arrays.
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`).
 #[pyfunction]
 pub fn polar<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<(Arr2<'py>, Arr2<'py>)> {
     let (r, p) = gl::polar(&mat("X", &X)?).py()?;
     Ok((py_mat(py, &r), py_mat(py, &p)))
 }
 
-/// Stratum of X in GL+(n) under the two-sided SO(n) x SO(n) action (001 §6.1, (9.2)): which
-/// singular values coincide, a_i - a_(i+1) <= tol * a_1.
+/// Stratum of :math:`X \in GL^+(n)` under the two-sided :math:`SO(n) \times SO(n)` action
+/// (001 §6.1, (9.2)): which singular values coincide,
+/// :math:`a_i - a_{i+1} \le \mathrm{tol} \cdot a_1`.
 ///
 /// Args:
-///     X: (n, n) array with det X > 0.
+///     X: (n, n) array with :math:`\det X > 0`.
 ///     tol: relative tolerance (default 1e-8, the one used by every principal-stratum check).
 /// Returns:
 ///     dict with "singular_values" (n,), "multiplicities" (list of block sizes from the

@@ -24,15 +24,16 @@ fn store(m: &Matrix3<f64>, out: &mut [f64]) {
 }
 
 /// `to_quaternion(R, scalar_first=True)`: the unit quaternion of a rotation (Shepperd's method),
-/// canonical sign: w ≥ 0 (where w = 0, the first non-zero of x, y, z is positive), i.e. scipy's
-/// `Rotation.from_matrix(R).as_quat(canonical=True)`. Hamilton convention, R v = q v q̄.
+/// canonical sign: :math:`w \ge 0` (where :math:`w = 0`, the first non-zero of x, y, z is
+/// positive), i.e. scipy's `Rotation.from_matrix(R).as_quat(canonical=True)`. Hamilton
+/// convention, :math:`R v = q v \bar q`.
 ///
 /// Args: R — (..., 3, 3) rotations (any leading axes); scalar_first — (w, x, y, z) if True
 /// (default), scipy's default order (x, y, z, w) if False.
 /// A matrix within that tolerance but not orthogonal to round-off is read as the nearest
 /// rotation (as scipy's `from_matrix`), as by every function taking rotations.
-/// Returns: (..., 4). Raises ShapeError, NonFiniteError, NotInGroupError (‖RᵀR − I‖_F or
-/// abs(det R − 1) > 1e-10).
+/// Returns: (..., 4). Raises ShapeError, NonFiniteError, NotInGroupError
+/// (:math:`\|R^\top R - I\|_F` or :math:`|\det R - 1| > 10^{-10}`).
 #[pyfunction]
 #[pyo3(signature = (R, scalar_first = true))]
 fn to_quaternion<'py>(
@@ -53,7 +54,7 @@ fn to_quaternion<'py>(
 
 /// `from_quaternion(q, scalar_first=True)`: the rotation matrix of a quaternion, normalised
 /// first (scale-safely: any non-zero finite size), as scipy's `Rotation.from_quat(q).as_matrix()`;
-/// q and −q give the same rotation.
+/// :math:`q` and :math:`-q` give the same rotation.
 ///
 /// Args: q — (..., 4) (any leading axes); scalar_first — q = (w, x, y, z) if True (default),
 /// (x, y, z, w) (scipy's default order) if False.
@@ -80,17 +81,19 @@ fn from_quaternion<'py>(
 
 /// `to_euler(R, seq)`: the Euler angles (radians) of rotations in scipy's sequence convention:
 /// those of scipy's `Rotation.from_matrix(R).as_euler(seq)` (the same method, Bernardes &
-/// Viollet 2022), equal except that an angle of exactly ±π may come out with the other sign
-/// (the same rotation): lieflow starts from the canonical quaternion (w ≥ 0), scipy from the
+/// Viollet 2022), equal except that an angle of exactly :math:`\pm\pi` may come out with the other
+/// sign (the same rotation): lieflow starts from the canonical quaternion (:math:`w \ge 0`), scipy
+/// from the
 /// sign its `from_matrix` returns.
 ///
 /// seq: 3 letters from x, y, z; upper case = intrinsic (about the rotating axes: "XYZ" is
-/// R = Rx(a) Ry(b) Rz(c)), lower case = extrinsic (about the fixed axes: "xyz" is
-/// R = Rz(c) Ry(b) Rx(a)); no two consecutive letters equal: the 6 proper-Euler ("ZXZ", …) and 6
-/// Tait–Bryan ("XYZ", …) sequences. Angles are in the order of the letters.
+/// :math:`R = R_x(a) R_y(b) R_z(c)`), lower case = extrinsic (about the fixed axes: "xyz" is
+/// :math:`R = R_z(c) R_y(b) R_x(a)`); no two consecutive letters equal: the 6 proper-Euler ("ZXZ",
+/// …) and 6 Tait–Bryan ("XYZ", …) sequences. Angles are in the order of the letters.
 ///
-/// Ranges (scipy's): first and third angle in [−π, π]; the middle one in [0, π] (proper Euler)
-/// or [−π/2, π/2] (Tait–Bryan). Gimbal lock (middle angle within 1e-7 of 0 or π, resp. ±π/2):
+/// Ranges (scipy's): first and third angle in :math:`[-\pi, \pi]`; the middle one in
+/// :math:`[0, \pi]` (proper Euler) or :math:`[-\pi/2, \pi/2]` (Tait–Bryan). Gimbal lock (middle
+/// angle within 1e-7 of 0 or :math:`\pi`, resp. :math:`\pm\pi/2`):
 /// as scipy, the third angle is set to 0 and the first carries the rotation about the common
 /// axis; unlike scipy, no warning is issued (never NaN). Inside that 1e-7 band
 /// from_euler(to_euler(R)) reproduces R to ~1e-7 only, as scipy's.
@@ -108,7 +111,8 @@ fn to_euler<'py>(py: Python<'py>, R: ArrayIn<'py>, seq: &str) -> PyResult<Bound<
 
 /// `from_euler(angles, seq)`: the rotation matrices of Euler angles (radians, in the order of
 /// the letters of seq; any values), as scipy's `Rotation.from_euler(seq, angles).as_matrix()`.
-/// seq as in `to_euler`: "XYZ" is Rx(a) Ry(b) Rz(c), "xyz" is Rz(c) Ry(b) Rx(a).
+/// seq as in `to_euler`: "XYZ" is :math:`R_x(a) R_y(b) R_z(c)`, "xyz" is
+/// :math:`R_z(c) R_y(b) R_x(a)`.
 ///
 /// Args: angles — (..., 3) (any leading axes); seq — the sequence. Returns: (..., 3, 3).
 /// Raises ShapeError, NonFiniteError, InvalidArgumentError (bad seq; an angle beyond

@@ -9,7 +9,8 @@ use pyo3::prelude::*;
 use crate::batch::{map_batch, map_pairs, Out};
 use crate::convert::ArrayIn;
 
-/// `se3_hat(xi)`: the 4×4 matrix [[ω̂, v], [0, 0]] of ξ = (ω, v) (so3_hat for ω̂).
+/// `se3_hat(xi)`: the 4×4 matrix :math:`\begin{pmatrix} \hat\omega & v \\ 0 & 0 \end{pmatrix}` of
+/// :math:`\xi = (\omega, v)` (so3_hat for :math:`\hat\omega`).
 ///
 /// Args: xi — (6,) or (..., 6). Returns (4, 4) or (..., 4, 4). Raises ShapeError, NonFiniteError.
 #[pyfunction]
@@ -17,7 +18,8 @@ fn se3_hat<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::hat(x)))
 }
 
-/// `se3_vee(X)`: the inverse of `se3_hat`, ξ = (ω, v) of X = [[ω̂, v], [0, 0]].
+/// `se3_vee(X)`: the inverse of `se3_hat`, :math:`\xi = (\omega, v)` of
+/// :math:`X = \begin{pmatrix} \hat\omega & v \\ 0 & 0 \end{pmatrix}`.
 ///
 /// Args: X — (4, 4) or (..., 4, 4). Returns (6,) or (..., 6). Raises ShapeError, NonFiniteError,
 /// NotInGroupError (last row not zero to 1e-12, or the rotation block not skew to 1e-10).
@@ -27,20 +29,25 @@ fn se3_vee<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "X", &X, se3::vee)
 }
 
-/// `se3_exp(xi)`: exp of ξ = (ω, v) (rotation first) as the 4×4 matrix [[exp(ω̂), V(ω) v], [0, 1]],
-/// V(ω) = I + ((1 − cos θ)/θ²) ω̂ + ((θ − sin θ)/θ³) ω̂² (the left Jacobian of SO(3)), θ = ‖ω‖;
-/// equal to scipy.linalg.expm([[ω̂, v], [0, 0]]).
+/// `se3_exp(xi)`: exp of :math:`\xi = (\omega, v)` (rotation first) as the 4×4 matrix
+/// :math:`\begin{pmatrix} \exp\hat\omega & V(\omega) v \\ 0 & 1 \end{pmatrix}`,
+/// :math:`V(\omega) = I + \frac{1 - \cos\theta}{\theta^2} \hat\omega + \frac{\theta - \sin\theta}{\theta^3} \hat\omega^2`
+/// (the left Jacobian of SO(3)), :math:`\theta = \|\omega\|`; equal to
+/// `scipy.linalg.expm(se3_hat(xi))`.
 ///
 /// Args: xi — (6,) or (..., 6). Returns (4, 4) or (..., 4, 4). Raises ShapeError, NonFiniteError,
-/// InvalidArgumentError (‖ω‖ > 2.25e14, the rule of so3_exp; a translation beyond the f64 range).
+/// InvalidArgumentError (:math:`\|\omega\| > 2.25 \cdot 10^{14}`, the rule of so3_exp; a
+/// translation beyond the f64 range).
 #[pyfunction]
 fn se3_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Out<'py>> {
     map_batch(py, "xi", &xi, |x: &Vector6<f64>| Ok(se3::exp(x)?.matrix4()))
 }
 
-/// `se3_log(g, strict=False)`: the logarithm ξ = (ω, v) of g = [[R, t], [0, 1]]: ω = so3_log(R)
-/// (‖ω‖ ≤ π) and v = V(ω)⁻¹ t. At a rotation angle of π exactly, `strict=False` returns one of the
-/// two logarithms and `strict=True` raises NoUniqueLogError (when π − θ ≤ 1e-12).
+/// `se3_log(g, strict=False)`: the logarithm :math:`\xi = (\omega, v)` of
+/// :math:`g = \begin{pmatrix} R & t \\ 0 & 1 \end{pmatrix}`: ω = `so3_log(R)`
+/// (:math:`\|\omega\| \le \pi`) and :math:`v = V(\omega)^{-1} t`. At a rotation angle of
+/// :math:`\pi` exactly, `strict=False` returns one of the two logarithms and `strict=True` raises
+/// NoUniqueLogError (when :math:`\pi - \theta \le 10^{-12}`).
 ///
 /// Args: g — (4, 4) or (..., 4, 4). Returns (6,) or (..., 6).
 /// Raises ShapeError, NonFiniteError, NotInGroupError (last row not (0, 0, 0, 1) to 1e-12, or R
@@ -58,9 +65,11 @@ fn se3_log<'py>(py: Python<'py>, g: ArrayIn<'py>, strict: bool) -> PyResult<Out<
     })
 }
 
-/// `se3_Ad(g, xi=None)`: the adjoint action Ad_g (ω, v) = (R ω, t × R ω + R v) on (ω, v)
-/// coordinates, so that exp(Ad_g ξ) = g exp(ξ) g⁻¹; without `xi`, its 6×6 matrix
-/// Ad_g = [[R, 0], [t̂ R, R]].
+/// `se3_Ad(g, xi=None)`: the adjoint action
+/// :math:`\operatorname{Ad}_g (\omega, v) = (R\omega, t \times R\omega + R v)` on
+/// :math:`(\omega, v)` coordinates, so that
+/// :math:`\exp(\operatorname{Ad}_g \xi) = g \exp(\xi) g^{-1}`; without `xi`, its 6×6 matrix
+/// :math:`\operatorname{Ad}_g = \begin{pmatrix} R & 0 \\ \hat t R & R \end{pmatrix}`.
 ///
 /// Args: g — (4, 4) or (..., 4, 4); xi — (6,) or (..., 6) (leading axes
 /// broadcast). Returns (6,) or (..., 6); without xi (6, 6) or (..., 6, 6).
@@ -86,8 +95,9 @@ fn se3_adjoint<'py>(
     }
 }
 
-/// `se3_ad(xi, eta)`: the bracket ad_(ω₁, v₁) (ω₂, v₂) = (ω₁ × ω₂, ω₁ × v₂ − ω₂ × v₁) (the
-/// commutator of the 4×4 matrices).
+/// `se3_ad(xi, eta)`: the bracket
+/// :math:`\operatorname{ad}_{(\omega_1, v_1)} (\omega_2, v_2) = (\omega_1 \times \omega_2, \omega_1 \times v_2 - \omega_2 \times v_1)`
+/// (the commutator of the 4×4 matrices).
 ///
 /// Args: xi, eta — (6,) or (..., 6) (leading axes broadcast). Returns (6,) or (..., 6).
 /// Raises ShapeError, NonFiniteError.
@@ -102,8 +112,9 @@ fn se3_ad<'py>(py: Python<'py>, xi: ArrayIn<'py>, eta: ArrayIn<'py>) -> PyResult
     )
 }
 
-/// `se3_ad_star(xi, mu)`: the coadjoint action ad*_(ω, v) (μ, p) = (μ × ω + p × v, p × ω), the
-/// transpose of ad_ξ under the dot-product pairing.
+/// `se3_ad_star(xi, mu)`: the coadjoint action
+/// :math:`\operatorname{ad}^*_{(\omega, v)} (\mu, p) = (\mu \times \omega + p \times v, p \times \omega)`,
+/// the transpose of :math:`\operatorname{ad}_\xi` under the dot-product pairing.
 ///
 /// Args: xi, mu — (6,) or (..., 6) (leading axes broadcast). Returns (6,) or (..., 6).
 /// Raises ShapeError, NonFiniteError.
@@ -118,7 +129,7 @@ fn se3_ad_star<'py>(py: Python<'py>, xi: ArrayIn<'py>, mu: ArrayIn<'py>) -> PyRe
     )
 }
 
-/// `se3_act(g, x)`: the rigid motion of a point, g · x = R x + t.
+/// `se3_act(g, x)`: the rigid motion of a point, :math:`g \cdot x = R x + t`.
 ///
 /// Args: g — (4, 4) or (..., 4, 4); x — (3,) or (..., 3) (leading axes broadcast). Returns
 /// (3,) or (..., 3). Raises ShapeError, NonFiniteError, NotInGroupError.
@@ -133,13 +144,15 @@ fn se3_act<'py>(py: Python<'py>, g: ArrayIn<'py>, x: ArrayIn<'py>) -> PyResult<O
     )
 }
 
-/// `se3_jacobian_left(xi, inverse=False)`: the 6×6 left Jacobian of exp on (ω, v) coordinates,
-/// [[J_l(ω), 0], [Q(ω, v), J_l(ω)]] (Barfoot's Q block), so that
-/// exp(ξ + δ) ≈ exp(J_l(ξ) δ) exp(ξ); with `inverse=True` its inverse.
+/// `se3_jacobian_left(xi, inverse=False)`: the 6×6 left Jacobian of exp on :math:`(\omega, v)`
+/// coordinates, :math:`\begin{pmatrix} J_l(\omega) & 0 \\ Q(\omega, v) & J_l(\omega) \end{pmatrix}`
+/// (Barfoot's Q block), so that :math:`\exp(\xi + \delta) \approx \exp(J_l(\xi) \delta) \exp(\xi)`;
+/// with `inverse=True` its inverse.
 ///
 /// Args: xi — (6,) or (..., 6). Returns (6, 6) or (..., 6, 6).
-/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at ‖ω‖ = 2πk, k ≥ 1;
-/// ‖ω‖ > 2.25e14, the rule of so3_exp; a Jacobian beyond the f64 range).
+/// Raises ShapeError, NonFiniteError, InvalidArgumentError (inverse at
+/// :math:`\|\omega\| = 2\pi k`, :math:`k \ge 1`; :math:`\|\omega\| > 2.25 \cdot 10^{14}`, the rule
+/// of so3_exp; a Jacobian beyond the f64 range).
 #[pyfunction]
 #[pyo3(signature = (xi, inverse = false))]
 fn se3_jacobian_left<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> PyResult<Out<'py>> {
@@ -151,8 +164,9 @@ fn se3_jacobian_left<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> P
     map_batch(py, "xi", &xi, f)
 }
 
-/// `se3_jacobian_right(xi, inverse=False)`: the 6×6 right Jacobian J_r(ξ) = J_l(−ξ), so that
-/// exp(ξ + δ) ≈ exp(ξ) exp(J_r(ξ) δ); with `inverse=True` its inverse.
+/// `se3_jacobian_right(xi, inverse=False)`: the 6×6 right Jacobian :math:`J_r(\xi) = J_l(-\xi)`,
+/// so that :math:`\exp(\xi + \delta) \approx \exp(\xi) \exp(J_r(\xi) \delta)`; with `inverse=True`
+/// its inverse.
 ///
 /// Args: xi — (6,) or (..., 6). Returns (6, 6) or (..., 6, 6). Raises as se3_jacobian_left.
 #[pyfunction]
@@ -166,7 +180,7 @@ fn se3_jacobian_right<'py>(py: Python<'py>, xi: ArrayIn<'py>, inverse: bool) -> 
     map_batch(py, "xi", &xi, f)
 }
 
-/// `se3_inverse(g)`: (R, t)⁻¹ = (Rᵀ, −Rᵀ t) as a 4×4 matrix.
+/// `se3_inverse(g)`: :math:`(R, t)^{-1} = (R^\top, -R^\top t)` as a 4×4 matrix.
 ///
 /// Args: g — (4, 4) or (..., 4, 4). Returns the same shape.
 /// Raises ShapeError, NonFiniteError, NotInGroupError.
@@ -177,7 +191,7 @@ fn se3_inverse<'py>(py: Python<'py>, g: ArrayIn<'py>) -> PyResult<Out<'py>> {
     })
 }
 
-/// `se3_compose(g, h)`: the product g·h = (R_g R_h, R_g t_h + t_g) as a 4×4 matrix.
+/// `se3_compose(g, h)`: the product :math:`g h = (R_g R_h, R_g t_h + t_g)` as a 4×4 matrix.
 ///
 /// Args: g, h — (4, 4) or (..., 4, 4); leading axes broadcast as numpy's. Returns (4, 4) or
 /// (..., 4, 4). Raises ShapeError (incl. leading axes that do not broadcast), NonFiniteError,

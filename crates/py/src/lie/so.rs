@@ -25,11 +25,12 @@ fn map_mats<'py>(
     })
 }
 
-/// `so_hat(c)` (alias `hat_n`): the skew-symmetric matrix with coordinates `c` in the e_ij basis (i < j, +1 at (i, j), −1 at
-/// (j, i)), ordered (1,2), (1,3), …, (1,n), (2,3), …, (n−1,n).
+/// `so_hat(c)` (alias `hat_n`): the skew-symmetric matrix with coordinates `c` in the
+/// :math:`e_{ij}` basis (:math:`i < j`, +1 at (i, j), −1 at (j, i)), ordered (1,2), (1,3), …,
+/// (1,n), (2,3), …, (n−1,n).
 ///
 /// Args:
-///     c: shape (d,) with d = n(n−1)/2 for some n ≥ 2, or (..., d).
+///     c: shape (d,) with :math:`d = n(n-1)/2` for some :math:`n \ge 2`, or (..., d).
 /// Returns:
 ///     xi: shape (n, n), or (..., n, n).
 /// Raises:
@@ -53,11 +54,12 @@ fn so_hat<'py>(py: Python<'py>, c: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
     })
 }
 
-/// `so_vee(xi)` (alias `vee_n`): the coordinates of a skew-symmetric matrix in the e_ij basis
-/// (the inverse of `so_hat`).
+/// `so_vee(xi)` (alias `vee_n`): the coordinates of a skew-symmetric matrix in the :math:`e_{ij}`
+/// basis (the inverse of `so_hat`).
 ///
 /// Args:
-///     xi: shape (n, n), skew-symmetric (relative defect ‖ξ + ξᵀ‖ ≤ 1e-10), or (..., n, n).
+///     xi: shape (n, n), skew-symmetric (relative defect :math:`\|\xi + \xi^\top\| \le 10^{-10}`),
+///         or (..., n, n).
 /// Returns:
 ///     c: shape (n(n−1)/2,), or (..., n(n−1)/2).
 /// Raises:
@@ -76,12 +78,12 @@ fn so_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>>
     )
 }
 
-/// Exponential map so(n) → SO(n).
+/// Exponential map :math:`\mathfrak{so}(n) \to SO(n)`.
 ///
 /// Closed form for n = 2, Rodrigues for n = 3, and for n > 3 scaling and squaring with diagonal
-/// Padé approximants (Al-Mohy & Higham 2009, as scipy's expm) followed by one Newton–Schulz
-/// step, orthogonal to round-off even for ‖ξ‖ ~ 1e3; the kernel allocates its storage once per
-/// thread and size, so repeated calls cost the same.
+/// Padé approximants (Al-Mohy & Higham 2009, as scipy's expm) followed by one Newton–Schulz step,
+/// orthogonal to round-off even for :math:`\|\xi\| \sim 10^3`; the kernel allocates its storage
+/// once per thread and size, so repeated calls cost the same.
 ///
 /// Args:
 ///     xi: skew matrix (n, n), or (..., n, n) (many computed in parallel without the GIL).
@@ -89,23 +91,28 @@ fn so_vee<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>>
 ///     R: shape (n, n) or (..., n, n), in SO(n).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (xi not skew),
-///     InvalidArgumentError (‖ξ‖ > 2.25e14 = 0.05/ε_mach, where more than 0.05 rad of
+///     InvalidArgumentError (:math:`\|\xi\| > 2.25 \cdot 10^{14} = 0.05/\varepsilon_\mathrm{mach}`,
+///     where more than 0.05 rad of
 ///     the angles is lost to rounding: the rule of every exponential in lieflow.lie).
 #[pyfunction]
 fn so_exp<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> {
     map_mats(py, "xi", &xi, so::exp)
 }
 
-/// Principal logarithm SO(n) → so(n) (all rotation angles in [0, π)).
+/// Principal logarithm :math:`SO(n) \to \mathfrak{so}(n)` (all rotation angles in
+/// :math:`[0, \pi)`).
 ///
 /// Args:
-///     R: rotation (n, n) (‖RᵀR − I‖_F ≤ 1e-10, det R > 0), or (..., n, n) (many
+///     R: rotation (n, n) (:math:`\|R^\top R - I\|_F \le 10^{-10}`, :math:`\det R > 0`), or
+///         (..., n, n) (many
 ///         computed in parallel without the GIL).
 /// Returns:
 ///     xi: skew matrix (n, n) or (..., n, n) with so_exp(xi) = R.
 /// Raises:
-///     NotInGroupError: R not a rotation (the message gives ‖RᵀR − I‖_F and det R).
-///     NoUniqueLogError: a rotation angle within 1e-12 of π, for every n (π within round-off;
+///     NotInGroupError: R not a rotation (the message gives :math:`\|R^\top R - I\|_F` and
+///     :math:`\det R`).
+///     NoUniqueLogError: a rotation angle within 1e-12 of :math:`\pi`, for every n (:math:`\pi`
+///     within round-off;
 ///     below it the log is computed accurately, also for clustered angles; the message gives
 ///     the angle).
 ///     ShapeError, NonFiniteError.
@@ -115,8 +122,9 @@ fn so_log<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAny>> 
     map_mats(py, "R", &R, so::log)
 }
 
-/// `so_cayley(xi)` (alias `cayley`): the Cayley map cay(ξ) = (I − ξ/2)⁻¹ (I + ξ/2),
-/// so(n) → SO(n).
+/// `so_cayley(xi)` (alias `cayley`): the Cayley map
+/// :math:`\operatorname{cay}(\xi) = (I - \xi/2)^{-1} (I + \xi/2)`,
+/// :math:`\mathfrak{so}(n) \to SO(n)`.
 ///
 /// Args:
 ///     xi: skew matrix (n, n).
@@ -129,15 +137,15 @@ fn so_cayley<'py>(py: Python<'py>, xi: ArrayIn<'py>) -> PyResult<Bound<'py, PyAr
     Ok(py_mat(py, &so::cayley(&mat("xi", &xi)?).py()?))
 }
 
-/// `so_cayley_inv(R)` (alias `cayley_inv`): the inverse Cayley map ξ = 2 (I + R)⁻¹ (R − I), the
-/// exact inverse of `so_cayley`.
+/// `so_cayley_inv(R)` (alias `cayley_inv`): the inverse Cayley map
+/// :math:`\xi = 2 (I + R)^{-1} (R - I)`, the exact inverse of `so_cayley`.
 ///
 /// Args:
 ///     R: rotation (n, n).
 /// Returns:
 ///     xi: skew matrix (n, n).
 /// Raises:
-///     InvalidArgumentError: I + R singular (R has an eigenvalue −1).
+///     InvalidArgumentError: :math:`I + R` singular (R has an eigenvalue :math:`-1`).
 ///     NotInGroupError, ShapeError, NonFiniteError.
 #[pyfunction]
 #[allow(non_snake_case)]
@@ -145,16 +153,19 @@ fn so_cayley_inv<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, P
     Ok(py_mat(py, &so::cayley_inv(&mat("R", &R)?).py()?))
 }
 
-/// `so_dexp(xi, eta)` (alias `dexp`): the right-trivialized derivative of exp, dexp_ξ η = Σ_k ad_ξᵏ η / (k+1)!, so that
-/// d/dt so_exp(ξ + tη) at t = 0 equals so_dexp(ξ, η) @ so_exp(ξ)
-/// (and so_exp(ξ) @ so_dexp(−ξ, η), the left-trivialized form). Any ξ.
+/// `so_dexp(xi, eta)` (alias `dexp`): the right-trivialized derivative of exp,
+/// :math:`\operatorname{dexp}_\xi \eta = \sum_k \operatorname{ad}_\xi^k \eta / (k+1)!`, so that
+/// :math:`\frac{d}{dt} \exp(\xi + t\eta) |_{t=0} = \operatorname{dexp}_\xi(\eta) \exp(\xi)`
+/// (and :math:`\exp(\xi) \operatorname{dexp}_{-\xi}(\eta)`, the left-trivialized form). Any
+/// :math:`\xi`.
 ///
 /// Args:
 ///     xi, eta: skew matrices (n, n).
 /// Returns:
 ///     skew matrix (n, n).
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError (‖ξ‖ > 2.25e14).
+///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError
+///     (:math:`\|\xi\| > 2.25 \cdot 10^{14}`).
 #[pyfunction]
 fn so_dexp<'py>(
     py: Python<'py>,
@@ -165,14 +176,16 @@ fn so_dexp<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// `so_dexp_inv(xi, eta)` (alias `dexp_inv`): the inverse of `so_dexp` (Bernoulli series Σ_k B_k/k! ad_ξᵏ η), for ‖ξ‖ < π where ‖ξ‖² = ½ tr(ξᵀξ).
+/// `so_dexp_inv(xi, eta)` (alias `dexp_inv`): the inverse of `so_dexp` (Bernoulli series
+/// :math:`\sum_k \frac{B_k}{k!} \operatorname{ad}_\xi^k \eta`), for :math:`\|\xi\| < \pi` where
+/// :math:`\|\xi\|^2 = \tfrac12 \operatorname{tr}(\xi^\top \xi)`.
 ///
 /// Args:
 ///     xi, eta: skew matrices (n, n).
 /// Returns:
 ///     skew matrix (n, n) with so_dexp(xi, result) = eta.
 /// Raises:
-///     InvalidArgumentError: ‖ξ‖ ≥ π. ShapeError, NonFiniteError, NotInGroupError.
+///     InvalidArgumentError: :math:`\|\xi\| \ge \pi`. ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 fn so_dexp_inv<'py>(
     py: Python<'py>,
@@ -183,7 +196,8 @@ fn so_dexp_inv<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// `so_Ad(g, xi)` (alias `Ad`): the adjoint action Ad_g ξ = g ξ gᵀ of SO(n) on so(n).
+/// `so_Ad(g, xi)` (alias `Ad`): the adjoint action :math:`\operatorname{Ad}_g \xi = g \xi g^\top`
+/// of SO(n) on :math:`\mathfrak{so}(n)`.
 ///
 /// Args:
 ///     g: rotation (n, n). xi: skew matrix (n, n).
@@ -202,7 +216,9 @@ fn so_adjoint<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// `so_ad(xi, eta)` (alias `ad`): ad_ξ η = [ξ, η] = ξη − ηξ on so(n).
+/// `so_ad(xi, eta)` (alias `ad`):
+/// :math:`\operatorname{ad}_\xi \eta = [\xi, \eta] = \xi\eta - \eta\xi` on
+/// :math:`\mathfrak{so}(n)`.
 ///
 /// Args:
 ///     xi, eta: skew matrices (n, n).
@@ -220,8 +236,12 @@ fn so_ad<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// `so_ad_star(xi, mu)` (alias `ad_star`): the coadjoint action ad*_ξ μ = [μ, ξ], with so(n)* identified with so(n) by the pairing
-/// ⟨ξ, η⟩ = ½ tr(ξᵀη), so that ⟨ad*_ξ μ, η⟩ = ⟨μ, [ξ, η]⟩ (000 §3.3).
+/// `so_ad_star(xi, mu)` (alias `ad_star`): the coadjoint action
+/// :math:`\operatorname{ad}^*_\xi \mu = [\mu, \xi]`, with :math:`\mathfrak{so}(n)^*` identified
+/// with :math:`\mathfrak{so}(n)` by the pairing
+/// :math:`\langle \xi, \eta \rangle = \tfrac12 \operatorname{tr}(\xi^\top \eta)`, so that
+/// :math:`\langle \operatorname{ad}^*_\xi \mu, \eta \rangle = \langle \mu, [\xi, \eta] \rangle`
+/// (000 §3.3).
 ///
 /// Args:
 ///     xi, mu: skew matrices (n, n).
@@ -239,7 +259,7 @@ fn so_ad_star<'py>(
     Ok(py_mat(py, &r))
 }
 
-/// Whether R is in SO(n): ‖RᵀR − I‖_F ≤ tol and det R > 0.
+/// Whether R is in SO(n): :math:`\|R^\top R - I\|_F \le \mathrm{tol}` and :math:`\det R > 0`.
 ///
 /// Args:
 ///     R: square matrix (n, n). tol: positive tolerance (default 1e-10).
@@ -256,8 +276,10 @@ fn is_rotation(R: ArrayIn<'_>, #[pyo3(from_py_with = real)] tol: f64) -> PyResul
 // The text_signature above spells the default out for help() and the stubs.
 const _: () = assert!(so::ROTATION_TOL == 1e-10);
 
-/// Nearest rotation to M in the Frobenius norm: U D Vᵀ from the SVD M = U Σ Vᵀ with
-/// D = diag(1, …, 1, sign det(UVᵀ)) (the polar factor when det M > 0).
+/// Nearest rotation to M in the Frobenius norm: :math:`U D V^\top` from the SVD
+/// :math:`M = U \Sigma V^\top` with
+/// :math:`D = \operatorname{diag}(1, \dots, 1, \operatorname{sign} \det(U V^\top))` (the polar
+/// factor when :math:`\det M > 0`).
 ///
 /// Args:
 ///     M: square matrix (n, n).
@@ -291,7 +313,7 @@ fn so_compose<'py>(
     Ok(py_mat(py, g.compose(&SOn::new(h).py()?).as_mat()))
 }
 
-/// `so_inverse(R)`: R⁻¹ = Rᵀ.
+/// `so_inverse(R)`: :math:`R^{-1} = R^\top`.
 ///
 /// Args:
 ///     R: rotation (n, n), or (..., n, n).
@@ -307,7 +329,7 @@ fn so_inverse<'py>(py: Python<'py>, R: ArrayIn<'py>) -> PyResult<Bound<'py, PyAn
     })
 }
 
-/// `so_act(R, x)`: the rotated vector R x.
+/// `so_act(R, x)`: the rotated vector :math:`R x`.
 ///
 /// Args:
 ///     R: rotation (n, n). x: vector (n,).
@@ -342,9 +364,9 @@ fn jacobian<'py>(
 }
 
 /// `so_jacobian_left(xi, inverse=False)`: the left Jacobian of exp on so(n), the d × d matrix
-/// (d = n(n−1)/2) of η ↦ so_dexp(ξ, η) in e_ij coordinates, so that
-/// so_exp(ξ + δ) ≈ so_exp(J_l(ξ) δ) so_exp(ξ); with `inverse=True` its inverse (the matrix of
-/// so_dexp_inv, for ‖ξ‖ < π).
+/// (:math:`d = n(n-1)/2`) of :math:`\eta \mapsto \operatorname{dexp}_\xi \eta` in :math:`e_{ij}`
+/// coordinates, so that :math:`\exp(\xi + \delta) \approx \exp(J_l(\xi) \delta) \exp(\xi)`; with
+/// `inverse=True` its inverse (the matrix of so_dexp_inv, for :math:`\|\xi\| < \pi`).
 ///
 /// Args:
 ///     xi: skew matrix (n, n).
@@ -352,7 +374,7 @@ fn jacobian<'py>(
 ///     (d, d) matrix.
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (not skew), InvalidArgumentError
-///     (‖ξ‖ > 2.25e14; inverse: ‖ξ‖ ≥ π).
+///     (:math:`\|\xi\| > 2.25 \cdot 10^{14}`; inverse: :math:`\|\xi\| \ge \pi`).
 #[pyfunction]
 #[pyo3(signature = (xi, inverse = false))]
 fn so_jacobian_left<'py>(
@@ -363,8 +385,9 @@ fn so_jacobian_left<'py>(
     jacobian(py, &xi, inverse, so::jacobian_left, so::jacobian_left_inv)
 }
 
-/// `so_jacobian_right(xi, inverse=False)`: the right Jacobian J_r(ξ) = J_l(−ξ), so that
-/// so_exp(ξ + δ) ≈ so_exp(ξ) so_exp(J_r(ξ) δ); with `inverse=True` its inverse.
+/// `so_jacobian_right(xi, inverse=False)`: the right Jacobian :math:`J_r(\xi) = J_l(-\xi)`, so
+/// that :math:`\exp(\xi + \delta) \approx \exp(\xi) \exp(J_r(\xi) \delta)`; with `inverse=True`
+/// its inverse.
 ///
 /// Args:
 ///     xi: skew matrix (n, n).
@@ -384,8 +407,10 @@ fn so_jacobian_right<'py>(
 
 type Pair<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
-/// Adjoint action of SO(n) × SO(n) on so(n) ⊕ so(n): Ad_(g,h)(ξ, η) = (g ξ gᵀ, h η hᵀ)
-/// (componentwise, 001 (7.23)).
+/// Adjoint action of :math:`SO(n) \times SO(n)` on
+/// :math:`\mathfrak{so}(n) \oplus \mathfrak{so}(n)`:
+/// :math:`\operatorname{Ad}_{(g,h)}(\xi, \eta) = (g \xi g^\top, h \eta h^\top)` (componentwise,
+/// 001 (7.23)).
 ///
 /// Args:
 ///     g, h: rotations (n, n). xi, eta: skew matrices (n, n).
@@ -407,7 +432,8 @@ fn product_adjoint<'py>(
     Ok((py_mat(py, &a), py_mat(py, &b)))
 }
 
-/// Bracket on so(n) ⊕ so(n), 001 (7.26): [(ξ', η'), (ξ, η)] = ([ξ', ξ], [η', η]).
+/// Bracket on :math:`\mathfrak{so}(n) \oplus \mathfrak{so}(n)`, 001 (7.26):
+/// :math:`[(\xi', \eta'), (\xi, \eta)] = ([\xi', \xi], [\eta', \eta])`.
 ///
 /// Args:
 ///     xi1, eta1, xi2, eta2: skew matrices (n, n).

@@ -109,11 +109,13 @@ fn reduced_state(n: usize, x: &[&[f64]]) -> ReducedState {
     }
 }
 
-/// The Riemann-ellipsoid equations (001 (3.20)) in Q = X X^T, N = X V^T:
-/// ``dQ/dt = N + N^T``, ``dN/dt = N^T Q^{-1} N - 2 Q dU/dQ``; the force term is computed as
-/// ``X (dU/dX)^T`` at ``X = Q^{1/2}`` (the same for every X with ``X X^T = Q``, U being
-/// SO(n) x SO(n)-invariant). With ``N = X V^T`` from `riemann_variables`, ``dN/dt`` is
-/// ``V V^T - X (dU/dX)^T``, the Riemann form of ``d^2X/dt^2 = -dU/dX``.
+/// The Riemann-ellipsoid equations (001 (3.20)) in :math:`Q = X X^\top`, :math:`N = X V^\top`:
+/// :math:`\dot Q = N + N^\top`, :math:`\dot N = N^\top Q^{-1} N - 2 Q\, \partial U/\partial Q`; the
+/// force term is computed as :math:`X (\partial U/\partial X)^\top` at :math:`X = Q^{1/2}` (the
+/// same for every X with :math:`X X^\top = Q`, U being :math:`SO(n) \times SO(n)`-invariant).
+/// With :math:`N = X V^\top` from `riemann_variables`, :math:`\dot N` is
+/// :math:`V V^\top - X (\partial U/\partial X)^\top`, the Riemann form of
+/// :math:`\ddot X = -\partial U/\partial X`.
 ///
 /// Args:
 ///     Q: (n, n), symmetric positive definite.
@@ -142,11 +144,13 @@ pub fn riemann_vector_field<'py>(
     })
 }
 
-/// The E term of 001 (4.8), ``E = D(-(Omega^2 + Lambda^2) A + Omega A Lambda + Lambda A Omega)``
-/// with ``A = diag(a)`` and D the diagonal part: ``E = dK/dA`` at fixed Omega, Lambda and
-/// ``dA/dt``, K the kinetic energy (4.5). At n = 3 through the vector form (5.4),
-/// ``E_1 = a_1 (w_2^2 + w_3^2 + l_2^2 + l_3^2) - 2 a_2 w_3 l_3 - 2 a_3 w_2 l_2`` and cyclically
-/// (``hat(w) = Omega``, ``hat(l) = Lambda``).
+/// The E term of 001 (4.8),
+/// :math:`E = D(-(\Omega^2 + \Lambda^2) A + \Omega A \Lambda + \Lambda A \Omega)` with
+/// :math:`A = \operatorname{diag}(a)` and D the diagonal part: :math:`E = \partial K/\partial A` at
+/// fixed :math:`\Omega`, :math:`\Lambda` and :math:`\dot A`, K the kinetic energy (4.5). At n = 3
+/// through the vector form (5.4),
+/// :math:`E_1 = a_1 (w_2^2 + w_3^2 + l_2^2 + l_3^2) - 2 a_2 w_3 l_3 - 2 a_3 w_2 l_2` and cyclically
+/// (:math:`\hat w = \Omega`, :math:`\hat l = \Lambda`).
 ///
 /// Args:
 ///     a: (n,) singular values, all > 0; Omega, Lambda: (n, n) skew body velocities.
@@ -154,7 +158,7 @@ pub fn riemann_vector_field<'py>(
 ///     (n,) array, the diagonal of E.
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (Omega, Lambda not skew),
-///     InvalidArgumentError (some a_i <= 0).
+///     InvalidArgumentError (some :math:`a_i \le 0`).
 #[pyfunction]
 pub fn e_term<'py>(
     py: Python<'py>,
@@ -179,25 +183,25 @@ pub fn e_term<'py>(
     })
 }
 
-/// The Euler–Lagrange equations of 001 Prop. 4.2 in body coordinates ``X = R A S^T``,
-/// ``Omega = R^T dR/dt``, ``Lambda = S^T dS/dt``: (4.11a) ``d^2A/dt^2 = E - dU/dA``,
-/// (4.11b) ``d/dt p_Omega = [p_Omega, Omega]``, (4.11c) ``d/dt p_Lambda = [p_Lambda, Lambda]``,
-/// with E of (4.8) and the body momenta (4.15)
-/// ``p_Omega = A^2 Omega + Omega A^2 - 2 A Lambda A = R^T L R``,
-/// ``p_Lambda = A^2 Lambda + Lambda A^2 - 2 A Omega A = S^T Gamma S``. At n = 3
-/// through the vector form (5.5): ``d^2a/dt^2 = E - grad U(a)``, ``dm/dt = m x w``,
-/// ``dc/dt = c x l`` (``hat(w) = Omega``, ``hat(l) = Lambda``, ``hat(m) = p_Omega``,
-/// ``hat(c) = p_Lambda``).
+/// The Euler–Lagrange equations of 001 Prop. 4.2 in body coordinates :math:`X = R A S^\top`,
+/// :math:`\Omega = R^\top \dot R`, :math:`\Lambda = S^\top \dot S`: (4.11a)
+/// :math:`\ddot A = E - \partial U/\partial A`, (4.11b) :math:`\dot p_\Omega = [p_\Omega, \Omega]`,
+/// (4.11c) :math:`\dot p_\Lambda = [p_\Lambda, \Lambda]`, with E of (4.8) and the body momenta
+/// (4.15) :math:`p_\Omega = A^2 \Omega + \Omega A^2 - 2 A \Lambda A = R^\top L R`,
+/// :math:`p_\Lambda = A^2 \Lambda + \Lambda A^2 - 2 A \Omega A = S^\top \Gamma S`. At n = 3
+/// through the vector form (5.5): :math:`\ddot a = E - \nabla U(a)`, :math:`\dot m = m \times w`,
+/// :math:`\dot c = c \times l` (:math:`\hat w = \Omega`, :math:`\hat l = \Lambda`,
+/// :math:`\hat m = p_\Omega`, :math:`\hat c = p_\Lambda`).
 ///
 /// Args:
 ///     a: (n,) singular values, all > 0; Omega, Lambda: (n, n) skew; potential: a
 ///     `lieflow.potentials` potential (default: the free body).
 /// Returns:
 ///     dict with "p_Omega", "p_Lambda" ((n, n)), "E", "addot" ((n,): E and the acceleration
-///     ``d^2a/dt^2``), "p_Omegadot", "p_Lambdadot" ((n, n)).
+///     :math:`\ddot a`), "p_Omegadot", "p_Lambdadot" ((n, n)).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (Omega, Lambda not skew),
-///     InvalidArgumentError (some a_i <= 0, a potential of another dimension).
+///     InvalidArgumentError (some :math:`a_i \le 0`, a potential of another dimension).
 #[pyfunction]
 #[pyo3(signature = (a, Omega, Lambda, potential=None))]
 pub fn lagrange_vector_field<'py>(
@@ -247,20 +251,29 @@ pub fn lagrange_vector_field<'py>(
     dict(py, &keys, &values)
 }
 
-/// The reduced Hamiltonian (001 (7.24), the form (6.30) at the reduced momenta):
-/// ``H = <p_a, p_a>/2 + <p_Omega + p_Lambda, B_A^{-1}(p_Omega + p_Lambda)>/2 + U(A)`` with
-/// ``A = diag(a)`` on the principal stratum, evaluated as a sum of pair terms
-/// ``((m + v)^2 / (a_i - a_j)^2 + (m - v)^2 / (a_i + a_j)^2) / 4`` over i < j
-/// (``m = p_Omega[i, j]``, ``v = p_Lambda[i, j]``; the eigenvalues of B_A, (8.15)).
+/// The reduced Hamiltonian (001 (7.24), the form (6.30) at the reduced momenta)
+///
+/// .. math::
+///
+///     H = \tfrac12 \langle p_a, p_a \rangle
+///         + \tfrac12 \langle p_\Omega + p_\Lambda, B_A^{-1}(p_\Omega + p_\Lambda) \rangle
+///         + U(A)
+///
+/// with :math:`A = \operatorname{diag}(a)` on the principal stratum, evaluated as a sum of pair
+/// terms :math:`\tfrac14 ((m + v)^2 / (a_i - a_j)^2 + (m - v)^2 / (a_i + a_j)^2)` over
+/// :math:`i < j` (:math:`m = (p_\Omega)_{ij}`, :math:`v = (p_\Lambda)_{ij}`; the eigenvalues of
+/// :math:`B_A`, (8.15)).
 ///
 /// Args:
-///     a, p_a: (n,) (a_i > 0, pairwise distinct); p_Omega, p_Lambda: (n, n) skew — the values of
-///     `reduce`'s dict; potential: a `lieflow.potentials` potential (default: the free body).
+///     a, p_a: (n,) (:math:`a_i > 0`, pairwise distinct); p_Omega, p_Lambda: (n, n) skew — the
+///         values of `reduce`'s dict; potential: a `lieflow.potentials` potential (default: the
+///         free body).
 /// Returns:
 ///     float (an array for leading axes).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (p's not skew), InvalidArgumentError
-///     (a_i <= 0, a potential of another dimension), DegenerateStratumError (equal a_i).
+///     (:math:`a_i \le 0`, a potential of another dimension), DegenerateStratumError (equal
+///     :math:`a_i`).
 #[pyfunction]
 #[pyo3(signature = (a, p_a, p_Omega, p_Lambda, potential=None))]
 pub fn reduced_hamiltonian<'py>(
@@ -287,9 +300,10 @@ pub fn reduced_hamiltonian<'py>(
 }
 
 /// The reduced Hamilton equations (001 (7.25)–(7.28)) on the principal stratum:
-/// ``da/dt = p_a``, ``dp_a/dt = -dH/da`` (7.28), and the Lie–Poisson equations (7.25)–(7.27)
-/// ``d/dt p_Omega = [p_Omega, Omega]``, ``d/dt p_Lambda = [p_Lambda, Lambda]`` with
-/// ``Omega + Lambda = B_A^{-1}(p_Omega + p_Lambda)`` (7.9), H of `reduced_hamiltonian`.
+/// :math:`\dot a = p_a`, :math:`\dot p_a = -\partial H/\partial a` (7.28), and the Lie–Poisson
+/// equations (7.25)–(7.27) :math:`\dot p_\Omega = [p_\Omega, \Omega]`,
+/// :math:`\dot p_\Lambda = [p_\Lambda, \Lambda]` with
+/// :math:`\Omega + \Lambda = B_A^{-1}(p_\Omega + p_\Lambda)` (7.9), H of `reduced_hamiltonian`.
 /// Arguments and errors as `reduced_hamiltonian`.
 ///
 /// Returns:

@@ -19,9 +19,9 @@ fn figure(
     RelativeEquilibrium::ellipsoid(&fluid, fig)
 }
 
-/// The Maclaurin spheroid of eccentricity e (0 <= e < 1): a = (1, 1, sqrt(1 - e^2)) in rigid
-/// rotation (EFE ch. 5), a relative equilibrium of `PseudoRigidBody(3, SelfGravity(G, rho),
-/// incompressible=True)`.
+/// The Maclaurin spheroid of eccentricity e (:math:`0 \le e < 1`):
+/// :math:`a = (1, 1, \sqrt{1 - e^2})` in rigid rotation (EFE ch. 5), a relative equilibrium of
+/// `PseudoRigidBody(3, SelfGravity(G, rho), incompressible=True)`.
 ///
 /// Raises:
 ///     InvalidArgumentError (e outside [0, 1), G or rho not > 0).
@@ -35,8 +35,9 @@ fn maclaurin(
     figure(G, rho, |f| f.maclaurin(e))
 }
 
-/// The Jacobi ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1] (EFE ch. 6 §39: rigid rotation,
-/// a1^2 a2^2 A12 = a3^2 A3; a2_over_a1 = 1 is the Maclaurin spheroid where they branch off).
+/// The Jacobi ellipsoid with :math:`a_1 = 1`, :math:`a_2` = `a2_over_a1` in (0, 1] (EFE ch. 6 §39:
+/// rigid rotation, :math:`a_1^2 a_2^2 A_{12} = a_3^2 A_3`; a2_over_a1 = 1 is the Maclaurin spheroid
+/// where they branch off).
 ///
 /// Raises:
 ///     InvalidArgumentError.
@@ -50,7 +51,8 @@ fn jacobi(
     figure(G, rho, |f| f.jacobi(a2_over_a1))
 }
 
-/// The Dedekind ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1]: the adjoint (X -> X^T) of the
+/// The Dedekind ellipsoid with :math:`a_1 = 1`, :math:`a_2` = `a2_over_a1` in (0, 1]: the adjoint
+/// (:math:`X \mapsto X^\top`) of the
 /// Jacobi ellipsoid with the same axes — a stationary figure with internal motion.
 ///
 /// Raises:
@@ -65,11 +67,13 @@ fn dedekind(
     figure(G, rho, |f| f.dedekind(a2_over_a1))
 }
 
-/// The Riemann S-type ellipsoid with a1 = 1, a2 = a2_over_a1 in (0, 1] and f = zeta/Omega (EFE
-/// ch. 7; f = 0 Jacobi, f = inf Dedekind, f = -2 irrotational).
+/// The Riemann S-type ellipsoid with :math:`a_1 = 1`, :math:`a_2` = `a2_over_a1` in (0, 1] and
+/// :math:`f = \zeta/\Omega` (EFE ch. 7; f = 0 Jacobi, :math:`f = \infty` Dedekind, f = -2
+/// irrotational).
 ///
 /// Raises:
-///     InvalidArgumentError (also when no such ellipsoid exists for a3/a1 in (1e-4, 1.5)).
+///     InvalidArgumentError (also when no such ellipsoid exists for :math:`a_3/a_1` in (1e-4,
+///     1.5)).
 #[pyfunction]
 #[pyo3(signature = (a2_over_a1, f, *, G = 1.0, rho = 1.0))]
 fn riemann_s(
@@ -81,8 +85,8 @@ fn riemann_s(
     figure(G, rho, |fl| fl.riemann_s(a2_over_a1, f))
 }
 
-/// The Maclaurin spheroid where the Jacobi ellipsoids branch off (a1^4 A11 = a3^2 A3; EFE:
-/// e = 0.81267, Omega^2/(pi G rho) = 0.37423), located by bisection to round-off.
+/// The Maclaurin spheroid where the Jacobi ellipsoids branch off (:math:`a_1^4 A_{11} = a_3^2 A_3`;
+/// EFE: e = 0.81267, :math:`\Omega^2/(\pi G\rho) = 0.37423`), located by bisection to round-off.
 ///
 /// Raises:
 ///     InvalidArgumentError.

@@ -33,8 +33,10 @@ fn with_potential<T>(
     checked(|| f(&*potential.get().inner))
 }
 
-/// The amended potential V_{lam+gam}(X) = U(X) + <lam+gam, B_X^{-1}(lam+gam)>/2 (001 (8.11)) for
-/// spatial momenta lam = L, gam = Γ (skew (n, n)) and X on the principal stratum.
+/// The amended potential
+/// :math:`V_{\lambda+\gamma}(X) = U(X) + \tfrac12 \langle \lambda+\gamma, B_X^{-1}(\lambda+\gamma) \rangle`
+/// (001 (8.11)) for spatial momenta :math:`\lambda = L`, :math:`\gamma = \Gamma` (skew (n, n)) and
+/// X on the principal stratum.
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError, DegenerateStratumError.
@@ -49,8 +51,10 @@ fn amended_potential(
     with_potential(potential, |p| eq::amended_potential(p, &x, &l, &g))
 }
 
-/// The augmented potential U_{xi+eta}(X) = U(X) - <xi+eta, B_X(xi+eta)>/2 (001 (8.12)), with
-/// <xi+eta, B_X(xi+eta)> = ‖xi X - X eta‖^2, for angular velocities xi, eta (skew (n, n)).
+/// The augmented potential
+/// :math:`U_{\xi+\eta}(X) = U(X) - \tfrac12 \langle \xi+\eta, B_X(\xi+\eta) \rangle` (001 (8.12)),
+/// with :math:`\langle \xi+\eta, B_X(\xi+\eta) \rangle = \|\xi X - X \eta\|^2`, for angular
+/// velocities :math:`\xi, \eta` (skew (n, n)).
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
@@ -65,8 +69,9 @@ fn augmented_potential(
     with_potential(potential, |p| eq::augmented_potential(p, &x, &a, &b))
 }
 
-/// dU_{xi+eta}/dX (pairing tr(A^T B)) as an (n, n) array (001 (8.12)); it vanishes at a relative
-/// equilibrium X0 with velocities xi, eta.
+/// :math:`\partial U_{\xi+\eta}/\partial X` (pairing :math:`\operatorname{tr}(A^\top B)`) as an
+/// (n, n) array (001 (8.12)); it vanishes at a relative equilibrium :math:`X_0` with velocities
+/// :math:`\xi, \eta`.
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
@@ -83,14 +88,16 @@ fn augmented_gradient<'py>(
     Ok(py_mat(py, &g))
 }
 
-/// The Hessian of the augmented potential U_{xi+eta} (001 (8.12)) at X, pairing tr(A^T B):
-/// D^2U_{xi+eta}(X)[V] = D^2U(X)[V] + xi W_V - W_V eta with W_V = xi V - V eta (the kinetic
-/// part -‖xi X - X eta‖^2/2 is quadratic in X).
+/// The Hessian of the augmented potential :math:`U_{\xi+\eta}` (001 (8.12)) at X, pairing
+/// :math:`\operatorname{tr}(A^\top B)`:
+/// :math:`D^2U_{\xi+\eta}(X)[V] = D^2U(X)[V] + \xi W_V - W_V \eta` with
+/// :math:`W_V = \xi V - V \eta` (the kinetic part :math:`-\tfrac12 \|\xi X - X \eta\|^2` is
+/// quadratic in X).
 ///
 /// Returns:
-///     with V an (n, n) direction: D^2U_{xi+eta}(X)[V], (n, n); without V: the symmetric
-///     (n^2, n^2) matrix in the row-major vec(X) basis (column i*n + j is the product with the
-///     unit matrix E_ij, flattened row-major).
+///     with V an (n, n) direction: :math:`D^2U_{\xi+\eta}(X)[V]`, (n, n); without V: the symmetric
+///     (n^2, n^2) matrix in the row-major vec(X) basis (column i*n + j is the product with the unit
+///     matrix E_ij, flattened row-major).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (n^4 too large).
 #[pyfunction]
@@ -114,15 +121,17 @@ fn augmented_hessian<'py>(
     Ok(py_mat(py, &h))
 }
 
-/// The Hessian of the amended potential V_{lam+gam}(X) = U(X) + <lam+gam, B_X^{-1}(lam+gam)>/2
-/// (001 (8.11)), analytic: with kappa = xi+eta = B_X^{-1}(lam+gam) and its derivative
-/// dkappa[V] = -B_X^{-1}(J(V, W) + J(X, W_V)) (J the momentum map, W = xi X - X eta,
-/// W_V = xi V - V eta), it is the augmented Hessian at kappa plus a positive semidefinite
-/// term: <Y, D^2V[V]> = <Y, D^2U_kappa[V]> + <dkappa[Y], B_X dkappa[V]>.
+/// The Hessian of the amended potential
+/// :math:`V_{\lambda+\gamma}(X) = U(X) + \tfrac12 \langle \lambda+\gamma, B_X^{-1}(\lambda+\gamma) \rangle`
+/// (001 (8.11)), analytic: with :math:`\kappa = \xi+\eta = B_X^{-1}(\lambda+\gamma)` and its
+/// derivative :math:`d\kappa[V] = -B_X^{-1}(J(V, W) + J(X, W_V))` (J the momentum map,
+/// :math:`W = \xi X - X \eta`, :math:`W_V = \xi V - V \eta`), it is the augmented Hessian at
+/// :math:`\kappa` plus a positive semidefinite term:
+/// :math:`\langle Y, D^2V[V] \rangle = \langle Y, D^2U_\kappa[V] \rangle + \langle d\kappa[Y], B_X\, d\kappa[V] \rangle`.
 ///
 /// Returns:
-///     with V an (n, n) direction: D^2V_{lam+gam}(X)[V], (n, n); without V: the symmetric
-///     (n^2, n^2) matrix in the row-major vec(X) basis.
+///     with V an (n, n) direction: :math:`D^2V_{\lambda+\gamma}(X)[V]`, (n, n); without V: the
+///     symmetric (n^2, n^2) matrix in the row-major vec(X) basis.
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError, DegenerateStratumError (X off the principal
 ///     stratum), InvalidArgumentError (n^4 too large).
@@ -147,15 +156,17 @@ fn amended_hessian<'py>(
     Ok(py_mat(py, &h))
 }
 
-/// The admissible velocity directions xi + eta for the diagonal shape A = diag(a): those that
-/// satisfy condition (8.6), [xi+eta, B_A(xi+eta)] = 0 — the eigen-directions e_ij + (±e_ij) of
-/// B_A (8.15) and, for n >= 4, sums over pairwise disjoint planes (8.17)–(8.18).
+/// The admissible velocity directions :math:`\xi + \eta` for the diagonal shape
+/// :math:`A = \operatorname{diag}(a)`: those that satisfy condition (8.6),
+/// :math:`[\xi+\eta, B_A(\xi+\eta)] = 0` — the eigen-directions :math:`e_{ij} + (\pm e_{ij})` of
+/// :math:`B_A` (8.15) and, for n >= 4, sums over pairwise disjoint planes (8.17)–(8.18).
 ///
 /// Returns:
 ///     a list of dicts with keys xi, eta ((n, n) skew), planes (list of (i, j), 0-based),
-///     signs, eigenvalues (of B_A, (a_i -+ a_j)^2) and description.
+///     signs, eigenvalues (of :math:`B_A`, :math:`(a_i \mp a_j)^2`) and description.
 /// Raises:
-///     ShapeError, NonFiniteError, InvalidArgumentError (a_i <= 0), DegenerateStratumError.
+///     ShapeError, NonFiniteError, InvalidArgumentError (:math:`a_i \le 0`),
+///     DegenerateStratumError.
 #[pyfunction]
 fn equilibrium_directions<'py>(
     py: Python<'py>,
@@ -187,14 +198,14 @@ fn pair(what: &str, v: &Bound<'_, PyAny>) -> PyResult<(Mat, Mat)> {
     Ok((mat(what, &a)?, mat(what, &b)?))
 }
 
-/// Relative equilibria of a pseudo-rigid body with the given potential (001 §8), represented at
-/// the diagonal shape X0 = diag(a) (so body and spatial quantities agree at t = 0). Exactly one
-/// way of asking:
+/// Relative equilibria of a pseudo-rigid body with the given potential (001 §8), represented at the
+/// diagonal shape :math:`X_0 = \operatorname{diag}(a)` (so body and spatial quantities agree at
+/// t = 0). Exactly one way of asking:
 ///
 /// * ``velocities=(xi, eta)``: the shapes a in the box ``bounds`` (Newton from ``starts ** n`` grid
 ///   points) for which the angular velocities xi, eta (skew (n, n)) give a relative equilibrium;
-/// * ``shape=a, plane=(i, j)``: every rotation xi = w e_ij, eta = m e_ij in that plane (0-based)
-///   that makes diag(a) a relative equilibrium, solved exactly;
+/// * ``shape=a, plane=(i, j)``: every rotation :math:`\xi = w e_{ij}`, :math:`\eta = m e_{ij}` in
+///   that plane (0-based) that makes diag(a) a relative equilibrium, solved exactly;
 /// * ``momenta=(lam, gam)``: the critical points of the amended potential (8.8), (8.11) over
 ///   shapes at the given body momenta.
 ///
@@ -299,13 +310,14 @@ fn relative_equilibria(
         .collect())
 }
 
-/// A relative equilibrium X(t) = exp(t xi) A0 exp(-t eta) (001 (8.2)–(8.3)) through the diagonal
-/// shape A0 = diag(shape), with constant body velocities xi, eta and momenta L, Gamma.
+/// A relative equilibrium :math:`X(t) = \exp(t\xi)\, A_0 \exp(-t\eta)` (001 (8.2)–(8.3)) through
+/// the diagonal shape :math:`A_0 = \operatorname{diag}(\mathrm{shape})`, with constant body
+/// velocities :math:`\xi, \eta` and momenta :math:`L, \Gamma`.
 #[pyclass(module = "lieflow.pseudo_rigid", name = "RelativeEquilibrium", frozen)]
 pub struct RelativeEquilibrium {
     inner: eq::RelativeEquilibrium,
     potential: Arc<dyn Potential>,
-    /// Whether it is a relative equilibrium of the incompressible body (det X kept).
+    /// Whether it is a relative equilibrium of the incompressible body (:math:`\det X` kept).
     incompressible: bool,
     /// For the ellipsoidal figures of `lieflow.ellipsoids`: the fluid, the figure and its
     /// physical quantities (the body is then incompressible).
@@ -353,7 +365,8 @@ impl RelativeEquilibrium {
         py_vec(py, &self.inner.a)
     }
 
-    /// The pressure: the multiplier p of det X = det A0 in dU_xi+eta/dX = p cof X (0 for a
+    /// The pressure: the multiplier p of :math:`\det X = \det A_0` in
+    /// :math:`\partial U_{\xi+\eta}/\partial X = p \operatorname{cof} X` (0 for a
     /// compressible body).
     #[getter]
     fn pressure(&self) -> f64 {
@@ -366,19 +379,19 @@ impl RelativeEquilibrium {
         self.incompressible
     }
 
-    /// Ellipsoids: the eccentricity sqrt(1 - a3^2/max(a1, a2)^2).
+    /// Ellipsoids: the eccentricity :math:`\sqrt{1 - a_3^2/\max(a_1, a_2)^2}`.
     #[getter]
     fn e(&self) -> PyResult<f64> {
         self.quantity("e", |q| q.e)
     }
 
-    /// Ellipsoids: a2/a1.
+    /// Ellipsoids: :math:`a_2/a_1`.
     #[getter]
     fn a2_over_a1(&self) -> PyResult<f64> {
         self.quantity("a2_over_a1", |q| q.a2_over_a1)
     }
 
-    /// Ellipsoids: a3/a1.
+    /// Ellipsoids: :math:`a_3/a_1`.
     #[getter]
     fn a3_over_a1(&self) -> PyResult<f64> {
         self.quantity("a3_over_a1", |q| q.a3_over_a1)
@@ -396,20 +409,20 @@ impl RelativeEquilibrium {
         self.quantity("zeta", |q| q.zeta)
     }
 
-    /// Ellipsoids: f = zeta/Omega (0 Jacobi, inf Dedekind, -2 irrotational).
+    /// Ellipsoids: :math:`f = \zeta/\Omega` (0 Jacobi, :math:`\infty` Dedekind, -2 irrotational).
     #[getter]
     fn f(&self) -> PyResult<f64> {
         self.quantity("f", |q| q.f)
     }
 
-    /// Ellipsoids: Omega^2/(pi G rho), rho the density of the figure.
+    /// Ellipsoids: :math:`\Omega^2/(\pi G \rho)`, :math:`\rho` the density of the figure.
     #[getter]
     fn Omega2_over_piGrho(&self) -> PyResult<f64> {
         self.quantity("Omega2_over_piGrho", |q| q.omega2_over_pi_g_rho)
     }
 
-    /// Ellipsoids: the angular momentum about x3 in units of sqrt(G M^3 abar), abar =
-    /// (a1 a2 a3)^(1/3) (EFE's units).
+    /// Ellipsoids: the angular momentum about :math:`x_3` in units of
+    /// :math:`\sqrt{G M^3 \bar a}`, :math:`\bar a = (a_1 a_2 a_3)^{1/3}` (EFE's units).
     #[getter]
     fn angular_momentum(&self) -> PyResult<f64> {
         self.quantity("angular_momentum", |q| q.angular_momentum)
@@ -422,7 +435,8 @@ impl RelativeEquilibrium {
         self.quantity("circulation", |q| q.circulation)
     }
 
-    /// Ellipsoids: all physical quantities as a dict (the energy in units of G M^2/abar).
+    /// Ellipsoids: all physical quantities as a dict (the energy in units of
+    /// :math:`G M^2/\bar a`).
     #[getter]
     fn quantities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let Some((_, _, q)) = &self.figure else {
@@ -448,38 +462,38 @@ impl RelativeEquilibrium {
         Ok(d)
     }
 
-    /// The angular velocity xi = Omega (skew (n, n)).
+    /// The angular velocity :math:`\xi = \Omega` (skew (n, n)).
     #[getter]
     fn xi<'py>(&self, py: Python<'py>) -> Arr2<'py> {
         py_mat(py, &self.inner.xi)
     }
 
-    /// The velocity of the right action eta = Lambda (skew (n, n)).
+    /// The velocity of the right action :math:`\eta = \Lambda` (skew (n, n)).
     #[getter]
     fn eta<'py>(&self, py: Python<'py>) -> Arr2<'py> {
         py_mat(py, &self.inner.eta)
     }
 
-    /// The angular momentum L = P X^T - X P^T at X0 (001 (7.3)).
+    /// The angular momentum :math:`L = P X^\top - X P^\top` at :math:`X_0` (001 (7.3)).
     #[getter]
     fn L<'py>(&self, py: Python<'py>) -> Arr2<'py> {
         py_mat(py, &self.inner.lam)
     }
 
-    /// The circulation Gamma = P^T X - X^T P at X0 (001 (7.3)).
+    /// The circulation :math:`\Gamma = P^\top X - X^\top P` at :math:`X_0` (001 (7.3)).
     #[getter]
     fn Gamma<'py>(&self, py: Python<'py>) -> Arr2<'py> {
         py_mat(py, &self.inner.gam)
     }
 
-    /// The energy H = tr(P^T P)/2 + U(X) along the motion.
+    /// The energy :math:`H = \tfrac12 \operatorname{tr}(P^\top P) + U(X)` along the motion.
     #[getter]
     fn energy(&self) -> f64 {
         self.inner.energy
     }
 
-    /// {"force": ‖grad_a U_xi+eta‖, "commutator": the (8.6) residual, "motion":
-    /// ‖dU_xi+eta/dX (A0)‖}.
+    /// {"force": :math:`\|\nabla_a U_{\xi+\eta}\|`, "commutator": the (8.6) residual, "motion":
+    /// :math:`\|\partial U_{\xi+\eta}/\partial X\,(A_0)\|`}.
     #[getter]
     fn residuals<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let r = &self.inner.residuals;
@@ -611,10 +625,10 @@ impl RelativeEquilibrium {
     }
 }
 
-/// A normal mode of a relative equilibrium (``RelativeEquilibrium.normal_modes``): an
-/// eigenvalue λ = σ + iω of the co-moving linearisation (σ = 0 for a stable equilibrium) and
-/// its eigenvector v in the state's coordinates; the linear motion about the equilibrium in
-/// the co-moving frame is Re(v exp(λt)).
+/// A normal mode of a relative equilibrium (``RelativeEquilibrium.normal_modes``): an eigenvalue
+/// :math:`\lambda = \sigma + i\omega` of the co-moving linearisation (:math:`\sigma = 0` for a
+/// stable equilibrium) and its eigenvector v in the state's coordinates; the linear motion about
+/// the equilibrium in the co-moving frame is :math:`\operatorname{Re}(v e^{\lambda t})`.
 #[pyclass(module = "lieflow.pseudo_rigid", name = "NormalMode", frozen)]
 pub struct NormalMode {
     index: usize,
@@ -629,19 +643,19 @@ impl NormalMode {
         self.index
     }
 
-    /// ω, the imaginary part of the eigenvalue: the mode's angular frequency.
+    /// :math:`\omega`, the imaginary part of the eigenvalue: the mode's angular frequency.
     #[getter]
     fn frequency(&self) -> f64 {
         self.inner.eigenvalue.1
     }
 
-    /// 2π/ω.
+    /// :math:`2\pi/\omega`.
     #[getter]
     fn period(&self) -> f64 {
         std::f64::consts::TAU / self.inner.eigenvalue.1
     }
 
-    /// λ = σ + iω.
+    /// :math:`\lambda = \sigma + i\omega`.
     #[getter]
     fn eigenvalue<'py>(&self, py: Python<'py>) -> Bound<'py, pyo3::types::PyComplex> {
         pyo3::types::PyComplex::from_doubles(py, self.inner.eigenvalue.0, self.inner.eigenvalue.1)

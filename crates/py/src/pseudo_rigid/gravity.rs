@@ -13,20 +13,22 @@ use crate::errors::IntoPy;
 type Symbols<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// Chandrasekhar's index symbols of the ellipsoid with semi-axes a (EFE ch. 3 §21):
-/// A_i = a1 a2 a3 int_0^inf du / ((a_i^2 + u) D) and
-/// A_ij = a1 a2 a3 int_0^inf du / ((a_i^2 + u)(a_j^2 + u) D), D = sqrt(prod_k (a_k^2 + u)).
+/// :math:`A_i = a_1 a_2 a_3 \int_0^\infty du / ((a_i^2 + u) D)` and
+/// :math:`A_{ij} = a_1 a_2 a_3 \int_0^\infty du / ((a_i^2 + u)(a_j^2 + u) D)`,
+/// :math:`D = \sqrt{\prod_k (a_k^2 + u)}`.
 ///
-/// A_i by Carlson's R_D (A_i = 2/3 a1 a2 a3 R_D(a_j^2, a_k^2, a_i^2)), all six A_ij by the
-/// trapezoidal rule in ln u; a few ulp for axis ratios down to 1e-3, near-coincident and equal
-/// axes. sum(A) = 2; a sphere of radius r has A_i = 2/3, A_ij = 2/(5 r^2).
+/// :math:`A_i` by Carlson's :math:`R_D` (:math:`A_i = \tfrac23 a_1 a_2 a_3 R_D(a_j^2, a_k^2,
+/// a_i^2)`), all six :math:`A_{ij}` by the trapezoidal rule in :math:`\ln u`; a few ulp for axis
+/// ratios down to 1e-3, near-coincident and equal axes. :math:`\sum_i A_i = 2`; a sphere of radius
+/// r has :math:`A_i = 2/3`, :math:`A_{ij} = 2/(5 r^2)`.
 ///
 /// Args:
 ///     a: the three semi-axes (any order), finite and > 0.
 /// Returns:
 ///     (A, Aij): A of shape (3,), Aij of shape (3, 3) (symmetric, diagonal included).
 /// Raises:
-///     ShapeError (a not of shape (3,)), NonFiniteError, InvalidArgumentError (a_i <= 0, an
-///     axis ratio below 2**-250, or A_ij beyond the float range).
+///     ShapeError (a not of shape (3,)), NonFiniteError, InvalidArgumentError (:math:`a_i \le 0`,
+///     an axis ratio below :math:`2^{-250}`, or :math:`A_{ij}` beyond the float range).
 #[pyfunction]
 pub fn index_symbols<'py>(
     py: Python<'py>,

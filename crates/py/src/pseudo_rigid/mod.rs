@@ -112,14 +112,14 @@ fn bi(n: usize, x: &[f64]) -> lieflow::Result<BiInertia> {
     BiInertia::new(&m(n, x))
 }
 
-/// Left inertia tensor A^L_X(xi) = X X^T xi + xi X X^T (001 (2.11)).
+/// Left inertia tensor :math:`A^L_X(\xi) = X X^\top \xi + \xi X X^\top` (001 (2.11)).
 ///
 /// Args:
 ///     X: (n, n) with det X > 0; xi: (n, n) skew.
 /// Returns:
 ///     (n, n) skew array.
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0 or xi not skew).
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0` or xi not skew).
 #[pyfunction]
 pub fn left_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, xi: ArrayIn<'py>) -> PyResult<Any<'py>> {
     map(
@@ -130,7 +130,7 @@ pub fn left_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, xi: ArrayIn<'py>) -> 
     )
 }
 
-/// Right inertia tensor A^R_X(xi) = X^T X xi + xi X^T X (001 (2.11)).
+/// Right inertia tensor :math:`A^R_X(\xi) = X^\top X \xi + \xi X^\top X` (001 (2.11)).
 ///
 /// Args and errors as `left_inertia`.
 #[pyfunction]
@@ -147,12 +147,14 @@ pub fn right_inertia<'py>(
     )
 }
 
-/// The bi-inertia tensor B_X (001 (6.9)) as an (n(n-1), n(n-1)) matrix in the e_ij basis, xi
-/// block first: [[A^L_X, -2 Ad_X], [-2 Ad_X^T, A^R_X]]. Symmetric on all of GL+(n), positive
-/// definite when the singular values of X are distinct (6.14).
+/// The bi-inertia tensor :math:`B_X` (001 (6.9)) as an (n(n-1), n(n-1)) matrix in the
+/// :math:`e_{ij}` basis, xi block first:
+/// :math:`\begin{pmatrix} A^L_X & -2 \operatorname{Ad}_X \\ -2 \operatorname{Ad}_X^\top & A^R_X \end{pmatrix}`.
+/// Symmetric on all of :math:`GL^+(n)`, positive definite when the singular values of X are
+/// distinct (6.14).
 ///
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`).
 #[pyfunction]
 pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Any<'py>> {
     map(py, &[("X", &X, Mat)], &[Dense], |n, x, out| {
@@ -160,7 +162,8 @@ pub fn bi_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Any<'py>> {
     })
 }
 
-/// B_X(xi + eta) = (A^L_X xi - 2 X eta X^T, -2 X^T xi X + A^R_X eta) (001 (6.9), (6.10)).
+/// :math:`B_X(\xi + \eta) = (A^L_X \xi - 2 X \eta X^\top, -2 X^\top \xi X + A^R_X \eta)`
+/// (001 (6.9), (6.10)).
 ///
 /// Returns:
 ///     (top, bottom): two (n, n) skew arrays.
@@ -180,16 +183,17 @@ pub fn bi_inertia_apply<'py>(
     })
 }
 
-/// Solves B_X(xi + eta) = lam + gam by the closed form in the SVD frame (001 (7.6)-(7.9)), in
-/// O(n^3) work: lam' = R^T lam R, gam' = S^T gam S,
-/// xi'_ij = ((a_i^2 + a_j^2) lam'_ij + 2 a_i a_j gam'_ij) / (a_i^2 - a_j^2)^2 (and symmetrically
-/// for eta'), rotated back.
+/// Solves :math:`B_X(\xi + \eta) = \lambda + \gamma` by the closed form in the SVD frame
+/// (001 (7.6)-(7.9)), in :math:`O(n^3)` work: :math:`\lambda' = R^\top \lambda R`,
+/// :math:`\gamma' = S^\top \gamma S`,
+/// :math:`\xi'_{ij} = ((a_i^2 + a_j^2) \lambda'_{ij} + 2 a_i a_j \gamma'_{ij}) / (a_i^2 - a_j^2)^2`
+/// (and symmetrically for :math:`\eta'`), rotated back.
 ///
 /// Returns:
 ///     (xi, eta): two (n, n) skew arrays.
 /// Raises:
-///     DegenerateStratumError if two singular values of X coincide (gap <= 1e-8 * a_1; the
-///     message gives the smallest gap), ShapeError, NonFiniteError, NotInGroupError.
+///     DegenerateStratumError if two singular values of X coincide (gap :math:`\le 10^{-8} a_1`;
+///     the message gives the smallest gap), ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
 pub fn bi_inertia_solve<'py>(
     py: Python<'py>,
@@ -204,13 +208,14 @@ pub fn bi_inertia_solve<'py>(
     })
 }
 
-/// Eigen-decomposition of B_X (001 (8.14)-(8.15)): eigenvalues (a_i - a_j)^2 and (a_i + a_j)^2
-/// (i < j) with orthonormal eigenvectors (R e_ij R^T + (+/-) S e_ij S^T) / sqrt(2). Valid on all
-/// of GL+(n).
+/// Eigen-decomposition of :math:`B_X` (001 (8.14)-(8.15)): eigenvalues :math:`(a_i - a_j)^2` and
+/// :math:`(a_i + a_j)^2` (:math:`i < j`) with orthonormal eigenvectors
+/// :math:`(R e_{ij} R^\top \pm S e_{ij} S^\top) / \sqrt2`. Valid on all of :math:`GL^+(n)`.
 ///
 /// Returns:
 ///     (values, vectors): (n(n-1),) non-decreasing and (n(n-1), n(n-1)) with the eigenvectors
-///     as columns in e_ij coordinates (xi block first): B = V diag(values) V^T.
+///     as columns in :math:`e_{ij}` coordinates (xi block first):
+///     :math:`B = V \operatorname{diag}(\mathrm{values}) V^\top`.
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
 #[pyfunction]
@@ -222,8 +227,8 @@ pub fn bi_inertia_eigen<'py>(py: Python<'py>, X: ArrayIn<'py>) -> PyResult<Any<'
     })
 }
 
-/// The quadratic form <xi + eta, B_X(xi + eta)> in SVD coordinates (001 (6.14)); equals
-/// ‖xi X + X eta^T‖_F^2.
+/// The quadratic form :math:`\langle \xi + \eta, B_X(\xi + \eta) \rangle` in SVD coordinates
+/// (001 (6.14)); equals :math:`\|\xi X + X \eta^\top\|_F^2`.
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
@@ -241,8 +246,8 @@ pub fn bi_inertia_quadratic_form<'py>(
     })
 }
 
-/// Left connection omega^L_X(Y) = (A^L_X)^{-1}(Y X^T - X Y^T) (001 (2.14)); defined on all of
-/// GL+(n) (omega^L(xi X) = xi, (2.16)).
+/// Left connection :math:`\omega^L_X(Y) = (A^L_X)^{-1}(Y X^\top - X Y^\top)` (001 (2.14)); defined
+/// on all of :math:`GL^+(n)` (:math:`\omega^L(\xi X) = \xi`, (2.16)).
 ///
 /// Args:
 ///     X: (n, n) with det X > 0; Y: (n, n) tangent vector.
@@ -262,8 +267,8 @@ pub fn left_connection<'py>(
     )
 }
 
-/// Right connection omega^R_X(Y) = (A^R_X)^{-1}(Y^T X - X^T Y) (001 (2.15)); defined on all of
-/// GL+(n) (omega^R(X eta^T) = eta, (2.17)).
+/// Right connection :math:`\omega^R_X(Y) = (A^R_X)^{-1}(Y^\top X - X^\top Y)` (001 (2.15));
+/// defined on all of :math:`GL^+(n)` (:math:`\omega^R(X \eta^\top) = \eta`, (2.17)).
 ///
 /// Args and errors as `left_connection`.
 #[pyfunction]
@@ -280,8 +285,10 @@ pub fn right_connection<'py>(
     )
 }
 
-/// Bi-connection omega^B_X(Y) = B_X^{-1}((Y X^T - X Y^T) + (Y^T X - X^T Y)) (001 (6.18)), via
-/// the closed-form inverse. omega^B(xi X + X eta^T) = (xi, eta) (6.19).
+/// Bi-connection
+/// :math:`\omega^B_X(Y) = B_X^{-1}((Y X^\top - X Y^\top) + (Y^\top X - X^\top Y))`
+/// (001 (6.18)), via the closed-form inverse.
+/// :math:`\omega^B(\xi X + X \eta^\top) = (\xi, \eta)` (6.19).
 ///
 /// Returns:
 ///     (xi, eta): two (n, n) skew arrays.
@@ -301,10 +308,10 @@ pub fn bi_connection<'py>(py: Python<'py>, X: ArrayIn<'py>, Y: ArrayIn<'py>) -> 
     )
 }
 
-/// The vertical vector (xi + eta)_P(X) = xi X + X eta^T (001 (6.17)).
+/// The vertical vector :math:`(\xi + \eta)_P(X) = \xi X + X \eta^\top` (001 (6.17)).
 ///
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0, xi or eta not skew).
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`, xi or eta not skew).
 #[pyfunction]
 pub fn vertical_vector<'py>(
     py: Python<'py>,
@@ -326,8 +333,9 @@ pub fn vertical_vector<'py>(
 }
 
 /// Horizontal part of Y at X for an action (001 (2.18)-(2.22), (6.4)-(6.7), (6.23)): Y minus
-/// its orthogonal projection (metric tr(Y^T Z)) onto the orbit's tangent space. "left": the
-/// result H has H X^T = X H^T; "right": H^T X = X^T H; "two-sided": both. Defined on every
+/// its orthogonal projection (metric :math:`\operatorname{tr}(Y^\top Z)`) onto the orbit's tangent
+/// space. "left": the result H has :math:`H X^\top = X H^\top`; "right":
+/// :math:`H^\top X = X^\top H`; "two-sided": both. Defined on every
 /// stratum (the two-sided projection uses the least-squares inverse of B_X).
 ///
 /// Args:
@@ -356,9 +364,10 @@ pub fn horizontal_part<'py>(
     )
 }
 
-/// Locked inertia tensor from the metric tr(Y^T Z) (001 (2.27), (6.24)): the matrix of
-/// tr(V(e_a)^T V(e_b)) with V(xi) = xi X ("left"), X xi^T ("right") or xi X + X eta^T
-/// ("two-sided", xi block first). Equals A^L_X, A^R_X, B_X.
+/// Locked inertia tensor from the metric :math:`\operatorname{tr}(Y^\top Z)` (001 (2.27), (6.24)):
+/// the matrix of :math:`\operatorname{tr}(V(e_a)^\top V(e_b))` with :math:`V(\xi) = \xi X`
+/// ("left"), :math:`X \xi^\top` ("right") or :math:`\xi X + X \eta^\top` ("two-sided", xi block
+/// first). Equals :math:`A^L_X`, :math:`A^R_X`, :math:`B_X`.
 ///
 /// Raises:
 ///     InvalidArgumentError (unknown action), ShapeError, NonFiniteError, NotInGroupError.
@@ -376,10 +385,11 @@ pub fn locked_inertia<'py>(py: Python<'py>, X: ArrayIn<'py>, action: &str) -> Py
     })
 }
 
-/// Angular momentum L = V X^T - X V^T (001 (2.29), (7.3)) of a velocity or momentum V at X.
+/// Angular momentum :math:`L = V X^\top - X V^\top` (001 (2.29), (7.3)) of a velocity or momentum V
+/// at X.
 ///
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`).
 #[pyfunction]
 pub fn angular_momentum<'py>(
     py: Python<'py>,
@@ -394,10 +404,11 @@ pub fn angular_momentum<'py>(
     )
 }
 
-/// Circulation Gamma = V^T X - X^T V (001 (2.29), (7.3)) of a velocity or momentum V at X.
+/// Circulation :math:`\Gamma = V^\top X - X^\top V` (001 (2.29), (7.3)) of a velocity or momentum V
+/// at X.
 ///
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`).
 #[pyfunction]
 pub fn circulation<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResult<Any<'py>> {
     map(
@@ -409,8 +420,8 @@ pub fn circulation<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> Py
 }
 
 /// Body coordinates (R, a, S, Omega, adot, Lambda) of (X, V) (001 (2.4), (2.33), §4.1):
-/// X = R diag(a) S^T,
-/// Omega = R^T dR/dt, Lambda = S^T dS/dt, from R^T V S = Omega A + Adot - A Lambda.
+/// :math:`X = R \operatorname{diag}(a) S^\top`, :math:`\Omega = R^\top \dot R`,
+/// :math:`\Lambda = S^\top \dot S`, from :math:`R^\top V S = \Omega A + \dot A - A \Lambda`.
 ///
 /// Returns:
 ///     (R, a, S, Omega, adot, Lambda).
@@ -433,7 +444,8 @@ pub fn to_body<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResu
     })
 }
 
-/// (X, V) from body coordinates: X = R A S^T, V = R (Omega A + Adot - A Lambda) S^T
+/// (X, V) from body coordinates: :math:`X = R A S^\top`,
+/// :math:`V = R (\Omega A + \dot A - A \Lambda) S^\top`
 /// (001 (2.4), (2.33), §4.1).
 ///
 /// Args:
@@ -442,7 +454,7 @@ pub fn to_body<'py>(py: Python<'py>, X: ArrayIn<'py>, V: ArrayIn<'py>) -> PyResu
 ///     (X, V).
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (R, S not rotations, Omega, Lambda not skew),
-///     InvalidArgumentError (some a_i <= 0).
+///     InvalidArgumentError (some :math:`a_i \le 0`).
 #[pyfunction]
 pub fn from_body<'py>(
     py: Python<'py>,
@@ -475,7 +487,8 @@ pub fn from_body<'py>(
     })
 }
 
-/// Kinetic energy K = tr(V^T V) / 2 (001 (3.2); equal to (4.5), (4.12), (6.28)).
+/// Kinetic energy :math:`K = \tfrac12 \operatorname{tr}(V^\top V)` (001 (3.2); equal to (4.5),
+/// (4.12), (6.28)).
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError.
@@ -496,15 +509,16 @@ pub fn kinetic_energy<'py>(
     )
 }
 
-/// Stratum and isotropy of X under the two-sided SO(n) x SO(n) action (001 (6.2), (9.2), (9.3)).
+/// Stratum and isotropy of X under the two-sided :math:`SO(n) \times SO(n)` action (001 (6.2),
+/// (9.2), (9.3)).
 ///
 /// Args:
 ///     X: (n, n) with det X > 0; tol: relative tolerance for coinciding singular values
 ///     (default 1e-8).
 /// Returns:
-///     dict with "singular_values", "multiplicities", "min_gap", "principal", "dim_vertical"
-///     (rank of (xi, eta) -> xi X + X eta^T), "dim_horizontal", "isotropy" (e.g. "(Z2)^2",
-///     "S(O(2)×O(1))", "SO(3)") and "isotropy_dim".
+///     dict with "singular_values", "multiplicities", "min_gap", "principal", "dim_vertical" (rank
+///     of :math:`(\xi, \eta) \mapsto \xi X + X \eta^\top`), "dim_horizontal", "isotropy" (e.g.
+///     "(Z2)^2", "S(O(2)×O(1))", "SO(3)") and "isotropy_dim".
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError, InvalidArgumentError (tol < 0).
 #[pyfunction]
@@ -529,8 +543,8 @@ pub fn stratum<'py>(
 // The text_signature above spells the default out for help() and the stubs.
 const _: () = assert!(STRATUM_TOL == 1e-8);
 
-/// Riemann-ellipsoid variables (001 (3.4)): Q = X X^T (quadrupole), N = X V^T (shear);
-/// N = (-L + dQ/dt) / 2 (3.10).
+/// Riemann-ellipsoid variables (001 (3.4)): :math:`Q = X X^\top` (quadrupole),
+/// :math:`N = X V^\top` (shear); :math:`N = \tfrac12 (-L + \dot Q)` (3.10).
 ///
 /// Returns:
 ///     (Q, N).
@@ -553,8 +567,10 @@ pub fn riemann_variables<'py>(
     )
 }
 
-/// Poisson bracket {f, g} of functions of (Q, N) from the structure functions (001 (9.1)):
-/// {Q_ij, Q_kl} = 0, {Q_ij, N_kl} = d_il Q_jk + d_jl Q_ik, {N_ij, N_kl} = d_il N_kj - d_jk N_il.
+/// Poisson bracket :math:`\{f, g\}` of functions of (Q, N) from the structure functions
+/// (001 (9.1)): :math:`\{Q_{ij}, Q_{kl}\} = 0`,
+/// :math:`\{Q_{ij}, N_{kl}\} = \delta_{il} Q_{jk} + \delta_{jl} Q_{ik}`,
+/// :math:`\{N_{ij}, N_{kl}\} = \delta_{il} N_{kj} - \delta_{jk} N_{il}`.
 ///
 /// Args:
 ///     Q, N: (n, n); dfdQ, dfdN, dgdQ, dgdN: (n, n) gradients (entries taken as coordinates).
@@ -626,13 +642,15 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// Reduction (X, P) -> (a, p_a, p_Omega, p_Lambda) on the principal stratum (001 §7):
-/// X = R diag(a) S^T (a decreasing), p_a = diag(R^T P S), p_Omega = R^T L R, p_Lambda = S^T Γ S
+/// :math:`X = R \operatorname{diag}(a) S^\top` (a decreasing),
+/// :math:`p_a = \operatorname{diag}(R^\top P S)`, :math:`p_\Omega = R^\top L R`,
+/// :math:`p_\Lambda = S^\top \Gamma S`
 /// (001 (2.32), (6.27)).
 ///
 /// Returns:
 ///     dict with "a", "p_a" ((n,) arrays), "p_Omega", "p_Lambda", "R", "S" ((n, n) arrays).
 /// Raises:
-///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0), DegenerateStratumError.
+///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`), DegenerateStratumError.
 #[pyfunction]
 pub fn reduce<'py>(
     py: Python<'py>,
@@ -651,12 +669,12 @@ pub fn reduce<'py>(
 }
 
 /// Reconstruction (R, S, a, p_a, p_Omega, p_Lambda) -> (X, P), the inverse of `reduce`:
-/// X = R A S^T, P = R(Omega A + diag(p_a) - A Lambda) S^T with Omega + Lambda =
-/// B_A^{-1}(p_Omega + p_Lambda) (001 (7.9)).
+/// :math:`X = R A S^\top`, :math:`P = R (\Omega A + \operatorname{diag}(p_a) - A \Lambda) S^\top`
+/// with :math:`\Omega + \Lambda = B_A^{-1}(p_\Omega + p_\Lambda)` (001 (7.9)).
 ///
 /// Raises:
 ///     ShapeError, NonFiniteError, NotInGroupError (R, S not rotations, p's not skew),
-///     InvalidArgumentError (a_i <= 0), DegenerateStratumError (equal a_i).
+///     InvalidArgumentError (:math:`a_i \le 0`), DegenerateStratumError (equal :math:`a_i`).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 pub fn reconstruct<'py>(
@@ -690,11 +708,11 @@ pub fn reconstruct<'py>(
 
 type ArrD<'py> = Bound<'py, numpy::PyArrayDyn<f64>>;
 
-/// Dedekind's adjoint motion X -> X^T, P -> P^T of stacked frames (..., n, n) (000 §5.3): maps
-/// motions to motions and swaps angular momentum and circulation.
+/// Dedekind's adjoint motion :math:`X \mapsto X^\top`, :math:`P \mapsto P^\top` of stacked frames
+/// (..., n, n) (000 §5.3): maps motions to motions and swaps angular momentum and circulation.
 ///
 /// Returns:
-///     (X^T, P^T) with the shapes of the inputs.
+///     :math:`(X^\top, P^\top)` with the shapes of the inputs.
 /// Raises:
 ///     ShapeError, NonFiniteError.
 #[pyfunction]
@@ -726,13 +744,15 @@ pub fn adjoint_motion<'py>(
     Ok((arr(xt)?, arr(pt)?))
 }
 
-/// Kelvin's circulation of a material loop (001 §2.5, (2.34)): the integral of v.dx around the
-/// loop C = X(C0) in space, where C0 is the closed polygon through the label points (rows of
-/// `labels`; closed back to the first), its particles at x = X u moving with v = V u.
+/// Kelvin's circulation of a material loop (001 §2.5, (2.34)): the integral of
+/// :math:`v \cdot dx` around the loop :math:`C = X(C_0)` in space, where :math:`C_0` is the
+/// closed polygon through the label points (rows of `labels`; closed back to the first), its
+/// particles at :math:`x = X u` moving with :math:`v = V u`.
 ///
-/// Equals <Gamma, zeta> = tr(Gamma^T zeta)/2 with Gamma = V^T X - X^T V the circulation and
-/// zeta = `loop_area(labels)` (2.35): Kelvin's theorem (the integral is constant along a motion
-/// for every loop) is the conservation of Gamma. Exact for the polygon (computed in space,
+/// Equals :math:`\langle \Gamma, \zeta \rangle = \tfrac12 \operatorname{tr}(\Gamma^\top \zeta)`
+/// with :math:`\Gamma = V^\top X - X^\top V` the circulation and :math:`\zeta` =
+/// `loop_area(labels)` (2.35): Kelvin's theorem (the integral is constant along a motion for
+/// every loop) is the conservation of :math:`\Gamma`. Exact for the polygon (computed in space,
 /// segment by segment).
 ///
 /// Args:
@@ -745,9 +765,11 @@ pub fn loop_circulation(X: ArrayIn<'_>, V: ArrayIn<'_>, labels: ArrayIn<'_>) -> 
     mo::loop_circulation(&mat("X", &X)?, &mat("V", &V)?, &labels).py()
 }
 
-/// The oriented areas zeta_ij = integral over S0 of du_i ^ du_j = loop integral of u_i du_j
+/// The oriented areas
+/// :math:`\zeta_{ij} = \int_{S_0} du_i \wedge du_j = \oint u_i\, du_j`
 /// (001 (2.36)) of the closed polygon through the rows of `labels` ((m, n), m >= 3): a skew
-/// (n, n) array whose (i, j) entry is the area of the loop's projection on the (u_i, u_j) plane
+/// (n, n) array whose (i, j) entry is the area of the loop's projection on the
+/// :math:`(u_i, u_j)` plane
 /// (counterclockwise positive).
 ///
 /// Raises:
@@ -761,12 +783,14 @@ pub fn loop_area<'py>(
 }
 
 /// Guichardet's connection of N particles (001 §2.3, (2.23)–(2.26)):
-/// omega = A_Q^-1 (sum_a m_a (v_a x_a^T - x_a v_a^T)) in so(n), A_Q xi = Q xi + xi Q,
-/// Q = sum_a m_a x_a x_a^T: the rigid rotation that carries the particles' angular momentum (in
-/// three dimensions hat^-1(omega) = A^-1 sum m x cross v with the inertia tensor
-/// A = tr(Q) 1 - Q). For particles x = X u whose labels have sum m u u^T = 1 it is the left
-/// connection `left_connection(X, V)` (2.14): the pseudo-rigid body's connection is its
-/// continuum case.
+/// :math:`\omega = A_Q^{-1} \bigl(\sum_a m_a (v_a x_a^\top - x_a v_a^\top)\bigr) \in \mathfrak{so}(n)`,
+/// :math:`A_Q \xi = Q \xi + \xi Q`, :math:`Q = \sum_a m_a x_a x_a^\top`: the rigid rotation that
+/// carries the particles' angular momentum (in three dimensions
+/// :math:`\omega^\vee = A^{-1} \sum m\, x \times v` with the inertia tensor
+/// :math:`A = \operatorname{tr}(Q)\, \mathrm{Id} - Q`, :math:`\omega^\vee` the vector of
+/// :math:`\omega`). For particles :math:`x = X u` whose labels have :math:`\sum m\, u u^\top = 1`
+/// it is the left connection `left_connection(X, V)` (2.14): the pseudo-rigid body's connection is
+/// its continuum case.
 ///
 /// Args:
 ///     masses: (N,) > 0; positions, velocities: (N, n).
@@ -793,8 +817,9 @@ pub fn guichardet_connection<'py>(
 }
 
 /// The locked inertia of N particles (001 (2.27)): the Gram matrix
-/// I_ab = sum_a m_a (e_a x_a).(e_b x_a) of so(n)'s basis e_ij (i < j, the order of
-/// `locked_inertia`), the matrix of A_Q; for x = X u with sum m u u^T = 1 it equals
+/// :math:`\mathbb{I}_{ab} = \sum_\alpha m_\alpha (e_a x_\alpha) \cdot (e_b x_\alpha)` of so(n)'s
+/// basis :math:`e_{ij}` (:math:`i < j`, the order of `locked_inertia`), the matrix of :math:`A_Q`; for :math:`x = X u` with
+/// :math:`\sum m\, u u^\top = 1` it equals
 /// `locked_inertia(X, "left")`.
 ///
 /// Args:

@@ -19,10 +19,10 @@ use crate::convert::{mat, py_mat, ArrayIn};
 use crate::convert::{named, real, Real};
 use crate::errors::{checked, raised, to_py, IntoPy};
 
-/// An SO(n)×SO(n)-invariant potential U(X) of a pseudo-rigid body (001 §4.1). Build one with
-/// `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`, `Volumetric(kappa, gamma)`, `Stretch(k)`,
-/// `SelfGravity(G, rho)` (n = 3 only), `Zero()` or `Callable(U, grad_U, hess_U=None)`; add
-/// potentials with `+`.
+/// An :math:`SO(n) \times SO(n)`-invariant potential :math:`U(X)` of a pseudo-rigid body
+/// (001 §4.1). Build one with `Harmonic(k)`, `SaintVenantKirchhoff(lam, mu)`,
+/// `Volumetric(kappa, gamma)`, `Stretch(k)`, `SelfGravity(G, rho)` (n = 3 only), `Zero()` or
+/// `Callable(U, grad_U, hess_U=None)`; add potentials with `+`.
 #[pyclass(module = "lieflow.potentials", frozen, name = "Potential")]
 #[derive(Clone)]
 pub struct PyPotential {
@@ -37,14 +37,16 @@ impl PyPotential {
     /// U(X) for an (n, n) array X.
     ///
     /// Raises:
-    ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0 for a volumetric term).
+    ///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0` for a volumetric
+    ///     term).
     fn value(&self, X: ArrayIn<'_>) -> PyResult<f64> {
         // A callable's own error (exception, non-finite return) first, then the core's.
         let x = mat("X", &X)?;
         checked(|| pot::value(&*self.inner, &x))
     }
 
-    /// The gradient dU/dX (pairing tr(A^T B)) at an (n, n) array X, as an (n, n) array.
+    /// The gradient :math:`\partial U/\partial X` (pairing :math:`\operatorname{tr}(A^\top B)`) at
+    /// an (n, n) array X, as an (n, n) array.
     fn gradient<'py>(
         &self,
         py: Python<'py>,
@@ -60,7 +62,7 @@ impl PyPotential {
     ///
     /// Raises:
     ///     ShapeError (X not square, V not of the shape of X), NonFiniteError,
-    ///     NotInGroupError (det X <= 0 for a volumetric term).
+    ///     NotInGroupError (:math:`\det X \le 0` for a volumetric term).
     fn hessian<'py>(
         &self,
         py: Python<'py>,
@@ -241,8 +243,9 @@ impl pot::Potential for CallablePotential {
     }
 
     /// The `hessian(X, V)` callable if given; otherwise the central difference
-    /// (∇U(X + hV̂) − ∇U(X − hV̂)) ‖V‖/(2h) of the gradient callable along V̂ = V/‖V‖ with
-    /// h = 1e-6·max(1, ‖X‖) (Frobenius norms; error O(h²) + O(ε/h) relative).
+    /// :math:`(\nabla U(X + h\hat V) - \nabla U(X - h\hat V))\, \|V\|/(2h)` of the gradient
+    /// callable along :math:`\hat V = V/\|V\|` with :math:`h = 10^{-6} \max(1, \|X\|)` (Frobenius
+    /// norms; error :math:`O(h^2) + O(\varepsilon/h)` relative).
     fn add_hessian(
         &self,
         x: faer::MatRef<'_, f64>,
@@ -281,7 +284,8 @@ impl pot::Potential for CallablePotential {
     }
 }
 
-/// Harmonic potential U = (k/2) tr(X^T X), dU/dX = k X (000 §5.3); k > 0.
+/// Harmonic potential :math:`U = \tfrac{k}{2} \operatorname{tr}(X^\top X)`,
+/// :math:`\partial U/\partial X = k X` (000 §5.3); k > 0.
 ///
 /// Raises:
 ///     InvalidArgumentError: k <= 0 or not finite.
@@ -291,7 +295,9 @@ fn Harmonic(py: Python<'_>, #[pyo3(from_py_with = real)] k: f64) -> PyResult<PyP
     PyPotential::new(py, inner, format!("Harmonic({k})"), "Harmonic", [k])
 }
 
-/// Isotropic Saint Venant–Kirchhoff energy U = (lam/2)(tr E)^2 + mu tr(E^2), E = (X^T X - I)/2.
+/// Isotropic Saint Venant–Kirchhoff energy
+/// :math:`U = \tfrac{\lambda}{2} (\operatorname{tr} E)^2 + \mu \operatorname{tr}(E^2)`,
+/// :math:`E = \tfrac12 (X^\top X - I)` (:math:`\lambda` = `lam`, :math:`\mu` = `mu`).
 ///
 /// Raises:
 ///     InvalidArgumentError: mu <= 0, lam < 0 or not finite.
@@ -306,8 +312,9 @@ fn SaintVenantKirchhoff(
     PyPotential::new(py, inner, desc, "SaintVenantKirchhoff", [lam, mu])
 }
 
-/// Polytropic volumetric (gas) term U = kappa (det(X)^(1-gamma) - 1)/(gamma - 1), gamma > 1, and
-/// U = -kappa ln det X for gamma = 1. Defined only for det X > 0 (integrations always check it).
+/// Polytropic volumetric (gas) term :math:`U = \kappa (\det(X)^{1-\gamma} - 1)/(\gamma - 1)`,
+/// :math:`\gamma > 1`, and :math:`U = -\kappa \ln\det X` for :math:`\gamma = 1`. Defined only for
+/// :math:`\det X > 0` (integrations always check it).
 ///
 /// Raises:
 ///     InvalidArgumentError: kappa <= 0, gamma < 1 or not finite.
@@ -323,9 +330,12 @@ fn Volumetric(
     PyPotential::new(py, inner, desc, "Volumetric", [kappa, gamma])
 }
 
-/// Isotropic quadratic stretch energy U = (k/2) sum_i (s_i - 1)^2 over the singular values s_i
-/// of X; k > 0. dU/dX = k (X - polar(X)) (polar(X) = X (X^T X)^(-1/2), the rotation of X on
-/// GL+(n)). Defined for every X through the SVD, but smooth only where det X != 0.
+/// Isotropic quadratic stretch energy :math:`U = \tfrac{k}{2} \sum_i (s_i - 1)^2` over the
+/// singular values :math:`s_i` of X; k > 0.
+/// :math:`\partial U/\partial X = k (X - \operatorname{polar}(X))`
+/// (:math:`\operatorname{polar}(X) = X (X^\top X)^{-1/2}`, the rotation of X on
+/// :math:`GL^+(n)`). Defined for every X through the SVD, but smooth only where
+/// :math:`\det X \ne 0`.
 ///
 /// Raises:
 ///     InvalidArgumentError: k <= 0 or not finite.
@@ -335,14 +345,16 @@ fn Stretch(py: Python<'_>, #[pyo3(from_py_with = real)] k: f64) -> PyResult<PyPo
     PyPotential::new(py, inner, format!("Stretch({k})"), "Stretch", [k])
 }
 
-/// Self-gravity of a homogeneous ellipsoid, U = -4 pi G rho R_F(s1^2, s2^2, s3^2) over the singular
-/// values s_i of X (Chandrasekhar, EFE ch. 3; Carlson's R_F): the potential of the Riemann
-/// ellipsoids, for n = 3 only. The reference configuration is the unit ball of density rho (mass
-/// M = 4 pi rho / 3) and the kinetic energy tr(V^T V)/2, i.e. the physical energy divided by M/5;
-/// a sphere of radius a has U = -4 pi G rho / a, and dU/ds_i = 2 pi G rho' s_i A_i with the actual
-/// density rho' = rho / (s1 s2 s3) and the index symbols A_i (`pseudo_rigid.index_symbols`).
-/// Defined for det X > 0 (integrations always check it); the Hessian is analytic, also at equal
-/// singular values (Maclaurin spheroids).
+/// Self-gravity of a homogeneous ellipsoid, :math:`U = -4\pi G\rho\, R_F(s_1^2, s_2^2, s_3^2)` over
+/// the singular values :math:`s_i` of X (Chandrasekhar, EFE ch. 3; Carlson's :math:`R_F`): the
+/// potential of the Riemann ellipsoids, for n = 3 only. The reference configuration is the unit
+/// ball of density :math:`\rho` (mass :math:`M = 4\pi\rho/3`) and the kinetic energy
+/// :math:`\tfrac12 \operatorname{tr}(V^\top V)`, i.e. the physical energy divided by :math:`M/5`; a
+/// sphere of radius a has :math:`U = -4\pi G\rho / a`, and
+/// :math:`\partial U/\partial s_i = 2\pi G \rho' s_i A_i` with the actual density
+/// :math:`\rho' = \rho / (s_1 s_2 s_3)` and the index symbols :math:`A_i`
+/// (`pseudo_rigid.index_symbols`). Defined for :math:`\det X > 0` (integrations always check it);
+/// the Hessian is analytic, also at equal singular values (Maclaurin spheroids).
 ///
 /// Raises:
 ///     InvalidArgumentError: G or rho <= 0 or not finite; a body or X of another dimension than 3.
@@ -358,7 +370,7 @@ fn SelfGravity(
     PyPotential::new(py, inner, desc, "SelfGravity", [G, rho])
 }
 
-/// U = 0, the free body (motions X(t) = X0 + t P0).
+/// :math:`U = 0`, the free body (motions :math:`X(t) = X_0 + t P_0`).
 #[pyfunction]
 pub(crate) fn Zero(py: Python<'_>) -> PyResult<PyPotential> {
     PyPotential::new(py, Arc::new(CoreZero), "Zero()".into(), "Zero", [0.0; 0])
@@ -368,7 +380,8 @@ pub(crate) fn Zero(py: Python<'_>) -> PyResult<PyPotential> {
 /// optionally `hessian(X, V) -> (n, n) array`, the Hessian applied to a direction,
 /// d/de gradient(X + e V) at e = 0; all are called with (n, n) float64 arrays. Without `hessian`,
 /// `Potential.hessian` uses central differences of `gradient`:
-/// (gradient(X + h V/‖V‖) - gradient(X - h V/‖V‖)) ‖V‖ / (2h) with h = 1e-6 max(1, ‖X‖)
+/// :math:`(g(X + hV/\|V\|) - g(X - hV/\|V\|))\, \|V\| / (2h)` (g = `gradient`) with
+/// :math:`h = 10^{-6} \max(1, \|X\|)`
 /// (Frobenius norms), accurate to about 1e-6 relative for a smooth gradient.
 /// This is the slow path (each call takes the GIL); U must be SO(n)×SO(n)-invariant (a function
 /// of the singular values of X) for L and Γ to be conserved. Exceptions raised by the callables

@@ -16,11 +16,13 @@ use crate::system::{PySystem, Thin};
 type Any<'py> = Bound<'py, PyAny>;
 
 /// A pseudo-rigid body reduced by its right SO(n) symmetry, the relabelling of its particles
-/// (001 §3): a system on T*GL+(n)/SO(n) in the Riemann variables Q = X X^T, N = X P^T.
+/// (001 §3): a system on :math:`T^*GL^+(n)/SO(n)` in the Riemann variables :math:`Q = X X^\top`,
+/// :math:`N = X P^\top`.
 ///
-/// H = tr(N^T Q^-1 N)/2 + U, the motion is the Riemann system (001 (3.20)) and the Poisson
-/// structure (9.1). The circulation Gamma = P^T X - X^T P is the momentum map of the symmetry:
-/// its spectral invariants are the Casimirs (the reduced spaces Gamma^-1(gamma)/G_gamma of
+/// :math:`H = \tfrac12 \operatorname{tr}(N^\top Q^{-1} N) + U`, the motion is the Riemann system
+/// (001 (3.20)) and the Poisson structure (9.1). The circulation
+/// :math:`\Gamma = P^\top X - X^\top P` is the momentum map of the symmetry: its spectral
+/// invariants are the Casimirs (the reduced spaces :math:`\Gamma^{-1}(\gamma)/G_\gamma` of
 /// 001 (3.27)), and with `reconstruct=True` the system carries X along, so the full motion and
 /// its circulation come back with `reconstruct(states)`.
 ///
@@ -32,16 +34,19 @@ type Any<'py> = Bound<'py, PyAny>;
 ///     reconstruct: carry X (state (Q, N, X), 3n² values) instead of (Q, N) (2n² values).
 ///
 /// Methods: verlet (default), verlet4, verlet6, rk4. The Verlet methods are the full body's
-/// Störmer–Verlet step reduced: a kick N <- N - tau C (dU/dX(C))^T (C C^T = Q) and the exact
-/// drift Q <- Q + tau (N + N^T) + tau^2 K, N <- N + tau K, K = N^T Q^-1 N, and their Suzuki /
+/// Störmer–Verlet step reduced: a kick
+/// :math:`N \leftarrow N - \tau C (\partial U/\partial X(C))^\top` (:math:`C C^\top = Q`) and the
+/// exact drift :math:`Q \leftarrow Q + \tau (N + N^\top) + \tau^2 K`,
+/// :math:`N \leftarrow N + \tau K`, :math:`K = N^\top Q^{-1} N`, and their Suzuki /
 /// Yoshida compositions: Poisson maps that keep the Casimirs to round-off and reconstruct
 /// exactly the full Verlet motion of the same steps. rk4 integrates the Riemann field, as a
-/// baseline. Q cannot see the sign of det X: integrate motions that collapse through
-/// det X = 0 with the full `PseudoRigidBody`.
+/// baseline. Q cannot see the sign of :math:`\det X`: integrate motions that collapse through
+/// :math:`\det X = 0` with the full `PseudoRigidBody`.
 ///
-/// States are flat: (Q row-major, N row-major[, X row-major]); make them with
-/// `body.reduce(X, P)`. Invariants: tr((L^T L)^k)/2 then tr((Gamma^T Gamma)^k)/2,
-/// k = 1..n//2 (the full body's values).
+/// States are flat: (Q row-major, N row-major[, X row-major]); make them with `body.reduce(X, P)`.
+/// Invariants: :math:`\tfrac12 \operatorname{tr}((L^\top L)^k)` then
+/// :math:`\tfrac12 \operatorname{tr}((\Gamma^\top \Gamma)^k)`,
+/// :math:`k = 1, \dots, \lfloor n/2 \rfloor` (the full body's values).
 #[pyclass(module = "lieflow.pseudo_rigid", name = "RightReduced", extends = PySystem, frozen)]
 pub struct PyRightReduced {
     potential: Py<PyPotential>,
@@ -108,15 +113,15 @@ impl PyRightReduced {
         self.potential.clone_ref(py)
     }
 
-    /// The reduced state of a full one: (Q, N) = (X X^T, X P^T) (001 (3.4)), then X when the
-    /// system reconstructs.
+    /// The reduced state of a full one: :math:`(Q, N) = (X X^\top, X P^\top)` (001 (3.4)), then X
+    /// when the system reconstructs.
     ///
     /// Args:
-    ///     X: (n, n) with det X > 0; P: (n, n).
+    ///     X: (n, n) with :math:`\det X > 0`; P: (n, n).
     /// Returns:
     ///     (d,) flat state.
     /// Raises:
-    ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+    ///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`).
     fn reduce<'py>(
         slf: &Bound<'py, Self>,
         X: ArrayIn<'py>,
@@ -126,8 +131,8 @@ impl PyRightReduced {
         Ok(numpy::PyArray1::from_vec(slf.py(), z))
     }
 
-    /// The full states (X, P = N^T X^-T) of states (..., d) of a reconstructing system ->
-    /// ((..., n, n), (..., n, n)).
+    /// The full states :math:`(X, P = N^\top X^{-\top})` of states (..., d) of a reconstructing
+    /// system -> ((..., n, n), (..., n, n)).
     ///
     /// Raises:
     ///     InvalidArgumentError (the system does not carry X), ShapeError, NonFiniteError.
@@ -150,8 +155,9 @@ impl PyRightReduced {
     }
 
     /// The three terms of the reduced Hamiltonian 001 (3.31) at the state's circulation gamma:
-    /// [<Y, Y>/2 (the horizontal kinetic energy, on T*(GL+(n)/SO(n))),
-    /// <gamma, (A^R_X)^-1 gamma>/2 (the locked energy of the relabelling), U]; they add up to H.
+    /// [:math:`\tfrac12 \langle Y, Y \rangle` (the horizontal kinetic energy, on
+    /// :math:`T^*(GL^+(n)/SO(n))`), :math:`\tfrac12 \langle \gamma, (A^R_X)^{-1} \gamma \rangle`
+    /// (the locked energy of the relabelling), U]; they add up to H.
     /// States (..., d) -> (..., 3).
     fn hamiltonian_parts<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let b = body(slf)?;
@@ -161,7 +167,8 @@ impl PyRightReduced {
         })
     }
 
-    /// Angular momentum L = N^T - N (001 (2.29), (3.10)) of states (..., d) -> (..., n, n).
+    /// Angular momentum :math:`L = N^\top - N` (001 (2.29), (3.10)) of states (..., d) -> (..., n,
+    /// n).
     fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let b = body(slf)?;
         let n = b.n();
@@ -172,8 +179,9 @@ impl PyRightReduced {
     }
 
     /// The circulation at the representative C (the Cholesky factor of Q):
-    /// Gamma_C = C^-1 N C - C^T N^T C^-T, conjugate to the circulation of every X over (Q, N)
-    /// (equal to it up to a rotation of the labels). States (..., d) -> (..., n, n).
+    /// :math:`\Gamma_C = C^{-1} N C - C^\top N^\top C^{-\top}`, conjugate to the circulation of
+    /// every X over (Q, N) (equal to it up to a rotation of the labels). States (..., d) -> (...,
+    /// n, n).
     fn circulation<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let b = body(slf)?;
         let n = b.n();
@@ -185,22 +193,29 @@ impl PyRightReduced {
 }
 
 /// The reduced Euler–Lagrange equation (001 (3.17)) of a right SO(n)-invariant Lagrangian
-/// L(Q, N) in the Riemann variables Q = X X^T, N = X dX/dt^T:
+/// :math:`L(Q, N)` in the Riemann variables :math:`Q = X X^\top`, :math:`N = X \dot X^\top`:
 ///
-///     d/dt (dL/dN)^T = (dL/dN - (dL/dN)^T) N^T Q^-1 + 2 dL/dQ,   dQ/dt = N + N^T.
+/// .. math::
 ///
-/// For L = tr(N^T Q^-1 N)/2 - U(Q) it is the Riemann field (001 (3.20)). dL/dQ is the gradient
-/// over symmetric matrices (Q's variations are symmetric). The Hessian of L in N and the mixed
-/// derivative along dQ/dt are central differences of the gradient (steps eps^(1/3) relative).
+///     \frac{d}{dt} (\partial L/\partial N)^\top
+///         = (\partial L/\partial N - (\partial L/\partial N)^\top) N^\top Q^{-1}
+///         + 2\, \partial L/\partial Q, \qquad \dot Q = N + N^\top.
+///
+/// For :math:`L = \tfrac12 \operatorname{tr}(N^\top Q^{-1} N) - U(Q)` it is the Riemann field
+/// (001 (3.20)). :math:`\partial L/\partial Q` is the gradient over symmetric matrices (Q's
+/// variations are symmetric). The Hessian of L in N and the mixed derivative along
+/// :math:`\dot Q` are central differences of the gradient (steps :math:`\varepsilon^{1/3}`
+/// relative).
 ///
 /// Args:
 ///     lagrangian: L(Q, N) -> float, Q and N (n, n) arrays.
 ///     Q: (n, n) symmetric positive definite; N: (n, n).
 ///     gradient: optional (Q, N) -> (dL/dQ, dL/dN), two (n, n) arrays; without it the gradient is
-///         a central difference of `lagrangian` (steps eps^(1/3) relative) and the Hessian a
-///         difference of that (steps eps^(2/9)), so dN/dt has about 7 digits instead of 10.
+///         a central difference of `lagrangian` (steps :math:`\varepsilon^{1/3}` relative) and
+///         the Hessian a difference of that (steps :math:`\varepsilon^{2/9}`), so :math:`\dot N`
+///         has about 7 digits instead of 10.
 /// Returns:
-///     (dQ/dt, dN/dt), two (n, n) arrays.
+///     :math:`(\dot Q, \dot N)`, two (n, n) arrays.
 /// Raises:
 ///     ShapeError, NonFiniteError, InvalidArgumentError (Q not positive definite, or the Hessian
 ///     of L in N singular: L not regular); an exception of `lagrangian` or `gradient` propagates.

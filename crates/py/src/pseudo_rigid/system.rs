@@ -16,28 +16,32 @@ use crate::system::{PySystem, Thin};
 
 type Any<'py> = Bound<'py, PyAny>;
 
-/// A generalized pseudo-rigid body on T*GL+(n) with H = tr(P^T P)/2 + U(X) (001 (3.22)).
+/// A generalized pseudo-rigid body on :math:`T^*GL^+(n)` with
+/// :math:`H = \tfrac12 \operatorname{tr}(P^\top P) + U(X)` (001 (3.22)).
 ///
 /// Args:
 ///     n: dimension (>= 2).
 ///     potential: a `lieflow.potentials` potential (default: Zero(), the free body).
-///     check_det: stop with LeftDomainError (naming the time) when det X <= 0 (always on for a
-///         volumetric potential and for an incompressible body; the equations extend to all n×n
-///         matrices otherwise).
-///     incompressible: hold the volume, det X = det X0 (a fluid or incompressible elastic
-///         ellipsoid; the pressure is the multiplier of the constraint).
+///     check_det: stop with LeftDomainError (naming the time) when :math:`\det X \le 0` (always
+///         on for a volumetric potential and for an incompressible body; the equations extend to
+///         all n×n matrices otherwise).
+///     incompressible: hold the volume, :math:`\det X = \det X_0` (a fluid or incompressible
+///         elastic ellipsoid; the pressure is the multiplier of the constraint).
 ///
 /// Integrate with `lf.integrate(body, (X0, P0), dt=..., steps=..., method=...)`.
 /// Methods: verlet (default), verlet4, verlet6 (Störmer–Verlet and its order-4/6
 /// compositions), reduced (reduced-space splitting on the principal stratum, 001 §7, order 2,
 /// exact coadjoint orbits). The incompressible body has its own methods instead:
 /// "rattle" (the default, order 2), "rattle4" and "rattle6" (RATTLE and its Suzuki / Yoshida
-/// compositions, orders 4 and 6): symplectic on T*{det X = det X0}, they keep det X, L and
-/// Gamma to round-off (`body.methods()` on the instance lists them). Its states must move
-/// without changing the volume, <cof X, P> = det(X) tr(X^-1 P) = 0 (InvalidArgumentError
-/// otherwise): make P so with `body.project_momentum(X, P)`. States are flat: z = (X row-major,
-/// P row-major), length 2n²; fields X and P. Invariants: tr((L^T L)^k)/2 then
-/// tr((Γ^T Γ)^k)/2, k = 1..n//2, then det X for the incompressible body.
+/// compositions, orders 4 and 6): symplectic on :math:`T^*\{\det X = \det X_0\}`, they keep
+/// :math:`\det X`, L and :math:`\Gamma` to round-off (`body.methods()` on the instance lists
+/// them). Its states must move without changing the volume,
+/// :math:`\langle \operatorname{cof} X, P \rangle = \det(X) \operatorname{tr}(X^{-1} P) = 0`
+/// (InvalidArgumentError otherwise): make P so with `body.project_momentum(X, P)`. States are
+/// flat: z = (X row-major, P row-major), length 2n²; fields X and P. Invariants:
+/// :math:`\tfrac12 \operatorname{tr}((L^\top L)^k)` then
+/// :math:`\tfrac12 \operatorname{tr}((\Gamma^\top \Gamma)^k)`,
+/// :math:`k = 1, \dots, \lfloor n/2 \rfloor`, then :math:`\det X` for the incompressible body.
 #[pyclass(module = "lieflow", name = "PseudoRigidBody", extends = PySystem, frozen)]
 pub struct PyPseudoRigidBody {
     potential: Py<PyPotential>,
@@ -95,28 +99,31 @@ impl PyPseudoRigidBody {
         Ok(body(slf)?.n())
     }
 
-    /// Whether det X > 0 is enforced during integrations.
+    /// Whether :math:`\det X > 0` is enforced during integrations.
     #[getter]
     fn check_det(slf: &Bound<'_, Self>) -> PyResult<bool> {
         Ok(body(slf)?.check_det())
     }
 
-    /// Whether the volume is held (det X = det X0; methods rattle, rattle4, rattle6).
+    /// Whether the volume is held (:math:`\det X = \det X_0`; methods rattle, rattle4, rattle6).
     #[getter]
     fn incompressible(slf: &Bound<'_, Self>) -> PyResult<bool> {
         Ok(body(slf)?.is_incompressible())
     }
 
     /// The projection of a momentum P onto the states of the incompressible body at X:
-    /// P - kappa cof X with kappa = <cof X, P> / ‖cof X‖^2 (cof X = det(X) X^-T), so that
-    /// <cof X, P> = det(X) tr(X^-1 P) = 0 (the motion keeps the volume).
+    /// :math:`P - \kappa \operatorname{cof} X` with
+    /// :math:`\kappa = \langle \operatorname{cof} X, P \rangle / \|\operatorname{cof} X\|^2`
+    /// (:math:`\operatorname{cof} X = \det(X) X^{-\top}`), so that
+    /// :math:`\langle \operatorname{cof} X, P \rangle = \det(X) \operatorname{tr}(X^{-1} P) = 0`
+    /// (the motion keeps the volume).
     ///
     /// Args:
-    ///     X: (n, n) with det X > 0; P: (n, n).
+    ///     X: (n, n) with :math:`\det X > 0`; P: (n, n).
     /// Returns:
     ///     (n, n) array.
     /// Raises:
-    ///     ShapeError, NonFiniteError, NotInGroupError (det X <= 0).
+    ///     ShapeError, NonFiniteError, NotInGroupError (:math:`\det X \le 0`).
     fn project_momentum<'py>(
         slf: &Bound<'py, Self>,
         X: ArrayIn<'py>,
@@ -132,7 +139,8 @@ impl PyPseudoRigidBody {
         self.potential.clone_ref(py)
     }
 
-    /// Angular momentum L = P X^T - X P^T (001 (7.3)) of states (..., d) -> (..., n, n).
+    /// Angular momentum :math:`L = P X^\top - X P^\top` (001 (7.3)) of states
+    /// (..., d) -> (..., n, n).
     fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let n = body(slf)?.n();
         observe(slf, states, &[n, n], |b, z, out| {
@@ -140,7 +148,8 @@ impl PyPseudoRigidBody {
         })
     }
 
-    /// Circulation Γ = P^T X - X^T P (001 (7.3)) of states (..., d) -> (..., n, n).
+    /// Circulation :math:`\Gamma = P^\top X - X^\top P` (001 (7.3)) of states
+    /// (..., d) -> (..., n, n).
     fn circulation<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let n = body(slf)?.n();
         observe(slf, states, &[n, n], |b, z, out| {
@@ -148,7 +157,8 @@ impl PyPseudoRigidBody {
         })
     }
 
-    /// Singular values a_1 >= ... >= a_n of X (the semi-axes), states (..., d) -> (..., n).
+    /// Singular values :math:`a_1 \ge \dots \ge a_n` of X (the semi-axes), states
+    /// (..., d) -> (..., n).
     fn singular_values<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let n = body(slf)?.n();
         observe(slf, states, &[n], |b, z, out| {

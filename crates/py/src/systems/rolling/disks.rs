@@ -33,17 +33,20 @@ fn point(what: &str, v: &Any<'_>) -> PyResult<[f64; 2]> {
 }
 
 /// Two disks rolling against each other in the plane without slipping (003 §1). Disk k has
-/// radius r_k, centre of mass gamma_k in its reference disk (a complex number or a 2-vector),
-/// mass m_k and moment of inertia I_k about its centre (003 (6): the integral of ‖p‖^2). The
-/// rolling constraint integrates to R phi - r1 theta1 - r2 theta2 = c (R = r1 + r2, c the
-/// rolling constant), leaving the two disk angles theta = (theta1, theta2); the centre of mass
-/// of the pair is at the origin. State (theta1, theta2, p1, p2); fields theta (2), p (2),
-/// thetadot (2), phi (the direction of the contact point from disk 1's centre).
-/// H = p^T M(theta)^-1 p / 2; invariant: the angular momentum J = p1 + p2. Methods: gauss4
+/// radius :math:`r_k`, centre of mass :math:`\gamma_k` in its reference disk (a complex number or
+/// a 2-vector), mass :math:`m_k` and moment of inertia :math:`I_k` about its centre (003 (6): the
+/// integral of :math:`\|p\|^2`). The rolling constraint integrates to
+/// :math:`R\phi - r_1\theta_1 - r_2\theta_2 = c` (:math:`R = r_1 + r_2`, c the rolling constant),
+/// leaving the two disk angles :math:`\theta = (\theta_1, \theta_2)`; the centre of mass of the
+/// pair is at the origin. State (theta1, theta2, p1, p2); fields theta (2), p (2), thetadot (2),
+/// phi (the direction of the contact point from disk 1's centre).
+/// :math:`H = \tfrac12 p^\top M(\theta)^{-1} p`; invariant: the angular momentum
+/// :math:`J = p_1 + p_2`. Methods: gauss4
 /// (default), gauss6, midpoint (symplectic Gauss–Legendre), rk4.
 ///
 /// Raises:
-///     InvalidArgumentError (r, m <= 0, ‖gamma‖ >= r, I <= m ‖gamma‖^2), TypeError.
+///     InvalidArgumentError (:math:`r, m \le 0`, :math:`\|\gamma\| \ge r`,
+///     :math:`I \le m \|\gamma\|^2`), TypeError.
 #[pyclass(name = "RollingDisks", module = "lieflow", extends = PySystem, frozen)]
 #[derive(Default)]
 pub struct PyRollingDisks;
@@ -91,7 +94,7 @@ impl PyRollingDisks {
         Ok(slf.core::<RollingDisks>()?.rolling_constant())
     }
 
-    /// The state (theta, M(theta) thetadot) from the angles and their rates.
+    /// The state :math:`(\theta, M(\theta)\dot\theta)` from the angles and their rates.
     ///
     /// Raises:
     ///     NonFiniteError.
@@ -103,7 +106,8 @@ impl PyRollingDisks {
         slf.core::<RollingDisks>()?.state(theta, thetadot).py()
     }
 
-    /// The mass matrix M(theta) of T = thetadot^T M thetadot / 2 (2, 2).
+    /// The mass matrix :math:`M(\theta)` of :math:`T = \tfrac12 \dot\theta^\top M \dot\theta` (2,
+    /// 2).
     fn mass_matrix(
         slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
@@ -111,8 +115,8 @@ impl PyRollingDisks {
         slf.core::<RollingDisks>()?.mass_matrix(theta).py()
     }
 
-    /// The locked inertia (1, 1) M(theta) (1, 1)^T: the moment of inertia of the pair rotating
-    /// rigidly about its centre of mass.
+    /// The locked inertia :math:`(1, 1)\, M(\theta)\, (1, 1)^\top`: the moment of inertia of the
+    /// pair rotating rigidly about its centre of mass.
     fn locked_inertia(
         slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
@@ -139,7 +143,8 @@ impl PyRollingDisks {
         Ok(fields)
     }
 
-    /// The total angular momentum about the centre of mass, J = p1 + p2, (..., 4) -> (...).
+    /// The total angular momentum about the centre of mass, :math:`J = p_1 + p_2`,
+    /// (..., 4) -> (...).
     fn angular_momentum<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let disks = slf.core::<RollingDisks>()?;
         slf.base().map_states(slf.py(), &states, &[], |z, out| {
@@ -175,13 +180,13 @@ impl PyRollingDisks {
         Ok(out)
     }
 
-    /// Every rotational relative equilibrium (the pair rotating rigidly about its centre of
-    /// mass) with theta1 in `theta1_range` (default: one turn of disk 1), in the gauge where
-    /// the contact point lies in the direction phi = 0 from disk 1's centre, for the rolling
-    /// constant `rolling_constant` (default: the system's). They are the configurations in
-    /// which both centres of mass and the contact point are collinear; stable where the locked
-    /// inertia is maximal along the rolling direction (003 §1, corrected; see the module docs
-    /// of `lieflow::systems::rolling::disks`).
+    /// Every rotational relative equilibrium (the pair rotating rigidly about its centre of mass)
+    /// with theta1 in `theta1_range` (default: one turn of disk 1), in the gauge where the contact
+    /// point lies in the direction :math:`\phi = 0` from disk 1's centre, for the rolling constant
+    /// `rolling_constant` (default: the system's). They are the configurations in which both
+    /// centres of mass and the contact point are collinear; stable where the locked inertia is
+    /// maximal along the rolling direction (003 §1, corrected; see the module docs of
+    /// `lieflow::systems::rolling::disks`).
     ///
     /// Raises:
     ///     InvalidArgumentError (an empty range), NonFiniteError.
@@ -208,8 +213,8 @@ impl PyRollingDisks {
     }
 }
 
-/// A rotational relative equilibrium of `RollingDisks`: the pair rotating rigidly about its
-/// centre of mass with any angular velocity omega != 0 (the equilibria and their stability do
+/// A rotational relative equilibrium of `RollingDisks`: the pair rotating rigidly about its centre
+/// of mass with any angular velocity :math:`\omega \ne 0` (the equilibria and their stability do
 /// not depend on it).
 #[pyclass(name = "RollingDisksEquilibrium", module = "lieflow", frozen)]
 pub struct PyDisksEquilibrium {
@@ -244,13 +249,14 @@ impl PyDisksEquilibrium {
         self.eq.degenerate
     }
 
-    /// The contact point P (centre-of-mass frame, gauge phi = 0).
+    /// The contact point P (centre-of-mass frame, gauge :math:`\phi = 0`).
     #[getter]
     fn contact_point(&self) -> [f64; 2] {
         self.eq.contact
     }
 
-    /// The range of abs(omega) for which it is a relative equilibrium: (0, inf), every rotation.
+    /// The range of :math:`|\omega|` for which it is a relative equilibrium: :math:`(0, \infty)`,
+    /// every rotation.
     #[getter]
     fn angular_velocity_range(&self) -> (f64, f64) {
         (0.0, f64::INFINITY)
@@ -262,7 +268,7 @@ impl PyDisksEquilibrium {
         self.eq.locked_inertia
     }
 
-    /// The second derivative of the locked inertia along the rolling direction (r2, -r1):
+    /// The second derivative of the locked inertia along the rolling direction :math:`(r_2, -r_1)`:
     /// negative where stable.
     #[getter]
     fn curvature(&self) -> f64 {

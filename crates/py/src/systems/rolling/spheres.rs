@@ -18,15 +18,17 @@ type Any<'py> = Bound<'py, PyAny>;
 
 /// Two rigid spheres rolling against each other without slipping, free in space (003 §2).
 ///
-/// Sphere k has radius r_k, mass m_k, centre of mass gamma_k (‖gamma_k‖ < r_k, in the reference
-/// sphere centred at 0) and second-moment matrix about its centre of mass
-/// I_k = int (p - gamma_k)(p - gamma_k)^T dm (symmetric positive semi-definite; the moment of
-/// inertia tensor is tr(I_k) 1 - I_k). State (z1, z2, u, Omega1, Omega2) (27,): attitudes
-/// z_k in SO(3) (row-major), u in S^2 the unit vector from centre 1 to centre 2, body angular
-/// velocities Omega_k; du/dt = (alpha1 z1 Omega1 + alpha2 z2 Omega2) x u (003 (10),
-/// alpha_k = r_k/(r1 + r2)). Energy: the kinetic energy of both bodies (centre-of-mass frame);
-/// invariants: the total angular momentum (3,). Methods: midpoint (default; symmetric Lie-group
-/// midpoint, order 2, bounded energy error), midpoint4, rkmk4, rk4.
+/// Sphere k has radius :math:`r_k`, mass :math:`m_k`, centre of mass :math:`\gamma_k`
+/// (:math:`\|\gamma_k\| < r_k`, in the reference sphere centred at 0) and second-moment matrix
+/// about its centre of mass :math:`I_k = \int (p - \gamma_k)(p - \gamma_k)^\top dm` (symmetric
+/// positive semi-definite; the moment of inertia tensor is
+/// :math:`\operatorname{tr}(I_k)\, \mathrm{Id} - I_k`). State (z1, z2, u, Omega1, Omega2) (27,):
+/// attitudes :math:`z_k \in SO(3)` (row-major), :math:`u \in S^2` the unit vector from centre 1 to
+/// centre 2, body angular velocities :math:`\Omega_k`;
+/// :math:`\dot u = (\alpha_1 z_1 \Omega_1 + \alpha_2 z_2 \Omega_2) \times u` (003 (10),
+/// :math:`\alpha_k = r_k/(r_1 + r_2)`). Energy: the kinetic energy of both bodies (centre-of-mass
+/// frame); invariants: the total angular momentum (3,). Methods: midpoint (default; symmetric
+/// Lie-group midpoint, order 2, bounded energy error), midpoint4, rkmk4, rk4.
 ///
 /// Args:
 ///     r1, r2, m1, m2 > 0; gamma1, gamma2 (3,); inertia1, inertia2 (3, 3).
@@ -92,13 +94,14 @@ impl PyRollingSpheres {
         Ok(PySystem::subclass(sys, args, names))
     }
 
-    /// e = m1 m2 / (m1 + m2) times R^2 = (r1 + r2)^2: the kinetic energy is this times L of 003 (8).
+    /// :math:`e = \frac{m_1 m_2}{m_1 + m_2} R^2` with :math:`R = r_1 + r_2`: the kinetic energy is
+    /// this times L of 003 (8).
     #[getter]
     fn scale(slf: &Bound<'_, Self>) -> PyResult<f64> {
         Ok(slf.core::<RollingSpheres>()?.scale())
     }
 
-    /// (alpha1, alpha2) = (r1, r2) / (r1 + r2).
+    /// :math:`(\alpha_1, \alpha_2) = (r_1, r_2) / (r_1 + r_2)`.
     #[getter]
     fn alphas(slf: &Bound<'_, Self>) -> PyResult<[f64; 2]> {
         Ok(slf.core::<RollingSpheres>()?.alphas())
@@ -120,11 +123,12 @@ impl PyRollingSpheres {
         sys.state(z1, z2, u, Omega1, Omega2).py()
     }
 
-    /// The planar state (003 §2.4 <-> §1): z_k the rotation by theta_k about e3,
-    /// u = (cos phi, sin phi, 0), Omega_k = (0, 0, thetadot_k); then dphi/dt =
-    /// (r1 thetadot_1 + r2 thetadot_2)/(r1 + r2). It stays planar when gamma_k is
-    /// perpendicular to e3 and e3 is an eigenvector of I_k. 003 §1's disk moment of inertia
-    /// (about the disk's centre) is I_k[0,0] + I_k[1,1] + m_k ‖gamma_k‖^2.
+    /// The planar state (003 §2.4 <-> §1): :math:`z_k` the rotation by :math:`\theta_k` about
+    /// :math:`e_3`, :math:`u = (\cos\phi, \sin\phi, 0)`, :math:`\Omega_k = (0, 0, \dot\theta_k)`;
+    /// then :math:`\dot\phi = (r_1\dot\theta_1 + r_2\dot\theta_2)/(r_1 + r_2)`. It stays planar
+    /// when :math:`\gamma_k` is perpendicular to :math:`e_3` and :math:`e_3` is an eigenvector of
+    /// :math:`I_k`. 003 §1's disk moment of inertia (about the disk's centre) is
+    /// :math:`I_k[0,0] + I_k[1,1] + m_k \|\gamma_k\|^2`.
     fn planar_state(
         slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] theta: [f64; 2],
@@ -155,13 +159,19 @@ impl PyRollingSpheres {
         slf.core::<RollingSpheres>()?.to_planar(&state, tol).py()
     }
 
-    /// The Lagrangian L of 003 (8), evaluated as printed with du/dt from the rolling constraint
-    /// (10):
-    /// ``L = Omega1^T J1 Omega1 / 2 + Omega2^T J2 Omega2 / 2 + |udot|^2 / 2 - B``,
-    /// ``B = dot(udot, alpha1 b1 - alpha2 b2) + alpha1 alpha2 dot(b1, b2)``, with
-    /// ``b_k = z_k (Omega_k x e_k)``,
-    /// ``e_k = gamma_k / r_k`` and the rescaled tensors J_k of 003 §2; ``scale * L`` is the kinetic
-    /// energy of both bodies (`energy`, computed in the completed-square form). (..., 27) -> (...).
+    /// The Lagrangian L of 003 (8), evaluated as printed with :math:`\dot u` from the rolling
+    /// constraint (10):
+    ///
+    /// .. math::
+    ///
+    ///     L = \tfrac12 \Omega_1^\top J_1 \Omega_1 + \tfrac12 \Omega_2^\top J_2 \Omega_2
+    ///         + \tfrac12 \|\dot u\|^2 - B,
+    ///
+    ///     B = \dot u \cdot (\alpha_1 b_1 - \alpha_2 b_2) + \alpha_1 \alpha_2\, b_1 \cdot b_2,
+    ///
+    /// with :math:`b_k = z_k (\Omega_k \times e_k)`, :math:`e_k = \gamma_k / r_k` and the rescaled
+    /// tensors :math:`J_k` of 003 §2; ``scale * L`` is the kinetic energy of both bodies
+    /// (`energy`, computed in the completed-square form). (..., 27) -> (...).
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError, NotInGroupError (z_k not rotations, u not a unit vector).
@@ -172,12 +182,19 @@ impl PyRollingSpheres {
         })
     }
 
-    /// The curvature of the rolling distribution (003 §2.2) in closed form:
-    /// ``Delta(X, X~) = alpha1 alpha2 u x ((z1 Omega1 - z2 Omega2) x (z1 Omega1~ - z2 Omega2~))``
-    /// for the constrained fields X, X~ with body angular velocities ``Omega = (Omega1, Omega2)``
-    /// and ``Omega_tilde = (Omega1~, Omega2~)``, at the configuration (z1, z2, u) of the states
-    /// (their velocities are ignored); ``Delta = -nu([X, X~])``, see `curvature_by_brackets`.
-    /// Maps over the broadcast leading axes of the three arguments.
+    /// The curvature of the rolling distribution (003 §2.2) in closed form,
+    ///
+    /// .. math::
+    ///
+    ///     \Delta(X, \tilde X) = \alpha_1 \alpha_2\, u \times ((z_1\Omega_1 - z_2\Omega_2)
+    ///     \times (z_1\tilde\Omega_1 - z_2\tilde\Omega_2)),
+    ///
+    /// for the constrained fields :math:`X, \tilde X` with body angular velocities
+    /// :math:`\Omega = (\Omega_1, \Omega_2)` (`Omega`) and
+    /// :math:`\tilde\Omega = (\tilde\Omega_1, \tilde\Omega_2)` (`Omega_tilde`), at the
+    /// configuration (z1, z2, u) of the states (their velocities are ignored);
+    /// :math:`\Delta = -\nu([X, \tilde X])`, see `curvature_by_brackets`. Maps over the broadcast
+    /// leading axes of the three arguments.
     ///
     /// Args:
     ///     states: (..., 27); Omega, Omega_tilde: (..., 2, 3), rows the angular velocities of the
@@ -198,13 +215,14 @@ impl PyRollingSpheres {
         })
     }
 
-    /// The curvature of the rolling distribution (003 §2.2) from the Lie bracket of the
-    /// constrained fields, ``Delta(X, X~) = -nu([X, X~])`` with
-    /// ``nu(Omega1, Omega2, v) = v - (alpha1 z1 Omega1 + alpha2 z2 Omega2) x u``: the bracket
-    /// from the commutator of the exact flows of X and X~ over the time s (second differences,
-    /// symmetrised in +-s and Richardson-extrapolated from s and 2s; error
-    /// O((s ‖Omega‖)^4) + O(eps / s^2): about 1e-9 relative at the default s for angular
-    /// velocities of order one). Equal to `curvature` (the closed form).
+    /// The curvature of the rolling distribution (003 §2.2) from the Lie bracket of the constrained
+    /// fields, :math:`\Delta(X, \tilde X) = -\nu([X, \tilde X])` with
+    /// :math:`\nu(\Omega_1, \Omega_2, v) = v - (\alpha_1 z_1\Omega_1 + \alpha_2 z_2\Omega_2) \times u`:
+    /// the bracket from the commutator of the exact flows of :math:`X` and :math:`\tilde X` over
+    /// the time s (second differences, symmetrised in :math:`\pm s` and Richardson-extrapolated
+    /// from s and 2s; error :math:`O((s \|\Omega\|)^4) + O(\varepsilon / s^2)`: about 1e-9 relative
+    /// at the default s for angular velocities of order one). Equal to `curvature` (the closed
+    /// form).
     ///
     /// Args:
     ///     states: (..., 27); Omega, Omega_tilde: (..., 2, 3); s: the flow time, > 0.
@@ -234,8 +252,9 @@ impl PyRollingSpheres {
         })
     }
 
-    /// Body momenta dKE/dOmega_k (physical units), (..., 27) -> (..., 2, 3); their component
-    /// along gamma_k is the (non-conserved) momentum of the material rotation about it.
+    /// Body momenta :math:`\partial T/\partial\Omega_k` (T the kinetic energy, physical units),
+    /// (..., 27) -> (..., 2, 3); their component along :math:`\gamma_k` is the (non-conserved)
+    /// momentum of the material rotation about it.
     fn body_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         observe(slf, states, &[2, 3], |s, z, out| {
             out.copy_from_slice(s.body_momenta(z)?.as_flattened());
@@ -243,8 +262,8 @@ impl PyRollingSpheres {
         })
     }
 
-    /// Spatial momenta P_k conjugate to the spatial angular velocities (P1 + P2 = total
-    /// angular momentum), (..., 27) -> (..., 2, 3).
+    /// Spatial momenta :math:`P_k` conjugate to the spatial angular velocities (:math:`P_1 + P_2` =
+    /// total angular momentum), (..., 27) -> (..., 2, 3).
     fn spatial_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         observe(slf, states, &[2, 3], |s, z, out| {
             out.copy_from_slice(s.spatial_momenta(z)?.as_flattened());
@@ -252,7 +271,7 @@ impl PyRollingSpheres {
         })
     }
 
-    /// du/dt of the rolling constraint 003 (10), (..., 27) -> (..., 3).
+    /// :math:`\dot u` of the rolling constraint 003 (10), (..., 27) -> (..., 3).
     fn udot<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         observe(slf, states, &[3], |s, z, out| {
             out.copy_from_slice(&s.udot(z)?);
@@ -268,7 +287,7 @@ impl PyRollingSpheres {
         })
     }
 
-    /// The geometric centres a_1, a_2 of 003 (4), (..., 27) -> (..., 2, 3).
+    /// The geometric centres :math:`a_1, a_2` of 003 (4), (..., 27) -> (..., 2, 3).
     fn centres<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         observe(slf, states, &[2, 3], |s, z, out| {
             out.copy_from_slice(s.centres(z)?.as_flattened());
@@ -284,7 +303,7 @@ impl PyRollingSpheres {
         })
     }
 
-    /// Body angular accelerations (dOmega1/dt, dOmega2/dt), (..., 27) -> (..., 2, 3).
+    /// Body angular accelerations :math:`(\dot\Omega_1, \dot\Omega_2)`, (..., 27) -> (..., 2, 3).
     fn accelerations<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         observe(slf, states, &[2, 3], |s, z, out| {
             out.copy_from_slice(s.accelerations(z)?.as_flattened());

@@ -43,9 +43,11 @@ fn tensor(inertia: &Any<'_>) -> PyResult<[f64; 4]> {
 
 /// The tangent Euler top on a surface (002 §II–III): a rigid planar body carried as an
 /// orthonormal frame tangent to the surface; configuration (x1, x2, theta), theta the angle from
-/// the surface's E1 to the body's E1. L = m g(xdot, xdot)/2 + I (thetadot + w(xdot))^2 / 2 with
-/// w the connection 1-form (002 (43); the cross term of (45)/(47) with the corrected sign); with
-/// `embedded=True` the body moves as embedded in R^3 and L gains the second-fundamental-form
+/// the surface's E1 to the body's E1.
+/// :math:`L = \tfrac12 m\, g(\dot x, \dot x) + \tfrac12 I (\dot\theta + w(\dot x))^2` with
+/// :math:`w` the connection 1-form (002 (43); the cross term of (45)/(47) with the corrected
+/// sign); with `embedded=True` the body moves as embedded in :math:`\mathbb{R}^3` and L gains the
+/// second-fundamental-form
 /// term of 002 (37) (for a symmetric body, (39)), which for an anisotropic body depends on theta.
 /// State (x1, x2, theta, p1, p2, p_theta); fields x (2), theta, p (3), xdot (2), thetadot.
 /// Invariants: p_theta (unless embedded and anisotropic) and the Killing momenta of the affine
@@ -54,9 +56,11 @@ fn tensor(inertia: &Any<'_>) -> PyResult<[f64; 4]> {
 /// Args:
 ///     surface: a `lieflow.surfaces` surface.
 ///     mass: m > 0.
-///     inertia: the scalar I = tr of the Euler tensor (a symmetric body, tensor I/2 Id), or the
-///         (2, 2) Euler tensor integral xi xi^T dm (symmetric positive semi-definite).
-///     embedded: include the embedding term (surfaces with an embedding in R^3 only).
+///     inertia: the scalar :math:`I`, the trace of the Euler tensor (a symmetric body, tensor
+///         :math:`\tfrac{I}{2} \mathrm{Id}`), or the (2, 2) Euler tensor
+///         :math:`\int \xi \xi^\top dm` (symmetric positive semi-definite).
+///     embedded: include the embedding term (surfaces with an embedding in :math:`\mathbb{R}^3`
+///         only).
 /// Raises:
 ///     InvalidArgumentError, ShapeError.
 #[pyclass(name = "TangentTop", module = "lieflow", extends = PySystem, frozen)]
@@ -105,12 +109,14 @@ impl PyTangentTop {
         crate::errors::checked(|| top.state(x, theta, xdot, thetadot))
     }
 
-    /// The metric of the configuration space at eta = (x1, x2, theta), 002 (47) with the sign of
-    /// its cross terms corrected: ``g_AB = [[m g + I a a^T, I a], [I a^T, I]]`` with g the surface's
-    /// metric, a = (alpha_1, alpha_2) its connection 1-form and I = tr of the Euler tensor; for the
-    /// embedded top ``m g`` becomes ``G(x, theta) = m g + W^T Q(theta) W`` (002 (37), (39)). The
-    /// Lagrangian is ``L = etadot^T g_AB etadot / 2`` and the canonical momenta of `state` are
-    /// ``p = g_AB etadot``.
+    /// The metric of the configuration space at :math:`\eta = (x_1, x_2, \theta)`, 002 (47) with
+    /// the sign of its cross terms corrected:
+    /// :math:`g_{AB} = \begin{pmatrix} m g + I a a^\top & I a \\ I a^\top & I \end{pmatrix}` with
+    /// :math:`g` the surface's metric, :math:`a = (\alpha_1, \alpha_2)` its connection 1-form and
+    /// :math:`I` the trace of the Euler tensor; for the embedded top :math:`m g` becomes
+    /// :math:`G(x, \theta) = m g + W^\top Q(\theta) W` (002 (37), (39)). The Lagrangian is
+    /// :math:`L = \tfrac12 \dot\eta^\top g_{AB} \dot\eta` and the canonical momenta of `state` are
+    /// :math:`p = g_{AB} \dot\eta`.
     ///
     /// Args:
     ///     x: (2,) in the surface's chart; theta: the body's angle.
@@ -129,9 +135,10 @@ impl PyTangentTop {
     }
 
     /// The Lagrangian of the top, 002 (43)–(47) (cross term with the corrected sign):
-    /// ``L = m g(xdot, xdot) / 2 + I (thetadot + alpha_i xdot^i)^2 / 2`` with I = tr of the Euler
-    /// tensor and alpha the connection 1-form of the surface's frame; for the embedded top
-    /// ``m g`` becomes ``G(x, theta) = m g + W^T Q(theta) W`` (002 (37), (39)).
+    /// :math:`L = \tfrac12 m\, g(\dot x, \dot x) + \tfrac12 I (\dot\theta + \alpha_i \dot x^i)^2`
+    /// with :math:`I` the trace of the Euler tensor and :math:`\alpha` the connection 1-form of the
+    /// surface's frame; for the embedded top :math:`m g` becomes
+    /// :math:`G(x, \theta) = m g + W^\top Q(\theta) W` (002 (37), (39)).
     ///
     /// Args:
     ///     x: (2,) in the surface's chart; theta; xdot: (2,); thetadot.
@@ -184,8 +191,8 @@ impl PyTangentTop {
         })
     }
 
-    /// All Killing momenta J = p_A X^A of the surface's isometry group (Plane: translations x, y
-    /// and the rotation; Sphere: the ambient angular momentum x, y, z; HyperbolicPlane: the
+    /// All Killing momenta :math:`J = p_A X^A` of the surface's isometry group (Plane: translations
+    /// x, y and the rotation; Sphere: the ambient angular momentum x, y, z; HyperbolicPlane: the
     /// Möbius generators E, H, F; Revolution and Torus: p_phi), (..., 6) -> (..., k).
     fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let top = slf.core::<TangentTop>()?;
@@ -196,7 +203,7 @@ impl PyTangentTop {
         })
     }
 
-    /// The body in R^3 for a surface with an embedding: rows (position c, E1, E2),
+    /// The body in :math:`\mathbb{R}^3` for a surface with an embedding: rows (position c, E1, E2),
     /// (..., 6) -> (..., 3, 3).
     ///
     /// Raises:
@@ -233,10 +240,12 @@ impl PyTangentTop {
 
 /// The charged particle of 002 §III.B that stands for a tangent top with angular momentum
 /// p_theta: mass m on the surface with metric g (plus the (39) term for a symmetric embedded
-/// top), magnetic potential A = alpha (the frame's connection 1-form) and charge p_theta. The
+/// top), magnetic potential :math:`A = \alpha` (the frame's connection 1-form) and charge
+/// :math:`p_\theta`. The
 /// Routhian of the top gives it; 002 (58) prints a different metric, potential and charge (a
 /// slip: it is p_theta, not thetadot, that is conserved). State (x1, x2, p1, p2); fields x, p,
-/// xdot. H = ‖p - p_theta A‖^2_G / 2 (the top's energy minus p_theta^2 / (2 I)).
+/// xdot. :math:`H = \tfrac12 \|p - p_\theta A\|_G^2` (the top's energy minus
+/// :math:`p_\theta^2 / (2 I)`).
 /// Methods: gauss4 (default), gauss6, midpoint (symplectic Gauss–Legendre), rk4.
 ///
 /// Args:
@@ -266,8 +275,8 @@ impl PyChargedParticle {
         Ok(slf.core::<ChargedParticle>()?.charge())
     }
 
-    /// The metric of the particle at x (2, 2): g, plus (I/2m) h g^-1 h for a symmetric embedded
-    /// top.
+    /// The metric of the particle at x (2, 2): :math:`g`, plus :math:`\frac{I}{2m} h g^{-1} h` for
+    /// a symmetric embedded top.
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
@@ -279,7 +288,7 @@ impl PyChargedParticle {
         crate::errors::checked(|| particle.metric(x))
     }
 
-    /// The magnetic potential A = alpha at x.
+    /// The magnetic potential :math:`A = \alpha` at x.
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
@@ -291,7 +300,7 @@ impl PyChargedParticle {
         crate::errors::checked(|| particle.potential(x))
     }
 
-    /// The canonical state (x, p = m G xdot + charge A) from x and xdot.
+    /// The canonical state (x, p), :math:`p = m G \dot x + \mathrm{charge}\, A`, from x and xdot.
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart), NonFiniteError.

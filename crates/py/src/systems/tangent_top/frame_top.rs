@@ -38,21 +38,26 @@ fn inertia_tensor(ob: &Any<'_>) -> PyResult<[f64; 9]> {
 
 /// The tangent Euler top on a three-dimensional space form (002 §V): a rigid body whose centre x
 /// moves on `space` (`lieflow.spaces.Euclidean(3)`, `Sphere(3, radius)`, `Hyperbolic(3, radius)`)
-/// and whose axes are an orthonormal frame tangent there; L = m g(xdot, xdot)/2 + omega.I omega/2
-/// with omega the angular velocity relative to parallel transport.
+/// and whose axes are an orthonormal frame tangent there;
+/// :math:`L = \tfrac12 m\, g(\dot x, \dot x) + \tfrac12 \omega \cdot \mathbb{I}\omega` with
+/// :math:`\omega` the angular velocity relative to parallel transport.
 ///
 /// The configuration space is the frame bundle, which is the isometry group G (SE(3), SO(4),
-/// SO+(1,3)): the columns of g are x/r, e1, e2, e3 (g = [[1, 0], [x, R]] on R^3), and the top is a left-invariant
-/// Lie–Poisson system on G with body momenta Pi = I omega, P = m v (v the body velocity):
-/// dPi/dt = Pi x Omega (the free Euler top), dP/dt = P x Omega + (kappa/m) Pi x P (kappa the
-/// curvature), dg/dt = g xi. Integrals: H, T = P.P/2m and H - T, the Casimirs Pi.P and
-/// P.P + kappa Pi.Pi, the six Killing momenta (`killing_momenta`).
+/// :math:`SO^+(1,3)`): the columns of :math:`g` are :math:`x/r, e_1, e_2, e_3`
+/// (:math:`g = \begin{pmatrix} 1 & 0 \\ x & R \end{pmatrix}` on :math:`\mathbb{R}^3`), and the top
+/// is a left-invariant Lie–Poisson system on G with body momenta :math:`\Pi = \mathbb{I}\omega`,
+/// :math:`P = m v` (v the body velocity): :math:`\dot\Pi = \Pi \times \omega` (the free Euler
+/// top), :math:`\dot P = P \times \omega + (\kappa/m)\, \Pi \times P` (:math:`\kappa` the
+/// curvature), :math:`\dot g = g\xi`. Integrals: :math:`H`, :math:`T = P \cdot P/(2m)` and
+/// :math:`H - T`, the Casimirs :math:`\Pi \cdot P` and :math:`P \cdot P + \kappa\, \Pi \cdot \Pi`,
+/// the six Killing momenta (`killing_momenta`).
 ///
 /// Args:
 ///     space: a `lieflow.spaces` space.
 ///     mass: m > 0.
 ///     inertia: the body's inertia tensor, (3,) principal moments or (3, 3) symmetric positive
-///         definite (for a mass distribution with Euler tensor E, I = tr(E) 1 - E).
+///         definite (for a mass distribution with Euler tensor E,
+///         :math:`\mathbb{I} = \operatorname{tr}(E)\, \mathrm{Id} - E`).
 ///
 /// Methods: exact (default), splitting, splitting4, splitting6, rk4. `exact` is the exact flow:
 /// T commutes with the rotational energy, whose flow is the free rigid body's (elliptic
@@ -60,17 +65,17 @@ fn inertia_tensor(ob: &Any<'_>) -> PyResult<[f64; 9]> {
 /// splittings split the rotational energy into the three axis rotations (orders 2, 4, 6); all of
 /// these keep the Casimirs, T and the Killing momenta to round-off. rk4 integrates the field,
 /// as a baseline. States are flat: (g row-major (16), Pi (3), P (3)); make them with
-/// `top.state(x, R, xdot, omega)`. Invariants: Pi.P, P.P + kappa Pi.Pi, T, then the six Killing
-/// momenta.
+/// `top.state(x, R, xdot, omega)`. Invariants: :math:`\Pi \cdot P`,
+/// :math:`P \cdot P + \kappa\, \Pi \cdot \Pi`, :math:`T`, then the six Killing momenta.
 ///
 /// On a chart (`lieflow.spaces.Riemannian(metric, frame)`) the top is minimally coupled to the
 /// frame's connection C: the spin still obeys the free Euler equations exactly, and the centre
-/// moves by Wong's equations of the spatial spin sigma = R Pi in C (the curvature force of
+/// moves by Wong's equations of the spatial spin :math:`\sigma = R\Pi` in C (the curvature force of
 /// 002 (122), orthogonal to xdot, so T is conserved). States (x, p, R row-major, Pi), 18 values.
 /// Methods: midpoint (default), midpoint4, midpoint6 (the Lie midpoint rule and its compositions),
-/// rkmk4, rk4; all but rk4 move the spin by its exact flow, so H - T and Pi.Pi are kept to
-/// round-off, R stays a rotation and H oscillates without drift. Invariants: H - T, Pi.Pi. No
-/// Killing momenta.
+/// rkmk4, rk4; all but rk4 move the spin by its exact flow, so :math:`H - T` and
+/// :math:`\Pi \cdot \Pi` are kept to round-off, R stays a rotation and H oscillates without
+/// drift. Invariants: :math:`H - T`, :math:`\Pi \cdot \Pi`. No Killing momenta.
 #[pyclass(name = "FrameTop", module = "lieflow", extends = PySystem, frozen)]
 pub struct PyFrameTop {
     space: Py<PySpace>,
@@ -148,7 +153,8 @@ impl PyFrameTop {
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
     }
 
-    /// The flat state of the body at the point x with frame Ê(x) R (Ê = `space.reference_frame`),
+    /// The flat state of the body at the point x with frame :math:`\hat E(x) R`
+    /// (:math:`\hat E` = `space.reference_frame`),
     /// velocity xdot (ambient components, tangent at x) and angular velocity omega relative to
     /// parallel transport (body frame).
     ///
@@ -157,7 +163,7 @@ impl PyFrameTop {
     ///     xdot: like x; omega: (3,).
     /// Returns:
     ///     (22,) state (g row-major, Pi, P) on a space form; (18,) state (x, p, R row-major,
-    ///     Pi) on a Riemannian chart, p = m g xdot + C^T R Pi the canonical momentum.
+    ///     Pi) on a Riemannian chart, :math:`p = m g \dot x + C^\top R \Pi` the canonical momentum.
     /// Raises:
     ///     ShapeError, NonFiniteError, InvalidArgumentError (x not on the space, xdot not tangent),
     ///     NotInGroupError (R not a rotation), the exception of a callable.
@@ -201,7 +207,8 @@ impl PyFrameTop {
         })
     }
 
-    /// The body frame R relative to the reference frame Ê(x): (..., 22) -> (..., 3, 3).
+    /// The body frame R relative to the reference frame :math:`\hat E(x)`: (..., 22) -> (..., 3,
+    /// 3).
     fn frame<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let t = top(slf)?;
         slf.base().map_states(slf.py(), &states, &[3, 3], |z, out| {
@@ -223,8 +230,8 @@ impl PyFrameTop {
         })
     }
 
-    /// The angular velocity omega = I^-1 Pi relative to parallel transport (body frame):
-    /// (..., 22) -> (..., 3).
+    /// The angular velocity :math:`\omega = \mathbb{I}^{-1} \Pi` relative to parallel transport
+    /// (body frame): (..., 22) -> (..., 3).
     fn angular_velocity<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let t = top(slf)?;
         slf.base().map_states(slf.py(), &states, &[3], |z, out| {
@@ -233,11 +240,13 @@ impl PyFrameTop {
         })
     }
 
-    /// The six Killing momenta (J_Pi, J_P), the spatial momentum Ad*_{g^-1}(Pi, P): on the sphere
-    /// and the hyperboloid the momenta of the rotations about, and the translations (boosts)
-    /// along, the axes at the base point, K = [[0, -r J_P^T], [r J_P, hat(J_Pi)]] =
-    /// m (xdot x^T - x xdot^T) + e hat(Pi) e^T; on R^3 the angular momentum about the origin
-    /// x cross m xdot + R Pi, then the momentum m xdot. (..., 22) -> (..., 6).
+    /// The six Killing momenta :math:`(J_\Pi, J_P)`, the spatial momentum
+    /// :math:`\operatorname{Ad}^*_{g^{-1}}(\Pi, P)`: on the sphere and the hyperboloid the momenta
+    /// of the rotations about, and the translations (boosts) along, the axes at the base point,
+    /// :math:`K = \begin{pmatrix} 0 & -r J_P^\top \\ r J_P & \hat J_\Pi \end{pmatrix}
+    /// = m (\dot x x^\top - x \dot x^\top) + e \hat\Pi e^\top`; on :math:`\mathbb{R}^3` the angular
+    /// momentum about the origin :math:`x \times m\dot x + R\Pi`, then the momentum
+    /// :math:`m\dot x`. (..., 22) -> (..., 6).
     fn killing_momenta<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let t = form_top(slf, "killing_momenta")?;
         slf.base().map_states(slf.py(), &states, &[6], |z, out| {
@@ -246,10 +255,13 @@ impl PyFrameTop {
         })
     }
 
-    /// On the 3-sphere: the so(4) body momentum M = [[0, -r P^T], [r P, hat(Pi)]] of the frame
-    /// g in SO(4) whose first column is x/r, with dM/dt = [M, xi] for xi = g^-1 dg/dt and the
-    /// pairing <M, xi> = tr(M^T xi)/2; the top is `lf.LiePoisson(("so", 4), H)` with
-    /// H(M) = <M, J^-1 M>/2, J = `group_inertia()`. (..., 22) -> (..., 4, 4).
+    /// On the 3-sphere: the so(4) body momentum
+    /// :math:`M = \begin{pmatrix} 0 & -r P^\top \\ r P & \hat\Pi \end{pmatrix}` of the frame
+    /// :math:`g \in SO(4)` whose first column is :math:`x/r`, with :math:`\dot M = [M, \xi]` for
+    /// :math:`\xi = g^{-1} \dot g` and the pairing
+    /// :math:`\langle M, \xi \rangle = \tfrac12 \operatorname{tr}(M^\top \xi)`; the top is
+    /// `lf.LiePoisson(("so", 4), H)` with :math:`H(M) = \tfrac12 \langle M, J^{-1} M \rangle`,
+    /// J = `group_inertia()`. (..., 22) -> (..., 4, 4).
     ///
     /// Raises:
     ///     InvalidArgumentError (not on the sphere).
@@ -265,9 +277,11 @@ impl PyFrameTop {
         })
     }
 
-    /// On the 3-sphere: the (6, 6) inertia J of the SO(4) top in so(4)'s e_ij coordinates
-    /// (01, 02, 03, 12, 13, 23): diag(m r^2, m r^2, m r^2) and the inertia tensor read through
-    /// (xi12, xi13, xi23) = (-Omega3, Omega2, -Omega1); l(xi) = <xi, J xi>/2, M = J xi.
+    /// On the 3-sphere: the (6, 6) inertia J of the SO(4) top in so(4)'s :math:`e_{ij}`
+    /// coordinates (01, 02, 03, 12, 13, 23): :math:`\operatorname{diag}(m r^2, m r^2, m r^2)` and
+    /// the inertia tensor read through
+    /// :math:`(\xi_{12}, \xi_{13}, \xi_{23}) = (-\Omega_3, \Omega_2, -\Omega_1)`;
+    /// :math:`l(\xi) = \tfrac12 \langle \xi, J\xi \rangle`, :math:`M = J\xi`.
     ///
     /// Raises:
     ///     InvalidArgumentError (not on the sphere).
@@ -278,7 +292,7 @@ impl PyFrameTop {
             .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
     }
 
-    /// T = P.P / 2m, the translational energy (conserved): (..., 22) -> (...).
+    /// :math:`T = P \cdot P / (2m)`, the translational energy (conserved): (..., 22) -> (...).
     fn translational_energy<'py>(
         slf: &Bound<'py, Self>,
         states: ArrayIn<'py>,
@@ -290,8 +304,8 @@ impl PyFrameTop {
         })
     }
 
-    /// H - T = Pi.I^-1 Pi / 2, the rotational energy (conserved; 002 §V's "H - T"):
-    /// (..., 22) -> (...).
+    /// :math:`H - T = \tfrac12 \Pi \cdot \mathbb{I}^{-1} \Pi`, the rotational energy (conserved;
+    /// 002 §V's "H - T"): (..., 22) -> (...).
     fn rotational_energy<'py>(slf: &Bound<'py, Self>, states: ArrayIn<'py>) -> PyResult<Any<'py>> {
         let t = top(slf)?;
         slf.base().map_states(slf.py(), &states, &[], |z, out| {

@@ -13,21 +13,24 @@ use crate::errors::{to_py, IntoPy};
 use crate::items::{map_items, par_map_items, Input};
 use crate::system::{PySystem, Thin};
 
-/// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical
-/// sign of the Lagrangian, L = -m/gamma + thetadot^2 (I gamma + gamma^3 xdot^T K(theta) xdot)/2),
-/// or, with `surface`, the top on the static space-time -dt^2 + g over that surface
-/// (002 (97)–(103)): L = -m/gamma + s^2 (I gamma + gamma^3 u^T K(theta) u) / 2,
-/// v^2 = g(xdot, xdot), s = thetadot + w(xdot) with w the surface's connection 1-form, u the
-/// components of xdot in the surface's orthonormal frame (for the symmetric top
-/// L = -m/gamma + I s^2 (gamma + gamma^3 v^2 / 2) / 2). State (x1, x2, theta, p1, p2, p_theta)
-/// in the chart; fields x, theta, p, p_theta; speeds v < 1. Invariants: (p_x, p_y) and, for
-/// the symmetric top, p_theta (Minkowski); p_theta (symmetric top) and the Killing momenta of
-/// the affine isometries (surface). Methods: gauss4 (default), gauss6, midpoint, rk4.
+/// The relativistic tangent Euler top in 1+2 Minkowski space-time (002 (87)–(96); physical sign of
+/// the Lagrangian,
+/// :math:`L = -m/\gamma + \tfrac12 \dot\theta^2 (I\gamma + \gamma^3 \dot x^\top K(\theta) \dot x)`),
+/// or, with `surface`, the top on the static space-time :math:`-dt^2 + g` over that surface
+/// (002 (97)–(103)): :math:`L = -m/\gamma + \tfrac12 s^2 (I\gamma + \gamma^3 u^\top K(\theta) u)`,
+/// :math:`v^2 = g(\dot x, \dot x)`, :math:`s = \dot\theta + w(\dot x)` with :math:`w` the surface's
+/// connection 1-form, :math:`u` the components of :math:`\dot x` in the surface's orthonormal frame
+/// (for the symmetric top :math:`L = -m/\gamma + \tfrac12 I s^2 (\gamma + \gamma^3 v^2 / 2)`).
+/// State (x1, x2, theta, p1, p2, p_theta) in the chart; fields x, theta, p, p_theta; speeds
+/// :math:`v < 1`. Invariants: (p_x, p_y) and, for the symmetric top, p_theta (Minkowski); p_theta
+/// (symmetric top) and the Killing momenta of the affine isometries (surface). Methods: gauss4
+/// (default), gauss6, midpoint, rk4.
 ///
 /// Args:
-///     mass > 0; inertia: the scalar tr I (the symmetric top) or the second-moment tensor
-///         integral xi xi^T dm as (I11, I12, I22) or a symmetric (2, 2) array, positive
-///         semidefinite; surface: a `lieflow.surfaces` surface, or None for the Minkowski plane.
+///     mass > 0; inertia: the scalar :math:`\operatorname{tr} I` (the symmetric top) or the
+///         second-moment tensor :math:`\int \xi \xi^\top dm` as (I11, I12, I22) or a symmetric
+///         (2, 2) array, positive semidefinite; surface: a `lieflow.surfaces` surface, or None for the
+///         Minkowski plane.
 /// Raises:
 ///     InvalidArgumentError, ShapeError, NonFiniteError, TypeError (surface not a lieflow
 ///     surface).
@@ -63,9 +66,10 @@ impl PyRelativisticTangentTop {
     }
 
     /// The Lagrangian of 002 (90) / (102) (physical sign, the negative of the text's):
-    /// ``L = -m/gamma + s^2 (I gamma + gamma^3 u^T K(theta) u) / 2`` with ``s = thetadot +
-    /// w(xdot)``, u the components of xdot in the surface's orthonormal frame (Cartesian in the
-    /// Minkowski plane), ``gamma = (1 - g(xdot, xdot))^(-1/2)``.
+    /// :math:`L = -m/\gamma + \tfrac12 s^2 (I\gamma + \gamma^3 u^\top K(\theta) u)` with
+    /// :math:`s = \dot\theta + w(\dot x)`, :math:`u` the components of :math:`\dot x` in the
+    /// surface's orthonormal frame (Cartesian in the Minkowski plane),
+    /// :math:`\gamma = (1 - g(\dot x, \dot x))^{-1/2}`.
     ///
     /// Args:
     ///     x: (2,) in the chart; theta; xdot: (2,); thetadot.
@@ -84,11 +88,13 @@ impl PyRelativisticTangentTop {
         crate::errors::checked(|| top.lagrangian([x[0], x[1], theta], [xdot[0], xdot[1], thetadot]))
     }
 
-    /// F(theta) of the spin about a centre in straight uniform motion with velocity u, 002 (91):
-    /// with xdot = u held fixed, ``L = -m/gamma + F(theta) thetadot^2 / 2``,
-    /// ``F = I gamma + gamma^3 u^T K(theta) u`` (period pi in theta). The text's (91) prints the
-    /// cross term as ``-2 I3 sin cos``; with ``I12 = integral xi1 xi2 dm`` it is
-    /// ``+2 I12 sin cos``. Maps over the broadcast leading axes of theta and velocity.
+    /// :math:`F(\theta)` of the spin about a centre in straight uniform motion with velocity
+    /// :math:`u`, 002 (91): with :math:`\dot x = u` held fixed,
+    /// :math:`L = -m/\gamma + \tfrac12 F(\theta) \dot\theta^2`,
+    /// :math:`F = I\gamma + \gamma^3 u^\top K(\theta) u` (period :math:`\pi` in :math:`\theta`).
+    /// The text's (91) prints the cross term as :math:`-2 I_3 \sin\theta \cos\theta`; with
+    /// :math:`I_{12} = \int \xi_1 \xi_2\, dm` it is :math:`+2 I_{12} \sin\theta \cos\theta`. Maps
+    /// over the broadcast leading axes of theta and velocity.
     ///
     /// Args:
     ///     theta: angle(s) of the body from the x axis; velocity: (..., 2), speed < 1.
@@ -112,9 +118,10 @@ impl PyRelativisticTangentTop {
         })
     }
 
-    /// The spin rate ``abs(thetadot) = sqrt(2 E / F(theta))`` about a centre in straight uniform
-    /// motion with velocity u, at spin energy ``E = F(theta) thetadot^2 / 2`` (conserved), 002
-    /// (92) (the text's ``thetadot^2 = E/F`` with its F half of this one). Fastest with the
+    /// The spin rate :math:`|\dot\theta| = \sqrt{2E / F(\theta)}` about a centre in straight
+    /// uniform motion with velocity :math:`u`, at spin energy
+    /// :math:`E = \tfrac12 F(\theta) \dot\theta^2` (conserved), 002 (92) (the text's
+    /// :math:`\dot\theta^2 = E/F` with its F half of this one). Fastest with the
     /// body's larger second moment along u, slowest across it. Maps over the broadcast leading
     /// axes.
     ///
@@ -136,10 +143,11 @@ impl PyRelativisticTangentTop {
         })
     }
 
-    /// The effective potential ``V(theta) = -E / F(theta)`` of the spin about a centre in
-    /// straight uniform motion with velocity u, at spin energy E: ``thetadot^2 / 2 + V = 0`` and
-    /// ``thetadot' = -V'(theta)`` (002 (92) calls E/F, which is thetadot^2, the effective
-    /// potential). Maps over the broadcast leading axes.
+    /// The effective potential :math:`V(\theta) = -E / F(\theta)` of the spin about a centre in
+    /// straight uniform motion with velocity :math:`u`, at spin energy E:
+    /// :math:`\tfrac12 \dot\theta^2 + V = 0` and :math:`\ddot\theta = -V'(\theta)` (002 (92) calls
+    /// :math:`E/F`, which is :math:`\dot\theta^2`, the effective potential). Maps over the
+    /// broadcast leading axes.
     ///
     /// Args:
     ///     theta: angle(s); energy: E >= 0; velocity: (..., 2), speed < 1.
@@ -190,7 +198,8 @@ impl PyRelativisticTangentTop {
         })
     }
 
-    /// The speed v = sqrt(g(xdot, xdot)) and the covariant spin rate s = thetadot + w(xdot) of
+    /// The speed :math:`v = \sqrt{g(\dot x, \dot x)}` and the covariant spin rate
+    /// :math:`s = \dot\theta + w(\dot x)` of
     /// states (both constant along a motion of the symmetric top), vectorised:
     /// (..., 6) -> (..., 2).
     ///
@@ -209,11 +218,12 @@ impl PyRelativisticTangentTop {
     }
 
     /// The momentum of the symmetric top as a function of its speed v and spin momentum
-    /// J = p_theta, 002 (94) (physical sign, J = p_theta; the text's J is half of it):
-    /// ``|p| = m gamma v (1 + J^2 (1 - v^2)(4 - v^2) / (2 I0 m (2 - v^2)^2))`` with
-    /// ``gamma = (1 - v^2)^(-1/2)``, ``I0 = tr I / 2``; on a surface ``|p|`` is the norm of
-    /// ``p_x - p_theta alpha`` in the inverse metric. The text concludes that ``|p|`` fixes v; it
-    /// does not for ``J^2 / (2 I0 m) > 7.34``, where v -> ``|p|`` decreases on an interval.
+    /// :math:`J = p_\theta`, 002 (94) (physical sign, :math:`J = p_\theta`; the text's J is half
+    /// of it): :math:`|p| = m\gamma v\, (1 + J^2 (1 - v^2)(4 - v^2) / (2 I_0 m (2 - v^2)^2))` with
+    /// :math:`\gamma = (1 - v^2)^{-1/2}`, :math:`I_0 = \tfrac12 \operatorname{tr} I`; on a surface
+    /// :math:`|p|` is the norm of :math:`p_x - p_\theta \alpha` in the inverse metric. The text
+    /// concludes that :math:`|p|` fixes v; it does not for :math:`J^2 / (2 I_0 m) > 7.34`, where
+    /// :math:`v \mapsto |p|` decreases on an interval.
     /// Maps over the broadcast leading axes of v and p_theta.
     ///
     /// Args:
@@ -233,9 +243,11 @@ impl PyRelativisticTangentTop {
         })
     }
 
-    /// The spin rate of the symmetric top from its speed v and spin momentum J = p_theta,
-    /// 002 (95): ``thetadot = J / (2 I0 gamma (1 + v^2 gamma^2 / 2))``, ``I0 = tr I / 2``; on a
-    /// surface the covariant spin rate ``s = thetadot + w(xdot)``. Maps over the broadcast
+    /// The spin rate of the symmetric top from its speed v and spin momentum
+    /// :math:`J = p_\theta`, 002 (95):
+    /// :math:`\dot\theta = J / (2 I_0 \gamma (1 + v^2 \gamma^2 / 2))`,
+    /// :math:`I_0 = \tfrac12 \operatorname{tr} I`; on a surface the covariant spin rate
+    /// :math:`s = \dot\theta + w(\dot x)`. Maps over the broadcast
     /// leading axes of v and p_theta.
     ///
     /// Args:
@@ -255,11 +267,11 @@ impl PyRelativisticTangentTop {
         })
     }
 
-    /// The energy of the symmetric top from its speed v and spin rate thetadot, 002 (96)
-    /// (physical sign):
-    /// ``E = m gamma + I0 thetadot^2 (gamma + 5 v^2 gamma^3 / 2 + 3 v^4 gamma^5 / 2)``,
-    /// ``I0 = tr I / 2``; on a surface with thetadot the covariant spin
-    /// rate ``s = thetadot + w(xdot)``. Maps over the broadcast leading axes of v and
+    /// The energy of the symmetric top from its speed v and spin rate thetadot, 002 (96) (physical
+    /// sign):
+    /// :math:`E = m\gamma + I_0 \dot\theta^2 (\gamma + \tfrac52 v^2 \gamma^3 + \tfrac32 v^4 \gamma^5)`,
+    /// :math:`I_0 = \tfrac12 \operatorname{tr} I`; on a surface with thetadot the covariant spin
+    /// rate :math:`s = \dot\theta + w(\dot x)`. Maps over the broadcast leading axes of v and
     /// thetadot.
     ///
     /// Args:
@@ -279,8 +291,8 @@ impl PyRelativisticTangentTop {
         })
     }
 
-    /// All Killing momenta J = p_A X^A of the surface's isometry group (the Minkowski plane and
-    /// Plane: translations x, y and the rotation; Sphere: the ambient angular momentum x, y, z;
+    /// All Killing momenta :math:`J = p_A X^A` of the surface's isometry group (the Minkowski plane
+    /// and Plane: translations x, y and the rotation; Sphere: the ambient angular momentum x, y, z;
     /// HyperbolicPlane: the Möbius generators E, H, F; Revolution: p_phi), (..., 6) -> (..., k).
     ///
     /// Raises:
@@ -367,16 +379,16 @@ fn relation<'py>(
     })
 }
 
-/// The tangent top in the weak-field limit of a static space-time with potential phi (002
-/// (115)–(120), (115) with its dt^2 restored and the sign of the spin–field coupling of (118)
-/// corrected). State (x, y, theta, p_x, p_y, p_theta). Methods: gauss4 (default), gauss6,
+/// The tangent top in the weak-field limit of a static space-time with potential :math:`\phi`
+/// (002 (115)–(120), (115) with its :math:`dt^2` restored and the sign of the spin–field coupling of
+/// (118) corrected). State (x, y, theta, p_x, p_y, p_theta). Methods: gauss4 (default), gauss6,
 /// midpoint, rk4.
 ///
 /// Args:
 ///     mass: m > 0.
 ///     inertia: tr I > 0.
-///     gm: a point mass, phi = -gm/r (give exactly one of gm and g).
-///     g: a uniform field, phi = g.x, (2,).
+///     gm: a point mass, :math:`\phi = -gm/r` (give exactly one of gm and g).
+///     g: a uniform field, :math:`\phi = g \cdot x`, (2,).
 /// Raises:
 ///     InvalidArgumentError.
 #[pyclass(name = "WeakFieldTop", module = "lieflow", extends = PySystem, frozen)]
@@ -419,8 +431,13 @@ impl PyWeakFieldTop {
     }
 
     /// The Lagrangian 002 (118) (coupling sign corrected, physical sign, rest energy dropped):
-    /// ``L = m v^2/2 - m phi + I0 thetadot^2 (1 - phi + v^2) + I0 thetadot (G_y xdot - G_x ydot)``,
-    /// ``I0 = tr I / 2``, ``G = grad phi``.
+    ///
+    /// .. math::
+    ///
+    ///     L = \tfrac12 m v^2 - m\phi + I_0 \dot\theta^2 (1 - \phi + v^2)
+    ///         + I_0 \dot\theta\, (G_y \dot x - G_x \dot y),
+    ///
+    /// :math:`I_0 = \tfrac12 \operatorname{tr} I`, :math:`G = \nabla\phi`.
     ///
     /// Args:
     ///     x: (2,); theta; xdot: (2,); thetadot.
@@ -440,7 +457,7 @@ impl PyWeakFieldTop {
             .py()
     }
 
-    /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
+    /// The angular momentum :math:`x p_y - y p_x` of states (conserved for a central potential),
     /// vectorised: (..., 6) -> (...).
     ///
     /// Raises:
@@ -474,27 +491,35 @@ fn potential(gm: Option<f64>, g: Option<[f64; 2]>) -> PyResult<core::Potential> 
 }
 
 /// The symmetric relativistic tangent top on the static space-time
-/// ``-exp(2 phi) dt^2 + dx^2 + dy^2`` of a potential phi, or, with `surface`,
-/// ``-exp(2 phi) dt^2 + g`` over that surface, to second order in the body's size
-/// (002 (115)-(117), derived again; physical sign): with ``Q = g(xdot, xdot)``,
-/// ``b = exp(2 phi) - Q``, ``I0 = tr I / 2``, ``s = thetadot + w(xdot)`` (w the surface's
-/// connection 1-form; s = thetadot in the plane), G the components of d phi and u those of xdot
-/// in an orthonormal frame, ``c = G_2 u_1 - G_1 u_2`` (``G_y xdot - G_x ydot`` in the plane),
-/// ``L = -m sqrt(b) + I0 s^2 / sqrt(b) - I0 exp(2 phi) G^2 / (2 sqrt(b))
-/// + I0 (s^2 Q + 2 exp(2 phi) s c + exp(4 phi) G^2) / (2 b^(3/2))``. In the plane, weak fields
-/// and slow motion give `WeakFieldTop` (002 (118)) plus -m; phi = 0 gives
-/// `RelativisticTangentTop` (flat or on the same surface). phi is a function of the chart
-/// coordinates (x1, x2). State (x1, x2, theta, p1, p2, p_theta); speeds sqrt(Q) below exp(phi).
-/// Invariants: p_theta, and in the plane x p_y - y p_x (point mass) or the momentum across a
-/// uniform field; on a surface the Killing momenta of its affine isometries that keep phi (e.g.
-/// J_z on the sphere in ``g=(k, 0)``, phi = k theta); the energy is conserved. Methods: gauss4
+/// :math:`-e^{2\phi} dt^2 + dx^2 + dy^2` of a potential :math:`\phi`, or, with `surface`,
+/// :math:`-e^{2\phi} dt^2 + g` over that surface, to second order in the body's size
+/// (002 (115)-(117), derived again; physical sign): with :math:`Q = g(\dot x, \dot x)`,
+/// :math:`b = e^{2\phi} - Q`, :math:`I_0 = \tfrac12 \operatorname{tr} I`,
+/// :math:`s = \dot\theta + w(\dot x)` (:math:`w` the surface's connection 1-form;
+/// :math:`s = \dot\theta` in the plane), :math:`G` the components of :math:`d\phi` and :math:`u`
+/// those of :math:`\dot x` in an orthonormal frame, :math:`c = G_2 u_1 - G_1 u_2`
+/// (:math:`G_y \dot x - G_x \dot y` in the plane),
+///
+/// .. math::
+///
+///     L = -m \sqrt{b} + I_0 s^2 / \sqrt{b} - I_0 e^{2\phi} G^2 / (2 \sqrt{b})
+///         + I_0 (s^2 Q + 2 e^{2\phi} s c + e^{4\phi} G^2) / (2 b^{3/2}).
+///
+/// In the plane, weak fields and slow motion give `WeakFieldTop` (002 (118)) plus :math:`-m`;
+/// :math:`\phi = 0` gives `RelativisticTangentTop` (flat or on the same surface). :math:`\phi` is
+/// a function of the chart coordinates (x1, x2). State (x1, x2, theta, p1, p2, p_theta); speeds
+/// :math:`\sqrt{Q}` below :math:`e^\phi`. Invariants: p_theta, and in the plane
+/// :math:`x p_y - y p_x` (point mass) or the momentum across a uniform field; on a surface the
+/// Killing momenta of its affine isometries that keep :math:`\phi` (e.g. :math:`J_z` on the
+/// sphere in ``g=(k, 0)``, :math:`\phi = k\theta`); the energy is conserved. Methods: gauss4
 /// (default), gauss6, midpoint, rk4.
 ///
 /// Args:
 ///     mass: m > 0.
 ///     inertia: tr I > 0.
-///     gm: a point mass at the chart's origin, phi = -gm/r (give exactly one of gm and g).
-///     g: a uniform field of the chart, phi = g.x, (2,).
+///     gm: a point mass at the chart's origin, :math:`\phi = -gm/r` (give exactly one of gm and
+///         g).
+///     g: a uniform field of the chart, :math:`\phi = g \cdot x`, (2,).
 ///     surface: a `lieflow.surfaces` surface, or None for the plane.
 /// Raises:
 ///     InvalidArgumentError, TypeError (surface not a lieflow surface).
@@ -528,10 +553,10 @@ impl PyStaticFieldTop {
         ))
     }
 
-    /// All Killing momenta J = p_A X^A of the spatial slice's isometry group (the plane:
-    /// translations x, y and the rotation x p_y - y p_x + p_theta; Sphere: the ambient angular
-    /// momentum x, y, z; HyperbolicPlane: the Möbius generators E, H, F; Revolution: p_phi),
-    /// (..., 6) -> (..., k). Conserved where the isometry also keeps phi.
+    /// All Killing momenta :math:`J = p_A X^A` of the spatial slice's isometry group (the plane:
+    /// translations x, y and the rotation :math:`x p_y - y p_x + p_\theta`; Sphere: the ambient
+    /// angular momentum x, y, z; HyperbolicPlane: the Möbius generators E, H, F; Revolution:
+    /// p_phi), (..., 6) -> (..., k). Conserved where the isometry also keeps phi.
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError, InvalidArgumentError (x outside the chart).
@@ -551,8 +576,8 @@ impl PyStaticFieldTop {
     /// velocities.
     ///
     /// Raises:
-    ///     InvalidArgumentError (a speed not below exp(phi), x outside the surface's chart, phi
-    ///     not finite at x, a Legendre map not invertible), NonFiniteError.
+    ///     InvalidArgumentError (a speed not below :math:`e^\phi`, x outside the surface's chart,
+    ///     phi not finite at x, a Legendre map not invertible), NonFiniteError.
     fn state(
         slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
@@ -571,8 +596,8 @@ impl PyStaticFieldTop {
     /// Returns:
     ///     float.
     /// Raises:
-    ///     InvalidArgumentError (a speed not below exp(phi), x outside the chart, phi not finite
-    ///     at x), NonFiniteError.
+    ///     InvalidArgumentError (a speed not below :math:`e^\phi`, x outside the chart, phi not
+    ///     finite at x), NonFiniteError.
     fn lagrangian(
         slf: &Bound<'_, Self>,
         #[pyo3(from_py_with = reals::<2>)] x: [f64; 2],
@@ -599,7 +624,7 @@ impl PyStaticFieldTop {
         })
     }
 
-    /// The angular momentum x p_y - y p_x of states (conserved for a central potential),
+    /// The angular momentum :math:`x p_y - y p_x` of states (conserved for a central potential),
     /// vectorised: (..., 6) -> (...).
     ///
     /// Raises:

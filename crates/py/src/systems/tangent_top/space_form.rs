@@ -27,11 +27,12 @@ pub(crate) enum Kind {
     },
 }
 
-/// A three-dimensional Riemannian space with an orthonormal reference frame field Ê(x): made by
-/// `Euclidean`, `Sphere`, `Hyperbolic` and `Riemannian` of this module. Points: x in R^3
-/// (Euclidean), unit vectors of R^4 times the radius (Sphere), the upper sheet
-/// x0^2 - x1^2 - x2^2 - x3^2 = r^2, x0 > 0, of the hyperboloid in Minkowski space (Hyperbolic;
-/// metric -a0 b0 + a.b on tangent vectors), chart coordinates (Riemannian).
+/// A three-dimensional Riemannian space with an orthonormal reference frame field
+/// :math:`\hat E(x)`: made by `Euclidean`, `Sphere`, `Hyperbolic` and `Riemannian` of this
+/// module. Points: :math:`x \in \mathbb{R}^3` (Euclidean), unit vectors of :math:`\mathbb{R}^4`
+/// times the radius (Sphere), the upper sheet :math:`x_0^2 - x_1^2 - x_2^2 - x_3^2 = r^2`,
+/// :math:`x_0 > 0`, of the hyperboloid in Minkowski space (Hyperbolic; metric
+/// :math:`-a_0 b_0 + a \cdot b` on tangent vectors), chart coordinates (Riemannian).
 #[pyclass(module = "lieflow.spaces", name = "Space", frozen)]
 pub struct PySpace {
     pub(crate) inner: Kind,
@@ -55,7 +56,7 @@ impl PySpace {
 
 #[pymethods]
 impl PySpace {
-    /// The sectional curvature: 0, 1/r^2 or -1/r^2.
+    /// The sectional curvature: 0, :math:`1/r^2` or :math:`-1/r^2`.
     ///
     /// Raises:
     ///     InvalidArgumentError (a Riemannian chart, whose curvature varies).
@@ -83,8 +84,8 @@ impl PySpace {
     }
 
     /// Checks at x that the frame of a `Riemannian` chart is orthonormal and positively oriented
-    /// for its metric: ``E^T g E = 1`` within `tol` (E the matrix whose columns are the rows of
-    /// `frame(x1, x2, x3)`) and ``det E > 0``. Returns None.
+    /// for its metric: :math:`E^\top g E = 1` within `tol` (E the matrix whose columns are the
+    /// rows of `frame(x1, x2, x3)`) and :math:`\det E > 0`. Returns None.
     ///
     /// Raises:
     ///     InvalidArgumentError (the frame fails the check, names the pair (a, b); x outside the
@@ -109,10 +110,11 @@ impl PySpace {
         }
     }
 
-    /// The reference frame Ê(x): a (d, 3) array whose columns are the ambient components of
-    /// Ê1, Ê2, Ê3 at the point x (d = `ambient_dim`). Euclidean: the constant frame; Sphere:
-    /// x.i/r, x.j/r, x.k/r (quaternion products, the left-invariant fields of SU(2)); Hyperbolic:
-    /// the boost taking (r, 0, 0, 0) to x applied to e1, e2, e3; Riemannian: the chart
+    /// The reference frame :math:`\hat E(x)`: a (d, 3) array whose columns are the ambient
+    /// components of :math:`\hat E_1, \hat E_2, \hat E_3` at the point x (d = `ambient_dim`).
+    /// Euclidean: the constant frame; Sphere: :math:`x i/r, x j/r, x k/r` (quaternion products,
+    /// the left-invariant fields of SU(2)); Hyperbolic: the boost taking (r, 0, 0, 0) to x applied
+    /// to :math:`e_1, e_2, e_3`; Riemannian: the chart
     /// components of the frame the callable gives (the transpose of its value).
     ///
     /// Raises:
@@ -206,7 +208,7 @@ fn three(n: i64) -> PyResult<()> {
     Ok(())
 }
 
-/// Euclidean space R^3 (curvature 0; frame bundle SE(3)).
+/// Euclidean space :math:`\mathbb{R}^3` (curvature 0; frame bundle SE(3)).
 ///
 /// Raises:
 ///     InvalidArgumentError (n != 3).
@@ -219,7 +221,7 @@ fn Euclidean(#[pyo3(from_py_with = int)] n: i64) -> PyResult<PySpace> {
     })
 }
 
-/// The 3-sphere of radius r in R^4 (curvature 1/r^2; frame bundle SO(4)).
+/// The 3-sphere of radius r in :math:`\mathbb{R}^4` (curvature :math:`1/r^2`; frame bundle SO(4)).
 ///
 /// Raises:
 ///     InvalidArgumentError (n != 3, r <= 0).
@@ -235,8 +237,9 @@ fn Sphere(
     })
 }
 
-/// Hyperbolic 3-space of radius r, the hyperboloid x0^2 - x1^2 - x2^2 - x3^2 = r^2, x0 > 0 in Minkowski R^(1,3)
-/// (curvature -1/r^2; frame bundle SO+(1,3)).
+/// Hyperbolic 3-space of radius r, the hyperboloid :math:`x_0^2 - x_1^2 - x_2^2 - x_3^2 = r^2`,
+/// :math:`x_0 > 0` in Minkowski :math:`\mathbb{R}^{1,3}` (curvature :math:`-1/r^2`; frame bundle
+/// :math:`SO^+(1,3)`).
 ///
 /// Raises:
 ///     InvalidArgumentError (n != 3, r <= 0).
@@ -256,15 +259,15 @@ fn Hyperbolic(
 /// orthonormal frame field given as callables of the chart coordinates.
 ///
 /// Numerical, like `lieflow.surfaces.MetricSurface`: the connection of the frame (the matrix C
-/// whose column j is the axial vector of ``A_j = (g(E_a, nabla_j E_b))_ab``) by fourth-order
+/// whose column j is the axial vector of :math:`A_j = (g(E_a, \nabla_j E_b))_{ab}`) by fourth-order
 /// differences of g and the frame, and its derivatives by differences of C (errors about 1e-12
 /// in C and 1e-9 in its derivatives for smooth data of order one). Each evaluation of the top's
 /// field calls the callables about 330 times. A `FrameTop` on it has no Killing momenta.
 ///
 /// Args:
-///     metric: ``metric(x1, x2, x3)`` -> (3, 3) symmetric positive definite g_ij.
-///     frame: ``frame(x1, x2, x3)`` -> (3, 3) whose row a holds the components e_a^i of the
-///         orthonormal frame vector E_a (check it with `check_frame`).
+///     metric: ``metric(x1, x2, x3)`` -> (3, 3) symmetric positive definite :math:`g_{ij}`.
+///     frame: ``frame(x1, x2, x3)`` -> (3, 3) whose row a holds the components :math:`e_a^i` of
+///         the orthonormal frame vector :math:`E_a` (check it with `check_frame`).
 ///     domain: optional ``domain(x1, x2, x3)`` -> bool; the chart is where it holds and g is
 ///         finite and positive definite.
 /// Returns:

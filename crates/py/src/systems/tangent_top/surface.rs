@@ -18,8 +18,9 @@ use crate::errors::{argument_type_error, checked, raised, IntoPy};
 
 type Any<'py> = Bound<'py, PyAny>;
 
-/// A surface in local coordinates x = (x1, x2) with an orthonormal frame (E1, E2) and the
-/// connection 1-form w = alpha_i dx^i of that frame, w(v) = <nabla_v E1, E2> (002 (43)).
+/// A surface in local coordinates :math:`x = (x_1, x_2)` with an orthonormal frame
+/// :math:`(E_1, E_2)` and the connection 1-form :math:`w = \alpha_i dx^i` of that frame,
+/// :math:`w(v) = \langle \nabla_v E_1, E_2 \rangle` (002 (43)).
 /// Made by `Plane`, `Sphere`, `HyperbolicPlane`, `Revolution`, `Torus`, `Graph`, `Quadric` and
 /// `MetricSurface` of this module.
 #[pyclass(module = "lieflow.surfaces", name = "Surface", frozen)]
@@ -68,7 +69,7 @@ impl PySurface {
         self.at(x, |x| self.inner.curvature(x))
     }
 
-    /// The metric g_ij at x, (2, 2).
+    /// The metric :math:`g_{ij}` at x, (2, 2).
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
@@ -80,7 +81,8 @@ impl PySurface {
         Ok(mat2(py, self.at(x, |x| self.inner.metric(x))?))
     }
 
-    /// The orthonormal frame at x, (2, 2): row a holds the components e_a^i of E_a = e_a^i d_i.
+    /// The orthonormal frame at x, (2, 2): row a holds the components :math:`e_a^i` of
+    /// :math:`E_a = e_a^i \partial_i`.
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
@@ -92,7 +94,7 @@ impl PySurface {
         Ok(mat2(py, self.at(x, |x| self.inner.frame(x))?))
     }
 
-    /// The connection 1-form (alpha_1, alpha_2) of the frame at x (002 (43)).
+    /// The connection 1-form :math:`(\alpha_1, \alpha_2)` of the frame at x (002 (43)).
     ///
     /// Raises:
     ///     InvalidArgumentError (x outside the chart).
@@ -101,8 +103,9 @@ impl PySurface {
     }
 
     /// Checks at x that the frame of a `MetricSurface` is orthonormal and positively oriented
-    /// for its metric: ``g(E_a, E_b) = delta_ab`` within `tol` (``g(E_a, E_b) = e_a^T g e_b``
-    /// with the rows e_a of `frame(x1, x2)`) and ``det e > 0``; the connection 1-form and the
+    /// for its metric: :math:`g(E_a, E_b) = \delta_{ab}` within `tol`
+    /// (:math:`g(E_a, E_b) = e_a^\top g\, e_b` with the rows :math:`e_a` of `frame(x1, x2)`) and
+    /// :math:`\det e > 0`; the connection 1-form and the
     /// dynamics on the surface assume it (002 (43)). Returns None.
     ///
     /// Raises:
@@ -134,8 +137,8 @@ impl PySurface {
         self.inner.killing_names().to_vec()
     }
 
-    /// Whether the surface comes with an embedding in R^3 (needed by `TangentTop(...,
-    /// embedded=True)` and `TangentTop.ambient_frame`).
+    /// Whether the surface comes with an embedding in :math:`\mathbb{R}^3` (needed by
+    /// `TangentTop(..., embedded=True)` and `TangentTop.ambient_frame`).
     #[getter]
     fn has_embedding(&self) -> bool {
         self.inner.embedding().is_some()
@@ -258,15 +261,16 @@ fn native(
     PySurface::new(Arc::new(inner), name, PyTuple::new(py, args)?)
 }
 
-/// The Euclidean plane, Cartesian x = (x, y), E = (d/dx, d/dy). Killing generators: translations
-/// along x and y, the rotation about the origin.
+/// The Euclidean plane, Cartesian x = (x, y), :math:`E = (\partial_x, \partial_y)`. Killing
+/// generators: translations along x and y, the rotation about the origin.
 #[pyfunction]
 pub(crate) fn Plane(py: Python<'_>) -> PyResult<PySurface> {
     native(py, surface::Plane, "Plane", &[])
 }
 
-/// The sphere of radius R, x = (colatitude, longitude), E1 = d/dtheta / R,
-/// E2 = d/dphi / (R sin theta). Killing generators: rotations about the ambient x, y, z axes.
+/// The sphere of radius R, x = (colatitude, longitude), :math:`E_1 = \partial_\theta / R`,
+/// :math:`E_2 = \partial_\phi / (R \sin\theta)`. Killing generators: rotations about the ambient x,
+/// y, z axes.
 ///
 /// Raises:
 ///     InvalidArgumentError (R <= 0).
@@ -275,18 +279,20 @@ fn Sphere(py: Python<'_>, #[pyo3(from_py_with = real)] radius: f64) -> PyResult<
     native(py, surface::Sphere::new(radius).py()?, "Sphere", &[radius])
 }
 
-/// The hyperbolic plane in the Poincaré half-plane y > 0 (002 (67)), E1 = y d/dx, E2 = y d/dy.
-/// Killing generators: the Möbius one-parameter groups of E, H, F in sl(2, R). Not embedded.
+/// The hyperbolic plane in the Poincaré half-plane :math:`y > 0` (002 (67)),
+/// :math:`E_1 = y\, \partial_x`, :math:`E_2 = y\, \partial_y`. Killing generators: the Möbius
+/// one-parameter groups of E, H, F in :math:`\mathfrak{sl}(2, \mathbb{R})`. Not embedded.
 #[pyfunction]
 fn HyperbolicPlane(py: Python<'_>) -> PyResult<PySurface> {
     native(py, surface::HyperbolicPlane, "HyperbolicPlane", &[])
 }
 
-/// The surface of revolution X(s, phi) = (r(s) cos phi, r(s) sin phi, z(s)) about the z axis on
-/// s_min < s < s_max (where r > 0), coordinates x = (s, phi), E1 = d/ds / ‖X_s‖,
-/// E2 = d/dphi / r. `r` and `z` are callables s -> (f, f', f'', f''') (the third derivative
-/// enters only the embedded top). Killing generator: the rotation about z (momentum p_phi).
-/// Slow path: every evaluation calls Python; exceptions raised by the callables are re-raised.
+/// The surface of revolution :math:`X(s, \phi) = (r(s) \cos\phi, r(s) \sin\phi, z(s))` about the z
+/// axis on :math:`s_{\min} < s < s_{\max}` (where :math:`r > 0`), coordinates
+/// :math:`x = (s, \phi)`, :math:`E_1 = \partial_s / \|X_s\|`, :math:`E_2 = \partial_\phi / r`. `r`
+/// and `z` are callables s -> (f, f', f'', f''') (the third derivative enters only the embedded
+/// top). Killing generator: the rotation about z (momentum p_phi). Slow path: every evaluation
+/// calls Python; exceptions raised by the callables are re-raised.
 ///
 /// Raises:
 ///     TypeError (not callable), InvalidArgumentError (an empty or non-finite range).
@@ -309,8 +315,8 @@ fn Revolution<'py>(
     PySurface::new(Arc::new(inner), "Revolution", args)
 }
 
-/// The torus of radii a > b > 0 as a surface of revolution: r = a + b cos s, z = b sin s,
-/// -pi < s < pi.
+/// The torus of radii :math:`a > b > 0` as a surface of revolution: :math:`r = a + b \cos s`,
+/// :math:`z = b \sin s`, :math:`-\pi < s < \pi`.
 ///
 /// Raises:
 ///     InvalidArgumentError (not a > b > 0).
@@ -323,7 +329,8 @@ fn Torus(
     native(py, surface::Revolution::torus(a, b).py()?, "Torus", &[a, b])
 }
 
-/// The graph z = f(x, y), coordinates x = (x, y), frame by Gram–Schmidt of (d/dx, d/dy). `f` is a
+/// The graph :math:`z = f(x, y)`, coordinates x = (x, y), frame by Gram–Schmidt of
+/// :math:`(\partial_x, \partial_y)`. `f` is a
 /// callable (x, y) -> the 10 numbers (f, f_x, f_y, f_xx, f_xy, f_yy, f_xxx, f_xxy, f_xyy, f_yyy).
 /// Slow path: every evaluation calls Python; exceptions raised by `f` are re-raised.
 ///
@@ -346,7 +353,8 @@ fn Graph(f: Any<'_>) -> PyResult<PySurface> {
     PySurface::new(Arc::new(inner), "Graph", args)
 }
 
-/// The quadric z = (a x^2 + b y^2)/2 as a graph (paraboloid for ab > 0, saddle for ab < 0).
+/// The quadric :math:`z = \tfrac12 (a x^2 + b y^2)` as a graph (paraboloid for :math:`ab > 0`,
+/// saddle for :math:`ab < 0`).
 ///
 /// Raises:
 ///     NonFiniteError.
@@ -360,14 +368,13 @@ fn Quadric(
 }
 
 /// A surface given by its metric and an orthonormal frame, as callables x1, x2 -> (2, 2) arrays:
-/// `metric` g_ij, `frame` with row a the components of E_a (orthonormal for g, positively
-/// oriented: `Surface.check_frame` checks it at a point); `domain(x1, x2) -> bool` optionally
-/// restricts the chart. The connection 1-form and
-/// the derivatives are computed numerically (errors about 1e-12 in alpha, 1e-9 in its
-/// derivatives). No Killing generators, no embedding. The slowest path: the differences call
-/// the two callables about 180 times per evaluation of a top's vector field, so a gauss4 step
-/// costs some thousands of Python calls; prefer a built-in, `Revolution` or `Graph` where one
-/// fits.
+/// `metric` :math:`g_{ij}`, `frame` with row a the components of :math:`E_a` (orthonormal for g,
+/// positively oriented: `Surface.check_frame` checks it at a point); `domain(x1, x2) -> bool`
+/// optionally restricts the chart. The connection 1-form and the derivatives are computed
+/// numerically (errors about 1e-12 in alpha, 1e-9 in its derivatives). No Killing generators, no
+/// embedding. The slowest path: the differences call the two callables about 180 times per
+/// evaluation of a top's vector field, so a gauss4 step costs some thousands of Python calls;
+/// prefer a built-in, `Revolution` or `Graph` where one fits.
 ///
 /// Raises:
 ///     TypeError (not callable).

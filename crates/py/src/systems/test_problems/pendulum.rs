@@ -13,7 +13,7 @@ use crate::items::{map_items, Input};
 use crate::system::{PySystem, Thin};
 
 /// A planar pendulum in canonical coordinates: q the angle from the downward vertical,
-/// p = m l^2 dq/dt, H = p^2 / (2 m l^2) - m g l cos q. State (q, p); fields q, p.
+/// :math:`p = m l^2 \dot q`, :math:`H = p^2 / (2 m l^2) - m g l \cos q`. State (q, p); fields q, p.
 /// Methods: midpoint (the implicit midpoint rule, Gauss(1)), gauss4, gauss6 (symplectic
 /// Gauss–Legendre), verlet, rk4.
 ///
@@ -62,10 +62,11 @@ impl PyPendulum {
     }
 }
 
-/// A particle of mass m on the sphere ‖q‖ = l in gravity g (the spherical pendulum in Cartesian
-/// coordinates), H = ‖p‖^2 / (2m) + m g q3 with the constraint (‖q‖^2 - l^2) / 2 = 0. State
-/// (q, p) with ‖q‖ = l and q . p = 0; fields q, p. Invariant: the vertical angular momentum
-/// (q x p)_3. Method: rattle (RATTLE: constraints kept to round-off, symplectic).
+/// A particle of mass m on the sphere :math:`\|q\| = l` in gravity g (the spherical pendulum in
+/// Cartesian coordinates), :math:`H = \|p\|^2 / (2m) + m g q_3` with the constraint
+/// :math:`\tfrac12 (\|q\|^2 - l^2) = 0`. State (q, p) with :math:`\|q\| = l` and
+/// :math:`q \cdot p = 0`; fields q, p. Invariant: the vertical angular momentum
+/// :math:`(q \times p)_3`. Method: rattle (RATTLE: constraints kept to round-off, symplectic).
 ///
 /// Args:
 ///     mass > 0, length > 0, g >= 0.

@@ -11,10 +11,11 @@ use crate::errors::IntoPy;
 use crate::items::{map_items, Input};
 use crate::system::{PySystem, Thin};
 
-/// The vertical rolling disk (Bloch, Nonholonomic Mechanics and Control, §1.4): q = (x, y,
-/// theta, phi) (contact point, rolling angle, heading), p = M dq/dt with
-/// M = diag(m, m, I, J), rolling without slipping dx/dt = R cos(phi) dtheta/dt,
-/// dy/dt = R sin(phi) dtheta/dt, in the potential U = spring (1 - cos phi) + m tilt x.
+/// The vertical rolling disk (Bloch, Nonholonomic Mechanics and Control, §1.4):
+/// :math:`q = (x, y, \theta, \phi)` (contact point, rolling angle, heading), :math:`p = M\dot q`
+/// with :math:`M = \operatorname{diag}(m, m, I, J)`, rolling without slipping
+/// :math:`\dot x = R \cos\phi\, \dot\theta`, :math:`\dot y = R \sin\phi\, \dot\theta`, in the
+/// potential :math:`U = \mathrm{spring}\, (1 - \cos\phi) + m\, \mathrm{tilt}\, x`.
 /// State (q, p); fields q, p. Method: nonholonomic (a reversible discrete Lagrange–d'Alembert
 /// method of RATTLE type; the constraints hold to round-off at every step).
 ///
@@ -54,7 +55,8 @@ impl PyRollingDisk {
         Ok(PySystem::subclass(disk, args, names))
     }
 
-    /// The state (q, p) rolling with the rates dtheta/dt, dphi/dt from q = (x, y, theta, phi).
+    /// The state (q, p) rolling with the rates :math:`\dot\theta` (`thetadot`), :math:`\dot\phi`
+    /// (`phidot`) from :math:`q = (x, y, \theta, \phi)`.
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.
@@ -69,8 +71,8 @@ impl PyRollingDisk {
             .py()
     }
 
-    /// The relative residual ‖A(q) M^-1 p‖ / ‖M^-1 p‖ of the rolling constraints, vectorised:
-    /// (..., 8) -> (...).
+    /// The relative residual :math:`\|A(q) M^{-1} p\| / \|M^{-1} p\|` of the rolling constraints,
+    /// vectorised: (..., 8) -> (...).
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.

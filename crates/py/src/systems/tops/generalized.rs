@@ -19,10 +19,12 @@ type Any<'py> = Bound<'py, PyAny>;
 /// The generalized rigid body on so(n)* (Euler–Arnold / Manakov equations; the form of the
 /// pseudo-rigid body's reduced equation 001 (7.25)).
 ///
-/// M = J Omega + Omega J with J the mass matrix; dM/dt = [M, Omega]; energy
-/// H = sum_{i<j} M_ij^2 / (J_i + J_j) / 2 (principal frame); Casimirs C_k = tr((M^T M)^k) / 2,
-/// k = 1 .. n // 2 (they fix the spectrum of M). State z = the e_ij coordinates of the skew
-/// matrix M (i < j, row by row), length n(n-1)/2; `state(M)` and `matrix(z)` convert.
+/// :math:`M = J\Omega + \Omega J` with :math:`J` the mass matrix; :math:`\dot M = [M, \Omega]`;
+/// energy :math:`H = \tfrac12 \sum_{i<j} M_{ij}^2 / (J_i + J_j)` (principal frame); Casimirs
+/// :math:`C_k = \tfrac12 \operatorname{tr}((M^\top M)^k)`,
+/// :math:`k = 1, \dots, \lfloor n/2 \rfloor` (they fix the spectrum of :math:`M`). State
+/// :math:`z` = the :math:`e_{ij}` coordinates of the skew matrix :math:`M` (:math:`i < j`, row by row),
+/// length n(n-1)/2; `state(M)` and `matrix(z)` convert.
 /// Methods: isospectral (default), rk4, rkmk4.
 ///
 /// Args:
@@ -62,20 +64,20 @@ impl PyGeneralizedRigidBody {
         ))
     }
 
-    /// The dimension n (M is n x n).
+    /// The dimension n (M is n × n).
     #[getter]
     fn n(slf: &Bound<'_, Self>) -> PyResult<usize> {
         Ok(body(slf)?.n())
     }
 
-    /// The principal entries J_i (n,).
+    /// The principal entries :math:`J_i` (n,).
     #[getter]
     fn moments<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         Ok(py_vec(slf.py(), body(slf)?.principal()))
     }
 
-    /// Flat state z (e_ij coordinates, `lieflow.lie.vee_n`) of skew matrices: (..., n, n) ->
-    /// (..., n(n-1)/2).
+    /// Flat state z (:math:`e_{ij}` coordinates, `lieflow.lie.vee_n`) of skew matrices: (..., n, n)
+    /// -> (..., n(n-1)/2).
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError, NotInGroupError (M not skew-symmetric).

@@ -20,11 +20,14 @@ type Any<'py> = Bound<'py, PyAny>;
 
 /// The heavy top (000 §5.2): a rigid body with a fixed point in uniform gravity.
 ///
-/// State z = (M, Gamma) (6,): body angular momentum M and Gamma = R^T e3, the upward vertical
-/// seen in the body. dM/dt = M x Omega + mgl Gamma x chi, dGamma/dt = Gamma x Omega,
-/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2 + mgl Gamma . chi; Casimirs [‖Gamma‖^2,
-/// M . Gamma]; for the Lagrange top (I1 = I2, chi = e3) also M3 is conserved. With an attitude
-/// R, Gamma must equal R^T e3 (use `state(M, attitude=R)`).
+/// State :math:`z = (M, \Gamma)` (6,): body angular momentum :math:`M` and
+/// :math:`\Gamma = R^\top e_3`, the upward vertical seen in the body.
+/// :math:`\dot M = M \times \Omega + mgl\, \Gamma \times \chi`,
+/// :math:`\dot\Gamma = \Gamma \times \Omega`, :math:`\Omega = \mathbb{I}^{-1} M`; energy
+/// :math:`H = \tfrac12 M \cdot \mathbb{I}^{-1} M + mgl\, \Gamma \cdot \chi`; Casimirs
+/// :math:`(\|\Gamma\|^2, M \cdot \Gamma)`; for the Lagrange top (:math:`I_1 = I_2`,
+/// :math:`\chi = e_3`) also :math:`M_3` is conserved. With an attitude :math:`R`, :math:`\Gamma`
+/// must equal :math:`R^\top e_3` (use `state(M, attitude=R)`).
 /// Methods: splitting (default), splitting4, splitting6, splitting8 (the Lie–Poisson splitting:
 /// Strang, Suzuki 4, Yoshida 6, Kahan–Li 8), processed6, processed8, processed10
 /// (Blanes–Casas–Murua processed splittings, effective orders 6, 8, 10), lgvi, rk4, exact_splitting, exact_splitting4, exact_splitting6 (the exact free
@@ -91,8 +94,9 @@ impl PyHeavyTop {
         Ok(py_vec(slf.py(), &top(slf)?.chi()))
     }
 
-    /// A flat state z = (M, Gamma) from M (..., 3) and either Gamma (..., 3) or the attitude R
-    /// (..., 3, 3) (then Gamma = R^T e3, the third row of R); leading axes broadcast.
+    /// A flat state :math:`z = (M, \Gamma)` from M (..., 3) and either Gamma (..., 3) or the
+    /// attitude R (..., 3, 3) (then :math:`\Gamma = R^\top e_3`, the third row of :math:`R`);
+    /// leading axes broadcast.
     ///
     /// Raises:
     ///     InvalidArgumentError (neither or both of Gamma and attitude; Gamma = 0), ShapeError,
@@ -133,8 +137,9 @@ impl PyHeavyTop {
         }
     }
 
-    /// Spatial angular momentum R M, vectorised with broadcasting: states (..., 6) and
-    /// attitude (..., 3, 3) -> (..., 3). Only its vertical component M . Gamma is conserved.
+    /// Spatial angular momentum :math:`R M`, vectorised with broadcasting: states (..., 6) and
+    /// attitude (..., 3, 3) -> (..., 3). Only its vertical component :math:`M \cdot \Gamma` is
+    /// conserved.
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.

@@ -53,12 +53,14 @@ fn mass_matrix_of_args(
     }
 }
 
-/// The inertia tensor ``I = sum_k m_k (x_k.x_k 1 - x_k x_k^T)`` (3, 3) of a body (000 §3.1): of
-/// point masses (`masses` (k,), `positions` (k, 3) in the body frame), or of a homogeneous
-/// solid in its principal frame (`shape` "ellipsoid" (I = m/5 diag(b^2 + c^2, a^2 + c^2,
-/// a^2 + b^2)) or "box" (m/3 diag(...), semi-axes the half-sides), with `mass` and `semi_axes`
-/// (a, b, c)). Its kinetic energy is <Omega, I Omega>/2: pass it to `RigidBody`, `HeavyTop` or
-/// `EulerPoincare("so3", inertia=...)`.
+/// The inertia tensor :math:`\mathbb{I} = \sum_k m_k (\|x_k\|^2 \mathrm{Id} - x_k x_k^\top)` (3, 3)
+/// of a body (000 §3.1): of point masses (`masses` (k,), `positions` (k, 3) in the body frame),
+/// or of a homogeneous solid in its principal frame (`shape` "ellipsoid"
+/// (:math:`\mathbb{I} = \frac{m}{5} \operatorname{diag}(b^2 + c^2, a^2 + c^2, a^2 + b^2)`) or "box"
+/// (:math:`\frac{m}{3} \operatorname{diag}(\dots)`, semi-axes the half-sides), with `mass` and
+/// `semi_axes` (a, b, c)). Its kinetic energy is
+/// :math:`\tfrac12 \langle \Omega, \mathbb{I}\Omega \rangle`: pass it to `RigidBody`, `HeavyTop`
+/// or `EulerPoincare("so3", inertia=...)`.
 ///
 /// Raises:
 ///     InvalidArgumentError (neither or both forms, negative masses, all masses zero, a
@@ -85,11 +87,12 @@ pub fn inertia_tensor<'py>(
     Ok(py_mat3(py, &core::from_mass_matrix(&j, "positions").py()?))
 }
 
-/// The mass matrix J = sum_k m_k x_k x_k^T (n, n) of a body in R^n (000 §3.1, the inertia of
-/// `GeneralizedRigidBody`, whose kinetic energy is <Omega, J Omega + Omega J>/2): of point
-/// masses (`masses` (k,), `positions` (k, n)), or of a homogeneous solid (`shape` "ellipsoid":
-/// m a_i^2/(n + 2) on the diagonal; "box": m a_i^2/3) with `mass` and `semi_axes` (n,). In three
-/// dimensions I = tr(J) 1 - J (`inertia_tensor`).
+/// The mass matrix :math:`J = \sum_k m_k x_k x_k^\top` (n, n) of a body in :math:`\mathbb{R}^n`
+/// (000 §3.1, the inertia of `GeneralizedRigidBody`, whose kinetic energy is
+/// :math:`\tfrac12 \langle \Omega, J\Omega + \Omega J \rangle`): of point masses (`masses` (k,),
+/// `positions` (k, n)), or of a homogeneous solid (`shape` "ellipsoid": :math:`m a_i^2/(n + 2)`
+/// on the diagonal; "box": :math:`m a_i^2/3`) with `mass` and `semi_axes` (n,). In three
+/// dimensions :math:`\mathbb{I} = \operatorname{tr}(J)\, \mathrm{Id} - J` (`inertia_tensor`).
 ///
 /// Raises:
 ///     InvalidArgumentError, ShapeError, NonFiniteError (as `inertia_tensor`).
@@ -110,9 +113,10 @@ pub fn mass_matrix<'py>(
     ))
 }
 
-/// The spatial inertia J = R I R^T (000 (4.1)) of a body at attitude R (..., 3, 3) with
-/// inertia I: principal moments (3,) or a matrix (3, 3) (leading axes broadcast with R):
-/// R I Omega = J omega for the spatial angular velocity omega = R Omega.
+/// The spatial inertia :math:`J = R\, \mathbb{I} R^\top` (000 (4.1)) of a body at attitude R
+/// (..., 3, 3) with inertia :math:`\mathbb{I}`: principal moments (3,) or a matrix (3, 3)
+/// (leading axes broadcast with R): :math:`R\, \mathbb{I}\Omega = J\omega` for the spatial
+/// angular velocity :math:`\omega = R\Omega`.
 ///
 /// Raises:
 ///     NotInGroupError (R not a rotation), ShapeError, NonFiniteError.

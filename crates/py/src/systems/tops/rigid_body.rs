@@ -18,9 +18,11 @@ type Any<'py> = Bound<'py, PyAny>;
 
 /// A free rigid body (Euler top) on so(3)* (000 §3–§4).
 ///
-/// State z = M, the body angular momentum (3,). Euler's equation dM/dt = M x Omega with
-/// Omega = I^{-1} M; energy H = M . I^{-1} M / 2; Casimir [‖M‖^2]. Carries an attitude R
-/// (dR/dt = R hat(Omega)) when `integrate(..., attitude=R0)` is given; R M is conserved.
+/// State :math:`z = M`, the body angular momentum (3,). Euler's equation
+/// :math:`\dot M = M \times \Omega` with :math:`\Omega = \mathbb{I}^{-1} M`; energy
+/// :math:`H = \tfrac12 M \cdot \mathbb{I}^{-1} M`; Casimir :math:`\|M\|^2`. Carries an attitude
+/// :math:`R` (:math:`\dot R = R \hat\Omega`) when `integrate(..., attitude=R0)` is given;
+/// :math:`R M` is conserved.
 /// Methods: splitting (default), splitting4, splitting6, splitting8 (the symmetric splitting
 /// into three axis rotations: Strang, Suzuki 4, Yoshida 6, Kahan–Li 8), processed6, processed8,
 /// processed10 (Blanes–Casas–Murua processed splittings, effective orders 6, 8, 10), isospectral, lgvi, dmv (discrete
@@ -63,15 +65,16 @@ impl PyRigidBody {
         Ok(py_vec(slf.py(), &slf.core::<core::RigidBody>()?.moments()))
     }
 
-    /// The principal frame Q in SO(3) (columns = principal axes, I = Q diag(moments) Q^T) when
-    /// the inertia was given as a matrix, else None.
+    /// The principal frame :math:`Q \in SO(3)` (columns = principal axes,
+    /// :math:`\mathbb{I} = Q \operatorname{diag}(\mathrm{moments})\, Q^\top`) when the inertia was
+    /// given as a matrix, else None.
     #[getter]
     fn frame<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
         let frame = slf.core::<core::RigidBody>()?.frame();
         Ok(frame.map(|q| py_mat3(slf.py(), &q)))
     }
 
-    /// Body angular velocity Omega = I^{-1} M, vectorised: (..., 3) -> (..., 3).
+    /// Body angular velocity :math:`\Omega = \mathbb{I}^{-1} M`, vectorised: (..., 3) -> (..., 3).
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.
@@ -88,7 +91,7 @@ impl PyRigidBody {
         )
     }
 
-    /// Spatial angular momentum R M (000 Theorem 4.2), conserved; vectorised with numpy
+    /// Spatial angular momentum :math:`R M` (000 Theorem 4.2), conserved; vectorised with numpy
     /// broadcasting: states (..., 3) and attitude (..., 3, 3) -> (..., 3).
     ///
     /// Raises:
@@ -101,13 +104,15 @@ impl PyRigidBody {
         super::spatial_momentum(slf.py(), &states, &attitude, 3)
     }
 
-    /// The exact body momentum M(t) from M(0) = M0 by Jacobi elliptic functions (000 §4; the
-    /// classical solution M1 = a1 cn u, M2 = a2 sn u, M3 = a3 dn u in suitably ordered principal
-    /// axes, u = u0 + lambda t; see `lieflow::systems::RigidBody::exact_momentum`), and with
-    /// `attitude` = R0 also the attitude R(t): R(t) = R0 B0^T Z(phi(t)) B(t) through the conserved
-    /// spatial momentum R M (Celledoni, Fassò, Säfström & Zanna 2008), the angle phi from
-    /// Carlson's R_J (`lieflow::systems::RigidBody::exact_motion`); accurate to a few
-    /// eps (1 + omega t) at every t.
+    /// The exact body momentum :math:`M(t)` from :math:`M(0) = M_0` by Jacobi elliptic functions
+    /// (000 §4; the classical solution :math:`M_1 = a_1 \operatorname{cn} u`,
+    /// :math:`M_2 = a_2 \operatorname{sn} u`, :math:`M_3 = a_3 \operatorname{dn} u` in suitably
+    /// ordered principal axes, :math:`u = u_0 + \lambda t`; see
+    /// `lieflow::systems::RigidBody::exact_momentum`), and with `attitude` = R0 also the attitude
+    /// :math:`R(t) = R_0 B_0^\top Z(\phi(t))\, B(t)` through the conserved spatial momentum
+    /// :math:`R M` (Celledoni, Fassò, Säfström & Zanna 2008), the angle :math:`\phi` from
+    /// Carlson's :math:`R_J` (`lieflow::systems::RigidBody::exact_motion`); accurate to a few
+    /// :math:`\varepsilon (1 + \omega t)` at every t.
     ///
     /// Args:
     ///     M0: (3,) or (..., 3); t: a time or a 1-D array of times (k,);

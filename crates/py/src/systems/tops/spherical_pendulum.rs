@@ -15,10 +15,12 @@ type Any<'py> = Bound<'py, PyAny>;
 
 /// The spherical pendulum (000 §5.1) as a Lie–Poisson system on se(3)*.
 ///
-/// State z = (q, L) (6,): q the unit vector from the pivot to the bob (e3 up) and
-/// L = m l^2 q x dq/dt the angular momentum about the pivot. dq/dt = L x q / (m l^2),
-/// dL/dt = m g l e3 x q; energy H = ‖L‖^2 / (2 m l^2) + m g l q3; Casimirs [‖q‖^2, q . L]
-/// (a state needs ‖q‖ = 1 and q . L = 0); the vertical momentum L3 is conserved.
+/// State :math:`z = (q, L)` (6,): :math:`q` the unit vector from the pivot to the bob
+/// (:math:`e_3` up) and :math:`L = m l^2\, q \times \dot q` the angular momentum about the
+/// pivot. :math:`\dot q = L \times q / (m l^2)`, :math:`\dot L = m g l\, e_3 \times q`; energy
+/// :math:`H = \|L\|^2 / (2 m l^2) + m g l\, q_3`; Casimirs :math:`(\|q\|^2, q \cdot L)` (a state
+/// needs :math:`\|q\| = 1` and :math:`q \cdot L = 0`); the vertical momentum :math:`L_3` is
+/// conserved.
 /// Methods: splitting, splitting4, splitting6, rk4.
 ///
 /// Args:
@@ -63,7 +65,8 @@ impl PySphericalPendulum {
     }
 
     /// The state (q, L) from the spherical coordinates of 000 §5.1.1 (theta from the downward
-    /// vertical): q = (sin th cos ph, sin th sin ph, -cos th), L = m l^2 q x dq/dt. The four
+    /// vertical): :math:`q = (\sin\theta \cos\phi, \sin\theta \sin\phi, -\cos\theta)`,
+    /// :math:`L = m l^2\, q \times \dot q`. The four
     /// arguments broadcast like numpy arrays; the result has shape (..., 6).
     ///
     /// Raises:
@@ -97,7 +100,7 @@ impl PySphericalPendulum {
         )
     }
 
-    /// The vertical angular momentum L3 (conserved), vectorised: (..., 6) -> (...).
+    /// The vertical angular momentum :math:`L_3` (conserved), vectorised: (..., 6) -> (...).
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError.

@@ -26,9 +26,11 @@ fn call_pair(c: &Callee, args: &[&[f64]], hq: &mut [f64], hp: &mut [f64]) -> lie
     Ok(())
 }
 
-/// A canonical Hamiltonian system H(q, p) on T*R^d given by Python callables.
+/// A canonical Hamiltonian system :math:`H(q, p)` on :math:`T^*\mathbb{R}^d` given by Python
+/// callables.
 ///
-/// State z = (q, p) (2d,); fields q, p. q' = dH/dp, p' = -dH/dq. Methods: gauss4 (default),
+/// State :math:`z = (q, p)` (2d,); fields q, p. :math:`\dot q = \partial H/\partial p`,
+/// :math:`\dot p = -\partial H/\partial q`. Methods: gauss4 (default),
 /// gauss6, midpoint (symplectic Gauss–Legendre, orders 4, 6, 2), rk4. No invariants.
 ///
 /// Args:

@@ -21,22 +21,28 @@ use crate::system::PySystem;
 use super::lie_poisson::{algebra, side};
 use super::{optional, Any, Callee};
 
-/// Mechanics from a reduced Lagrangian (000 §4): the Euler–Poincaré equations of l(xi) on a Lie
-/// algebra g, or of l(xi, a) with an advected parameter a (a symmetry-breaking parameter such as
-/// the heavy top's vertical Gamma), integrated in their Lie–Poisson form.
+/// Mechanics from a reduced Lagrangian (000 §4): the Euler–Poincaré equations of
+/// :math:`l(\xi)` on a Lie algebra :math:`\mathfrak{g}`, or of :math:`l(\xi, a)` with an advected
+/// parameter :math:`a` (a symmetry-breaking parameter such as the heavy top's vertical
+/// :math:`\Gamma`), integrated in their Lie–Poisson form.
 ///
-/// The state is the momentum mu = dl/dxi (d,), followed by a (m,) with a parameter. The
-/// equations (left, body frame): d mu/dt = ad*_xi mu + dl/da <> a, da/dt = -xi.a, with the
-/// diamond <b <> a, eta> = -<b, eta.a>; right (spatial frame, `side="right"`): d mu/dt =
-/// -ad*_xi mu - dl/da <> a, da/dt = xi.a (derived by the mirror g -> g^{-1}; the notes' right
-/// version keeps the sign of the parameter term, which the mirror test contradicts). xi is found
-/// from mu by inverting the Legendre transform (Newton's method to round-off for a
-/// non-quadratic l; a singular d2l/dxi2 is an InvalidArgumentError naming the point), and the
-/// energy is E = <mu, xi> - l. The algebras, conventions and Casimirs (`invariants`) are
-/// `LiePoisson`'s. With `integrate(..., attitude=g0)` the configuration g (a rotation (3, 3),
-/// an (n, n) element of SO(n), or a homogeneous (4, 4) element of SE(3)) is carried along,
-/// dg/dt = g xi (left) or xi g (right), and, without a parameter, the Noether momentum joins
-/// the invariants (`noether`, 000 Theorems 4.3-4.4).
+/// The state is the momentum :math:`\mu = \partial l/\partial\xi` (d,), followed by a (m,) with a
+/// parameter. The equations (left, body frame):
+/// :math:`\dot\mu = \operatorname{ad}^*_\xi \mu + \partial l/\partial a \diamond a`,
+/// :math:`\dot a = -\xi \cdot a`, with the diamond
+/// :math:`\langle b \diamond a, \eta \rangle = -\langle b, \eta \cdot a \rangle`; right (spatial
+/// frame, `side="right"`):
+/// :math:`\dot\mu = -\operatorname{ad}^*_\xi \mu - \partial l/\partial a \diamond a`,
+/// :math:`\dot a = \xi \cdot a` (derived by the mirror :math:`g \mapsto g^{-1}`; the notes' right
+/// version keeps the sign of the parameter term, which the mirror test contradicts).
+/// :math:`\xi` is found from :math:`\mu` by inverting the Legendre transform (Newton's method to
+/// round-off for a non-quadratic :math:`l`; a singular :math:`\partial^2 l/\partial\xi^2` is an
+/// InvalidArgumentError naming the point), and the energy is
+/// :math:`E = \langle \mu, \xi \rangle - l`. The algebras, conventions and Casimirs
+/// (`invariants`) are `LiePoisson`'s. With `integrate(..., attitude=g0)` the configuration g (a
+/// rotation (3, 3), an (n, n) element of SO(n), or a homogeneous (4, 4) element of SE(3)) is
+/// carried along, :math:`\dot g = g\xi` (left) or :math:`\dot g = \xi g` (right), and, without a
+/// parameter, the Noether momentum joins the invariants (`noether`, 000 Theorems 4.3-4.4).
 /// Methods: variational (default; the discrete Euler–Poincaré method: the Lie group
 /// variational integrator of l, symplectic and symmetric, order 2, keeping the coadjoint orbit
 /// and the Noether momentum to round-off), variational4, variational6 (its compositions of
@@ -46,15 +52,17 @@ use super::{optional, Any, Callee};
 /// Args:
 ///     algebra: "so3", "se3", ("so", n) or structure constants (d, d, d), as `LiePoisson`.
 ///     lagrangian: l(xi) -> float, or l(xi, a) -> float with an `action`; or None with `inertia`.
-///     inertia: a symmetric positive definite (d, d) matrix I for l = <xi, I xi>/2: the native
+///     inertia: a symmetric positive definite (d, d) matrix :math:`\mathbb{I}` for
+///         :math:`l = \tfrac12 \langle \xi, \mathbb{I}\xi \rangle`: the native
 ///         path (no Python call per step; no parameter).
-///     gradient: dl/dxi as a callable xi -> (d,), or with a parameter (xi, a) -> (dl/dxi (d,),
-///         dl/da (m,)); None: central differences of l.
-///     hessian: d2l/dxi2 as a callable (xi[, a]) -> (d, d); None: central differences of the
-///         gradient.
+///     gradient: :math:`\partial l/\partial\xi` as a callable xi -> (d,), or with a parameter
+///         (xi, a) -> (dl/dxi (d,), dl/da (m,)); None: central differences of l.
+///     hessian: :math:`\partial^2 l/\partial\xi^2` as a callable (xi[, a]) -> (d, d); None:
+///         central differences of the gradient.
 ///     side: "left" (default) or "right".
 ///     action: None (no parameter), "vector" (the defining representation of so3 or ("so", n)
-///         on R^n: xi.a = hat(xi) a, m = n; on se3 its rotation part on R^3: a direction
+///         on :math:`\mathbb{R}^n`: :math:`\xi \cdot a = \hat\xi a`, m = n; on se3 its rotation
+///         part on :math:`\mathbb{R}^3`: a direction
 ///         fixed in space, such as gravity for a vehicle in a fluid), or a callable
 ///         (xi, a) -> xi.a, linear in both, with `parameter_dim` m.
 ///     parameter_dim: m for a callable action.
@@ -207,7 +215,7 @@ impl PyEulerPoincare {
         ("noether",)
     }
 
-    /// dim g (the length of mu).
+    /// :math:`\dim\mathfrak{g}` (the length of mu).
     #[getter]
     fn dim(&self) -> usize {
         self.ep.dims().0
@@ -231,7 +239,8 @@ impl PyEulerPoincare {
         self.ep.system().side().name()
     }
 
-    /// The state (mu[, a]) of the velocity xi (d,) and parameter a (m,): mu = dl/dxi(xi, a).
+    /// The state (mu[, a]) of the velocity xi (d,) and parameter a (m,):
+    /// :math:`\mu = \partial l/\partial\xi\,(\xi, a)`.
     ///
     /// Raises:
     ///     ShapeError, NonFiniteError, the callables' errors.
@@ -254,8 +263,8 @@ impl PyEulerPoincare {
     /// The velocity xi (d,) of a state (mu[, a]): the inverse Legendre transform.
     ///
     /// Raises:
-    ///     ShapeError, NonFiniteError, InvalidArgumentError (a singular d2l/dxi2 on the way),
-    ///     ConvergenceError, the callables' errors.
+    ///     ShapeError, NonFiniteError, InvalidArgumentError (a singular
+    ///     :math:`\partial^2 l/\partial\xi^2` on the way), ConvergenceError, the callables' errors.
     fn velocity<'py>(
         &self,
         py: Python<'py>,
@@ -273,8 +282,9 @@ impl PyEulerPoincare {
 
     /// The Noether momentum of states (..., d[+m]) at group elements g (..., n, n) (the motion's
     /// configuration, body to space; n = 3 for so3, n for ("so", n), 4 for se3 as homogeneous
-    /// matrices): Ad*_{g^-1} mu for a left-invariant Lagrangian (000 Theorem 4.3: the spatial
-    /// momentum R M of the rigid body), Ad*_g mu for a right-invariant one (Theorem 4.4);
+    /// matrices): :math:`\operatorname{Ad}^*_{g^{-1}} \mu` for a left-invariant Lagrangian
+    /// (000 Theorem 4.3: the spatial momentum :math:`R M` of the rigid body),
+    /// :math:`\operatorname{Ad}^*_g \mu` for a right-invariant one (Theorem 4.4);
     /// conserved along a motion. With a parameter only the components that fix the reference
     /// parameter are (Theorem 4.11: for the heavy top the vertical one, (R M)[2]); the whole
     /// vector (..., d) is returned. Leading axes broadcast.
@@ -310,8 +320,10 @@ impl PyEulerPoincare {
         )
     }
 
-    /// The diamond b <> a in g* (d,) of b in V (m,: a derivative dl/da) and a in V* (m,):
-    /// <b <> a, eta> = -<b, eta.a> for every eta in g.
+    /// The diamond :math:`b \diamond a \in \mathfrak{g}^*` (d,) of :math:`b \in V` (m,: a
+    /// derivative :math:`\partial l/\partial a`) and :math:`a \in V^*` (m,):
+    /// :math:`\langle b \diamond a, \eta \rangle = -\langle b, \eta \cdot a \rangle` for every
+    /// :math:`\eta \in \mathfrak{g}`.
     fn diamond<'py>(
         &self,
         py: Python<'py>,

@@ -37,14 +37,16 @@ fn damping_values(d: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
 /// The equations are those of `system` plus the non-conservative terms: a force F(t, state) on one
 /// momentum block (the body torque on M of RigidBody/HeavyTop, a force matrix on a
 /// PseudoRigidBody's P, a force on p of a canonical system, ...), Rayleigh damping
-/// p' = -C dH/dp of a canonical system, or double-bracket dissipation (Bloch, Krishnaprasad,
-/// Marsden & Ratiu 1996) of a Lie-Poisson system, mu' = ad*_{dH} mu + alpha ad*_{w} mu,
-/// w = ad*_{dH} mu (the rigid body: M' = M x Omega + alpha M x (M x Omega)), which lowers the
-/// energy and keeps every Casimir exactly.
+/// :math:`\dot p = -C\, \partial H/\partial p` of a canonical system, or double-bracket
+/// dissipation (Bloch, Krishnaprasad, Marsden & Ratiu 1996) of a Lie-Poisson system,
+/// :math:`\dot\mu = \operatorname{ad}^*_{\partial H/\partial\mu} \mu + \alpha \operatorname{ad}^*_w \mu`,
+/// :math:`w = \operatorname{ad}^*_{\partial H/\partial\mu} \mu` (the rigid body:
+/// :math:`\dot M = M \times \Omega + \alpha M \times (M \times \Omega)`), which lowers the energy
+/// and keeps every Casimir exactly.
 ///
 /// Methods: for every symmetric second-order method m of `system`, m (the Strang composition
-/// kick(h/2) . m(h) . kick(h/2), order 2), m4 and m6 (its Suzuki and Yoshida compositions,
-/// orders 4 and 6); the first is the default. The kicks are exact for a force that does not
+/// :math:`\mathrm{kick}(h/2) \circ m(h) \circ \mathrm{kick}(h/2)`, order 2), m4 and m6 (its Suzuki
+/// and Yoshida compositions, orders 4 and 6); the first is the default. The kicks are exact for a force that does not
 /// depend on its block, otherwise implicit midpoint steps (symmetric, order 2); double-bracket
 /// dissipation is stepped by the Lie midpoint rule on the coadjoint orbit. The free part keeps
 /// what its method keeps (the group, the sphere); energy and invariants are those of `system`.
@@ -59,8 +61,8 @@ fn damping_values(d: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
 ///     block: the block the force acts on; None for the first of M, P, p, L, mu the system has.
 ///     depends_on_block: False declares that the force does not depend on its block (one call
 ///         per kick instead of the implicit iteration; a false claim lowers the order to 1).
-///     damping: Rayleigh damping of a canonical system: c >= 0 (C = c I) or a symmetric positive
-///         semi-definite matrix (d, d); or None.
+///     damping: Rayleigh damping of a canonical system: c >= 0 (:math:`C = c\,\mathrm{Id}`) or a
+///         symmetric positive semi-definite matrix (d, d); or None.
 ///     dissipation: the double-bracket coefficient alpha >= 0 of a Lie-Poisson system without
 ///         attitude (RigidBody, GeneralizedRigidBody, LiePoisson); or None.
 /// Raises:

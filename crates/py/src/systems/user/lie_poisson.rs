@@ -80,20 +80,26 @@ pub(super) fn side(s: Option<&Any<'_>>) -> PyResult<Side> {
     }
 }
 
-/// A Lie–Poisson system on g*: d mu/dt = ad*_{dH/dmu} mu (left-invariant), or
-/// d mu/dt = -ad*_{dH/dmu} mu (`side="right"`).
+/// A Lie–Poisson system on :math:`\mathfrak{g}^*`:
+/// :math:`\dot\mu = \operatorname{ad}^*_{\partial H/\partial\mu} \mu` (left-invariant), or
+/// :math:`\dot\mu = -\operatorname{ad}^*_{\partial H/\partial\mu} \mu` (`side="right"`).
 ///
-/// With [e_i, e_j] = C_ij^k e_k and mu the coordinates dual to e_k (the pairing is the dot
-/// product), (ad*_xi mu)_j = sum_{i,k} C_ij^k xi_i mu_k; on so(3) this is dM/dt = M x Omega for
-/// H = M . I^{-1} M / 2 (the rigid body's sign). State mu (d,); fields: M (so3), M and Gamma
-/// (se3: dM/dt = M x Omega + Gamma x V, dGamma/dt = Gamma x Omega with (Omega, V) = dH/dmu,
-/// Kirchhoff's equations with Gamma the impulse), M (so(n)*, e_ij coordinates as
-/// `GeneralizedRigidBody`; fields show the skew matrix), mu (structure constants).
-/// Casimirs (`invariants`): ‖M‖^2 (so3); ‖Gamma‖^2, M . Gamma (se3); tr((M^T M)^k)/2,
-/// k = 1..n//2 (so(n)); none for structure constants; or the `casimirs` given.
+/// With :math:`[e_i, e_j] = C_{ij}^k e_k` and :math:`\mu` the coordinates dual to :math:`e_k`
+/// (the pairing is the dot product),
+/// :math:`(\operatorname{ad}^*_\xi \mu)_j = \sum_{i,k} C_{ij}^k \xi_i \mu_k`; on so(3) this is
+/// :math:`\dot M = M \times \Omega` for :math:`H = \tfrac12 M \cdot \mathbb{I}^{-1} M` (the rigid
+/// body's sign). State mu (d,); fields: M (so3), M and Gamma (se3:
+/// :math:`\dot M = M \times \Omega + \Gamma \times V`, :math:`\dot\Gamma = \Gamma \times \Omega`
+/// with :math:`(\Omega, V) = \partial H/\partial\mu`, Kirchhoff's equations with :math:`\Gamma`
+/// the impulse), M (so(n)*, :math:`e_{ij}` coordinates as `GeneralizedRigidBody`; fields show
+/// the skew matrix), mu (structure constants). Casimirs (`invariants`): :math:`\|M\|^2` (so3);
+/// :math:`\|\Gamma\|^2`, :math:`M \cdot \Gamma` (se3);
+/// :math:`\tfrac12 \operatorname{tr}((M^\top M)^k)`, :math:`k = 1, \dots, \lfloor n/2 \rfloor`
+/// (so(n)); none for structure constants; or the `casimirs` given.
 /// `side` is the invariance the system is reduced from (000 §4.1, Theorems 4.3-4.4): "left"
 /// (body frame, as above) or "right" (spatial frame: the sign of the bracket flips; a right
-/// run from mu0 is the negated left run of H(-mu) from -mu0, the mirror g -> g^{-1}).
+/// run from :math:`\mu_0` is the negated left run of :math:`H(-\mu)` from :math:`-\mu_0`, the
+/// mirror :math:`g \mapsto g^{-1}`).
 /// Methods: rkmk4 (default; Runge–Kutta–Munthe-Kaas, order 4, explicit), midpoint (the Lie
 /// midpoint, symmetric, order 2), midpoint4 (its Suzuki composition, order 4), rk4 (baseline,
 /// keeps no Casimir). All but rk4 advance by the coadjoint action, so every Casimir is kept to
@@ -101,17 +107,17 @@ pub(super) fn side(s: Option<&Any<'_>>) -> PyResult<Side> {
 ///
 /// Args:
 ///     algebra: "so3", "se3", ("so", n) with n >= 2, or structure constants C (d, d, d),
-///         C[i, j, k] = C_ij^k (antisymmetric in i, j and satisfying Jacobi: checked).
+///         C[i, j, k] = :math:`C_{ij}^k` (antisymmetric in i, j and satisfying Jacobi: checked).
 ///     hamiltonian: a callable mu -> float (mu a float64 array (d,)), or a symmetric (d, d)
-///         matrix A for H = mu . A mu / 2 (the native path: no Python call per step, runs in
-///         parallel).
+///         matrix A for :math:`H = \tfrac12 \mu \cdot A\mu` (the native path: no Python call per
+///         step, runs in parallel).
 ///     gradient: a callable mu -> dH/dmu (d,), or None (central differences of H, see
 ///         `Canonical`); must be None for a matrix hamiltonian.
 ///     casimirs: None (the algebra's), or a sequence of callables mu -> float to monitor as
 ///         `invariants` in their place.
 ///     side: "left" (default) or "right".
-///     hessian: a callable (mu, dmu) -> D^2 H(mu)[dmu] (d,), the derivative of `gradient` along
-///         dmu, or None. With `gradient` it gives the runs with ``sensitivity=True`` (every
+///     hessian: a callable (mu, dmu) -> :math:`D^2 H(\mu)[d\mu]` (d,), the derivative of
+///         `gradient` along dmu, or None. With `gradient` it gives the runs with ``sensitivity=True`` (every
 ///         method: the exact Jacobian of the discrete flow); a matrix hamiltonian needs none.
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError, ShapeError, NonFiniteError.
@@ -229,7 +235,7 @@ impl PyLiePoisson {
         Ok(slf.core::<CoreLiePoisson>()?.side().name())
     }
 
-    /// dim g (the length d of a state).
+    /// :math:`\dim\mathfrak{g}` (the length d of a state).
     #[getter]
     fn dim(slf: &Bound<'_, Self>) -> PyResult<usize> {
         Ok(slf.core::<CoreLiePoisson>()?.dim())
@@ -241,7 +247,8 @@ impl PyLiePoisson {
         Ok(slf.core::<CoreLiePoisson>()?.is_quadratic())
     }
 
-    /// The structure constants C (d, d, d), C[i, j, k] = C_ij^k, [e_i, e_j] = C_ij^k e_k.
+    /// The structure constants C (d, d, d), C[i, j, k] = :math:`C_{ij}^k`,
+    /// :math:`[e_i, e_j] = C_{ij}^k e_k`.
     ///
     /// Raises:
     ///     InvalidArgumentError (an array too large to hold: so(n) for n of some hundreds).

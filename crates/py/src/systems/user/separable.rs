@@ -34,21 +34,22 @@ fn kinetic_mass(m: &Any<'_>) -> PyResult<KineticMass> {
     }
 }
 
-/// A separable system H = p^T M^{-1} p / 2 + U(q) with a constant kinetic mass M and U given by
-/// Python callables.
+/// A separable system :math:`H = \tfrac12 p^\top M^{-1} p + U(q)` with a constant kinetic mass
+/// :math:`M` and :math:`U` given by Python callables.
 ///
-/// State z = (q, p) (2d,); fields q, p. q' = M^{-1} p, p' = -grad U(q). Methods: verlet
+/// State :math:`z = (q, p)` (2d,); fields q, p. :math:`\dot q = M^{-1} p`,
+/// :math:`\dot p = -\nabla U(q)`. Methods: verlet
 /// (default), verlet4, verlet6 (Störmer–Verlet and its compositions of orders 4 and 6: one call
 /// of the gradient per stage), gauss4, gauss6, midpoint, rk4. No invariants.
 ///
 /// Args:
-///     mass: M > 0 as a number (M = m I; then `dof` is required), a vector (d,) of
-///         positive entries (diagonal M) or a symmetric positive-definite matrix (d, d).
+///     mass: M > 0 as a number (:math:`M = m\,\mathrm{Id}`; then `dof` is required), a vector
+///         (d,) of positive entries (diagonal M) or a symmetric positive-definite matrix (d, d).
 ///     potential: callable q -> U(q), q a float64 array (d,).
 ///     gradient: callable q -> grad U (d,), or None for central differences (see `Canonical`).
 ///     dof: the number of degrees of freedom (needed for a scalar mass; must agree otherwise).
-///     hessian: callable (q, v) -> the Hessian product D^2 U(q)[v] (d,), or None. With it (and
-///         `gradient`) `lieflow.integrate(..., sensitivity=True)` gives the exact Jacobians of the
+///     hessian: callable (q, v) -> the Hessian product :math:`D^2 U(q)[v]` (d,), or None. With
+///         it (and `gradient`) `lieflow.integrate(..., sensitivity=True)` gives the exact Jacobians of the
 ///         Verlet methods (`sensitivity_methods()`).
 /// Raises:
 ///     ArgumentTypeError, InvalidArgumentError (a mass that is not positive definite),
@@ -114,7 +115,7 @@ impl PySeparable {
         Ok(lieflow::integrate::problem::Separable::dof(sys))
     }
 
-    /// Whether grad U is computed by finite differences (no `gradient` was given).
+    /// Whether :math:`\nabla U` is computed by finite differences (no `gradient` was given).
     #[getter]
     fn finite_differences(slf: &Bound<'_, Self>) -> PyResult<bool> {
         Ok(slf.core::<UserSeparable>()?.finite_differences())
