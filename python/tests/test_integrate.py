@@ -565,6 +565,10 @@ def test_a_step_that_resolves_the_rotation_badly_warns_once_per_run():
         lf.integrate(body, m0, 100.0, 10, method="exact")
         lf.integrate(body, m0, 0.5, 10)
         lf.integrate(body, np.array([[0.01, 0, 0], [1.0, 0, 0]]), 1.0, 5)
+    # Numbers in the message are short at any exponent (no 1.4530000000000006e+153).
+    with pytest.warns(lf.LieflowWarning, match=r"by 1\.453e\+98 rad .* take dt <= 1\.08e-100$"):
+        with pytest.raises(lf.LeftDomainError):       # such a step cannot be taken at all
+            lf.integrate(body, [1.453e100, 0, 0], 0.01, 1, method="splitting")
     # The heavy top: its pendulum frequency √(mgl|Γ|/I_min) counts too.
     with pytest.warns(lf.LieflowWarning, match="rad per step"):
         lf.integrate(lf.HeavyTop([1.0, 1.0, 0.5], 50.0), [0, 0, 0, 0, 0, 1.0], 0.2, 5)

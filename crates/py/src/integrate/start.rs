@@ -177,11 +177,11 @@ fn warn_unresolved(
                      the start): beyond a quarter turn per step {} (order {}) resolves it badly \
                      and its errors are no longer small; take dt <= {}",
                     args::float_repr(dt),
-                    args::float_repr(four_digits(turn)),
-                    args::float_repr(four_digits(rate)),
+                    args::float_repr(significant(turn, 4, false)),
+                    args::float_repr(significant(rate, 4, false)),
                     method.name,
                     method.properties.order,
-                    args::float_repr(three_digits_below(MAX_TURN_PER_STEP / rate))
+                    args::float_repr(significant(MAX_TURN_PER_STEP / rate, 3, true))
                 ),
             )
         })?;
@@ -189,18 +189,21 @@ fn warn_unresolved(
     Ok(())
 }
 
-/// x rounded to four significant digits (for a message).
-fn four_digits(x: f64) -> f64 {
-    let p = 10f64.powi(3 - x.abs().log10().floor() as i32);
-    if p.is_finite() && p > 0.0 {
-        (x * p).round() / p
-    } else {
-        x
+/// x to `digits` significant digits for a message (rounded to nearest, or down with `down`: a
+/// step safely below a bound), as the double nearest that decimal, so that its repr is short at
+/// any exponent (1.453e+153, not the 1.4530000000000006e+153 of scaling by a power of ten).
+fn significant(x: f64, digits: usize, down: bool) -> f64 {
+    let decimal = format!("{:.*e}", digits - 1, x);
+    let rounded: f64 = decimal.parse().unwrap_or(x);
+    if !(down && rounded > x) {
+        return rounded;
     }
-}
-
-/// x rounded down to three significant digits (a step that is safely below).
-fn three_digits_below(x: f64) -> f64 {
-    let p = 10f64.powi(2 - x.log10().floor() as i32);
-    (x * p).floor() / p
+    let Some((mantissa, exponent)) = decimal.split_once('e') else {
+        return rounded;
+    };
+    let unit = 10f64.powi(1 - digits as i32);
+    let lower = mantissa.parse::<f64>().map(|m| m - unit).unwrap_or(x);
+    format!("{lower:.*}e{exponent}", digits - 1)
+        .parse()
+        .unwrap_or(x)
 }
