@@ -819,3 +819,22 @@ def test_a_file_opened_by_xarray_itself_verifies(tmp_path):
         back = lf.load(ds.load())
     np.testing.assert_array_equal(back.states, traj.states)
     np.testing.assert_array_equal(back.attitude, traj.attitude)
+
+
+def test_the_invariant_labels_are_checksummed_as_text(tmp_path):
+    """The `invariant` coordinate (the system's invariant_names) is the one text variable a
+    file holds: it round-trips, a relabelled one is refused, and any other text is refused."""
+    traj = heavy_top_batch()
+    traj.save(tmp_path / "run.nc")
+    with xr.open_dataset(tmp_path / "run.nc") as ds:
+        ds = ds.load()
+    assert list(ds["invariant"].values) == traj.invariant_names == ["|Γ|²", "M·Γ"]
+    swapped = ds.assign_coords(invariant=["M·Γ", "|Γ|²"])
+    with pytest.raises(lf.io.FileFormatError, match="invariant"):
+        lf.load(swapped)
+    texty = ds.assign(note=("invariant", np.array([["a", "b"]], dtype=object)[0]))
+    with pytest.raises(lf.io.FileFormatError):
+        lf.load(texty)
+    grid = ds.assign(note=(("invariant", "x"), np.array([["a"], ["b"]])))
+    with pytest.raises(lf.io.FileFormatError):
+        lf.load(grid)

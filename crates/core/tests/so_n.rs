@@ -678,3 +678,28 @@ proptest! {
         prop_assert!(back < 1e-13, "angles {:?}: backward {:.2e}", angles, back);
     }
 }
+
+#[test]
+fn spectral_names_label_each_spectral_invariant() {
+    for n in 2..9 {
+        let xi = so::hat_n(&vec![0.3; n * (n - 1) / 2]).unwrap();
+        assert_eq!(
+            so::spectral_names("M", n).len(),
+            so::spectral_invariants(&xi).len()
+        );
+    }
+    assert_eq!(so::spectral_names("M", 5), ["½tr(MᵀM)", "½tr((MᵀM)²)"]);
+    assert_eq!(so::spectral_names("X", 24)[10], "½tr((XᵀX)¹¹)");
+    assert!(so::spectral_names("L", 1).is_empty());
+}
+
+#[test]
+fn indexed_names_use_subscript_digits() {
+    use lieflow::integrate::problem::indexed_names;
+    let j = indexed_names("J", 12);
+    assert_eq!(
+        (j[0].as_str(), j[9].as_str(), j[11].as_str()),
+        ("J₁", "J₁₀", "J₁₂")
+    );
+    assert!(indexed_names("J", 0).is_empty());
+}
